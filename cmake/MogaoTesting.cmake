@@ -1,0 +1,20 @@
+# mogao_add_gtest(<name> SOURCES <files...> LIBS <targets...> [LABELS <labels...>])
+# Builds a GoogleTest executable and registers each TEST with CTest (gtest_discover_tests).
+# Tests that need ../shared/data get MOGAO_SCANS_DIR / MOGAO_MPCDI_DIR as compile definitions and call
+# GTEST_SKIP() with a message when the folder is absent; CTest reports those as skipped.
+function(mogao_add_gtest name)
+  if(NOT MOGAO_BUILD_TESTS)
+    return()
+  endif()
+  cmake_parse_arguments(T "" "" "SOURCES;LIBS;LABELS" ${ARGN})
+  add_executable(${name} ${T_SOURCES})
+  target_link_libraries(${name} PRIVATE ${T_LIBS} GTest::gtest GTest::gtest_main)
+  target_compile_definitions(${name} PRIVATE
+    MOGAO_SCANS_DIR="${MOGAO_SCANS_DIR}" MOGAO_MPCDI_DIR="${MOGAO_MPCDI_DIR}"
+    MOGAO_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  mogao_target_defaults(${name})
+  if(NOT T_LABELS)
+    set(T_LABELS unit)
+  endif()
+  gtest_discover_tests(${name} PROPERTIES LABELS "${T_LABELS}" SKIP_RETURN_CODE 77 DISCOVERY_TIMEOUT 60)
+endfunction()

@@ -1,0 +1,88 @@
+// The scene a farm renders: meshes placed by per-object transforms, materials, lights and the
+// viewer. Produced by load_scene() from a scene file (schema: docs/scene-format.md).
+//
+// World frame: right-handed, metres, +y up (same as view/view_request.h).
+// Meshes keep their file units; each instance's object_to_world carries scale (e.g. 0.001 for
+// millimetre scans), rotation and translation. Meshes are re-centred on load (recentre_mesh) so
+// that their local coordinates stay near the origin in float; the offset is folded into the
+// transforms, in double precision.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "renderfarm/scene/mesh.h"
+
+namespace mogao {
+
+using Rgb = Eigen::Vector3f;  // linear RGB
+
+struct Material {
+    std::string name;
+    Rgb albedo{0.7f, 0.7f, 0.7f};   // diffuse reflectance, each channel in [0, 1]
+    Rgb specular{0.f, 0.f, 0.f};    // Blinn-Phong specular reflectance; zero = no glossy term
+    float shininess = 32.f;         // Blinn-Phong exponent
+};
+
+struct Instance {
+    std::string name;
+    std::size_t mesh = 0;                 // index into Scene::meshes
+    std::size_t material = 0;             // index into Scene::materials
+    Eigen::Affine3d object_to_world = Eigen::Affine3d::Identity();
+};
+
+// Sun: parallel light arriving from `direction_to_light` with irradiance (W/m² per channel) on a
+// surface facing it.
+struct DirectionalLight {
+    Eigen::Vector3d direction_to_light{0.0, 1.0, 0.0};  // unit vector, world
+    Rgb irradiance{3.f, 3.f, 3.f};
+    bool cast_shadows = true;
+};
+
+// Isotropic point light; irradiance at distance d is intensity / d².
+struct PointLight {
+    Eigen::Vector3d position{0.0, 2.0, 0.0};  // world metres
+    Rgb intensity{10.f, 10.f, 10.f};          // W/sr per channel
+    bool cast_shadows = true;
+};
+
+// One-sided emitting parallelogram corner + s*edge_u + t*edge_v, s,t in [0,1]; it emits toward
+// edge_u x edge_v. Not visible to camera rays (it lights the scene only).
+struct AreaLight {
+    Eigen::Vector3d corner{0.0, 3.0, 0.0};
+    Eigen::Vector3d edge_u{1.0, 0.0, 0.0};
+    Eigen::Vector3d edge_v{0.0, 0.0, 1.0};
+    Rgb radiance{5.f, 5.f, 5.f};              // W/(sr·m²) per channel
+    bool cast_shadows = true;
+};
+
+// Constant environment (sky) radiance arriving from every direction not blocked by the scene.
+struct EnvironmentLight {
+    Rgb radiance{0.2f, 0.2f, 0.25f};
+};
+
+struct Viewer {
+    double eye_height_m = 1.6;
+    Eigen::Vector3d start{0.0, 0.0, 5.0};     // floor position of the viewer at start, world metres
+    double start_yaw_deg = 0.0;
+};
+
+struct Scene {
+    std::string source;                        // scene file path, for messages
+    std::vector<Mesh> meshes;
+    std::vector<Material> materials;           // at least one
+    std::vector<Instance> instances;
+    std::vector<DirectionalLight> directional_lights;
+    std::vector<PointLight> point_lights;
+    std::vector<AreaLight> area_lights;
+    std::vector<EnvironmentLight> environment_lights;
+    Viewer viewer;
+    float exposure = 1.f;                      // multiplies radiance before the sRGB transfer
+
+    [[nodiscard]] std::size_t triangle_count() const;   // summed over instances
+};
+
+}  // namespace mogao
