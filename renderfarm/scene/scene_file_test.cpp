@@ -1,1 +1,169 @@
+#include "renderfarm/scene/scene_file.h"
+
+#include <filesystem>
+#include <string>
+
 #include <gtest/gtest.h>
+
+#include "renderfarm/scene/procedural.h"
+
+namespace mogao {
+namespace {
+
+const std::filesystem::path kOrigin = "/nonexistent/test.json";
+
+std::string minimal(const std::string& objects, const std::string& extra = "") {
+    return R"({ "meshes": { "ball": { "procedural": "uv_sphere", "radius": 0.5, "segments": 16, "rings": 8 },
+                            "box": { "procedural": "box", "size": [1, 2, 3] } },
+               "materials": { "red": { "albedo": [0.8, 0.1, 0.1] } },
+               "objects": )" + objects + extra + "}";
+}
+
+// Expects a SceneError whose message contains every fragment.
+void expect_error(const std::string& text, std::initializer_list<std::string> fragments) {
+    try {
+        (void)parse_scene(text, kOrigin);
+        FAIL() << "no error for: " << text;
+    } catch (const SceneError& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find(kOrigin.string()), std::string::npos) << message;
+        for (const std::string& f : fragments) EXPECT_NE(message.find(f), std::string::npos) << "missing '" << f << "' in: " << message;
+    }
+}
+
+TEST(SceneFile, ParsesMeshesMaterialsObjectsAndLights) {
+    const Scene scene = parse_scene(minimal(R"([ { "mesh": "ball", "material": "red" }, { "mesh": "box" } ])",
+                                            R"(, "lights": [ { "type": "sun", "direction_to_light": [0, 2, 0] },
+                                                           { "type": "environment", "radiance": 0.3 } ],
+                                               "viewer": { "eye_height": 1.7, "start": [1, 0, 2] })"),
+                                    kOrigin);
+    ASSERT_EQ(scene.meshes.size(), 2u);
+    ASSERT_EQ(scene.instances.size(), 2u);
+    EXPECT_EQ(scene.materials[scene.instances[0].material].name, "red");
+    EXPECT_EQ(scene.materials[scene.instances[1].material].name, "default");
+    ASSERT_EQ(scene.directional_lights.size(), 1u);
+    EXPECT_NEAR(scene.directional_lights[0].direction_to_light.norm(), 1.0, 1e-12);
+    ASSERT_EQ(scene.environment_lights.size(), 1u);
+    EXPECT_FLOAT_EQ(scene.environment_lights[0].radiance.y(), 0.3f);
+    EXPECT_DOUBLE_EQ(scene.viewer.eye_height_m, 1.7);
+    EXPECT_EQ(scene.triangle_count(), scene.meshes[0].triangle_count() + scene.meshes[1].triangle_count());
+}
+
+TEST(SceneFile, TransformAppliesScaleRotationTranslationInOrder) {
+    const Scene scene = parse_scene(
+        minimal(R"([ { "mesh": "box", "transform": { "scale": 2, "rotate_deg": [0, 90, 0], "translate": [10, 0, 0] } } ])"),
+        kOrigin);
+    const Eigen::Affine3d& m = scene.instances[0].object_to_world;
+    // A file point (1, 0, 0): scaled to (2, 0, 0), turned 90° about +y to (0, 0, -2), moved by +10 x.
+    const Eigen::Vector3d p = m * Eigen::Vector3d(1, 0, 0);
+    EXPECT_NEAR(p.x(), 10, 1e-12);
+    EXPECT_NEAR(p.z(), -2, 1e-12);
+}
+
+TEST(SceneFile, BaseAnchorPutsTheBottomCentreOnTheTranslation) {
+    const Scene scene = parse_scene(
+        minimal(R"([ { "mesh": "box", "transform": { "scale": 0.5, "anchor": "base", "translate": [3, 1, -2] } } ])"), kOrigin);
+    Eigen::AlignedBox3d box;
+    for (const auto& p : scene.meshes[1].positions) box.extend(scene.instances[0].object_to_world * p.cast<double>());
+    EXPECT_NEAR(box.min().y(), 1.0, 1e-6);
+    EXPECT_NEAR(box.center().x(), 3.0, 1e-6);
+    EXPECT_NEAR(box.center().z(), -2.0, 1e-6);
+    EXPECT_NEAR(box.max().y() - box.min().y(), 1.0, 1e-6);  // 2 m box at scale 0.5
+}
+
+TEST(SceneFile, FarFromOriginMeshesAreRecentredWithoutLosingPlacement) {
+    // The transform moves the object 1e5 m away; the world position must survive in double.
+    const Scene scene = parse_scene(
+        minimal(R"([ { "mesh": "ball", "transform": { "translate": [100000.25, 0, -100000.5] } } ])"), kOrigin);
+    const Eigen::Vector3d centre = scene.instances[0].object_to_world * Eigen::Vector3d::Zero();
+    EXPECT_NEAR(centre.x(), 100000.25, 1e-9);
+    EXPECT_NEAR(centre.z(), -100000.5, 1e-9);
+}
+
+TEST(SceneFile, RingMakesCopiesFacingTheAxis) {
+    const Scene scene = parse_scene(
+        minimal(R"([ { "mesh": "ball", "ring": { "count": 5, "radius": 4, "start_deg": -90, "end_deg": 90, "heights": [0, 2] } } ])"),
+        kOrigin);
+    ASSERT_EQ(scene.instances.size(), 10u);
+    for (const Instance& instance : scene.instances) {
+        const Eigen::Vector3d c = instance.object_to_world.translation();
+        EXPECT_NEAR(std::hypot(c.x(), c.z()), 4.0, 1e-9) << instance.name;
+        // The copy's +z (its front) points at the axis.
+        const Eigen::Vector3d front = instance.object_to_world.linear() * Eigen::Vector3d::UnitZ();
+        EXPECT_NEAR(front.dot(-Eigen::Vector3d(c.x(), 0, c.z()).normalized()), 1.0, 1e-9) << instance.name;
+    }
+    EXPECT_NEAR(scene.instances[5].object_to_world.translation().y(), 2.0, 1e-12);
+}
+
+TEST(SceneFile, BadInputNamesTheFieldAndTheRule) {
+    expect_error("{ not json", {"not valid JSON"});
+    expect_error(R"({ "objects": [] })", {"meshes", "missing"});
+    expect_error(minimal("[]"), {"objects", "non-empty"});
+    expect_error(minimal(R"([ { "mesh": "teapot" } ])"), {"objects[0].mesh", "teapot"});
+    expect_error(minimal(R"([ { "mesh": "ball", "material": "gold" } ])"), {"objects[0].material", "gold"});
+    expect_error(minimal(R"([ { "mesh": "ball", "transform": { "scale": 0 } } ])"), {"objects[0].transform.scale", "outside"});
+    expect_error(minimal(R"([ { "mesh": "ball", "transform": { "scale": -1 } } ])"), {"objects[0].transform.scale"});
+    expect_error(minimal(R"([ { "mesh": "ball", "transform": { "translate": [0, 1e300, 0] } } ])"),
+                 {"objects[0].transform.translate[1]", "outside"});
+    expect_error(minimal(R"([ { "mesh": "ball", "transform": { "translate": [0, 0] } } ])"), {"translate", "3 numbers"});
+    expect_error(minimal(R"([ { "mesh": "ball", "transform": { "anchor": "top" } } ])"), {"anchor"});
+    expect_error(minimal(R"([ { "mesh": "ball", "colour": 1 } ])"), {"objects[0].colour", "unknown key"});
+    expect_error(minimal(R"([ { "mesh": "ball" } ])", R"(, "lights": [ { "type": "laser" } ])"), {"lights[0].type", "laser"});
+    expect_error(minimal(R"([ { "mesh": "ball" } ])", R"(, "lights": [ { "type": "sun", "direction_to_light": [0, 0, 0] } ])"),
+                 {"lights[0].direction_to_light", "zero"});
+    expect_error(minimal(R"([ { "mesh": "ball" } ])",
+                         R"(, "lights": [ { "type": "area", "corner": [0,0,0], "edge_u": [1,0,0], "edge_v": [2,0,0] } ])"),
+                 {"lights[0]", "area"});
+    expect_error(R"({ "meshes": { "room": { "procedural": "grotto_room", "radius": -3 } }, "objects": [ { "mesh": "room" } ] })",
+                 {"meshes.room", "radius"});
+    expect_error(R"({ "meshes": { "m": { "procedural": "torus" } }, "objects": [ { "mesh": "m" } ] })",
+                 {"meshes.m.procedural", "torus"});
+    expect_error(R"({ "meshes": { "m": { "file": "missing.obj" } }, "objects": [ { "mesh": "m" } ] })",
+                 {"meshes.m.file", "missing.obj", "does not exist"});
+}
+
+TEST(Procedural, GrottoRoomIsClosedExceptTheEntranceAndFacesInward) {
+    GrottoRoomParams p;
+    p.segments = 64;
+    p.rings = 8;
+    const Mesh room = make_grotto_room(p);
+    ASSERT_GT(room.triangle_count(), 0u);
+    // Every wall/dome triangle faces the axis: its normal points toward the centre line.
+    int outward = 0;
+    for (const auto& t : room.triangles) {
+        const Eigen::Vector3f a = room.positions[t[0]], b = room.positions[t[1]], c = room.positions[t[2]];
+        const Eigen::Vector3f n = (b - a).cross(c - a);
+        const Eigen::Vector3f centroid = (a + b + c) / 3;
+        if (centroid.y() < 1e-6f) {  // floor faces up
+            outward += n.y() <= 0;
+            continue;
+        }
+        // Wall and dome face the axis point at their height (at most the dome's springing line).
+        const Eigen::Vector3f target(0, std::min(centroid.y(), static_cast<float>(p.height)), 0);
+        outward += n.dot(target - centroid) <= 0;
+    }
+    EXPECT_EQ(outward, 0);
+    EXPECT_THROW(make_grotto_room(GrottoRoomParams{.radius = 0.1}), std::invalid_argument);
+}
+
+TEST(SceneFile, GrottoScenesHaveTheRequiredTriangleCounts) {
+    const std::filesystem::path scans = MOGAO_SCANS_DIR;
+    if (!std::filesystem::exists(scans)) GTEST_SKIP() << "real scans not found at " << scans << " (../shared/data/scans)";
+    const std::filesystem::path scenes = std::filesystem::path(MOGAO_SOURCE_DIR) / "scenes";
+    SceneLoadReport report;
+    const Scene grotto = load_scene(scenes / "grotto.json", {scans}, &report);
+    EXPECT_GE(grotto.triangle_count(), 500'000u);
+    EXPECT_EQ(report.instanced_triangles, grotto.triangle_count());
+    for (const MeshLoadFigures& m : report.meshes) {
+        EXPECT_GT(m.triangles, 0u) << m.name;
+        std::printf("%-10s %9zu triangles %8zu vertices %7.3f s  %s\n", m.name.c_str(), m.triangles, m.vertices,
+                    m.seconds, m.source.c_str());
+    }
+    const Scene big = load_scene(scenes / "grotto-6m.json", {scans});
+    EXPECT_GE(big.triangle_count(), 6'000'000u);
+    // Instancing: the 6M variant holds no more distinct meshes than it names.
+    EXPECT_LE(big.meshes.size(), grotto.meshes.size() + 1);
+}
+
+}  // namespace
+}  // namespace mogao

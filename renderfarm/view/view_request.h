@@ -5,6 +5,8 @@
 // (counter-clockwise seen from above, i.e. a rotation about +y). Positive pitch looks up.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <variant>
 
@@ -64,5 +66,14 @@ struct ViewRequest {
     std::uint64_t seed = 1;             // same seed + same request = same pixels
     std::int64_t request_time_ns = 0;   // CLOCK_REALTIME of the sender, for latency accounting
 };
+
+// The size actually traced: size scaled by quality.resolution_scale, rounded to nearest, at least
+// 1x1. The farm and the renderer both use this one definition.
+[[nodiscard]] inline ImageSize render_size(const ViewRequest& view) {
+    const auto scaled = [&](int n) {
+        return std::max(1, static_cast<int>(std::lround(n * view.quality.resolution_scale)));
+    };
+    return {scaled(view.size.width), scaled(view.size.height)};
+}
 
 }  // namespace mogao

@@ -1,0 +1,36 @@
+// One rank's share of a frame: render its rects tile by tile, time every tile, and pack the
+// sRGB8 pixels for the admin. This is the measured input of the PBT (schedule/).
+//
+// Tiles are cost-map cells (cell_size x cell_size pixels, aligned to the global image grid) clipped
+// to each rect, so a tile's time maps onto exactly one cell. Pixels are packed rect by rect, row by
+// row, RGB8 — the order unpack_rects() expects.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "renderfarm/schedule/cost_map.h"
+#include "renderfarm/trace/renderer.h"
+#include "renderfarm/view/image.h"
+
+namespace mogao {
+
+struct TilePassResult {
+    std::vector<std::uint8_t> packed_pixels;
+    std::vector<TileTime> tile_times;
+    std::uint64_t rays = 0;
+    double render_seconds = 0.0;  // wall time of the whole pass on this rank
+};
+
+// Renders `rects` of the frame begun on `renderer` with `threads` worker threads (>= 1).
+// Throws what the renderer throws (std::invalid_argument for rects outside the image).
+[[nodiscard]] TilePassResult render_tile_pass(const Renderer& renderer, const std::vector<PixelRect>& rects,
+                                              int cell_size, int threads, float exposure);
+
+// Copies packed pixels of `rects` into `frame`. Throws std::invalid_argument when the byte count
+// does not match the rects or a rect lies outside the frame.
+void unpack_rects(const std::vector<PixelRect>& rects, const std::vector<std::uint8_t>& packed, Rgb8Image& frame);
+
+[[nodiscard]] std::size_t packed_size(const std::vector<PixelRect>& rects);
+
+}  // namespace mogao

@@ -1,0 +1,69 @@
+#include "renderfarm/farm/tile_pass.h"
+
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "renderfarm/scene/procedural.h"
+
+namespace mogao {
+namespace {
+
+TEST(UnpackRects, PlacesEveryRectAndRejectsMismatchedSizes) {
+    Rgb8Image frame({8, 4});
+    const std::vector<PixelRect> rects{{0, 0, 4, 4}, {4, 0, 8, 2}};
+    std::vector<std::uint8_t> packed(packed_size(rects));
+    for (std::size_t i = 0; i < packed.size(); ++i) packed[i] = static_cast<std::uint8_t>(i % 251);
+    unpack_rects(rects, packed, frame);
+    EXPECT_EQ(frame.at(0, 0)[0], 0);
+    EXPECT_EQ(frame.at(4, 0)[0], packed[static_cast<std::size_t>(4 * 4 * 3)]);
+    EXPECT_EQ(frame.at(7, 3)[0], 0);  // not in any rect: untouched
+    packed.pop_back();
+    EXPECT_THROW(unpack_rects(rects, packed, frame), std::invalid_argument);
+    EXPECT_THROW(unpack_rects({{4, 0, 9, 2}}, std::vector<std::uint8_t>(30), frame), std::invalid_argument);
+}
+
+Scene small_scene() {
+    Scene scene;
+    scene.meshes.push_back(make_uv_sphere(1.0, 32, 16));
+    scene.meshes.push_back(make_ground_plane(20.0, 4));
+    scene.materials.push_back(Material{"grey"});
+    Instance sphere;
+    sphere.mesh = 0;
+    sphere.object_to_world.translation() = Eigen::Vector3d(0, 1, 0);
+    scene.instances.push_back(sphere);
+    Instance ground;
+    ground.mesh = 1;
+    scene.instances.push_back(ground);
+    scene.directional_lights.push_back(DirectionalLight{});
+    scene.point_lights.push_back(PointLight{Eigen::Vector3d(2, 3, 2), Rgb(5, 5, 5), true});
+    scene.environment_lights.push_back(EnvironmentLight{});
+    return scene;
+}
+
+TEST(TilePass, SplitRectsWithThreadsGiveTheSamePixelsAsOneRect) {
+    const Scene scene = small_scene();
+    Renderer renderer(scene, RendererOptions{});
+    ViewRequest view;
+    view.size = {96, 64};
+    view.pose.eye = {0, 1.5, 5};
+    view.quality.spp = 2;
+    view.quality.ao_samples = 2;
+    renderer.begin_frame(view);
+    const TilePassResult whole = render_tile_pass(renderer, {{0, 0, 96, 64}}, 16, 1, 1.f);
+    const std::vector<PixelRect> parts{{0, 0, 48, 64}, {48, 0, 96, 32}, {48, 32, 96, 64}};
+    const TilePassResult split = render_tile_pass(renderer, parts, 16, 3, 1.f);
+    Rgb8Image a({96, 64}), b({96, 64});
+    unpack_rects({{0, 0, 96, 64}}, whole.packed_pixels, a);
+    unpack_rects(parts, split.packed_pixels, b);
+    EXPECT_EQ(a.pixels, b.pixels);
+    EXPECT_EQ(whole.rays, split.rays);
+    EXPECT_GT(whole.rays, 96u * 64u);  // camera rays plus shadow/AO rays
+    // One timed tile per 16x16 cell, and only cells of the given rects.
+    EXPECT_EQ(whole.tile_times.size(), 6u * 4u);
+    for (const TileTime& t : split.tile_times) EXPECT_GE(t.seconds, 0.0);
+    EXPECT_THROW((void)render_tile_pass(renderer, {{0, 0, 97, 64}}, 16, 1, 1.f), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace mogao

@@ -1,0 +1,49 @@
+// Camera models: image position -> world ray. Pure functions of the view request, no Embree.
+//
+// Image coordinates are continuous: (px, py) in [0, W] x [0, H] of the render size, x right,
+// y down; pixel (x, y) has its centre at (x + 0.5, y + 0.5) (view/pixel_rect.h).
+//
+// Pose (view/view_request.h): world is right-handed, metres, +y up. The pose rotation is
+// R = Ry(yaw) * Rx(pitch): yaw 0 looks along -z, +yaw turns left (counter-clockwise about +y seen
+// from above), +pitch looks up. Camera frame columns of R: right (+x), up (+y), back (+z).
+//
+// Pinhole: vertical field of view fov, aspect = W / H of the render size,
+//   d_cam = ( (2 px/W - 1) tan(fov/2) W/H,  (1 - 2 py/H) tan(fov/2),  -1 ),
+//   ray = (pose.eye, normalize(R d_cam)).
+// Cylinder screen (CylinderScreen in view/view_request.h, physical screen frame):
+//   θ = -arc/2 + arc px/W,  y = top - (top - bottom) py/H,  S = (r sinθ, y, -r cosθ),
+//   d_screen = S - eye_m   (from the physical eye through the screen point),
+//   ray = (pose.eye, normalize(R d_screen))   (the physical eye is placed at pose.eye).
+// With px = u + 0.5, py = v + 0.5 these are exactly the documented per-pixel formulas.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "renderfarm/view/pixel_rect.h"
+#include "renderfarm/view/view_request.h"
+
+namespace mogao {
+
+struct Ray {
+    Eigen::Vector3d origin;     // world metres
+    Eigen::Vector3d direction;  // unit, world
+};
+
+// Everything generate_ray needs, precomputed once per frame.
+struct CameraSetup {
+    CameraModel model;
+    ImageSize size;                 // render size (after resolution_scale)
+    Eigen::Vector3d eye;            // pose.eye, world metres
+    Eigen::Matrix3d rotation;       // R = Ry(yaw) Rx(pitch): camera/screen frame -> world
+    double tan_half_fov = 0.0;      // pinhole only
+};
+
+// Rotation of a pose (see above). Angles in degrees.
+[[nodiscard]] Eigen::Matrix3d pose_rotation(double yaw_deg, double pitch_deg);
+
+// Does not validate (see view_validation.h); render_size is the size rays are generated for.
+[[nodiscard]] CameraSetup make_camera_setup(const ViewRequest& request, ImageSize render_size);
+
+[[nodiscard]] Ray generate_ray(const CameraSetup& camera, double px, double py);
+
+}  // namespace mogao

@@ -1,0 +1,67 @@
+#include "renderfarm/trace/embree_device.h"
+
+#include <stdexcept>
+#include <utility>
+
+namespace mogao {
+namespace {
+
+// Embree calls the error function on the thread whose API call failed, so a thread-local message
+// pairs correctly with that thread's rtcGetDeviceError() code without locking.
+thread_local std::string last_embree_message;
+
+void record_error(void* /*user*/, RTCError /*code*/, const char* message) {
+    last_embree_message = message != nullptr ? message : "";
+}
+
+const char* error_name(RTCError code) {
+    switch (code) {
+        case RTC_ERROR_NONE: return "RTC_ERROR_NONE";
+        case RTC_ERROR_UNKNOWN: return "RTC_ERROR_UNKNOWN";
+        case RTC_ERROR_INVALID_ARGUMENT: return "RTC_ERROR_INVALID_ARGUMENT";
+        case RTC_ERROR_INVALID_OPERATION: return "RTC_ERROR_INVALID_OPERATION";
+        case RTC_ERROR_OUT_OF_MEMORY: return "RTC_ERROR_OUT_OF_MEMORY";
+        case RTC_ERROR_UNSUPPORTED_CPU: return "RTC_ERROR_UNSUPPORTED_CPU";
+        case RTC_ERROR_CANCELLED: return "RTC_ERROR_CANCELLED";
+    }
+    return "RTC_ERROR_?";
+}
+
+[[noreturn]] void throw_error(std::string_view what, RTCError code) {
+    std::string message = std::string(what) + ": " + error_name(code);
+    if (!last_embree_message.empty()) message += ": " + last_embree_message;
+    last_embree_message.clear();
+    throw std::runtime_error(message);
+}
+
+}  // namespace
+
+EmbreeDevice::EmbreeDevice(const std::string& config) {
+    device_ = rtcNewDevice(config.empty() ? nullptr : config.c_str());
+    if (device_ == nullptr) {
+        // Creation errors are only reported through the null device's error code.
+        throw_error("rtcNewDevice(\"" + config + "\")", rtcGetDeviceError(nullptr));
+    }
+    rtcSetDeviceErrorFunction(device_, record_error, nullptr);
+}
+
+EmbreeDevice::~EmbreeDevice() {
+    if (device_ != nullptr) rtcReleaseDevice(device_);
+}
+
+EmbreeDevice::EmbreeDevice(EmbreeDevice&& other) noexcept : device_(std::exchange(other.device_, nullptr)) {}
+
+EmbreeDevice& EmbreeDevice::operator=(EmbreeDevice&& other) noexcept {
+    if (this != &other) {
+        if (device_ != nullptr) rtcReleaseDevice(device_);
+        device_ = std::exchange(other.device_, nullptr);
+    }
+    return *this;
+}
+
+void EmbreeDevice::check(std::string_view what) const {
+    const RTCError code = rtcGetDeviceError(device_);
+    if (code != RTC_ERROR_NONE) throw_error(what, code);
+}
+
+}  // namespace mogao

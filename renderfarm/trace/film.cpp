@@ -1,0 +1,52 @@
+#include "renderfarm/trace/film.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <stdexcept>
+
+namespace mogao {
+namespace {
+
+
+double srgb_oetf_inverse(double e) { return e <= 0.04045 ? e / 12.92 : std::pow((e + 0.055) / 1.055, 2.4); }
+
+// thresholds[k] = smallest linear value whose code is k + 1, i.e. OETF⁻¹((k + 0.5) / 255): the
+// code is the number of thresholds <= v. Same result as lround(255 * OETF(v)) without a pow per
+// channel (a 1080p frame has 6 million channels).
+const std::array<double, 255>& code_thresholds() {
+    static const std::array<double, 255> thresholds = [] {
+        std::array<double, 255> t{};
+        for (std::size_t k = 0; k < t.size(); ++k) t[k] = srgb_oetf_inverse((static_cast<double>(k) + 0.5) / 255.0);
+        return t;
+    }();
+    return thresholds;
+}
+
+}  // namespace
+
+std::uint8_t encode_srgb8(float linear) {
+    // NaN fails the comparison and ends at 0; +inf clamps to 1.
+    const double v = linear > 0.0f ? std::min(static_cast<double>(linear), 1.0) : 0.0;
+    const auto& t = code_thresholds();
+    return static_cast<std::uint8_t>(std::upper_bound(t.begin(), t.end(), v) - t.begin());
+}
+
+void to_srgb8(const RgbFloatImage& in, const PixelRect& rect, float exposure, Rgb8Image& out) {
+    if (!(in.size == out.size)) throw std::invalid_argument("to_srgb8: input and output sizes differ");
+    if (rect.x0 < 0 || rect.y0 < 0 || rect.x1 > in.size.width || rect.y1 > in.size.height) {
+        throw std::invalid_argument("to_srgb8: rect is outside the image");
+    }
+    if (!(exposure >= 0.0f) || !std::isfinite(exposure)) {
+        throw std::invalid_argument("to_srgb8: exposure must be finite and >= 0");
+    }
+    for (int y = rect.y0; y < rect.y1; ++y) {
+        for (int x = rect.x0; x < rect.x1; ++x) {
+            const float* src = in.at(x, y);
+            std::uint8_t* dst = out.at(x, y);
+            for (int c = 0; c < 3; ++c) dst[c] = encode_srgb8(exposure * src[c]);
+        }
+    }
+}
+
+}  // namespace mogao

@@ -1,0 +1,227 @@
+#include "renderfarm/trace/renderer.h"
+
+#include <array>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <embree3/rtcore.h>
+
+#include "renderfarm/trace/camera.h"
+#include "renderfarm/trace/integrator.h"
+#include "renderfarm/trace/light_set.h"
+#include "renderfarm/trace/render_scene.h"
+#include "renderfarm/trace/rng.h"
+#include "renderfarm/trace/sampling.h"
+#include "renderfarm/trace/shading.h"
+#include "renderfarm/trace/view_validation.h"
+
+namespace mogao {
+namespace {
+
+constexpr int kBlock = 4;  // 4x4 pixels = one rtcIntersect16 packet
+constexpr int kLanes = kBlock * kBlock;
+
+// One 4x4 block of the global pixel grid and which of its pixels belong to the rect.
+struct Block {
+    alignas(64) std::array<int, kLanes> valid{};  // -1 = trace, 0 = masked (Embree convention)
+    int x0 = 0;
+    int y0 = 0;
+    int active = 0;
+};
+
+Block make_block(int x0, int y0, const PixelRect& rect) {
+    Block block;
+    block.x0 = x0;
+    block.y0 = y0;
+    for (int lane = 0; lane < kLanes; ++lane) {
+        const bool inside = rect.contains(x0 + lane % kBlock, y0 + lane / kBlock);
+        block.valid[static_cast<std::size_t>(lane)] = inside ? -1 : 0;
+        block.active += inside ? 1 : 0;
+    }
+    return block;
+}
+
+std::string describe(const PixelRect& r) {
+    return "[" + std::to_string(r.x0) + ", " + std::to_string(r.x1) + ") x [" + std::to_string(r.y0) + ", " +
+           std::to_string(r.y1) + ")";
+}
+
+}  // namespace
+
+struct Renderer::Impl {
+    Impl(const Scene& scene, const RendererOptions& opts)
+        : options(opts), geometry(scene, opts.embree_config), lights(LightSet::from_scene(scene)) {
+        materials.reserve(scene.materials.size());
+        for (const Material& m : scene.materials) materials.push_back(make_shading_material(m));
+    }
+
+    RendererOptions options;
+    RenderScene geometry;
+    LightSet lights;
+    std::vector<ShadingMaterial> materials;
+
+    // Current frame (set by begin_frame).
+    bool ready = false;
+    ImageSize size;
+    std::optional<CameraSetup> camera;
+    std::uint64_t key = 0;
+    int spp = 1;
+    FrameContext context;
+
+    void check_ready() const {
+        if (!ready) throw std::logic_error("Renderer: begin_frame() must be called before rendering");
+    }
+
+    // Fills the camera rays of one sample index for the lanes of `block` and their random streams.
+    void fill_packet(const Block& block, int sample, RTCRayHit16& packet, std::array<PixelRng, kLanes>& rngs) const {
+        const Eigen::Vector3d& origin = geometry.origin();
+        for (int lane = 0; lane < kLanes; ++lane) {
+            const auto l = static_cast<std::size_t>(lane);
+            packet.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
+            packet.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
+            if (block.valid[l] == 0) continue;
+            const int x = block.x0 + lane % kBlock;
+            const int y = block.y0 + lane / kBlock;
+            rngs[l] = PixelRng(key, x, y, sample);
+            Eigen::Vector2f jitter(0.5f, 0.5f);
+            if (spp > 1) {
+                const float u1 = rngs[l].next();
+                const float u2 = rngs[l].next();
+                jitter = stratified_jitter(sample, spp, u1, u2);
+            }
+            const Ray ray = generate_ray(*camera, x + static_cast<double>(jitter.x()), y + static_cast<double>(jitter.y()));
+            const Eigen::Vector3f org = (ray.origin - origin).cast<float>();
+            const Eigen::Vector3f dir = ray.direction.cast<float>();
+            packet.ray.org_x[l] = org.x();
+            packet.ray.org_y[l] = org.y();
+            packet.ray.org_z[l] = org.z();
+            packet.ray.dir_x[l] = dir.x();
+            packet.ray.dir_y[l] = dir.y();
+            packet.ray.dir_z[l] = dir.z();
+            packet.ray.tnear[l] = 0.0f;
+            packet.ray.tfar[l] = std::numeric_limits<float>::infinity();
+            packet.ray.time[l] = 0.0f;
+            packet.ray.mask[l] = 0xFFFFFFFFu;
+            packet.ray.id[l] = static_cast<unsigned>(lane);
+            packet.ray.flags[l] = 0;
+        }
+    }
+
+    void intersect(const Block& block, RTCRayHit16& packet) const {
+        RTCIntersectContext context_flags;
+        rtcInitIntersectContext(&context_flags);
+        context_flags.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        rtcIntersect16(block.valid.data(), geometry.root(), &context_flags, &packet);
+    }
+
+    void check_target(const PixelRect& rect, const RgbFloatImage* frame) const {
+        check_ready();
+        if (rect.x0 < 0 || rect.y0 < 0 || rect.x1 > size.width || rect.y1 > size.height) {
+            throw std::invalid_argument("Renderer::render: rect " + describe(rect) + " is outside the render size " +
+                                        std::to_string(size.width) + "x" + std::to_string(size.height));
+        }
+        if (frame != nullptr && (frame->size != size || frame->pixels.size() != static_cast<std::size_t>(size.pixel_count()) * 3)) {
+            throw std::invalid_argument("Renderer::render: frame is " + std::to_string(frame->size.width) + "x" +
+                                        std::to_string(frame->size.height) + ", render size is " +
+                                        std::to_string(size.width) + "x" + std::to_string(size.height));
+        }
+    }
+
+    // Visits the 4x4 blocks of the global grid that overlap rect.
+    template <typename Visit>
+    static void for_each_block(const PixelRect& rect, Visit&& visit) {
+        const int bx0 = rect.x0 - rect.x0 % kBlock;
+        const int by0 = rect.y0 - rect.y0 % kBlock;
+        for (int by = by0; by < rect.y1; by += kBlock) {
+            for (int bx = bx0; bx < rect.x1; bx += kBlock) visit(make_block(bx, by, rect));
+        }
+    }
+};
+
+Renderer::Renderer(const Scene& scene, const RendererOptions& options)
+    : impl_(std::make_unique<Impl>(scene, options)) {}
+Renderer::~Renderer() = default;
+Renderer::Renderer(Renderer&&) noexcept = default;
+Renderer& Renderer::operator=(Renderer&&) noexcept = default;
+
+void Renderer::begin_frame(const ViewRequest& request) {
+    Impl& s = *impl_;
+    const ImageSize size = render_size_for(request);  // validates before any state changes
+    const Eigen::Vector3d origin = s.options.rebase_on_eye ? request.pose.eye : Eigen::Vector3d::Zero();
+    s.geometry.rebase(origin);
+    s.lights.rebase(origin);
+    s.size = size;
+    s.camera = make_camera_setup(request, size);
+    s.key = frame_key(request.seed, request.frame_id);
+    s.spp = request.quality.spp;
+    s.context = FrameContext{&s.geometry, &s.lights, &s.materials, request.quality.max_bounces,
+                             request.quality.ao_samples, request.quality.area_light_samples};
+    s.ready = true;
+}
+
+ImageSize Renderer::render_size() const {
+    impl_->check_ready();
+    return impl_->size;
+}
+
+TileStats Renderer::render(const PixelRect& rect, RgbFloatImage& frame) const {
+    const Impl& s = *impl_;
+    s.check_target(rect, &frame);
+    TileStats stats;
+    if (rect.empty()) return stats;
+    const float inv_spp = 1.0f / static_cast<float>(s.spp);
+    Impl::for_each_block(rect, [&](const Block& block) {
+        std::array<Eigen::Vector3f, kLanes> sum;
+        sum.fill(Eigen::Vector3f::Zero());
+        for (int sample = 0; sample < s.spp; ++sample) {
+            RTCRayHit16 packet;
+            std::array<PixelRng, kLanes> rngs;
+            s.fill_packet(block, sample, packet, rngs);
+            s.intersect(block, packet);
+            stats.rays += static_cast<std::uint64_t>(block.active);
+            for (std::size_t l = 0; l < kLanes; ++l) {
+                if (block.valid[l] == 0) continue;
+                if (packet.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID) {
+                    sum[l] += s.lights.environment;  // the sky behind everything
+                    continue;
+                }
+                const Eigen::Vector3f org(packet.ray.org_x[l], packet.ray.org_y[l], packet.ray.org_z[l]);
+                const Eigen::Vector3f dir(packet.ray.dir_x[l], packet.ray.dir_y[l], packet.ray.dir_z[l]);
+                const SurfaceHit hit = s.geometry.surface(
+                    org, dir, packet.ray.tfar[l], packet.hit.instID[0][l], packet.hit.primID[l], packet.hit.u[l],
+                    packet.hit.v[l], Eigen::Vector3f(packet.hit.Ng_x[l], packet.hit.Ng_y[l], packet.hit.Ng_z[l]));
+                sum[l] += radiance_at(s.context, hit, -dir, rngs[l], stats.rays);
+            }
+        }
+        for (int lane = 0; lane < kLanes; ++lane) {
+            if (block.valid[static_cast<std::size_t>(lane)] == 0) continue;
+            float* out = frame.at(block.x0 + lane % kBlock, block.y0 + lane / kBlock);
+            const Eigen::Vector3f value = sum[static_cast<std::size_t>(lane)] * inv_spp;
+            out[0] = value.x();
+            out[1] = value.y();
+            out[2] = value.z();
+        }
+    });
+    return stats;
+}
+
+TileStats Renderer::trace_camera_rays(const PixelRect& rect) const {
+    const Impl& s = *impl_;
+    s.check_target(rect, nullptr);
+    TileStats stats;
+    Impl::for_each_block(rect, [&](const Block& block) {
+        for (int sample = 0; sample < s.spp; ++sample) {
+            RTCRayHit16 packet;
+            std::array<PixelRng, kLanes> rngs;
+            s.fill_packet(block, sample, packet, rngs);
+            s.intersect(block, packet);
+            stats.rays += static_cast<std::uint64_t>(block.active);
+        }
+    });
+    return stats;
+}
+
+}  // namespace mogao

@@ -1,0 +1,77 @@
+// The trace stage: renders linear radiance for a rect of a view request's frame with Embree.
+//
+// Usage: Renderer r(scene, options); per frame: r.begin_frame(request); then any number of
+// r.render(rect, frame) calls, possibly concurrently from several threads on disjoint rects of
+// the same frame buffer (render() is const and has no shared mutable state).
+//
+// Frame buffer: RgbFloatImage of exactly render_size() (= round(request.size * resolution_scale),
+// view_validation.h); render() writes linear radiance (scene units, before exposure) only to the
+// pixels inside `rect` and leaves every other pixel untouched. Camera rays that hit nothing see
+// the summed environment radiance (the sky); integrator.h describes what a hit receives.
+//
+// Determinism: a pixel's value depends only on (scene, request incl. seed and frame_id, x, y):
+// camera rays are traced in 4x4 packets aligned to the global image grid (x0 % 4 == 0,
+// y0 % 4 == 0), lanes outside rect or image masked off, one packet per sample index; all random
+// numbers are hashes of (seed, frame_id, x, y, sample, dimension) (rng.h). So any split of the
+// frame into rects (e.g. across MPI ranks) reproduces the single-rect frame bit for bit.
+//
+// Lifetime: the Scene must outlive the Renderer (mesh indices and normals are shared, not copied).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "renderfarm/scene/scene.h"
+#include "renderfarm/view/image.h"
+#include "renderfarm/view/pixel_rect.h"
+#include "renderfarm/view/view_request.h"
+
+namespace mogao {
+
+struct RendererOptions {
+    // rtcNewDevice configuration, e.g. "threads=1" to build BVHs on one thread; "" = Embree default
+    // (all hardware threads for BVH builds; rendering itself runs on the caller's threads).
+    std::string embree_config;
+    // Rebase the world on the eye every frame (render_scene.h). Only benchmarks and the precision
+    // test turn this off, to measure what it buys.
+    bool rebase_on_eye = true;
+};
+
+struct TileStats {
+    std::uint64_t rays = 0;  // every ray traced: camera, shadow, ambient-occlusion and bounce
+};
+
+class Renderer {
+public:
+    // Builds the Embree BVHs (seconds for millions of triangles). Throws std::invalid_argument for
+    // an inconsistent scene (bad indices, degenerate lights, ...), std::runtime_error for Embree.
+    explicit Renderer(const Scene& scene, const RendererOptions& options = {});
+    ~Renderer();
+    Renderer(const Renderer&) = delete;
+    Renderer& operator=(const Renderer&) = delete;
+    Renderer(Renderer&&) noexcept;
+    Renderer& operator=(Renderer&&) noexcept;
+
+    // Validates the request (std::invalid_argument naming the field and limit, see
+    // view_validation.h), rebases the world on the eye and prepares cameras and lights. Not
+    // thread-safe: no render() may run concurrently. On throw, the previous frame stays current.
+    void begin_frame(const ViewRequest& request);
+
+    // Size of the frame buffer for the current frame. Throws std::logic_error before begin_frame.
+    [[nodiscard]] ImageSize render_size() const;
+
+    // Renders the pixels of `rect` into `frame`. Throws std::invalid_argument if rect is not inside
+    // [0, render_size()) or frame.size != render_size(), std::logic_error before begin_frame.
+    TileStats render(const PixelRect& rect, RgbFloatImage& frame) const;
+
+    // Benchmark baseline: generates and intersects exactly the camera ray packets render() would
+    // (same grid, masks and samples) with rtcIntersect16, without any shading or secondary rays.
+    TileStats trace_camera_rays(const PixelRect& rect) const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace mogao

@@ -1,0 +1,64 @@
+// Sampling helpers (float, unit vectors). Formulas from Pharr, Jakob, Humphreys, "Physically
+// Based Rendering", 3rd ed. (PBRT): §13.6.3 (concentric disk, Shirley-Chiu), §13.6.3 Malley's
+// method (cosine-weighted hemisphere, pdf = cosθ/π), §2.2.4-style orthonormal basis from one
+// vector (Duff et al., "Building an Orthonormal Basis, Revisited", JCGT 2017).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <Eigen/Core>
+
+namespace mogao {
+
+// Tangent frame (t, b, n) around a unit vector n; branchless, no normalisation needed.
+struct Frame {
+    Eigen::Vector3f t, b, n;
+    explicit Frame(const Eigen::Vector3f& normal) : n(normal) {
+        const float sign = std::copysign(1.0f, n.z());
+        const float a = -1.0f / (sign + n.z());
+        const float c = n.x() * n.y() * a;
+        t = Eigen::Vector3f(1.0f + sign * n.x() * n.x() * a, sign * c, -sign * n.x());
+        b = Eigen::Vector3f(c, sign + n.y() * n.y() * a, -n.y());
+    }
+    [[nodiscard]] Eigen::Vector3f to_world(const Eigen::Vector3f& v) const { return t * v.x() + b * v.y() + n * v.z(); }
+};
+
+// Concentric mapping of [0,1)² onto the unit disk (area-preserving, low distortion).
+[[nodiscard]] inline Eigen::Vector2f concentric_disk(float u1, float u2) {
+    const float ox = 2.0f * u1 - 1.0f;
+    const float oy = 2.0f * u2 - 1.0f;
+    if (ox == 0.0f && oy == 0.0f) return {0.0f, 0.0f};
+    constexpr float kPiOver4 = std::numbers::pi_v<float> / 4.0f;
+    float r = 0.0f;
+    float theta = 0.0f;
+    if (std::fabs(ox) > std::fabs(oy)) {
+        r = ox;
+        theta = kPiOver4 * (oy / ox);
+    } else {
+        r = oy;
+        theta = 2.0f * kPiOver4 - kPiOver4 * (ox / oy);
+    }
+    return {r * std::cos(theta), r * std::sin(theta)};
+}
+
+// Cosine-weighted direction on the hemisphere around frame.n; pdf = cosθ/π.
+[[nodiscard]] inline Eigen::Vector3f cosine_hemisphere(const Frame& frame, float u1, float u2) {
+    const Eigen::Vector2f d = concentric_disk(u1, u2);
+    const float z = std::sqrt(std::max(0.0f, 1.0f - d.squaredNorm()));
+    return frame.to_world(Eigen::Vector3f(d.x(), d.y(), z));
+}
+
+// Position of sample `sample` of `spp` inside the unit pixel square: the pixel is split into a
+// cols x rows grid (cols = ceil(sqrt(spp)), rows = ceil(spp / cols)), sample s is jittered by
+// (u1, u2) inside cell (s % cols, s / cols). spp == 1 returns the pixel centre (no jitter).
+[[nodiscard]] inline Eigen::Vector2f stratified_jitter(int sample, int spp, float u1, float u2) {
+    if (spp <= 1) return {0.5f, 0.5f};
+    const int cols = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(spp))));
+    const int rows = (spp + cols - 1) / cols;
+    return {(static_cast<float>(sample % cols) + u1) / static_cast<float>(cols),
+            (static_cast<float>(sample / cols) + u2) / static_cast<float>(rows)};
+}
+
+}  // namespace mogao
