@@ -2,9 +2,9 @@
 //
 // EncodeError: an image could not be turned into bytes (bad arguments, codec failure).
 // DecodeError: bytes could not be turned into an image (corrupt, truncated, unsupported, too large).
-// Both derive from std::runtime_error; messages name the file (when there is one) and the reason.
-// Failures of the file system itself (missing directory, full disk) are std::system_error naming
-// the path, so callers can tell "bad data" from "bad environment".
+// Both derive from std::runtime_error; messages name the file (when there is one) and the reason,
+// including file-system failures (missing directory, full disk) of the PNG/PPM readers and writers.
+// Bad arguments (quality 0, a malformed Rgb8Image) are std::invalid_argument instead.
 #pragma once
 
 #include <stdexcept>

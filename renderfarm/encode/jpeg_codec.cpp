@@ -32,6 +32,16 @@ int tj_subsampling(Subsampling s) {
     throw std::invalid_argument("JpegEncoder::encode: unknown subsampling");
 }
 
+// libjpeg-turbo 2.1.5: when tjDecompressHeader3 fails mid-header it longjmps out without
+// jpeg_abort_decompress, so the handle keeps its half-parsed marker state and every later
+// decode on it fails (even of a valid file, e.g. "Bogus DQT index"). A failed call therefore
+// replaces the handle; that costs microseconds and only on the error path. Same for the encoder,
+// to be safe against similar state after a failed tjCompress2.
+void replace_handle(void*& handle, tjhandle (*init)()) {
+    tjDestroy(handle);
+    handle = init();  // nullptr only if malloc fails; the next call then reports that
+}
+
 }  // namespace
 
 JpegEncoder::JpegEncoder() : handle_(tjInitCompress()) {
@@ -55,7 +65,7 @@ JpegEncoder& JpegEncoder::operator=(JpegEncoder&& other) noexcept {
 }
 
 std::vector<std::uint8_t> JpegEncoder::encode(const Rgb8Image& image, int quality, Subsampling subsampling) {
-    if (handle_ == nullptr) throw std::logic_error("JpegEncoder::encode: used after move");
+    if (handle_ == nullptr) throw std::logic_error("JpegEncoder::encode: no handle (moved from, or out of memory)");
     require_valid_image(image, "JpegEncoder::encode");
     if (quality < 1 || quality > 100) {
         throw std::invalid_argument("JpegEncoder::encode: quality " + std::to_string(quality) + " is outside 1..100");
@@ -80,8 +90,10 @@ std::vector<std::uint8_t> JpegEncoder::encode(const Rgb8Image& image, int qualit
     const int rc = tjCompress2(handle_, image.pixels.data(), w, w * 3, h, TJPF_RGB, &dst, &size, samp, quality,
                                TJFLAG_NOREALLOC);
     if (rc != 0) {
+        const std::string reason = tj_reason(handle_);
+        replace_handle(handle_, tjInitCompress);
         throw EncodeError("JpegEncoder::encode: tjCompress2 failed for " + std::to_string(w) + "x" +
-                          std::to_string(h) + " at quality " + std::to_string(quality) + ": " + tj_reason(handle_));
+                          std::to_string(h) + " at quality " + std::to_string(quality) + ": " + reason);
     }
     out.resize(size);
     return out;
@@ -108,7 +120,7 @@ JpegDecoder& JpegDecoder::operator=(JpegDecoder&& other) noexcept {
 }
 
 Rgb8Image JpegDecoder::decode(std::span<const std::uint8_t> jpeg) {
-    if (handle_ == nullptr) throw std::logic_error("JpegDecoder::decode: used after move");
+    if (handle_ == nullptr) throw std::logic_error("JpegDecoder::decode: no handle (moved from, or out of memory)");
     if (jpeg.empty()) throw DecodeError("JpegDecoder::decode: no data (0 bytes)");
     if (jpeg.size() > std::numeric_limits<unsigned long>::max()) {
         throw DecodeError("JpegDecoder::decode: input too large");
@@ -120,8 +132,10 @@ Rgb8Image JpegDecoder::decode(std::span<const std::uint8_t> jpeg) {
     int samp = 0;
     int colorspace = 0;
     if (tjDecompressHeader3(handle_, jpeg.data(), size, &w, &h, &samp, &colorspace) != 0) {
+        const std::string reason = tj_reason(handle_);
+        replace_handle(handle_, tjInitDecompress);
         throw DecodeError("JpegDecoder::decode: bad JPEG header (" + std::to_string(jpeg.size()) +
-                          " bytes): " + tj_reason(handle_));
+                          " bytes): " + reason);
     }
     // Refuse before allocating: the header's size is attacker/corruption controlled.
     if (w <= 0 || h <= 0 || w > kMaxDecodedDimension || h > kMaxDecodedDimension) {
@@ -140,9 +154,11 @@ Rgb8Image JpegDecoder::decode(std::span<const std::uint8_t> jpeg) {
     const int flags = TJFLAG_STOPONWARNING | TJFLAG_LIMITSCANS;
     if (tjDecompress2(handle_, jpeg.data(), size, image.pixels.data(), w, w * 3, h, TJPF_RGB, flags) != 0) {
         const bool warning = tjGetErrorCode(handle_) == TJERR_WARNING;
+        const std::string reason = tj_reason(handle_);
+        replace_handle(handle_, tjInitDecompress);
         throw DecodeError(std::string("JpegDecoder::decode: ") + (warning ? "damaged" : "corrupt") + " " +
                           std::to_string(w) + "x" + std::to_string(h) + " JPEG (" + std::to_string(jpeg.size()) +
-                          " bytes): " + tj_reason(handle_));
+                          " bytes): " + reason);
     }
     return image;
 }

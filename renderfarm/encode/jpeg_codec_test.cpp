@@ -70,8 +70,8 @@ TEST(JpegCodec, SmoothGradientAtQuality90HasHighPsnr) {
     const auto jpeg = encoder.encode(original, 90);
     const Rgb8Image decoded = decoder.decode(jpeg);
     ASSERT_EQ(decoded.size, original.size);
-    // 4:2:0 at quality 90 on this gradient measures 49.4 dB (libjpeg-turbo 2.1.5); 45 dB leaves margin for other
-    // libjpeg-turbo versions while still catching a wrong pixel format, stride or channel order.
+    // 4:2:0 at quality 90 on this gradient measures 49.4 dB (libjpeg-turbo 2.1.5). The 45 dB bound
+    // leaves margin for other versions yet fails for a wrong pixel format, stride or channel order.
     EXPECT_GT(psnr(original, decoded), 45.0);
     EXPECT_LT(jpeg.size(), original.pixels.size() / 10) << "not compressing";
 }
@@ -172,6 +172,46 @@ TEST(JpegDecode, CorruptDataIsAnError) {
 
     // The decoder stays usable after a failure (the handle's error state is per call).
     EXPECT_EQ(decoder.decode(jpeg).size, (ImageSize{128, 128}));
+}
+
+// Robustness sweep, mainly for the sanitizer build: every outcome must be a complete image of the
+// declared size or a DecodeError; anything else (crash, other exception, other size) fails. After
+// each failure the same decoder must still decode the intact file: libjpeg-turbo 2.1.5 leaves a
+// handle unusable after some header errors, which JpegDecoder has to hide.
+TEST(JpegDecode, DamagedStreamsGiveAnImageOrDecodeErrorAndNeverPoisonTheDecoder) {
+    JpegEncoder encoder;
+    JpegDecoder decoder;
+    const auto jpeg = encoder.encode(textured({64, 48}), 80);
+    auto still_usable = [&](const std::string& after) {
+        try {
+            EXPECT_EQ(decoder.decode(jpeg).size, (ImageSize{64, 48})) << "after " << after;
+        } catch (const DecodeError& e) {
+            ADD_FAILURE() << "intact JPEG refused after " << after << ": " << e.what();
+        }
+    };
+    for (std::size_t keep = 0; keep < jpeg.size(); ++keep) {  // no truncation is acceptable
+        const std::string what = "truncation to " + std::to_string(keep);
+        expect_decode_error(decoder,
+                            std::vector<std::uint8_t>(jpeg.begin(), jpeg.begin() + static_cast<std::ptrdiff_t>(keep)),
+                            what);
+        still_usable(what);
+    }
+    int refused = 0;
+    std::uint32_t rng = 7;
+    for (int trial = 0; trial < 300; ++trial) {
+        auto damaged = jpeg;
+        for (int flips = 0; flips < 3; ++flips) {
+            rng = rng * 1664525u + 1013904223u;
+            damaged[(rng >> 8) % damaged.size()] ^= static_cast<std::uint8_t>(1u << (rng >> 29));
+        }
+        try {
+            EXPECT_EQ(decoder.decode(damaged).size, (ImageSize{64, 48}));
+        } catch (const DecodeError&) {
+            ++refused;
+        }
+        still_usable("bit flips, trial " + std::to_string(trial));
+    }
+    EXPECT_GT(refused, 0) << "no bit flip was detected: the sweep is not exercising the error path";
 }
 
 TEST(JpegDecode, DeclaredSizeAboveLimitIsRefusedBeforeAllocation) {

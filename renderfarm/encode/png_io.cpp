@@ -5,6 +5,7 @@
 #include <cctype>
 #include <cstring>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,25 @@ struct PngImageGuard {
     PngImageGuard(const PngImageGuard&) = delete;
     PngImageGuard& operator=(const PngImageGuard&) = delete;
 };
+
+// The project's reader/writer convention (docs/architecture.md) is one typed error per direction,
+// so file-system failures (std::system_error from file_io) are re-thrown as DecodeError/EncodeError
+// with the same message, which already names the path and the errno reason.
+std::vector<std::uint8_t> read_or_throw(const std::filesystem::path& path, const char* who) {
+    try {
+        return read_file_bytes(path);
+    } catch (const std::runtime_error& e) {
+        throw DecodeError(std::string(who) + ": " + e.what());
+    }
+}
+
+void write_or_throw(const std::filesystem::path& path, const std::vector<std::uint8_t>& bytes, const char* who) {
+    try {
+        write_file_atomically(path, bytes);
+    } catch (const std::runtime_error& e) {
+        throw EncodeError(std::string(who) + ": " + e.what());
+    }
+}
 
 }  // namespace
 
@@ -50,11 +70,11 @@ void write_png(const std::filesystem::path& path, const Rgb8Image& image) {
         throw EncodeError("write_png " + quoted(path) + ": libpng: " + png.image.message);
     }
     bytes.resize(size);
-    write_file_atomically(path, bytes);
+    write_or_throw(path, bytes, "write_png");
 }
 
 Rgb8Image read_png(const std::filesystem::path& path) {
-    const std::vector<std::uint8_t> bytes = read_file_bytes(path);
+    const std::vector<std::uint8_t> bytes = read_or_throw(path, "read_png");
     PngImageGuard png;
     if (png_image_begin_read_from_memory(&png.image, bytes.data(), bytes.size()) == 0) {
         throw DecodeError("read_png " + quoted(path) + ": " + png.image.message);
@@ -81,11 +101,11 @@ void write_ppm(const std::filesystem::path& path, const Rgb8Image& image) {
         "P6\n" + std::to_string(image.size.width) + " " + std::to_string(image.size.height) + "\n255\n";
     std::vector<std::uint8_t> bytes(header.begin(), header.end());
     bytes.insert(bytes.end(), image.pixels.begin(), image.pixels.end());
-    write_file_atomically(path, bytes);
+    write_or_throw(path, bytes, "write_ppm");
 }
 
 Rgb8Image read_ppm(const std::filesystem::path& path) {
-    const std::vector<std::uint8_t> bytes = read_file_bytes(path);
+    const std::vector<std::uint8_t> bytes = read_or_throw(path, "read_ppm");
     const std::string who = "read_ppm " + quoted(path) + ": ";
     std::size_t pos = 0;
     auto fail = [&](const std::string& why) -> DecodeError { return DecodeError(who + why); };

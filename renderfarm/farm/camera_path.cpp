@@ -1,5 +1,6 @@
 #include "renderfarm/farm/camera_path.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <numbers>
@@ -24,14 +25,24 @@ double yaw_toward(const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
     return std::atan2(-d.x(), -d.z()) * kDeg;
 }
 
+// Spreads frames evenly over the path's length so the visitor moves at a constant pace: a segment's
+// length is its floor distance plus 1 m per 90 degrees of turn (so turning on the spot takes time too).
 std::vector<ViewerPose> sample(const std::vector<Keyframe>& keys, const Viewer& viewer, int frames) {
+    std::vector<double> along{0.0};
+    for (std::size_t k = 1; k < keys.size(); ++k) {
+        const double turn = std::abs(std::remainder(keys[k].yaw_deg - keys[k - 1].yaw_deg, 360.0)) +
+                            std::abs(keys[k].pitch_deg - keys[k - 1].pitch_deg);
+        along.push_back(along.back() + (keys[k].floor - keys[k - 1].floor).norm() + turn / 90.0);
+    }
     std::vector<ViewerPose> poses;
     poses.reserve(static_cast<std::size_t>(frames));
+    std::size_t i = 0;
     for (int f = 0; f < frames; ++f) {
-        const double u = frames == 1 ? 0.0 : static_cast<double>(f) * static_cast<double>(keys.size() - 1) / (frames - 1);
-        const std::size_t i = std::min(static_cast<std::size_t>(u), keys.size() - 1);
+        const double s = frames == 1 ? 0.0 : along.back() * f / (frames - 1);
+        while (i + 2 < keys.size() && along[i + 1] < s) ++i;
         const std::size_t j = std::min(i + 1, keys.size() - 1);
-        const double t = u - static_cast<double>(i);
+        const double length = along[j] - along[i];
+        const double t = length > 0 ? std::clamp((s - along[i]) / length, 0.0, 1.0) : 0.0;
         const Keyframe& a = keys[i];
         const Keyframe& b = keys[j];
         const double dyaw = std::remainder(b.yaw_deg - a.yaw_deg, 360.0);
@@ -69,7 +80,7 @@ std::vector<ViewerPose> make_camera_path(const std::string& name_or_file, const 
         // Walk in looking ahead, stop at half the distance, then circle 240° around the centre
         // while looking at it: a visitor's first minute in the grotto.
         keys.push_back({start, viewer.start_yaw_deg, 0.0});
-        const double inner = std::max(0.5 * radius, 1.0);
+        const double inner = std::max(0.6 * radius, 1.0);
         const Eigen::Vector3d near = on_circle(inner, start_angle);
         keys.push_back({near, yaw_toward(near, centre), 0.0});
         const int steps = 24;

@@ -7,7 +7,8 @@
 //
 // Path files (JSON): { "keyframes": [ { "position": [x, y, z], "yaw_deg": a, "pitch_deg": b }, ... ] }
 // where position is the floor point under the eye (y is the floor height). Frames are spread
-// evenly over the keyframes and interpolated linearly (yaw along the shorter arc).
+// evenly over the path's length (floor distance + 1 m per 90 degrees of turn, i.e. a constant
+// pace) and interpolated linearly between keyframes (yaw along the shorter arc).
 // Errors: PathError naming the file/field and the rule broken.
 #pragma once
 

@@ -281,7 +281,7 @@ int run_farm_job(const MpiSession& mpi, const FarmJob& job) {
         const auto bvh_start = Clock::now();
         try {
             RendererOptions options;
-            options.threads = job.threads;
+            options.embree_config = fmt::format("threads={}", job.threads);
             renderer.emplace(*scene, options);
         } catch (const std::exception& e) {
             error = e.what();

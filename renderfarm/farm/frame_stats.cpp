@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "renderfarm/encode/file_io.h"
+#include "renderfarm/schedule/tile_cost_log.h"
 
 namespace mogao {
 namespace {
@@ -77,16 +78,8 @@ void write_stats_json(const std::filesystem::path& file, const RunInfo& run, con
 
 void write_tile_costs_json(const std::filesystem::path& file, ImageSize size, int cell_size,
                            const std::vector<std::vector<TileTime>>& frames) {
-    nlohmann::json j;
-    j["image"] = {{"width", size.width}, {"height", size.height}};
-    j["cell_size"] = cell_size;
-    j["frames"] = nlohmann::json::array();
-    for (const auto& tiles : frames) {
-        nlohmann::json list = nlohmann::json::array();
-        for (const TileTime& t : tiles) list.push_back({t.rect.x0, t.rect.y0, t.rect.x1, t.rect.y1, t.seconds});
-        j["frames"].push_back({{"tiles", std::move(list)}});
-    }
-    write_json(file, j);
+    const std::string text = tile_cost_log_json(TileCostLog{size, cell_size, frames});
+    write_file_atomically(file, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
 }
 
 }  // namespace mogao

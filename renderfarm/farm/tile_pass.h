@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "renderfarm/schedule/cost_map.h"
+#include "renderfarm/trace/film.h"
 #include "renderfarm/trace/renderer.h"
 #include "renderfarm/view/image.h"
 

@@ -68,6 +68,26 @@ bool append_mesh(Mesh& out, const aiMesh& in, const Eigen::Matrix4d& to_file, co
     return in.HasNormals();
 }
 
+// Vertex numbers here are assimp's, before joining (for OBJ: one per face corner); the
+// coordinates in the message help find the line.
+void check_finite(const aiScene& scene, const std::string& file) {
+    for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+        const aiMesh& mesh = *scene.mMeshes[m];
+        for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+            const aiVector3D& p = mesh.mVertices[v];
+            if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+                throw MeshLoadError(file, fmt::format("mesh {} vertex {}: coordinate is not finite ({}, {}, {})", m, v, p.x, p.y, p.z));
+            }
+            if (mesh.HasNormals()) {
+                const aiVector3D& n = mesh.mNormals[v];
+                if (!std::isfinite(n.x) || !std::isfinite(n.y) || !std::isfinite(n.z)) {
+                    throw MeshLoadError(file, fmt::format("mesh {} normal {}: not finite", m, v));
+                }
+            }
+        }
+    }
+}
+
 Mesh read_with_assimp(const std::filesystem::path& path) {
     const std::string file = path.string();
     Assimp::Importer importer;
@@ -75,9 +95,14 @@ Mesh read_with_assimp(const std::filesystem::path& path) {
     if (ext.empty() || !importer.IsExtensionSupported(ext)) {
         throw MeshLoadError(file, fmt::format("unsupported file extension '{}'", ext));
     }
-    // Triangulate polygons; join identical vertices because the OBJ importer otherwise emits one
-    // vertex per face corner (3x the memory). No normal generation or smoothing: we keep the file.
-    const aiScene* scene = importer.ReadFile(file, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
+    // Triangulate polygons. No normal generation or smoothing: we keep what the file has.
+    const aiScene* scene = importer.ReadFile(file, aiProcess_Triangulate);
+    if (scene == nullptr) throw MeshLoadError(file, fmt::format("assimp: {}", importer.GetErrorString()));
+    // Checked before joining: JoinIdenticalVertices silently merges a NaN vertex into another one.
+    check_finite(*scene, file);
+    // Join identical vertices because the OBJ importer emits one vertex per face corner (3x the
+    // memory, and no shared vertices to smooth normals over).
+    scene = importer.ApplyPostProcessing(aiProcess_JoinIdenticalVertices);
     if (scene == nullptr) throw MeshLoadError(file, fmt::format("assimp: {}", importer.GetErrorString()));
 
     Mesh mesh;

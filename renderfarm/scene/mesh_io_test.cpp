@@ -11,12 +11,14 @@
 #include <fstream>
 #include <limits>
 #include <set>
+#include <ostream>
 #include <sstream>
 #include <string>
 #include <tuple>
 #include <unistd.h>
 #include <utility>
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include "renderfarm/scene/mesh_io.h"
@@ -196,6 +198,9 @@ TEST_F(MeshIo, TruncatedAsciiPlyNamesElementAndIndex) {
     const std::string full = plain_ply("ascii");
     expect_error(write("cut.ply", full.substr(0, full.rfind("3 0 2 3"))), "face 1: unexpected end of file");
     expect_error(write("cut2.ply", full.substr(0, full.find("1 1 0"))), "vertex 2: unexpected end of file");
+    std::string bad = full;
+    bad.replace(bad.find("1 0 0"), 5, "1 abc 0");
+    expect_error(write("token.ply", bad), "vertex 1: line 12: 'abc' is not a valid number");
 }
 
 // Corrupt counts must fail at once, without allocating for the declared size or looping over it.
@@ -239,7 +244,8 @@ TEST_F(MeshIo, NonFiniteCoordinatesRejected) {
     const float inf = std::numeric_limits<float>::infinity();
     expect_error(write("nan.ply", plain_ply("ascii", nan)), "vertex 2: coordinate is not finite");
     expect_error(write("inf.ply", plain_ply("binary_big_endian", inf)), "vertex 2: coordinate is not finite");
-    expect_error(write("nan.obj", "v 0 0 0\nv 1 0 nan\nv 0 1 0\nf 1 2 3\n"), "not finite");
+    // assimp's vertex joining would merge this NaN vertex into vertex 0; we check before joining.
+    expect_error(write("nan.obj", "v 0 0 0\nv 1 0 nan\nv 0 1 0\nf 1 2 3\n"), "vertex 1: coordinate is not finite");
     expect_error(write("inf.obj", "v 0 0 0\nv 1 0 inf\nv 0 1 0\nf 1 2 3\n"), "vertex 1: coordinate is not finite");
 }
 
@@ -350,7 +356,10 @@ struct Scan {
     std::size_t triangles;
     std::size_t vertices;  // as loaded (see comments)
     const char* loader;
+    std::size_t repeated_directed_edges;  // orientation defects of the file itself
 };
+
+void PrintTo(const Scan& s, std::ostream* os) { *os << s.file; }
 
 class RealScans : public ::testing::TestWithParam<Scan> {};
 
@@ -366,23 +375,24 @@ TEST_P(RealScans, CountsMatchProvenance) {
     RecordProperty("load_seconds", std::to_string(report.seconds));
     std::printf("[ load     ] %-26s %7zu triangles %7zu vertices %8.3f s (%s)\n", s.file, report.triangles, report.vertices,
                 report.seconds, report.loader.c_str());
-    // Consistent orientation (the point of alternating strip winding): no directed edge may be
-    // used twice. Holds for every scan here, so it is checked for all.
+    // Consistent orientation: in a consistently wound mesh no directed edge is used twice. For
+    // igea this checks the alternating strip winding on real data (a wrong parity flips half of
+    // the triangles); happy-buddha's decimation left 102 such edges, a property of the file.
     std::set<std::pair<std::uint32_t, std::uint32_t>> edges;
     std::size_t repeated = 0;
     for (const auto& t : m.triangles) {
         for (int k = 0; k < 3; ++k) repeated += edges.emplace(t[k], t[(k + 1) % 3]).second ? 0 : 1;
     }
-    EXPECT_EQ(repeated, 0u);
+    EXPECT_EQ(repeated, s.repeated_directed_edges);
 }
 
 // Vertex counts: the OBJ files have as many vertices as PROVENANCE.md except the bunny, whose
 // file holds 1,113 vertices no face uses (35,947 in the file); assimp keeps only used ones.
 INSTANTIATE_TEST_SUITE_P(Scans, RealScans,
-                         ::testing::Values(Scan{"igea.ply", 268686, 134345, "ply"}, Scan{"happy-buddha-100k.obj", 100000, 49950, "assimp"},
-                                           Scan{"stanford-dragon-100k.obj", 100000, 50000, "assimp"},
-                                           Scan{"nefertiti-100k.obj", 99938, 49971, "assimp"},
-                                           Scan{"stanford-bunny.obj", 69451, 34834, "assimp"}),
+                         ::testing::Values(Scan{"igea.ply", 268686, 134345, "ply", 0}, Scan{"happy-buddha-100k.obj", 100000, 49950, "assimp", 102},
+                                           Scan{"stanford-dragon-100k.obj", 100000, 50000, "assimp", 0},
+                                           Scan{"nefertiti-100k.obj", 99938, 49971, "assimp", 0},
+                                           Scan{"stanford-bunny.obj", 69451, 34834, "assimp", 0}),
                          [](const ::testing::TestParamInfo<Scan>& scan) {
                              std::string name = fs::path(scan.param.file).stem().string();
                              std::replace(name.begin(), name.end(), '-', '_');

@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include <Eigen/Geometry>
 #include <fmt/format.h>
 
 namespace mogao {
@@ -113,7 +114,8 @@ Mesh make_grotto_room(const GrottoRoomParams& p) {
                                          static_cast<float>(-std::cos(theta_mid)));
             const auto at = [&](int jj, int ii) { return grid[static_cast<std::size_t>(jj) * seg + ii]; };
             add_oriented(mesh, at(j, i), at(j, i1), at(j + 1, i1), inward);
-            add_oriented(mesh, at(j, i), at(j + 1, i1), at(j + 1, i), inward);
+            // The last dome row is the apex (radius 0): its second triangle would be degenerate.
+            if (j + 2 < rows || dome_rings == 0) add_oriented(mesh, at(j, i), at(j + 1, i1), at(j + 1, i), inward);
         }
     }
 

@@ -397,9 +397,10 @@ private:
 }  // namespace
 
 std::filesystem::path resolve_scans_dir(const std::filesystem::path& scene_file, const SceneLoadOptions& options) {
-    if (!options.scans_dir.empty()) return options.scans_dir;
-    if (const char* env = std::getenv("MOGAO_SCANS_DIR"); env && *env) return env;
-    return scene_file.parent_path() / ".." / ".." / "shared" / "data" / "scans";
+    // Absolute, so that "{scans}/x.obj" is not joined to the scene's folder a second time.
+    if (!options.scans_dir.empty()) return std::filesystem::absolute(options.scans_dir);
+    if (const char* env = std::getenv("MOGAO_SCANS_DIR"); env && *env) return std::filesystem::absolute(env);
+    return std::filesystem::absolute(scene_file.parent_path() / ".." / ".." / "shared" / "data" / "scans").lexically_normal();
 }
 
 Scene parse_scene(const std::string& json_text, const std::filesystem::path& origin, const SceneLoadOptions& options,

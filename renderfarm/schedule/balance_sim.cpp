@@ -38,10 +38,18 @@ std::vector<BalanceSimResult> simulate_balance(std::span<const CostMap> frames, 
             BalanceSimResult r;
             r.balancer = std::string(balancer->name());
             r.ranks = ranks;
+            std::size_t rects = 0;
             for (std::size_t f = 0; f < frames.size(); ++f) {
                 const CostMap& predicted = f == 0 ? first : frames[f - 1];
-                r.efficiency.push_back(balance_efficiency(balancer->assign(predicted, ranks), frames[f]));
+                const Assignment assignment = balancer->assign(predicted, ranks);
+                r.efficiency.push_back(balance_efficiency(assignment, frames[f]));
+                for (const auto& list : assignment.rects) {
+                    rects += static_cast<std::size_t>(
+                        std::count_if(list.begin(), list.end(), [](const PixelRect& p) { return !p.empty(); }));
+                }
             }
+            r.mean_rects_per_rank =
+                static_cast<double>(rects) / static_cast<double>(frames.size()) / static_cast<double>(ranks);
             double sum = 0.0;
             for (const double e : r.efficiency) {
                 sum += e;
@@ -75,12 +83,12 @@ std::string ratio_text(std::optional<double> num, std::optional<double> den) {
 }  // namespace
 
 std::string balance_table_markdown(std::span<const BalanceSimResult> results) {
-    std::string out = "| ranks | balancer | frames | mean efficiency | min efficiency |\n"
-                      "|------:|----------|-------:|----------------:|---------------:|\n";
+    std::string out = "| ranks | balancer | frames | mean efficiency | min efficiency | rects per rank |\n"
+                      "|------:|----------|-------:|----------------:|---------------:|---------------:|\n";
     std::vector<int> rank_counts;
     for (const auto& r : results) {
-        out += fmt::format("| {} | {} | {} | {:.3f} | {:.3f} |\n", r.ranks, r.balancer, r.efficiency.size(),
-                           r.mean_efficiency, r.min_efficiency);
+        out += fmt::format("| {} | {} | {} | {:.3f} | {:.3f} | {:.1f} |\n", r.ranks, r.balancer,
+                           r.efficiency.size(), r.mean_efficiency, r.min_efficiency, r.mean_rects_per_rank);
         if (std::find(rank_counts.begin(), rank_counts.end(), r.ranks) == rank_counts.end()) {
             rank_counts.push_back(r.ranks);
         }

@@ -30,6 +30,9 @@ struct BalanceSimResult {
     std::vector<double> efficiency;  // per frame, in (0, 1]
     double mean_efficiency = 0.0;
     double min_efficiency = 0.0;
+    // Mean non-empty rects per rank per frame: the simulation models only how cost is spread, not the
+    // per-tile overhead and lost ray coherence of many small tiles, so this column shows that price.
+    double mean_rects_per_rank = 0.0;
 };
 
 // frames: actual cost map of each frame, all with the same image size and cell size, at least one.
@@ -38,7 +41,7 @@ struct BalanceSimResult {
 [[nodiscard]] std::vector<BalanceSimResult> simulate_balance(std::span<const CostMap> frames,
                                                              const BalanceSimOptions& options);
 
-// Markdown: a table of mean/min efficiency per rank count and balancer, then a table of the ratios
+// Markdown: a table of mean/min efficiency (and rects per rank) per rank count and balancer, then a table of the ratios
 // pbt/equal and pbt/roundrobin of mean efficiencies per rank count ("n/a" if a balancer is missing).
 [[nodiscard]] std::string balance_table_markdown(std::span<const BalanceSimResult> results);
 

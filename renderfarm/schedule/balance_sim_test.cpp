@@ -34,6 +34,7 @@ TEST(BalanceSim, PbtBeatsEqualSplitOnASlowlyMovingHotSpot) {
         EXPECT_GT(pbt.mean_efficiency, equal.mean_efficiency + 0.1) << pbt.ranks;
         EXPECT_GT(pbt.min_efficiency, 0.0);
         EXPECT_LE(pbt.mean_efficiency, 1.0);
+        EXPECT_DOUBLE_EQ(pbt.mean_rects_per_rank, 1.0);  // one non-empty leaf per rank here
     }
 }
 
@@ -55,11 +56,11 @@ TEST(BalanceSim, FrameFIsPredictedFromFrameFMinusOne) {
 }
 
 TEST(BalanceSim, MarkdownTableHasEfficienciesAndRatios) {
-    BalanceSimResult pbt{"pbt", 4, {0.9, 0.8}, 0.85, 0.8};
-    BalanceSimResult equal{"equal", 4, {0.5, 0.35}, 0.425, 0.35};
+    BalanceSimResult pbt{"pbt", 4, {0.9, 0.8}, 0.85, 0.8, 1.0};
+    BalanceSimResult equal{"equal", 4, {0.5, 0.35}, 0.425, 0.35, 1.0};
     const std::vector<BalanceSimResult> results{pbt, equal};
     const std::string table = balance_table_markdown(results);
-    EXPECT_NE(table.find("| 4 | pbt | 2 | 0.850 | 0.800 |"), std::string::npos) << table;
+    EXPECT_NE(table.find("| 4 | pbt | 2 | 0.850 | 0.800 | 1.0 |"), std::string::npos) << table;
     EXPECT_NE(table.find("| 4 | 2.000 | n/a |"), std::string::npos) << table;
 }
 

@@ -23,6 +23,9 @@
 //    ties (within 1e-12 relative) going to the p closest to the area-proportional position;
 //  * zero-cost node (C <= 1e-12 of the frame's total, e.g. all-zero map, or the cold side of a hot
 //    pixel): the same rule with pixel area as cost, so idle regions are still split evenly.
+// A leaf can be an empty rect: when R has fewer snapped positions than leaves, or when the cost
+// minimum is a cut on R's edge (e.g. R's cost is one hot pixel in its first snap column and R has 3
+// leaves: giving the low leaf nothing and the hot pixel to the 2-leaf side is the predicted optimum).
 // Bound (tested): with p_a the last candidate with L <= C*floor(n/2)/n and p_b the next one, the
 // low child's cost differs from its ideal C*floor(n/2)/n by at most the cost of the strip
 // [p_a, p_b) across R; each leaf differs from total/ranks by at most the sum of those strip costs

@@ -86,9 +86,10 @@ TileCostLog parse_tile_cost_log(std::string_view json_text) {
 TileCostLog read_tile_cost_log(const std::filesystem::path& path) {
     std::ifstream in(path, std::ios::binary);
     std::ostringstream text;
-    if (!in || !(text << in.rdbuf())) {
+    if (!in) {
         throw std::runtime_error(fmt::format("cannot read tile cost log {}", path.string()));
     }
+    text << in.rdbuf();  // an empty file inserts nothing and is then reported as invalid JSON
     return parse_tile_cost_log(text.str());
 }
 

@@ -177,7 +177,7 @@ TileStats Renderer::render(const PixelRect& rect, RgbFloatImage& frame) const {
         std::array<Eigen::Vector3f, kLanes> sum;
         sum.fill(Eigen::Vector3f::Zero());
         for (int sample = 0; sample < s.spp; ++sample) {
-            RTCRayHit16 packet;
+            RTCRayHit16 packet{};  // masked lanes stay zero (defined for tools like valgrind)
             std::array<PixelRng, kLanes> rngs;
             s.fill_packet(block, sample, packet, rngs);
             s.intersect(block, packet);
@@ -214,7 +214,7 @@ TileStats Renderer::trace_camera_rays(const PixelRect& rect) const {
     TileStats stats;
     Impl::for_each_block(rect, [&](const Block& block) {
         for (int sample = 0; sample < s.spp; ++sample) {
-            RTCRayHit16 packet;
+            RTCRayHit16 packet{};  // masked lanes stay zero (defined for tools like valgrind)
             std::array<PixelRng, kLanes> rngs;
             s.fill_packet(block, sample, packet, rngs);
             s.intersect(block, packet);

@@ -1,7 +1,7 @@
 // Sampling helpers (float, unit vectors). Formulas from Pharr, Jakob, Humphreys, "Physically
-// Based Rendering", 3rd ed. (PBRT): §13.6.3 (concentric disk, Shirley-Chiu), §13.6.3 Malley's
-// method (cosine-weighted hemisphere, pdf = cosθ/π), §2.2.4-style orthonormal basis from one
-// vector (Duff et al., "Building an Orthonormal Basis, Revisited", JCGT 2017).
+// Based Rendering", 3rd ed. (PBRT): §13.6.2 concentric disk mapping (Shirley & Chiu), §13.6.3
+// cosine-weighted hemisphere by Malley's method (pdf = cosθ/π); orthonormal basis from one vector
+// after Duff et al., "Building an Orthonormal Basis, Revisited", JCGT 6(1), 2017.
 #pragma once
 
 #include <algorithm>

@@ -3,7 +3,7 @@
 //   f(wi, wo) = albedo / π  +  specular · (s + 2) / (2π) · max(0, n·h)^s,   h = normalize(wi + wo)
 //
 // Lambert: PBRT 3rd ed. §8.3. The glossy term uses the normalised Blinn-Phong distribution
-// D(h) = (s+2)/(2π) (n·h)^s (Akenine-Möller et al., "Real-Time Rendering", 4th ed., eq. 9.38,
+// D(h) = (s+2)/(2π) (n·h)^s (Akenine-Möller et al., "Real-Time Rendering", 4th ed., §9.8.1,
 // after Blinn 1977), used directly as the lobe. Directions are unit vectors pointing away from the
 // surface; the caller multiplies by cosθ_i = n·wi. The glossy term is only evaluated for materials
 // whose specular is non-zero (ShadingMaterial::glossy), so matte scenes never pay for it.

@@ -1,0 +1,171 @@
+// Renderer cost against raw Embree, measured in the same run (ratios are meaningful on any
+// machine, absolute times are not):
+//   (a) Embree alone: generate + rtcIntersect16 the camera packets the renderer traces;
+//   (b) the full renderer with direct light and shadows (sun + its shadow rays);
+//   (c) "model only what the scene requires": a sun without shadows and nothing else, vs the same
+//       scene carrying present-but-unused features (zero-power area/point/environment lights,
+//       an uninstanced mesh, a zero-specular material), vs a shadowing sun plus a used area light.
+// The scene is built in code: a ~1M-triangle smooth height field plus a sphere.
+// Usage: mogao_bench_render [--width W] [--height H] [--spp N] [--reps N] [--grid N]
+// Timings use Renderer/RenderTimings from renderfarm/trace/render_timing.h, which the farm can
+// reuse on a real scene: time_render_vs_embree(scene, request).
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <numbers>
+#include <string>
+
+#include "renderfarm/scene/scene.h"
+#include "renderfarm/trace/render_timing.h"
+#include "renderfarm/trace/renderer.h"
+
+namespace {
+
+using namespace mogao;
+
+// Height field y = h(x, z) over [-10, 10]² with n x n cells (2 n² triangles), analytic normals.
+Mesh height_field(int n) {
+    Mesh mesh;
+    mesh.source = "height_field";
+    const auto height = [](double x, double z) { return 0.4 * std::sin(1.3 * x) * std::cos(0.9 * z) + 0.1 * std::sin(4.0 * x + 3.0 * z); };
+    const double half = 10.0;
+    const double step = 2.0 * half / n;
+    for (int j = 0; j <= n; ++j) {
+        for (int i = 0; i <= n; ++i) {
+            const double x = -half + step * i;
+            const double z = -half + step * j;
+            const double e = 1e-4;
+            const double dx = (height(x + e, z) - height(x - e, z)) / (2 * e);
+            const double dz = (height(x, z + e) - height(x, z - e)) / (2 * e);
+            mesh.positions.emplace_back(static_cast<float>(x), static_cast<float>(height(x, z)), static_cast<float>(z));
+            mesh.normals.push_back(Eigen::Vector3d(-dx, 1.0, -dz).normalized().cast<float>());
+        }
+    }
+    const auto index = [n](int i, int j) { return static_cast<std::uint32_t>(j * (n + 1) + i); };
+    for (int j = 0; j < n; ++j) {
+        for (int i = 0; i < n; ++i) {
+            mesh.triangles.push_back({index(i, j), index(i, j + 1), index(i + 1, j)});
+            mesh.triangles.push_back({index(i + 1, j), index(i, j + 1), index(i + 1, j + 1)});
+        }
+    }
+    return mesh;
+}
+
+Mesh sphere(int segments, int rings) {
+    Mesh mesh;
+    mesh.source = "sphere";
+    for (int r = 0; r <= rings; ++r) {
+        const double phi = std::numbers::pi * r / rings;
+        for (int s = 0; s <= segments; ++s) {
+            const double theta = 2.0 * std::numbers::pi * s / segments;
+            const Eigen::Vector3f p(static_cast<float>(std::sin(phi) * std::sin(theta)), static_cast<float>(std::cos(phi)),
+                                    static_cast<float>(std::sin(phi) * std::cos(theta)));
+            mesh.positions.push_back(p);
+            mesh.normals.push_back(p);
+        }
+    }
+    const auto index = [segments](int r, int s) { return static_cast<std::uint32_t>(r * (segments + 1) + s); };
+    for (int r = 0; r < rings; ++r) {
+        for (int s = 0; s < segments; ++s) {
+            mesh.triangles.push_back({index(r, s), index(r + 1, s), index(r, s + 1)});
+            mesh.triangles.push_back({index(r, s + 1), index(r + 1, s), index(r + 1, s + 1)});
+        }
+    }
+    return mesh;
+}
+
+// Matte height field + sphere, one sun; no other lights.
+Scene base_scene(int grid, bool sun_shadows) {
+    Scene scene;
+    scene.source = "bench:height_field+sphere";
+    scene.meshes = {height_field(grid), sphere(128, 64)};
+    Material ground;
+    ground.albedo = Rgb(0.55f, 0.5f, 0.4f);
+    Material ball;
+    ball.albedo = Rgb(0.3f, 0.4f, 0.7f);
+    scene.materials = {ground, ball};
+    Instance field{"field", 0, 0, Eigen::Affine3d::Identity()};
+    Instance ball_instance{"ball", 1, 1, Eigen::Affine3d::Identity()};
+    ball_instance.object_to_world.translate(Eigen::Vector3d(0.0, 1.5, -3.0));
+    scene.instances = {field, ball_instance};
+    DirectionalLight sun;
+    sun.direction_to_light = Eigen::Vector3d(-0.5, 0.8, 0.3).normalized();
+    sun.cast_shadows = sun_shadows;
+    scene.directional_lights = {sun};
+    return scene;
+}
+
+// Features present in the scene description but contributing nothing.
+Scene with_unused_features(Scene scene) {
+    scene.area_lights = {AreaLight{{-1.0, 4.0, -4.0}, {2.0, 0.0, 0.0}, {0.0, 0.0, 2.0}, Rgb(0.0f, 0.0f, 0.0f), true}};
+    scene.point_lights = {PointLight{{0.0, 3.0, 0.0}, Rgb(0.0f, 0.0f, 0.0f), true}};
+    scene.environment_lights = {EnvironmentLight{Rgb(0.0f, 0.0f, 0.0f)}};
+    scene.meshes.push_back(sphere(64, 32));  // never instanced
+    Material unused_glossy;
+    unused_glossy.specular = Rgb(0.5f, 0.5f, 0.5f);  // no instance uses it
+    scene.materials.push_back(unused_glossy);
+    return scene;
+}
+
+Scene with_used_area_light(Scene scene) {
+    scene.area_lights = {AreaLight{{-1.0, 4.0, -4.0}, {2.0, 0.0, 0.0}, {0.0, 0.0, 2.0}, Rgb(4.0f, 4.0f, 4.0f), true}};
+    return scene;
+}
+
+int arg_int(int argc, char** argv, const char* name, int fallback) {
+    for (int i = 1; i + 1 < argc; ++i) {
+        if (std::strcmp(argv[i], name) == 0) return std::atoi(argv[i + 1]);
+    }
+    return fallback;
+}
+
+void print(const char* label, const RenderTimings& t, double baseline_s) {
+    std::printf("%-44s %9.2f ms  %11llu rays  %6.2f Mrays/s  x%.2f vs (a)\n", label, 1e3 * t.render_s,
+                static_cast<unsigned long long>(t.render_rays), 1e-6 * static_cast<double>(t.render_rays) / t.render_s,
+                t.render_s / baseline_s);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    ViewRequest request;
+    request.size = {arg_int(argc, argv, "--width", 640), arg_int(argc, argv, "--height", 360)};
+    request.quality.spp = arg_int(argc, argv, "--spp", 1);
+    const int reps = arg_int(argc, argv, "--reps", 5);
+    const int grid = arg_int(argc, argv, "--grid", 708);  // 2 * 708² = 1.0M triangles
+    request.pose.eye = {0.0, 3.0, 6.0};
+    request.pose.pitch_deg = -20.0;
+    request.camera = PinholeCamera{60.0};
+    const RendererOptions options{"threads=1", true};
+
+    try {
+        const Scene shadowed = base_scene(grid, true);
+        std::printf("scene: %zu + %zu triangles, %dx%d, spp %d, best of %d, one thread\n",
+                    shadowed.meshes[0].triangle_count(), shadowed.meshes[1].triangle_count(), request.size.width,
+                    request.size.height, request.quality.spp, reps);
+        Renderer renderer(shadowed, options);
+        const RenderTimings direct = time_frame(renderer, request, reps);
+        std::printf("(a) Embree rtcIntersect16, camera rays only    %9.2f ms  %11llu rays  %6.2f Mrays/s\n",
+                    1e3 * direct.camera_rays_s, static_cast<unsigned long long>(direct.camera_rays),
+                    1e-6 * static_cast<double>(direct.camera_rays) / direct.camera_rays_s);
+        print("(b) renderer, sun + shadows", direct, direct.camera_rays_s);
+        std::printf("    ratio (b)/(a) = %.2f\n", direct.ratio());
+
+        // (c) Each variant gets its own (a) baseline from its own renderer, so ratios compare alike.
+        const auto run = [&](const Scene& scene) { return time_render_vs_embree(scene, request, options, reps); };
+        const RenderTimings plain = run(base_scene(grid, false));
+        const RenderTimings unused = run(with_unused_features(base_scene(grid, false)));
+        const RenderTimings used = run(with_used_area_light(base_scene(grid, true)));
+        print("(c1) sun, no shadows, nothing else", plain, plain.camera_rays_s);
+        print("(c2) (c1) + unused lights/mesh/material", unused, unused.camera_rays_s);
+        print("(c3) sun + shadows + used area light", used, used.camera_rays_s);
+        std::printf("    (c2)/(c1) = %.3f  (unused features should cost nothing: ~1.0)\n", unused.render_s / plain.render_s);
+        std::printf("    (c3)/(c1) = %.3f  (what shadows and an area light cost when used)\n", used.render_s / plain.render_s);
+        std::printf("    BVH build (c1): %.2f s\n", plain.build_s);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "mogao_bench_render: %s\n", e.what());
+        return 1;
+    }
+    return 0;
+}

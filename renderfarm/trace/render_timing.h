@@ -1,0 +1,32 @@
+// Measures the renderer against raw Embree on the same camera rays, in one run, so the ratio is
+// meaningful on any machine: (a) Renderer::trace_camera_rays (ray generation + rtcIntersect16 of
+// exactly the packets render() traces), (b) Renderer::render (everything). Both run on the calling
+// thread over the whole frame; each figure is the calling thread's CPU time (not wall time, so
+// other processes on a shared machine do not inflate it), best (minimum) of `repetitions` runs.
+#pragma once
+
+#include <cstdint>
+
+#include "renderfarm/scene/scene.h"
+#include "renderfarm/trace/renderer.h"
+#include "renderfarm/view/view_request.h"
+
+namespace mogao {
+
+struct RenderTimings {
+    double build_s = 0.0;              // Renderer construction (BVH builds), wall seconds; 0 if not measured
+    double camera_rays_s = 0.0;        // (a) raw Embree camera packets, CPU seconds per frame
+    double render_s = 0.0;             // (b) full render, CPU seconds per frame
+    std::uint64_t camera_rays = 0;     // rays per frame in (a)
+    std::uint64_t render_rays = 0;     // rays per frame in (b): camera + shadow + AO + bounce
+    [[nodiscard]] double ratio() const { return camera_rays_s > 0.0 ? render_s / camera_rays_s : 0.0; }
+};
+
+// Uses an existing renderer (calls begin_frame(request)).
+[[nodiscard]] RenderTimings time_frame(Renderer& renderer, const ViewRequest& request, int repetitions = 3);
+
+// Builds a renderer for `scene` (timed as build_s) and times one frame of `request`.
+[[nodiscard]] RenderTimings time_render_vs_embree(const Scene& scene, const ViewRequest& request,
+                                                  const RendererOptions& options = {}, int repetitions = 3);
+
+}  // namespace mogao
