@@ -5,6 +5,8 @@ set -euo pipefail
 farm=$1 MPIEXEC=$2 scene=$3 balancer=$4 work=$5
 source "$(dirname "$0")/mpi_env.sh"
 rm -rf "$work" && mkdir -p "$work"
+# On any failure show what the ranks said.
+trap 'status=$?; [ $status -ne 0 ] && for l in "$work"/*.log; do echo "== $l"; cat "$l"; done; exit $status' EXIT
 common=(render --scene "$scene" --frames 3 --path orbit --width 160 --height 96 --spp 2 --ao 2 --bounces 1
         --save-raw --contact-sheet 0 --balance "$balancer")
 mpirun_n 1 "$farm" "${common[@]}" --out "$work/one" 2> "$work/one.log"

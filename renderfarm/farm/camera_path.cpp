@@ -77,7 +77,7 @@ std::vector<ViewerPose> make_camera_path(const std::string& name_or_file, const 
         return sample(keys, viewer, frames);
     }
     if (name_or_file == "walk") {
-        // Walk in looking ahead, stop at half the distance, then circle 240° around the centre
+        // Walk in looking ahead, stop at 0.6 of the distance, then circle 240° around the centre
         // while looking at it: a visitor's first minute in the grotto.
         keys.push_back({start, viewer.start_yaw_deg, 0.0});
         const double inner = std::max(0.6 * radius, 1.0);
