@@ -7,6 +7,8 @@
 #include <optional>
 #include <stdexcept>
 
+#include <time.h>
+
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
@@ -27,6 +29,37 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
+// Waits without spinning: Open MPI busy-polls inside blocking calls, and when the admin shares cores
+// with render ranks (one machine, or a 2-core CI box) a spinning admin steals whole time slices from
+// them — seen as 4 ms spikes in tile times that mislead the PBT. 100 µs sleeps cost nothing per frame.
+void sleep_briefly() {
+    timespec pause{0, 100'000};
+    nanosleep(&pause, nullptr);
+}
+
+void wait_politely(MPI_Request& request) {
+    for (int done = 0;;) {
+        MPI_Test(&request, &done, MPI_STATUS_IGNORE);
+        if (done) return;
+        sleep_briefly();
+    }
+}
+
+MPI_Status probe_politely(int source, int tag) {
+    MPI_Status status;
+    for (int found = 0;;) {
+        MPI_Iprobe(source, tag, MPI_COMM_WORLD, &found, &status);
+        if (found) return status;
+        sleep_briefly();
+    }
+}
+
+void broadcast_view(WireView& wire) {
+    MPI_Request request;
+    MPI_Ibcast(&wire, sizeof wire, MPI_BYTE, 0, MPI_COMM_WORLD, &request);
+    wait_politely(request);
+}
+
 enum Tag : int { kTagRects = 1, kTagReplyHeader, kTagReplyPixels, kTagReplyTiles };
 
 struct ReplyHeader {
@@ -41,8 +74,7 @@ struct ReplyHeader {
 // ---- render ranks -------------------------------------------------------------------------------
 
 std::vector<PixelRect> receive_rects() {
-    MPI_Status status;
-    MPI_Probe(0, kTagRects, MPI_COMM_WORLD, &status);
+    MPI_Status status = probe_politely(0, kTagRects);
     int count = 0;
     MPI_Get_count(&status, MPI_INT, &count);
     std::vector<int> flat(static_cast<std::size_t>(count));
@@ -62,7 +94,7 @@ void send_reply(const ReplyHeader& header, const void* payload, std::size_t payl
 void render_rank_loop(Renderer* renderer, const FarmJob& job, float exposure, const std::string& load_error) {
     for (;;) {
         WireView wire{};
-        MPI_Bcast(&wire, sizeof wire, MPI_BYTE, 0, MPI_COMM_WORLD);
+        broadcast_view(wire);
         if (wire.stop) return;
         const std::vector<PixelRect> rects = receive_rects();
         ReplyHeader header{wire.frame_id, 0, 0, 0, 0.0, 1};
@@ -117,7 +149,7 @@ void stop_render_ranks(const MpiSession& mpi) {
     if (mpi.size() < 2) return;
     WireView stop{};
     stop.stop = 1;
-    MPI_Bcast(&stop, sizeof stop, MPI_BYTE, 0, MPI_COMM_WORLD);
+    broadcast_view(stop);
 }
 
 class Admin {
@@ -207,7 +239,7 @@ private:
             return true;
         }
         WireView wire = to_wire(view);
-        MPI_Bcast(&wire, sizeof wire, MPI_BYTE, 0, MPI_COMM_WORLD);
+        broadcast_view(wire);
         for (int r = 0; r < mpi_.render_ranks(); ++r) {
             std::vector<int> flat;
             for (const PixelRect& rect : assignment.rects[static_cast<std::size_t>(r)])
@@ -218,9 +250,7 @@ private:
         bool ok = true;
         for (int k = 0; k < mpi_.render_ranks(); ++k) {
             // Take replies in arrival order so a slow rank does not hold up compositing the others.
-            MPI_Status status;
-            MPI_Probe(MPI_ANY_SOURCE, kTagReplyHeader, MPI_COMM_WORLD, &status);
-            const int source = status.MPI_SOURCE;
+            const int source = probe_politely(MPI_ANY_SOURCE, kTagReplyHeader).MPI_SOURCE;
             RankReply reply = receive_reply(source);
             if (!reply.header.ok) {
                 spdlog::error("{}", std::string(reply.payload.begin(), reply.payload.end()));
