@@ -1,14 +1,19 @@
 # mogao_add_gtest(<name> SOURCES <files...> LIBS <targets...> [LABELS <labels...>])
 # Builds a GoogleTest executable and registers each TEST with CTest (gtest_discover_tests).
 # Tests that need ../shared/data get MOGAO_SCANS_DIR / MOGAO_MPCDI_DIR as compile definitions and call
-# GTEST_SKIP() with a message when the folder is absent; CTest reports those as skipped.
+# GTEST_SKIP() with a message when the folder is absent; the shared main (tests/support) then exits
+# 77 and CTest reports those tests as skipped.
 function(mogao_add_gtest name)
   if(NOT MOGAO_BUILD_TESTS)
     return()
   endif()
   cmake_parse_arguments(T "" "" "SOURCES;LIBS;LABELS" ${ARGN})
+  if(NOT TARGET mogao_gtest_main)
+    add_library(mogao_gtest_main STATIC ${PROJECT_SOURCE_DIR}/tests/support/gtest_main_skip77.cpp)
+    target_link_libraries(mogao_gtest_main PUBLIC GTest::gtest)
+  endif()
   add_executable(${name} ${T_SOURCES})
-  target_link_libraries(${name} PRIVATE ${T_LIBS} GTest::gtest GTest::gtest_main)
+  target_link_libraries(${name} PRIVATE ${T_LIBS} mogao_gtest_main GTest::gtest)
   target_compile_definitions(${name} PRIVATE
     MOGAO_SCANS_DIR="${MOGAO_SCANS_DIR}" MOGAO_MPCDI_DIR="${MOGAO_MPCDI_DIR}"
     MOGAO_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
