@@ -10,6 +10,7 @@
 #include <spdlog/spdlog.h>
 
 #include "renderfarm/farm/farm.h"
+#include "renderfarm/farm/path_tour.h"
 #include "renderfarm/farm/mpi_session.h"
 
 namespace {
@@ -20,9 +21,10 @@ struct CameraFlags {
     double radius = 3.0, arc = 150.0, bottom = 0.2, top = 2.8, eye_height = 1.6;
 };
 
-void add_render_flags(CLI::App& render, mogao::FarmJob& job, CameraFlags& camera, std::string& scans) {
+void add_render_flags(CLI::App& render, mogao::FarmSetup& setup, mogao::PathTour& job, CameraFlags& camera,
+                      std::string& scans) {
     auto& q = job.view_template.quality;
-    render.add_option("--scene", job.scene_file, "Scene file (JSON, docs/scene-format.md)")->required()->check(CLI::ExistingFile);
+    render.add_option("--scene", setup.scene_file, "Scene file (JSON, docs/scene-format.md)")->required()->check(CLI::ExistingFile);
     render.add_option("--frames", job.frames, "Number of frames of the camera path")->check(CLI::Range(1, 1000000));
     render.add_option("--path", job.path, "walk | orbit | a JSON path file");
     render.add_option("--out", job.out_dir, "Output folder for frame-NNNN.jpg, stats.json, tile-costs.json, contact-sheet.png")->required();
@@ -42,10 +44,10 @@ void add_render_flags(CLI::App& render, mogao::FarmJob& job, CameraFlags& camera
     render.add_option("--scale", q.resolution_scale, "Resolution scale (0, 1]")->check(CLI::Range(0.01, 1.0));
     render.add_option("--jpeg-quality", q.jpeg_quality, "TurboJPEG quality 1..100")->check(CLI::Range(1, 100));
     render.add_option("--seed", job.view_template.seed, "Sampling seed (same seed, same pixels)");
-    render.add_option("--balance", job.balancer, "pbt | equal | roundrobin")->check(CLI::IsMember({"pbt", "equal", "roundrobin"}));
-    render.add_option("--snap", job.snap, "PBT/equal split snap in pixels")->check(CLI::IsMember({4, 8, 16, 32}));
-    render.add_option("--rr-tile", job.roundrobin_tile, "Round-robin tile size in pixels")->check(CLI::Range(8, 1024));
-    render.add_option("--threads", job.threads, "Render threads per rank")->check(CLI::Range(1, 256));
+    render.add_option("--balance", setup.dispatch.balancer, "pbt | equal | roundrobin")->check(CLI::IsMember({"pbt", "equal", "roundrobin"}));
+    render.add_option("--snap", setup.dispatch.snap, "PBT/equal split snap in pixels")->check(CLI::IsMember({4, 8, 16, 32}));
+    render.add_option("--rr-tile", setup.dispatch.roundrobin_tile, "Round-robin tile size in pixels")->check(CLI::Range(8, 1024));
+    render.add_option("--threads", setup.dispatch.threads, "Render threads per rank")->check(CLI::Range(1, 256));
     render.add_option("--scans", scans, "Folder of the real scans (default: $MOGAO_SCANS_DIR or ../shared/data/scans)");
     render.add_flag("--save-raw", job.save_raw, "Also write lossless frame-NNNN.ppm");
     render.add_option("--contact-sheet", job.contact_sheet_frames, "Frames on the contact sheet (0 = none)")->check(CLI::Range(0, 64));
@@ -63,11 +65,12 @@ int main(int argc, char** argv) {
 
     CLI::App app{"mogao-farm: the mogao render farm (Embree ray tracing, sort-first PBT over MPI ranks, JPEG frames)"};
     app.require_subcommand(1);
-    mogao::FarmJob job;
+    mogao::FarmSetup setup;
+    mogao::PathTour job;
     CameraFlags camera;
     std::string scans;
     CLI::App* render = app.add_subcommand("render", "Render a camera path headless into numbered JPEG frames");
-    add_render_flags(*render, job, camera, scans);
+    add_render_flags(*render, setup, job, camera, scans);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -83,6 +86,8 @@ int main(int argc, char** argv) {
         job.view_template.camera =
             mogao::CylinderScreen{camera.radius, camera.arc, camera.bottom, camera.top, {0.0, camera.eye_height, 0.0}};
     }
-    job.scene_options.scans_dir = scans;
-    return mogao::run_farm_job(mpi, job);
+    setup.scene_options.scans_dir = scans;
+    return mogao::run_farm(mpi, setup, [&](mogao::FrameDispatcher& farm, const mogao::Scene& scene, mogao::RunInfo& run) {
+        return mogao::run_path_tour(job, farm, scene, run);
+    });
 }

@@ -1,0 +1,37 @@
+// How a warp or blend grid is read at an output pixel: the one CPU definition that the GL backend
+// (drivers/) mirrors with a GL_LINEAR, CLAMP_TO_EDGE texture (see projector_calibration.h).
+//
+// Grid convention ("corner-aligned on pixel centres"): for an output of W pixels and a grid of G
+// samples along one axis, output pixel x (centre x + 0.5) reads grid position
+// g = x * (G - 1) / (W - 1) (g = 0 when G == 1 or W == 1). Sample 0 is the first pixel's centre,
+// sample G - 1 the last pixel's centre, so a per-pixel grid (G = W) gives g = x exactly. Between
+// samples the value is bilinear in g. This matches MPCDI's coarse level-1/2 grids, whose first and
+// last samples belong to the projector's first and last pixels (VESA MPCDI v1.0, geometry warp file).
+#pragma once
+
+#include "appliance/warp/projector_calibration.h"
+
+namespace mogao {
+
+// A content position, normalised (see projector_calibration.h). Both NaN = no content.
+struct ContentUv {
+    float u = 0.0F;
+    float v = 0.0F;
+    [[nodiscard]] bool valid() const { return !std::isnan(u) && !std::isnan(v); }
+};
+
+// Continuous grid coordinate of output pixel `x` (0-based pixel index, may be fractional: x is the
+// position relative to pixel centres, pixel centre x + 0.5 <-> x) for `output_extent` output pixels
+// and `grid_extent` samples. The inverse is grid_to_output.
+[[nodiscard]] double output_to_grid(double x, int output_extent, int grid_extent);
+[[nodiscard]] double grid_to_output(double g, int output_extent, int grid_extent);
+
+// Bilinear warp at output pixel (x, y), x in [0, output.width). If a contributing sample (one with
+// a non-zero bilinear weight) is NaN, the result is NaN, NaN: "no content" never blends into a
+// neighbour's value. Preconditions: validate_warp passed, output non-empty.
+[[nodiscard]] ContentUv sample_warp(const WarpMap& warp, ImageSize output, int x, int y);
+
+// Bilinear blend weight at output pixel (x, y). Preconditions: validate_blend passed.
+[[nodiscard]] float sample_blend(const BlendMask& blend, ImageSize output, int x, int y);
+
+}  // namespace mogao

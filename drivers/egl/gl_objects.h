@@ -1,0 +1,67 @@
+// RAII for GL object names (texture, renderbuffer, framebuffer, shader, program) and GL error
+// checks. GL names belong to the context that made them: create, use and destroy each object with
+// that context current on the calling thread (owners such as WarpBlendRenderer document this).
+#pragma once
+
+#include <GLES3/gl3.h>
+
+#include <string_view>
+#include <utility>
+
+#include "drivers/result.h"
+
+namespace mogao {
+
+// Drains glGetError(); EIO naming `what` and the first error (e.g. "GL_INVALID_VALUE") if any.
+[[nodiscard]] Status gl_check(std::string_view what);
+
+namespace gl_detail {
+inline void delete_texture(GLuint n) { glDeleteTextures(1, &n); }
+inline void delete_renderbuffer(GLuint n) { glDeleteRenderbuffers(1, &n); }
+inline void delete_framebuffer(GLuint n) { glDeleteFramebuffers(1, &n); }
+inline void delete_shader(GLuint n) { glDeleteShader(n); }
+inline void delete_program(GLuint n) { glDeleteProgram(n); }
+}  // namespace gl_detail
+
+// Owns one GL name; 0 = empty. Move-only.
+template <void (*Delete)(GLuint)>
+class GlObject {
+public:
+    GlObject() = default;
+    explicit GlObject(GLuint name) noexcept : name_(name) {}
+    GlObject(GlObject&& other) noexcept : name_(std::exchange(other.name_, 0)) {}
+    GlObject& operator=(GlObject&& other) noexcept {
+        if (this != &other) {
+            reset();
+            name_ = std::exchange(other.name_, 0);
+        }
+        return *this;
+    }
+    GlObject(const GlObject&) = delete;
+    GlObject& operator=(const GlObject&) = delete;
+    ~GlObject() { reset(); }
+
+    [[nodiscard]] GLuint get() const noexcept { return name_; }
+    [[nodiscard]] bool valid() const noexcept { return name_ != 0; }
+    void reset() noexcept {
+        if (name_ != 0) Delete(std::exchange(name_, 0));
+    }
+
+private:
+    GLuint name_ = 0;
+};
+
+using GlTexture = GlObject<&gl_detail::delete_texture>;
+using GlRenderbuffer = GlObject<&gl_detail::delete_renderbuffer>;
+using GlFramebuffer = GlObject<&gl_detail::delete_framebuffer>;
+using GlShader = GlObject<&gl_detail::delete_shader>;
+using GlProgram = GlObject<&gl_detail::delete_program>;
+
+[[nodiscard]] GlTexture make_texture();
+[[nodiscard]] GlRenderbuffer make_renderbuffer();
+[[nodiscard]] GlFramebuffer make_framebuffer();
+
+// Compiles a vertex + fragment shader pair and links them; EIO with the info log on failure.
+[[nodiscard]] Result<GlProgram> link_program(std::string_view vertex_source, std::string_view fragment_source);
+
+}  // namespace mogao

@@ -1,0 +1,236 @@
+#include "renderfarm/farm/frame_dispatcher.h"
+
+#include <algorithm>
+#include <chrono>
+#include <numeric>
+
+#include <time.h>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "renderfarm/farm/tile_pass.h"
+#include "renderfarm/farm/wire_view.h"
+
+namespace mogao {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// Waits without spinning: Open MPI busy-polls inside blocking calls, and when the admin shares cores
+// with render ranks (one machine, or a 2-core CI box) a spinning admin steals whole time slices from
+// them — seen as 4 ms spikes in tile times that mislead the PBT. 100 µs sleeps cost nothing per frame.
+void sleep_briefly() {
+    timespec pause{0, 100'000};
+    nanosleep(&pause, nullptr);
+}
+
+void wait_politely(MPI_Request& request) {
+    for (int done = 0;;) {
+        MPI_Test(&request, &done, MPI_STATUS_IGNORE);
+        if (done) return;
+        sleep_briefly();
+    }
+}
+
+MPI_Status probe_politely(int source, int tag) {
+    MPI_Status status;
+    for (int found = 0;;) {
+        MPI_Iprobe(source, tag, MPI_COMM_WORLD, &found, &status);
+        if (found) return status;
+        sleep_briefly();
+    }
+}
+
+void broadcast_view(WireView& wire) {
+    MPI_Request request;
+    MPI_Ibcast(&wire, sizeof wire, MPI_BYTE, 0, MPI_COMM_WORLD, &request);
+    wait_politely(request);
+}
+
+enum Tag : int { kTagRects = 1, kTagReplyHeader, kTagReplyPixels, kTagReplyTiles };
+
+struct ReplyHeader {
+    std::uint64_t frame_id;
+    std::uint64_t rays;
+    std::uint64_t payload_bytes;  // pixels, or the error message when ok == 0
+    std::uint64_t tiles;
+    double render_seconds;
+    std::int32_t ok;
+};
+
+// ---- render ranks --------------------------------------------------------------------------------
+
+std::vector<PixelRect> receive_rects() {
+    MPI_Status status = probe_politely(0, kTagRects);
+    int count = 0;
+    MPI_Get_count(&status, MPI_INT, &count);
+    std::vector<int> flat(static_cast<std::size_t>(count));
+    MPI_Recv(flat.data(), count, MPI_INT, 0, kTagRects, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    std::vector<PixelRect> rects;
+    for (std::size_t i = 0; i + 3 < flat.size(); i += 4) rects.push_back({flat[i], flat[i + 1], flat[i + 2], flat[i + 3]});
+    return rects;
+}
+
+void send_reply(const ReplyHeader& header, const void* payload, std::size_t payload_bytes,
+                const std::vector<double>& tiles_flat) {
+    MPI_Send(&header, sizeof header, MPI_BYTE, 0, kTagReplyHeader, MPI_COMM_WORLD);
+    MPI_Send(payload, static_cast<int>(payload_bytes), MPI_BYTE, 0, kTagReplyPixels, MPI_COMM_WORLD);
+    MPI_Send(tiles_flat.data(), static_cast<int>(tiles_flat.size()), MPI_DOUBLE, 0, kTagReplyTiles, MPI_COMM_WORLD);
+}
+
+// ---- admin -----------------------------------------------------------------------------------------
+
+struct RankReply {
+    ReplyHeader header{};
+    std::vector<std::uint8_t> payload;
+    std::vector<double> tiles;
+};
+
+RankReply receive_reply(int source) {
+    RankReply reply;
+    MPI_Recv(&reply.header, sizeof reply.header, MPI_BYTE, source, kTagReplyHeader, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    reply.payload.resize(reply.header.payload_bytes);
+    MPI_Recv(reply.payload.data(), static_cast<int>(reply.payload.size()), MPI_BYTE, source, kTagReplyPixels,
+             MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    MPI_Status status;
+    MPI_Probe(source, kTagReplyTiles, MPI_COMM_WORLD, &status);
+    int count = 0;
+    MPI_Get_count(&status, MPI_DOUBLE, &count);
+    reply.tiles.resize(static_cast<std::size_t>(count));
+    MPI_Recv(reply.tiles.data(), count, MPI_DOUBLE, source, kTagReplyTiles, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    return reply;
+}
+
+void finish_stats(FrameStats& stats) {
+    const auto& t = stats.rank_render_seconds;
+    const double max_rank = t.empty() ? 0.0 : *std::max_element(t.begin(), t.end());
+    const double mean_rank = t.empty() ? 0.0 : std::accumulate(t.begin(), t.end(), 0.0) / double(t.size());
+    stats.balance_efficiency = max_rank > 0 ? mean_rank / max_rank : 1.0;
+    stats.rays_per_second = stats.render_phase_seconds > 0 ? double(stats.rays) / stats.render_phase_seconds : 0.0;
+}
+
+}  // namespace
+
+void serve_render_rank(Renderer* renderer, const DispatchSettings& settings, const std::string& load_error) {
+    for (;;) {
+        WireView wire{};
+        broadcast_view(wire);
+        if (wire.stop) return;
+        const std::vector<PixelRect> rects = receive_rects();
+        ReplyHeader header{wire.frame_id, 0, 0, 0, 0.0, 1};
+        try {
+            if (!renderer) throw std::runtime_error(load_error);
+            renderer->begin_frame(from_wire(wire));
+            const TilePassResult pass = render_tile_pass(*renderer, rects, settings.cell_size, settings.threads, settings.exposure);
+            std::vector<double> tiles_flat;
+            tiles_flat.reserve(pass.tile_times.size() * 5);
+            for (const TileTime& t : pass.tile_times)
+                tiles_flat.insert(tiles_flat.end(), {double(t.rect.x0), double(t.rect.y0), double(t.rect.x1),
+                                                     double(t.rect.y1), t.seconds});
+            header.rays = pass.rays;
+            header.payload_bytes = pass.packed_pixels.size();
+            header.tiles = pass.tile_times.size();
+            header.render_seconds = pass.render_seconds;
+            send_reply(header, pass.packed_pixels.data(), pass.packed_pixels.size(), tiles_flat);
+        } catch (const std::exception& e) {
+            int rank = 0;
+            MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+            const std::string message = fmt::format("rank {}: frame {}: {}", rank, wire.frame_id, e.what());
+            header.ok = 0;
+            header.payload_bytes = message.size();
+            send_reply(header, message.data(), message.size(), {});
+        }
+    }
+}
+
+FrameDispatcher::FrameDispatcher(const MpiSession& mpi, DispatchSettings settings, Renderer* local)
+    : mpi_(mpi), settings_(std::move(settings)), local_(mpi.size() == 1 ? local : nullptr),
+      balancer_(make_load_balancer(settings_.balancer,
+                                   settings_.balancer == "roundrobin" ? settings_.roundrobin_tile : settings_.snap)) {
+    if (mpi.size() == 1 && !local) throw std::invalid_argument("a one-process farm needs a local renderer");
+}
+
+FrameDispatcher::~FrameDispatcher() { stop(); }
+
+int FrameDispatcher::render_ranks() const { return std::max(1, mpi_.render_ranks()); }
+
+void FrameDispatcher::stop() {
+    if (stopped_) return;
+    stopped_ = true;
+    if (mpi_.size() < 2) return;
+    WireView stop_view{};
+    stop_view.stop = 1;
+    broadcast_view(stop_view);
+}
+
+DispatchedFrame FrameDispatcher::render(const ViewRequest& view, std::uint64_t stream) {
+    if (stopped_) throw FarmError("the farm was stopped");
+    const ImageSize size = render_size(view);
+    auto predicted = predicted_.find(stream);
+    if (predicted == predicted_.end() || predicted->second.size() != size)
+        predicted = predicted_.insert_or_assign(stream, CostMap::uniform(size, settings_.cell_size)).first;
+    const Assignment assignment = balancer_->assign(predicted->second, render_ranks());
+
+    DispatchedFrame frame;
+    frame.image = Rgb8Image(size);
+    frame.stats.frame = view.frame_id;
+    frame.stats.rank_predicted_seconds = assignment.predicted_cost;
+    const auto start = Clock::now();
+    if (!gather(view, assignment, frame)) throw FarmError(fmt::format("frame {} failed on a render rank", view.frame_id));
+    frame.stats.render_phase_seconds = seconds_since(start);
+    finish_stats(frame.stats);
+    // Re-balance: this frame's measured tile times predict the stream's next frame.
+    predicted->second = CostMap::from_tile_times(size, settings_.cell_size, frame.tiles);
+    return frame;
+}
+
+bool FrameDispatcher::gather(const ViewRequest& view, const Assignment& assignment, DispatchedFrame& frame) {
+    if (local_) {  // a one-process farm: the admin traces the whole frame itself
+        local_->begin_frame(view);
+        TilePassResult pass = render_tile_pass(*local_, assignment.rects[0], settings_.cell_size, settings_.threads,
+                                               settings_.exposure);
+        unpack_rects(assignment.rects[0], pass.packed_pixels, frame.image);
+        frame.tiles = std::move(pass.tile_times);
+        frame.stats.rays = pass.rays;
+        frame.stats.rank_render_seconds = {pass.render_seconds};
+        return true;
+    }
+    WireView wire = to_wire(view);
+    broadcast_view(wire);
+    for (int r = 0; r < mpi_.render_ranks(); ++r) {
+        std::vector<int> flat;
+        for (const PixelRect& rect : assignment.rects[static_cast<std::size_t>(r)])
+            flat.insert(flat.end(), {rect.x0, rect.y0, rect.x1, rect.y1});
+        MPI_Send(flat.data(), static_cast<int>(flat.size()), MPI_INT, r + 1, kTagRects, MPI_COMM_WORLD);
+    }
+    frame.stats.rank_render_seconds.assign(static_cast<std::size_t>(mpi_.render_ranks()), 0.0);
+    bool ok = true;
+    for (int k = 0; k < mpi_.render_ranks(); ++k) {
+        // Replies in arrival order: a slow rank does not hold up compositing the others.
+        const int source = probe_politely(MPI_ANY_SOURCE, kTagReplyHeader).MPI_SOURCE;
+        RankReply reply = receive_reply(source);
+        if (!reply.header.ok) {
+            spdlog::error("{}", std::string(reply.payload.begin(), reply.payload.end()));
+            ok = false;
+            continue;
+        }
+        try {
+            unpack_rects(assignment.rects[static_cast<std::size_t>(source - 1)], reply.payload, frame.image);
+        } catch (const std::exception& e) {
+            spdlog::error("rank {}: frame {}: bad reply: {}", source, view.frame_id, e.what());
+            ok = false;
+            continue;
+        }
+        for (std::size_t i = 0; i + 4 < reply.tiles.size(); i += 5)
+            frame.tiles.push_back({{int(reply.tiles[i]), int(reply.tiles[i + 1]), int(reply.tiles[i + 2]), int(reply.tiles[i + 3])},
+                                   reply.tiles[i + 4]});
+        frame.stats.rays += reply.header.rays;
+        frame.stats.rank_render_seconds[static_cast<std::size_t>(source - 1)] = reply.header.render_seconds;
+    }
+    return ok;
+}
+
+}  // namespace mogao

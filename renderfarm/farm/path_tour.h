@@ -1,0 +1,29 @@
+// The headless tour: the admin renders a scripted camera path (camera_path.h) on the farm and
+// writes DIR/frame-NNNN.jpg (TurboJPEG, full frame encoded once on the admin), optional lossless
+// frame-NNNN.ppm, stats.json (per-frame figures), tile-costs.json (measured tile times, input of
+// bench/balance_sim) and contact-sheet.png.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include "renderfarm/farm/frame_dispatcher.h"
+#include "renderfarm/farm/frame_stats.h"
+#include "renderfarm/scene/scene.h"
+#include "renderfarm/view/view_request.h"
+
+namespace mogao {
+
+struct PathTour {
+    std::string path = "walk";        // walk | orbit | path file
+    int frames = 60;
+    ViewRequest view_template;        // camera, size, quality, seed; the pose comes from the path
+    std::filesystem::path out_dir;
+    bool save_raw = false;            // also write lossless frame-NNNN.ppm
+    int contact_sheet_frames = 12;    // 0: no contact sheet
+};
+
+// Returns the exit code; throws PathError / FarmError / file errors, which run_farm reports.
+int run_path_tour(const PathTour& tour, FrameDispatcher& farm, const Scene& scene, RunInfo& run);
+
+}  // namespace mogao
