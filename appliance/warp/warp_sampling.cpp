@@ -14,7 +14,7 @@ struct Taps {
     double f = 0.0;
 };
 
-Taps taps_at(int pixel, int output_extent, int grid_extent) {
+Taps taps_at(double pixel, int output_extent, int grid_extent) {
     const double g = std::clamp(output_to_grid(pixel, output_extent, grid_extent), 0.0,
                                 static_cast<double>(grid_extent - 1));
     Taps t;
@@ -37,6 +37,10 @@ double grid_to_output(double g, int output_extent, int grid_extent) {
 }
 
 ContentUv sample_warp(const WarpMap& warp, ImageSize output, int x, int y) {
+    return sample_warp_at(warp, output, x, y);
+}
+
+ContentUv sample_warp_at(const WarpMap& warp, ImageSize output, double x, double y) {
     const Taps tx = taps_at(x, output.width, warp.size.width);
     const Taps ty = taps_at(y, output.height, warp.size.height);
     const int xs[2] = {tx.i0, tx.i1};

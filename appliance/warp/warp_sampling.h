@@ -20,9 +20,9 @@ struct ContentUv {
     [[nodiscard]] bool valid() const { return !std::isnan(u) && !std::isnan(v); }
 };
 
-// Continuous grid coordinate of output pixel `x` (0-based pixel index, may be fractional: x is the
-// position relative to pixel centres, pixel centre x + 0.5 <-> x) for `output_extent` output pixels
-// and `grid_extent` samples. The inverse is grid_to_output.
+// Grid coordinate of output position x for `output_extent` output pixels and `grid_extent`
+// samples. x is in pixel-index coordinates: pixel x's centre (image position x + 0.5) is x, and
+// fractional values lie between centres. grid_to_output is the inverse.
 [[nodiscard]] double output_to_grid(double x, int output_extent, int grid_extent);
 [[nodiscard]] double grid_to_output(double g, int output_extent, int grid_extent);
 
@@ -30,6 +30,10 @@ struct ContentUv {
 // a non-zero bilinear weight) is NaN, the result is NaN, NaN: "no content" never blends into a
 // neighbour's value. Preconditions: validate_warp passed, output non-empty.
 [[nodiscard]] ContentUv sample_warp(const WarpMap& warp, ImageSize output, int x, int y);
+
+// The same at a continuous output position in pixel-index coordinates (pixel x's centre is x;
+// positions outside [0, W-1] clamp to the edge samples). Used by the inverse warp and its tests.
+[[nodiscard]] ContentUv sample_warp_at(const WarpMap& warp, ImageSize output, double x, double y);
 
 // Bilinear blend weight at output pixel (x, y). Preconditions: validate_blend passed.
 [[nodiscard]] float sample_blend(const BlendMask& blend, ImageSize output, int x, int y);

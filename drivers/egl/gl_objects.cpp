@@ -87,8 +87,10 @@ Result<GlProgram> link_program(std::string_view vertex_source, std::string_view 
         glGetProgramInfoLog(program.get(), static_cast<GLsizei>(log.size()), nullptr, log.data());
         return make_error(EIO, std::string("program does not link: ") + log.c_str());
     }
-    // The shaders are owned by `vertex`/`fragment` and deleted on return; a linked program keeps
-    // working without them.
+    // A linked program keeps working without its shaders; detach them so that deleting `vertex`
+    // and `fragment` on return frees them now rather than with the program.
+    glDetachShader(program.get(), vertex->get());
+    glDetachShader(program.get(), fragment->get());
     return program;
 }
 

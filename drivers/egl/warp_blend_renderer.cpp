@@ -1,0 +1,347 @@
+#include "drivers/egl/warp_blend_renderer.h"
+
+#include <EGL/egl.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <string>
+
+namespace mogao {
+namespace {
+
+// Uploaded warp texels below this mean "no content". NaN is the CPU-side marker, but GLSL ES 3.00
+// does not require NaN support (isnan may be constant false), so NaN is replaced on upload by
+// kNoContentUpload and valid uv are clamped to [-1, 2], which renders identically (clamp-to-edge)
+// and keeps them far from the marker.
+constexpr float kNoContentUpload = -1.0e30f;
+
+constexpr const char* kVertexShader = R"(#version 300 es
+// One triangle covering the viewport; no vertex attributes (vertex ids 0,1,2 -> (-1,-1),(3,-1),(-1,3)).
+void main() {
+    vec2 p = vec2(float((gl_VertexID & 1) << 2) - 1.0, float((gl_VertexID & 2) << 1) - 1.0);
+    gl_Position = vec4(p, 0.0, 1.0);
+}
+)";
+
+constexpr const char* kFragmentShader = R"(#version 300 es
+precision highp float;
+precision highp int;
+precision highp sampler2D;
+
+uniform sampler2D u_content;  // GL_SRGB8: texelFetch returns linear light
+uniform sampler2D u_warp;     // GL_RG32F (u, v); u < kNoContent marks "no content"
+uniform sampler2D u_blend;    // GL_R32F weight in linear light
+uniform sampler2D u_lut;      // GL_RGB32F, N x 1: display value per channel at linear i / (N - 1)
+uniform vec2 u_output_size;   // projector pixels
+uniform vec2 u_warp_scale;    // warp size / output size (exactly 1.0 when equal)
+uniform vec2 u_blend_scale;   // blend size / output size
+
+out vec4 o_color;
+
+const float kNoContent = -1.0e29;
+
+// The 2x2 texels around q (texel-centre coordinates: texel i is centred at q = i), indices clamped
+// to the map's edge, and the fractional position between them.
+struct Taps { ivec2 lo; ivec2 hi; vec2 f; };
+
+Taps taps_at(vec2 q, ivec2 size) {
+    vec2 base = floor(q);
+    Taps t;
+    t.f = q - base;
+    ivec2 b = ivec2(base);
+    t.lo = clamp(b, ivec2(0), size - ivec2(1));
+    t.hi = clamp(b + ivec2(1), ivec2(0), size - ivec2(1));
+    return t;
+}
+
+vec4 weights(vec2 f) {
+    return vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
+}
+
+// False when a texel with non-zero weight has no content.
+bool warp_at(vec2 p, out vec2 uv) {
+    Taps t = taps_at(p * u_warp_scale - 0.5, textureSize(u_warp, 0));
+    vec2 a = texelFetch(u_warp, t.lo, 0).rg;
+    vec2 b = texelFetch(u_warp, ivec2(t.hi.x, t.lo.y), 0).rg;
+    vec2 c = texelFetch(u_warp, ivec2(t.lo.x, t.hi.y), 0).rg;
+    vec2 d = texelFetch(u_warp, t.hi, 0).rg;
+    vec4 w = weights(t.f);
+    bvec4 none = lessThan(vec4(a.x, b.x, c.x, d.x), vec4(kNoContent));
+    if ((none.x && w.x > 0.0) || (none.y && w.y > 0.0) || (none.z && w.z > 0.0) || (none.w && w.w > 0.0)) {
+        return false;
+    }
+    // Zero the markers of zero-weight texels so they cannot leak into the sum.
+    a = none.x ? vec2(0.0) : a;
+    b = none.y ? vec2(0.0) : b;
+    c = none.z ? vec2(0.0) : c;
+    d = none.w ? vec2(0.0) : d;
+    uv = a * w.x + b * w.y + c * w.z + d * w.w;
+    return true;
+}
+
+float blend_at(vec2 p) {
+    Taps t = taps_at(p * u_blend_scale - 0.5, textureSize(u_blend, 0));
+    vec4 w = weights(t.f);
+    return texelFetch(u_blend, t.lo, 0).r * w.x + texelFetch(u_blend, ivec2(t.hi.x, t.lo.y), 0).r * w.y +
+           texelFetch(u_blend, ivec2(t.lo.x, t.hi.y), 0).r * w.z + texelFetch(u_blend, t.hi, 0).r * w.w;
+}
+
+// Bilinear in linear light: each texel is decoded from sRGB by the texture unit before weighting.
+vec3 content_at(vec2 uv) {
+    ivec2 size = textureSize(u_content, 0);
+    Taps t = taps_at(uv * vec2(size) - 0.5, size);
+    vec4 w = weights(t.f);
+    return texelFetch(u_content, t.lo, 0).rgb * w.x + texelFetch(u_content, ivec2(t.hi.x, t.lo.y), 0).rgb * w.y +
+           texelFetch(u_content, ivec2(t.lo.x, t.hi.y), 0).rgb * w.z + texelFetch(u_content, t.hi, 0).rgb * w.w;
+}
+
+vec3 apply_lut(vec3 x) {
+    int n = textureSize(u_lut, 0).x;
+    vec3 pos = clamp(x, 0.0, 1.0) * float(n - 1);
+    ivec3 i = min(ivec3(floor(pos)), ivec3(n - 2));
+    vec3 f = pos - vec3(i);
+    vec3 lo = vec3(texelFetch(u_lut, ivec2(i.r, 0), 0).r, texelFetch(u_lut, ivec2(i.g, 0), 0).g,
+                   texelFetch(u_lut, ivec2(i.b, 0), 0).b);
+    vec3 hi = vec3(texelFetch(u_lut, ivec2(i.r + 1, 0), 0).r, texelFetch(u_lut, ivec2(i.g + 1, 0), 0).g,
+                   texelFetch(u_lut, ivec2(i.b + 1, 0), 0).b);
+    return lo * (1.0 - f) + hi * f;
+}
+
+void main() {
+    // Output pixel centre with y down from the top row (GL window y grows up).
+    vec2 p = vec2(gl_FragCoord.x, u_output_size.y - gl_FragCoord.y);
+    vec2 uv;
+    if (!warp_at(p, uv)) {
+        o_color = vec4(0.0, 0.0, 0.0, 1.0);
+        return;
+    }
+    o_color = vec4(apply_lut(content_at(uv) * blend_at(p)), 1.0);
+}
+)";
+
+std::string size_text(ImageSize s) { return std::to_string(s.width) + "x" + std::to_string(s.height); }
+
+bool fits(ImageSize s, GLint max_size) {
+    return s.width > 0 && s.height > 0 && s.width <= max_size && s.height <= max_size;
+}
+
+Status check_size(std::string_view what, ImageSize s, GLint max_size) {
+    if (s.width <= 0 || s.height <= 0) {
+        return make_error(EINVAL, std::string(what) + " size " + size_text(s) + " is empty");
+    }
+    if (!fits(s, max_size)) {
+        return make_error(E2BIG, std::string(what) + " size " + size_text(s) + " exceeds GL_MAX_TEXTURE_SIZE " +
+                                     std::to_string(max_size));
+    }
+    return {};
+}
+
+// A 2D texture with one level, nearest filtering (all filtering is in the shader; float formats
+// are not filterable in GLES 3.0) and edge clamping.
+Result<GlTexture> upload(std::string_view what, GLenum internal_format, ImageSize size, GLenum format, GLenum type,
+                         const void* data) {
+    GlTexture texture = make_texture();
+    glBindTexture(GL_TEXTURE_2D, texture.get());
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(internal_format), size.width, size.height, 0, format, type,
+                 data);
+    if (auto s = gl_check("upload " + std::string(what)); !s) return s.error();
+    return texture;
+}
+
+}  // namespace
+
+Result<WarpBlendRenderer> WarpBlendRenderer::create() {
+    // Without a current context every GL call is silently ignored; say so instead.
+    if (eglGetCurrentContext() == EGL_NO_CONTEXT) {
+        return make_error(EINVAL, "WarpBlendRenderer::create: no EGL context is current on this thread");
+    }
+    WarpBlendRenderer r;
+    auto program = link_program(kVertexShader, kFragmentShader);
+    if (!program) return with_context(program.error(), "WarpBlendRenderer");
+    r.program_ = std::move(program.value());
+    glUseProgram(r.program_.get());
+    glUniform1i(glGetUniformLocation(r.program_.get(), "u_content"), 0);
+    glUniform1i(glGetUniformLocation(r.program_.get(), "u_warp"), 1);
+    glUniform1i(glGetUniformLocation(r.program_.get(), "u_blend"), 2);
+    glUniform1i(glGetUniformLocation(r.program_.get(), "u_lut"), 3);
+    r.loc_output_size_ = glGetUniformLocation(r.program_.get(), "u_output_size");
+    r.loc_warp_scale_ = glGetUniformLocation(r.program_.get(), "u_warp_scale");
+    r.loc_blend_scale_ = glGetUniformLocation(r.program_.get(), "u_blend_scale");
+    GLint max_texture = 0;
+    GLint max_renderbuffer = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture);
+    glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_renderbuffer);
+    r.max_texture_size_ = std::min(max_texture, max_renderbuffer);
+    if (auto s = gl_check("WarpBlendRenderer::create"); !s) return s.error();
+    return r;
+}
+
+Status WarpBlendRenderer::set_content(const Rgb8Image& frame) {
+    if (auto s = check_size("content frame", frame.size, max_texture_size_); !s) return s;
+    if (frame.pixels.size() != static_cast<std::size_t>(frame.size.pixel_count()) * 3) {
+        return make_error(EINVAL, "content frame " + size_text(frame.size) + " holds " +
+                                      std::to_string(frame.pixels.size()) + " values, expected width*height*3");
+    }
+    if (content_.valid() && frame.size == content_size_) {
+        glBindTexture(GL_TEXTURE_2D, content_.get());
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, frame.size.width, frame.size.height, GL_RGB, GL_UNSIGNED_BYTE,
+                        frame.pixels.data());
+        return gl_check("upload content frame");
+    }
+    auto texture = upload("content frame", GL_SRGB8, frame.size, GL_RGB, GL_UNSIGNED_BYTE, frame.pixels.data());
+    if (!texture) return texture.error();
+    content_ = std::move(texture.value());
+    content_size_ = frame.size;
+    return {};
+}
+
+Result<std::size_t> WarpBlendRenderer::add_projector(const ProjectorCalibration& c) {
+    const std::string who = "projector '" + c.id + "'";
+    if (auto s = check_size(who + " output", c.output, max_texture_size_); !s) return s.error();
+    if (auto s = check_size(who + " warp map", c.warp.size, max_texture_size_); !s) return s.error();
+    if (auto s = check_size(who + " blend mask", c.blend.size, max_texture_size_); !s) return s.error();
+    if (c.warp.uv.size() != static_cast<std::size_t>(c.warp.size.pixel_count()) * 2) {
+        return make_error(EINVAL, who + ": warp map " + size_text(c.warp.size) + " holds " +
+                                      std::to_string(c.warp.uv.size()) + " values, expected width*height*2");
+    }
+    if (c.blend.weight.size() != static_cast<std::size_t>(c.blend.size.pixel_count())) {
+        return make_error(EINVAL, who + ": blend mask " + size_text(c.blend.size) + " holds " +
+                                      std::to_string(c.blend.weight.size()) + " values, expected width*height");
+    }
+    if (!std::all_of(c.blend.weight.begin(), c.blend.weight.end(), [](float w) { return std::isfinite(w); })) {
+        return make_error(EINVAL, who + ": blend mask has a non-finite weight");
+    }
+    const std::size_t n = c.response.lut[0].size();
+    if (n < 2 || c.response.lut[1].size() != n || c.response.lut[2].size() != n) {
+        return make_error(EINVAL, who + ": response LUT channels must have the same length >= 2 (have " +
+                                      std::to_string(c.response.lut[0].size()) + ", " +
+                                      std::to_string(c.response.lut[1].size()) + ", " +
+                                      std::to_string(c.response.lut[2].size()) + ")");
+    }
+    if (n > static_cast<std::size_t>(max_texture_size_)) {
+        return make_error(E2BIG, who + ": response LUT has " + std::to_string(n) +
+                                     " entries, more than GL_MAX_TEXTURE_SIZE " + std::to_string(max_texture_size_));
+    }
+
+    std::vector<float> uv(c.warp.uv.size());
+    for (std::size_t i = 0; i < uv.size(); i += 2) {
+        const float u = c.warp.uv[i];
+        const float v = c.warp.uv[i + 1];
+        const bool valid = std::isfinite(u) && std::isfinite(v);
+        uv[i] = valid ? std::clamp(u, -1.0f, 2.0f) : kNoContentUpload;
+        uv[i + 1] = valid ? std::clamp(v, -1.0f, 2.0f) : kNoContentUpload;
+    }
+    std::vector<float> lut(n * 3);
+    for (std::size_t i = 0; i < n; ++i) {
+        for (std::size_t ch = 0; ch < 3; ++ch) {
+            const float value = c.response.lut[ch][i];
+            if (!std::isfinite(value)) return make_error(EINVAL, who + ": response LUT has a non-finite entry");
+            lut[i * 3 + ch] = value;
+        }
+    }
+
+    Projector p;
+    p.output = c.output;
+    p.warp_size = c.warp.size;
+    p.blend_size = c.blend.size;
+    auto warp = upload(who + " warp map", GL_RG32F, c.warp.size, GL_RG, GL_FLOAT, uv.data());
+    if (!warp) return warp.error();
+    auto blend = upload(who + " blend mask", GL_R32F, c.blend.size, GL_RED, GL_FLOAT, c.blend.weight.data());
+    if (!blend) return blend.error();
+    auto lut_texture = upload(who + " response LUT", GL_RGB32F, ImageSize{static_cast<int>(n), 1}, GL_RGB, GL_FLOAT,
+                              lut.data());
+    if (!lut_texture) return lut_texture.error();
+    p.warp = std::move(warp.value());
+    p.blend = std::move(blend.value());
+    p.lut = std::move(lut_texture.value());
+    projectors_.push_back(std::move(p));
+    return projectors_.size() - 1;
+}
+
+Status WarpBlendRenderer::check_index(std::size_t index) const {
+    if (index >= projectors_.size()) {
+        return make_error(EINVAL, "projector index " + std::to_string(index) + " out of range (have " +
+                                      std::to_string(projectors_.size()) + ")");
+    }
+    if (!content_.valid()) return make_error(EINVAL, "no content frame: call set_content() first");
+    return {};
+}
+
+Status WarpBlendRenderer::draw(std::size_t index) {
+    if (auto s = check_index(index); !s) return s;
+    const Projector& p = projectors_[index];
+    glUseProgram(program_.get());
+    const auto out_w = static_cast<float>(p.output.width);
+    const auto out_h = static_cast<float>(p.output.height);
+    glUniform2f(loc_output_size_, out_w, out_h);
+    glUniform2f(loc_warp_scale_, static_cast<float>(p.warp_size.width) / out_w,
+                static_cast<float>(p.warp_size.height) / out_h);
+    glUniform2f(loc_blend_scale_, static_cast<float>(p.blend_size.width) / out_w,
+                static_cast<float>(p.blend_size.height) / out_h);
+    const GLuint textures[] = {content_.get(), p.warp.get(), p.blend.get(), p.lut.get()};
+    for (GLuint unit = 0; unit < 4; ++unit) {
+        glActiveTexture(GL_TEXTURE0 + unit);
+        glBindTexture(GL_TEXTURE_2D, textures[unit]);
+    }
+    glActiveTexture(GL_TEXTURE0);
+    // Fixed-function state that would alter the pixels; dithering is on by default in GL.
+    glDisable(GL_BLEND);
+    glDisable(GL_DITHER);
+    glDisable(GL_SCISSOR_TEST);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_STENCIL_TEST);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glViewport(0, 0, p.output.width, p.output.height);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    return gl_check("WarpBlendRenderer::draw");
+}
+
+Result<Rgb8Image> WarpBlendRenderer::render(std::size_t index) {
+    if (auto s = check_index(index); !s) return s.error();
+    Projector& p = projectors_[index];
+    if (!p.fbo.valid()) {
+        GlRenderbuffer color = make_renderbuffer();
+        glBindRenderbuffer(GL_RENDERBUFFER, color.get());
+        glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, p.output.width, p.output.height);
+        GlFramebuffer fbo = make_framebuffer();
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo.get());
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color.get());
+        if (auto s = gl_check("create output FBO"); !s) return s.error();
+        if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+            return make_error(EIO, "output FBO " + size_text(p.output) + " is incomplete");
+        }
+        p.color = std::move(color);
+        p.fbo = std::move(fbo);
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, p.fbo.get());
+    if (auto s = draw(index); !s) return s.error();
+
+    const auto w = static_cast<std::size_t>(p.output.width);
+    const auto h = static_cast<std::size_t>(p.output.height);
+    readback_.resize(w * h * 4);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    // GL_RGBA/GL_UNSIGNED_BYTE is the one read format every GLES 3 implementation accepts.
+    glReadPixels(0, 0, p.output.width, p.output.height, GL_RGBA, GL_UNSIGNED_BYTE, readback_.data());
+    if (auto s = gl_check("glReadPixels"); !s) return s.error();
+    Rgb8Image out(p.output);
+    for (std::size_t y = 0; y < h; ++y) {
+        const std::uint8_t* src = readback_.data() + (h - 1 - y) * w * 4;  // GL row 0 is the bottom
+        std::uint8_t* dst = out.pixels.data() + y * w * 3;
+        for (std::size_t x = 0; x < w; ++x) {
+            dst[x * 3 + 0] = src[x * 4 + 0];
+            dst[x * 3 + 1] = src[x * 4 + 1];
+            dst[x * 3 + 2] = src[x * 4 + 2];
+        }
+    }
+    return out;
+}
+
+}  // namespace mogao

@@ -1,0 +1,95 @@
+// WarpBlendRenderer: the GL layer of one projector output. It only uploads and draws: the content
+// frame once per frame, each projector's calibration once, then one full-screen triangle per
+// projector per frame. The maths (fragment shader, GLSL ES 3.00), per output pixel (x, y):
+//
+//   p      = (x + 0.5, y + 0.5)                       output pixel centre, y down from the top row
+//   uv     = bilinear(warp,  p * warp.size / output - 0.5)   in warp texel-centre coordinates
+//   w      = bilinear(blend, p * blend.size / output - 0.5)
+//   linear = bilinear over the 4 content texels around uv * content.size - 0.5, each texel
+//            decoded sRGB -> linear first (GL_SRGB8 + texelFetch), so the filtering is in linear light
+//   out    = lut_c(clamp(linear_c * w, 0, 1))  per channel c; lut_c is piecewise linear over its N
+//            entries at linear positions i / (N - 1)
+//   out    = 0 (black) when a warp texel with non-zero bilinear weight is NaN/non-finite
+//
+// Bilinear lookups clamp texel indices to the map's edge (GL_CLAMP_TO_EDGE semantics); with
+// map size == output size the warp and blend are read exactly per pixel. All filtering is done in
+// the shader with texelFetch, so results do not depend on a GPU's filtering precision or on
+// whether it supports linear filtering of float textures. Output values are written to an 8-bit
+// UNORM target (x * 255 rounded to nearest).
+//
+// Targets: render() draws into the projector's own FBO (GL_RGBA8 renderbuffer) and reads it back;
+// the headless backend never touches a default framebuffer (the surfaceless context has none).
+// draw() draws into whatever framebuffer is bound to GL_DRAW_FRAMEBUFFER; the KMS backend binds 0
+// with the output's GBM/EGL window surface current, then eglSwapBuffers + gbm lock + atomic flip.
+// Output row 0 (top) is GL window row height-1, which is how both a window surface scans out and
+// render() reads back (rows are flipped to top-first).
+//
+// Threading and lifetime: every call needs the GLES >= 3.0 context that was current at create()
+// to be current on the calling thread, and the renderer must be destroyed with it still current.
+// Errors: EINVAL for bad arguments (sizes, lengths, indices, missing content), E2BIG for sizes
+// beyond GL_MAX_TEXTURE_SIZE, EIO for GL failures.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "appliance/warp/projector_calibration.h"
+#include "drivers/egl/gl_objects.h"
+#include "drivers/result.h"
+#include "renderfarm/view/image.h"
+
+namespace mogao {
+
+class WarpBlendRenderer {
+public:
+    // Compiles and links the program; EIO if no GLES 3 context is current or the shader fails.
+    [[nodiscard]] static Result<WarpBlendRenderer> create();
+
+    // Uploads the content frame: sRGB-encoded RGB8, rows top first (renderfarm/view/image.h).
+    // Call once per frame before draw()/render(); the texture is reallocated only on a size change.
+    [[nodiscard]] Status set_content(const Rgb8Image& frame);
+
+    // Validates and uploads one projector's warp map (RG32F), blend mask (R32F) and response LUT
+    // (N x 1 RGB32F), once. Returns the projector's index for draw()/render(). EINVAL when a size
+    // is empty or does not match its data, the LUT channels differ in length or have < 2 entries,
+    // or a blend weight is not finite.
+    [[nodiscard]] Result<std::size_t> add_projector(const ProjectorCalibration& calibration);
+
+    [[nodiscard]] std::size_t projector_count() const { return projectors_.size(); }
+    // Output size of projector `index` (< projector_count()).
+    [[nodiscard]] ImageSize output_size(std::size_t index) const { return projectors_.at(index).output; }
+
+    // Draws projector `index` into the framebuffer bound to GL_DRAW_FRAMEBUFFER, viewport
+    // (0, 0, output size). Leaves its program, textures (units 0-3) and viewport bound.
+    [[nodiscard]] Status draw(std::size_t index);
+
+    // Draws projector `index` into its own FBO and reads it back as RGB8, rows top first.
+    [[nodiscard]] Result<Rgb8Image> render(std::size_t index);
+
+private:
+    struct Projector {
+        ImageSize output;
+        ImageSize warp_size;
+        ImageSize blend_size;
+        GlTexture warp;
+        GlTexture blend;
+        GlTexture lut;
+        GlRenderbuffer color;  // render() target, made on first use
+        GlFramebuffer fbo;
+    };
+
+    WarpBlendRenderer() = default;
+    [[nodiscard]] Status check_index(std::size_t index) const;
+
+    GlProgram program_;
+    GLint loc_output_size_ = -1;
+    GLint loc_warp_scale_ = -1;
+    GLint loc_blend_scale_ = -1;
+    GLint max_texture_size_ = 0;
+    GlTexture content_;
+    ImageSize content_size_;
+    std::vector<Projector> projectors_;
+    std::vector<std::uint8_t> readback_;  // RGBA scratch for render()
+};
+
+}  // namespace mogao

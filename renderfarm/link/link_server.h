@@ -1,0 +1,91 @@
+// The farm side of the link: a gRPC server (service mogao.link.v1.Tour, mogao_link.proto) that
+// accepts appliance sessions over mutual TLS on an IPv6 endpoint and answers their view requests
+// with JPEG frames made by an injected renderer. See docs/link.md for the protocol and the PKI.
+//
+// Flow control, per session: only the NEWEST unrendered request is kept (a newer one replaces it;
+// the replaced one is counted in requests_dropped), requests not newer than one already seen are
+// dropped, and at most `max_frames_in_flight` frames are rendering or sent-but-unacknowledged
+// (the appliance acknowledges frames in ViewRequestMsg.ack_frame_id once it has taken them), so a
+// slow appliance or network never builds a queue of stale frames in the farm or in socket buffers.
+//
+// Threads: gRPC runs each session's handler on its own thread (it writes that session's frames);
+// the handler starts one reader thread (requests and acks); `render_threads` workers shared by all
+// sessions call the renderer, picking sessions round-robin. With render_threads = 1 (the default)
+// the renderer is never called concurrently, which is what the MPI farm needs.
+//
+// Errors: construction throws LinkError (bad endpoint, unusable TLS material, port taken). After
+// that nothing is thrown: an invalid request is refused and logged (the session continues), a
+// renderer exception costs that request its frame, a broken session ends alone; all of it is
+// logged to stderr through spdlog (logger "mogao-link").
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "renderfarm/link/endpoint.h"
+#include "renderfarm/link/link_types.h"
+#include "renderfarm/link/tls_material.h"
+#include "renderfarm/view/view_request.h"
+
+namespace mogao {
+
+// Renders and encodes one validated request. Called from the server's render threads; may throw
+// (the request then gets no frame). ViewRequest::frame_id holds the appliance's request id.
+using FrameRenderer = std::function<RenderedFrame(const ViewRequest&)>;
+
+struct LinkServerOptions {
+    // "[address]:port". On "[::]" gRPC opens one dual-stack socket (IPV6_V6ONLY = 0) and offers no
+    // way to change that; see ipv6_only.
+    std::string listen{kDefaultListenEndpoint};
+    TlsMaterial tls;  // farm certificate + key; ca_pem: the CA every appliance certificate must chain to
+    // Appliance certificate common names allowed in; empty = every certificate the CA issued.
+    std::vector<std::string> allowed_appliances;
+    int render_threads = 1;        // renderer calls at once over all sessions, 1..64
+    int max_frames_in_flight = 2;  // per session, 1..16
+    int max_sessions = 8;          // concurrent appliance sessions; more are refused (RESOURCE_EXHAUSTED)
+    int max_request_bytes = 64 * 1024;  // larger messages end that session (RESOURCE_EXHAUSTED)
+    // Refuse sessions that arrive over IPv4 (an IPv4-mapped peer on the dual-stack [::] socket)
+    // with PERMISSION_DENIED: the link is specified as IPv6 and the appliances' certificates and
+    // firewall rules are written for IPv6 addresses.
+    bool ipv6_only = true;
+};
+
+struct LinkServerStats {
+    std::uint64_t sessions_opened = 0;   // sessions that reached the handler (TLS and checks passed)
+    std::uint64_t sessions_refused = 0;  // IPv4 peer, name not allowed, too many sessions, stopping
+    std::uint64_t sessions_active = 0;
+    std::uint64_t requests_received = 0;  // valid view requests read
+    std::uint64_t requests_invalid = 0;   // refused by validation (logged)
+    std::uint64_t requests_dropped = 0;   // stale: replaced before rendering, or not newer than one seen
+    std::uint64_t render_calls = 0;
+    std::uint64_t render_failures = 0;    // renderer threw or returned an unusable frame
+    std::uint64_t frames_sent = 0;
+    std::uint64_t jpeg_bytes_sent = 0;
+};
+
+class LinkServer {
+public:
+    // Validates the options, binds and starts serving. Throws LinkError naming the option.
+    LinkServer(LinkServerOptions options, FrameRenderer renderer);
+    ~LinkServer();  // stop()
+    LinkServer(const LinkServer&) = delete;
+    LinkServer& operator=(const LinkServer&) = delete;
+
+    // The endpoint actually bound (with the port the kernel picked for port 0).
+    [[nodiscard]] Endpoint endpoint() const;
+    [[nodiscard]] LinkServerStats stats() const;
+
+    // Ends every session (appliances see UNAVAILABLE/CANCELLED and reconnect elsewhere or later),
+    // waits for a renderer call in progress, closes the port. Idempotent.
+    void stop();
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace mogao
