@@ -16,6 +16,7 @@
 #include <numbers>
 #include <string>
 
+#include "renderfarm/scene/procedural.h"
 #include "renderfarm/scene/scene.h"
 #include "renderfarm/trace/render_timing.h"
 #include "renderfarm/trace/renderer.h"
@@ -52,34 +53,11 @@ Mesh height_field(int n) {
     return mesh;
 }
 
-Mesh sphere(int segments, int rings) {
-    Mesh mesh;
-    mesh.source = "sphere";
-    for (int r = 0; r <= rings; ++r) {
-        const double phi = std::numbers::pi * r / rings;
-        for (int s = 0; s <= segments; ++s) {
-            const double theta = 2.0 * std::numbers::pi * s / segments;
-            const Eigen::Vector3f p(static_cast<float>(std::sin(phi) * std::sin(theta)), static_cast<float>(std::cos(phi)),
-                                    static_cast<float>(std::sin(phi) * std::cos(theta)));
-            mesh.positions.push_back(p);
-            mesh.normals.push_back(p);
-        }
-    }
-    const auto index = [segments](int r, int s) { return static_cast<std::uint32_t>(r * (segments + 1) + s); };
-    for (int r = 0; r < rings; ++r) {
-        for (int s = 0; s < segments; ++s) {
-            mesh.triangles.push_back({index(r, s), index(r + 1, s), index(r, s + 1)});
-            mesh.triangles.push_back({index(r, s + 1), index(r + 1, s), index(r + 1, s + 1)});
-        }
-    }
-    return mesh;
-}
-
 // Matte height field + sphere, one sun; no other lights.
 Scene base_scene(int grid, bool sun_shadows) {
     Scene scene;
     scene.source = "bench:height_field+sphere";
-    scene.meshes = {height_field(grid), sphere(128, 64)};
+    scene.meshes = {height_field(grid), make_uv_sphere(1.0, 128, 64)};
     Material ground;
     ground.albedo = Rgb(0.55f, 0.5f, 0.4f);
     Material ball;
@@ -101,7 +79,7 @@ Scene with_unused_features(Scene scene) {
     scene.area_lights = {AreaLight{{-1.0, 4.0, -4.0}, {2.0, 0.0, 0.0}, {0.0, 0.0, 2.0}, Rgb(0.0f, 0.0f, 0.0f), true}};
     scene.point_lights = {PointLight{{0.0, 3.0, 0.0}, Rgb(0.0f, 0.0f, 0.0f), true}};
     scene.environment_lights = {EnvironmentLight{Rgb(0.0f, 0.0f, 0.0f)}};
-    scene.meshes.push_back(sphere(64, 32));  // never instanced
+    scene.meshes.push_back(make_uv_sphere(1.0, 64, 32));  // never instanced
     Material unused_glossy;
     unused_glossy.specular = Rgb(0.5f, 0.5f, 0.5f);  // no instance uses it
     scene.materials.push_back(unused_glossy);

@@ -10,6 +10,7 @@
 
 #include "renderfarm/trace/camera.h"
 #include "renderfarm/trace/renderer.h"
+#include "renderfarm/scene/procedural.h"
 #include "renderfarm/trace/test_scenes.h"
 
 namespace mogao {
@@ -28,7 +29,7 @@ bool hit_unit_sphere(const Ray& ray, Eigen::Vector3d& point) {
 TEST(RendererLambert, TessellatedSphereMatchesAnalyticRadiance) {
     Scene scene;
     scene.source = "lambert_sphere";
-    scene.meshes.push_back(test::make_uv_sphere(200, 100, 1.0f));
+    scene.meshes.push_back(make_uv_sphere(1.0, 200, 100));
     Material m;
     m.albedo = Rgb(0.5f, 0.5f, 0.5f);
     scene.materials = {m};

@@ -1,33 +1,11 @@
 #include "renderfarm/trace/test_scenes.h"
 
+#include "renderfarm/scene/procedural.h"
+
 #include <cmath>
 #include <numbers>
 
 namespace mogao::test {
-
-Mesh make_uv_sphere(int segments, int rings, float radius) {
-    Mesh mesh;
-    mesh.source = "uv_sphere";
-    const double pi = std::numbers::pi;
-    for (int r = 0; r <= rings; ++r) {
-        const double phi = pi * r / rings;  // from +y (north pole) to -y
-        for (int s = 0; s <= segments; ++s) {
-            const double theta = 2.0 * pi * s / segments;
-            const Eigen::Vector3d n(std::sin(phi) * std::sin(theta), std::cos(phi), std::sin(phi) * std::cos(theta));
-            mesh.normals.push_back(n.cast<float>());
-            mesh.positions.push_back((radius * n).cast<float>());
-        }
-    }
-    const auto index = [segments](int r, int s) { return static_cast<std::uint32_t>(r * (segments + 1) + s); };
-    for (int r = 0; r < rings; ++r) {
-        for (int s = 0; s < segments; ++s) {
-            // Counter-clockwise seen from outside (theta grows toward +x from +z).
-            if (r != 0) mesh.triangles.push_back({index(r, s), index(r + 1, s), index(r, s + 1)});
-            if (r != rings - 1) mesh.triangles.push_back({index(r, s + 1), index(r + 1, s), index(r + 1, s + 1)});
-        }
-    }
-    return mesh;
-}
 
 Mesh make_grid(int n, float half, bool with_normals) {
     Mesh mesh;
@@ -53,7 +31,7 @@ Mesh make_grid(int n, float half, bool with_normals) {
 Scene make_sphere_over_floor(const Eigen::Vector3d& offset) {
     Scene scene;
     scene.source = "sphere_over_floor";
-    scene.meshes.push_back(make_uv_sphere(64, 32, 0.5f));
+    scene.meshes.push_back(make_uv_sphere(0.5, 64, 32));
     scene.meshes.push_back(make_grid(8, 2.0f, false));
     Material grey;
     grey.name = "grey";

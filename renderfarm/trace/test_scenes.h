@@ -9,10 +9,6 @@
 
 namespace mogao::test {
 
-// UV sphere centred at the origin: `segments` around +y, `rings` from pole to pole, unit vertex
-// normals pointing outward, counter-clockwise seen from outside.
-[[nodiscard]] Mesh make_uv_sphere(int segments, int rings, float radius);
-
 // Flat square [-half, half]² in the y = 0 plane, n x n cells of two triangles, facing +y,
 // optionally with (+y) vertex normals.
 [[nodiscard]] Mesh make_grid(int n, float half, bool with_normals);
