@@ -1,9 +1,14 @@
 // mogao-farm: the render farm's command line. This file is the one place where the farm's stages
-// are wired: scene (load) -> schedule (PBT) -> trace (Embree) -> encode (TurboJPEG), under MPI.
+// are wired: scene (load) -> schedule (PBT) -> trace (Embree) -> encode (TurboJPEG), under MPI, and
+// for live tours -> link (gRPC + mutual TLS over IPv6).
 //
 //   mpirun -n 3 mogao-farm render --scene scenes/grotto.json --frames 60 --out out/tour
+//   mpirun -n 3 mogao-farm serve --scene scenes/grotto.json --listen [::]:7443 --tls-dir /etc/mogao/pki --name farm
+//   mogao-farm pki init-ca --dir /etc/mogao/pki        (no MPI; see docs/link.md)
 #include <cstdio>
+#include <filesystem>
 #include <string>
+#include <string_view>
 
 #include <CLI/CLI.hpp>
 #include <spdlog/sinks/stdout_color_sinks.h>
@@ -11,6 +16,9 @@
 
 #include "renderfarm/farm/farm.h"
 #include "renderfarm/farm/path_tour.h"
+#include "renderfarm/farm/serve.h"
+#include "renderfarm/link/pki.h"
+#include "renderfarm/link/tls_material.h"
 #include "renderfarm/farm/mpi_session.h"
 
 namespace {
@@ -21,10 +29,18 @@ struct CameraFlags {
     double radius = 3.0, arc = 150.0, bottom = 0.2, top = 2.8, eye_height = 1.6;
 };
 
-void add_render_flags(CLI::App& render, mogao::FarmSetup& setup, mogao::PathTour& job, CameraFlags& camera,
-                      std::string& scans) {
+// Flags every farm command shares: the scene and how frames are split over the ranks.
+void add_farm_flags(CLI::App& command, mogao::FarmSetup& setup, std::string& scans) {
+    command.add_option("--scene", setup.scene_file, "Scene file (JSON, docs/scene-format.md)")->required()->check(CLI::ExistingFile);
+    command.add_option("--scans", scans, "Folder of the real scans (default: $MOGAO_SCANS_DIR or ../shared/data/scans)");
+    command.add_option("--balance", setup.dispatch.balancer, "pbt | equal | roundrobin")->check(CLI::IsMember({"pbt", "equal", "roundrobin"}));
+    command.add_option("--snap", setup.dispatch.snap, "PBT/equal split snap in pixels")->check(CLI::IsMember({4, 8, 16, 32}));
+    command.add_option("--rr-tile", setup.dispatch.roundrobin_tile, "Round-robin tile size in pixels")->check(CLI::Range(8, 1024));
+    command.add_option("--threads", setup.dispatch.threads, "Render threads per rank")->check(CLI::Range(1, 256));
+}
+
+void add_render_flags(CLI::App& render, mogao::PathTour& job, CameraFlags& camera) {
     auto& q = job.view_template.quality;
-    render.add_option("--scene", setup.scene_file, "Scene file (JSON, docs/scene-format.md)")->required()->check(CLI::ExistingFile);
     render.add_option("--frames", job.frames, "Number of frames of the camera path")->check(CLI::Range(1, 1000000));
     render.add_option("--path", job.path, "walk | orbit | a JSON path file");
     render.add_option("--out", job.out_dir, "Output folder for frame-NNNN.jpg, stats.json, tile-costs.json, contact-sheet.png")->required();
@@ -44,11 +60,6 @@ void add_render_flags(CLI::App& render, mogao::FarmSetup& setup, mogao::PathTour
     render.add_option("--scale", q.resolution_scale, "Resolution scale (0, 1]")->check(CLI::Range(0.01, 1.0));
     render.add_option("--jpeg-quality", q.jpeg_quality, "TurboJPEG quality 1..100")->check(CLI::Range(1, 100));
     render.add_option("--seed", job.view_template.seed, "Sampling seed (same seed, same pixels)");
-    render.add_option("--balance", setup.dispatch.balancer, "pbt | equal | roundrobin")->check(CLI::IsMember({"pbt", "equal", "roundrobin"}));
-    render.add_option("--snap", setup.dispatch.snap, "PBT/equal split snap in pixels")->check(CLI::IsMember({4, 8, 16, 32}));
-    render.add_option("--rr-tile", setup.dispatch.roundrobin_tile, "Round-robin tile size in pixels")->check(CLI::Range(8, 1024));
-    render.add_option("--threads", setup.dispatch.threads, "Render threads per rank")->check(CLI::Range(1, 256));
-    render.add_option("--scans", scans, "Folder of the real scans (default: $MOGAO_SCANS_DIR or ../shared/data/scans)");
     render.add_flag("--save-raw", job.save_raw, "Also write lossless frame-NNNN.ppm");
     render.add_option("--contact-sheet", job.contact_sheet_frames, "Frames on the contact sheet (0 = none)")->check(CLI::Range(0, 64));
 }
@@ -56,6 +67,8 @@ void add_render_flags(CLI::App& render, mogao::FarmSetup& setup, mogao::PathTour
 }  // namespace
 
 int main(int argc, char** argv) {
+    // The PKI needs no farm: handle it before MPI starts.
+    if (argc >= 2 && std::string_view(argv[1]) == "pki") return mogao::run_pki_command(argc - 1, argv + 1);
     mogao::MpiSession mpi(&argc, &argv);
     auto logger = spdlog::stderr_color_mt("mogao-farm");
     spdlog::set_default_logger(logger);
@@ -70,11 +83,37 @@ int main(int argc, char** argv) {
     CameraFlags camera;
     std::string scans;
     CLI::App* render = app.add_subcommand("render", "Render a camera path headless into numbered JPEG frames");
-    add_render_flags(*render, setup, job, camera, scans);
+    add_farm_flags(*render, setup, scans);
+    add_render_flags(*render, job, camera);
+
+    mogao::ServeOptions serve_options;
+    std::filesystem::path tls_dir;
+    std::string farm_name = "farm";
+    CLI::App* serve = app.add_subcommand("serve", "Serve live tours to authenticated appliances over IPv6 (gRPC, mutual TLS)");
+    add_farm_flags(*serve, setup, scans);
+    serve->add_option("--listen", serve_options.link.listen, "IPv6 endpoint [addr]:port");
+    serve->add_option("--tls-dir", tls_dir, "PKI folder: ca.pem, farm-NAME.pem, farm-NAME.key (mogao-farm pki)")->required()->check(CLI::ExistingDirectory);
+    serve->add_option("--name", farm_name, "Farm certificate name in --tls-dir");
+    serve->add_option("--allow", serve_options.link.allowed_appliances, "Only these appliance certificate names (default: any the CA issued)");
+    serve->add_option("--max-sessions", serve_options.link.max_sessions, "Concurrent appliance sessions")->check(CLI::Range(1, 256));
+    serve->add_option("--duration", serve_options.duration_s, "Stop after this many seconds (0 = until SIGTERM)")->check(CLI::Range(0.0, 1e9));
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         return mpi.is_admin() ? app.exit(e) : (e.get_exit_code() == 0 ? 0 : 2);
+    }
+    setup.scene_options.scans_dir = scans;
+    if (serve->parsed()) {
+        try {
+            serve_options.link.tls = mogao::load_tls_files(tls_dir / "ca.pem", tls_dir / ("farm-" + farm_name + ".pem"),
+                                                           tls_dir / ("farm-" + farm_name + ".key"));
+        } catch (const std::exception& e) {
+            if (mpi.is_admin()) spdlog::error("{}", e.what());
+            return 2;
+        }
+        return mogao::run_farm(mpi, setup, [&](mogao::FrameDispatcher& farm, const mogao::Scene& scene, mogao::RunInfo& run) {
+            return mogao::run_serve(serve_options, farm, scene, run);
+        });
     }
     if (camera.kind == "pinhole") {
         job.view_template.camera = mogao::PinholeCamera{camera.fov_deg};
@@ -86,7 +125,6 @@ int main(int argc, char** argv) {
         job.view_template.camera =
             mogao::CylinderScreen{camera.radius, camera.arc, camera.bottom, camera.top, {0.0, camera.eye_height, 0.0}};
     }
-    setup.scene_options.scans_dir = scans;
     return mogao::run_farm(mpi, setup, [&](mogao::FrameDispatcher& farm, const mogao::Scene& scene, mogao::RunInfo& run) {
         return mogao::run_path_tour(job, farm, scene, run);
     });

@@ -1,0 +1,28 @@
+// The live farm: the admin serves appliances over the link (gRPC + mutual TLS over IPv6,
+// renderfarm/link) and renders each session's newest view request on the MPI farm.
+//
+// Threads: gRPC calls the frame renderer from its own threads, but MPI may only be used from the
+// main thread (MPI_THREAD_FUNNELED), so renderer calls are queued to the main thread, which renders
+// them one at a time on the FrameDispatcher, encodes with TurboJPEG and hands the frame back.
+// Errors: a request that fails (bad view, a rank's error) fails that request only — the link logs
+// it and the session goes on; SIGINT/SIGTERM stop the service cleanly (exit 0).
+#pragma once
+
+#include <cstdint>
+
+#include "renderfarm/farm/frame_dispatcher.h"
+#include "renderfarm/farm/frame_stats.h"
+#include "renderfarm/link/link_server.h"
+#include "renderfarm/scene/scene.h"
+
+namespace mogao {
+
+struct ServeOptions {
+    LinkServerOptions link;
+    double duration_s = 0.0;     // stop after this long (tests); 0 = until SIGINT/SIGTERM
+    double stats_period_s = 10;  // log the link's counters this often
+};
+
+int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& scene, RunInfo& run);
+
+}  // namespace mogao
