@@ -88,6 +88,8 @@ public:
     T* operator->() { return &value(); }
     const T* operator->() const { return &value(); }
     T& operator*() & { return value(); }
+    const T& operator*() const& { return value(); }
+    T&& operator*() && { return std::move(*this).value(); }
 
     [[nodiscard]] const Error& error() const {
         if (ok()) result_detail::misuse("Result::error() on a value", "");

@@ -19,12 +19,13 @@ std::vector<ContentBand> ideal_bands(int projectors, double overlap) {
                                     " is outside [0, 0.5)");
     }
     const double band = 1.0 / (projectors - (projectors - 1) * overlap);
+    const double shared = band * overlap;
     std::vector<ContentBand> bands(static_cast<std::size_t>(projectors));
-    for (int k = 0; k < projectors; ++k) {
-        const double u0 = k * band * (1.0 - overlap);
-        // The last band ends exactly at 1, not at 1 +- rounding.
-        bands[static_cast<std::size_t>(k)] = {u0, k == projectors - 1 ? 1.0 : u0 + band};
-    }
+    for (int k = 0; k < projectors; ++k) bands[static_cast<std::size_t>(k)].u0 = k * band * (1.0 - overlap);
+    // Each band ends exactly `shared` past its neighbour's start (no rounding gap between bands,
+    // identical edges for both projectors of an overlap), and the last one exactly at 1.
+    for (std::size_t k = 0; k + 1 < bands.size(); ++k) bands[k].u1 = bands[k + 1].u0 + shared;
+    bands.back().u1 = 1.0;
     return bands;
 }
 
@@ -43,9 +44,11 @@ double ideal_blend_weight(const std::vector<ContentBand>& bands, int k, double u
     if (u < b.u0 || u > b.u1) return 0.0;
     // Left overlap with k - 1: [b.u0, bands[k-1].u1], the same t that projector k - 1 uses.
     if (i > 0 && u < bands[i - 1].u1) return smooth_ramp((u - b.u0) / (bands[i - 1].u1 - b.u0));
-    // Right overlap with k + 1: [bands[k+1].u0, b.u1].
-    if (i + 1 < bands.size() && u > bands[i + 1].u0) {
-        return 1.0 - smooth_ramp((u - bands[i + 1].u0) / (b.u1 - bands[i + 1].u0));
+    // Right overlap with k + 1: [bands[k+1].u0, b.u1]. Without overlap the shared edge belongs to
+    // k + 1 (bands are then half-open), so the weights still sum to 1 there.
+    if (i + 1 < bands.size() && u >= bands[i + 1].u0) {
+        const double width = b.u1 - bands[i + 1].u0;
+        return width > 0.0 ? 1.0 - smooth_ramp((u - bands[i + 1].u0) / width) : 0.0;
     }
     return 1.0;
 }

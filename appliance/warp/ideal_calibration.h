@@ -11,13 +11,15 @@
 //
 // Layout, normalised content u: band width b = 1 / (N - (N - 1) * overlap), projector k covers
 // [u0_k, u1_k] = [k * b * (1 - overlap), u0_k + b], full height v in [0, 1]; neighbours share
-// overlap * b. Output pixel (x, y) of a W x H projector samples
-// u = u0_k + b * (x + 0.5) / W, v = (y + 0.5) / H (its pixel footprint tiles the band exactly).
+// overlap * b (with overlap 0 the shared edge belongs to the right-hand projector). Output pixel
+// (x, y) of a W x H projector samples u = u0_k + b * (x + 0.5) / W, v = (y + 0.5) / H (its pixel
+// footprint tiles the band exactly).
 //
 // Blend (in linear light, before the response): outside overlaps 1; in the overlap [a, c] of
 // projectors k and k + 1, t = (u - a) / (c - a), projector k + 1 gets S(t) and projector k gets
-// 1 - S(t) with S the smoothstep 3t^2 - 2t^3 (C1, so no visible kink at the overlap edges); the
-// two weights sum to 1 at every content point up to float rounding (|sum - 1| <= 1.2e-7).
+// 1 - S(t) with S the smoothstep 3t^2 - 2t^3 (the cubic Hermite ramp of GLSL smoothstep(); C1, so
+// no visible kink at the overlap edges). The two weights sum to 1 at every content point up to
+// rounding (2.3e-16 in double; the float32 masks round each weight by at most 6e-8).
 // Response: gamma 2.2 LUT (make_gamma_response).
 #pragma once
 

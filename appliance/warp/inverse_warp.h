@@ -10,9 +10,11 @@
 // cell to claim a pixel wins: a warp that folds over itself shows one layer. Cells with a NaN
 // corner or a degenerate (zero-area) patch claim nothing.
 //
-// Coverage: the grid spans output pixel centres 0..W-1 (corner-aligned), so the outer half pixel
-// of the projector's image is not inverted; content there counts as uncovered. That is the
-// rounding of the projector's border, not a gap between projectors, whose overlaps cover it.
+// Coverage: the grid's samples span output positions grid_to_output(0) .. grid_to_output(M - 1)
+// (pixel centres 0 .. W - 1 for a per-pixel grid), so the outer half pixel of the projector's
+// image (plus, for a coarse grid, the edge band that reads a clamped edge sample) is not inverted;
+// content there counts as uncovered. That is the projector's border, not a gap between
+// projectors, whose overlaps cover it.
 #pragma once
 
 #include <vector>

@@ -8,14 +8,14 @@
 // content pixel (i, j) of a W x H frame is centred at ((i + 0.5) / W, (j + 0.5) / H).
 //
 // Warp and blend grids coarser than the output (MPCDI levels 1 and 2 store e.g. 192x108 samples
-// for a 1920x1080 projector) are sampled "corner-aligned on pixel centres": grid sample (i, j) of a
-// Gw x Gh grid sits on output pixel centre (i * (W - 1) / (Gw - 1), j * (H - 1) / (Gh - 1)) of a
-// W x H output (0 when Gw or W is 1), so sample (0, 0) is the top-left pixel, sample
-// (Gw-1, Gh-1) the bottom-right pixel, and a per-pixel grid (Gw = W) is used as is. Between
-// samples the value is bilinear. In GL terms: texture coordinate
-// s = (x * (Gw - 1) / (W - 1) + 0.5) / Gw for output pixel x, GL_LINEAR, CLAMP_TO_EDGE.
-// The CPU definition is sample_warp()/sample_blend() in appliance/warp/warp_sampling.h; the
-// checks (sizes, finiteness, ranges) are in appliance/warp/calibration_validation.h.
+// for a 1920x1080 projector) are sampled like a GL texture: an M-sample grid covers the whole
+// W-pixel output, grid sample k is centred at output image position (k + 0.5) * W / M, and output
+// pixel centre p = x + 0.5 reads grid position g = p * M / W - 0.5 (sample k at g = k), bilinear
+// between samples, clamped to the edge samples. With M = W this is exactly one sample per pixel.
+// In GL terms: texture coordinate (x + 0.5) / W with GL_LINEAR and CLAMP_TO_EDGE (drivers/egl
+// does the same bilinear with texelFetch, docs/outputs.md). The CPU definition is
+// sample_warp()/sample_blend() in appliance/warp/warp_sampling.h; the checks (sizes, finiteness,
+// ranges) are in appliance/warp/calibration_validation.h.
 #pragma once
 
 #include <array>

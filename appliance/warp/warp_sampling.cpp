@@ -27,13 +27,11 @@ Taps taps_at(double pixel, int output_extent, int grid_extent) {
 }  // namespace
 
 double output_to_grid(double x, int output_extent, int grid_extent) {
-    if (output_extent <= 1 || grid_extent <= 1) return 0.0;
-    return x * static_cast<double>(grid_extent - 1) / static_cast<double>(output_extent - 1);
+    return (x + 0.5) * static_cast<double>(grid_extent) / static_cast<double>(output_extent) - 0.5;
 }
 
 double grid_to_output(double g, int output_extent, int grid_extent) {
-    if (output_extent <= 1 || grid_extent <= 1) return 0.0;
-    return g * static_cast<double>(output_extent - 1) / static_cast<double>(grid_extent - 1);
+    return (g + 0.5) * static_cast<double>(output_extent) / static_cast<double>(grid_extent) - 0.5;
 }
 
 ContentUv sample_warp(const WarpMap& warp, ImageSize output, int x, int y) {

@@ -1,12 +1,12 @@
 // How a warp or blend grid is read at an output pixel: the one CPU definition that the GL backend
-// (drivers/) mirrors with a GL_LINEAR, CLAMP_TO_EDGE texture (see projector_calibration.h).
+// (drivers/egl, docs/outputs.md) implements in its shader (see projector_calibration.h).
 //
-// Grid convention ("corner-aligned on pixel centres"): for an output of W pixels and a grid of G
+// Grid convention (texel centres, as a GL texture): for an output of W pixels and a grid of M
 // samples along one axis, output pixel x (centre x + 0.5) reads grid position
-// g = x * (G - 1) / (W - 1) (g = 0 when G == 1 or W == 1). Sample 0 is the first pixel's centre,
-// sample G - 1 the last pixel's centre, so a per-pixel grid (G = W) gives g = x exactly. Between
-// samples the value is bilinear in g. This matches MPCDI's coarse level-1/2 grids, whose first and
-// last samples belong to the projector's first and last pixels (VESA MPCDI v1.0, geometry warp file).
+// g = (x + 0.5) * M / W - 0.5, sample k being at g = k; bilinear between samples, clamped to the
+// first and last sample. A per-pixel grid (M = W) gives g = x exactly. For a coarse grid the
+// outermost W / (2M) - 0.5 pixels on each side read the edge sample unchanged (e.g. 4.5 px for an
+// MPCDI level-1 grid of a tenth of the resolution).
 #pragma once
 
 #include "appliance/warp/projector_calibration.h"

@@ -94,4 +94,42 @@ Result<GlProgram> link_program(std::string_view vertex_source, std::string_view 
     return program;
 }
 
+Result<GlRenderTarget> make_render_target(ImageSize size) {
+    GlRenderTarget target;
+    target.size = size;
+    target.color = make_renderbuffer();
+    glBindRenderbuffer(GL_RENDERBUFFER, target.color.get());
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, size.width, size.height);
+    target.fbo = make_framebuffer();
+    glBindFramebuffer(GL_FRAMEBUFFER, target.fbo.get());
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, target.color.get());
+    if (auto s = gl_check("make_render_target"); !s) return s.error();
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+        return make_error(EIO, "RGBA8 framebuffer " + std::to_string(size.width) + "x" + std::to_string(size.height) +
+                                   " is incomplete");
+    }
+    return target;
+}
+
+Status read_rgb8(ImageSize size, Rgb8Image& out, std::vector<std::uint8_t>& scratch) {
+    const auto w = static_cast<std::size_t>(size.width);
+    const auto h = static_cast<std::size_t>(size.height);
+    scratch.resize(w * h * 4);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    // GL_RGBA/GL_UNSIGNED_BYTE is the one read format every GLES 3 implementation accepts.
+    glReadPixels(0, 0, size.width, size.height, GL_RGBA, GL_UNSIGNED_BYTE, scratch.data());
+    if (auto s = gl_check("glReadPixels"); !s) return s;
+    if (!(out.size == size)) out = Rgb8Image(size);
+    for (std::size_t y = 0; y < h; ++y) {
+        const std::uint8_t* src = scratch.data() + (h - 1 - y) * w * 4;
+        std::uint8_t* dst = out.pixels.data() + y * w * 3;
+        for (std::size_t x = 0; x < w; ++x) {
+            dst[x * 3 + 0] = src[x * 4 + 0];
+            dst[x * 3 + 1] = src[x * 4 + 1];
+            dst[x * 3 + 2] = src[x * 4 + 2];
+        }
+    }
+    return {};
+}
+
 }  // namespace mogao

@@ -5,10 +5,13 @@
 
 #include <GLES3/gl3.h>
 
+#include <cstdint>
 #include <string_view>
+#include <vector>
 #include <utility>
 
 #include "drivers/result.h"
+#include "renderfarm/view/image.h"
 
 namespace mogao {
 
@@ -63,5 +66,20 @@ using GlProgram = GlObject<&gl_detail::delete_program>;
 
 // Compiles a vertex + fragment shader pair and links them; EIO with the info log on failure.
 [[nodiscard]] Result<GlProgram> link_program(std::string_view vertex_source, std::string_view fragment_source);
+
+// An offscreen colour target: GL_RGBA8 renderbuffer attached to a framebuffer object.
+struct GlRenderTarget {
+    ImageSize size;
+    GlRenderbuffer color;
+    GlFramebuffer fbo;
+};
+
+// Makes a complete RGBA8 FBO of `size` (leaves it bound to GL_FRAMEBUFFER); EIO if incomplete.
+[[nodiscard]] Result<GlRenderTarget> make_render_target(ImageSize size);
+
+// Reads the framebuffer bound to GL_READ_FRAMEBUFFER, rectangle (0, 0, size), into `out` as RGB8
+// with rows top first (GL row 0 is the bottom, so rows are flipped). `scratch` is reused RGBA
+// memory so a per-frame readback does not allocate.
+[[nodiscard]] Status read_rgb8(ImageSize size, Rgb8Image& out, std::vector<std::uint8_t>& scratch);
 
 }  // namespace mogao

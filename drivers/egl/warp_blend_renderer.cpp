@@ -307,40 +307,15 @@ Status WarpBlendRenderer::draw(std::size_t index) {
 Result<Rgb8Image> WarpBlendRenderer::render(std::size_t index) {
     if (auto s = check_index(index); !s) return s.error();
     Projector& p = projectors_[index];
-    if (!p.fbo.valid()) {
-        GlRenderbuffer color = make_renderbuffer();
-        glBindRenderbuffer(GL_RENDERBUFFER, color.get());
-        glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, p.output.width, p.output.height);
-        GlFramebuffer fbo = make_framebuffer();
-        glBindFramebuffer(GL_FRAMEBUFFER, fbo.get());
-        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color.get());
-        if (auto s = gl_check("create output FBO"); !s) return s.error();
-        if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-            return make_error(EIO, "output FBO " + size_text(p.output) + " is incomplete");
-        }
-        p.color = std::move(color);
-        p.fbo = std::move(fbo);
+    if (!p.target.fbo.valid()) {
+        auto target = make_render_target(p.output);
+        if (!target) return with_context(target.error(), "projector " + std::to_string(index));
+        p.target = std::move(target.value());
     }
-    glBindFramebuffer(GL_FRAMEBUFFER, p.fbo.get());
+    glBindFramebuffer(GL_FRAMEBUFFER, p.target.fbo.get());
     if (auto s = draw(index); !s) return s.error();
-
-    const auto w = static_cast<std::size_t>(p.output.width);
-    const auto h = static_cast<std::size_t>(p.output.height);
-    readback_.resize(w * h * 4);
-    glPixelStorei(GL_PACK_ALIGNMENT, 4);
-    // GL_RGBA/GL_UNSIGNED_BYTE is the one read format every GLES 3 implementation accepts.
-    glReadPixels(0, 0, p.output.width, p.output.height, GL_RGBA, GL_UNSIGNED_BYTE, readback_.data());
-    if (auto s = gl_check("glReadPixels"); !s) return s.error();
     Rgb8Image out(p.output);
-    for (std::size_t y = 0; y < h; ++y) {
-        const std::uint8_t* src = readback_.data() + (h - 1 - y) * w * 4;  // GL row 0 is the bottom
-        std::uint8_t* dst = out.pixels.data() + y * w * 3;
-        for (std::size_t x = 0; x < w; ++x) {
-            dst[x * 3 + 0] = src[x * 4 + 0];
-            dst[x * 3 + 1] = src[x * 4 + 1];
-            dst[x * 3 + 2] = src[x * 4 + 2];
-        }
-    }
+    if (auto s = read_rgb8(p.output, out, readback_); !s) return s.error();
     return out;
 }
 

@@ -74,8 +74,7 @@ private:
         GlTexture warp;
         GlTexture blend;
         GlTexture lut;
-        GlRenderbuffer color;  // render() target, made on first use
-        GlFramebuffer fbo;
+        GlRenderTarget target;  // render()'s FBO, made on first use
     };
 
     WarpBlendRenderer() = default;

@@ -52,10 +52,10 @@ struct LinkClientStats {
     std::uint64_t requests_submitted = 0;
     std::uint64_t requests_sent = 0;
     std::uint64_t requests_coalesced = 0;  // replaced by a newer one before they could be sent
-    std::uint64_t frames_received = 0;     // delivered to the callback
+    std::uint64_t frames_received = 0;     // delivered to the callback (counted when it returns)
     std::uint64_t frames_discarded = 0;    // malformed, or answering a request older than one delivered
     std::uint64_t bytes_received = 0;      // JPEG bytes delivered
-    std::uint64_t last_request_id = 0;     // of the last frame delivered
+    std::uint64_t last_request_id = 0;     // of the last frame whose callback returned
     // Over the last stats_window frames (0 until two frames arrived):
     double last_latency_ms = 0;  // request_time_ns (appliance clock) -> frame receipt (appliance clock)
     double mean_latency_ms = 0;

@@ -54,7 +54,7 @@ struct LinkServer::Impl final : v1::Tour::Service {
     mutable std::mutex mutex;
     std::condition_variable work_cv;  // render workers: a session became ready, or stopping
     std::condition_variable out_cv;   // session handlers: a frame is queued, or a session closed
-    std::vector<std::shared_ptr<Session>> sessions;
+    std::vector<std::shared_ptr<SessionState>> sessions;
     std::size_t next_pick = 0;
     std::uint64_t next_session_id = 1;
     bool stopping = false;
@@ -82,6 +82,14 @@ std::string common_name(const grpc::ServerContext& ctx) {
     return names.empty() ? "?" : std::string(names.front().data(), names.front().size());
 }
 
+// gRPC percent-encodes the brackets of IPv6 peers ("ipv6:%5B::1%5D:5000"); logs read better without.
+std::string readable_peer(std::string peer) {
+    for (const auto& [from, to] : {std::pair{"%5B", "["}, std::pair{"%5D", "]"}}) {
+        if (const auto at = peer.find(from); at != std::string::npos) peer.replace(at, 3, to);
+    }
+    return peer;
+}
+
 void check_options(const LinkServerOptions& o) {
     const auto range = [](const char* name, int v, int lo, int hi) {
         if (v < lo || v > hi) {
@@ -98,7 +106,7 @@ void check_options(const LinkServerOptions& o) {
 
 grpc::Status LinkServer::Impl::admit(grpc::ServerContext* ctx, std::shared_ptr<SessionState>& out) {
     auto s = std::make_shared<SessionState>();
-    s->peer = ctx->peer();
+    s->peer = readable_peer(ctx->peer());
     s->identity = common_name(*ctx);
     const auto refuse = [&](grpc::StatusCode code, const std::string& why) {
         link_log().warn("refused {} from {}: {}", s->identity, s->peer, why);

@@ -10,7 +10,7 @@
 
 #include "renderfarm/link/link_types.h"
 #include "renderfarm/link/openssl_util.h"
-#include "renderfarm/link/unique_fd.h"
+#include "drivers/unique_fd.h"
 
 namespace mogao {
 

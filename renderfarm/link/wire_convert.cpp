@@ -150,17 +150,19 @@ std::string view_from_msg(const v1::ViewRequestMsg& msg, ViewRequest& out) {
     for (const auto& f : fields) {
         if (auto e = check_range(f.name, f.value, f.lo, f.hi); !e.empty()) return e;
     }
-    out = ViewRequest{};
+    // Every field of `out` is assigned below (no `out = ViewRequest{}`: GCC 12 with sanitizers
+    // then reports a false maybe-uninitialized in the variant's move).
     out.frame_id = msg.request_id();
     out.pose = pose_from(msg.pose());
     switch (msg.camera_case()) {
     case v1::ViewRequestMsg::kPinhole:
-        out.camera = PinholeCamera{msg.pinhole().vertical_fov_deg()};
+        out.camera.emplace<PinholeCamera>(PinholeCamera{msg.pinhole().vertical_fov_deg()});
         break;
     case v1::ViewRequestMsg::kCylinder: {
         const auto& c = msg.cylinder();
         if (!c.has_eye_m()) return "cylinder.eye_m is missing";
-        out.camera = CylinderScreen{c.radius_m(), c.arc_deg(), c.bottom_m(), c.top_m(), vec_from(c.eye_m())};
+        out.camera.emplace<CylinderScreen>(
+            CylinderScreen{c.radius_m(), c.arc_deg(), c.bottom_m(), c.top_m(), vec_from(c.eye_m())});
         break;
     }
     default:

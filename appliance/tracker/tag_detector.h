@@ -1,0 +1,66 @@
+// TagDetector: AprilTag 3 detection of one family in grey images (Wang & Olson, "AprilTag 2:
+// Efficient and robust fiducial detection", IROS 2016; AprilTag 3 is its successor library).
+// Owns one apriltag_detector_t and its TagFamily (RAII, move-only); not thread-safe.
+//
+// Corner order (AprilTag's): the four corners wrap counter-clockwise as seen in the image (y
+// down) when the tag is upright: corners[0] bottom-left, [1] bottom-right, [2] top-right,
+// [3] top-left of the tag as printed (tag_bitmap.h), i.e. the homography maps the ideal tag
+// corners (-1, 1), (1, 1), (1, -1), (-1, -1) (x right, y down) to corners[0..3].
+//
+// Pixel convention (AprilTag 3.3's, measured: tag_detector_test, tracker_bench): sub-pixel
+// positions with the CENTRE of the top-left pixel at (0.5, 0.5), i.e. (0, 0) is the top-left
+// corner of the image -- the same as mogao's frame convention (docs/architecture.md). OpenCV
+// (and so the camera intrinsics) puts that centre at (0, 0): solve_tag_pose subtracts 0.5.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "appliance/tracker/detector_settings.h"
+#include "appliance/tracker/tag_family.h"
+#include "drivers/camera/camera_frame.h"
+
+struct apriltag_detector;
+
+namespace mogao {
+
+struct TagDetection {
+    int id = 0;
+    int hamming = 0;                         // bits corrected to decode
+    float decision_margin = 0.0f;            // mean distance of the bit values from the threshold (AprilTag's)
+    std::array<Eigen::Vector2d, 4> corners;  // pixels, AprilTag order, pixel centres at +0.5 (above)
+    Eigen::Vector2d centre;                  // pixels, image of the tag centre (homography)
+};
+
+class TagDetector {
+public:
+    // Throws std::invalid_argument for bad settings (validate()) or an unknown family.
+    explicit TagDetector(const DetectorSettings& settings = {});
+    TagDetector(TagDetector&&) noexcept;
+    TagDetector& operator=(TagDetector&&) noexcept;
+    TagDetector(const TagDetector&) = delete;
+    TagDetector& operator=(const TagDetector&) = delete;
+    ~TagDetector();
+
+    // Every tag of the family in `image`, sorted by id; `image` is not modified. Throws
+    // std::invalid_argument for an image that is not valid() or wider/taller than
+    // kMaxCaptureDimension.
+    [[nodiscard]] std::vector<TagDetection> detect(const GrayImage& image);
+
+    [[nodiscard]] const DetectorSettings& settings() const { return settings_; }
+    [[nodiscard]] const TagFamily& family() const { return *family_; }
+
+private:
+    struct DetectorDeleter {
+        void operator()(apriltag_detector* d) const noexcept;
+    };
+    DetectorSettings settings_;
+    std::vector<std::uint8_t> scratch_;  // a copy of the image when AprilTag would blur it in place
+    std::unique_ptr<TagFamily> family_;  // heap: its address must not change while the detector uses it
+    std::unique_ptr<apriltag_detector, DetectorDeleter> detector_;  // destroyed before family_
+};
+
+}  // namespace mogao

@@ -1,0 +1,58 @@
+// What every capture source delivers: one 8-bit grey (luma) image and when it was taken.
+//
+// The tracker only needs luma (AprilTag detects on grey), so every source converts to grey as it
+// captures: GREY is copied, YUYV keeps its Y bytes, MJPEG is decoded straight to grey by TurboJPEG
+// (cheaper than decoding colour and converting). Colour is never kept.
+//
+// Pixels: row-major, top row first, no padding between rows. Pixel (x, y) covers [x, x+1) x
+// [y, y+1); its centre is at (x + 0.5, y + 0.5) (docs/architecture.md). AprilTag 3.3 reports
+// corners in this convention too; OpenCV (and so camera intrinsics) puts the top-left pixel's
+// centre at (0, 0). docs/tracking.md says where each is used.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace mogao {
+
+struct GrayImage {
+    int width = 0;                     // pixels
+    int height = 0;                    // pixels
+    std::vector<std::uint8_t> pixels;  // width * height values, 0 = black, 255 = white
+
+    GrayImage() = default;
+    GrayImage(int w, int h, std::uint8_t fill = 0)
+        : width(w), height(h), pixels(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), fill) {}
+
+    [[nodiscard]] bool valid() const {
+        return width > 0 && height > 0 &&
+               pixels.size() == static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+    }
+    [[nodiscard]] std::uint8_t at(int x, int y) const {
+        return pixels[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)];
+    }
+};
+
+// Where a frame's timestamp comes from.
+enum class TimestampSource {
+    kernel_monotonic,   // the driver's buffer timestamp, CLOCK_MONOTONIC (V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC):
+                        // when the first byte of the frame was captured (V4L2 "start of exposure" is
+                        // driver-specific; uvcvideo stamps the start of the frame)
+    dequeue_monotonic,  // the driver gave no monotonic stamp: CLOCK_MONOTONIC read when the buffer was dequeued
+    replay,             // from the replay folder's timestamps.txt, or index / fps
+};
+
+// The pixel format the frame had on the wire, before conversion to grey.
+enum class CaptureFormat { grey, yuyv, mjpeg, image_file };
+
+struct CameraFrame {
+    GrayImage image;
+    std::int64_t timestamp_ns = 0;  // see `clock`; only differences between frames of one source are meaningful
+    TimestampSource clock = TimestampSource::replay;
+    std::uint64_t sequence = 0;  // driver's frame counter (V4L2 sequence) or index in the replay
+    std::uint32_t skipped = 0;   // older frames that were ready but dropped to deliver this, the newest
+    CaptureFormat format = CaptureFormat::grey;
+};
+
+}  // namespace mogao

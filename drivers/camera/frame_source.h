@@ -1,0 +1,33 @@
+// The one interface the tracker reads frames from: a V4L2 camera (v4l2_capture.h) or a folder of
+// images (replay_source.h). A libcamera backend is not implemented (docs/tracking.md, "left").
+//
+// Errors follow drivers/result.h: next_frame() never throws. Codes a caller can branch on:
+//   ENODATA    a finite source (replay without loop) has no more frames
+//   ETIMEDOUT  no frame arrived within the source's timeout (camera unplugged, stalled stream)
+//   EBADMSG    one frame could not be decoded (corrupt MJPEG, unreadable image); the next may work
+//   other      errno of the failed system call (ENODEV after an unplug, EIO, ...)
+#pragma once
+
+#include <string>
+
+#include "drivers/camera/camera_frame.h"
+#include "drivers/result.h"
+
+namespace mogao {
+
+class FrameSource {
+public:
+    virtual ~FrameSource() = default;
+    FrameSource() = default;
+    FrameSource(const FrameSource&) = delete;
+    FrameSource& operator=(const FrameSource&) = delete;
+
+    // Blocks until a frame is available and returns the newest one (a camera drops older frames
+    // that queued up while the caller was busy, and says how many in CameraFrame::skipped).
+    [[nodiscard]] virtual Result<CameraFrame> next_frame() = 0;
+
+    // One line for logs: device or folder, size, format.
+    [[nodiscard]] virtual std::string description() const = 0;
+};
+
+}  // namespace mogao

@@ -1,0 +1,66 @@
+// Prints milliseconds per projector output for this machine's GL (llvmpipe without a GPU):
+// content upload, draw (glFinish'ed) and draw + readback, for one output of --output WxH.
+// Usage: mogao_warp_blend_bench [width height [content_width content_height [frames]]]
+#include <GLES3/gl3.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+
+#include "drivers/egl/egl_display.h"
+#include "drivers/egl/test_pattern.h"
+#include "drivers/egl/warp_blend_renderer.h"
+
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+int arg(int argc, char** argv, int i, int fallback) { return argc > i ? std::atoi(argv[i]) : fallback; }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    using namespace mogao;
+    const ImageSize output{arg(argc, argv, 1, 1024), arg(argc, argv, 2, 768)};
+    const ImageSize content_size{arg(argc, argv, 3, 2048), arg(argc, argv, 4, 1024)};
+    const int frames = arg(argc, argv, 5, 20);
+    if (output.width <= 0 || output.height <= 0 || content_size.width <= 0 || content_size.height <= 0 || frames <= 0) {
+        std::fprintf(stderr, "usage: %s [width height [content_width content_height [frames]]]\n", argv[0]);
+        return 2;
+    }
+    auto display = EglDisplay::open_surfaceless();
+    if (!display) return std::fprintf(stderr, "%s\n", display.error().message.c_str()), 77;
+    auto context = EglContext::create(display.value(), EGL_NO_CONFIG_KHR);
+    if (!context || !context->make_current()) return std::fprintf(stderr, "no GLES 3 context\n"), 1;
+    {
+        auto renderer = WarpBlendRenderer::create();
+        if (!renderer) return std::fprintf(stderr, "%s\n", renderer.error().message.c_str()), 1;
+        const Rgb8Image content = make_test_pattern(content_size);
+        auto index = renderer->add_projector(identity_calibration("bench", output));
+        if (!index) return std::fprintf(stderr, "%s\n", index.error().message.c_str()), 1;
+        if (!renderer->set_content(content) || !renderer->render(*index)) return 1;  // warm-up (shader JIT)
+
+        double upload = 0, draw = 0, readback = 0;
+        for (int f = 0; f < frames; ++f) {
+            auto t0 = std::chrono::steady_clock::now();
+            if (!renderer->set_content(content)) return 1;
+            glFinish();
+            upload += ms_since(t0);
+            t0 = std::chrono::steady_clock::now();
+            if (!renderer->draw(*index)) return 1;  // into render()'s FBO, still bound
+            glFinish();
+            draw += ms_since(t0);
+            t0 = std::chrono::steady_clock::now();
+            if (!renderer->render(*index)) return 1;
+            readback += ms_since(t0);
+        }
+        std::printf("renderer: %s\n", reinterpret_cast<const char*>(glGetString(GL_RENDERER)));
+        std::printf("output %dx%d, content %dx%d, %d frames (mean ms)\n", output.width, output.height,
+                    content_size.width, content_size.height, frames);
+        std::printf("  upload content  %8.2f\n  draw            %8.2f\n  draw + readback %8.2f\n", upload / frames,
+                    draw / frames, readback / frames);
+    }
+    return 0;
+}

@@ -1,0 +1,408 @@
+// WarpBlendRenderer against a CPU reference written here (reference_render, a pure function of
+// the content and the calibration, in double precision), plus hand-computed expectations for
+// the properties that matter on the wall: orientation, half-pixel sampling, NaN = black,
+// attenuation in linear light, the response LUT, and a golden PNG.
+#include "drivers/egl/warp_blend_renderer.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <thread>
+
+#include "drivers/egl/egl_test_support.h"
+#include "drivers/egl/test_pattern.h"
+#include "renderfarm/encode/png_io.h"
+
+namespace mogao {
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+double srgb_decode(std::uint8_t code) {
+    const double e = code / 255.0;
+    return e <= 0.04045 ? e / 12.92 : std::pow((e + 0.055) / 1.055, 2.4);
+}
+
+double srgb_encode(double x) { return x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055; }
+
+int to_code(double x) { return static_cast<int>(std::lround(std::clamp(x, 0.0, 1.0) * 255.0)); }
+
+// Bilinear taps in texel-centre coordinates with edge clamping, as docs/outputs.md specifies.
+struct Taps {
+    int x0, y0, x1, y1;
+    double fx, fy;
+    [[nodiscard]] double w(int k) const {
+        const double wx = (k & 1) != 0 ? fx : 1.0 - fx;
+        const double wy = (k & 2) != 0 ? fy : 1.0 - fy;
+        return wx * wy;
+    }
+    [[nodiscard]] int x(int k) const { return (k & 1) != 0 ? x1 : x0; }
+    [[nodiscard]] int y(int k) const { return (k & 2) != 0 ? y1 : y0; }
+};
+
+Taps taps_at(double qx, double qy, ImageSize size) {
+    const double bx = std::floor(qx);
+    const double by = std::floor(qy);
+    const auto ix = static_cast<int>(bx);
+    const auto iy = static_cast<int>(by);
+    return {std::clamp(ix, 0, size.width - 1), std::clamp(iy, 0, size.height - 1),
+            std::clamp(ix + 1, 0, size.width - 1), std::clamp(iy + 1, 0, size.height - 1), qx - bx, qy - by};
+}
+
+std::size_t at(ImageSize s, int x, int y) {
+    return static_cast<std::size_t>(y) * static_cast<std::size_t>(s.width) + static_cast<std::size_t>(x);
+}
+
+// The CPU reference: see the maths in warp_blend_renderer.h.
+Rgb8Image reference_render(const Rgb8Image& content, const ProjectorCalibration& c) {
+    Rgb8Image out(c.output);
+    // Scales in float, as the renderer passes them to the shader.
+    const double wsx = static_cast<float>(c.warp.size.width) / static_cast<float>(c.output.width);
+    const double wsy = static_cast<float>(c.warp.size.height) / static_cast<float>(c.output.height);
+    const double bsx = static_cast<float>(c.blend.size.width) / static_cast<float>(c.output.width);
+    const double bsy = static_cast<float>(c.blend.size.height) / static_cast<float>(c.output.height);
+    const std::size_t n = c.response.lut[0].size();
+    for (int y = 0; y < c.output.height; ++y) {
+        for (int x = 0; x < c.output.width; ++x) {
+            const double px = x + 0.5;
+            const double py = y + 0.5;
+            const Taps wt = taps_at(px * wsx - 0.5, py * wsy - 0.5, c.warp.size);
+            double u = 0.0;
+            double v = 0.0;
+            bool black = false;
+            for (int k = 0; k < 4; ++k) {
+                const float* t = &c.warp.uv[at(c.warp.size, wt.x(k), wt.y(k)) * 2];
+                const bool valid = std::isfinite(t[0]) && std::isfinite(t[1]);
+                if (!valid) {
+                    black = black || wt.w(k) > 0.0;
+                    continue;
+                }
+                u += wt.w(k) * std::clamp(static_cast<double>(t[0]), -1.0, 2.0);
+                v += wt.w(k) * std::clamp(static_cast<double>(t[1]), -1.0, 2.0);
+            }
+            std::uint8_t* dst = out.at(x, y);
+            if (black) {
+                dst[0] = dst[1] = dst[2] = 0;
+                continue;
+            }
+            const Taps bt = taps_at(px * bsx - 0.5, py * bsy - 0.5, c.blend.size);
+            double weight = 0.0;
+            for (int k = 0; k < 4; ++k) weight += bt.w(k) * c.blend.weight[at(c.blend.size, bt.x(k), bt.y(k))];
+            const Taps ct = taps_at(u * content.size.width - 0.5, v * content.size.height - 0.5, content.size);
+            for (int ch = 0; ch < 3; ++ch) {
+                double linear = 0.0;
+                for (int k = 0; k < 4; ++k) linear += ct.w(k) * srgb_decode(content.at(ct.x(k), ct.y(k))[ch]);
+                const double pos = std::clamp(linear * weight, 0.0, 1.0) * static_cast<double>(n - 1);
+                const auto i = std::min(static_cast<std::size_t>(pos), n - 2);
+                const double f = pos - static_cast<double>(i);
+                const auto& lut = c.response.lut[static_cast<std::size_t>(ch)];
+                dst[ch] = static_cast<std::uint8_t>(to_code(lut[i] * (1.0 - f) + lut[i + 1] * f));
+            }
+        }
+    }
+    return out;
+}
+
+struct Diff {
+    int max = 0;
+    int x = -1, y = -1;
+};
+
+Diff max_abs_diff(const Rgb8Image& a, const Rgb8Image& b) {
+    Diff d;
+    EXPECT_EQ(a.size, b.size);
+    if (!(a.size == b.size)) return {255, 0, 0};
+    for (int y = 0; y < a.size.height; ++y) {
+        for (int x = 0; x < a.size.width; ++x) {
+            for (int ch = 0; ch < 3; ++ch) {
+                const int diff = std::abs(int{a.at(x, y)[ch]} - int{b.at(x, y)[ch]});
+                if (diff > d.max) d = {diff, x, y};
+            }
+        }
+    }
+    return d;
+}
+
+// Deterministic busy content (LCG), every channel using the full 0..255 range.
+Rgb8Image noise_content(ImageSize size, std::uint32_t seed) {
+    Rgb8Image img(size);
+    for (auto& v : img.pixels) {
+        seed = seed * 1664525u + 1013904223u;
+        v = static_cast<std::uint8_t>(seed >> 24);
+    }
+    return img;
+}
+
+Rgb8Image uniform_content(ImageSize size, std::uint8_t value) { return Rgb8Image(size, value); }
+
+ProjectorCalibration with_uniform_blend(ProjectorCalibration c, float weight) {
+    c.blend.size = {1, 1};
+    c.blend.weight = {weight};
+    return c;
+}
+
+// A realistic calibration: a coarse (1/4 resolution) barrel-ish warp over part of the content
+// with a NaN patch, a coarse blend ramp (edge blend on the right), a different gamma per channel.
+ProjectorCalibration busy_calibration(ImageSize output) {
+    ProjectorCalibration c;
+    c.id = "busy";
+    c.output = output;
+    c.warp.size = {output.width / 4, output.height / 4};
+    c.warp.uv.resize(static_cast<std::size_t>(c.warp.size.pixel_count()) * 2);
+    for (int y = 0; y < c.warp.size.height; ++y) {
+        for (int x = 0; x < c.warp.size.width; ++x) {
+            const double sx = (x + 0.5) / c.warp.size.width - 0.5;  // -0.5..0.5
+            const double sy = (y + 0.5) / c.warp.size.height - 0.5;
+            const double r2 = sx * sx + sy * sy;
+            float* t = &c.warp.uv[at(c.warp.size, x, y) * 2];
+            t[0] = static_cast<float>(0.55 + 0.8 * sx * (1.0 + 0.3 * r2));
+            t[1] = static_cast<float>(0.5 + 0.9 * sy * (1.0 + 0.3 * r2) + 0.05 * sx);
+            if (x < 3 && y < 2) t[0] = t[1] = kNaN;  // outside the screen
+        }
+    }
+    c.blend.size = {output.width / 8, 3};
+    c.blend.weight.resize(static_cast<std::size_t>(c.blend.size.pixel_count()));
+    for (int y = 0; y < c.blend.size.height; ++y) {
+        for (int x = 0; x < c.blend.size.width; ++x) {
+            const double t = std::clamp((x + 0.5) / c.blend.size.width * 3.0 - 1.5, 0.0, 1.0);
+            c.blend.weight[at(c.blend.size, x, y)] = static_cast<float>(1.0 - t * (0.6 + 0.1 * y));
+        }
+    }
+    const double gammas[3] = {1.8, 2.2, 2.6};
+    for (std::size_t ch = 0; ch < 3; ++ch) c.response.lut[ch] = gamma_response(gammas[ch], 257).lut[ch];
+    return c;
+}
+
+class WarpBlendRendererTest : public mogao::testing::GlTest {
+protected:
+    void SetUp() override {
+        GlTest::SetUp();
+        if (IsSkipped() || HasFatalFailure()) return;
+        auto r = WarpBlendRenderer::create();
+        ASSERT_TRUE(r) << r.error().message;
+        renderer_.emplace(std::move(r.value()));
+    }
+    void TearDown() override {
+        renderer_.reset();  // while the context is current
+        GlTest::TearDown();
+    }
+
+    Rgb8Image render(const Rgb8Image& content, const ProjectorCalibration& c) {
+        EXPECT_TRUE(renderer_->set_content(content).ok());
+        auto index = renderer_->add_projector(c);
+        EXPECT_TRUE(index) << index.error().message;
+        if (!index) return {};
+        auto image = renderer_->render(index.value());
+        EXPECT_TRUE(image) << image.error().message;
+        return image ? std::move(image).value() : Rgb8Image{};
+    }
+
+    std::optional<WarpBlendRenderer> renderer_;
+};
+
+TEST_F(WarpBlendRendererTest, IdentityReproducesContent) {
+    const ImageSize size{37, 23};  // odd sizes: no accidental power-of-two exactness
+    const Rgb8Image content = noise_content(size, 1);
+    const Rgb8Image out = render(content, identity_calibration("p0", size));
+    const Diff d = max_abs_diff(out, content);
+    EXPECT_LE(d.max, 1) << "at (" << d.x << ", " << d.y << ")";
+}
+
+TEST_F(WarpBlendRendererTest, WholePixelShiftKeepsOrientation) {
+    // Content column x has red = 10 * x, row y has green = 20 * y; sampling at content pixel
+    // (x + 1, y + 1) must give output (x, y) those values: catches flipped rows or columns.
+    const ImageSize content_size{16, 8};
+    Rgb8Image content(content_size);
+    for (int y = 0; y < content_size.height; ++y) {
+        for (int x = 0; x < content_size.width; ++x) {
+            content.at(x, y)[0] = static_cast<std::uint8_t>(10 * x);
+            content.at(x, y)[1] = static_cast<std::uint8_t>(20 * y);
+            content.at(x, y)[2] = 77;
+        }
+    }
+    ProjectorCalibration c = identity_calibration("shift", {15, 7});
+    for (int y = 0; y < 7; ++y) {
+        for (int x = 0; x < 15; ++x) {
+            c.warp.uv[at(c.warp.size, x, y) * 2] = static_cast<float>((x + 1.5) / 16.0);
+            c.warp.uv[at(c.warp.size, x, y) * 2 + 1] = static_cast<float>((y + 1.5) / 8.0);
+        }
+    }
+    const Rgb8Image out = render(content, c);
+    for (int y = 0; y < 7; ++y) {
+        for (int x = 0; x < 15; ++x) {
+            EXPECT_NEAR(out.at(x, y)[0], 10 * (x + 1), 1) << x << "," << y;
+            EXPECT_NEAR(out.at(x, y)[1], 20 * (y + 1), 1) << x << "," << y;
+            EXPECT_NEAR(out.at(x, y)[2], 77, 1) << x << "," << y;
+        }
+    }
+}
+
+TEST_F(WarpBlendRendererTest, HalfPixelShiftAveragesNeighboursInLinearLight) {
+    // Columns alternate black/white; sampling halfway between two column centres gives linear
+    // 0.5, which the sRGB response encodes as 188 -- not 128, the average of the codes.
+    const ImageSize content_size{16, 4};
+    Rgb8Image content(content_size);
+    for (int y = 0; y < 4; ++y) {
+        for (int x = 0; x < 16; ++x) std::fill_n(content.at(x, y), 3, static_cast<std::uint8_t>(x % 2 == 0 ? 0 : 255));
+    }
+    ProjectorCalibration c = identity_calibration("half", {15, 4});
+    for (int y = 0; y < 4; ++y) {
+        for (int x = 0; x < 15; ++x) {
+            c.warp.uv[at(c.warp.size, x, y) * 2] = static_cast<float>((x + 1.0) / 16.0);  // between x and x+1
+            c.warp.uv[at(c.warp.size, x, y) * 2 + 1] = static_cast<float>((y + 0.5) / 4.0);
+        }
+    }
+    const Rgb8Image out = render(content, c);
+    ASSERT_EQ(to_code(srgb_encode(0.5)), 188);
+    for (int y = 0; y < 4; ++y) {
+        for (int x = 0; x < 15; ++x) EXPECT_NEAR(out.at(x, y)[1], 188, 1) << x << "," << y;
+    }
+}
+
+TEST_F(WarpBlendRendererTest, NaNWarpGivesBlackEvenWithLiftedResponse) {
+    const ImageSize size{20, 10};
+    ProjectorCalibration c = identity_calibration("nan", size);
+    for (int y = 2; y < 6; ++y) {
+        for (int x = 3; x < 9; ++x) {
+            c.warp.uv[at(size, x, y) * 2] = kNaN;
+            c.warp.uv[at(size, x, y) * 2 + 1] = kNaN;
+        }
+    }
+    for (auto& channel : c.response.lut) {
+        for (auto& v : channel) v = 0.2f + 0.8f * v;  // black level 0.2: NaN must still be 0
+    }
+    const Rgb8Image out = render(uniform_content(size, 200), c);
+    for (int y = 0; y < size.height; ++y) {
+        for (int x = 0; x < size.width; ++x) {
+            const bool inside = x >= 3 && x < 9 && y >= 2 && y < 6;
+            const int expected = inside ? 0 : to_code(0.2 + 0.8 * (200 / 255.0));
+            EXPECT_NEAR(out.at(x, y)[0], expected, 1) << x << "," << y;
+        }
+    }
+}
+
+TEST_F(WarpBlendRendererTest, BlendHalvesLinearLightNotCodes) {
+    const ImageSize size{8, 8};
+    const Rgb8Image out = render(uniform_content(size, 200), with_uniform_blend(identity_calibration("b", size), 0.5f));
+    const int expected = to_code(srgb_encode(0.5 * srgb_decode(200)));
+    ASSERT_EQ(expected, 146);  // 200 -> linear 0.578 -> 0.289 -> sRGB 146 (half the code would be 100)
+    for (int y = 0; y < size.height; ++y) {
+        for (int x = 0; x < size.width; ++x) {
+            for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(out.at(x, y)[ch], expected, 1);
+        }
+    }
+}
+
+TEST_F(WarpBlendRendererTest, Gamma22ResponseIsApplied) {
+    const ImageSize size{256, 1};
+    Rgb8Image ramp(size);
+    for (int x = 0; x < 256; ++x) std::fill_n(ramp.at(x, 0), 3, static_cast<std::uint8_t>(x));
+    ProjectorCalibration c = identity_calibration("g", size);
+    c.response = gamma_response(2.2, 1024);
+    const Rgb8Image out = render(ramp, c);
+    const Diff d = max_abs_diff(out, reference_render(ramp, c));
+    EXPECT_LE(d.max, 2) << "vs CPU reference at code " << d.x;
+    for (int x = 16; x < 256; ++x) {
+        const int analytic = to_code(std::pow(srgb_decode(static_cast<std::uint8_t>(x)), 1.0 / 2.2));
+        EXPECT_NEAR(out.at(x, 0)[0], analytic, 2) << "code " << x;
+    }
+    // Where gamma 2.2 and sRGB differ most (dark codes), the output is not the identity.
+    for (int x = 10; x <= 30; ++x) EXPECT_GE(out.at(x, 0)[0], x + 3) << "code " << x;
+}
+
+TEST_F(WarpBlendRendererTest, BusyCalibrationMatchesCpuReference) {
+    const Rgb8Image content = noise_content({80, 50}, 7);
+    const ProjectorCalibration c = busy_calibration({64, 48});
+    const Rgb8Image out = render(content, c);
+    const Diff d = max_abs_diff(out, reference_render(content, c));
+    EXPECT_LE(d.max, 2) << "at (" << d.x << ", " << d.y << ")";
+    EXPECT_EQ(out.at(0, 0)[0], 0);  // inside the NaN patch
+}
+
+TEST_F(WarpBlendRendererTest, MatchesGoldenPng) {
+    // Regenerate with MOGAO_UPDATE_GOLDEN=1 after an intended change, and look at the file.
+    const std::filesystem::path golden =
+        std::filesystem::path(MOGAO_SOURCE_DIR) / "drivers/egl/testdata/warp_blend_golden.png";
+    const Rgb8Image content = make_test_pattern({96, 64});
+    const ProjectorCalibration c = busy_calibration({128, 96});
+    const Rgb8Image out = render(content, c);
+    EXPECT_LE(max_abs_diff(out, reference_render(content, c)).max, 2);
+    if (std::getenv("MOGAO_UPDATE_GOLDEN") != nullptr) write_png(golden, out);
+    ASSERT_TRUE(std::filesystem::exists(golden)) << golden << " is missing; run with MOGAO_UPDATE_GOLDEN=1";
+    const Diff d = max_abs_diff(out, read_png(golden));
+    EXPECT_LE(d.max, 2) << "at (" << d.x << ", " << d.y << ")";  // tolerance for other GPUs' rounding
+}
+
+TEST_F(WarpBlendRendererTest, ContentSizeMayChangeBetweenFrames) {
+    const ImageSize size{12, 6};
+    auto index = renderer_->add_projector(identity_calibration("p", size));
+    ASSERT_TRUE(index);
+    ASSERT_TRUE(renderer_->set_content(uniform_content({3, 3}, 40)).ok());
+    ASSERT_TRUE(renderer_->render(*index));
+    const Rgb8Image content = noise_content(size, 3);
+    ASSERT_TRUE(renderer_->set_content(content).ok());
+    auto out = renderer_->render(*index);
+    ASSERT_TRUE(out);
+    EXPECT_LE(max_abs_diff(*out, content).max, 1);
+}
+
+TEST_F(WarpBlendRendererTest, ProjectorsRenderIndependently) {
+    const Rgb8Image content = noise_content({30, 20}, 5);
+    ASSERT_TRUE(renderer_->set_content(content).ok());
+    auto a = renderer_->add_projector(identity_calibration("a", {30, 20}));
+    auto b = renderer_->add_projector(with_uniform_blend(identity_calibration("b", {30, 20}), 0.0f));
+    ASSERT_TRUE(a && b);
+    EXPECT_EQ(renderer_->projector_count(), 2u);
+    auto out_b = renderer_->render(*b);
+    auto out_a = renderer_->render(*a);
+    ASSERT_TRUE(out_a && out_b);
+    EXPECT_LE(max_abs_diff(*out_a, content).max, 1);
+    EXPECT_EQ(max_abs_diff(*out_b, Rgb8Image({30, 20}, 0)).max, 0);
+}
+
+TEST_F(WarpBlendRendererTest, RejectsInconsistentInput) {
+    ProjectorCalibration c = identity_calibration("bad", {8, 8});
+    c.warp.uv.pop_back();
+    auto r = renderer_->add_projector(c);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.code(), EINVAL);
+    EXPECT_NE(r.error().message.find("projector 'bad': warp map 8x8"), std::string::npos) << r.error().message;
+
+    c = identity_calibration("lut", {8, 8});
+    c.response.lut[2].pop_back();
+    EXPECT_EQ(renderer_->add_projector(c).code(), EINVAL);
+    c.response.lut = {std::vector<float>{0.5f}, std::vector<float>{0.5f}, std::vector<float>{0.5f}};
+    EXPECT_EQ(renderer_->add_projector(c).code(), EINVAL);
+
+    c = with_uniform_blend(identity_calibration("inf", {8, 8}), std::numeric_limits<float>::infinity());
+    EXPECT_EQ(renderer_->add_projector(c).code(), EINVAL);
+
+    c = identity_calibration("huge", {8, 8});
+    c.output = {1 << 20, 8};
+    EXPECT_EQ(renderer_->add_projector(c).code(), E2BIG);
+
+    EXPECT_EQ(renderer_->projector_count(), 0u);
+    auto ok = renderer_->add_projector(identity_calibration("ok", {8, 8}));
+    ASSERT_TRUE(ok);
+    EXPECT_EQ(renderer_->render(*ok).code(), EINVAL);  // no content yet
+    ASSERT_TRUE(renderer_->set_content(uniform_content({4, 4}, 1)).ok());
+    EXPECT_EQ(renderer_->render(7).code(), EINVAL);
+    Rgb8Image short_frame({4, 4});
+    short_frame.pixels.pop_back();
+    EXPECT_EQ(renderer_->set_content(short_frame).code(), EINVAL);
+}
+
+TEST(WarpBlendRenderer, CreateWithoutCurrentContextIsAnError) {
+    int code = 0;
+    std::thread([&] { code = WarpBlendRenderer::create().code(); }).join();  // a thread has no context
+    EXPECT_EQ(code, EINVAL);
+}
+
+}  // namespace
+}  // namespace mogao

@@ -1,0 +1,90 @@
+// The farm's certificate authority for the link's mutual TLS (OpenSSL 3). One CA per farm signs
+// the farm's server certificate (extendedKeyUsage serverAuth, IP/DNS SANs) and one client
+// certificate per appliance (clientAuth); the farm admits any appliance certificate that chains to
+// it (optionally narrowed by LinkServerOptions::allowed_appliances). Keys: EC P-256 by default
+// (RSA-3072 on request), unencrypted PKCS#8 protected by file mode 0600. See docs/link.md.
+//
+// Files in the PKI folder (every file mode 0600, the folder 0700 when created here):
+//   ca.pem, ca.key                          farm CA (10 years by default)
+//   farm-<name>.pem, farm-<name>.key        farm server certificate (825 days by default)
+//   appliance-<name>.pem, appliance-<name>.key  appliance client certificate (365 days by default)
+// Names: 1..64 of [A-Za-z0-9._-], not starting with '.' or '-'.
+//
+// Errors: PkiError (a std::runtime_error) naming the file or the field and the reason. Existing
+// files are never overwritten unless `force` (then replaced atomically via a temporary + rename).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "renderfarm/link/tls_material.h"
+
+namespace mogao {
+
+struct PkiError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+enum class KeyAlgorithm { ec_p256, rsa_3072 };
+enum class CertRole { ca, farm, appliance };
+
+struct PemPair {
+    std::string cert_pem;
+    std::string key_pem;
+};
+
+inline constexpr std::int64_t kSecondsPerDay = 86'400;
+
+struct CertSpec {
+    CertRole role = CertRole::appliance;
+    std::string common_name;
+    // Farm only: IPv6 (or IPv4) literals become IP SANs, anything else a DNS SAN (the common name
+    // is always added as a DNS SAN). The appliance checks the farm's address against the IP SANs.
+    std::vector<std::string> sans;
+    // Validity starts at now + not_before_offset_s (back-dated 5 minutes for clock skew between
+    // farm and appliances) and lasts lifetime_s. Negative values make expired certificates for tests.
+    std::int64_t not_before_offset_s = -300;
+    std::int64_t lifetime_s = 365 * kSecondsPerDay;
+    KeyAlgorithm key = KeyAlgorithm::ec_p256;
+};
+
+// In memory: a self-signed CA (role must be ca), or a certificate signed by `ca`.
+[[nodiscard]] PemPair make_ca(const CertSpec& spec);
+[[nodiscard]] PemPair issue_cert(const PemPair& ca, const CertSpec& spec);
+
+// File names inside a PKI folder.
+[[nodiscard]] std::filesystem::path ca_cert_path(const std::filesystem::path& dir);
+[[nodiscard]] std::filesystem::path ca_key_path(const std::filesystem::path& dir);
+[[nodiscard]] std::filesystem::path farm_cert_path(const std::filesystem::path& dir, const std::string& name);
+[[nodiscard]] std::filesystem::path farm_key_path(const std::filesystem::path& dir, const std::string& name);
+[[nodiscard]] std::filesystem::path appliance_cert_path(const std::filesystem::path& dir, const std::string& name);
+[[nodiscard]] std::filesystem::path appliance_key_path(const std::filesystem::path& dir, const std::string& name);
+
+// "" when `name` is a valid certificate/file name, else why not.
+[[nodiscard]] std::string check_pki_name(const std::string& name);
+
+// The commands of `mogao-farm pki`. Return the files written.
+std::vector<std::filesystem::path> pki_init_ca(const std::filesystem::path& dir, const std::string& name, int days,
+                                               KeyAlgorithm key, bool force);
+std::vector<std::filesystem::path> pki_issue_farm(const std::filesystem::path& dir, const std::string& name,
+                                                  const std::vector<std::string>& sans, int days, bool force);
+std::vector<std::filesystem::path> pki_issue_appliance(const std::filesystem::path& dir, const std::string& name,
+                                                       int days, bool force);
+
+// What each side loads to start (throws LinkError naming the missing file).
+[[nodiscard]] TlsMaterial load_farm_tls(const std::filesystem::path& dir, const std::string& name);
+[[nodiscard]] TlsMaterial load_appliance_tls(const std::filesystem::path& dir, const std::string& name);
+
+// Writes `content` to a new file with mode 0600 (O_CREAT|O_EXCL|O_CLOEXEC, then fchmod so that the
+// umask cannot change it), fsync'd. Refuses an existing file unless `force`.
+void write_private_file(const std::filesystem::path& path, const std::string& content, bool force);
+
+// `mogao-farm pki <init-ca|issue-farm|issue-appliance> ...`: argv[0] is the word "pki" (or any
+// program name), the subcommand follows. Returns 0 on success, 1 when the PKI operation failed
+// (logged), 2 for a bad command line (CLI11's message on stderr). Never throws.
+int run_pki_command(int argc, char** argv);
+
+}  // namespace mogao

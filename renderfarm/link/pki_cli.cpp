@@ -1,0 +1,74 @@
+// `mogao-farm pki ...`: the command line of the farm's appliance CA (pki.h).
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+#include <sstream>
+
+#include "renderfarm/link/link_log.h"
+#include "renderfarm/link/pki.h"
+
+namespace mogao {
+namespace {
+
+std::vector<std::string> split_sans(const std::string& text) {
+    std::vector<std::string> out;
+    std::stringstream in(text);
+    for (std::string item; std::getline(in, item, ',');) {
+        if (!item.empty()) out.push_back(item);
+    }
+    return out;
+}
+
+}  // namespace
+
+int run_pki_command(int argc, char** argv) {
+    CLI::App app{"mogao link PKI: the farm CA, the farm's server certificate and one client certificate per "
+                 "appliance (files mode 0600; docs/link.md)",
+                 "pki"};
+    app.require_subcommand(1);
+    std::string dir, name, san, key = "ec";
+    int days = 0;
+    bool force = false;
+    const auto common = [&](CLI::App* sub) {
+        sub->add_option("--dir", dir, "PKI folder (created 0700 if missing)")->required();
+        sub->add_flag("--force", force, "Replace existing files (atomically)");
+    };
+    CLI::App* init = app.add_subcommand("init-ca", "Create the farm CA: ca.pem + ca.key");
+    common(init);
+    init->add_option("--name", name, "CA common name")->default_val("mogao farm CA");
+    init->add_option("--days", days, "Validity in days")->default_val(3650)->check(CLI::Range(1, 36500));
+    init->add_option("--key", key, "Key type: ec (P-256) | rsa (3072 bits)")->check(CLI::IsMember({"ec", "rsa"}));
+    CLI::App* farm = app.add_subcommand("issue-farm", "Issue the farm's server certificate: farm-NAME.pem + .key");
+    common(farm);
+    farm->add_option("--name", name, "Farm host name (also a DNS SAN)")->required();
+    farm->add_option("--san", san, "Comma-separated IPv6 addresses (IP SANs) or DNS names, e.g. ::1,2001:db8::5")
+        ->required();
+    farm->add_option("--days", days, "Validity in days")->default_val(825)->check(CLI::Range(1, 36500));
+    CLI::App* appliance = app.add_subcommand("issue-appliance", "Issue an appliance client certificate: appliance-NAME.pem + .key");
+    common(appliance);
+    appliance->add_option("--name", name, "Appliance name, e.g. museum-1")->required();
+    appliance->add_option("--days", days, "Validity in days")->default_val(365)->check(CLI::Range(1, 36500));
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        const int code = app.exit(e);  // prints help or the error
+        return code == 0 ? 0 : 2;
+    }
+    try {
+        std::vector<std::filesystem::path> written;
+        if (init->parsed()) {
+            written = pki_init_ca(dir, name, days, key == "rsa" ? KeyAlgorithm::rsa_3072 : KeyAlgorithm::ec_p256, force);
+        } else if (farm->parsed()) {
+            written = pki_issue_farm(dir, name, split_sans(san), days, force);
+        } else {
+            written = pki_issue_appliance(dir, name, days, force);
+        }
+        for (const auto& path : written) std::cout << path.string() << '\n';
+        return 0;
+    } catch (const std::exception& e) {
+        link_log().error("pki: {}", e.what());
+        return 1;
+    }
+}
+
+}  // namespace mogao
