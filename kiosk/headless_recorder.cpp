@@ -1,0 +1,62 @@
+#include "kiosk/headless_recorder.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "appliance/warp/composite.h"
+#include "renderfarm/encode/png_io.h"
+
+namespace mogao {
+namespace {
+
+std::uint8_t linear_to_srgb8(float linear) {
+    const double x = std::clamp(static_cast<double>(linear), 0.0, 1.0);
+    const double s = x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055;
+    return static_cast<std::uint8_t>(std::lround(s * 255.0));
+}
+
+}  // namespace
+
+HeadlessRecorder::HeadlessRecorder(const HeadlessOutputBackend& backend, std::filesystem::path dir, int every)
+    : backend_(&backend), dir_(std::move(dir)), every_(every) {
+    if (every_ < 1) throw std::invalid_argument("HeadlessRecorder: every must be >= 1");
+    std::filesystem::create_directories(dir_);
+}
+
+std::size_t HeadlessRecorder::write_round(std::uint64_t round, std::uint64_t request_id) {
+    if (round % static_cast<std::uint64_t>(every_) != 0) return 0;
+    std::size_t written = 0;
+    for (std::size_t i = 0; i < backend_->outputs().size(); ++i) {
+        const Rgb8Image& frame = backend_->last_frame(i);
+        if (frame.size.pixel_count() == 0) continue;
+        write_png(dir_ / fmt::format("{}-{:06}-req{}.png", backend_->outputs()[i].name, round, request_id), frame);
+        ++written;
+    }
+    return written;
+}
+
+void HeadlessRecorder::write_composite(const ScreenCalibration& screen,
+                                       const std::vector<std::optional<std::size_t>>& projector_of,
+                                       const std::filesystem::path& file) const {
+    // composite_on_screen takes one signal image per projector of `screen`: the output that shows
+    // it (in [0, 1], the projector's input signal), or black where no output does.
+    std::vector<RgbFloatImage> signals;
+    signals.reserve(screen.projectors.size());
+    for (const auto& p : screen.projectors) signals.emplace_back(p.output, 0.0f);
+    for (std::size_t i = 0; i < projector_of.size() && i < backend_->outputs().size(); ++i) {
+        if (!projector_of[i]) continue;
+        const Rgb8Image& frame = backend_->last_frame(i);
+        RgbFloatImage& signal = signals[*projector_of[i]];
+        if (!(frame.size == signal.size)) continue;  // resampled output: not the calibrated pixel grid
+        for (std::size_t k = 0; k < frame.pixels.size(); ++k) signal.pixels[k] = static_cast<float>(frame.pixels[k]) / 255.0f;
+    }
+    const RgbFloatImage light = composite_on_screen(screen, signals);
+    Rgb8Image out(light.size);
+    for (std::size_t k = 0; k < light.pixels.size(); ++k) out.pixels[k] = linear_to_srgb8(light.pixels[k]);
+    write_png(file, out);
+}
+
+}  // namespace mogao

@@ -1,0 +1,385 @@
+#include "kiosk/kiosk_config.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <set>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <toml.hpp>
+
+#include "renderfarm/link/endpoint.h"
+
+namespace mogao {
+namespace {
+
+using Value = toml::value;
+namespace fs = std::filesystem;
+
+constexpr int kMaxSide = 16384;
+
+std::string type_name(const Value& v) {
+    switch (v.type()) {
+        case toml::value_t::boolean: return "a boolean";
+        case toml::value_t::integer: return "an integer";
+        case toml::value_t::floating: return "a float";
+        case toml::value_t::string: return "a string";
+        case toml::value_t::offset_datetime:
+        case toml::value_t::local_datetime:
+        case toml::value_t::local_date:
+        case toml::value_t::local_time: return "a date/time";
+        case toml::value_t::array: return "an array";
+        case toml::value_t::table: return "a table";
+        case toml::value_t::empty: break;
+    }
+    return "nothing";
+}
+
+// Where messages point: the file, and the line of the offending value when toml11 knows it.
+struct Context {
+    std::string file;
+    fs::path dir;  // relative paths are resolved against it
+
+    [[noreturn]] void fail(const Value* where, const std::string& message) const {
+        if (where != nullptr) {
+            const auto line = where->location().line();
+            if (line > 0 && where->location().file_name() != "unknown file") {
+                throw KioskConfigError(fmt::format("{}:{}: {}", file, line, message));
+            }
+        }
+        throw KioskConfigError(fmt::format("{}: {}", file, message));
+    }
+
+    [[nodiscard]] fs::path resolve(const std::string& text) const {
+        const fs::path p(text);
+        return (p.is_relative() ? dir / p : p).lexically_normal();
+    }
+};
+
+// One [section]: typed getters that check ranges, and a final check for unknown keys.
+class Section {
+public:
+    Section(const Context& ctx, std::string name, const Value* table, std::vector<std::string> known)
+        : ctx_(ctx), name_(std::move(name)), table_(table), known_(std::move(known)) {}
+
+    [[nodiscard]] std::string field(std::string_view key) const { return fmt::format("[{}].{}", name_, key); }
+
+    [[nodiscard]] const Value* find(std::string_view key) const {
+        if (table_ == nullptr) return nullptr;
+        const auto& t = table_->as_table();
+        const auto it = t.find(std::string(key));
+        return it == t.end() ? nullptr : &it->second;
+    }
+
+    [[noreturn]] void fail(const Value* where, std::string_view key, const std::string& what) const {
+        ctx_.fail(where != nullptr ? where : table_, field(key) + what);
+    }
+
+    [[nodiscard]] const Value& require(std::string_view key, std::string_view what) const {
+        const Value* v = find(key);
+        if (v == nullptr) fail(nullptr, key, fmt::format(" is required ({})", what));
+        return *v;
+    }
+
+    [[nodiscard]] std::string string(std::string_view key, std::string fallback) const {
+        const Value* v = find(key);
+        return v == nullptr ? fallback : as_string(*v, key);
+    }
+
+    [[nodiscard]] std::string as_string(const Value& v, std::string_view key) const {
+        if (!v.is_string()) fail(&v, key, ": expected a string, got " + type_name(v));
+        return v.as_string().str;
+    }
+
+    [[nodiscard]] bool boolean(std::string_view key, bool fallback) const {
+        const Value* v = find(key);
+        if (v == nullptr) return fallback;
+        if (!v->is_boolean()) fail(v, key, ": expected true or false, got " + type_name(*v));
+        return v->as_boolean();
+    }
+
+    [[nodiscard]] int integer(std::string_view key, int fallback, int lo, int hi) const {
+        const Value* v = find(key);
+        if (v == nullptr) return fallback;
+        if (!v->is_integer()) fail(v, key, ": expected an integer, got " + type_name(*v));
+        const std::int64_t n = v->as_integer();
+        if (n < lo || n > hi) fail(v, key, fmt::format(" = {} is outside [{}, {}]", n, lo, hi));
+        return static_cast<int>(n);
+    }
+
+    // A number (integer or float) that `ok` accepts; `range` describes the limit in messages.
+    [[nodiscard]] double number(std::string_view key, double fallback, const std::function<bool(double)>& ok,
+                                std::string_view range) const {
+        const Value* v = find(key);
+        if (v == nullptr) return fallback;
+        return as_number(*v, key, ok, range);
+    }
+
+    [[nodiscard]] double as_number(const Value& v, std::string_view key, const std::function<bool(double)>& ok,
+                                   std::string_view range) const {
+        double x = 0;
+        if (v.is_integer()) {
+            x = static_cast<double>(v.as_integer());
+        } else if (v.is_floating()) {
+            x = v.as_floating();
+        } else {
+            fail(&v, key, ": expected a number, got " + type_name(v));
+        }
+        if (!std::isfinite(x) || !ok(x)) fail(&v, key, fmt::format(" = {} is outside {}", x, range));
+        return x;
+    }
+
+    [[nodiscard]] ImageSize size(std::string_view key, ImageSize fallback, int lo) const {
+        const Value* v = find(key);
+        return v == nullptr ? fallback : as_size(*v, key, lo);
+    }
+
+    [[nodiscard]] ImageSize as_size(const Value& v, std::string_view key, int lo) const {
+        const std::string text = as_string(v, key);
+        ImageSize s;
+        if (!parse_size(text, s)) fail(&v, key, fmt::format(": '{}' is not WIDTHxHEIGHT (e.g. \"1920x1080\")", text));
+        if (s.width < lo || s.width > kMaxSide || s.height < lo || s.height > kMaxSide) {
+            fail(&v, key, fmt::format(" = '{}' is outside [{}, {}] pixels per side", text, lo, kMaxSide));
+        }
+        return s;
+    }
+
+    // A path to an existing regular file.
+    [[nodiscard]] fs::path existing_file(const Value& v, std::string_view key) const {
+        const std::string text = as_string(v, key);
+        if (text.empty()) fail(&v, key, ": empty path");
+        const fs::path p = ctx_.resolve(text);
+        std::error_code ec;
+        if (!fs::exists(p, ec)) fail(&v, key, fmt::format(": '{}' does not exist", p.string()));
+        if (!fs::is_regular_file(p, ec)) fail(&v, key, fmt::format(": '{}' is not a regular file", p.string()));
+        return p;
+    }
+
+    // Keys only meaningful in one mode ("only with backend = \"headless\"").
+    void forbid(std::string_view key, std::string_view reason) const {
+        if (const Value* v = find(key)) fail(v, key, fmt::format(": only {}", reason));
+    }
+
+    // Unknown keys are errors: a typo must not fall back to a default silently.
+    void finish() const {
+        if (table_ == nullptr) return;
+        std::set<std::string> unknown;
+        for (const auto& [key, value] : table_->as_table()) {
+            if (std::find(known_.begin(), known_.end(), key) == known_.end()) unknown.insert(key);
+        }
+        if (unknown.empty()) return;
+        const std::string& key = *unknown.begin();
+        fail(&table_->as_table().at(key), key,
+             fmt::format(": unknown field (known: {})", fmt::join(known_, ", ")));
+    }
+
+    [[nodiscard]] const Context& context() const { return ctx_; }
+
+private:
+    const Context& ctx_;
+    std::string name_;
+    const Value* table_;
+    std::vector<std::string> known_;
+};
+
+Section section(const Context& ctx, const Value& root, const std::string& name, std::vector<std::string> known) {
+    const auto& t = root.as_table();
+    const auto it = t.find(name);
+    if (it == t.end()) return Section(ctx, name, nullptr, std::move(known));
+    if (!it->second.is_table()) ctx.fail(&it->second, fmt::format("[{}]: expected a table, got {}", name, type_name(it->second)));
+    return Section(ctx, name, &it->second, std::move(known));
+}
+
+void read_farm(const Section& s, FarmConfig& farm) {
+    const Value& endpoint = s.require("endpoint", "the farm as \"[address]:port\"");
+    farm.endpoint = s.as_string(endpoint, "endpoint");
+    std::string why;
+    const auto parsed = parse_endpoint(farm.endpoint, &why);
+    if (!parsed) s.fail(&endpoint, "endpoint", ": " + why);
+    if (parsed->port == 0) s.fail(&endpoint, "endpoint", fmt::format(": '{}' has port 0 (the farm's port is 1..65535)", farm.endpoint));
+    if (parsed->is_wildcard()) s.fail(&endpoint, "endpoint", fmt::format(": '{}' is the wildcard address, not a farm", farm.endpoint));
+    farm.server_name = s.string("server_name", "");
+    farm.ca = s.existing_file(s.require("ca", "PEM file of the farm CA"), "ca");
+    farm.cert = s.existing_file(s.require("cert", "PEM file of this appliance's certificate"), "cert");
+    farm.key = s.existing_file(s.require("key", "PEM file of this appliance's private key"), "key");
+}
+
+void read_outputs(const Section& display, const Section& s, OutputsConfig& out) {
+    out.rate_hz = display.number("rate_hz", out.rate_hz, [](double x) { return x >= 0.5 && x <= 240; }, "[0.5, 240] Hz");
+    const Value* backend = s.find("backend");
+    if (backend != nullptr) {
+        const std::string kind = s.as_string(*backend, "backend");
+        if (kind == "headless") {
+            out.backend = OutputKind::headless;
+        } else if (kind == "kms") {
+            out.backend = OutputKind::kms;
+        } else {
+            s.fail(backend, "backend", fmt::format(": '{}' is not one of headless, kms", kind));
+        }
+    }
+    if (out.backend == OutputKind::kms) {
+        for (const char* key : {"sizes", "png_dir", "png_every", "composite"}) s.forbid(key, "with backend = \"headless\"");
+        const std::string device = s.string("device", "");
+        if (!device.empty()) out.device = s.context().resolve(device);
+        return;
+    }
+    s.forbid("device", "with backend = \"kms\"");
+    if (const Value* sizes = s.find("sizes")) {
+        if (!sizes->is_array()) s.fail(sizes, "sizes", ": expected an array of \"WIDTHxHEIGHT\" strings, got " + type_name(*sizes));
+        const auto& list = sizes->as_array();
+        if (list.empty() || list.size() > 64) s.fail(sizes, "sizes", fmt::format(": {} outputs is outside [1, 64]", list.size()));
+        for (std::size_t i = 0; i < list.size(); ++i) {
+            out.sizes.push_back(s.as_size(list[i], fmt::format("sizes[{}]", i), 1));
+        }
+    }
+    const std::string png_dir = s.string("png_dir", "");
+    if (!png_dir.empty()) out.png_dir = s.context().resolve(png_dir);
+    out.png_every = s.integer("png_every", out.png_every, 1, 1'000'000);
+    out.composite = s.boolean("composite", out.composite);
+}
+
+void read_calibration(const Section& s, CalibrationConfig& c) {
+    const Value* source = s.find("source");
+    const std::string text = source == nullptr ? "ideal" : s.as_string(*source, "source");
+    if (text != "ideal") {
+        c.mpcdi = s.existing_file(*source, "source");
+        for (const char* key : {"projectors", "overlap", "output", "gamma"}) s.forbid(key, "with source = \"ideal\"");
+        return;
+    }
+    c.projectors = s.integer("projectors", c.projectors, 1, 64);
+    c.overlap = s.number("overlap", c.overlap, [](double x) { return x >= 0 && x < 0.5; }, "[0, 0.5)");
+    c.output = s.size("output", c.output, 1);
+    c.gamma = s.number("gamma", c.gamma, [](double x) { return x > 0 && x <= 10; }, "(0, 10]");
+}
+
+void read_quality(const Section& s, QualityConfig& q) {
+    q.content = s.size("content", q.content, 16);
+    q.spp = s.integer("spp", q.spp, 1, 4096);
+    q.jpeg_quality = s.integer("jpeg_quality", q.jpeg_quality, 1, 100);
+    q.max_bounces = s.integer("bounces", q.max_bounces, 0, 64);
+    q.ao_samples = s.integer("ao_samples", q.ao_samples, 0, 1024);
+    q.area_light_samples = s.integer("area_light_samples", q.area_light_samples, 1, 1024);
+}
+
+void read_screen(const Section& s, CylinderScreen& screen) {
+    screen.radius_m = s.number("radius_m", screen.radius_m, [](double x) { return x > 0 && x <= 1000; }, "(0, 1000] m");
+    screen.arc_deg = s.number("arc_deg", screen.arc_deg, [](double x) { return x > 0 && x <= 360; }, "(0, 360] degrees");
+    const auto height = [](double x) { return std::abs(x) <= 1000; };
+    screen.bottom_m = s.number("bottom_m", screen.bottom_m, height, "[-1000, 1000] m");
+    screen.top_m = s.number("top_m", screen.top_m, height, "[-1000, 1000] m");
+    if (!(screen.top_m > screen.bottom_m)) {
+        s.fail(s.find("top_m") != nullptr ? s.find("top_m") : s.find("bottom_m"), "top_m",
+               fmt::format(" = {} must be above [screen].bottom_m = {}", screen.top_m, screen.bottom_m));
+    }
+}
+
+void read_navigation(const Section& s, NavigationConfig& n) {
+    if (const Value* path = s.find("path")) {
+        const std::string text = s.as_string(*path, "path");
+        if (text == "walk" || text == "orbit") {
+            n.path = text;
+        } else if (text.empty()) {
+            s.fail(path, "path", ": empty (expected walk, orbit or a JSON path file)");
+        } else {
+            n.path = s.existing_file(*path, "path").string();
+        }
+    }
+    n.path_frames = s.integer("path_frames", n.path_frames, 2, 1'000'000);
+    if (const Value* start = s.find("start")) {
+        if (!start->is_array() || start->as_array().size() != 3) {
+            s.fail(start, "start", ": expected [x, y, z] (floor point of the viewer's start, metres)");
+        }
+        for (std::size_t i = 0; i < 3; ++i) {
+            n.start[static_cast<Eigen::Index>(i)] = s.as_number(start->as_array()[i], fmt::format("start[{}]", i),
+                                                                [](double x) { return std::abs(x) <= 1e9; }, "[-1e9, 1e9] m");
+        }
+    }
+    n.start_yaw_deg = s.number("start_yaw_deg", n.start_yaw_deg, [](double x) { return std::abs(x) <= 3600; }, "[-3600, 3600] degrees");
+    n.eye_height_m = s.number("eye_height_m", n.eye_height_m, [](double x) { return x > 0 && x <= 100; }, "(0, 100] m");
+}
+
+void read_stats(const Section& s, StatsConfig& st) {
+    const std::string file = s.string("file", "");
+    if (!file.empty()) st.file = s.context().resolve(file);
+    st.log_period_s = s.number("log_period_s", st.log_period_s, [](double x) { return x >= 0.1 && x <= 86400; }, "[0.1, 86400] s");
+}
+
+}  // namespace
+
+bool parse_size(std::string_view text, ImageSize& out) {
+    const auto x = text.find('x');
+    if (x == std::string_view::npos || x == 0 || x + 1 >= text.size()) return false;
+    const auto parse = [](std::string_view digits, int& value) {
+        if (digits.empty() || digits.size() > 6) return false;
+        for (const char c : digits) {
+            if (c < '0' || c > '9') return false;
+        }
+        const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+        return ec == std::errc() && end == digits.data() + digits.size();
+    };
+    ImageSize s;
+    if (!parse(text.substr(0, x), s.width) || !parse(text.substr(x + 1), s.height)) return false;
+    out = s;
+    return true;
+}
+
+KioskConfig parse_kiosk_config(std::string_view text, const std::filesystem::path& name) {
+    const Context ctx{name.string(), name.has_parent_path() ? name.parent_path() : fs::path(".")};
+    Value root;
+    try {
+        std::istringstream in{std::string(text)};
+        root = toml::parse(in, name.string());
+    } catch (const toml::syntax_error& e) {
+        // toml11's message already names the file, line and column, with the offending text.
+        throw KioskConfigError(fmt::format("{}: not valid TOML: {}", ctx.file, e.what()));
+    } catch (const std::exception& e) {
+        throw KioskConfigError(fmt::format("{}: not valid TOML: {}", ctx.file, e.what()));
+    }
+    const std::vector<std::string> known_sections{"farm", "display", "outputs", "calibration", "quality", "screen", "navigation", "stats"};
+    for (const auto& [key, value] : root.as_table()) {
+        if (std::find(known_sections.begin(), known_sections.end(), key) == known_sections.end()) {
+            ctx.fail(&value, fmt::format("[{}]: unknown section (known: {})", key, fmt::join(known_sections, ", ")));
+        }
+    }
+    KioskConfig config;
+    config.source = name;
+    if (root.as_table().count("farm") == 0) {
+        ctx.fail(nullptr, "[farm] is required (endpoint, ca, cert, key)");
+    }
+    const Section farm = section(ctx, root, "farm", {"endpoint", "server_name", "ca", "cert", "key"});
+    read_farm(farm, config.farm);
+    const Section display = section(ctx, root, "display", {"rate_hz"});
+    const Section outputs = section(ctx, root, "outputs", {"backend", "device", "sizes", "png_dir", "png_every", "composite"});
+    read_outputs(display, outputs, config.outputs);
+    const Section calibration = section(ctx, root, "calibration", {"source", "projectors", "overlap", "output", "gamma"});
+    read_calibration(calibration, config.calibration);
+    const Section quality = section(ctx, root, "quality", {"content", "spp", "jpeg_quality", "bounces", "ao_samples", "area_light_samples"});
+    read_quality(quality, config.quality);
+    const Section screen = section(ctx, root, "screen", {"radius_m", "arc_deg", "bottom_m", "top_m"});
+    read_screen(screen, config.screen);
+    const Section navigation = section(ctx, root, "navigation", {"path", "path_frames", "start", "start_yaw_deg", "eye_height_m"});
+    read_navigation(navigation, config.navigation);
+    config.screen.eye_m = Eigen::Vector3d(0.0, config.navigation.eye_height_m, 0.0);
+    const Section stats = section(ctx, root, "stats", {"file", "log_period_s"});
+    read_stats(stats, config.stats);
+    for (const Section* s : {&farm, &display, &outputs, &calibration, &quality, &screen, &navigation, &stats}) s->finish();
+    return config;
+}
+
+KioskConfig load_kiosk_config(const std::filesystem::path& file) {
+    std::error_code ec;
+    if (!fs::is_regular_file(file, ec)) {
+        throw KioskConfigError(fmt::format("{}: {}", file.string(), fs::exists(file, ec) ? "not a regular file" : "no such file"));
+    }
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw KioskConfigError(fmt::format("{}: cannot open for reading", file.string()));
+    std::ostringstream text;
+    text << in.rdbuf();
+    if (text.str().size() > (1u << 20)) throw KioskConfigError(fmt::format("{}: larger than 1 MiB, not a kiosk configuration", file.string()));
+    return parse_kiosk_config(text.str(), file);
+}
+
+}  // namespace mogao

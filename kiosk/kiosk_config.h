@@ -1,0 +1,116 @@
+// The kiosk's configuration file (TOML, read with toml11): where the farm is and how to trust it,
+// which outputs to drive, the projector calibration, what to ask the farm to render, how the
+// scripted visitor moves, and where statistics go. Schema and an example: docs/kiosk.md and
+// kiosk/kiosk.example.toml.
+//
+// Units: metres, degrees, hertz, seconds; sizes are "WIDTHxHEIGHT" strings in pixels.
+// Relative paths in the file are resolved against the folder of the configuration file, so a
+// configuration and its PKI/calibration can move together.
+//
+// Errors: KioskConfigError, whose message starts with the file name (and the line when toml11
+// knows it) and names the field as "[section].key", with the value and the limit or reason:
+//   kiosk.toml:14: [quality].spp = 0 is outside [1, 4096]
+//   kiosk.toml: [farm].endpoint is required (the farm as "[address]:port")
+//   kiosk.toml:3: [farm].ca: '/etc/mogao/pki/ca.pem' does not exist
+//   kiosk.toml:20: [outputs].colour: unknown field (known: backend, device, sizes, png_dir, ...)
+// Unknown sections and keys are errors (a typo must not silently fall back to a default). A
+// parse returns a complete configuration or throws; it never returns a partial one, so a caller
+// reloading a configuration keeps its last good one on error.
+#pragma once
+
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "renderfarm/view/pixel_rect.h"
+#include "renderfarm/view/view_request.h"
+
+namespace mogao {
+
+struct KioskConfigError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+// [farm]: the link (renderfarm/link/link_client.h).
+struct FarmConfig {
+    std::string endpoint;             // required, "[address]:port", IPv6 literal, port 1..65535
+    std::string server_name;          // optional DNS SAN to expect; empty: the endpoint's address
+    std::filesystem::path ca;         // required, PEM of the farm CA
+    std::filesystem::path cert;       // required, PEM of this appliance's certificate
+    std::filesystem::path key;        // required, PEM of its private key
+};
+
+enum class OutputKind { headless, kms };
+
+// [display] and [outputs].
+struct OutputsConfig {
+    double rate_hz = 30.0;                  // [display].rate_hz: request + repaint tick, [0.5, 240]
+    OutputKind backend = OutputKind::kms;   // "headless" | "kms"
+    std::filesystem::path device;           // kms: /dev/dri/cardN; empty = first card with an output
+    std::vector<ImageSize> sizes;           // headless: one per output; empty = the projectors' sizes
+    std::filesystem::path png_dir;          // headless: PNG folder (created); empty = no PNGs
+    int png_every = 1;                      // headless: PNGs of every k-th displayed round, [1, 1000000]
+    bool composite = true;                  // headless: screen-composite.png (CPU reference) at exit
+};
+
+// [calibration]: an MPCDI file (2d profile) or the ideal layout (appliance/warp/ideal_calibration.h).
+struct CalibrationConfig {
+    std::filesystem::path mpcdi;            // source = FILE; empty: source = "ideal"
+    int projectors = 3;                     // ideal: [1, 64]
+    double overlap = 0.15;                  // ideal: [0, 0.5)
+    ImageSize output{1024, 768};            // ideal: each projector, [1, 16384] per side
+    double gamma = 2.2;                     // ideal: projector response gamma, (0, 10]
+};
+
+// [quality]: the render the kiosk requests (renderfarm/view/view_request.h).
+struct QualityConfig {
+    ImageSize content{1920, 1080};          // content frame, [16, 16384] per side
+    int spp = 1;                            // [1, 4096]
+    int jpeg_quality = 85;                  // [1, 100]
+    int max_bounces = 0;                    // [0, 64]
+    int ao_samples = 0;                     // [0, 1024]
+    int area_light_samples = 1;             // [1, 1024]
+};
+
+// [navigation]: the scripted visitor (renderfarm/farm/camera_path.h) until tracking lands. The
+// appliance has no scene, so the scene's viewer start and eye height are given here.
+struct NavigationConfig {
+    std::string path = "walk";              // "walk" | "orbit" | a JSON path file (must exist)
+    int path_frames = 900;                  // requests per loop of the path, [2, 1000000]
+    Eigen::Vector3d start{0.0, 0.0, 5.0};   // floor point of the viewer's start, world metres
+    double start_yaw_deg = 0.0;             // |.| <= 3600
+    double eye_height_m = 1.6;              // (0, 100]: also the screen camera's eye height
+};
+
+// [stats].
+struct StatsConfig {
+    std::filesystem::path file;             // JSON written at exit; empty = none
+    double log_period_s = 10.0;             // stderr summary period, [0.1, 86400]
+};
+
+struct KioskConfig {
+    std::filesystem::path source;           // the file it was read from
+    FarmConfig farm;
+    OutputsConfig outputs;
+    CalibrationConfig calibration;
+    QualityConfig quality;
+    CylinderScreen screen{3.0, 150.0, 0.2, 2.8, {0.0, 1.6, 0.0}};  // [screen]; eye_m from navigation
+    NavigationConfig navigation;
+    StatsConfig stats;
+};
+
+// Reads and validates `file`. Throws KioskConfigError.
+[[nodiscard]] KioskConfig load_kiosk_config(const std::filesystem::path& file);
+
+// Validates TOML `text` as if read from `name` (messages and relative paths use it).
+[[nodiscard]] KioskConfig parse_kiosk_config(std::string_view text, const std::filesystem::path& name);
+
+// "WIDTHxHEIGHT" (decimal digits only, at most 6 per side) -> true and `out` set; false and `out`
+// untouched otherwise.
+[[nodiscard]] bool parse_size(std::string_view text, ImageSize& out);
+
+}  // namespace mogao

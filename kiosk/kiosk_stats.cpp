@@ -1,0 +1,146 @@
+#include "kiosk/kiosk_stats.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "renderfarm/encode/file_io.h"
+
+namespace mogao {
+namespace {
+
+double ms(std::int64_t ns) { return static_cast<double>(ns) / 1e6; }
+
+double percentile(std::vector<double> values, double p) {
+    if (values.empty()) return 0;
+    std::sort(values.begin(), values.end());
+    const auto rank = static_cast<std::size_t>(std::ceil(p * static_cast<double>(values.size())));
+    return values[std::min(values.size() - 1, rank == 0 ? 0 : rank - 1)];
+}
+
+double round3(double x) { return std::round(x * 1000.0) / 1000.0; }
+
+nlohmann::json summary_json(const StatsSummary& s) {
+    return {{"frames", s.frames},
+            {"fps", round3(s.fps)},
+            {"motion_to_photon_ms", {{"mean", round3(s.latency_mean_ms)}, {"p50", round3(s.latency_p50_ms)},
+                                     {"p95", round3(s.latency_p95_ms)}, {"max", round3(s.latency_max_ms)}}},
+            {"link_mean_ms", round3(s.link_mean_ms)},
+            {"kiosk_mean_ms", round3(s.kiosk_mean_ms)},
+            {"decode_mean_ms", round3(s.decode_mean_ms)},
+            {"bytes_per_frame", round3(s.bytes_per_frame)},
+            {"bandwidth_bytes_per_s", round3(s.bandwidth_bytes_per_s)}};
+}
+
+}  // namespace
+
+KioskStats::KioskStats(std::size_t window, std::size_t max_history)
+    : window_size_(std::max<std::size_t>(window, 2)), max_history_(max_history) {}
+
+void KioskStats::presented(const PresentedFrame& frame) {
+    if (frame.request_id <= last_request_id_) ++out_of_order_;
+    last_request_id_ = frame.request_id;
+    ++frames_;
+    bytes_ += frame.jpeg_bytes;
+    window_.push_back(frame);
+    while (window_.size() > window_size_) window_.pop_front();
+    if (history_.size() < max_history_) history_.push_back(frame);
+}
+
+void KioskStats::event(std::int64_t realtime_ns, std::string what, std::uint64_t last_request_id) {
+    events_.push_back({{"time_ns", realtime_ns},
+                       {"event", std::move(what)},
+                       {"display_round", rounds_},
+                       {"frames", frames_},
+                       {"last_request_id", last_request_id}});
+}
+
+StatsSummary KioskStats::summarise(const std::vector<const PresentedFrame*>& frames) {
+    StatsSummary s;
+    s.frames = frames.size();
+    if (frames.empty()) return s;
+    std::vector<double> latency;
+    double link = 0, kiosk = 0, decode = 0, bytes = 0;
+    for (const PresentedFrame* f : frames) {
+        latency.push_back(ms(f->presented_ns - f->request_ns));
+        link += ms(f->receive_ns - f->request_ns);
+        kiosk += ms(f->presented_ns - f->receive_ns);
+        decode += f->decode_ms;
+        bytes += static_cast<double>(f->jpeg_bytes);
+    }
+    const auto n = static_cast<double>(frames.size());
+    double sum = 0;
+    for (const double l : latency) sum += l;
+    s.latency_mean_ms = sum / n;
+    s.latency_max_ms = *std::max_element(latency.begin(), latency.end());
+    s.latency_p50_ms = percentile(latency, 0.50);
+    s.latency_p95_ms = percentile(latency, 0.95);
+    s.link_mean_ms = link / n;
+    s.kiosk_mean_ms = kiosk / n;
+    s.decode_mean_ms = decode / n;
+    s.bytes_per_frame = bytes / n;
+    const double span_s = static_cast<double>(frames.back()->presented_ns - frames.front()->presented_ns) / 1e9;
+    if (frames.size() >= 2 && span_s > 0) {
+        s.fps = (n - 1) / span_s;
+        s.bandwidth_bytes_per_s = (bytes - static_cast<double>(frames.front()->jpeg_bytes)) / span_s;
+    }
+    return s;
+}
+
+StatsSummary KioskStats::window_summary() const {
+    std::vector<const PresentedFrame*> frames;
+    for (const auto& f : window_) frames.push_back(&f);
+    return summarise(frames);
+}
+
+StatsSummary KioskStats::total_summary() const {
+    std::vector<const PresentedFrame*> frames;
+    for (const auto& f : history_) frames.push_back(&f);
+    StatsSummary s = summarise(frames);
+    s.frames = frames_;
+    return s;
+}
+
+std::string KioskStats::log_line() const {
+    const StatsSummary w = window_summary();
+    return fmt::format(
+        "frames={} fps={:.1f} motion_to_photon_ms(mean={:.1f} p95={:.1f} max={:.1f}) link_ms={:.1f} kiosk_ms={:.1f} "
+        "bytes_per_frame={:.0f} bandwidth_MBps={:.3f} rejected={} superseded={} rounds={}",
+        frames_, w.fps, w.latency_mean_ms, w.latency_p95_ms, w.latency_max_ms, w.link_mean_ms, w.kiosk_mean_ms,
+        w.bytes_per_frame, w.bandwidth_bytes_per_s / 1e6, rejected_, superseded_, rounds_);
+}
+
+nlohmann::json KioskStats::to_json(const nlohmann::json& extra) const {
+    nlohmann::json frames = nlohmann::json::array();
+    for (const auto& f : history_) {
+        frames.push_back({{"request_id", f.request_id},
+                          {"link_frame_id", f.link_frame_id},
+                          {"jpeg_bytes", f.jpeg_bytes},
+                          {"request_ns", f.request_ns},
+                          {"receive_ns", f.receive_ns},
+                          {"presented_ns", f.presented_ns},
+                          {"motion_to_photon_ms", round3(ms(f.presented_ns - f.request_ns))},
+                          {"decode_ms", round3(f.decode_ms)},
+                          {"display_round", f.display_round}});
+    }
+    nlohmann::json out = {{"frames_presented", frames_},
+                          {"jpeg_bytes_presented", bytes_},
+                          {"frames_rejected", rejected_},
+                          {"frames_superseded", superseded_},
+                          {"frames_out_of_order", out_of_order_},
+                          {"display_rounds", rounds_},
+                          {"total", summary_json(total_summary())},
+                          {"window", summary_json(window_summary())},
+                          {"events", events_},
+                          {"frames", std::move(frames)}};
+    for (const auto& [key, value] : extra.items()) out[key] = value;
+    return out;
+}
+
+void KioskStats::write_json(const std::filesystem::path& path, const nlohmann::json& extra) const {
+    const std::string text = to_json(extra).dump(1) + "\n";
+    write_file_atomically(path, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
+}
+
+}  // namespace mogao

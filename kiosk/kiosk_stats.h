@@ -1,0 +1,98 @@
+// KioskStats: what the kiosk measures per displayed frame, its periodic stderr summary and the
+// statistics JSON written at exit.
+//
+// Per frame (times are CLOCK_REALTIME nanoseconds of the appliance, renderfarm/link/link_types.h):
+//   motion-to-photon = presented_ns - request_ns: the view request was stamped (pose sampled) ->
+//                      every output presented the frame (headless: present() returned; KMS: its
+//                      page flip completed, i.e. the frame is being scanned out)
+//   link             = receive_ns - request_ns (request upstream + render + encode + downstream)
+//   kiosk            = presented_ns - receive_ns (slot hand-over + decode + warp/blend + flip)
+//   bytes            = JPEG bytes of the frame
+// Rates over a sliding window of the last `window` presented frames: fps = (n - 1) / span of their
+// presented times, bandwidth = bytes of all but the first / span (the first frame's bytes arrived
+// before the span began). Totals and latency percentiles cover the whole run (the per-frame list
+// in the JSON keeps the first `max_history` frames; the counters keep counting after that).
+//
+// Not thread-safe: the event loop owns it.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace mogao {
+
+struct PresentedFrame {
+    std::uint64_t request_id = 0;
+    std::uint64_t link_frame_id = 0;
+    std::size_t jpeg_bytes = 0;
+    std::int64_t request_ns = 0;
+    std::int64_t receive_ns = 0;
+    std::int64_t presented_ns = 0;
+    double decode_ms = 0;
+    std::uint64_t display_round = 0;  // the kiosk's display round that first showed it
+};
+
+struct StatsSummary {
+    std::uint64_t frames = 0;
+    double fps = 0;
+    double latency_mean_ms = 0;  // motion-to-photon
+    double latency_p50_ms = 0;
+    double latency_p95_ms = 0;
+    double latency_max_ms = 0;
+    double link_mean_ms = 0;     // request -> receive
+    double kiosk_mean_ms = 0;    // receive -> presented
+    double decode_mean_ms = 0;
+    double bytes_per_frame = 0;
+    double bandwidth_bytes_per_s = 0;
+};
+
+class KioskStats {
+public:
+    explicit KioskStats(std::size_t window = 120, std::size_t max_history = 100'000);
+
+    void presented(const PresentedFrame& frame);
+    void rejected() { ++rejected_; }              // a frame failed to decode (last good kept)
+    void superseded(std::uint64_t n) { superseded_ = n; }  // frames replaced in the slot (running total)
+    void display_round() { ++rounds_; }           // one present on every ready output
+    // A link state change or other notable event, kept in order with its time and display round.
+    void event(std::int64_t realtime_ns, std::string what, std::uint64_t last_request_id);
+
+    [[nodiscard]] std::uint64_t frames() const { return frames_; }
+    [[nodiscard]] std::uint64_t rounds() const { return rounds_; }
+    [[nodiscard]] StatsSummary window_summary() const;  // the sliding window
+    [[nodiscard]] StatsSummary total_summary() const;   // the kept history
+
+    // One journald-friendly line (no timestamp): frames, fps, latency, bytes, bandwidth, counters.
+    [[nodiscard]] std::string log_line() const;
+
+    // Everything: summaries, counters, events, per-frame list. `extra` is merged at the top level.
+    [[nodiscard]] nlohmann::json to_json(const nlohmann::json& extra = nlohmann::json::object()) const;
+
+    // Writes to_json(extra) atomically (renderfarm/encode/file_io.h). Throws std::system_error
+    // naming the path.
+    void write_json(const std::filesystem::path& path, const nlohmann::json& extra = nlohmann::json::object()) const;
+
+private:
+    [[nodiscard]] static StatsSummary summarise(const std::vector<const PresentedFrame*>& frames);
+
+    std::size_t window_size_;
+    std::size_t max_history_;
+    std::deque<PresentedFrame> window_;
+    std::vector<PresentedFrame> history_;
+    std::uint64_t frames_ = 0;
+    std::uint64_t bytes_ = 0;
+    std::uint64_t rejected_ = 0;
+    std::uint64_t superseded_ = 0;
+    std::uint64_t rounds_ = 0;
+    std::uint64_t out_of_order_ = 0;  // presented request ids not increasing (must stay 0)
+    std::uint64_t last_request_id_ = 0;
+    nlohmann::json events_ = nlohmann::json::array();
+};
+
+}  // namespace mogao

@@ -1,0 +1,176 @@
+#include "kiosk/screen_presenter.h"
+
+#include <gtest/gtest.h>
+
+#include "appliance/warp/ideal_calibration.h"
+#include "drivers/egl/egl_test_support.h"
+#include "drivers/headless_output.h"
+#include "kiosk/connecting_screen.h"
+#include "kiosk/last_good_frame.h"
+#include "renderfarm/encode/jpeg_codec.h"
+
+namespace mogao {
+namespace {
+
+using mogao::testing::skip_or_fail_without_egl;
+
+constexpr ImageSize kContent{160, 90};
+
+ScreenCalibration three_projectors() {
+    IdealCalibrationParams p;
+    p.projectors = 3;
+    p.overlap = 0.15;
+    p.output = {96, 72};
+    p.content = kContent;
+    p.response_entries = 256;
+    return make_ideal_calibration(p);
+}
+
+std::unique_ptr<HeadlessOutputBackend> headless(const ScreenCalibration& screen) {
+    HeadlessOptions options;
+    for (const auto& p : screen.projectors) options.outputs.push_back(p.output);
+    auto backend = HeadlessOutputBackend::create(options);
+    if (!backend) {
+        if (backend.code() == ENODEV) skip_or_fail_without_egl(backend.error().message);
+        else ADD_FAILURE() << backend.error().message;
+        return nullptr;
+    }
+    return std::move(backend).value();
+}
+
+Rgb8Image uniform(ImageSize size, std::uint8_t v) { return Rgb8Image(size, v); }
+
+double mean(const Rgb8Image& image) {
+    double sum = 0;
+    for (const auto v : image.pixels) sum += v;
+    return image.pixels.empty() ? 0 : sum / static_cast<double>(image.pixels.size());
+}
+
+// Simulates KMS on top of the headless backend: the first present of an output is a blocking
+// modeset (ready on return); later presents wait for a page flip the test triggers with flip().
+class FlipBackend final : public OutputBackend {
+public:
+    explicit FlipBackend(HeadlessOutputBackend& inner) : inner_(inner), busy_(inner.outputs().size(), false),
+                                                         presented_(inner.outputs().size(), 0) {}
+    const std::vector<OutputInfo>& outputs() const override { return inner_.outputs(); }
+    WarpBlendRenderer& renderer() override { return inner_.renderer(); }
+    Status begin_frame(std::size_t i) override {
+        if (busy_.at(i)) return make_error(EBUSY, "flip pending");
+        return inner_.begin_frame(i);
+    }
+    Status present(std::size_t i) override {
+        if (Status s = inner_.present(i); !s) return s;
+        if (presented_.at(i)++ > 0) busy_[i] = true;
+        return {};
+    }
+    bool ready(std::size_t i) const override { return !busy_.at(i); }
+    int event_fd() const override { return -1; }
+    Result<std::vector<std::size_t>> dispatch_events() override { return std::exchange(flipped_, {}); }
+
+    void flip(std::size_t i) {
+        if (busy_.at(i)) {
+            busy_[i] = false;
+            flipped_.push_back(i);
+        }
+    }
+    [[nodiscard]] int presents(std::size_t i) const { return presented_.at(i); }
+
+private:
+    HeadlessOutputBackend& inner_;
+    std::vector<bool> busy_;
+    std::vector<int> presented_;
+    std::vector<std::size_t> flipped_;
+};
+
+TEST(ScreenPresenter, ShowsTheConnectingScreenThenFramesOnEveryOutput) {
+    const ScreenCalibration screen = three_projectors();
+    auto backend = headless(screen);
+    if (!backend) return;
+    auto presenter = ScreenPresenter::create(*backend, screen, nullptr);
+    ASSERT_TRUE(presenter) << presenter.error().message;
+
+    ASSERT_TRUE(presenter->show(make_connecting_screen(kContent, "FARM [::1]:7443"), 0));
+    EXPECT_EQ(presenter->last_presents(), 3u);
+    EXPECT_EQ(presenter->take_completed(), std::optional<std::uint64_t>(0));
+    for (std::size_t i = 0; i < 3; ++i) {
+        EXPECT_GT(mean(backend->last_frame(i)), 20.0) << "output " << i << " is black while connecting";
+    }
+
+    ASSERT_TRUE(presenter->show(uniform(kContent, 128), 5));
+    EXPECT_EQ(presenter->take_completed(), std::optional<std::uint64_t>(5));
+    EXPECT_FALSE(presenter->take_completed().has_value());
+    // Middle of the middle projector (blend 1): sRGB 128 -> linear 0.216 -> gamma 2.2 LUT -> 127.
+    const Rgb8Image& mid = backend->last_frame(1);
+    EXPECT_NEAR(mid.at(48, 36)[0], 127, 3);
+    EXPECT_FALSE(presenter->show(uniform(kContent, 10), 4)) << "tags must not go back";
+}
+
+TEST(ScreenPresenter, OutputsKeepTheLastGoodFrameWhenACorruptJpegArrives) {
+    const ScreenCalibration screen = three_projectors();
+    auto backend = headless(screen);
+    if (!backend) return;
+    auto presenter = ScreenPresenter::create(*backend, screen, nullptr);
+    ASSERT_TRUE(presenter);
+    JpegEncoder encoder;
+    LastGoodFrame last;
+    LinkFrame good;
+    good.request_id = 1;
+    good.size = kContent;
+    Rgb8Image content(kContent);
+    for (std::size_t k = 0; k < content.pixels.size(); ++k) content.pixels[k] = static_cast<std::uint8_t>(40 + k % 150);
+    good.jpeg = encoder.encode(content, 90);
+    ASSERT_EQ(last.accept(good), "");
+    ASSERT_TRUE(presenter->show(last.current()->image, last.current()->request_id));
+    std::vector<Rgb8Image> before;
+    for (std::size_t i = 0; i < 3; ++i) before.push_back(backend->last_frame(i));
+
+    LinkFrame corrupt = good;
+    corrupt.request_id = 2;
+    corrupt.jpeg.resize(corrupt.jpeg.size() * 2 / 3);
+    ASSERT_NE(last.accept(corrupt), "");
+    // What the kiosk does next: repaint what is current.
+    ASSERT_TRUE(presenter->show(last.current()->image, last.current()->request_id));
+    ASSERT_TRUE(presenter->repaint());
+    for (std::size_t i = 0; i < 3; ++i) {
+        EXPECT_EQ(backend->last_frame(i).pixels, before[i].pixels) << "output " << i << " changed";
+        EXPECT_GT(mean(backend->last_frame(i)), 20.0);
+    }
+}
+
+TEST(ScreenPresenter, PendingFlipsGetTheNewestContentAndCompleteInOrder) {
+    const ScreenCalibration screen = three_projectors();
+    auto inner = headless(screen);
+    if (!inner) return;
+    FlipBackend backend(*inner);
+    auto created = ScreenPresenter::create(backend, screen, nullptr);
+    ASSERT_TRUE(created);
+    ScreenPresenter& p = *created;
+
+    ASSERT_TRUE(p.show(uniform(kContent, 50), 1));  // modeset: on screen at once
+    EXPECT_EQ(p.take_completed(), std::optional<std::uint64_t>(1));
+    ASSERT_TRUE(p.show(uniform(kContent, 60), 2));  // flips pending on all three
+    EXPECT_EQ(p.last_presents(), 3u);
+    EXPECT_FALSE(p.take_completed().has_value());
+    ASSERT_TRUE(p.show(uniform(kContent, 70), 3));  // nothing can be presented yet
+    EXPECT_EQ(p.last_presents(), 0u);
+    ASSERT_TRUE(p.repaint());
+    EXPECT_EQ(p.last_presents(), 0u);
+
+    backend.flip(0);
+    backend.flip(1);
+    ASSERT_TRUE(p.on_ready(*backend.dispatch_events()));
+    EXPECT_EQ(p.last_presents(), 2u);  // 0 and 1 get frame 3 right away
+    EXPECT_FALSE(p.take_completed().has_value()) << "output 2 still shows frame 1";
+    backend.flip(2);
+    ASSERT_TRUE(p.on_ready(*backend.dispatch_events()));
+    EXPECT_EQ(p.take_completed(), std::optional<std::uint64_t>(2));
+    for (std::size_t i = 0; i < 3; ++i) backend.flip(i);
+    ASSERT_TRUE(p.on_ready(*backend.dispatch_events()));
+    EXPECT_EQ(p.take_completed(), std::optional<std::uint64_t>(3));
+    EXPECT_EQ(backend.presents(0), 3);
+    EXPECT_EQ(backend.presents(2), 3);
+    EXPECT_NEAR(inner->last_frame(1).at(48, 36)[0], 70, 12);  // the newest content, not 60
+}
+
+}  // namespace
+}  // namespace mogao

@@ -1,0 +1,58 @@
+#include "kiosk/signal_fd.h"
+
+#include <pthread.h>
+#include <sys/signalfd.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <string>
+#include <utility>
+
+namespace mogao {
+
+Result<SignalFd> SignalFd::create(std::initializer_list<int> signals) {
+    if (signals.size() == 0) return make_error(EINVAL, "signalfd: empty signal set");
+    sigset_t set;
+    sigemptyset(&set);
+    for (const int s : signals) {
+        if (sigaddset(&set, s) != 0) return make_error(EINVAL, "signalfd: invalid signal number " + std::to_string(s));
+    }
+    sigset_t previous;
+    if (const int rc = ::pthread_sigmask(SIG_BLOCK, &set, &previous); rc != 0) {
+        return make_error(rc, std::string("pthread_sigmask: ") + std::strerror(rc));
+    }
+    const int fd = ::signalfd(-1, &set, SFD_CLOEXEC | SFD_NONBLOCK);
+    if (fd < 0) {
+        Error error = errno_error("signalfd");
+        ::pthread_sigmask(SIG_SETMASK, &previous, nullptr);
+        return error;
+    }
+    return SignalFd(UniqueFd(fd), set, previous);
+}
+
+SignalFd::SignalFd(SignalFd&& other) noexcept
+    : fd_(std::move(other.fd_)), set_(other.set_), previous_(other.previous_), restore_(std::exchange(other.restore_, false)) {}
+
+SignalFd::~SignalFd() {
+    if (!restore_) return;
+    // Consume what is pending for the set, then unblock: a late SIGTERM must not kill the process
+    // half-way through its clean shutdown.
+    const timespec zero{};
+    while (::sigtimedwait(&set_, nullptr, &zero) > 0) {
+    }
+    ::pthread_sigmask(SIG_SETMASK, &previous_, nullptr);
+}
+
+Result<std::optional<int>> SignalFd::read() const {
+    signalfd_siginfo info{};
+    for (;;) {
+        const ssize_t n = ::read(fd_.get(), &info, sizeof info);
+        if (n == static_cast<ssize_t>(sizeof info)) return std::optional<int>(static_cast<int>(info.ssi_signo));
+        if (n < 0 && errno == EINTR) continue;
+        if (n < 0 && errno == EAGAIN) return std::optional<int>();
+        return errno_error("signalfd read");
+    }
+}
+
+}  // namespace mogao
