@@ -1,5 +1,5 @@
 // The one interface the tracker reads frames from: a V4L2 camera (v4l2_capture.h) or a folder of
-// images (replay_source.h). A libcamera backend is not implemented (docs/tracking.md, "left").
+// images (replay_source.h), and libcamera where built with it (libcamera_capture.h, MOGAO_LIBCAMERA).
 //
 // Errors follow drivers/result.h: next_frame() never throws. Codes a caller can branch on:
 //   ENODATA    a finite source (replay without loop) has no more frames

@@ -1,0 +1,388 @@
+// LibcameraCapture with libcamera (MOGAO_HAVE_LIBCAMERA). See libcamera_capture.h for the design.
+#include "drivers/camera/libcamera_capture.h"
+
+#include <libcamera/camera.h>
+#include <libcamera/camera_manager.h>
+#include <libcamera/control_ids.h>
+#include <libcamera/formats.h>
+#include <libcamera/framebuffer.h>
+#include <libcamera/framebuffer_allocator.h>
+#include <libcamera/request.h>
+#include <libcamera/stream.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <cstring>
+#include <map>
+#include <mutex>
+
+#include "drivers/camera/mapped_buffer.h"
+#include "drivers/camera/mjpeg_decoder.h"
+#include "drivers/camera/pixel_format.h"
+
+namespace mogao {
+
+static_assert(libcamera_fourcc(CaptureFormat::grey) == libcamera::formats::R8.fourcc());
+static_assert(libcamera_fourcc(CaptureFormat::yuyv) == libcamera::formats::YUYV.fourcc());
+static_assert(libcamera_fourcc(CaptureFormat::mjpeg) == libcamera::formats::MJPEG.fourcc());
+
+namespace {
+
+// libcamera 0.0.x allows one CameraManager per process (a second one is a Fatal log: abort).
+std::mutex g_manager_mutex;
+bool g_manager_in_use = false;
+
+// libcamera returns negative errno values.
+Error libcamera_error(int ret, const std::string& what) {
+    const int code = ret < 0 ? -ret : EIO;
+    return make_error(code, what + ": " + std::strerror(code));
+}
+
+std::string format_list(const std::vector<libcamera::PixelFormat>& formats) {
+    std::string list;
+    for (const libcamera::PixelFormat& f : formats) list += (list.empty() ? "" : ", ") + f.toString();
+    return list.empty() ? std::string("none") : list;
+}
+
+}  // namespace
+
+bool libcamera_built_in() noexcept { return true; }
+
+struct LibcameraCapture::Impl {
+    // Holds the process-wide CameraManager slot; declared first so it is given back last.
+    struct ManagerSlot {
+        bool held = false;
+        ManagerSlot() = default;
+        ManagerSlot(const ManagerSlot&) = delete;
+        ManagerSlot& operator=(const ManagerSlot&) = delete;
+        ~ManagerSlot() {
+            if (!held) return;
+            const std::lock_guard<std::mutex> lock(g_manager_mutex);
+            g_manager_in_use = false;
+        }
+    };
+    struct Mapping {
+        MappedBuffer map;  // [0, offset + length) of the plane's dmabuf
+        std::size_t offset = 0;
+        std::size_t length = 0;
+    };
+
+    ManagerSlot slot;
+    std::unique_ptr<libcamera::CameraManager> manager;
+    bool manager_started = false;
+    std::shared_ptr<libcamera::Camera> camera;
+    bool acquired = false;
+    std::unique_ptr<libcamera::CameraConfiguration> configuration;
+    libcamera::Stream* stream = nullptr;
+    std::unique_ptr<libcamera::FrameBufferAllocator> allocator;
+    std::map<const libcamera::FrameBuffer*, Mapping> mappings;
+    std::vector<std::unique_ptr<libcamera::Request>> requests;
+    bool connected = false;
+    bool started = false;
+    std::unique_ptr<MjpegDecoder> mjpeg;  // only for MJPEG
+    std::string id;
+    CaptureFormat format = CaptureFormat::grey;
+    int width = 0;
+    int height = 0;
+    int stride = 0;
+    int timeout_ms = 2000;
+
+    // Shared with libcamera's thread.
+    std::mutex mutex;
+    std::condition_variable ready;
+    std::vector<libcamera::Request*> completed;  // capacity = requests.size(): push_back never allocates
+    bool disconnected = false;
+
+    std::vector<libcamera::Request*> taken;  // next_frame()'s copy of `completed` (same capacity)
+
+    Impl() = default;
+    Impl(const Impl&) = delete;
+    Impl& operator=(const Impl&) = delete;
+
+    ~Impl() {
+        // stop() cancels the queued requests; they complete (RequestCancelled, ignored by the slot)
+        // before it returns. Then nothing calls into this object any more.
+        if (started) (void)camera->stop();
+        if (connected) {
+            camera->requestCompleted.disconnect(this);
+            camera->disconnected.disconnect(this);
+        }
+        completed.clear();
+        taken.clear();
+        requests.clear();
+        mappings.clear();  // unmap before the buffers are freed
+        if (allocator && stream != nullptr) (void)allocator->free(stream);
+        allocator.reset();
+        configuration.reset();
+        if (acquired) (void)camera->release();
+        camera.reset();  // before the manager: it owns the pipeline handlers
+        if (manager_started) manager->stop();
+        manager.reset();
+    }
+
+    // libcamera's thread. Must not throw or block for long.
+    void on_request_completed(libcamera::Request* request) {
+        if (request->status() == libcamera::Request::RequestCancelled) return;  // camera stopping
+        {
+            const std::lock_guard<std::mutex> lock(mutex);
+            if (completed.size() < completed.capacity()) completed.push_back(request);
+        }
+        ready.notify_one();
+    }
+
+    void on_disconnected() {
+        {
+            const std::lock_guard<std::mutex> lock(mutex);
+            disconnected = true;
+        }
+        ready.notify_one();
+    }
+
+    Status requeue(libcamera::Request* request) {
+        request->reuse(libcamera::Request::ReuseBuffers);
+        if (const int ret = camera->queueRequest(request); ret < 0) {
+            return libcamera_error(ret, "libcamera camera " + id + ": queueRequest");
+        }
+        return {};
+    }
+
+    [[nodiscard]] bool frame_ok(const libcamera::Request* request) const {
+        if (request->status() != libcamera::Request::RequestComplete) return false;
+        const libcamera::FrameBuffer* buffer = request->findBuffer(stream);
+        return buffer != nullptr && buffer->metadata().status == libcamera::FrameMetadata::FrameSuccess &&
+               mappings.count(buffer) != 0;
+    }
+
+    Status convert(const libcamera::FrameBuffer& buffer, GrayImage& out) {
+        const Mapping& m = mappings.at(&buffer);
+        std::span<const std::uint8_t> bytes = m.map.bytes().subspan(m.offset, m.length);
+        const auto planes = buffer.metadata().planes();
+        // bytesused bounds a compressed frame; 0 means the whole plane.
+        if (!planes.empty() && planes[0].bytesused != 0) {
+            bytes = bytes.first(std::min<std::size_t>(bytes.size(), planes[0].bytesused));
+        }
+        Status s;
+        switch (format) {
+            case CaptureFormat::grey:
+                s = grey_from_grey(bytes, width, height, stride, out);
+                break;
+            case CaptureFormat::yuyv:
+                s = grey_from_yuyv(bytes, width, height, stride, out);
+                break;
+            case CaptureFormat::mjpeg:
+                s = mjpeg->decode_grey(bytes, out, width, height);
+                break;
+            case CaptureFormat::image_file:
+                s = make_error(EINVAL, "image_file is not a capture format");
+                break;
+        }
+        if (!s) return make_error(EBADMSG, "libcamera camera " + id + ": " + s.error().message);
+        return {};
+    }
+
+    Status configure(const LibcameraConfig& config);
+    Status allocate_and_start(const LibcameraConfig& config);
+};
+
+LibcameraCapture::LibcameraCapture() : impl_(std::make_unique<Impl>()) {}
+LibcameraCapture::~LibcameraCapture() = default;
+
+Result<std::unique_ptr<LibcameraCapture>> LibcameraCapture::open(const LibcameraConfig& config) {
+    if (Status s = check_libcamera_config(config); !s) return s.error();
+    std::unique_ptr<LibcameraCapture> cam(new LibcameraCapture());
+    Impl& d = *cam->impl_;
+    d.timeout_ms = config.timeout_ms;
+    {
+        const std::lock_guard<std::mutex> lock(g_manager_mutex);
+        if (g_manager_in_use) {
+            return make_error(EBUSY, "libcamera: another LibcameraCapture is open (libcamera 0.0.x allows one "
+                                     "CameraManager per process)");
+        }
+        g_manager_in_use = true;
+        d.slot.held = true;
+    }
+
+    d.manager = std::make_unique<libcamera::CameraManager>();
+    if (const int ret = d.manager->start(); ret < 0) return libcamera_error(ret, "libcamera: CameraManager::start");
+    d.manager_started = true;
+
+    const std::vector<std::shared_ptr<libcamera::Camera>> cameras = d.manager->cameras();
+    if (config.camera_id.empty()) {
+        if (cameras.empty()) {
+            return make_error(ENODEV, "libcamera: no camera found (CameraManager lists none: no supported camera "
+                                      "attached, or its pipeline handler or IPA module is missing)");
+        }
+        d.camera = cameras.front();
+    } else {
+        d.camera = d.manager->get(config.camera_id);
+        if (!d.camera) {
+            std::string list;
+            for (const auto& c : cameras) list += (list.empty() ? "" : ", ") + c->id();
+            return make_error(ENODEV, "libcamera camera " + config.camera_id +
+                                          ": not found; cameras: " + (list.empty() ? std::string("none") : list));
+        }
+    }
+    d.id = d.camera->id();
+    if (const int ret = d.camera->acquire(); ret < 0) {
+        return libcamera_error(ret, "libcamera camera " + d.id + ": acquire (in use by another process?)");
+    }
+    d.acquired = true;
+    if (Status s = d.configure(config); !s) return s.error();
+    if (Status s = d.allocate_and_start(config); !s) return s.error();
+
+    cam->camera_id_ = d.id;
+    cam->format_ = d.format;
+    cam->width_ = d.width;
+    cam->height_ = d.height;
+    cam->buffer_count_ = static_cast<int>(d.requests.size());
+    return cam;
+}
+
+Status LibcameraCapture::Impl::configure(const LibcameraConfig& config) {
+    const std::string name = "libcamera camera " + id;
+    const libcamera::StreamRoles roles{libcamera::StreamRole::Viewfinder};
+    configuration = camera->generateConfiguration(roles);
+    if (!configuration || configuration->empty()) {
+        return make_error(ENOTSUP, name + ": no Viewfinder stream configuration");
+    }
+    libcamera::StreamConfiguration& sc = configuration->at(0);
+    const std::vector<libcamera::PixelFormat> offered_formats = sc.formats().pixelformats();
+    std::vector<std::uint32_t> offered;
+    for (const libcamera::PixelFormat& f : offered_formats) offered.push_back(f.fourcc());
+    const std::optional<CaptureFormat> chosen = choose_libcamera_format(config.formats, offered);
+    if (!chosen) {
+        return make_error(ENOTSUP, name + ": none of the wanted formats (R8/YUYV/MJPEG) is offered; camera has: " +
+                                       format_list(offered_formats));
+    }
+    const libcamera::PixelFormat wanted(libcamera_fourcc(*chosen));
+    sc.pixelFormat = wanted;
+    sc.size = libcamera::Size(static_cast<unsigned int>(config.width), static_cast<unsigned int>(config.height));
+    sc.bufferCount = static_cast<unsigned int>(config.buffer_count);
+    if (configuration->validate() == libcamera::CameraConfiguration::Invalid) {
+        return make_error(EINVAL, name + ": the pipeline rejects " + wanted.toString() + " " +
+                                      std::to_string(config.width) + "x" + std::to_string(config.height));
+    }
+    if (sc.pixelFormat != wanted) {
+        return make_error(ENOTSUP, name + ": asked " + wanted.toString() + ", the pipeline adjusted to " +
+                                       sc.pixelFormat.toString());
+    }
+    if (sc.size.width < 1 || sc.size.height < 1 || sc.size.width > kMaxCaptureDimension ||
+        sc.size.height > kMaxCaptureDimension) {
+        return make_error(EINVAL, name + ": pipeline chose size " + sc.size.toString() + ", outside [1, " +
+                                      std::to_string(kMaxCaptureDimension) + "]");
+    }
+    format = *chosen;
+    width = static_cast<int>(sc.size.width);
+    height = static_cast<int>(sc.size.height);
+    stride = static_cast<int>(sc.stride);
+    if (const int ret = camera->configure(configuration.get()); ret < 0) {
+        return libcamera_error(ret, name + ": configure " + sc.toString());
+    }
+    stream = sc.stream();
+    if (stream == nullptr) return make_error(EIO, name + ": configure left the stream unset");
+    if (format == CaptureFormat::mjpeg) {
+        auto decoder = MjpegDecoder::create();
+        if (!decoder) return decoder.error();
+        mjpeg = std::make_unique<MjpegDecoder>(std::move(decoder).value());
+    }
+    return {};
+}
+
+Status LibcameraCapture::Impl::allocate_and_start(const LibcameraConfig& config) {
+    const std::string name = "libcamera camera " + id;
+    allocator = std::make_unique<libcamera::FrameBufferAllocator>(camera);
+    const int count = allocator->allocate(stream);
+    if (count < 0) return libcamera_error(count, name + ": FrameBufferAllocator::allocate");
+    if (count < 2) {
+        return make_error(ENOMEM, name + ": " + std::to_string(count) + " buffer(s) allocated (asked " +
+                                      std::to_string(config.buffer_count) + "), at least 2 are needed");
+    }
+    const std::vector<std::unique_ptr<libcamera::FrameBuffer>>& buffers = allocator->buffers(stream);
+    for (std::size_t i = 0; i < buffers.size(); ++i) {
+        const libcamera::FrameBuffer& buffer = *buffers[i];
+        const std::string which = name + ": buffer " + std::to_string(i);
+        // R8, YUYV and MJPEG are single-plane formats.
+        if (buffer.planes().empty()) return make_error(EIO, which + " has no planes");
+        const libcamera::FrameBuffer::Plane& plane = buffer.planes()[0];
+        const std::size_t offset =
+            plane.offset == libcamera::FrameBuffer::Plane::kInvalidOffset ? 0 : std::size_t{plane.offset};
+        auto map = MappedBuffer::map(plane.fd.get(), offset + plane.length, 0);
+        if (!map) return with_context(map.error(), which);
+        mappings.emplace(&buffer, Mapping{std::move(map).value(), offset, plane.length});
+
+        std::unique_ptr<libcamera::Request> request = camera->createRequest(i);
+        if (!request) return make_error(ENOMEM, which + ": createRequest failed");
+        if (const int ret = request->addBuffer(stream, buffers[i].get()); ret < 0) {
+            return libcamera_error(ret, which + ": Request::addBuffer");
+        }
+        requests.push_back(std::move(request));
+    }
+    completed.reserve(requests.size());
+    taken.reserve(requests.size());
+
+    camera->requestCompleted.connect(this, &Impl::on_request_completed);
+    camera->disconnected.connect(this, &Impl::on_disconnected);
+    connected = true;
+    if (const int ret = camera->start(); ret < 0) return libcamera_error(ret, name + ": start");
+    started = true;
+    for (const auto& request : requests) {
+        if (const int ret = camera->queueRequest(request.get()); ret < 0) {
+            return libcamera_error(ret, name + ": queueRequest");
+        }
+    }
+    return {};
+}
+
+Result<CameraFrame> LibcameraCapture::next_frame() {
+    Impl& d = *impl_;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(d.timeout_ms);
+    std::uint32_t skipped = 0;
+    for (;;) {
+        {
+            std::unique_lock<std::mutex> lock(d.mutex);
+            if (!d.ready.wait_until(lock, deadline, [&] { return !d.completed.empty() || d.disconnected; })) {
+                return make_error(ETIMEDOUT,
+                                  "libcamera camera " + d.id + ": no frame for " + std::to_string(d.timeout_ms) + " ms");
+            }
+            if (d.disconnected) return make_error(ENODEV, "libcamera camera " + d.id + ": disconnected");
+            d.taken.assign(d.completed.begin(), d.completed.end());  // within capacity: no allocation
+            d.completed.clear();
+        }
+        // Keep the newest good frame, give every other request straight back.
+        libcamera::Request* newest = nullptr;
+        for (libcamera::Request* request : d.taken) {
+            if (!d.frame_ok(request)) {
+                if (Status s = d.requeue(request); !s) return s.error();
+                ++skipped;
+                continue;
+            }
+            if (newest != nullptr) {
+                if (Status s = d.requeue(newest); !s) return s.error();
+                ++skipped;
+            }
+            newest = request;
+        }
+        d.taken.clear();
+        if (newest == nullptr) continue;  // only failed frames: wait for the next
+
+        const libcamera::FrameBuffer& buffer = *newest->findBuffer(d.stream);
+        CameraFrame frame;
+        frame.format = d.format;
+        frame.sequence = buffer.metadata().sequence;
+        frame.skipped = skipped;
+        frame.timestamp_ns = libcamera_frame_timestamp_ns(newest->metadata().get(libcamera::controls::SensorTimestamp),
+                                                          buffer.metadata().timestamp);
+        frame.clock = TimestampSource::kernel_monotonic;
+        const Status converted = d.convert(buffer, frame.image);
+        if (Status s = d.requeue(newest); !s) return s.error();
+        if (!converted) return converted.error();
+        return frame;
+    }
+}
+
+std::string LibcameraCapture::description() const {
+    return "libcamera " + camera_id_ + " " + std::to_string(width_) + "x" + std::to_string(height_) + " " +
+           pixel_format_name(format_) + ", " + std::to_string(buffer_count_) + " dmabuf buffers";
+}
+
+}  // namespace mogao
