@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <toml.hpp>
 
+#include "appliance/tracker/tag_family.h"
 #include "renderfarm/link/endpoint.h"
 
 namespace mogao {
@@ -276,7 +277,178 @@ void read_screen(const Section& s, CylinderScreen& screen) {
     }
 }
 
+// A [section.sub] table inside `parent` (e.g. [navigation.detector]); absent: an empty section.
+Section subsection(const Section& parent, std::string_view key, const std::string& name, std::vector<std::string> known) {
+    const Value* v = parent.find(key);
+    if (v != nullptr && !v->is_table()) parent.fail(v, key, ": expected a table ([" + name + "]), got " + type_name(*v));
+    return Section(parent.context(), name, v, std::move(known));
+}
+
+const std::vector<std::string> kTrackingKeys{"camera", "camera_size", "camera_fps", "intrinsics", "tag_size_m",
+                                             "tag_id", "replay_end", "detector", "control"};
+
+void read_detector(const Section& s, DetectorSettings& d) {
+    d.family = s.string("family", d.family);
+    const auto within = [](double lo, double hi) { return [lo, hi](double x) { return x >= lo && x <= hi; }; };
+    d.decimation = static_cast<float>(s.number("decimation", d.decimation, within(1, 8), "[1, 8]"));
+    d.blur_sigma = static_cast<float>(s.number("blur_sigma", d.blur_sigma, within(-5, 5), "[-5, 5] px"));
+    d.refine_edges = s.boolean("refine_edges", d.refine_edges);
+    d.min_white_black_diff = s.integer("min_white_black_diff", d.min_white_black_diff, 0, 255);
+    d.decode_sharpening = s.number("decode_sharpening", d.decode_sharpening, within(0, 1), "[0, 1]");
+    d.max_hamming = s.integer("max_hamming", d.max_hamming, 0, 2);
+    d.threads = s.integer("threads", d.threads, 1, 64);
+    const auto& families = TagFamily::known_names();
+    if (std::find(families.begin(), families.end(), d.family) == families.end()) {
+        s.fail(s.find("family"), "family", fmt::format(": '{}' is not one of {}", d.family, fmt::join(families, ", ")));
+    }
+    try {
+        validate(d);
+    } catch (const std::invalid_argument& e) {
+        s.context().fail(nullptr, fmt::format("[navigation.detector]: {}", e.what()));
+    }
+}
+
+void read_control(const Section& s, NavigationParams& p) {
+    const auto any = [](double x) { return std::abs(x) <= 1e6; };
+    const auto non_negative = [](double x) { return x >= 0 && x <= 1e6; };
+    const auto positive = [](double x) { return x > 0 && x <= 1e6; };
+    const auto exponent = [](double x) { return x >= 1 && x <= 4; };
+    struct Field {
+        const char* key;
+        double* value;
+        std::function<bool(double)> ok;
+        const char* range;
+    };
+    const Field fields[] = {
+        {"rest_yaw_deg", &p.rest.yaw_deg, any, "[-1e6, 1e6] degrees"},
+        {"rest_pitch_deg", &p.rest.pitch_deg, any, "[-1e6, 1e6] degrees"},
+        {"rest_distance_m", &p.rest.distance_m, positive, "(0, 1e6] m"},
+        {"rest_lateral_m", &p.rest.lateral_m, any, "[-1e6, 1e6] m"},
+        {"turn_dead_zone_deg", &p.turn.dead_zone, non_negative, "[0, 1e6] degrees"},
+        {"turn_full_scale_deg", &p.turn.full_scale, positive, "(0, 1e6] degrees, above the dead zone"},
+        {"turn_max_deg_s", &p.turn.max_rate, non_negative, "[0, 1e6] deg/s"},
+        {"turn_exponent", &p.turn.exponent, exponent, "[1, 4]"},
+        {"forward_dead_zone_m", &p.forward.dead_zone, non_negative, "[0, 1e6] m"},
+        {"forward_full_scale_m", &p.forward.full_scale, positive, "(0, 1e6] m, above the dead zone"},
+        {"forward_max_m_s", &p.forward.max_rate, non_negative, "[0, 1e6] m/s"},
+        {"forward_exponent", &p.forward.exponent, exponent, "[1, 4]"},
+        {"strafe_dead_zone_m", &p.strafe.dead_zone, non_negative, "[0, 1e6] m"},
+        {"strafe_full_scale_m", &p.strafe.full_scale, positive, "(0, 1e6] m, above the dead zone"},
+        {"strafe_max_m_s", &p.strafe.max_rate, non_negative, "[0, 1e6] m/s (0 = off)"},
+        {"strafe_exponent", &p.strafe.exponent, exponent, "[1, 4]"},
+        {"max_angular_accel_deg_s2", &p.max_angular_accel_deg_s2, positive, "(0, 1e6] deg/s^2"},
+        {"max_linear_accel_m_s2", &p.max_linear_accel_m_s2, positive, "(0, 1e6] m/s^2"},
+        {"hold_s", &p.hold_s, [](double x) { return x >= 0 && x <= 60; }, "[0, 60] s"},
+        {"forget_s", &p.forget_s, [](double x) { return x >= 0 && x <= 3600; }, "[0, 3600] s"},
+        {"max_dt_s", &p.max_dt_s, [](double x) { return x > 0 && x <= 10; }, "(0, 10] s"},
+    };
+    for (const Field& f : fields) *f.value = s.number(f.key, *f.value, f.ok, f.range);
+    p.pitch.enabled = s.boolean("pitch", p.pitch.enabled);
+    try {
+        validate(p);  // the relations: full scale above dead zone, hold_s <= forget_s
+    } catch (const std::invalid_argument& e) {
+        s.context().fail(nullptr, fmt::format("[{}]: {}", "navigation.control", e.what()));
+    }
+}
+
+void read_tracking(const Section& s, TrackingConfig& t, double eye_height_m) {
+    const Value& camera = s.require("camera", "with source = \"tracking\": \"replay:<folder>\" or \"v4l2:/dev/videoN\"");
+    t.camera = s.as_string(camera, "camera");
+    std::string why;
+    if (!parse_camera_source(t.camera, t.source, &why)) s.fail(&camera, "camera", ": " + why);
+    const bool replay = t.source.kind == CameraSourceSpec::Kind::replay;
+    if (replay) {
+        t.source.folder = s.context().resolve(t.source.folder.string());
+        std::error_code ec;
+        if (!fs::is_directory(t.source.folder, ec)) {
+            s.fail(&camera, "camera", fmt::format(": replay folder '{}' does not exist", t.source.folder.string()));
+        }
+        s.forbid("camera_size", "with a \"v4l2:\" camera (a replay has the size of its images)");
+        t.source.replay_fps = s.number("camera_fps", t.source.replay_fps, [](double x) { return x > 0 && x <= 1000; },
+                                       "(0, 1000] Hz (replay rate without timestamps.txt)");
+        if (const Value* end = s.find("replay_end")) {
+            const std::string text = s.as_string(*end, "replay_end");
+            if (text == "stop") {
+                t.replay_end = ReplayEnd::stop;
+            } else if (text == "loop") {
+                t.replay_end = ReplayEnd::loop;
+            } else if (text == "idle") {
+                t.replay_end = ReplayEnd::idle;
+            } else {
+                s.fail(end, "replay_end", fmt::format(": '{}' is not one of stop, loop, idle", text));
+            }
+        }
+        t.source.loop = t.replay_end == ReplayEnd::loop;
+    } else {
+        if (!fs::path(t.source.device).is_absolute()) {
+            s.fail(&camera, "camera", fmt::format(": '{}' is not an absolute device path (\"v4l2:/dev/videoN\")", t.source.device));
+        }
+        s.forbid("replay_end", "with a \"replay:\" camera");
+        t.source.fps = s.integer("camera_fps", 0, 0, 240);
+    }
+    const Value* intrinsics = s.find("intrinsics");
+    if (intrinsics != nullptr) {
+        t.intrinsics_file = s.existing_file(*intrinsics, "intrinsics");
+    } else if (replay && fs::exists(t.source.folder / "camera.json")) {
+        t.intrinsics_file = t.source.folder / "camera.json";
+    } else {
+        s.fail(nullptr, "intrinsics", replay ? fmt::format(" is required (the camera calibration, JSON or OpenCV YAML; "
+                                                           "'{}' has no camera.json)", t.source.folder.string())
+                                             : std::string(" is required with a \"v4l2:\" camera (the camera calibration, "
+                                                           "JSON or OpenCV YAML)"));
+    }
+    try {
+        t.intrinsics = read_intrinsics(t.intrinsics_file);
+    } catch (const std::exception& e) {
+        s.fail(intrinsics, "intrinsics", fmt::format(": {}", e.what()));
+    }
+    if (!replay) {
+        const ImageSize calibrated{t.intrinsics.width, t.intrinsics.height};
+        const ImageSize size = s.size("camera_size", calibrated, 1);
+        if (size.width > 8192 || size.height > 8192) {
+            s.fail(s.find("camera_size"), "camera_size", " is outside [1, 8192] pixels per side");
+        }
+        if (size.width != calibrated.width || size.height != calibrated.height) {
+            t.intrinsics = rescale(t.intrinsics, size.width, size.height);  // a binned mode of the calibrated sensor
+        }
+        t.source.width = size.width;
+        t.source.height = size.height;
+    }
+    t.tag_size_m = s.number("tag_size_m", t.tag_size_m, [](double x) { return x > 0 && x <= 10; }, "(0, 10] m");
+    t.tag_id = s.integer("tag_id", t.tag_id, 0, 1'000'000);
+    const Section detector = subsection(s, "detector", "navigation.detector",
+                                        {"family", "decimation", "blur_sigma", "refine_edges", "min_white_black_diff",
+                                         "decode_sharpening", "max_hamming", "threads"});
+    read_detector(detector, t.detector);
+    detector.finish();
+    const Section control = subsection(s, "control", "navigation.control",
+                                       {"rest_yaw_deg", "rest_pitch_deg", "rest_distance_m", "rest_lateral_m",
+                                        "turn_dead_zone_deg", "turn_full_scale_deg", "turn_max_deg_s", "turn_exponent",
+                                        "forward_dead_zone_m", "forward_full_scale_m", "forward_max_m_s",
+                                        "forward_exponent", "strafe_dead_zone_m", "strafe_full_scale_m",
+                                        "strafe_max_m_s", "strafe_exponent", "pitch", "max_angular_accel_deg_s2",
+                                        "max_linear_accel_m_s2", "hold_s", "forget_s", "max_dt_s"});
+    t.params.eye_height_m = eye_height_m;
+    read_control(control, t.params);
+    control.finish();
+}
+
 void read_navigation(const Section& s, NavigationConfig& n) {
+    if (const Value* source = s.find("source")) {
+        const std::string text = s.as_string(*source, "source");
+        if (text == "path") {
+            n.source = NavigationSource::path;
+        } else if (text == "tracking") {
+            n.source = NavigationSource::tracking;
+        } else {
+            s.fail(source, "source", fmt::format(": '{}' is not one of path, tracking", text));
+        }
+    }
+    if (n.source == NavigationSource::path) {
+        for (const auto& key : kTrackingKeys) s.forbid(key, "with source = \"tracking\"");
+    } else {
+        for (const char* key : {"path", "path_frames"}) s.forbid(key, "with source = \"path\"");
+    }
     if (const Value* path = s.find("path")) {
         const std::string text = s.as_string(*path, "path");
         if (text == "walk" || text == "orbit") {
@@ -299,6 +471,7 @@ void read_navigation(const Section& s, NavigationConfig& n) {
     }
     n.start_yaw_deg = s.number("start_yaw_deg", n.start_yaw_deg, [](double x) { return std::abs(x) <= 3600; }, "[-3600, 3600] degrees");
     n.eye_height_m = s.number("eye_height_m", n.eye_height_m, [](double x) { return x > 0 && x <= 100; }, "(0, 100] m");
+    if (n.source == NavigationSource::tracking) read_tracking(s, n.tracking, n.eye_height_m);
 }
 
 void read_stats(const Section& s, StatsConfig& st) {
@@ -308,6 +481,14 @@ void read_stats(const Section& s, StatsConfig& st) {
 }
 
 }  // namespace
+
+ViewerPose start_pose(const NavigationConfig& navigation) {
+    ViewerPose pose;
+    pose.eye = navigation.start + Eigen::Vector3d(0.0, navigation.eye_height_m, 0.0);
+    pose.yaw_deg = navigation.start_yaw_deg;
+    pose.pitch_deg = 0.0;
+    return pose;
+}
 
 bool parse_size(std::string_view text, ImageSize& out) {
     const auto x = text.find('x');
@@ -360,7 +541,9 @@ KioskConfig parse_kiosk_config(std::string_view text, const std::filesystem::pat
     read_quality(quality, config.quality);
     const Section screen = section(ctx, root, "screen", {"radius_m", "arc_deg", "bottom_m", "top_m"});
     read_screen(screen, config.screen);
-    const Section navigation = section(ctx, root, "navigation", {"path", "path_frames", "start", "start_yaw_deg", "eye_height_m"});
+    const Section navigation = section(ctx, root, "navigation", {"source", "path", "path_frames", "start", "start_yaw_deg", "eye_height_m", "camera",
+                                                                     "camera_size", "camera_fps", "intrinsics", "tag_size_m", "tag_id",
+                                                                     "replay_end", "detector", "control"});
     read_navigation(navigation, config.navigation);
     config.screen.eye_m = Eigen::Vector3d(0.0, config.navigation.eye_height_m, 0.0);
     const Section stats = section(ctx, root, "stats", {"file", "log_period_s"});

@@ -26,6 +26,10 @@
 
 #include <Eigen/Core>
 
+#include "appliance/navigation/navigator.h"
+#include "appliance/tracker/camera_intrinsics.h"
+#include "appliance/tracker/camera_source.h"
+#include "appliance/tracker/detector_settings.h"
 #include "renderfarm/view/pixel_rect.h"
 #include "renderfarm/view/view_request.h"
 
@@ -76,15 +80,43 @@ struct QualityConfig {
     int area_light_samples = 1;             // [1, 1024]
 };
 
-// [navigation]: the scripted visitor (renderfarm/farm/camera_path.h) until tracking lands. The
-// appliance has no scene, so the scene's viewer start and eye height are given here.
+enum class NavigationSource { path, tracking };
+
+// What the tracking thread does when a replay camera runs out of frames (kiosk/tracking_thread.h).
+enum class ReplayEnd {
+    stop,  // the kiosk stops (exit 0) once the last sample has been shown: demos and tests
+    loop,  // the replay starts again (timestamps continue), the kiosk runs on
+    idle,  // no more samples: the view decelerates to rest and stays; the kiosk runs on
+};
+
+// [navigation] with source = "tracking": camera -> TagTracker -> Navigator (docs/kiosk.md).
+struct TrackingConfig {
+    std::string camera;                 // as written: "replay:<folder>" | "v4l2:/dev/videoN"
+    CameraSourceSpec source;            // parsed; replay folder resolved against the file's folder
+    std::filesystem::path intrinsics_file;  // [navigation].intrinsics (replay default: <folder>/camera.json)
+    CameraIntrinsics intrinsics;        // read; v4l2: rescaled to camera_size when that differs
+    double tag_size_m = 0.10;           // (0, 10]: side of the tag's black border square
+    int tag_id = -1;                    // -1 (omitted): the largest tag of the family
+    DetectorSettings detector;          // [navigation.detector]
+    NavigationParams params;            // [navigation.control]; eye_height_m from [navigation]
+    ReplayEnd replay_end = ReplayEnd::stop;  // replay only
+};
+
+// [navigation]: how the visitor moves -- the scripted visitor (renderfarm/farm/camera_path.h) or
+// the tracked tag. The appliance has no scene, so the scene's viewer start and eye height are given
+// here; they are the start pose of both.
 struct NavigationConfig {
+    NavigationSource source = NavigationSource::path;
     std::string path = "walk";              // "walk" | "orbit" | a JSON path file (must exist)
     int path_frames = 900;                  // requests per loop of the path, [2, 1000000]
     Eigen::Vector3d start{0.0, 0.0, 5.0};   // floor point of the viewer's start, world metres
     double start_yaw_deg = 0.0;             // |.| <= 3600
     double eye_height_m = 1.6;              // (0, 100]: also the screen camera's eye height
+    TrackingConfig tracking;                // source = "tracking" only
 };
+
+// The viewer's start pose: eye at start + eye height, start yaw, level.
+[[nodiscard]] ViewerPose start_pose(const NavigationConfig& navigation);
 
 // [stats].
 struct StatsConfig {

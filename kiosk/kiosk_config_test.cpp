@@ -1,11 +1,14 @@
 #include "kiosk/kiosk_config.h"
 
+#include "appliance/tracker/camera_intrinsics.h"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
 
 namespace mogao {
@@ -15,7 +18,7 @@ namespace fs = std::filesystem;
 
 // A folder with the files a configuration references (contents do not matter to the parser).
 class KioskConfigTest : public ::testing::Test {
-protected:
+public:  // the free helpers below build on good()
     void SetUp() override {
         dir_ = fs::temp_directory_path() / ("mogao-kiosk-config-" + std::to_string(::getpid()));
         fs::remove_all(dir_);
@@ -23,6 +26,18 @@ protected:
         for (const char* f : {"pki/ca.pem", "pki/appliance-a.pem", "pki/appliance-a.key", "screen.mpcdi", "tour.json"}) {
             std::ofstream(dir_ / f) << "x";
         }
+        // A replay folder with its camera.json (as `mogao-track make-sequence` writes it), and a
+        // separate calibration file.
+        fs::create_directories(dir_ / "seq");
+        CameraIntrinsics camera;
+        camera.width = 800;
+        camera.height = 600;
+        camera.fx = camera.fy = 700.0;
+        camera.cx = 399.5;
+        camera.cy = 299.5;
+        write_intrinsics(dir_ / "seq/camera.json", camera);
+        write_intrinsics(dir_ / "webcam.json", camera);
+        std::ofstream(dir_ / "broken.json") << "{\"image_width\": 800}";
     }
     void TearDown() override { fs::remove_all(dir_); }
 
@@ -302,6 +317,241 @@ TEST_F(KioskConfigTest, TheExampleFileIsValid) {
     EXPECT_EQ(c.outputs.backend, OutputKind::kms);
     EXPECT_EQ(c.calibration.mpcdi, dir_ / "etc/screen.mpcdi");
     EXPECT_EQ(c.navigation.path, "walk");
+}
+
+// --- [navigation] source = "tracking" ---------------------------------------------------------
+
+// good() with a tracking [navigation] section (every tracking field set).
+std::string tracking(const std::string& navigation) {
+    return replace(KioskConfigTest::good(), R"([navigation]
+path = "orbit"
+path_frames = 120
+)", "[navigation]\n" + navigation);
+}
+
+const char* const kTrackingFields = R"(source = "tracking"
+camera = "replay:seq"
+camera_fps = 25
+tag_size_m = 0.12
+tag_id = 3
+replay_end = "idle"
+)";
+
+const char* const kTrackingTables = R"(
+[navigation.detector]
+family = "tag25h9"
+decimation = 1.5
+blur_sigma = 0.0
+refine_edges = false
+min_white_black_diff = 10
+decode_sharpening = 0.5
+max_hamming = 1
+threads = 2
+
+[navigation.control]
+rest_distance_m = 0.45
+rest_yaw_deg = 2
+turn_dead_zone_deg = 5
+turn_full_scale_deg = 25
+turn_max_deg_s = 60
+forward_max_m_s = 0.5
+strafe_max_m_s = 0.3
+pitch = true
+max_angular_accel_deg_s2 = 90
+hold_s = 0.2
+forget_s = 1.0
+max_dt_s = 0.05
+)";
+
+std::string full_tracking() {
+    return replace(tracking(kTrackingFields), "[stats]", std::string(kTrackingTables) + "\n[stats]");
+}
+
+TEST_F(KioskConfigTest, ReadsTheTrackingFields) {
+    const KioskConfig c = parse(full_tracking());
+    const TrackingConfig& t = c.navigation.tracking;
+    EXPECT_EQ(c.navigation.source, NavigationSource::tracking);
+    EXPECT_EQ(t.camera, "replay:seq");
+    EXPECT_EQ(t.source.kind, CameraSourceSpec::Kind::replay);
+    EXPECT_EQ(t.source.folder, dir_ / "seq");
+    EXPECT_DOUBLE_EQ(t.source.replay_fps, 25.0);
+    EXPECT_EQ(t.intrinsics_file, dir_ / "seq/camera.json");  // the replay's own calibration by default
+    EXPECT_EQ(t.intrinsics.width, 800);
+    EXPECT_DOUBLE_EQ(t.intrinsics.fx, 700.0);
+    EXPECT_DOUBLE_EQ(t.tag_size_m, 0.12);
+    EXPECT_EQ(t.tag_id, 3);
+    EXPECT_EQ(t.replay_end, ReplayEnd::idle);
+    EXPECT_FALSE(t.source.loop);
+    EXPECT_EQ(t.detector.family, "tag25h9");
+    EXPECT_FLOAT_EQ(t.detector.decimation, 1.5f);
+    EXPECT_FLOAT_EQ(t.detector.blur_sigma, 0.0f);
+    EXPECT_FALSE(t.detector.refine_edges);
+    EXPECT_EQ(t.detector.min_white_black_diff, 10);
+    EXPECT_DOUBLE_EQ(t.detector.decode_sharpening, 0.5);
+    EXPECT_EQ(t.detector.max_hamming, 1);
+    EXPECT_EQ(t.detector.threads, 2);
+    EXPECT_DOUBLE_EQ(t.params.rest.distance_m, 0.45);
+    EXPECT_DOUBLE_EQ(t.params.rest.yaw_deg, 2.0);
+    EXPECT_DOUBLE_EQ(t.params.turn.dead_zone, 5.0);
+    EXPECT_DOUBLE_EQ(t.params.turn.full_scale, 25.0);
+    EXPECT_DOUBLE_EQ(t.params.turn.max_rate, 60.0);
+    EXPECT_DOUBLE_EQ(t.params.forward.max_rate, 0.5);
+    EXPECT_DOUBLE_EQ(t.params.strafe.max_rate, 0.3);
+    EXPECT_TRUE(t.params.pitch.enabled);
+    EXPECT_DOUBLE_EQ(t.params.max_angular_accel_deg_s2, 90.0);
+    EXPECT_DOUBLE_EQ(t.params.hold_s, 0.2);
+    EXPECT_DOUBLE_EQ(t.params.forget_s, 1.0);
+    EXPECT_DOUBLE_EQ(t.params.max_dt_s, 0.05);
+    EXPECT_DOUBLE_EQ(t.params.eye_height_m, 1.5);  // [navigation].eye_height_m
+    const ViewerPose start = start_pose(c.navigation);
+    EXPECT_DOUBLE_EQ(start.eye.y(), 1.5);
+    EXPECT_DOUBLE_EQ(start.eye.z(), 4.0);
+    EXPECT_DOUBLE_EQ(start.yaw_deg, 10.0);
+}
+
+TEST_F(KioskConfigTest, TrackingDefaultsComeFromTheLibraries) {
+    const KioskConfig c = parse(tracking("source = \"tracking\"\ncamera = \"replay:seq\"\n"));
+    const TrackingConfig& t = c.navigation.tracking;
+    EXPECT_EQ(t.replay_end, ReplayEnd::stop);
+    EXPECT_EQ(t.tag_id, -1);
+    EXPECT_DOUBLE_EQ(t.tag_size_m, 0.10);
+    EXPECT_EQ(t.detector.family, DetectorSettings{}.family);
+    EXPECT_DOUBLE_EQ(t.params.turn.max_rate, NavigationParams{}.turn.max_rate);
+    EXPECT_DOUBLE_EQ(t.params.rest.distance_m, NavigationParams{}.rest.distance_m);
+    EXPECT_EQ(parse(tracking("source = \"tracking\"\ncamera = \"replay:seq\"\nreplay_end = \"loop\"\n"))
+                  .navigation.tracking.source.loop,
+              true);
+}
+
+TEST_F(KioskConfigTest, AV4l2CameraNeedsIntrinsicsAndRescalesThemToItsSize) {
+    const KioskConfig c = parse(tracking(R"(source = "tracking"
+camera = "v4l2:/dev/video2"
+intrinsics = "webcam.json"
+camera_size = "400x300"
+camera_fps = 30
+)"));
+    const TrackingConfig& t = c.navigation.tracking;
+    EXPECT_EQ(t.source.kind, CameraSourceSpec::Kind::v4l2);
+    EXPECT_EQ(t.source.device, "/dev/video2");
+    EXPECT_EQ(t.source.width, 400);
+    EXPECT_EQ(t.source.height, 300);
+    EXPECT_EQ(t.source.fps, 30);
+    EXPECT_EQ(t.intrinsics.width, 400);
+    EXPECT_DOUBLE_EQ(t.intrinsics.fx, 350.0);  // a 2x2-binned mode of the calibrated sensor
+    EXPECT_DOUBLE_EQ(t.intrinsics.cx, 199.5);
+    const KioskConfig same = parse(tracking("source = \"tracking\"\ncamera = \"v4l2:/dev/video0\"\nintrinsics = \"webcam.json\"\n"));
+    EXPECT_EQ(same.navigation.tracking.source.width, 800);  // the calibrated size by default
+    EXPECT_EQ(same.navigation.tracking.source.fps, 0);
+}
+
+class KioskTrackingBadField : public KioskConfigTest, public ::testing::WithParamInterface<BadField> {};
+
+TEST_P(KioskTrackingBadField, NamesTheFileTheFieldAndTheReason) {
+    const BadField& bad = GetParam();
+    const std::string message = error_of(replace(full_tracking(), bad.from, bad.to));
+    ASSERT_FALSE(message.empty()) << "accepted: " << bad.to;
+    EXPECT_EQ(message.rfind(name().string(), 0), 0u) << message;
+    EXPECT_NE(message.find(bad.expected), std::string::npos) << message;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    EveryTrackingField, KioskTrackingBadField,
+    ::testing::Values(
+        BadField{R"(source = "tracking")", R"(source = "tag")", "[navigation].source: 'tag' is not one of path, tracking"},
+        BadField{R"(source = "tracking")", R"(source = "path")", "[navigation].camera: only with source = \"tracking\""},
+        BadField{R"(source = "tracking")", "source = \"tracking\"\npath = \"walk\"", "[navigation].path: only with source = \"path\""},
+        BadField{R"(camera = "replay:seq")", "# no camera", "[navigation].camera is required"},
+        BadField{R"(camera = "replay:seq")", R"(camera = "seq")", "[navigation].camera: 'seq' is neither \"replay:<folder>\" nor \"v4l2:/dev/videoN\""},
+        BadField{R"(camera = "replay:seq")", R"(camera = "replay:")", "[navigation].camera: 'replay:' needs a folder"},
+        BadField{R"(camera = "replay:seq")", R"(camera = "replay:nowhere")", "[navigation].camera: replay folder '"},
+        BadField{R"(camera = "replay:seq")", R"(camera = "v4l2:video0")", "[navigation].camera: 'video0' is not an absolute device path"},
+        BadField{R"(camera = "replay:seq")", R"(camera = "v4l2:/dev/video0")", "[navigation].replay_end: only with a \"replay:\" camera"},
+        BadField{R"(camera = "replay:seq")", "camera = \"replay:.\"", "[navigation].intrinsics is required"},
+        BadField{"camera_fps = 25", "camera_fps = 0", "[navigation].camera_fps = 0 is outside (0, 1000] Hz"},
+        BadField{"camera_fps = 25", "camera_fps = 25\ncamera_size = \"640x480\"", "[navigation].camera_size: only with a \"v4l2:\" camera"},
+        BadField{"camera_fps = 25", "camera_fps = 25\nintrinsics = \"absent.json\"", "[navigation].intrinsics: '"},
+        BadField{"camera_fps = 25", "camera_fps = 25\nintrinsics = \"broken.json\"", "[navigation].intrinsics: "},
+        BadField{"tag_size_m = 0.12", "tag_size_m = 0", "[navigation].tag_size_m = 0 is outside (0, 10] m"},
+        BadField{"tag_id = 3", "tag_id = -2", "[navigation].tag_id = -2 is outside [0, 1000000]"},
+        BadField{R"(replay_end = "idle")", R"(replay_end = "rewind")", "[navigation].replay_end: 'rewind' is not one of stop, loop, idle"},
+        BadField{R"(family = "tag25h9")", R"(family = "qr")", "[navigation.detector].family: "},
+        BadField{"decimation = 1.5", "decimation = 9", "[navigation.detector].decimation = 9 is outside [1, 8]"},
+        BadField{"max_hamming = 1", "max_hamming = 3", "[navigation.detector].max_hamming = 3 is outside [0, 2]"},
+        BadField{"threads = 2", "thread = 2", "[navigation.detector].thread: unknown field (known: family"},
+        BadField{"rest_distance_m = 0.45", "rest_distance_m = 0", "[navigation.control].rest_distance_m = 0 is outside (0, 1e6] m"},
+        BadField{"turn_dead_zone_deg = 5", "turn_dead_zone_deg = 40", "[navigation.control]: NavigationParams.turn"},
+        BadField{"hold_s = 0.2", "hold_s = 2", "[navigation.control]: NavigationParams: need 0 <= hold_s"},
+        BadField{"pitch = true", "pitch = 1", "[navigation.control].pitch: expected true or false"},
+        BadField{"max_dt_s = 0.05", "max_dt = 0.05", "[navigation.control].max_dt: unknown field (known: rest_yaw_deg"},
+        BadField{"[navigation.control]", "[navigation.controls]", "[navigation].controls: unknown field"}));
+
+TEST_F(KioskConfigTest, ThePathSourceRejectsTrackingTables) {
+    const std::string text = replace(good(), "[stats]", "[navigation.detector]\nthreads = 1\n\n[stats]");
+    EXPECT_NE(error_of(text).find("[navigation].detector: only with source = \"tracking\""), std::string::npos)
+        << error_of(text);
+}
+
+std::string read_source_file(const char* relative) {
+    std::ifstream in(fs::path(MOGAO_SOURCE_DIR) / relative);
+    EXPECT_TRUE(in) << relative << " not found";
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// The commented tracking example of kiosk.example.toml, uncommented, is valid too: every "# key ="
+// line after `source = "tracking"` and the two tables.
+TEST_F(KioskConfigTest, TheExampleFilesTrackingBlockIsValid) {
+    std::string text = read_source_file("kiosk/kiosk.example.toml");
+    const std::string prefix = "/etc/mogao/";
+    for (auto at = text.find(prefix); at != std::string::npos; at = text.find(prefix, at)) {
+        text.replace(at, prefix.size(), (dir_ / "etc").string() + "/");
+    }
+    fs::create_directories(dir_ / "etc/pki");
+    for (const char* f : {"etc/pki/ca.pem", "etc/pki/appliance-museum-1.pem", "etc/pki/appliance-museum-1.key", "etc/screen.mpcdi"}) {
+        std::ofstream(dir_ / f) << "x";
+    }
+    fs::copy_file(dir_ / "webcam.json", dir_ / "etc/camera.json");
+    text = replace(text, "source = \"path\"", "source = \"tracking\"");
+    text = replace(text, "path = \"walk\"\n", "");
+    text = replace(text, "path_frames = 900", "# path_frames");
+    // Uncomment the tracking block in place, from "# camera =" to [stats]: "# key = value" lines
+    // and "# [table]" headers (comment-only lines stay comments).
+    const auto from = text.find("# camera = ");
+    const auto stats = text.find("[stats]");
+    ASSERT_NE(from, std::string::npos);
+    ASSERT_NE(stats, std::string::npos);
+    std::string block;
+    std::istringstream lines(text.substr(from, stats - from));
+    for (std::string line; std::getline(lines, line);) {
+        const auto eq = line.find(" = ");
+        const bool key = line.rfind("# ", 0) == 0 && eq != std::string::npos && line.find_first_of(" ", 2) == eq;
+        block += (key || line.rfind("# [", 0) == 0 ? line.substr(2) : line) + "\n";
+    }
+    text = text.substr(0, from) + block + text.substr(stats);
+    text = replace(text, "\nreplay_end = ", "\n# replay only: replay_end = ");  // the example's camera is v4l2
+    const KioskConfig c = parse(text);
+    EXPECT_EQ(c.navigation.source, NavigationSource::tracking);
+    EXPECT_EQ(c.navigation.tracking.source.device, "/dev/video0");
+    EXPECT_EQ(c.navigation.tracking.intrinsics_file, dir_ / "etc/camera.json");
+    EXPECT_EQ(c.navigation.tracking.tag_id, 0);
+    EXPECT_EQ(c.navigation.tracking.detector.family, "tag36h11");
+    EXPECT_DOUBLE_EQ(c.navigation.tracking.params.turn.max_rate, 45.0);
+}
+
+// kiosk/tour-tracking.toml, placed as the README's live tour uses it: out/live/ with its PKI, the
+// sequence in out/hand-sequence.
+TEST_F(KioskConfigTest, TheTourTrackingFileIsValidInItsPlace) {
+    fs::create_directories(dir_ / "out/live/pki");
+    for (const char* f : {"out/live/pki/ca.pem", "out/live/pki/appliance-museum-1.pem", "out/live/pki/appliance-museum-1.key"}) {
+        std::ofstream(dir_ / f) << "x";
+    }
+    fs::create_directories(dir_ / "out/hand-sequence");
+    fs::copy_file(dir_ / "webcam.json", dir_ / "out/hand-sequence/camera.json");
+    const KioskConfig c = parse_kiosk_config(read_source_file("kiosk/tour-tracking.toml"), dir_ / "out/live/kiosk-tracking.toml");
+    EXPECT_EQ(c.navigation.source, NavigationSource::tracking);
+    EXPECT_EQ(c.navigation.tracking.source.folder, dir_ / "out/hand-sequence");
+    EXPECT_EQ(c.navigation.tracking.intrinsics_file, dir_ / "out/hand-sequence/camera.json");
+    EXPECT_EQ(c.navigation.tracking.replay_end, ReplayEnd::stop);
+    EXPECT_EQ(c.outputs.backend, OutputKind::headless);
 }
 
 TEST(ParseSize, AcceptsOnlyWidthXHeight) {

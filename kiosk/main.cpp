@@ -2,13 +2,16 @@
 // appliance's stages are wired:
 //
 //   config (TOML) -> calibration (MPCDI | ideal) -> outputs (KMS | headless) + warp/blend renderer
-//   scripted visitor (camera path) -> view requests -> link (gRPC + mutual TLS over IPv6) -> farm
+//   navigation: scripted visitor (camera path) | tracking (camera -> TagTracker on its own thread
+//               -> TagSampleQueue -> Navigator in the loop) -> view requests -> link (gRPC + mutual
+//               TLS over IPv6) -> farm
 //   farm frames -> latest-frame slot -> decode (TurboJPEG, last good frame kept) -> warp/blend -> outputs
 //
 // One thread runs everything display-side in one poll loop (kiosk/event_loop.h) over four fds:
 //   signalfd  SIGINT/SIGTERM -> clean stop
 //   eventfd   the link's frame callback (a gRPC thread) stored a frame in the slot
-//   timerfd   display/request tick: submit the next view request, repaint when idle, log, watchdog
+//   timerfd   display/request tick: next pose (path, or Navigator fed with the queued tag samples),
+//             submit the view request, repaint when idle, log, watchdog
 //   backend   DRM page-flip events (KMS only): outputs ready again, pending content presented
 // See docs/kiosk.md.
 //
@@ -43,9 +46,12 @@
 #include "kiosk/last_good_frame.h"
 #include "kiosk/latest_frame_slot.h"
 #include "kiosk/screen_calibration_source.h"
+#include "kiosk/pose_log.h"
 #include "kiosk/screen_presenter.h"
 #include "kiosk/signal_fd.h"
+#include "kiosk/tag_sample_queue.h"
 #include "kiosk/timer_fd.h"
+#include "kiosk/tracking_thread.h"
 #include "kiosk/view_script.h"
 #include "renderfarm/farm/service_notify.h"
 #include "renderfarm/link/link_client.h"
@@ -63,12 +69,18 @@ struct Flags {
     std::filesystem::path dump_dir;   // --dump-content
     int dump_every = 1;
     std::filesystem::path stats_file; // overrides [stats].file
+    std::filesystem::path pose_log;   // every submitted pose, JSON lines
     bool check_only = false;
 };
 
 // Frames shown on the outputs but not yet on screen everywhere (KMS flips pending), by request id.
 using PendingFrames = std::map<std::uint64_t, PresentedFrame>;
 constexpr std::size_t kMaxPendingFrames = 64;
+
+ViewRequest with_pose(ViewRequest request, const ViewerPose& pose) {
+    request.pose = pose;
+    return request;
+}
 
 int run(const Flags& flags, const SignalFd& signals) {
     // --- configuration -----------------------------------------------------------------------
@@ -79,12 +91,16 @@ int run(const Flags& flags, const SignalFd& signals) {
         spdlog::error("{}", e.what());
         return 2;
     }
-    if (!flags.path.empty()) config.navigation.path = flags.path;
+    if (!flags.path.empty()) {
+        config.navigation.source = NavigationSource::path;  // --path: the scripted visitor, whatever the file says
+        config.navigation.path = flags.path;
+    }
+    const bool tracking = config.navigation.source == NavigationSource::tracking;
     if (!flags.stats_file.empty()) config.stats.file = flags.stats_file;
     std::optional<ViewScript> script;
     TlsMaterial tls;
     try {
-        script.emplace(make_view_script(config));
+        if (!tracking) script.emplace(make_view_script(config));
         tls = load_tls_files(config.farm.ca, config.farm.cert, config.farm.key);
     } catch (const std::exception& e) {
         spdlog::error("{}: {}", config.source.string(), e.what());
@@ -229,9 +245,46 @@ int run(const Flags& flags, const SignalFd& signals) {
         spdlog::error("link: {}", e.what());
         return 1;
     }
-    spdlog::info("farm {}: {}x{} content, spp {}, JPEG quality {}, path '{}' ({} poses), {} Hz", config.farm.endpoint,
+    spdlog::info("farm {}: {}x{} content, spp {}, JPEG quality {}, {}, {} Hz", config.farm.endpoint,
                  config.quality.content.width, config.quality.content.height, config.quality.spp,
-                 config.quality.jpeg_quality, config.navigation.path, script->size(), config.outputs.rate_hz);
+                 config.quality.jpeg_quality,
+                 tracking ? fmt::format("tracking '{}'", config.navigation.tracking.camera)
+                          : fmt::format("path '{}' ({} poses)", config.navigation.path, script->size()),
+                 config.outputs.rate_hz);
+
+    // --- navigation input --------------------------------------------------------------------
+    std::optional<PoseLog> pose_log;
+    if (!flags.pose_log.empty()) {
+        try {
+            pose_log.emplace(flags.pose_log);
+        } catch (const std::exception& e) {
+            spdlog::error("--pose-log: {}", e.what());
+            return 1;
+        }
+    }
+    const ViewRequest view_template = make_view_template(config);
+    std::optional<Navigator> navigator;
+    TagSampleQueue samples;
+    std::unique_ptr<TrackingThread> tracker;  // last: stopped before the navigator and queue go
+    if (tracking) {
+        try {
+            navigator.emplace(config.navigation.tracking.params, start_pose(config.navigation));
+            tracker = std::make_unique<TrackingThread>(config.navigation.tracking, samples);
+        } catch (const std::exception& e) {
+            spdlog::error("tracking: {}", e.what());
+            client->stop();
+            return 1;
+        }
+        spdlog::info("tracking: {} -> tag {} of {} mm ({}), intrinsics {}; replay end: {}", tracker->description(),
+                     config.navigation.tracking.tag_id < 0 ? std::string("largest")
+                                                           : std::to_string(config.navigation.tracking.tag_id),
+                     config.navigation.tracking.tag_size_m * 1000.0, config.navigation.tracking.detector.family,
+                     config.navigation.tracking.intrinsics_file.string(),
+                     config.navigation.tracking.replay_end == ReplayEnd::stop   ? "stop"
+                     : config.navigation.tracking.replay_end == ReplayEnd::loop ? "loop"
+                                                                                : "idle");
+    }
+    std::uint64_t ticks = 0;
 
     LastGoodFrame last_good;
     bool connected = false;
@@ -298,9 +351,39 @@ int run(const Flags& flags, const SignalFd& signals) {
             loop.stop();
             return;
         }
+        // The next pose: the scripted visitor's, or the Navigator's after every pending tag sample.
+        PoseLogEntry entry;
+        bool replay_done = false;
+        if (navigator) {
+            const TagSampleQueue::Batch batch = samples.take_all();
+            for (const TagSample& sample : batch.samples) navigator->observe(sample);
+            entry.tracking_source = true;
+            entry.samples = batch.samples.size();
+            replay_done = batch.closed && config.navigation.tracking.replay_end == ReplayEnd::stop;
+        }
+        entry.time_ns = monotonic_ns();
+        const ViewRequest request =
+            navigator ? with_pose(view_template, navigator->advance(entry.time_ns)) : script->next();
+        if (navigator) {
+            entry.tracking = navigator->tracking();
+            entry.velocity = navigator->velocity();
+        }
         std::string why;
-        if (client->submit(script->next(), &why) == 0) {
-            spdlog::error("view request refused: {}", why);
+        entry.request_id = client->submit(request, &why);
+        if (entry.request_id == 0) spdlog::error("view request refused: {}", why);
+        entry.tick = ++ticks;
+        entry.pose = request.pose;
+        if (pose_log) {
+            try {
+                pose_log->write(entry);
+            } catch (const std::exception& e) {
+                spdlog::error("--pose-log: {}; no more poses are logged", e.what());
+                pose_log.reset();
+            }
+        }
+        if (replay_done) {
+            spdlog::info("stopping: the tracking replay ended (replay_end = \"stop\")");
+            loop.stop();
         }
         const LinkClientStats link = client->stats();
         if (link.connected != connected) {
@@ -344,7 +427,36 @@ int run(const Flags& flags, const SignalFd& signals) {
 
     // --- shutdown: no more frames, then the record of the run ---------------------------------
     notifier.stopping();
+    if (tracker) tracker->stop();
     client->stop();
+    if (pose_log) {
+        try {
+            pose_log->close();
+        } catch (const std::exception& e) {
+            spdlog::error("--pose-log: {}", e.what());
+            if (exit_code == 0) exit_code = 1;
+        }
+    }
+    nlohmann::json navigation_stats = {{"source", tracking ? "tracking" : "path"}, {"ticks", ticks}};
+    if (tracker) {
+        const TrackingCounters c = tracker->counters();
+        navigation_stats.update({{"camera", tracker->description()},
+                                 {"frames_tracked", c.frames},
+                                 {"tag_visible", c.visible},
+                                 {"ambiguous", c.ambiguous},
+                                 {"frame_errors", c.frame_errors},
+                                 {"camera_timeouts", c.timeouts},
+                                 {"camera_reopens", c.reopens},
+                                 {"replay_ended", c.ended},
+                                 {"samples_queued", samples.pushed()},
+                                 {"samples_dropped", samples.dropped()},
+                                 {"samples_rejected_by_gate", navigator->rejected_samples()},
+                                 {"final_pose", {{"eye", {navigator->pose().eye.x(), navigator->pose().eye.y(),
+                                                          navigator->pose().eye.z()}},
+                                                 {"yaw_deg", navigator->pose().yaw_deg}}}});
+        spdlog::info("tracking: {} frames, tag visible in {}, {} rejected by the flip gate, {} samples dropped",
+                     c.frames, c.visible, navigator->rejected_samples(), samples.dropped());
+    }
     const LinkClientStats link = client->stats();
     spdlog::info("stats: {} link_sessions={}", stats.log_line(), link.sessions_opened);
     if (recorder && config.outputs.composite) {
@@ -361,6 +473,7 @@ int run(const Flags& flags, const SignalFd& signals) {
             {"endpoint", config.farm.endpoint},
             {"content", {config.quality.content.width, config.quality.content.height}},
             {"jpeg_quality", config.quality.jpeg_quality},
+            {"navigation", navigation_stats},
             {"link", {{"sessions_opened", link.sessions_opened},
                       {"attempts_failed", link.attempts_failed},
                       {"requests_submitted", link.requests_submitted},
@@ -395,12 +508,14 @@ int main(int argc, char** argv) {
     CLI::App app{"mogao-kiosk: the appliance's projector outputs, fed by the render farm (docs/kiosk.md)"};
     Flags flags;
     app.add_option("--config", flags.config, "Configuration file (TOML)")->check(CLI::ExistingFile);
-    app.add_option("--path", flags.path, "Scripted visitor: walk | orbit | a JSON path file (overrides [navigation].path)");
+    app.add_option("--path", flags.path,
+                   "Scripted visitor: walk | orbit | a JSON path file (overrides [navigation].path and .source)");
     app.add_option("--frames", flags.frames, "Stop after this many farm frames are on screen")->check(CLI::Range(1, 100000000));
     app.add_option("--duration", flags.duration_s, "Stop after this many seconds")->check(CLI::Range(0.001, 1e9));
     app.add_option("--dump-content", flags.dump_dir, "Write decoded content frames (PPM + pose JSON) here");
     app.add_option("--dump-every", flags.dump_every, "With --dump-content: every k-th frame")->check(CLI::Range(1, 1000000));
     app.add_option("--stats", flags.stats_file, "Statistics JSON written at exit (overrides [stats].file)");
+    app.add_option("--pose-log", flags.pose_log, "Write every submitted pose here (JSON lines, one per display tick)");
     app.add_flag("--check-config", flags.check_only, "Validate the configuration (and TLS files, path) and exit");
     try {
         app.parse(argc, argv);

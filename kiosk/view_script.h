@@ -1,4 +1,4 @@
-// ViewScript: the scripted visitor that stands in for tracking (issue 5). It walks a camera path
+// ViewScript: the scripted visitor ([navigation] source = "path"; tracking: kiosk/tracking_thread.h). It walks a camera path
 // (renderfarm/farm/camera_path.h: "walk", "orbit" or a JSON path file) of `path_frames` poses and
 // starts over at the end, turning each pose into the ViewRequest the kiosk submits to the farm:
 // the cylindrical-screen camera, the content size and the quality knobs of the configuration.

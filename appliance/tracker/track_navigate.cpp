@@ -11,10 +11,10 @@
 #include <nlohmann/json.hpp>
 
 #include "appliance/navigation/navigator.h"
+#include "appliance/tracker/camera_source.h"
+#include "appliance/tracker/tag_sample_of.h"
 #include "appliance/tracker/tag_tracker.h"
 #include "appliance/tracker/track_commands.h"
-#include "drivers/camera/replay_source.h"
-#include "drivers/camera/v4l2_capture.h"
 
 namespace mogao::track {
 namespace {
@@ -39,26 +39,23 @@ int navigate(const NavigateOptions& o) {
     TrackerConfig config;
     config.detector = o.detector;
     config.camera = read_intrinsics(o.camera.empty() ? o.replay / "camera.json" : o.camera);
-    std::unique_ptr<FrameSource> source;
+    CameraSourceSpec spec;
     if (o.device.empty()) {
-        auto replay = ReplaySource::open({o.replay, o.fps, false});
-        if (!replay) {
-            std::fprintf(stderr, "mogao-track navigate: %s\n", replay.error().message.c_str());
-            return 1;
-        }
-        source = std::move(replay).value();
+        spec.kind = CameraSourceSpec::Kind::replay;
+        spec.folder = o.replay;
+        spec.replay_fps = o.fps;
     } else {
-        V4l2Config v4l2;
-        v4l2.device = o.device;
-        v4l2.width = config.camera.width;  // the calibrated size; the tracker refuses any other
-        v4l2.height = config.camera.height;
-        auto camera = V4l2Capture::open(v4l2);
-        if (!camera) {
-            std::fprintf(stderr, "mogao-track navigate: %s\n", camera.error().message.c_str());
-            return 1;
-        }
-        source = std::move(camera).value();
+        spec.kind = CameraSourceSpec::Kind::v4l2;
+        spec.device = o.device;
+        spec.width = config.camera.width;  // the calibrated size; the tracker refuses any other
+        spec.height = config.camera.height;
     }
+    auto opened = open_camera_source(spec);
+    if (!opened) {
+        std::fprintf(stderr, "mogao-track navigate: %s\n", opened.error().message.c_str());
+        return 1;
+    }
+    std::unique_ptr<FrameSource> source = std::move(opened).value();
     std::fprintf(stderr, "source: %s\n", source->description().c_str());
     config.tag_size_m = o.tag_size_mm / 1000.0;
     config.tag_id = o.id;
@@ -109,7 +106,7 @@ int navigate(const NavigateOptions& o) {
                 << '\n';
         }
         const TrackedTag tag = tracker.track(*frame);
-        navigator.observe({tag.timestamp_ns, tag.visible, tag.pose.rotation, tag.pose.translation_m});
+        navigator.observe(tag_sample_of(tag));
         const std::size_t index = static_cast<std::size_t>(frames++);
         visible += tag.visible ? 1 : 0;
         ambiguous += tag.ambiguous ? 1 : 0;

@@ -1,0 +1,156 @@
+#!/usr/bin/env bash
+# End to end, tracking as the kiosk's navigation input: a hand-held tag sequence with known motion
+# (`mogao-track make-sequence`: rest, turn the tag left 25 deg, back, push it 12 cm toward the
+# camera, back, fast turn right 30 deg, back, tag out of view 11.0-11.6 s, rest; 12 s, 800x600)
+# replayed as the camera of a headless kiosk ([navigation] source = "tracking",
+# replay_end = "stop"), which streams from a 3-rank farm over [::1] with mutual TLS.
+#
+# Checks, from the kiosk's --pose-log (one submitted pose per display tick) and statistics:
+#   * order of motion: the ticks in which the view moved, labelled L (yaw up: turned left),
+#     F (moved along its forward direction f(yaw) = (-sin yaw, 0, -cos yaw)), R (yaw down) and
+#     grouped into runs, read exactly L, F, R -- never two at once, never backwards;
+#   * sizes: L >= +30 deg (expected ~+90), F >= 0.3 m (~1.1 m), R <= -10 deg (~-40);
+#   * no jump: between consecutive ticks |dyaw| <= 4.6 deg and |deye| <= 0.11 m (the Navigator's
+#     45 deg/s and 1 m/s caps times its 0.1 s max_dt, plus rounding), eye height constant;
+#   * tag lost: some ticks after the right turn are not tracking, and the view came to rest: the
+#     last 15 poses are identical, velocities 0;
+#   * the kiosk stopped by itself at the end of the replay (exit 0), every frame tracked, the tag
+#     seen in most, no sample dropped; farm frames were shown.
+#
+# usage: e2e_tracking.sh FARM KIOSK TRACK MPIEXEC SOURCE_DIR WORK_DIR
+farm=$1 kiosk=$2 track=$3 MPIEXEC=$4 src=$5 work=$6
+tool=true  # kiosk_e2e_common.sh's PNG checks are not used here
+source "$src/tests/kiosk/kiosk_e2e_common.sh"
+
+rm -rf "$work"
+mkdir -p "$work"
+"$track" make-sequence "$work/hand-sequence" >"$work/make-sequence.log" 2>&1 \
+  || { cat "$work/make-sequence.log"; fail "mogao-track make-sequence"; }
+[[ -f "$work/hand-sequence/camera.json" ]] || fail "make-sequence wrote no camera.json"
+
+port=$((20000 + ($$ + 4099) % 20000))
+endpoint="[::1]:$port"
+make_pki "$work/pki" "::1"
+write_config "$work/kiosk.toml" "$endpoint" "$work/pki" "$work/png" 30
+# The scripted visitor's lines out, the tracking source in.
+python3 - "$work/kiosk.toml" <<'PY'
+import sys
+p = sys.argv[1]
+text = open(p).read()
+text = text.replace('path = "walk"\npath_frames = 240\n', '''source = "tracking"
+camera = "replay:hand-sequence"      # its camera.json is the intrinsics
+tag_size_m = 0.10
+tag_id = 0
+replay_end = "stop"
+''')
+assert 'source = "tracking"' in text
+open(p, "w").write(text)
+PY
+start_farm "$work/farm.log" "$endpoint"
+log "farm up at $endpoint"
+
+timeout 120 "$kiosk" --config "$work/kiosk.toml" --duration 90 --pose-log "$work/poses.jsonl" \
+  --stats "$work/stats.json" >"$work/kiosk.log" 2>&1
+rc=$?
+stop_farm TERM
+cat "$work/kiosk.log"
+(( rc == 0 )) || fail "mogao-kiosk exited with $rc"
+grep -q "stopping: the tracking replay ended" "$work/kiosk.log" || fail "the kiosk did not stop at the end of the replay"
+[[ -f "$work/poses.jsonl" ]] || fail "no pose log written"
+[[ -f "$work/stats.json" ]] || fail "no statistics written"
+
+python3 - "$work/poses.jsonl" "$work/stats.json" <<'PY' || fail "see above"
+import json, math, sys
+
+poses = [json.loads(line) for line in open(sys.argv[1])]
+stats = json.load(open(sys.argv[2]))
+nav = stats["navigation"]
+ok = True
+
+def bad(message):
+    global ok
+    print("FAIL:", message)
+    ok = False
+
+print(f"{len(poses)} poses; navigation stats: {json.dumps({k: nav[k] for k in nav if k != 'final_pose'})}")
+print(f"final pose: {nav['final_pose']}; farm frames shown: {stats['frames_presented']}")
+if nav["source"] != "tracking":
+    bad(f"navigation source {nav['source']}")
+if nav["frames_tracked"] != 360:
+    bad(f"{nav['frames_tracked']} frames tracked, the sequence has 360")
+if nav["tag_visible"] < 300:
+    bad(f"the tag was seen in {nav['tag_visible']} of 360 frames")
+if nav["samples_dropped"] != 0:
+    bad(f"{nav['samples_dropped']} samples dropped")
+if stats["frames_presented"] < 5:
+    bad(f"only {stats['frames_presented']} farm frames shown")
+if len(poses) < 200:
+    bad(f"only {len(poses)} poses for a 12 s replay at 30 Hz")
+
+# No jumps between ticks; eye height fixed.
+MAX_DYAW, MAX_DPOS = 4.6, 0.11
+worst_yaw = worst_pos = 0.0
+for a, b in zip(poses, poses[1:]):
+    dyaw = abs(b["yaw_deg"] - a["yaw_deg"])
+    dpos = math.dist(a["eye"], b["eye"])
+    worst_yaw, worst_pos = max(worst_yaw, dyaw), max(worst_pos, dpos)
+    if dyaw > MAX_DYAW or dpos > MAX_DPOS:
+        bad(f"jump between ticks {a['tick']} and {b['tick']}: yaw {dyaw:.2f} deg, eye {dpos:.3f} m")
+    if abs(b["eye"][1] - 1.6) > 1e-9:
+        bad(f"tick {b['tick']}: eye height {b['eye'][1]}")
+print(f"largest step between ticks: yaw {worst_yaw:.2f} deg (bound {MAX_DYAW}), eye {worst_pos:.4f} m (bound {MAX_DPOS})")
+
+# Label each tick's motion and group the labels into runs.
+EPS_YAW, EPS_POS = 1e-6, 1e-6
+runs = []  # [label, ticks, total yaw or distance, first tick]
+for a, b in zip(poses, poses[1:]):
+    dyaw = b["yaw_deg"] - a["yaw_deg"]
+    d = [b["eye"][i] - a["eye"][i] for i in range(3)]
+    dist = math.hypot(d[0], d[2])
+    labels = []
+    if dyaw > EPS_YAW:
+        labels.append("L")
+    elif dyaw < -EPS_YAW:
+        labels.append("R")
+    if dist > EPS_POS:
+        mid = math.radians((a["yaw_deg"] + b["yaw_deg"]) / 2)
+        along = -math.sin(mid) * d[0] - math.cos(mid) * d[2]
+        labels.append("F" if along > 0.99 * dist else "B")
+    if not labels:
+        continue
+    label = "+".join(labels)
+    amount = dyaw if label in ("L", "R") else dist
+    if runs and runs[-1][0] == label:
+        runs[-1][1] += 1
+        runs[-1][2] += amount
+    else:
+        runs.append([label, 1, amount, b["tick"]])
+for label, n, amount, first in runs:
+    unit = "deg" if label in ("L", "R") else "m"
+    print(f"  run {label}: from tick {first}, {n} ticks, {amount:+.3f} {unit}")
+order = [r[0] for r in runs]
+if order != ["L", "F", "R"]:
+    bad(f"motion order {order}, expected ['L', 'F', 'R'] (turn left, walk forward, turn right)")
+else:
+    (_, _, left, _), (_, _, walked, _), (_, _, right, right_start) = runs
+    if left < 30:
+        bad(f"turned left by {left:.1f} deg, expected >= 30")
+    if walked < 0.3:
+        bad(f"walked {walked:.2f} m, expected >= 0.3")
+    if right > -10:
+        bad(f"turned right by {right:.1f} deg, expected <= -10")
+    lost = [p for p in poses if p["tick"] > right_start and not p["tracking"]]
+    if not lost:
+        bad("the tag never left the view after the right turn (no tick without tracking)")
+    else:
+        print(f"tag lost after the right turn in {len(lost)} ticks (from tick {lost[0]['tick']})")
+
+# Came to rest.
+tail = poses[-15:]
+if any(p["yaw_deg"] != tail[0]["yaw_deg"] or p["eye"] != tail[0]["eye"] for p in tail):
+    bad("the view still moves in the last 15 ticks")
+if any(p["turn_deg_s"] != 0 or p["forward_m_s"] != 0 for p in tail):
+    bad("non-zero velocity in the last 15 ticks")
+sys.exit(0 if ok else 1)
+PY
+log "PASS"
