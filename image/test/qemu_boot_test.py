@@ -1,0 +1,595 @@
+#!/usr/bin/env python3
+"""Boots the appliance image in QEMU (real kernel, real drivers) and checks it end to end.
+
+    qemu_boot_test.py --image mogao-kiosk.img --repo SRC --kiosk BIN --farm BIN --image-tool BIN
+                      [--mpiexec MPIEXEC] [--camera-test BIN] [--work DIR] [--accel tcg|kvm]
+                      [--no-farm] [--no-tco] [--results FILE]
+
+A copy of the image is provisioned (image/provision) with a test PKI and a kiosk.toml whose farm is
+the host ([fec0::2]:PORT through QEMU's IPv6 user network), and its ESP gets one extra loader entry
+(the default of the copy) that adds a serial console and runs image/test/selftest.sh from a second,
+test-only disk. The shipped image is never changed. QEMU: q35 (ICH9 TCO watchdog), OVMF (UEFI),
+virtio-gpu with 3 outputs, TCG by default.
+
+Assertions (each printed; any failure fails the test):
+  * mogao-kiosk.service reaches READY (active) on the KMS outputs;
+  * each of the 3 outputs is lit (screendump not black) and shows the connecting screen: PSNR
+    against the same kiosk's headless rendering on the host >= 30 dB;
+  * the farm (mogao-farm serve on the host, [::1]:PORT) streams over IPv6 + mutual TLS into the
+    guest: the kiosk logs 'connected' and the outputs then differ from the connecting screen;
+  * a SIGSTOPped kiosk is killed by its watchdog (WatchdogSec) and restarted by systemd;
+  * the hardware watchdog (iTCO_wdt) is used by PID 1 and resets a hung (panicked) kernel;
+  * lock-down: read-only root, no failed units, no login prompt, no passwords, no listening sockets;
+  * V4L2 capture test of drivers/camera against vivid, when its test binary is given.
+Exit 77 (skip) with a message when QEMU, OVMF, mtools or the image are missing.
+"""
+import argparse
+import json
+import os
+import re
+import shutil
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+
+SKIP = 77
+OVMF_CODE = "/usr/share/OVMF/OVMF_CODE_4M.fd"
+OVMF_VARS = "/usr/share/OVMF/OVMF_VARS_4M.fd"
+OUTPUTS = 3
+MODE = (1024, 768)       # per output: virtio-gpu gives its forced outputs 1024x768 (preferred)
+RATE_HZ = 1               # llvmpipe under TCG renders a round of 3 outputs in seconds
+PSNR_MIN_DB = 30.0       # KMS output vs headless rendering of the same connecting screen
+PSNR_CHANGED_DB = 25.0   # a farm frame must differ from the connecting screen (below this)
+T0 = time.monotonic()
+
+
+def log(msg):
+    print(f"[qemu_boot_test {time.monotonic() - T0:7.1f}s] {msg}", flush=True)
+
+
+def skip(msg):
+    print(f"SKIP: {msg}", flush=True)
+    sys.exit(SKIP)
+
+
+class Failures:
+    def __init__(self):
+        self.items = []
+
+    def check(self, cond, what):
+        log(("PASS " if cond else "FAIL ") + what)
+        if not cond:
+            self.items.append(what)
+        return cond
+
+
+# --- images -----------------------------------------------------------------------------------------
+def read_ppm(path):
+    with open(path, "rb") as f:
+        data = f.read()
+    fields = []
+    pos = 0
+    while len(fields) < 4:
+        while data[pos:pos + 1].isspace():
+            pos += 1
+        if data[pos:pos + 1] == b"#":
+            pos = data.index(b"\n", pos) + 1
+            continue
+        start = pos
+        while not data[pos:pos + 1].isspace():
+            pos += 1
+        fields.append(data[start:pos])
+    if fields[0] != b"P6" or int(fields[3]) != 255:
+        raise ValueError(f"{path}: not an 8-bit P6 PPM")
+    w, h = int(fields[1]), int(fields[2])
+    return w, h, data[pos + 1:pos + 1 + w * h * 3]
+
+
+def ppm_stats(path):
+    """(width, height, mean code, fraction of pixels with max channel < 16)."""
+    w, h, px = read_ppm(path)
+    n = w * h
+    step = 7  # sample every 7th pixel: plenty for "is it lit"
+    total = dark = count = 0
+    for i in range(0, n, step):
+        r, g, b = px[3 * i], px[3 * i + 1], px[3 * i + 2]
+        total += r + g + b
+        dark += max(r, g, b) < 16
+        count += 1
+    return w, h, total / (3 * count), dark / count
+
+
+# --- QMP ----------------------------------------------------------------------------------------------
+class Qmp:
+    def __init__(self, path, timeout=60):
+        deadline = time.monotonic() + timeout
+        while True:
+            try:
+                self.sock = socket.socket(socket.AF_UNIX)
+                self.sock.connect(path)
+                break
+            except OSError:
+                if time.monotonic() > deadline:
+                    raise
+                time.sleep(0.2)
+        self.buf = b""
+        self.events = []
+        self._read()  # greeting
+        self.cmd("qmp_capabilities")
+
+    def _read(self, timeout=120):
+        self.sock.settimeout(timeout)
+        while b"\n" not in self.buf:
+            chunk = self.sock.recv(65536)
+            if not chunk:
+                raise EOFError("QMP closed")
+            self.buf += chunk
+        line, self.buf = self.buf.split(b"\n", 1)
+        return json.loads(line)
+
+    def cmd(self, name, **arguments):
+        msg = {"execute": name}
+        if arguments:
+            msg["arguments"] = arguments
+        self.sock.sendall(json.dumps(msg).encode() + b"\n")
+        while True:
+            reply = self._read()
+            if "event" in reply:
+                self.events.append(reply)
+                continue
+            if "error" in reply:
+                raise RuntimeError(f"QMP {name}: {reply['error']}")
+            return reply.get("return")
+
+    def poll_events(self, timeout):
+        """Collects events for up to `timeout` seconds; returns all seen so far (False on EOF)."""
+        deadline = time.monotonic() + timeout
+        try:
+            while time.monotonic() < deadline:
+                try:
+                    self.events.append(self._read(timeout=max(0.1, deadline - time.monotonic())))
+                except socket.timeout:
+                    break
+        except (EOFError, OSError):
+            return False
+        return True
+
+
+# --- serial console -----------------------------------------------------------------------------------
+class Serial:
+    """Follows the serial log file; collects MOGAO-SELFTEST lines."""
+
+    MARK = re.compile(r"MOGAO-SELFTEST (.*)")
+
+    def __init__(self, path):
+        self.path = path
+        self.pos = 0
+        self.partial = ""
+        self.marks = []   # (host time, text)
+
+    def pump(self):
+        try:
+            with open(self.path, "rb") as f:
+                f.seek(self.pos)
+                data = f.read()
+                self.pos += len(data)
+        except FileNotFoundError:
+            return
+        text = self.partial + data.decode("utf-8", "replace")
+        lines = text.split("\n")
+        self.partial = lines.pop()
+        now = time.monotonic()
+        for line in lines:
+            m = self.MARK.search(line)
+            if m:
+                self.marks.append((now, m.group(1).strip()))
+                log(f"guest: {m.group(1).strip()}")
+
+    def wait(self, pattern, timeout, alive):
+        """Waits for a marker matching `pattern` (regex, from its start); returns (time, text)."""
+        rx = re.compile(pattern)
+        deadline = time.monotonic() + timeout
+        while True:
+            self.pump()
+            for t, text in self.marks:
+                if rx.match(text):
+                    return t, text
+            if time.monotonic() > deadline or not alive():
+                break
+            time.sleep(0.5)
+        return None, None
+
+    def tail(self, n=60):
+        try:
+            with open(self.path, "rb") as f:
+                lines = f.read().decode("utf-8", "replace").splitlines()
+            return "\n".join(lines[-n:])
+        except FileNotFoundError:
+            return ""
+
+
+def free_port():
+    s = socket.socket(socket.AF_INET6)
+    s.bind(("::1", 0))
+    port = s.getsockname()[1]
+    s.close()
+    return port
+
+
+def psnr(tool, a, b):
+    """PSNR in dB of two images (PNG/PPM) by mogao_kiosk_image_tool; None if they cannot be compared."""
+    r = subprocess.run([tool, "psnr", a, b], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    if r.returncode != 0:
+        log(f"psnr {a} {b}: {r.stdout.strip()}")
+        return None
+    return float(r.stdout.strip())
+
+
+def db_json(db):
+    """JSON-safe PSNR: identical images give inf."""
+    return db if db is None or db != float("inf") else "inf"
+
+
+def run(cmd, **kw):
+    return subprocess.run(cmd, check=True, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, **kw)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--image", required=True)
+    ap.add_argument("--repo", required=True)
+    ap.add_argument("--kiosk", required=True, help="mogao-kiosk (host) for the headless reference and --check-config")
+    ap.add_argument("--farm", required=True, help="mogao-farm (host): PKI and the streaming farm")
+    ap.add_argument("--image-tool", required=True, help="mogao_kiosk_image_tool (PSNR of PNG/PPM)")
+    ap.add_argument("--mpiexec", default=shutil.which("mpirun") or "mpirun")
+    ap.add_argument("--camera-test", default="", help="drivers/camera test binary (mogao_camera_test), optional")
+    ap.add_argument("--work", default="")
+    ap.add_argument("--accel", default=os.environ.get("MOGAO_IMAGE_QEMU_ACCEL", "tcg"), choices=["tcg", "kvm"])
+    ap.add_argument("--no-farm", action="store_true")
+    ap.add_argument("--no-tco", action="store_true")
+    ap.add_argument("--results", default="")
+    ap.add_argument("--timeout", type=float, default=float(os.environ.get("MOGAO_IMAGE_BOOT_TIMEOUT", "900")))
+    a = ap.parse_args()
+
+    # --- preconditions (skip, not fail) ---------------------------------------------------------
+    qemu = shutil.which("qemu-system-x86_64")
+    if not qemu:
+        skip("qemu-system-x86_64 not found (apt-get install qemu-system-x86)")
+    for f in (OVMF_CODE, OVMF_VARS):
+        if not os.path.exists(f):
+            skip(f"{f} not found (apt-get install ovmf)")
+    for tool in ("mcopy", "mtype", "mke2fs", "sfdisk"):
+        if not shutil.which(tool):
+            skip(f"{tool} not found (apt-get install mtools e2fsprogs fdisk)")
+    if not os.path.isfile(a.image):
+        skip(f"no image at {a.image} (build it with image/build, or run the image_build test first)")
+    if os.geteuid() != 0:
+        skip("needs root (image/provision writes files owned by the kiosk user)")
+    for b in (a.kiosk, a.farm, a.image_tool):
+        if not os.access(b, os.X_OK):
+            skip(f"{b} not built")
+    if a.accel == "kvm" and not os.access("/dev/kvm", os.R_OK | os.W_OK):
+        skip("--accel kvm without a usable /dev/kvm")
+
+    work = a.work or tempfile.mkdtemp(prefix="mogao-qemu-")
+    os.makedirs(work, exist_ok=True)
+    log(f"work folder {work}")
+    fails = Failures()
+    results = {"accel": a.accel}
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+               OMPI_MCA_rmaps_base_oversubscribe="1", OMPI_MCA_hwloc_base_binding_policy="none",
+               OMPI_MCA_btl_vader_single_copy_mechanism="none", MTOOLS_SKIP_CHECK="1")
+    port = free_port()
+    endpoint = f"[fec0::2]:{port}"
+
+    # --- PKI and configuration -------------------------------------------------------------------
+    pki = os.path.join(work, "pki")
+    cfg = os.path.join(work, "config")
+    shutil.rmtree(pki, ignore_errors=True)
+    shutil.rmtree(cfg, ignore_errors=True)
+    run([a.farm, "pki", "init-ca", "--dir", pki])
+    run([a.farm, "pki", "issue-farm", "--dir", pki, "--name", "farm", "--san", "fec0::2,::1"])
+    run([a.farm, "pki", "issue-appliance", "--dir", pki, "--name", "museum-1"])
+    os.makedirs(os.path.join(cfg, "pki"))
+    for f in ("ca.pem", "appliance-museum-1.pem", "appliance-museum-1.key"):
+        shutil.copy(os.path.join(pki, f), os.path.join(cfg, "pki", f))
+
+    def kiosk_toml(outputs_section):
+        return f"""# written by image/test/qemu_boot_test.py
+[farm]
+endpoint = "{endpoint}"
+ca = "pki/ca.pem"
+cert = "pki/appliance-museum-1.pem"
+key = "pki/appliance-museum-1.key"
+
+[display]
+rate_hz = {RATE_HZ}
+
+[outputs]
+{outputs_section}
+
+[calibration]
+source = "ideal"
+projectors = {OUTPUTS}
+overlap = 0.15
+output = "{MODE[0]}x{MODE[1]}"
+
+[quality]
+content = "480x270"
+spp = 1
+jpeg_quality = 85
+
+[navigation]
+path = "walk"
+path_frames = 240
+start = [0.0, 0.0, 4.0]
+eye_height_m = 1.6
+
+[stats]
+log_period_s = 10
+"""
+    with open(os.path.join(cfg, "kiosk.toml"), "w") as f:
+        f.write(kiosk_toml('backend = "kms"'))
+
+    # Reference: the same kiosk on the host, headless, same calibration and connecting screen.
+    ref = os.path.join(work, "reference")
+    shutil.rmtree(ref, ignore_errors=True)
+    os.makedirs(ref)
+    with open(os.path.join(cfg, "reference.toml"), "w") as f:
+        f.write(kiosk_toml(f'backend = "headless"\npng_dir = "{ref}"\ncomposite = false'))
+    subprocess.run([a.kiosk, "--config", os.path.join(cfg, "reference.toml"), "--duration", "2"],
+                   stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT, env=env, timeout=120)
+    os.remove(os.path.join(cfg, "reference.toml"))
+    refs = []
+    for i in range(OUTPUTS):
+        pngs = sorted(p for p in os.listdir(ref) if p.startswith(f"headless-{i}-") and p.endswith("-req0.png"))
+        refs.append(os.path.join(ref, pngs[0]) if pngs else None)
+    log(f"reference renderings: {refs}")
+
+    # --- the test copy of the image: provisioned, with a self-test loader entry -----------------------
+    img = os.path.join(work, "test.img")
+    log(f"copying {a.image}")
+    run(["cp", "--sparse=always", a.image, img])
+    run([os.path.join(a.repo, "image", "provision"), "--kiosk", a.kiosk, img, cfg])
+    esp = f"{img}@@1M"
+    entry = run(["mtype", "-i", esp, "::/loader/entries/mogao.conf"], env=env).stdout
+    options = re.search(r"^options (.*)$", entry, re.M).group(1)
+    options = re.sub(r"\b(quiet|loglevel=\d|systemd.show_status=\S+)\b", "", options)
+    boot = ("udevadm settle; mount -o ro /dev/disk/by-label/mogao-test /mnt && exec /bin/sh /mnt/selftest.sh")
+    extra = [
+        "console=tty0", "console=ttyS0,115200", "systemd.show_status=true",
+        "systemd.journald.forward_to_console=1",
+        # QEMU enables only virtio-gpu's first output; the kernel forces the others on (as a
+        # projector that is plugged in would be).
+        *[f"video=Virtual-{i + 1}:{MODE[0]}x{MODE[1]}e" for i in range(1, OUTPUTS)],
+        "systemd.unit=multi-user.target", "systemd.wants=kernel-command-line.service",
+        f"systemd.run=\"/bin/sh -c '{boot}'\"",
+        "systemd.run_success_action=none", "systemd.run_failure_action=none",
+    ]
+    if not a.no_tco:
+        extra.append("mogao.selftest.tco=1")
+    selftest_entry = (f"title mogao self-test (QEMU)\nlinux /mogao/vmlinuz\ninitrd /mogao/initrd.img\n"
+                      f"options {' '.join(options.split())} {' '.join(extra)}\n")
+    with open(os.path.join(work, "selftest.conf"), "w") as f:
+        f.write(selftest_entry)
+    with open(os.path.join(work, "loader.conf"), "w") as f:
+        f.write("default selftest.conf\ntimeout 0\neditor no\n")
+    run(["mcopy", "-o", "-i", esp, os.path.join(work, "selftest.conf"), "::/loader/entries/selftest.conf"], env=env)
+    run(["mcopy", "-o", "-i", esp, os.path.join(work, "loader.conf"), "::/loader/loader.conf"], env=env)
+
+    # Test disk: the self-test script (+ the camera test and the libraries it needs, from this host).
+    disk = os.path.join(work, "testdisk")
+    shutil.rmtree(disk, ignore_errors=True)
+    os.makedirs(os.path.join(disk, "bin"))
+    os.makedirs(os.path.join(disk, "lib"))
+    shutil.copy(os.path.join(a.repo, "image", "test", "selftest.sh"), os.path.join(disk, "selftest.sh"))
+    if a.camera_test and os.access(a.camera_test, os.X_OK):
+        shutil.copy(a.camera_test, os.path.join(disk, "bin", "mogao_camera_test"))
+        glibc = re.compile(r"^(libc|libm|libpthread|libdl|librt|ld-linux.*)\.so")
+        for line in run(["ldd", a.camera_test]).stdout.splitlines():
+            m = re.search(r"=> (/\S+)", line)
+            if m and not glibc.match(os.path.basename(m.group(1))):
+                shutil.copy(m.group(1), os.path.join(disk, "lib", os.path.basename(m.group(1))))
+        log(f"camera test on the test disk: {a.camera_test}")
+    else:
+        log("no drivers/camera test binary given: the V4L2 capture test is skipped")
+    size_mib = int(run(["du", "-sm", disk]).stdout.split()[0]) * 12 // 10 + 16
+    testimg = os.path.join(work, "testdisk.img")
+    if os.path.exists(testimg):
+        os.remove(testimg)
+    run(["truncate", "-s", f"{size_mib}M", testimg])
+    run(["mke2fs", "-q", "-F", "-t", "ext4", "-L", "mogao-test", "-d", disk, testimg])
+
+    # --- boot ---------------------------------------------------------------------------------------
+    vars_fd = os.path.join(work, "OVMF_VARS.fd")
+    shutil.copy(OVMF_VARS, vars_fd)
+    serial_log = os.path.join(work, "serial.log")
+    qmp_sock = os.path.join(work, "qmp.sock")
+    ctl_sock = os.path.join(work, "ctl.sock")
+    for p in (serial_log, qmp_sock, ctl_sock):
+        if os.path.exists(p):
+            os.remove(p)
+    cmd = [qemu, "-nodefaults", "-machine", "q35", "-m", "2048", "-smp", "2",
+           "-accel", "kvm" if a.accel == "kvm" else "tcg", "-cpu", "host" if a.accel == "kvm" else "max",
+           "-drive", f"if=pflash,format=raw,readonly=on,file={OVMF_CODE}",
+           "-drive", f"if=pflash,format=raw,file={vars_fd}",
+           "-drive", f"if=virtio,format=raw,file={img}",
+           "-drive", f"if=virtio,format=raw,readonly=on,file={testimg}",
+           "-device", f"virtio-gpu-pci,id=gpu0,max_outputs={OUTPUTS},xres={MODE[0]},yres={MODE[1]},edid=off",
+           "-global", "ICH9-LPC.noreboot=off", "-action", "reboot=shutdown",
+           "-netdev", "user,id=n0,ipv4=off,ipv6=on", "-device", "virtio-net-pci,netdev=n0",
+           "-display", "none", "-serial", f"file:{serial_log}",
+           "-serial", f"unix:{ctl_sock},server=on,wait=off",
+           "-qmp", f"unix:{qmp_sock},server=on,wait=off"]
+    log("starting QEMU: " + " ".join(cmd))
+    qemu_log = open(os.path.join(work, "qemu.log"), "w")
+    t_start = time.monotonic()
+    proc = subprocess.Popen(cmd, stdout=qemu_log, stderr=subprocess.STDOUT)
+    farm_proc = None
+    serial = Serial(serial_log)
+    alive = lambda: proc.poll() is None
+    try:
+        qmp = Qmp(qmp_sock)
+        ctl = socket.socket(socket.AF_UNIX)
+        ctl.connect(ctl_sock)
+
+        def tell(line):
+            ctl.sendall(line.encode() + b"\n")
+
+        def screendumps(tag):
+            stats = []
+            for head in range(OUTPUTS):
+                path = os.path.join(work, f"{tag}-head{head}.ppm")
+                qmp.cmd("screendump", filename=path, device="gpu0", head=head)
+                stats.append((path, *ppm_stats(path)))
+            return stats
+
+        t, text = serial.wait(r"start ", a.timeout, alive)
+        if not fails.check(t is not None, "the self-test started in the guest (serial marker)"):
+            raise RuntimeError("no self-test")
+        t_ready, text = serial.wait(r"(ok|FAIL) kiosk-ready", a.timeout, alive)
+        ok = fails.check(t_ready is not None and text.startswith("ok"), "mogao-kiosk.service reached READY")
+        if t_ready is not None:
+            results["host_qemu_start_to_ready_s"] = round(t_ready - t_start, 1)
+            m = re.search(r"ready_us=(\d+)", text or "")
+            if m:
+                results["guest_kernel_to_ready_s"] = round(int(m.group(1)) / 1e6, 1)
+        t, text = serial.wait(r"boot ", 60, alive)
+        if text:
+            b = dict(kv.split("=", 1) for kv in text.split()[1:])
+            results["boot_us"] = b
+        t, _ = serial.wait(r"screens-ready", 120, alive)
+        if ok and t is not None:
+            time.sleep(5)  # the first flips are done; the connecting screen is steady
+            for path, w, h, mean, dark in screendumps("connecting"):
+                head = int(path[-5])
+                lit = w == MODE[0] and h == MODE[1] and mean > 10 and dark < 0.5
+                fails.check(lit, f"output {head} lit: {w}x{h}, mean code {mean:.1f}, dark fraction {dark:.2f}")
+                if refs[head]:
+                    db = psnr(a.image_tool, path, refs[head])
+                    results[f"connecting_psnr_head{head}"] = db_json(db)
+                    fails.check(db is not None and db >= PSNR_MIN_DB,
+                                f"output {head} shows the connecting screen: PSNR {db} dB vs headless (>= {PSNR_MIN_DB})")
+                else:
+                    fails.check(False, f"no headless reference for output {head}")
+        # Farm on the host, reached from the guest as [fec0::2]:PORT (QEMU user network, IPv6).
+        if a.no_farm or not ok:
+            tell("nofarm")
+        else:
+            farm_log = open(os.path.join(work, "farm.log"), "w")
+            farm_proc = subprocess.Popen(
+                [a.mpiexec, "--oversubscribe", "-n", "1", a.farm, "serve", "--scene",
+                 os.path.join(a.repo, "scenes", "test-room.json"), "--listen", f"[::1]:{port}",
+                 "--tls-dir", pki, "--name", "farm", "--threads", "1", "--duration", "1200"],
+                stdout=farm_log, stderr=subprocess.STDOUT, env=env, start_new_session=True)
+            deadline = time.monotonic() + 120
+            while time.monotonic() < deadline and farm_proc.poll() is None:
+                with open(os.path.join(work, "farm.log")) as f:
+                    if re.search(r"serving .* on ", f.read()):
+                        break
+                time.sleep(0.5)
+            served = farm_proc.poll() is None
+            fails.check(served, f"mogao-farm serves on [::1]:{port} (host)")
+            tell("farm" if served else "nofarm")
+            if served:
+                t, text = serial.wait(r"(ok|FAIL) farm-connected", 420, alive)
+                fails.check(text is not None and text.startswith("ok"),
+                            "the kiosk connected to the farm over IPv6 + mutual TLS")
+                t, _ = serial.wait(r"farm-frames$", 240, alive)
+                if t is not None:
+                    for path, w, h, mean, dark in screendumps("farm"):
+                        head = int(path[-5])
+                        fails.check(mean > 10 and dark < 0.5,
+                                    f"output {head} lit with farm frames: mean {mean:.1f}, dark {dark:.2f}")
+                        if refs[head]:
+                            db = psnr(a.image_tool, path, refs[head])
+                            results[f"farm_vs_connecting_psnr_head{head}"] = db_json(db)
+                            fails.check(db is not None and db < PSNR_CHANGED_DB,
+                                        f"output {head} shows farm content, not the connecting screen "
+                                        f"(PSNR {db} dB < {PSNR_CHANGED_DB})")
+                tell("continue")
+
+        t, text = serial.wait(r"kiosk-stopped", 300, alive)
+        m = re.search(r"restarts=(\d+)", text or "")
+        fails.check(m is not None and m.group(1) == "0",
+                    f"the kiosk ran without restarts from boot to the watchdog test ({text})")
+        t, text = serial.wait(r"(ok|FAIL) watchdog-restart", 300, alive)
+        fails.check(text is not None and text.startswith("ok"), "the per-service watchdog restarted a hung kiosk")
+        if text:
+            m = re.search(r"seconds=([\d.]+)", text)
+            if m:
+                results["watchdog_restart_s"] = float(m.group(1))
+        t_done, text = serial.wait(r"done ", 300, alive)
+        fails.check(t_done is not None, "the self-test finished")
+        for _, mark in serial.marks:
+            if mark.startswith("FAIL "):
+                fails.check(False, f"guest: {mark[5:]}")
+            elif mark.startswith("ok "):
+                name = mark.split()[1]
+                if name in ("hw-watchdog", "root-readonly", "root-write", "no-failed-units", "no-login-prompt",
+                            "no-passwords", "no-listening-sockets", "v4l2-capture-test", "vivid-loaded",
+                            "farm-frames-presented"):
+                    fails.check(True, f"guest: {mark[3:]}")
+            elif mark.startswith("skip "):
+                log(f"SKIPPED {mark[5:]}")
+
+        # Hardware watchdog: the guest panics with panic=0; the TCO timer must reset the machine.
+        if not a.no_tco and t_done is not None:
+            t_panic, _ = serial.wait(r"tco-test panic", 60, alive)
+            reset = None
+            if t_panic is not None:
+                deadline = time.monotonic() + 180
+                while time.monotonic() < deadline and reset is None:
+                    open_ = qmp.poll_events(2)
+                    for ev in qmp.events:
+                        if ev.get("event") in ("WATCHDOG", "RESET") or (
+                                ev.get("event") == "SHUTDOWN" and ev.get("data", {}).get("reason") == "guest-reset"):
+                            reset = ev
+                            break
+                    if not open_:
+                        break
+            events = [e.get("event") + ":" + json.dumps(e.get("data", {})) for e in qmp.events]
+            log(f"QMP events: {events}")
+            fired = any(e.get("event") == "WATCHDOG" for e in qmp.events)
+            if t_panic is not None and reset is not None:
+                results["tco_reset_after_panic_s"] = round(time.monotonic() - t_panic, 1)
+            fails.check(fired, "the hardware watchdog (iTCO) reset the hung machine (QMP WATCHDOG event)")
+    except Exception as e:  # noqa: BLE001 - report, then fail below
+        fails.check(False, f"test aborted: {type(e).__name__}: {e}")
+    finally:
+        if farm_proc and farm_proc.poll() is None:
+            os.killpg(farm_proc.pid, 15)
+            try:
+                farm_proc.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                os.killpg(farm_proc.pid, 9)
+        if proc.poll() is None:
+            proc.terminate()
+            try:
+                proc.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+        qemu_log.close()
+    results["failures"] = fails.items
+    results["image_bytes"] = os.path.getsize(a.image)
+    results["test_seconds"] = round(time.monotonic() - T0, 1)
+    log("results: " + json.dumps(results))
+    if a.results:
+        with open(a.results, "w") as f:
+            json.dump(results, f, indent=2)
+    if fails.items:
+        log("serial console (last lines):\n" + serial.tail(80))
+        log(f"{len(fails.items)} check(s) failed; logs in {work}")
+        return 1
+    for big in (img, testimg, img + ".bmap", img + ".sha256"):   # ~1 GB; logs and screendumps stay
+        if os.path.exists(big):
+            os.remove(big)
+    shutil.rmtree(disk, ignore_errors=True)
+    log("all checks passed")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

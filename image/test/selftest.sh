@@ -1,0 +1,169 @@
+#!/bin/sh
+# Runs INSIDE the appliance under QEMU (image/test/qemu_boot_test.py), as root, from the test disk
+# (label mogao-test, mounted read-only at /mnt) through the test copy's kernel command line:
+#   systemd.unit=multi-user.target systemd.wants=kernel-command-line.service
+#   systemd.run="/bin/sh -c '... mount ... /mnt; exec /bin/sh /mnt/selftest.sh'"
+# The shipped image contains nothing of this. Results go to the first serial port as lines
+#   MOGAO-SELFTEST <key> [k=v ...]
+# that the host parses; the host answers on the second serial port (one line per request).
+# Ends with the hardware watchdog test: kernel panic with panic=0, the TCO watchdog must reset.
+set -u
+out=/dev/ttyS0
+ctl=/dev/ttyS1
+fails=0
+
+say() { echo "MOGAO-SELFTEST $*" > "$out"; }
+ok() { say "ok $*"; }
+bad() { say "FAIL $*"; fails=$((fails + 1)); }
+uptime_s() { cut -d' ' -f1 /proc/uptime; }
+prop() { systemctl show -P "$2" "$1" 2>/dev/null; }
+# host_wait TIMEOUT: the next line the host sends on the control port (empty on timeout).
+host_wait() { timeout "$1" head -n1 "$ctl" 2>/dev/null | tr -d '\r'; }
+
+stty -F "$ctl" -echo icanon 2>/dev/null
+say "start uptime=$(uptime_s) kernel=$(uname -r)"
+
+# --- V4L2: vivid, the kernel's virtual capture driver -------------------------------------------
+if modprobe vivid n_devs=1 2>/dev/null; then
+  sleep 2
+  ok "vivid-loaded devices=$(ls /dev/video* 2>/dev/null | tr '\n' ',')"
+else
+  bad "vivid-loaded (modprobe vivid failed)"
+fi
+
+# --- kiosk READY (Type=notify: active == READY=1 received, after the first frame is shown) -------
+state=""
+i=0
+while [ $i -lt 900 ]; do
+  state=$(systemctl is-active mogao-kiosk.service)
+  [ "$state" = active ] && break
+  [ $((i % 30)) -eq 0 ] && say "waiting kiosk state=$state restarts=$(prop mogao-kiosk.service NRestarts) uptime=$(uptime_s)"
+  sleep 1; i=$((i + 1))
+done
+if [ "$state" = active ]; then
+  ok "kiosk-ready uptime=$(uptime_s) ready_us=$(prop mogao-kiosk.service ActiveEnterTimestampMonotonic)" \
+     "exec_us=$(prop mogao-kiosk.service ExecMainStartTimestampMonotonic) restarts=$(prop mogao-kiosk.service NRestarts)" \
+     "pid=$(prop mogao-kiosk.service MainPID)"
+else
+  bad "kiosk-ready state=$state"
+  journalctl -b -u mogao-kiosk.service --no-pager -n 40 > "$out" 2>&1
+fi
+# Boot phases as systemd saw them (µs): firmware and loader from systemd-boot's EFI variables.
+say "boot firmware_us=$(systemctl show -P FirmwareTimestampMonotonic) loader_us=$(systemctl show -P LoaderTimestampMonotonic)" \
+    "initrd_us=$(systemctl show -P InitRDTimestampMonotonic) userspace_us=$(systemctl show -P UserspaceTimestampMonotonic)" \
+    "network_online_us=$(prop network-online.target ActiveEnterTimestampMonotonic)" \
+    "localfs_us=$(prop local-fs.target ActiveEnterTimestampMonotonic) card0_us=$(prop dev-dri-card0.device ActiveEnterTimestampMonotonic)"
+journalctl -b -u mogao-kiosk.service --no-pager -o cat 2>/dev/null | grep -E "output |outputs|KMS|calibration" | head -n 12 |
+  while read -r line; do say "kiosk-log $line"; done
+
+# --- the host takes screendumps of every output, then (maybe) starts the farm ---------------------
+say "screens-ready"
+answer=$(host_wait 900)
+say "host said '$answer'"
+case $answer in
+  farm*)
+    i=0
+    while [ $i -lt 300 ]; do
+      journalctl -b -u mogao-kiosk.service --no-pager -o cat 2>/dev/null | grep -q " connected; showing" && break
+      sleep 1; i=$((i + 1))
+    done
+    if journalctl -b -u mogao-kiosk.service --no-pager -o cat 2>/dev/null | grep -q " connected; showing"; then
+      ok "farm-connected after_s=$i addr=$(awk '$4 != "10" && $4 != "20" { print $1; exit }' /proc/net/if_inet6)"
+      # Frames arrive, are decoded, warped and shown; the kiosk logs its statistics every 10 s.
+      frames=0 i=0
+      while [ $i -lt 120 ] && [ "${frames:-0}" -eq 0 ]; do
+        sleep 5; i=$((i + 5))
+        frames=$(journalctl -b -u mogao-kiosk.service --no-pager -o cat 2>/dev/null | grep "stats: frames=" | tail -n1 |
+                 sed -E 's/.*stats: frames=([0-9]+).*/\1/')
+      done
+      journalctl -b -u mogao-kiosk.service --no-pager -o cat 2>/dev/null | grep -E "stats:" | tail -n 2 |
+        while read -r line; do say "kiosk-log $line"; done
+      [ "${frames:-0}" -gt 0 ] && ok "farm-frames-presented frames=$frames" || bad "farm-frames-presented (none in 120 s)"
+    else
+      bad "farm-connected (no 'connected' in the kiosk's journal after 300 s)"
+      journalctl -b -u mogao-kiosk.service --no-pager -o cat -n 20 > "$out" 2>&1
+    fi
+    say "farm-frames"
+    answer=$(host_wait 600)
+    say "host said '$answer'"
+    ;;
+esac
+
+# --- per-service watchdog: a hung kiosk (SIGSTOP) is killed (WatchdogSec=10s) and restarted ---------
+pid=$(prop mogao-kiosk.service MainPID)
+n0=$(prop mogao-kiosk.service NRestarts)
+if [ "${pid:-0}" -gt 0 ]; then
+  t0=$(date +%s.%N)
+  kill -STOP "$pid"
+  say "kiosk-stopped pid=$pid restarts=$n0 uptime=$(uptime_s)"
+  i=0
+  while [ $i -lt 240 ]; do
+    sleep 0.5; i=$((i + 1))
+    n=$(prop mogao-kiosk.service NRestarts); p=$(prop mogao-kiosk.service MainPID)
+    [ "$n" -gt "$n0" ] && [ "$p" != "$pid" ] && [ "$(systemctl is-active mogao-kiosk.service)" = active ] && break
+  done
+  t1=$(date +%s.%N)
+  why=$(journalctl -b -u mogao-kiosk.service --no-pager -o cat 2>/dev/null | grep -m1 -i "watchdog timeout")
+  if [ "$n" -gt "$n0" ] && [ "$p" != "$pid" ]; then
+    ok "watchdog-restart seconds=$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.1f", b - a }') new_pid=$p restarts=$n reason='$why'"
+  else
+    bad "watchdog-restart (pid $pid still there or not restarted: restarts=$n pid=$p)"
+  fi
+else
+  bad "watchdog-restart (no kiosk process)"
+fi
+
+# --- hardware watchdog ------------------------------------------------------------------------------
+if [ -e /sys/class/watchdog/watchdog0 ]; then
+  w=/sys/class/watchdog/watchdog0
+  ok "hw-watchdog identity='$(cat $w/identity 2>/dev/null)' state=$(cat $w/state 2>/dev/null) timeout=$(cat $w/timeout 2>/dev/null)" \
+     "pid1='$(journalctl -b -o cat --no-pager 2>/dev/null | grep -m1 'Using hardware watchdog')'"
+else
+  bad "hw-watchdog (no /sys/class/watchdog/watchdog0)"
+fi
+
+# --- lock-down --------------------------------------------------------------------------------------
+opts=$(findmnt -no OPTIONS /)
+case ",$opts," in *,ro,*) ok "root-readonly options=$opts" ;; *) bad "root-readonly options=$opts" ;; esac
+if touch /.mogao-write-probe 2>/dev/null; then bad "root-write (a file could be created in /)"; rm -f /.mogao-write-probe; else ok "root-write refused"; fi
+ok "mounts $(findmnt -rno TARGET,FSTYPE,OPTIONS /var/lib/mogao | tr ' ' ':') $(findmnt -rno TARGET,OPTIONS /etc/mogao | tr ' ' ':') $(findmnt -rno TARGET,FSTYPE /tmp | tr ' ' ':')"
+failed=$(systemctl --failed --plain --no-legend 2>/dev/null | awk '{print $1}' | tr '\n' ' ')
+[ -z "$failed" ] && ok "no-failed-units" || bad "failed-units $failed"
+gettys=$(systemctl list-units --plain --no-legend --state=active 'getty@*' 'serial-getty@*' 'autovt@*' 'console-getty*' 2>/dev/null | awk '{print $1}' | tr '\n' ' ')
+logins=$(for p in /proc/[0-9]*; do readlink "$p/exe"; done 2>/dev/null | grep -cE '/(agetty|login|sulogin|sshd)$')
+[ -z "$gettys" ] && [ "$logins" -eq 0 ] && ok "no-login-prompt" || bad "login-prompt units='$gettys' processes=$logins"
+pw=$(awk -F: '$2 !~ /^[*!]/ { print $1 }' /etc/shadow | tr '\n' ' ')
+[ -z "$pw" ] && ok "no-passwords" || bad "accounts-with-password $pw"
+# Listening sockets: TCP in state LISTEN (0A), any bound UDP/raw socket with a local port.
+listen=$(awk 'FNR > 1 && $4 == "0A" { print FILENAME ":" $2 }' /proc/net/tcp /proc/net/tcp6 2>/dev/null | tr '\n' ' ')
+udp=$(awk 'FNR > 1 { split($2, a, ":"); if (a[2] != "0000") print FILENAME ":" $2 }' /proc/net/udp /proc/net/udp6 2>/dev/null | tr '\n' ' ')
+[ -z "$listen" ] && [ -z "$udp" ] && ok "no-listening-sockets" || bad "listening tcp='$listen' udp='$udp'"
+kuid=$(awk '/^Uid:/ { print $2 }' /proc/"$(prop mogao-kiosk.service MainPID)"/status 2>/dev/null)
+ok "kiosk-user uid=$kuid seccomp=$(awk '/^Seccomp:/ { print $2 }' /proc/"$(prop mogao-kiosk.service MainPID)"/status 2>/dev/null)"
+ok "units running=$(systemctl list-units --type=service --state=running --plain --no-legend | awk '{print $1}' | tr '\n' ',')"
+
+# --- V4L2 capture test of drivers/camera, when the host put it on the test disk ---------------------
+if [ -x /mnt/bin/mogao_camera_test ]; then
+  LD_LIBRARY_PATH=/mnt/lib /mnt/bin/mogao_camera_test --gtest_filter='V4l2Capture*' > /tmp/camera.log 2>&1
+  rc=$?
+  sed 's/^/MOGAO-SELFTEST camera-log /' /tmp/camera.log | grep -E "OK|FAILED|SKIPPED|PASSED|Skipped|error" | head -n 20 > "$out"
+  passed=$(grep -c '^\[       OK \] V4l2CaptureVivid' /tmp/camera.log)
+  skipped=$(grep -c '^\[  SKIPPED \] V4l2CaptureVivid' /tmp/camera.log)
+  if [ $rc -eq 0 ] && [ "$passed" -gt 0 ]; then ok "v4l2-capture-test vivid_passed=$passed vivid_skipped=$skipped"
+  elif [ $rc -eq 0 ]; then say "skip v4l2-capture-test (no vivid test ran: skipped=$skipped)"
+  else bad "v4l2-capture-test rc=$rc"; fi
+else
+  say "skip v4l2-capture-test (no drivers/camera test binary on the test disk)"
+fi
+
+say "done fails=$fails uptime=$(uptime_s)"
+
+# --- hardware watchdog reset: hang the kernel (panic, no automatic reboot); iTCO must reset ---------
+if grep -q "mogao.selftest.tco=1" /proc/cmdline; then
+  say "tco-test panic uptime=$(uptime_s)"
+  sync
+  echo 0 > /proc/sys/kernel/panic
+  sleep 1
+  echo c > /proc/sysrq-trigger
+fi
+exit 0
