@@ -6,7 +6,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 
-#include "drivers/camera/replay_source.h"
+#include "drivers/camera/image_file.h"
 
 namespace mogao {
 

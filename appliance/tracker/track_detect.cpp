@@ -5,7 +5,7 @@
 
 #include "appliance/tracker/tag_detector.h"
 #include "appliance/tracker/track_commands.h"
-#include "drivers/camera/replay_source.h"
+#include "drivers/camera/image_file.h"
 
 namespace mogao::track {
 

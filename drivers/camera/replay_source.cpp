@@ -7,9 +7,7 @@
 #include <fstream>
 #include <system_error>
 
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
-
+#include "drivers/camera/image_file.h"
 #include "drivers/camera/pixel_format.h"
 
 namespace mogao {
@@ -55,26 +53,6 @@ Result<std::vector<std::int64_t>> read_timestamps(const std::filesystem::path& p
 }
 
 }  // namespace
-
-Result<GrayImage> read_gray_image(const std::filesystem::path& path) {
-    cv::Mat mat;
-    try {  // imread reports most failures by an empty Mat, a few by cv::Exception
-        mat = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
-    } catch (const cv::Exception& e) {
-        return make_error(EBADMSG, path.string() + ": " + e.what());
-    }
-    if (mat.empty()) return make_error(EBADMSG, path.string() + ": cannot be read or decoded as PNG/PGM/JPEG");
-    if (mat.cols > kMaxCaptureDimension || mat.rows > kMaxCaptureDimension) {
-        return make_error(EINVAL, path.string() + ": " + std::to_string(mat.cols) + "x" + std::to_string(mat.rows) +
-                                      " exceeds " + std::to_string(kMaxCaptureDimension) + " per side");
-    }
-    GrayImage image(mat.cols, mat.rows);
-    for (int y = 0; y < mat.rows; ++y) {
-        std::memcpy(image.pixels.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(mat.cols),
-                    mat.ptr<std::uint8_t>(y), static_cast<std::size_t>(mat.cols));
-    }
-    return image;
-}
 
 Result<std::unique_ptr<ReplaySource>> ReplaySource::open(const ReplayConfig& config) {
     if (!(config.frames_per_second > 0.0 && config.frames_per_second <= 1000.0)) {

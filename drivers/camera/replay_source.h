@@ -1,8 +1,8 @@
 // ReplaySource: a folder of images played back as a camera, for tests, demos and the benchmark.
 //
 // Files: every *.png, *.pgm, *.jpg, *.jpeg (any case) directly in the folder, in byte-wise name
-// order (write names zero-padded: frame-00000.png). Colour images are converted to grey (OpenCV
-// imread, IMREAD_GRAYSCALE: Y = 0.299 R + 0.587 G + 0.114 B). Images may differ in size.
+// order (write names zero-padded: frame-00000.png). Each is read by read_gray_image (image_file.h:
+// PNG, binary PGM, JPEG; colour converted to grey as documented there). Images may differ in size.
 //
 // Timestamps: if the folder has `timestamps.txt`, its lines are the frames' timestamps in ns, one
 // integer per line in file order, strictly increasing, as many lines as images (the hand-held
@@ -54,8 +54,5 @@ private:
     std::uint64_t pass_ = 0;
 };
 
-// Reads one image file as grey (PNG, PGM, JPEG, anything OpenCV's imread reads). EBADMSG naming
-// the file if it cannot be read or decoded, EINVAL if a side exceeds kMaxCaptureDimension.
-[[nodiscard]] Result<GrayImage> read_gray_image(const std::filesystem::path& path);
 
 }  // namespace mogao
