@@ -66,7 +66,7 @@ Status ScreenPresenter::present_dirty() {
         OutputState& o = states_[i];
         if (!o.lit || !o.dirty || o.in_flight || !backend_->ready(i)) continue;
         Status s = backend_->begin_frame(i);
-        if (s) s = backend_->renderer().draw(o.projector);
+        if (s) s = backend_->renderer().draw(o.projector, backend_->outputs()[i].size);
         if (s) s = backend_->present(i);
         if (!s) {
             if (first_error.ok()) first_error = with_context(s.error(), backend_->outputs()[i].name);

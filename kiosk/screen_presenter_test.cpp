@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <utility>
+
 #include "appliance/warp/ideal_calibration.h"
 #include "drivers/egl/egl_test_support.h"
 #include "drivers/headless_output.h"
@@ -103,6 +105,30 @@ TEST(ScreenPresenter, ShowsTheConnectingScreenThenFramesOnEveryOutput) {
     const Rgb8Image& mid = backend->last_frame(1);
     EXPECT_NEAR(mid.at(48, 36)[0], 127, 3);
     EXPECT_FALSE(presenter->show(uniform(kContent, 10), 4)) << "tags must not go back";
+}
+
+// A mode other than the calibrated size (the projector runs 192x144, calibrated at 96x72): the
+// whole output shows the picture, resampled; no corner is left black.
+TEST(ScreenPresenter, OutputModeLargerThanTheCalibrationIsFilled) {
+    const ScreenCalibration screen = three_projectors();
+    HeadlessOptions options;
+    for (const auto& p : screen.projectors) options.outputs.push_back({p.output.width * 2, p.output.height * 2});
+    auto created = HeadlessOutputBackend::create(options);
+    if (!created) {
+        if (created.code() == ENODEV) skip_or_fail_without_egl(created.error().message);
+        else ADD_FAILURE() << created.error().message;
+        return;
+    }
+    auto& backend = *created;
+    auto presenter = ScreenPresenter::create(*backend, screen, nullptr);
+    ASSERT_TRUE(presenter) << presenter.error().message;
+    ASSERT_TRUE(presenter->show(uniform(kContent, 128), 1));
+    const Rgb8Image& mid = backend->last_frame(1);
+    ASSERT_EQ(mid.size, (ImageSize{192, 144}));
+    // Middle projector, blend 1 away from its overlaps: every quadrant shows sRGB 128 -> 127.
+    for (const auto& [x, y] : {std::pair{48, 36}, std::pair{144, 36}, std::pair{48, 108}, std::pair{144, 108}}) {
+        EXPECT_NEAR(mid.at(x, y)[0], 127, 3) << "at (" << x << ", " << y << ")";
+    }
 }
 
 TEST(ScreenPresenter, OutputsKeepTheLastGoodFrameWhenACorruptJpegArrives) {

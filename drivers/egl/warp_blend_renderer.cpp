@@ -277,10 +277,18 @@ Status WarpBlendRenderer::check_index(std::size_t index) const {
 
 Status WarpBlendRenderer::draw(std::size_t index) {
     if (auto s = check_index(index); !s) return s;
+    return draw(index, projectors_[index].output);
+}
+
+Status WarpBlendRenderer::draw(std::size_t index, ImageSize target) {
+    if (auto s = check_index(index); !s) return s;
+    if (auto s = check_size("draw target", target, max_texture_size_); !s) return s;
     const Projector& p = projectors_[index];
     glUseProgram(program_.get());
-    const auto out_w = static_cast<float>(p.output.width);
-    const auto out_h = static_cast<float>(p.output.height);
+    // The shader maps each target pixel centre to warp/blend coordinates by size ratios, so a
+    // target larger or smaller than the calibration's output is the same picture resampled.
+    const auto out_w = static_cast<float>(target.width);
+    const auto out_h = static_cast<float>(target.height);
     glUniform2f(loc_output_size_, out_w, out_h);
     glUniform2f(loc_warp_scale_, static_cast<float>(p.warp_size.width) / out_w,
                 static_cast<float>(p.warp_size.height) / out_h);
@@ -299,7 +307,7 @@ Status WarpBlendRenderer::draw(std::size_t index) {
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_STENCIL_TEST);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    glViewport(0, 0, p.output.width, p.output.height);
+    glViewport(0, 0, target.width, target.height);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     return gl_check("WarpBlendRenderer::draw");
 }

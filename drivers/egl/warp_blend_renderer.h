@@ -62,6 +62,12 @@ public:
     // Draws projector `index` into the framebuffer bound to GL_DRAW_FRAMEBUFFER, viewport
     // (0, 0, output size). Leaves its program, textures (units 0-3) and viewport bound.
     [[nodiscard]] Status draw(std::size_t index);
+    // The same picture resampled to fill a framebuffer of `target` pixels: for an output whose mode
+    // differs from the projector's calibrated output size. In the formulas above `output` becomes
+    // `target`, so warp and blend are read at p * map.size / target (bilinear); the calibration's
+    // geometry scales with the mode (a projector shows its whole panel at any mode). EINVAL/E2BIG
+    // for an empty target or one beyond GL_MAX_TEXTURE_SIZE.
+    [[nodiscard]] Status draw(std::size_t index, ImageSize target);
 
     // Draws projector `index` into its own FBO and reads it back as RGB8, rows top first.
     [[nodiscard]] Result<Rgb8Image> render(std::size_t index);

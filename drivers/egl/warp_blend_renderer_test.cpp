@@ -325,6 +325,33 @@ TEST_F(WarpBlendRendererTest, BusyCalibrationMatchesCpuReference) {
     EXPECT_EQ(out.at(0, 0)[0], 0);  // inside the NaN patch
 }
 
+// An output whose mode differs from the calibration's output size (a 640x480 calibration on a
+// 1024x768 mode): the whole target is the calibrated picture resampled, not a corner of it.
+TEST_F(WarpBlendRendererTest, DrawIntoLargerOrSmallerTargetResamplesTheWholePicture) {
+    const Rgb8Image content = noise_content({80, 50}, 11);
+    const ProjectorCalibration c = busy_calibration({64, 48});
+    ASSERT_TRUE(renderer_->set_content(content).ok());
+    auto index = renderer_->add_projector(c);
+    ASSERT_TRUE(index) << index.error().message;
+    for (const ImageSize target : {ImageSize{101, 77}, ImageSize{40, 30}}) {
+        auto fbo = make_render_target(target);
+        ASSERT_TRUE(fbo) << fbo.error().message;
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo->fbo.get());
+        ASSERT_TRUE(renderer_->draw(*index, target).ok());
+        Rgb8Image out(target);
+        std::vector<std::uint8_t> scratch;
+        ASSERT_TRUE(read_rgb8(target, out, scratch).ok());
+        ProjectorCalibration as_target = c;
+        as_target.output = target;  // the reference's output pixel grid is the target's
+        const Diff d = max_abs_diff(out, reference_render(content, as_target));
+        EXPECT_LE(d.max, 2) << target.width << "x" << target.height << " at (" << d.x << ", " << d.y << ")";
+        // The far corner is drawn (a corner-only draw would leave it at the cleared value).
+        const std::uint8_t* far = out.at(target.width - 1, target.height - 1);
+        EXPECT_GT(int{far[0]} + far[1] + far[2], 0);
+    }
+    EXPECT_FALSE(renderer_->draw(*index, ImageSize{0, 10}).ok());
+}
+
 TEST_F(WarpBlendRendererTest, MatchesGoldenPng) {
     // Regenerate with MOGAO_UPDATE_GOLDEN=1 after an intended change, and look at the file.
     const std::filesystem::path golden =

@@ -8,6 +8,9 @@ namespace mogao {
 std::optional<std::size_t> pick_mode(std::span<const drmModeModeInfo> modes) {
     std::optional<std::size_t> best;
     const auto better = [&](const drmModeModeInfo& a, const drmModeModeInfo& b) {
+        const bool ua = (a.type & DRM_MODE_TYPE_USERDEF) != 0;
+        const bool ub = (b.type & DRM_MODE_TYPE_USERDEF) != 0;
+        if (ua != ub) return ua;
         const bool pa = (a.type & DRM_MODE_TYPE_PREFERRED) != 0;
         const bool pb = (b.type & DRM_MODE_TYPE_PREFERRED) != 0;
         if (pa != pb) return pa;

@@ -12,9 +12,11 @@
 
 namespace mogao {
 
-// The mode a projector output uses: the connector's preferred mode (DRM_MODE_TYPE_PREFERRED, the
-// projector's native panel); without one, the largest area, then the highest refresh. nullopt
-// for no modes.
+// The mode a projector output uses: a mode forced on the kernel command line
+// (`video=<connector>:<W>x<H>[@<Hz>]`, which the kernel adds as DRM_MODE_TYPE_USERDEF; see the
+// kernel's Documentation/fb/modedb.rst), else the connector's preferred mode
+// (DRM_MODE_TYPE_PREFERRED, the projector's native panel), else the largest area, then the
+// highest refresh. nullopt for no modes.
 [[nodiscard]] std::optional<std::size_t> pick_mode(std::span<const drmModeModeInfo> modes);
 
 // Vertical refresh in Hz from the pixel clock and totals (more precise than mode.vrefresh,

@@ -24,6 +24,10 @@ TEST(PickMode, PrefersPreferredThenAreaThenRefresh) {
     const std::array no_preferred{mode(1280, 720, 74250), mode(1920, 1080, 74250), mode(1920, 1080, 148500)};
     EXPECT_EQ(pick_mode(no_preferred), 2u);  // largest, then the higher refresh
     EXPECT_FALSE(pick_mode(std::span<const drmModeModeInfo>{}));
+    // video=Virtual-1:1024x768 on the kernel command line: the forced mode wins over the preferred one.
+    std::array forced{mode(1920, 1080, 148500, true), mode(1024, 768, 65000), mode(800, 600, 40000)};
+    forced[1].type |= DRM_MODE_TYPE_USERDEF;
+    EXPECT_EQ(pick_mode(forced), 1u);
 }
 
 TEST(RefreshHz, FromClockAndTotals) {

@@ -38,7 +38,12 @@ SKIP = 77
 OVMF_CODE = "/usr/share/OVMF/OVMF_CODE_4M.fd"
 OVMF_VARS = "/usr/share/OVMF/OVMF_VARS_4M.fd"
 OUTPUTS = 3
-MODE = (1024, 768)       # per output: virtio-gpu gives its forced outputs 1024x768 (preferred)
+CALIBRATION = (1024, 768)  # every projector's calibrated output size (ideal calibration)
+# Per output: the mode the kiosk must pick. virtio-gpu (edid=off) lists the DMT modes and prefers
+# xres x yres = 1024x768; the kernel command line forces the last output to 1280x800
+# (video=Virtual-3:1280x800e, a DRM_MODE_TYPE_USERDEF mode), so that output also shows the
+# 1024x768 calibration resampled to a larger mode.
+MODES = [(1024, 768), (1024, 768), (1280, 800)]
 RATE_HZ = 1               # llvmpipe under TCG renders a round of 3 outputs in seconds
 PSNR_MIN_DB = 30.0       # KMS output vs headless rendering of the same connecting screen
 PSNR_CHANGED_DB = 25.0   # a farm frame must differ from the connecting screen (below this)
@@ -87,17 +92,20 @@ def read_ppm(path):
     return w, h, data[pos + 1:pos + 1 + w * h * 3]
 
 
-def ppm_stats(path):
-    """(width, height, mean code, fraction of pixels with max channel < 16)."""
+def ppm_stats(path, x_from=0):
+    """(width, height, mean code, fraction of pixels with max channel < 16) of the columns >= x_from."""
     w, h, px = read_ppm(path)
-    n = w * h
-    step = 7  # sample every 7th pixel: plenty for "is it lit"
+    step = 7  # sample every 7th pixel of a row: plenty for "is it lit"
     total = dark = count = 0
-    for i in range(0, n, step):
-        r, g, b = px[3 * i], px[3 * i + 1], px[3 * i + 2]
-        total += r + g + b
-        dark += max(r, g, b) < 16
-        count += 1
+    for y in range(h):
+        for x in range(x_from, w, step):
+            i = y * w + x
+            r, g, b = px[3 * i], px[3 * i + 1], px[3 * i + 2]
+            total += r + g + b
+            dark += max(r, g, b) < 16
+            count += 1
+    if count == 0:
+        return w, h, 0.0, 1.0
     return w, h, total / (3 * count), dark / count
 
 
@@ -314,7 +322,7 @@ rate_hz = {RATE_HZ}
 source = "ideal"
 projectors = {OUTPUTS}
 overlap = 0.15
-output = "{MODE[0]}x{MODE[1]}"
+output = "{CALIBRATION[0]}x{CALIBRATION[1]}"
 
 [quality]
 content = "480x270"
@@ -338,7 +346,8 @@ log_period_s = 10
     shutil.rmtree(ref, ignore_errors=True)
     os.makedirs(ref)
     with open(os.path.join(cfg, "reference.toml"), "w") as f:
-        f.write(kiosk_toml(f'backend = "headless"\npng_dir = "{ref}"\ncomposite = false'))
+        sizes = ", ".join(f'"{w}x{h}"' for w, h in MODES)
+        f.write(kiosk_toml(f'backend = "headless"\nsizes = [{sizes}]\npng_dir = "{ref}"\ncomposite = false'))
     subprocess.run([a.kiosk, "--config", os.path.join(cfg, "reference.toml"), "--duration", "2"],
                    stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT, env=env, timeout=120)
     os.remove(os.path.join(cfg, "reference.toml"))
@@ -363,7 +372,7 @@ log_period_s = 10
         "systemd.journald.forward_to_console=1",
         # QEMU enables only virtio-gpu's first output; the kernel forces the others on (as a
         # projector that is plugged in would be).
-        *[f"video=Virtual-{i + 1}:{MODE[0]}x{MODE[1]}e" for i in range(1, OUTPUTS)],
+        *[f"video=Virtual-{i + 1}:{MODES[i][0]}x{MODES[i][1]}e" for i in range(1, OUTPUTS)],
         "systemd.unit=multi-user.target", "systemd.wants=kernel-command-line.service",
         f"systemd.run=\"/bin/sh -c '{boot}'\"",
         "systemd.run_success_action=none", "systemd.run_failure_action=none",
@@ -417,7 +426,7 @@ log_period_s = 10
            "-drive", f"if=pflash,format=raw,file={vars_fd}",
            "-drive", f"if=virtio,format=raw,file={img}",
            "-drive", f"if=virtio,format=raw,readonly=on,file={testimg}",
-           "-device", f"virtio-gpu-pci,id=gpu0,max_outputs={OUTPUTS},xres={MODE[0]},yres={MODE[1]},edid=off",
+           "-device", f"virtio-gpu-pci,id=gpu0,max_outputs={OUTPUTS},xres={CALIBRATION[0]},yres={CALIBRATION[1]},edid=off",
            "-global", "ICH9-LPC.noreboot=off", "-action", "reboot=shutdown",
            "-netdev", "user,id=n0,ipv4=off,ipv6=on", "-device", "virtio-net-pci,netdev=n0",
            "-display", "none", "-serial", f"file:{serial_log}",
@@ -465,8 +474,15 @@ log_period_s = 10
             time.sleep(5)  # the first flips are done; the connecting screen is steady
             for path, w, h, mean, dark in screendumps("connecting"):
                 head = int(path[-5])
-                lit = w == MODE[0] and h == MODE[1] and mean > 10 and dark < 0.5
-                fails.check(lit, f"output {head} lit: {w}x{h}, mean code {mean:.1f}, dark fraction {dark:.2f}")
+                lit = (w, h) == MODES[head] and mean > 10 and dark < 0.5
+                fails.check(lit, f"output {head} lit in mode {w}x{h} (expected {MODES[head][0]}x{MODES[head][1]}): "
+                                 f"mean code {mean:.1f}, dark fraction {dark:.2f}")
+                if MODES[head][0] > CALIBRATION[0] and (w, h) == MODES[head]:
+                    # The columns beyond the calibration's width: black if only a corner were drawn.
+                    _, _, smean, sdark = ppm_stats(path, x_from=CALIBRATION[0])
+                    fails.check(smean > 10 and sdark < 0.5,
+                                f"output {head}: the {CALIBRATION[0]}x{CALIBRATION[1]} calibration fills the "
+                                f"{w}x{h} mode (columns >= {CALIBRATION[0]}: mean {smean:.1f}, dark {sdark:.2f})")
                 if refs[head]:
                     db = psnr(a.image_tool, path, refs[head])
                     results[f"connecting_psnr_head{head}"] = db_json(db)
