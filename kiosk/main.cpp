@@ -442,6 +442,7 @@ int run(const Flags& flags, const SignalFd& signals) {
         const TrackingCounters c = tracker->counters();
         navigation_stats.update({{"camera", tracker->description()},
                                  {"frames_tracked", c.frames},
+                                 {"frames_skipped", c.skipped},
                                  {"tag_visible", c.visible},
                                  {"ambiguous", c.ambiguous},
                                  {"frame_errors", c.frame_errors},
@@ -454,8 +455,9 @@ int run(const Flags& flags, const SignalFd& signals) {
                                  {"final_pose", {{"eye", {navigator->pose().eye.x(), navigator->pose().eye.y(),
                                                           navigator->pose().eye.z()}},
                                                  {"yaw_deg", navigator->pose().yaw_deg}}}});
-        spdlog::info("tracking: {} frames, tag visible in {}, {} rejected by the flip gate, {} samples dropped",
-                     c.frames, c.visible, navigator->rejected_samples(), samples.dropped());
+        spdlog::info("tracking: {} frames ({} skipped behind newer ones), tag visible in {}, {} rejected by the "
+                     "flip gate, {} samples dropped",
+                     c.frames, c.skipped, c.visible, navigator->rejected_samples(), samples.dropped());
     }
     const LinkClientStats link = client->stats();
     spdlog::info("stats: {} link_sessions={}", stats.log_line(), link.sessions_opened);

@@ -123,6 +123,14 @@ void TrackingThread::run() {
                 rebased = true;
             }
             time_ns = frame->timestamp_ns + offset_ns;
+            // A live camera hands out its newest frame (V4L2 capture keeps only the newest), so a
+            // tracker slower than the camera skips frames instead of falling further and further
+            // behind. A replay does the same: a frame whose successor is already due is dropped;
+            // otherwise the Navigator would get samples older than its hold_s and stop tracking.
+            if (const auto next = source_->next_capture_time_ns(); next && *next + offset_ns <= monotonic_ns()) {
+                count(&TrackingCounters::skipped);
+                continue;
+            }
             if (!wait_until(time_ns)) return;  // released at its capture time
         }
         TrackedTag tag;

@@ -8,7 +8,9 @@
 // CLOCK_MONOTONIC). A replay's timestamps (timestamps.txt, from 0) are rebased: the first frame is
 // "captured" when the thread starts, and each later frame is released at its rebased time -- the
 // replay plays in real time, as a camera would (the image is read before the wait, detection after
-// it, so the sample's latency is the detection's, as with a camera).
+// it, so the sample's latency is the detection's, as with a camera). Like a camera, it never
+// queues: when detection falls behind, a frame whose successor is already due is skipped (counted
+// in TrackingCounters::skipped), so samples stay fresh on a slow or busy machine.
 //
 // Errors never end the kiosk: an undecodable frame (EBADMSG) or a frame of the wrong size is
 // skipped and counted; a camera timeout (ETIMEDOUT) is logged and waited out (the Navigator sees no
@@ -41,6 +43,7 @@ namespace mogao {
 
 struct TrackingCounters {
     std::uint64_t frames = 0;        // tracked
+    std::uint64_t skipped = 0;       // replay frames dropped because a newer one was already due
     std::uint64_t visible = 0;       // with the tag
     std::uint64_t ambiguous = 0;     // IPPE choice by continuity
     std::uint64_t frame_errors = 0;  // skipped: undecodable or wrong size

@@ -84,6 +84,28 @@ TEST_F(TrackingThreadTest, ReplaysEveryFrameInOrderOnTheMonotonicClock) {
     }
 }
 
+// A "camera" far faster than any tracker: 10 frames 1 us apart. Reading and detecting a frame take
+// far longer than 1 us, so every frame but the last (which has no successor) and perhaps the first
+// (read as the replay's clock starts) has a successor already due when it is read: those are
+// skipped, as a live camera would have overwritten them.
+TEST_F(TrackingThreadTest, FramesBehindANewerDueFrameAreSkipped) {
+    {
+        std::ofstream stamps(dir_ / "timestamps.txt");
+        for (int i = 0; i < 10; ++i) stamps << i * 1000 << "\n";
+    }
+    TagSampleQueue queue;
+    TrackingThread thread(config_, queue);
+    const std::vector<TagSample> samples = drain(queue);
+    thread.stop();
+    const TrackingCounters c = thread.counters();
+    EXPECT_TRUE(c.ended);
+    EXPECT_GE(c.frames, 1u);
+    EXPECT_LE(c.frames, 2u);
+    EXPECT_EQ(c.frames + c.skipped, 10u);
+    ASSERT_EQ(samples.size(), c.frames);
+    EXPECT_EQ(samples.back().time_ns - samples.front().time_ns, samples.size() == 2 ? 9000 : 0);  // the last frame
+}
+
 TEST_F(TrackingThreadTest, StopsWhileALoopingReplayRuns) {
     config_.source.loop = true;
     TagSampleQueue queue;

@@ -8,6 +8,9 @@
 //   other      errno of the failed system call (ENODEV after an unplug, EIO, ...)
 #pragma once
 
+#include <cstdint>
+#include <optional>
+
 #include <string>
 
 #include "drivers/camera/camera_frame.h"
@@ -25,6 +28,12 @@ public:
     // Blocks until a frame is available and returns the newest one (a camera drops older frames
     // that queued up while the caller was busy, and says how many in CameraFrame::skipped).
     [[nodiscard]] virtual Result<CameraFrame> next_frame() = 0;
+
+    // When the frame that next_frame() would return next was (or will be) captured, on the clock of
+    // CameraFrame::timestamp_ns -- known only to sources that play recorded frames (a replay);
+    // nullopt for live cameras and after a finite source's last frame. A pacing caller uses it to
+    // drop a frame whose successor is already due, as a live camera would have overwritten it.
+    [[nodiscard]] virtual std::optional<std::int64_t> next_capture_time_ns() const { return std::nullopt; }
 
     // One line for logs: device or folder, size, format.
     [[nodiscard]] virtual std::string description() const = 0;

@@ -111,6 +111,12 @@ Result<CameraFrame> ReplaySource::next_frame() {
     return frame;
 }
 
+std::optional<std::int64_t> ReplaySource::next_capture_time_ns() const {
+    if (next_ < files_.size()) return stamps_[next_] + static_cast<std::int64_t>(pass_) * pass_duration_ns_;
+    if (!config_.loop) return std::nullopt;
+    return stamps_.front() + static_cast<std::int64_t>(pass_ + 1) * pass_duration_ns_;  // the next pass's first
+}
+
 std::string ReplaySource::description() const {
     return "replay " + config_.folder.string() + " (" + std::to_string(files_.size()) + " images" +
            (config_.loop ? ", looping)" : ")");

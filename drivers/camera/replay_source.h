@@ -38,6 +38,7 @@ public:
     [[nodiscard]] static Result<std::unique_ptr<ReplaySource>> open(const ReplayConfig& config);
 
     [[nodiscard]] Result<CameraFrame> next_frame() override;
+    [[nodiscard]] std::optional<std::int64_t> next_capture_time_ns() const override;
     [[nodiscard]] std::string description() const override;
 
     [[nodiscard]] const std::vector<std::filesystem::path>& files() const { return files_; }

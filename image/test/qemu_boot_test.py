@@ -16,7 +16,11 @@ Assertions (each printed; any failure fails the test):
   * each of the 3 outputs is lit (screendump not black) and shows the connecting screen: PSNR
     against the same kiosk's headless rendering on the host >= 30 dB;
   * the farm (mogao-farm serve on the host, [::1]:PORT) streams over IPv6 + mutual TLS into the
-    guest: the kiosk logs 'connected' and the outputs then differ from the connecting screen;
+    guest: the kiosk logs 'connected', the outputs then differ from the connecting screen and each
+    shows the warped farm frame: PSNR >= 35 dB against the host's headless kiosk looking at the same
+    still view through the same farm;
+  * the last output runs the 1280x800 mode forced with video= (not the preferred 1024x768) and the
+    1024x768 calibration fills it (resampled);
   * a SIGSTOPped kiosk is killed by its watchdog (WatchdogSec) and restarted by systemd;
   * the hardware watchdog (iTCO_wdt) is used by PID 1 and resets a hung (panicked) kernel;
   * lock-down: read-only root, no failed units, no login prompt, no passwords, no listening sockets;
@@ -47,6 +51,11 @@ MODES = [(1024, 768), (1024, 768), (1280, 800)]
 RATE_HZ = 1               # llvmpipe under TCG renders a round of 3 outputs in seconds
 PSNR_MIN_DB = 30.0       # KMS output vs headless rendering of the same connecting screen
 PSNR_CHANGED_DB = 25.0   # a farm frame must differ from the connecting screen (below this)
+PSNR_FARM_MIN_DB = 35.0  # KMS output vs the host's headless kiosk showing the same still view from
+                         # the same farm; only the per-frame noise seed differs (measured 52-57 dB)
+# The guest and the host reference look at one still view (a two-keyframe path file), so that a
+# farm frame on a KMS output can be compared with the host's warped frame pixel by pixel.
+STILL_VIEW = {"keyframes": [{"position": [0.0, 1.6, 4.0], "yaw_deg": 0.0, "pitch_deg": 0.0}] * 2}
 T0 = time.monotonic()
 
 
@@ -304,10 +313,13 @@ def main():
     for f in ("ca.pem", "appliance-museum-1.pem", "appliance-museum-1.key"):
         shutil.copy(os.path.join(pki, f), os.path.join(cfg, "pki", f))
 
-    def kiosk_toml(outputs_section):
+    with open(os.path.join(cfg, "still.json"), "w") as f:
+        json.dump(STILL_VIEW, f)
+
+    def kiosk_toml(outputs_section, farm_endpoint=endpoint):
         return f"""# written by image/test/qemu_boot_test.py
 [farm]
-endpoint = "{endpoint}"
+endpoint = "{farm_endpoint}"
 ca = "pki/ca.pem"
 cert = "pki/appliance-museum-1.pem"
 key = "pki/appliance-museum-1.key"
@@ -330,7 +342,7 @@ spp = 1
 jpeg_quality = 85
 
 [navigation]
-path = "walk"
+path = "still.json"
 path_frames = 240
 start = [0.0, 0.0, 4.0]
 eye_height_m = 1.6
@@ -341,21 +353,33 @@ log_period_s = 10
     with open(os.path.join(cfg, "kiosk.toml"), "w") as f:
         f.write(kiosk_toml('backend = "kms"'))
 
-    # Reference: the same kiosk on the host, headless, same calibration and connecting screen.
-    ref = os.path.join(work, "reference")
-    shutil.rmtree(ref, ignore_errors=True)
-    os.makedirs(ref)
-    with open(os.path.join(cfg, "reference.toml"), "w") as f:
+    def headless_reference(name, farm_endpoint, seconds, farm):
+        """The same kiosk on the host, headless, same calibration, outputs in MODES: per output the
+        PNG of its first round (the connecting screen) or, with farm=True, of its last farm frame."""
+        ref = os.path.join(work, name)
+        shutil.rmtree(ref, ignore_errors=True)
+        os.makedirs(ref)
         sizes = ", ".join(f'"{w}x{h}"' for w, h in MODES)
-        f.write(kiosk_toml(f'backend = "headless"\nsizes = [{sizes}]\npng_dir = "{ref}"\ncomposite = false'))
-    subprocess.run([a.kiosk, "--config", os.path.join(cfg, "reference.toml"), "--duration", "2"],
-                   stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT, env=env, timeout=120)
-    os.remove(os.path.join(cfg, "reference.toml"))
-    refs = []
-    for i in range(OUTPUTS):
-        pngs = sorted(p for p in os.listdir(ref) if p.startswith(f"headless-{i}-") and p.endswith("-req0.png"))
-        refs.append(os.path.join(ref, pngs[0]) if pngs else None)
-    log(f"reference renderings: {refs}")
+        with open(os.path.join(cfg, "reference.toml"), "w") as f:
+            f.write(kiosk_toml(f'backend = "headless"\nsizes = [{sizes}]\npng_dir = "{ref}"\ncomposite = false',
+                               farm_endpoint))
+        subprocess.run([a.kiosk, "--config", os.path.join(cfg, "reference.toml"), "--duration", str(seconds)],
+                       stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT, env=env, timeout=120)
+        os.remove(os.path.join(cfg, "reference.toml"))
+        found = []
+        for i in range(OUTPUTS):
+            pngs = sorted(p for p in os.listdir(ref) if p.startswith(f"headless-{i}-") and p.endswith(".png"))
+            if farm:
+                pngs = [p for p in pngs if not p.endswith("-req0.png")][-1:]
+            else:
+                pngs = [p for p in pngs if p.endswith("-req0.png")][:1]
+            found.append(os.path.join(ref, pngs[0]) if pngs else None)
+        log(f"{name}: {found}")
+        return found
+
+    # Reference for the connecting screen, which names the guest's endpoint ([fec0::2], not
+    # reachable from the host: the host kiosk stays on its connecting screen too).
+    refs = headless_reference("reference", endpoint, 2, farm=False)
 
     # --- the test copy of the image: provisioned, with a self-test loader entry -----------------------
     img = os.path.join(work, "test.img")
@@ -508,6 +532,9 @@ log_period_s = 10
                 time.sleep(0.5)
             served = farm_proc.poll() is None
             fails.check(served, f"mogao-farm serves on [::1]:{port} (host)")
+            farm_refs = [None] * OUTPUTS
+            if served:
+                farm_refs = headless_reference("farm-reference", f"[::1]:{port}", 8, farm=True)
             tell("farm" if served else "nofarm")
             if served:
                 t, text = serial.wait(r"(ok|FAIL) farm-connected", 420, alive)
@@ -525,6 +552,11 @@ log_period_s = 10
                             fails.check(db is not None and db < PSNR_CHANGED_DB,
                                         f"output {head} shows farm content, not the connecting screen "
                                         f"(PSNR {db} dB < {PSNR_CHANGED_DB})")
+                        db = psnr(a.image_tool, path, farm_refs[head]) if farm_refs[head] else None
+                        results[f"farm_psnr_head{head}"] = db_json(db)
+                        fails.check(db is not None and db >= PSNR_FARM_MIN_DB,
+                                    f"output {head} shows the warped farm frame: PSNR {db} dB vs the host's "
+                                    f"headless kiosk on the same view (>= {PSNR_FARM_MIN_DB})")
                 tell("continue")
 
         t, text = serial.wait(r"kiosk-stopped", 300, alive)

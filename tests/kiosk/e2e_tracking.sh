@@ -14,7 +14,8 @@
 #     45 deg/s and 1 m/s caps times its 0.1 s max_dt, plus rounding), eye height constant;
 #   * tag lost: some ticks after the right turn are not tracking, and the view came to rest: the
 #     last 15 poses are identical, velocities 0;
-#   * the kiosk stopped by itself at the end of the replay (exit 0), every frame tracked, the tag
+#   * the kiosk stopped by itself at the end of the replay (exit 0), every frame tracked or skipped
+#     behind a newer one (as a busy camera reader would), at least 60 tracked, the tag
 #     seen in most, no sample dropped; farm frames were shown.
 #
 # usage: e2e_tracking.sh FARM KIOSK TRACK MPIEXEC SOURCE_DIR WORK_DIR
@@ -76,15 +77,19 @@ print(f"{len(poses)} poses; navigation stats: {json.dumps({k: nav[k] for k in na
 print(f"final pose: {nav['final_pose']}; farm frames shown: {stats['frames_presented']}")
 if nav["source"] != "tracking":
     bad(f"navigation source {nav['source']}")
-if nav["frames_tracked"] != 360:
-    bad(f"{nav['frames_tracked']} frames tracked, the sequence has 360")
-if nav["tag_visible"] < 300:
-    bad(f"the tag was seen in {nav['tag_visible']} of 360 frames")
+# Every frame is tracked or, on a busy machine, skipped because a newer one was due (as a camera
+# would drop it); most must be tracked for the motion checks below to mean anything.
+if nav["frames_tracked"] + nav["frames_skipped"] != 360:
+    bad(f"{nav['frames_tracked']} frames tracked + {nav['frames_skipped']} skipped, the sequence has 360")
+if nav["frames_tracked"] < 60:
+    bad(f"only {nav['frames_tracked']} of 360 frames tracked ({nav['frames_skipped']} skipped)")
+if nav["tag_visible"] < 0.83 * nav["frames_tracked"]:
+    bad(f"the tag was seen in {nav['tag_visible']} of {nav['frames_tracked']} tracked frames")
 if nav["samples_dropped"] != 0:
     bad(f"{nav['samples_dropped']} samples dropped")
 if stats["frames_presented"] < 5:
     bad(f"only {stats['frames_presented']} farm frames shown")
-if len(poses) < 200:
+if len(poses) < 120:  # 360 at 30 Hz on an idle machine; a busy one ticks less often
     bad(f"only {len(poses)} poses for a 12 s replay at 30 Hz")
 
 # No jumps between ticks; eye height fixed.
