@@ -1,4 +1,5 @@
 #include "appliance/tracker/camera_intrinsics.h"
+#include "tests/support/scratch_dir.h"
 
 #include <unistd.h>
 
@@ -14,12 +15,7 @@ namespace fs = std::filesystem;
 
 class CalibrationFile : public ::testing::Test {
 protected:
-    void SetUp() override {
-        dir_ = fs::temp_directory_path() / ("mogao-intrinsics-" + std::to_string(::getpid()) + "-" +
-                                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
+    mogao::testing::ScratchDir scratch_{"intrinsics"};
     fs::path write(const std::string& name, const std::string& text) {
         std::ofstream(dir_ / name) << text;
         return dir_ / name;
@@ -33,7 +29,7 @@ protected:
         }
         return "no error";
     }
-    fs::path dir_;
+    const fs::path dir_ = scratch_.path();
 };
 
 CameraIntrinsics example() {

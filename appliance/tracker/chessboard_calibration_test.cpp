@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "appliance/tracker/synthetic_view.h"
+#include "tests/support/scratch_dir.h"
 
 namespace mogao {
 namespace {
@@ -17,17 +18,12 @@ namespace fs = std::filesystem;
 
 class ChessboardFolder : public ::testing::Test {
 protected:
-    void SetUp() override {
-        dir_ = fs::temp_directory_path() / ("mogao-chessboard-" + std::to_string(::getpid()) + "-" +
-                                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
+    mogao::testing::ScratchDir scratch_{"chessboard"};
     void write(const std::string& name, const GrayImage& image) {
         const cv::Mat m(image.height, image.width, CV_8UC1, const_cast<std::uint8_t*>(image.pixels.data()));
         ASSERT_TRUE(cv::imwrite((dir_ / name).string(), m));
     }
-    fs::path dir_;
+    const fs::path dir_ = scratch_.path();
 };
 
 // Views of a 9x6 board from different angles, as a person calibrating would take them.

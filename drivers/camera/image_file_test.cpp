@@ -1,6 +1,7 @@
 // read_gray_image: fixtures are written by an independent encoder (OpenCV's imwrite) or by hand
 // (PGM headers), and read back by our libpng/TurboJPEG/PGM reader.
 #include "drivers/camera/image_file.h"
+#include "tests/support/scratch_dir.h"
 
 #include <unistd.h>
 
@@ -20,13 +21,7 @@ namespace fs = std::filesystem;
 
 class ImageFile : public ::testing::Test {
 protected:
-    void SetUp() override {
-        dir_ = fs::temp_directory_path() / ("mogao-imagefile-" + std::to_string(::getpid()) + "-" +
-                                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
+    mogao::testing::ScratchDir scratch_{"imagefile"};
 
     // A gradient, so that row order, column order and every value are checked.
     static cv::Mat gradient(int w, int h) {
@@ -53,7 +48,7 @@ protected:
         EXPECT_LE(worst, tolerance);
     }
 
-    fs::path dir_;
+    const fs::path dir_ = scratch_.path();
 };
 
 TEST_F(ImageFile, GreyPngAndPgmAreExact) {

@@ -1,4 +1,5 @@
 #include "drivers/camera/replay_source.h"
+#include "tests/support/scratch_dir.h"
 
 #include <unistd.h>
 
@@ -16,13 +17,7 @@ namespace fs = std::filesystem;
 // A fresh folder per test, removed afterwards.
 class ReplayFolder : public ::testing::Test {
 protected:
-    void SetUp() override {
-        dir_ = fs::temp_directory_path() / ("mogao-replay-" + std::to_string(::getpid()) + "-" +
-                                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
+    mogao::testing::ScratchDir scratch_{"replay"};
 
     // An image whose every pixel is `value`, so the frame order can be read back from the pixels.
     void write(const std::string& name, int value, int channels = 1) {
@@ -31,7 +26,7 @@ protected:
     }
     void write_text(const std::string& name, const std::string& text) { std::ofstream(dir_ / name) << text; }
 
-    fs::path dir_;
+    const fs::path dir_ = scratch_.path();
 };
 
 TEST_F(ReplayFolder, PlaysPngPgmJpegInNameOrderAndEndsWithEnodata) {
