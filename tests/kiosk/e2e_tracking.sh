@@ -13,7 +13,7 @@
 #   * no jump: between consecutive ticks |dyaw| <= 4.6 deg and |deye| <= 0.11 m (the Navigator's
 #     45 deg/s and 1 m/s caps times its 0.1 s max_dt, plus rounding), eye height constant;
 #   * tag lost: some ticks after the right turn are not tracking, and the view came to rest: the
-#     last 15 poses are identical, velocities 0;
+#     poses of the last 0.5 s are identical, velocities 0;
 #   * the kiosk stopped by itself at the end of the replay (exit 0), every frame tracked or skipped
 #     behind a newer one (as a busy camera reader would), at least 60 tracked, the tag
 #     seen in most, no sample dropped; farm frames were shown.
@@ -38,6 +38,10 @@ python3 - "$work/kiosk.toml" <<'PY'
 import sys
 p = sys.argv[1]
 text = open(p).read()
+# 15 Hz display and requests (not 30): the farm's ranks and the outputs then leave the tracking
+# thread a core's worth of time on a 2-core machine; navigation does not depend on the rate.
+assert "rate_hz = 30\n" in text
+text = text.replace("rate_hz = 30\n", "rate_hz = 15\n")
 text = text.replace('path = "walk"\npath_frames = 240\n', '''source = "tracking"
 camera = "replay:hand-sequence"      # its camera.json is the intrinsics
 tag_size_m = 0.10
@@ -89,8 +93,8 @@ if nav["samples_dropped"] != 0:
     bad(f"{nav['samples_dropped']} samples dropped")
 if stats["frames_presented"] < 5:
     bad(f"only {stats['frames_presented']} farm frames shown")
-if len(poses) < 120:  # 360 at 30 Hz on an idle machine; a busy one ticks less often
-    bad(f"only {len(poses)} poses for a 12 s replay at 30 Hz")
+if len(poses) < 90:  # 180 at 15 Hz on an idle machine; a busy one ticks less often
+    bad(f"only {len(poses)} poses for a 12 s replay at 15 Hz")
 
 # No jumps between ticks; eye height fixed.
 MAX_DYAW, MAX_DPOS = 4.6, 0.11
@@ -150,12 +154,14 @@ else:
     else:
         print(f"tag lost after the right turn in {len(lost)} ticks (from tick {lost[0]['tick']})")
 
-# Came to rest.
-tail = poses[-15:]
+# Came to rest: the poses of the last 0.5 s (the sequence ends with the tag at rest).
+tail = [p for p in poses if p["t_ns"] >= poses[-1]["t_ns"] - 500_000_000]
+if len(tail) < 2:
+    bad(f"only {len(tail)} ticks in the last 0.5 s")
 if any(p["yaw_deg"] != tail[0]["yaw_deg"] or p["eye"] != tail[0]["eye"] for p in tail):
-    bad("the view still moves in the last 15 ticks")
+    bad(f"the view still moves in the last 0.5 s ({len(tail)} ticks)")
 if any(p["turn_deg_s"] != 0 or p["forward_m_s"] != 0 for p in tail):
-    bad("non-zero velocity in the last 15 ticks")
+    bad(f"non-zero velocity in the last 0.5 s ({len(tail)} ticks)")
 sys.exit(0 if ok else 1)
 PY
 log "PASS"
