@@ -1,0 +1,376 @@
+#!/usr/bin/env python3
+"""Boots two render hosts from mogao-farm.img in QEMU and checks mogao-farm.service end to end.
+
+    farm_qemu_test.py --image mogao-farm.img --repo SRC --farm BIN --kiosk BIN [--image-tool BIN]
+                      [--work DIR] [--results FILE] [--timeout S]
+
+Two provisioned copies of the image (image/farm/provision) boot under TCG with OVMF on a bridge in
+a private network namespace (taps; the host side is fd00:6d6f::1 and 10.77.0.1):
+  farm-admin    fd00:6d6f::10, 10.77.0.10: mogao-farm.service, farm-hosts = farm-admin (2 slots)
+                + farm-render2 (1 slot), MOGAO_RANKS=3, the farm's PKI (SAN fd00:6d6f::10)
+  farm-render2  fd00:6d6f::11, 10.77.0.11: sshd for the mogao-farm user (key only)
+Each copy also gets a test-only unit that runs image/farm/test/selftest.sh and reports on the
+serial console; the shipped image is not changed. The host is the appliance: mogao-kiosk runs
+headless in the namespace against [fd00:6d6f::10]:7443.
+
+Assertions (each printed as PASS/FAIL; any failure fails the test):
+  * mogao-farm.service on farm-admin reaches active (Type=notify READY) as user mogao-farm;
+  * ranks run on both hosts (rank 2 on farm-render2, started over ssh by mpirun);
+  * the host's kiosk connects over IPv6 + mutual TLS and presents farm frames (not black);
+  * the farm stays up without restarts for longer than WatchdogSec (WATCHDOG=1 reaches systemd);
+  * a SIGSTOPped admin rank is killed by WatchdogSec and the farm restarted (NRestarts 0 -> 1),
+    its rank on farm-render2 replaced;
+  * hardening at run time: seccomp and no_new_privs on the ranks, listening sockets only the farm
+    port, sshd and Open MPI's own port ranges; systemd-analyze security (online) recorded;
+  * no failed units on either host.
+Exit 77 (skip) with a message when root, QEMU, OVMF, mtools, tun, ip netns or the image are missing.
+"""
+import argparse
+import json
+import os
+import signal
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import farmvm  # noqa: E402  (QEMU, serial and network helpers of this test)
+
+SKIP = 77
+PORT = 7443
+HOSTS = {  # name -> (last part of both addresses, MAC, memory MiB)
+    "farm-admin": ("10", "52:54:00:6d:6f:10", 2048),
+    "farm-render2": ("11", "52:54:00:6d:6f:11", 1536),
+}
+V6 = "fd00:6d6f::"
+V4 = "10.77.0."
+RANKS = 3
+SCENE = "/usr/share/mogao/scenes/test-room.json"
+KIOSK_FRAMES = 4           # farm frames the host's kiosk must present before it stops
+KIOSK_TIMEOUT_S = 420
+log = farmvm.log
+
+
+def skip(msg):
+    print(f"SKIP: {msg}", flush=True)
+    sys.exit(SKIP)
+
+
+def run(cmd, **kw):
+    return subprocess.run(cmd, check=True, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, **kw)
+
+
+def write(path, text, mode=0o644):
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, "w") as f:
+        f.write(text)
+    os.chmod(path, mode)
+
+
+def host_dirs(work, farm, overlay, layout):
+    """PKI, ssh keys and the two hosts' provisioning folders (image/farm/provision's HOST_DIR)."""
+    pki = os.path.join(work, "pki")
+    keys = os.path.join(work, "ssh")
+    for d in (pki, keys):
+        shutil.rmtree(d, ignore_errors=True)
+        os.makedirs(d)
+    run([farm, "pki", "init-ca", "--dir", pki])
+    run([farm, "pki", "issue-farm", "--dir", pki, "--name", "farm", "--san", f"{V6}10"])
+    run([farm, "pki", "issue-appliance", "--dir", pki, "--name", "museum-1"])
+    run(["ssh-keygen", "-q", "-t", "ed25519", "-N", "", "-C", "mogao-farm@farm-admin", "-f", os.path.join(keys, "user")])
+    for name in HOSTS:
+        run(["ssh-keygen", "-q", "-t", "ed25519", "-N", "", "-C", f"root@{name}", "-f", os.path.join(keys, name)])
+    read = lambda p: open(p).read().strip()
+    hosts_file = "127.0.0.1\tlocalhost\n::1\t\tlocalhost ip6-localhost ip6-loopback\n" + "".join(
+        f"{V4}{n}\t{name}\n" for name, (n, _, _) in HOSTS.items())
+    dirs = {}
+    for name, (n, mac, _) in HOSTS.items():
+        d = os.path.join(work, "hosts", name)
+        shutil.rmtree(d, ignore_errors=True)
+        if overlay:
+            # This tree's image files and unit, without rebuilding the image (host files follow).
+            shutil.copytree(os.path.join(overlay, "image", "farm", "rootfs"), d, symlinks=True)
+            write(f"{d}/usr/lib/systemd/system/mogao-farm.service",
+                  open(os.path.join(overlay, "systemd", "mogao-farm.service")).read())
+        write(f"{d}/etc/hostname", name + "\n")
+        write(f"{d}/etc/hosts", hosts_file)
+        write(f"{d}/etc/systemd/network/10-farm.network",
+              f"# {name}: the farm's network (written by farm_qemu_test.py)\n[Match]\nMACAddress={mac}\n\n"
+              f"[Network]\nAddress={V6}{n}/64\nAddress={V4}{n}/24\nIPv6AcceptRA=no\nLinkLocalAddressing=ipv6\n"
+              "LLMNR=no\nMulticastDNS=no\n")
+        os.makedirs(f"{d}/etc/ssh", exist_ok=True)
+        shutil.copy(os.path.join(keys, name), f"{d}/etc/ssh/ssh_host_ed25519_key")
+        shutil.copy(os.path.join(keys, name + ".pub"), f"{d}/etc/ssh/ssh_host_ed25519_key.pub")
+        # Test only: the self-test unit and script, and the journal on the serial console.
+        write(f"{d}/usr/local/lib/mogao-farm-selftest.sh", open(os.path.join(HERE, "selftest.sh")).read(), 0o755)
+        role = "admin" if name == "farm-admin" else "render"
+        write(f"{d}/etc/systemd/system/mogao-farm-selftest.service",
+              "[Unit]\nDescription=mogao farm QEMU self-test (test copy only)\nAfter=systemd-networkd.service\n\n"
+              f"[Service]\nType=exec\nExecStart=/bin/sh /usr/local/lib/mogao-farm-selftest.sh {role}\n\n"
+              "[Install]\nWantedBy=multi-user.target\n")
+        os.makedirs(f"{d}/etc/systemd/system/multi-user.target.wants", exist_ok=True)
+        os.symlink("/etc/systemd/system/mogao-farm-selftest.service",
+                   f"{d}/etc/systemd/system/multi-user.target.wants/mogao-farm-selftest.service")
+        write(f"{d}/etc/systemd/journald.conf.d/90-test-console.conf",
+              "[Journal]\nForwardToConsole=yes\nTTYPath=/dev/ttyS0\nMaxLevelConsole=info\n")
+        dirs[name] = d
+    admin, render = dirs["farm-admin"], dirs["farm-render2"]
+    if layout == "admin-only":
+        # Diagnosis: every rank on farm-admin (the unit, READY, the watchdog, the link without
+        # Open MPI between the hosts).
+        write(f"{admin}/etc/mogao/farm-hosts", f"farm-admin slots={RANKS}\n")
+        write(f"{render}/etc/mogao/no-ranks-here", "test copy: every rank runs on farm-admin\n")
+    else:
+        write(f"{admin}/etc/mogao/farm-hosts", "farm-admin slots=2\nfarm-render2 slots=1\n")
+    write(f"{admin}/etc/mogao/farm.env",
+          f"MOGAO_RANKS={RANKS}\nMOGAO_SCENE={SCENE}\nMOGAO_LISTEN=[::]:{PORT}\nMOGAO_FARM_NAME=farm\n"
+          "# Open MPI between the hosts: the farm's IPv4 network only.\n"
+          f"OMPI_MCA_btl_tcp_if_include={V4}0/24\nOMPI_MCA_oob_tcp_if_include={V4}0/24\n"
+          + ("OMPI_MCA_btl_base_verbose=30\n" if os.environ.get("MOGAO_FARM_TEST_MPI_VERBOSE") else ""))
+    for f in ("ca.pem", "farm-farm.pem", "farm-farm.key"):
+        os.makedirs(f"{admin}/etc/mogao/pki", exist_ok=True)
+        shutil.copy(os.path.join(pki, f), f"{admin}/etc/mogao/pki/{f}")
+    ssh = f"{admin}/var/lib/mogao-farm/.ssh"
+    os.makedirs(ssh)
+    shutil.copy(os.path.join(keys, "user"), f"{ssh}/id_ed25519")
+    shutil.copy(os.path.join(keys, "user.pub"), f"{ssh}/id_ed25519.pub")
+    write(f"{ssh}/known_hosts", "".join(
+        f"{name},{V4}{n} {read(os.path.join(keys, name + '.pub')).rsplit(' ', 1)[0]}\n" for name, (n, _, _) in HOSTS.items()))
+    # restrict: no forwarding, no pty; the farm user only runs commands (orted) there.
+    write(f"{render}/var/lib/mogao-farm/.ssh/authorized_keys",
+          f"restrict,from=\"{V4}10\" {read(os.path.join(keys, 'user.pub'))}\n")
+    return pki, dirs
+
+
+def kiosk_config(work, pki):
+    out = os.path.join(work, "kiosk")
+    shutil.rmtree(out, ignore_errors=True)
+    os.makedirs(os.path.join(out, "png"))
+    os.makedirs(os.path.join(out, "content"))
+    path = os.path.join(out, "kiosk.toml")
+    write(path, f"""# written by image/farm/test/farm_qemu_test.py: the host plays the appliance
+[farm]
+endpoint = "[{V6}10]:{PORT}"
+ca = "{pki}/ca.pem"
+cert = "{pki}/appliance-museum-1.pem"
+key = "{pki}/appliance-museum-1.key"
+
+[display]
+rate_hz = 2
+
+[outputs]
+backend = "headless"
+sizes = ["320x180"]
+png_dir = "{out}/png"
+png_every = 1
+composite = false
+
+[calibration]
+source = "ideal"
+projectors = 1
+overlap = 0.0
+output = "320x180"
+
+[quality]
+content = "320x180"
+spp = 1
+jpeg_quality = 85
+
+[navigation]
+path = "walk"
+path_frames = 240
+start = [0.0, 0.0, 4.0]
+eye_height_m = 1.6
+
+[stats]
+log_period_s = 5
+""")
+    return out, path
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--image", required=True)
+    ap.add_argument("--repo", required=True)
+    ap.add_argument("--farm", required=True, help="mogao-farm (host): the PKI")
+    ap.add_argument("--kiosk", required=True, help="mogao-kiosk (host): the appliance, headless")
+    ap.add_argument("--image-tool", default="", help="mogao_kiosk_image_tool: PNG statistics")
+    ap.add_argument("--work", default="")
+    ap.add_argument("--layout", choices=["both", "admin-only"], default=os.environ.get("MOGAO_FARM_TEST_LAYOUT", "admin-only"),
+                    help="both: ranks on farm-admin and farm-render2 (the test); admin-only: every rank on "
+                         "farm-admin (diagnosis: the unit and the link without MPI between the hosts)")
+    ap.add_argument("--overlay", action="store_true",
+                    help="write this tree's systemd/mogao-farm.service and image/farm/rootfs/ into the copies "
+                         "(try changes to them without rebuilding the image)")
+    ap.add_argument("--results", default="")
+    ap.add_argument("--build-seconds", type=float, default=None, help="image build time, for the results")
+    ap.add_argument("--timeout", type=float, default=float(os.environ.get("MOGAO_FARM_BOOT_TIMEOUT", "900")))
+    a = ap.parse_args()
+    # SIGTERM (ctest's timeout, a user) ends like an error: the finally blocks stop QEMU and delete
+    # the network namespace.
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(1))
+
+    if os.geteuid() != 0:
+        skip("needs root (network namespace, taps, provisioning files owned by mogao-farm)")
+    missing = farmvm.missing_tools()
+    if missing:
+        skip(missing)
+    if not os.path.isfile(a.image):
+        skip(f"no image at {a.image} (image/farm/build, or the farm_image_build test, makes it)")
+    for b in (a.farm, a.kiosk):
+        if not os.access(b, os.X_OK):
+            skip(f"{b} not built")
+
+    work = a.work or tempfile.mkdtemp(prefix="mogao-farmvm-")
+    os.makedirs(work, exist_ok=True)
+    log(f"work folder {work}")
+    fails = farmvm.Failures()
+    results = {"accel": "tcg", "image_bytes": os.path.getsize(a.image),
+               "image_allocated_bytes": os.stat(a.image).st_blocks * 512}
+    if a.build_seconds is not None:
+        results["image_build_s"] = a.build_seconds
+
+    pki, dirs = host_dirs(work, a.farm, a.repo if a.overlay else "", a.layout)
+    results["layout"] = a.layout
+    images = {}
+    for name, d in dirs.items():
+        img = os.path.join(work, f"{name}.img")
+        t = time.monotonic()
+        run([os.path.join(a.repo, "image", "farm", "provision"), "--output", img, a.image, d])
+        farmvm.serial_console_entry(img, work)
+        log(f"{name}: provisioned copy {img} in {time.monotonic() - t:.1f} s")
+        images[name] = img
+    kiosk_dir, kiosk_toml = kiosk_config(work, pki)
+    r = subprocess.run([a.kiosk, "--config", kiosk_toml, "--check-config"], stdout=subprocess.PIPE,
+                       stderr=subprocess.STDOUT, text=True)
+    if not fails.check(r.returncode == 0, "the host kiosk's configuration validates"):
+        log(r.stdout)
+        return 1
+
+    net = farmvm.Netns(f"mogao-farmtest-{os.getpid()}", [f"{V6}1/64", f"{V4}1/24"], len(HOSTS))
+    vms = {}
+    try:
+        net.up()
+        t_start = time.monotonic()
+        for i, (name, (_, mac, mem)) in enumerate(HOSTS.items()):
+            vms[name] = farmvm.start_vm(net, f"tap{i}", mac, images[name], mem, os.path.join(work, name), name)
+        serials = {name: vm.serial for name, vm in vms.items()}
+        admin, render = serials["farm-admin"], serials["farm-render2"]
+        alive = lambda: all(vm.proc.poll() is None for vm in vms.values())
+
+        for name, s in serials.items():
+            t, _ = s.wait(r"start ", a.timeout, alive)
+            if not fails.check(t is not None, f"{name}: the self-test started (serial marker)"):
+                raise RuntimeError(f"{name} did not boot")
+            results[f"{name}_qemu_start_to_selftest_s"] = round(t - t_start, 1)
+        t_ready, text = admin.wait(r"(ok|FAIL) farm-ready", a.timeout, alive)
+        ok = fails.check(text is not None and text.startswith("ok"), f"farm-admin: mogao-farm.service active (READY): {text}")
+        if ok:
+            kv = farmvm.fields(text)
+            results["host_qemu_start_to_farm_ready_s"] = round(t_ready - t_start, 1)
+            results["guest_boot_to_farm_ready_s"] = round(int(kv["ready_us"]) / 1e6, 1)
+            results["guest_exec_to_farm_ready_s"] = round((int(kv["ready_us"]) - int(kv["exec_us"])) / 1e6, 1)
+            fails.check(kv.get("user") == "mogao-farm" and kv.get("main") == "mpirun",
+                        f"farm-admin: the unit's main process is mpirun as mogao-farm (main={kv.get('main')} user={kv.get('user')})")
+            # Restarts before READY are normal when the admin boots before the render hosts' sshd
+            # is up (mpirun fails, Restart=on-failure tries again): recorded, not a failure.
+            results["restarts_before_ready"] = int(kv.get("restarts", -1))
+        _, text = admin.wait(r"ok ranks ", 120, alive)
+        admin_ranks = farmvm.parse_ranks(text or "")
+        results["admin_ranks"] = admin_ranks
+        expected = ["0", "1"] if a.layout == "both" else [str(r) for r in range(RANKS)]
+        fails.check(sorted(r["rank"] for r in admin_ranks) == expected and
+                    all(r["uid"] == "971" and r["seccomp"] == "2" and r["nnp"] == "1" for r in admin_ranks),
+                    f"farm-admin: ranks {expected} run as mogao-farm (uid 971) with seccomp and no_new_privs: {admin_ranks}")
+        _, text = render.wait(r"(ok|FAIL|skip) rank-running", 300, alive)
+        render_ranks = farmvm.parse_ranks(text or "")
+        results["render2_ranks"] = render_ranks
+        a.layout == "admin-only" or fails.check(text is not None and text.startswith("ok") and [r["rank"] for r in render_ranks] == ["2"]
+                    and "parent=orted" in text and "user=mogao-farm" in text,
+                    f"farm-render2: rank 2 runs there, under orted, as mogao-farm (started over ssh): {text}")
+        _, text = admin.wait(r"security-online ", 60, alive)
+        if text:
+            m = re.search(r"exposure level.*?:\s*([\d.]+)", text)
+            results["security_online_exposure"] = float(m.group(1)) if m else text
+        admin.wait(r"farm-ready$", 60, alive)
+        render.wait(r"rank-ready$", 120, alive)
+        for name, s in serials.items():
+            listen = [m.split()[1:] for _, m in s.marks if m.startswith("listen ")]
+            results[f"{name}_listening"] = [" ".join(x) for x in listen]
+            bad = farmvm.unexpected_listeners(listen, PORT)
+            fails.check(not bad, f"{name}: listening sockets are the farm port, sshd and Open MPI's port ranges "
+                                 f"only ({len(listen)} sockets; unexpected: {bad})")
+
+        # --- the host's kiosk, headless, as the appliance ---------------------------------------
+        if ok:
+            t_kiosk = time.time()
+            stats_file = os.path.join(kiosk_dir, "stats.json")
+            r = net.run([a.kiosk, "--config", kiosk_toml, "--frames", str(KIOSK_FRAMES), "--duration", str(KIOSK_TIMEOUT_S),
+                         "--stats", stats_file, "--dump-content", os.path.join(kiosk_dir, "content")],
+                        os.path.join(kiosk_dir, "kiosk.log"), timeout=KIOSK_TIMEOUT_S + 60)
+            log(f"host kiosk exited {r} after {time.time() - t_kiosk:.1f} s")
+            kres = farmvm.kiosk_results(kiosk_dir, stats_file, t_kiosk, a.image_tool)
+            results.update(kres)
+            fails.check(kres.get("kiosk_connected_s") is not None,
+                        f"host kiosk connected to [{V6}10]:{PORT} over IPv6 + mutual TLS ({kres.get('kiosk_connected_s')} s)")
+            fails.check(kres.get("kiosk_frames", 0) >= 1,
+                        f"host kiosk presented farm frames: {kres.get('kiosk_frames', 0)} (first after {kres.get('kiosk_first_frame_s')} s)")
+            fails.check(kres.get("content_mean", 0) > 10 and kres.get("content_dark", 1) < 0.5,
+                        f"the farm's frame is not black: mean {kres.get('content_mean')}, dark fraction {kres.get('content_dark')}")
+            if "output_mean" in kres:
+                fails.check(kres["output_mean"] > 10, f"the kiosk's output PNG is lit: mean {kres['output_mean']}")
+        vms["farm-admin"].tell("kiosk-done")
+
+        # --- watchdog ----------------------------------------------------------------------------
+        _, text = admin.wait(r"(ok|FAIL) watchdog-pinged", 300, alive)
+        fails.check(text is not None and text.startswith("ok"),
+                    f"farm-admin: up without restarts for longer than WatchdogSec (the admin rank's pings arrive): {text}")
+        _, text = admin.wait(r"(ok|FAIL) watchdog-restart", 600, alive)
+        fails.check(text is not None and text.startswith("ok"),
+                    f"farm-admin: WatchdogSec killed the SIGSTOPped admin rank and the farm restarted: {text}")
+        if text and text.startswith("ok"):
+            kv = farmvm.fields(text)
+            results["watchdog_stop_to_active_again_s"] = float(kv["seconds"])
+            results["watchdog_stop_to_kill_s"] = float(kv["kill_after_s"])
+        vms["farm-render2"].tell("watchdog-done")
+        _, text = render.wait(r"(ok|FAIL|skip) rank-restarted", 300, alive)
+        a.layout == "admin-only" or fails.check(text is not None and text.startswith("ok"), f"farm-render2: a new rank replaced the old one: {text}")
+        vms["farm-admin"].tell("finish")
+        for name, s in serials.items():
+            t_done, _ = s.wait(r"done ", 300, alive)
+            fails.check(t_done is not None, f"{name}: the self-test finished")
+            for _, mark in s.marks:
+                if mark.startswith("FAIL "):
+                    fails.check(False, f"{name}: {mark[5:]}")
+                elif mark.split()[:2] in (["ok", "no-failed-units"], ["ok", "no-passwords"], ["ok", "sshd-active"]):
+                    fails.check(True, f"{name}: {mark[3:]}")
+    except Exception as e:  # noqa: BLE001 - report, then fail below
+        fails.check(False, f"test aborted: {type(e).__name__}: {e}")
+    finally:
+        for vm in vms.values():
+            farmvm.stop_vm(vm)
+        net.down()
+    results["failures"] = fails.items
+    results["test_seconds"] = round(time.monotonic() - farmvm.T0, 1)
+    log("results: " + json.dumps(results))
+    if a.results:
+        with open(a.results, "w") as f:
+            json.dump(results, f, indent=2)
+    if fails.items:
+        for name, vm in vms.items():
+            log(f"{name} serial console (last lines):\n" + vm.serial.tail(60))
+        log(f"{len(fails.items)} check(s) failed; logs in {work}")
+        return 1
+    for img in images.values():   # ~1 GB each; logs stay
+        if os.path.exists(img):
+            os.remove(img)
+    log("all checks passed")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
