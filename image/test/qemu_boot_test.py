@@ -38,6 +38,8 @@ import sys
 import tempfile
 import time
 
+from qemu_common import T0, Failures, Serial, log, set_name  # noqa: E402 (this folder)
+
 SKIP = 77
 OVMF_CODE = "/usr/share/OVMF/OVMF_CODE_4M.fd"
 OVMF_VARS = "/usr/share/OVMF/OVMF_VARS_4M.fd"
@@ -58,27 +60,10 @@ PSNR_FARM_MIN_DB = 35.0  # KMS output vs the host's headless kiosk showing the s
 # The guest and the host reference look at one still view (a two-keyframe path file), so that a
 # farm frame on a KMS output can be compared with the host's warped frame pixel by pixel.
 STILL_VIEW = {"keyframes": [{"position": [0.0, 1.6, 4.0], "yaw_deg": 0.0, "pitch_deg": 0.0}] * 2}
-T0 = time.monotonic()
-
-
-def log(msg):
-    print(f"[qemu_boot_test {time.monotonic() - T0:7.1f}s] {msg}", flush=True)
-
 
 def skip(msg):
     print(f"SKIP: {msg}", flush=True)
     sys.exit(SKIP)
-
-
-class Failures:
-    def __init__(self):
-        self.items = []
-
-    def check(self, cond, what):
-        log(("PASS " if cond else "FAIL ") + what)
-        if not cond:
-            self.items.append(what)
-        return cond
 
 
 # --- images -----------------------------------------------------------------------------------------
@@ -177,58 +162,6 @@ class Qmp:
 
 
 # --- serial console -----------------------------------------------------------------------------------
-class Serial:
-    """Follows the serial log file; collects MOGAO-SELFTEST lines."""
-
-    MARK = re.compile(r"MOGAO-SELFTEST (.*)")
-
-    def __init__(self, path):
-        self.path = path
-        self.pos = 0
-        self.partial = ""
-        self.marks = []   # (host time, text)
-
-    def pump(self):
-        try:
-            with open(self.path, "rb") as f:
-                f.seek(self.pos)
-                data = f.read()
-                self.pos += len(data)
-        except FileNotFoundError:
-            return
-        text = self.partial + data.decode("utf-8", "replace")
-        lines = text.split("\n")
-        self.partial = lines.pop()
-        now = time.monotonic()
-        for line in lines:
-            m = self.MARK.search(line)
-            if m:
-                self.marks.append((now, m.group(1).strip()))
-                log(f"guest: {m.group(1).strip()}")
-
-    def wait(self, pattern, timeout, alive):
-        """Waits for a marker matching `pattern` (regex, from its start); returns (time, text)."""
-        rx = re.compile(pattern)
-        deadline = time.monotonic() + timeout
-        while True:
-            self.pump()
-            for t, text in self.marks:
-                if rx.match(text):
-                    return t, text
-            if time.monotonic() > deadline or not alive():
-                break
-            time.sleep(0.5)
-        return None, None
-
-    def tail(self, n=60):
-        try:
-            with open(self.path, "rb") as f:
-                lines = f.read().decode("utf-8", "replace").splitlines()
-            return "\n".join(lines[-n:])
-        except FileNotFoundError:
-            return ""
-
-
 def free_port():
     s = socket.socket(socket.AF_INET6)
     s.bind(("::1", 0))
@@ -256,6 +189,7 @@ def run(cmd, **kw):
 
 
 def main():
+    set_name("qemu_boot_test")
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--image", required=True)
     ap.add_argument("--repo", required=True)

@@ -5,31 +5,22 @@ import re
 import shutil
 import socket
 import subprocess
+import sys
 import time
+
+# The helpers both QEMU tests share live beside the appliance's test (image/test/qemu_common.py).
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "test"))
+from qemu_common import T0, Failures, Serial, log, set_name  # noqa: E402,F401 (re-exported to farm_qemu_test.py)
+
+set_name("farm_qemu_test")
 
 OVMF_CODE = "/usr/share/OVMF/OVMF_CODE_4M.fd"
 OVMF_VARS = "/usr/share/OVMF/OVMF_VARS_4M.fd"
-T0 = time.monotonic()
 # Listeners a render host may have besides the farm's port and sshd: Open MPI's daemons (mpirun,
 # orted: any port, their out-of-band channel) and ranks (the BTL port range of
 # image/farm/rootfs/etc/openmpi/openmpi-mca-params.conf; PMIx on loopback).
 MPI_PORTS = range(46000, 46100)
 MPI_DAEMONS = {"mpirun", "orterun", "orted"}
-
-
-def log(msg):
-    print(f"[farm_qemu_test {time.monotonic() - T0:7.1f}s] {msg}", flush=True)
-
-
-class Failures:
-    def __init__(self):
-        self.items = []
-
-    def check(self, cond, what):
-        log(("PASS " if cond else "FAIL ") + what)
-        if not cond:
-            self.items.append(what)
-        return cond
 
 
 def missing_tools():
@@ -145,54 +136,6 @@ class Netns:
         if self.created:
             subprocess.run(["ip", "netns", "delete", self.name])
             self.created = False
-
-
-class Serial:
-    """Follows a serial log file; collects MOGAO-SELFTEST lines."""
-
-    MARK = re.compile(r"MOGAO-SELFTEST (.*)")
-
-    def __init__(self, path, name):
-        self.path, self.name = path, name
-        self.pos = 0
-        self.partial = ""
-        self.marks = []   # (host time, text)
-
-    def pump(self):
-        try:
-            with open(self.path, "rb") as f:
-                f.seek(self.pos)
-                data = f.read()
-                self.pos += len(data)
-        except FileNotFoundError:
-            return
-        lines = (self.partial + data.decode("utf-8", "replace")).split("\n")
-        self.partial = lines.pop()
-        for line in lines:
-            m = self.MARK.search(line)
-            if m:
-                self.marks.append((time.monotonic(), m.group(1).strip()))
-                log(f"{self.name}: {m.group(1).strip()}")
-
-    def wait(self, pattern, timeout, alive):
-        """Waits for a marker matching `pattern` (regex, from its start); returns (time, text)."""
-        rx = re.compile(pattern)
-        deadline = time.monotonic() + timeout
-        while True:
-            self.pump()
-            for t, text in self.marks:
-                if rx.match(text):
-                    return t, text
-            if time.monotonic() > deadline or not alive():
-                return None, None
-            time.sleep(0.5)
-
-    def tail(self, n=60):
-        try:
-            with open(self.path, "rb") as f:
-                return "\n".join(f.read().decode("utf-8", "replace").splitlines()[-n:])
-        except FileNotFoundError:
-            return ""
 
 
 class Vm:
