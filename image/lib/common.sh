@@ -100,3 +100,20 @@ img_write_checksums() {
     bmaptool -q create -o "$image.bmap" "$image" || img_log "warning: bmaptool create failed"
   fi
 }
+
+# img_build_preconditions TOOL...: whether an image can be built here (the image tests skip, not
+# fail, when it cannot). Prints the reason and returns 1 when a tool, systemd-boot or the Debian
+# mirror ($MOGAO_IMAGE_MIRROR, default deb.debian.org) is missing; returns 0 otherwise.
+img_build_preconditions() {
+  local tool mirror=${MOGAO_IMAGE_MIRROR:-http://deb.debian.org/debian}
+  for tool in "$@"; do
+    command -v "$tool" >/dev/null \
+      || { echo "$tool not found (apt-get install mmdebstrap e2fsprogs dosfstools mtools fdisk xz-utils)"; return 1; }
+  done
+  [[ -f /usr/lib/systemd/boot/efi/systemd-bootx64.efi ]] \
+    || { echo "systemd-boot not found (apt-get install systemd-boot-efi)"; return 1; }
+  python3 - "$mirror/dists/bookworm/Release" 2>/dev/null <<'PY' || { echo "the Debian mirror $mirror is not reachable"; return 1; }
+import sys, urllib.request
+urllib.request.urlopen(urllib.request.Request(sys.argv[1], method="HEAD"), timeout=20)
+PY
+}

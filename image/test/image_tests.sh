@@ -14,15 +14,8 @@ skip() { echo "SKIP: $*"; exit 77; }
 case $mode in
   build)
     if [[ -n "${MOGAO_IMAGE:-}" ]]; then skip "MOGAO_IMAGE=$MOGAO_IMAGE given: not building an image"; fi
-    for tool in mmdebstrap mke2fs mkfs.vfat mcopy sfdisk xz python3; do
-      command -v "$tool" >/dev/null || skip "$tool not found (apt-get install mmdebstrap e2fsprogs dosfstools mtools fdisk xz-utils)"
-    done
-    [[ -f /usr/lib/systemd/boot/efi/systemd-bootx64.efi ]] || skip "systemd-boot not found (apt-get install systemd-boot-efi)"
-    mirror=${MOGAO_IMAGE_MIRROR:-http://deb.debian.org/debian}
-    python3 - "$mirror/dists/bookworm/Release" <<'PY' || skip "the Debian mirror $mirror is not reachable"
-import sys, urllib.request
-urllib.request.urlopen(urllib.request.Request(sys.argv[1], method="HEAD"), timeout=20)
-PY
+    source "$repo/image/lib/common.sh"
+    why=$(img_build_preconditions mmdebstrap mke2fs mkfs.vfat mcopy sfdisk xz python3) || skip "$why"
     mkdir -p "$outdir"
     start=$(date +%s)
     "$repo/image/build" --kiosk "$kiosk" --out "$outdir" --cache "$outdir/apt-cache" || exit 1
