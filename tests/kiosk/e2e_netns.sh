@@ -4,12 +4,19 @@
 #             ideal 3-projector calibration) in namespace B at fd00:6d6f::2, joined by a veth pair
 #             with 5 ms netem delay each way; skipped (77) where namespaces are not permitted
 #   loopback  the same over [::1] without namespaces
+#   multihost the farm on two hosts: its admin (mpirun, ranks 0 and 1) in namespace A and a render
+#             host (rank 2) in namespace R, each with its own host name (UTS namespace), joined by a
+#             veth pair on 10.77.1.0/24 that Open MPI's TCP transport must use; mpirun reads a host
+#             file and starts the remote daemon with an rsh agent that enters R -- a stand-in for
+#             the ssh of docs/services.md (the rest is the real Open MPI launch and TCP exchange,
+#             with the Open MPI settings of systemd/mogao-farm.service); the kiosk in namespace B
+#             reaches A over IPv6. Also checks that a farm rank ran in R.
 # Checks: 100 frames delivered and shown, request ids strictly increasing, no frame rejected; each
 # dumped content frame within 35 dB PSNR of the farm's lossless render of the same pose (and a
 # different pose's render below it); the projector PNGs and the composited screen readable and
 # not black. Latency, fps and bandwidth go to the test log.
 #
-# usage: e2e_netns.sh netns|loopback FARM KIOSK IMAGE_TOOL MPIEXEC SOURCE_DIR WORK_DIR
+# usage: e2e_netns.sh netns|loopback|multihost FARM KIOSK IMAGE_TOOL MPIEXEC SOURCE_DIR WORK_DIR
 mode=$1 farm=$2 kiosk=$3 tool=$4 MPIEXEC=$5 src=$6 work=$7
 source "$src/tests/kiosk/kiosk_e2e_common.sh"
 
@@ -17,7 +24,7 @@ rm -rf "$work"
 mkdir -p "$work"
 farm_prefix=()
 kiosk_prefix=()
-if [[ "$mode" == netns ]]; then
+if [[ "$mode" == netns || "$mode" == multihost ]]; then
   ns_farm="mogao-farm-$$"
   ns_kiosk="mogao-kiosk-$$"
   if ! ip netns add "$ns_farm" 2>"$work/netns.err"; then
@@ -50,6 +57,35 @@ if [[ "$mode" == netns ]]; then
   port=7443
   farm_prefix=(ip netns exec "$ns_farm")
   kiosk_prefix=(ip netns exec "$ns_kiosk")
+  if [[ "$mode" == multihost ]]; then
+    ns_render="mogao-render-$$"
+    ip netns add "$ns_render" || fail "ip netns add $ns_render"
+    netns_created+=("$ns_render")
+    ip link add "mga$$" netns "$ns_farm" type veth peer name "mgr$$" netns "$ns_render" || fail "veth pair to the render host"
+    ip -n "$ns_render" link set lo up
+    ip -n "$ns_farm" addr add 10.77.1.1/24 dev "mga$$" || fail "address in $ns_farm"
+    ip -n "$ns_render" addr add 10.77.1.2/24 dev "mgr$$" || fail "address in $ns_render"
+    ip -n "$ns_farm" link set "mga$$" up
+    ip -n "$ns_render" link set "mgr$$" up
+    # The rsh agent: "agent HOST COMMAND" runs COMMAND on HOST, here by entering its namespace
+    # with its own host name (Open MPI passes the remote command as arguments, like to ssh).
+    cat > "$work/rsh-agent" <<AGENT
+#!/bin/sh
+host=\$1; shift
+case \$host in
+  10.77.1.1) exec ip netns exec $ns_farm unshare --uts sh -c "hostname farm-admin; \$*" ;;
+  10.77.1.2) exec ip netns exec $ns_render unshare --uts sh -c "hostname farm-render2; \$*" ;;
+  *) echo "rsh-agent: unknown host \$host" >&2; exit 1 ;;
+esac
+AGENT
+    chmod +x "$work/rsh-agent"
+    printf '10.77.1.1 slots=2\n10.77.1.2 slots=1\n' > "$work/farm-hosts"
+    # The Open MPI settings of systemd/mogao-farm.service, and the farm network only.
+    export OMPI_MCA_pml=ob1 OMPI_MCA_osc=^ucx OMPI_MCA_memory=^patcher
+    FARM_MPI_ARGS=(--hostfile "$work/farm-hosts" --mca plm_rsh_agent "$work/rsh-agent"
+                   --mca btl self,vader,tcp --mca btl_tcp_if_include 10.77.1.0/24 --mca oob_tcp_if_include 10.77.1.0/24)
+    farm_prefix=(ip netns exec "$ns_farm" unshare --uts sh -c 'hostname farm-admin; exec "$@"' farm-admin)
+  fi
 elif [[ "$mode" == loopback ]]; then
   farm_addr="::1"
   port=$((20000 + $$ % 20000))
@@ -62,6 +98,12 @@ log "farm at $endpoint ($mode)"
 make_pki "$work/pki" "$farm_addr"
 write_config "$work/kiosk.toml" "$endpoint" "$work/pki" "$work/png" 10
 start_farm "$work/farm.log" "$endpoint" "${farm_prefix[@]}"
+if [[ "$mode" == multihost ]]; then
+  grep -q "(2 render ranks" "$work/farm.log" || { cat "$work/farm.log"; fail "the farm does not serve with 2 render ranks"; }
+  remote=$(for pid in $(ip netns pids "$ns_render"); do cat "/proc/$pid/comm" 2>/dev/null; done | grep -c '^mogao-farm$')
+  (( remote == 1 )) || fail "$remote mogao-farm processes on the render host (namespace $ns_render), expected 1 (rank 2)"
+  log "rank 2 runs on the render host (namespace $ns_render); ranks 0-1 on the admin"
+fi
 
 "${kiosk_prefix[@]}" timeout 300 "$kiosk" --config "$work/kiosk.toml" --frames 100 --duration 240 \
   --dump-content "$work/content" --dump-every 25 --stats "$work/stats.json" >"$work/kiosk.log" 2>&1

@@ -114,9 +114,10 @@ TOML
 
 # start_farm LOG LISTEN [PREFIX...]: 3 MPI ranks serving the test room; returns once the farm logs
 # that it serves (or fails).
+FARM_MPI_ARGS=()        # more mpirun arguments (e2e_netns.sh multihost: host file, rsh agent)
 start_farm() {
   local logf=$1 listen=$2; shift 2
-  setsid "$@" "$MPIEXEC" --oversubscribe -n 3 "$farm" serve --scene "$src/scenes/test-room.json" \
+  setsid "$@" "$MPIEXEC" --oversubscribe "${FARM_MPI_ARGS[@]}" -n 3 "$farm" serve --scene "$src/scenes/test-room.json" \
     --listen "$listen" --tls-dir "$work/pki" --duration 300 >>"$logf" 2>&1 &
   farm_sid=$!
   disown "$farm_sid"  # stopped by session id in stop_farm; no job-control report when killed
