@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "renderfarm/encode/image_compare.h"
-#include "renderfarm/farm/camera_path.h"
+#include "common/image_compare.h"
+#include "common/camera_path.h"
 #include "renderfarm/scene/scene_file.h"
 #include "renderfarm/trace/film.h"
 #include "renderfarm/trace/render_timing.h"

@@ -10,7 +10,7 @@
 //
 // Projectors are added with renderer().add_projector(calibration); which projector an output
 // shows is the caller's choice (normally the calibration whose output size equals the output's).
-// Errors follow drivers/result.h: EINVAL for a bad output index, EBUSY when an output is not
+// Errors follow common/result.h: EINVAL for a bad output index, EBUSY when an output is not
 // ready (its previous frame is still waiting for a flip), EIO/EACCES/... from the kernel or EGL.
 #pragma once
 
@@ -19,8 +19,8 @@
 #include <vector>
 
 #include "drivers/egl/warp_blend_renderer.h"
-#include "drivers/result.h"
-#include "renderfarm/view/pixel_rect.h"
+#include "common/result.h"
+#include "common/pixel_rect.h"
 
 namespace mogao {
 

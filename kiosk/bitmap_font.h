@@ -1,14 +1,14 @@
 // A 5x7 pixel bitmap font for the kiosk's own screens (the "connecting" card): upper-case A-Z
 // (lower case is drawn upper case), digits, space and . : - / [ ] _ = ; any other character is drawn
 // as '?'. Each glyph cell is 6x8 font pixels (one column and one row of spacing), scaled by an
-// integer factor. Pixels: (0, 0) top-left of the image, rows top first (renderfarm/view/image.h).
+// integer factor. Pixels: (0, 0) top-left of the image, rows top first (common/image.h).
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <string_view>
 
-#include "renderfarm/view/image.h"
+#include "common/image.h"
 
 namespace mogao {
 

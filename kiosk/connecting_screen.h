@@ -13,7 +13,7 @@
 
 #include <string_view>
 
-#include "renderfarm/view/image.h"
+#include "common/image.h"
 
 namespace mogao {
 

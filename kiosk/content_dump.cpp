@@ -6,8 +6,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "renderfarm/encode/file_io.h"
-#include "renderfarm/encode/png_io.h"
+#include "common/file_io.h"
+#include "common/png_io.h"
 
 namespace mogao {
 

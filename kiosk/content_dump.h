@@ -9,7 +9,7 @@
 
 #include <filesystem>
 
-#include "kiosk/last_good_frame.h"
+#include "appliance/decode/last_good_frame.h"
 
 namespace mogao {
 

@@ -2,7 +2,7 @@
 // callback (a gRPC thread) calls signal() after it stored a frame in the LatestFrameSlot; the event
 // loop polls fd() for POLLIN and calls drain(). Opened EFD_CLOEXEC | EFD_NONBLOCK.
 //
-// Errors (drivers/result.h): create() returns the errno of eventfd(2) (EMFILE, ENFILE, ENOMEM);
+// Errors (common/result.h): create() returns the errno of eventfd(2) (EMFILE, ENFILE, ENOMEM);
 // signal() and drain() return EIO-style errno errors that only a closed or broken fd produces.
 // signal() and drain() are safe to call from any thread at the same time (eventfd reads and writes
 // are atomic in the kernel).
@@ -10,8 +10,8 @@
 
 #include <cstdint>
 
-#include "drivers/result.h"
-#include "drivers/unique_fd.h"
+#include "common/result.h"
+#include "common/unique_fd.h"
 
 namespace mogao {
 

@@ -12,7 +12,7 @@
 #include <functional>
 #include <vector>
 
-#include "drivers/result.h"
+#include "common/result.h"
 
 namespace mogao {
 

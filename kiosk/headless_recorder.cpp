@@ -7,7 +7,7 @@
 #include <fmt/format.h>
 
 #include "appliance/warp/composite.h"
-#include "renderfarm/encode/png_io.h"
+#include "common/png_io.h"
 
 namespace mogao {
 namespace {

@@ -2,7 +2,7 @@
 //
 // * Every k-th display round (a round = one show or repaint that presented the outputs), each
 //   output's pixels as <dir>/<output>-<round, 6 digits>-req<request id>.png (request id 0 = the
-//   kiosk's connecting screen), written atomically (renderfarm/encode/png_io.h).
+//   kiosk's connecting screen), written atomically (common/png_io.h).
 // * At exit, <dir>/screen-composite.png: the light on the cylindrical screen computed by the CPU
 //   reference composite_on_screen (appliance/warp/composite.h) from the last frame of every
 //   output, encoded back to sRGB. It is content-sized and should look like the content frame:
@@ -17,8 +17,8 @@
 #include <optional>
 #include <vector>
 
-#include "appliance/warp/projector_calibration.h"
-#include "drivers/headless_output.h"
+#include "common/projector_calibration.h"
+#include "drivers/headless/headless_output.h"
 
 namespace mogao {
 

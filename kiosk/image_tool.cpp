@@ -10,8 +10,8 @@
 #include <filesystem>
 #include <string>
 
-#include "renderfarm/encode/image_compare.h"
-#include "renderfarm/encode/png_io.h"
+#include "common/image_compare.h"
+#include "common/png_io.h"
 
 namespace {
 

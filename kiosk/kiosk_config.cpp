@@ -12,6 +12,7 @@
 #include <toml.hpp>
 
 #include "appliance/tracker/tag_family.h"
+#include "common/request_limits.h"
 #include "renderfarm/link/endpoint.h"
 
 namespace mogao {
@@ -20,7 +21,7 @@ namespace {
 using Value = toml::value;
 namespace fs = std::filesystem;
 
-constexpr int kMaxSide = 16384;
+constexpr int kMaxSide = request_limits::kImageSide.max;
 
 std::string type_name(const Value& v) {
     switch (v.type()) {
@@ -109,6 +110,10 @@ public:
         const std::int64_t n = v->as_integer();
         if (n < lo || n > hi) fail(v, key, fmt::format(" = {} is outside [{}, {}]", n, lo, hi));
         return static_cast<int>(n);
+    }
+
+    [[nodiscard]] int integer(std::string_view key, int fallback, IntRange range) const {
+        return integer(key, fallback, range.min, range.max);
     }
 
     // A number (integer or float) that `ok` accepts; `range` describes the limit in messages.
@@ -257,12 +262,12 @@ void read_calibration(const Section& s, CalibrationConfig& c) {
 }
 
 void read_quality(const Section& s, QualityConfig& q) {
-    q.content = s.size("content", q.content, 16);
-    q.spp = s.integer("spp", q.spp, 1, 4096);
-    q.jpeg_quality = s.integer("jpeg_quality", q.jpeg_quality, 1, 100);
-    q.max_bounces = s.integer("bounces", q.max_bounces, 0, 64);
-    q.ao_samples = s.integer("ao_samples", q.ao_samples, 0, 1024);
-    q.area_light_samples = s.integer("area_light_samples", q.area_light_samples, 1, 1024);
+    q.content = s.size("content", q.content, request_limits::kLinkImageSide.min);
+    q.spp = s.integer("spp", q.spp, request_limits::kSpp);
+    q.jpeg_quality = s.integer("jpeg_quality", q.jpeg_quality, request_limits::kJpegQuality);
+    q.max_bounces = s.integer("bounces", q.max_bounces, request_limits::kMaxBounces);
+    q.ao_samples = s.integer("ao_samples", q.ao_samples, request_limits::kAoSamples);
+    q.area_light_samples = s.integer("area_light_samples", q.area_light_samples, request_limits::kAreaLightSamples);
 }
 
 void read_screen(const Section& s, CylinderScreen& screen) {

@@ -28,10 +28,10 @@
 
 #include "appliance/navigation/navigator.h"
 #include "appliance/tracker/camera_intrinsics.h"
-#include "appliance/tracker/camera_source.h"
+#include "drivers/camera/camera_source.h"
 #include "appliance/tracker/detector_settings.h"
-#include "renderfarm/view/pixel_rect.h"
-#include "renderfarm/view/view_request.h"
+#include "common/pixel_rect.h"
+#include "common/view_request.h"
 
 namespace mogao {
 
@@ -70,7 +70,7 @@ struct CalibrationConfig {
     double gamma = 2.2;                     // ideal: projector response gamma, (0, 10]
 };
 
-// [quality]: the render the kiosk requests (renderfarm/view/view_request.h).
+// [quality]: the render the kiosk requests (common/view_request.h).
 struct QualityConfig {
     ImageSize content{1920, 1080};          // content frame, [16, 16384] per side
     int spp = 1;                            // [1, 4096]
@@ -102,7 +102,7 @@ struct TrackingConfig {
     ReplayEnd replay_end = ReplayEnd::stop;  // replay only
 };
 
-// [navigation]: how the visitor moves -- the scripted visitor (renderfarm/farm/camera_path.h) or
+// [navigation]: how the visitor moves -- the scripted visitor (common/camera_path.h) or
 // the tracked tag. The appliance has no scene, so the scene's viewer start and eye height are given
 // here; they are the start pose of both.
 struct NavigationConfig {

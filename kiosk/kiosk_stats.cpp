@@ -5,7 +5,7 @@
 
 #include <fmt/format.h>
 
-#include "renderfarm/encode/file_io.h"
+#include "common/file_io.h"
 
 namespace mogao {
 namespace {

@@ -1,7 +1,7 @@
 // KioskStats: what the kiosk measures per displayed frame, its periodic stderr summary and the
 // statistics JSON written at exit.
 //
-// Per frame (times are CLOCK_REALTIME nanoseconds of the appliance, renderfarm/link/link_types.h):
+// Per frame (times are CLOCK_REALTIME nanoseconds of the appliance, common/link_types.h):
 //   motion-to-photon = presented_ns - request_ns: the view request was stamped (pose sampled) ->
 //                      every output presented the frame (headless: present() returned; KMS: its
 //                      page flip completed, i.e. the frame is being scanned out)
@@ -74,7 +74,7 @@ public:
     // Everything: summaries, counters, events, per-frame list. `extra` is merged at the top level.
     [[nodiscard]] nlohmann::json to_json(const nlohmann::json& extra = nlohmann::json::object()) const;
 
-    // Writes to_json(extra) atomically (renderfarm/encode/file_io.h). Throws std::system_error
+    // Writes to_json(extra) atomically (common/file_io.h). Throws std::system_error
     // naming the path.
     void write_json(const std::filesystem::path& path, const nlohmann::json& extra = nlohmann::json::object()) const;
 

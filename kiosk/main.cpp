@@ -32,8 +32,8 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include "appliance/warp/projector_calibration.h"
-#include "drivers/headless_output.h"
+#include "common/projector_calibration.h"
+#include "drivers/headless/headless_output.h"
 #include "drivers/kms/kms_backend.h"
 #include "kiosk/connecting_screen.h"
 #include "kiosk/content_dump.h"
@@ -43,8 +43,8 @@
 #include "kiosk/kiosk_config.h"
 #include "kiosk/kiosk_log.h"
 #include "kiosk/kiosk_stats.h"
-#include "kiosk/last_good_frame.h"
-#include "kiosk/latest_frame_slot.h"
+#include "appliance/decode/last_good_frame.h"
+#include "appliance/decode/latest_frame_slot.h"
 #include "kiosk/screen_calibration_source.h"
 #include "kiosk/pose_log.h"
 #include "kiosk/screen_presenter.h"
@@ -53,7 +53,7 @@
 #include "kiosk/timer_fd.h"
 #include "kiosk/tracking_thread.h"
 #include "kiosk/view_script.h"
-#include "renderfarm/farm/service_notify.h"
+#include "common/service_notify.h"
 #include "renderfarm/link/link_client.h"
 #include "renderfarm/link/tls_material.h"
 

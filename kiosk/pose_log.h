@@ -14,7 +14,7 @@
 #include <optional>
 
 #include "appliance/navigation/navigator.h"
-#include "renderfarm/view/view_request.h"
+#include "common/view_request.h"
 
 namespace mogao {
 

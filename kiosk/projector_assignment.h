@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "appliance/warp/projector_calibration.h"
+#include "common/projector_calibration.h"
 #include "drivers/output.h"
 
 namespace mogao {

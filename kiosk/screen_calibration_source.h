@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "appliance/warp/projector_calibration.h"
+#include "common/projector_calibration.h"
 #include "kiosk/kiosk_config.h"
 
 namespace mogao {

@@ -11,7 +11,7 @@
 // Tags must increase from show() to show() (the kiosk uses 0 for its own screens and the request
 // id for farm frames).
 //
-// Threading: the backend's thread (its GL context). Errors: drivers/result.h codes from the
+// Threading: the backend's thread (its GL context). Errors: common/result.h codes from the
 // backend/renderer (EINVAL, EIO, ...); a failed output is left dirty and retried on the next
 // show/repaint/on_ready.
 #pragma once
@@ -22,10 +22,10 @@
 #include <string>
 #include <vector>
 
-#include "appliance/warp/projector_calibration.h"
+#include "common/projector_calibration.h"
 #include "drivers/output.h"
-#include "drivers/result.h"
-#include "renderfarm/view/image.h"
+#include "common/result.h"
+#include "common/image.h"
 
 namespace mogao {
 

@@ -6,10 +6,10 @@
 
 #include "appliance/warp/ideal_calibration.h"
 #include "drivers/egl/egl_test_support.h"
-#include "drivers/headless_output.h"
+#include "drivers/headless/headless_output.h"
 #include "kiosk/connecting_screen.h"
-#include "kiosk/last_good_frame.h"
-#include "renderfarm/encode/jpeg_codec.h"
+#include "appliance/decode/last_good_frame.h"
+#include "common/jpeg_codec.h"
 
 namespace mogao {
 namespace {

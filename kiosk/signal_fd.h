@@ -9,7 +9,7 @@
 // previous mask of the destroying thread after consuming the set's pending signals (so a SIGTERM
 // that arrived during shutdown does not kill the process on the way out).
 //
-// Errors (drivers/result.h): create() EINVAL for an empty set or an invalid signal number, or the
+// Errors (common/result.h): create() EINVAL for an empty set or an invalid signal number, or the
 // errno of pthread_sigmask/signalfd; read() an errno error for a broken fd.
 #pragma once
 
@@ -17,8 +17,8 @@
 #include <initializer_list>
 #include <optional>
 
-#include "drivers/result.h"
-#include "drivers/unique_fd.h"
+#include "common/result.h"
+#include "common/unique_fd.h"
 
 namespace mogao {
 

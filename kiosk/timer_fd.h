@@ -3,15 +3,15 @@
 // TFD_CLOEXEC | TFD_NONBLOCK. CLOCK_MONOTONIC: a wall-clock step (NTP on boot) never bunches or
 // skips ticks.
 //
-// Errors (drivers/result.h): create() returns the errno of timerfd_create(2); arm() EINVAL for a
+// Errors (common/result.h): create() returns the errno of timerfd_create(2); arm() EINVAL for a
 // period outside [1 ms, 1 h]; drain() an errno error only for a broken fd.
 #pragma once
 
 #include <chrono>
 #include <cstdint>
 
-#include "drivers/result.h"
-#include "drivers/unique_fd.h"
+#include "common/result.h"
+#include "common/unique_fd.h"
 
 namespace mogao {
 

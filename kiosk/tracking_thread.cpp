@@ -6,8 +6,8 @@
 
 #include <spdlog/spdlog.h>
 
-#include "appliance/tracker/camera_source.h"
-#include "appliance/tracker/tag_sample_of.h"
+#include "drivers/camera/camera_source.h"
+#include "appliance/navigation/tag_sample_of.h"
 
 namespace mogao {
 namespace {

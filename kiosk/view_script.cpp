@@ -2,7 +2,7 @@
 
 #include <stdexcept>
 
-#include "renderfarm/farm/camera_path.h"
+#include "common/camera_path.h"
 
 namespace mogao {
 

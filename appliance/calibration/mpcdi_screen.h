@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "appliance/calibration/mpcdi_types.h"
-#include "appliance/warp/projector_calibration.h"
+#include "common/projector_calibration.h"
 #include "appliance/warp/response_curve.h"
 
 namespace mogao {

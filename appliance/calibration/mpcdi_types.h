@@ -21,7 +21,7 @@
 #include <string_view>
 #include <vector>
 
-#include "renderfarm/view/pixel_rect.h"
+#include "common/pixel_rect.h"
 
 namespace mogao {
 

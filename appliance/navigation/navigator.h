@@ -33,7 +33,7 @@
 #include "appliance/navigation/one_euro_filter.h"
 #include "appliance/navigation/rate_mapping.h"
 #include "appliance/navigation/tag_control.h"
-#include "renderfarm/view/view_request.h"
+#include "common/view_request.h"
 
 namespace mogao {
 

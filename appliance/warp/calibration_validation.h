@@ -7,7 +7,7 @@
 
 #include <string_view>
 
-#include "appliance/warp/projector_calibration.h"
+#include "common/projector_calibration.h"
 
 namespace mogao {
 

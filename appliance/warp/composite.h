@@ -3,7 +3,7 @@
 // itself against composite_on_screen (a calibration is right when the composite equals the
 // content).
 //
-// Colour: images are RgbFloatImage (renderfarm/view/image.h). Content and screen light are linear,
+// Colour: images are RgbFloatImage (common/image.h). Content and screen light are linear,
 // display-referred in [0, 1] (1 = the projector's full white); projector outputs hold the
 // projector's input signal in [0, 1] (after the response curve).
 // Pixel centres: content pixel (i, j) is at normalised ((i + 0.5) / W, (j + 0.5) / H); output pixel
@@ -18,8 +18,8 @@
 #include <array>
 #include <vector>
 
-#include "appliance/warp/projector_calibration.h"
-#include "renderfarm/view/image.h"
+#include "common/projector_calibration.h"
+#include "common/image.h"
 
 namespace mogao {
 

@@ -2,8 +2,8 @@
 // the seam measure across a content column. Used by the tests and by the calibration CLI's report.
 #pragma once
 
-#include "renderfarm/view/image.h"
-#include "renderfarm/view/pixel_rect.h"
+#include "common/image.h"
+#include "common/pixel_rect.h"
 
 namespace mogao {
 

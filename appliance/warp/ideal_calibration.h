@@ -2,7 +2,7 @@
 // covering one vertical band of the content frame with a chosen overlap to its neighbours.
 //
 // Assumption (why the warp is linear): the content frame is already the cylinder's unrolled
-// surface (CylinderScreen in renderfarm/view/view_request.h maps content column u linearly to the
+// surface (CylinderScreen in common/view_request.h maps content column u linearly to the
 // angle on the arc and row v linearly to the height). A projector whose optical axis meets the
 // cylinder axis and whose image is a rectangle on the unrolled surface therefore needs a linear
 // map from its pixels to content (u, v); a real projector on a curved screen needs the curved map
@@ -25,7 +25,7 @@
 
 #include <vector>
 
-#include "appliance/warp/projector_calibration.h"
+#include "common/projector_calibration.h"
 #include "appliance/warp/response_curve.h"
 
 namespace mogao {

@@ -19,7 +19,7 @@
 
 #include <vector>
 
-#include "appliance/warp/projector_calibration.h"
+#include "common/projector_calibration.h"
 
 namespace mogao {
 

@@ -13,7 +13,7 @@
 #include <string_view>
 #include <vector>
 
-#include "appliance/warp/projector_calibration.h"
+#include "common/projector_calibration.h"
 
 namespace mogao {
 

@@ -9,7 +9,7 @@
 // MPCDI level-1 grid of a tenth of the resolution).
 #pragma once
 
-#include "appliance/warp/projector_calibration.h"
+#include "common/projector_calibration.h"
 
 namespace mogao {
 

@@ -1,7 +1,7 @@
 // The one interface the tracker reads frames from: a V4L2 camera (v4l2_capture.h) or a folder of
 // images (replay_source.h), and libcamera where built with it (libcamera_capture.h, MOGAO_LIBCAMERA).
 //
-// Errors follow drivers/result.h: next_frame() never throws. Codes a caller can branch on:
+// Errors follow common/result.h: next_frame() never throws. Codes a caller can branch on:
 //   ENODATA    a finite source (replay without loop) has no more frames
 //   ETIMEDOUT  no frame arrived within the source's timeout (camera unplugged, stalled stream)
 //   EBADMSG    one frame could not be decoded (corrupt MJPEG, unreadable image); the next may work
@@ -14,7 +14,7 @@
 #include <string>
 
 #include "drivers/camera/camera_frame.h"
-#include "drivers/result.h"
+#include "common/result.h"
 
 namespace mogao {
 

@@ -16,7 +16,7 @@
 
 #include "drivers/camera/mjpeg_decoder.h"
 #include "drivers/camera/pixel_format.h"
-#include "drivers/unique_fd.h"
+#include "common/unique_fd.h"
 
 namespace mogao {
 namespace {

@@ -11,7 +11,7 @@
 // already there, decode.
 //
 // Pixels: row-major, top row first, as GrayImage (camera_frame.h).
-// Errors (drivers/result.h), each naming the file: errno of open/read; EFBIG if the file is larger
+// Errors (common/result.h), each naming the file: errno of open/read; EFBIG if the file is larger
 // than kMaxImageFileBytes; EBADMSG for an unknown format or corrupt/truncated data; EINVAL if a
 // side exceeds kMaxCaptureDimension.
 #pragma once
@@ -20,7 +20,7 @@
 #include <filesystem>
 
 #include "drivers/camera/camera_frame.h"
-#include "drivers/result.h"
+#include "common/result.h"
 
 namespace mogao {
 

@@ -26,7 +26,7 @@
 // One at a time: libcamera 0.0.x aborts the process (Fatal log) if a second CameraManager is
 // created, so a second open() while one LibcameraCapture lives returns EBUSY.
 //
-// Errors (drivers/result.h), naming the camera and the call: ENODEV (no camera, unknown id,
+// Errors (common/result.h), naming the camera and the call: ENODEV (no camera, unknown id,
 // camera disconnected), EBUSY (acquire refused, or another LibcameraCapture open), ENOTSUP (none of
 // the wanted formats; the message lists the camera's; or built without libcamera), EINVAL (config
 // field and limit, or a configuration the pipeline rejects), ETIMEDOUT / EBADMSG from next_frame();
@@ -40,7 +40,7 @@
 #include <vector>
 
 #include "drivers/camera/frame_source.h"
-#include "renderfarm/view/pixel_rect.h"
+#include "common/pixel_rect.h"
 
 namespace mogao {
 

@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <span>
 
-#include "drivers/result.h"
+#include "common/result.h"
 
 namespace mogao {
 

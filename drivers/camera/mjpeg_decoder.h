@@ -5,7 +5,7 @@
 // omit the Huffman tables (DHT) in their frames; libjpeg-turbo then uses the standard tables of
 // ITU-T T.81 Annex K, which is what those cameras encode with.
 //
-// Errors (drivers/result.h): EBADMSG for empty, truncated or corrupt data (TurboJPEG's message),
+// Errors (common/result.h): EBADMSG for empty, truncated or corrupt data (TurboJPEG's message),
 // for a libjpeg warning (a frame with corrupt data decodes partly grey; the tracker must not see
 // it), and for a size other than the one negotiated with the driver; ENOMEM if no handle.
 #pragma once
@@ -14,7 +14,7 @@
 #include <span>
 
 #include "drivers/camera/camera_frame.h"
-#include "drivers/result.h"
+#include "common/result.h"
 
 namespace mogao {
 

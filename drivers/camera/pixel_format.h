@@ -6,7 +6,7 @@
 //         the grey image is the Y' bytes as they are (limited-range Y' 16..235 is not expanded:
 //         AprilTag thresholds locally, so a range scale changes nothing it measures)
 //   MJPEG see mjpeg_decoder.h
-// Errors (drivers/result.h): EINVAL for a width/height outside [1, kMaxCaptureDimension], a
+// Errors (common/result.h): EINVAL for a width/height outside [1, kMaxCaptureDimension], a
 // stride below the row size, or a buffer shorter than the image it must hold; the message names
 // the format, the value and the limit.
 #pragma once
@@ -16,7 +16,7 @@
 #include <string>
 
 #include "drivers/camera/camera_frame.h"
-#include "drivers/result.h"
+#include "common/result.h"
 
 namespace mogao {
 

@@ -12,7 +12,7 @@
 // Playback is as fast as next_frame() is called; pacing to real time is the caller's business.
 // Images are decoded on demand, so a long sequence costs no memory up front.
 //
-// Errors (drivers/result.h): open() gives ENOENT for a missing folder or one without images,
+// Errors (common/result.h): open() gives ENOENT for a missing folder or one without images,
 // EINVAL for a bad config or timestamps.txt (naming the file, the line and the rule);
 // next_frame() gives EBADMSG naming the file that cannot be decoded, ENODATA after the last frame.
 #pragma once

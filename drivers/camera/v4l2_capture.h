@@ -17,7 +17,7 @@
 // is a MappedBuffer. The destructor stops streaming (VIDIOC_STREAMOFF), then the mappings are
 // unmapped and the fd closed, which frees the driver's buffers.
 //
-// Errors (drivers/result.h), each naming the device and the call: ENOENT/EACCES/EBUSY from open;
+// Errors (common/result.h), each naming the device and the call: ENOENT/EACCES/EBUSY from open;
 // ENOTTY "not a V4L2 device" (VIDIOC_QUERYCAP refused); ENODEV when it cannot capture or stream;
 // ENOTSUP when none of the wanted formats is offered (the message lists the device's formats);
 // EINVAL for a bad config (names the field and its limit); ETIMEDOUT / EBADMSG from next_frame().
@@ -31,8 +31,8 @@
 #include "drivers/camera/frame_source.h"
 #include "drivers/camera/mapped_buffer.h"
 #include "drivers/camera/mjpeg_decoder.h"
-#include "drivers/unique_fd.h"
-#include "renderfarm/view/pixel_rect.h"
+#include "common/unique_fd.h"
+#include "common/pixel_rect.h"
 
 namespace mogao {
 

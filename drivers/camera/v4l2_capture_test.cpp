@@ -15,7 +15,7 @@
 #include <optional>
 #include <thread>
 
-#include "drivers/unique_fd.h"
+#include "common/unique_fd.h"
 
 namespace mogao {
 namespace {

@@ -1,6 +1,6 @@
 // RAII for EGL objects: EglDisplay (eglInitialize/eglTerminate), EglContext (a GLES 3 context),
 // EglSurface (a window surface, e.g. on a gbm_surface for KMS). Errors are Status/Result
-// (drivers/result.h) with code ENODEV (no such platform/display), EINVAL (bad argument) or EIO
+// (common/result.h) with code ENODEV (no such platform/display), EINVAL (bad argument) or EIO
 // (EGL call failed; the message names the call and the EGL error, e.g. "EGL_BAD_MATCH").
 //
 // Lifetimes: an EglContext or EglSurface keeps the raw EGLDisplay handle of the EglDisplay it was
@@ -13,7 +13,7 @@
 #include <string>
 #include <string_view>
 
-#include "drivers/result.h"
+#include "common/result.h"
 
 namespace mogao {
 

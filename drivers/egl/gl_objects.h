@@ -10,8 +10,8 @@
 #include <vector>
 #include <utility>
 
-#include "drivers/result.h"
-#include "renderfarm/view/image.h"
+#include "common/result.h"
+#include "common/image.h"
 
 namespace mogao {
 

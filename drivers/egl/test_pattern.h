@@ -6,8 +6,8 @@
 #include <cstddef>
 #include <string>
 
-#include "appliance/warp/projector_calibration.h"
-#include "renderfarm/view/image.h"
+#include "common/projector_calibration.h"
+#include "common/image.h"
 
 namespace mogao {
 

@@ -33,10 +33,10 @@
 #include <cstddef>
 #include <vector>
 
-#include "appliance/warp/projector_calibration.h"
+#include "common/projector_calibration.h"
 #include "drivers/egl/gl_objects.h"
-#include "drivers/result.h"
-#include "renderfarm/view/image.h"
+#include "common/result.h"
+#include "common/image.h"
 
 namespace mogao {
 
@@ -45,7 +45,7 @@ public:
     // Compiles and links the program; EIO if no GLES 3 context is current or the shader fails.
     [[nodiscard]] static Result<WarpBlendRenderer> create();
 
-    // Uploads the content frame: sRGB-encoded RGB8, rows top first (renderfarm/view/image.h).
+    // Uploads the content frame: sRGB-encoded RGB8, rows top first (common/image.h).
     // Call once per frame before draw()/render(); the texture is reallocated only on a size change.
     [[nodiscard]] Status set_content(const Rgb8Image& frame);
 

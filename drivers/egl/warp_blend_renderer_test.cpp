@@ -17,7 +17,7 @@
 
 #include "drivers/egl/egl_test_support.h"
 #include "drivers/egl/test_pattern.h"
-#include "renderfarm/encode/png_io.h"
+#include "common/png_io.h"
 
 namespace mogao {
 namespace {

@@ -1,6 +1,6 @@
 // RAII for DRM/KMS kernel objects (libdrm): the device fd, the drmMode* structures libdrm
 // allocates (freed with their drmModeFree* function), property blobs and framebuffers.
-// Errors: Result/Status (drivers/result.h) with the kernel's errno (ENOENT, EACCES, EBUSY,
+// Errors: Result/Status (common/result.h) with the kernel's errno (ENOENT, EACCES, EBUSY,
 // EINVAL, ...) and a message naming the call and the object id.
 #pragma once
 
@@ -15,8 +15,8 @@
 #include <utility>
 #include <vector>
 
-#include "drivers/result.h"
-#include "drivers/unique_fd.h"
+#include "common/result.h"
+#include "common/unique_fd.h"
 
 namespace mogao {
 

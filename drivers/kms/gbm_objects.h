@@ -10,8 +10,8 @@
 #include <cstdint>
 #include <utility>
 
-#include "drivers/result.h"
-#include "renderfarm/view/pixel_rect.h"
+#include "common/result.h"
+#include "common/pixel_rect.h"
 
 namespace mogao {
 

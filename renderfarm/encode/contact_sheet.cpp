@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "renderfarm/encode/errors.h"
+#include "common/codec_errors.h"
 
 namespace mogao {
 namespace {

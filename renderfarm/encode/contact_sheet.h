@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <span>
 
-#include "renderfarm/view/image.h"
+#include "common/image.h"
 
 namespace mogao {
 

@@ -6,7 +6,7 @@
 #include <utility>
 #include <vector>
 
-#include "renderfarm/encode/test_images.h"
+#include "common/test_images.h"
 
 namespace mogao {
 namespace {

@@ -17,9 +17,9 @@
 #include <string>
 #include <vector>
 
-#include "renderfarm/encode/image_compare.h"
-#include "renderfarm/encode/jpeg_codec.h"
-#include "renderfarm/encode/png_io.h"
+#include "common/image_compare.h"
+#include "common/jpeg_codec.h"
+#include "common/png_io.h"
 
 namespace {
 

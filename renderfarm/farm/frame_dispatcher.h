@@ -22,8 +22,8 @@
 #include "renderfarm/schedule/cost_map.h"
 #include "renderfarm/schedule/load_balancer.h"
 #include "renderfarm/trace/renderer.h"
-#include "renderfarm/view/image.h"
-#include "renderfarm/view/view_request.h"
+#include "common/image.h"
+#include "common/view_request.h"
 
 namespace mogao {
 

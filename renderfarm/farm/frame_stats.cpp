@@ -6,7 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "renderfarm/encode/file_io.h"
+#include "common/file_io.h"
 #include "renderfarm/schedule/tile_cost_log.h"
 
 namespace mogao {

@@ -9,7 +9,7 @@
 
 #include "renderfarm/schedule/cost_map.h"
 #include "renderfarm/scene/scene_file.h"
-#include "renderfarm/view/pixel_rect.h"
+#include "common/pixel_rect.h"
 
 namespace mogao {
 

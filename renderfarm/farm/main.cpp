@@ -14,6 +14,7 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include "common/request_limits.h"
 #include "renderfarm/farm/farm.h"
 #include "renderfarm/farm/path_tour.h"
 #include "renderfarm/farm/serve.h"
@@ -22,6 +23,8 @@
 #include "renderfarm/farm/mpi_session.h"
 
 namespace {
+
+namespace L = mogao::request_limits;
 
 struct CameraFlags {
     std::string kind = "cylinder";
@@ -44,8 +47,8 @@ void add_render_flags(CLI::App& render, mogao::PathTour& job, CameraFlags& camer
     render.add_option("--frames", job.frames, "Number of frames of the camera path")->check(CLI::Range(1, 1000000));
     render.add_option("--path", job.path, "walk | orbit | a JSON path file");
     render.add_option("--out", job.out_dir, "Output folder for frame-NNNN.jpg, stats.json, tile-costs.json, contact-sheet.png")->required();
-    render.add_option("--width", job.view_template.size.width, "Frame width in pixels")->check(CLI::Range(16, 16384));
-    render.add_option("--height", job.view_template.size.height, "Frame height in pixels")->check(CLI::Range(16, 16384));
+    render.add_option("--width", job.view_template.size.width, "Frame width in pixels")->check(CLI::Range(16, L::kImageSide.max));
+    render.add_option("--height", job.view_template.size.height, "Frame height in pixels")->check(CLI::Range(16, L::kImageSide.max));
     render.add_option("--camera", camera.kind, "cylinder (the projection screen's content) | pinhole")
         ->check(CLI::IsMember({"cylinder", "pinhole"}));
     render.add_option("--fov", camera.fov_deg, "Pinhole vertical field of view, degrees")->check(CLI::Range(1.0, 179.0));
@@ -53,12 +56,12 @@ void add_render_flags(CLI::App& render, mogao::PathTour& job, CameraFlags& camer
     render.add_option("--screen-arc", camera.arc, "Cylinder screen arc, degrees")->check(CLI::Range(1.0, 360.0));
     render.add_option("--screen-bottom", camera.bottom, "Cylinder screen bottom edge, metres above the floor");
     render.add_option("--screen-top", camera.top, "Cylinder screen top edge, metres above the floor");
-    render.add_option("--spp", q.spp, "Samples per pixel")->check(CLI::Range(1, 4096));
-    render.add_option("--bounces", q.max_bounces, "Path-tracing bounces (0 = direct light only)")->check(CLI::Range(0, 64));
-    render.add_option("--ao", q.ao_samples, "Ambient-occlusion rays for the environment light (0 = unoccluded)")->check(CLI::Range(0, 1024));
-    render.add_option("--area-samples", q.area_light_samples, "Shadow rays per area light per sample")->check(CLI::Range(1, 1024));
+    render.add_option("--spp", q.spp, "Samples per pixel")->check(CLI::Range(L::kSpp.min, L::kSpp.max));
+    render.add_option("--bounces", q.max_bounces, "Path-tracing bounces (0 = direct light only)")->check(CLI::Range(L::kMaxBounces.min, L::kMaxBounces.max));
+    render.add_option("--ao", q.ao_samples, "Ambient-occlusion rays for the environment light (0 = unoccluded)")->check(CLI::Range(L::kAoSamples.min, L::kAoSamples.max));
+    render.add_option("--area-samples", q.area_light_samples, "Shadow rays per area light per sample")->check(CLI::Range(L::kAreaLightSamples.min, L::kAreaLightSamples.max));
     render.add_option("--scale", q.resolution_scale, "Resolution scale (0, 1]")->check(CLI::Range(0.01, 1.0));
-    render.add_option("--jpeg-quality", q.jpeg_quality, "TurboJPEG quality 1..100")->check(CLI::Range(1, 100));
+    render.add_option("--jpeg-quality", q.jpeg_quality, "TurboJPEG quality 1..100")->check(CLI::Range(L::kJpegQuality.min, L::kJpegQuality.max));
     render.add_option("--seed", job.view_template.seed, "Sampling seed (same seed, same pixels)");
     render.add_flag("--save-raw", job.save_raw, "Also write lossless frame-NNNN.ppm");
     render.add_option("--contact-sheet", job.contact_sheet_frames, "Frames on the contact sheet (0 = none)")->check(CLI::Range(0, 64));

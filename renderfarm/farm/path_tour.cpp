@@ -7,10 +7,10 @@
 #include <spdlog/spdlog.h>
 
 #include "renderfarm/encode/contact_sheet.h"
-#include "renderfarm/encode/file_io.h"
-#include "renderfarm/encode/jpeg_codec.h"
-#include "renderfarm/encode/png_io.h"
-#include "renderfarm/farm/camera_path.h"
+#include "common/file_io.h"
+#include "common/jpeg_codec.h"
+#include "common/png_io.h"
+#include "common/camera_path.h"
 
 namespace mogao {
 namespace {

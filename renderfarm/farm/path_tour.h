@@ -10,7 +10,7 @@
 #include "renderfarm/farm/frame_dispatcher.h"
 #include "renderfarm/farm/frame_stats.h"
 #include "renderfarm/scene/scene.h"
-#include "renderfarm/view/view_request.h"
+#include "common/view_request.h"
 
 namespace mogao {
 

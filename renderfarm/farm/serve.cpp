@@ -11,8 +11,8 @@
 
 #include <spdlog/spdlog.h>
 
-#include "renderfarm/encode/jpeg_codec.h"
-#include "renderfarm/farm/service_notify.h"
+#include "common/jpeg_codec.h"
+#include "common/service_notify.h"
 
 namespace mogao {
 namespace {

@@ -12,7 +12,7 @@
 #include "renderfarm/schedule/cost_map.h"
 #include "renderfarm/trace/film.h"
 #include "renderfarm/trace/renderer.h"
-#include "renderfarm/view/image.h"
+#include "common/image.h"
 
 namespace mogao {
 

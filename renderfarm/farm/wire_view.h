@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <type_traits>
 
-#include "renderfarm/view/view_request.h"
+#include "common/view_request.h"
 
 namespace mogao {
 

@@ -24,9 +24,9 @@
 #include <memory>
 #include <string>
 
-#include "renderfarm/link/link_types.h"
+#include "common/link_types.h"
 #include "renderfarm/link/tls_material.h"
-#include "renderfarm/view/view_request.h"
+#include "common/view_request.h"
 
 namespace mogao {
 

@@ -10,7 +10,7 @@
 #include "renderfarm/link/link_client.h"
 #include "renderfarm/link/link_server.h"
 #include "renderfarm/link/link_test_support.h"
-#include "drivers/unique_fd.h"
+#include "common/unique_fd.h"
 #include "renderfarm/link/wire_convert.h"
 
 namespace mogao {

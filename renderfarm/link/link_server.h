@@ -27,9 +27,9 @@
 #include <vector>
 
 #include "renderfarm/link/endpoint.h"
-#include "renderfarm/link/link_types.h"
+#include "common/link_types.h"
 #include "renderfarm/link/tls_material.h"
-#include "renderfarm/view/view_request.h"
+#include "common/view_request.h"
 
 namespace mogao {
 

@@ -8,8 +8,8 @@
 #include <stdexcept>
 #include <thread>
 
-#include "renderfarm/encode/jpeg_codec.h"
-#include "drivers/unique_fd.h"
+#include "common/jpeg_codec.h"
+#include "common/unique_fd.h"
 #include "renderfarm/link/wire_convert.h"
 
 namespace mogao::testing {

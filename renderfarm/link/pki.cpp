@@ -9,7 +9,7 @@
 #include <cstring>
 
 #include "renderfarm/link/openssl_util.h"
-#include "drivers/unique_fd.h"
+#include "common/unique_fd.h"
 
 namespace mogao {
 namespace {

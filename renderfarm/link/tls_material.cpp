@@ -8,9 +8,9 @@
 
 #include <openssl/err.h>
 
-#include "renderfarm/link/link_types.h"
+#include "common/link_types.h"
 #include "renderfarm/link/openssl_util.h"
-#include "drivers/unique_fd.h"
+#include "common/unique_fd.h"
 
 namespace mogao {
 

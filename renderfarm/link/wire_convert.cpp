@@ -9,6 +9,8 @@
 namespace mogao {
 namespace {
 
+namespace L = request_limits;
+
 namespace v1 = link::v1;
 
 std::string outside(std::string_view field, double value, std::string_view limit) {
@@ -83,14 +85,14 @@ std::string validate_link_request(const ViewRequest& r) {
     if (auto e = check_range("width", r.size.width, kMinLinkImageSide, kMaxLinkImageSide); !e.empty()) return e;
     if (auto e = check_range("height", r.size.height, kMinLinkImageSide, kMaxLinkImageSide); !e.empty()) return e;
     const Quality& q = r.quality;
-    if (auto e = check_range("quality.spp", q.spp, 1, 4096); !e.empty()) return e;
-    if (auto e = check_range("quality.max_bounces", q.max_bounces, 0, 64); !e.empty()) return e;
-    if (auto e = check_range("quality.ao_samples", q.ao_samples, 0, 1024); !e.empty()) return e;
-    if (auto e = check_range("quality.area_light_samples", q.area_light_samples, 1, 1024); !e.empty()) return e;
+    if (auto e = check_range("quality.spp", q.spp, L::kSpp.min, L::kSpp.max); !e.empty()) return e;
+    if (auto e = check_range("quality.max_bounces", q.max_bounces, L::kMaxBounces.min, L::kMaxBounces.max); !e.empty()) return e;
+    if (auto e = check_range("quality.ao_samples", q.ao_samples, L::kAoSamples.min, L::kAoSamples.max); !e.empty()) return e;
+    if (auto e = check_range("quality.area_light_samples", q.area_light_samples, L::kAreaLightSamples.min, L::kAreaLightSamples.max); !e.empty()) return e;
     if (!(q.resolution_scale > 0.0 && q.resolution_scale <= 1.0)) {
         return outside("quality.resolution_scale", q.resolution_scale, "(0, 1]");
     }
-    return check_range("quality.jpeg_quality", q.jpeg_quality, 1, 100);
+    return check_range("quality.jpeg_quality", q.jpeg_quality, L::kJpegQuality.min, L::kJpegQuality.max);
 }
 
 void pose_to_msg(const ViewerPose& pose, v1::PoseMsg& msg) {
@@ -142,11 +144,11 @@ std::string view_from_msg(const v1::ViewRequestMsg& msg, ViewRequest& out) {
     };
     const Field fields[] = {{"width", msg.width(), kMinLinkImageSide, kMaxLinkImageSide},
                             {"height", msg.height(), kMinLinkImageSide, kMaxLinkImageSide},
-                            {"quality.spp", q.spp(), 1, 4096},
-                            {"quality.max_bounces", q.max_bounces(), 0, 64},
-                            {"quality.ao_samples", q.ao_samples(), 0, 1024},
-                            {"quality.area_light_samples", q.area_light_samples(), 1, 1024},
-                            {"quality.jpeg_quality", q.jpeg_quality(), 1, 100}};
+                            {"quality.spp", q.spp(), L::kSpp.min, L::kSpp.max},
+                            {"quality.max_bounces", q.max_bounces(), L::kMaxBounces.min, L::kMaxBounces.max},
+                            {"quality.ao_samples", q.ao_samples(), L::kAoSamples.min, L::kAoSamples.max},
+                            {"quality.area_light_samples", q.area_light_samples(), L::kAreaLightSamples.min, L::kAreaLightSamples.max},
+                            {"quality.jpeg_quality", q.jpeg_quality(), L::kJpegQuality.min, L::kJpegQuality.max}};
     for (const auto& f : fields) {
         if (auto e = check_range(f.name, f.value, f.lo, f.hi); !e.empty()) return e;
     }

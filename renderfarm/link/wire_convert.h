@@ -5,23 +5,22 @@
 // session carries on. Error strings name the field, its value and the limit, e.g.
 // "quality.spp = 0 is outside [1, 4096]".
 //
-// Limits (inclusive unless noted; the farm's render limits, with a 16-pixel minimum side):
-// width/height 16..16384; quality.spp 1..4096, max_bounces 0..64, ao_samples 0..1024,
-// area_light_samples 1..1024, resolution_scale (0, 1], jpeg_quality 1..100; pose and camera
+// Limits: the table in common/request_limits.h (frame sides in kLinkImageSide); pose and camera
 // finite; pinhole vertical_fov_deg (0, 180); cylinder radius_m > 0, arc_deg (0, 360],
 // top_m > bottom_m. The request id is ViewRequest::frame_id and must be non-zero.
 #pragma once
 
 #include <string>
 
-#include "renderfarm/link/link_types.h"
+#include "common/link_types.h"
+#include "common/request_limits.h"
 #include "renderfarm/link/mogao_link.pb.h"
-#include "renderfarm/view/view_request.h"
+#include "common/view_request.h"
 
 namespace mogao {
 
-inline constexpr int kMinLinkImageSide = 16;
-inline constexpr int kMaxLinkImageSide = 16384;
+inline constexpr int kMinLinkImageSide = request_limits::kLinkImageSide.min;
+inline constexpr int kMaxLinkImageSide = request_limits::kLinkImageSide.max;
 
 // Checks the limits above; returns "" when the request is valid.
 [[nodiscard]] std::string validate_link_request(const ViewRequest& request);

@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "common/viewer.h"
 #include "renderfarm/scene/mesh.h"
 
 namespace mogao {
@@ -62,12 +63,6 @@ struct AreaLight {
 // Constant environment (sky) radiance arriving from every direction not blocked by the scene.
 struct EnvironmentLight {
     Rgb radiance{0.2f, 0.2f, 0.25f};
-};
-
-struct Viewer {
-    double eye_height_m = 1.6;
-    Eigen::Vector3d start{0.0, 0.0, 5.0};     // floor position of the viewer at start, world metres
-    double start_yaw_deg = 0.0;
 };
 
 struct Scene {

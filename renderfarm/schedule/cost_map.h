@@ -3,7 +3,7 @@
 // Shape: the image (ImageSize, pixels) is covered by a grid of cells_x() x cells_y() square cells of
 // cell_size() pixels; cell (cx, cy) covers the pixel rect
 //   [cx*cell_size, min((cx+1)*cell_size, width)) x [cy*cell_size, min((cy+1)*cell_size, height)),
-// so the last column and row of cells may be partial (pixel convention of renderfarm/view/pixel_rect.h).
+// so the last column and row of cells may be partial (pixel convention of common/pixel_rect.h).
 // Units: each cell holds the predicted time in seconds to render all of its pixels (>= 0, finite).
 //
 // Sum queries are O(1) through a summed-area table (Crow 1984, "Summed-area tables for texture
@@ -18,7 +18,7 @@
 #include <span>
 #include <vector>
 
-#include "renderfarm/view/pixel_rect.h"
+#include "common/pixel_rect.h"
 
 namespace mogao {
 

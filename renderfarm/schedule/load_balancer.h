@@ -3,7 +3,7 @@
 // A LoadBalancer turns a predicted CostMap into an Assignment of pixel rects to ranks 0..ranks-1.
 // Every balancer's assignment tiles the image exactly once: each pixel is in exactly one rect of
 // exactly one rank. Rects may be empty (a rank then renders nothing), and a rank may have no rects.
-// Pixel convention and rects: renderfarm/view/pixel_rect.h. Algorithms: docs/load-balancing.md.
+// Pixel convention and rects: common/pixel_rect.h. Algorithms: docs/load-balancing.md.
 #pragma once
 
 #include <memory>
@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "renderfarm/schedule/cost_map.h"
-#include "renderfarm/view/pixel_rect.h"
+#include "common/pixel_rect.h"
 
 namespace mogao {
 

@@ -38,7 +38,7 @@
 
 #include "renderfarm/schedule/cost_map.h"
 #include "renderfarm/schedule/load_balancer.h"
-#include "renderfarm/view/pixel_rect.h"
+#include "common/pixel_rect.h"
 
 namespace mogao {
 

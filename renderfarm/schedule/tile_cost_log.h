@@ -3,7 +3,7 @@
 // Format (docs/load-balancing.md):
 //   {"image": {"width": W, "height": H}, "cell_size": 16,
 //    "frames": [{"tiles": [[x0, y0, x1, y1, seconds], ...]}, ...]}
-// Tiles are half-open pixel rects [x0,x1) x [y0,y1) (renderfarm/view/pixel_rect.h) inside the image,
+// Tiles are half-open pixel rects [x0,x1) x [y0,y1) (common/pixel_rect.h) inside the image,
 // normally cell-aligned; seconds is the tile's measured render time (finite, >= 0). Frames are in
 // display order. Unknown keys are ignored so the farm may add fields.
 #pragma once

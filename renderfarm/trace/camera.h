@@ -19,8 +19,8 @@
 
 #include <Eigen/Core>
 
-#include "renderfarm/view/pixel_rect.h"
-#include "renderfarm/view/view_request.h"
+#include "common/pixel_rect.h"
+#include "common/view_request.h"
 
 namespace mogao {
 

@@ -11,8 +11,8 @@
 
 #include <cstdint>
 
-#include "renderfarm/view/image.h"
-#include "renderfarm/view/pixel_rect.h"
+#include "common/image.h"
+#include "common/pixel_rect.h"
 
 namespace mogao {
 

@@ -30,7 +30,7 @@
 #include "renderfarm/trace/render_scene.h"
 #include "renderfarm/trace/rng.h"
 #include "renderfarm/trace/shading.h"
-#include "renderfarm/view/view_request.h"
+#include "common/view_request.h"
 
 namespace mogao {
 

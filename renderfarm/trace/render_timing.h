@@ -9,7 +9,7 @@
 
 #include "renderfarm/scene/scene.h"
 #include "renderfarm/trace/renderer.h"
-#include "renderfarm/view/view_request.h"
+#include "common/view_request.h"
 
 namespace mogao {
 

@@ -16,7 +16,7 @@
 #include "renderfarm/trace/rng.h"
 #include "renderfarm/trace/sampling.h"
 #include "renderfarm/trace/shading.h"
-#include "renderfarm/trace/view_validation.h"
+#include "common/request_limits.h"
 
 namespace mogao {
 namespace {

@@ -23,9 +23,9 @@
 #include <string>
 
 #include "renderfarm/scene/scene.h"
-#include "renderfarm/view/image.h"
-#include "renderfarm/view/pixel_rect.h"
-#include "renderfarm/view/view_request.h"
+#include "common/image.h"
+#include "common/pixel_rect.h"
+#include "common/view_request.h"
 
 namespace mogao {
 

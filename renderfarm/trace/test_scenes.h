@@ -5,7 +5,7 @@
 
 #include "renderfarm/scene/mesh.h"
 #include "renderfarm/scene/scene.h"
-#include "renderfarm/view/view_request.h"
+#include "common/view_request.h"
 
 namespace mogao::test {
 

@@ -1,0 +1,147 @@
+// mogao-track: tag detection, camera calibration, synthetic sequences and tag-driven navigation
+// from the command line (docs/tracking.md). Exit codes: 0 success, 1 job failed, 2 bad command line.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+
+#include "appliance/tracker/tag_family.h"
+#include "appliance/tools/track_commands.h"
+
+namespace {
+
+using mogao::DetectorSettings;
+
+// The detector flags shared by `detect` and `navigate`.
+void add_detector_flags(CLI::App& cmd, DetectorSettings& s) {
+    cmd.add_option("--family", s.family, "tag family")
+        ->check(CLI::IsMember(mogao::TagFamily::known_names()))
+        ->capture_default_str();
+    cmd.add_option("--decimate", s.decimation, "quad decimation factor")
+        ->check(CLI::Range(1.0f, 8.0f))
+        ->capture_default_str();
+    cmd.add_option("--blur", s.blur_sigma, "Gaussian blur sigma before the quad search (px)")
+        ->check(CLI::Range(-5.0f, 5.0f))
+        ->capture_default_str();
+    cmd.add_flag("!--no-refine", s.refine_edges, "do not refine the quad edges");
+    cmd.add_option("--min-white-black-diff", s.min_white_black_diff, "threshold contrast floor")
+        ->check(CLI::Range(0, 255))
+        ->capture_default_str();
+    cmd.add_option("--threads", s.threads, "detector threads")->check(CLI::Range(1, 64))->capture_default_str();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"mogao-track: AprilTag tracking and tag-driven navigation"};
+    app.require_subcommand(1);
+
+    mogao::track::DetectOptions detect;
+    auto* d = app.add_subcommand("detect", "print every tag's id and corners in images (JPEG, PNG, PGM)");
+    d->add_option("IMAGE", detect.images, "images")->required();
+    d->add_flag("--json", detect.json, "one JSON array instead of text");
+    add_detector_flags(*d, detect.detector);
+
+    mogao::track::CalibrateOptions calib;
+    std::string board = "9x6";
+    auto* c = app.add_subcommand("calibrate-camera", "camera intrinsics from chessboard photos in a folder");
+    c->add_option("FOLDER", calib.folder, "folder of chessboard images")->required()->check(CLI::ExistingDirectory);
+    c->add_option("--board", board, "inner corners, COLUMNSxROWS")->capture_default_str();
+    c->add_option("--square-mm", calib.square_mm, "side of one square (mm)")
+        ->check(CLI::Range(0.1, 1000.0))
+        ->capture_default_str();
+    c->add_option("--out", calib.out, "calibration file to write (.json)")->capture_default_str();
+
+    mogao::track::SequenceOptions seq;
+    auto* s = app.add_subcommand("make-sequence", "render a hand-held tag sequence (PNGs + truth) for replay");
+    s->add_option("OUT", seq.out, "output folder")->required();
+    s->add_option("--seconds", seq.seconds, "length")->check(CLI::Range(0.01, 600.0))->capture_default_str();
+    s->add_option("--fps", seq.fps, "frames per second")->check(CLI::Range(0.1, 240.0))->capture_default_str();
+    s->add_option("--family", seq.family, "tag family")
+        ->check(CLI::IsMember(mogao::TagFamily::known_names()))
+        ->capture_default_str();
+    s->add_option("--id", seq.id, "tag id")->check(CLI::NonNegativeNumber)->capture_default_str();
+    s->add_option("--tag-size-mm", seq.tag_size_mm, "tag size (black border)")
+        ->check(CLI::Range(1.0, 1000.0))
+        ->capture_default_str();
+    s->add_option("--width", seq.width, "image width")->check(CLI::Range(16, 8192))->capture_default_str();
+    s->add_option("--height", seq.height, "image height")->check(CLI::Range(16, 8192))->capture_default_str();
+    s->add_option("--focal-px", seq.focal_px, "focal length (px)")
+        ->check(CLI::Range(10.0, 100000.0))
+        ->capture_default_str();
+    s->add_option("--noise", seq.noise, "sensor noise sigma (grey levels)")
+        ->check(CLI::Range(0.0, 50.0))
+        ->capture_default_str();
+    s->add_option("--seed", seq.seed, "noise seed")->capture_default_str();
+
+    mogao::track::TagImageOptions tag;
+    auto* t = app.add_subcommand("make-tag", "write a printable tag image (PNG), generated from the family's codes");
+    t->add_option("ID", tag.id, "tag id")->required()->check(CLI::NonNegativeNumber);
+    t->add_option("--family", tag.family, "tag family")
+        ->check(CLI::IsMember(mogao::TagFamily::known_names()))
+        ->capture_default_str();
+    t->add_option("--px-per-cell", tag.pixels_per_cell, "pixels per cell")
+        ->check(CLI::Range(1, 1000))
+        ->capture_default_str();
+    t->add_option("--margin-cells", tag.margin_cells, "extra white margin (cells)")
+        ->check(CLI::Range(0, 100))
+        ->capture_default_str();
+    t->add_option("--out", tag.out, "PNG to write")->required();
+
+    mogao::track::NavigateOptions nav;
+    auto* n = app.add_subcommand("navigate", "frames through tracker and navigation; print ViewerPoses (JSON lines)");
+    auto* replay =
+        n->add_option("REPLAY", nav.replay, "folder of frames (see make-sequence)")->check(CLI::ExistingDirectory);
+    auto* device = n->add_option("--device", nav.device, "V4L2 camera instead of a folder (runs until killed)");
+    replay->excludes(device);
+    n->add_option("--camera", nav.camera, "calibration file (default REPLAY/camera.json; required with --device)");
+    n->add_option("--tag-size-mm", nav.tag_size_mm, "tag size (black border)")
+        ->check(CLI::Range(1.0, 1000.0))
+        ->capture_default_str();
+    n->add_option("--id", nav.id, "tag id to follow (-1: the largest)")
+        ->check(CLI::Range(-1, 100000))
+        ->capture_default_str();
+    n->add_option("--display-hz", nav.display_hz, "rate of the output poses")
+        ->check(CLI::Range(1.0, 1000.0))
+        ->capture_default_str();
+    n->add_option("--fps", nav.fps, "replay rate without timestamps.txt")
+        ->check(CLI::Range(0.1, 1000.0))
+        ->capture_default_str();
+    n->add_option("--out", nav.out, "JSON lines file (default stdout)");
+    add_detector_flags(*n, nav.detector);
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        const int code = app.exit(e);
+        return code == 0 ? 0 : 2;
+    }
+    try {
+        if (*d) return mogao::track::detect(detect);
+        if (*c) {
+            const auto x = board.find('x');
+            try {
+                if (x == std::string::npos) throw std::invalid_argument("");
+                calib.inner_columns = std::stoi(board.substr(0, x));
+                calib.inner_rows = std::stoi(board.substr(x + 1));
+            } catch (const std::exception&) {
+                std::fprintf(stderr, "mogao-track: --board '%s' is not COLUMNSxROWS (e.g. 9x6)\n", board.c_str());
+                return 2;
+            }
+            return mogao::track::calibrate_camera(calib);
+        }
+        if (*s) return mogao::track::make_sequence(seq);
+        if (*t) return mogao::track::make_tag(tag);
+        if (*n) {
+            if (nav.replay.empty() == nav.device.empty() || (!nav.device.empty() && nav.camera.empty())) {
+                std::fprintf(stderr, "mogao-track navigate: give REPLAY, or --device with --camera\n");
+                return 2;
+            }
+            return mogao::track::navigate(nav);
+        }
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "mogao-track: %s\n", e.what());
+        return 1;
+    }
+    return 2;
+}

@@ -1,0 +1,50 @@
+// mogao-track make-sequence and make-tag: synthetic inputs for replay and a printable tag.
+#include <cstdio>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "appliance/tracker/hand_sequence.h"
+#include "appliance/tracker/tag_bitmap.h"
+#include "appliance/tools/track_commands.h"
+
+namespace mogao::track {
+
+int make_sequence(const SequenceOptions& o) {
+    HandSequenceSpec spec;
+    spec.seconds = o.seconds;
+    spec.frames_per_second = o.fps;
+    spec.family = o.family;
+    spec.tag_id = o.id;
+    spec.tag_size_m = o.tag_size_mm / 1000.0;
+    spec.camera = ideal_camera(o.width, o.height, o.focal_px);
+    spec.noise_sigma = o.noise;
+    spec.seed = o.seed;
+    write_hand_sequence(o.out, spec);
+    std::printf("wrote %zu frames, timestamps.txt, camera.json and truth.json to %s\n", hand_trajectory(spec).size(),
+                o.out.string().c_str());
+    return 0;
+}
+
+int make_tag(const TagImageOptions& o) {
+    const TagFamily family(o.family);
+    const TagBitmap bitmap = make_tag_bitmap(family, o.id);
+    const int cells = bitmap.cells + 2 * o.margin_cells;
+    cv::Mat image(cells * o.pixels_per_cell, cells * o.pixels_per_cell, CV_8UC1, cv::Scalar(255));
+    for (int y = 0; y < bitmap.cells; ++y) {
+        for (int x = 0; x < bitmap.cells; ++x) {
+            const cv::Rect cell((x + o.margin_cells) * o.pixels_per_cell, (y + o.margin_cells) * o.pixels_per_cell,
+                                o.pixels_per_cell, o.pixels_per_cell);
+            image(cell).setTo(bitmap.at(x, y));
+        }
+    }
+    if (!cv::imwrite(o.out.string(), image)) {
+        std::fprintf(stderr, "mogao-track make-tag: cannot write %s\n", o.out.string().c_str());
+        return 1;
+    }
+    std::printf("wrote %s: %s id %d; print it so that the black square is the tag size you pass to the tracker\n",
+                o.out.string().c_str(), o.family.c_str(), o.id);
+    return 0;
+}
+
+}  // namespace mogao::track
