@@ -91,22 +91,25 @@ std::vector<std::uint8_t> ZipReader::read(const std::string& name) const {
                          std::to_string(kMaxZipEntryBytes));
     }
     if (unzOpenCurrentFile(zip_) != UNZ_OK) throw MpcdiError(who + ": cannot open the entry's data");
-    std::vector<std::uint8_t> bytes(static_cast<std::size_t>(info.uncompressed_size));
-    std::size_t got = 0;
+    // The buffer grows with the data actually inflated, never to the size the header declares up
+    // front: a 100-byte file may declare a 1 GiB entry. One byte past the declared size is asked
+    // for, to notice data longer than its header claims.
+    const auto declared = static_cast<std::size_t>(info.uncompressed_size);
+    constexpr std::size_t kChunk = std::size_t{1} << 20;
+    std::vector<std::uint8_t> bytes;
     int rc = 1;
-    // Read one byte past the declared size to notice data longer than its header claims.
-    std::uint8_t extra = 0;
-    while (got < bytes.size()) {
-        const auto want = static_cast<unsigned>(std::min<std::size_t>(bytes.size() - got, 1U << 30));
-        rc = unzReadCurrentFile(zip_, bytes.data() + got, want);
+    while (bytes.size() <= declared) {
+        const std::size_t old = bytes.size();
+        const std::size_t want = std::min(kChunk, declared + 1 - old);
+        bytes.resize(old + want);
+        rc = unzReadCurrentFile(zip_, bytes.data() + old, static_cast<unsigned>(want));
+        bytes.resize(old + static_cast<std::size_t>(std::max(rc, 0)));
         if (rc <= 0) break;
-        got += static_cast<std::size_t>(rc);
     }
-    const int tail = (rc >= 0) ? unzReadCurrentFile(zip_, &extra, 1) : rc;
     const int close_rc = unzCloseCurrentFile(zip_);
-    if (rc < 0 || tail < 0) throw MpcdiError(who + ": corrupt compressed data (minizip error " + std::to_string(std::min(rc, tail)) + ")");
-    if (got != bytes.size() || tail > 0) {
-        throw MpcdiError(who + ": data length differs from the " + std::to_string(bytes.size()) +
+    if (rc < 0) throw MpcdiError(who + ": corrupt compressed data (minizip error " + std::to_string(rc) + ")");
+    if (bytes.size() != declared) {
+        throw MpcdiError(who + ": data length differs from the " + std::to_string(declared) +
                          " bytes its header declares");
     }
     if (close_rc == UNZ_CRCERROR) throw MpcdiError(who + ": CRC-32 mismatch (corrupt entry)");

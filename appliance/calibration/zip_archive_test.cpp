@@ -1,5 +1,8 @@
 #include "appliance/calibration/zip_archive.h"
 
+#include <sys/resource.h>
+
+#include <algorithm>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -59,6 +62,43 @@ TEST(ZipArchive, MissingEntriesAndNonZipFilesAreErrors) {
     EXPECT_THROW(ZipReader(dir / "not.zip", "t"), MpcdiError);
     EXPECT_THROW(ZipReader(dir / "missing.zip", "t"), MpcdiError);
     EXPECT_THROW(write_zip(dir / "no-such-dir" / "a.zip", {{"x", {1}}}, "t"), MpcdiError);
+}
+
+long peak_rss_kib() {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return usage.ru_maxrss;
+}
+
+void put_u32(std::vector<std::uint8_t>& b, std::size_t at, std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) b[at + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(v >> (8 * i));
+}
+
+// A tiny archive whose headers declare a huge entry must be refused without allocating what they
+// declare (before the fix, reading it value-initialised a 1 GiB buffer).
+TEST(ZipArchive, DeclaredSizeIsNotAllocatedUpFront) {
+    test::ScratchDir dir;
+    write_zip(dir / "a.zip", {{"x", std::vector<std::uint8_t>(100, 7)}}, "test");
+    std::vector<std::uint8_t> bytes = test::read_bytes(dir / "a.zip");
+    const std::uint32_t huge = (1U << 30) - 1;  // just under kMaxZipEntryBytes
+    put_u32(bytes, 22, huge);                    // local header: uncompressed size
+    const std::uint8_t central[] = {0x50, 0x4b, 0x01, 0x02};
+    const auto it = std::search(bytes.begin(), bytes.end(), std::begin(central), std::end(central));
+    ASSERT_NE(it, bytes.end());
+    put_u32(bytes, static_cast<std::size_t>(it - bytes.begin()) + 24, huge);  // central directory
+    test::write_bytes(dir / "huge.zip", bytes);
+    ASSERT_LT(bytes.size(), 400U);
+
+    const long before = peak_rss_kib();
+    const ZipReader zip(dir / "huge.zip", "test");
+    try {
+        (void)zip.read("x");
+        ADD_FAILURE() << "a 100-byte entry declared as 1 GiB was accepted";
+    } catch (const MpcdiError& e) {
+        EXPECT_NE(std::string(e.what()).find("differs from the 1073741823 bytes its header declares"), std::string::npos)
+            << e.what();
+    }
+    EXPECT_LT(peak_rss_kib() - before, 64 * 1024) << "KiB of peak memory for a 100-byte entry";
 }
 
 }  // namespace

@@ -170,14 +170,18 @@ grpc::Status LinkServer::Impl::Session(grpc::ServerContext* ctx, Stream* stream)
     ctx->TryCancel();  // unblocks the reader's Read when the appliance is still connected
     reader.join();
     bool server_stopping = false;
+    std::string summary;
     {
+        // A render worker may still hold this session (it counts failures under the lock), so the
+        // counters are read under the lock too.
         const std::lock_guard lock(mutex);
         std::erase(sessions, s);
         totals.sessions_active = sessions.size();
         server_stopping = stopping;
+        summary = fmt::format("{} closed: {}; {} requests, {} dropped as stale, {} invalid, {} frames, {} render failures",
+                              s->name(), s->close_reason, s->requests, s->dropped, s->invalid, s->frames, s->failures);
     }
-    link_log().info("{} closed: {}; {} requests, {} dropped as stale, {} invalid, {} frames, {} render failures",
-                    s->name(), s->close_reason, s->requests, s->dropped, s->invalid, s->frames, s->failures);
+    link_log().info("{}", summary);
     return server_stopping ? grpc::Status(grpc::StatusCode::UNAVAILABLE, "farm is shutting down") : grpc::Status::OK;
 }
 
