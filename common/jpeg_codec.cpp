@@ -6,7 +6,6 @@
 #include <stdexcept>
 #include <string>
 #include <type_traits>
-#include <utility>
 
 namespace mogao {
 namespace {
@@ -37,35 +36,23 @@ int tj_subsampling(Subsampling s) {
 // decode on it fails (even of a valid file, e.g. "Bogus DQT index"). A failed call therefore
 // replaces the handle; that costs microseconds and only on the error path. Same for the encoder,
 // to be safe against similar state after a failed tjCompress2.
-void replace_handle(void*& handle, tjhandle (*init)()) {
-    tjDestroy(handle);
-    handle = init();  // nullptr only if malloc fails; the next call then reports that
+void replace_handle(UniqueHandle<TjHandleTraits>& handle, tjhandle (*init)()) {
+    handle.reset();
+    handle.reset(init());  // nullptr only if malloc fails; the next call then reports that
 }
 
 }  // namespace
 
+void TjHandleTraits::close(void* handle) noexcept { tjDestroy(handle); }
+
 JpegEncoder::JpegEncoder() : handle_(tjInitCompress()) {
-    if (handle_ == nullptr) {
+    if (!handle_) {
         throw EncodeError("JpegEncoder: tjInitCompress failed: " + tj_reason(nullptr));
     }
 }
 
-JpegEncoder::~JpegEncoder() {
-    if (handle_ != nullptr) tjDestroy(handle_);
-}
-
-JpegEncoder::JpegEncoder(JpegEncoder&& other) noexcept : handle_(std::exchange(other.handle_, nullptr)) {}
-
-JpegEncoder& JpegEncoder::operator=(JpegEncoder&& other) noexcept {
-    if (this != &other) {
-        if (handle_ != nullptr) tjDestroy(handle_);
-        handle_ = std::exchange(other.handle_, nullptr);
-    }
-    return *this;
-}
-
 std::vector<std::uint8_t> JpegEncoder::encode(const Rgb8Image& image, int quality, Subsampling subsampling) {
-    if (handle_ == nullptr) throw std::logic_error("JpegEncoder::encode: no handle (moved from, or out of memory)");
+    if (!handle_) throw std::logic_error("JpegEncoder::encode: no handle (moved from, or out of memory)");
     require_valid_image(image, "JpegEncoder::encode");
     if (quality < 1 || quality > 100) {
         throw std::invalid_argument("JpegEncoder::encode: quality " + std::to_string(quality) + " is outside 1..100");
@@ -87,10 +74,10 @@ std::vector<std::uint8_t> JpegEncoder::encode(const Rgb8Image& image, int qualit
     std::vector<std::uint8_t> out(bound);
     unsigned char* dst = out.data();
     unsigned long size = bound;
-    const int rc = tjCompress2(handle_, image.pixels.data(), w, w * 3, h, TJPF_RGB, &dst, &size, samp, quality,
+    const int rc = tjCompress2(handle_.get(), image.pixels.data(), w, w * 3, h, TJPF_RGB, &dst, &size, samp, quality,
                                TJFLAG_NOREALLOC);
     if (rc != 0) {
-        const std::string reason = tj_reason(handle_);
+        const std::string reason = tj_reason(handle_.get());
         replace_handle(handle_, tjInitCompress);
         throw EncodeError("JpegEncoder::encode: tjCompress2 failed for " + std::to_string(w) + "x" +
                           std::to_string(h) + " at quality " + std::to_string(quality) + ": " + reason);
@@ -100,27 +87,13 @@ std::vector<std::uint8_t> JpegEncoder::encode(const Rgb8Image& image, int qualit
 }
 
 JpegDecoder::JpegDecoder() : handle_(tjInitDecompress()) {
-    if (handle_ == nullptr) {
+    if (!handle_) {
         throw DecodeError("JpegDecoder: tjInitDecompress failed: " + tj_reason(nullptr));
     }
 }
 
-JpegDecoder::~JpegDecoder() {
-    if (handle_ != nullptr) tjDestroy(handle_);
-}
-
-JpegDecoder::JpegDecoder(JpegDecoder&& other) noexcept : handle_(std::exchange(other.handle_, nullptr)) {}
-
-JpegDecoder& JpegDecoder::operator=(JpegDecoder&& other) noexcept {
-    if (this != &other) {
-        if (handle_ != nullptr) tjDestroy(handle_);
-        handle_ = std::exchange(other.handle_, nullptr);
-    }
-    return *this;
-}
-
 Rgb8Image JpegDecoder::decode(std::span<const std::uint8_t> jpeg) {
-    if (handle_ == nullptr) throw std::logic_error("JpegDecoder::decode: no handle (moved from, or out of memory)");
+    if (!handle_) throw std::logic_error("JpegDecoder::decode: no handle (moved from, or out of memory)");
     if (jpeg.empty()) throw DecodeError("JpegDecoder::decode: no data (0 bytes)");
     if (jpeg.size() > std::numeric_limits<unsigned long>::max()) {
         throw DecodeError("JpegDecoder::decode: input too large");
@@ -131,8 +104,8 @@ Rgb8Image JpegDecoder::decode(std::span<const std::uint8_t> jpeg) {
     int h = 0;
     int samp = 0;
     int colorspace = 0;
-    if (tjDecompressHeader3(handle_, jpeg.data(), size, &w, &h, &samp, &colorspace) != 0) {
-        const std::string reason = tj_reason(handle_);
+    if (tjDecompressHeader3(handle_.get(), jpeg.data(), size, &w, &h, &samp, &colorspace) != 0) {
+        const std::string reason = tj_reason(handle_.get());
         replace_handle(handle_, tjInitDecompress);
         throw DecodeError("JpegDecoder::decode: bad JPEG header (" + std::to_string(jpeg.size()) +
                           " bytes): " + reason);
@@ -152,9 +125,9 @@ Rgb8Image JpegDecoder::decode(std::span<const std::uint8_t> jpeg) {
     // scans is a known CPU-exhaustion input. Even with these flags, 2.1 returns -1 with a warning
     // code for any warning it still saw, so any non-zero return is a failure.
     const int flags = TJFLAG_STOPONWARNING | TJFLAG_LIMITSCANS;
-    if (tjDecompress2(handle_, jpeg.data(), size, image.pixels.data(), w, w * 3, h, TJPF_RGB, flags) != 0) {
-        const bool warning = tjGetErrorCode(handle_) == TJERR_WARNING;
-        const std::string reason = tj_reason(handle_);
+    if (tjDecompress2(handle_.get(), jpeg.data(), size, image.pixels.data(), w, w * 3, h, TJPF_RGB, flags) != 0) {
+        const bool warning = tjGetErrorCode(handle_.get()) == TJERR_WARNING;
+        const std::string reason = tj_reason(handle_.get());
         replace_handle(handle_, tjInitDecompress);
         throw DecodeError(std::string("JpegDecoder::decode: ") + (warning ? "damaged" : "corrupt") + " " +
                           std::to_string(w) + "x" + std::to_string(h) + " JPEG (" + std::to_string(jpeg.size()) +

@@ -11,6 +11,7 @@
 
 #include "common/codec_errors.h"
 #include "common/image.h"
+#include "common/unique_handle.h"
 
 namespace mogao {
 
@@ -20,14 +21,16 @@ enum class Subsampling { yuv444, yuv422, yuv420 };
 
 inline constexpr int kDefaultJpegQuality = 85;  // matches Quality::jpeg_quality in view_request.h
 
+// One tjhandle (void* in TurboJPEG 2.x, which keeps turbojpeg.h out of this header); tjDestroy.
+struct TjHandleTraits {
+    using Value = void*;
+    static constexpr void* null() noexcept { return nullptr; }
+    static void close(void* handle) noexcept;
+};
+
 class JpegEncoder {
 public:
     JpegEncoder();  // throws EncodeError if TurboJPEG cannot allocate a handle
-    ~JpegEncoder();
-    JpegEncoder(JpegEncoder&& other) noexcept;
-    JpegEncoder& operator=(JpegEncoder&& other) noexcept;
-    JpegEncoder(const JpegEncoder&) = delete;
-    JpegEncoder& operator=(const JpegEncoder&) = delete;
 
     // Baseline JFIF of an sRGB8 image. quality is 1..100 (std::invalid_argument otherwise, and for
     // an inconsistent image); EncodeError names TurboJPEG's reason if compression fails.
@@ -35,17 +38,12 @@ public:
                                                    Subsampling subsampling = Subsampling::yuv420);
 
 private:
-    void* handle_ = nullptr;  // tjhandle; void* keeps turbojpeg.h out of this header
+    UniqueHandle<TjHandleTraits> handle_;  // null when moved from (or after a failed re-init)
 };
 
 class JpegDecoder {
 public:
     JpegDecoder();  // throws DecodeError if TurboJPEG cannot allocate a handle
-    ~JpegDecoder();
-    JpegDecoder(JpegDecoder&& other) noexcept;
-    JpegDecoder& operator=(JpegDecoder&& other) noexcept;
-    JpegDecoder(const JpegDecoder&) = delete;
-    JpegDecoder& operator=(const JpegDecoder&) = delete;
 
     // Decodes a whole JPEG (any subsampling, grayscale or colour) to RGB8. Throws DecodeError for
     // empty, truncated or corrupt data, for CMYK, and for a declared size above
@@ -55,7 +53,7 @@ public:
     [[nodiscard]] Rgb8Image decode(std::span<const std::uint8_t> jpeg);
 
 private:
-    void* handle_ = nullptr;  // tjhandle
+    UniqueHandle<TjHandleTraits> handle_;
 };
 
 }  // namespace mogao

@@ -31,11 +31,8 @@ Result<SignalFd> SignalFd::create(std::initializer_list<int> signals) {
     return SignalFd(UniqueFd(fd), set, previous);
 }
 
-SignalFd::SignalFd(SignalFd&& other) noexcept
-    : fd_(std::move(other.fd_)), set_(other.set_), previous_(other.previous_), restore_(std::exchange(other.restore_, false)) {}
-
 SignalFd::~SignalFd() {
-    if (!restore_) return;
+    if (!fd_.valid()) return;  // moved from
     // Consume what is pending for the set, then unblock: a late SIGTERM must not kill the process
     // half-way through its clean shutdown.
     const timespec zero{};

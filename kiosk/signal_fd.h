@@ -25,8 +25,12 @@ namespace mogao {
 class SignalFd {
 public:
     [[nodiscard]] static Result<SignalFd> create(std::initializer_list<int> signals);
+    // Restores the mask unless moved from (an empty fd_ marks that: it is valid exactly while this
+    // object owns the blocked set).
     ~SignalFd();
-    SignalFd(SignalFd&& other) noexcept;
+    SignalFd(SignalFd&&) noexcept = default;
+    // Not assignable: replacing a live SignalFd would have to restore its mask first, and no caller
+    // needs that.
     SignalFd& operator=(SignalFd&&) = delete;
     SignalFd(const SignalFd&) = delete;
     SignalFd& operator=(const SignalFd&) = delete;
@@ -41,7 +45,6 @@ private:
     UniqueFd fd_;
     sigset_t set_{};
     sigset_t previous_{};
-    bool restore_ = true;
 };
 
 }  // namespace mogao

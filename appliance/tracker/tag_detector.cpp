@@ -6,41 +6,38 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/unique_handle.h"
 #include "drivers/camera/pixel_format.h"
 
 namespace mogao {
 
-void TagDetector::DetectorDeleter::operator()(apriltag_detector* d) const noexcept { apriltag_detector_destroy(d); }
+struct TagDetector::Engine {
+    explicit Engine(const std::string& family_name) : family(family_name) {}
+    TagFamily family;
+    // Declared after the family so it is destroyed first: apriltag_detector_destroy frees the
+    // decode tables it hung on the family, reading the family to find them.
+    UniquePtr<apriltag_detector, &apriltag_detector_destroy> detector{apriltag_detector_create()};
+};
 
 TagDetector::TagDetector(const DetectorSettings& settings)
-    : settings_(settings), family_(std::make_unique<TagFamily>(settings.family)) {
+    : settings_(settings), engine_(std::make_unique<Engine>(settings.family)) {
     validate(settings_);
-    detector_.reset(apriltag_detector_create());
-    if (!detector_) throw std::runtime_error("AprilTag could not allocate a detector");
-    apriltag_detector_add_family_bits(detector_.get(), family_->get(), settings_.max_hamming);
-    detector_->quad_decimate = settings_.decimation;
-    detector_->quad_sigma = settings_.blur_sigma;
-    detector_->refine_edges = settings_.refine_edges;
-    detector_->decode_sharpening = settings_.decode_sharpening;
-    detector_->nthreads = settings_.threads;
-    detector_->qtp.min_white_black_diff = settings_.min_white_black_diff;
+    apriltag_detector* detector = engine_->detector.get();
+    if (detector == nullptr) throw std::runtime_error("AprilTag could not allocate a detector");
+    apriltag_detector_add_family_bits(detector, engine_->family.get(), settings_.max_hamming);
+    detector->quad_decimate = settings_.decimation;
+    detector->quad_sigma = settings_.blur_sigma;
+    detector->refine_edges = settings_.refine_edges;
+    detector->decode_sharpening = settings_.decode_sharpening;
+    detector->nthreads = settings_.threads;
+    detector->qtp.min_white_black_diff = settings_.min_white_black_diff;
 }
 
 TagDetector::TagDetector(TagDetector&&) noexcept = default;
-// Not defaulted: the old detector must be destroyed before the old family (destroying a detector
-// frees the decode table it hung on its families), and member-wise assignment would free the
-// family first.
-TagDetector& TagDetector::operator=(TagDetector&& other) noexcept {
-    if (this != &other) {
-        detector_.reset();
-        settings_ = std::move(other.settings_);
-        scratch_ = std::move(other.scratch_);
-        family_ = std::move(other.family_);
-        detector_ = std::move(other.detector_);
-    }
-    return *this;
-}
+TagDetector& TagDetector::operator=(TagDetector&&) noexcept = default;
 TagDetector::~TagDetector() = default;
+
+const TagFamily& TagDetector::family() const { return engine_->family; }
 
 std::vector<TagDetection> TagDetector::detect(const GrayImage& image) {
     if (!image.valid()) {
@@ -61,7 +58,7 @@ std::vector<TagDetection> TagDetector::detect(const GrayImage& image) {
         pixels = scratch_.data();
     }
     image_u8_t view{image.width, image.height, image.width, const_cast<std::uint8_t*>(pixels)};
-    zarray_t* found = apriltag_detector_detect(detector_.get(), &view);
+    zarray_t* found = apriltag_detector_detect(engine_->detector.get(), &view);
     std::vector<TagDetection> out;
     out.reserve(static_cast<std::size_t>(zarray_size(found)));
     for (int i = 0; i < zarray_size(found); ++i) {

@@ -23,8 +23,6 @@
 #include "appliance/tracker/tag_family.h"
 #include "drivers/camera/camera_frame.h"
 
-struct apriltag_detector;
-
 namespace mogao {
 
 struct TagDetection {
@@ -51,16 +49,17 @@ public:
     [[nodiscard]] std::vector<TagDetection> detect(const GrayImage& image);
 
     [[nodiscard]] const DetectorSettings& settings() const { return settings_; }
-    [[nodiscard]] const TagFamily& family() const { return *family_; }
+    [[nodiscard]] const TagFamily& family() const;
 
 private:
-    struct DetectorDeleter {
-        void operator()(apriltag_detector* d) const noexcept;
-    };
+    // The family and the detector that hangs its decode tables on it, together on the heap: the
+    // family's address must not change while the detector uses it, and the detector must be
+    // destroyed before the family (tag_detector.cpp). As one pointer they also move and are
+    // replaced as one, so the moves are defaulted.
+    struct Engine;
     DetectorSettings settings_;
     std::vector<std::uint8_t> scratch_;  // a copy of the image when AprilTag would blur it in place
-    std::unique_ptr<TagFamily> family_;  // heap: its address must not change while the detector uses it
-    std::unique_ptr<apriltag_detector, DetectorDeleter> detector_;  // destroyed before family_
+    std::unique_ptr<Engine> engine_;
 };
 
 }  // namespace mogao

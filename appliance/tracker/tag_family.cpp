@@ -12,7 +12,6 @@
 #include <tagStandard52h13.h>
 
 #include <stdexcept>
-#include <utility>
 
 namespace mogao {
 namespace {
@@ -50,9 +49,9 @@ const std::vector<std::string>& TagFamily::known_names() {
 TagFamily::TagFamily(std::string_view name) : name_(name) {
     for (const auto& f : kFamilies) {
         if (name == f.name) {
-            family_ = f.create();
-            destroy_ = f.destroy;
-            if (family_ == nullptr) throw std::runtime_error("AprilTag could not allocate family " + name_);
+            apriltag_family_t* family = f.create();
+            if (family == nullptr) throw std::runtime_error("AprilTag could not allocate family " + name_);
+            family_.reset(Owned{family, f.destroy});
             return;
         }
     }
@@ -61,30 +60,8 @@ TagFamily::TagFamily(std::string_view name) : name_(name) {
     throw std::invalid_argument("tag family '" + name_ + "' is unknown; known: " + list);
 }
 
-TagFamily::TagFamily(TagFamily&& other) noexcept
-    : name_(std::move(other.name_)),
-      family_(std::exchange(other.family_, nullptr)),
-      destroy_(std::exchange(other.destroy_, nullptr)) {}
-
-TagFamily& TagFamily::operator=(TagFamily&& other) noexcept {
-    if (this != &other) {
-        destroy();
-        name_ = std::move(other.name_);
-        family_ = std::exchange(other.family_, nullptr);
-        destroy_ = std::exchange(other.destroy_, nullptr);
-    }
-    return *this;
-}
-
-TagFamily::~TagFamily() { destroy(); }
-
-void TagFamily::destroy() noexcept {
-    if (family_ != nullptr && destroy_ != nullptr) destroy_(family_);
-    family_ = nullptr;
-}
-
-int TagFamily::code_count() const { return static_cast<int>(family_->ncodes); }
-int TagFamily::total_width_cells() const { return family_->total_width; }
-int TagFamily::border_width_cells() const { return family_->width_at_border; }
+int TagFamily::code_count() const { return static_cast<int>(get()->ncodes); }
+int TagFamily::total_width_cells() const { return get()->total_width; }
+int TagFamily::border_width_cells() const { return get()->width_at_border; }
 
 }  // namespace mogao

@@ -2,8 +2,6 @@
 
 #include <sys/mman.h>
 
-#include <utility>
-
 namespace mogao {
 
 Result<MappedBuffer> MappedBuffer::map(int fd, std::size_t length, off_t offset) {
@@ -13,25 +11,9 @@ Result<MappedBuffer> MappedBuffer::map(int fd, std::size_t length, off_t offset)
     return MappedBuffer(address, length);
 }
 
-MappedBuffer::MappedBuffer(MappedBuffer&& other) noexcept
-    : address_(std::exchange(other.address_, nullptr)), length_(std::exchange(other.length_, 0)) {}
-
-MappedBuffer& MappedBuffer::operator=(MappedBuffer&& other) noexcept {
-    if (this != &other) {
-        reset();
-        address_ = std::exchange(other.address_, nullptr);
-        length_ = std::exchange(other.length_, 0);
-    }
-    return *this;
-}
-
-MappedBuffer::~MappedBuffer() { reset(); }
-
-void MappedBuffer::reset() noexcept {
+void MappedBuffer::Traits::close(Mapping mapping) noexcept {
     // munmap only fails for arguments that did not come from mmap; nothing to do about it here.
-    if (address_ != nullptr) ::munmap(address_, length_);
-    address_ = nullptr;
-    length_ = 0;
+    ::munmap(mapping.address, mapping.length);
 }
 
 }  // namespace mogao

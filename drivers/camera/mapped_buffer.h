@@ -1,7 +1,8 @@
 // MappedBuffer: sole owner of one read-only shared mapping of a device buffer (a V4L2 capture
 // buffer mapped with mmap at the offset VIDIOC_QUERYBUF returned). Unmaps on destruction;
-// move-only. The fd it was mapped from may be closed afterwards (the mapping keeps the buffer
-// alive), but V4l2Capture unmaps before closing anyway.
+// move-only (UniqueHandle, common/unique_handle.h): a moved-from buffer is empty. The fd it was
+// mapped from may be closed afterwards (the mapping keeps the buffer alive), but V4l2Capture
+// unmaps before closing anyway.
 #pragma once
 
 #include <sys/types.h>
@@ -11,6 +12,7 @@
 #include <span>
 
 #include "common/result.h"
+#include "common/unique_handle.h"
 
 namespace mogao {
 
@@ -21,23 +23,27 @@ public:
     [[nodiscard]] static Result<MappedBuffer> map(int fd, std::size_t length, off_t offset);
 
     MappedBuffer() = default;
-    MappedBuffer(MappedBuffer&& other) noexcept;
-    MappedBuffer& operator=(MappedBuffer&& other) noexcept;
-    MappedBuffer(const MappedBuffer&) = delete;
-    MappedBuffer& operator=(const MappedBuffer&) = delete;
-    ~MappedBuffer();
 
     [[nodiscard]] std::span<const std::uint8_t> bytes() const noexcept {
-        return {static_cast<const std::uint8_t*>(address_), length_};
+        return {static_cast<const std::uint8_t*>(mapping_.get().address), mapping_.get().length};
     }
-    [[nodiscard]] bool valid() const noexcept { return address_ != nullptr; }
+    [[nodiscard]] bool valid() const noexcept { return mapping_.valid(); }
 
 private:
-    MappedBuffer(void* address, std::size_t length) noexcept : address_(address), length_(length) {}
-    void reset() noexcept;
+    // munmap needs the length too, so address and length move together; {nullptr, 0} is empty.
+    struct Mapping {
+        void* address = nullptr;
+        std::size_t length = 0;
+        bool operator==(const Mapping&) const = default;
+    };
+    struct Traits {
+        using Value = Mapping;
+        static constexpr Mapping null() noexcept { return {}; }
+        static void close(Mapping mapping) noexcept;
+    };
+    MappedBuffer(void* address, std::size_t length) noexcept : mapping_(Mapping{address, length}) {}
 
-    void* address_ = nullptr;
-    std::size_t length_ = 0;
+    UniqueHandle<Traits> mapping_;
 };
 
 }  // namespace mogao

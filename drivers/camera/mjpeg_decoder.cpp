@@ -3,7 +3,6 @@
 #include <turbojpeg.h>
 
 #include <string>
-#include <utility>
 
 #include "drivers/camera/pixel_format.h"
 
@@ -15,23 +14,13 @@ Result<MjpegDecoder> MjpegDecoder::create() {
     return MjpegDecoder(handle);
 }
 
-MjpegDecoder::MjpegDecoder(MjpegDecoder&& other) noexcept : handle_(std::exchange(other.handle_, nullptr)) {}
-
-MjpegDecoder& MjpegDecoder::operator=(MjpegDecoder&& other) noexcept {
-    if (this != &other) {
-        if (handle_ != nullptr) tjDestroy(handle_);
-        handle_ = std::exchange(other.handle_, nullptr);
-    }
-    return *this;
-}
-
-MjpegDecoder::~MjpegDecoder() {
-    if (handle_ != nullptr) tjDestroy(handle_);
-}
+void MjpegDecoder::Traits::close(void* handle) noexcept { tjDestroy(handle); }
 
 Status MjpegDecoder::decode_grey(std::span<const std::uint8_t> jpeg, GrayImage& out, int expected_width,
                                  int expected_height) {
+    if (!handle_) return make_error(EINVAL, "MjpegDecoder::decode_grey on a moved-from decoder");
     if (jpeg.empty()) return make_error(EBADMSG, "MJPEG frame: 0 bytes");
+    tjhandle handle = handle_.get();
     int width = 0;
     int height = 0;
     int subsampling = 0;
@@ -39,8 +28,8 @@ Status MjpegDecoder::decode_grey(std::span<const std::uint8_t> jpeg, GrayImage& 
     // TurboJPEG 2.1 takes a non-const pointer but does not write through it.
     auto* data = const_cast<unsigned char*>(jpeg.data());
     const auto size = static_cast<unsigned long>(jpeg.size());
-    if (tjDecompressHeader3(handle_, data, size, &width, &height, &subsampling, &colorspace) != 0) {
-        return make_error(EBADMSG, std::string("MJPEG frame header: ") + tjGetErrorStr2(handle_));
+    if (tjDecompressHeader3(handle, data, size, &width, &height, &subsampling, &colorspace) != 0) {
+        return make_error(EBADMSG, std::string("MJPEG frame header: ") + tjGetErrorStr2(handle));
     }
     if (width < 1 || height < 1 || width > kMaxCaptureDimension || height > kMaxCaptureDimension) {
         return make_error(EBADMSG, "MJPEG frame: size " + std::to_string(width) + "x" + std::to_string(height) +
@@ -55,8 +44,8 @@ Status MjpegDecoder::decode_grey(std::span<const std::uint8_t> jpeg, GrayImage& 
     out.height = height;
     out.pixels.resize(static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
     // Warnings are failures: TurboJPEG returns -1 for them too and the frame is partly garbage.
-    if (tjDecompress2(handle_, data, size, out.pixels.data(), width, width, height, TJPF_GRAY, 0) != 0) {
-        return make_error(EBADMSG, std::string("MJPEG frame: ") + tjGetErrorStr2(handle_));
+    if (tjDecompress2(handle, data, size, out.pixels.data(), width, width, height, TJPF_GRAY, 0) != 0) {
+        return make_error(EBADMSG, std::string("MJPEG frame: ") + tjGetErrorStr2(handle));
     }
     return {};
 }

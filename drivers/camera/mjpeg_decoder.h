@@ -15,6 +15,7 @@
 
 #include "drivers/camera/camera_frame.h"
 #include "common/result.h"
+#include "common/unique_handle.h"
 
 namespace mogao {
 
@@ -22,20 +23,21 @@ class MjpegDecoder {
 public:
     [[nodiscard]] static Result<MjpegDecoder> create();
 
-    MjpegDecoder(MjpegDecoder&& other) noexcept;
-    MjpegDecoder& operator=(MjpegDecoder&& other) noexcept;
-    MjpegDecoder(const MjpegDecoder&) = delete;
-    MjpegDecoder& operator=(const MjpegDecoder&) = delete;
-    ~MjpegDecoder();
-
     // Decodes `jpeg` into `out`. expected_width/height: the size negotiated with the driver; 0
-    // accepts any size up to kMaxCaptureDimension (replay of loose JPEG files).
+    // accepts any size up to kMaxCaptureDimension (replay of loose JPEG files). EINVAL on a
+    // moved-from decoder.
     [[nodiscard]] Status decode_grey(std::span<const std::uint8_t> jpeg, GrayImage& out, int expected_width = 0,
                                      int expected_height = 0);
 
 private:
+    // tjhandle is void* in TurboJPEG 2.x, which keeps turbojpeg.h out of this header; tjDestroy.
+    struct Traits {
+        using Value = void*;
+        static constexpr void* null() noexcept { return nullptr; }
+        static void close(void* handle) noexcept;
+    };
     explicit MjpegDecoder(void* handle) noexcept : handle_(handle) {}
-    void* handle_ = nullptr;  // tjhandle; void* keeps turbojpeg.h out of this header
+    UniqueHandle<Traits> handle_;  // move-only; null when moved from
 };
 
 }  // namespace mogao

@@ -3,7 +3,6 @@
 #include <cstdio>
 #include <map>
 #include <mutex>
-#include <utility>
 #include <vector>
 
 namespace mogao {
@@ -85,34 +84,17 @@ Result<EglDisplay> EglDisplay::open_platform(EGLenum platform, void* native_disp
     return EglDisplay(display, major, minor);
 }
 
-EglDisplay::EglDisplay(EglDisplay&& other) noexcept
-    : display_(std::exchange(other.display_, EGL_NO_DISPLAY)), major_(other.major_), minor_(other.minor_) {}
-
-EglDisplay& EglDisplay::operator=(EglDisplay&& other) noexcept {
-    if (this != &other) {
-        reset();
-        display_ = std::exchange(other.display_, EGL_NO_DISPLAY);
-        major_ = other.major_;
-        minor_ = other.minor_;
-    }
-    return *this;
-}
-
-EglDisplay::~EglDisplay() { reset(); }
-
-void EglDisplay::reset() {
-    if (display_ == EGL_NO_DISPLAY) return;
+void EglDisplay::Traits::close(EGLDisplay display) noexcept {
     std::lock_guard lock(registry_mutex());
-    auto it = registry().find(display_);
+    auto it = registry().find(display);
     if (it != registry().end() && --it->second == 0) {
         registry().erase(it);
-        eglTerminate(display_);
+        eglTerminate(display);
     }
-    display_ = EGL_NO_DISPLAY;
 }
 
 bool EglDisplay::has_extension(std::string_view name) const {
-    return has_token(eglQueryString(display_, EGL_EXTENSIONS), name);
+    return has_token(eglQueryString(display_.get(), EGL_EXTENSIONS), name);
 }
 
 Result<EGLConfig> choose_window_config(const EglDisplay& display, EGLint native_visual_id) {
@@ -154,34 +136,19 @@ Result<EglContext> EglContext::create(const EglDisplay& display, EGLConfig confi
     return EglContext(display.get(), context);
 }
 
-EglContext::EglContext(EglContext&& other) noexcept
-    : display_(other.display_), context_(std::exchange(other.context_, EGL_NO_CONTEXT)) {}
-
-EglContext& EglContext::operator=(EglContext&& other) noexcept {
-    if (this != &other) {
-        reset();
-        display_ = other.display_;
-        context_ = std::exchange(other.context_, EGL_NO_CONTEXT);
+void EglContext::Traits::close(egl_detail::OnDisplay context) noexcept {
+    if (eglGetCurrentContext() == context.object) {
+        eglMakeCurrent(context.display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     }
-    return *this;
-}
-
-EglContext::~EglContext() { reset(); }
-
-void EglContext::reset() {
-    if (context_ == EGL_NO_CONTEXT) return;
-    if (eglGetCurrentContext() == context_) {
-        eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-    }
-    eglDestroyContext(display_, context_);
-    context_ = EGL_NO_CONTEXT;
+    eglDestroyContext(context.display, context.object);
 }
 
 Status EglContext::make_current() const { return make_current(EGL_NO_SURFACE); }
 
 Status EglContext::make_current(EGLSurface surface) const {
-    if (context_ == EGL_NO_CONTEXT) return make_error(EINVAL, "make_current on an empty EglContext");
-    if (eglMakeCurrent(display_, surface, surface, context_) != EGL_TRUE) return egl_failure("eglMakeCurrent");
+    if (!context_) return make_error(EINVAL, "make_current on an empty EglContext");
+    const egl_detail::OnDisplay c = context_.get();
+    if (eglMakeCurrent(c.display, surface, surface, c.object) != EGL_TRUE) return egl_failure("eglMakeCurrent");
     return {};
 }
 
@@ -194,33 +161,18 @@ Result<EglSurface> EglSurface::create_window(const EglDisplay& display, EGLConfi
     return EglSurface(display.get(), surface);
 }
 
-EglSurface::EglSurface(EglSurface&& other) noexcept
-    : display_(other.display_), surface_(std::exchange(other.surface_, EGL_NO_SURFACE)) {}
-
-EglSurface& EglSurface::operator=(EglSurface&& other) noexcept {
-    if (this != &other) {
-        reset();
-        display_ = other.display_;
-        surface_ = std::exchange(other.surface_, EGL_NO_SURFACE);
-    }
-    return *this;
-}
-
-EglSurface::~EglSurface() { reset(); }
-
-void EglSurface::reset() {
-    if (surface_ == EGL_NO_SURFACE) return;
+void EglSurface::Traits::close(egl_detail::OnDisplay surface) noexcept {
     // A current surface is only destroyed when released; release it now so the gbm_surface under
     // it can be destroyed right after.
-    if (eglGetCurrentSurface(EGL_DRAW) == surface_ || eglGetCurrentSurface(EGL_READ) == surface_) {
-        eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    if (eglGetCurrentSurface(EGL_DRAW) == surface.object || eglGetCurrentSurface(EGL_READ) == surface.object) {
+        eglMakeCurrent(surface.display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     }
-    eglDestroySurface(display_, surface_);
-    surface_ = EGL_NO_SURFACE;
+    eglDestroySurface(surface.display, surface.object);
 }
 
 Status EglSurface::swap_buffers() const {
-    if (eglSwapBuffers(display_, surface_) != EGL_TRUE) return egl_failure("eglSwapBuffers");
+    const egl_detail::OnDisplay s = surface_.get();
+    if (eglSwapBuffers(s.display, s.object) != EGL_TRUE) return egl_failure("eglSwapBuffers");
     return {};
 }
 

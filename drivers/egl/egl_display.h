@@ -5,6 +5,8 @@
 //
 // Lifetimes: an EglContext or EglSurface keeps the raw EGLDisplay handle of the EglDisplay it was
 // made from; that EglDisplay must outlive them. Declare the display before its contexts/surfaces.
+// All three are move-only UniqueHandle owners (common/unique_handle.h): a moved-from object owns
+// nothing and its destructor makes no EGL call.
 #pragma once
 
 #include <EGL/egl.h>
@@ -14,6 +16,7 @@
 #include <string_view>
 
 #include "common/result.h"
+#include "common/unique_handle.h"
 
 namespace mogao {
 
@@ -33,25 +36,34 @@ public:
     // Any platform display, e.g. (EGL_PLATFORM_GBM_KHR, gbm_device*) for KMS output.
     [[nodiscard]] static Result<EglDisplay> open_platform(EGLenum platform, void* native_display);
 
-    EglDisplay(EglDisplay&& other) noexcept;
-    EglDisplay& operator=(EglDisplay&& other) noexcept;
-    EglDisplay(const EglDisplay&) = delete;
-    EglDisplay& operator=(const EglDisplay&) = delete;
-    ~EglDisplay();
-
-    [[nodiscard]] EGLDisplay get() const { return display_; }
+    [[nodiscard]] EGLDisplay get() const { return display_.get(); }
     [[nodiscard]] int major_version() const { return major_; }
     [[nodiscard]] int minor_version() const { return minor_; }
     // True when the display's extension string lists `name` (exact token match).
     [[nodiscard]] bool has_extension(std::string_view name) const;
 
 private:
+    // close(): drops this owner's count in the registry and calls eglTerminate on the last one.
+    struct Traits {
+        using Value = EGLDisplay;
+        static EGLDisplay null() noexcept { return EGL_NO_DISPLAY; }
+        static void close(EGLDisplay display) noexcept;
+    };
     EglDisplay(EGLDisplay display, EGLint major, EGLint minor) : display_(display), major_(major), minor_(minor) {}
-    void reset();
-    EGLDisplay display_ = EGL_NO_DISPLAY;
+    UniqueHandle<Traits> display_;
     int major_ = 0;
     int minor_ = 0;
 };
+
+namespace egl_detail {
+// An EGL object with the display it was made on: eglDestroy* needs both, so they move together and
+// a moved-from owner holds {EGL_NO_DISPLAY, null}.
+struct OnDisplay {
+    EGLDisplay display = EGL_NO_DISPLAY;
+    void* object = nullptr;  // EGLContext or EGLSurface (both void*; EGL_NO_* are null)
+    bool operator==(const OnDisplay&) const = default;
+};
+}  // namespace egl_detail
 
 // An EGL config for window surfaces with 8-bit RGB, no alpha, GLES 3 renderable, whose
 // EGL_NATIVE_VISUAL_ID equals `native_visual_id` (for GBM: the gbm_surface's format, e.g.
@@ -67,25 +79,23 @@ public:
     [[nodiscard]] static Result<EglContext> create(const EglDisplay& display, EGLConfig config, int major = 3,
                                                    int minor = 0);
 
-    EglContext(EglContext&& other) noexcept;
-    EglContext& operator=(EglContext&& other) noexcept;
-    EglContext(const EglContext&) = delete;
-    EglContext& operator=(const EglContext&) = delete;
-    // Releases the context from this thread if it is current here, then destroys it. GL objects
-    // made in it must already be deleted (their owners destroyed while it was current).
-    ~EglContext();
+    // Destruction releases the context from this thread if it is current here, then destroys it.
+    // GL objects made in it must already be deleted (their owners destroyed while it was current).
 
     // Makes the context current on the calling thread without a surface (FBO rendering).
     [[nodiscard]] Status make_current() const;
     // Makes the context current on the calling thread drawing to and reading from `surface`.
     [[nodiscard]] Status make_current(EGLSurface surface) const;
-    [[nodiscard]] EGLContext get() const { return context_; }
+    [[nodiscard]] EGLContext get() const { return context_.get().object; }
 
 private:
-    EglContext(EGLDisplay display, EGLContext context) : display_(display), context_(context) {}
-    void reset();
-    EGLDisplay display_ = EGL_NO_DISPLAY;
-    EGLContext context_ = EGL_NO_CONTEXT;
+    struct Traits {
+        using Value = egl_detail::OnDisplay;
+        static Value null() noexcept { return {}; }
+        static void close(Value context) noexcept;
+    };
+    EglContext(EGLDisplay display, EGLContext context) : context_({display, context}) {}
+    UniqueHandle<Traits> context_;
 };
 
 // A window surface; for KMS the native window is a gbm_surface* (drivers/kms/gbm_objects.h).
@@ -93,23 +103,21 @@ class EglSurface {
 public:
     [[nodiscard]] static Result<EglSurface> create_window(const EglDisplay& display, EGLConfig config,
                                                           void* native_window);
-    EglSurface(EglSurface&& other) noexcept;
-    EglSurface& operator=(EglSurface&& other) noexcept;
-    EglSurface(const EglSurface&) = delete;
-    EglSurface& operator=(const EglSurface&) = delete;
-    // Unbinds the current context first if it draws to this surface on this thread.
-    ~EglSurface();
+    // Destruction unbinds the current context first if it draws to this surface on this thread.
 
     // eglSwapBuffers: the back buffer becomes the front buffer (for GBM: lockable with
     // gbm_surface_lock_front_buffer). The surface must be current on this thread.
     [[nodiscard]] Status swap_buffers() const;
-    [[nodiscard]] EGLSurface get() const { return surface_; }
+    [[nodiscard]] EGLSurface get() const { return surface_.get().object; }
 
 private:
-    EglSurface(EGLDisplay display, EGLSurface surface) : display_(display), surface_(surface) {}
-    void reset();
-    EGLDisplay display_ = EGL_NO_DISPLAY;
-    EGLSurface surface_ = EGL_NO_SURFACE;
+    struct Traits {
+        using Value = egl_detail::OnDisplay;
+        static Value null() noexcept { return {}; }
+        static void close(Value surface) noexcept;
+    };
+    EglSurface(EGLDisplay display, EGLSurface surface) : surface_({display, surface}) {}
+    UniqueHandle<Traits> surface_;
 };
 
 }  // namespace mogao

@@ -8,10 +8,10 @@
 #include <cstdint>
 #include <string_view>
 #include <vector>
-#include <utility>
 
 #include "common/result.h"
 #include "common/image.h"
+#include "common/unique_handle.h"
 
 namespace mogao {
 
@@ -26,33 +26,17 @@ inline void delete_shader(GLuint n) { glDeleteShader(n); }
 inline void delete_program(GLuint n) { glDeleteProgram(n); }
 }  // namespace gl_detail
 
-// Owns one GL name; 0 = empty. Move-only.
+// Owns one GL name; 0 = empty. Move-only: a UniqueHandle (common/unique_handle.h) whose close()
+// is the object's glDelete* (get(), valid(), release(), reset(name)).
 template <void (*Delete)(GLuint)>
-class GlObject {
-public:
-    GlObject() = default;
-    explicit GlObject(GLuint name) noexcept : name_(name) {}
-    GlObject(GlObject&& other) noexcept : name_(std::exchange(other.name_, 0)) {}
-    GlObject& operator=(GlObject&& other) noexcept {
-        if (this != &other) {
-            reset();
-            name_ = std::exchange(other.name_, 0);
-        }
-        return *this;
-    }
-    GlObject(const GlObject&) = delete;
-    GlObject& operator=(const GlObject&) = delete;
-    ~GlObject() { reset(); }
-
-    [[nodiscard]] GLuint get() const noexcept { return name_; }
-    [[nodiscard]] bool valid() const noexcept { return name_ != 0; }
-    void reset() noexcept {
-        if (name_ != 0) Delete(std::exchange(name_, 0));
-    }
-
-private:
-    GLuint name_ = 0;
+struct GlNameTraits {
+    using Value = GLuint;
+    static constexpr GLuint null() noexcept { return 0; }
+    static void close(GLuint name) noexcept { Delete(name); }
 };
+
+template <void (*Delete)(GLuint)>
+using GlObject = UniqueHandle<GlNameTraits<Delete>>;
 
 using GlTexture = GlObject<&gl_detail::delete_texture>;
 using GlRenderbuffer = GlObject<&gl_detail::delete_renderbuffer>;

@@ -122,17 +122,4 @@ Result<PropertyBlob> PropertyBlob::create(int fd, const void* data, std::size_t 
     return PropertyBlob(fd, id);
 }
 
-PropertyBlob& PropertyBlob::operator=(PropertyBlob&& other) noexcept {
-    if (this != &other) {
-        reset();
-        fd_ = other.fd_;
-        id_ = std::exchange(other.id_, 0);
-    }
-    return *this;
-}
-
-void PropertyBlob::reset() noexcept {
-    if (id_ != 0) drmModeDestroyPropertyBlob(fd_, std::exchange(id_, 0));
-}
-
 }  // namespace mogao

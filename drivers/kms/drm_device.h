@@ -9,35 +9,34 @@
 
 #include <cstdint>
 #include <filesystem>
-#include <memory>
 #include <string>
 #include <string_view>
-#include <utility>
 #include <vector>
 
 #include "common/result.h"
 #include "common/unique_fd.h"
+#include "common/unique_handle.h"
 
 namespace mogao {
 
-// Deleter calling libdrm's matching free function.
-template <auto Free>
-struct DrmFree {
-    template <typename T>
-    void operator()(T* p) const noexcept {
-        Free(p);
-    }
-};
+// libdrm structures, each freed with its matching drmModeFree* function.
+using DrmResources = UniquePtr<drmModeRes, &drmModeFreeResources>;
+using DrmConnector = UniquePtr<drmModeConnector, &drmModeFreeConnector>;
+using DrmEncoder = UniquePtr<drmModeEncoder, &drmModeFreeEncoder>;
+using DrmCrtc = UniquePtr<drmModeCrtc, &drmModeFreeCrtc>;
+using DrmPlaneResources = UniquePtr<drmModePlaneRes, &drmModeFreePlaneResources>;
+using DrmPlane = UniquePtr<drmModePlane, &drmModeFreePlane>;
+using DrmObjectProperties = UniquePtr<drmModeObjectProperties, &drmModeFreeObjectProperties>;
+using DrmProperty = UniquePtr<drmModePropertyRes, &drmModeFreeProperty>;
+using DrmAtomicRequest = UniquePtr<drmModeAtomicReq, &drmModeAtomicFree>;
 
-using DrmResources = std::unique_ptr<drmModeRes, DrmFree<&drmModeFreeResources>>;
-using DrmConnector = std::unique_ptr<drmModeConnector, DrmFree<&drmModeFreeConnector>>;
-using DrmEncoder = std::unique_ptr<drmModeEncoder, DrmFree<&drmModeFreeEncoder>>;
-using DrmCrtc = std::unique_ptr<drmModeCrtc, DrmFree<&drmModeFreeCrtc>>;
-using DrmPlaneResources = std::unique_ptr<drmModePlaneRes, DrmFree<&drmModeFreePlaneResources>>;
-using DrmPlane = std::unique_ptr<drmModePlane, DrmFree<&drmModeFreePlane>>;
-using DrmObjectProperties = std::unique_ptr<drmModeObjectProperties, DrmFree<&drmModeFreeObjectProperties>>;
-using DrmProperty = std::unique_ptr<drmModePropertyRes, DrmFree<&drmModeFreeProperty>>;
-using DrmAtomicRequest = std::unique_ptr<drmModeAtomicReq, DrmFree<&drmModeAtomicFree>>;
+// A KMS object id together with the DRM fd it lives on (its destroy call needs both). {-1, 0}
+// owns nothing: what a moved-from PropertyBlob or DrmFramebuffer holds.
+struct DrmObjectId {
+    int fd = -1;
+    std::uint32_t id = 0;
+    bool operator==(const DrmObjectId&) const = default;
+};
 
 // The /dev/dri/card* nodes under `dir`, sorted by number (card0, card1, ...). Empty if none.
 [[nodiscard]] std::vector<std::filesystem::path> list_drm_cards(const std::filesystem::path& dir = "/dev/dri");
@@ -100,37 +99,33 @@ private:
 class PropertyBlob {
 public:
     [[nodiscard]] static Result<PropertyBlob> create(int fd, const void* data, std::size_t size);
-    PropertyBlob(PropertyBlob&& other) noexcept : fd_(other.fd_), id_(std::exchange(other.id_, 0)) {}
-    PropertyBlob& operator=(PropertyBlob&& other) noexcept;
-    PropertyBlob(const PropertyBlob&) = delete;
-    PropertyBlob& operator=(const PropertyBlob&) = delete;
-    ~PropertyBlob() { reset(); }
-    [[nodiscard]] std::uint32_t id() const { return id_; }
+    [[nodiscard]] std::uint32_t id() const { return blob_.get().id; }
 
 private:
-    PropertyBlob(int fd, std::uint32_t id) : fd_(fd), id_(id) {}
-    void reset() noexcept;
-    int fd_ = -1;
-    std::uint32_t id_ = 0;
+    struct Traits {
+        using Value = DrmObjectId;
+        static constexpr DrmObjectId null() noexcept { return {}; }
+        static void close(DrmObjectId blob) noexcept { drmModeDestroyPropertyBlob(blob.fd, blob.id); }
+    };
+    PropertyBlob(int fd, std::uint32_t id) : blob_(DrmObjectId{fd, id}) {}
+    UniqueHandle<Traits> blob_;
 };
 
 // A DRM framebuffer id (drmModeAddFB2 ...); removed with drmModeRmFB. Removing a framebuffer that
-// is on screen turns its CRTC off, which is what should happen when the kiosk exits.
+// is on screen turns its CRTC off, which is what should happen when the kiosk exits. Id 0 (no
+// framebuffer) owns nothing.
 class DrmFramebuffer {
 public:
-    DrmFramebuffer(int fd, std::uint32_t id) noexcept : fd_(fd), id_(id) {}
-    DrmFramebuffer(DrmFramebuffer&& other) noexcept : fd_(other.fd_), id_(std::exchange(other.id_, 0)) {}
-    DrmFramebuffer& operator=(DrmFramebuffer&&) = delete;
-    DrmFramebuffer(const DrmFramebuffer&) = delete;
-    DrmFramebuffer& operator=(const DrmFramebuffer&) = delete;
-    ~DrmFramebuffer() {
-        if (id_ != 0) drmModeRmFB(fd_, id_);
-    }
-    [[nodiscard]] std::uint32_t id() const { return id_; }
+    DrmFramebuffer(int fd, std::uint32_t id) noexcept : framebuffer_(id != 0 ? DrmObjectId{fd, id} : DrmObjectId{}) {}
+    [[nodiscard]] std::uint32_t id() const { return framebuffer_.get().id; }
 
 private:
-    int fd_;
-    std::uint32_t id_;
+    struct Traits {
+        using Value = DrmObjectId;
+        static constexpr DrmObjectId null() noexcept { return {}; }
+        static void close(DrmObjectId fb) noexcept { drmModeRmFB(fb.fd, fb.id); }
+    };
+    UniqueHandle<Traits> framebuffer_;
 };
 
 }  // namespace mogao

@@ -2,16 +2,17 @@
 // output), a locked front buffer (gbm_bo, released back to its surface), and the DRM framebuffer
 // of a bo, owned by the bo itself as its user data (drmModeRmFB when GBM destroys the bo).
 // Order of destruction: LockedBo before its GbmSurface, every GbmSurface (and the EGL display on
-// the device) before the GbmDevice, the GbmDevice before the DRM fd.
+// the device) before the GbmDevice, the GbmDevice before the DRM fd. All are move-only owners
+// (common/unique_handle.h); a moved-from one owns nothing.
 #pragma once
 
 #include <gbm.h>
 
 #include <cstdint>
-#include <utility>
 
 #include "common/result.h"
 #include "common/pixel_rect.h"
+#include "common/unique_handle.h"
 
 namespace mogao {
 
@@ -19,18 +20,11 @@ class GbmDevice {
 public:
     // `drm_fd` stays owned by the caller (DrmDevice) and must outlive the device.
     [[nodiscard]] static Result<GbmDevice> create(int drm_fd);
-    GbmDevice(GbmDevice&& other) noexcept : device_(std::exchange(other.device_, nullptr)) {}
-    GbmDevice& operator=(GbmDevice&&) = delete;
-    GbmDevice(const GbmDevice&) = delete;
-    GbmDevice& operator=(const GbmDevice&) = delete;
-    ~GbmDevice() {
-        if (device_ != nullptr) gbm_device_destroy(device_);
-    }
-    [[nodiscard]] gbm_device* get() const { return device_; }
+    [[nodiscard]] gbm_device* get() const { return device_.get(); }
 
 private:
     explicit GbmDevice(gbm_device* device) : device_(device) {}
-    gbm_device* device_ = nullptr;
+    UniquePtr<gbm_device, &gbm_device_destroy> device_;
 };
 
 class GbmSurface {
@@ -38,20 +32,13 @@ public:
     // `format`: a GBM_FORMAT_* fourcc; `flags`: GBM_BO_USE_SCANOUT | GBM_BO_USE_RENDERING for KMS.
     [[nodiscard]] static Result<GbmSurface> create(const GbmDevice& device, ImageSize size, std::uint32_t format,
                                                    std::uint32_t flags);
-    GbmSurface(GbmSurface&& other) noexcept : surface_(std::exchange(other.surface_, nullptr)) {}
-    GbmSurface& operator=(GbmSurface&&) = delete;
-    GbmSurface(const GbmSurface&) = delete;
-    GbmSurface& operator=(const GbmSurface&) = delete;
-    ~GbmSurface() {
-        if (surface_ != nullptr) gbm_surface_destroy(surface_);
-    }
-    [[nodiscard]] gbm_surface* get() const { return surface_; }
+    [[nodiscard]] gbm_surface* get() const { return surface_.get(); }
     // False while every buffer is locked (on screen or waiting for a flip): don't render yet.
-    [[nodiscard]] bool has_free_buffers() const { return gbm_surface_has_free_buffers(surface_) != 0; }
+    [[nodiscard]] bool has_free_buffers() const { return gbm_surface_has_free_buffers(surface_.get()) != 0; }
 
 private:
     explicit GbmSurface(gbm_surface* surface) : surface_(surface) {}
-    gbm_surface* surface_ = nullptr;
+    UniquePtr<gbm_surface, &gbm_surface_destroy> surface_;
 };
 
 // The front buffer of a gbm_surface, locked after eglSwapBuffers; released to the surface (to be
@@ -61,29 +48,24 @@ public:
     LockedBo() = default;
     // EBUSY when the surface has no new front buffer (eglSwapBuffers not called since the last lock).
     [[nodiscard]] static Result<LockedBo> lock_front(const GbmSurface& surface);
-    LockedBo(LockedBo&& other) noexcept
-        : surface_(std::exchange(other.surface_, nullptr)), bo_(std::exchange(other.bo_, nullptr)) {}
-    LockedBo& operator=(LockedBo&& other) noexcept {
-        if (this != &other) {
-            reset();
-            surface_ = std::exchange(other.surface_, nullptr);
-            bo_ = std::exchange(other.bo_, nullptr);
-        }
-        return *this;
-    }
-    LockedBo(const LockedBo&) = delete;
-    LockedBo& operator=(const LockedBo&) = delete;
-    ~LockedBo() { reset(); }
-    [[nodiscard]] gbm_bo* get() const { return bo_; }
-    [[nodiscard]] bool valid() const { return bo_ != nullptr; }
-    void reset() noexcept {
-        if (bo_ != nullptr) gbm_surface_release_buffer(surface_, std::exchange(bo_, nullptr));
-    }
+    [[nodiscard]] gbm_bo* get() const { return bo_.get().bo; }
+    [[nodiscard]] bool valid() const { return bo_.valid(); }
+    void reset() noexcept { bo_.reset(); }
 
 private:
-    LockedBo(gbm_surface* surface, gbm_bo* bo) : surface_(surface), bo_(bo) {}
-    gbm_surface* surface_ = nullptr;
-    gbm_bo* bo_ = nullptr;
+    // The bo with the surface it goes back to: both move together, {nullptr, nullptr} owns nothing.
+    struct Locked {
+        gbm_surface* surface = nullptr;
+        gbm_bo* bo = nullptr;
+        bool operator==(const Locked&) const = default;
+    };
+    struct Traits {
+        using Value = Locked;
+        static constexpr Locked null() noexcept { return {}; }
+        static void close(Locked locked) noexcept { gbm_surface_release_buffer(locked.surface, locked.bo); }
+    };
+    LockedBo(gbm_surface* surface, gbm_bo* bo) : bo_(Locked{surface, bo}) {}
+    UniqueHandle<Traits> bo_;
 };
 
 // The DRM framebuffer id scanning out `bo`: added (drmModeAddFB2, with the bo's modifier when it

@@ -20,7 +20,7 @@
 namespace {
 
 using namespace mogao;
-using DrmVersionPtr = std::unique_ptr<drmVersion, DrmFree<&drmFreeVersion>>;
+using DrmVersionPtr = UniquePtr<drmVersion, &drmFreeVersion>;
 
 const char* connection_text(drmModeConnection c) {
     switch (c) {

@@ -13,25 +13,19 @@
 #include <string_view>
 #include <vector>
 
+#include "common/unique_handle.h"
+
 namespace mogao::ossl {
 
-template <auto Free>
-struct Deleter {
-    template <typename T>
-    void operator()(T* p) const noexcept {
-        Free(p);
-    }
-};
-
-using Pkey = std::unique_ptr<EVP_PKEY, Deleter<&EVP_PKEY_free>>;
-using Cert = std::unique_ptr<X509, Deleter<&X509_free>>;
-using Bio = std::unique_ptr<BIO, Deleter<&BIO_free_all>>;
-using Bignum = std::unique_ptr<BIGNUM, Deleter<&BN_free>>;
-using Store = std::unique_ptr<X509_STORE, Deleter<&X509_STORE_free>>;
-using StoreCtx = std::unique_ptr<X509_STORE_CTX, Deleter<&X509_STORE_CTX_free>>;
-using GeneralNames = std::unique_ptr<GENERAL_NAMES, Deleter<&GENERAL_NAMES_free>>;
-using GeneralName = std::unique_ptr<GENERAL_NAME, Deleter<&GENERAL_NAME_free>>;
-using OctetString = std::unique_ptr<ASN1_OCTET_STRING, Deleter<&ASN1_OCTET_STRING_free>>;
+using Pkey = UniquePtr<EVP_PKEY, &EVP_PKEY_free>;
+using Cert = UniquePtr<X509, &X509_free>;
+using Bio = UniquePtr<BIO, &BIO_free_all>;
+using Bignum = UniquePtr<BIGNUM, &BN_free>;
+using Store = UniquePtr<X509_STORE, &X509_STORE_free>;
+using StoreCtx = UniquePtr<X509_STORE_CTX, &X509_STORE_CTX_free>;
+using GeneralNames = UniquePtr<GENERAL_NAMES, &GENERAL_NAMES_free>;
+using GeneralName = UniquePtr<GENERAL_NAME, &GENERAL_NAME_free>;
+using OctetString = UniquePtr<ASN1_OCTET_STRING, &ASN1_OCTET_STRING_free>;
 
 // Drains OpenSSL's thread-local error queue into one line ("" when empty).
 [[nodiscard]] std::string errors();

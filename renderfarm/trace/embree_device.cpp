@@ -1,7 +1,6 @@
 #include "renderfarm/trace/embree_device.h"
 
 #include <stdexcept>
-#include <utility>
 
 namespace mogao {
 namespace {
@@ -36,31 +35,17 @@ const char* error_name(RTCError code) {
 
 }  // namespace
 
-EmbreeDevice::EmbreeDevice(const std::string& config) {
-    device_ = rtcNewDevice(config.empty() ? nullptr : config.c_str());
-    if (device_ == nullptr) {
+EmbreeDevice::EmbreeDevice(const std::string& config)
+    : device_(rtcNewDevice(config.empty() ? nullptr : config.c_str())) {
+    if (!device_) {
         // Creation errors are only reported through the null device's error code.
         throw_error("rtcNewDevice(\"" + config + "\")", rtcGetDeviceError(nullptr));
     }
-    rtcSetDeviceErrorFunction(device_, record_error, nullptr);
-}
-
-EmbreeDevice::~EmbreeDevice() {
-    if (device_ != nullptr) rtcReleaseDevice(device_);
-}
-
-EmbreeDevice::EmbreeDevice(EmbreeDevice&& other) noexcept : device_(std::exchange(other.device_, nullptr)) {}
-
-EmbreeDevice& EmbreeDevice::operator=(EmbreeDevice&& other) noexcept {
-    if (this != &other) {
-        if (device_ != nullptr) rtcReleaseDevice(device_);
-        device_ = std::exchange(other.device_, nullptr);
-    }
-    return *this;
+    rtcSetDeviceErrorFunction(device_.get(), record_error, nullptr);
 }
 
 void EmbreeDevice::check(std::string_view what) const {
-    const RTCError code = rtcGetDeviceError(device_);
+    const RTCError code = rtcGetDeviceError(device_.get());
     if (code != RTC_ERROR_NONE) throw_error(what, code);
 }
 

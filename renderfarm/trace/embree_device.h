@@ -14,6 +14,8 @@
 
 #include <embree3/rtcore.h>
 
+#include "common/unique_handle.h"
+
 namespace mogao {
 
 class EmbreeDevice {
@@ -21,20 +23,20 @@ public:
     // config: Embree device configuration, e.g. "threads=1" (BVH builds on one thread); "" = defaults.
     // Throws std::runtime_error if the device cannot be created (bad config, unsupported CPU).
     explicit EmbreeDevice(const std::string& config = "");
-    ~EmbreeDevice();
-    EmbreeDevice(const EmbreeDevice&) = delete;
-    EmbreeDevice& operator=(const EmbreeDevice&) = delete;
-    EmbreeDevice(EmbreeDevice&& other) noexcept;
-    EmbreeDevice& operator=(EmbreeDevice&& other) noexcept;
 
-    [[nodiscard]] RTCDevice get() const noexcept { return device_; }
+    [[nodiscard]] RTCDevice get() const noexcept { return device_.get(); }
 
     // Throws std::runtime_error naming `what` if an Embree call on this thread failed since the
     // last check(); no-op otherwise.
     void check(std::string_view what) const;
 
 private:
-    RTCDevice device_ = nullptr;
+    struct Traits {
+        using Value = RTCDevice;
+        static constexpr RTCDevice null() noexcept { return nullptr; }
+        static void close(RTCDevice device) noexcept { rtcReleaseDevice(device); }
+    };
+    UniqueHandle<Traits> device_;  // move-only; a moved-from device holds nullptr
 };
 
 }  // namespace mogao
