@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Renderer cost against raw Embree, measured in the same run (ratios are meaningful on any
 // machine, absolute times are not):
 //   (a) Embree alone: generate + rtcIntersect16 the camera packets the renderer traces;
@@ -6,15 +7,20 @@
 //       scene carrying present-but-unused features (zero-power area/point/environment lights,
 //       an uninstanced mesh, a zero-specular material), vs a shadowing sun plus a used area light.
 // The scene is built in code: a ~1M-triangle smooth height field plus a sphere.
-// Usage: mogao_bench_render [--width W] [--height H] [--spp N] [--reps N] [--grid N]
+// Usage: mogao_bench_render [--width W] [--height H] [--spp N] [--reps N] [--grid N] [--json FILE]
+// The table goes to stdout; --json FILE also writes every figure as JSON (for bench/regenerate-docs).
 // Timings use Renderer/RenderTimings from renderfarm/trace/render_timing.h, which the farm can
 // reuse on a real scene: time_render_vs_embree(scene, request).
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <numbers>
+#include <stdexcept>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "renderfarm/scene/procedural.h"
 #include "renderfarm/scene/scene.h"
@@ -98,6 +104,24 @@ int arg_int(int argc, char** argv, const char* name, int fallback) {
     return fallback;
 }
 
+const char* arg_str(int argc, char** argv, const char* name, const char* fallback) {
+    for (int i = 1; i + 1 < argc; ++i) {
+        if (std::strcmp(argv[i], name) == 0) return argv[i + 1];
+    }
+    return fallback;
+}
+
+nlohmann::json timing_json(const char* label, const RenderTimings& t) {
+    return {{"label", label},
+            {"embree_camera_ms", 1e3 * t.camera_rays_s},
+            {"embree_camera_rays", t.camera_rays},
+            {"renderer_ms", 1e3 * t.render_s},
+            {"renderer_rays", t.render_rays},
+            {"renderer_mrays_per_s", 1e-6 * static_cast<double>(t.render_rays) / t.render_s},
+            {"renderer_vs_embree", t.ratio()},
+            {"bvh_build_s", t.build_s}};
+}
+
 void print(const char* label, const RenderTimings& t, double baseline_s) {
     std::printf("%-44s %9.2f ms  %11llu rays  %6.2f Mrays/s  x%.2f vs (a)\n", label, 1e3 * t.render_s,
                 static_cast<unsigned long long>(t.render_rays), 1e-6 * static_cast<double>(t.render_rays) / t.render_s,
@@ -116,6 +140,7 @@ int main(int argc, char** argv) {
     request.pose.pitch_deg = -20.0;
     request.camera = PinholeCamera{60.0};
     const RendererOptions options{"threads=1", true};
+    const std::string json_file = arg_str(argc, argv, "--json", "");
 
     try {
         const Scene shadowed = base_scene(grid, true);
@@ -141,6 +166,26 @@ int main(int argc, char** argv) {
         std::printf("    (c2)/(c1) = %.3f  (unused features should cost nothing: ~1.0)\n", unused.render_s / plain.render_s);
         std::printf("    (c3)/(c1) = %.3f  (what shadows and an area light cost when used)\n", used.render_s / plain.render_s);
         std::printf("    BVH build (c1): %.2f s\n", plain.build_s);
+        if (!json_file.empty()) {
+            const nlohmann::json out = {
+                {"bench", "render_vs_embree"},
+                {"triangles", shadowed.meshes[0].triangle_count() + shadowed.meshes[1].triangle_count()},
+                {"width", request.size.width},
+                {"height", request.size.height},
+                {"spp", request.quality.spp},
+                {"reps", reps},
+                {"threads", 1},
+                {"b", timing_json("renderer, sun + shadows", direct)},
+                {"c1", timing_json("sun, no shadows, nothing else", plain)},
+                {"c2", timing_json("(c1) + unused lights/mesh/material", unused)},
+                {"c3", timing_json("sun + shadows + used area light", used)},
+                {"ratio_b_over_a", direct.ratio()},
+                {"ratio_c2_over_c1", unused.render_s / plain.render_s},
+                {"ratio_c3_over_c1", used.render_s / plain.render_s}};
+            std::ofstream file(json_file);
+            file << out.dump(1) << '\n';
+            if (!file.flush()) throw std::runtime_error("cannot write " + json_file);
+        }
     } catch (const std::exception& e) {
         std::fprintf(stderr, "mogao_bench_render: %s\n", e.what());
         return 1;

@@ -1,12 +1,14 @@
+// SPDX-License-Identifier: Apache-2.0
 // Bytes, encode/decode time and PSNR vs JPEG quality for one frame: the table in docs/encoding.md.
 //
-//   mogao_jpeg_quality_bench [frame.png|frame.ppm] [--reps N] [--subsampling 420|422|444]
+//   mogao_jpeg_quality_bench [frame.png|frame.ppm] [--reps N] [--subsampling 420|422|444] [--json FILE]
 //
 // Without an input it uses a synthetic 1920x1080 "render-like" frame (shaded gradient sky,
 // perspective checker floor, shaded discs, mild per-pixel noise like a low-spp path trace). Times
 // are medians over N encodes with one reused handle, after a warm-up round; "vs q85" is the encode
 // time relative to quality 85 measured in the same run, which survives a noisy shared machine
-// better than absolute milliseconds.
+// better than absolute milliseconds. --json FILE also writes the table as JSON (for
+// bench/regenerate-docs, which fills docs/benchmarks.md).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -14,6 +16,8 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
+#include <fstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -81,6 +85,24 @@ double median(std::vector<double> v) {
     return v.size() % 2 == 1 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
+// A JSON string literal (the input path is the only free text written).
+std::string json_string(const std::string& s) {
+    std::string out = "\"";
+    for (const char c : s) {
+        if (c == '"' || c == '\\') {
+            out += '\\';
+            out += c;
+        } else if (static_cast<unsigned char>(c) < 0x20) {
+            char buf[8];
+            std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
+            out += buf;
+        } else {
+            out += c;
+        }
+    }
+    return out + "\"";
+}
+
 struct Row {
     int quality = 0;
     std::size_t bytes = 0;
@@ -91,6 +113,7 @@ struct Row {
 
 int run(int argc, char** argv) {
     std::string input;
+    std::string json_file;
     int reps = 15;
     mogao::Subsampling subsampling = mogao::Subsampling::yuv420;
     std::string subsampling_name = "4:2:0";
@@ -104,10 +127,14 @@ int run(int argc, char** argv) {
             else if (s == "422") subsampling = mogao::Subsampling::yuv422;
             else if (s != "420") throw std::invalid_argument("--subsampling takes 420, 422 or 444");
             subsampling_name = s.substr(0, 1) + ":" + s.substr(1, 1) + ":" + s.substr(2, 1);
+        } else if (arg == "--json" && i + 1 < argc) {
+            json_file = argv[++i];
         } else if (!arg.empty() && arg[0] != '-' && input.empty()) {
             input = arg;
         } else {
-            std::fprintf(stderr, "usage: %s [frame.png|frame.ppm] [--reps N] [--subsampling 420|422|444]\n", argv[0]);
+            std::fprintf(stderr,
+                         "usage: %s [frame.png|frame.ppm] [--reps N] [--subsampling 420|422|444] [--json FILE]\n",
+                         argv[0]);
             return 2;
         }
     }
@@ -159,6 +186,26 @@ int run(int argc, char** argv) {
         std::printf("| %d | %zu | %.2f | %.2f | %.2fx | %.2f | %.2f |\n", r.quality, r.bytes,
                     8.0 * static_cast<double>(r.bytes) / pixels, r.encode_ms, r.encode_ms / q85->encode_ms,
                     r.decode_ms, r.psnr_db);
+    }
+    if (!json_file.empty()) {
+        std::ofstream out(json_file);
+        out << "{\n \"bench\": \"jpeg_quality\",\n \"input\": "
+            << json_string(input.empty() ? "synthetic render-like frame" : input)
+            << ",\n \"width\": " << image.size.width << ",\n \"height\": " << image.size.height
+            << ",\n \"subsampling\": " << json_string(subsampling_name) << ",\n \"reps\": " << reps
+            << ",\n \"rows\": [";
+        for (std::size_t i = 0; i < rows.size(); ++i) {
+            const Row& r = rows[i];
+            char line[320];
+            std::snprintf(line, sizeof line,
+                          "%s\n  {\"quality\": %d, \"bytes\": %zu, \"bits_per_pixel\": %.6g, \"encode_ms\": %.6g, "
+                          "\"encode_vs_q85\": %.6g, \"decode_ms\": %.6g, \"psnr_db\": %.6g}",
+                          i == 0 ? "" : ",", r.quality, r.bytes, 8.0 * static_cast<double>(r.bytes) / pixels,
+                          r.encode_ms, r.encode_ms / q85->encode_ms, r.decode_ms, r.psnr_db);
+            out << line;
+        }
+        out << "\n ]\n}\n";
+        if (!out.flush()) throw std::runtime_error("cannot write " + json_file);
     }
     return 0;
 }
