@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <optional>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -121,6 +123,11 @@ TEST(JpegCodec, RejectsBadArguments) {
     EXPECT_THROW((void)encoder.encode(Rgb8Image{}, 85), std::invalid_argument);
 }
 
+static_assert(!std::is_copy_constructible_v<JpegEncoder> && std::is_nothrow_move_constructible_v<JpegEncoder> &&
+              std::is_nothrow_move_assignable_v<JpegEncoder>);
+static_assert(!std::is_copy_constructible_v<JpegDecoder> && std::is_nothrow_move_constructible_v<JpegDecoder> &&
+              std::is_nothrow_move_assignable_v<JpegDecoder>);
+
 TEST(JpegCodec, MovedFromHandlesAreEmptyAndMovedToWork) {
     JpegEncoder a;
     JpegEncoder b = std::move(a);
@@ -129,7 +136,32 @@ TEST(JpegCodec, MovedFromHandlesAreEmptyAndMovedToWork) {
     JpegDecoder d1;
     JpegDecoder d2;
     d2 = std::move(d1);
+    EXPECT_THROW((void)d1.decode(b.encode(image, 85)), std::logic_error);  // NOLINT(bugprone-use-after-move)
     EXPECT_EQ(d2.decode(b.encode(image, 85)).size, image.size);
+}
+
+// The moved-to object's handle outlives the moved-from object (which must not tjDestroy it), and
+// assignment replaces a live handle; a failed decode replaces the handle in place, and the new one
+// moves like the old. Under the sanitizer build a second tjDestroy is a reported double free.
+TEST(JpegCodec, MovedHandlesSurviveTheSourceAndAssignmentReplacesALiveOne) {
+    const Rgb8Image image = test_images::gradient({24, 16});
+    std::optional<JpegEncoder> source(std::in_place);
+    JpegEncoder encoder = std::move(*source);
+    source.reset();
+    JpegEncoder replaced;
+    replaced = std::move(encoder);
+    const std::vector<std::uint8_t> jpeg = replaced.encode(image, 90);
+
+    std::optional<JpegDecoder> first(std::in_place);
+    EXPECT_THROW((void)first->decode(std::vector<std::uint8_t>(64, 0x42)), DecodeError);  // replaces the handle
+    JpegDecoder decoder;
+    decoder = std::move(*first);
+    first.reset();
+    EXPECT_EQ(decoder.decode(jpeg).size, image.size);
+    JpegDecoder again = std::move(decoder);
+    EXPECT_EQ(again.decode(jpeg).size, image.size);
+    decoder = std::move(again);  // assigning into a moved-from object
+    EXPECT_EQ(decoder.decode(jpeg).size, image.size);
 }
 
 TEST(JpegDecode, EmptyAndGarbageInputAreDecodeErrors) {

@@ -1,5 +1,13 @@
+#include <sys/types.h>
+
+#include <algorithm>
+#include <atomic>
+#include <iterator>
+#include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 #include <gtest/gtest.h>
@@ -9,6 +17,50 @@
 
 namespace mogao {
 namespace {
+
+static_assert(!std::is_copy_constructible_v<EmbreeDevice> && std::is_nothrow_move_constructible_v<EmbreeDevice> &&
+              std::is_nothrow_move_assignable_v<EmbreeDevice>);
+static_assert(!std::is_copy_constructible_v<EmbreeScene> && std::is_nothrow_move_assignable_v<EmbreeScene>);
+static_assert(!std::is_copy_constructible_v<EmbreeGeometry> && std::is_nothrow_move_assignable_v<EmbreeGeometry>);
+
+// Embree's memory monitor: bytes before each allocation, minus the bytes after each free.
+bool count_bytes(void* user, ssize_t bytes, bool /*post*/) {
+    static_cast<std::atomic<long long>*>(user)->fetch_add(bytes);
+    return true;
+}
+
+// A committed scene of one triangle at z = -5 facing +z; the geometry's owner is gone on return,
+// so the scene holds the only reference to it.
+EmbreeScene triangle_scene(const EmbreeDevice& device) {
+    EmbreeScene scene(device);
+    EmbreeGeometry triangle(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(triangle.get(), RTC_BUFFER_TYPE_VERTEX, 0,
+                                                          RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3));
+    const float vertices[9] = {-1, -1, -5, 1, -1, -5, 0, 1, -5};
+    std::copy(std::begin(vertices), std::end(vertices), v);
+    auto* index = static_cast<unsigned*>(rtcSetNewGeometryBuffer(triangle.get(), RTC_BUFFER_TYPE_INDEX, 0,
+                                                                 RTC_FORMAT_UINT3, 3 * sizeof(unsigned), 1));
+    index[0] = 0;
+    index[1] = 1;
+    index[2] = 2;
+    rtcCommitGeometry(triangle.get());
+    rtcAttachGeometry(scene.get(), triangle.get());
+    rtcCommitScene(scene.get());
+    device.check("triangle scene");
+    return scene;
+}
+
+bool ray_down_z_hits(RTCScene scene) {
+    RTCRayHit rh{};
+    rh.ray.dir_z = -1;
+    rh.ray.tfar = std::numeric_limits<float>::infinity();
+    rh.ray.mask = ~0u;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    rtcIntersect1(scene, &context, &rh);
+    return rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+}
 
 TEST(EmbreeRaii, MovesTransferOwnership) {
     EmbreeDevice device("threads=1");
@@ -28,6 +80,60 @@ TEST(EmbreeRaii, MovesTransferOwnership) {
     EmbreeDevice device2 = std::move(device);
     EXPECT_EQ(device.get(), nullptr);  // NOLINT(bugprone-use-after-move)
     EXPECT_NE(device2.get(), nullptr);
+}
+
+TEST(EmbreeRaii, MovedSceneIsReleasedOnceByItsLastOwner) {
+    EmbreeDevice device("threads=1");
+    std::atomic<long long> bytes{0};
+    rtcSetDeviceMemoryMonitorFunction(device.get(), count_bytes, &bytes);
+
+    std::optional<EmbreeScene> source(triangle_scene(device));
+    const long long one_scene = bytes.load();
+    ASSERT_GT(one_scene, 0) << "Embree reported no memory for a built BVH; this test cannot observe releases";
+    const RTCScene handle = source->get();
+    EmbreeScene target(std::move(*source));
+    EXPECT_EQ(source->get(), nullptr);  // NOLINT(bugprone-use-after-move)
+    EXPECT_EQ(target.get(), handle);
+    source.reset();
+    EXPECT_EQ(bytes.load(), one_scene) << "destroying the moved-from owner released the scene";
+    EXPECT_TRUE(ray_down_z_hits(target.get()));
+
+    // Assignment releases the target's old scene, and keeps the new one alive and usable.
+    EmbreeScene other = triangle_scene(device);
+    const long long two_scenes = bytes.load();
+    target = std::move(other);
+    EXPECT_EQ(other.get(), nullptr);  // NOLINT(bugprone-use-after-move)
+    EXPECT_LT(bytes.load(), two_scenes) << "the replaced scene was not released";
+    const long long after_assignment = bytes.load();
+    { EmbreeScene dropped = std::move(other); }
+    EXPECT_EQ(bytes.load(), after_assignment);
+    EXPECT_TRUE(ray_down_z_hits(target.get()));
+    target = EmbreeScene(device);
+    EXPECT_LT(bytes.load(), after_assignment);
+}
+
+TEST(EmbreeRaii, MovedDeviceIsReleasedOnceByItsLastOwner) {
+    RTCDevice raw = nullptr;
+    {
+        EmbreeDevice source("threads=1");
+        raw = source.get();
+        rtcRetainDevice(raw);  // the test's own reference, which outlives every owner
+        EmbreeDevice target(std::move(source));
+        EXPECT_EQ(source.get(), nullptr);  // NOLINT(bugprone-use-after-move)
+        EmbreeDevice assigned("threads=1");
+        assigned = std::move(target);
+        EXPECT_EQ(target.get(), nullptr);  // NOLINT(bugprone-use-after-move)
+        EXPECT_EQ(assigned.get(), raw);
+        EXPECT_NO_THROW(assigned.check("after moves"));
+    }
+    // Three owners held one reference between them; ours keeps the device alive. A second release
+    // would have freed it under us (a use after free that the sanitizer build reports).
+    EXPECT_EQ(rtcGetDeviceProperty(raw, RTC_DEVICE_PROPERTY_VERSION), RTC_VERSION);
+    RTCScene scene = rtcNewScene(raw);
+    EXPECT_NE(scene, nullptr);
+    EXPECT_EQ(rtcGetDeviceError(raw), RTC_ERROR_NONE);
+    rtcReleaseScene(scene);
+    rtcReleaseDevice(raw);
 }
 
 TEST(EmbreeRaii, EmbreeErrorsBecomeExceptions) {
