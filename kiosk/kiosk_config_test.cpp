@@ -1,5 +1,7 @@
 #include "kiosk/kiosk_config.h"
 
+#include "kiosk/config_overrides.h"
+
 #include "appliance/tracker/camera_intrinsics.h"
 
 #include <gtest/gtest.h>
@@ -43,58 +45,8 @@ public:  // the free helpers below build on good()
 
     [[nodiscard]] fs::path name() const { return dir_ / "kiosk.toml"; }
 
-    // Every field set, valid.
-    static std::string good() {
-        return R"([farm]
-endpoint = "[fd00:6d6f::1]:7443"
-server_name = "farm-1"
-ca = "pki/ca.pem"
-cert = "pki/appliance-a.pem"
-key = "pki/appliance-a.key"
-
-[display]
-rate_hz = 25
-
-[outputs]
-backend = "headless"
-sizes = ["320x240", "320x240", "320x240"]
-png_dir = "out/png"
-png_every = 5
-composite = true
-
-[calibration]
-source = "ideal"
-projectors = 3
-overlap = 0.2
-output = "320x240"
-gamma = 2.4
-
-[quality]
-content = "480x270"
-spp = 2
-jpeg_quality = 90
-bounces = 1
-ao_samples = 4
-area_light_samples = 2
-
-[screen]
-radius_m = 3.5
-arc_deg = 160
-bottom_m = 0.1
-top_m = 2.9
-
-[navigation]
-path = "orbit"
-path_frames = 120
-start = [0.0, 0.0, 4.0]
-start_yaw_deg = 10
-eye_height_m = 1.5
-
-[stats]
-file = "out/stats.json"
-log_period_s = 2.5
-)";
-    }
+    // Every field set, valid: kiosk.example.toml with kGood's overrides (defined below).
+    static std::string good(const std::vector<std::string>& more = {});
 
     [[nodiscard]] KioskConfig parse(const std::string& text) const { return parse_kiosk_config(text, name()); }
 
@@ -110,6 +62,31 @@ log_period_s = 2.5
 
     fs::path dir_;
 };
+
+std::string read_source_file(const char* relative) {
+    std::ifstream in(fs::path(MOGAO_SOURCE_DIR) / relative);
+    EXPECT_TRUE(in) << relative << " not found";
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Overrides of the shipped example that set every field (the files are made by SetUp).
+const std::vector<std::string> kGood = {
+    R"(farm.endpoint="[fd00:6d6f::1]:7443")", R"(farm.server_name="farm-1")", R"(farm.ca="pki/ca.pem")",
+    R"(farm.cert="pki/appliance-a.pem")", R"(farm.key="pki/appliance-a.key")", "display.rate_hz=25",
+    R"(outputs.backend="headless")", R"(outputs.sizes=["320x240", "320x240", "320x240"])", R"(outputs.png_dir="out/png")",
+    "outputs.png_every=5", "outputs.composite=true", R"(calibration.source="ideal")", "calibration.projectors=3",
+    "calibration.overlap=0.2", R"(calibration.output="320x240")", "calibration.gamma=2.4", R"(quality.content="480x270")",
+    "quality.spp=2", "quality.jpeg_quality=90", "quality.bounces=1", "quality.ao_samples=4",
+    "quality.area_light_samples=2", "screen.radius_m=3.5", "screen.arc_deg=160", "screen.bottom_m=0.1",
+    "screen.top_m=2.9", R"(navigation.path="orbit")", "navigation.path_frames=120", "navigation.start=[0.0, 0.0, 4.0]",
+    "navigation.start_yaw_deg=10", "navigation.eye_height_m=1.5", R"(stats.file="out/stats.json")",
+    "stats.log_period_s=2.5"};
+
+std::string KioskConfigTest::good(const std::vector<std::string>& more) {
+    std::vector<std::string> overrides = kGood;
+    overrides.insert(overrides.end(), more.begin(), more.end());
+    return apply_config_overrides(read_source_file("kiosk/kiosk.example.toml"), overrides);
+}
 
 // `text` with the first occurrence of `from` replaced by `to` (fails the test if absent).
 std::string replace(std::string text, const std::string& from, const std::string& to) {
@@ -170,18 +147,11 @@ key = "pki/appliance-a.key"
 }
 
 TEST_F(KioskConfigTest, AcceptsAnMpcdiSourceAPathFileAndKmsDevice) {
-    std::string text = replace(good(), R"(source = "ideal"
-projectors = 3
-overlap = 0.2
-output = "320x240"
-gamma = 2.4)", R"(source = "screen.mpcdi")");
-    text = replace(text, R"(path = "orbit")", R"(path = "tour.json")");
-    text = replace(text, R"(backend = "headless"
-sizes = ["320x240", "320x240", "320x240"]
-png_dir = "out/png"
-png_every = 5
-composite = true)", R"(backend = "kms"
-device = "/dev/dri/card1")");
+    // Empty values comment the ideal-only and headless-only keys out again.
+    const std::string text = good({R"(calibration.source="screen.mpcdi")", "calibration.projectors=", "calibration.overlap=",
+                                   "calibration.output=", "calibration.gamma=", R"(navigation.path="tour.json")",
+                                   R"(outputs.backend="kms")", R"(outputs.device="/dev/dri/card1")", "outputs.sizes=",
+                                   "outputs.png_dir=", "outputs.png_every=", "outputs.composite="});
     const KioskConfig c = parse(text);
     EXPECT_EQ(c.calibration.mpcdi, dir_ / "screen.mpcdi");
     EXPECT_EQ(c.navigation.path, (dir_ / "tour.json").string());
@@ -263,7 +233,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadField{"log_period_s = 2.5", "log_period_s = 0", "[stats].log_period_s = 0 is outside [0.1, 86400] s"},
         BadField{R"(file = "out/stats.json")", "file = 3", "[stats].file: expected a string"},
         BadField{"[display]", "[displays]", "[displays]: unknown section (known: farm, display"},
-        BadField{"[display]\nrate_hz = 25", "[display.rate]\nhz = 25", "[display].rate: unknown field (known: rate_hz)"},
+        BadField{"rate_hz = 25", "[display.rate]\nhz = 25", "[display].rate: unknown field (known: rate_hz)"},
         BadField{"rate_hz = 25", "rate_hz = = 25", "not valid TOML"}));
 
 TEST_F(KioskConfigTest, MessagesCarryTheLineOfTheOffendingValue) {
@@ -321,50 +291,26 @@ TEST_F(KioskConfigTest, TheExampleFileIsValid) {
 
 // --- [navigation] source = "tracking" ---------------------------------------------------------
 
-// good() with a tracking [navigation] section (every tracking field set).
-std::string tracking(const std::string& navigation) {
-    return replace(KioskConfigTest::good(), R"([navigation]
-path = "orbit"
-path_frames = 120
-)", "[navigation]\n" + navigation);
+// good() with the tracking source: the scripted visitor's keys out, `navigation` in.
+std::string tracking(std::vector<std::string> navigation) {
+    navigation.insert(navigation.begin(), {"navigation.path=", "navigation.path_frames=", R"(navigation.source="tracking")"});
+    return KioskConfigTest::good(navigation);
 }
 
-const char* const kTrackingFields = R"(source = "tracking"
-camera = "replay:seq"
-camera_fps = 25
-tag_size_m = 0.12
-tag_id = 3
-replay_end = "idle"
-)";
-
-const char* const kTrackingTables = R"(
-[navigation.detector]
-family = "tag25h9"
-decimation = 1.5
-blur_sigma = 0.0
-refine_edges = false
-min_white_black_diff = 10
-decode_sharpening = 0.5
-max_hamming = 1
-threads = 2
-
-[navigation.control]
-rest_distance_m = 0.45
-rest_yaw_deg = 2
-turn_dead_zone_deg = 5
-turn_full_scale_deg = 25
-turn_max_deg_s = 60
-forward_max_m_s = 0.5
-strafe_max_m_s = 0.3
-pitch = true
-max_angular_accel_deg_s2 = 90
-hold_s = 0.2
-forget_s = 1.0
-max_dt_s = 0.05
-)";
-
+// Every tracking field set, the two tables included.
 std::string full_tracking() {
-    return replace(tracking(kTrackingFields), "[stats]", std::string(kTrackingTables) + "\n[stats]");
+    return tracking({R"(navigation.camera="replay:seq")", "navigation.camera_fps=25", "navigation.tag_size_m=0.12",
+                     "navigation.tag_id=3", R"(navigation.replay_end="idle")",
+                     R"(navigation.detector.family="tag25h9")", "navigation.detector.decimation=1.5",
+                     "navigation.detector.blur_sigma=0.0", "navigation.detector.refine_edges=false",
+                     "navigation.detector.min_white_black_diff=10", "navigation.detector.decode_sharpening=0.5",
+                     "navigation.detector.max_hamming=1", "navigation.detector.threads=2",
+                     "navigation.control.rest_distance_m=0.45", "navigation.control.rest_yaw_deg=2",
+                     "navigation.control.turn_dead_zone_deg=5", "navigation.control.turn_full_scale_deg=25",
+                     "navigation.control.turn_max_deg_s=60", "navigation.control.forward_max_m_s=0.5",
+                     "navigation.control.strafe_max_m_s=0.3", "navigation.control.pitch=true",
+                     "navigation.control.max_angular_accel_deg_s2=90", "navigation.control.hold_s=0.2",
+                     "navigation.control.forget_s=1.0", "navigation.control.max_dt_s=0.05"});
 }
 
 TEST_F(KioskConfigTest, ReadsTheTrackingFields) {
@@ -410,7 +356,7 @@ TEST_F(KioskConfigTest, ReadsTheTrackingFields) {
 }
 
 TEST_F(KioskConfigTest, TrackingDefaultsComeFromTheLibraries) {
-    const KioskConfig c = parse(tracking("source = \"tracking\"\ncamera = \"replay:seq\"\n"));
+    const KioskConfig c = parse(tracking({R"(navigation.camera="replay:seq")"}));
     const TrackingConfig& t = c.navigation.tracking;
     EXPECT_EQ(t.replay_end, ReplayEnd::stop);
     EXPECT_EQ(t.tag_id, -1);
@@ -418,18 +364,14 @@ TEST_F(KioskConfigTest, TrackingDefaultsComeFromTheLibraries) {
     EXPECT_EQ(t.detector.family, DetectorSettings{}.family);
     EXPECT_DOUBLE_EQ(t.params.turn.max_rate, NavigationParams{}.turn.max_rate);
     EXPECT_DOUBLE_EQ(t.params.rest.distance_m, NavigationParams{}.rest.distance_m);
-    EXPECT_EQ(parse(tracking("source = \"tracking\"\ncamera = \"replay:seq\"\nreplay_end = \"loop\"\n"))
+    EXPECT_EQ(parse(tracking({R"(navigation.camera="replay:seq")", R"(navigation.replay_end="loop")"}))
                   .navigation.tracking.source.loop,
               true);
 }
 
 TEST_F(KioskConfigTest, AV4l2CameraNeedsIntrinsicsAndRescalesThemToItsSize) {
-    const KioskConfig c = parse(tracking(R"(source = "tracking"
-camera = "v4l2:/dev/video2"
-intrinsics = "webcam.json"
-camera_size = "400x300"
-camera_fps = 30
-)"));
+    const KioskConfig c = parse(tracking({R"(navigation.camera="v4l2:/dev/video2")", R"(navigation.intrinsics="webcam.json")",
+                                          R"(navigation.camera_size="400x300")", "navigation.camera_fps=30"}));
     const TrackingConfig& t = c.navigation.tracking;
     EXPECT_EQ(t.source.kind, CameraSourceSpec::Kind::v4l2);
     EXPECT_EQ(t.source.device, "/dev/video2");
@@ -439,7 +381,8 @@ camera_fps = 30
     EXPECT_EQ(t.intrinsics.width, 400);
     EXPECT_DOUBLE_EQ(t.intrinsics.fx, 350.0);  // a 2x2-binned mode of the calibrated sensor
     EXPECT_DOUBLE_EQ(t.intrinsics.cx, 199.5);
-    const KioskConfig same = parse(tracking("source = \"tracking\"\ncamera = \"v4l2:/dev/video0\"\nintrinsics = \"webcam.json\"\n"));
+    const KioskConfig same =
+        parse(tracking({R"(navigation.camera="v4l2:/dev/video0")", R"(navigation.intrinsics="webcam.json")"}));
     EXPECT_EQ(same.navigation.tracking.source.width, 800);  // the calibrated size by default
     EXPECT_EQ(same.navigation.tracking.source.fps, 0);
 }
@@ -486,15 +429,9 @@ INSTANTIATE_TEST_SUITE_P(
         BadField{"[navigation.control]", "[navigation.controls]", "[navigation].controls: unknown field"}));
 
 TEST_F(KioskConfigTest, ThePathSourceRejectsTrackingTables) {
-    const std::string text = replace(good(), "[stats]", "[navigation.detector]\nthreads = 1\n\n[stats]");
+    const std::string text = good({"navigation.detector.threads=1"});
     EXPECT_NE(error_of(text).find("[navigation].detector: only with source = \"tracking\""), std::string::npos)
         << error_of(text);
-}
-
-std::string read_source_file(const char* relative) {
-    std::ifstream in(fs::path(MOGAO_SOURCE_DIR) / relative);
-    EXPECT_TRUE(in) << relative << " not found";
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 // The commented tracking example of kiosk.example.toml, uncommented, is valid too: every "# key ="
@@ -537,8 +474,8 @@ TEST_F(KioskConfigTest, TheExampleFilesTrackingBlockIsValid) {
     EXPECT_DOUBLE_EQ(c.navigation.tracking.params.turn.max_rate, 45.0);
 }
 
-// kiosk/tour-tracking.toml, placed as the README's live tour uses it: out/live/ with its PKI, the
-// sequence in out/hand-sequence.
+// kiosk/tour-tracking.overrides applied to the example, placed as the README's live tour uses it:
+// out/live/ with its PKI, the sequence in out/hand-sequence.
 TEST_F(KioskConfigTest, TheTourTrackingFileIsValidInItsPlace) {
     fs::create_directories(dir_ / "out/live/pki");
     for (const char* f : {"out/live/pki/ca.pem", "out/live/pki/appliance-museum-1.pem", "out/live/pki/appliance-museum-1.key"}) {
@@ -546,12 +483,69 @@ TEST_F(KioskConfigTest, TheTourTrackingFileIsValidInItsPlace) {
     }
     fs::create_directories(dir_ / "out/hand-sequence");
     fs::copy_file(dir_ / "webcam.json", dir_ / "out/hand-sequence/camera.json");
-    const KioskConfig c = parse_kiosk_config(read_source_file("kiosk/tour-tracking.toml"), dir_ / "out/live/kiosk-tracking.toml");
+    const std::vector<std::string> overrides =
+        expand_override_files({"@" + (fs::path(MOGAO_SOURCE_DIR) / "kiosk/tour-tracking.overrides").string()});
+    ASSERT_GE(overrides.size(), 10u);
+    const KioskConfig c = parse_kiosk_config(apply_config_overrides(kiosk_example_toml(), overrides),
+                                             dir_ / "out/live/kiosk-tracking.toml");
     EXPECT_EQ(c.navigation.source, NavigationSource::tracking);
     EXPECT_EQ(c.navigation.tracking.source.folder, dir_ / "out/hand-sequence");
     EXPECT_EQ(c.navigation.tracking.intrinsics_file, dir_ / "out/hand-sequence/camera.json");
     EXPECT_EQ(c.navigation.tracking.replay_end, ReplayEnd::stop);
     EXPECT_EQ(c.outputs.backend, OutputKind::headless);
+    EXPECT_EQ(c.outputs.png_dir, dir_ / "out/live/outputs-tracking");
+    EXPECT_DOUBLE_EQ(c.navigation.tracking.params.max_dt_s, 0.5);
+}
+
+// --- the example with overrides (mogao-kiosk --print-config) -----------------------------------
+
+TEST(ConfigOverrides, TheBuiltInExampleIsTheFileAndNoOverridesChangeNothing) {
+    const std::string example = read_source_file("kiosk/kiosk.example.toml");
+    EXPECT_EQ(kiosk_example_toml(), example) << "the built-in example is stale: re-run CMake";
+    EXPECT_EQ(apply_config_overrides(example, {}), example);
+}
+
+TEST(ConfigOverrides, SetUncommentAndCommentOutKeysAndTables) {
+    const std::string text = apply_config_overrides(
+        kiosk_example_toml(), {"display.rate_hz=15", "outputs.png_every=3", "stats.file=",
+                               "navigation.control.max_dt_s=0.5", "display.rate_hz=20"});
+    EXPECT_NE(text.find("\nrate_hz = 20\n"), std::string::npos) << "the later override wins";
+    EXPECT_EQ(text.find("rate_hz = 15"), std::string::npos);
+    EXPECT_NE(text.find("\npng_every = 3\n"), std::string::npos);
+    EXPECT_NE(text.find("\n# file = \"/var/lib/mogao/kiosk-stats.json\""), std::string::npos);
+    EXPECT_NE(text.find("\n[navigation.control]"), std::string::npos);
+    EXPECT_NE(text.find("\nmax_dt_s = 0.5\n"), std::string::npos);
+    EXPECT_EQ(text.find("\n[navigation.detector]"), std::string::npos) << "an untouched table stays commented";
+}
+
+TEST(ConfigOverrides, RejectUnknownKeysSectionsMalformedOverridesAndInvalidToml) {
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"outputs.colour=1", "[outputs] has no field 'colour'"},
+        {"display.png_every=1", "[display] has no field 'png_every'"},  // a key of another section
+        {"displays.rate_hz=1", "no section [displays]"},
+        {"rate_hz=30", "expected section.key=VALUE"},
+        {"display.rate_hz", "expected section.key=VALUE"},
+        {"farm.endpoint=[::1]:7443", "not valid TOML"},  // the quotes are the caller's
+        {"display.rate_hz=1\nspp = 2", "one line"},
+    };
+    for (const auto& [override_text, expected] : cases) {
+        try {
+            (void)apply_config_overrides(kiosk_example_toml(), {override_text});
+            ADD_FAILURE() << "accepted: " << override_text;
+        } catch (const KioskConfigError& e) {
+            EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find(override_text), std::string::npos) << e.what();
+        }
+    }
+}
+
+TEST(ConfigOverrides, OverrideFilesSkipCommentsAndBlankLines) {
+    const fs::path file = fs::temp_directory_path() / ("mogao-overrides-" + std::to_string(::getpid()));
+    std::ofstream(file) << "# a comment\n\n  display.rate_hz=12\nstats.file=\n";
+    const std::vector<std::string> got = expand_override_files({"quality.spp=2", "@" + file.string()});
+    fs::remove(file);
+    EXPECT_EQ(got, (std::vector<std::string>{"quality.spp=2", "display.rate_hz=12", "stats.file="}));
+    EXPECT_THROW((void)expand_override_files({"@/nonexistent/overrides"}), KioskConfigError);
 }
 
 TEST(ParseSize, AcceptsOnlyWidthXHeight) {

@@ -6,6 +6,8 @@
 #include <fmt/format.h>
 
 #include "common/file_io.h"
+#include "kiosk/tracking_thread.h"
+#include "renderfarm/link/link_client.h"
 
 namespace mogao {
 namespace {
@@ -141,6 +143,41 @@ nlohmann::json KioskStats::to_json(const nlohmann::json& extra) const {
 void KioskStats::write_json(const std::filesystem::path& path, const nlohmann::json& extra) const {
     const std::string text = to_json(extra).dump(1) + "\n";
     write_file_atomically(path, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
+}
+
+nlohmann::json link_stats_json(const LinkClientStats& link) {
+    return {{"sessions_opened", link.sessions_opened},       {"attempts_failed", link.attempts_failed},
+            {"requests_submitted", link.requests_submitted}, {"requests_sent", link.requests_sent},
+            {"requests_coalesced", link.requests_coalesced}, {"frames_received", link.frames_received},
+            {"frames_discarded", link.frames_discarded},     {"bytes_received", link.bytes_received}};
+}
+
+nlohmann::json tracking_stats_json(const std::string& camera, const TrackingCounters& c, std::uint64_t samples_queued,
+                                   std::uint64_t samples_dropped, std::uint64_t samples_rejected_by_gate,
+                                   const ViewerPose& final_pose) {
+    return {{"camera", camera},
+            {"frames_tracked", c.frames},
+            {"frames_skipped", c.skipped},
+            {"tag_visible", c.visible},
+            {"ambiguous", c.ambiguous},
+            {"frame_errors", c.frame_errors},
+            {"camera_timeouts", c.timeouts},
+            {"camera_reopens", c.reopens},
+            {"replay_ended", c.ended},
+            {"samples_queued", samples_queued},
+            {"samples_dropped", samples_dropped},
+            {"samples_rejected_by_gate", samples_rejected_by_gate},
+            {"final_pose", {{"eye", {final_pose.eye.x(), final_pose.eye.y(), final_pose.eye.z()}},
+                            {"yaw_deg", final_pose.yaw_deg}}}};
+}
+
+nlohmann::json run_stats_json(const RunRecord& run) {
+    return {{"endpoint", run.endpoint},
+            {"content", {run.content.width, run.content.height}},
+            {"jpeg_quality", run.jpeg_quality},
+            {"navigation", run.navigation},
+            {"link", run.link},
+            {"exit_code", run.exit_code}};
 }
 
 }  // namespace mogao

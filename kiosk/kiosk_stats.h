@@ -14,6 +14,9 @@
 // in the JSON keeps the first `max_history` frames; the counters keep counting after that).
 //
 // Not thread-safe: the event loop owns it.
+//
+// Also here: the statistics JSON's other sections (link, navigation, run), built from the parts'
+// counters at exit (docs/kiosk.md lists the fields; tests and the live tour read them).
 #pragma once
 
 #include <cstddef>
@@ -25,7 +28,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/pixel_rect.h"
+#include "common/view_request.h"
+
 namespace mogao {
+
+struct LinkClientStats;   // renderfarm/link/link_client.h
+struct TrackingCounters;  // kiosk/tracking_thread.h
 
 struct PresentedFrame {
     std::uint64_t request_id = 0;
@@ -94,5 +103,24 @@ private:
     std::uint64_t last_request_id_ = 0;
     nlohmann::json events_ = nlohmann::json::array();
 };
+
+// "link": the LinkClient's counters at exit.
+[[nodiscard]] nlohmann::json link_stats_json(const LinkClientStats& link);
+
+// The tracking fields of "navigation": camera, tracking thread counters, queue and gate counts, final pose.
+[[nodiscard]] nlohmann::json tracking_stats_json(const std::string& camera, const TrackingCounters& counters,
+                                                 std::uint64_t samples_queued, std::uint64_t samples_dropped,
+                                                 std::uint64_t samples_rejected_by_gate, const ViewerPose& final_pose);
+
+// The run's fields beside KioskStats' own (KioskStats::write_json's `extra`).
+struct RunRecord {
+    std::string endpoint;
+    ImageSize content;
+    int jpeg_quality = 0;
+    nlohmann::json navigation;  // KioskNavigation::report
+    nlohmann::json link;        // link_stats_json
+    int exit_code = 0;
+};
+[[nodiscard]] nlohmann::json run_stats_json(const RunRecord& run);
 
 }  // namespace mogao

@@ -252,42 +252,20 @@ def main():
     with open(os.path.join(cfg, "still.json"), "w") as f:
         json.dump(STILL_VIEW, f)
 
-    def kiosk_toml(outputs_section, farm_endpoint=endpoint):
-        return f"""# written by image/test/qemu_boot_test.py
-[farm]
-endpoint = "{farm_endpoint}"
-ca = "pki/ca.pem"
-cert = "pki/appliance-museum-1.pem"
-key = "pki/appliance-museum-1.key"
+    def kiosk_toml(outputs, farm_endpoint=endpoint):
+        """kiosk/kiosk.example.toml with this test's overrides (mogao-kiosk --print-config; section.key=TOML
+        value, empty: commented out); `outputs`: the [outputs] overrides."""
+        overrides = [f'farm.endpoint="{farm_endpoint}"', 'farm.ca="pki/ca.pem"', 'farm.cert="pki/appliance-museum-1.pem"',
+                     'farm.key="pki/appliance-museum-1.key"', f"display.rate_hz={RATE_HZ}", *outputs,
+                     'calibration.source="ideal"', f"calibration.projectors={OUTPUTS}", "calibration.overlap=0.15",
+                     f'calibration.output="{CALIBRATION[0]}x{CALIBRATION[1]}"', 'quality.content="480x270"',
+                     'navigation.path="still.json"', "navigation.path_frames=240", "navigation.start=[0.0, 0.0, 4.0]",
+                     "stats.file=", "stats.log_period_s=10"]
+        printed = subprocess.run([a.kiosk, "--print-config", *overrides], check=True, stdout=subprocess.PIPE, text=True)
+        return "# written by image/test/qemu_boot_test.py\n" + printed.stdout
 
-[display]
-rate_hz = {RATE_HZ}
-
-[outputs]
-{outputs_section}
-
-[calibration]
-source = "ideal"
-projectors = {OUTPUTS}
-overlap = 0.15
-output = "{CALIBRATION[0]}x{CALIBRATION[1]}"
-
-[quality]
-content = "480x270"
-spp = 1
-jpeg_quality = 85
-
-[navigation]
-path = "still.json"
-path_frames = 240
-start = [0.0, 0.0, 4.0]
-eye_height_m = 1.6
-
-[stats]
-log_period_s = 10
-"""
     with open(os.path.join(cfg, "kiosk.toml"), "w") as f:
-        f.write(kiosk_toml('backend = "kms"'))
+        f.write(kiosk_toml(['outputs.backend="kms"']))
 
     def headless_reference(name, farm_endpoint, seconds, farm):
         """The same kiosk on the host, headless, same calibration, outputs in MODES: per output the
@@ -297,8 +275,8 @@ log_period_s = 10
         os.makedirs(ref)
         sizes = ", ".join(f'"{w}x{h}"' for w, h in MODES)
         with open(os.path.join(cfg, "reference.toml"), "w") as f:
-            f.write(kiosk_toml(f'backend = "headless"\nsizes = [{sizes}]\npng_dir = "{ref}"\ncomposite = false',
-                               farm_endpoint))
+            f.write(kiosk_toml(['outputs.backend="headless"', f"outputs.sizes=[{sizes}]", f'outputs.png_dir="{ref}"',
+                                'outputs.composite=false'], farm_endpoint))
         subprocess.run([a.kiosk, "--config", os.path.join(cfg, "reference.toml"), "--duration", str(seconds)],
                        stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT, env=env, timeout=120)
         os.remove(os.path.join(cfg, "reference.toml"))

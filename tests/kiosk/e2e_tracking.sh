@@ -32,25 +32,14 @@ mkdir -p "$work"
 port=$((20000 + ($$ + 4099) % 20000))
 endpoint="[::1]:$port"
 make_pki "$work/pki" "::1"
-write_config "$work/kiosk.toml" "$endpoint" "$work/pki" "$work/png" 30
-# The scripted visitor's lines out, the tracking source in.
-python3 - "$work/kiosk.toml" <<'PY'
-import sys
-p = sys.argv[1]
-text = open(p).read()
 # 15 Hz display and requests (not 30): the farm's ranks and the outputs then leave the tracking
 # thread a core's worth of time on a 2-core machine; navigation does not depend on the rate.
-assert "rate_hz = 30\n" in text
-text = text.replace("rate_hz = 30\n", "rate_hz = 15\n")
-text = text.replace('path = "walk"\npath_frames = 240\n', '''source = "tracking"
-camera = "replay:hand-sequence"      # its camera.json is the intrinsics
-tag_size_m = 0.10
-tag_id = 0
-replay_end = "stop"
-''')
-assert 'source = "tracking"' in text
-open(p, "w").write(text)
-PY
+# The scripted visitor's keys out, the tracking source in (the replay's camera.json is the intrinsics).
+write_config "$work/kiosk.toml" "$endpoint" "$work/pki" "$work/png" 30 \
+  'display.rate_hz=15' 'navigation.path=' 'navigation.path_frames=' 'navigation.source="tracking"' \
+  'navigation.camera="replay:hand-sequence"' 'navigation.tag_size_m=0.10' 'navigation.tag_id=0' \
+  'navigation.replay_end="stop"'
+grep -q '^source = "tracking"' "$work/kiosk.toml" || fail "the tracking source is not in $work/kiosk.toml"
 start_farm "$work/farm.log" "$endpoint"
 log "farm up at $endpoint"
 

@@ -67,49 +67,20 @@ make_pki() {
   "$farm" pki issue-appliance --dir "$1" --name museum-1 >/dev/null || fail "pki issue-appliance"
 }
 
-# write_config FILE ENDPOINT PKI PNG_DIR PNG_EVERY
+# write_config FILE ENDPOINT PKI PNG_DIR PNG_EVERY [OVERRIDE...]: kiosk/kiosk.example.toml with the
+# test's overrides (mogao-kiosk --print-config; section.key=TOML value, empty value: commented out):
+# headless, the ideal 3-projector calibration at 320x240, the walk; later OVERRIDEs win.
 write_config() {
-  cat > "$1" <<TOML
-[farm]
-endpoint = "$2"
-ca = "$3/ca.pem"
-cert = "$3/appliance-museum-1.pem"
-key = "$3/appliance-museum-1.key"
-
-[display]
-rate_hz = 30
-
-[outputs]
-backend = "headless"
-png_dir = "$4"
-png_every = $5
-
-[calibration]
-source = "ideal"
-projectors = 3
-overlap = 0.15
-output = "320x240"
-
-[quality]
-content = "${CONTENT_W}x${CONTENT_H}"
-spp = 1
-jpeg_quality = $JPEG_QUALITY
-
-[screen]
-radius_m = 3.0
-arc_deg = 150
-bottom_m = 0.2
-top_m = 2.8
-
-[navigation]
-path = "walk"
-path_frames = 240
-start = [0.0, 0.0, 4.0]
-eye_height_m = 1.6
-
-[stats]
-log_period_s = 2
-TOML
+  local file=$1 endpoint=$2 pki=$3 png_dir=$4 png_every=$5
+  shift 5
+  "$kiosk" --print-config \
+    "farm.endpoint=\"$endpoint\"" "farm.ca=\"$pki/ca.pem\"" \
+    "farm.cert=\"$pki/appliance-museum-1.pem\"" "farm.key=\"$pki/appliance-museum-1.key\"" \
+    'outputs.backend="headless"' "outputs.png_dir=\"$png_dir\"" "outputs.png_every=$png_every" \
+    'calibration.source="ideal"' 'calibration.projectors=3' 'calibration.overlap=0.15' 'calibration.output="320x240"' \
+    "quality.content=\"${CONTENT_W}x${CONTENT_H}\"" 'quality.spp=1' "quality.jpeg_quality=$JPEG_QUALITY" \
+    'navigation.path="walk"' 'navigation.path_frames=240' 'navigation.start=[0.0, 0.0, 4.0]' \
+    'stats.file=' 'stats.log_period_s=2' "$@" > "$file" || fail "mogao-kiosk --print-config"
 }
 
 # start_farm LOG LISTEN [PREFIX...]: 3 MPI ranks serving the test room; returns once the farm logs

@@ -146,49 +146,23 @@ def host_dirs(work, farm, overlay, layout):
     return pki, dirs
 
 
-def kiosk_config(work, pki):
+def kiosk_config(kiosk, work, pki):
+    """kiosk/kiosk.example.toml with this test's overrides (mogao-kiosk --print-config; section.key=TOML value,
+    empty: commented out): headless, one 320x180 output, the walk."""
     out = os.path.join(work, "kiosk")
     shutil.rmtree(out, ignore_errors=True)
     os.makedirs(os.path.join(out, "png"))
     os.makedirs(os.path.join(out, "content"))
     path = os.path.join(out, "kiosk.toml")
-    write(path, f"""# written by image/farm/test/farm_qemu_test.py: the host plays the appliance
-[farm]
-endpoint = "[{V6}10]:{PORT}"
-ca = "{pki}/ca.pem"
-cert = "{pki}/appliance-museum-1.pem"
-key = "{pki}/appliance-museum-1.key"
-
-[display]
-rate_hz = 2
-
-[outputs]
-backend = "headless"
-sizes = ["320x180"]
-png_dir = "{out}/png"
-png_every = 1
-composite = false
-
-[calibration]
-source = "ideal"
-projectors = 1
-overlap = 0.0
-output = "320x180"
-
-[quality]
-content = "320x180"
-spp = 1
-jpeg_quality = 85
-
-[navigation]
-path = "walk"
-path_frames = 240
-start = [0.0, 0.0, 4.0]
-eye_height_m = 1.6
-
-[stats]
-log_period_s = 5
-""")
+    overrides = [f'farm.endpoint="[{V6}10]:{PORT}"', f'farm.ca="{pki}/ca.pem"', f'farm.cert="{pki}/appliance-museum-1.pem"',
+                 f'farm.key="{pki}/appliance-museum-1.key"', "display.rate_hz=2", 'outputs.backend="headless"',
+                 'outputs.sizes=["320x180"]', f'outputs.png_dir="{out}/png"', "outputs.png_every=1",
+                 "outputs.composite=false", 'calibration.source="ideal"', "calibration.projectors=1",
+                 "calibration.overlap=0.0", 'calibration.output="320x180"', 'quality.content="320x180"',
+                 'navigation.path="walk"', "navigation.path_frames=240", "navigation.start=[0.0, 0.0, 4.0]",
+                 "stats.file=", "stats.log_period_s=5"]
+    printed = subprocess.run([kiosk, "--print-config", *overrides], check=True, stdout=subprocess.PIPE, text=True)
+    write(path, "# written by image/farm/test/farm_qemu_test.py: the host plays the appliance\n" + printed.stdout)
     return out, path
 
 
@@ -244,7 +218,7 @@ def main():
         farmvm.serial_console_entry(img, work)
         log(f"{name}: provisioned copy {img} in {time.monotonic() - t:.1f} s")
         images[name] = img
-    kiosk_dir, kiosk_toml = kiosk_config(work, pki)
+    kiosk_dir, kiosk_toml = kiosk_config(a.kiosk, work, pki)
     r = subprocess.run([a.kiosk, "--config", kiosk_toml, "--check-config"], stdout=subprocess.PIPE,
                        stderr=subprocess.STDOUT, text=True)
     if not fails.check(r.returncode == 0, "the host kiosk's configuration validates"):

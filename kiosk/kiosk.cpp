@@ -1,0 +1,207 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "kiosk/kiosk.h"
+
+#include <csignal>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "kiosk/kiosk_setup.h"
+
+namespace mogao {
+
+namespace {
+
+TimerFd armed_tick(double rate_hz) {
+    auto tick = TimerFd::create();
+    if (!tick) throw KioskSetupError(1, "display tick: " + tick.error().message);
+    const auto period = std::chrono::nanoseconds(static_cast<std::int64_t>(1e9 / rate_hz));
+    if (Status s = tick->arm(period); !s) throw KioskSetupError(1, "display tick: " + s.error().message);
+    return std::move(tick).value();
+}
+
+const char* signal_name(int sig) { return sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "signal"; }
+
+std::string showing(const LastGoodFrame& last_good) {
+    const std::uint64_t last = last_good.current() ? last_good.current()->request_id : 0;
+    return last == 0 ? std::string("the connecting screen") : fmt::format("request {}", last);
+}
+
+}  // namespace
+
+KioskLink link_of(LinkClient& client) {
+    return {[&client](ViewRequest request, std::string* why) { return client.submit(std::move(request), why); },
+            [&client] { return client.stats(); }, [&client] { client.stop(); }};
+}
+
+Kiosk::Kiosk(const KioskConfig& config, KioskParts parts, KioskRunOptions options)
+    : config_(config), parts_(std::move(parts)), options_(std::move(options)), tick_(armed_tick(config.outputs.rate_hz)),
+      start_(std::chrono::steady_clock::now()), last_log_(start_) {
+    loop_.watch(parts_.signals.fd(), [this] { on_signal(); });
+    loop_.watch(parts_.inbox.fd(), [this] { on_frame(); });
+    loop_.watch(tick_.fd(), [this] { on_tick(); });
+    loop_.watch(parts_.display.event_fd(), [this] { on_flip(); });  // -1 headless: ignored
+}
+
+int Kiosk::run() {
+    if (Status s = loop_.run(); !s) {
+        spdlog::error("event loop: {}", s.error().message);
+        exit_code_ = 1;
+    }
+    return finish();
+}
+
+void Kiosk::fail(const char* what, const std::string& message) {
+    spdlog::error("{}: {}", what, message);
+    exit_code_ = 1;
+    loop_.stop();
+}
+
+void Kiosk::on_signal() {
+    auto sig = parts_.signals.read();
+    if (!sig) return fail("signals", sig.error().message);
+    if (!sig->has_value()) return;
+    spdlog::info("stopping: {}", signal_name(**sig));
+    loop_.stop();
+}
+
+void Kiosk::on_frame() {
+    std::optional<LinkFrame> frame = parts_.inbox.take();
+    parts_.display.stats().superseded(parts_.inbox.replaced());
+    if (!frame || !accept(*frame)) return;
+    const ContentFrame& f = *last_good_.current();
+    if (options_.dump) {
+        try {
+            options_.dump->dump(f);
+        } catch (const std::exception& e) {
+            spdlog::warn("--dump-content: {}", e.what());
+        }
+    }
+    parts_.display.show(f);
+    shown_since_tick_ = true;
+    check_frames_shown();
+}
+
+bool Kiosk::accept(const LinkFrame& frame) {
+    const std::uint64_t on_screen = last_good_.current() ? last_good_.current()->request_id : 0;
+    const std::string why = last_good_.accept(frame);
+    if (why.empty()) return true;
+    parts_.display.stats().rejected();
+    // The first ten, then every hundredth: a farm sending garbage must not flood the journal.
+    if (last_good_.rejected() <= 10 || last_good_.rejected() % 100 == 0) {
+        spdlog::warn("frame dropped ({} so far): {}; keeping request {} on screen", last_good_.rejected(), why,
+                     on_screen);
+    }
+    return false;
+}
+
+void Kiosk::check_frames_shown() {
+    const std::uint64_t shown = parts_.display.frames_on_screen();
+    if (shown == frames_seen_) return;
+    frames_seen_ = shown;
+    if (options_.frames > 0 && shown >= options_.frames) {
+        spdlog::info("stopping: {} frames shown (--frames)", shown);
+        loop_.stop();
+    }
+}
+
+void Kiosk::on_tick() {
+    auto expirations = tick_.drain();
+    if (!expirations) return fail("display tick", expirations.error().message);
+    if (*expirations == 0) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (options_.duration_s > 0 && std::chrono::duration<double>(now - start_).count() >= options_.duration_s) {
+        spdlog::info("stopping: {} s elapsed (--duration)", options_.duration_s);
+        loop_.stop();
+        return;
+    }
+    submit_next_view();
+    const LinkClientStats link = parts_.link.stats();
+    note_link_state(link);
+    if (!shown_since_tick_) {
+        // Nothing new this tick: show the current frame again (headless PNGs keep coming, a KMS
+        // output is refreshed).
+        parts_.display.repaint();
+        check_frames_shown();
+    }
+    shown_since_tick_ = false;
+    if (std::chrono::duration<double>(now - last_log_).count() >= config_.stats.log_period_s) {
+        spdlog::info("stats: {} link_sessions={} link_connected={}", parts_.display.stats().log_line(),
+                     link.sessions_opened, link.connected);
+        last_log_ = now;
+    }
+    parts_.notifier.watchdog();
+}
+
+void Kiosk::submit_next_view() {
+    KioskNavigation::Step step = parts_.navigation.next();
+    std::string why;
+    step.entry.request_id = parts_.link.submit(step.request, &why);
+    if (step.entry.request_id == 0) spdlog::error("view request refused: {}", why);
+    step.entry.tick = ++ticks_;
+    step.entry.pose = step.request.pose;
+    write_pose(step.entry);
+    if (step.replay_ended) {
+        spdlog::info("stopping: the tracking replay ended (replay_end = \"stop\")");
+        loop_.stop();
+    }
+}
+
+void Kiosk::write_pose(const PoseLogEntry& entry) {
+    if (!options_.pose_log) return;
+    try {
+        options_.pose_log->write(entry);
+    } catch (const std::exception& e) {
+        spdlog::error("--pose-log: {}; no more poses are logged", e.what());
+        options_.pose_log.reset();
+    }
+}
+
+void Kiosk::note_link_state(const LinkClientStats& link) {
+    if (link.connected == connected_) return;
+    connected_ = link.connected;
+    const char* state = connected_ ? "connected" : "disconnected";
+    spdlog::info("farm {} {}; showing {}", config_.farm.endpoint, state, showing(last_good_));
+    parts_.display.stats().event(realtime_ns(), state, last_good_.current() ? last_good_.current()->request_id : 0);
+}
+
+void Kiosk::on_flip() {
+    if (Status s = parts_.display.on_flip(); !s) return fail("output events", s.error().message);
+    check_frames_shown();
+}
+
+int Kiosk::finish() {
+    parts_.notifier.stopping();
+    parts_.navigation.stop();
+    parts_.link.stop();
+    if (options_.pose_log) {
+        try {
+            options_.pose_log->close();
+        } catch (const std::exception& e) {
+            spdlog::error("--pose-log: {}", e.what());
+            if (exit_code_ == 0) exit_code_ = 1;
+        }
+    }
+    const nlohmann::json navigation = parts_.navigation.report(ticks_);
+    const LinkClientStats link = parts_.link.stats();
+    spdlog::info("stats: {} link_sessions={}", parts_.display.stats().log_line(), link.sessions_opened);
+    if (config_.outputs.composite) parts_.display.write_composite();
+    write_statistics(navigation, link);
+    return exit_code_;
+}
+
+void Kiosk::write_statistics(const nlohmann::json& navigation, const LinkClientStats& link) {
+    if (config_.stats.file.empty()) return;
+    const RunRecord run{config_.farm.endpoint, config_.quality.content, config_.quality.jpeg_quality,
+                        navigation,           link_stats_json(link),   exit_code_};
+    try {
+        parts_.display.stats().write_json(config_.stats.file, run_stats_json(run));
+        spdlog::info("statistics: {}", config_.stats.file.string());
+    } catch (const std::exception& e) {
+        spdlog::error("statistics: {}", e.what());
+        if (exit_code_ == 0) exit_code_ = 1;
+    }
+}
+
+}  // namespace mogao

@@ -1,0 +1,116 @@
+// SPDX-License-Identifier: Apache-2.0
+// Kiosk: the appliance's display loop (docs/kiosk.md, "The event loop"). One poll(2) loop on the main
+// thread over four fds, one handler each:
+//   on_signal  signalfd: SIGINT/SIGTERM -> clean stop
+//   on_frame   the FrameInbox's eventfd: decode the newest farm frame (or drop it and keep the last
+//              good one) and show it on every output
+//   on_tick    timerfd ([display].rate_hz): --duration; next pose from the navigation; submit the view
+//              request; link state changes; idle repaint; periodic stats line; WATCHDOG=1
+//   on_flip    the backend's event fd (KMS page flips): pending content onto outputs ready again
+// The handlers are public so that tests can drive them one at a time (kiosk/kiosk_test.cpp).
+// run() loops until a stop (signal, --frames N on screen, --duration, end of a tracking replay), then
+// makes the clean stop: STOPPING=1, navigation, link, pose log, final stats line, composite, JSON.
+//
+// The parts are made by kiosk/main.cpp (kiosk/kiosk_setup.h) and outlive the Kiosk. Loop thread only
+// (the link's thread only touches the FrameInbox). Errors per docs/architecture.md: a bad frame is
+// dropped and logged; a broken fd stops the loop with exit code 1; run() returns the exit code.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "appliance/decode/last_good_frame.h"
+#include "common/service_notify.h"
+#include "common/view_request.h"
+#include "kiosk/content_dump.h"
+#include "kiosk/event_loop.h"
+#include "kiosk/frame_inbox.h"
+#include "kiosk/kiosk_config.h"
+#include "kiosk/kiosk_display.h"
+#include "kiosk/kiosk_navigation.h"
+#include "kiosk/pose_log.h"
+#include "kiosk/signal_fd.h"
+#include "kiosk/timer_fd.h"
+#include "renderfarm/link/link_client.h"
+
+namespace mogao {
+
+// What the loop needs of the link: mogao-kiosk wires a LinkClient (link_of); tests may record.
+struct KioskLink {
+    std::function<std::uint64_t(ViewRequest, std::string*)> submit;  // LinkClient::submit
+    std::function<LinkClientStats()> stats;
+    std::function<void()> stop;  // no frame callback runs afterwards
+};
+[[nodiscard]] KioskLink link_of(LinkClient& client);
+
+// The parts the loop drives, in pipeline order.
+struct KioskParts {
+    KioskDisplay& display;
+    FrameInbox& inbox;
+    KioskLink link;
+    KioskNavigation& navigation;
+    const SignalFd& signals;
+    ServiceNotifier& notifier;
+};
+
+// What the command line adds: stop conditions and records of the run.
+struct KioskRunOptions {
+    std::uint64_t frames = 0;        // --frames: stop once this many farm frames are on screen (0: never)
+    double duration_s = 0;           // --duration (0: never)
+    std::optional<ContentDump> dump;    // --dump-content
+    std::optional<PoseLog> pose_log;    // --pose-log
+};
+
+class Kiosk {
+public:
+    // Creates and arms the display tick and watches the four fds. Throws KioskSetupError (exit 1,
+    // "display tick: ...") when the timerfd cannot be made.
+    Kiosk(const KioskConfig& config, KioskParts parts, KioskRunOptions options);
+    Kiosk(const Kiosk&) = delete;
+    Kiosk& operator=(const Kiosk&) = delete;
+
+    // Loops until a stop, then the clean stop. Returns the exit code (0 stopped, 1 failure).
+    [[nodiscard]] int run();
+
+    void on_signal();
+    void on_frame();
+    void on_tick();
+    void on_flip();
+
+    [[nodiscard]] bool stopping() const { return loop_.stopping(); }
+    [[nodiscard]] int exit_code() const { return exit_code_; }
+    [[nodiscard]] std::uint64_t ticks() const { return ticks_; }
+    [[nodiscard]] const LastGoodFrame& last_good() const { return last_good_; }
+    [[nodiscard]] int tick_fd() const { return tick_.fd(); }
+
+    // The clean stop after the loop (run() calls it); returns the exit code.
+    [[nodiscard]] int finish();
+
+private:
+    void fail(const char* what, const std::string& message);  // logs, exit code 1, stops the loop
+    [[nodiscard]] bool accept(const LinkFrame& frame);         // decode into last_good_, or log the drop
+    void check_frames_shown();                                 // --frames
+    void submit_next_view();
+    void note_link_state(const LinkClientStats& link);
+    void write_pose(const PoseLogEntry& entry);
+    void write_statistics(const nlohmann::json& navigation, const LinkClientStats& link);
+
+    const KioskConfig& config_;
+    KioskParts parts_;
+    KioskRunOptions options_;
+    EventLoop loop_;
+    TimerFd tick_;
+    LastGoodFrame last_good_;
+    std::uint64_t ticks_ = 0;
+    std::uint64_t frames_seen_ = 0;
+    bool connected_ = false;
+    bool shown_since_tick_ = true;
+    std::chrono::steady_clock::time_point start_;
+    std::chrono::steady_clock::time_point last_log_;
+    int exit_code_ = 0;
+};
+
+}  // namespace mogao

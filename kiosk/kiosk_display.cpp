@@ -1,0 +1,81 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "kiosk/kiosk_display.h"
+
+#include <iterator>
+
+#include <spdlog/spdlog.h>
+
+#include "common/link_types.h"
+#include "kiosk/connecting_screen.h"
+
+namespace mogao {
+
+Result<KioskDisplay> KioskDisplay::create(std::unique_ptr<OutputBackend> backend, ScreenCalibration screen,
+                                          std::vector<std::string>* notes) {
+    auto presenter = ScreenPresenter::create(*backend, screen, notes);
+    if (!presenter) return presenter.error();
+    return KioskDisplay(std::move(backend), std::move(presenter).value(), std::move(screen));
+}
+
+Status KioskDisplay::show_connecting_screen(ImageSize content, const std::string& endpoint) {
+    if (Status s = presenter_.show(make_connecting_screen(content, "FARM " + endpoint), 0); !s) return s;
+    account();
+    return {};
+}
+
+void KioskDisplay::show(const ContentFrame& f) {
+    pending_[f.request_id] = PresentedFrame{f.request_id,       f.link_frame_id, f.jpeg_bytes, f.times.request_ns,
+                                            f.times.receive_ns, 0,               f.decode_ms,  stats_.rounds() + 1};
+    while (pending_.size() > kMaxPendingFrames) pending_.erase(pending_.begin());
+    if (Status s = presenter_.show(f.image, f.request_id); !s) spdlog::warn("present: {}", s.error().message);
+    account();
+}
+
+void KioskDisplay::repaint() {
+    // Outputs with a flip pending are left alone; the others show the current frame again.
+    if (Status s = presenter_.repaint(); !s) spdlog::warn("repaint: {}", s.error().message);
+    account();
+}
+
+Status KioskDisplay::on_flip() {
+    auto ready = backend_->dispatch_events();
+    if (!ready) return ready.error();
+    if (Status s = presenter_.on_ready(*ready); !s) spdlog::warn("present: {}", s.error().message);
+    account();
+    return {};
+}
+
+void KioskDisplay::account() {
+    if (presenter_.last_presents() > 0) {
+        stats_.display_round();
+        if (recorder_) {
+            try {
+                recorder_->write_round(stats_.rounds(), presenter_.current_tag());
+            } catch (const std::exception& e) {
+                spdlog::warn("PNG output: {}", e.what());
+            }
+        }
+    }
+    while (const auto tag = presenter_.take_completed()) {
+        const auto it = pending_.find(*tag);
+        if (it == pending_.end()) continue;  // the connecting screen (tag 0)
+        PresentedFrame done = it->second;
+        done.presented_ns = realtime_ns();
+        stats_.presented(done);
+        ++frames_on_screen_;
+        pending_.erase(pending_.begin(), std::next(it));  // older ones were overtaken on some output
+    }
+}
+
+void KioskDisplay::write_composite() const {
+    if (!recorder_) return;
+    const auto file = recorder_->dir() / "screen-composite.png";
+    try {
+        recorder_->write_composite(screen_, presenter_.projector_of(), file);
+        spdlog::info("composited screen: {}", file.string());
+    } catch (const std::exception& e) {
+        spdlog::warn("composited screen: {}", e.what());
+    }
+}
+
+}  // namespace mogao

@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: Apache-2.0
+// KioskDisplay: the kiosk's projector outputs and what it knows about them: the OutputBackend (KMS or
+// headless), the ScreenPresenter that warps and blends content onto every output, the headless PNG
+// recorder, and the frame accounting -- which farm frames are on screen everywhere (KioskStats:
+// motion-to-photon ends there), display rounds, PNGs per round.
+//
+// After every show / repaint / flip: a round that presented anything is counted (and recorded as
+// PNGs), and every frame that is now on screen on all outputs is passed to KioskStats. Frames shown
+// but not yet on screen everywhere (KMS flips pending) wait in a map by request id; a frame overtaken
+// on some output by a newer one is dropped from it when the newer one completes.
+//
+// Errors: presenting and PNG writing are logged as warnings (the show goes on, docs/kiosk.md); the
+// backend's event dispatch error is returned (the loop stops on it). Loop thread only (GL context).
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "appliance/decode/last_good_frame.h"
+#include "common/projector_calibration.h"
+#include "common/result.h"
+#include "drivers/output.h"
+#include "kiosk/headless_recorder.h"
+#include "kiosk/kiosk_stats.h"
+#include "kiosk/screen_presenter.h"
+
+namespace mogao {
+
+class KioskDisplay {
+public:
+    // `backend`'s outputs showing `screen` (ScreenPresenter::create; its notes are appended).
+    [[nodiscard]] static Result<KioskDisplay> create(std::unique_ptr<OutputBackend> backend, ScreenCalibration screen,
+                                                     std::vector<std::string>* notes);
+
+    // Headless PNGs of every k-th round and the composite at exit (the recorder reads `backend`).
+    void record_to(HeadlessRecorder recorder) { recorder_.emplace(std::move(recorder)); }
+
+    // The card shown until the first farm frame (tag 0: never counted as a farm frame).
+    [[nodiscard]] Status show_connecting_screen(ImageSize content, const std::string& endpoint);
+    // A decoded farm frame, newer than the one before.
+    void show(const ContentFrame& frame);
+    // The current frame again on every ready output (the tick's idle repaint).
+    void repaint();
+    // Page-flip events of the backend (KMS): outputs ready again get pending content.
+    [[nodiscard]] Status on_flip();
+
+    // Writes <png dir>/screen-composite.png when recording (logged; a failure is a warning).
+    void write_composite() const;
+
+    [[nodiscard]] std::uint64_t frames_on_screen() const { return frames_on_screen_; }
+    [[nodiscard]] KioskStats& stats() { return stats_; }
+    [[nodiscard]] const KioskStats& stats() const { return stats_; }
+    [[nodiscard]] int event_fd() const { return backend_->event_fd(); }
+    [[nodiscard]] const ScreenPresenter& presenter() const { return presenter_; }
+
+private:
+    KioskDisplay(std::unique_ptr<OutputBackend> backend, ScreenPresenter presenter, ScreenCalibration screen)
+        : backend_(std::move(backend)), presenter_(std::move(presenter)), screen_(std::move(screen)) {}
+    void account();  // after every present: rounds, PNGs, frames now on screen
+
+    // Frames on some outputs but not yet on screen everywhere, by request id; bounded, so that an
+    // output that never completes cannot grow it.
+    static constexpr std::size_t kMaxPendingFrames = 64;
+
+    // Declaration order: released recorder, presenter, then backend (docs/kiosk.md, clean stop).
+    std::unique_ptr<OutputBackend> backend_;
+    ScreenPresenter presenter_;
+    ScreenCalibration screen_;
+    std::optional<HeadlessRecorder> recorder_;
+    KioskStats stats_;
+    std::map<std::uint64_t, PresentedFrame> pending_;
+    std::uint64_t frames_on_screen_ = 0;
+};
+
+}  // namespace mogao

@@ -1,0 +1,151 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "kiosk/kiosk_setup.h"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "drivers/headless/headless_output.h"
+#include "drivers/kms/kms_backend.h"
+#include "kiosk/screen_calibration_source.h"
+
+namespace mogao {
+
+namespace {
+
+// The headless backend (its PNGs need it) or KMS.
+std::unique_ptr<OutputBackend> open_backend(const OutputsConfig& outputs, const ScreenCalibration& screen,
+                                            HeadlessOutputBackend** headless) {
+    if (outputs.backend == OutputKind::headless) {
+        HeadlessOptions options;
+        options.outputs = outputs.sizes;
+        if (options.outputs.empty()) {
+            for (const auto& p : screen.projectors) options.outputs.push_back(p.output);
+        }
+        auto created = HeadlessOutputBackend::create(options);
+        if (!created) throw KioskSetupError(1, "headless outputs: " + created.error().message);
+        *headless = created->get();
+        return std::move(created).value();
+    }
+    auto created = KmsOutputBackend::create(KmsOptions{outputs.device});
+    if (!created) {
+        throw KioskSetupError(1, fmt::format("KMS outputs{}: {}",
+                                             outputs.device.empty() ? "" : " on " + outputs.device.string(),
+                                             created.error().message));
+    }
+    return std::move(created).value();
+}
+
+}  // namespace
+
+KioskSetup load_setup(const std::filesystem::path& file, const std::string& path,
+                      const std::filesystem::path& stats_file) {
+    KioskSetup setup;
+    try {
+        setup.config = load_kiosk_config(file);
+    } catch (const KioskConfigError& e) {
+        throw KioskSetupError(2, e.what());
+    }
+    KioskConfig& config = setup.config;
+    if (!path.empty()) {
+        config.navigation.source = NavigationSource::path;  // --path: the scripted visitor, whatever the file says
+        config.navigation.path = path;
+    }
+    if (!stats_file.empty()) config.stats.file = stats_file;
+    try {
+        if (config.navigation.source != NavigationSource::tracking) setup.script.emplace(make_view_script(config));
+        setup.tls = load_tls_files(config.farm.ca, config.farm.cert, config.farm.key);
+    } catch (const std::exception& e) {
+        throw KioskSetupError(2, fmt::format("{}: {}", config.source.string(), e.what()));
+    }
+    return setup;
+}
+
+ScreenCalibration load_calibration(const KioskConfig& config) {
+    std::vector<std::string> notes;
+    ScreenCalibration screen;
+    try {
+        screen = load_screen_calibration(config.calibration, config.quality.content, &notes);
+    } catch (const std::exception& e) {
+        throw KioskSetupError(1, fmt::format("calibration: {}", e.what()));
+    }
+    for (const auto& n : notes) spdlog::info("calibration: {}", n);
+    return screen;
+}
+
+KioskDisplay open_display(const KioskConfig& config, ScreenCalibration screen) {
+    HeadlessOutputBackend* headless = nullptr;
+    std::unique_ptr<OutputBackend> backend = open_backend(config.outputs, screen, &headless);
+    for (const auto& o : backend->outputs()) {
+        spdlog::info("output {}: {}x{}{}", o.name, o.size.width, o.size.height,
+                     o.refresh_hz > 0 ? fmt::format(" @ {:.2f} Hz", o.refresh_hz) : std::string());
+    }
+    std::vector<std::string> notes;
+    auto display = KioskDisplay::create(std::move(backend), std::move(screen), &notes);
+    if (!display) throw KioskSetupError(1, "outputs: " + display.error().message);
+    for (const auto& n : notes) spdlog::warn("outputs: {}", n);
+    if (headless != nullptr && !config.outputs.png_dir.empty()) {
+        try {
+            display->record_to(HeadlessRecorder(*headless, config.outputs.png_dir, config.outputs.png_every));
+        } catch (const std::exception& e) {
+            throw KioskSetupError(1, fmt::format("output folders: {}", e.what()));
+        }
+    }
+    return std::move(display).value();
+}
+
+std::optional<ContentDump> open_content_dump(const std::filesystem::path& dir, int every) {
+    if (dir.empty()) return std::nullopt;
+    try {
+        return ContentDump(dir, every);
+    } catch (const std::exception& e) {
+        throw KioskSetupError(1, fmt::format("output folders: {}", e.what()));
+    }
+}
+
+std::unique_ptr<FrameInbox> open_inbox() {
+    auto inbox = FrameInbox::create();
+    if (!inbox) throw KioskSetupError(1, "event fds: " + inbox.error().message);
+    return std::move(inbox).value();
+}
+
+std::unique_ptr<LinkClient> open_link(const KioskConfig& config, TlsMaterial tls, FrameInbox& inbox,
+                                      const std::optional<ViewScript>& script) {
+    LinkClientOptions options;
+    options.endpoint = config.farm.endpoint;
+    options.server_name = config.farm.server_name;
+    options.tls = std::move(tls);
+    std::unique_ptr<LinkClient> client;
+    try {
+        // Runs on the link's connection thread: hand over and wake the loop, nothing else.
+        client = std::make_unique<LinkClient>(options, [&inbox](LinkFrame&& frame) { inbox.put(std::move(frame)); });
+    } catch (const std::exception& e) {
+        throw KioskSetupError(1, fmt::format("link: {}", e.what()));
+    }
+    spdlog::info("farm {}: {}x{} content, spp {}, JPEG quality {}, {}, {} Hz", config.farm.endpoint,
+                 config.quality.content.width, config.quality.content.height, config.quality.spp,
+                 config.quality.jpeg_quality,
+                 script ? fmt::format("path '{}' ({} poses)", config.navigation.path, script->size())
+                        : fmt::format("tracking '{}'", config.navigation.tracking.camera),
+                 config.outputs.rate_hz);
+    return client;
+}
+
+std::optional<PoseLog> open_pose_log(const std::filesystem::path& file) {
+    if (file.empty()) return std::nullopt;
+    try {
+        return PoseLog(file);
+    } catch (const std::exception& e) {
+        throw KioskSetupError(1, fmt::format("--pose-log: {}", e.what()));
+    }
+}
+
+std::unique_ptr<KioskNavigation> start_navigation(const KioskConfig& config, std::optional<ViewScript> script) {
+    if (config.navigation.source != NavigationSource::tracking) return std::make_unique<KioskNavigation>(std::move(*script));
+    try {
+        return std::make_unique<KioskNavigation>(config);
+    } catch (const std::exception& e) {
+        throw KioskSetupError(1, fmt::format("tracking: {}", e.what()));
+    }
+}
+
+}  // namespace mogao

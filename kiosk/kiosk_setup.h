@@ -1,0 +1,69 @@
+// SPDX-License-Identifier: Apache-2.0
+// The kiosk's start-up steps, in pipeline order (kiosk/main.cpp): configuration -> calibration ->
+// outputs -> link -> navigation. Each returns its part, logging what it found, or throws
+// KioskSetupError with the exit code and the message mogao-kiosk logs (docs/kiosk.md): 2 for a bad
+// configuration, 1 when the appliance cannot run (outputs, calibration, link set-up, files).
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include "common/projector_calibration.h"
+#include "kiosk/content_dump.h"
+#include "kiosk/frame_inbox.h"
+#include "kiosk/kiosk_config.h"
+#include "kiosk/kiosk_display.h"
+#include "kiosk/kiosk_navigation.h"
+#include "kiosk/pose_log.h"
+#include "kiosk/view_script.h"
+#include "renderfarm/link/link_client.h"
+#include "renderfarm/link/tls_material.h"
+
+namespace mogao {
+
+struct KioskSetupError : std::runtime_error {
+    KioskSetupError(int code, const std::string& message) : std::runtime_error(message), exit_code(code) {}
+    int exit_code;
+};
+
+// A checked configuration: the file with the command line's overrides, its TLS files, and the
+// scripted visitor's path (empty with tracking).
+struct KioskSetup {
+    KioskConfig config;
+    TlsMaterial tls;
+    std::optional<ViewScript> script;
+};
+
+// --path (non-empty: the scripted visitor on that path) and --stats (non-empty) override the file.
+[[nodiscard]] KioskSetup load_setup(const std::filesystem::path& file, const std::string& path,
+                                    const std::filesystem::path& stats_file);
+
+// MPCDI or ideal calibration ([calibration]); notes logged.
+[[nodiscard]] ScreenCalibration load_calibration(const KioskConfig& config);
+
+// The [outputs] backend (headless or KMS) showing `screen`, each output logged; headless PNGs when
+// png_dir is set. Then the connecting screen on every output.
+[[nodiscard]] KioskDisplay open_display(const KioskConfig& config, ScreenCalibration screen);
+
+// --dump-content DIR (empty: none).
+[[nodiscard]] std::optional<ContentDump> open_content_dump(const std::filesystem::path& dir, int every);
+
+// The loop's wake-up and frame slot.
+[[nodiscard]] std::unique_ptr<FrameInbox> open_inbox();
+
+// The link to [farm], delivering into `inbox`; logs what the kiosk asks the farm for (`script`: the
+// scripted visitor, if that is the navigation).
+[[nodiscard]] std::unique_ptr<LinkClient> open_link(const KioskConfig& config, TlsMaterial tls, FrameInbox& inbox,
+                                                    const std::optional<ViewScript>& script);
+
+// --pose-log FILE (empty: none).
+[[nodiscard]] std::optional<PoseLog> open_pose_log(const std::filesystem::path& file);
+
+// The scripted visitor (`script`) or, with tracking, the Navigator and tracking thread.
+[[nodiscard]] std::unique_ptr<KioskNavigation> start_navigation(const KioskConfig& config,
+                                                                std::optional<ViewScript> script);
+
+}  // namespace mogao

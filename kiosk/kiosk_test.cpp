@@ -1,0 +1,271 @@
+// SPDX-License-Identifier: Apache-2.0
+// The Kiosk's loop handlers (kiosk/kiosk.h), one at a time, on real parts: headless outputs on
+// surfaceless EGL (Mesa llvmpipe), the ideal 3-projector calibration, a real FrameInbox (slot +
+// eventfd), timerfd and signalfd, the scripted visitor, KioskStats, PoseLog and the configuration
+// made from kiosk.example.toml with overrides. The one stand-in is the link: the real LinkClient
+// needs a farm over gRPC + mutual TLS (the end-to-end tests in tests/kiosk/ run it), so here a
+// recording KioskLink keeps the view requests the loop submits and plays the link's counters.
+#include "kiosk/kiosk.h"
+
+#include <gtest/gtest.h>
+#include <poll.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <fstream>
+
+#include "common/jpeg_codec.h"
+#include "drivers/egl/egl_test_support.h"
+#include "drivers/headless/headless_output.h"
+#include "kiosk/config_overrides.h"
+#include "kiosk/kiosk_setup.h"
+
+namespace mogao {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr ImageSize kContent{160, 90};
+
+// Records what the loop asks of the link.
+struct RecordingLink {
+    std::vector<ViewRequest> requests;
+    LinkClientStats stats;
+    bool stopped = false;
+    KioskLink port() {
+        return {[this](ViewRequest r, std::string*) {
+                    requests.push_back(r);
+                    return std::uint64_t{100} + requests.size();
+                },
+                [this] { return stats; }, [this] { stopped = true; }};
+    }
+};
+
+LinkFrame jpeg_frame(std::uint64_t request_id, std::uint8_t base) {
+    Rgb8Image content(kContent);
+    for (std::size_t k = 0; k < content.pixels.size(); ++k) {
+        content.pixels[k] = static_cast<std::uint8_t>(base + k % 7);
+    }
+    LinkFrame frame;
+    frame.frame_id = request_id;
+    frame.request_id = request_id;
+    frame.size = kContent;
+    frame.jpeg = JpegEncoder().encode(content, 90);
+    return frame;
+}
+
+// Blocks until `fd` is readable (the timerfd's next expiration): no sleeping, no timing assumptions.
+void wait_readable(int fd) {
+    pollfd p{fd, POLLIN, 0};
+    ASSERT_EQ(::poll(&p, 1, -1), 1);
+}
+
+class KioskTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        dir_ = fs::temp_directory_path() / ("mogao-kiosk-test-" + std::to_string(::getpid()));
+        fs::remove_all(dir_);
+        fs::create_directories(dir_ / "pki");
+        for (const char* f : {"pki/ca.pem", "pki/a.pem", "pki/a.key"}) std::ofstream(dir_ / f) << "x";
+        config_ = parse_kiosk_config(
+            apply_config_overrides(kiosk_example_toml(),
+                                   {R"(farm.endpoint="[::1]:7443")", R"(farm.ca="pki/ca.pem")", R"(farm.cert="pki/a.pem")",
+                                    R"(farm.key="pki/a.key")", "display.rate_hz=240", R"(outputs.backend="headless")",
+                                    R"(calibration.source="ideal")", R"(calibration.output="96x72")",
+                                    R"(quality.content="160x90")", "navigation.path_frames=10",
+                                    R"(stats.file="stats.json")"}),
+            dir_ / "kiosk.toml");
+        screen_ = load_calibration(config_);
+        HeadlessOptions options;
+        for (const auto& p : screen_.projectors) options.outputs.push_back(p.output);
+        auto backend = HeadlessOutputBackend::create(options);
+        if (!backend) {
+            if (backend.code() == ENODEV) return mogao::testing::skip_or_fail_without_egl(backend.error().message);
+            FAIL() << backend.error().message;
+        }
+        headless_ = backend->get();
+        auto display = KioskDisplay::create(std::move(backend).value(), screen_, nullptr);
+        ASSERT_TRUE(display) << display.error().message;
+        display_.emplace(std::move(display).value());
+        ASSERT_TRUE(display_->show_connecting_screen(config_.quality.content, config_.farm.endpoint));
+        inbox_ = open_inbox();
+        navigation_ = std::make_unique<KioskNavigation>(make_view_script(config_));
+        auto signals = SignalFd::create({SIGUSR1});
+        ASSERT_TRUE(signals) << signals.error().message;
+        signals_.emplace(std::move(signals).value());
+    }
+    void TearDown() override {
+        kiosk_.reset();
+        fs::remove_all(dir_);
+    }
+
+    Kiosk& kiosk(KioskRunOptions options = {}) {
+        kiosk_.emplace(config_,
+                       KioskParts{*display_, *inbox_, link_.port(), *navigation_, *signals_, notifier_},
+                       std::move(options));
+        return *kiosk_;
+    }
+    [[nodiscard]] std::vector<Rgb8Image> outputs() const {
+        std::vector<Rgb8Image> out;
+        for (std::size_t i = 0; i < headless_->outputs().size(); ++i) out.push_back(headless_->last_frame(i));
+        return out;
+    }
+
+    fs::path dir_;
+    KioskConfig config_;
+    ScreenCalibration screen_;
+    HeadlessOutputBackend* headless_ = nullptr;
+    std::optional<KioskDisplay> display_;
+    std::unique_ptr<FrameInbox> inbox_;
+    std::unique_ptr<KioskNavigation> navigation_;
+    std::optional<SignalFd> signals_;
+    ServiceNotifier notifier_;
+    RecordingLink link_;
+    std::optional<Kiosk> kiosk_;
+};
+
+TEST_F(KioskTest, OnFrameShowsTheFrameInTheSlotOnEveryOutput) {
+    Kiosk& k = kiosk();
+    const std::vector<Rgb8Image> connecting = outputs();
+    inbox_->put(jpeg_frame(1, 120));
+    k.on_frame();
+    ASSERT_NE(k.last_good().current(), nullptr);
+    EXPECT_EQ(k.last_good().current()->request_id, 1u);
+    EXPECT_EQ(display_->frames_on_screen(), 1u);
+    EXPECT_EQ(display_->stats().frames(), 1u);
+    const std::vector<Rgb8Image> shown = outputs();
+    ASSERT_EQ(shown.size(), 3u);
+    for (std::size_t i = 0; i < shown.size(); ++i) {
+        EXPECT_NE(shown[i].pixels, connecting[i].pixels) << "output " << i << " still shows the connecting screen";
+    }
+    // Middle of the middle projector (blend 1): content codes ~120..126 come out near them.
+    EXPECT_NEAR(shown[1].at(48, 36)[0], 123, 8);
+    k.on_frame();  // woken with nothing new: nothing changes
+    EXPECT_EQ(display_->frames_on_screen(), 1u);
+}
+
+TEST_F(KioskTest, OnFrameShowsTheNewestFrameAndCountsTheReplacedOne) {
+    Kiosk& k = kiosk();
+    inbox_->put(jpeg_frame(1, 40));
+    inbox_->put(jpeg_frame(2, 200));
+    k.on_frame();
+    EXPECT_EQ(k.last_good().current()->request_id, 2u);
+    EXPECT_EQ(display_->frames_on_screen(), 1u);
+    EXPECT_EQ(display_->stats().to_json()["frames_superseded"], 1);
+}
+
+TEST_F(KioskTest, ACorruptJpegKeepsTheLastGoodFrameOnEveryOutput) {
+    Kiosk& k = kiosk();
+    inbox_->put(jpeg_frame(1, 90));
+    k.on_frame();
+    const std::vector<Rgb8Image> before = outputs();
+    LinkFrame corrupt = jpeg_frame(2, 200);
+    corrupt.jpeg.resize(corrupt.jpeg.size() * 2 / 3);
+    inbox_->put(std::move(corrupt));
+    k.on_frame();
+    EXPECT_EQ(k.last_good().current()->request_id, 1u);
+    EXPECT_EQ(display_->frames_on_screen(), 1u);
+    EXPECT_EQ(display_->stats().to_json()["frames_rejected"], 1);
+    const std::vector<Rgb8Image> after = outputs();
+    for (std::size_t i = 0; i < after.size(); ++i) EXPECT_EQ(after[i].pixels, before[i].pixels) << "output " << i;
+}
+
+TEST_F(KioskTest, FramesOptionStopsOnceThatManyFramesAreOnScreen) {
+    KioskRunOptions options;
+    options.frames = 2;
+    Kiosk& k = kiosk(std::move(options));
+    inbox_->put(jpeg_frame(1, 60));
+    k.on_frame();
+    EXPECT_FALSE(k.stopping());
+    inbox_->put(jpeg_frame(2, 70));
+    k.on_frame();
+    EXPECT_TRUE(k.stopping());
+    EXPECT_EQ(k.exit_code(), 0);
+}
+
+TEST_F(KioskTest, OnTickSubmitsTheNavigationsPoseAndLogsIt) {
+    KioskRunOptions options;
+    options.pose_log.emplace(dir_ / "poses.jsonl");
+    Kiosk& k = kiosk(std::move(options));
+    ViewScript expected = make_view_script(config_);  // the same scripted visitor, stepped alongside
+    for (int tick = 1; tick <= 3; ++tick) {
+        wait_readable(k.tick_fd());
+        k.on_tick();
+        ASSERT_EQ(link_.requests.size(), static_cast<std::size_t>(tick));
+        const ViewRequest want = expected.next();
+        const ViewRequest& got = link_.requests.back();
+        EXPECT_EQ(got.pose.eye, want.pose.eye) << "tick " << tick;
+        EXPECT_DOUBLE_EQ(got.pose.yaw_deg, want.pose.yaw_deg);
+        EXPECT_EQ(got.size, kContent);
+    }
+    EXPECT_EQ(k.ticks(), 3u);
+    EXPECT_NE(link_.requests[0].pose.eye, link_.requests[2].pose.eye) << "the walk does not move";
+    ASSERT_EQ(k.finish(), 0);
+    std::ifstream log(dir_ / "poses.jsonl");
+    std::string first;
+    ASSERT_TRUE(std::getline(log, first));
+    const auto line = nlohmann::json::parse(first);
+    EXPECT_EQ(line["tick"], 1);
+    EXPECT_EQ(line["request_id"], 101);  // what the link returned
+}
+
+TEST_F(KioskTest, OnTickRepaintsOnlyWhenNoFrameCameSinceThePreviousTick) {
+    Kiosk& k = kiosk();
+    const std::uint64_t rounds = display_->stats().rounds();  // the connecting screen
+    wait_readable(k.tick_fd());
+    k.on_tick();  // the connecting screen was shown since start: no repaint
+    EXPECT_EQ(display_->stats().rounds(), rounds);
+    wait_readable(k.tick_fd());
+    k.on_tick();
+    EXPECT_EQ(display_->stats().rounds(), rounds + 1);
+    inbox_->put(jpeg_frame(1, 80));
+    k.on_frame();
+    wait_readable(k.tick_fd());
+    k.on_tick();
+    EXPECT_EQ(display_->stats().rounds(), rounds + 2) << "a frame came: the tick must not repaint";
+}
+
+TEST_F(KioskTest, OnTickRecordsLinkStateChanges) {
+    Kiosk& k = kiosk();
+    link_.stats.connected = true;
+    wait_readable(k.tick_fd());
+    k.on_tick();
+    link_.stats.connected = false;
+    wait_readable(k.tick_fd());
+    k.on_tick();
+    const auto events = display_->stats().to_json()["events"];
+    ASSERT_EQ(events.size(), 2u) << events.dump();
+    EXPECT_EQ(events[0]["event"], "connected");
+    EXPECT_EQ(events[1]["event"], "disconnected");
+}
+
+TEST_F(KioskTest, OnSignalStopsTheLoop) {
+    Kiosk& k = kiosk();
+    k.on_signal();  // nothing pending
+    EXPECT_FALSE(k.stopping());
+    ASSERT_EQ(::raise(SIGUSR1), 0);
+    k.on_signal();
+    EXPECT_TRUE(k.stopping());
+    EXPECT_EQ(k.exit_code(), 0);
+}
+
+TEST_F(KioskTest, RunShowsFramesUntilASignalThenWritesTheStatistics) {
+    Kiosk& k = kiosk();
+    inbox_->put(jpeg_frame(7, 100));
+    ASSERT_EQ(::raise(SIGUSR1), 0);
+    link_.stats.sessions_opened = 1;
+    EXPECT_EQ(k.run(), 0);
+    EXPECT_TRUE(link_.stopped);
+    std::ifstream in(dir_ / "stats.json");
+    ASSERT_TRUE(in) << "no statistics written";
+    const auto stats = nlohmann::json::parse(in);
+    EXPECT_EQ(stats["exit_code"], 0);
+    EXPECT_EQ(stats["endpoint"], "[::1]:7443");
+    EXPECT_EQ(stats["content"], nlohmann::json::array({160, 90}));
+    EXPECT_EQ(stats["navigation"]["source"], "path");
+    EXPECT_EQ(stats["link"]["sessions_opened"], 1);
+    EXPECT_EQ(stats["jpeg_quality"], config_.quality.jpeg_quality);
+}
+
+}  // namespace
+}  // namespace mogao
