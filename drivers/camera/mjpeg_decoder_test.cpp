@@ -4,7 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cerrno>
 #include <cstdlib>
+#include <optional>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace mogao {
@@ -69,6 +73,9 @@ TEST(MjpegDecoder, RefusesWrongSizeTruncatedAndEmptyFrames) {
     EXPECT_EQ(s.code(), EBADMSG);
 }
 
+static_assert(!std::is_copy_constructible_v<MjpegDecoder> && std::is_nothrow_move_constructible_v<MjpegDecoder> &&
+              std::is_nothrow_move_assignable_v<MjpegDecoder>);
+
 TEST(MjpegDecoder, MovedFromDecoderIsSafeToDestroy) {
     auto decoder = MjpegDecoder::create();
     ASSERT_TRUE(decoder.ok());
@@ -76,6 +83,28 @@ TEST(MjpegDecoder, MovedFromDecoderIsSafeToDestroy) {
     MjpegDecoder other = std::move(moved);
     GrayImage out;
     EXPECT_TRUE(other.decode_grey(ramp_jpeg(8, 8), out).ok());
+    const Status s = moved.decode_grey(ramp_jpeg(8, 8), out);  // NOLINT(bugprone-use-after-move)
+    ASSERT_FALSE(s.ok());
+    EXPECT_EQ(s.code(), EINVAL) << s.error().message;
+}
+
+// The handle outlives its moved-from owners (which must not tjDestroy it) and assignment replaces
+// a live one; a double tjDestroy is a reported double free in the sanitizer build.
+TEST(MjpegDecoder, MovedHandleOutlivesItsSourceAndAssignmentReplacesALiveOne) {
+    auto first = MjpegDecoder::create();
+    auto second = MjpegDecoder::create();
+    ASSERT_TRUE(first.ok() && second.ok());
+    std::optional<MjpegDecoder> source(std::move(first).value());
+    MjpegDecoder target = std::move(*source);
+    source.reset();
+    MjpegDecoder replaced = std::move(second).value();
+    replaced = std::move(target);
+    GrayImage out;
+    ASSERT_TRUE(replaced.decode_grey(ramp_jpeg(16, 8), out, 16, 8).ok());
+    EXPECT_EQ(out.width, 16);
+    target = std::move(replaced);  // into a moved-from decoder
+    EXPECT_TRUE(target.decode_grey(ramp_jpeg(8, 8), out).ok());
+    EXPECT_EQ(replaced.decode_grey(ramp_jpeg(8, 8), out).code(), EINVAL);  // NOLINT(bugprone-use-after-move)
 }
 
 }  // namespace
