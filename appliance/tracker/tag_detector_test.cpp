@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <optional>
 #include <stdexcept>
+#include <type_traits>
+#include <utility>
 
 #include "appliance/tracker/synthetic_view.h"
 
@@ -90,14 +93,42 @@ TEST(TagDetector, NothingInAFlatImage) {
     EXPECT_TRUE(detector.detect(GrayImage(320, 240, 128)).empty());
 }
 
+static_assert(!std::is_copy_constructible_v<TagDetector> && std::is_nothrow_move_constructible_v<TagDetector> &&
+              std::is_nothrow_move_assignable_v<TagDetector>);
+static_assert(!std::is_copy_constructible_v<TagFamily> && std::is_nothrow_move_constructible_v<TagFamily> &&
+              std::is_nothrow_move_assignable_v<TagFamily>);
+
 TEST(TagDetector, MovedDetectorStillWorks) {
     DetectorSettings s;
     s.family = "tag25h9";
     TagDetector a(s);
+    const TagFamily* family = &a.family();
     TagDetector b;     // tag36h11
-    b = std::move(a);  // the old tag36h11 detector is destroyed before its family
+    b = std::move(a);  // the old tag36h11 detector is destroyed before its family (ASan checks)
     EXPECT_EQ(b.family().name(), "tag25h9");
+    EXPECT_EQ(&b.family(), family);  // the detector's family did not move in memory
     EXPECT_TRUE(look(b, 4, tag_pose_facing_camera(0.5, 0.0)).found);
+    std::optional<TagDetector> c(std::move(b));
+    TagDetector d = std::move(*c);
+    c.reset();  // the moved-from detector releases nothing
+    EXPECT_TRUE(look(d, 4, tag_pose_facing_camera(0.5, 0.0)).found);
+}
+
+TEST(TagFamily, MoveLeavesTheSourceEmptyAndKeepsTheTable) {
+    std::optional<TagFamily> a(std::in_place, "tag25h9");
+    apriltag_family* table = a->get();
+    ASSERT_NE(table, nullptr);
+    TagFamily b = std::move(*a);
+    EXPECT_EQ(a->get(), nullptr);  // NOLINT(bugprone-use-after-move)
+    EXPECT_EQ(b.get(), table);
+    a.reset();  // destroys nothing
+    EXPECT_EQ(b.code_count(), 35);
+    TagFamily c("tag16h5");
+    c = std::move(b);  // frees tag16h5's table, takes tag25h9's
+    EXPECT_EQ(b.get(), nullptr);  // NOLINT(bugprone-use-after-move)
+    EXPECT_EQ(c.get(), table);
+    EXPECT_EQ(c.name(), "tag25h9");
+    EXPECT_EQ(c.code_count(), 35);
 }
 
 TEST(TagDetector, BadSettingsAndImagesNameTheProblem) {
