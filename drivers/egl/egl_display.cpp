@@ -81,10 +81,12 @@ Result<EglDisplay> EglDisplay::open_platform(EGLenum platform, void* native_disp
     // Re-initialising an initialised display is allowed and returns its version.
     if (eglInitialize(display, &major, &minor) != EGL_TRUE) return egl_failure("eglInitialize", ENODEV);
     ++registry()[display];
-    return EglDisplay(display, major, minor);
+    static unsigned long long serial = 0;  // guarded by registry_mutex()
+    return EglDisplay(Registration{display, ++serial}, major, minor);
 }
 
-void EglDisplay::Traits::close(EGLDisplay display) noexcept {
+void EglDisplay::Traits::close(Registration registration) noexcept {
+    const EGLDisplay display = registration.display;
     std::lock_guard lock(registry_mutex());
     auto it = registry().find(display);
     if (it != registry().end() && --it->second == 0) {
@@ -94,7 +96,7 @@ void EglDisplay::Traits::close(EGLDisplay display) noexcept {
 }
 
 bool EglDisplay::has_extension(std::string_view name) const {
-    return has_token(eglQueryString(display_.get(), EGL_EXTENSIONS), name);
+    return has_token(eglQueryString(get(), EGL_EXTENSIONS), name);
 }
 
 Result<EGLConfig> choose_window_config(const EglDisplay& display, EGLint native_visual_id) {
