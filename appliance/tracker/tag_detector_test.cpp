@@ -124,7 +124,7 @@ TEST(TagFamily, MoveLeavesTheSourceEmptyAndKeepsTheTable) {
     a.reset();  // destroys nothing
     EXPECT_EQ(b.code_count(), 35);
     TagFamily c("tag16h5");
-    c = std::move(b);  // frees tag16h5's table, takes tag25h9's
+    c = std::move(b);             // frees tag16h5's table, takes tag25h9's
     EXPECT_EQ(b.get(), nullptr);  // NOLINT(bugprone-use-after-move)
     EXPECT_EQ(c.get(), table);
     EXPECT_EQ(c.name(), "tag25h9");

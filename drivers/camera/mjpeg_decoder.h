@@ -13,9 +13,9 @@
 #include <cstdint>
 #include <span>
 
-#include "drivers/camera/camera_frame.h"
 #include "common/result.h"
 #include "common/unique_handle.h"
+#include "drivers/camera/camera_frame.h"
 
 namespace mogao {
 

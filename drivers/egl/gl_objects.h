@@ -9,8 +9,8 @@
 #include <string_view>
 #include <vector>
 
-#include "common/result.h"
 #include "common/image.h"
+#include "common/result.h"
 #include "common/unique_handle.h"
 
 namespace mogao {

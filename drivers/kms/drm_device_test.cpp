@@ -57,8 +57,7 @@ namespace {
 
 static_assert(!std::is_copy_constructible_v<PropertyBlob> && std::is_nothrow_move_constructible_v<PropertyBlob> &&
               std::is_nothrow_move_assignable_v<PropertyBlob>);
-static_assert(!std::is_copy_constructible_v<DrmFramebuffer> &&
-              std::is_nothrow_move_constructible_v<DrmFramebuffer> &&
+static_assert(!std::is_copy_constructible_v<DrmFramebuffer> && std::is_nothrow_move_constructible_v<DrmFramebuffer> &&
               std::is_nothrow_move_assignable_v<DrmFramebuffer>);
 
 TEST(DrmFramebuffer, MoveLeavesTheSourceEmptyAndTheLastOwnerRemovesOnce) {

@@ -10,8 +10,8 @@
 
 #include <cstdint>
 
-#include "common/result.h"
 #include "common/pixel_rect.h"
+#include "common/result.h"
 #include "common/unique_handle.h"
 
 namespace mogao {

@@ -34,12 +34,12 @@ bool count_bytes(void* user, ssize_t bytes, bool /*post*/) {
 EmbreeScene triangle_scene(const EmbreeDevice& device) {
     EmbreeScene scene(device);
     EmbreeGeometry triangle(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(triangle.get(), RTC_BUFFER_TYPE_VERTEX, 0,
-                                                          RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3));
+    auto* v = static_cast<float*>(
+        rtcSetNewGeometryBuffer(triangle.get(), RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3));
     const float vertices[9] = {-1, -1, -5, 1, -1, -5, 0, 1, -5};
     std::copy(std::begin(vertices), std::end(vertices), v);
-    auto* index = static_cast<unsigned*>(rtcSetNewGeometryBuffer(triangle.get(), RTC_BUFFER_TYPE_INDEX, 0,
-                                                                 RTC_FORMAT_UINT3, 3 * sizeof(unsigned), 1));
+    auto* index = static_cast<unsigned*>(
+        rtcSetNewGeometryBuffer(triangle.get(), RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), 1));
     index[0] = 0;
     index[1] = 1;
     index[2] = 2;
