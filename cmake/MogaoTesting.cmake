@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # mogao_add_gtest(<name> SOURCES <files...> LIBS <targets...> [LABELS <labels...>] [TIMEOUT <seconds, 300>])
 # Builds a GoogleTest executable and registers each TEST with CTest (gtest_discover_tests).
 # Tests that need ../shared/data get MOGAO_SCANS_DIR / MOGAO_MPCDI_DIR as compile definitions and call

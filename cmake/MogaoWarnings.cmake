@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Warning and sanitizer flags for every mogao target: call mogao_target_defaults(<target>).
 add_library(mogao_warnings INTERFACE)
 target_compile_options(mogao_warnings INTERFACE -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wno-sign-conversion)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Scripted viewer paths for headless tours: the farm's stand-in for the appliance's navigation
 // until live view requests arrive over the link.
 //

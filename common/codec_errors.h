@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Error types of the encode stage and the layout check every entry point shares.
 //
 // EncodeError: an image could not be turned into bytes (bad arguments, codec failure).

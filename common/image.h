@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Frame buffers exchanged between the trace, encode and farm stages.
 //
 // Layout: row-major, top row first, channels interleaved (R, G, B), no padding between rows.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Image comparison metrics for codec tests, the quality benchmark and multi-rank == single-rank
 // checks. All functions throw std::invalid_argument if the images differ in size or are malformed.
 #pragma once

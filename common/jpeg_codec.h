@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // JPEG encode/decode with TurboJPEG (libjpeg-turbo 2.1 "tj" API, as shipped by Debian 12).
 //
 // Each class owns one tjhandle and reuses it for every frame: creating a handle allocates the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Value types shared by the link's server (farm) and client (appliance), free of gRPC and protobuf.
 //
 // Times are nanoseconds since the Unix epoch on CLOCK_REALTIME of the host that took them (the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Integer pixel rectangles and image sizes shared by every farm stage.
 //
 // Pixel convention: pixel (x, y) covers [x, x+1) x [y, y+1) in image coordinates; its centre is at

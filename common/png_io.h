@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Lossless frame files: PNG (libpng simplified API) and binary PPM (P6).
 //
 // The farm writes PPM for lossless test frames (trivial format, no library, easy to diff) and PNG

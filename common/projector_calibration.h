@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What one projector output needs to show its part of the cylindrical screen: a warp map, a blend
 // mask and a per-channel response curve. Value types shared by the calibration reader/writer
 // (MPCDI), the CPU reference compositor and the GL output backends (drivers/).

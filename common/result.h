@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Error convention of drivers/ (kernel-, EGL- and GL-facing code): functions return Status or
 // Result<T> instead of throwing, so that a missing device, a refused modeset or a lost GPU is an
 // ordinary value the kiosk can log and act on (fall back to headless, retry, exit with a code).

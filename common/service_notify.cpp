@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "common/service_notify.h"
 
 #ifdef MOGAO_HAVE_LIBSYSTEMD

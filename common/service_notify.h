@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // systemd service notification (sd_notify: READY=1, WATCHDOG=1, STOPPING=1) for Type=notify units
 // with WatchdogSec=. Without libsystemd at build time, or outside systemd ($NOTIFY_SOCKET unset),
 // every call does nothing. A process started by the service's main process (a rank under mpirun in

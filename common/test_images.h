@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Synthetic images shared by the encode tests and the quality benchmark.
 #pragma once
 

@@ -26,8 +26,13 @@ public:
     UniqueHandle() = default;
     explicit UniqueHandle(Value value) noexcept : value_(value) {}
     UniqueHandle(UniqueHandle&& other) noexcept : value_(other.release()) {}
+    // Releases what this owns, then takes the other's value: two owners of a reference-counted
+    // handle that share one value (Mesa returns the same EGLDisplay for every open) each release.
     UniqueHandle& operator=(UniqueHandle&& other) noexcept {
-        reset(other.release());
+        if (this != &other) {
+            reset();
+            value_ = other.release();
+        }
         return *this;
     }
     UniqueHandle(const UniqueHandle&) = delete;

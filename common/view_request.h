@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What the appliance asks the farm to render: the viewer's pose in the virtual world, the camera
 // model (pinhole or the cylindrical projection screen), the output size and the quality knobs.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // OutputBackend: what the kiosk drives, one instance per GPU/display. Each output is one projector
 // (a KMS connector/CRTC pair, or a headless FBO). The frame loop, per new content frame:
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A 5x7 pixel bitmap font for the kiosk's own screens (the "connecting" card): upper-case A-Z
 // (lower case is drawn upper case), digits, space and . : - / [ ] _ = ; any other character is drawn
 // as '?'. Each glyph cell is 6x8 font pixels (one column and one row of spacing), scaled by an

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The "connecting" card the kiosk shows from start-up until the first good frame from the farm:
 // never a black screen, so staff can tell "the appliance is up and waiting for the farm" from
 // "projector off / no signal" at a glance. It is an ordinary content frame (sRGB RGB8, rows top

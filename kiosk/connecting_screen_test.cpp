@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "kiosk/connecting_screen.h"
 
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ContentDump (--dump-content DIR): keeps every k-th decoded content frame as the kiosk got it, for
 // end-to-end checks against the farm's lossless render of the same pose.
 //   <dir>/content-req<id>.ppm   the decoded frame (binary PPM, lossless, what the outputs sampled)

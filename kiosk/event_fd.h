@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // EventFd: one eventfd(2) counter, the kiosk's wake-up from other threads. The link's frame
 // callback (a gRPC thread) calls signal() after it stored a frame in the LatestFrameSlot; the event
 // loop polls fd() for POLLIN and calls drain(). Opened EFD_CLOEXEC | EFD_NONBLOCK.

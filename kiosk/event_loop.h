@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // EventLoop: the kiosk's single-threaded poll(2) loop. Each watched fd has a handler that runs on
 // the loop's thread when the fd is readable (POLLIN; POLLERR/POLLHUP also run it, so the handler's
 // read reports the problem). Everything the appliance does per frame happens in these handlers:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // HeadlessRecorder: what the headless kiosk leaves behind for people and tests to look at.
 //
 // * Every k-th display round (a round = one show or repaint that presented the outputs), each

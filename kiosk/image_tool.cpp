@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // mogao_kiosk_image_tool: image checks for the kiosk's end-to-end scripts (not installed).
 //
 //   mogao_kiosk_image_tool psnr A B      prints the PSNR of A against B in dB ("inf" if identical)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The kiosk's configuration file (TOML, read with toml11): where the farm is and how to trust it,
 // which outputs to drive, the projector calibration, what to ask the farm to render, how the
 // scripted visitor moves, and where statistics go. Schema and an example: docs/kiosk.md and

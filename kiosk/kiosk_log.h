@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Logging of the kiosk (spdlog, stderr): journald-friendly lines "<logger> <level>: <message>",
 // no timestamps of our own (the journal adds them). When stderr is the journal (systemd sets
 // JOURNAL_STREAM to stderr's device:inode), each line starts with the syslog priority prefix

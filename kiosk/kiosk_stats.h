@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // KioskStats: what the kiosk measures per displayed frame, its periodic stderr summary and the
 // statistics JSON written at exit.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // mogao-kiosk: the appliance's boot-to-display program. This file is the one place where the
 // appliance's stages are wired, in pipeline order (docs/kiosk.md):
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // PoseLog: every pose the kiosk submitted to the farm, one JSON line per display tick
 // (`mogao-kiosk --pose-log FILE`), for tests and for replaying a visit:
 //   {"tick": 1, "t_ns": <CLOCK_MONOTONIC>, "request_id": 1, "eye": [x, y, z], "yaw_deg": 0.0,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Which projector calibration each output shows.
 //
 // Rules, in order: output i shows projector i when their sizes are equal (the normal case: outputs

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "kiosk/projector_assignment.h"
 
 #include <gtest/gtest.h>

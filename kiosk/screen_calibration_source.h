@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The projector calibration the kiosk starts with: the MPCDI file of the configuration (2d
 // profile, appliance/calibration) or the ideal N-projector layout (appliance/warp), checked with
 // validate_screen before any output uses it.

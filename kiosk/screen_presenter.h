@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ScreenPresenter: puts one content frame on every projector output of an OutputBackend, through
 // each output's projector calibration (warp, blend, response: drivers/egl/warp_blend_renderer.h),
 // and tells when a frame has reached the screen.

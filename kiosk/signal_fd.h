@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // SignalFd: SIGINT/SIGTERM (or any set) delivered as readable data on a signalfd(2) instead of an
 // asynchronous handler, so the kiosk stops cleanly from its event loop (stats written, outputs
 // released in order).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // TagSampleQueue: hands the tracking thread's tag samples to the kiosk's display loop.
 //
 // A bounded FIFO, not "newest wins": the Navigator's One Euro filters and flip gate want every

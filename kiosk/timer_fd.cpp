@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "kiosk/timer_fd.h"
 
 #include <sys/timerfd.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // TimerFd: one periodic timerfd(2) on CLOCK_MONOTONIC, the kiosk's display/request tick (one view
 // request per tick; outputs repainted when no new frame came since the last tick). Opened
 // TFD_CLOEXEC | TFD_NONBLOCK. CLOCK_MONOTONIC: a wall-clock step (NTP on boot) never bunches or

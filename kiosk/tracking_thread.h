@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // TrackingThread: the kiosk's navigation input when [navigation].source = "tracking". One thread
 // runs camera -> TagTracker and pushes one TagSample per frame into a TagSampleQueue; the display
 // loop (main thread) feeds them to its Navigator and advances it every tick (docs/kiosk.md,

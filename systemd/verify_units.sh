@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # systemd-analyze verify on every unit, with stand-in binaries so ExecStart resolves, and the
 # offline security exposure score of each (recorded in docs/services.md).
 set -uo pipefail

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Bad input to a multi-rank farm ends quickly with a clear message and exit code != 0 — no hang
 # (the CTest TIMEOUT catches a hang), no crash.
 set -uo pipefail

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The grotto with the real scans renders on 3 MPI ranks (small frames, few frames).
 set -euo pipefail
 farm=$1 MPIEXEC=$2 scene=$3 scans=$4 work=$5

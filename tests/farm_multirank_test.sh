@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # A frame rendered by N ranks equals the frame rendered by one process, pixel for pixel, for the
 # given balancer (the per-pixel RNG depends only on pixel and seed, never on the rect or rank).
 set -euo pipefail

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Sourced by the MPI integration tests: lets Open MPI run as root (CI runs as root) and keeps
 # ranks on this machine without binding, so several ranks share the 2 cores of CI.
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1

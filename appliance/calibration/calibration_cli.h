@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // mogao-calibration: make and inspect MPCDI calibration files (docs/calibration.md).
 //
 //   mogao-calibration ideal --projectors 3 --overlap 0.15 --output 1024x768 --content 1920x1080 --out ideal.mpcdi

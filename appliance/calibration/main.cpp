@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // mogao-calibration: see calibration_cli.h.
 #include <iostream>
 

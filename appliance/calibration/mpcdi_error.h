@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The one error type of the MPCDI reader, writer and conversions (docs/architecture.md: file
 // readers throw a typed error whose message names the file, the entry or field, and the limit or
 // reason; a reader returns a complete value or throws, never a partial one).

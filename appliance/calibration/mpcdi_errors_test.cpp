@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Bad input gives a clear MpcdiError naming the file, the entry or field, and the reason.
 #include <algorithm>
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The reference-library fixtures (../shared/data/mpcdi, PROVENANCE.md there), checked value by value
 // against the analytic content their generators wrote.
 #include <cmath>

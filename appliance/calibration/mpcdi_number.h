@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Number text of mpcdi.xml, locale-independent (std::to_chars / std::from_chars).
 #pragma once
 

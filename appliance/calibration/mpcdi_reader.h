@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Reading an MPCDI v1.0 file (see mpcdi_types.h for what comes back, docs/calibration.md for the
 // conventions and the quirks of the reference-library files it accepts).
 #pragma once

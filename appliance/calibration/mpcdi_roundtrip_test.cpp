@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // read -> write -> read is identity for every fixture, in the fixtures' own conventions; the ideal
 // calibration survives MPCDI.
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Conversions between MPCDI files and the appliance's ScreenCalibration (2d profile only).
 //
 // MPCDI 2d profile -> ScreenCalibration (to_screen_calibration):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Helpers shared by the MPCDI tests: fixture paths, a scratch folder, a small valid file and raw
 // ZIP building for corrupt-input tests.
 #pragma once

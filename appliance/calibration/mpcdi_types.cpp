@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "appliance/calibration/mpcdi_types.h"
 
 #include <cstring>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The raw content of an MPCDI file (VESA Multiple Projection Common Data Interchange, v1.0, as
 // written by the VESA reference library, github.com/scaredyfish/MPCDI): what read_mpcdi returns and
 // write_mpcdi writes, kept faithful to the file so that read -> write -> read is identity.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Writing an MPCDI v1.0 file in the reference library's conventions (ZIP entry names and order,
 // PFM "-1.000000" little-endian bottom-to-top, "Xresolution", "%g" numbers, DOS date 0) without
 // its bugs: <originof3DData> holds the real origin (spelling: see mpcdi_xml.h) and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // mpcdi.xml of an MPCDI v1.0 file: parse into MpcdiFile (maps not loaded yet) and print.
 //
 // Element and attribute names are the reference library's (src/IO/mpcdiXMLStrings.h): buffer and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // PFM (Portable Float Map, the Netpbm-family float format of Paul Debevec's HDRShop, used by MPCDI
 // for geometry warp and distortion maps).
 //

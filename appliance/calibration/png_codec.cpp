@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "appliance/calibration/png_codec.h"
 
 #include <png.h>

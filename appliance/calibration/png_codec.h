@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // PNG alpha and beta maps of MPCDI, through libpng's classic API so that sample values pass
 // through untouched (the simplified png_image API would colour-manage them by any gAMA/sRGB chunk).
 //

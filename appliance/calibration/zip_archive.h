@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The ZIP container of an MPCDI file, through minizip 1.1 (zlib contrib, Debian libminizip-dev):
 // the same ZIP layer the reference library used to write the fixtures.
 //

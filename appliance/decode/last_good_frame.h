@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // LastGoodFrame: the content frame the outputs show, and the rule that keeps it.
 //
 // accept() decodes a frame's JPEG completely (TurboJPEG through JpegDecoder, which treats libjpeg's

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "appliance/decode/last_good_frame.h"
 
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "appliance/decode/latest_frame_slot.h"
 
 #include <utility>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // LatestFrameSlot: hands frames from the link's connection thread to the kiosk's event loop.
 // One slot, newest wins: put() replaces a frame the loop has not taken yet (that frame is dropped
 // and counted), so a slow display always shows the newest frame instead of working through a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // FlipGate: rejects tag poses that moved faster than a hand can (a pose flip of the planar
 // ambiguity the tracker could not resolve, or a misdetection), so one bad frame cannot reverse
 // the turn direction.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A plain first-order low-pass (exponential smoothing with a fixed cutoff), time-aware:
 // y_i = y_{i-1} + alpha (x_i - y_{i-1}), alpha = smoothing_factor(cutoff_hz, dt) (one_euro_filter.h).
 // The baseline the One Euro filter is compared with in navigation_bench.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // One Euro filter vs a plain first-order low-pass on the tag's yaw (docs/tracking.md, "Jitter
 // filter"). Not a test: prints a table and ratios measured in the same run.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Navigator: the visitor's tag steers the virtual camera by rate control (seed paper). Tag samples
 // arrive at the camera rate (observe), ViewerPoses leave at the display rate (advance); the
 // velocities are integrated with dt from the timestamps. Pure: no clock, no I/O, no threads --

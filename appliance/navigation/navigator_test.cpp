@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "appliance/navigation/navigator.h"
 
 #include <gtest/gtest.h>

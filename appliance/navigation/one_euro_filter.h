@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The One Euro filter (Casiez, Roussel, Vogel, "1 Euro Filter: A Simple Speed-based Low-pass
 // Filter for Noisy Input in Interactive Systems", CHI 2012): a first-order low-pass whose cutoff
 // rises with the signal's speed, so a still hand gives a still view (low cutoff, little jitter)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Rate control (seed paper: the tag's displacement from its rest pose sets a velocity, not a
 // position, so a visitor can turn all the way round and walk the whole grotto with small hand
 // movements). One axis:

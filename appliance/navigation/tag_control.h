@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The control signals navigation reads from the tag's pose: how the visitor turned, tilted and
 // moved the tag. Pure functions.
 //

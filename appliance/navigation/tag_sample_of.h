@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The tracker's result as the navigation's input: TrackedTag (tag_tracker.h) -> TagSample
 // (appliance/navigation/navigator.h). Used by `mogao-track navigate` and the kiosk's tracking
 // thread; time_ns is the frame's timestamp unless the caller gives another (a replay rebased onto

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Test helper: the tag pose a visitor produces by turning (yaw), tilting (pitch) and rolling the
 // tag at a distance, in the tracker's frames (tag_control.h). Same convention as the tracker's
 // tag_pose_facing_camera (synthetic_view.h): R = diag(1,-1,-1) Ry(yaw) Rx(-pitch) Rz(roll).

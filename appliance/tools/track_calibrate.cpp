@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // mogao-track calibrate-camera: OpenCV chessboard calibration of a folder of photos.
 #include <cstdio>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The subcommands of mogao-track (track_main.cpp parses the command line with CLI11 and calls
 // one of these). Each returns the process exit code: 0 success, 1 the job failed (an image could
 // not be read, no board found, ...); bad command lines exit 2 in track_main.cpp.

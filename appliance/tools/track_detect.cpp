@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // mogao-track detect: every tag's id and corners per image.
 #include <cstdio>
 

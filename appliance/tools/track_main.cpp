@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // mogao-track: tag detection, camera calibration, synthetic sequences and tag-driven navigation
 // from the command line (docs/tracking.md). Exit codes: 0 success, 1 job failed, 2 bad command line.
 #include <CLI/CLI.hpp>

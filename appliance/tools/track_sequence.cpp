@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // mogao-track make-sequence and make-tag: synthetic inputs for replay and a printable tag.
 #include <cstdio>
 

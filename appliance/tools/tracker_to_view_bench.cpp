@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Tracker-to-view latency: the time from a camera frame handed to the tracker to the ViewerPose the
 // kiosk submits for it — AprilTag detection, IPPE pose + ambiguity resolution, then the navigator's
 // observe (One Euro filtering, flip gate) and advance — measured frame by frame on the synthetic

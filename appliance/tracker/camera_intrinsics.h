@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Pinhole camera intrinsics with OpenCV's distortion model, and the calibration files they come
 // from.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "appliance/tracker/camera_intrinsics.h"
 #include "tests/support/scratch_dir.h"
 

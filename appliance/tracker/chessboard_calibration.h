@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Camera calibration from photos of a chessboard (Zhang, "A flexible new technique for camera
 // calibration", PAMI 2000, as implemented by OpenCV calibrateCamera).
 //

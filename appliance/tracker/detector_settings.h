@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // AprilTag 3 detector settings, with the defaults mogao uses for an 800x600 camera.
 //
 // The defaults come from the speed/accuracy sweep of tracker_bench (docs/tracking.md, "Detector

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "appliance/tracker/hand_sequence.h"
 
 #include <algorithm>

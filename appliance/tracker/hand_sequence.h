@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A replayed camera sequence of a hand-held tag: known poses over time rendered to a folder of
 // PNGs that ReplaySource (drivers/camera/replay_source.h) plays back, so the tracker, the
 // navigation and the main demo can be driven and checked without a camera.

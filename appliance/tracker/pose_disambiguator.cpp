@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "appliance/tracker/pose_disambiguator.h"
 
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // PoseDisambiguator: picks one of the two IPPE poses of a tag per frame (tag_pose.h).
 //
 // Rule. The second solution is a real alternative ("ambiguous") when its reprojection RMS is below

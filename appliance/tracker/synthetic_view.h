@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Synthetic camera images of a planar target (a tag on a white card, or a chessboard) at a known
 // pose: the ground truth of the tracker's tests and benchmark (docs/tracking.md, "Measurements").
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "appliance/tracker/tag_bitmap.h"
 
 #include <apriltag.h>

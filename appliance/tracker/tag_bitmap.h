@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The printable image of one tag, generated from the family's code table (the bits of
 // apriltag_family_t::codes laid out at bit_x/bit_y), never shipped as a binary.
 //

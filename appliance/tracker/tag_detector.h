@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // TagDetector: AprilTag 3 detection of one family in grey images (Wang & Olson, "AprilTag 2:
 // Efficient and robust fiducial detection", IROS 2016; AprilTag 3 is its successor library).
 // Owns one apriltag_detector_t and its TagFamily (RAII, move-only); not thread-safe.

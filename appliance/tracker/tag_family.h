@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // TagFamily: sole owner of one AprilTag 3 family (the code table apriltag_family_t), created by
 // name. Move-only (UniqueHandle, common/unique_handle.h; a moved-from family owns nothing and
 // get() is null). A family may be added to one detector only (AprilTag's rule), so each

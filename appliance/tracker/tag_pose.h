@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Tag pose from its four detected corners: both solutions of the planar PnP problem.
 //
 // Frames (metres):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // TagTracker: one frame in, the visitor's tag pose out. Detection (tag_detector.h), both IPPE
 // poses (tag_pose.h), then the choice between them (pose_disambiguator.h). The visitor holds one
 // tag: with tag_id < 0 the largest detected tag of the family is used, else only that id.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Tracker accuracy and speed on synthetic ground truth (docs/tracking.md, "Measurements"). Not a
 // test: prints markdown tables; every speed figure is a ratio against the default settings
 // measured in the same run.

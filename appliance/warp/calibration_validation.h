@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Checks of the calibration value types (projector_calibration.h) that every consumer runs before
 // trusting one: the CPU compositor, the MPCDI writer and the GL backend.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // CPU reference of what the projectors put on the screen, in both directions. Slow and exact by
 // construction: the GL backend's output is checked against render_output, and the calibration
 // itself against composite_on_screen (a calibration is right when the composite equals the

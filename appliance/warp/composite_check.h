@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Measures for "does the composite equal the content": per-pixel differences inside a region and
 // the seam measure across a content column. Used by the tests and by the calibration CLI's report.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The composite check of docs/calibration.md: render the ideal calibration's outputs from a
 // content image, put them back on the screen, and compare with the content.
 #include "appliance/warp/composite.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The ideal calibration: N identical projectors side by side on the cylindrical screen, each
 // covering one vertical band of the content frame with a chosen overlap to its neighbours.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The inverse of a projector's warp: for every content pixel, which output position lands on it.
 //
 // Method (per-projector inverse lookup by cell scan): the forward warp is the bilinear

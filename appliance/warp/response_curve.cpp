@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "appliance/warp/response_curve.h"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Projector response curves: construction, application, inversion and validation of the
 // ResponseCurve LUT of projector_calibration.h.
 //

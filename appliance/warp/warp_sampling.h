@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // How a warp or blend grid is read at an output pixel: the one CPU definition that the GL backend
 // (drivers/egl, docs/outputs.md) implements in its shader (see projector_calibration.h).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What every capture source delivers: one 8-bit grey (luma) image and when it was taken.
 //
 // The tracker only needs luma (AprilTag detects on grey), so every source converts to grey as it

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "drivers/camera/camera_source.h"
 
 #include <cerrno>

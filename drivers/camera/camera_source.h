@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The camera the tracking input reads from, named by one string, and opened as a FrameSource:
 //   "replay:<folder>"     a folder of images (drivers/camera/replay_source.h), e.g. the output of
 //                         `mogao-track make-sequence`

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The one interface the tracker reads frames from: a V4L2 camera (v4l2_capture.h) or a folder of
 // images (replay_source.h), and libcamera where built with it (libcamera_capture.h, MOGAO_LIBCAMERA).
 //

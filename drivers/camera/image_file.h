@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Reading one still image file as 8-bit grey, for the replay source and the camera tools.
 //
 // Formats, recognised by their magic bytes (not the file name):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // read_gray_image: fixtures are written by an independent encoder (OpenCV's imwrite) or by hand
 // (PGM headers), and read back by our libpng/TurboJPEG/PGM reader.
 #include "drivers/camera/image_file.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // LibcameraCapture with libcamera (MOGAO_HAVE_LIBCAMERA). See libcamera_capture.h for the design.
 #include "drivers/camera/libcamera_capture.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // LibcameraCapture: a camera streamed through libcamera (0.0.x API, Debian 12 ships 0.0.3), the
 // second FrameSource backend beside V4l2Capture. Built only with MOGAO_LIBCAMERA (CMake option:
 // AUTO = if pkg-config finds libcamera, ON = required, OFF); without it open() returns ENOTSUP

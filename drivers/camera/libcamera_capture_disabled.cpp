@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // LibcameraCapture in a build without libcamera (MOGAO_LIBCAMERA=OFF, or AUTO without the
 // libcamera pkg-config module): open() reports it, nothing else is reachable.
 #include "drivers/camera/libcamera_capture.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // LibcameraCapture: the pure helpers and the build-without-libcamera path run in every build; the
 // streaming test needs a camera libcamera can see and otherwise skips ("no libcamera camera; ...",
 // the binary exits 77 if nothing else ran).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The pure helpers of libcamera_capture.h: built with and without libcamera.
 #include <algorithm>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // MappedBuffer: sole owner of one read-only shared mapping of a device buffer (a V4L2 capture
 // buffer mapped with mmap at the offset VIDIOC_QUERYBUF returned). Unmaps on destruction;
 // move-only (UniqueHandle, common/unique_handle.h): a moved-from buffer is empty. The fd it was

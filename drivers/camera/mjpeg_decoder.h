@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // MjpegDecoder: decodes Motion-JPEG camera frames straight to grey with TurboJPEG (libjpeg-turbo
 // 2.1 "tj" API). Owns one tjhandle (RAII, move-only) reused for every frame; not thread-safe.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "drivers/camera/mjpeg_decoder.h"
 
 #include <turbojpeg.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Conversions from the V4L2 wire formats the capture accepts to GrayImage, and their names.
 //
 // Layouts (V4L2 uAPI, "Image Formats"):

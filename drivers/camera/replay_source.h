@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ReplaySource: a folder of images played back as a camera, for tests, demos and the benchmark.
 //
 // Files: every *.png, *.pgm, *.jpg, *.jpeg (any case) directly in the folder, in byte-wise name

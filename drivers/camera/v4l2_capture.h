@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // V4l2Capture: a V4L2 video-capture device streamed with memory-mapped buffers (V4L2 uAPI,
 // "Streaming I/O (Memory Mapping)": VIDIOC_REQBUFS, QUERYBUF + mmap, QBUF, STREAMON, DQBUF).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Against a real kernel V4L2 driver: vivid (modprobe vivid), the kernel's virtual capture device.
 // Without one, the device tests skip with a message (the binary exits 77 if nothing else ran);
 // the error-path tests need no device and run everywhere.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // RAII for EGL objects: EglDisplay (eglInitialize/eglTerminate), EglContext (a GLES 3 context),
 // EglSurface (a window surface, e.g. on a gbm_surface for KMS). Errors are Status/Result
 // (common/result.h) with code ENODEV (no such platform/display), EINVAL (bad argument) or EIO

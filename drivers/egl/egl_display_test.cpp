@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "drivers/egl/egl_display.h"
 
 #include <GLES3/gl3.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Test-only: a GoogleTest fixture with a surfaceless EGL display and a current GLES 3.0 context.
 // Without EGL the tests are skipped with the reason, unless MOGAO_REQUIRE_EGL is set (CI sets it
 // on machines that have Mesa), in which case they fail.

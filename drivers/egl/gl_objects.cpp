@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "drivers/egl/gl_objects.h"
 
 #include <cstdio>

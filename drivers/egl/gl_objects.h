@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // RAII for GL object names (texture, renderbuffer, framebuffer, shader, program) and GL error
 // checks. GL names belong to the context that made them: create, use and destroy each object with
 // that context current on the calling thread (owners such as WarpBlendRenderer document this).

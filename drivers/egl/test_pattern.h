@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Calibrations and frames for bring-up and tests: an identity calibration (the output shows the
 // content unchanged), standard response curves and a test pattern a technician can read (colour
 // bars, a one-pixel grid, a white border and an arrow-free corner marker in the top-left).

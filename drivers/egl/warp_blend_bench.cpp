@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Prints milliseconds per projector output for this machine's GL (llvmpipe without a GPU):
 // content upload, draw (glFinish'ed) and draw + readback, for one output of --output WxH.
 // Usage: mogao_warp_blend_bench [width height [content_width content_height [frames]]]

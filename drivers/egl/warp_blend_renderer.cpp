@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "drivers/egl/warp_blend_renderer.h"
 
 #include <EGL/egl.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // WarpBlendRenderer: the GL layer of one projector output. It only uploads and draws: the content
 // frame once per frame, each projector's calibration once, then one full-screen triangle per
 // projector per frame. The maths (fragment shader, GLSL ES 3.00), per output pixel (x, y):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // WarpBlendRenderer against a CPU reference written here (reference_render, a pure function of
 // the content and the calibration, in double precision), plus hand-computed expectations for
 // the properties that matter on the wall: orientation, half-pixel sampling, NaN = black,

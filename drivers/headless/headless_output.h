@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // HeadlessOutputBackend: projector outputs as offscreen FBOs in a surfaceless EGL context (Mesa;
 // llvmpipe on machines without a GPU). For the render farm's previews, CI and the kiosk's
 // --headless mode. present() reads each frame back (RGB8, rows top first) and, when png_dir is

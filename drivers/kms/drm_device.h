@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // RAII for DRM/KMS kernel objects (libdrm): the device fd, the drmMode* structures libdrm
 // allocates (freed with their drmModeFree* function), property blobs and framebuffers.
 // Errors: Result/Status (common/result.h) with the kernel's errno (ENOENT, EACCES, EBUSY,

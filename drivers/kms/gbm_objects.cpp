@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "drivers/kms/gbm_objects.h"
 
 #include <drm_fourcc.h>

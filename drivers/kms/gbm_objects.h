@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // RAII for GBM objects on a DRM fd: the gbm_device, a gbm_surface (the EGL window of one KMS
 // output), a locked front buffer (gbm_bo, released back to its surface), and the DRM framebuffer
 // of a bo, owned by the bo itself as its user data (drmModeRmFB when GBM destroys the bo).

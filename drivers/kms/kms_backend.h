@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // KmsOutputBackend: one output per connected connector that gets a CRTC and a plane (several
 // projectors on one card), each with a GBM surface and an EGL window surface, all drawn by one
 // GLES context and one WarpBlendRenderer.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Lights every connected output of the first usable /dev/dri/card* with the test pattern through
 // WarpBlendRenderer: a blocking modeset, then page flips driven by the event fd. Skipped where
 // there is no DRM device; the image issue runs it inside QEMU with virtio-gpu.

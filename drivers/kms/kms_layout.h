@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Pure decisions of KMS output setup, separate from the ioctls so they are unit-tested without a
 // device: which mode a connector gets, which CRTC drives which connector, which plane scans out.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // mogao-kms-probe: what a technician needs to know about the card before the kiosk runs: the
 // driver, each connector (state, modes, possible CRTCs), CRTCs, planes, and which outputs the
 // kiosk would light. With --test-pattern SECONDS it lights them with the test pattern through

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Shared by image/build, image/provision and the QEMU test (sourced, bash).
 #
 # Disk layout of mogao-kiosk.img (GPT, 512-byte sectors, partitions aligned to 1 MiB):

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Steps of a bootable Debian 12 disk image (raw, GPT, UEFI + systemd-boot) from packages, without
 # loop devices or mounts: mmdebstrap into a folder, mke2fs -d, mkfs.vfat + mtools, sfdisk + dd.
 # Sourced (bash) after common.sh by image/farm/build; image/build does the same steps inline for the

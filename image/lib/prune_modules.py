@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Prune a kernel's module tree to an allowlist plus its dependencies (image/build).
 
 prune_modules.py MODULES_DIR ALLOWLIST

@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: Apache-2.0
 # image_scripts test: the image scripts parse, and their --help works (no root, no network).
 set -eu
 dir=$1

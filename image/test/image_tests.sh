@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: Apache-2.0
 # CTest entry of the opt-in image tests (labels "image;qemu"); see image/CMakeLists.txt.
 #   image_tests.sh build REPO OUTDIR KIOSK
 #   image_tests.sh boot  REPO OUTDIR KIOSK FARM IMAGE_TOOL MPIEXEC [CAMERA_TEST]

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Boots the appliance image in QEMU (real kernel, real drivers) and checks it end to end.
 
     qemu_boot_test.py --image mogao-kiosk.img --repo SRC --kiosk BIN --farm BIN --image-tool BIN

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """What the QEMU tests share (image/test/qemu_boot_test.py, image/farm/test/farm_qemu_test.py):
 timestamped logging, PASS/FAIL bookkeeping and the serial-console marker reader. python3 stdlib only.
 

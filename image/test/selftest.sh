@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: Apache-2.0
 # Runs INSIDE the appliance under QEMU (image/test/qemu_boot_test.py), as root, from the test disk
 # (label mogao-test, mounted read-only at /mnt) through the test copy's kernel command line:
 #   systemd.unit=multi-user.target systemd.wants=kernel-command-line.service

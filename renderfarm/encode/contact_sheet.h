@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Thumbnails and contact sheets: one picture showing many frames (a turntable sweep, every rank's
 // region, a benchmark's quality ladder) for reports and for eyeballing regressions.
 #pragma once

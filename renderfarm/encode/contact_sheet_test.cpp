@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "renderfarm/encode/contact_sheet.h"
 
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Setting up a farm under Open MPI (sort-first): every rank loads the scene itself, the render ranks
 // build the Embree BVH, then rank 0 (the admin) runs an admin job — a scripted camera path
 // (path_tour.h) — on a FrameDispatcher while ranks 1..N-1 serve frames. Only frames leave the farm.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The MPI side of one sort-first frame, both ends of it:
 //  - FrameDispatcher (admin, rank 0): assigns rects with the load balancer from the stream's
 //    predicted cost map, broadcasts the view, gathers sRGB8 pixels and per-tile times from the render

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Per-frame figures the farm records (stats.json) and the per-tile times it measured
 // (tile-costs.json, input of bench/balance_sim — format in docs/load-balancing.md).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // mogao-farm: the render farm's command line. This file is the one place where the farm's stages
 // are wired: scene (load) -> schedule (PBT) -> trace (Embree) -> encode (TurboJPEG), under MPI, and
 // for live tours -> link (gRPC + mutual TLS over IPv6).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // RAII for the MPI runtime (Open MPI): one MpiSession per process, created first in main() and
 // destroyed last. Rank 0 is the admin (scene description, view, PBT, compositing, encoding);
 // ranks 1..N-1 render.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The headless tour: the admin renders a scripted camera path (camera_path.h) on the farm and
 // writes DIR/frame-NNNN.jpg (TurboJPEG, full frame encoded once on the admin), optional lossless
 // frame-NNNN.ppm, stats.json (per-frame figures), tile-costs.json (measured tile times, input of

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The live farm: the admin serves appliances over the link (gRPC + mutual TLS over IPv6,
 // renderfarm/link) and renders each session's newest view request on the MPI farm.
 //

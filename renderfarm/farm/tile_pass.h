@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // One rank's share of a frame: render its rects tile by tile, time every tile, and pack the
 // sRGB8 pixels for the admin. This is the measured input of the PBT (schedule/).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The view request as it travels between MPI ranks of one farm: a trivially copyable struct sent
 // as MPI_BYTE. All ranks run the same binary on the same architecture (a farm is homogeneous), so
 // no byte-order or padding conversion is needed; the appliance link uses its own versioned schema.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // IPv6 endpoints written "[address]:port", e.g. "[::]:7443", "[::1]:7443", "[2001:db8::5]:7443".
 //
 // Only literal IPv6 addresses are accepted (no host names: the farm's certificate is issued for

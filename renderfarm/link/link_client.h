@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The appliance side of the link: connects to the farm's LinkServer over mutual TLS on IPv6,
 // streams view requests (latest wins) and hands every frame to a callback, reconnecting by itself
 // with exponential backoff whenever the farm goes away. See docs/link.md.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The farm going away and coming back: the appliance reconnects by itself and never shows a frame
 // older than one it already showed.
 #include <gtest/gtest.h>

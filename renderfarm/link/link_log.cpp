@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "renderfarm/link/link_log.h"
 
 #include <spdlog/sinks/stdout_color_sinks.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The link's spdlog logger "mogao-link", writing to stderr (journald adds timestamps on the
 // appliance; the farm sets its own pattern with spdlog::set_pattern before the logger exists).
 // Internal to renderfarm/link.

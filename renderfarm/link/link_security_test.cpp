@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Who gets frames: only appliances with a certificate from the farm CA, over TLS, over IPv6.
 // Garbage and oversized input end one connection or session, never the farm.
 #include <gtest/gtest.h>

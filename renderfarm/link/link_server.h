@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The farm side of the link: a gRPC server (service mogao.link.v1.Tour, mogao_link.proto) that
 // accepts appliance sessions over mutual TLS on an IPv6 endpoint and answers their view requests
 // with JPEG frames made by an injected renderer. See docs/link.md for the protocol and the PKI.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Frames over real gRPC + mutual TLS on [::1]: delivery, newest-request-wins, flow control,
 // concurrent sessions, bad requests and renderer failures.
 #include <gtest/gtest.h>

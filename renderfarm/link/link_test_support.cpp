@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "renderfarm/link/link_test_support.h"
 
 #include <netinet/in.h>

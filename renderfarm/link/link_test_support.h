@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Test helpers for the link (not installed, linked by the tests only): an in-memory PKI with the
 // bad certificates the security tests need, a renderer-free frame source that encodes the request
 // it answers into the pixels (real TurboJPEG), raw gRPC channels that bypass LinkClient, and waits

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // RAII owners for the OpenSSL 3 objects the link uses and PEM helpers. Internal to
 // renderfarm/link (tls_material.cpp, pki.cpp). Every owner frees with the object's own *_free.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The farm's certificate authority for the link's mutual TLS (OpenSSL 3). One CA per farm signs
 // the farm's server certificate (extendedKeyUsage serverAuth, IP/DNS SANs) and one client
 // certificate per appliance (clientAuth); the farm admits any appliance certificate that chains to

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `mogao-farm pki ...`: the command line of the farm's appliance CA (pki.h).
 #include <CLI/CLI.hpp>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "renderfarm/link/pki.h"
 
 #include <gtest/gtest.h>

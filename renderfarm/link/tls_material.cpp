@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "renderfarm/link/tls_material.h"
 
 #include <fcntl.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The PEM texts one side of the link needs for mutual TLS, and checks that turn a misconfigured
 // appliance or farm into one clear message at start-up instead of an opaque handshake failure.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Conversions between the link's protobuf messages (mogao_link.proto, schema v1) and the farm's
 // value types, with the validation every message from the network goes through.
 //

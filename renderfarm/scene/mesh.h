@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A triangle mesh as loaded from a file, in the file's own units and frame.
 //
 // Shapes: positions.size() == normals.size() (or normals empty); triangles index positions,

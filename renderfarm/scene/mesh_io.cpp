@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // load_mesh: dispatch by extension to our PLY reader or assimp, then validate and tidy normals.
 // validate_mesh / compute_vertex_normals / recentre_mesh live in mesh_validate.cpp.
 #include "renderfarm/scene/mesh_io.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Mesh loading for the scene stage: our own PLY reader for .ply, assimp for everything else.
 // Every loaded mesh is validated (validate_mesh) before it is returned, so callers can rely on the
 // invariants in mesh.h. Details, error messages and measured load times: docs/mesh-loading.md.

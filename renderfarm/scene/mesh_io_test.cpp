@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Tests for load_mesh (own PLY reader + assimp), validate_mesh, compute_vertex_normals and
 // recentre_mesh. Bad input is written to a temp dir; real scans are read from MOGAO_SCANS_DIR and
 // skipped when it is absent. RealScans/* also print the load times quoted in docs/mesh-loading.md.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Mesh checks and fix-ups declared in mesh_io.h: validate_mesh, compute_vertex_normals,
 // recentre_mesh. Accumulation is in double so that large scans and far-off origins stay exact.
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // PLY reader: header parser, two value sources (binary with optional byte swap, ascii tokens) and
 // element readers templated on the source, so binary and ascii share one set of rules.
 #include "renderfarm/scene/ply_reader.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Our own PLY reader (used by load_mesh for ".ply"). We need the header anyway to see whether the
 // faces come as a `tristrips` element, and Debian 12's assimp 5.2.5 reads that layout silently
 // wrong (igea.ply becomes one triangle), so we parse the whole format ourselves.

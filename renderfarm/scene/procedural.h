@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Procedural meshes named in scene files ("procedural": "<kind>"): the grotto room the scans stand
 // in, pedestals, and analytic test shapes. All in metres, +y up, counter-clockwise front faces.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The scene a farm renders: meshes placed by per-object transforms, materials, lights and the
 // viewer. Produced by load_scene() from a scene file (schema: docs/scene-format.md).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Reading a scene file (JSON; schema and examples in docs/scene-format.md) into a Scene.
 //
 // Errors: every problem throws SceneError whose message names the scene file, the JSON field

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Load-balance efficiency of a sort-first assignment, measured against the costs that really occurred.
 //
 // efficiency = mean over ranks of (actual cost of the rank's rects) / max over ranks of the same.

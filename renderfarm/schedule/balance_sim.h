@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Load-balance simulation: how well each balancer would have split a recorded frame sequence.
 //
 // For frame f every balancer gets the same prediction, the actual cost map of frame f-1

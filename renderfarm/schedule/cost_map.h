@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Cost map of the schedule stage: predicted render time of each cell of a frame.
 //
 // Shape: the image (ImageSize, pixels) is covered by a grid of cells_x() x cells_y() square cells of

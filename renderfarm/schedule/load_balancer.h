@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Sort-first load balancing: which pixels of the next frame each render rank traces.
 //
 // A LoadBalancer turns a predicted CostMap into an Assignment of pixel rects to ranks 0..ranks-1.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Prediction binary tree (PBT): the sort-first split of a frame over the render ranks.
 //
 // Source: the seed paper, "Immersive Virtual Tour using Multi-projection with Remote Cluster

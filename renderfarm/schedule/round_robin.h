@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Round-robin tile dealing: the classic static alternative to a cost-driven sort-first split.
 //
 // The image is cut into square tiles of `tile` pixels aligned on absolute multiples of `tile` (the

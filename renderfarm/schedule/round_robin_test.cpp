@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "renderfarm/schedule/round_robin.h"
 
 #include <stdexcept>

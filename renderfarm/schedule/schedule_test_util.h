@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Test-only helpers shared by the schedule stage's *_test.cpp files.
 #pragma once
 

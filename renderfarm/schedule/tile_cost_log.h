@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // tile-costs.json: the per-frame tile times the farm records, input of the load-balance simulator.
 //
 // Format (docs/load-balancing.md):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Camera models: image position -> world ray. Pure functions of the view request, no Embree.
 //
 // Image coordinates are continuous: (px, py) in [0, W] x [0, H] of the render size, x right,

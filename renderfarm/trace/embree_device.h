@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // RAII owner of an Embree device (RTCDevice) and the error channel of every Embree call made on it.
 //
 // Errors: Embree reports errors through a per-thread error code and an error callback. The callback

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // RAII owners of an Embree scene (RTCScene) and geometry (RTCGeometry).
 //
 // Embree reference-counts both: attaching a geometry to a scene, or instancing a scene, takes its

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Linear radiance -> display 8-bit sRGB for a rect of a frame.
 //
 // Per channel: v = clamp(exposure * L, 0, 1) (NaN -> 0), then the sRGB OETF of IEC 61966-2-1:

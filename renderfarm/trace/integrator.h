@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Light transport at a surface hit: next-event estimation of every light plus `max_bounces`
 // indirect diffuse bounces (a path tracer without Russian roulette).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The lights of a Scene prepared for shading: directions normalised, positions rebased onto the
 // frame origin (see render_scene.h), lights with zero power dropped, environment lights summed.
 // "Model only what the scene asks for": empty lists make the corresponding loops free, and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Self-intersection avoidance for secondary rays: move a hit point off its surface before
 // tracing a new ray from it.
 //

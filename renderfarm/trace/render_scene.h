@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Embree geometry of a Scene: one bottom-level BVH (BLAS) per referenced Mesh and a top-level
 // scene (TLAS) holding every Instance as an Embree instance, so a mesh placed N times is built
 // and stored once (the 6-million-triangle scans are instanced, never copied).

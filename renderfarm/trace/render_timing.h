@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Measures the renderer against raw Embree on the same camera rays, in one run, so the ratio is
 // meaningful on any machine: (a) Renderer::trace_camera_rays (ray generation + rtcIntersect16 of
 // exactly the packets render() traces), (b) Renderer::render (everything). Both run on the calling

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The trace stage: renders linear radiance for a rect of a view request's frame with Embree.
 //
 // Usage: Renderer r(scene, options); per frame: r.begin_frame(request); then any number of

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A pixel's value may depend only on (scene, request, x, y): rendering a frame as one rect, as
 // many rects (in any order, on several threads) or again must give bit-identical buffers.
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Precision far from the world origin: the same scene and camera moved by (1e5, 0, -1e5) m must
 // render the same image, thanks to rebasing the world on the eye every frame (render_scene.h).
 #include <cmath>

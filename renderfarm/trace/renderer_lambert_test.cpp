@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Analytic check of the direct-light path: a finely tessellated unit sphere under one sun must
 // show L = albedo/π · E · max(0, n·l) with n the exact sphere normal where each camera ray hits.
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Each light type and the glossy lobe against closed-form values on a flat floor, plus the
 // no-double-counting rule for escaping bounce rays.
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Shadows: a sphere casts a dark disc on the floor under an overhead sun and nowhere else, and a
 // flat plane lit at grazing incidence does not shadow itself (ray_offset.h at work).
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Counter-based random numbers: every value is a pure hash of (seed, frame_id, pixel x, y,
 // sample index, dimension), so a pixel's samples never depend on which rect, thread or packet
 // rendered it, nor on how many random numbers other pixels used.

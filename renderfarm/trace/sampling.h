@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Sampling helpers (float, unit vectors). Formulas from Pharr, Jakob, Humphreys, "Physically
 // Based Rendering", 3rd ed. (PBRT): §13.6.2 concentric disk mapping (Shirley & Chiu), §13.6.3
 // cosine-weighted hemisphere by Malley's method (pdf = cosθ/π); orthonormal basis from one vector

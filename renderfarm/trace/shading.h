@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Surface reflectance: Lambert diffuse plus an optional normalised Blinn-Phong glossy lobe.
 //
 //   f(wi, wo) = albedo / π  +  specular · (s + 2) / (2π) · max(0, n·h)^s,   h = normalize(wi + wo)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "renderfarm/trace/test_scenes.h"
 
 #include "renderfarm/scene/procedural.h"

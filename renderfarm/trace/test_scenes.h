@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Procedural meshes and scenes for the trace tests, built in code (no scene files).
 #pragma once
 

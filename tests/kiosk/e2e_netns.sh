@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # End to end, farm -> appliance over real IPv6 with mutual TLS:
 #   netns     the farm (3 MPI ranks) in network namespace A at fd00:6d6f::1, the kiosk (headless,
 #             ideal 3-projector calibration) in namespace B at fd00:6d6f::2, joined by a veth pair

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # End to end, tracking as the kiosk's navigation input: a hand-held tag sequence with known motion
 # (`mogao-track make-sequence`: rest, turn the tag left 25 deg, back, push it 12 cm toward the
 # camera, back, fast turn right 30 deg, back, tag out of view 11.0-11.6 s, rest; 12 s, 800x600)

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Fault: the farm dies mid-stream (SIGKILL to every process of its session: a crash, not a clean
 # stop) and comes back 5 s later on the same address. Over [::1], no namespaces needed.
 # Checks, from the kiosk's statistics, log and PNG outputs:

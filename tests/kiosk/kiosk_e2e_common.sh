@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Sourced by the kiosk's end-to-end scripts (e2e_netns.sh, fault_farm_restart.sh): PKI, the kiosk
 # configuration, starting and stopping a farm, and the checks on the kiosk's statistics.
 #

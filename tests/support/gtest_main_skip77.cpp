@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // GoogleTest main for every mogao test binary. Same as gtest_main, except that a run in which every
 // selected test was skipped (GTEST_SKIP, e.g. the real scans in ../shared/data are absent) exits
 // with 77, the conventional "skipped" code CTest is told about (SKIP_RETURN_CODE 77), so a skip is

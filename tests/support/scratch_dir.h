@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ScratchDir: a fresh, empty folder for one test, removed with everything in it when the object
 // goes out of scope. Named <temp>/mogao-<tag>-<pid>-<test name>, so tests of parallel ctest runs
 // (one process each) and tests of one binary never share a folder; a folder left by a crashed run

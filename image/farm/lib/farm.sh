@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Shared by image/farm/build, image/farm/provision and the farm's QEMU test (sourced, bash).
 #
 # Disk layout of mogao-farm.img (GPT, 512-byte sectors, partitions aligned to 1 MiB):

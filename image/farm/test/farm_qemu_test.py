@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Boots two render hosts from mogao-farm.img in QEMU and checks mogao-farm.service end to end.
 
     farm_qemu_test.py --image mogao-farm.img --repo SRC --farm BIN --kiosk BIN [--image-tool BIN]

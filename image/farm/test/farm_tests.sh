@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: Apache-2.0
 # CTest entry of the render-host image tests (labels "image;qemu;farm"); see image/CMakeLists.txt.
 #   farm_tests.sh check REPO                                  syntax and --help (always runs)
 #   farm_tests.sh build REPO OUTDIR FARM                      image/farm/build into OUTDIR

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """QEMU, serial console and network-namespace helpers of farm_qemu_test.py (python3 stdlib only)."""
 import json
 import os

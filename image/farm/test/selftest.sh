@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: Apache-2.0
 # Runs INSIDE a render host under QEMU (image/farm/test/farm_qemu_test.py), as root, from the
 # test-only unit mogao-farm-selftest.service that the test provisions into its copy of the image:
 #   selftest.sh admin    the admin host: mogao-farm.service (mpirun + ranks)
