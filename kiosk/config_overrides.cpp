@@ -76,7 +76,8 @@ std::size_t find_section(std::vector<std::string>& lines, const Override& o, con
         if (!commented) return i;
         if (!commented_at) commented_at = i;
     }
-    if (!commented_at) throw KioskConfigError(fmt::format("override '{}': no section [{}] in the example", text, o.section));
+    if (!commented_at)
+        throw KioskConfigError(fmt::format("override '{}': no section [{}] in the example", text, o.section));
     if (open) lines[*commented_at] = lines[*commented_at].substr(2);
     return *commented_at;
 }
@@ -94,7 +95,8 @@ void apply(std::vector<std::string>& lines, const std::string& text) {
         else if (!commented_at) commented_at = i;
     }
     if (!set_at && !commented_at) {
-        throw KioskConfigError(fmt::format("override '{}': [{}] has no field '{}' in the example", text, o.section, o.key));
+        throw KioskConfigError(
+            fmt::format("override '{}': [{}] has no field '{}' in the example", text, o.section, o.key));
     }
     if (o.value.empty()) {
         if (set_at) lines[*set_at] = "# " + lines[*set_at];

@@ -36,8 +36,12 @@ KioskLink link_of(LinkClient& client) {
 }
 
 Kiosk::Kiosk(const KioskConfig& config, KioskParts parts, KioskRunOptions options)
-    : config_(config), parts_(std::move(parts)), options_(std::move(options)), tick_(armed_tick(config.outputs.rate_hz)),
-      start_(std::chrono::steady_clock::now()), last_log_(start_) {
+    : config_(config),
+      parts_(std::move(parts)),
+      options_(std::move(options)),
+      tick_(armed_tick(config.outputs.rate_hz)),
+      start_(std::chrono::steady_clock::now()),
+      last_log_(start_) {
     loop_.watch(parts_.signals.fd(), [this] { on_signal(); });
     loop_.watch(parts_.inbox.fd(), [this] { on_frame(); });
     loop_.watch(tick_.fd(), [this] { on_tick(); });
@@ -193,8 +197,9 @@ int Kiosk::finish() {
 
 void Kiosk::write_statistics(const nlohmann::json& navigation, const LinkClientStats& link) {
     if (config_.stats.file.empty()) return;
-    const RunRecord run{config_.farm.endpoint, config_.quality.content, config_.quality.jpeg_quality,
-                        navigation,           link_stats_json(link),   exit_code_};
+    const RunRecord run{config_.farm.endpoint,        config_.quality.content,
+                        config_.quality.jpeg_quality, navigation,
+                        link_stats_json(link),        exit_code_};
     try {
         parts_.display.stats().write_json(config_.stats.file, run_stats_json(run));
         spdlog::info("statistics: {}", config_.stats.file.string());

@@ -58,10 +58,10 @@ struct KioskParts {
 
 // What the command line adds: stop conditions and records of the run.
 struct KioskRunOptions {
-    std::uint64_t frames = 0;        // --frames: stop once this many farm frames are on screen (0: never)
-    double duration_s = 0;           // --duration (0: never)
-    std::optional<ContentDump> dump;    // --dump-content
-    std::optional<PoseLog> pose_log;    // --pose-log
+    std::uint64_t frames = 0;         // --frames: stop once this many farm frames are on screen (0: never)
+    double duration_s = 0;            // --duration (0: never)
+    std::optional<ContentDump> dump;  // --dump-content
+    std::optional<PoseLog> pose_log;  // --pose-log
 };
 
 class Kiosk {
@@ -91,8 +91,8 @@ public:
 
 private:
     void fail(const char* what, const std::string& message);  // logs, exit code 1, stops the loop
-    [[nodiscard]] bool accept(const LinkFrame& frame);         // decode into last_good_, or log the drop
-    void check_frames_shown();                                 // --frames
+    [[nodiscard]] bool accept(const LinkFrame& frame);        // decode into last_good_, or log the drop
+    void check_frames_shown();                                // --frames
     void submit_next_view();
     void note_link_state(const LinkClientStats& link);
     void write_pose(const PoseLogEntry& entry);

@@ -71,17 +71,39 @@ std::string read_source_file(const char* relative) {
 }
 
 // Overrides of the shipped example that set every field (the files are made by SetUp).
-const std::vector<std::string> kGood = {
-    R"(farm.endpoint="[fd00:6d6f::1]:7443")", R"(farm.server_name="farm-1")", R"(farm.ca="pki/ca.pem")",
-    R"(farm.cert="pki/appliance-a.pem")", R"(farm.key="pki/appliance-a.key")", "display.rate_hz=25",
-    R"(outputs.backend="headless")", R"(outputs.sizes=["320x240", "320x240", "320x240"])", R"(outputs.png_dir="out/png")",
-    "outputs.png_every=5", "outputs.composite=true", R"(calibration.source="ideal")", "calibration.projectors=3",
-    "calibration.overlap=0.2", R"(calibration.output="320x240")", "calibration.gamma=2.4", R"(quality.content="480x270")",
-    "quality.spp=2", "quality.jpeg_quality=90", "quality.bounces=1", "quality.ao_samples=4",
-    "quality.area_light_samples=2", "screen.radius_m=3.5", "screen.arc_deg=160", "screen.bottom_m=0.1",
-    "screen.top_m=2.9", R"(navigation.path="orbit")", "navigation.path_frames=120", "navigation.start=[0.0, 0.0, 4.0]",
-    "navigation.start_yaw_deg=10", "navigation.eye_height_m=1.5", R"(stats.file="out/stats.json")",
-    "stats.log_period_s=2.5"};
+const std::vector<std::string> kGood = {R"(farm.endpoint="[fd00:6d6f::1]:7443")",
+                                        R"(farm.server_name="farm-1")",
+                                        R"(farm.ca="pki/ca.pem")",
+                                        R"(farm.cert="pki/appliance-a.pem")",
+                                        R"(farm.key="pki/appliance-a.key")",
+                                        "display.rate_hz=25",
+                                        R"(outputs.backend="headless")",
+                                        R"(outputs.sizes=["320x240", "320x240", "320x240"])",
+                                        R"(outputs.png_dir="out/png")",
+                                        "outputs.png_every=5",
+                                        "outputs.composite=true",
+                                        R"(calibration.source="ideal")",
+                                        "calibration.projectors=3",
+                                        "calibration.overlap=0.2",
+                                        R"(calibration.output="320x240")",
+                                        "calibration.gamma=2.4",
+                                        R"(quality.content="480x270")",
+                                        "quality.spp=2",
+                                        "quality.jpeg_quality=90",
+                                        "quality.bounces=1",
+                                        "quality.ao_samples=4",
+                                        "quality.area_light_samples=2",
+                                        "screen.radius_m=3.5",
+                                        "screen.arc_deg=160",
+                                        "screen.bottom_m=0.1",
+                                        "screen.top_m=2.9",
+                                        R"(navigation.path="orbit")",
+                                        "navigation.path_frames=120",
+                                        "navigation.start=[0.0, 0.0, 4.0]",
+                                        "navigation.start_yaw_deg=10",
+                                        "navigation.eye_height_m=1.5",
+                                        R"(stats.file="out/stats.json")",
+                                        "stats.log_period_s=2.5"};
 
 std::string KioskConfigTest::good(const std::vector<std::string>& more) {
     std::vector<std::string> overrides = kGood;
@@ -149,10 +171,11 @@ key = "pki/appliance-a.key"
 
 TEST_F(KioskConfigTest, AcceptsAnMpcdiSourceAPathFileAndKmsDevice) {
     // Empty values comment the ideal-only and headless-only keys out again.
-    const std::string text = good({R"(calibration.source="screen.mpcdi")", "calibration.projectors=", "calibration.overlap=",
-                                   "calibration.output=", "calibration.gamma=", R"(navigation.path="tour.json")",
-                                   R"(outputs.backend="kms")", R"(outputs.device="/dev/dri/card1")", "outputs.sizes=",
-                                   "outputs.png_dir=", "outputs.png_every=", "outputs.composite="});
+    const std::string text =
+        good({R"(calibration.source="screen.mpcdi")", "calibration.projectors=", "calibration.overlap=",
+              "calibration.output=", "calibration.gamma=", R"(navigation.path="tour.json")", R"(outputs.backend="kms")",
+              R"(outputs.device="/dev/dri/card1")",
+              "outputs.sizes=", "outputs.png_dir=", "outputs.png_every=", "outputs.composite="});
     const KioskConfig c = parse(text);
     EXPECT_EQ(c.calibration.mpcdi, dir_ / "screen.mpcdi");
     EXPECT_EQ(c.navigation.path, (dir_ / "tour.json").string());
@@ -180,10 +203,13 @@ INSTANTIATE_TEST_SUITE_P(
     EveryField, KioskConfigBadField,
     ::testing::Values(
         BadField{R"(endpoint = "[fd00:6d6f::1]:7443")", R"(endpoint = "fd00:6d6f::1:7443")", "[farm].endpoint: "},
-        BadField{R"(endpoint = "[fd00:6d6f::1]:7443")", R"(endpoint = "[fd00:6d6f::1]:0")", "[farm].endpoint: '[fd00:6d6f::1]:0' has port 0"},
+        BadField{R"(endpoint = "[fd00:6d6f::1]:7443")", R"(endpoint = "[fd00:6d6f::1]:0")",
+                 "[farm].endpoint: '[fd00:6d6f::1]:0' has port 0"},
         BadField{R"(endpoint = "[fd00:6d6f::1]:7443")", R"(endpoint = "[::]:7443")", "is the wildcard address"},
-        BadField{R"(endpoint = "[fd00:6d6f::1]:7443")", R"(endpoint = 7443)", "[farm].endpoint: expected a string, got an integer"},
-        BadField{R"(endpoint = "[fd00:6d6f::1]:7443")", R"(endpoints = "[fd00:6d6f::1]:7443")", "[farm].endpoint is required"},
+        BadField{R"(endpoint = "[fd00:6d6f::1]:7443")", R"(endpoint = 7443)",
+                 "[farm].endpoint: expected a string, got an integer"},
+        BadField{R"(endpoint = "[fd00:6d6f::1]:7443")", R"(endpoints = "[fd00:6d6f::1]:7443")",
+                 "[farm].endpoint is required"},
         BadField{R"(server_name = "farm-1")", R"(server_name = ["farm-1"])", "[farm].server_name: expected a string"},
         BadField{R"(ca = "pki/ca.pem")", R"(ca = "pki/missing.pem")", "[farm].ca: '"},
         BadField{R"(ca = "pki/ca.pem")", R"(ca = "pki")", "is not a regular file"},
@@ -193,24 +219,33 @@ INSTANTIATE_TEST_SUITE_P(
         BadField{"rate_hz = 25", "rate_hz = 1000.0", "[display].rate_hz = 1000 is outside"},
         BadField{"rate_hz = 25", "rate_hz = nan", "[display].rate_hz = nan is outside"},
         BadField{"rate_hz = 25", "rate_hz = \"fast\"", "[display].rate_hz: expected a number, got a string"},
-        BadField{R"(backend = "headless")", R"(backend = "x11")", "[outputs].backend: 'x11' is not one of headless, kms"},
-        BadField{R"(sizes = ["320x240", "320x240", "320x240"])", R"(sizes = ["320x240", "320x", "320x240"])", "[outputs].sizes[1]: '320x' is not WIDTHxHEIGHT"},
-        BadField{R"(sizes = ["320x240", "320x240", "320x240"])", R"(sizes = ["0x240"])", "[outputs].sizes[0] = '0x240' is outside [1, 16384]"},
+        BadField{R"(backend = "headless")", R"(backend = "x11")",
+                 "[outputs].backend: 'x11' is not one of headless, kms"},
+        BadField{R"(sizes = ["320x240", "320x240", "320x240"])", R"(sizes = ["320x240", "320x", "320x240"])",
+                 "[outputs].sizes[1]: '320x' is not WIDTHxHEIGHT"},
+        BadField{R"(sizes = ["320x240", "320x240", "320x240"])", R"(sizes = ["0x240"])",
+                 "[outputs].sizes[0] = '0x240' is outside [1, 16384]"},
         BadField{R"(sizes = ["320x240", "320x240", "320x240"])", R"(sizes = ["99999x240"])", "[outputs].sizes[0]"},
-        BadField{R"(sizes = ["320x240", "320x240", "320x240"])", R"(sizes = [])", "[outputs].sizes: 0 outputs is outside [1, 64]"},
-        BadField{R"(sizes = ["320x240", "320x240", "320x240"])", R"(sizes = "320x240")", "[outputs].sizes: expected an array"},
+        BadField{R"(sizes = ["320x240", "320x240", "320x240"])", R"(sizes = [])",
+                 "[outputs].sizes: 0 outputs is outside [1, 64]"},
+        BadField{R"(sizes = ["320x240", "320x240", "320x240"])", R"(sizes = "320x240")",
+                 "[outputs].sizes: expected an array"},
         BadField{"png_every = 5", "png_every = 0", "[outputs].png_every = 0 is outside [1, 1000000]"},
         BadField{"png_every = 5", "png_every = 2.5", "[outputs].png_every: expected an integer, got a float"},
         BadField{"composite = true", "composite = 1", "[outputs].composite: expected true or false"},
-        BadField{"composite = true", "composite = true\ndevice = \"/dev/dri/card0\"", "[outputs].device: only with backend = \"kms\""},
-        BadField{"composite = true", "composite = true\ncolour = 1", "[outputs].colour: unknown field (known: backend, device"},
+        BadField{"composite = true", "composite = true\ndevice = \"/dev/dri/card0\"",
+                 "[outputs].device: only with backend = \"kms\""},
+        BadField{"composite = true", "composite = true\ncolour = 1",
+                 "[outputs].colour: unknown field (known: backend, device"},
         BadField{R"(source = "ideal")", R"(source = "missing.mpcdi")", "[calibration].source: '"},
-        BadField{R"(source = "ideal")", R"(source = "screen.mpcdi")", "[calibration].projectors: only with source = \"ideal\""},
+        BadField{R"(source = "ideal")", R"(source = "screen.mpcdi")",
+                 "[calibration].projectors: only with source = \"ideal\""},
         BadField{"projectors = 3", "projectors = 0", "[calibration].projectors = 0 is outside [1, 64]"},
         BadField{"projectors = 3", "projectors = 65", "[calibration].projectors = 65 is outside [1, 64]"},
         BadField{"overlap = 0.2", "overlap = 0.5", "[calibration].overlap = 0.5 is outside [0, 0.5)"},
         BadField{"overlap = 0.2", "overlap = -0.1", "[calibration].overlap = -0.1 is outside"},
-        BadField{R"(output = "320x240")", R"(output = "320 x 240")", "[calibration].output: '320 x 240' is not WIDTHxHEIGHT"},
+        BadField{R"(output = "320x240")", R"(output = "320 x 240")",
+                 "[calibration].output: '320 x 240' is not WIDTHxHEIGHT"},
         BadField{"gamma = 2.4", "gamma = 0", "[calibration].gamma = 0 is outside (0, 10]"},
         BadField{R"(content = "480x270")", R"(content = "8x8")", "[quality].content = '8x8' is outside [16, 16384]"},
         BadField{"spp = 2", "spp = 0", "[quality].spp = 0 is outside [1, 4096]"},
@@ -218,7 +253,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadField{"jpeg_quality = 90", "jpeg_quality = 101", "[quality].jpeg_quality = 101 is outside [1, 100]"},
         BadField{"bounces = 1", "bounces = 65", "[quality].bounces = 65 is outside [0, 64]"},
         BadField{"ao_samples = 4", "ao_samples = -1", "[quality].ao_samples = -1 is outside [0, 1024]"},
-        BadField{"area_light_samples = 2", "area_light_samples = 0", "[quality].area_light_samples = 0 is outside [1, 1024]"},
+        BadField{"area_light_samples = 2", "area_light_samples = 0",
+                 "[quality].area_light_samples = 0 is outside [1, 1024]"},
         BadField{"radius_m = 3.5", "radius_m = 0", "[screen].radius_m = 0 is outside (0, 1000] m"},
         BadField{"arc_deg = 160", "arc_deg = 400", "[screen].arc_deg = 400 is outside (0, 360] degrees"},
         BadField{"bottom_m = 0.1", "bottom_m = inf", "[screen].bottom_m = inf is outside"},
@@ -228,8 +264,10 @@ INSTANTIATE_TEST_SUITE_P(
         BadField{"path_frames = 120", "path_frames = 1", "[navigation].path_frames = 1 is outside [2, 1000000]"},
         BadField{"start = [0.0, 0.0, 4.0]", "start = [0.0, 4.0]", "[navigation].start: expected [x, y, z]"},
         BadField{"start = [0.0, 0.0, 4.0]", "start = [0.0, \"a\", 4.0]", "[navigation].start[1]: expected a number"},
-        BadField{"start = [0.0, 0.0, 4.0]", "start = [0.0, 0.0, 1e12]", "[navigation].start[2] = 1000000000000 is outside"},
-        BadField{"start_yaw_deg = 10", "start_yaw_deg = 4000", "[navigation].start_yaw_deg = 4000 is outside [-3600, 3600]"},
+        BadField{"start = [0.0, 0.0, 4.0]", "start = [0.0, 0.0, 1e12]",
+                 "[navigation].start[2] = 1000000000000 is outside"},
+        BadField{"start_yaw_deg = 10", "start_yaw_deg = 4000",
+                 "[navigation].start_yaw_deg = 4000 is outside [-3600, 3600]"},
         BadField{"eye_height_m = 1.5", "eye_height_m = 0", "[navigation].eye_height_m = 0 is outside (0, 100] m"},
         BadField{"log_period_s = 2.5", "log_period_s = 0", "[stats].log_period_s = 0 is outside [0.1, 86400] s"},
         BadField{R"(file = "out/stats.json")", "file = 3", "[stats].file: expected a string"},
@@ -294,24 +332,38 @@ TEST_F(KioskConfigTest, TheExampleFileIsValid) {
 
 // good() with the tracking source: the scripted visitor's keys out, `navigation` in.
 std::string tracking(std::vector<std::string> navigation) {
-    navigation.insert(navigation.begin(), {"navigation.path=", "navigation.path_frames=", R"(navigation.source="tracking")"});
+    navigation.insert(navigation.begin(),
+                      {"navigation.path=", "navigation.path_frames=", R"(navigation.source="tracking")"});
     return KioskConfigTest::good(navigation);
 }
 
 // Every tracking field set, the two tables included.
 std::string full_tracking() {
-    return tracking({R"(navigation.camera="replay:seq")", "navigation.camera_fps=25", "navigation.tag_size_m=0.12",
-                     "navigation.tag_id=3", R"(navigation.replay_end="idle")",
-                     R"(navigation.detector.family="tag25h9")", "navigation.detector.decimation=1.5",
-                     "navigation.detector.blur_sigma=0.0", "navigation.detector.refine_edges=false",
-                     "navigation.detector.min_white_black_diff=10", "navigation.detector.decode_sharpening=0.5",
-                     "navigation.detector.max_hamming=1", "navigation.detector.threads=2",
-                     "navigation.control.rest_distance_m=0.45", "navigation.control.rest_yaw_deg=2",
-                     "navigation.control.turn_dead_zone_deg=5", "navigation.control.turn_full_scale_deg=25",
-                     "navigation.control.turn_max_deg_s=60", "navigation.control.forward_max_m_s=0.5",
-                     "navigation.control.strafe_max_m_s=0.3", "navigation.control.pitch=true",
-                     "navigation.control.max_angular_accel_deg_s2=90", "navigation.control.hold_s=0.2",
-                     "navigation.control.forget_s=1.0", "navigation.control.max_dt_s=0.05"});
+    return tracking({R"(navigation.camera="replay:seq")",
+                     "navigation.camera_fps=25",
+                     "navigation.tag_size_m=0.12",
+                     "navigation.tag_id=3",
+                     R"(navigation.replay_end="idle")",
+                     R"(navigation.detector.family="tag25h9")",
+                     "navigation.detector.decimation=1.5",
+                     "navigation.detector.blur_sigma=0.0",
+                     "navigation.detector.refine_edges=false",
+                     "navigation.detector.min_white_black_diff=10",
+                     "navigation.detector.decode_sharpening=0.5",
+                     "navigation.detector.max_hamming=1",
+                     "navigation.detector.threads=2",
+                     "navigation.control.rest_distance_m=0.45",
+                     "navigation.control.rest_yaw_deg=2",
+                     "navigation.control.turn_dead_zone_deg=5",
+                     "navigation.control.turn_full_scale_deg=25",
+                     "navigation.control.turn_max_deg_s=60",
+                     "navigation.control.forward_max_m_s=0.5",
+                     "navigation.control.strafe_max_m_s=0.3",
+                     "navigation.control.pitch=true",
+                     "navigation.control.max_angular_accel_deg_s2=90",
+                     "navigation.control.hold_s=0.2",
+                     "navigation.control.forget_s=1.0",
+                     "navigation.control.max_dt_s=0.05"});
 }
 
 TEST_F(KioskConfigTest, ReadsTheTrackingFields) {
@@ -371,8 +423,9 @@ TEST_F(KioskConfigTest, TrackingDefaultsComeFromTheLibraries) {
 }
 
 TEST_F(KioskConfigTest, AV4l2CameraNeedsIntrinsicsAndRescalesThemToItsSize) {
-    const KioskConfig c = parse(tracking({R"(navigation.camera="v4l2:/dev/video2")", R"(navigation.intrinsics="webcam.json")",
-                                          R"(navigation.camera_size="400x300")", "navigation.camera_fps=30"}));
+    const KioskConfig c =
+        parse(tracking({R"(navigation.camera="v4l2:/dev/video2")", R"(navigation.intrinsics="webcam.json")",
+                        R"(navigation.camera_size="400x300")", "navigation.camera_fps=30"}));
     const TrackingConfig& t = c.navigation.tracking;
     EXPECT_EQ(t.source.kind, CameraSourceSpec::Kind::v4l2);
     EXPECT_EQ(t.source.device, "/dev/video2");
@@ -508,8 +561,8 @@ TEST(ConfigOverrides, TheBuiltInExampleIsTheFileAndNoOverridesChangeNothing) {
 
 TEST(ConfigOverrides, SetUncommentAndCommentOutKeysAndTables) {
     const std::string text = apply_config_overrides(
-        kiosk_example_toml(), {"display.rate_hz=15", "outputs.png_every=3", "stats.file=",
-                               "navigation.control.max_dt_s=0.5", "display.rate_hz=20"});
+        kiosk_example_toml(), {"display.rate_hz=15", "outputs.png_every=3",
+                               "stats.file=", "navigation.control.max_dt_s=0.5", "display.rate_hz=20"});
     EXPECT_NE(text.find("\nrate_hz = 20\n"), std::string::npos) << "the later override wins";
     EXPECT_EQ(text.find("rate_hz = 15"), std::string::npos);
     EXPECT_NE(text.find("\npng_every = 3\n"), std::string::npos);

@@ -24,8 +24,9 @@ Status KioskDisplay::show_connecting_screen(ImageSize content, const std::string
 }
 
 void KioskDisplay::show(const ContentFrame& f) {
-    pending_[f.request_id] = PresentedFrame{f.request_id,       f.link_frame_id, f.jpeg_bytes, f.times.request_ns,
-                                            f.times.receive_ns, 0,               f.decode_ms,  stats_.rounds() + 1};
+    pending_[f.request_id] =
+        PresentedFrame{f.request_id, f.link_frame_id,    f.jpeg_bytes, f.times.request_ns, f.times.receive_ns, 0,
+                       f.decode_ms,  stats_.rounds() + 1};
     while (pending_.size() > kMaxPendingFrames) pending_.erase(pending_.begin());
     if (Status s = presenter_.show(f.image, f.request_id); !s) spdlog::warn("present: {}", s.error().message);
     account();

@@ -62,9 +62,10 @@ nlohmann::json KioskNavigation::report(std::uint64_t ticks) const {
     const TrackingCounters c = tracker_->counters();
     navigation.update(tracking_stats_json(tracker_->description(), c, samples_->pushed(), samples_->dropped(),
                                           navigator_->rejected_samples(), navigator_->pose()));
-    spdlog::info("tracking: {} frames ({} skipped behind newer ones), tag visible in {}, {} rejected by the "
-                 "flip gate, {} samples dropped",
-                 c.frames, c.skipped, c.visible, navigator_->rejected_samples(), samples_->dropped());
+    spdlog::info(
+        "tracking: {} frames ({} skipped behind newer ones), tag visible in {}, {} rejected by the "
+        "flip gate, {} samples dropped",
+        c.frames, c.skipped, c.visible, navigator_->rejected_samples(), samples_->dropped());
     return navigation;
 }
 

@@ -38,8 +38,8 @@ public:
     KioskNavigation& operator=(const KioskNavigation&) = delete;
 
     struct Step {
-        ViewRequest request;   // to submit; frame_id and request_time_ns are the link's
-        PoseLogEntry entry;    // time_ns and the tracking fields; tick, request_id, pose are the caller's
+        ViewRequest request;        // to submit; frame_id and request_time_ns are the link's
+        PoseLogEntry entry;         // time_ns and the tracking fields; tick, request_id, pose are the caller's
         bool replay_ended = false;  // the replay's last samples were observed and replay_end = "stop"
     };
     // The next tick's view: after observing every queued tag sample, in order (tracking).

@@ -28,9 +28,9 @@ std::unique_ptr<OutputBackend> open_backend(const OutputsConfig& outputs, const 
     }
     auto created = KmsOutputBackend::create(KmsOptions{outputs.device});
     if (!created) {
-        throw KioskSetupError(1, fmt::format("KMS outputs{}: {}",
-                                             outputs.device.empty() ? "" : " on " + outputs.device.string(),
-                                             created.error().message));
+        throw KioskSetupError(
+            1, fmt::format("KMS outputs{}: {}", outputs.device.empty() ? "" : " on " + outputs.device.string(),
+                           created.error().message));
     }
     return std::move(created).value();
 }
@@ -140,7 +140,8 @@ std::optional<PoseLog> open_pose_log(const std::filesystem::path& file) {
 }
 
 std::unique_ptr<KioskNavigation> start_navigation(const KioskConfig& config, std::optional<ViewScript> script) {
-    if (config.navigation.source != NavigationSource::tracking) return std::make_unique<KioskNavigation>(std::move(*script));
+    if (config.navigation.source != NavigationSource::tracking)
+        return std::make_unique<KioskNavigation>(std::move(*script));
     try {
         return std::make_unique<KioskNavigation>(config);
     } catch (const std::exception& e) {

@@ -168,8 +168,8 @@ nlohmann::json tracking_stats_json(const std::string& camera, const TrackingCoun
             {"samples_queued", samples_queued},
             {"samples_dropped", samples_dropped},
             {"samples_rejected_by_gate", samples_rejected_by_gate},
-            {"final_pose", {{"eye", {final_pose.eye.x(), final_pose.eye.y(), final_pose.eye.z()}},
-                            {"yaw_deg", final_pose.yaw_deg}}}};
+            {"final_pose",
+             {{"eye", {final_pose.eye.x(), final_pose.eye.y(), final_pose.eye.z()}}, {"yaw_deg", final_pose.yaw_deg}}}};
 }
 
 nlohmann::json run_stats_json(const RunRecord& run) {

@@ -68,12 +68,12 @@ protected:
         fs::create_directories(dir_ / "pki");
         for (const char* f : {"pki/ca.pem", "pki/a.pem", "pki/a.key"}) std::ofstream(dir_ / f) << "x";
         config_ = parse_kiosk_config(
-            apply_config_overrides(kiosk_example_toml(),
-                                   {R"(farm.endpoint="[::1]:7443")", R"(farm.ca="pki/ca.pem")", R"(farm.cert="pki/a.pem")",
-                                    R"(farm.key="pki/a.key")", "display.rate_hz=240", R"(outputs.backend="headless")",
-                                    R"(calibration.source="ideal")", R"(calibration.output="96x72")",
-                                    R"(quality.content="160x90")", "navigation.path_frames=10",
-                                    R"(stats.file="stats.json")"}),
+            apply_config_overrides(
+                kiosk_example_toml(),
+                {R"(farm.endpoint="[::1]:7443")", R"(farm.ca="pki/ca.pem")", R"(farm.cert="pki/a.pem")",
+                 R"(farm.key="pki/a.key")", "display.rate_hz=240", R"(outputs.backend="headless")",
+                 R"(calibration.source="ideal")", R"(calibration.output="96x72")", R"(quality.content="160x90")",
+                 "navigation.path_frames=10", R"(stats.file="stats.json")"}),
             dir_ / "kiosk.toml");
         screen_ = load_calibration(config_);
         HeadlessOptions options;
@@ -100,8 +100,7 @@ protected:
     }
 
     Kiosk& kiosk(KioskRunOptions options = {}) {
-        kiosk_.emplace(config_,
-                       KioskParts{*display_, *inbox_, link_.port(), *navigation_, *signals_, notifier_},
+        kiosk_.emplace(config_, KioskParts{*display_, *inbox_, link_.port(), *navigation_, *signals_, notifier_},
                        std::move(options));
         return *kiosk_;
     }

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
-// ViewScript: the scripted visitor ([navigation] source = "path"; tracking: kiosk/tracking_thread.h). It walks a camera path
-// (common/camera_path.h: "walk", "orbit" or a JSON path file) of `path_frames` poses and
-// starts over at the end, turning each pose into the ViewRequest the kiosk submits to the farm:
-// the cylindrical-screen camera, the content size and the quality knobs of the configuration.
-// One request per display tick; the LinkClient assigns its id and stamps request_time_ns.
+// ViewScript: the scripted visitor ([navigation] source = "path"; tracking: kiosk/tracking_thread.h). It walks a camera
+// path (common/camera_path.h: "walk", "orbit" or a JSON path file) of `path_frames` poses and starts over at the end,
+// turning each pose into the ViewRequest the kiosk submits to the farm: the cylindrical-screen camera, the content size
+// and the quality knobs of the configuration. One request per display tick; the LinkClient assigns its id and stamps
+// request_time_ns.
 #pragma once
 
 #include <cstdint>

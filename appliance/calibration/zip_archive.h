@@ -3,10 +3,10 @@
 // the same ZIP layer the reference library used to write the fixtures.
 //
 // Reading is tolerant of what the reference writer emits (DOS date "1980-01-00" with day 0, version
-// made by 0; minizip never validates dates) and strict about what could hurt: names with ".." components, absolute or backslash
-// names, duplicate names, encrypted entries, methods other than stored/deflate, entries larger
-// than kMaxZipEntryBytes, and CRC mismatches all throw MpcdiError naming the archive and entry.
-// Entries are only ever read into memory; nothing is extracted to disk.
+// made by 0; minizip never validates dates) and strict about what could hurt: names with ".." components, absolute or
+// backslash names, duplicate names, encrypted entries, methods other than stored/deflate, entries larger than
+// kMaxZipEntryBytes, and CRC mismatches all throw MpcdiError naming the archive and entry. Entries are only ever read
+// into memory; nothing is extracted to disk.
 #pragma once
 
 #include <cstdint>

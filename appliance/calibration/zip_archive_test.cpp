@@ -82,7 +82,7 @@ TEST(ZipArchive, DeclaredSizeIsNotAllocatedUpFront) {
     write_zip(dir / "a.zip", {{"x", std::vector<std::uint8_t>(100, 7)}}, "test");
     std::vector<std::uint8_t> bytes = test::read_bytes(dir / "a.zip");
     const std::uint32_t huge = (1U << 30) - 1;  // just under kMaxZipEntryBytes
-    put_u32(bytes, 22, huge);                    // local header: uncompressed size
+    put_u32(bytes, 22, huge);                   // local header: uncompressed size
     const std::uint8_t central[] = {0x50, 0x4b, 0x01, 0x02};
     const auto it = std::search(bytes.begin(), bytes.end(), std::begin(central), std::end(central));
     ASSERT_NE(it, bytes.end());
@@ -96,7 +96,8 @@ TEST(ZipArchive, DeclaredSizeIsNotAllocatedUpFront) {
         (void)zip.read("x");
         ADD_FAILURE() << "a 100-byte entry declared as 1 GiB was accepted";
     } catch (const MpcdiError& e) {
-        EXPECT_NE(std::string(e.what()).find("differs from the 1073741823 bytes its header declares"), std::string::npos)
+        EXPECT_NE(std::string(e.what()).find("differs from the 1073741823 bytes its header declares"),
+                  std::string::npos)
             << e.what();
     }
     EXPECT_LT(peak_rss_kib() - before, 64 * 1024) << "KiB of peak memory for a 100-byte entry";

@@ -179,8 +179,9 @@ grpc::Status LinkServer::Impl::Session(grpc::ServerContext* ctx, Stream* stream)
         std::erase(sessions, s);
         totals.sessions_active = sessions.size();
         server_stopping = stopping;
-        summary = fmt::format("{} closed: {}; {} requests, {} dropped as stale, {} invalid, {} frames, {} render failures",
-                              s->name(), s->close_reason, s->requests, s->dropped, s->invalid, s->frames, s->failures);
+        summary =
+            fmt::format("{} closed: {}; {} requests, {} dropped as stale, {} invalid, {} frames, {} render failures",
+                        s->name(), s->close_reason, s->requests, s->dropped, s->invalid, s->frames, s->failures);
     }
     link_log().info("{}", summary);
     return server_stopping ? grpc::Status(grpc::StatusCode::UNAVAILABLE, "farm is shutting down") : grpc::Status::OK;
