@@ -358,7 +358,8 @@ void read_control(const Section& s, NavigationParams& p) {
 }
 
 void read_tracking(const Section& s, TrackingConfig& t, double eye_height_m) {
-    const Value& camera = s.require("camera", "with source = \"tracking\": \"replay:<folder>\" or \"v4l2:/dev/videoN\"");
+    const Value& camera = s.require(
+        "camera", "with source = \"tracking\": \"replay:<folder>\", \"v4l2:/dev/videoN\" or \"libcamera:[<id>]\"");
     t.camera = s.as_string(camera, "camera");
     std::string why;
     if (!parse_camera_source(t.camera, t.source, &why)) s.fail(&camera, "camera", ": " + why);
@@ -369,7 +370,8 @@ void read_tracking(const Section& s, TrackingConfig& t, double eye_height_m) {
         if (!fs::is_directory(t.source.folder, ec)) {
             s.fail(&camera, "camera", fmt::format(": replay folder '{}' does not exist", t.source.folder.string()));
         }
-        s.forbid("camera_size", "with a \"v4l2:\" camera (a replay has the size of its images)");
+        s.forbid("camera_size",
+                 "with a live camera, \"v4l2:\" or \"libcamera:\" (a replay has the size of its images)");
         t.source.replay_fps = s.number("camera_fps", t.source.replay_fps, [](double x) { return x > 0 && x <= 1000; },
                                        "(0, 1000] Hz (replay rate without timestamps.txt)");
         if (const Value* end = s.find("replay_end")) {
@@ -386,10 +388,13 @@ void read_tracking(const Section& s, TrackingConfig& t, double eye_height_m) {
         }
         t.source.loop = t.replay_end == ReplayEnd::loop;
     } else {
-        if (!fs::path(t.source.device).is_absolute()) {
+        const bool v4l2 = t.source.kind == CameraSourceSpec::Kind::v4l2;
+        if (v4l2 && !fs::path(t.source.device).is_absolute()) {
             s.fail(&camera, "camera", fmt::format(": '{}' is not an absolute device path (\"v4l2:/dev/videoN\")", t.source.device));
         }
         s.forbid("replay_end", "with a \"replay:\" camera");
+        if (!v4l2)
+            s.forbid("camera_fps", "with a \"replay:\" or \"v4l2:\" camera (libcamera runs its pipeline's own rate)");
         t.source.fps = s.integer("camera_fps", 0, 0, 240);
     }
     const Value* intrinsics = s.find("intrinsics");
@@ -398,10 +403,12 @@ void read_tracking(const Section& s, TrackingConfig& t, double eye_height_m) {
     } else if (replay && fs::exists(t.source.folder / "camera.json")) {
         t.intrinsics_file = t.source.folder / "camera.json";
     } else {
-        s.fail(nullptr, "intrinsics", replay ? fmt::format(" is required (the camera calibration, JSON or OpenCV YAML; "
-                                                           "'{}' has no camera.json)", t.source.folder.string())
-                                             : std::string(" is required with a \"v4l2:\" camera (the camera calibration, "
-                                                           "JSON or OpenCV YAML)"));
+        s.fail(nullptr, "intrinsics",
+               replay ? fmt::format(" is required (the camera calibration, JSON or OpenCV YAML; "
+                                    "'{}' has no camera.json)",
+                                    t.source.folder.string())
+                      : std::string(" is required with a live camera (\"v4l2:\" or \"libcamera:\"; "
+                                    "the camera calibration, JSON or OpenCV YAML)"));
     }
     try {
         t.intrinsics = read_intrinsics(t.intrinsics_file);

@@ -92,10 +92,10 @@ enum class ReplayEnd {
 
 // [navigation] with source = "tracking": camera -> TagTracker -> Navigator (docs/kiosk.md).
 struct TrackingConfig {
-    std::string camera;                 // as written: "replay:<folder>" | "v4l2:/dev/videoN"
+    std::string camera;                 // as written: "replay:<folder>" | "v4l2:/dev/videoN" | "libcamera:[<id>]"
     CameraSourceSpec source;            // parsed; replay folder resolved against the file's folder
     std::filesystem::path intrinsics_file;  // [navigation].intrinsics (replay default: <folder>/camera.json)
-    CameraIntrinsics intrinsics;        // read; v4l2: rescaled to camera_size when that differs
+    CameraIntrinsics intrinsics;            // read; live camera: rescaled to camera_size when that differs
     double tag_size_m = 0.10;           // (0, 10]: side of the tag's black border square
     int tag_id = -1;                    // -1 (omitted): the largest tag of the family
     DetectorSettings detector;          // [navigation.detector]

@@ -441,6 +441,23 @@ TEST_F(KioskConfigTest, AV4l2CameraNeedsIntrinsicsAndRescalesThemToItsSize) {
     EXPECT_EQ(same.navigation.tracking.source.fps, 0);
 }
 
+TEST_F(KioskConfigTest, ALibcameraCameraIsNamedLikeAnyOtherAndRunsAtItsPipelinesRate) {
+    const KioskConfig c =
+        parse(tracking({R"(navigation.camera="libcamera:/base/platform/vivid.0-0000")",
+                        R"(navigation.intrinsics="webcam.json")", R"(navigation.camera_size="400x300")"}));
+    const TrackingConfig& t = c.navigation.tracking;
+    EXPECT_EQ(t.source.kind, CameraSourceSpec::Kind::libcamera);
+    EXPECT_EQ(t.source.camera_id, "/base/platform/vivid.0-0000");
+    EXPECT_EQ(t.source.width, 400);
+    EXPECT_EQ(t.intrinsics.width, 400);
+    EXPECT_EQ(parse(tracking({R"(navigation.camera="libcamera:")", R"(navigation.intrinsics="webcam.json")"}))
+                  .navigation.tracking.source.width,
+              800);  // the calibrated size by default
+    const std::string message = error_of(tracking(
+        {R"(navigation.camera="libcamera:")", R"(navigation.intrinsics="webcam.json")", "navigation.camera_fps=30"}));
+    EXPECT_NE(message.find("camera_fps: only with a \"replay:\" or \"v4l2:\" camera"), std::string::npos) << message;
+}
+
 class KioskTrackingBadField : public KioskConfigTest, public ::testing::WithParamInterface<BadField> {};
 
 TEST_P(KioskTrackingBadField, NamesTheFileTheFieldAndTheReason) {
@@ -454,28 +471,38 @@ TEST_P(KioskTrackingBadField, NamesTheFileTheFieldAndTheReason) {
 INSTANTIATE_TEST_SUITE_P(
     EveryTrackingField, KioskTrackingBadField,
     ::testing::Values(
-        BadField{R"(source = "tracking")", R"(source = "tag")", "[navigation].source: 'tag' is not one of path, tracking"},
-        BadField{R"(source = "tracking")", R"(source = "path")", "[navigation].camera: only with source = \"tracking\""},
-        BadField{R"(source = "tracking")", "source = \"tracking\"\npath = \"walk\"", "[navigation].path: only with source = \"path\""},
+        BadField{R"(source = "tracking")", R"(source = "tag")",
+                 "[navigation].source: 'tag' is not one of path, tracking"},
+        BadField{R"(source = "tracking")", R"(source = "path")",
+                 "[navigation].camera: only with source = \"tracking\""},
+        BadField{R"(source = "tracking")", "source = \"tracking\"\npath = \"walk\"",
+                 "[navigation].path: only with source = \"path\""},
         BadField{R"(camera = "replay:seq")", "# no camera", "[navigation].camera is required"},
-        BadField{R"(camera = "replay:seq")", R"(camera = "seq")", "[navigation].camera: 'seq' is neither \"replay:<folder>\" nor \"v4l2:/dev/videoN\""},
+        BadField{R"(camera = "replay:seq")", R"(camera = "seq")",
+                 "[navigation].camera: 'seq' is none of \"replay:<folder>\", \"v4l2:/dev/videoN\", "
+                 "\"libcamera:[<camera id>]\""},
         BadField{R"(camera = "replay:seq")", R"(camera = "replay:")", "[navigation].camera: 'replay:' needs a folder"},
         BadField{R"(camera = "replay:seq")", R"(camera = "replay:nowhere")", "[navigation].camera: replay folder '"},
-        BadField{R"(camera = "replay:seq")", R"(camera = "v4l2:video0")", "[navigation].camera: 'video0' is not an absolute device path"},
-        BadField{R"(camera = "replay:seq")", R"(camera = "v4l2:/dev/video0")", "[navigation].replay_end: only with a \"replay:\" camera"},
+        BadField{R"(camera = "replay:seq")", R"(camera = "v4l2:video0")",
+                 "[navigation].camera: 'video0' is not an absolute device path"},
+        BadField{R"(camera = "replay:seq")", R"(camera = "v4l2:/dev/video0")",
+                 "[navigation].replay_end: only with a \"replay:\" camera"},
         BadField{R"(camera = "replay:seq")", "camera = \"replay:.\"", "[navigation].intrinsics is required"},
         BadField{"camera_fps = 25", "camera_fps = 0", "[navigation].camera_fps = 0 is outside (0, 1000] Hz"},
-        BadField{"camera_fps = 25", "camera_fps = 25\ncamera_size = \"640x480\"", "[navigation].camera_size: only with a \"v4l2:\" camera"},
+        BadField{"camera_fps = 25", "camera_fps = 25\ncamera_size = \"640x480\"",
+                 "[navigation].camera_size: only with a live camera, \"v4l2:\" or \"libcamera:\""},
         BadField{"camera_fps = 25", "camera_fps = 25\nintrinsics = \"absent.json\"", "[navigation].intrinsics: '"},
         BadField{"camera_fps = 25", "camera_fps = 25\nintrinsics = \"broken.json\"", "[navigation].intrinsics: "},
         BadField{"tag_size_m = 0.12", "tag_size_m = 0", "[navigation].tag_size_m = 0 is outside (0, 10] m"},
         BadField{"tag_id = 3", "tag_id = -2", "[navigation].tag_id = -2 is outside [0, 1000000]"},
-        BadField{R"(replay_end = "idle")", R"(replay_end = "rewind")", "[navigation].replay_end: 'rewind' is not one of stop, loop, idle"},
+        BadField{R"(replay_end = "idle")", R"(replay_end = "rewind")",
+                 "[navigation].replay_end: 'rewind' is not one of stop, loop, idle"},
         BadField{R"(family = "tag25h9")", R"(family = "qr")", "[navigation.detector].family: "},
         BadField{"decimation = 1.5", "decimation = 9", "[navigation.detector].decimation = 9 is outside [1, 8]"},
         BadField{"max_hamming = 1", "max_hamming = 3", "[navigation.detector].max_hamming = 3 is outside [0, 2]"},
         BadField{"threads = 2", "thread = 2", "[navigation.detector].thread: unknown field (known: family"},
-        BadField{"rest_distance_m = 0.45", "rest_distance_m = 0", "[navigation.control].rest_distance_m = 0 is outside (0, 1e6] m"},
+        BadField{"rest_distance_m = 0.45", "rest_distance_m = 0",
+                 "[navigation.control].rest_distance_m = 0 is outside (0, 1e6] m"},
         BadField{"turn_dead_zone_deg = 5", "turn_dead_zone_deg = 40", "[navigation.control]: NavigationParams.turn"},
         BadField{"hold_s = 0.2", "hold_s = 2", "[navigation.control]: NavigationParams: need 0 <= hold_s"},
         BadField{"pitch = true", "pitch = 1", "[navigation.control].pitch: expected true or false"},

@@ -3,6 +3,7 @@
 
 #include <cerrno>
 
+#include "drivers/camera/libcamera_capture.h"
 #include "drivers/camera/replay_source.h"
 #include "drivers/camera/v4l2_capture.h"
 
@@ -29,7 +30,14 @@ bool parse_camera_source(std::string_view text, CameraSourceSpec& out, std::stri
         out.device = std::string(device);
         return true;
     }
-    return set_why("'" + std::string(text) + "' is neither \"replay:<folder>\" nor \"v4l2:/dev/videoN\"");
+    constexpr std::string_view libcamera = "libcamera:";
+    if (text.starts_with(libcamera)) {
+        out.kind = CameraSourceSpec::Kind::libcamera;
+        out.camera_id = std::string(text.substr(libcamera.size()));  // empty: the first camera
+        return true;
+    }
+    return set_why("'" + std::string(text) +
+                   "' is none of \"replay:<folder>\", \"v4l2:/dev/videoN\", \"libcamera:[<camera id>]\"");
 }
 
 Result<std::unique_ptr<FrameSource>> open_camera_source(const CameraSourceSpec& spec) {
@@ -37,6 +45,23 @@ Result<std::unique_ptr<FrameSource>> open_camera_source(const CameraSourceSpec& 
         auto replay = ReplaySource::open({spec.folder, spec.replay_fps, spec.loop});
         if (!replay) return replay.error();
         return std::unique_ptr<FrameSource>(std::move(replay).value());
+    }
+    const auto check_size = [&spec](ImageSize got, const std::string& name) -> Status {
+        if (got.width == spec.width && got.height == spec.height) return {};
+        return make_error(EINVAL, name + ": delivers " + std::to_string(got.width) + "x" + std::to_string(got.height) +
+                                      ", not the calibrated " + std::to_string(spec.width) + "x" +
+                                      std::to_string(spec.height));
+    };
+    if (spec.kind == CameraSourceSpec::Kind::libcamera) {
+        LibcameraConfig config;
+        config.camera_id = spec.camera_id;
+        config.width = spec.width;
+        config.height = spec.height;
+        config.timeout_ms = spec.timeout_ms;
+        auto camera = LibcameraCapture::open(config);
+        if (!camera) return camera.error();
+        if (Status s = check_size((*camera)->size(), "libcamera:" + spec.camera_id); !s) return s.error();
+        return std::unique_ptr<FrameSource>(std::move(camera).value());
     }
     V4l2Config config;
     config.device = spec.device;
@@ -46,12 +71,7 @@ Result<std::unique_ptr<FrameSource>> open_camera_source(const CameraSourceSpec& 
     config.timeout_ms = spec.timeout_ms;
     auto camera = V4l2Capture::open(config);
     if (!camera) return camera.error();
-    const ImageSize got = (*camera)->size();
-    if (got.width != spec.width || got.height != spec.height) {
-        return make_error(EINVAL, spec.device + ": delivers " + std::to_string(got.width) + "x" +
-                                      std::to_string(got.height) + ", not the calibrated " +
-                                      std::to_string(spec.width) + "x" + std::to_string(spec.height));
-    }
+    if (Status s = check_size((*camera)->size(), spec.device); !s) return s.error();
     return std::unique_ptr<FrameSource>(std::move(camera).value());
 }
 

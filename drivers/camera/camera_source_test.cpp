@@ -19,6 +19,17 @@ TEST(CameraSource, ParsesReplayAndV4l2Names) {
     EXPECT_EQ(spec.device, "/dev/video2");
 }
 
+TEST(CameraSource, ParsesLibcameraNamesWithOrWithoutAnId) {
+    CameraSourceSpec spec;
+    std::string why;
+    ASSERT_TRUE(parse_camera_source("libcamera:/base/platform/vivid.0-0000", spec, &why)) << why;
+    EXPECT_EQ(spec.kind, CameraSourceSpec::Kind::libcamera);
+    EXPECT_EQ(spec.camera_id, "/base/platform/vivid.0-0000");
+    ASSERT_TRUE(parse_camera_source("libcamera:", spec, &why)) << why;  // the first camera libcamera lists
+    EXPECT_EQ(spec.kind, CameraSourceSpec::Kind::libcamera);
+    EXPECT_TRUE(spec.camera_id.empty());
+}
+
 TEST(CameraSource, RejectsOtherNamesSayingWhy) {
     for (const char* bad : {"", "replay:", "v4l2:", "/dev/video0", "usb:0", "REPLAY:x"}) {
         CameraSourceSpec spec;
@@ -38,6 +49,20 @@ TEST(CameraSource, OpeningAMissingSourceIsAnErrorNotACrash) {
     v4l2.kind = CameraSourceSpec::Kind::v4l2;
     v4l2.device = "/nonexistent/video9";
     EXPECT_FALSE(open_camera_source(v4l2).ok());
+}
+
+// A libcamera camera that is not there is an error naming it (ENODEV), or ENOTSUP when the build
+// has no libcamera: never a crash or a hang. (A machine with a real camera of that id cannot exist.)
+TEST(CameraSource, OpeningAnUnknownLibcameraCameraNamesIt) {
+    CameraSourceSpec spec;
+    spec.kind = CameraSourceSpec::Kind::libcamera;
+    spec.camera_id = "no-such-camera-mogao";
+    const auto r = open_camera_source(spec);
+    ASSERT_FALSE(r.ok());
+    EXPECT_TRUE(r.code() == ENODEV || r.code() == ENOTSUP) << r.error().message;
+    if (r.code() == ENODEV) {
+        EXPECT_NE(r.error().message.find("no-such-camera-mogao"), std::string::npos) << r.error().message;
+    }
 }
 
 }  // namespace
