@@ -82,12 +82,10 @@ Result<EglDisplay> EglDisplay::open_platform(EGLenum platform, void* native_disp
     // Re-initialising an initialised display is allowed and returns its version.
     if (eglInitialize(display, &major, &minor) != EGL_TRUE) return egl_failure("eglInitialize", ENODEV);
     ++registry()[display];
-    static unsigned long long serial = 0;  // guarded by registry_mutex()
-    return EglDisplay(Registration{display, ++serial}, major, minor);
+    return EglDisplay(display, major, minor);
 }
 
-void EglDisplay::Traits::close(Registration registration) noexcept {
-    const EGLDisplay display = registration.display;
+void EglDisplay::Traits::close(EGLDisplay display) noexcept {
     std::lock_guard lock(registry_mutex());
     auto it = registry().find(display);
     if (it != registry().end() && --it->second == 0) {

@@ -37,29 +37,23 @@ public:
     // Any platform display, e.g. (EGL_PLATFORM_GBM_KHR, gbm_device*) for KMS output.
     [[nodiscard]] static Result<EglDisplay> open_platform(EGLenum platform, void* native_display);
 
-    [[nodiscard]] EGLDisplay get() const { return display_.get().display; }
+    [[nodiscard]] EGLDisplay get() const { return display_.get(); }
     [[nodiscard]] int major_version() const { return major_; }
     [[nodiscard]] int minor_version() const { return minor_; }
     // True when the display's extension string lists `name` (exact token match).
     [[nodiscard]] bool has_extension(std::string_view name) const;
 
 private:
-    // One open_platform() call: Mesa's shared handle plus a serial number unique to that call.
-    // Two owners of the same handle therefore hold different values, so that assigning one to the
-    // other releases the replaced owner (UniqueHandle keeps a value that is reset to itself).
-    struct Registration {
-        EGLDisplay display = EGL_NO_DISPLAY;
-        unsigned long long serial = 0;
-        bool operator==(const Registration&) const = default;
-    };
-    // close(): drops this owner's count in the registry and calls eglTerminate on the last one.
+    // Mesa returns one shared handle for every open_platform() call, so owners are counted per
+    // handle: close() drops this owner's count and calls eglTerminate on the last one.
+    // (UniqueHandle's move assignment releases before it takes, so two owners of the same handle
+    // each count once.)
     struct Traits {
-        using Value = Registration;
-        static Registration null() noexcept { return {}; }
-        static void close(Registration registration) noexcept;
+        using Value = EGLDisplay;
+        static EGLDisplay null() noexcept { return EGL_NO_DISPLAY; }
+        static void close(EGLDisplay display) noexcept;
     };
-    EglDisplay(Registration registration, EGLint major, EGLint minor)
-        : display_(registration), major_(major), minor_(minor) {}
+    EglDisplay(EGLDisplay display, EGLint major, EGLint minor) : display_(display), major_(major), minor_(minor) {}
     UniqueHandle<Traits> display_;
     int major_ = 0;
     int minor_ = 0;
