@@ -72,23 +72,30 @@ if s["link"]["sessions_opened"] < 2:
 after = [f for f in s["frames"] if f["presented_ns"] > up["time_ns"]]
 if len(after) < 10:
     print(f"FAIL: only {len(after)} frames shown after the reconnect", file=sys.stderr); sys.exit(1)
-last = down["last_request_id"]
-if last == 0:
+if down["last_request_id"] == 0:
     print("FAIL: nothing had been shown before the farm went down", file=sys.stderr); sys.exit(1)
-# Rounds while down: after the disconnect was noticed, up to the reconnect being noticed or the
-# first new frame, whichever came first (a frame can arrive before the tick that notices the link).
-end = min([up["display_round"]] + [f["display_round"] - 1 for f in s["frames"] if f["request_id"] > last])
+# Rounds while down: the longest run of display rounds without a new frame that spans the
+# disconnect. Its first frame may be one still in flight when farm 1 died (presented just after the
+# disconnect was noticed), its end a frame of farm 2 presented before the tick that notices the
+# reconnect: the gap between presented frames is what the screen had to hold, not the events.
+shown = sorted(s["frames"], key=lambda f: f["display_round"])
+gaps = [(b["display_round"] - a["display_round"], a, b) for a, b in zip(shown, shown[1:])
+        if a["presented_ns"] < up["time_ns"] and b["presented_ns"] > down["time_ns"]]
+if not gaps:
+    print("FAIL: no frame shown on both sides of the disconnect", file=sys.stderr); sys.exit(1)
+_, before, after_gap = max(gaps, key=lambda g: g[0])
+last, start, end = before["request_id"], before["display_round"], after_gap["display_round"] - 1
 pngs = []
 for name in sorted(os.listdir(sys.argv[2])):
     m = re.fullmatch(r"headless-(\d+)-(\d+)-req(\d+)\.png", name)
-    if m and down["display_round"] < int(m.group(2)) <= end:
+    if m and start < int(m.group(2)) <= end:
         pngs.append((name, int(m.group(1)), int(m.group(3))))
 wrong = [p for p in pngs if p[2] != last]
 if len(pngs) < 9 or wrong:
     print(f"FAIL: {len(pngs)} PNGs while down (>= 9 expected), showing other requests than {last}: {wrong[:3]}",
           file=sys.stderr); sys.exit(1)
 down_s = (up["time_ns"] - down["time_ns"]) / 1e9
-print(f"# farm down {down_s:.1f} s: display rounds {down['display_round'] + 1}..{end}, "
+print(f"# farm down {down_s:.1f} s: display rounds {start + 1}..{end}, "
       f"request {last} kept on screen; {len(after)} frames after the reconnect", file=sys.stderr)
 for name, output, _ in pngs:
     print(output, os.path.join(sys.argv[2], name))
