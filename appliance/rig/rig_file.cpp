@@ -1,0 +1,211 @@
+// SPDX-License-Identifier: Apache-2.0
+// Rig files: TOML -> VirtualRig with every field checked (rig_file.h).
+#include "appliance/rig/rig_file.h"
+
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <toml.hpp>
+
+namespace mogao::rig {
+namespace {
+
+// One TOML table with its path in the file ("camera", "projectors[1]") for messages; every key
+// read is remembered so that unknown keys (typos) are refused.
+class Table {
+public:
+    Table(const toml::value& v, std::string where, const std::string& file) : file_(file), where_(std::move(where)) {
+        if (!v.is_table()) fail("", "must be a table");
+        table_ = &v.as_table();
+    }
+
+    [[noreturn]] void fail(const std::string& key, const std::string& why) const {
+        throw RigError("rig file '" + file_ + "': " + where_ + (key.empty() ? "" : "." + key) + ": " + why);
+    }
+
+    const toml::value* find(const std::string& key) {
+        known_.insert(key);
+        const auto it = table_->find(key);
+        return it == table_->end() ? nullptr : &it->second;
+    }
+
+    double number(const std::string& key, double fallback) {
+        const toml::value* v = find(key);
+        if (v == nullptr) return fallback;
+        if (v->is_floating()) return v->as_floating();
+        if (v->is_integer()) return static_cast<double>(v->as_integer());
+        fail(key, "must be a number");
+    }
+
+    int integer(const std::string& key, int fallback) {
+        const toml::value* v = find(key);
+        if (v == nullptr) return fallback;
+        if (!v->is_integer() || v->as_integer() < -1000000000 || v->as_integer() > 1000000000) fail(key, "must be an integer");
+        return static_cast<int>(v->as_integer());
+    }
+
+    std::string string(const std::string& key, const std::string& fallback) {
+        const toml::value* v = find(key);
+        if (v == nullptr) return fallback;
+        if (!v->is_string()) fail(key, "must be a string");
+        return v->as_string().str;
+    }
+
+    template <std::size_t N>
+    std::array<double, N> numbers(const std::string& key, std::array<double, N> fallback) {
+        const toml::value* v = find(key);
+        if (v == nullptr) return fallback;
+        if (!v->is_array() || v->as_array().size() != N) fail(key, "must be an array of " + std::to_string(N) + " numbers");
+        std::array<double, N> out{};
+        for (std::size_t i = 0; i < N; ++i) {
+            const toml::value& e = v->as_array()[i];
+            if (e.is_floating()) {
+                out[i] = e.as_floating();
+            } else if (e.is_integer()) {
+                out[i] = static_cast<double>(e.as_integer());
+            } else {
+                fail(key, "must be an array of " + std::to_string(N) + " numbers");
+            }
+        }
+        return out;
+    }
+
+    Eigen::Vector3d vector3(const std::string& key, const Eigen::Vector3d& fallback) {
+        const auto a = numbers<3>(key, {fallback.x(), fallback.y(), fallback.z()});
+        return {a[0], a[1], a[2]};
+    }
+
+    ImageSize size(const std::string& key, ImageSize fallback) {
+        const auto a = numbers<2>(key, {double(fallback.width), double(fallback.height)});
+        if (a[0] != std::floor(a[0]) || a[1] != std::floor(a[1]) || a[0] < 1 || a[1] < 1 || a[0] > 16384 || a[1] > 16384) {
+            fail(key, "must be [width, height], integers 1..16384");
+        }
+        return {static_cast<int>(a[0]), static_cast<int>(a[1])};
+    }
+
+    void finish() const {
+        for (const auto& [key, value] : *table_) {
+            if (!known_.count(key)) fail(key, "unknown key");
+        }
+    }
+
+private:
+    std::string file_;
+    std::string where_;
+    const toml::table* table_ = nullptr;
+    std::set<std::string> known_;
+};
+
+RigPose read_pose(Table& t) {
+    RigPose pose;
+    pose.position_m = t.vector3("position_m", pose.position_m);
+    pose.yaw_deg = t.number("yaw_deg", 0.0);
+    pose.pitch_deg = t.number("pitch_deg", 0.0);
+    pose.roll_deg = t.number("roll_deg", 0.0);
+    return pose;
+}
+
+RigProjector read_projector(Table& t, int k) {
+    RigProjector p;
+    p.id = t.string("id", "proj" + std::to_string(k));
+    p.resolution = t.size("resolution", p.resolution);
+    // Data-sheet terms: throw ratio = throw distance / image width, lens shift as a fraction of the
+    // image (x right, y down; +0.5 in y puts the optical axis on the image's bottom edge).
+    const double throw_ratio = t.number("throw_ratio", 1.0);
+    const auto shift = t.numbers<2>("lens_shift", {0.0, 0.0});
+    p.intrinsics.fx_px = p.intrinsics.fy_px = throw_ratio * p.resolution.width;
+    p.intrinsics.cx_px = p.resolution.width * (0.5 + shift[0]);
+    p.intrinsics.cy_px = p.resolution.height * (0.5 + shift[1]);
+    p.pose = read_pose(t);
+    p.gamma = t.numbers<3>("gamma", p.gamma);
+    p.black_level = t.number("black_level", p.black_level);
+    p.brightness = t.numbers<3>("brightness", p.brightness);
+    t.finish();
+    return p;
+}
+
+RigCamera read_camera(Table& t) {
+    RigCamera c;
+    c.resolution = t.size("resolution", c.resolution);
+    const auto f = t.numbers<2>("focal_px", {1000.0, 1000.0});
+    const auto pp = t.numbers<2>("principal_point_px", {c.resolution.width / 2.0, c.resolution.height / 2.0});
+    c.intrinsics = {f[0], f[1], pp[0], pp[1], t.numbers<5>("distortion", {})};
+    c.pose = read_pose(t);
+    c.exposure = t.number("exposure", c.exposure);
+    c.gain = t.number("gain", c.gain);
+    c.read_noise = t.number("read_noise", c.read_noise);
+    c.shot_noise = t.number("shot_noise", c.shot_noise);
+    c.blur_sigma_px = t.number("blur_sigma_px", c.blur_sigma_px);
+    c.bits = t.integer("bits", c.bits);
+    c.supersample = t.integer("supersample", c.supersample);
+    const int seed = t.integer("seed", 1);
+    if (seed < 0) t.fail("seed", "must be >= 0");
+    c.seed = static_cast<std::uint64_t>(seed);
+    t.finish();
+    return c;
+}
+
+VirtualRig read_root(const toml::value& root, const std::string& file) {
+    Table top(root, "rig", file);
+    VirtualRig rig;
+    rig.name = top.string("name", "rig");
+    rig.ambient = top.number("ambient", rig.ambient);
+    if (const toml::value* s = top.find("screen")) {
+        Table t(*s, "screen", file);
+        rig.screen.radius_m = t.number("radius_m", rig.screen.radius_m);
+        rig.screen.arc_deg = t.number("arc_deg", rig.screen.arc_deg);
+        rig.screen.bottom_m = t.number("bottom_m", rig.screen.bottom_m);
+        rig.screen.top_m = t.number("top_m", rig.screen.top_m);
+        t.finish();
+    }
+    const toml::value* c = top.find("camera");
+    if (c == nullptr) top.fail("camera", "missing [camera] section");
+    Table cam(*c, "camera", file);
+    rig.camera = read_camera(cam);
+    if (const toml::value* p = top.find("prior")) {
+        Table t(*p, "prior", file);
+        rig.prior.camera_position_error_m = t.vector3("camera_position_error_m", rig.prior.camera_position_error_m);
+        rig.prior.camera_angle_error_deg = t.vector3("camera_angle_error_deg", rig.prior.camera_angle_error_deg);
+        rig.prior.camera_focal_error = t.number("camera_focal_error", 0.0);
+        rig.prior.projector_focal_error = t.number("projector_focal_error", 0.0);
+        t.finish();
+    }
+    const toml::value* ps = top.find("projectors");
+    if (ps == nullptr || !ps->is_array()) top.fail("projectors", "missing [[projectors]] (1..16 of them)");
+    for (std::size_t k = 0; k < ps->as_array().size(); ++k) {
+        Table t(ps->as_array()[k], "projectors[" + std::to_string(k) + "]", file);
+        rig.projectors.push_back(read_projector(t, static_cast<int>(k)));
+    }
+    top.finish();
+    return rig;
+}
+
+}  // namespace
+
+VirtualRig parse_rig(const std::string& toml_text, const std::string& name) {
+    toml::value root;
+    try {
+        std::istringstream in(toml_text);
+        root = toml::parse(in, name);
+    } catch (const std::exception& e) {
+        throw RigError("rig file '" + name + "': not valid TOML: " + e.what());
+    }
+    VirtualRig rig = read_root(root, name);
+    try {
+        validate_rig(rig);
+    } catch (const std::invalid_argument& e) {
+        throw RigError("rig file '" + name + "': " + e.what());
+    }
+    return rig;
+}
+
+VirtualRig load_rig(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw RigError("rig file '" + path.string() + "': cannot be opened");
+    std::ostringstream text;
+    text << in.rdbuf();
+    return parse_rig(text.str(), path.string());
+}
+
+}  // namespace mogao::rig

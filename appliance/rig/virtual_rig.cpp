@@ -1,0 +1,279 @@
+// SPDX-License-Identifier: Apache-2.0
+// The virtual rig: geometry (ground truth) and camera image formation. Formulas in virtual_rig.h.
+#include "appliance/rig/virtual_rig.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+#include <Eigen/Geometry>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace mogao::rig {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+void check(bool ok, const std::string& field, const std::string& limit) {
+    if (!ok) throw std::invalid_argument("rig: " + field + " must be " + limit);
+}
+
+void check_range(double v, double lo, double hi, const std::string& field) {
+    check(std::isfinite(v) && v >= lo && v <= hi, field,
+          "in [" + std::to_string(lo) + ", " + std::to_string(hi) + "] (got " + std::to_string(v) + ")");
+}
+
+void validate_size(ImageSize s, const std::string& field) {
+    check(s.width >= 1 && s.width <= 16384 && s.height >= 1 && s.height <= 16384, field,
+          "1..16384 per side (got " + std::to_string(s.width) + "x" + std::to_string(s.height) + ")");
+}
+
+void validate_intrinsics(const RigIntrinsics& in, ImageSize size, const std::string& field) {
+    check_range(in.fx_px, 1e-3, 1e6, field + ".fx_px");
+    check_range(in.fy_px, 1e-3, 1e6, field + ".fy_px");
+    check_range(in.cx_px, -4.0 * size.width, 5.0 * size.width, field + ".cx_px");
+    check_range(in.cy_px, -4.0 * size.height, 5.0 * size.height, field + ".cy_px");
+    for (double d : in.distortion) check_range(d, -10.0, 10.0, field + ".distortion");
+}
+
+void validate_pose(const RigPose& pose, const RigScreen& screen, const std::string& field) {
+    for (int i = 0; i < 3; ++i) check_range(pose.position_m[i], -1e3, 1e3, field + ".position_m");
+    check(std::hypot(pose.position_m.x(), pose.position_m.z()) < screen.radius_m, field + ".position_m",
+          "inside the cylinder (distance from the axis < radius_m = " + std::to_string(screen.radius_m) + ")");
+    check_range(pose.yaw_deg, -360.0, 360.0, field + ".yaw_deg");
+    check_range(pose.pitch_deg, -89.0, 89.0, field + ".pitch_deg");
+    check_range(pose.roll_deg, -180.0, 180.0, field + ".roll_deg");
+}
+
+// The far (forward) intersection of o + t d with the cylinder x^2 + z^2 = r^2, o inside.
+std::optional<Eigen::Vector3d> hit_cylinder(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double r) {
+    const double a = d.x() * d.x() + d.z() * d.z();
+    if (a < 1e-18) return std::nullopt;
+    const double b = 2.0 * (o.x() * d.x() + o.z() * d.z());
+    const double c = o.x() * o.x() + o.z() * o.z() - r * r;
+    const double disc = b * b - 4.0 * a * c;
+    if (disc < 0.0) return std::nullopt;
+    const double t = (-b + std::sqrt(disc)) / (2.0 * a);
+    if (t <= 0.0) return std::nullopt;
+    return o + t * d;
+}
+
+std::optional<ScreenPoint> on_screen(const RigScreen& screen, const Eigen::Vector3d& p) {
+    const ScreenPoint s{std::atan2(p.x(), -p.z()), p.y()};
+    const double half = screen.arc_deg * kDeg / 2.0;
+    if (std::abs(s.theta_rad) > half || s.h_m < screen.bottom_m || s.h_m > screen.top_m) return std::nullopt;
+    return s;
+}
+
+Eigen::Vector3d screen_position(const RigScreen& screen, ScreenPoint p) {
+    return {screen.radius_m * std::sin(p.theta_rad), p.h_m, -screen.radius_m * std::cos(p.theta_rad)};
+}
+
+}  // namespace
+
+void validate_rig(const VirtualRig& rig) {
+    const RigScreen& s = rig.screen;
+    check_range(s.radius_m, 0.1, 100.0, "screen.radius_m");
+    check_range(s.arc_deg, 1.0, 360.0, "screen.arc_deg");
+    check(std::isfinite(s.bottom_m) && std::isfinite(s.top_m) && s.top_m - s.bottom_m >= 0.01, "screen.top_m",
+          "at least 0.01 m above screen.bottom_m");
+    check(!rig.projectors.empty() && rig.projectors.size() <= 16, "projectors", "1..16 projectors");
+    check_range(rig.ambient, 0.0, 10.0, "ambient");
+    for (std::size_t k = 0; k < rig.projectors.size(); ++k) {
+        const RigProjector& p = rig.projectors[k];
+        const std::string f = "projectors[" + std::to_string(k) + "] '" + p.id + "'";
+        check(!p.id.empty(), f + ".id", "non-empty");
+        validate_size(p.resolution, f + ".resolution");
+        validate_intrinsics(p.intrinsics, p.resolution, f);
+        for (double d : p.intrinsics.distortion) check(d == 0.0, f + ".distortion", "zero (projectors are pinholes)");
+        validate_pose(p.pose, s, f);
+        for (double g : p.gamma) check_range(g, 0.1, 10.0, f + ".gamma");
+        for (double b : p.brightness) check_range(b, 1e-3, 100.0, f + ".brightness");
+        check_range(p.black_level, 0.0, 0.5, f + ".black_level");
+    }
+    const RigCamera& c = rig.camera;
+    validate_size(c.resolution, "camera.resolution");
+    validate_intrinsics(c.intrinsics, c.resolution, "camera");
+    validate_pose(c.pose, s, "camera");
+    check_range(c.exposure, 1e-3, 100.0, "camera.exposure");
+    check_range(c.gain, 1e-3, 100.0, "camera.gain");
+    check_range(c.read_noise, 0.0, 0.5, "camera.read_noise");
+    check_range(c.shot_noise, 0.0, 0.5, "camera.shot_noise");
+    check_range(c.blur_sigma_px, 0.0, 20.0, "camera.blur_sigma_px");
+    check(c.bits >= 1 && c.bits <= 16, "camera.bits", "1..16");
+    check(c.supersample >= 1 && c.supersample <= 4, "camera.supersample", "1..4");
+}
+
+Eigen::Matrix3d device_to_screen(const RigPose& pose) {
+    const Eigen::Matrix3d r = (Eigen::AngleAxisd(pose.yaw_deg * kDeg, Eigen::Vector3d::UnitY()) *
+                               Eigen::AngleAxisd(pose.pitch_deg * kDeg, Eigen::Vector3d::UnitX()) *
+                               Eigen::AngleAxisd(pose.roll_deg * kDeg, Eigen::Vector3d::UnitZ()))
+                                  .toRotationMatrix();
+    // Device x right = screen +x, y down = -y, forward = -z at zero angles.
+    return r * Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();
+}
+
+std::optional<ScreenPoint> projector_to_screen(const VirtualRig& rig, int k, double x, double y) {
+    const RigProjector& p = rig.projectors.at(static_cast<std::size_t>(k));
+    const RigIntrinsics& in = p.intrinsics;
+    const Eigen::Vector3d d_dev((x - in.cx_px) / in.fx_px, (y - in.cy_px) / in.fy_px, 1.0);
+    const auto hit = hit_cylinder(p.pose.position_m, device_to_screen(p.pose) * d_dev, rig.screen.radius_m);
+    if (!hit) return std::nullopt;
+    return on_screen(rig.screen, *hit);
+}
+
+std::optional<Eigen::Vector2d> screen_to_projector(const VirtualRig& rig, int k, ScreenPoint s) {
+    const RigProjector& p = rig.projectors.at(static_cast<std::size_t>(k));
+    const Eigen::Vector3d d = device_to_screen(p.pose).transpose() * (screen_position(rig.screen, s) - p.pose.position_m);
+    if (d.z() <= 1e-9) return std::nullopt;
+    const Eigen::Vector2d xy(p.intrinsics.fx_px * d.x() / d.z() + p.intrinsics.cx_px,
+                             p.intrinsics.fy_px * d.y() / d.z() + p.intrinsics.cy_px);
+    if (!(xy.x() >= 0.0 && xy.x() < p.resolution.width && xy.y() >= 0.0 && xy.y() < p.resolution.height)) {
+        return std::nullopt;
+    }
+    return xy;
+}
+
+Eigen::Vector2d content_of(const RigScreen& screen, ScreenPoint p) {
+    const double arc = screen.arc_deg * kDeg;
+    return {(p.theta_rad + arc / 2.0) / arc, (screen.top_m - p.h_m) / (screen.top_m - screen.bottom_m)};
+}
+
+ScreenPoint screen_of(const RigScreen& screen, Eigen::Vector2d uv) {
+    const double arc = screen.arc_deg * kDeg;
+    return {uv.x() * arc - arc / 2.0, screen.top_m - uv.y() * (screen.top_m - screen.bottom_m)};
+}
+
+CameraSimulator::CameraSimulator(const VirtualRig& rig) : rig_(rig) {
+    validate_rig(rig_);
+    const RigCamera& cam = rig_.camera;
+    const int ss = cam.supersample;
+    samples_w_ = cam.resolution.width * ss;
+    samples_h_ = cam.resolution.height * ss;
+    const std::size_t n = static_cast<std::size_t>(samples_w_) * static_cast<std::size_t>(samples_h_);
+    // Normalised distorted coordinates of every sample, undistorted by OpenCV's iterative inverse.
+    std::vector<cv::Point2d> distorted(n);
+    for (int y = 0; y < samples_h_; ++y) {
+        for (int x = 0; x < samples_w_; ++x) {
+            const double px = (x + 0.5) / ss;
+            const double py = (y + 0.5) / ss;
+            distorted[static_cast<std::size_t>(y) * samples_w_ + x] = {(px - cam.intrinsics.cx_px) / cam.intrinsics.fx_px,
+                                                                        (py - cam.intrinsics.cy_px) / cam.intrinsics.fy_px};
+        }
+    }
+    std::vector<cv::Point2d> ideal(n);
+    cv::undistortPoints(distorted, ideal, cv::Matx33d::eye(), cam.intrinsics.distortion, cv::noArray(), cv::noArray(),
+                        cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100, 1e-14));
+    on_screen_.assign(n, 0);
+    hit_.assign(rig_.projectors.size(), std::vector<std::int32_t>(n, -1));
+    const Eigen::Matrix3d r = device_to_screen(cam.pose);
+    cv::parallel_for_(cv::Range(0, samples_h_), [&](const cv::Range& rows) {
+        for (int y = rows.start; y < rows.end; ++y) {
+            for (int x = 0; x < samples_w_; ++x) {
+                const std::size_t i = static_cast<std::size_t>(y) * samples_w_ + x;
+                const Eigen::Vector3d d = r * Eigen::Vector3d(ideal[i].x, ideal[i].y, 1.0);
+                const auto hit = hit_cylinder(cam.pose.position_m, d, rig_.screen.radius_m);
+                const auto s = hit ? on_screen(rig_.screen, *hit) : std::nullopt;
+                if (!s) continue;
+                on_screen_[i] = 1;
+                for (std::size_t k = 0; k < rig_.projectors.size(); ++k) {
+                    const auto xy = screen_to_projector(rig_, static_cast<int>(k), *s);
+                    if (!xy) continue;
+                    const int w = rig_.projectors[k].resolution.width;
+                    hit_[k][i] = static_cast<std::int32_t>(std::floor(xy->y())) * w +
+                                 static_cast<std::int32_t>(std::floor(xy->x()));
+                }
+            }
+        }
+    });
+}
+
+cv::Mat1f CameraSimulator::capture(const std::vector<cv::Mat>& signals, std::uint64_t frame) const {
+    const std::size_t np = rig_.projectors.size();
+    if (signals.size() != np) {
+        throw std::invalid_argument("capture: " + std::to_string(signals.size()) + " signal images for " +
+                                    std::to_string(np) + " projectors");
+    }
+    for (std::size_t k = 0; k < np; ++k) {
+        const ImageSize r = rig_.projectors[k].resolution;
+        const cv::Mat& s = signals[k];
+        if (s.empty()) continue;
+        if ((s.type() != CV_32FC1 && s.type() != CV_32FC3) || s.cols != r.width || s.rows != r.height || !s.isContinuous()) {
+            throw std::invalid_argument("capture: signals[" + std::to_string(k) + "] must be a continuous CV_32FC1 or CV_32FC3 of " +
+                                        std::to_string(r.width) + "x" + std::to_string(r.height));
+        }
+    }
+    // Light per projector pixel value, per channel: brightness * (black + (1 - black) * s^gamma), mean of channels.
+    const auto light = [&](std::size_t k, const float* v, int channels) {
+        const RigProjector& p = rig_.projectors[k];
+        double sum = 0.0;
+        for (int c = 0; c < 3; ++c) {
+            const double s = std::clamp(static_cast<double>(v[channels == 3 ? c : 0]), 0.0, 1.0);
+            const double lin = s <= 0.0 ? 0.0 : (s >= 1.0 ? 1.0 : std::pow(s, p.gamma[static_cast<std::size_t>(c)]));
+            sum += p.brightness[static_cast<std::size_t>(c)] * (p.black_level + (1.0 - p.black_level) * lin);
+        }
+        return sum / 3.0;
+    };
+    const int ss = rig_.camera.supersample;
+    const ImageSize res = rig_.camera.resolution;
+    cv::Mat1f img(res.height, res.width, 0.0f);
+    cv::parallel_for_(cv::Range(0, res.height), [&](const cv::Range& rows) {
+        for (int y = rows.start; y < rows.end; ++y) {
+            for (int x = 0; x < res.width; ++x) {
+                double acc = 0.0;
+                for (int sy = 0; sy < ss; ++sy) {
+                    for (int sx = 0; sx < ss; ++sx) {
+                        const std::size_t i = static_cast<std::size_t>(y * ss + sy) * samples_w_ + (x * ss + sx);
+                        double l = on_screen_[i] ? rig_.ambient : 0.3 * rig_.ambient;
+                        for (std::size_t k = 0; k < np; ++k) {
+                            const std::int32_t h = hit_[k][i];
+                            if (h < 0) continue;
+                            const float zero = 0.0f;
+                            const cv::Mat& s = signals[k];
+                            l += s.empty() ? light(k, &zero, 1)
+                                           : light(k, s.ptr<float>() + static_cast<std::size_t>(h) * s.channels(), s.channels());
+                        }
+                        acc += l;
+                    }
+                }
+                img(y, x) = static_cast<float>(acc / (ss * ss));
+            }
+        }
+    });
+    const RigCamera& cam = rig_.camera;
+    if (cam.blur_sigma_px > 0.0) cv::GaussianBlur(img, img, cv::Size(0, 0), cam.blur_sigma_px, cam.blur_sigma_px, cv::BORDER_REPLICATE);
+    img *= cam.exposure * cam.gain;
+    cv::Mat1f noise(img.size());
+    cv::RNG rng(cam.seed * 0x9E3779B97F4A7C15ULL + frame * 0xD1B54A32D192ED03ULL + 1);
+    rng.fill(noise, cv::RNG::NORMAL, 0.0, 1.0);
+    const double levels = std::ldexp(1.0, cam.bits) - 1.0;
+    for (int y = 0; y < img.rows; ++y) {
+        for (int x = 0; x < img.cols; ++x) {
+            const double v = img(y, x);
+            const double sigma = std::sqrt(cam.read_noise * cam.read_noise + cam.shot_noise * cam.shot_noise * std::max(v, 0.0));
+            const double q = std::round(std::clamp(v + sigma * noise(y, x), 0.0, 1.0) * levels) / levels;
+            img(y, x) = static_cast<float>(q);
+        }
+    }
+    return img;
+}
+
+double CameraSimulator::camera_coverage(int k) const {
+    const std::vector<std::int32_t>& hits = hit_.at(static_cast<std::size_t>(k));
+    const ImageSize r = rig_.projectors[static_cast<std::size_t>(k)].resolution;
+    // Projector pixels in 8x8 blocks that some camera sample sees, over all blocks.
+    const int bw = (r.width + 7) / 8;
+    const int bh = (r.height + 7) / 8;
+    std::vector<std::uint8_t> seen(static_cast<std::size_t>(bw) * bh, 0);
+    for (std::int32_t h : hits) {
+        if (h < 0) continue;
+        seen[static_cast<std::size_t>((h / r.width) / 8) * bw + (h % r.width) / 8] = 1;
+    }
+    return static_cast<double>(std::count(seen.begin(), seen.end(), 1)) / static_cast<double>(seen.size());
+}
+
+}  // namespace mogao::rig

@@ -1,0 +1,163 @@
+// SPDX-License-Identifier: Apache-2.0
+// The virtual rig: a cylindrical screen, N projectors and one camera, simulated well enough to
+// calibrate against, with the ground truth a real rig never gives (docs/calibration.md, "The
+// virtual rig"). It is the reference the camera-based calibration (appliance/autocal) is measured
+// against, so it shares no geometry code with it: every formula here is written out again.
+//
+// Frames and units. Screen frame = CylinderScreen's (common/view_request.h): metres, origin on the
+// cylinder axis at floor level, +y up along the axis, -z toward the middle of the arc. A screen
+// point is (theta, h): theta in radians measured from -z toward +x (left to right for a viewer
+// inside), h in metres; its position is (r sin theta, h, -r cos theta). The screen spans
+// theta in [-arc/2, arc/2], h in [bottom_m, top_m]. Content (u, v), normalised as in
+// common/projector_calibration.h: u = (theta + arc/2) / arc, v = (top - h) / (top - bottom).
+//
+// Devices (projectors, camera) are pinholes at `position_m` with yaw/pitch/roll as in ViewerPose:
+// yaw about +y (0 looks along -z, positive turns left), then pitch about the device's right axis
+// (positive looks up), then roll about its forward axis (positive turns the image clockwise as
+// seen by the device). Device image: x right, y down, z forward (OpenCV's camera frame).
+// Image positions are continuous with pixel (x, y) covering [x, x + 1) x [y, y + 1), so its centre
+// is at (x + 0.5, y + 0.5) (projector_calibration.h); principal points use the same convention
+// (OpenCV's matrices put the centre at integers: cx_opencv = cx - 0.5).
+// Lens distortion (camera only): OpenCV's Brown-Conrady model, coefficients (k1, k2, p1, p2, k3)
+// on normalised coordinates (Brown 1966; OpenCV calib3d "Camera Calibration and 3D
+// Reconstruction").
+//
+// Light (linear, relative to a projector's full white = 1): projector k at signal s in [0, 1]
+// (per channel c) puts brightness_k[c] * (black + (1 - black) * s^gamma_k[c]) on the screen point
+// its pixel lands on, independent of distance and incidence (pixel-density fall-off is outside
+// the model, as in appliance/warp/composite.h); light of all projectors adds, plus `ambient`.
+// The camera is monochrome with a flat spectral response: it sees the mean of the three channels,
+// integrated over each pixel by `supersample`^2 point samples, blurred by a Gaussian of
+// `blur_sigma_px`, scaled by exposure * gain, with Gaussian noise of standard deviation
+// sqrt(read_noise^2 + shot_noise^2 * value), clipped to [0, 1] and quantised to `bits`.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "common/pixel_rect.h"
+
+namespace mogao::rig {
+
+struct RigScreen {
+    double radius_m = 3.0;
+    double arc_deg = 150.0;  // (0, 360]
+    double bottom_m = 0.8;
+    double top_m = 2.3;
+};
+
+struct RigPose {
+    Eigen::Vector3d position_m{0.0, 1.6, 0.0};  // screen frame
+    double yaw_deg = 0.0;
+    double pitch_deg = 0.0;
+    double roll_deg = 0.0;
+};
+
+// Pinhole intrinsics in pixels, principal point in image positions (pixel centre at +0.5).
+struct RigIntrinsics {
+    double fx_px = 1000.0;
+    double fy_px = 1000.0;
+    double cx_px = 0.0;
+    double cy_px = 0.0;
+    std::array<double, 5> distortion{};  // k1, k2, p1, p2, k3 (OpenCV order)
+};
+
+struct RigProjector {
+    std::string id;
+    ImageSize resolution{1920, 1080};
+    RigIntrinsics intrinsics;  // no distortion for projectors (checked)
+    RigPose pose;
+    std::array<double, 3> gamma{2.2, 2.2, 2.2};      // per channel, (0, 10]
+    double black_level = 0.002;                      // fraction of full white at signal 0, [0, 1)
+    std::array<double, 3> brightness{1.0, 1.0, 1.0};  // full white per channel, (0, 100]
+};
+
+struct RigCamera {
+    ImageSize resolution{1280, 720};
+    RigIntrinsics intrinsics;
+    RigPose pose;
+    double exposure = 1.0;       // (0, 100]
+    double gain = 1.0;           // (0, 100]
+    double read_noise = 0.003;   // standard deviation of the signal, fraction of full scale, [0, 0.5]
+    double shot_noise = 0.0;     // signal-dependent part, see the header comment, [0, 0.5]
+    double blur_sigma_px = 0.7;  // Gaussian blur, camera pixels, [0, 20]
+    int bits = 8;                // quantisation, 1..16
+    int supersample = 1;         // point samples per pixel side, 1..4
+    std::uint64_t seed = 1;
+};
+
+// What the calibration is told about the rig, as errors added to the truth: where the installer
+// measured the camera, how well the camera intrinsics are known (a chessboard calibration), what
+// the projectors' data sheets say.
+struct RigPrior {
+    Eigen::Vector3d camera_position_error_m{0.0, 0.0, 0.0};
+    Eigen::Vector3d camera_angle_error_deg{0.0, 0.0, 0.0};  // yaw, pitch, roll
+    double camera_focal_error = 0.0;     // relative error of fx, fy
+    double projector_focal_error = 0.0;  // relative error of the projectors' fx, fy
+};
+
+struct VirtualRig {
+    std::string name;
+    RigScreen screen;
+    std::vector<RigProjector> projectors;  // 1..16
+    RigCamera camera;
+    double ambient = 0.01;  // linear light everywhere on the screen, [0, 10]
+    RigPrior prior;
+};
+
+struct ScreenPoint {
+    double theta_rad = 0.0;
+    double h_m = 0.0;
+};
+
+// Checks every field's range, that the devices are inside the cylinder and that projectors have no
+// distortion. Throws std::invalid_argument naming the field and its limit.
+void validate_rig(const VirtualRig& rig);
+
+// Rotation device -> screen frame (columns: the device's x right, y down, z forward in the screen
+// frame) for the yaw/pitch/roll convention above.
+[[nodiscard]] Eigen::Matrix3d device_to_screen(const RigPose& pose);
+
+// Ground truth: where the ray through projector k's image position (x, y) lands on the screen, or
+// nullopt when it misses the screen (beyond the arc or the heights).
+[[nodiscard]] std::optional<ScreenPoint> projector_to_screen(const VirtualRig& rig, int k, double x, double y);
+
+// Ground truth, the other way: the image position of projector k that lands on screen point p, or
+// nullopt when p is behind the projector or outside its image [0, W) x [0, H).
+[[nodiscard]] std::optional<Eigen::Vector2d> screen_to_projector(const VirtualRig& rig, int k, ScreenPoint p);
+
+// Content (u, v) of a screen point and back (formulas in the header comment).
+[[nodiscard]] Eigen::Vector2d content_of(const RigScreen& screen, ScreenPoint p);
+[[nodiscard]] ScreenPoint screen_of(const RigScreen& screen, Eigen::Vector2d uv);
+
+// Forms camera images of the rig. Building it traces every camera sample once (ray -> screen ->
+// each projector's pixel); capture() then only looks up the projectors' images.
+class CameraSimulator {
+public:
+    explicit CameraSimulator(const VirtualRig& rig);  // validates the rig
+
+    // signals[k]: projector k's input signal, CV_32FC1 (grey, the same on R, G and B) or CV_32FC3
+    // (RGB), resolution of projector k, values clipped to [0, 1]; an empty Mat = projector off
+    // (black level only). `frame` seeds the noise (same frame = same image). Returns the camera
+    // image, CV_32FC1 in [0, 1], camera resolution. Throws std::invalid_argument for wrong sizes.
+    [[nodiscard]] cv::Mat1f capture(const std::vector<cv::Mat>& signals, std::uint64_t frame) const;
+
+    [[nodiscard]] const VirtualRig& rig() const { return rig_; }
+    // Fraction of projector k's 8x8-pixel blocks that some camera sample sees (ground truth coverage).
+    [[nodiscard]] double camera_coverage(int k) const;
+
+private:
+    VirtualRig rig_;
+    int samples_w_ = 0;
+    int samples_h_ = 0;
+    std::vector<std::uint8_t> on_screen_;        // per sample
+    std::vector<std::vector<std::int32_t>> hit_;  // per projector, per sample: pixel index or -1
+};
+
+}  // namespace mogao::rig

@@ -1,0 +1,131 @@
+// SPDX-License-Identifier: Apache-2.0
+// The virtual rig against independent geometry: round trips projector <-> screen, a lit projector
+// block seen where cv::projectPoints puts it in the camera, and rig-file errors.
+#include "appliance/rig/virtual_rig.h"
+
+#include <cmath>
+#include <numbers>
+
+#include <gtest/gtest.h>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "appliance/rig/rig_file.h"
+
+namespace mogao::rig {
+namespace {
+
+VirtualRig standard() { return load_rig(std::string(MOGAO_SOURCE_DIR) + "/rigs/standard.toml"); }
+
+TEST(VirtualRig, ProjectorScreenRoundTrip) {
+    const VirtualRig rig = standard();
+    int landed = 0;
+    int total = 0;
+    for (int k = 0; k < 3; ++k) {
+        for (double y = 0.5; y < 1080; y += 53.0) {
+            for (double x = 0.5; x < 1920; x += 71.0) {
+                ++total;
+                const auto s = projector_to_screen(rig, k, x, y);
+                if (!s) continue;
+                ++landed;
+                const auto back = screen_to_projector(rig, k, *s);
+                ASSERT_TRUE(back.has_value());
+                EXPECT_NEAR(back->x(), x, 1e-6);
+                EXPECT_NEAR(back->y(), y, 1e-6);
+                const Eigen::Vector2d uv = content_of(rig.screen, *s);
+                const ScreenPoint s2 = screen_of(rig.screen, uv);
+                EXPECT_NEAR(s2.theta_rad, s->theta_rad, 1e-12);
+                EXPECT_NEAR(s2.h_m, s->h_m, 1e-12);
+            }
+        }
+    }
+    // Most of each image lands on the screen; the rest overfills its edges (71 % measured).
+    EXPECT_GT(landed, total * 6 / 10);
+    EXPECT_LT(landed, total * 9 / 10);
+}
+
+TEST(VirtualRig, StandardRigCoversTheScreenWithOverlap) {
+    const VirtualRig rig = standard();
+    // Content corners and the middle of each overlap: covered by one, resp. two projectors.
+    const auto covering = [&](double u, double v) {
+        int n = 0;
+        for (int k = 0; k < 3; ++k) n += screen_to_projector(rig, k, screen_of(rig.screen, {u, v})).has_value();
+        return n;
+    };
+    EXPECT_EQ(covering(0.001, 0.001), 1);
+    EXPECT_EQ(covering(0.999, 0.999), 1);
+    EXPECT_EQ(covering(0.5, 0.5), 1);
+    EXPECT_EQ(covering(0.3, 0.5), 2);
+    EXPECT_EQ(covering(0.7, 0.5), 2);
+}
+
+TEST(VirtualRig, LitBlockAppearsWhereTheCameraModelProjectsIt) {
+    VirtualRig rig = standard();
+    rig.camera.read_noise = 0.0;
+    rig.camera.shot_noise = 0.0;
+    const CameraSimulator sim(rig);
+    const RigCamera& cam = rig.camera;
+    // Independent camera model: OpenCV's projectPoints with the rig's pose and distortion.
+    const Eigen::Matrix3d r_sc = device_to_screen(cam.pose).transpose();
+    const Eigen::Vector3d t = -r_sc * cam.pose.position_m;
+    cv::Matx33d rm;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) rm(i, j) = r_sc(i, j);
+    cv::Vec3d rvec;
+    cv::Rodrigues(rm, rvec);
+    const cv::Matx33d kmat(cam.intrinsics.fx_px, 0, cam.intrinsics.cx_px - 0.5, 0, cam.intrinsics.fy_px, cam.intrinsics.cy_px - 0.5, 0, 0, 1);
+    for (int k = 0; k < 3; ++k) {
+        const double px = 960.0;
+        const double py = 540.0;
+        const auto s = projector_to_screen(rig, k, px, py);
+        ASSERT_TRUE(s.has_value());
+        const double radius = rig.screen.radius_m;
+        const std::vector<cv::Point3d> world{{radius * std::sin(s->theta_rad), s->h_m, -radius * std::cos(s->theta_rad)}};
+        std::vector<cv::Point2d> image;
+        cv::projectPoints(world, rvec, cv::Vec3d(t.x(), t.y(), t.z()), kmat, cam.intrinsics.distortion, image);
+        std::vector<cv::Mat> signals(3);
+        signals[static_cast<std::size_t>(k)] = cv::Mat1f(1080, 1920, 0.0f);
+        cv::rectangle(signals[static_cast<std::size_t>(k)], cv::Rect(940, 520, 40, 40), 1.0, cv::FILLED);
+        const cv::Mat1f img = sim.capture(signals, 0);
+        cv::Point peak;
+        cv::Mat1f smooth;
+        cv::GaussianBlur(img, smooth, cv::Size(0, 0), 3.0);
+        cv::minMaxLoc(smooth, nullptr, nullptr, nullptr, &peak);
+        EXPECT_NEAR(peak.x, image[0].x, 1.5) << "projector " << k;
+        EXPECT_NEAR(peak.y, image[0].y, 1.5) << "projector " << k;
+    }
+}
+
+TEST(VirtualRig, CaptureIsDeterministicAndNoisy) {
+    const CameraSimulator sim(standard());
+    const std::vector<cv::Mat> off(3);
+    const cv::Mat1f a = sim.capture(off, 1);
+    const cv::Mat1f b = sim.capture(off, 1);
+    const cv::Mat1f c = sim.capture(off, 2);
+    EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0);
+    EXPECT_GT(cv::norm(a, c, cv::NORM_INF), 0.0);
+    EXPECT_THROW((void)sim.capture(std::vector<cv::Mat>(2), 0), std::invalid_argument);
+}
+
+TEST(RigFile, ErrorsNameTheField) {
+    const auto message = [](const std::string& text) {
+        try {
+            (void)parse_rig(text, "bad.toml");
+        } catch (const RigError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    EXPECT_NE(message("[screen]\nradius_m = 3\n").find("missing [camera]"), std::string::npos);
+    EXPECT_NE(message("[camera]\n[[projectors]]\nthrow_ratio = 1\nfoo = 2\n").find("projectors[0].foo: unknown key"), std::string::npos);
+    EXPECT_NE(message("[camera]\nposition_m = [0, 1, 5]\n[[projectors]]\n").find("camera.position_m must be inside the cylinder"),
+              std::string::npos);
+    EXPECT_NE(message("[camera]\nbits = 40\n[[projectors]]\n").find("camera.bits must be 1..16"), std::string::npos);
+    EXPECT_NE(message("[camera]\n[[projectors]]\ngamma = [2.2, 2.2]\n").find("projectors[0].gamma: must be an array of 3"),
+              std::string::npos);
+    EXPECT_NE(message("[camera\n").find("not valid TOML"), std::string::npos);
+    EXPECT_THROW((void)load_rig("/nonexistent/rig.toml"), RigError);
+}
+
+}  // namespace
+}  // namespace mogao::rig
