@@ -20,4 +20,21 @@ source "$dir/lib/common.sh"
 grep -q "^LABEL=$MOGAO_ROOT_LABEL " "$dir/rootfs/etc/fstab"
 grep -q "^LABEL=$MOGAO_CONFIG_LABEL " "$dir/rootfs/etc/fstab"
 grep -q "^u mogao-kiosk $MOGAO_KIOSK_UID:$MOGAO_KIOSK_GID " "$dir/rootfs/usr/lib/sysusers.d/mogao.conf"
+# provision refuses a configuration folder holding a CA's private key, by name and by content,
+# before it needs root or an image.
+farm=${2:-}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+mkdir -p "$tmp/cfg/pki"
+touch "$tmp/cfg/kiosk.toml" "$tmp/cfg/pki/ca.key"
+out=$("$dir/provision" "$tmp/none.img" "$tmp/cfg" 2>&1) && { echo "provision accepted ca.key"; exit 1; }
+grep -q "ca.key: a CA or farm private key" <<< "$out" || { echo "provision: unexpected message: $out"; exit 1; }
+if [[ -n "$farm" && -x "$farm" ]]; then
+  "$farm" pki init-ca --dir "$tmp/ca" > /dev/null
+  rm "$tmp/cfg/pki/ca.key"
+  cp "$tmp/ca/ca.pem" "$tmp/cfg/pki/ca.pem"
+  cp "$tmp/ca/ca.key" "$tmp/cfg/pki/appliance-museum-1.key"   # the CA key under an innocent name
+  out=$("$dir/provision" "$tmp/none.img" "$tmp/cfg" 2>&1) && { echo "provision accepted a renamed CA key"; exit 1; }
+  grep -q "appliance-museum-1.key: this is a CA's private key" <<< "$out" || { echo "provision: unexpected message: $out"; exit 1; }
+fi
 echo "image scripts: ok"

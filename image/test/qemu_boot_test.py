@@ -246,6 +246,9 @@ def main():
     run([a.farm, "pki", "init-ca", "--dir", pki])
     run([a.farm, "pki", "issue-farm", "--dir", pki, "--name", "farm", "--san", "fec0::2,::1"])
     run([a.farm, "pki", "issue-appliance", "--dir", pki, "--name", "museum-1"])
+    farm_tls = os.path.join(work, "farm-tls")  # what the farm serves with: never ca.key
+    shutil.rmtree(farm_tls, ignore_errors=True)
+    run([a.farm, "pki", "export-farm", "--dir", pki, "--name", "farm", "--to", farm_tls])
     os.makedirs(os.path.join(cfg, "pki"))
     for f in ("ca.pem", "appliance-museum-1.pem", "appliance-museum-1.key"):
         shutil.copy(os.path.join(pki, f), os.path.join(cfg, "pki", f))
@@ -437,7 +440,7 @@ def main():
             farm_proc = subprocess.Popen(
                 [a.mpiexec, "--oversubscribe", "-n", "1", a.farm, "serve", "--scene",
                  os.path.join(a.repo, "scenes", "test-room.json"), "--listen", f"[::1]:{port}",
-                 "--tls-dir", pki, "--name", "farm", "--threads", "1", "--duration", "1200"],
+                 "--tls-dir", farm_tls, "--name", "farm", "--threads", "1", "--duration", "1200"],
                 stdout=farm_log, stderr=subprocess.STDOUT, env=env, start_new_session=True)
             deadline = time.monotonic() + 120
             while time.monotonic() < deadline and farm_proc.poll() is None:

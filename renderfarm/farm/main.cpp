@@ -96,9 +96,10 @@ int main(int argc, char** argv) {
     CLI::App* serve = app.add_subcommand("serve", "Serve live tours to authenticated appliances over IPv6 (gRPC, mutual TLS)");
     add_farm_flags(*serve, setup, scans);
     serve->add_option("--listen", serve_options.link.listen, "IPv6 endpoint [addr]:port");
-    serve->add_option("--tls-dir", tls_dir, "PKI folder: ca.pem, farm-NAME.pem, farm-NAME.key (mogao-farm pki)")->required()->check(CLI::ExistingDirectory);
+    serve->add_option("--tls-dir", tls_dir, "TLS folder: ca.pem, farm-NAME.pem, farm-NAME.key, optional crl.pem; never ca.key (mogao-farm pki export-farm)")->required()->check(CLI::ExistingDirectory);
     serve->add_option("--name", farm_name, "Farm certificate name in --tls-dir");
     serve->add_option("--allow", serve_options.link.allowed_appliances, "Only these appliance certificate names (default: any the CA issued)");
+    serve->add_option("--crl", serve_options.link.crl_path, "Revocation list (PEM CRL of the farm CA, re-read when it changes; default: --tls-dir/crl.pem if present)");
     serve->add_option("--max-sessions", serve_options.link.max_sessions, "Concurrent appliance sessions")->check(CLI::Range(1, 256));
     serve->add_option("--duration", serve_options.duration_s, "Stop after this many seconds (0 = until SIGTERM)")->check(CLI::Range(0.0, 1e9));
     try {
@@ -109,8 +110,10 @@ int main(int argc, char** argv) {
     setup.scene_options.scans_dir = scans;
     if (serve->parsed()) {
         try {
-            serve_options.link.tls = mogao::load_tls_files(tls_dir / "ca.pem", tls_dir / ("farm-" + farm_name + ".pem"),
-                                                           tls_dir / ("farm-" + farm_name + ".key"));
+            serve_options.link.tls = mogao::load_farm_tls(tls_dir, farm_name);
+            if (serve_options.link.crl_path.empty() && std::filesystem::exists(mogao::crl_path(tls_dir))) {
+                serve_options.link.crl_path = mogao::crl_path(tls_dir).string();
+            }
         } catch (const std::exception& e) {
             if (mpi.is_admin()) spdlog::error("{}", e.what());
             return 2;

@@ -7,10 +7,14 @@
 
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <thread>
 
 #include "renderfarm/link/link_client.h"
 #include "renderfarm/link/link_server.h"
 #include "renderfarm/link/link_test_support.h"
+#include "renderfarm/link/revocation.h"
 #include "common/unique_fd.h"
 #include "renderfarm/link/wire_convert.h"
 
@@ -43,6 +47,12 @@ protected:
         EXPECT_EQ(outcome.status.error_code(), grpc::StatusCode::UNAVAILABLE) << what << ": " << outcome.status.error_message();
         EXPECT_EQ(server_->stats().sessions_opened, before.sessions_opened) << what << " reached the session handler";
         EXPECT_EQ(server_->stats().render_calls, before.render_calls) << what;
+    }
+
+    void expect_refused_by_revocation(const PemPair& who) {
+        const RawOutcome outcome = raw_session_once(tls_channel(target(), TestPki::get().appliance_tls(who)));
+        EXPECT_FALSE(outcome.got_frame);
+        EXPECT_EQ(outcome.status.error_code(), grpc::StatusCode::PERMISSION_DENIED) << outcome.status.error_message();
     }
 
     SyntheticRenderer renderer_;
@@ -184,6 +194,47 @@ TEST_F(LinkSecurity, ApplianceOutsideTheAllowedListIsRefused) {
     const RawOutcome allowed = raw_session_once(tls_channel(target(), TestPki::get().appliance_tls(TestPki::get().museum2)));
     EXPECT_TRUE(allowed.got_frame) << allowed.status.error_message();
     EXPECT_EQ(server_->stats().sessions_refused, 1u);
+}
+
+TEST_F(LinkSecurity, RevokedApplianceIsRefusedAndItsOpenSessionEnds) {
+    const auto& pki = TestPki::get();
+    const TempDir tmp;
+    const auto crl = tmp.path() / "crl.pem";
+    const auto write_crl = [&](const std::vector<RevokedCert>& revoked) {
+        std::ofstream(tmp.path() / "crl.new") << make_crl(pki.ca, revoked, kSecondsPerDay);
+        std::filesystem::rename(tmp.path() / "crl.new", crl);
+    };
+    write_crl({{cert_serial_hex(pki.museum2.cert_pem), 0}});
+    server_.reset();
+    auto options = test_server_options();
+    options.crl_path = crl.string();
+    server_ = std::make_unique<LinkServer>(options, renderer_.function());
+
+    const RawOutcome refused = raw_session_once(tls_channel(target(), pki.appliance_tls(pki.museum2)));
+    EXPECT_FALSE(refused.got_frame);
+    EXPECT_EQ(refused.status.error_code(), grpc::StatusCode::PERMISSION_DENIED) << refused.status.error_message();
+    EXPECT_NE(refused.status.error_message().find("revoked"), std::string::npos) << refused.status.error_message();
+    EXPECT_EQ(server_->stats().sessions_refused, 1u);
+
+    // museum-1 streams; then its certificate is revoked while the farm runs: the session ends.
+    LinkClient client(test_client_options(server_->endpoint().port, pki.museum1), [](LinkFrame&&) {});
+    const auto first = client.submit(test_request(1.0));
+    ASSERT_TRUE(wait_until([&] { return client.stats().last_request_id == first; }));
+    write_crl({{cert_serial_hex(pki.museum2.cert_pem), 0}, {cert_serial_hex(pki.museum1.cert_pem), 0}});
+    // The list is re-read at most once a second, on the session's next request.
+    std::uint64_t last = first;
+    ASSERT_TRUE(wait_until([&] {
+        last = client.submit(test_request(2.0));
+        return server_->stats().sessions_revoked == 1;
+    })) << "the revoked appliance's session is still open";
+    EXPECT_TRUE(wait_until([&] { return server_->stats().sessions_active == 0; }));
+    // It does not get back in, and is served nothing more.
+    const auto served = client.stats().last_request_id;
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    EXPECT_EQ(client.stats().last_request_id, served);
+    EXPECT_LT(served, last);
+    EXPECT_GE(server_->stats().sessions_refused, 1u);
+    expect_refused_by_revocation(pki.museum1);
 }
 
 TEST(LinkIpv6Only, Ipv4PeerOnTheDualStackWildcardIsRefused) {

@@ -14,6 +14,7 @@
 
 #include "renderfarm/link/link_log.h"
 #include "renderfarm/link/mogao_link.grpc.pb.h"
+#include "renderfarm/link/revocation.h"
 #include "renderfarm/link/wire_convert.h"
 
 namespace mogao {
@@ -30,6 +31,9 @@ struct SessionState {
     std::uint64_t id = 0;
     std::string peer;      // "ipv6:[addr]:port"
     std::string identity;  // certificate CN
+    std::string serial;    // certificate serial number (hex), checked against the revocation list
+    std::uint64_t revocation_generation = 0;  // of the list last checked against (reader thread only)
+    bool revoked = false;
     std::optional<ViewRequest> pending;
     std::int64_t pending_received_ns = 0;
     std::uint64_t newest_request_id = 0;
@@ -51,6 +55,7 @@ struct LinkServer::Impl final : v1::Tour::Service {
     LinkServerOptions options;
     FrameRenderer renderer;
     Endpoint endpoint;
+    std::unique_ptr<RevocationWatcher> revocation;  // null without LinkServerOptions::crl_path
 
     mutable std::mutex mutex;
     std::condition_variable work_cv;  // render workers: a session became ready, or stopping
@@ -68,6 +73,7 @@ struct LinkServer::Impl final : v1::Tour::Service {
     grpc::Status admit(grpc::ServerContext* ctx, std::shared_ptr<SessionState>& out);
     void read_loop(SessionState& s, Stream& stream);
     void on_message(SessionState& s, const v1::ViewRequestMsg& msg);
+    bool still_trusted(SessionState& s);
     void close(SessionState& s, const std::string& reason);
     void render_loop();
     std::shared_ptr<SessionState> pick_ready();  // with mutex held
@@ -81,6 +87,13 @@ std::string common_name(const grpc::ServerContext& ctx) {
     if (!auth) return "?";
     const auto names = auth->FindPropertyValues("x509_common_name");
     return names.empty() ? "?" : std::string(names.front().data(), names.front().size());
+}
+
+std::string peer_serial(const grpc::ServerContext& ctx) {
+    const auto auth = ctx.auth_context();
+    if (!auth) return {};
+    const auto pems = auth->FindPropertyValues("x509_pem_cert");
+    return pems.empty() ? std::string{} : cert_serial_hex(std::string(pems.front().data(), pems.front().size()));
 }
 
 // gRPC percent-encodes the brackets of IPv6 peers ("ipv6:%5B::1%5D:5000"); logs read better without.
@@ -122,6 +135,15 @@ grpc::Status LinkServer::Impl::admit(grpc::ServerContext* ctx, std::shared_ptr<S
     const auto& allowed = options.allowed_appliances;
     if (!allowed.empty() && std::find(allowed.begin(), allowed.end(), s->identity) == allowed.end()) {
         return refuse(grpc::StatusCode::PERMISSION_DENIED, "appliance '" + s->identity + "' is not in the allowed list");
+    }
+    if (revocation) {
+        s->serial = peer_serial(*ctx);
+        s->revocation_generation = revocation->generation();
+        if (s->serial.empty() || revocation->revoked(s->serial)) {
+            return refuse(grpc::StatusCode::PERMISSION_DENIED,
+                          "certificate " + s->serial + " of '" + s->identity + "' is revoked (" +
+                              revocation->path().string() + ")");
+        }
     }
     {
         const std::lock_guard lock(mutex);
@@ -184,15 +206,36 @@ grpc::Status LinkServer::Impl::Session(grpc::ServerContext* ctx, Stream* stream)
                         s->name(), s->close_reason, s->requests, s->dropped, s->invalid, s->frames, s->failures);
     }
     link_log().info("{}", summary);
+    if (s->revoked) return grpc::Status(grpc::StatusCode::PERMISSION_DENIED, "the appliance's certificate was revoked");
     return server_stopping ? grpc::Status(grpc::StatusCode::UNAVAILABLE, "farm is shutting down") : grpc::Status::OK;
 }
 
 void LinkServer::Impl::read_loop(SessionState& s, Stream& stream) {
     v1::ViewRequestMsg msg;
-    while (stream.Read(&msg)) on_message(s, msg);
+    while (stream.Read(&msg)) {
+        if (!still_trusted(s)) return;
+        on_message(s, msg);
+    }
     // Read fails on a clean half-close, on cancellation and on a message above max_request_bytes
     // (gRPC then ends the call with RESOURCE_EXHAUSTED and logs it).
     close(s, "appliance stream ended");
+}
+
+bool LinkServer::Impl::still_trusted(SessionState& s) {
+    if (!revocation) return true;
+    const std::uint64_t generation = revocation->generation();
+    if (generation == s.revocation_generation) return true;
+    s.revocation_generation = generation;
+    if (!revocation->revoked(s.serial)) return true;
+    link_log().warn("{}: certificate {} revoked ({}); ending the session", s.name(), s.serial,
+                    revocation->path().string());
+    {
+        const std::lock_guard lock(mutex);
+        s.revoked = true;
+        ++totals.sessions_revoked;
+    }
+    close(s, "certificate revoked");
+    return false;
 }
 
 void LinkServer::Impl::on_message(SessionState& s, const v1::ViewRequestMsg& msg) {
@@ -338,6 +381,9 @@ LinkServer::LinkServer(LinkServerOptions options, FrameRenderer renderer) : impl
     impl_->options = std::move(options);
     impl_->renderer = std::move(renderer);
     impl_->endpoint = *endpoint;
+    if (!impl_->options.crl_path.empty()) {
+        impl_->revocation = std::make_unique<RevocationWatcher>(impl_->options.crl_path, impl_->options.tls.ca_pem);
+    }
 
     grpc::SslServerCredentialsOptions ssl(GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY);
     ssl.pem_root_certs = impl_->options.tls.ca_pem;

@@ -14,7 +14,8 @@
 // sessions call the renderer, picking sessions round-robin. With render_threads = 1 (the default)
 // the renderer is never called concurrently, which is what the MPI farm needs.
 //
-// Errors: construction throws LinkError (bad endpoint, unusable TLS material, port taken). After
+// Errors: construction throws LinkError (bad endpoint, unusable TLS material or revocation list,
+// port taken). After
 // that nothing is thrown: an invalid request is refused and logged (the session continues), a
 // renderer exception costs that request its frame, a broken session ends alone; all of it is
 // logged to stderr through spdlog (logger "mogao-link").
@@ -45,6 +46,9 @@ struct LinkServerOptions {
     TlsMaterial tls;  // farm certificate + key; ca_pem: the CA every appliance certificate must chain to
     // Appliance certificate common names allowed in; empty = every certificate the CA issued.
     std::vector<std::string> allowed_appliances;
+    // The farm CA's revocation list (PEM CRL, revocation.h); empty = none. Re-read when the file
+    // changes: a listed certificate is refused, and its open sessions end (PERMISSION_DENIED).
+    std::string crl_path;
     int render_threads = 1;        // renderer calls at once over all sessions, 1..64
     int max_frames_in_flight = 2;  // per session, 1..16
     int max_sessions = 8;          // concurrent appliance sessions; more are refused (RESOURCE_EXHAUSTED)
@@ -57,7 +61,8 @@ struct LinkServerOptions {
 
 struct LinkServerStats {
     std::uint64_t sessions_opened = 0;   // sessions that reached the handler (TLS and checks passed)
-    std::uint64_t sessions_refused = 0;  // IPv4 peer, name not allowed, too many sessions, stopping
+    std::uint64_t sessions_refused = 0;  // IPv4 peer, name not allowed, revoked, too many sessions, stopping
+    std::uint64_t sessions_revoked = 0;  // open sessions ended because their certificate got revoked
     std::uint64_t sessions_active = 0;
     std::uint64_t requests_received = 0;  // valid view requests read
     std::uint64_t requests_invalid = 0;   // refused by validation (logged)

@@ -4,6 +4,8 @@
 #include <openssl/err.h>
 #include <openssl/pem.h>
 
+#include <ctime>
+
 namespace mogao::ossl {
 namespace {
 
@@ -54,6 +56,35 @@ Pkey parse_key(std::string_view pem) {
     Bio bio = read_bio(pem);
     // No passphrase callback: keys are stored unencrypted, protected by mode 0600 (docs/link.md).
     return bio ? Pkey(PEM_read_bio_PrivateKey(bio.get(), nullptr, nullptr, nullptr)) : nullptr;
+}
+
+Crl parse_crl(std::string_view pem) {
+    if (pem.size() > (16u << 20)) return nullptr;
+    Bio bio = read_bio(pem);
+    return bio ? Crl(PEM_read_bio_X509_CRL(bio.get(), nullptr, nullptr, nullptr)) : nullptr;
+}
+
+std::string crl_to_pem(X509_CRL* crl) {
+    Bio bio(BIO_new(BIO_s_mem()));
+    if (!bio || PEM_write_bio_X509_CRL(bio.get(), crl) != 1) return {};
+    return drain(bio.get());
+}
+
+std::string integer_hex(const ASN1_INTEGER* value) {
+    if (!value) return {};
+    Bignum bn(ASN1_INTEGER_to_BN(value, nullptr));
+    if (!bn) return {};
+    char* hex = BN_bn2hex(bn.get());
+    if (!hex) return {};
+    std::string out(hex);
+    OPENSSL_free(hex);
+    return out;
+}
+
+std::int64_t time_seconds(const ASN1_TIME* time) {
+    std::tm tm{};
+    if (!time || ASN1_TIME_to_tm(time, &tm) != 1) return 0;
+    return static_cast<std::int64_t>(timegm(&tm));
 }
 
 std::string cert_to_pem(X509* cert) {

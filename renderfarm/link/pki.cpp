@@ -6,10 +6,13 @@
 #include <openssl/err.h>
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <ctime>
 #include <cstring>
 
 #include "renderfarm/link/openssl_util.h"
+#include "common/link_types.h"
 #include "common/unique_fd.h"
 
 namespace mogao {
@@ -195,12 +198,47 @@ PemPair issue_cert(const PemPair& ca, const CertSpec& spec) {
     return {ossl::cert_to_pem(cert.get()), ossl::key_to_pem(key.get())};
 }
 
+std::string make_crl(const PemPair& ca, const std::vector<RevokedCert>& revoked, std::int64_t lifetime_s) {
+    if (lifetime_s <= 0) throw PkiError("revocation list lifetime must be positive");
+    ossl::Cert ca_cert = ossl::parse_cert(ca.cert_pem);
+    ossl::Pkey ca_key = ossl::parse_key(ca.key_pem);
+    if (!ca_cert || !ca_key) fail("cannot parse the CA certificate or key");
+    if (X509_check_private_key(ca_cert.get(), ca_key.get()) != 1) fail("the CA key does not match the CA certificate");
+    ossl::Crl crl(X509_CRL_new());
+    ossl::Time now(ASN1_TIME_adj(nullptr, std::time(nullptr), 0, 0));
+    ossl::Time next(ASN1_TIME_adj(nullptr, std::time(nullptr), 0, static_cast<long>(lifetime_s)));
+    if (!crl || !now || !next || X509_CRL_set_version(crl.get(), X509_CRL_VERSION_2) != 1 ||
+        X509_CRL_set_issuer_name(crl.get(), X509_get_subject_name(ca_cert.get())) != 1 ||
+        X509_CRL_set1_lastUpdate(crl.get(), now.get()) != 1 || X509_CRL_set1_nextUpdate(crl.get(), next.get()) != 1) {
+        fail("cannot start a revocation list");
+    }
+    for (const auto& r : revoked) {
+        ossl::Revoked entry(X509_REVOKED_new());
+        BIGNUM* raw = nullptr;
+        if (!entry || BN_hex2bn(&raw, r.serial_hex.c_str()) == 0) fail("bad serial number '" + r.serial_hex + "'");
+        const ossl::Bignum serial(raw);
+        UniquePtr<ASN1_INTEGER, &ASN1_INTEGER_free> number(BN_to_ASN1_INTEGER(serial.get(), nullptr));
+        ossl::Time when(ASN1_TIME_set(nullptr, static_cast<time_t>(r.revoked_at_s)));
+        if (!number || !when || X509_REVOKED_set_serialNumber(entry.get(), number.get()) != 1 ||
+            X509_REVOKED_set_revocationDate(entry.get(), when.get()) != 1 ||
+            X509_CRL_add0_revoked(crl.get(), entry.get()) != 1) {
+            fail("cannot list serial number " + r.serial_hex);
+        }
+        static_cast<void>(entry.release());  // owned by the CRL now
+    }
+    if (X509_CRL_sort(crl.get()) != 1 || X509_CRL_sign(crl.get(), ca_key.get(), EVP_sha256()) == 0) {
+        fail("cannot sign the revocation list");
+    }
+    return ossl::crl_to_pem(crl.get());
+}
+
 fs::path ca_cert_path(const fs::path& dir) { return dir / "ca.pem"; }
 fs::path ca_key_path(const fs::path& dir) { return dir / "ca.key"; }
 fs::path farm_cert_path(const fs::path& dir, const std::string& name) { return dir / ("farm-" + name + ".pem"); }
 fs::path farm_key_path(const fs::path& dir, const std::string& name) { return dir / ("farm-" + name + ".key"); }
 fs::path appliance_cert_path(const fs::path& dir, const std::string& name) { return dir / ("appliance-" + name + ".pem"); }
 fs::path appliance_key_path(const fs::path& dir, const std::string& name) { return dir / ("appliance-" + name + ".key"); }
+fs::path crl_path(const fs::path& dir) { return dir / "crl.pem"; }
 
 std::vector<fs::path> pki_init_ca(const fs::path& dir, const std::string& name, int days, KeyAlgorithm key,
                                   bool force) {
@@ -226,7 +264,77 @@ std::vector<fs::path> pki_issue_appliance(const fs::path& dir, const std::string
     return write_pair(appliance_cert_path(dir, name), appliance_key_path(dir, name), pair, force);
 }
 
+namespace {
+
+std::vector<RevokedCert> current_revocations(const fs::path& dir, const PemPair& ca) {
+    std::error_code ec;
+    if (!fs::exists(crl_path(dir), ec)) return {};
+    try {
+        return parse_crl(read_pem_file(crl_path(dir)), ca.cert_pem, crl_path(dir).string()).revoked;
+    } catch (const std::exception& e) {
+        throw PkiError(std::string(e.what()) + " (move it away to start a new list)");
+    }
+}
+
+void write_crl(const fs::path& dir, const PemPair& ca, const std::vector<RevokedCert>& revoked, int days) {
+    write_private_file(crl_path(dir), make_crl(ca, revoked, days_to_seconds(days)), true);
+}
+
+}  // namespace
+
+std::vector<fs::path> pki_revoke(const fs::path& dir, const fs::path& cert, int days) {
+    const PemPair ca = load_ca_files(dir);
+    std::string serial;
+    try {
+        serial = cert_serial_hex(read_pem_file(cert));
+    } catch (const std::exception& e) {
+        throw PkiError(e.what());
+    }
+    if (serial.empty()) throw PkiError(cert.string() + ": not a PEM certificate");
+    std::vector<RevokedCert> revoked = current_revocations(dir, ca);
+    const bool listed = std::any_of(revoked.begin(), revoked.end(), [&](const auto& r) { return r.serial_hex == serial; });
+    if (!listed) revoked.push_back({serial, static_cast<std::int64_t>(std::time(nullptr))});
+    write_crl(dir, ca, revoked, days);
+    return {crl_path(dir)};
+}
+
+std::vector<fs::path> pki_refresh_crl(const fs::path& dir, int days) {
+    const PemPair ca = load_ca_files(dir);
+    write_crl(dir, ca, current_revocations(dir, ca), days);
+    return {crl_path(dir)};
+}
+
+std::vector<fs::path> pki_export_farm(const fs::path& dir, const std::string& name, const fs::path& to, bool force) {
+    if (auto why = check_pki_name(name); !why.empty()) throw PkiError(why);
+    std::error_code ec;
+    if (fs::equivalent(dir, to, ec)) throw PkiError("export-farm: --to must be another folder than --dir (it holds ca.key)");
+    std::vector<std::pair<fs::path, fs::path>> copies{{ca_cert_path(dir), ca_cert_path(to)},
+                                                      {farm_cert_path(dir, name), farm_cert_path(to, name)},
+                                                      {farm_key_path(dir, name), farm_key_path(to, name)}};
+    if (fs::exists(crl_path(dir), ec)) copies.emplace_back(crl_path(dir), crl_path(to));
+    std::vector<std::string> contents;
+    for (const auto& [from, _] : copies) {
+        try {
+            contents.push_back(read_pem_file(from));
+        } catch (const std::exception& e) {
+            throw PkiError(std::string(e.what()) + " (pki issue-farm --dir " + dir.string() + " --name " + name + ")");
+        }
+    }
+    std::vector<fs::path> targets;
+    for (const auto& [_, target] : copies) targets.push_back(target);
+    require_absent(targets, force);
+    ensure_dir(to);
+    for (std::size_t i = 0; i < copies.size(); ++i) write_private_file(copies[i].second, contents[i], force);
+    return targets;
+}
+
 TlsMaterial load_farm_tls(const fs::path& dir, const std::string& name) {
+    std::error_code ec;
+    if (fs::exists(ca_key_path(dir), ec)) {
+        throw LinkError(ca_key_path(dir).string() + ": the CA's private key is in the farm's TLS folder; keep it " +
+                        "offline and serve from a folder made by `mogao-farm pki export-farm --dir " + dir.string() +
+                        " --name " + name + " --to FOLDER` (docs/link.md)");
+    }
     return load_tls_files(ca_cert_path(dir), farm_cert_path(dir, name), farm_key_path(dir, name));
 }
 

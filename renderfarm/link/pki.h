@@ -9,6 +9,10 @@
 //   ca.pem, ca.key                          farm CA (10 years by default)
 //   farm-<name>.pem, farm-<name>.key        farm server certificate (825 days by default)
 //   appliance-<name>.pem, appliance-<name>.key  appliance client certificate (365 days by default)
+//   crl.pem                                 revocation list signed by the CA (revocation.h)
+// That folder is the CA's workspace and holds ca.key: keep it offline. The farm serves from a
+// folder made by `pki export-farm` (ca.pem, crl.pem, farm-<name>.pem/.key, never ca.key) and
+// refuses a folder that holds ca.key (load_farm_tls); appliances get ca.pem and their own pair.
 // Names: 1..64 of [A-Za-z0-9._-], not starting with '.' or '-'.
 //
 // Errors: PkiError (a std::runtime_error) naming the file or the field and the reason. Existing
@@ -21,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "renderfarm/link/revocation.h"
 #include "renderfarm/link/tls_material.h"
 
 namespace mogao {
@@ -56,6 +61,10 @@ struct CertSpec {
 [[nodiscard]] PemPair make_ca(const CertSpec& spec);
 [[nodiscard]] PemPair issue_cert(const PemPair& ca, const CertSpec& spec);
 
+// In memory: a CRL (X.509 v2, RFC 5280 section 5) signed by `ca` listing `revoked` in serial
+// order, thisUpdate now, nextUpdate in `lifetime_s`.
+[[nodiscard]] std::string make_crl(const PemPair& ca, const std::vector<RevokedCert>& revoked, std::int64_t lifetime_s);
+
 // File names inside a PKI folder.
 [[nodiscard]] std::filesystem::path ca_cert_path(const std::filesystem::path& dir);
 [[nodiscard]] std::filesystem::path ca_key_path(const std::filesystem::path& dir);
@@ -63,6 +72,7 @@ struct CertSpec {
 [[nodiscard]] std::filesystem::path farm_key_path(const std::filesystem::path& dir, const std::string& name);
 [[nodiscard]] std::filesystem::path appliance_cert_path(const std::filesystem::path& dir, const std::string& name);
 [[nodiscard]] std::filesystem::path appliance_key_path(const std::filesystem::path& dir, const std::string& name);
+[[nodiscard]] std::filesystem::path crl_path(const std::filesystem::path& dir);
 
 // "" when `name` is a valid certificate/file name, else why not.
 [[nodiscard]] std::string check_pki_name(const std::string& name);
@@ -75,7 +85,19 @@ std::vector<std::filesystem::path> pki_issue_farm(const std::filesystem::path& d
 std::vector<std::filesystem::path> pki_issue_appliance(const std::filesystem::path& dir, const std::string& name,
                                                        int days, bool force);
 
-// What each side loads to start (throws LinkError naming the missing file).
+// `pki revoke`: adds `cert`'s serial number to dir/crl.pem (created if missing), re-signed and valid
+// for `days`; revoking twice is not an error. `pki crl`: re-issues dir/crl.pem with the same
+// entries and a fresh nextUpdate. Both return crl.pem.
+std::vector<std::filesystem::path> pki_revoke(const std::filesystem::path& dir, const std::filesystem::path& cert,
+                                              int days);
+std::vector<std::filesystem::path> pki_refresh_crl(const std::filesystem::path& dir, int days);
+// `pki export-farm`: copies what farm `name` serves with into `to` (created 0700): ca.pem,
+// farm-<name>.pem, farm-<name>.key and crl.pem when there is one. Never ca.key.
+std::vector<std::filesystem::path> pki_export_farm(const std::filesystem::path& dir, const std::string& name,
+                                                   const std::filesystem::path& to, bool force);
+
+// What each side loads to start (throws LinkError naming the missing file). load_farm_tls also
+// refuses a folder holding ca.key: the CA's key must not sit on a networked farm.
 [[nodiscard]] TlsMaterial load_farm_tls(const std::filesystem::path& dir, const std::string& name);
 [[nodiscard]] TlsMaterial load_appliance_tls(const std::filesystem::path& dir, const std::string& name);
 
@@ -83,7 +105,7 @@ std::vector<std::filesystem::path> pki_issue_appliance(const std::filesystem::pa
 // umask cannot change it), fsync'd. Refuses an existing file unless `force`.
 void write_private_file(const std::filesystem::path& path, const std::string& content, bool force);
 
-// `mogao-farm pki <init-ca|issue-farm|issue-appliance> ...`: argv[0] is the word "pki" (or any
+// `mogao-farm pki <init-ca|issue-farm|issue-appliance|revoke|crl|export-farm> ...`: argv[0] is the word "pki" (or any
 // program name), the subcommand follows. Returns 0 on success, 1 when the PKI operation failed
 // (logged), 2 for a bad command line (CLI11's message on stderr). Never throws.
 int run_pki_command(int argc, char** argv);

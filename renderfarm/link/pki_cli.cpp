@@ -23,8 +23,8 @@ std::vector<std::string> split_sans(const std::string& text) {
 }  // namespace
 
 int run_pki_command(int argc, char** argv) {
-    CLI::App app{"mogao link PKI: the farm CA, the farm's server certificate and one client certificate per "
-                 "appliance (files mode 0600; docs/link.md)",
+    CLI::App app{"mogao link PKI: the farm CA, the farm's server certificate, one client certificate per "
+                 "appliance and the revocation list (files mode 0600; docs/link.md)",
                  "pki"};
     app.require_subcommand(1);
     std::string dir, name, san, key = "ec";
@@ -49,6 +49,20 @@ int run_pki_command(int argc, char** argv) {
     common(appliance);
     appliance->add_option("--name", name, "Appliance name, e.g. museum-1")->required();
     appliance->add_option("--days", days, "Validity in days")->default_val(365)->check(CLI::Range(1, 36500));
+    std::string cert, to;
+    CLI::App* revoke = app.add_subcommand("revoke", "Revoke an appliance certificate: add it to crl.pem (re-signed)");
+    revoke->add_option("--dir", dir, "PKI folder (with ca.key)")->required();
+    auto* by_name = revoke->add_option("--name", name, "Appliance name: revokes appliance-NAME.pem in --dir");
+    revoke->add_option("--cert", cert, "Or the certificate file to revoke")->excludes(by_name);
+    revoke->add_option("--days", days, "The list's validity (nextUpdate) in days")->default_val(30)->check(CLI::Range(1, 36500));
+    CLI::App* crl = app.add_subcommand("crl", "Re-issue crl.pem with the same entries and a fresh nextUpdate");
+    crl->add_option("--dir", dir, "PKI folder (with ca.key)")->required();
+    crl->add_option("--days", days, "The list's validity (nextUpdate) in days")->default_val(30)->check(CLI::Range(1, 36500));
+    CLI::App* export_farm = app.add_subcommand(
+        "export-farm", "Copy what the farm serves with (ca.pem, crl.pem, farm-NAME.pem/.key; never ca.key) to --to");
+    common(export_farm);
+    export_farm->add_option("--name", name, "Farm certificate name")->required();
+    export_farm->add_option("--to", to, "The farm's TLS folder (mogao-farm serve --tls-dir)")->required();
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -61,8 +75,15 @@ int run_pki_command(int argc, char** argv) {
             written = pki_init_ca(dir, name, days, key == "rsa" ? KeyAlgorithm::rsa_3072 : KeyAlgorithm::ec_p256, force);
         } else if (farm->parsed()) {
             written = pki_issue_farm(dir, name, split_sans(san), days, force);
-        } else {
+        } else if (appliance->parsed()) {
             written = pki_issue_appliance(dir, name, days, force);
+        } else if (revoke->parsed()) {
+            if (name.empty() && cert.empty()) throw PkiError("revoke: give --name or --cert");
+            written = pki_revoke(dir, cert.empty() ? appliance_cert_path(dir, name) : std::filesystem::path(cert), days);
+        } else if (crl->parsed()) {
+            written = pki_refresh_crl(dir, days);
+        } else {
+            written = pki_export_farm(dir, name, to, force);
         }
         for (const auto& path : written) std::cout << path.string() << '\n';
         return 0;

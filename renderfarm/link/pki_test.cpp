@@ -49,8 +49,11 @@ TEST(Pki, CommandsWriteEveryFileWithMode0600) {
     ::umask(old_umask);
     for (const auto& f : files) EXPECT_EQ(mode_of(f), 0600u) << f;
 
-    // What the two sides load fits together: key matches, chains to the CA, not expired.
-    const TlsCheck farm = check_tls_material(load_farm_tls(dir, "farm-1"), "farm");
+    // What the two sides load fits together: key matches, chains to the CA, not expired. The farm
+    // serves from an exported folder (without ca.key).
+    const fs::path served = tmp.path() / "farm-tls";
+    ASSERT_EQ(run({"export-farm", "--dir", dir.string(), "--name", "farm-1", "--to", served.string()}), 0);
+    const TlsCheck farm = check_tls_material(load_farm_tls(served, "farm-1"), "farm");
     EXPECT_EQ(farm.error, "");
     EXPECT_TRUE(farm.warnings.empty()) << farm.warnings.front();
     const TlsCheck appliance = check_tls_material(load_appliance_tls(dir, "museum-1"), "appliance");

@@ -61,11 +61,14 @@ cleanup() {
 }
 trap cleanup EXIT
 
-# make_pki DIR SAN: farm CA, farm certificate for SAN (its IPv6 address), appliance certificate.
+# make_pki DIR SAN: farm CA, farm certificate for SAN (its IPv6 address), appliance certificate,
+# an empty revocation list; the farm serves from DIR/../farm-tls (pki export-farm: without ca.key).
 make_pki() {
   "$farm" pki init-ca --dir "$1" >/dev/null || fail "pki init-ca"
   "$farm" pki issue-farm --dir "$1" --name farm --san "$2" >/dev/null || fail "pki issue-farm"
   "$farm" pki issue-appliance --dir "$1" --name museum-1 >/dev/null || fail "pki issue-appliance"
+  "$farm" pki crl --dir "$1" >/dev/null || fail "pki crl"
+  "$farm" pki export-farm --dir "$1" --name farm --to "$(dirname "$1")/farm-tls" >/dev/null || fail "pki export-farm"
 }
 
 # write_config FILE ENDPOINT PKI PNG_DIR PNG_EVERY [OVERRIDE...]: kiosk/kiosk.example.toml with the
@@ -90,7 +93,7 @@ FARM_MPI_ARGS=()        # more mpirun arguments (e2e_netns.sh multihost: host fi
 start_farm() {
   local logf=$1 listen=$2; shift 2
   setsid "$@" "$MPIEXEC" --oversubscribe "${FARM_MPI_ARGS[@]}" -n 3 "$farm" serve --scene "$src/scenes/test-room.json" \
-    --listen "$listen" --tls-dir "$work/pki" --duration 300 >>"$logf" 2>&1 &
+    --listen "$listen" --tls-dir "$work/farm-tls" --duration 300 >>"$logf" 2>&1 &
   farm_sid=$!
   disown "$farm_sid"  # stopped by session id in stop_farm; no job-control report when killed
   for _ in $(seq 1 300); do

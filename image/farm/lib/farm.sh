@@ -53,6 +53,9 @@ farm_check_host_dir() {
   for key in ca.pem "farm-${env[MOGAO_FARM_NAME]}.pem" "farm-${env[MOGAO_FARM_NAME]}.key"; do
     [[ -s "$dir/etc/mogao/pki/$key" ]] || img_die "$dir/etc/mogao/pki/$key missing (mogao-farm pki init-ca / issue-farm --name ${env[MOGAO_FARM_NAME]})"
   done
+  # The CA's key signs appliance certificates: it stays offline, never on a networked farm host.
+  [[ ! -e "$dir/etc/mogao/pki/ca.key" ]] \
+    || img_die "$dir/etc/mogao/pki/ca.key: the CA's private key must not go onto a farm host (copy the folder made by mogao-farm pki export-farm)"
 }
 
 # farm_stage_host_dir SRC DEST: SRC's tree in DEST with the ownership and modes a render host
