@@ -1,9 +1,13 @@
 // SPDX-License-Identifier: Apache-2.0
-// What every capture source delivers: one 8-bit grey (luma) image and when it was taken.
+// What every capture source delivers: one 8-bit grey (luma) image, optionally a colour image,
+// and when it was taken.
 //
 // The tracker only needs luma (AprilTag detects on grey), so every source converts to grey as it
-// captures: GREY is copied, YUYV keeps its Y bytes, MJPEG is decoded straight to grey by TurboJPEG
-// (cheaper than decoding colour and converting). Colour is never kept.
+// captures: GREY is copied, YUYV and the 4:2:0 formats keep their Y' bytes, MJPEG is decoded
+// straight to grey by TurboJPEG (cheaper than decoding colour and converting). Colour is converted
+// only when the source was opened with `colour = true` (camera-based projector calibration); it is
+// then R'G'B' as the camera encodes it (gamma-encoded, no linearisation, no colour management) and
+// `colour` has the same size as `image`. Without it, `colour` stays empty and costs nothing.
 //
 // Pixels: row-major, top row first, no padding between rows. Pixel (x, y) covers [x, x+1) x
 // [y, y+1); its centre is at (x + 0.5, y + 0.5) (docs/architecture.md). AprilTag 3.3 reports
@@ -13,7 +17,10 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
+
+#include "common/image.h"
 
 namespace mogao {
 
@@ -44,8 +51,10 @@ enum class TimestampSource {
     replay,             // from the replay folder's timestamps.txt, or index / fps
 };
 
-// The pixel format the frame had on the wire, before conversion to grey.
-enum class CaptureFormat { grey, yuyv, mjpeg, image_file };
+// The pixel format the frame had on the wire, before conversion (pixel_format.h has the layouts).
+// nv12/nv21/yuv420/yvu420 are 4:2:0 and cover both the one-buffer V4L2 formats (NV12, NV21, YU12,
+// YV12) and their multi-plane variants (NV12M, NV21M, YUV420M, YVU420M).
+enum class CaptureFormat { grey, yuyv, mjpeg, image_file, nv12, nv21, yuv420, yvu420 };
 
 struct CameraFrame {
     GrayImage image;
@@ -54,6 +63,7 @@ struct CameraFrame {
     std::uint64_t sequence = 0;  // driver's frame counter (V4L2 sequence) or index in the replay
     std::uint32_t skipped = 0;   // older frames that were ready but dropped to deliver this, the newest
     CaptureFormat format = CaptureFormat::grey;
+    std::optional<Rgb8Image> colour;  // only when the source was opened with colour = true
 };
 
 }  // namespace mogao

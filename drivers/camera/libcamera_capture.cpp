@@ -12,6 +12,7 @@
 #include <libcamera/stream.h>
 
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstring>
 #include <map>
@@ -26,6 +27,10 @@ namespace mogao {
 static_assert(libcamera_fourcc(CaptureFormat::grey) == libcamera::formats::R8.fourcc());
 static_assert(libcamera_fourcc(CaptureFormat::yuyv) == libcamera::formats::YUYV.fourcc());
 static_assert(libcamera_fourcc(CaptureFormat::mjpeg) == libcamera::formats::MJPEG.fourcc());
+static_assert(libcamera_fourcc(CaptureFormat::nv12) == libcamera::formats::NV12.fourcc());
+static_assert(libcamera_fourcc(CaptureFormat::nv21) == libcamera::formats::NV21.fourcc());
+static_assert(libcamera_fourcc(CaptureFormat::yuv420) == libcamera::formats::YUV420.fourcc());
+static_assert(libcamera_fourcc(CaptureFormat::yvu420) == libcamera::formats::YVU420.fourcc());
 
 namespace {
 
@@ -76,7 +81,7 @@ struct LibcameraCapture::Impl {
     std::unique_ptr<libcamera::CameraConfiguration> configuration;
     libcamera::Stream* stream = nullptr;
     std::unique_ptr<libcamera::FrameBufferAllocator> allocator;
-    std::map<const libcamera::FrameBuffer*, Mapping> mappings;
+    std::map<const libcamera::FrameBuffer*, std::vector<Mapping>> mappings;  // one per plane
     std::vector<std::unique_ptr<libcamera::Request>> requests;
     bool connected = false;
     bool started = false;
@@ -87,6 +92,9 @@ struct LibcameraCapture::Impl {
     int height = 0;
     int stride = 0;
     int timeout_ms = 2000;
+    bool colour = false;
+    YcbcrEncoding encoding;
+    std::string skipped_controls;
 
     // Shared with libcamera's thread.
     std::mutex mutex;
@@ -151,36 +159,60 @@ struct LibcameraCapture::Impl {
         if (request->status() != libcamera::Request::RequestComplete) return false;
         const libcamera::FrameBuffer* buffer = request->findBuffer(stream);
         return buffer != nullptr && buffer->metadata().status == libcamera::FrameMetadata::FrameSuccess &&
-               mappings.count(buffer) != 0;
+               mappings.count(buffer) != 0 && !mappings.at(buffer).empty();
     }
 
-    Status convert(const libcamera::FrameBuffer& buffer, GrayImage& out) {
-        const Mapping& m = mappings.at(&buffer);
-        std::span<const std::uint8_t> bytes = m.map.bytes().subspan(m.offset, m.length);
+    Status convert(const libcamera::FrameBuffer& buffer, CameraFrame& frame) {
+        const std::vector<Mapping>& maps = mappings.at(&buffer);
         const auto planes = buffer.metadata().planes();
-        // bytesused bounds a compressed frame; 0 means the whole plane.
-        if (!planes.empty() && planes[0].bytesused != 0) {
-            bytes = bytes.first(std::min<std::size_t>(bytes.size(), planes[0].bytesused));
+        PlaneBytes bytes[3];
+        const std::size_t count = std::min<std::size_t>(maps.size(), 3);
+        for (std::size_t p = 0; p < count; ++p) {
+            const Mapping& m = maps[p];
+            std::span<const std::uint8_t> b = m.map.bytes().subspan(m.offset, m.length);
+            // bytesused bounds a compressed frame; 0 means the whole plane.
+            if (p < planes.size() && planes[p].bytesused != 0) {
+                b = b.first(std::min<std::size_t>(b.size(), planes[p].bytesused));
+            }
+            // Chroma rows: a full stride when interleaved (NV12), half of it when planar (YUV420).
+            const bool planar_chroma = p > 0 && (format == CaptureFormat::yuv420 || format == CaptureFormat::yvu420);
+            bytes[p] = {b, planar_chroma ? stride / 2 : stride};
         }
-        Status s;
-        switch (format) {
-            case CaptureFormat::grey:
-                s = grey_from_grey(bytes, width, height, stride, out);
-                break;
-            case CaptureFormat::yuyv:
-                s = grey_from_yuyv(bytes, width, height, stride, out);
-                break;
-            case CaptureFormat::mjpeg:
-                s = mjpeg->decode_grey(bytes, out, width, height);
-                break;
-            case CaptureFormat::image_file:
-                s = make_error(EINVAL, "image_file is not a capture format");
-                break;
-        }
+        Status s = convert_planes(std::span<const PlaneBytes>(bytes, count), frame);
         if (!s) return make_error(EBADMSG, "libcamera camera " + id + ": " + s.error().message);
         return {};
     }
 
+    Status convert_planes(std::span<const PlaneBytes> planes, CameraFrame& frame) {
+        const std::span<const std::uint8_t> bytes = planes[0].data;
+        if (colour) frame.colour.emplace();
+        switch (format) {
+            case CaptureFormat::grey: {
+                Status s = grey_from_grey(bytes, width, height, stride, frame.image);
+                if (s && colour) rgb_from_grey(frame.image, *frame.colour);
+                return s;
+            }
+            case CaptureFormat::yuyv: {
+                Status s = grey_from_yuyv(bytes, width, height, stride, frame.image);
+                if (s && colour) s = rgb_from_yuyv(bytes, width, height, stride, encoding, *frame.colour);
+                return s;
+            }
+            case CaptureFormat::mjpeg:
+                return colour ? mjpeg->decode_colour(bytes, frame.image, *frame.colour, width, height)
+                              : mjpeg->decode_grey(bytes, frame.image, width, height);
+            case CaptureFormat::nv12:
+            case CaptureFormat::nv21:
+            case CaptureFormat::yuv420:
+            case CaptureFormat::yvu420:
+                return convert_yuv420(format, planes, width, height, encoding, frame.image,
+                                      colour ? &*frame.colour : nullptr);
+            case CaptureFormat::image_file:
+                break;
+        }
+        return make_error(EINVAL, "image_file is not a capture format");
+    }
+
+    Status apply_controls(const CameraControls& wanted, libcamera::ControlList& out);
     Status configure(const LibcameraConfig& config);
     Status allocate_and_start(const LibcameraConfig& config);
 };
@@ -250,10 +282,11 @@ Status LibcameraCapture::Impl::configure(const LibcameraConfig& config) {
     const std::vector<libcamera::PixelFormat> offered_formats = sc.formats().pixelformats();
     std::vector<std::uint32_t> offered;
     for (const libcamera::PixelFormat& f : offered_formats) offered.push_back(f.fourcc());
-    const std::optional<CaptureFormat> chosen = choose_libcamera_format(config.formats, offered);
+    const std::optional<CaptureFormat> chosen = choose_libcamera_format(config.formats, offered, config.colour);
     if (!chosen) {
-        return make_error(ENOTSUP, name + ": none of the wanted formats (R8/YUYV/MJPEG) is offered; camera has: " +
-                                       format_list(offered_formats));
+        return make_error(ENOTSUP, name + ": none of the wanted formats (R8/YUYV/NV12/NV21/YUV420/YVU420/MJPEG" +
+                                       (config.colour ? std::string(", in colour") : std::string()) +
+                                       ") is offered; camera has: " + format_list(offered_formats));
     }
     const libcamera::PixelFormat wanted(libcamera_fourcc(*chosen));
     sc.pixelFormat = wanted;
@@ -276,6 +309,16 @@ Status LibcameraCapture::Impl::configure(const LibcameraConfig& config) {
     width = static_cast<int>(sc.size.width);
     height = static_cast<int>(sc.size.height);
     stride = static_cast<int>(sc.stride);
+    colour = config.colour;
+    // libcamera's colour space of the stream (JPEG: full-range BT.601, as decoded by TurboJPEG).
+    if (sc.colorSpace) {
+        const auto enc = sc.colorSpace->ycbcrEncoding;
+        encoding.matrix = enc == libcamera::ColorSpace::YcbcrEncoding::Rec709    ? YcbcrMatrix::bt709
+                          : enc == libcamera::ColorSpace::YcbcrEncoding::Rec2020 ? YcbcrMatrix::bt2020
+                                                                                 : YcbcrMatrix::bt601;
+        encoding.range =
+            sc.colorSpace->range == libcamera::ColorSpace::Range::Full ? YcbcrRange::full : YcbcrRange::limited;
+    }
     if (const int ret = camera->configure(configuration.get()); ret < 0) {
         return libcamera_error(ret, name + ": configure " + sc.toString());
     }
@@ -302,14 +345,19 @@ Status LibcameraCapture::Impl::allocate_and_start(const LibcameraConfig& config)
     for (std::size_t i = 0; i < buffers.size(); ++i) {
         const libcamera::FrameBuffer& buffer = *buffers[i];
         const std::string which = name + ": buffer " + std::to_string(i);
-        // R8, YUYV and MJPEG are single-plane formats.
-        if (buffer.planes().empty()) return make_error(EIO, which + " has no planes");
-        const libcamera::FrameBuffer::Plane& plane = buffer.planes()[0];
-        const std::size_t offset =
-            plane.offset == libcamera::FrameBuffer::Plane::kInvalidOffset ? 0 : std::size_t{plane.offset};
-        auto map = MappedBuffer::map(plane.fd.get(), offset + plane.length, 0);
-        if (!map) return with_context(map.error(), which);
-        mappings.emplace(&buffer, Mapping{std::move(map).value(), offset, plane.length});
+        // R8, YUYV and MJPEG have one plane; NV12/YUV420 two or three (often in one dmabuf).
+        if (buffer.planes().empty() || buffer.planes().size() > 3) {
+            return make_error(EIO, which + " has " + std::to_string(buffer.planes().size()) + " planes");
+        }
+        std::vector<Mapping> planes;
+        for (const libcamera::FrameBuffer::Plane& plane : buffer.planes()) {
+            const std::size_t offset =
+                plane.offset == libcamera::FrameBuffer::Plane::kInvalidOffset ? 0 : std::size_t{plane.offset};
+            auto map = MappedBuffer::map(plane.fd.get(), offset + plane.length, 0);
+            if (!map) return with_context(map.error(), which);
+            planes.push_back(Mapping{std::move(map).value(), offset, plane.length});
+        }
+        mappings.emplace(&buffer, std::move(planes));
 
         std::unique_ptr<libcamera::Request> request = camera->createRequest(i);
         if (!request) return make_error(ENOMEM, which + ": createRequest failed");
@@ -324,7 +372,9 @@ Status LibcameraCapture::Impl::allocate_and_start(const LibcameraConfig& config)
     camera->requestCompleted.connect(this, &Impl::on_request_completed);
     camera->disconnected.connect(this, &Impl::on_disconnected);
     connected = true;
-    if (const int ret = camera->start(); ret < 0) return libcamera_error(ret, name + ": start");
+    libcamera::ControlList controls(camera->controls());
+    if (Status s = apply_controls(config.controls, controls); !s) return s;
+    if (const int ret = camera->start(&controls); ret < 0) return libcamera_error(ret, name + ": start");
     started = true;
     for (const auto& request : requests) {
         if (const int ret = camera->queueRequest(request.get()); ret < 0) {
@@ -374,7 +424,7 @@ Result<CameraFrame> LibcameraCapture::next_frame() {
         frame.timestamp_ns = libcamera_frame_timestamp_ns(newest->metadata().get(libcamera::controls::SensorTimestamp),
                                                           buffer.metadata().timestamp);
         frame.clock = TimestampSource::kernel_monotonic;
-        const Status converted = d.convert(buffer, frame.image);
+        const Status converted = d.convert(buffer, frame);
         if (Status s = d.requeue(newest); !s) return s.error();
         if (!converted) return converted.error();
         return frame;
@@ -382,8 +432,68 @@ Result<CameraFrame> LibcameraCapture::next_frame() {
 }
 
 std::string LibcameraCapture::description() const {
-    return "libcamera " + camera_id_ + " " + std::to_string(width_) + "x" + std::to_string(height_) + " " +
-           pixel_format_name(format_) + ", " + std::to_string(buffer_count_) + " dmabuf buffers";
+    std::string text = "libcamera " + camera_id_ + " " + std::to_string(width_) + "x" + std::to_string(height_) + " " +
+                       pixel_format_name(format_) + (impl_->colour ? ", colour" : "") + ", " +
+                       std::to_string(buffer_count_) + " dmabuf buffers";
+    if (!impl_->skipped_controls.empty()) text += "; controls not on this camera: " + impl_->skipped_controls;
+    return text;
+}
+
+// libcamera controls (control_ids.h): AeEnable switches exposure and gain together; ExposureTime
+// (us, int32) and AnalogueGain (float, 1.0 = unity) set them manually; AwbEnable switches white
+// balance. With AeEnable or AwbEnable false and no manual value the pipeline holds its last values
+// (lock). libcamera 0.0.3 cannot set a colour temperature: manual white balance is ENOTSUP.
+Status LibcameraCapture::Impl::apply_controls(const CameraControls& wanted, libcamera::ControlList& out) {
+    using Mode = ControlSetting::Mode;
+    const libcamera::ControlInfoMap& info = camera->controls();
+    const auto missing = [&](const ControlSetting& s, const std::string& what) -> Status {
+        if (s.required) return make_error(ENOTSUP, "libcamera camera " + id + ": " + s.name + " = " + describe(s) +
+                                                       ": the camera has no " + what);
+        skipped_controls += (skipped_controls.empty() ? "" : ", ") + s.name + " (no " + what + ")";
+        return {};
+    };
+    const auto range_check = [&](const ControlSetting& s, const libcamera::ControlInfo& ci, double lo, double hi,
+                                 const std::string& unit) -> Status {
+        if (s.value >= lo && s.value <= hi) return {};
+        (void)ci;
+        return make_error(EINVAL, "libcamera camera " + id + ": " + s.name + " = " + std::to_string(s.value) +
+                                      " is outside the camera's range [" + std::to_string(lo) + ", " +
+                                      std::to_string(hi) + "]" + unit);
+    };
+    const bool has_ae = info.count(&libcamera::controls::AeEnable) != 0;
+    const ControlSetting& e = wanted.exposure;
+    const ControlSetting& g = wanted.gain;
+    if (e.mode != Mode::keep || g.mode == Mode::manual || g.mode == Mode::lock) {
+        if (!has_ae) {
+            if (Status s = missing(e.mode != Mode::keep ? e : g, "AeEnable control"); !s) return s;
+        } else {
+            out.set(libcamera::controls::AeEnable, e.mode == Mode::automatic && g.mode != Mode::lock);
+        }
+    }
+    if (e.mode == Mode::manual) {
+        const auto it = info.find(&libcamera::controls::ExposureTime);
+        if (it == info.end()) return missing(e, "ExposureTime control");
+        const libcamera::ControlInfo& ci = it->second;
+        if (Status s = range_check(e, ci, ci.min().get<int32_t>(), ci.max().get<int32_t>(), " us"); !s) return s;
+        out.set(libcamera::controls::ExposureTime, static_cast<int32_t>(std::lround(e.value)));
+    }
+    if (g.mode == Mode::manual) {
+        const auto it = info.find(&libcamera::controls::AnalogueGain);
+        if (it == info.end()) return missing(g, "AnalogueGain control");
+        const libcamera::ControlInfo& ci = it->second;
+        if (Status s = range_check(g, ci, ci.min().get<float>(), ci.max().get<float>(), ""); !s) return s;
+        out.set(libcamera::controls::AnalogueGain, static_cast<float>(g.value));
+    }
+    const ControlSetting& w = wanted.white_balance;
+    if (w.mode == Mode::manual) {
+        return make_error(ENOTSUP, "libcamera camera " + id + ": " + w.name +
+                                       ": libcamera 0.0.3 cannot set a colour temperature (use lock or auto)");
+    }
+    if (w.mode != Mode::keep) {
+        if (info.count(&libcamera::controls::AwbEnable) == 0) return missing(w, "AwbEnable control");
+        out.set(libcamera::controls::AwbEnable, w.mode == Mode::automatic);
+    }
+    return {};
 }
 
 }  // namespace mogao

@@ -40,6 +40,7 @@
 #include <string>
 #include <vector>
 
+#include "drivers/camera/camera_controls.h"
 #include "drivers/camera/frame_source.h"
 #include "common/pixel_rect.h"
 
@@ -50,7 +51,11 @@ struct LibcameraConfig {
     int width = 800;        // requested; the pipeline may adjust it (see size())
     int height = 600;
     // Formats to try, in order of preference (GREY needs no conversion, MJPEG the most CPU).
-    std::vector<CaptureFormat> formats{CaptureFormat::grey, CaptureFormat::yuyv, CaptureFormat::mjpeg};
+    std::vector<CaptureFormat> formats{CaptureFormat::grey,   CaptureFormat::yuyv,   CaptureFormat::nv12,
+                                       CaptureFormat::nv21,   CaptureFormat::yuv420, CaptureFormat::yvu420,
+                                       CaptureFormat::mjpeg};
+    bool colour = false;      // also deliver CameraFrame::colour (R'G'B'); GREY (R8) is then not used
+    CameraControls controls;  // applied when the camera starts (camera_controls.h)
     int buffer_count = 3;   // [2, 4]
     int timeout_ms = 2000;  // [1, 60000]: next_frame() gives ETIMEDOUT after this long without a frame
 };
@@ -58,8 +63,8 @@ struct LibcameraConfig {
 // True when this build of mogao_camera has the libcamera backend (MOGAO_HAVE_LIBCAMERA).
 [[nodiscard]] bool libcamera_built_in() noexcept;
 
-// libcamera's (DRM) fourcc for a capture format: GREY -> R8 ("R8  "), YUYV, MJPEG ("MJPG"); 0 for
-// image_file. Pure; the .cpp checks these against libcamera::formats at compile time.
+// libcamera's (DRM) fourcc for a capture format: GREY -> R8 ("R8  "), YUYV, MJPEG ("MJPG"), NV12,
+// NV21, YUV420 ("YU12"), YVU420 ("YV12"); 0 for image_file. Pure; the .cpp checks these against libcamera::formats at compile time.
 [[nodiscard]] constexpr std::uint32_t libcamera_fourcc(CaptureFormat format) noexcept {
     constexpr auto cc = [](char a, char b, char c, char d) {
         return static_cast<std::uint32_t>(static_cast<unsigned char>(a)) |
@@ -74,6 +79,14 @@ struct LibcameraConfig {
             return cc('Y', 'U', 'Y', 'V');
         case CaptureFormat::mjpeg:
             return cc('M', 'J', 'P', 'G');
+        case CaptureFormat::nv12:
+            return cc('N', 'V', '1', '2');
+        case CaptureFormat::nv21:
+            return cc('N', 'V', '2', '1');
+        case CaptureFormat::yuv420:
+            return cc('Y', 'U', '1', '2');
+        case CaptureFormat::yvu420:
+            return cc('Y', 'V', '1', '2');
         case CaptureFormat::image_file:
             break;
     }
@@ -85,8 +98,10 @@ struct LibcameraConfig {
 
 // The first of `preference` whose libcamera fourcc is in `offered` (fourccs, e.g. from
 // StreamFormats::pixelformats()), or nothing. Pure.
+// With `colour`, GREY is passed over (R8 has no colour).
 [[nodiscard]] std::optional<CaptureFormat> choose_libcamera_format(const std::vector<CaptureFormat>& preference,
-                                                                   const std::vector<std::uint32_t>& offered);
+                                                                   const std::vector<std::uint32_t>& offered,
+                                                                   bool colour = false);
 
 // The frame timestamp: the request's SensorTimestamp when present and positive, else the buffer's
 // metadata timestamp (ns). Pure.

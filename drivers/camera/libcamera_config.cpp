@@ -15,7 +15,7 @@ Status check_libcamera_config(const LibcameraConfig& c) {
     }
     if (c.formats.empty()) return bad("formats is empty");
     for (CaptureFormat f : c.formats) {
-        if (libcamera_fourcc(f) == 0) return bad("formats: only GREY, YUYV and MJPG can be captured");
+        if (libcamera_fourcc(f) == 0) return bad("formats: image_file is not a capture format");
     }
     if (c.buffer_count < 2 || c.buffer_count > 4) {
         return bad("buffer_count " + std::to_string(c.buffer_count) + " outside [2, 4]");
@@ -27,8 +27,9 @@ Status check_libcamera_config(const LibcameraConfig& c) {
 }
 
 std::optional<CaptureFormat> choose_libcamera_format(const std::vector<CaptureFormat>& preference,
-                                                     const std::vector<std::uint32_t>& offered) {
+                                                     const std::vector<std::uint32_t>& offered, bool colour) {
     for (CaptureFormat f : preference) {
+        if (colour && f == CaptureFormat::grey) continue;  // R8 has no colour
         const std::uint32_t fourcc = libcamera_fourcc(f);
         if (fourcc != 0 && std::find(offered.begin(), offered.end(), fourcc) != offered.end()) return f;
     }

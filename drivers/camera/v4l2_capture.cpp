@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <optional>
 
 #include "drivers/camera/pixel_format.h"
 
@@ -24,6 +25,7 @@ int xioctl(int fd, unsigned long request, void* arg) {
     return r;
 }
 
+// The one-buffer fourcc of a format (0 for image_file).
 std::uint32_t fourcc_of(CaptureFormat format) {
     switch (format) {
         case CaptureFormat::grey:
@@ -32,10 +34,38 @@ std::uint32_t fourcc_of(CaptureFormat format) {
             return V4L2_PIX_FMT_YUYV;
         case CaptureFormat::mjpeg:
             return V4L2_PIX_FMT_MJPEG;
+        case CaptureFormat::nv12:
+            return V4L2_PIX_FMT_NV12;
+        case CaptureFormat::nv21:
+            return V4L2_PIX_FMT_NV21;
+        case CaptureFormat::yuv420:
+            return V4L2_PIX_FMT_YUV420;
+        case CaptureFormat::yvu420:
+            return V4L2_PIX_FMT_YVU420;
         case CaptureFormat::image_file:
             break;
     }
     return 0;
+}
+
+// The multi-plane (one buffer per plane) fourcc of a 4:2:0 format, else 0.
+std::uint32_t multiplane_fourcc_of(CaptureFormat format) {
+    switch (format) {
+        case CaptureFormat::nv12:
+            return V4L2_PIX_FMT_NV12M;
+        case CaptureFormat::nv21:
+            return V4L2_PIX_FMT_NV21M;
+        case CaptureFormat::yuv420:
+            return V4L2_PIX_FMT_YUV420M;
+        case CaptureFormat::yvu420:
+            return V4L2_PIX_FMT_YVU420M;
+        default:
+            return 0;
+    }
+}
+
+bool offered_has(const std::vector<std::uint32_t>& offered, std::uint32_t fourcc) {
+    return fourcc != 0 && std::find(offered.begin(), offered.end(), fourcc) != offered.end();
 }
 
 std::int64_t monotonic_now_ns() {
@@ -53,7 +83,7 @@ Status check_config(const V4l2Config& c) {
     }
     if (c.formats.empty()) return bad("formats is empty");
     for (CaptureFormat f : c.formats) {
-        if (fourcc_of(f) == 0) return bad("formats: only GREY, YUYV and MJPG can be captured");
+        if (fourcc_of(f) == 0) return bad("formats: image_file is not a capture format");
     }
     if (c.buffer_count < 2 || c.buffer_count > 4) {
         return bad("buffer_count " + std::to_string(c.buffer_count) + " outside [2, 4]");
@@ -86,54 +116,109 @@ Result<std::unique_ptr<V4l2Capture>> V4l2Capture::open(const V4l2Config& config)
     cam->driver_ = reinterpret_cast<const char*>(cap.driver);
     // device_caps describes this node; capabilities the whole physical device.
     const std::uint32_t caps = (cap.capabilities & V4L2_CAP_DEVICE_CAPS) != 0 ? cap.device_caps : cap.capabilities;
-    if ((caps & V4L2_CAP_VIDEO_CAPTURE) == 0) {
-        return make_error(ENODEV, config.device + " (" + cam->driver_ + "): not a single-planar video capture node");
+    if ((caps & (V4L2_CAP_VIDEO_CAPTURE | V4L2_CAP_VIDEO_CAPTURE_MPLANE)) == 0) {
+        return make_error(ENODEV, config.device + " (" + cam->driver_ + "): not a video capture node");
     }
+    cam->multiplanar_ = (caps & V4L2_CAP_VIDEO_CAPTURE) == 0;
+    cam->buf_type_ = cam->multiplanar_ ? V4L2_BUF_TYPE_VIDEO_CAPTURE_MPLANE : V4L2_BUF_TYPE_VIDEO_CAPTURE;
+    cam->colour_ = config.colour;
     if ((caps & V4L2_CAP_STREAMING) == 0) {
         return make_error(ENODEV, config.device + " (" + cam->driver_ + "): no streaming I/O");
     }
     if (Status s = cam->negotiate_format(config); !s) return s.error();
+    if (Status s = apply_v4l2_controls(cam->fd_.get(), cam->device_, config.controls, &cam->skipped_controls_); !s)
+        return s.error();
     if (Status s = cam->start_streaming(config); !s) return s.error();
     return cam;
 }
+
+namespace {
+
+// The wanted format the device offers (first in preference), and the fourcc to ask for: on a
+// multi-planar node the multi-plane variant when offered.
+struct Choice {
+    CaptureFormat format = CaptureFormat::grey;
+    std::uint32_t fourcc = 0;
+};
+
+std::optional<Choice> choose_format(const V4l2Config& config, const std::vector<std::uint32_t>& offered,
+                                    bool multiplanar) {
+    for (CaptureFormat f : config.formats) {
+        if (config.colour && f == CaptureFormat::grey) continue;  // no colour in GREY
+        if (multiplanar && offered_has(offered, multiplane_fourcc_of(f))) return Choice{f, multiplane_fourcc_of(f)};
+        if (offered_has(offered, fourcc_of(f))) return Choice{f, fourcc_of(f)};
+        if (offered_has(offered, multiplane_fourcc_of(f))) return Choice{f, multiplane_fourcc_of(f)};
+    }
+    return std::nullopt;
+}
+
+}  // namespace
 
 Status V4l2Capture::negotiate_format(const V4l2Config& config) {
     std::vector<std::uint32_t> offered;
     for (std::uint32_t i = 0;; ++i) {
         v4l2_fmtdesc desc{};
         desc.index = i;
-        desc.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+        desc.type = buf_type_;
         if (xioctl(fd_.get(), VIDIOC_ENUM_FMT, &desc) == -1) break;  // EINVAL ends the list
         offered.push_back(desc.pixelformat);
     }
-    const auto wanted = std::find_if(config.formats.begin(), config.formats.end(), [&](CaptureFormat f) {
-        return std::find(offered.begin(), offered.end(), fourcc_of(f)) != offered.end();
-    });
-    if (wanted == config.formats.end()) {
+    const std::optional<Choice> wanted = choose_format(config, offered, multiplanar_);
+    if (!wanted) {
         std::string list;
         for (std::uint32_t f : offered) list += (list.empty() ? "" : ", ") + fourcc_name(f);
-        return make_error(ENOTSUP, device_ + ": none of the wanted formats (GREY/YUYV/MJPG) is offered; device has: " +
-                                       (list.empty() ? std::string("none") : list));
+        std::string names;
+        for (CaptureFormat f : config.formats) names += (names.empty() ? "" : "/") + pixel_format_name(f);
+        return make_error(ENOTSUP, device_ + ": none of the wanted formats (" + names + (config.colour ? ", in colour" : "") +
+                                       ") is offered; device has: " + (list.empty() ? std::string("none") : list));
     }
     v4l2_format fmt{};
-    fmt.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    fmt.fmt.pix.width = static_cast<std::uint32_t>(config.width);
-    fmt.fmt.pix.height = static_cast<std::uint32_t>(config.height);
-    fmt.fmt.pix.pixelformat = fourcc_of(*wanted);
-    fmt.fmt.pix.field = V4L2_FIELD_NONE;
-    if (xioctl(fd_.get(), VIDIOC_S_FMT, &fmt) == -1) return errno_error(device_ + ": VIDIOC_S_FMT");
-    if (fmt.fmt.pix.pixelformat != fourcc_of(*wanted)) {
-        return make_error(ENOTSUP, device_ + ": VIDIOC_S_FMT: asked " + fourcc_name(fourcc_of(*wanted)) + ", got " +
-                                       fourcc_name(fmt.fmt.pix.pixelformat));
+    fmt.type = buf_type_;
+    std::uint32_t got = 0;
+    std::uint32_t field = 0;
+    if (multiplanar_) {
+        fmt.fmt.pix_mp.width = static_cast<std::uint32_t>(config.width);
+        fmt.fmt.pix_mp.height = static_cast<std::uint32_t>(config.height);
+        fmt.fmt.pix_mp.pixelformat = wanted->fourcc;
+        fmt.fmt.pix_mp.field = V4L2_FIELD_NONE;
+    } else {
+        fmt.fmt.pix.width = static_cast<std::uint32_t>(config.width);
+        fmt.fmt.pix.height = static_cast<std::uint32_t>(config.height);
+        fmt.fmt.pix.pixelformat = wanted->fourcc;
+        fmt.fmt.pix.field = V4L2_FIELD_NONE;
     }
-    if (fmt.fmt.pix.field != V4L2_FIELD_NONE && fmt.fmt.pix.field != V4L2_FIELD_ANY) {
-        return make_error(ENOTSUP, device_ + ": interlaced capture (field " + std::to_string(fmt.fmt.pix.field) +
+    if (xioctl(fd_.get(), VIDIOC_S_FMT, &fmt) == -1) return errno_error(device_ + ": VIDIOC_S_FMT");
+    if (multiplanar_) {
+        const v4l2_pix_format_mplane& mp = fmt.fmt.pix_mp;
+        got = mp.pixelformat;
+        field = mp.field;
+        width_ = static_cast<int>(mp.width);
+        height_ = static_cast<int>(mp.height);
+        plane_count_ = mp.num_planes;
+        if (plane_count_ < 1 || plane_count_ > 3) {
+            return make_error(ENOTSUP, device_ + ": VIDIOC_S_FMT: " + std::to_string(plane_count_) +
+                                           " planes, at most 3 are supported");
+        }
+        for (int p = 0; p < plane_count_; ++p) plane_bytes_per_line_.push_back(static_cast<int>(mp.plane_fmt[p].bytesperline));
+        encoding_ = ycbcr_encoding_from_v4l2(mp.colorspace, mp.ycbcr_enc, mp.quantization);
+    } else {
+        got = fmt.fmt.pix.pixelformat;
+        field = fmt.fmt.pix.field;
+        width_ = static_cast<int>(fmt.fmt.pix.width);
+        height_ = static_cast<int>(fmt.fmt.pix.height);
+        plane_bytes_per_line_ = {static_cast<int>(fmt.fmt.pix.bytesperline)};
+        encoding_ = ycbcr_encoding_from_v4l2(fmt.fmt.pix.colorspace, fmt.fmt.pix.ycbcr_enc, fmt.fmt.pix.quantization);
+    }
+    if (got != wanted->fourcc) {
+        return make_error(ENOTSUP, device_ + ": VIDIOC_S_FMT: asked " + fourcc_name(wanted->fourcc) + ", got " +
+                                       fourcc_name(got));
+    }
+    if (field != V4L2_FIELD_NONE && field != V4L2_FIELD_ANY) {
+        return make_error(ENOTSUP, device_ + ": interlaced capture (field " + std::to_string(field) +
                                        ") is not supported");
     }
-    format_ = *wanted;
-    width_ = static_cast<int>(fmt.fmt.pix.width);
-    height_ = static_cast<int>(fmt.fmt.pix.height);
-    bytes_per_line_ = static_cast<int>(fmt.fmt.pix.bytesperline);
+    format_ = wanted->format;
+    bytes_per_line_ = plane_bytes_per_line_.front();
     if (width_ < 1 || height_ < 1 || width_ > kMaxCaptureDimension || height_ > kMaxCaptureDimension) {
         return make_error(EINVAL, device_ + ": driver chose size " + std::to_string(width_) + "x" +
                                       std::to_string(height_) + ", outside [1, " +
@@ -147,7 +232,7 @@ Status V4l2Capture::negotiate_format(const V4l2Config& config) {
     if (config.frames_per_second > 0) {
         // Best effort: many drivers ignore or round the rate; the timestamps are what counts.
         v4l2_streamparm parm{};
-        parm.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+        parm.type = buf_type_;
         parm.parm.capture.timeperframe.numerator = 1;
         parm.parm.capture.timeperframe.denominator = static_cast<std::uint32_t>(config.frames_per_second);
         (void)xioctl(fd_.get(), VIDIOC_S_PARM, &parm);
@@ -155,10 +240,43 @@ Status V4l2Capture::negotiate_format(const V4l2Config& config) {
     return {};
 }
 
+Status V4l2Capture::map_buffer(std::uint32_t index) {
+    v4l2_plane planes[VIDEO_MAX_PLANES]{};
+    v4l2_buffer buf{};
+    buf.type = buf_type_;
+    buf.memory = V4L2_MEMORY_MMAP;
+    buf.index = index;
+    if (multiplanar_) {
+        buf.m.planes = planes;
+        buf.length = VIDEO_MAX_PLANES;
+    }
+    if (xioctl(fd_.get(), VIDIOC_QUERYBUF, &buf) == -1) {
+        return errno_error(device_ + ": VIDIOC_QUERYBUF " + std::to_string(index));
+    }
+    std::vector<MappedBuffer> mapped;
+    const int count = multiplanar_ ? static_cast<int>(buf.length) : 1;
+    if (count != plane_count_) {
+        return make_error(EIO, device_ + ": buffer " + std::to_string(index) + " has " + std::to_string(count) +
+                                   " planes, the format " + std::to_string(plane_count_));
+    }
+    for (int p = 0; p < count; ++p) {
+        const std::uint32_t length = multiplanar_ ? planes[p].length : buf.length;
+        const auto offset = static_cast<off_t>(multiplanar_ ? planes[p].m.mem_offset : buf.m.offset);
+        auto mapping = MappedBuffer::map(fd_.get(), length, offset);
+        if (!mapping) {
+            return with_context(mapping.error(),
+                                device_ + ": buffer " + std::to_string(index) + " plane " + std::to_string(p));
+        }
+        mapped.push_back(std::move(mapping).value());
+    }
+    buffers_.push_back(std::move(mapped));
+    return {};
+}
+
 Status V4l2Capture::start_streaming(const V4l2Config& config) {
     v4l2_requestbuffers req{};
     req.count = static_cast<std::uint32_t>(config.buffer_count);
-    req.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+    req.type = buf_type_;
     req.memory = V4L2_MEMORY_MMAP;
     if (xioctl(fd_.get(), VIDIOC_REQBUFS, &req) == -1) return errno_error(device_ + ": VIDIOC_REQBUFS (mmap)");
     if (req.count < 2) {
@@ -166,19 +284,10 @@ Status V4l2Capture::start_streaming(const V4l2Config& config) {
                                       " buffer(s), at least 2 are needed");
     }
     for (std::uint32_t i = 0; i < req.count; ++i) {
-        v4l2_buffer buf{};
-        buf.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-        buf.memory = V4L2_MEMORY_MMAP;
-        buf.index = i;
-        if (xioctl(fd_.get(), VIDIOC_QUERYBUF, &buf) == -1) {
-            return errno_error(device_ + ": VIDIOC_QUERYBUF " + std::to_string(i));
-        }
-        auto mapping = MappedBuffer::map(fd_.get(), buf.length, static_cast<off_t>(buf.m.offset));
-        if (!mapping) return with_context(mapping.error(), device_ + ": buffer " + std::to_string(i));
-        buffers_.push_back(std::move(mapping).value());
+        if (Status s = map_buffer(i); !s) return s;
         if (Status s = requeue(i); !s) return s;
     }
-    v4l2_buf_type type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+    auto type = static_cast<v4l2_buf_type>(buf_type_);
     if (xioctl(fd_.get(), VIDIOC_STREAMON, &type) == -1) return errno_error(device_ + ": VIDIOC_STREAMON");
     streaming_ = true;
     return {};
@@ -186,36 +295,60 @@ Status V4l2Capture::start_streaming(const V4l2Config& config) {
 
 V4l2Capture::~V4l2Capture() {
     if (streaming_) {
-        v4l2_buf_type type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+        auto type = static_cast<v4l2_buf_type>(buf_type_);
         (void)xioctl(fd_.get(), VIDIOC_STREAMOFF, &type);  // nothing to do on failure: the fd closes next
     }
 }
 
 Status V4l2Capture::requeue(std::uint32_t index) {
+    v4l2_plane planes[VIDEO_MAX_PLANES]{};
     v4l2_buffer buf{};
-    buf.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+    buf.type = buf_type_;
     buf.memory = V4L2_MEMORY_MMAP;
     buf.index = index;
+    if (multiplanar_) {
+        buf.m.planes = planes;
+        buf.length = static_cast<std::uint32_t>(plane_count_);
+    }
     if (xioctl(fd_.get(), VIDIOC_QBUF, &buf) == -1)
         return errno_error(device_ + ": VIDIOC_QBUF " + std::to_string(index));
     return {};
 }
 
-Status V4l2Capture::convert(std::uint32_t index, std::uint32_t bytes_used, GrayImage& out) {
-    std::span<const std::uint8_t> bytes = buffers_[index].bytes();
+Status V4l2Capture::convert(std::uint32_t index, const std::uint32_t* bytes_used, const std::uint32_t* data_offset,
+                            CameraFrame& frame) {
     // bytesused bounds a compressed frame; a driver that leaves it 0 for a raw format gets the
     // whole buffer (the layout checks still demand the full image).
-    if (bytes_used != 0) bytes = bytes.first(std::min<std::size_t>(bytes.size(), bytes_used));
+    PlaneBytes planes[VIDEO_MAX_PLANES];
+    for (int p = 0; p < plane_count_; ++p) {
+        std::span<const std::uint8_t> bytes = buffers_[index][static_cast<std::size_t>(p)].bytes();
+        if (bytes_used[p] != 0) bytes = bytes.first(std::min<std::size_t>(bytes.size(), bytes_used[p]));
+        // Multi-planar: bytesused counts from the plane's start, the data from data_offset.
+        bytes = bytes.subspan(std::min<std::size_t>(bytes.size(), data_offset[p]));
+        planes[p] = {bytes, plane_bytes_per_line_[static_cast<std::size_t>(p)]};
+    }
+    const std::span<const std::uint8_t> bytes = planes[0].data;
     Status s;
+    if (colour_) frame.colour.emplace();
     switch (format_) {
         case CaptureFormat::grey:
-            s = grey_from_grey(bytes, width_, height_, bytes_per_line_, out);
+            s = grey_from_grey(bytes, width_, height_, bytes_per_line_, frame.image);
+            if (s && colour_) rgb_from_grey(frame.image, *frame.colour);
             break;
         case CaptureFormat::yuyv:
-            s = grey_from_yuyv(bytes, width_, height_, bytes_per_line_, out);
+            s = grey_from_yuyv(bytes, width_, height_, bytes_per_line_, frame.image);
+            if (s && colour_) s = rgb_from_yuyv(bytes, width_, height_, bytes_per_line_, encoding_, *frame.colour);
             break;
         case CaptureFormat::mjpeg:
-            s = mjpeg_->decode_grey(bytes, out, width_, height_);
+            s = colour_ ? mjpeg_->decode_colour(bytes, frame.image, *frame.colour, width_, height_)
+                        : mjpeg_->decode_grey(bytes, frame.image, width_, height_);
+            break;
+        case CaptureFormat::nv12:
+        case CaptureFormat::nv21:
+        case CaptureFormat::yuv420:
+        case CaptureFormat::yvu420:
+            s = convert_yuv420(format_, std::span<const PlaneBytes>(planes, static_cast<std::size_t>(plane_count_)),
+                               width_, height_, encoding_, frame.image, colour_ ? &*frame.colour : nullptr);
             break;
         case CaptureFormat::image_file:
             s = make_error(EINVAL, "image_file is not a capture format");
@@ -243,12 +376,19 @@ Result<CameraFrame> V4l2Capture::next_frame() {
 
         // Drain every ready buffer; keep the newest, give the older ones straight back.
         v4l2_buffer newest{};
+        std::uint32_t used[VIDEO_MAX_PLANES]{};
+        std::uint32_t offset[VIDEO_MAX_PLANES]{};
         bool have = false;
         std::uint32_t skipped = 0;
         for (;;) {
+            v4l2_plane planes[VIDEO_MAX_PLANES]{};
             v4l2_buffer buf{};
-            buf.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+            buf.type = buf_type_;
             buf.memory = V4L2_MEMORY_MMAP;
+            if (multiplanar_) {
+                buf.m.planes = planes;
+                buf.length = static_cast<std::uint32_t>(plane_count_);
+            }
             if (xioctl(fd_.get(), VIDIOC_DQBUF, &buf) == -1) {
                 if (errno == EAGAIN) break;
                 const Error e = errno_error(device_ + ": VIDIOC_DQBUF");
@@ -266,6 +406,10 @@ Result<CameraFrame> V4l2Capture::next_frame() {
                 ++skipped;
             }
             newest = buf;
+            for (int p = 0; p < plane_count_; ++p) {
+                used[p] = multiplanar_ ? planes[p].bytesused : buf.bytesused;
+                offset[p] = multiplanar_ ? std::min(planes[p].data_offset, planes[p].bytesused) : 0;
+            }
             have = true;
         }
         if (!have) continue;  // only damaged frames were ready: wait for the next
@@ -282,7 +426,7 @@ Result<CameraFrame> V4l2Capture::next_frame() {
             frame.timestamp_ns = monotonic_now_ns();
             frame.clock = TimestampSource::dequeue_monotonic;
         }
-        const Status converted = convert(newest.index, newest.bytesused, frame.image);
+        const Status converted = convert(newest.index, used, offset, frame);
         if (Status s = requeue(newest.index); !s) return s.error();
         if (!converted) return converted.error();
         return frame;
@@ -290,8 +434,23 @@ Result<CameraFrame> V4l2Capture::next_frame() {
 }
 
 std::string V4l2Capture::description() const {
-    return device_ + " (" + driver_ + ") " + std::to_string(width_) + "x" + std::to_string(height_) + " " +
-           pixel_format_name(format_) + ", " + std::to_string(buffers_.size()) + " mmap buffers";
+    std::string text = device_ + " (" + driver_ + ") " + std::to_string(width_) + "x" + std::to_string(height_) + " " +
+                       pixel_format_name(format_);
+    if (multiplanar_) text += " (" + std::to_string(plane_count_) + "-plane mplane)";
+    if (colour_ || format_ != CaptureFormat::grey) text += " " + ycbcr_encoding_name(encoding_);
+    if (colour_) text += ", colour";
+    text += ", " + std::to_string(buffers_.size()) + " mmap buffers";
+    if (!skipped_controls_.empty()) text += "; controls not on this device: " + skipped_controls_;
+    return text;
 }
+
+Status V4l2Capture::apply_controls(const CameraControls& controls) {
+    std::string skipped;
+    if (Status s = apply_v4l2_controls(fd_.get(), device_, controls, &skipped); !s) return s;
+    skipped_controls_ = skipped;
+    return {};
+}
+
+CameraControlValues V4l2Capture::control_values() const { return read_v4l2_controls(fd_.get()); }
 
 }  // namespace mogao
