@@ -111,6 +111,9 @@ int main(int argc, char** argv) {
     if (serve->parsed()) {
         try {
             serve_options.link.tls = mogao::load_farm_tls(tls_dir, farm_name);
+            // Re-read while serving: the farm certificate is rotated by replacing the files.
+            serve_options.link.tls_files = {mogao::ca_cert_path(tls_dir), mogao::farm_cert_path(tls_dir, farm_name),
+                                            mogao::farm_key_path(tls_dir, farm_name)};
             if (serve_options.link.crl_path.empty() && std::filesystem::exists(mogao::crl_path(tls_dir))) {
                 serve_options.link.crl_path = mogao::crl_path(tls_dir).string();
             }

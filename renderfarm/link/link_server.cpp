@@ -3,6 +3,9 @@
 
 #include <fmt/format.h>
 #include <grpcpp/grpcpp.h>
+#include <grpcpp/security/server_credentials.h>
+#include <grpcpp/security/tls_certificate_provider.h>
+#include <grpcpp/security/tls_credentials_options.h>
 
 #include <algorithm>
 #include <chrono>
@@ -114,6 +117,30 @@ void check_options(const LinkServerOptions& o) {
     range("max_frames_in_flight", o.max_frames_in_flight, 1, 16);
     range("max_sessions", o.max_sessions, 1, 1024);
     range("max_request_bytes", o.max_request_bytes, 1024, 16 << 20);
+    range("tls_refresh_s", o.tls_refresh_s, 1, 86'400);
+    if (!o.tls_files.empty() && (o.tls_files.ca.empty() || o.tls_files.key.empty())) {
+        throw LinkError("LinkServerOptions.tls_files: give the CA, certificate and key paths together");
+    }
+}
+
+// Mutual TLS through gRPC's certificate providers: the material in memory, or files gRPC re-reads
+// (rotation without a restart). Appliances must present a certificate that chains to the CA.
+std::shared_ptr<grpc::ServerCredentials> server_credentials(const LinkServerOptions& o) {
+    namespace ex = grpc::experimental;
+    std::shared_ptr<ex::CertificateProviderInterface> provider;
+    if (o.tls_files.empty()) {
+        provider = std::make_shared<ex::StaticDataCertificateProvider>(
+            o.tls.ca_pem, std::vector<ex::IdentityKeyCertPair>{{o.tls.key_pem, o.tls.cert_pem}});
+    } else {
+        provider = std::make_shared<ex::FileWatcherCertificateProvider>(
+            o.tls_files.key.string(), o.tls_files.cert.string(), o.tls_files.ca.string(),
+            static_cast<unsigned>(o.tls_refresh_s));
+    }
+    ex::TlsServerCredentialsOptions tls(provider);
+    tls.watch_root_certs();
+    tls.watch_identity_key_cert_pairs();
+    tls.set_cert_request_type(GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY);
+    return ex::TlsServerCredentials(tls);
 }
 
 }  // namespace
@@ -385,12 +412,9 @@ LinkServer::LinkServer(LinkServerOptions options, FrameRenderer renderer) : impl
         impl_->revocation = std::make_unique<RevocationWatcher>(impl_->options.crl_path, impl_->options.tls.ca_pem);
     }
 
-    grpc::SslServerCredentialsOptions ssl(GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY);
-    ssl.pem_root_certs = impl_->options.tls.ca_pem;
-    ssl.pem_key_cert_pairs.push_back({impl_->options.tls.key_pem, impl_->options.tls.cert_pem});
     grpc::ServerBuilder builder;
     int port = 0;
-    builder.AddListeningPort(endpoint->to_string(), grpc::SslServerCredentials(ssl), &port);
+    builder.AddListeningPort(endpoint->to_string(), server_credentials(impl_->options), &port);
     builder.RegisterService(impl_.get());
     builder.SetMaxReceiveMessageSize(impl_->options.max_request_bytes);
     // A second farm on the same port must fail loudly, not share the port's connections.

@@ -44,6 +44,12 @@ struct LinkServerOptions {
     // way to change that; see ipv6_only.
     std::string listen{kDefaultListenEndpoint};
     TlsMaterial tls;  // farm certificate + key; ca_pem: the CA every appliance certificate must chain to
+    // Where `tls` was read from. When set, gRPC re-reads these files every tls_refresh_s seconds:
+    // the farm's certificate is rotated by replacing the files (write a temporary, rename), without
+    // a restart; open sessions continue, new handshakes get the new certificate. A key that does
+    // not match its certificate is not taken (gRPC keeps the pair it has). Empty: `tls` only.
+    TlsFilePaths tls_files;
+    int tls_refresh_s = 60;  // 1..86400
     // Appliance certificate common names allowed in; empty = every certificate the CA issued.
     std::vector<std::string> allowed_appliances;
     // The farm CA's revocation list (PEM CRL, revocation.h); empty = none. Re-read when the file

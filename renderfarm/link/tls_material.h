@@ -15,6 +15,11 @@ struct TlsMaterial {
     std::string key_pem;   // our private key (PKCS#8 or traditional PEM)
 };
 
+struct TlsFilePaths {
+    std::filesystem::path ca, cert, key;
+    [[nodiscard]] bool empty() const { return cert.empty(); }
+};
+
 // Reads a whole PEM file (at most 1 MiB). Throws LinkError naming the path and the reason.
 [[nodiscard]] std::string read_pem_file(const std::filesystem::path& path);
 
