@@ -290,8 +290,54 @@ Section subsection(const Section& parent, std::string_view key, const std::strin
     return Section(parent.context(), name, v, std::move(known));
 }
 
-const std::vector<std::string> kTrackingKeys{"camera", "camera_size", "camera_fps", "intrinsics", "tag_size_m",
-                                             "tag_id", "replay_end", "detector", "control"};
+const std::vector<std::string> kCameraControlKeys{"camera_exposure_us", "camera_gain", "camera_white_balance_k",
+                                                  "camera_colour"};
+const std::vector<std::string> kTrackingKeys{"camera",     "camera_size", "camera_fps", "intrinsics",
+                                             "tag_size_m", "tag_id",      "replay_end", "detector",
+                                             "control",    "camera_exposure_us", "camera_gain",
+                                             "camera_white_balance_k", "camera_colour"};
+
+// One camera control key: "auto", "lock", "keep" or a number within `range` (the device's own range
+// is checked when the camera opens; the setting carries the key's name for that message). Written:
+// required (a camera without the control is an error); absent: `fallback`, not required.
+ControlSetting read_control_setting(const Section& s, std::string_view key, ControlSetting fallback,
+                                    const std::function<bool(double)>& ok, std::string_view range) {
+    ControlSetting setting = std::move(fallback);
+    setting.name = fmt::format("{}: {}", s.context().file, s.field(key));
+    const Value* v = s.find(key);
+    if (v == nullptr) return setting;
+    setting.required = true;
+    if (v->is_string()) {
+        const std::string text = v->as_string().str;
+        if (text == "auto") {
+            setting.mode = ControlSetting::Mode::automatic;
+        } else if (text == "lock") {
+            setting.mode = ControlSetting::Mode::lock;
+        } else if (text == "keep") {
+            setting.mode = ControlSetting::Mode::keep;
+        } else {
+            s.fail(v, key, fmt::format(": '{}' is not one of auto, lock, keep or a number in {}", text, range));
+        }
+        return setting;
+    }
+    setting.mode = ControlSetting::Mode::manual;
+    setting.value = s.as_number(*v, key, ok, range);
+    return setting;
+}
+
+// The camera control keys of a live camera (CameraControls, drivers/camera/camera_controls.h).
+void read_camera_controls(const Section& s, CameraSourceSpec& source) {
+    // A short exposure by default: 8 ms keeps a hand moving at 1 m/s within 8 mm of blur.
+    const ControlSetting short_exposure{ControlSetting::Mode::manual, kDefaultExposureUs, false, ""};
+    source.controls.exposure = read_control_setting(s, "camera_exposure_us", short_exposure,
+                                                    [](double x) { return x > 0 && x <= 1e6; }, "(0, 1e6] us");
+    source.controls.gain =
+        read_control_setting(s, "camera_gain", {}, [](double x) { return x >= 0 && x <= 1e6; }, "[0, 1e6]");
+    source.controls.white_balance = read_control_setting(s, "camera_white_balance_k", {},
+                                                         [](double x) { return x >= 1000 && x <= 20000; },
+                                                         "[1000, 20000] K");
+    source.colour = s.boolean("camera_colour", false);
+}
 
 void read_detector(const Section& s, DetectorSettings& d) {
     d.family = s.string("family", d.family);
@@ -387,7 +433,11 @@ void read_tracking(const Section& s, TrackingConfig& t, double eye_height_m) {
             }
         }
         t.source.loop = t.replay_end == ReplayEnd::loop;
+        for (const auto& key : kCameraControlKeys) {
+            s.forbid(key, "with a live camera, \"v4l2:\" or \"libcamera:\" (a replay has no camera controls)");
+        }
     } else {
+        read_camera_controls(s, t.source);
         const bool v4l2 = t.source.kind == CameraSourceSpec::Kind::v4l2;
         if (v4l2 && !fs::path(t.source.device).is_absolute()) {
             s.fail(&camera, "camera", fmt::format(": '{}' is not an absolute device path (\"v4l2:/dev/videoN\")", t.source.device));
@@ -556,7 +606,8 @@ KioskConfig parse_kiosk_config(std::string_view text, const std::filesystem::pat
     read_screen(screen, config.screen);
     const Section navigation = section(ctx, root, "navigation", {"source", "path", "path_frames", "start", "start_yaw_deg", "eye_height_m", "camera",
                                                                      "camera_size", "camera_fps", "intrinsics", "tag_size_m", "tag_id",
-                                                                     "replay_end", "detector", "control"});
+                                                                     "replay_end", "detector", "control", "camera_exposure_us",
+                                                                     "camera_gain", "camera_white_balance_k", "camera_colour"});
     read_navigation(navigation, config.navigation);
     config.screen.eye_m = Eigen::Vector3d(0.0, config.navigation.eye_height_m, 0.0);
     const Section stats = section(ctx, root, "stats", {"file", "log_period_s"});

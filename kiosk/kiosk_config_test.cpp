@@ -458,6 +458,53 @@ TEST_F(KioskConfigTest, ALibcameraCameraIsNamedLikeAnyOtherAndRunsAtItsPipelines
     EXPECT_NE(message.find("camera_fps: only with a \"replay:\" or \"v4l2:\" camera"), std::string::npos) << message;
 }
 
+TEST_F(KioskConfigTest, LiveCameraControlsDefaultToAShortExposureAndAreRequiredWhenWritten) {
+    const KioskConfig c =
+        parse(tracking({R"(navigation.camera="v4l2:/dev/video0")", R"(navigation.intrinsics="webcam.json")"}));
+    const CameraControls& d = c.navigation.tracking.source.controls;
+    EXPECT_EQ(d.exposure.mode, ControlSetting::Mode::manual);
+    EXPECT_DOUBLE_EQ(d.exposure.value, kDefaultExposureUs);
+    EXPECT_FALSE(d.exposure.required);  // a camera without manual exposure keeps its own
+    EXPECT_EQ(d.gain.mode, ControlSetting::Mode::keep);
+    EXPECT_EQ(d.white_balance.mode, ControlSetting::Mode::keep);
+    EXPECT_FALSE(c.navigation.tracking.source.colour);
+    EXPECT_NE(d.exposure.name.find("[navigation].camera_exposure_us"), std::string::npos) << d.exposure.name;
+
+    const KioskConfig set = parse(tracking({R"(navigation.camera="v4l2:/dev/video0")",
+                                            R"(navigation.intrinsics="webcam.json")", "navigation.camera_exposure_us=4000",
+                                            R"(navigation.camera_gain="auto")", R"(navigation.camera_white_balance_k="lock")",
+                                            "navigation.camera_colour=true"}));
+    const CameraControls& w = set.navigation.tracking.source.controls;
+    EXPECT_EQ(w.exposure.mode, ControlSetting::Mode::manual);
+    EXPECT_DOUBLE_EQ(w.exposure.value, 4000);
+    EXPECT_TRUE(w.exposure.required);
+    EXPECT_EQ(w.gain.mode, ControlSetting::Mode::automatic);
+    EXPECT_TRUE(w.gain.required);
+    EXPECT_EQ(w.white_balance.mode, ControlSetting::Mode::lock);
+    EXPECT_TRUE(set.navigation.tracking.source.colour);
+    // The device's own range is checked when the camera opens; the message then names this key.
+    EXPECT_EQ(w.gain.name, name().string() + ": [navigation].camera_gain");
+}
+
+TEST_F(KioskConfigTest, CameraControlKeysAreCheckedAndRefusedForAReplay) {
+    const auto live = [](const std::string& line) {
+        return tracking({R"(navigation.camera="v4l2:/dev/video0")", R"(navigation.intrinsics="webcam.json")", line});
+    };
+    std::string message = error_of(live("navigation.camera_exposure_us=0"));
+    EXPECT_NE(message.find("[navigation].camera_exposure_us = 0 is outside (0, 1e6] us"), std::string::npos) << message;
+    message = error_of(live(R"(navigation.camera_gain="max")"));
+    EXPECT_NE(message.find("[navigation].camera_gain: 'max' is not one of auto, lock, keep or a number in [0, 1e6]"),
+              std::string::npos)
+        << message;
+    message = error_of(live("navigation.camera_white_balance_k=500"));
+    EXPECT_NE(message.find("[navigation].camera_white_balance_k = 500 is outside [1000, 20000] K"), std::string::npos)
+        << message;
+    message = error_of(live(R"(navigation.camera_colour="yes")"));
+    EXPECT_NE(message.find("[navigation].camera_colour: expected true or false"), std::string::npos) << message;
+    message = error_of(tracking({R"(navigation.camera="replay:seq")", "navigation.camera_exposure_us=4000"}));
+    EXPECT_NE(message.find("[navigation].camera_exposure_us: only with a live camera"), std::string::npos) << message;
+}
+
 class KioskTrackingBadField : public KioskConfigTest, public ::testing::WithParamInterface<BadField> {};
 
 TEST_P(KioskTrackingBadField, NamesTheFileTheFieldAndTheReason) {

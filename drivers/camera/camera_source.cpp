@@ -58,6 +58,8 @@ Result<std::unique_ptr<FrameSource>> open_camera_source(const CameraSourceSpec& 
         config.width = spec.width;
         config.height = spec.height;
         config.timeout_ms = spec.timeout_ms;
+        config.colour = spec.colour;
+        config.controls = spec.controls;
         auto camera = LibcameraCapture::open(config);
         if (!camera) return camera.error();
         if (Status s = check_size((*camera)->size(), "libcamera:" + spec.camera_id); !s) return s.error();
@@ -69,6 +71,8 @@ Result<std::unique_ptr<FrameSource>> open_camera_source(const CameraSourceSpec& 
     config.height = spec.height;
     config.frames_per_second = spec.fps;
     config.timeout_ms = spec.timeout_ms;
+    config.colour = spec.colour;
+    config.controls = spec.controls;
     auto camera = V4l2Capture::open(config);
     if (!camera) return camera.error();
     if (Status s = check_size((*camera)->size(), spec.device); !s) return s.error();

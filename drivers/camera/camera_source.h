@@ -16,6 +16,7 @@
 #include <string>
 #include <string_view>
 
+#include "drivers/camera/camera_controls.h"
 #include "drivers/camera/frame_source.h"
 #include "common/result.h"
 
@@ -33,6 +34,8 @@ struct CameraSourceSpec {
     int height = 600;
     int fps = 0;                   // v4l2: requested rate, 0 = the driver's default
     int timeout_ms = 2000;         // v4l2, libcamera: next_frame() gives ETIMEDOUT after this long
+    bool colour = false;           // v4l2, libcamera: also deliver CameraFrame::colour (camera_frame.h)
+    CameraControls controls;       // v4l2, libcamera: exposure, gain, white balance (camera_controls.h)
 };
 
 // "replay:<folder>", "v4l2:<device>" or "libcamera:[<id>]" -> true and `out.kind` + folder/device/
