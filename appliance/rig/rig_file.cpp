@@ -41,7 +41,8 @@ public:
     int integer(const std::string& key, int fallback) {
         const toml::value* v = find(key);
         if (v == nullptr) return fallback;
-        if (!v->is_integer() || v->as_integer() < -1000000000 || v->as_integer() > 1000000000) fail(key, "must be an integer");
+        if (!v->is_integer() || v->as_integer() < -1000000000 || v->as_integer() > 1000000000)
+            fail(key, "must be an integer");
         return static_cast<int>(v->as_integer());
     }
 
@@ -56,7 +57,8 @@ public:
     std::array<double, N> numbers(const std::string& key, std::array<double, N> fallback) {
         const toml::value* v = find(key);
         if (v == nullptr) return fallback;
-        if (!v->is_array() || v->as_array().size() != N) fail(key, "must be an array of " + std::to_string(N) + " numbers");
+        if (!v->is_array() || v->as_array().size() != N)
+            fail(key, "must be an array of " + std::to_string(N) + " numbers");
         std::array<double, N> out{};
         for (std::size_t i = 0; i < N; ++i) {
             const toml::value& e = v->as_array()[i];
@@ -78,7 +80,8 @@ public:
 
     ImageSize size(const std::string& key, ImageSize fallback) {
         const auto a = numbers<2>(key, {double(fallback.width), double(fallback.height)});
-        if (a[0] != std::floor(a[0]) || a[1] != std::floor(a[1]) || a[0] < 1 || a[1] < 1 || a[0] > 16384 || a[1] > 16384) {
+        if (a[0] != std::floor(a[0]) || a[1] != std::floor(a[1]) || a[0] < 1 || a[1] < 1 || a[0] > 16384 ||
+            a[1] > 16384) {
             fail(key, "must be [width, height], integers 1..16384");
         }
         return {static_cast<int>(a[0]), static_cast<int>(a[1])};

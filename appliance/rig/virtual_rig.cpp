@@ -128,7 +128,8 @@ std::optional<ScreenPoint> projector_to_screen(const VirtualRig& rig, int k, dou
 
 std::optional<Eigen::Vector2d> screen_to_projector(const VirtualRig& rig, int k, ScreenPoint s) {
     const RigProjector& p = rig.projectors.at(static_cast<std::size_t>(k));
-    const Eigen::Vector3d d = device_to_screen(p.pose).transpose() * (screen_position(rig.screen, s) - p.pose.position_m);
+    const Eigen::Vector3d d =
+        device_to_screen(p.pose).transpose() * (screen_position(rig.screen, s) - p.pose.position_m);
     if (d.z() <= 1e-9) return std::nullopt;
     const Eigen::Vector2d xy(p.intrinsics.fx_px * d.x() / d.z() + p.intrinsics.cx_px,
                              p.intrinsics.fy_px * d.y() / d.z() + p.intrinsics.cy_px);
@@ -161,8 +162,8 @@ CameraSimulator::CameraSimulator(const VirtualRig& rig) : rig_(rig) {
         for (int x = 0; x < samples_w_; ++x) {
             const double px = (x + 0.5) / ss;
             const double py = (y + 0.5) / ss;
-            distorted[static_cast<std::size_t>(y) * samples_w_ + x] = {(px - cam.intrinsics.cx_px) / cam.intrinsics.fx_px,
-                                                                        (py - cam.intrinsics.cy_px) / cam.intrinsics.fy_px};
+            distorted[static_cast<std::size_t>(y) * samples_w_ + x] = {
+                (px - cam.intrinsics.cx_px) / cam.intrinsics.fx_px, (py - cam.intrinsics.cy_px) / cam.intrinsics.fy_px};
         }
     }
     std::vector<cv::Point2d> ideal(n);
@@ -202,9 +203,11 @@ cv::Mat1f CameraSimulator::capture(const std::vector<cv::Mat>& signals, std::uin
         const ImageSize r = rig_.projectors[k].resolution;
         const cv::Mat& s = signals[k];
         if (s.empty()) continue;
-        if ((s.type() != CV_32FC1 && s.type() != CV_32FC3) || s.cols != r.width || s.rows != r.height || !s.isContinuous()) {
-            throw std::invalid_argument("capture: signals[" + std::to_string(k) + "] must be a continuous CV_32FC1 or CV_32FC3 of " +
-                                        std::to_string(r.width) + "x" + std::to_string(r.height));
+        if ((s.type() != CV_32FC1 && s.type() != CV_32FC3) || s.cols != r.width || s.rows != r.height ||
+            !s.isContinuous()) {
+            throw std::invalid_argument("capture: signals[" + std::to_string(k) +
+                                        "] must be a continuous CV_32FC1 or CV_32FC3 of " + std::to_string(r.width) +
+                                        "x" + std::to_string(r.height));
         }
     }
     // Light per projector pixel value, per channel: brightness * (black + (1 - black) * s^gamma), mean of channels.
@@ -235,7 +238,8 @@ cv::Mat1f CameraSimulator::capture(const std::vector<cv::Mat>& signals, std::uin
                             const float zero = 0.0f;
                             const cv::Mat& s = signals[k];
                             l += s.empty() ? light(k, &zero, 1)
-                                           : light(k, s.ptr<float>() + static_cast<std::size_t>(h) * s.channels(), s.channels());
+                                           : light(k, s.ptr<float>() + static_cast<std::size_t>(h) * s.channels(),
+                                                   s.channels());
                         }
                         acc += l;
                     }
@@ -245,7 +249,8 @@ cv::Mat1f CameraSimulator::capture(const std::vector<cv::Mat>& signals, std::uin
         }
     });
     const RigCamera& cam = rig_.camera;
-    if (cam.blur_sigma_px > 0.0) cv::GaussianBlur(img, img, cv::Size(0, 0), cam.blur_sigma_px, cam.blur_sigma_px, cv::BORDER_REPLICATE);
+    if (cam.blur_sigma_px > 0.0)
+        cv::GaussianBlur(img, img, cv::Size(0, 0), cam.blur_sigma_px, cam.blur_sigma_px, cv::BORDER_REPLICATE);
     img *= cam.exposure * cam.gain;
     cv::Mat1f noise(img.size());
     cv::RNG rng(cam.seed * 0x9E3779B97F4A7C15ULL + frame * 0xD1B54A32D192ED03ULL + 1);
@@ -254,7 +259,8 @@ cv::Mat1f CameraSimulator::capture(const std::vector<cv::Mat>& signals, std::uin
     for (int y = 0; y < img.rows; ++y) {
         for (int x = 0; x < img.cols; ++x) {
             const double v = img(y, x);
-            const double sigma = std::sqrt(cam.read_noise * cam.read_noise + cam.shot_noise * cam.shot_noise * std::max(v, 0.0));
+            const double sigma =
+                std::sqrt(cam.read_noise * cam.read_noise + cam.shot_noise * cam.shot_noise * std::max(v, 0.0));
             const double q = std::round(std::clamp(v + sigma * noise(y, x), 0.0, 1.0) * levels) / levels;
             img(y, x) = static_cast<float>(q);
         }

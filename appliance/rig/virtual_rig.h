@@ -73,8 +73,8 @@ struct RigProjector {
     ImageSize resolution{1920, 1080};
     RigIntrinsics intrinsics;  // no distortion for projectors (checked)
     RigPose pose;
-    std::array<double, 3> gamma{2.2, 2.2, 2.2};      // per channel, (0, 10]
-    double black_level = 0.002;                      // fraction of full white at signal 0, [0, 1)
+    std::array<double, 3> gamma{2.2, 2.2, 2.2};       // per channel, (0, 10]
+    double black_level = 0.002;                       // fraction of full white at signal 0, [0, 1)
     std::array<double, 3> brightness{1.0, 1.0, 1.0};  // full white per channel, (0, 100]
 };
 
@@ -98,8 +98,8 @@ struct RigCamera {
 struct RigPrior {
     Eigen::Vector3d camera_position_error_m{0.0, 0.0, 0.0};
     Eigen::Vector3d camera_angle_error_deg{0.0, 0.0, 0.0};  // yaw, pitch, roll
-    double camera_focal_error = 0.0;     // relative error of fx, fy
-    double projector_focal_error = 0.0;  // relative error of the projectors' fx, fy
+    double camera_focal_error = 0.0;                        // relative error of fx, fy
+    double projector_focal_error = 0.0;                     // relative error of the projectors' fx, fy
 };
 
 struct VirtualRig {
@@ -156,7 +156,7 @@ private:
     VirtualRig rig_;
     int samples_w_ = 0;
     int samples_h_ = 0;
-    std::vector<std::uint8_t> on_screen_;        // per sample
+    std::vector<std::uint8_t> on_screen_;         // per sample
     std::vector<std::vector<std::int32_t>> hit_;  // per projector, per sample: pixel index or -1
 };
 

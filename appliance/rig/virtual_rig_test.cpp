@@ -73,14 +73,16 @@ TEST(VirtualRig, LitBlockAppearsWhereTheCameraModelProjectsIt) {
         for (int j = 0; j < 3; ++j) rm(i, j) = r_sc(i, j);
     cv::Vec3d rvec;
     cv::Rodrigues(rm, rvec);
-    const cv::Matx33d kmat(cam.intrinsics.fx_px, 0, cam.intrinsics.cx_px - 0.5, 0, cam.intrinsics.fy_px, cam.intrinsics.cy_px - 0.5, 0, 0, 1);
+    const cv::Matx33d kmat(cam.intrinsics.fx_px, 0, cam.intrinsics.cx_px - 0.5, 0, cam.intrinsics.fy_px,
+                           cam.intrinsics.cy_px - 0.5, 0, 0, 1);
     for (int k = 0; k < 3; ++k) {
         const double px = 960.0;
         const double py = 540.0;
         const auto s = projector_to_screen(rig, k, px, py);
         ASSERT_TRUE(s.has_value());
         const double radius = rig.screen.radius_m;
-        const std::vector<cv::Point3d> world{{radius * std::sin(s->theta_rad), s->h_m, -radius * std::cos(s->theta_rad)}};
+        const std::vector<cv::Point3d> world{
+            {radius * std::sin(s->theta_rad), s->h_m, -radius * std::cos(s->theta_rad)}};
         std::vector<cv::Point2d> image;
         cv::projectPoints(world, rvec, cv::Vec3d(t.x(), t.y(), t.z()), kmat, cam.intrinsics.distortion, image);
         std::vector<cv::Mat> signals(3);
@@ -117,12 +119,15 @@ TEST(RigFile, ErrorsNameTheField) {
         return std::string("no error");
     };
     EXPECT_NE(message("[screen]\nradius_m = 3\n").find("missing [camera]"), std::string::npos);
-    EXPECT_NE(message("[camera]\n[[projectors]]\nthrow_ratio = 1\nfoo = 2\n").find("projectors[0].foo: unknown key"), std::string::npos);
-    EXPECT_NE(message("[camera]\nposition_m = [0, 1, 5]\n[[projectors]]\n").find("camera.position_m must be inside the cylinder"),
+    EXPECT_NE(message("[camera]\n[[projectors]]\nthrow_ratio = 1\nfoo = 2\n").find("projectors[0].foo: unknown key"),
+              std::string::npos);
+    EXPECT_NE(message("[camera]\nposition_m = [0, 1, 5]\n[[projectors]]\n")
+                  .find("camera.position_m must be inside the cylinder"),
               std::string::npos);
     EXPECT_NE(message("[camera]\nbits = 40\n[[projectors]]\n").find("camera.bits must be 1..16"), std::string::npos);
-    EXPECT_NE(message("[camera]\n[[projectors]]\ngamma = [2.2, 2.2]\n").find("projectors[0].gamma: must be an array of 3"),
-              std::string::npos);
+    EXPECT_NE(
+        message("[camera]\n[[projectors]]\ngamma = [2.2, 2.2]\n").find("projectors[0].gamma: must be an array of 3"),
+        std::string::npos);
     EXPECT_NE(message("[camera\n").find("not valid TOML"), std::string::npos);
     EXPECT_THROW((void)load_rig("/nonexistent/rig.toml"), RigError);
 }

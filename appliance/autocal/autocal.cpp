@@ -1,0 +1,149 @@
+// SPDX-License-Identifier: Apache-2.0
+// The calibration pipeline: decode, camera pose, projector fits, warp, blend (autocal.h).
+#include "appliance/autocal/autocal.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "appliance/autocal/gray_code.h"
+#include "appliance/autocal/screen_geometry.h"
+#include "appliance/warp/calibration_validation.h"
+#include "appliance/warp/ideal_calibration.h"
+#include "appliance/warp/response_curve.h"
+#include "appliance/warp/warp_sampling.h"
+
+namespace mogao::autocal {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+void check_inputs(const CalibrationPrior& prior, ImageSize content, const AutocalOptions& o) {
+    const auto fail = [](const std::string& what) { throw std::invalid_argument("calibrate: " + what); };
+    if (prior.projectors.empty() || prior.projectors.size() > 16) fail("prior.projectors: 1..16 projectors");
+    if (content.width < 1 || content.height < 1 || content.width > 16384 || content.height > 16384)
+        fail("content: 1..16384 per side");
+    if (o.warp_step_px < 1 || o.warp_step_px > 64) fail("options.warp_step_px: 1..64");
+    if (!(o.blend_ramp > 0.0 && o.blend_ramp <= 0.5)) fail("options.blend_ramp: (0, 0.5]");
+    if (!(prior.screen.radius_m > 0.0 && prior.screen.arc_deg > 0.0 && prior.screen.top_m > prior.screen.bottom_m)) {
+        fail("prior.screen: radius_m > 0, arc_deg > 0, top_m > bottom_m");
+    }
+    for (const DeviceModel& p : prior.projectors) {
+        if (p.resolution.width < 16 || p.resolution.height < 16 || !(p.fx_px > 0.0) || !(p.fy_px > 0.0)) {
+            fail("prior.projectors '" + p.id + "': resolution >= 16x16 and focal lengths > 0");
+        }
+    }
+}
+
+// Screen point of a pinhole device's image position as (theta, h), or NaN.
+Eigen::Vector2d device_screen(const DeviceModel& d, const ScreenModel& s, double x, double y) {
+    const Eigen::Vector3d dir = d.rotation * Eigen::Vector3d((x - d.cx_px) / d.fx_px, (y - d.cy_px) / d.fy_px, 1.0);
+    const auto hit = cylinder_hit(s, d.position_m, dir);
+    if (!hit) return {std::nan(""), std::nan("")};
+    return {std::atan2(hit->x(), -hit->z()), hit->y()};
+}
+
+// Distance of screen point (theta, h) from device j's image border in its pixels (0 outside).
+double border_distance(const DeviceModel& d, const ScreenModel& s, const Eigen::Vector2d& th) {
+    const Eigen::Vector3d p(s.radius_m * std::sin(th.x()), th.y(), -s.radius_m * std::cos(th.x()));
+    const Eigen::Vector3d q = d.rotation.transpose() * (p - d.position_m);
+    if (q.z() <= 0.0) return 0.0;
+    const double x = d.fx_px * q.x() / q.z() + d.cx_px;
+    const double y = d.fy_px * q.y() / q.z() + d.cy_px;
+    return std::max(0.0, std::min({x, d.resolution.width - x, y, d.resolution.height - y}));
+}
+
+ProjectorCalibration build_projector(const std::vector<DeviceModel>& fitted, std::size_t k, const ScreenModel& s,
+                                     const AutocalOptions& o) {
+    const DeviceModel& d = fitted[k];
+    ProjectorCalibration pc;
+    pc.id = d.id;
+    pc.output = d.resolution;
+    const ImageSize grid{std::max(2, (d.resolution.width + o.warp_step_px - 1) / o.warp_step_px),
+                         std::max(2, (d.resolution.height + o.warp_step_px - 1) / o.warp_step_px)};
+    pc.warp.size = grid;
+    pc.blend.size = grid;
+    pc.warp.uv.resize(static_cast<std::size_t>(grid.pixel_count()) * 2);
+    pc.blend.weight.resize(static_cast<std::size_t>(grid.pixel_count()));
+    const double arc = s.arc_deg * kDeg;
+    for (int gy = 0; gy < grid.height; ++gy) {
+        for (int gx = 0; gx < grid.width; ++gx) {
+            const std::size_t i = static_cast<std::size_t>(gy) * grid.width + gx;
+            const double x = grid_to_output(gx, d.resolution.width, grid.width);
+            const double y = grid_to_output(gy, d.resolution.height, grid.height);
+            const Eigen::Vector2d th = device_screen(d, s, x, y);
+            pc.warp.uv[2 * i] = static_cast<float>((th.x() + arc / 2.0) / arc);
+            pc.warp.uv[2 * i + 1] = static_cast<float>((s.top_m - th.y()) / (s.top_m - s.bottom_m));
+            const bool on =
+                std::isfinite(th.x()) && std::abs(th.x()) <= arc / 2.0 && th.y() >= s.bottom_m && th.y() <= s.top_m;
+            double sum = 0.0;
+            double own = 0.0;
+            for (std::size_t j = 0; j < fitted.size() && on; ++j) {
+                const double ramp = o.blend_ramp * fitted[j].resolution.width;
+                const double f = smooth_ramp(border_distance(fitted[j], s, th) / ramp);
+                sum += f;
+                if (j == k) own = f;
+            }
+            pc.blend.weight[i] = sum > 0.0 ? static_cast<float>(std::clamp(own / sum, 0.0, 1.0)) : 0.0f;
+        }
+    }
+    pc.response = make_gamma_response(2.2);
+    return pc;
+}
+
+}  // namespace
+
+Eigen::Vector2d projector_content(const DeviceModel& projector, const ScreenModel& screen, double x, double y) {
+    const Eigen::Vector2d th = device_screen(projector, screen, x, y);
+    const double arc = screen.arc_deg * kDeg;
+    return {(th.x() + arc / 2.0) / arc, (screen.top_m - th.y()) / (screen.top_m - screen.bottom_m)};
+}
+
+AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, ImageSize content,
+                        const AutocalOptions& options) {
+    check_inputs(prior, content, options);
+    const std::size_t n = prior.projectors.size();
+    std::vector<ImageSize> sizes;
+    for (const DeviceModel& p : prior.projectors) sizes.push_back(p.resolution);
+    AutocalResult result;
+    // Step 2 first: all projectors white minus all black shows the screen's lit edges.
+    std::vector<cv::Mat> signals(n);
+    const cv::Mat1f black = source.show(signals);
+    for (std::size_t k = 0; k < n; ++k) signals[k] = cv::Mat1f(sizes[k].height, sizes[k].width, 1.0f);
+    const cv::Mat1f white = source.show(signals);
+    result.report.captures = 2;
+    cv::Mat1f lit;
+    cv::subtract(white, black, lit);
+    const EdgeFit edge = fit_camera_pose(lit, prior, options);
+    result.camera = edge.camera;
+    result.report.edge_points = edge.points;
+    result.report.edge_rms_m = edge.rms_m;
+    result.report.camera_position_m = edge.camera.position_m;
+    for (std::size_t k = 0; k < n; ++k) {
+        const Correspondences c = decode_projector(source, static_cast<int>(k), sizes, options);
+        result.report.captures += c.captures;
+        ProjectorReport pr{
+            prior.projectors[k].id, c.column_bits, c.row_bits, static_cast<int>(c.camera.size()), 0.0, 0.0};
+        if (c.column_bits < options.min_bits || c.row_bits < options.min_bits) {
+            throw CalibrationRefused("projector " + std::to_string(k) + " '" + pr.id +
+                                     "': Gray-code decoding failed: " + std::to_string(c.column_bits) + " column and " +
+                                     std::to_string(c.row_bits) +
+                                     " row bits resolved (need >= " + std::to_string(options.min_bits) + "; " +
+                                     std::to_string(c.lit_pixels) + " camera pixels lit)");
+        }
+        const ProjectorFit fit = fit_projector(edge.camera, prior, static_cast<int>(k), c.camera, c.projector, options);
+        pr.rms_px = fit.rms_px;
+        pr.mean_view_angle_deg = fit.mean_view_angle_deg;
+        result.projectors.push_back(fit.model);
+        result.report.projectors.push_back(pr);
+    }
+    result.calibration.content = content;
+    for (std::size_t k = 0; k < n; ++k) {
+        result.calibration.projectors.push_back(build_projector(result.projectors, k, prior.screen, options));
+    }
+    validate_screen(result.calibration);
+    return result;
+}
+
+}  // namespace mogao::autocal

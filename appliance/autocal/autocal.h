@@ -1,0 +1,150 @@
+// SPDX-License-Identifier: Apache-2.0
+// Camera-based geometric calibration of projectors on a cylindrical screen (issue 13; seed paper
+// II.B): Gray-code structured light per projector, the camera's pose from the screen's lit edges,
+// a pinhole model per projector fitted to the correspondences, and from it a piecewise-linear warp
+// (grid step = knob), smooth blend masks from the measured coverage and a response curve: the
+// ScreenCalibration (common/projector_calibration.h) the compositor and the kiosk use.
+// Pure maths on camera images: no GL, no hardware. A PatternSource shows images and returns what
+// the camera saw (the virtual rig in tests, real projectors and a camera later).
+//
+// Frames, units and pixel conventions are the virtual rig's (appliance/rig/virtual_rig.h):
+// screen frame in metres (+y up the cylinder axis, -z to the middle of the arc), screen points
+// (theta, h), content u = (theta + arc/2) / arc, v = (top - h) / (top - bottom); image positions
+// with pixel (x, y)'s centre at (x + 0.5, y + 0.5); devices in OpenCV's camera frame (x right,
+// y down, z forward); camera distortion in OpenCV's Brown-Conrady model.
+//
+// Method (docs/calibration.md, "Camera-based calibration"):
+//  1. Gray code (Gray 1953, reflected binary; as in Inokuchi, Sato, Matsuda 1984) per projector and
+//     axis, each pattern followed by its inverse; a pixel's bit is the sign of pattern - inverse
+//     (per-pixel threshold), a pixel counts where white - black exceeds `min_contrast` (shadow
+//     mask); bits are captured from the coarsest down and stop at the first one the camera cannot
+//     resolve (fewer than `min_bit_fraction` of the pixels with |pattern - inverse| > half the
+//     contrast). Decoded blocks of projector pixels (cells) whose camera pixels form a complete
+//     neighbourhood give one correspondence each: the centroid of their camera pixels <-> the cell
+//     centre.
+//  2. Camera pose: the lit region of all projectors at full white ends at the screen's edges
+//     (projectors overfill them). Edge points are located to sub-pixel as the crossing of the local
+//     half level; Gauss-Newton on the camera's 6 pose parameters minimises the distance, on the
+//     screen, of each edge point's ray from the edge it belongs to (h = top/bottom, theta = +-arc/2),
+//     from the prior pose, with a weak pull to the prior (the ends fix the yaw about the axis).
+//  3. Projector: camera ray of each correspondence -> cylinder -> 3D point; cv::calibrateCamera
+//     (Zhang 2000 with Levenberg-Marquardt; non-planar points, intrinsic guess from the prior, no
+//     distortion, square pixels) fits intrinsics and pose; outliers beyond 4x the median residual
+//     are dropped and the fit repeated.
+//  4. Warp: grid samples at texel centres (warp_sampling.h) -> fitted projector ray -> cylinder
+//     -> content (u, v), left unclamped past the screen's edges (the blend is 0 there).
+//  5. Blend (linear light): w_k = f(d_k) / sum_j f(d_j), d_j = distance in projector j's pixels of
+//     the screen point from j's image border, f = smoothstep(d / ramp); 0 off the screen. Sums to 1
+//     wherever a projector lights the screen, C1-smooth.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "common/projector_calibration.h"
+
+namespace mogao::autocal {
+
+struct ScreenModel {
+    double radius_m = 3.0;
+    double arc_deg = 150.0;
+    double bottom_m = 0.8;
+    double top_m = 2.3;
+};
+
+// A pinhole device: intrinsics (image positions, pixel centre +0.5), distortion (cameras only),
+// pose in the screen frame (rotation device -> screen, position).
+struct DeviceModel {
+    std::string id;
+    ImageSize resolution;
+    double fx_px = 0.0;
+    double fy_px = 0.0;
+    double cx_px = 0.0;
+    double cy_px = 0.0;
+    std::array<double, 5> distortion{};
+    Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+    Eigen::Vector3d position_m = Eigen::Vector3d::Zero();
+};
+
+// What is known before calibrating: the screen's size, the camera's intrinsics and roughly its
+// pose, each projector's resolution and data-sheet intrinsics (its pose is not used).
+struct CalibrationPrior {
+    ScreenModel screen;
+    DeviceModel camera;
+    std::vector<DeviceModel> projectors;
+};
+
+struct AutocalOptions {
+    int warp_step_px = 8;               // warp/blend grid: one sample per this many output pixels, 1..64
+    double blend_ramp = 0.12;           // blend ramp width, fraction of the projector's width, (0, 0.5]
+    double min_contrast = 0.04;         // white - black for a camera pixel to count (shadow mask), (0, 1)
+    double min_bit_fraction = 0.6;      // fraction of pixels a Gray bit must resolve to be used, (0, 1]
+    int min_cells = 150;                // correspondences per projector, below: refused
+    int min_bits = 4;                   // resolved Gray bits per axis, below: decoding failed
+    double max_edge_rms_m = 0.01;       // camera pose fit gate
+    double max_projector_rms_px = 3.0;  // projector fit gate (cell-quantised correspondences)
+    double max_view_angle_deg = 75.0;   // camera rays steeper than this to the screen normal: grazing
+};
+
+// Shows one signal image per projector (CV_32FC1 in [0, 1], projector resolution; empty = black)
+// and returns the camera image (CV_32FC1, [0, 1]).
+class PatternSource {
+public:
+    virtual ~PatternSource() = default;
+    [[nodiscard]] virtual cv::Mat1f show(const std::vector<cv::Mat>& signals) = 0;
+};
+
+// The calibration cannot give a good result; the message says why (which projector, which gate,
+// the measured value and its limit). The caller keeps its last good calibration.
+class CalibrationRefused : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+struct ProjectorReport {
+    std::string id;
+    int column_bits = 0;
+    int row_bits = 0;
+    int cells = 0;        // correspondences used
+    double rms_px = 0.0;  // projector fit residual, projector pixels
+    double mean_view_angle_deg = 0.0;
+};
+
+struct AutocalReport {
+    int edge_points = 0;
+    double edge_rms_m = 0.0;
+    Eigen::Vector3d camera_position_m = Eigen::Vector3d::Zero();
+    int captures = 0;
+    std::vector<ProjectorReport> projectors;
+};
+
+struct AutocalResult {
+    ScreenCalibration calibration;
+    DeviceModel camera;                   // fitted pose
+    std::vector<DeviceModel> projectors;  // fitted models
+    AutocalReport report;
+};
+
+// Gray code pattern: bit `bit` (0 = most significant of gray_code_bits(extent)) of the reflected
+// binary code of the column (rows = false) or row index; 1 = white. Inverted flips it.
+[[nodiscard]] int gray_code_bits(int extent);
+[[nodiscard]] cv::Mat1f gray_code_pattern(ImageSize size, bool rows, int bit, bool inverted);
+
+// Content frame size the calibration's warps address (the farm's frame), 1..16384 per side.
+// Runs the whole method above. Throws CalibrationRefused (see the gates in AutocalOptions) or
+// std::invalid_argument for a malformed prior/options.
+[[nodiscard]] AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, ImageSize content,
+                                      const AutocalOptions& options = {});
+
+// Screen point where a pinhole projector's image position (x, y) lands, as content (u, v)
+// (unclamped), or nullopt-like NaN when the ray misses the cylinder.
+[[nodiscard]] Eigen::Vector2d projector_content(const DeviceModel& projector, const ScreenModel& screen, double x,
+                                                double y);
+
+}  // namespace mogao::autocal

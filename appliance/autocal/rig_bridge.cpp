@@ -1,0 +1,152 @@
+// SPDX-License-Identifier: Apache-2.0
+// The virtual rig as calibration input, and accuracy against its ground truth (rig_bridge.h).
+#include "appliance/autocal/rig_bridge.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <Eigen/Geometry>
+
+#include "appliance/warp/response_curve.h"
+#include "appliance/warp/warp_sampling.h"
+
+namespace mogao::autocal {
+
+namespace {
+
+void scale_device(ImageSize& size, rig::RigIntrinsics& in, double s) {
+    const ImageSize old = size;
+    size = {std::max(16, static_cast<int>(std::lround(old.width * s))),
+            std::max(16, static_cast<int>(std::lround(old.height * s)))};
+    const double sx = static_cast<double>(size.width) / old.width;
+    const double sy = static_cast<double>(size.height) / old.height;
+    in.fx_px *= sx;
+    in.fy_px *= sy;
+    in.cx_px *= sx;
+    in.cy_px *= sy;
+}
+
+}  // namespace
+
+rig::VirtualRig scaled_rig(const rig::VirtualRig& rig, double projector_scale, double camera_scale) {
+    if (!(projector_scale > 0.0 && projector_scale <= 1.0 && camera_scale > 0.0 && camera_scale <= 1.0)) {
+        throw std::invalid_argument("scaled_rig: scales must be in (0, 1]");
+    }
+    rig::VirtualRig out = rig;
+    for (rig::RigProjector& p : out.projectors) scale_device(p.resolution, p.intrinsics, projector_scale);
+    scale_device(out.camera.resolution, out.camera.intrinsics, camera_scale);
+    out.camera.blur_sigma_px *= camera_scale;
+    return out;
+}
+
+CalibrationPrior prior_from_rig(const rig::VirtualRig& rig) {
+    CalibrationPrior prior;
+    prior.screen = {rig.screen.radius_m, rig.screen.arc_deg, rig.screen.bottom_m, rig.screen.top_m};
+    const rig::RigCamera& c = rig.camera;
+    const rig::RigPrior& e = rig.prior;
+    rig::RigPose pose = c.pose;
+    pose.position_m += e.camera_position_error_m;
+    pose.yaw_deg += e.camera_angle_error_deg.x();
+    pose.pitch_deg += e.camera_angle_error_deg.y();
+    pose.roll_deg += e.camera_angle_error_deg.z();
+    const double cf = 1.0 + e.camera_focal_error;
+    prior.camera = {"camera",           c.resolution,       c.intrinsics.fx_px * cf, c.intrinsics.fy_px * cf,
+                    c.intrinsics.cx_px, c.intrinsics.cy_px, c.intrinsics.distortion, rig::device_to_screen(pose),
+                    pose.position_m};
+    const double pf = 1.0 + e.projector_focal_error;
+    for (const rig::RigProjector& p : rig.projectors) {
+        prior.projectors.push_back({p.id,
+                                    p.resolution,
+                                    p.intrinsics.fx_px * pf,
+                                    p.intrinsics.fy_px * pf,
+                                    p.intrinsics.cx_px,
+                                    p.intrinsics.cy_px,
+                                    {},
+                                    Eigen::Matrix3d::Identity(),
+                                    Eigen::Vector3d::Zero()});
+    }
+    return prior;
+}
+
+GeometryError measure_geometry(const rig::VirtualRig& rig, const ScreenCalibration& calibration, int step) {
+    std::vector<double> errors;
+    GeometryError out;
+    for (std::size_t k = 0; k < calibration.projectors.size(); ++k) {
+        const ProjectorCalibration& pc = calibration.projectors[k];
+        for (int y = 0; y < pc.output.height; y += step) {
+            for (int x = 0; x < pc.output.width; x += step) {
+                const auto truth = rig::projector_to_screen(rig, static_cast<int>(k), x + 0.5, y + 0.5);
+                if (!truth) continue;
+                const float w = sample_blend(pc.blend, pc.output, x, y);
+                const ContentUv uv = sample_warp(pc.warp, pc.output, x, y);
+                ++out.samples;
+                if (w <= 0.0f || !std::isfinite(uv.u)) {
+                    ++out.missing;
+                    continue;
+                }
+                const auto belongs =
+                    rig::screen_to_projector(rig, static_cast<int>(k), rig::screen_of(rig.screen, {uv.u, uv.v}));
+                if (!belongs) {
+                    ++out.outside;  // its content belongs beyond this projector's image (edge pixels)
+                    continue;
+                }
+                errors.push_back(std::hypot(belongs->x() - (x + 0.5), belongs->y() - (y + 0.5)));
+            }
+        }
+    }
+    if (errors.empty()) return out;
+    std::sort(errors.begin(), errors.end());
+    double sum = 0.0;
+    for (double e : errors) sum += e;
+    out.mean_px = sum / static_cast<double>(errors.size());
+    out.p95_px =
+        errors[std::min(errors.size() - 1, static_cast<std::size_t>(0.95 * static_cast<double>(errors.size())))];
+    out.max_px = errors.back();
+    return out;
+}
+
+LuminanceError measure_luminance(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double inset) {
+    std::vector<double> lum;
+    std::vector<bool> seam;
+    constexpr int kSteps = 400;
+    for (int j = 0; j <= kSteps / 4; ++j) {
+        for (int i = 0; i <= kSteps; ++i) {
+            const Eigen::Vector2d uv(inset + (1.0 - 2.0 * inset) * i / kSteps,
+                                     inset + (1.0 - 2.0 * inset) * j / (kSteps / 4));
+            const rig::ScreenPoint s = rig::screen_of(rig.screen, uv);
+            double l = 0.0;
+            int lit = 0;
+            for (std::size_t k = 0; k < calibration.projectors.size(); ++k) {
+                const auto p = rig::screen_to_projector(rig, static_cast<int>(k), s);
+                if (!p) continue;
+                const ProjectorCalibration& pc = calibration.projectors[k];
+                const int x = std::clamp(static_cast<int>(std::floor(p->x())), 0, pc.output.width - 1);
+                const int y = std::clamp(static_cast<int>(std::floor(p->y())), 0, pc.output.height - 1);
+                const float w = sample_blend(pc.blend, pc.output, x, y);
+                if (w > 0.0f) ++lit;
+                const rig::RigProjector& rp = rig.projectors[k];
+                for (int c = 0; c < 3; ++c) {
+                    const double signal = apply_response(pc.response, c, w);
+                    l += rp.brightness[static_cast<std::size_t>(c)] *
+                         std::pow(signal, rp.gamma[static_cast<std::size_t>(c)]) / 3.0;
+                }
+            }
+            lum.push_back(l);
+            seam.push_back(lit >= 2);
+        }
+    }
+    LuminanceError out;
+    out.samples = static_cast<int>(lum.size());
+    std::vector<double> sorted = lum;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
+    const double median = sorted[sorted.size() / 2];
+    for (std::size_t i = 0; i < lum.size(); ++i) {
+        const double d = std::abs(lum[i] / median - 1.0);
+        out.max_deviation = std::max(out.max_deviation, d);
+        if (seam[i]) out.seam_max_deviation = std::max(out.seam_max_deviation, d);
+    }
+    return out;
+}
+
+}  // namespace mogao::autocal

@@ -1,0 +1,66 @@
+// SPDX-License-Identifier: Apache-2.0
+// The virtual rig as the calibration's input, and the calibration measured against the rig's
+// ground truth (never against the calibration's own prediction): docs/calibration.md.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "appliance/autocal/autocal.h"
+#include "appliance/rig/virtual_rig.h"
+
+namespace mogao::autocal {
+
+// Shows patterns on the virtual rig and returns its camera image (a new noise seed per image).
+class RigPatternSource : public PatternSource {
+public:
+    explicit RigPatternSource(const rig::VirtualRig& rig) : sim_(rig) {}
+    [[nodiscard]] cv::Mat1f show(const std::vector<cv::Mat>& signals) override {
+        return sim_.capture(signals, frame_++);
+    }
+    [[nodiscard]] const rig::CameraSimulator& simulator() const { return sim_; }
+
+private:
+    rig::CameraSimulator sim_;
+    std::uint64_t frame_ = 0;
+};
+
+// The rig at reduced resolution: projector and camera sizes and intrinsics scaled (errors in
+// projector pixels then scale with `projector_scale`). Scales in (0, 1].
+[[nodiscard]] rig::VirtualRig scaled_rig(const rig::VirtualRig& rig, double projector_scale, double camera_scale);
+
+// What the calibration is told about a rig: screen, camera intrinsics (focal error applied) and
+// pose (position and angle errors applied), projector resolutions, data-sheet intrinsics (focal
+// error applied) and ids; the rig's [prior] section holds the errors.
+[[nodiscard]] CalibrationPrior prior_from_rig(const rig::VirtualRig& rig);
+
+struct GeometryError {
+    int samples = 0;       // projector pixels that land on the screen and were measured
+    int missing = 0;       // of those, pixels the calibration shows nothing on (NaN warp or blend 0)
+    int outside = 0;       // of those, pixels showing content that belongs beyond this projector's image
+    double mean_px = 0.0;  // distance in projector pixels between where the pixel lands and where its content belongs
+    double p95_px = 0.0;
+    double max_px = 0.0;
+};
+
+// Every `step`-th projector pixel (centres at +0.5): ground truth screen point of the pixel vs the
+// screen point of the content the calibration shows there (sample_warp), as the distance in the
+// same projector's pixels (ground-truth projection of the belonging point). Pixels with blend 0
+// are not shown and not measured, except as `missing` when they land inside the screen by more
+// than `margin_px` projector pixels of border distance.
+[[nodiscard]] GeometryError measure_geometry(const rig::VirtualRig& rig, const ScreenCalibration& calibration,
+                                             int step);
+
+struct LuminanceError {
+    int samples = 0;
+    double max_deviation = 0.0;       // max |L / median - 1| over the screen (white content)
+    double seam_max_deviation = 0.0;  // the same over points lit by two or more projectors
+};
+
+// White content through the calibration onto the rig (ground truth projections, the rig's
+// responses and brightness, black level left out: black-level compensation is a later step), on
+// a grid of content points inset by `inset` of the frame on every side.
+[[nodiscard]] LuminanceError measure_luminance(const rig::VirtualRig& rig, const ScreenCalibration& calibration,
+                                               double inset = 0.01);
+
+}  // namespace mogao::autocal

@@ -1,0 +1,328 @@
+// SPDX-License-Identifier: Apache-2.0
+// Camera pose from the screen's lit edges and projector models from correspondences (autocal.h).
+#include "appliance/autocal/screen_geometry.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include <Eigen/Dense>
+#include <Eigen/Geometry>
+#include <opencv2/calib3d.hpp>
+
+namespace mogao::autocal {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+std::string fmt(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.4g", v);
+    return buf;
+}
+
+struct EdgePoint {
+    cv::Point2d image;
+    bool vertical_scan = false;  // found scanning a column: top or bottom edge
+};
+
+// Sub-pixel crossings of the local half level where the lit mask changes, along columns and rows.
+std::vector<EdgePoint> find_edges(const cv::Mat1f& lit) {
+    std::vector<float> values(lit.begin(), lit.end());
+    std::nth_element(values.begin(), values.begin() + static_cast<long>(values.size() * 9 / 10), values.end());
+    const float level = 0.5f * values[values.size() * 9 / 10];
+    std::vector<EdgePoint> out;
+    constexpr int kReach = 3;
+    const auto scan = [&](int n, int len, bool vertical) {
+        for (int i = 0; i < n; ++i) {
+            const auto at = [&](int j) { return vertical ? lit(j, i) : lit(i, j); };
+            for (int j = kReach + 1; j < len - kReach; ++j) {
+                const bool a = at(j - 1) > level;
+                const bool b = at(j) > level;
+                if (a == b) continue;
+                const float in = a ? at(j - 1 - kReach + 1) : at(j + kReach - 1);
+                const float out_v = a ? at(j + kReach - 1) : at(j - 1 - kReach + 1);
+                if (in - out_v < level) continue;  // weak edge (a shadow, a dim overlap)
+                const float half = 0.5f * (in + out_v);
+                const float va = at(j - 1);
+                const float vb = at(j);
+                if ((va - half) * (vb - half) > 0.0f) continue;
+                const double t = std::clamp(static_cast<double>((half - va) / (vb - va)), 0.0, 1.0);
+                const double pos = (j - 0.5) + t;
+                out.push_back({vertical ? cv::Point2d(i + 0.5, pos) : cv::Point2d(pos, i + 0.5), vertical});
+            }
+        }
+    };
+    scan(lit.cols, lit.rows, true);
+    scan(lit.rows, lit.cols, false);
+    return out;
+}
+
+Eigen::Matrix3d small_rotation(const Eigen::Vector3d& w) {
+    const double a = w.norm();
+    return a < 1e-15 ? Eigen::Matrix3d::Identity() : Eigen::AngleAxisd(a, w / a).toRotationMatrix();
+}
+
+// Residual of one edge point for pose (R, o): metres on the screen from its edge, or NaN if it
+// belongs to no edge within `gate`.
+double edge_residual(const ScreenModel& s, const Eigen::Matrix3d& r, const Eigen::Vector3d& o,
+                     const Eigen::Vector3d& ray_cam, bool vertical, double gate) {
+    const auto hit = cylinder_hit(s, o, r * ray_cam);
+    if (!hit) return std::nan("");
+    const double theta = std::atan2(hit->x(), -hit->z());
+    const double half = s.arc_deg * kDeg / 2.0;
+    if (vertical) {
+        if (std::abs(theta) > half) return std::nan("");
+        const double e =
+            std::abs(hit->y() - s.top_m) < std::abs(hit->y() - s.bottom_m) ? hit->y() - s.top_m : hit->y() - s.bottom_m;
+        return std::abs(e) < gate ? e : std::nan("");
+    }
+    if (hit->y() < s.bottom_m || hit->y() > s.top_m) return std::nan("");
+    const double e = s.radius_m * (theta > 0.0 ? theta - half : theta + half);
+    return std::abs(e) < gate ? e : std::nan("");
+}
+
+template <typename Project>
+void refine_projector(const std::vector<cv::Point3f>& world, const std::vector<cv::Point2f>& proj,
+                      Eigen::Matrix<double, 9, 1>& q, const Project& project) {
+    const auto residuals = [&](const Eigen::Matrix<double, 9, 1>& v) {
+        std::vector<cv::Point2f> back;
+        project(v, back);
+        Eigen::VectorXd r(2 * static_cast<Eigen::Index>(world.size()));
+        for (std::size_t i = 0; i < world.size(); ++i) {
+            r[2 * static_cast<Eigen::Index>(i)] = back[i].x - proj[i].x;
+            r[2 * static_cast<Eigen::Index>(i) + 1] = back[i].y - proj[i].y;
+        }
+        return r;
+    };
+    double lambda = 1e-3;
+    Eigen::VectorXd r = residuals(q);
+    for (int iter = 0; iter < 30; ++iter) {
+        Eigen::MatrixXd j(r.size(), 9);
+        for (int c = 0; c < 9; ++c) {
+            Eigen::Matrix<double, 9, 1> v = q;
+            const double h = c < 3 ? 1e-3 : 1e-7;
+            v[c] += h;
+            j.col(c) = (residuals(v) - r) / h;
+        }
+        const Eigen::MatrixXd jtj = j.transpose() * j;
+        const Eigen::VectorXd jtr = j.transpose() * r;
+        Eigen::MatrixXd a = jtj;
+        a.diagonal() *= 1.0 + lambda;
+        const Eigen::Matrix<double, 9, 1> next = q - a.ldlt().solve(jtr);
+        const Eigen::VectorXd rn = residuals(next);
+        if (rn.squaredNorm() < r.squaredNorm()) {
+            const bool done = r.squaredNorm() - rn.squaredNorm() < 1e-12 * r.squaredNorm();
+            q = next;
+            r = rn;
+            lambda = std::max(lambda / 10.0, 1e-12);
+            if (done) break;
+        } else {
+            lambda *= 10.0;
+        }
+    }
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> camera_rays(const DeviceModel& camera, const std::vector<cv::Point2d>& image) {
+    std::vector<cv::Point2d> distorted(image.size());
+    for (std::size_t i = 0; i < image.size(); ++i) {
+        distorted[i] = {(image[i].x - camera.cx_px) / camera.fx_px, (image[i].y - camera.cy_px) / camera.fy_px};
+    }
+    std::vector<cv::Point2d> ideal(image.size());
+    if (!image.empty()) {
+        cv::undistortPoints(distorted, ideal, cv::Matx33d::eye(), camera.distortion, cv::noArray(), cv::noArray(),
+                            cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100, 1e-14));
+    }
+    std::vector<Eigen::Vector3d> rays(image.size());
+    for (std::size_t i = 0; i < image.size(); ++i) rays[i] = Eigen::Vector3d(ideal[i].x, ideal[i].y, 1.0);
+    return rays;
+}
+
+std::optional<Eigen::Vector3d> cylinder_hit(const ScreenModel& screen, const Eigen::Vector3d& o,
+                                            const Eigen::Vector3d& d) {
+    const double a = d.x() * d.x() + d.z() * d.z();
+    if (a < 1e-18) return std::nullopt;
+    const double b = 2.0 * (o.x() * d.x() + o.z() * d.z());
+    const double c = o.x() * o.x() + o.z() * o.z() - screen.radius_m * screen.radius_m;
+    const double disc = b * b - 4.0 * a * c;
+    if (disc < 0.0) return std::nullopt;
+    const double t = (-b + std::sqrt(disc)) / (2.0 * a);
+    if (t <= 0.0) return std::nullopt;
+    return o + t * d;
+}
+
+EdgeFit fit_camera_pose(const cv::Mat1f& lit, const CalibrationPrior& prior, const AutocalOptions& options) {
+    const std::vector<EdgePoint> edges = find_edges(lit);
+    std::vector<cv::Point2d> image;
+    for (const EdgePoint& e : edges) image.push_back(e.image);
+    const std::vector<Eigen::Vector3d> rays = camera_rays(prior.camera, image);
+    const Eigen::Matrix3d r0 = prior.camera.rotation;
+    const Eigen::Vector3d o0 = prior.camera.position_m;
+    Eigen::Matrix<double, 6, 1> p = Eigen::Matrix<double, 6, 1>::Zero();  // position offset, rotation vector
+    const auto pose = [&](const Eigen::Matrix<double, 6, 1>& q) {
+        return std::make_pair(Eigen::Matrix3d(small_rotation(q.tail<3>()) * r0), Eigen::Vector3d(o0 + q.head<3>()));
+    };
+    constexpr double kPrior = 1e-3;  // weak pull to the prior pose (m and rad)
+    EdgeFit fit;
+    for (int iter = 0; iter < 25; ++iter) {
+        const double gate = std::max(0.02, 0.3 * std::pow(0.75, iter));
+        const auto [r, o] = pose(p);
+        std::vector<int> used;
+        std::vector<double> res;
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            const double e = edge_residual(prior.screen, r, o, rays[i], edges[i].vertical_scan, gate);
+            if (std::isfinite(e)) {
+                used.push_back(static_cast<int>(i));
+                res.push_back(e);
+            }
+        }
+        Eigen::Matrix<double, 6, 6> jtj = kPrior * kPrior * Eigen::Matrix<double, 6, 6>::Identity();
+        Eigen::Matrix<double, 6, 1> jtr = kPrior * kPrior * p;
+        constexpr double kStep = 1e-6;
+        for (std::size_t u = 0; u < used.size(); ++u) {
+            const int i = used[u];
+            Eigen::Matrix<double, 6, 1> row;
+            for (int j = 0; j < 6; ++j) {
+                Eigen::Matrix<double, 6, 1> q = p;
+                q[j] += kStep;
+                const auto [rq, oq] = pose(q);
+                const double e = edge_residual(prior.screen, rq, oq, rays[static_cast<std::size_t>(i)],
+                                               edges[static_cast<std::size_t>(i)].vertical_scan, 1e9);
+                row[j] = (e - res[u]) / kStep;
+            }
+            if (!row.allFinite()) continue;
+            jtj += row * row.transpose();
+            jtr += row * res[u];
+        }
+        p -= jtj.ldlt().solve(jtr);
+        double ss = 0.0;
+        int sides = 0;
+        for (std::size_t u = 0; u < used.size(); ++u) {
+            ss += res[u] * res[u];
+            sides += edges[static_cast<std::size_t>(used[u])].vertical_scan ? 0 : 1;
+        }
+        fit.points = static_cast<int>(used.size());
+        fit.side_points = sides;
+        fit.rms_m = used.empty() ? 0.0 : std::sqrt(ss / static_cast<double>(used.size()));
+    }
+    const auto [r, o] = pose(p);
+    fit.camera = prior.camera;
+    fit.camera.rotation = r;
+    fit.camera.position_m = o;
+    if (fit.points < 200) {
+        throw CalibrationRefused(
+            "camera pose: only " + std::to_string(fit.points) +
+            " points on the screen's lit edges (need >= 200): the camera does not see the screen's top and "
+            "bottom edges lit (projectors must overfill them)");
+    }
+    if (fit.side_points < 20) {
+        throw CalibrationRefused(
+            "camera pose: only " + std::to_string(fit.side_points) +
+            " points on the arc's ends (need >= 20): the ends of the screen are not lit or not seen");
+    }
+    if (fit.rms_m > options.max_edge_rms_m) {
+        throw CalibrationRefused("camera pose: edge fit rms " + fmt(fit.rms_m * 1000.0) + " mm above its gate " +
+                                 fmt(options.max_edge_rms_m * 1000.0) +
+                                 " mm (wrong screen size or camera intrinsics?)");
+    }
+    return fit;
+}
+
+ProjectorFit fit_projector(const DeviceModel& camera, const CalibrationPrior& prior, int k,
+                           const std::vector<cv::Point2d>& camera_points,
+                           const std::vector<cv::Point2d>& projector_points, const AutocalOptions& options) {
+    const DeviceModel& guess = prior.projectors.at(static_cast<std::size_t>(k));
+    const std::string who = "projector " + std::to_string(k) + " '" + guess.id + "'";
+    const std::vector<Eigen::Vector3d> rays = camera_rays(camera, camera_points);
+    std::vector<cv::Point3f> world;
+    std::vector<cv::Point2f> proj;
+    double angle_sum = 0.0;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        const Eigen::Vector3d d = (camera.rotation * rays[i]).normalized();
+        const auto hit = cylinder_hit(prior.screen, camera.position_m, d);
+        if (!hit) continue;
+        const Eigen::Vector3d normal = Eigen::Vector3d(-hit->x(), 0.0, -hit->z()).normalized();
+        angle_sum += std::acos(std::clamp(-d.dot(normal), -1.0, 1.0)) / kDeg;
+        world.emplace_back(static_cast<float>(hit->x()), static_cast<float>(hit->y()), static_cast<float>(hit->z()));
+        // OpenCV puts pixel centres at integers.
+        proj.emplace_back(static_cast<float>(projector_points[i].x - 0.5),
+                          static_cast<float>(projector_points[i].y - 0.5));
+    }
+    ProjectorFit fit;
+    fit.mean_view_angle_deg = world.empty() ? 90.0 : angle_sum / static_cast<double>(world.size());
+    if (static_cast<int>(world.size()) < options.min_cells) {
+        throw CalibrationRefused(who + ": the camera sees too little of it: " + std::to_string(world.size()) +
+                                 " decoded cells (need >= " + std::to_string(options.min_cells) + ")");
+    }
+    if (fit.mean_view_angle_deg > options.max_view_angle_deg) {
+        throw CalibrationRefused(who + ": the camera views its part of the screen at a grazing angle: mean " +
+                                 fmt(fit.mean_view_angle_deg) + " deg from the normal (limit " +
+                                 fmt(options.max_view_angle_deg) + " deg)");
+    }
+    // Pose from the data-sheet intrinsics (SQPnP), then Levenberg-Marquardt on focal length,
+    // principal point and pose together, twice, dropping residuals beyond 4x the median.
+    Eigen::Matrix<double, 9, 1> q;
+    {
+        cv::Vec3d rv;
+        cv::Vec3d tv;
+        const cv::Matx33d k0(guess.fx_px, 0, guess.cx_px - 0.5, 0, guess.fy_px, guess.cy_px - 0.5, 0, 0, 1);
+        cv::solvePnP(world, proj, k0, cv::noArray(), rv, tv, false, cv::SOLVEPNP_SQPNP);
+        q << guess.fx_px, guess.cx_px - 0.5, guess.cy_px - 0.5, rv[0], rv[1], rv[2], tv[0], tv[1], tv[2];
+    }
+    const double aspect = guess.fy_px / guess.fx_px;
+    const auto project = [&](const Eigen::Matrix<double, 9, 1>& v, std::vector<cv::Point2f>& out) {
+        const cv::Matx33d km(v[0], 0, v[1], 0, v[0] * aspect, v[2], 0, 0, 1);
+        cv::projectPoints(world, cv::Vec3d(v[3], v[4], v[5]), cv::Vec3d(v[6], v[7], v[8]), km, cv::noArray(), out);
+    };
+    for (int round = 0; round < 2; ++round) {
+        refine_projector(world, proj, q, project);
+        std::vector<cv::Point2f> back;
+        project(q, back);
+        std::vector<double> err(world.size());
+        for (std::size_t i = 0; i < world.size(); ++i) err[i] = cv::norm(back[i] - proj[i]);
+        std::vector<double> sorted = err;
+        std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
+        const double limit = 4.0 * std::max(sorted[sorted.size() / 2], 0.25);
+        double ss = 0.0;
+        std::vector<cv::Point3f> w2;
+        std::vector<cv::Point2f> p2;
+        for (std::size_t i = 0; i < world.size(); ++i) {
+            ss += err[i] * err[i];
+            if (err[i] <= limit) {
+                w2.push_back(world[i]);
+                p2.push_back(proj[i]);
+            }
+        }
+        fit.rms_px = std::sqrt(ss / static_cast<double>(world.size()));
+        fit.points = static_cast<int>(world.size());
+        world = std::move(w2);
+        proj = std::move(p2);
+    }
+    const cv::Matx33d kmat(q[0], 0, q[1], 0, q[0] * aspect, q[2], 0, 0, 1);
+    std::vector<cv::Mat> rvecs{cv::Mat(cv::Vec3d(q[3], q[4], q[5]))};
+    std::vector<cv::Mat> tvecs{cv::Mat(cv::Vec3d(q[6], q[7], q[8]))};
+    if (fit.rms_px > options.max_projector_rms_px) {
+        throw CalibrationRefused(who + ": fit rms " + fmt(fit.rms_px) + " px above its gate " +
+                                 fmt(options.max_projector_rms_px) +
+                                 " px (decoding errors, or the screen is not the cylinder in the prior)");
+    }
+    cv::Matx33d rm;
+    cv::Rodrigues(rvecs[0], rm);
+    Eigen::Matrix3d r_cs;  // screen -> device
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) r_cs(i, j) = rm(i, j);
+    const Eigen::Vector3d t(tvecs[0].at<double>(0), tvecs[0].at<double>(1), tvecs[0].at<double>(2));
+    fit.model = guess;
+    fit.model.fx_px = kmat(0, 0);
+    fit.model.fy_px = kmat(1, 1);
+    fit.model.cx_px = kmat(0, 2) + 0.5;
+    fit.model.cy_px = kmat(1, 2) + 0.5;
+    fit.model.rotation = r_cs.transpose();
+    fit.model.position_m = -r_cs.transpose() * t;
+    return fit;
+}
+
+}  // namespace mogao::autocal

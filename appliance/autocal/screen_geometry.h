@@ -1,0 +1,49 @@
+// SPDX-License-Identifier: Apache-2.0
+// Geometry of the calibration (autocal.h): camera rays, the cylinder, the camera pose from the
+// screen's lit edges (step 2) and the projector fit (step 3).
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "appliance/autocal/autocal.h"
+
+namespace mogao::autocal {
+
+// Unit-free ray directions in the screen frame through camera image positions (undistorted).
+[[nodiscard]] std::vector<Eigen::Vector3d> camera_rays(const DeviceModel& camera,
+                                                       const std::vector<cv::Point2d>& image);
+
+// Forward intersection of o + t d with the cylinder, o inside; nullopt when the ray is vertical.
+[[nodiscard]] std::optional<Eigen::Vector3d> cylinder_hit(const ScreenModel& screen, const Eigen::Vector3d& o,
+                                                          const Eigen::Vector3d& d);
+
+struct EdgeFit {
+    DeviceModel camera;
+    int points = 0;       // edge points used (inliers)
+    int side_points = 0;  // of which on the arc's ends
+    double rms_m = 0.0;
+};
+
+// Step 2: lit = all projectors white minus all black. Throws CalibrationRefused when the edges are
+// too few or the fit is above its gate.
+[[nodiscard]] EdgeFit fit_camera_pose(const cv::Mat1f& lit, const CalibrationPrior& prior,
+                                      const AutocalOptions& options);
+
+struct ProjectorFit {
+    DeviceModel model;
+    int points = 0;
+    double rms_px = 0.0;
+    double mean_view_angle_deg = 0.0;
+};
+
+// Step 3 for projector k. Throws CalibrationRefused naming the projector.
+[[nodiscard]] ProjectorFit fit_projector(const DeviceModel& camera, const CalibrationPrior& prior, int k,
+                                         const std::vector<cv::Point2d>& camera_points,
+                                         const std::vector<cv::Point2d>& projector_points,
+                                         const AutocalOptions& options);
+
+}  // namespace mogao::autocal
