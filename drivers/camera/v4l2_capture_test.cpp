@@ -18,6 +18,7 @@
 
 #include "common/unique_fd.h"
 #include "drivers/camera/pixel_format.h"
+#include "drivers/camera/v4l2_info.h"
 
 namespace mogao {
 namespace {
@@ -205,6 +206,27 @@ TEST(V4l2CaptureVivid, MissingControlsAreErrorsOnlyWhenRequired) {
     EXPECT_NE(cam.error().message.find("exposure_us = manual 8000: the device has no V4L2_CID_EXPOSURE_ABSOLUTE"),
               std::string::npos)
         << cam.error().message;
+}
+
+// What `mogao-camera info` prints: vivid's formats with sizes, and its gain control with its range.
+TEST(V4l2CaptureVivid, InfoListsFormatsSizesAndControlRanges) {
+    REQUIRE_VIVID(device);
+    auto info = query_v4l2_device(*device);
+    ASSERT_TRUE(info.ok()) << info.error().message;
+    EXPECT_EQ(info->driver, "vivid");
+    bool nv12 = false;
+    for (const V4l2FormatInfo& f : info->formats) {
+        if (f.fourcc == V4L2_PIX_FMT_NV12) nv12 = !f.sizes.empty();
+    }
+    EXPECT_TRUE(nv12) << format_v4l2_info(*info);
+    bool gain = false;
+    for (const V4l2ControlInfo& c : info->controls) {
+        if (c.id == V4L2_CID_GAIN) gain = c.minimum == 0 && c.maximum == 255 && c.type == "int";
+    }
+    EXPECT_TRUE(gain) << format_v4l2_info(*info);
+    bool listed = false;
+    for (const V4l2DeviceInfo& d : list_v4l2_devices()) listed = listed || d.device == *device;
+    EXPECT_TRUE(listed);
 }
 
 TEST(V4l2CaptureVivid, StreamsMjpegWhenOffered) {

@@ -1,0 +1,67 @@
+// SPDX-License-Identifier: Apache-2.0
+// mogao-camera: what the cameras on this machine support, to choose the kiosk's camera keys.
+//   mogao-camera list                          every V4L2 capture node (device, driver, card)
+//   mogao-camera info v4l2:/dev/videoN|/dev/videoN   formats, sizes, frame rates, controls with ranges
+// Exit codes (docs/architecture.md): 0 success, 1 the device could not be queried, 2 bad command line.
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+#include <string>
+
+#include "drivers/camera/camera_source.h"
+#include "drivers/camera/v4l2_info.h"
+
+namespace {
+
+int run_info(const std::string& camera) {
+    std::string device = camera;
+    if (!camera.starts_with("/")) {
+        mogao::CameraSourceSpec spec;
+        std::string why;
+        if (!mogao::parse_camera_source(camera, spec, &why)) {
+            std::cerr << "mogao-camera info: " << why << "\n";
+            return 2;
+        }
+        if (spec.kind != mogao::CameraSourceSpec::Kind::v4l2) {
+            std::cerr << "mogao-camera info: '" << camera
+                      << "': only V4L2 cameras (\"v4l2:/dev/videoN\") can be listed; a replay has no controls, "
+                         "and libcamera's are listed by `cam --list-controls` (libcamera-tools)\n";
+            return 2;
+        }
+        device = spec.device;
+    }
+    auto info = mogao::query_v4l2_device(device);
+    if (!info) {
+        std::cerr << "mogao-camera info: " << info.error().message << "\n";
+        return 1;
+    }
+    std::cout << mogao::format_v4l2_info(*info);
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"mogao-camera: the cameras this machine has and what they support (formats, sizes, rates, controls)"};
+    app.require_subcommand(1);
+    CLI::App* list = app.add_subcommand("list", "every V4L2 capture node: device, driver, card, bus");
+    CLI::App* info =
+        app.add_subcommand("info", "formats, sizes, frame rates and controls (ranges, values) of one camera");
+    std::string camera;
+    info->add_option("camera", camera, "v4l2:/dev/videoN or /dev/videoN")->required();
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e) == 0 ? 0 : 2;  // --help is 0
+    }
+    if (list->parsed()) {
+        const auto devices = mogao::list_v4l2_devices();
+        if (devices.empty()) std::cout << "no V4L2 capture devices in /dev/video*\n";
+        for (const auto& d : devices) {
+            std::cout << "v4l2:" << d.device << "  " << d.driver << "  \"" << d.card << "\"  " << d.bus
+                      << (d.multiplanar ? "  multi-planar" : "") << "\n";
+        }
+        return 0;
+    }
+    return run_info(camera);
+}
