@@ -101,6 +101,10 @@ int main(int argc, char** argv) {
     serve->add_option("--allow", serve_options.link.allowed_appliances, "Only these appliance certificate names (default: any the CA issued)");
     serve->add_option("--crl", serve_options.link.crl_path, "Revocation list (PEM CRL of the farm CA, re-read when it changes; default: --tls-dir/crl.pem if present)");
     serve->add_option("--max-sessions", serve_options.link.max_sessions, "Concurrent appliance sessions")->check(CLI::Range(1, 256));
+    serve
+        ->add_option("--max-sessions-per-appliance", serve_options.link.max_sessions_per_appliance,
+                     "Concurrent sessions of one appliance certificate")
+        ->check(CLI::Range(1, 256));
     serve->add_option("--duration", serve_options.duration_s, "Stop after this many seconds (0 = until SIGTERM)")->check(CLI::Range(0.0, 1e9));
     try {
         app.parse(argc, argv);

@@ -237,6 +237,25 @@ TEST_F(LinkSecurity, RevokedApplianceIsRefusedAndItsOpenSessionEnds) {
     expect_refused_by_revocation(pki.museum1);
 }
 
+TEST_F(LinkSecurity, OneApplianceCannotTakeEverySessionSlot) {
+    const auto& pki = TestPki::get();
+    // Two sessions of museum-1 held open (the renderer is held: their first requests stay pending).
+    const auto hold = renderer_.hold();
+    LinkClient a(test_client_options(server_->endpoint().port, pki.museum1), [](LinkFrame&&) {});
+    LinkClient b(test_client_options(server_->endpoint().port, pki.museum1), [](LinkFrame&&) {});
+    a.submit(test_request());
+    b.submit(test_request());
+    ASSERT_TRUE(wait_until([&] { return server_->stats().sessions_active == 2; }));
+    // A third of the same certificate is refused, by name; another appliance still gets in.
+    const RawOutcome third = raw_session_once(tls_channel(target(), pki.appliance_tls(pki.museum1)));
+    EXPECT_EQ(third.status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << third.status.error_message();
+    EXPECT_NE(third.status.error_message().find("museum-1"), std::string::npos) << third.status.error_message();
+    EXPECT_EQ(server_->stats().sessions_active, 2u);
+    renderer_.release();
+    const RawOutcome other = raw_session_once(tls_channel(target(), pki.appliance_tls(pki.museum2)));
+    EXPECT_TRUE(other.got_frame) << other.status.error_message();
+}
+
 TEST(LinkIpv6Only, Ipv4PeerOnTheDualStackWildcardIsRefused) {
     REQUIRE_IPV6_LOOPBACK();
     SyntheticRenderer renderer;

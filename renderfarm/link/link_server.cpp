@@ -118,6 +118,7 @@ void check_options(const LinkServerOptions& o) {
     range("max_sessions", o.max_sessions, 1, 1024);
     range("max_request_bytes", o.max_request_bytes, 1024, 16 << 20);
     range("tls_refresh_s", o.tls_refresh_s, 1, 86'400);
+    range("max_sessions_per_appliance", o.max_sessions_per_appliance, 1, 1024);
     if (!o.tls_files.empty() && (o.tls_files.ca.empty() || o.tls_files.key.empty())) {
         throw LinkError("LinkServerOptions.tls_files: give the CA, certificate and key paths together");
     }
@@ -175,6 +176,15 @@ grpc::Status LinkServer::Impl::admit(grpc::ServerContext* ctx, std::shared_ptr<S
     {
         const std::lock_guard lock(mutex);
         if (stopping) return grpc::Status(grpc::StatusCode::UNAVAILABLE, "farm is shutting down");
+        const auto same = std::count_if(sessions.begin(), sessions.end(),
+                                        [&](const auto& other) { return other->identity == s->identity; });
+        if (same >= options.max_sessions_per_appliance) {
+            ++totals.sessions_refused;
+            link_log().warn("refused {} from {}: it already has {} sessions", s->identity, s->peer, same);
+            return grpc::Status(
+                grpc::StatusCode::RESOURCE_EXHAUSTED,
+                fmt::format("'{}' already has {} sessions (the most one appliance may hold)", s->identity, same));
+        }
         if (sessions.size() < static_cast<std::size_t>(options.max_sessions)) {
             s->id = next_session_id++;
             sessions.push_back(s);

@@ -58,6 +58,9 @@ struct LinkServerOptions {
     int render_threads = 1;        // renderer calls at once over all sessions, 1..64
     int max_frames_in_flight = 2;  // per session, 1..16
     int max_sessions = 8;          // concurrent appliance sessions; more are refused (RESOURCE_EXHAUSTED)
+    // Concurrent sessions of one certificate (common name), 1..1024: one appliance cannot
+    // take every slot. 2 lets a reconnecting appliance overlap the session it is leaving.
+    int max_sessions_per_appliance = 2;
     int max_request_bytes = 64 * 1024;  // larger messages end that session (RESOURCE_EXHAUSTED)
     // Refuse sessions that arrive over IPv4 (an IPv4-mapped peer on the dual-stack [::] socket)
     // with PERMISSION_DENIED: the link is specified as IPv6 and the appliances' certificates and
