@@ -1,7 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "appliance/tracker/tag_tracker.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -18,10 +22,41 @@ double quad_area(const TagDetection& d) {  // shoelace formula
     return std::abs(a) / 2.0;
 }
 
+template <typename T>
+void check_roi(const char* field, T value, T lo, T hi, bool open_low = false) {
+    if (!(open_low ? value > lo : value >= lo) || !(value <= hi)) {
+        std::ostringstream msg;
+        msg << "RoiSettings." << field << " = " << value << " outside " << (open_low ? "(" : "[") << lo << ", " << hi
+            << "]";
+        throw std::invalid_argument(msg.str());
+    }
+}
+
+void validate(const RoiSettings& r) {
+    check_roi("margin", r.margin, 0.0, 5.0, true);
+    check_roi("min_margin_px", r.min_margin_px, 0.0, 1000.0);
+    check_roi("full_search_every", r.full_search_every, 0, 100000);
+    check_roi("search_decimation", r.search_decimation, 1.0f, 8.0f);
+    check_roi("search_blur_sigma", r.search_blur_sigma, -5.0f, 5.0f);
+}
+
+DetectorSettings search_settings(const TrackerConfig& config) {
+    validate(config.roi);  // here, before the search detector is built from it
+    DetectorSettings s = config.detector;
+    if (config.roi.enabled) {
+        s.decimation = config.roi.search_decimation;
+        s.blur_sigma = config.roi.search_blur_sigma;
+    }
+    return s;
+}
+
 }  // namespace
 
 TagTracker::TagTracker(const TrackerConfig& config)
-    : config_(config), detector_(config.detector), disambiguator_(config.disambiguation) {
+    : config_(config),
+      detector_(config.detector),
+      search_detector_(search_settings(config)),
+      disambiguator_(config.disambiguation) {
     validate(config_.camera);
     if (!(config_.tag_size_m > 0.0 && config_.tag_size_m <= 10.0)) {
         throw std::invalid_argument("TrackerConfig.tag_size_m " + std::to_string(config_.tag_size_m) +
@@ -35,6 +70,52 @@ TagTracker::TagTracker(const TrackerConfig& config)
     if (!(config_.forget_after_s >= 0.0)) throw std::invalid_argument("TrackerConfig.forget_after_s must be >= 0");
 }
 
+const TagDetection* TagTracker::pick(const std::vector<TagDetection>& detections) const {
+    const TagDetection* best = nullptr;
+    for (const auto& d : detections) {
+        if (config_.tag_id >= 0 ? d.id == config_.tag_id : (best == nullptr || quad_area(d) > quad_area(*best)))
+            best = &d;
+    }
+    return best;
+}
+
+std::vector<TagDetection> TagTracker::detect_in_window(const GrayImage& image, std::int64_t timestamp_ns) {
+    // Constant-velocity prediction of the corners (velocity from the last two sightings).
+    const double dt = static_cast<double>(timestamp_ns - last_corners_ns_) * 1e-9;
+    double x0 = image.width, y0 = image.height, x1 = 0.0, y1 = 0.0, side = 0.0;
+    for (std::size_t i = 0; i < 4; ++i) {
+        const Eigen::Vector2d& c = last_corners_[i];
+        const Eigen::Vector2d p = sightings_ >= 2 ? Eigen::Vector2d(c + velocity_px_s_[i] * dt) : c;
+        x0 = std::min({x0, c.x(), p.x()});
+        y0 = std::min({y0, c.y(), p.y()});
+        x1 = std::max({x1, c.x(), p.x()});
+        y1 = std::max({y1, c.y(), p.y()});
+        side = std::max(side, (last_corners_[(i + 1) % 4] - c).norm());
+    }
+    const double grow = std::max(config_.roi.margin * side, config_.roi.min_margin_px);
+    const int left = std::clamp(static_cast<int>(std::floor(x0 - grow)), 0, image.width);
+    const int top = std::clamp(static_cast<int>(std::floor(y0 - grow)), 0, image.height);
+    const int right = std::clamp(static_cast<int>(std::ceil(x1 + grow)), 0, image.width);
+    const int bottom = std::clamp(static_cast<int>(std::ceil(y1 + grow)), 0, image.height);
+    if (right - left < 8 || bottom - top < 8) return {};  // predicted out of the frame
+    window_.width = right - left;
+    window_.height = bottom - top;
+    window_.pixels.resize(static_cast<std::size_t>(window_.width) * static_cast<std::size_t>(window_.height));
+    for (int y = 0; y < window_.height; ++y) {
+        std::memcpy(window_.pixels.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(window_.width),
+                    image.pixels.data() + static_cast<std::size_t>(y + top) * static_cast<std::size_t>(image.width) +
+                        static_cast<std::size_t>(left),
+                    static_cast<std::size_t>(window_.width));
+    }
+    auto found = detector_.detect(window_);
+    const Eigen::Vector2d origin(left, top);  // pixel (i, j) of the window is (i + left, j + top)
+    for (auto& d : found) {
+        for (auto& c : d.corners) c += origin;
+        d.centre += origin;
+    }
+    return found;
+}
+
 TrackedTag TagTracker::track(const CameraFrame& frame) {
     if (frame.image.width != config_.camera.width || frame.image.height != config_.camera.height) {
         throw std::invalid_argument("TagTracker: frame " + std::to_string(frame.image.width) + "x" +
@@ -43,20 +124,55 @@ TrackedTag TagTracker::track(const CameraFrame& frame) {
     }
     TrackedTag out;
     out.timestamp_ns = frame.timestamp_ns;
-    const auto detections = detector_.detect(frame.image);
-    const TagDetection* pick = nullptr;
-    for (const auto& d : detections) {
-        if (config_.tag_id >= 0 ? d.id == config_.tag_id : (pick == nullptr || quad_area(d) > quad_area(*pick)))
-            pick = &d;
+    std::vector<TagDetection> detections;
+    std::optional<TagDetection> chosen;
+    if (config_.roi.enabled && sightings_ > 0) {
+        detections = detect_in_window(frame.image, frame.timestamp_ns);
+        // In the window: the followed tag (its id), so a neighbour does not steal the track.
+        for (const auto& d : detections) {
+            if (d.id == followed_id_) chosen = d;
+        }
+        out.from_window = chosen.has_value();
     }
-    if (pick == nullptr) return out;
+    ++frames_since_search_;
+    const bool cadence = config_.roi.full_search_every > 0 && frames_since_search_ >= config_.roi.full_search_every;
+    if (!config_.roi.enabled || !chosen || cadence) {
+        detections = (config_.roi.enabled ? search_detector_ : detector_).detect(frame.image);
+        ++full_searches_;
+        frames_since_search_ = 0;
+        const TagDetection* p = pick(detections);
+        // A whole-frame result replaces the window's only for another (larger) tag: the window's
+        // corners come from full resolution.
+        if (p != nullptr && (!chosen || (p->id != chosen->id && quad_area(*p) > quad_area(*chosen)))) {
+            chosen = *p;
+            out.from_window = false;
+        }
+    }
+    if (!chosen) {
+        sightings_ = 0;
+        return out;
+    }
     if (seen_ && static_cast<double>(frame.timestamp_ns - last_seen_ns_) > config_.forget_after_s * 1e9)
         disambiguator_.reset();
-    const auto candidates = solve_tag_pose(pick->corners, config_.camera, config_.tag_size_m);
-    if (candidates.empty()) return out;
+    const auto candidates = solve_tag_pose(chosen->corners, config_.camera, config_.tag_size_m);
+    if (candidates.empty()) {
+        sightings_ = 0;
+        return out;
+    }
+    // The prediction's state: velocity only between two consecutive sightings of the same tag.
+    const double dt = static_cast<double>(frame.timestamp_ns - last_corners_ns_) * 1e-9;
+    const bool continues = sightings_ > 0 && chosen->id == followed_id_ && dt > 0.0;
+    for (std::size_t i = 0; i < 4; ++i)
+        velocity_px_s_[i] =
+            continues ? Eigen::Vector2d((chosen->corners[i] - last_corners_[i]) / dt) : Eigen::Vector2d::Zero();
+    sightings_ = continues ? sightings_ + 1 : 1;
+    followed_id_ = chosen->id;
+    last_corners_ = chosen->corners;
+    last_corners_ns_ = frame.timestamp_ns;
+
     out.visible = true;
-    out.id = pick->id;
-    out.detection = *pick;
+    out.id = chosen->id;
+    out.detection = *chosen;
     out.pose = disambiguator_.choose(candidates);
     out.ambiguous = disambiguator_.last_was_ambiguous();
     seen_ = true;

@@ -1,0 +1,46 @@
+// SPDX-License-Identifier: Apache-2.0
+// mogao_tracking_eval: detector and tracker evaluation on image sets with ground truth or an
+// independent reference (docs/tracking.md, "Evaluation"). Not part of the appliance. Each
+// subcommand prints a Markdown table (bench/tracking-eval puts them into docs/tracking.md).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "appliance/tracker/detector_settings.h"
+#include "appliance/tracker/tag_tracker.h"
+
+namespace mogao::eval {
+
+// One detector configuration under test, with the name printed in the tables.
+struct NamedSettings {
+    std::string name;
+    DetectorSettings settings;
+};
+// The configurations every table compares: the defaults, AprilTag's stock (decimation 1, no blur),
+// the old defaults (2, 0.8) and the tracker's whole-frame search (RoiSettings).
+[[nodiscard]] std::vector<NamedSettings> compared_settings();
+
+struct RealOptions {
+    std::filesystem::path truth;  // tags_real_truth.json
+    std::filesystem::path data;   // the tags-real folder
+    int repeat = 3;               // timing: fastest of this many runs per image
+    bool per_image = false;
+};
+int run_real(const RealOptions& options);
+
+struct ReferenceOptions {
+    std::filesystem::path manifest;
+    std::filesystem::path data;
+    std::filesystem::path out;
+};
+int run_reference(const ReferenceOptions& options);
+
+struct RoiOptions {
+    double seconds = 12.0;  // of the hand-held sequence (hand_sequence.h), 30 fps, 800x600
+    int repeat = 3;         // timing: fastest of this many passes per frame
+};
+int run_roi(const RoiOptions& options);
+
+}  // namespace mogao::eval

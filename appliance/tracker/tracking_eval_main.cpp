@@ -1,0 +1,57 @@
+// SPDX-License-Identifier: Apache-2.0
+// mogao_tracking_eval: evaluation of the detector defaults and of region-of-interest tracking
+// (tracking_eval.h). Exit codes: 0, 1 the job failed, 2 bad command line, 77 data absent.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+
+#include "appliance/tracker/tags_real.h"
+#include "appliance/tracker/tracking_eval.h"
+
+int main(int argc, char** argv) {
+    CLI::App app{"mogao_tracking_eval: tag detection and tracking against ground truth"};
+    app.require_subcommand(1);
+    const std::filesystem::path source = MOGAO_SOURCE_DIR;
+    const std::filesystem::path data_default = mogao::tags_real_dir(MOGAO_TAGS_REAL_DIR);
+
+    mogao::eval::RealOptions real{source / "appliance/tracker/tags_real_truth.json", data_default};
+    auto* r = app.add_subcommand("real", "detection rate and corner error on the real photographs, per setting");
+    r->add_option("--truth", real.truth, "truth file")->capture_default_str();
+    r->add_option("--data", real.data, "tags-real folder")->capture_default_str();
+    r->add_option("--repeat", real.repeat, "timing runs per image")->check(CLI::Range(1, 100))->capture_default_str();
+    r->add_flag("--per-image", real.per_image, "per-image lines on stderr");
+
+    mogao::eval::ReferenceOptions ref{source / "appliance/tracker/tags_real_manifest.json", data_default,
+                                      source / "appliance/tracker/tags_real_truth.json"};
+    auto* f = app.add_subcommand("reference", "independent reference corners (ArUco + edge-line fits) -> truth file");
+    f->add_option("--manifest", ref.manifest, "hand-written manifest")->capture_default_str();
+    f->add_option("--data", ref.data, "tags-real folder")->capture_default_str();
+    f->add_option("--out", ref.out, "truth file to write")->capture_default_str();
+
+    mogao::eval::RoiOptions roi;
+    auto* o = app.add_subcommand("roi", "ROI tracking against full-frame detection on the hand-held sequence");
+    o->add_option("--seconds", roi.seconds, "sequence length")->check(CLI::Range(0.5, 60.0))->capture_default_str();
+    o->add_option("--repeat", roi.repeat, "timing passes")->check(CLI::Range(1, 100))->capture_default_str();
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        const int code = app.exit(e);
+        return code == 0 ? 0 : 2;
+    }
+    try {
+        if ((*r && !std::filesystem::exists(real.data)) || (*f && !std::filesystem::exists(ref.data))) {
+            std::fprintf(stderr, "mogao_tracking_eval: real photographs not found at %s (../shared/data/tags-real)\n",
+                         (*r ? real.data : ref.data).c_str());
+            return 77;
+        }
+        if (*r) return mogao::eval::run_real(real);
+        if (*f) return mogao::eval::run_reference(ref);
+        if (*o) return mogao::eval::run_roi(roi);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "mogao_tracking_eval: %s\n", e.what());
+        return 1;
+    }
+    return 2;
+}
