@@ -130,6 +130,12 @@ void Kiosk::on_tick() {
         check_frames_shown();
     }
     shown_since_tick_ = false;
+    if (const auto stuck = parts_.display.overdue_output(now, options_.flip_timeout)) {
+        return fail("output", fmt::format("{}: its page flip has not completed for over {:.1f} s; stopping so that "
+                                          "the service manager restarts the kiosk",
+                                          parts_.display.output_name(*stuck),
+                                          std::chrono::duration<double>(options_.flip_timeout).count()));
+    }
     if (std::chrono::duration<double>(now - last_log_).count() >= config_.stats.log_period_s) {
         spdlog::info("stats: {} link_sessions={} link_connected={}", parts_.display.stats().log_line(),
                      link.sessions_opened, link.connected);

@@ -62,6 +62,10 @@ struct KioskRunOptions {
     double duration_s = 0;            // --duration (0: never)
     std::optional<ContentDump> dump;  // --dump-content
     std::optional<PoseLog> pose_log;  // --pose-log
+    // An output whose page flip has not completed for this long fails the kiosk (exit 1, the
+    // watchdog no longer fed) so that systemd restarts it: a 60 Hz flip takes 17 ms, a mode set
+    // under a second.
+    std::chrono::steady_clock::duration flip_timeout = std::chrono::seconds(3);
 };
 
 class Kiosk {

@@ -47,6 +47,15 @@ Status KioskDisplay::on_flip() {
 }
 
 void KioskDisplay::account() {
+    const auto now = std::chrono::steady_clock::now();
+    busy_since_.resize(backend_->outputs().size());
+    for (std::size_t i = 0; i < busy_since_.size(); ++i) {
+        if (backend_->ready(i)) {
+            busy_since_[i].reset();
+        } else if (!busy_since_[i]) {
+            busy_since_[i] = now;
+        }
+    }
     if (presenter_.last_presents() > 0) {
         stats_.display_round();
         if (recorder_) {
@@ -66,6 +75,18 @@ void KioskDisplay::account() {
         ++frames_on_screen_;
         pending_.erase(pending_.begin(), std::next(it));  // older ones were overtaken on some output
     }
+}
+
+std::optional<std::size_t> KioskDisplay::overdue_output(std::chrono::steady_clock::time_point now,
+                                                        std::chrono::steady_clock::duration timeout) {
+    for (std::size_t i = 0; i < busy_since_.size(); ++i) {
+        if (backend_->ready(i)) {
+            busy_since_[i].reset();
+        } else if (busy_since_[i] && now - *busy_since_[i] > timeout) {
+            return i;
+        }
+    }
+    return std::nullopt;
 }
 
 void KioskDisplay::write_composite() const {

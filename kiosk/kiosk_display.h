@@ -13,6 +13,7 @@
 // backend's event dispatch error is returned (the loop stops on it). Loop thread only (GL context).
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -48,6 +49,13 @@ public:
     // Page-flip events of the backend (KMS): outputs ready again get pending content.
     [[nodiscard]] Status on_flip();
 
+    // The first output whose last present has not completed (KMS: no page-flip event) for longer
+    // than `timeout` at `now`; nullopt when every output is ready or busy for less. A flip that
+    // never completes would otherwise freeze that projector while the loop runs on.
+    [[nodiscard]] std::optional<std::size_t> overdue_output(std::chrono::steady_clock::time_point now,
+                                                            std::chrono::steady_clock::duration timeout);
+    [[nodiscard]] const std::string& output_name(std::size_t i) const { return backend_->outputs().at(i).name; }
+
     // Writes <png dir>/screen-composite.png when recording (logged; a failure is a warning).
     void write_composite() const;
 
@@ -74,6 +82,8 @@ private:
     KioskStats stats_;
     std::map<std::uint64_t, PresentedFrame> pending_;
     std::uint64_t frames_on_screen_ = 0;
+    // Per output: since when it has been not ready (a present in flight), as first seen by account().
+    std::vector<std::optional<std::chrono::steady_clock::time_point>> busy_since_;
 };
 
 }  // namespace mogao

@@ -60,6 +60,32 @@ void wait_readable(int fd) {
     ASSERT_EQ(::poll(&p, 1, -1), 1);
 }
 
+// Stand-in for KMS outputs whose page-flip events stop arriving (a hung display driver, a link
+// lost mid-flip). KMS cannot run on this build machine (no DRM device), so the real headless
+// backend draws and presents, and this wrapper withholds the completion once `withhold` is set.
+class FlipNeverCompletes final : public OutputBackend {
+public:
+    explicit FlipNeverCompletes(std::unique_ptr<OutputBackend> inner)
+        : inner_(std::move(inner)), in_flight_(inner_->outputs().size(), false) {}
+    const std::vector<OutputInfo>& outputs() const override { return inner_->outputs(); }
+    WarpBlendRenderer& renderer() override { return inner_->renderer(); }
+    Status begin_frame(std::size_t i) override { return inner_->begin_frame(i); }
+    Status present(std::size_t i) override {
+        Status s = inner_->present(i);
+        if (s && withhold) in_flight_.at(i) = true;
+        return s;
+    }
+    bool ready(std::size_t i) const override { return !in_flight_.at(i) && inner_->ready(i); }
+    int event_fd() const override { return -1; }
+    Result<std::vector<std::size_t>> dispatch_events() override { return std::vector<std::size_t>{}; }
+
+    bool withhold = false;
+
+private:
+    std::unique_ptr<OutputBackend> inner_;
+    std::vector<bool> in_flight_;
+};
+
 class KioskTest : public ::testing::Test {
 protected:
     void SetUp() override {
@@ -246,6 +272,45 @@ TEST_F(KioskTest, OnSignalStopsTheLoop) {
     k.on_signal();
     EXPECT_TRUE(k.stopping());
     EXPECT_EQ(k.exit_code(), 0);
+}
+
+TEST_F(KioskTest, AnOutputWhoseFlipNeverCompletesStopsTheKioskForARestart) {
+    // The fixture's display is replaced by one whose flips can be made to hang.
+    display_.reset();
+    HeadlessOptions options;
+    for (const auto& p : screen_.projectors) options.outputs.push_back(p.output);
+    auto headless = HeadlessOutputBackend::create(options);
+    ASSERT_TRUE(headless) << headless.error().message;
+    auto wrapper = std::make_unique<FlipNeverCompletes>(std::move(headless).value());
+    FlipNeverCompletes& backend = *wrapper;
+    auto display = KioskDisplay::create(std::move(wrapper), screen_, nullptr);
+    ASSERT_TRUE(display) << display.error().message;
+    display_.emplace(std::move(display).value());
+    KioskRunOptions run;
+    run.flip_timeout = std::chrono::milliseconds(100);
+    Kiosk& k = kiosk(std::move(run));
+
+    // Flips complete: ticks well past the timeout change nothing.
+    const auto start = std::chrono::steady_clock::now();
+    while (std::chrono::steady_clock::now() - start < std::chrono::milliseconds(300)) {
+        wait_readable(k.tick_fd());
+        k.on_tick();
+    }
+    ASSERT_FALSE(k.stopping());
+
+    // From now on no flip completes: the kiosk stops with a failure (systemd restarts it) after
+    // the timeout, not before, and feeds the watchdog no more.
+    backend.withhold = true;
+    inbox_->put(jpeg_frame(1, 150));
+    k.on_frame();
+    const auto hung = std::chrono::steady_clock::now();
+    while (!k.stopping() && std::chrono::steady_clock::now() - hung < std::chrono::seconds(10)) {
+        wait_readable(k.tick_fd());
+        k.on_tick();
+    }
+    EXPECT_TRUE(k.stopping()) << "the kiosk runs on with a frozen output";
+    EXPECT_GE(std::chrono::steady_clock::now() - hung, std::chrono::milliseconds(100));
+    EXPECT_EQ(k.exit_code(), 1);
 }
 
 TEST_F(KioskTest, RunShowsFramesUntilASignalThenWritesTheStatistics) {
