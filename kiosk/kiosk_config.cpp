@@ -292,10 +292,10 @@ Section subsection(const Section& parent, std::string_view key, const std::strin
 
 const std::vector<std::string> kCameraControlKeys{"camera_exposure_us", "camera_gain", "camera_white_balance_k",
                                                   "camera_colour"};
-const std::vector<std::string> kTrackingKeys{"camera",     "camera_size", "camera_fps", "intrinsics",
-                                             "tag_size_m", "tag_id",      "replay_end", "detector",
-                                             "control",    "camera_exposure_us", "camera_gain",
-                                             "camera_white_balance_k", "camera_colour"};
+const std::vector<std::string> kTrackingKeys{
+    "camera",       "camera_size", "camera_fps", "intrinsics",         "tag_size_m",  "tag_id",
+    "replay_end",   "detector",    "control",    "camera_exposure_us", "camera_gain", "camera_white_balance_k",
+    "camera_colour"};
 
 // One camera control key: "auto", "lock", "keep" or a number within `range` (the device's own range
 // is checked when the camera opens; the setting carries the key's name for that message). Written:
@@ -329,13 +329,12 @@ ControlSetting read_control_setting(const Section& s, std::string_view key, Cont
 void read_camera_controls(const Section& s, CameraSourceSpec& source) {
     // A short exposure by default: 8 ms keeps a hand moving at 1 m/s within 8 mm of blur.
     const ControlSetting short_exposure{ControlSetting::Mode::manual, kDefaultExposureUs, false, ""};
-    source.controls.exposure = read_control_setting(s, "camera_exposure_us", short_exposure,
-                                                    [](double x) { return x > 0 && x <= 1e6; }, "(0, 1e6] us");
-    source.controls.gain =
-        read_control_setting(s, "camera_gain", {}, [](double x) { return x >= 0 && x <= 1e6; }, "[0, 1e6]");
-    source.controls.white_balance = read_control_setting(s, "camera_white_balance_k", {},
-                                                         [](double x) { return x >= 1000 && x <= 20000; },
-                                                         "[1000, 20000] K");
+    source.controls.exposure = read_control_setting(
+        s, "camera_exposure_us", short_exposure, [](double x) { return x > 0 && x <= 1e6; }, "(0, 1e6] us");
+    source.controls.gain = read_control_setting(
+        s, "camera_gain", {}, [](double x) { return x >= 0 && x <= 1e6; }, "[0, 1e6]");
+    source.controls.white_balance = read_control_setting(
+        s, "camera_white_balance_k", {}, [](double x) { return x >= 1000 && x <= 20000; }, "[1000, 20000] K");
     source.colour = s.boolean("camera_colour", false);
 }
 
@@ -604,10 +603,11 @@ KioskConfig parse_kiosk_config(std::string_view text, const std::filesystem::pat
     read_quality(quality, config.quality);
     const Section screen = section(ctx, root, "screen", {"radius_m", "arc_deg", "bottom_m", "top_m"});
     read_screen(screen, config.screen);
-    const Section navigation = section(ctx, root, "navigation", {"source", "path", "path_frames", "start", "start_yaw_deg", "eye_height_m", "camera",
-                                                                     "camera_size", "camera_fps", "intrinsics", "tag_size_m", "tag_id",
-                                                                     "replay_end", "detector", "control", "camera_exposure_us",
-                                                                     "camera_gain", "camera_white_balance_k", "camera_colour"});
+    const Section navigation =
+        section(ctx, root, "navigation",
+                {"source", "path", "path_frames", "start", "start_yaw_deg", "eye_height_m", "camera", "camera_size",
+                 "camera_fps", "intrinsics", "tag_size_m", "tag_id", "replay_end", "detector", "control",
+                 "camera_exposure_us", "camera_gain", "camera_white_balance_k", "camera_colour"});
     read_navigation(navigation, config.navigation);
     config.screen.eye_m = Eigen::Vector3d(0.0, config.navigation.eye_height_m, 0.0);
     const Section stats = section(ctx, root, "stats", {"file", "log_period_s"});

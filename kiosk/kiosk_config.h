@@ -96,10 +96,10 @@ inline constexpr double kDefaultExposureUs = 8000.0;
 
 // [navigation] with source = "tracking": camera -> TagTracker -> Navigator (docs/kiosk.md).
 struct TrackingConfig {
-    std::string camera;                 // as written: "replay:<folder>" | "v4l2:/dev/videoN" | "libcamera:[<id>]"
-    CameraSourceSpec source;            // parsed; replay folder resolved against the file's folder; live
-                                        // cameras: controls and colour from camera_exposure_us,
-                                        // camera_gain, camera_white_balance_k, camera_colour
+    std::string camera;                     // as written: "replay:<folder>" | "v4l2:/dev/videoN" | "libcamera:[<id>]"
+    CameraSourceSpec source;                // parsed; replay folder resolved against the file's folder; live
+                                            // cameras: controls and colour from camera_exposure_us,
+                                            // camera_gain, camera_white_balance_k, camera_colour
     std::filesystem::path intrinsics_file;  // [navigation].intrinsics (replay default: <folder>/camera.json)
     CameraIntrinsics intrinsics;            // read; live camera: rescaled to camera_size when that differs
     double tag_size_m = 0.10;           // (0, 10]: side of the tag's black border square

@@ -470,10 +470,10 @@ TEST_F(KioskConfigTest, LiveCameraControlsDefaultToAShortExposureAndAreRequiredW
     EXPECT_FALSE(c.navigation.tracking.source.colour);
     EXPECT_NE(d.exposure.name.find("[navigation].camera_exposure_us"), std::string::npos) << d.exposure.name;
 
-    const KioskConfig set = parse(tracking({R"(navigation.camera="v4l2:/dev/video0")",
-                                            R"(navigation.intrinsics="webcam.json")", "navigation.camera_exposure_us=4000",
-                                            R"(navigation.camera_gain="auto")", R"(navigation.camera_white_balance_k="lock")",
-                                            "navigation.camera_colour=true"}));
+    const KioskConfig set =
+        parse(tracking({R"(navigation.camera="v4l2:/dev/video0")", R"(navigation.intrinsics="webcam.json")",
+                        "navigation.camera_exposure_us=4000", R"(navigation.camera_gain="auto")",
+                        R"(navigation.camera_white_balance_k="lock")", "navigation.camera_colour=true"}));
     const CameraControls& w = set.navigation.tracking.source.controls;
     EXPECT_EQ(w.exposure.mode, ControlSetting::Mode::manual);
     EXPECT_DOUBLE_EQ(w.exposure.value, 4000);

@@ -16,9 +16,9 @@
 #include <string>
 #include <string_view>
 
+#include "common/result.h"
 #include "drivers/camera/camera_controls.h"
 #include "drivers/camera/frame_source.h"
-#include "common/result.h"
 
 namespace mogao {
 

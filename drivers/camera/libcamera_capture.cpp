@@ -447,8 +447,9 @@ Status LibcameraCapture::Impl::apply_controls(const CameraControls& wanted, libc
     using Mode = ControlSetting::Mode;
     const libcamera::ControlInfoMap& info = camera->controls();
     const auto missing = [&](const ControlSetting& s, const std::string& what) -> Status {
-        if (s.required) return make_error(ENOTSUP, "libcamera camera " + id + ": " + s.name + " = " + describe(s) +
-                                                       ": the camera has no " + what);
+        if (s.required)
+            return make_error(ENOTSUP, "libcamera camera " + id + ": " + s.name + " = " + describe(s) +
+                                           ": the camera has no " + what);
         skipped_controls += (skipped_controls.empty() ? "" : ", ") + s.name + " (no " + what + ")";
         return {};
     };

@@ -40,9 +40,9 @@
 #include <string>
 #include <vector>
 
+#include "common/pixel_rect.h"
 #include "drivers/camera/camera_controls.h"
 #include "drivers/camera/frame_source.h"
-#include "common/pixel_rect.h"
 
 namespace mogao {
 
@@ -51,8 +51,8 @@ struct LibcameraConfig {
     int width = 800;        // requested; the pipeline may adjust it (see size())
     int height = 600;
     // Formats to try, in order of preference (GREY needs no conversion, MJPEG the most CPU).
-    std::vector<CaptureFormat> formats{CaptureFormat::grey,   CaptureFormat::yuyv,   CaptureFormat::nv12,
-                                       CaptureFormat::nv21,   CaptureFormat::yuv420, CaptureFormat::yvu420,
+    std::vector<CaptureFormat> formats{CaptureFormat::grey, CaptureFormat::yuyv,   CaptureFormat::nv12,
+                                       CaptureFormat::nv21, CaptureFormat::yuv420, CaptureFormat::yvu420,
                                        CaptureFormat::mjpeg};
     bool colour = false;      // also deliver CameraFrame::colour (R'G'B'); GREY (R8) is then not used
     CameraControls controls;  // applied when the camera starts (camera_controls.h)
@@ -64,7 +64,8 @@ struct LibcameraConfig {
 [[nodiscard]] bool libcamera_built_in() noexcept;
 
 // libcamera's (DRM) fourcc for a capture format: GREY -> R8 ("R8  "), YUYV, MJPEG ("MJPG"), NV12,
-// NV21, YUV420 ("YU12"), YVU420 ("YV12"); 0 for image_file. Pure; the .cpp checks these against libcamera::formats at compile time.
+// NV21, YUV420 ("YU12"), YVU420 ("YV12"); 0 for image_file. Pure; the .cpp checks these against libcamera::formats at
+// compile time.
 [[nodiscard]] constexpr std::uint32_t libcamera_fourcc(CaptureFormat format) noexcept {
     constexpr auto cc = [](char a, char b, char c, char d) {
         return static_cast<std::uint32_t>(static_cast<unsigned char>(a)) |

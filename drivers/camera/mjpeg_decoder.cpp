@@ -83,8 +83,8 @@ Status MjpegDecoder::decode_colour(std::span<const std::uint8_t> jpeg, GrayImage
     if (Status s = read_header(jpeg, expected_width, expected_height, width, height); !s) return s;
     colour.size = ImageSize{width, height};
     colour.pixels.resize(static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 3);
-    if (tjDecompress2(handle_.get(), jpeg.data(), static_cast<unsigned long>(jpeg.size()), colour.pixels.data(),
-                      width, width * 3, height, TJPF_RGB, kDecodeFlags) != 0) {
+    if (tjDecompress2(handle_.get(), jpeg.data(), static_cast<unsigned long>(jpeg.size()), colour.pixels.data(), width,
+                      width * 3, height, TJPF_RGB, kDecodeFlags) != 0) {
         return fail(std::string("MJPEG frame: ") + tjGetErrorStr2(handle_.get()));
     }
     grey_from_rgb(colour, grey);

@@ -83,14 +83,15 @@ TEST(MjpegDecoder, RecoversAfterACorruptFrame) {
     std::vector<std::uint8_t> bogus_length = good;
     for (std::size_t i = 0; i + 6 < bogus_length.size(); ++i) {
         if (bogus_length[i] == 0xFF && bogus_length[i + 1] == 0xC0) {  // SOF0: length field follows
-            bogus_length[i + 5] = 0;  // height 0 in the frame header
+            bogus_length[i + 5] = 0;                                   // height 0 in the frame header
             bogus_length[i + 6] = 0;
             break;
         }
     }
     std::vector<std::uint8_t> scrambled = good;  // damaged tables: "SOS before SOF"
     for (std::size_t i = 20; i < 200 && i < scrambled.size(); ++i) scrambled[i] ^= 0x5A;
-    const std::vector<std::uint8_t> truncated(good.begin(), good.begin() + static_cast<std::ptrdiff_t>(good.size() / 2));
+    const std::vector<std::uint8_t> truncated(good.begin(),
+                                              good.begin() + static_cast<std::ptrdiff_t>(good.size() / 2));
     const std::vector<const std::vector<std::uint8_t>*> bads{&bogus_length, &scrambled, &truncated};
     for (const std::vector<std::uint8_t>* bad : bads) {
         GrayImage out;

@@ -202,10 +202,10 @@ YcbcrEncoding ycbcr_encoding_from_v4l2(std::uint32_t colorspace, std::uint32_t y
     YcbcrEncoding e;
     std::uint32_t enc = ycbcr_enc;
     if (enc == V4L2_YCBCR_ENC_DEFAULT) {
-        enc = colorspace == V4L2_COLORSPACE_REC709       ? V4L2_YCBCR_ENC_709
-              : colorspace == V4L2_COLORSPACE_BT2020     ? V4L2_YCBCR_ENC_BT2020
+        enc = colorspace == V4L2_COLORSPACE_REC709      ? V4L2_YCBCR_ENC_709
+              : colorspace == V4L2_COLORSPACE_BT2020    ? V4L2_YCBCR_ENC_BT2020
               : colorspace == V4L2_COLORSPACE_SMPTE240M ? V4L2_YCBCR_ENC_SMPTE240M
-                                                         : V4L2_YCBCR_ENC_601;
+                                                        : V4L2_YCBCR_ENC_601;
     }
     switch (enc) {
         case V4L2_YCBCR_ENC_709:
@@ -315,7 +315,8 @@ Status convert_yuv420(CaptureFormat format, std::span<const PlaneBytes> planes, 
     const auto step = static_cast<std::size_t>(view->chroma_step);
     for (int y = 0; y < height; ++y) {
         const std::uint8_t* luma = grey.pixels.data() + static_cast<std::size_t>(y) * w;
-        const std::size_t crow = static_cast<std::size_t>(y / 2) * static_cast<std::size_t>(view->chroma_bytes_per_line);
+        const std::size_t crow =
+            static_cast<std::size_t>(y / 2) * static_cast<std::size_t>(view->chroma_bytes_per_line);
         const std::uint8_t* cb = view->cb.data() + crow;
         const std::uint8_t* cr = view->cr.data() + crow;
         std::uint8_t* dst = colour->pixels.data() + static_cast<std::size_t>(y) * w * 3;

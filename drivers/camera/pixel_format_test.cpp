@@ -72,8 +72,8 @@ void expect_bars(YcbcrEncoding encoding, const std::vector<Bar>& bars) {
     for (const Bar& bar : bars) {
         std::uint8_t rgb[3] = {};
         rgb_from_ycbcr(bar.y, bar.cb, bar.cr, encoding, rgb);
-        EXPECT_NEAR(rgb[0], bar.r, 2) << ycbcr_encoding_name(encoding) << " Y'CbCr " << int{bar.y} << ","
-                                      << int{bar.cb} << "," << int{bar.cr};
+        EXPECT_NEAR(rgb[0], bar.r, 2) << ycbcr_encoding_name(encoding) << " Y'CbCr " << int{bar.y} << "," << int{bar.cb}
+                                      << "," << int{bar.cr};
         EXPECT_NEAR(rgb[1], bar.g, 2) << ycbcr_encoding_name(encoding) << " Y' " << int{bar.y};
         EXPECT_NEAR(rgb[2], bar.b, 2) << ycbcr_encoding_name(encoding) << " Y' " << int{bar.y};
     }

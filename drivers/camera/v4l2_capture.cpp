@@ -169,7 +169,8 @@ Status V4l2Capture::negotiate_format(const V4l2Config& config) {
         for (std::uint32_t f : offered) list += (list.empty() ? "" : ", ") + fourcc_name(f);
         std::string names;
         for (CaptureFormat f : config.formats) names += (names.empty() ? "" : "/") + pixel_format_name(f);
-        return make_error(ENOTSUP, device_ + ": none of the wanted formats (" + names + (config.colour ? ", in colour" : "") +
+        return make_error(ENOTSUP, device_ + ": none of the wanted formats (" + names +
+                                       (config.colour ? ", in colour" : "") +
                                        ") is offered; device has: " + (list.empty() ? std::string("none") : list));
     }
     v4l2_format fmt{};
@@ -199,7 +200,8 @@ Status V4l2Capture::negotiate_format(const V4l2Config& config) {
             return make_error(ENOTSUP, device_ + ": VIDIOC_S_FMT: " + std::to_string(plane_count_) +
                                            " planes, at most 3 are supported");
         }
-        for (int p = 0; p < plane_count_; ++p) plane_bytes_per_line_.push_back(static_cast<int>(mp.plane_fmt[p].bytesperline));
+        for (int p = 0; p < plane_count_; ++p)
+            plane_bytes_per_line_.push_back(static_cast<int>(mp.plane_fmt[p].bytesperline));
         encoding_ = ycbcr_encoding_from_v4l2(mp.colorspace, mp.ycbcr_enc, mp.quantization);
     } else {
         got = fmt.fmt.pix.pixelformat;
@@ -210,12 +212,12 @@ Status V4l2Capture::negotiate_format(const V4l2Config& config) {
         encoding_ = ycbcr_encoding_from_v4l2(fmt.fmt.pix.colorspace, fmt.fmt.pix.ycbcr_enc, fmt.fmt.pix.quantization);
     }
     if (got != wanted->fourcc) {
-        return make_error(ENOTSUP, device_ + ": VIDIOC_S_FMT: asked " + fourcc_name(wanted->fourcc) + ", got " +
-                                       fourcc_name(got));
+        return make_error(
+            ENOTSUP, device_ + ": VIDIOC_S_FMT: asked " + fourcc_name(wanted->fourcc) + ", got " + fourcc_name(got));
     }
     if (field != V4L2_FIELD_NONE && field != V4L2_FIELD_ANY) {
-        return make_error(ENOTSUP, device_ + ": interlaced capture (field " + std::to_string(field) +
-                                       ") is not supported");
+        return make_error(ENOTSUP,
+                          device_ + ": interlaced capture (field " + std::to_string(field) + ") is not supported");
     }
     format_ = wanted->format;
     bytes_per_line_ = plane_bytes_per_line_.front();

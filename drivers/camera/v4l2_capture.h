@@ -39,14 +39,14 @@
 #include <string>
 #include <vector>
 
+#include "common/pixel_rect.h"
+#include "common/unique_fd.h"
 #include "drivers/camera/camera_controls.h"
 #include "drivers/camera/frame_source.h"
 #include "drivers/camera/mapped_buffer.h"
 #include "drivers/camera/mjpeg_decoder.h"
 #include "drivers/camera/pixel_format.h"
 #include "drivers/camera/v4l2_controls.h"
-#include "common/unique_fd.h"
-#include "common/pixel_rect.h"
 
 namespace mogao {
 
@@ -55,11 +55,11 @@ struct V4l2Config {
     int width = 800;  // requested; the driver may pick the nearest size it supports (see size())
     int height = 600;
     // Formats to try, in order of preference (GREY needs no conversion, MJPEG the most CPU).
-    std::vector<CaptureFormat> formats{CaptureFormat::grey,   CaptureFormat::yuyv,   CaptureFormat::nv12,
-                                       CaptureFormat::nv21,   CaptureFormat::yuv420, CaptureFormat::yvu420,
+    std::vector<CaptureFormat> formats{CaptureFormat::grey, CaptureFormat::yuyv,   CaptureFormat::nv12,
+                                       CaptureFormat::nv21, CaptureFormat::yuv420, CaptureFormat::yvu420,
                                        CaptureFormat::mjpeg};
-    bool colour = false;      // also deliver CameraFrame::colour (R'G'B'); GREY is then not used
-    CameraControls controls;  // applied at open (default: every setting left as the device has it)
+    bool colour = false;        // also deliver CameraFrame::colour (R'G'B'); GREY is then not used
+    CameraControls controls;    // applied at open (default: every setting left as the device has it)
     int buffer_count = 3;       // [2, 4]: 2-3 keeps latency at most one frame (see above)
     int frames_per_second = 0;  // 0 = the driver's default; else VIDIOC_S_PARM (best effort)
     int timeout_ms = 2000;      // [1, 60000]: next_frame() gives ETIMEDOUT after this long without a frame

@@ -47,8 +47,7 @@ std::optional<std::string> find_vivid(bool multiplanar = false) {
 
 #define REQUIRE_VIVID_MPLANE(var)      \
     const auto var = find_vivid(true); \
-    if (!var)                          \
-    GTEST_SKIP() << "no multi-planar vivid capture device (modprobe vivid n_devs=2 multiplanar=1,2)"
+    if (!var) GTEST_SKIP() << "no multi-planar vivid capture device (modprobe vivid n_devs=2 multiplanar=1,2)"
 
 void expect_streams(const std::string& device, CaptureFormat format, bool colour = false) {
     V4l2Config config;
@@ -104,8 +103,7 @@ void expect_colour_bars(const std::string& device, CaptureFormat format) {
     for (int i = 0; i < 8; ++i) {
         const int x = (2 * i + 1) * rgb.size.width / 16;
         for (int c = 0; c < 3; ++c) {
-            EXPECT_NEAR(rgb.at(x, y)[c], bars[i][c], 12)
-                << (*cam)->description() << ": bar " << i << " channel " << c;
+            EXPECT_NEAR(rgb.at(x, y)[c], bars[i][c], 12) << (*cam)->description() << ": bar " << i << " channel " << c;
         }
     }
 }

@@ -25,7 +25,8 @@ stty -F "$ctl" -echo icanon 2>/dev/null
 say "start uptime=$(uptime_s) kernel=$(uname -r)"
 
 # --- V4L2: vivid, the kernel's virtual capture driver -------------------------------------------
-if modprobe vivid n_devs=1 2>/dev/null; then
+# Two instances: a single-planar one and a multi-planar one (multiplanar=2: NV12M/YUV420M buffers).
+if modprobe vivid n_devs=2 multiplanar=1,2 2>/dev/null; then
   sleep 2
   ok "vivid-loaded devices=$(ls /dev/video* 2>/dev/null | tr '\n' ',')"
 else
