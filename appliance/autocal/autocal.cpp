@@ -7,6 +7,7 @@
 #include <limits>
 #include <numbers>
 
+#include "appliance/autocal/bundle_adjust.h"
 #include "appliance/autocal/gray_code.h"
 #include "appliance/autocal/screen_geometry.h"
 #include "appliance/warp/calibration_validation.h"
@@ -44,14 +45,31 @@ Eigen::Vector2d device_screen(const DeviceModel& d, const ScreenModel& s, double
     return {std::atan2(hit->x(), -hit->z()), hit->y()};
 }
 
-// Distance of screen point (theta, h) from device j's image border in its pixels (0 outside).
+// Distance of screen point (theta, h) from device d's image border in its pixels (0 outside),
+// counting only the parts of the border that lie on the screen: a border beyond the screen's top,
+// bottom or arc end is no overlap edge, so the blend ramps run across the overlaps only (Raskar et
+// al. 1999, "Multi-projector displays using camera-based registration": the weight falls with the
+// distance to the edge of the projector's footprint on the display surface).
 double border_distance(const DeviceModel& d, const ScreenModel& s, const Eigen::Vector2d& th) {
     const Eigen::Vector3d p(s.radius_m * std::sin(th.x()), th.y(), -s.radius_m * std::cos(th.x()));
     const Eigen::Vector3d q = d.rotation.transpose() * (p - d.position_m);
     if (q.z() <= 0.0) return 0.0;
     const double x = d.fx_px * q.x() / q.z() + d.cx_px;
     const double y = d.fy_px * q.y() / q.z() + d.cy_px;
-    return std::max(0.0, std::min({x, d.resolution.width - x, y, d.resolution.height - y}));
+    const double w = d.resolution.width;
+    const double h = d.resolution.height;
+    if (!(x >= 0.0 && x <= w && y >= 0.0 && y <= h)) return 0.0;
+    const double arc = s.arc_deg * kDeg;
+    const auto on_screen = [&](double bx, double by) {
+        const Eigen::Vector2d b = device_screen(d, s, bx, by);
+        return std::isfinite(b.x()) && std::abs(b.x()) <= arc / 2.0 && b.y() >= s.bottom_m && b.y() <= s.top_m;
+    };
+    double best = std::numeric_limits<double>::infinity();
+    if (on_screen(0.0, y)) best = std::min(best, x);
+    if (on_screen(w, y)) best = std::min(best, w - x);
+    if (on_screen(x, 0.0)) best = std::min(best, y);
+    if (on_screen(x, h)) best = std::min(best, h - y);
+    return best;
 }
 
 ProjectorCalibration build_projector(const std::vector<DeviceModel>& fitted, std::size_t k, const ScreenModel& s,
@@ -70,8 +88,10 @@ ProjectorCalibration build_projector(const std::vector<DeviceModel>& fitted, std
     for (int gy = 0; gy < grid.height; ++gy) {
         for (int gx = 0; gx < grid.width; ++gx) {
             const std::size_t i = static_cast<std::size_t>(gy) * grid.width + gx;
-            const double x = grid_to_output(gx, d.resolution.width, grid.width);
-            const double y = grid_to_output(gy, d.resolution.height, grid.height);
+            // grid_to_output is in pixel-index coordinates (centre at x); the models use image
+            // positions (centre at x + 0.5).
+            const double x = grid_to_output(gx, d.resolution.width, grid.width) + 0.5;
+            const double y = grid_to_output(gy, d.resolution.height, grid.height) + 0.5;
             const Eigen::Vector2d th = device_screen(d, s, x, y);
             pc.warp.uv[2 * i] = static_cast<float>((th.x() + arc / 2.0) / arc);
             pc.warp.uv[2 * i + 1] = static_cast<float>((s.top_m - th.y()) / (s.top_m - s.bottom_m));
@@ -120,6 +140,7 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
     result.report.edge_points = edge.points;
     result.report.edge_rms_m = edge.rms_m;
     result.report.camera_position_m = edge.camera.position_m;
+    std::vector<ProjectorObservations> observations;
     for (std::size_t k = 0; k < n; ++k) {
         const Correspondences c = decode_projector(source, static_cast<int>(k), sizes, options);
         result.report.captures += c.captures;
@@ -132,11 +153,23 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
                                      " row bits resolved (need >= " + std::to_string(options.min_bits) + "; " +
                                      std::to_string(c.lit_pixels) + " camera pixels lit)");
         }
-        const ProjectorFit fit = fit_projector(edge.camera, prior, static_cast<int>(k), c.camera, c.projector, options);
+        ProjectorFit fit =
+            fit_projector(edge.camera, prior, static_cast<int>(k), c.camera, c.projector, c.block, options);
         pr.rms_px = fit.rms_px;
         pr.mean_view_angle_deg = fit.mean_view_angle_deg;
         result.projectors.push_back(fit.model);
         result.report.projectors.push_back(pr);
+        observations.push_back(std::move(fit.observations));
+    }
+    // Step 4: camera pose and projector models refined together on every observation.
+    const BundleResult ba = bundle_adjust(prior.screen, edge.camera, result.projectors, edge.edges, observations);
+    result.camera = ba.camera;
+    result.projectors = ba.projectors;
+    result.report.camera_position_m = ba.camera.position_m;
+    result.report.edge_rms_m = ba.edge_rms_m;
+    for (std::size_t k = 0; k < n; ++k) {
+        result.report.projectors[k].rms_px = ba.rms_px[k];
+        result.report.projectors[k].cells = ba.inliers[k];
     }
     result.calibration.content = content;
     for (std::size_t k = 0; k < n; ++k) {

@@ -19,23 +19,29 @@
 //     (per-pixel threshold), a pixel counts where white - black exceeds `min_contrast` (shadow
 //     mask); bits are captured from the coarsest down and stop at the first one the camera cannot
 //     resolve (fewer than `min_bit_fraction` of the pixels with |pattern - inverse| > half the
-//     contrast). Decoded blocks of projector pixels (cells) whose camera pixels form a complete
-//     neighbourhood give one correspondence each: the centroid of their camera pixels <-> the cell
-//     centre.
+//     contrast). Per camera pixel, bits are taken until its first one below half its contrast; in
+//     the reflected Gray code that bit flips at the middle of the pixel's block, so the block's
+//     centre is the pixel's position. Each decoded camera pixel (all but at most two of the
+//     resolved bits per axis) gives a correspondence: its centre <-> the block's centre, with the
+//     block's size / sqrt(12) as its uncertainty (a uniform error over the block).
 //  2. Camera pose: the lit region of all projectors at full white ends at the screen's edges
 //     (projectors overfill them). Edge points are located to sub-pixel as the crossing of the local
 //     half level; Gauss-Newton on the camera's 6 pose parameters minimises the distance, on the
 //     screen, of each edge point's ray from the edge it belongs to (h = top/bottom, theta = +-arc/2),
 //     from the prior pose, with a weak pull to the prior (the ends fix the yaw about the axis).
-//  3. Projector: camera ray of each correspondence -> cylinder -> 3D point; cv::calibrateCamera
-//     (Zhang 2000 with Levenberg-Marquardt; non-planar points, intrinsic guess from the prior, no
-//     distortion, square pixels) fits intrinsics and pose; outliers beyond 4x the median residual
-//     are dropped and the fit repeated.
-//  4. Warp: grid samples at texel centres (warp_sampling.h) -> fitted projector ray -> cylinder
+//  3. Projector: camera ray of each correspondence -> cylinder -> 3D point; SQPnP with the
+//     data-sheet intrinsics for the pose, then Levenberg-Marquardt on focal length, principal point
+//     and pose (bundle_adjust.h with the camera fixed), outliers beyond 4x the median dropped.
+//  4. Bundle adjustment (bundle_adjust.h; Sajadi & Majumder 2010): camera pose and all projector
+//     models together on every correspondence and edge point, the 3D points constrained to the
+//     cylinder.
+//  5. Warp: grid samples at texel centres (warp_sampling.h) -> fitted projector ray -> cylinder
 //     -> content (u, v), left unclamped past the screen's edges (the blend is 0 there).
-//  5. Blend (linear light): w_k = f(d_k) / sum_j f(d_j), d_j = distance in projector j's pixels of
-//     the screen point from j's image border, f = smoothstep(d / ramp); 0 off the screen. Sums to 1
-//     wherever a projector lights the screen, C1-smooth.
+//  6. Blend (linear light; Raskar et al. 1999): w_k = f(d_k) / sum_j f(d_j), d_j = distance in
+//     projector j's pixels of the screen point from the parts of j's image border that lie on the
+//     screen (borders beyond the screen's top, bottom or ends are no overlap edges), f =
+//     smoothstep(d / ramp); 0 off the screen. Sums to 1 wherever a projector lights the screen,
+//     C1-smooth, ramps only across the overlaps.
 #pragma once
 
 #include <array>
@@ -81,15 +87,16 @@ struct CalibrationPrior {
 };
 
 struct AutocalOptions {
-    int warp_step_px = 8;               // warp/blend grid: one sample per this many output pixels, 1..64
-    double blend_ramp = 0.12;           // blend ramp width, fraction of the projector's width, (0, 0.5]
-    double min_contrast = 0.04;         // white - black for a camera pixel to count (shadow mask), (0, 1)
-    double min_bit_fraction = 0.6;      // fraction of pixels a Gray bit must resolve to be used, (0, 1]
-    int min_cells = 150;                // correspondences per projector, below: refused
-    int min_bits = 4;                   // resolved Gray bits per axis, below: decoding failed
-    double max_edge_rms_m = 0.01;       // camera pose fit gate
-    double max_projector_rms_px = 3.0;  // projector fit gate (cell-quantised correspondences)
-    double max_view_angle_deg = 75.0;   // camera rays steeper than this to the screen normal: grazing
+    int warp_step_px = 2;              // warp/blend grid: one sample per this many output pixels, 1..64
+    double blend_ramp = 0.12;          // blend ramp width, fraction of the projector's width, (0, 0.5]
+    double min_contrast = 0.04;        // white - black for a camera pixel to count (shadow mask), (0, 1)
+    double min_bit_fraction = 0.6;     // fraction of pixels a Gray bit must resolve to be used, (0, 1]
+    int min_cells = 150;               // correspondences per projector, below: refused
+    int max_correspondences = 20000;   // per projector (decoded camera pixels, evenly strided), >= min_cells
+    int min_bits = 4;                  // resolved Gray bits per axis, below: decoding failed
+    double max_edge_rms_m = 0.01;      // camera pose fit gate
+    double max_projector_rms = 3.0;    // projector fit gate, rms in units of the decoding uncertainty, > 0
+    double max_view_angle_deg = 75.0;  // camera rays steeper than this to the screen normal: grazing
 };
 
 // Shows one signal image per projector (CV_32FC1 in [0, 1], projector resolution; empty = black)

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 
 namespace mogao::autocal {
 
@@ -34,11 +33,17 @@ cv::Mat1f gray_code_pattern(ImageSize size, bool rows, int bit, bool inverted) {
 namespace {
 
 // Decodes one axis: captures bits from the coarsest while the camera resolves them. Returns the
-// number of bits used; `code` gets the binary prefix of the index per camera pixel (-1 = invalid).
+// number of bits used. Per camera pixel, `gray` gets the Gray-code prefix and `depth` the number of
+// bits it resolved: a pixel stops at its first bit with |pattern - inverse| below half its
+// contrast. For the reflected Gray code that bit changes at the middle of the pixel's block of
+// `depth` bits, so the block's centre is where the pixel is (Inokuchi et al. 1984; the same
+// property makes Gray code robust at stripe edges). Pixels below `shadow` contrast stay at -1.
 int decode_axis(PatternSource& source, int k, std::size_t projectors, ImageSize size, bool rows,
-                const cv::Mat1f& contrast, const AutocalOptions& options, cv::Mat1i& code, int& captures) {
+                const cv::Mat1f& contrast, const AutocalOptions& options, cv::Mat1i& code, cv::Mat1i& depth,
+                int& captures) {
     const int n = gray_code_bits(rows ? size.height : size.width);
     cv::Mat1i gray(contrast.size(), 0);
+    cv::Mat1b open(contrast.size(), 1);  // the pixel still takes bits
     int used = 0;
     for (int bit = 0; bit < n; ++bit) {
         std::vector<cv::Mat> signals(projectors);
@@ -53,20 +58,20 @@ int decode_axis(PatternSource& source, int k, std::size_t projectors, ImageSize 
             for (int x = 0; x < on.cols; ++x) {
                 if (code(y, x) < 0) continue;
                 ++valid;
-                const float d = on(y, x) - off(y, x);
-                resolved += std::abs(d) > 0.5f * contrast(y, x);
+                resolved += std::abs(on(y, x) - off(y, x)) > 0.5f * contrast(y, x);
             }
         }
         if (valid == 0 || static_cast<double>(resolved) < options.min_bit_fraction * static_cast<double>(valid)) break;
         for (int y = 0; y < on.rows; ++y) {
             for (int x = 0; x < on.cols; ++x) {
-                if (code(y, x) < 0) continue;
+                if (code(y, x) < 0 || !open(y, x)) continue;
                 const float d = on(y, x) - off(y, x);
-                if (std::abs(d) < 0.15f * contrast(y, x)) {
-                    code(y, x) = -1;  // too close to call: a stripe edge crosses this pixel
+                if (std::abs(d) < 0.5f * contrast(y, x)) {
+                    open(y, x) = 0;
                     continue;
                 }
                 gray(y, x) = (gray(y, x) << 1) | (d > 0.0f ? 1 : 0);
+                ++depth(y, x);
             }
         }
         ++used;
@@ -82,42 +87,6 @@ int decode_axis(PatternSource& source, int k, std::size_t projectors, ImageSize 
         }
     }
     return used;
-}
-
-// One correspondence per cell (column block, row block) of `cbits` x `rbits` prefix bits whose
-// camera pixels and 4 neighbours' were seen (>= 3 pixels each).
-void make_cells(const cv::Mat1i& col, const cv::Mat1i& row, ImageSize size, int cbits, int rbits, int drop,
-                Correspondences& out) {
-    if (cbits < 1 || rbits < 1) return;
-    const int cw = 1 << (gray_code_bits(size.width) - cbits);
-    const int ch = 1 << (gray_code_bits(size.height) - rbits);
-    struct Acc {
-        double x = 0.0, y = 0.0;
-        int n = 0;
-    };
-    std::map<std::pair<int, int>, Acc> cells;
-    for (int y = 0; y < col.rows; ++y) {
-        for (int x = 0; x < col.cols; ++x) {
-            if (col(y, x) < 0 || row(y, x) < 0) continue;
-            Acc& a = cells[{col(y, x) >> drop, row(y, x) >> drop}];
-            a.x += x + 0.5;
-            a.y += y + 0.5;
-            ++a.n;
-        }
-    }
-    const auto full = [&](int c, int r) {
-        const auto it = cells.find({c, r});
-        return it != cells.end() && it->second.n >= 3;
-    };
-    for (const auto& [key, a] : cells) {
-        const auto [c, r] = key;
-        // Only cells inside the image whose neighbours were all seen: a cell cut by the screen's
-        // edge or a shadow would pull its centroid.
-        if ((c + 1) * cw > size.width || (r + 1) * ch > size.height) continue;
-        if (!full(c, r) || !full(c - 1, r) || !full(c + 1, r) || !full(c, r - 1) || !full(c, r + 1)) continue;
-        out.camera.emplace_back(a.x / a.n, a.y / a.n);
-        out.projector.emplace_back((c + 0.5) * cw, (r + 0.5) * ch);
-    }
 }
 
 }  // namespace
@@ -139,19 +108,43 @@ Correspondences decode_projector(PatternSource& source, int k, const std::vector
         for (int x = 0; x < contrast.cols; ++x) col(y, x) = contrast(y, x) > options.min_contrast ? 0 : -1;
     }
     cv::Mat1i row = col.clone();
+    cv::Mat1i col_depth(contrast.size(), 0);
+    cv::Mat1i row_depth(contrast.size(), 0);
     out.lit_pixels = cv::countNonZero(col == 0);
-    out.column_bits = decode_axis(source, k, projectors.size(), size, false, contrast, options, col, out.captures);
-    out.row_bits = decode_axis(source, k, projectors.size(), size, true, contrast, options, row, out.captures);
+    out.column_bits =
+        decode_axis(source, k, projectors.size(), size, false, contrast, options, col, col_depth, out.captures);
+    out.row_bits =
+        decode_axis(source, k, projectors.size(), size, true, contrast, options, row, row_depth, out.captures);
     if (out.column_bits < options.min_bits || out.row_bits < options.min_bits) return out;
-    // Cells of 2^drop finer blocks merged: the drop giving the most complete cells wins (cells a
-    // camera pixel or two wide have no usable centroid).
-    Correspondences best = out;
-    for (int drop = 0; drop <= 4; ++drop) {
-        Correspondences c = out;
-        make_cells(col, row, size, out.column_bits - drop, out.row_bits - drop, drop, c);
-        if (c.camera.size() > best.camera.size()) best = std::move(c);
+    // One correspondence per decoded camera pixel with at least all but two of the resolved bits
+    // per axis: its centre <-> the centre of the projector block its code names, with the block's
+    // size (its uncertainty). A regular stride keeps at most `max_correspondences`.
+    const int nc = gray_code_bits(size.width);
+    const int nr = gray_code_bits(size.height);
+    const auto usable = [&](int y, int x) {
+        return col(y, x) >= 0 && row(y, x) >= 0 && col_depth(y, x) >= std::max(1, out.column_bits - 2) &&
+               row_depth(y, x) >= std::max(1, out.row_bits - 2);
+    };
+    long valid = 0;
+    for (int y = 0; y < col.rows; ++y) {
+        for (int x = 0; x < col.cols; ++x) valid += usable(y, x);
     }
-    return best;
+    const long stride = std::max<long>(1, (valid + options.max_correspondences - 1) / options.max_correspondences);
+    long seen = 0;
+    for (int y = 0; y < col.rows; ++y) {
+        for (int x = 0; x < col.cols; ++x) {
+            if (!usable(y, x) || seen++ % stride != 0) continue;
+            const int cw = 1 << (nc - col_depth(y, x));
+            const int ch = 1 << (nr - row_depth(y, x));
+            const double px = (col(y, x) + 0.5) * cw;
+            const double py = (row(y, x) + 0.5) * ch;
+            if (px >= size.width || py >= size.height) continue;  // codes past the image: decoding errors
+            out.camera.emplace_back(x + 0.5, y + 0.5);
+            out.projector.emplace_back(px, py);
+            out.block.emplace_back(cw, ch);
+        }
+    }
+    return out;
 }
 
 }  // namespace mogao::autocal

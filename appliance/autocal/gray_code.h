@@ -14,7 +14,8 @@ namespace mogao::autocal {
 
 struct Correspondences {
     std::vector<cv::Point2d> camera;     // camera image positions (pixel centre +0.5)
-    std::vector<cv::Point2d> projector;  // projector image positions of the cell centres
+    std::vector<cv::Point2d> projector;  // projector image positions: centres of the decoded blocks
+    std::vector<cv::Point2d> block;      // the blocks' width and height, projector pixels
     int column_bits = 0;                 // Gray bits resolved per axis
     int row_bits = 0;
     int lit_pixels = 0;  // camera pixels over the shadow-mask contrast

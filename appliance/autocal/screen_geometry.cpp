@@ -83,47 +83,6 @@ double edge_residual(const ScreenModel& s, const Eigen::Matrix3d& r, const Eigen
     return std::abs(e) < gate ? e : std::nan("");
 }
 
-template <typename Project>
-void refine_projector(const std::vector<cv::Point3f>& world, const std::vector<cv::Point2f>& proj,
-                      Eigen::Matrix<double, 9, 1>& q, const Project& project) {
-    const auto residuals = [&](const Eigen::Matrix<double, 9, 1>& v) {
-        std::vector<cv::Point2f> back;
-        project(v, back);
-        Eigen::VectorXd r(2 * static_cast<Eigen::Index>(world.size()));
-        for (std::size_t i = 0; i < world.size(); ++i) {
-            r[2 * static_cast<Eigen::Index>(i)] = back[i].x - proj[i].x;
-            r[2 * static_cast<Eigen::Index>(i) + 1] = back[i].y - proj[i].y;
-        }
-        return r;
-    };
-    double lambda = 1e-3;
-    Eigen::VectorXd r = residuals(q);
-    for (int iter = 0; iter < 30; ++iter) {
-        Eigen::MatrixXd j(r.size(), 9);
-        for (int c = 0; c < 9; ++c) {
-            Eigen::Matrix<double, 9, 1> v = q;
-            const double h = c < 3 ? 1e-3 : 1e-7;
-            v[c] += h;
-            j.col(c) = (residuals(v) - r) / h;
-        }
-        const Eigen::MatrixXd jtj = j.transpose() * j;
-        const Eigen::VectorXd jtr = j.transpose() * r;
-        Eigen::MatrixXd a = jtj;
-        a.diagonal() *= 1.0 + lambda;
-        const Eigen::Matrix<double, 9, 1> next = q - a.ldlt().solve(jtr);
-        const Eigen::VectorXd rn = residuals(next);
-        if (rn.squaredNorm() < r.squaredNorm()) {
-            const bool done = r.squaredNorm() - rn.squaredNorm() < 1e-12 * r.squaredNorm();
-            q = next;
-            r = rn;
-            lambda = std::max(lambda / 10.0, 1e-12);
-            if (done) break;
-        } else {
-            lambda *= 10.0;
-        }
-    }
-}
-
 }  // namespace
 
 std::vector<Eigen::Vector3d> camera_rays(const DeviceModel& camera, const std::vector<cv::Point2d>& image) {
@@ -212,6 +171,16 @@ EdgeFit fit_camera_pose(const cv::Mat1f& lit, const CalibrationPrior& prior, con
     fit.camera = prior.camera;
     fit.camera.rotation = r;
     fit.camera.position_m = o;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        if (!std::isfinite(edge_residual(prior.screen, r, o, rays[i], edges[i].vertical_scan, 0.02))) continue;
+        const Eigen::Vector3d x = ray_on_screen(prior.screen, fit.camera, rays[i]);
+        ScreenEdge which = std::atan2(x.x(), -x.z()) > 0.0 ? ScreenEdge::right_end : ScreenEdge::left_end;
+        if (edges[i].vertical_scan) {
+            which = std::abs(x.y() - prior.screen.top_m) < std::abs(x.y() - prior.screen.bottom_m) ? ScreenEdge::top
+                                                                                                   : ScreenEdge::bottom;
+        }
+        fit.edges.push_back({rays[i], which});
+    }
     if (fit.points < 200) {
         throw CalibrationRefused(
             "camera pose: only " + std::to_string(fit.points) +
@@ -233,7 +202,8 @@ EdgeFit fit_camera_pose(const cv::Mat1f& lit, const CalibrationPrior& prior, con
 
 ProjectorFit fit_projector(const DeviceModel& camera, const CalibrationPrior& prior, int k,
                            const std::vector<cv::Point2d>& camera_points,
-                           const std::vector<cv::Point2d>& projector_points, const AutocalOptions& options) {
+                           const std::vector<cv::Point2d>& projector_points, const std::vector<cv::Point2d>& blocks,
+                           const AutocalOptions& options) {
     const DeviceModel& guess = prior.projectors.at(static_cast<std::size_t>(k));
     const std::string who = "projector " + std::to_string(k) + " '" + guess.id + "'";
     const std::vector<Eigen::Vector3d> rays = camera_rays(camera, camera_points);
@@ -263,65 +233,42 @@ ProjectorFit fit_projector(const DeviceModel& camera, const CalibrationPrior& pr
                                  fmt(options.max_view_angle_deg) + " deg)");
     }
     // Pose from the data-sheet intrinsics (SQPnP), then Levenberg-Marquardt on focal length,
-    // principal point and pose together, twice, dropping residuals beyond 4x the median.
-    Eigen::Matrix<double, 9, 1> q;
-    {
-        cv::Vec3d rv;
-        cv::Vec3d tv;
-        const cv::Matx33d k0(guess.fx_px, 0, guess.cx_px - 0.5, 0, guess.fy_px, guess.cy_px - 0.5, 0, 0, 1);
-        cv::solvePnP(world, proj, k0, cv::noArray(), rv, tv, false, cv::SOLVEPNP_SQPNP);
-        q << guess.fx_px, guess.cx_px - 0.5, guess.cy_px - 0.5, rv[0], rv[1], rv[2], tv[0], tv[1], tv[2];
-    }
-    const double aspect = guess.fy_px / guess.fx_px;
-    const auto project = [&](const Eigen::Matrix<double, 9, 1>& v, std::vector<cv::Point2f>& out) {
-        const cv::Matx33d km(v[0], 0, v[1], 0, v[0] * aspect, v[2], 0, 0, 1);
-        cv::projectPoints(world, cv::Vec3d(v[3], v[4], v[5]), cv::Vec3d(v[6], v[7], v[8]), km, cv::noArray(), out);
-    };
-    for (int round = 0; round < 2; ++round) {
-        refine_projector(world, proj, q, project);
-        std::vector<cv::Point2f> back;
-        project(q, back);
-        std::vector<double> err(world.size());
-        for (std::size_t i = 0; i < world.size(); ++i) err[i] = cv::norm(back[i] - proj[i]);
-        std::vector<double> sorted = err;
-        std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
-        const double limit = 4.0 * std::max(sorted[sorted.size() / 2], 0.25);
-        double ss = 0.0;
-        std::vector<cv::Point3f> w2;
-        std::vector<cv::Point2f> p2;
-        for (std::size_t i = 0; i < world.size(); ++i) {
-            ss += err[i] * err[i];
-            if (err[i] <= limit) {
-                w2.push_back(world[i]);
-                p2.push_back(proj[i]);
-            }
-        }
-        fit.rms_px = std::sqrt(ss / static_cast<double>(world.size()));
-        fit.points = static_cast<int>(world.size());
-        world = std::move(w2);
-        proj = std::move(p2);
-    }
-    const cv::Matx33d kmat(q[0], 0, q[1], 0, q[0] * aspect, q[2], 0, 0, 1);
-    std::vector<cv::Mat> rvecs{cv::Mat(cv::Vec3d(q[3], q[4], q[5]))};
-    std::vector<cv::Mat> tvecs{cv::Mat(cv::Vec3d(q[6], q[7], q[8]))};
-    if (fit.rms_px > options.max_projector_rms_px) {
-        throw CalibrationRefused(who + ": fit rms " + fmt(fit.rms_px) + " px above its gate " +
-                                 fmt(options.max_projector_rms_px) +
-                                 " px (decoding errors, or the screen is not the cylinder in the prior)");
-    }
+    // principal point and pose together (bundle_adjust with the camera fixed), dropping
+    // correspondences beyond 4x the median residual between rounds.
+    cv::Vec3d rv;
+    cv::Vec3d tv;
+    const cv::Matx33d k0(guess.fx_px, 0, guess.cx_px - 0.5, 0, guess.fy_px, guess.cy_px - 0.5, 0, 0, 1);
+    cv::solvePnP(world, proj, k0, cv::noArray(), rv, tv, false, cv::SOLVEPNP_SQPNP);
     cv::Matx33d rm;
-    cv::Rodrigues(rvecs[0], rm);
+    cv::Rodrigues(rv, rm);
     Eigen::Matrix3d r_cs;  // screen -> device
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) r_cs(i, j) = rm(i, j);
-    const Eigen::Vector3d t(tvecs[0].at<double>(0), tvecs[0].at<double>(1), tvecs[0].at<double>(2));
-    fit.model = guess;
-    fit.model.fx_px = kmat(0, 0);
-    fit.model.fy_px = kmat(1, 1);
-    fit.model.cx_px = kmat(0, 2) + 0.5;
-    fit.model.cy_px = kmat(1, 2) + 0.5;
-    fit.model.rotation = r_cs.transpose();
-    fit.model.position_m = -r_cs.transpose() * t;
+    DeviceModel start = guess;
+    start.rotation = r_cs.transpose();
+    start.position_m = -r_cs.transpose() * Eigen::Vector3d(tv[0], tv[1], tv[2]);
+    ProjectorObservations obs;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        if (!cylinder_hit(prior.screen, camera.position_m, camera.rotation * rays[i])) continue;
+        obs.rays.push_back(rays[i]);
+        obs.projector.emplace_back(projector_points[i].x, projector_points[i].y);
+        obs.sigma_px.emplace_back(blocks[i].x / std::sqrt(12.0), blocks[i].y / std::sqrt(12.0));
+    }
+    BundleOptions bo;
+    bo.refine_camera = false;
+    const BundleResult b = bundle_adjust(prior.screen, camera, {start}, {}, {obs}, bo);
+    fit.rms_px = b.rms_px[0];
+    fit.rms_sigma = b.rms_sigma[0];
+    fit.points = b.inliers[0];
+    fit.observations = std::move(obs);
+    if (fit.rms_sigma > options.max_projector_rms) {
+        throw CalibrationRefused(who + ": fit rms " + fmt(fit.rms_sigma) +
+                                 " (in units of the decoded blocks' uncertainty, 1 = as good as the decoding) above "
+                                 "its gate " +
+                                 fmt(options.max_projector_rms) + " (" + fmt(fit.rms_px) +
+                                 " px: decoding errors, or the screen is not the cylinder in the prior)");
+    }
+    fit.model = b.projectors[0];
     return fit;
 }
 

@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 
 #include "appliance/autocal/autocal.h"
+#include "appliance/autocal/bundle_adjust.h"
 
 namespace mogao::autocal {
 
@@ -26,6 +27,7 @@ struct EdgeFit {
     int points = 0;       // edge points used (inliers)
     int side_points = 0;  // of which on the arc's ends
     double rms_m = 0.0;
+    std::vector<EdgeObservation> edges;  // the inliers with the edge each lies on (for bundle_adjust)
 };
 
 // Step 2: lit = all projectors white minus all black. Throws CalibrationRefused when the edges are
@@ -37,13 +39,15 @@ struct ProjectorFit {
     DeviceModel model;
     int points = 0;
     double rms_px = 0.0;
+    double rms_sigma = 0.0;  // rms in units of the points' decoding uncertainty
     double mean_view_angle_deg = 0.0;
+    ProjectorObservations observations;  // all correspondences (for bundle_adjust)
 };
 
 // Step 3 for projector k. Throws CalibrationRefused naming the projector.
 [[nodiscard]] ProjectorFit fit_projector(const DeviceModel& camera, const CalibrationPrior& prior, int k,
                                          const std::vector<cv::Point2d>& camera_points,
                                          const std::vector<cv::Point2d>& projector_points,
-                                         const AutocalOptions& options);
+                                         const std::vector<cv::Point2d>& blocks, const AutocalOptions& options);
 
 }  // namespace mogao::autocal
