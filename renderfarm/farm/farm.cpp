@@ -65,6 +65,7 @@ int run_farm(const MpiSession& mpi, const FarmSetup& setup, const AdminJob& admi
 
     DispatchSettings dispatch = setup.dispatch;
     dispatch.exposure = scene->exposure;
+    dispatch.tone_map = scene->tone_map;
     if (!mpi.is_admin()) {
         serve_render_rank(renderer ? &*renderer : nullptr, dispatch, error);
         return 0;

@@ -125,7 +125,8 @@ void serve_render_rank(Renderer* renderer, const DispatchSettings& settings, con
         try {
             if (!renderer) throw std::runtime_error(load_error);
             renderer->begin_frame(from_wire(wire));
-            const TilePassResult pass = render_tile_pass(*renderer, rects, settings.cell_size, settings.threads, settings.exposure);
+            const TilePassResult pass = render_tile_pass(*renderer, rects, settings.cell_size, settings.threads,
+                                                         settings.exposure, settings.tone_map);
             std::vector<double> tiles_flat;
             tiles_flat.reserve(pass.tile_times.size() * 5);
             for (const TileTime& t : pass.tile_times)
@@ -192,7 +193,7 @@ bool FrameDispatcher::gather(const ViewRequest& view, const Assignment& assignme
     if (local_) {  // a one-process farm: the admin traces the whole frame itself
         local_->begin_frame(view);
         TilePassResult pass = render_tile_pass(*local_, assignment.rects[0], settings_.cell_size, settings_.threads,
-                                               settings_.exposure);
+                                               settings_.exposure, settings_.tone_map);
         unpack_rects(assignment.rects[0], pass.packed_pixels, frame.image);
         frame.tiles = std::move(pass.tile_times);
         frame.stats.rays = pass.rays;

@@ -39,6 +39,7 @@ struct DispatchSettings {
     int cell_size = 16;            // tile timing / cost-map cell, pixels
     int threads = 1;               // render threads per rank
     float exposure = 1.f;          // the scene's exposure (sRGB8 conversion happens on the ranks)
+    ToneMap tone_map = ToneMap::clamp;  // the scene's tone map (film.h)
 };
 
 struct DispatchedFrame {

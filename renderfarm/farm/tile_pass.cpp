@@ -34,7 +34,7 @@ std::size_t packed_size(const std::vector<PixelRect>& rects) {
 }
 
 TilePassResult render_tile_pass(const Renderer& renderer, const std::vector<PixelRect>& rects, int cell_size,
-                                int threads, float exposure) {
+                                int threads, float exposure, ToneMap tone_map) {
     if (cell_size < 1) throw std::invalid_argument("cell_size must be >= 1");
     const auto start = Clock::now();
     const ImageSize size = renderer.render_size();
@@ -57,7 +57,7 @@ TilePassResult render_tile_pass(const Renderer& renderer, const std::vector<Pixe
             for (std::size_t i = next++; i < tiles.size(); i = next++) {
                 const auto t0 = Clock::now();
                 const TileStats stats = renderer.render(tiles[i], radiance);
-                to_srgb8(radiance, tiles[i], exposure, display);
+                to_srgb8(radiance, tiles[i], exposure, display, tone_map);
                 result.tile_times[i] = {tiles[i], std::chrono::duration<double>(Clock::now() - t0).count()};
                 rays += stats.rays;
             }

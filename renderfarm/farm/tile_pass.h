@@ -27,7 +27,8 @@ struct TilePassResult {
 // Renders `rects` of the frame begun on `renderer` with `threads` worker threads (>= 1).
 // Throws what the renderer throws (std::invalid_argument for rects outside the image).
 [[nodiscard]] TilePassResult render_tile_pass(const Renderer& renderer, const std::vector<PixelRect>& rects,
-                                              int cell_size, int threads, float exposure);
+                                              int cell_size, int threads, float exposure,
+                                              ToneMap tone_map = ToneMap::clamp);
 
 // Copies packed pixels of `rects` into `frame`. Throws std::invalid_argument when the byte count
 // does not match the rects or a rect lies outside the frame.

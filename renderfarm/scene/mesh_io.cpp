@@ -5,21 +5,28 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <fstream>
 #include <limits>
+#include <sstream>
 #include <system_error>
 #include <utility>
 #include <vector>
 
 #include <Eigen/Dense>
+#include <assimp/DefaultIOSystem.h>
 #include <assimp/Importer.hpp>
+#include <assimp/MemoryIOWrapper.h>
+#include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <fmt/format.h>
 
 #include "renderfarm/scene/ply_reader.h"
+#include "renderfarm/scene/texture_io.h"
 
 namespace mogao {
 
@@ -40,9 +47,23 @@ Eigen::Matrix4d to_eigen(const aiMatrix4x4& m) {
     return r;
 }
 
+// Which optional per-vertex attributes every appended aiMesh had (all-or-nothing, mesh.h).
+struct Attributes {
+    bool normals = true;
+    bool colors = true;
+    bool uvs = true;
+};
+
+float srgb_to_linear(float v) {
+    const double c = std::clamp(static_cast<double>(v), 0.0, 1.0);
+    return static_cast<float>(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
+}
+
 // Appends the triangles of one aiMesh placed by `to_file` (the node's accumulated transform).
-// Returns false when the mesh has no normals.
-bool append_mesh(Mesh& out, const aiMesh& in, const Eigen::Matrix4d& to_file, const std::string& file) {
+// Colours: glTF COLOR_0 is linear by the glTF 2.0 spec (§3.7.2.1); other formats' colours are
+// display sRGB and are decoded. UVs are channel 0.
+void append_mesh(Mesh& out, const aiMesh& in, const Eigen::Matrix4d& to_file, const std::string& file,
+                 bool linear_colors, Attributes& has) {
     const std::size_t base = out.positions.size();
     if (base + in.mNumVertices > std::numeric_limits<std::uint32_t>::max()) {
         throw MeshLoadError(file, "more vertices than 32-bit indices can address");
@@ -59,6 +80,12 @@ bool append_mesh(Mesh& out, const aiMesh& in, const Eigen::Matrix4d& to_file, co
             const aiVector3D& n = in.mNormals[v];
             out.normals.push_back((normal_matrix * Eigen::Vector3d(n.x, n.y, n.z)).cast<float>());
         }
+        if (in.HasVertexColors(0)) {
+            const aiColor4D& c = in.mColors[0][v];
+            const auto channel = [&](float x) { return linear_colors ? std::clamp(x, 0.0f, 1.0f) : srgb_to_linear(x); };
+            out.colors.emplace_back(channel(c.r), channel(c.g), channel(c.b));
+        }
+        if (in.HasTextureCoords(0)) out.uvs.emplace_back(in.mTextureCoords[0][v].x, in.mTextureCoords[0][v].y);
     }
     for (unsigned f = 0; f < in.mNumFaces; ++f) {
         const aiFace& face = in.mFaces[f];
@@ -66,7 +93,9 @@ bool append_mesh(Mesh& out, const aiMesh& in, const Eigen::Matrix4d& to_file, co
         out.triangles.push_back({static_cast<std::uint32_t>(base + face.mIndices[0]), static_cast<std::uint32_t>(base + face.mIndices[1]),
                                  static_cast<std::uint32_t>(base + face.mIndices[2])});
     }
-    return in.HasNormals();
+    has.normals = has.normals && in.HasNormals();
+    has.colors = has.colors && in.HasVertexColors(0);
+    has.uvs = has.uvs && in.HasTextureCoords(0);
 }
 
 // Vertex numbers here are assimp's, before joining (for OBJ: one per face corner); the
@@ -89,15 +118,92 @@ void check_finite(const aiScene& scene, const std::string& file) {
     }
 }
 
-Mesh read_with_assimp(const std::filesystem::path& path) {
+// OBJ text with every vertex line "v x y z ..." rewritten relative to the bounding-box centre of
+// all vertex lines, computed in double. assimp (Debian's build: ai_real = float) then parses
+// small offsets instead of large absolute coordinates. Lines that do not parse stay as they are
+// (assimp reports them).
+struct RecentredObj {
+    std::string text;
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+};
+
+bool parse_vertex_line(std::string_view line, Eigen::Vector3d& p, std::size_t& rest) {
+    if (line.size() < 2 || line[0] != 'v' || (line[1] != ' ' && line[1] != '\t')) return false;
+    std::size_t pos = 1;
+    for (int k = 0; k < 3; ++k) {
+        while (pos < line.size() && (line[pos] == ' ' || line[pos] == '\t')) ++pos;
+        const auto r = std::from_chars(line.data() + pos, line.data() + line.size(), p[k]);
+        if (r.ec != std::errc{}) return false;
+        pos = static_cast<std::size_t>(r.ptr - line.data());
+    }
+    rest = pos;
+    return p.allFinite();
+}
+
+RecentredObj recentre_obj_text(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream buffer;
+    buffer << in.rdbuf();
+    const std::string text = buffer.str();
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector3d hi = -lo;
+    std::size_t rest = 0;
+    Eigen::Vector3d p;
+    for (std::size_t start = 0; start < text.size();) {
+        const std::size_t end = std::min(text.find('\n', start), text.size());
+        if (parse_vertex_line(std::string_view(text).substr(start, end - start), p, rest)) {
+            lo = lo.cwiseMin(p);
+            hi = hi.cwiseMax(p);
+        }
+        start = end + 1;
+    }
+    RecentredObj out;
+    if (!(lo.x() <= hi.x())) {
+        out.text = text;
+        return out;
+    }
+    out.centre = 0.5 * (lo + hi);
+    out.text.reserve(text.size() + text.size() / 8);
+    for (std::size_t start = 0; start < text.size();) {
+        const std::size_t end = std::min(text.find('\n', start), text.size());
+        const std::string_view line = std::string_view(text).substr(start, end - start);
+        if (parse_vertex_line(line, p, rest)) {
+            const Eigen::Vector3d q = p - out.centre;
+            out.text += fmt::format("v {:.17g} {:.17g} {:.17g}", q.x(), q.y(), q.z());
+            out.text += line.substr(rest);
+        } else {
+            out.text += line;
+        }
+        if (end < text.size()) out.text += '\n';
+        start = end + 1;
+    }
+    return out;
+}
+
+// Serves the re-centred OBJ text for the main file; every other file (.mtl, textures) from disk.
+class RecentredObjIOSystem : public Assimp::DefaultIOSystem {
+public:
+    RecentredObjIOSystem(std::string file, const std::string& text) : file_(std::move(file)), text_(text) {}
+    Assimp::IOStream* Open(const char* file, const char* mode) override {
+        if (file_ == file)
+            return new Assimp::MemoryIOStream(reinterpret_cast<const std::uint8_t*>(text_.data()), text_.size());
+        return Assimp::DefaultIOSystem::Open(file, mode);
+    }
+
+private:
+    std::string file_;
+    const std::string& text_;
+};
+
+const aiScene* import_scene(Assimp::Importer& importer, const std::filesystem::path& path) {
     const std::string file = path.string();
-    Assimp::Importer importer;
     const std::string ext = lower_extension(path);
     if (ext.empty() || !importer.IsExtensionSupported(ext)) {
         throw MeshLoadError(file, fmt::format("unsupported file extension '{}'", ext));
     }
-    // Triangulate polygons. No normal generation or smoothing: we keep what the file has.
-    const aiScene* scene = importer.ReadFile(file, aiProcess_Triangulate);
+    // Triangulate polygons; UVs with (0, 0) at the image's top-left (texture.h). No normal
+    // generation or smoothing: we keep what the file has.
+    const aiScene* scene = importer.ReadFile(file, aiProcess_Triangulate | aiProcess_FlipUVs);
     if (scene == nullptr) throw MeshLoadError(file, fmt::format("assimp: {}", importer.GetErrorString()));
     // Checked before joining: JoinIdenticalVertices silently merges a NaN vertex into another one.
     check_finite(*scene, file);
@@ -105,10 +211,26 @@ Mesh read_with_assimp(const std::filesystem::path& path) {
     // memory, and no shared vertices to smooth normals over).
     scene = importer.ApplyPostProcessing(aiProcess_JoinIdenticalVertices);
     if (scene == nullptr) throw MeshLoadError(file, fmt::format("assimp: {}", importer.GetErrorString()));
+    return scene;
+}
+
+Mesh read_with_assimp(const std::filesystem::path& path) {
+    const std::string file = path.string();
+    const std::string ext = lower_extension(path);
+    RecentredObj obj;  // outlives the importer, which reads it through the IO handler
+    Assimp::Importer importer;
+    if (ext == ".obj") {
+        obj = recentre_obj_text(path);
+        importer.SetIOHandler(new RecentredObjIOSystem(file, obj.text));  // the importer owns it
+    }
+    const aiScene* scene = import_scene(importer, path);
 
     Mesh mesh;
     mesh.source = file;
-    bool all_normals = true;
+    mesh.origin = obj.centre;  // OBJ has no node transforms: the file frame is the mesh frame
+    Attributes has;
+    const bool linear_colors = ext == ".gltf" || ext == ".glb";
+    std::vector<unsigned> materials;
     // Iterative walk: a hostile file must not be able to overflow the stack with deep nesting.
     std::vector<std::pair<const aiNode*, Eigen::Matrix4d>> stack;
     if (scene->mRootNode != nullptr) stack.emplace_back(scene->mRootNode, Eigen::Matrix4d::Identity());
@@ -118,12 +240,19 @@ Mesh read_with_assimp(const std::filesystem::path& path) {
         const Eigen::Matrix4d to_file = parent * to_eigen(node->mTransformation);
         for (unsigned k = 0; k < node->mNumMeshes; ++k) {
             if (node->mMeshes[k] >= scene->mNumMeshes) throw MeshLoadError(file, "assimp: node refers to a missing mesh");
-            all_normals = append_mesh(mesh, *scene->mMeshes[node->mMeshes[k]], to_file, file) && all_normals;
+            const aiMesh& part = *scene->mMeshes[node->mMeshes[k]];
+            append_mesh(mesh, part, to_file, file, linear_colors, has);
+            materials.push_back(part.mMaterialIndex);
         }
         for (unsigned c = 0; c < node->mNumChildren; ++c) stack.emplace_back(node->mChildren[c], to_file);
     }
-    // Normals are all-or-nothing per mesh.h; a file where only some parts have them gets none.
-    if (!all_normals) mesh.normals.clear();
+    // Normals, colours and UVs are all-or-nothing per mesh.h: a file where only some parts have
+    // them gets none.
+    if (!has.normals) mesh.normals.clear();
+    if (!has.colors) mesh.colors.clear();
+    if (!has.uvs) mesh.uvs.clear();
+    if (!mesh.uvs.empty()) mesh.texture = load_base_color_texture(*scene, materials, path);
+    if (!mesh.texture) mesh.uvs.clear();  // UVs without a texture are of no use to the renderer
     return mesh;
 }
 

@@ -128,7 +128,8 @@ TEST_F(MeshIo, PlyAsciiSkipsUnknownPropertiesAndElements) {
     MeshLoadReport report;
     const Mesh m = load_mesh(write("sample.ply", sample_ply("ascii")), &report);
     ASSERT_EQ(m.positions.size(), 5u);
-    EXPECT_EQ(m.positions[3], Eigen::Vector3f(0.f, 1.f, 0.75f));  // z read past `confidence`
+    // z read past `confidence`; positions are offsets from the mesh origin (mesh.h)
+    EXPECT_EQ((m.positions[3].cast<double>() + m.origin).cast<float>(), Eigen::Vector3f(0.f, 1.f, 0.75f));
     using Tri = std::array<std::uint32_t, 3>;
     EXPECT_EQ(m.triangles, (std::vector<Tri>{{0, 1, 2}, {0, 2, 3}, {1, 4, 2}}));  // quad as a fan
     EXPECT_TRUE(m.normals.empty());

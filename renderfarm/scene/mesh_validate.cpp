@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -35,6 +36,24 @@ void validate_mesh(const Mesh& mesh) {
     for (std::size_t i = 0; i < mesh.normals.size(); ++i) {
         if (!mesh.normals[i].allFinite()) throw MeshLoadError(file, fmt::format("normal {}: not finite", i));
     }
+    if (!mesh.origin.allFinite()) throw MeshLoadError(file, "origin (bounding-box centre) is not finite");
+    if (!mesh.colors.empty() && mesh.colors.size() != n) {
+        throw MeshLoadError(file,
+                            fmt::format("colours count mismatch: {} colours for {} vertices", mesh.colors.size(), n));
+    }
+    for (std::size_t i = 0; i < mesh.colors.size(); ++i) {
+        const Eigen::Vector3f& c = mesh.colors[i];
+        if (!(c.minCoeff() >= 0.0f && c.maxCoeff() <= 1.0f))
+            throw MeshLoadError(file, fmt::format("colour {}: outside [0, 1]", i));
+    }
+    if (!mesh.uvs.empty() && mesh.uvs.size() != n) {
+        throw MeshLoadError(file,
+                            fmt::format("texture coordinates count mismatch: {} for {} vertices", mesh.uvs.size(), n));
+    }
+    for (std::size_t i = 0; i < mesh.uvs.size(); ++i) {
+        if (!mesh.uvs[i].allFinite()) throw MeshLoadError(file, fmt::format("texture coordinate {}: not finite", i));
+    }
+    if (mesh.texture && mesh.uvs.empty()) throw MeshLoadError(file, "a texture but no texture coordinates");
 }
 
 void compute_vertex_normals(Mesh& mesh) {
@@ -56,7 +75,7 @@ void compute_vertex_normals(Mesh& mesh) {
 }
 
 Eigen::Vector3d recentre_mesh(Mesh& mesh) {
-    if (mesh.positions.empty()) return Eigen::Vector3d::Zero();
+    if (mesh.positions.empty()) return std::exchange(mesh.origin, Eigen::Vector3d::Zero());
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
     Eigen::Vector3d hi = -lo;
     for (const Eigen::Vector3f& p : mesh.positions) {
@@ -65,7 +84,9 @@ Eigen::Vector3d recentre_mesh(Mesh& mesh) {
     }
     const Eigen::Vector3d centre = 0.5 * (lo + hi);
     for (Eigen::Vector3f& p : mesh.positions) p = (p.cast<double>() - centre).cast<float>();
-    return centre;
+    const Eigen::Vector3d file_centre = mesh.origin + centre;
+    mesh.origin = Eigen::Vector3d::Zero();
+    return file_centre;
 }
 
 }  // namespace mogao

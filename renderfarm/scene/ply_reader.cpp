@@ -328,32 +328,70 @@ int find_scalar(const Element& e, std::string_view name) {
     return -1;
 }
 
+// A colour channel as written by scanners (display sRGB): integer types are codes scaled by the
+// type's maximum (uchar / 255, ushort / 65535), floating-point types must already be in [0, 1].
+// Returned linear (IEC 61966-2-1 EOTF), as the renderer's albedo is.
+double colour_channel(double raw, const Property& p) {
+    double v = raw;
+    if (p.type == Type::u8) v = raw / 255.0;
+    else if (p.type == Type::u16) v = raw / 65535.0;
+    else if (is_integer(p.type))
+        throw ParseFailure(fmt::format("colour '{}' must be uchar, ushort, float or double", p.name));
+    if (!(v >= 0.0 && v <= 1.0)) throw ParseFailure(fmt::format("colour {} = {} is outside [0, 1]", p.name, raw));
+    return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
+}
+
+// Positions are read in double and re-centred on their bounding-box centre (mesh.origin) before
+// they are narrowed to float, so coordinates far from the file's origin keep their precision.
 template <class Source>
 void read_vertices(const Element& e, Source& src, Mesh& mesh, std::uint64_t& i) {
-    // role[k]: 0..2 position, 3..5 normal, -1 skipped.
+    // role[k]: 0..2 position, 3..5 normal, 6..8 colour, -1 skipped.
     std::vector<int> role(e.props.size(), -1);
-    const char* names[6] = {"x", "y", "z", "nx", "ny", "nz"};
-    int found[6];
-    for (int r = 0; r < 6; ++r) found[r] = find_scalar(e, names[r]);
+    const char* names[9] = {"x", "y", "z", "nx", "ny", "nz", "red", "green", "blue"};
+    int found[9];
+    for (int r = 0; r < 9; ++r) found[r] = find_scalar(e, names[r]);
     const bool has_normals = found[3] >= 0 && found[4] >= 0 && found[5] >= 0;
-    for (int r = 0; r < (has_normals ? 6 : 3); ++r) {
+    const bool has_colours = found[6] >= 0 && found[7] >= 0 && found[8] >= 0;
+    for (int r = 0; r < 9; ++r) {
+        if (r >= 3 && r < 6 && !has_normals) continue;
+        if (r >= 6 && !has_colours) continue;
         if (found[r] < 0) throw ParseFailure(fmt::format("no scalar property '{}' in the header", names[r]));
         role[static_cast<std::size_t>(found[r])] = r;
     }
     // Capped by bytes left so that a corrupt count cannot make us allocate without bound.
     const auto cap = std::min<std::uint64_t>(e.count, src.remaining() / 3 + 1);
-    mesh.positions.reserve(static_cast<std::size_t>(cap));
+    std::vector<Eigen::Vector3d> wide;
+    wide.reserve(static_cast<std::size_t>(cap));
     if (has_normals) mesh.normals.reserve(static_cast<std::size_t>(cap));
-    float v[6] = {};
+    if (has_colours) mesh.colors.reserve(static_cast<std::size_t>(cap));
+    double v[9] = {};
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector3d hi = -lo;
     for (; i < e.count; ++i) {
         for (std::size_t k = 0; k < e.props.size(); ++k) {
             const Property& p = e.props[k];
-            if (role[k] < 0) skip_property(src, p);
-            else v[role[k]] = to_float(src.real(p.type), p);
+            const int r = role[k];
+            if (r < 0) {
+                skip_property(src, p);
+                continue;
+            }
+            const double raw = src.real(p.type);
+            if (r < 6) (void)to_float(raw, p);  // the range check: positions end up in float
+            v[r] = r < 6 ? raw : colour_channel(raw, p);
         }
-        mesh.positions.emplace_back(v[0], v[1], v[2]);
-        if (has_normals) mesh.normals.emplace_back(v[3], v[4], v[5]);
+        wide.emplace_back(v[0], v[1], v[2]);
+        if (wide.back().allFinite()) {
+            lo = lo.cwiseMin(wide.back());
+            hi = hi.cwiseMax(wide.back());
+        }
+        if (has_normals)
+            mesh.normals.emplace_back(static_cast<float>(v[3]), static_cast<float>(v[4]), static_cast<float>(v[5]));
+        if (has_colours)
+            mesh.colors.emplace_back(static_cast<float>(v[6]), static_cast<float>(v[7]), static_cast<float>(v[8]));
     }
+    mesh.origin = lo.x() <= hi.x() ? Eigen::Vector3d(0.5 * (lo + hi)) : Eigen::Vector3d::Zero();
+    mesh.positions.reserve(wide.size());
+    for (const Eigen::Vector3d& p : wide) mesh.positions.push_back((p - mesh.origin).cast<float>());
 }
 
 // The list property holding vertex indices of a face/tristrips element.

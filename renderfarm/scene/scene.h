@@ -66,6 +66,10 @@ struct EnvironmentLight {
     Rgb radiance{0.2f, 0.2f, 0.25f};
 };
 
+// Display transform applied to exposure · L before the sRGB encoding (film.h has the formulas):
+// clamp to [0, 1], Reinhard (x / (1 + x)) or the ACES filmic fit of Narkowicz 2015.
+enum class ToneMap { clamp, reinhard, aces };
+
 struct Scene {
     std::string source;                        // scene file path, for messages
     std::vector<Mesh> meshes;
@@ -77,6 +81,7 @@ struct Scene {
     std::vector<EnvironmentLight> environment_lights;
     Viewer viewer;
     float exposure = 1.f;                      // multiplies radiance before the sRGB transfer
+    ToneMap tone_map = ToneMap::clamp;         // scene file "tone_map": "clamp" | "reinhard" | "aces"
 
     [[nodiscard]] std::size_t triangle_count() const;   // summed over instances
 };

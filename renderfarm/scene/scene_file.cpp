@@ -129,9 +129,11 @@ public:
 
     Scene parse(const json& root) {
         if (!root.is_object()) fields_.fail("(root)", "expected a JSON object");
-        fields_.only_keys(root, "(root)", {"name", "exposure", "meshes", "materials", "objects", "lights", "viewer"});
+        fields_.only_keys(root, "(root)",
+                          {"name", "exposure", "tone_map", "meshes", "materials", "objects", "lights", "viewer"});
         scene_.source = origin_.string();
         scene_.exposure = static_cast<float>(fields_.number_or(root, "(root)", "exposure", 1.0, 1e-6, 1e6));
+        if (root.contains("tone_map")) scene_.tone_map = parse_tone_map_field(root["tone_map"]);
         parse_meshes(fields_.member(root, "(root)", "meshes"));
         parse_materials(root.contains("materials") ? root["materials"] : json::object());
         parse_objects(fields_.member(root, "(root)", "objects"));
@@ -141,6 +143,14 @@ public:
     }
 
 private:
+    ToneMap parse_tone_map_field(const json& value) {
+        const std::string name = fields_.string(value, "tone_map");
+        if (name == "clamp") return ToneMap::clamp;
+        if (name == "reinhard") return ToneMap::reinhard;
+        if (name == "aces") return ToneMap::aces;
+        fields_.fail("tone_map", fmt::format("'{}' is not one of clamp, reinhard, aces", name));
+    }
+
     void parse_meshes(const json& meshes) {
         if (!meshes.is_object() || meshes.empty()) fields_.fail("meshes", "expected a non-empty object of named meshes");
         for (auto it = meshes.begin(); it != meshes.end(); ++it) {

@@ -50,6 +50,17 @@ TEST(SceneFile, ParsesMeshesMaterialsObjectsAndLights) {
     EXPECT_EQ(scene.triangle_count(), scene.meshes[0].triangle_count() + scene.meshes[1].triangle_count());
 }
 
+TEST(SceneFile, ToneMapIsReadAndCheckedByName) {
+    EXPECT_EQ(parse_scene(minimal(R"([ { "mesh": "ball" } ])"), kOrigin).tone_map, ToneMap::clamp);
+    EXPECT_EQ(parse_scene(minimal(R"([ { "mesh": "ball" } ])", R"(, "tone_map": "aces")"), kOrigin).tone_map,
+              ToneMap::aces);
+    EXPECT_EQ(parse_scene(minimal(R"([ { "mesh": "ball" } ])", R"(, "tone_map": "reinhard")"), kOrigin).tone_map,
+              ToneMap::reinhard);
+    expect_error(minimal(R"([ { "mesh": "ball" } ])", R"(, "tone_map": "filmic")"),
+                 {"tone_map", "'filmic' is not one of clamp, reinhard, aces"});
+    expect_error(minimal(R"([ { "mesh": "ball" } ])", R"(, "tone_map": 3)"), {"tone_map"});
+}
+
 TEST(SceneFile, TransformAppliesScaleRotationTranslationInOrder) {
     const Scene scene = parse_scene(
         minimal(R"([ { "mesh": "box", "transform": { "scale": 2, "rotate_deg": [0, 90, 0], "translate": [10, 0, 0] } } ])"),

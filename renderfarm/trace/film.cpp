@@ -33,7 +33,38 @@ std::uint8_t encode_srgb8(float linear) {
     return static_cast<std::uint8_t>(std::upper_bound(t.begin(), t.end(), v) - t.begin());
 }
 
-void to_srgb8(const RgbFloatImage& in, const PixelRect& rect, float exposure, Rgb8Image& out) {
+float tone_map(ToneMap op, float x) {
+    switch (op) {
+        case ToneMap::clamp:
+            return x;  // encode_srgb8 clamps
+        case ToneMap::reinhard:
+            return x / (1.0f + x);
+        case ToneMap::aces:
+            return (x * (2.51f * x + 0.03f)) / (x * (2.43f * x + 0.59f) + 0.14f);
+    }
+    return x;
+}
+
+ToneMap parse_tone_map(const std::string& name) {
+    if (name == "clamp") return ToneMap::clamp;
+    if (name == "reinhard") return ToneMap::reinhard;
+    if (name == "aces") return ToneMap::aces;
+    throw std::invalid_argument("tone map '" + name + "' is not one of clamp, reinhard, aces");
+}
+
+const char* tone_map_name(ToneMap op) {
+    switch (op) {
+        case ToneMap::clamp:
+            return "clamp";
+        case ToneMap::reinhard:
+            return "reinhard";
+        case ToneMap::aces:
+            return "aces";
+    }
+    return "?";
+}
+
+void to_srgb8(const RgbFloatImage& in, const PixelRect& rect, float exposure, Rgb8Image& out, ToneMap op) {
     if (!(in.size == out.size)) throw std::invalid_argument("to_srgb8: input and output sizes differ");
     if (rect.x0 < 0 || rect.y0 < 0 || rect.x1 > in.size.width || rect.y1 > in.size.height) {
         throw std::invalid_argument("to_srgb8: rect is outside the image");
@@ -45,7 +76,12 @@ void to_srgb8(const RgbFloatImage& in, const PixelRect& rect, float exposure, Rg
         for (int x = rect.x0; x < rect.x1; ++x) {
             const float* src = in.at(x, y);
             std::uint8_t* dst = out.at(x, y);
-            for (int c = 0; c < 3; ++c) dst[c] = encode_srgb8(exposure * src[c]);
+            for (int c = 0; c < 3; ++c) {
+                const float v = exposure * src[c];
+                // NaN fails the comparison and stays NaN -> code 0; +inf -> 1 for every operator.
+                dst[c] =
+                    encode_srgb8(op == ToneMap::clamp || !(v > 0.0f) ? v : (std::isinf(v) ? 1.0f : tone_map(op, v)));
+            }
         }
     }
 }

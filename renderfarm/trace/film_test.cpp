@@ -52,5 +52,43 @@ TEST(Film, AppliesExposureInsideRectOnly) {
     EXPECT_THROW(to_srgb8(in, {0, 0, 1, 1}, -1.0f, out), std::invalid_argument);
 }
 
+// Highlights: with clamp everything above 1 is one flat code; the tone maps keep an ordering
+// up to several times white, match their formulas, and stay monotonic and within [0, 1].
+TEST(Film, ToneMapsKeepHighlightsApart) {
+    RgbFloatImage in({4, 1});
+    const float values[4] = {0.18f, 1.0f, 2.0f, 4.0f};
+    for (int x = 0; x < 4; ++x)
+        for (int c = 0; c < 3; ++c) in.at(x, 0)[c] = values[x];
+    Rgb8Image clamped(in.size);
+    to_srgb8(in, PixelRect::whole(in.size), 1.0f, clamped, ToneMap::clamp);
+    EXPECT_EQ(clamped.at(1, 0)[0], 255);
+    EXPECT_EQ(clamped.at(3, 0)[0], 255);  // 1, 2 and 4 all clip to the same code
+    for (const ToneMap op : {ToneMap::reinhard, ToneMap::aces}) {
+        Rgb8Image out(in.size);
+        to_srgb8(in, PixelRect::whole(in.size), 1.0f, out, op);
+        for (int x = 1; x < 4; ++x) EXPECT_LT(out.at(x - 1, 0)[0], out.at(x, 0)[0]) << tone_map_name(op) << " " << x;
+        EXPECT_LT(out.at(2, 0)[0], 255) << tone_map_name(op);
+        float previous = 0.0f;
+        for (int i = 0; i <= 1000; ++i) {
+            const float x = 0.01f * static_cast<float>(i);
+            const float v = tone_map(op, x);
+            ASSERT_GE(v, previous) << tone_map_name(op) << " at " << x;
+            ASSERT_GE(v, 0.0f);
+            ASSERT_LE(v, 1.04f);  // the ACES fit tends to 2.51/2.43 before encode_srgb8 clamps
+            previous = v;
+        }
+    }
+    EXPECT_FLOAT_EQ(tone_map(ToneMap::reinhard, 3.0f), 0.75f);
+    EXPECT_NEAR(tone_map(ToneMap::aces, 1.0f), (2.51 + 0.03) / (2.43 + 0.59 + 0.14), 1e-6);
+    EXPECT_EQ(parse_tone_map("aces"), ToneMap::aces);
+    EXPECT_THROW((void)parse_tone_map("filmic"), std::invalid_argument);
+    Rgb8Image odd(in.size);
+    in.at(0, 0)[0] = std::numeric_limits<float>::quiet_NaN();
+    in.at(0, 0)[1] = std::numeric_limits<float>::infinity();
+    to_srgb8(in, PixelRect::whole(in.size), 1.0f, odd, ToneMap::aces);
+    EXPECT_EQ(odd.at(0, 0)[0], 0);
+    EXPECT_EQ(odd.at(0, 0)[1], 255);
+}
+
 }  // namespace
 }  // namespace mogao

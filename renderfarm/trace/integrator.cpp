@@ -1,12 +1,15 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "renderfarm/trace/integrator.h"
 
+#include <algorithm>
 #include <limits>
+#include <numbers>
 
 #include <embree3/rtcore.h>
 
 #include "renderfarm/trace/ray_offset.h"
 #include "renderfarm/trace/sampling.h"
+#include "renderfarm/trace/sobol.h"
 
 namespace mogao {
 namespace {
@@ -43,7 +46,7 @@ bool occluded(RTCScene scene, const Eigen::Vector3f& org, const Eigen::Vector3f&
 
 struct Vertex {
     const SurfaceHit& hit;
-    const ShadingMaterial& material;
+    const ShadingMaterial& material;  // with the hit's tint applied (tinted_material)
     const Eigen::Vector3f& wo;
     Eigen::Vector3f origin;  // offset along the geometric normal, for rays leaving on its side
 };
@@ -55,7 +58,25 @@ Eigen::Vector3f reflect_factor(const Vertex& x, const Eigen::Vector3f& wi) {
     return eval_brdf(x.material, x.hit.shading_normal, x.wo, wi) * cos_shading;
 }
 
-Eigen::Vector3f direct_light(const FrameContext& frame, const Vertex& x, PixelRng& rng, std::uint64_t& rays) {
+// Environment: (1/N) Σ π f(wo, w) V(w) L_env over N = max(1, ao_samples) cosine-weighted
+// directions (pdf cosθ/π), so f cosθ / pdf = π f. See integrator.h for why N >= 1.
+Eigen::Vector3f environment_light(const FrameContext& frame, const Vertex& x, PixelSampler& sampler,
+                                  std::uint64_t& rays) {
+    const int count = std::max(1, frame.ao_samples);
+    const PixelSampler::Pair pair = sampler.take();
+    const Frame tangent(x.hit.shading_normal);
+    Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+    for (int s = 0; s < count; ++s) {
+        const Eigen::Vector2f u = pair.point(s, count);
+        const Eigen::Vector3f w = cosine_hemisphere(tangent, u.x(), u.y());
+        if (x.hit.geometric_normal.dot(w) <= 0.0f) continue;  // into the surface itself
+        if (occluded(frame.scene->root(), x.origin, w, kInfinity, rays)) continue;
+        sum += eval_brdf(x.material, x.hit.shading_normal, x.wo, w);
+    }
+    return sum.cwiseProduct(frame.lights->environment) * (std::numbers::pi_v<float> / static_cast<float>(count));
+}
+
+Eigen::Vector3f direct_light(const FrameContext& frame, const Vertex& x, PixelSampler& sampler, std::uint64_t& rays) {
     const LightSet& lights = *frame.lights;
     const RTCScene scene = frame.scene->root();
     Eigen::Vector3f sum = Eigen::Vector3f::Zero();
@@ -79,10 +100,10 @@ Eigen::Vector3f direct_light(const FrameContext& frame, const Vertex& x, PixelRn
     if (!lights.area.empty()) {
         const float weight = 1.0f / static_cast<float>(frame.area_light_samples);
         for (const PreparedArea& l : lights.area) {
+            const PixelSampler::Pair pair = sampler.take();
             for (int s = 0; s < frame.area_light_samples; ++s) {
-                const float u1 = rng.next();
-                const float u2 = rng.next();
-                const Eigen::Vector3f to_light = l.corner + u1 * l.edge_u + u2 * l.edge_v - x.hit.position;
+                const Eigen::Vector2f u = pair.point(s, frame.area_light_samples);
+                const Eigen::Vector3f to_light = l.corner + u.x() * l.edge_u + u.y() * l.edge_v - x.hit.position;
                 const float distance2 = to_light.squaredNorm();
                 if (!(distance2 > 0.0f)) continue;
                 const float distance = std::sqrt(distance2);
@@ -96,44 +117,33 @@ Eigen::Vector3f direct_light(const FrameContext& frame, const Vertex& x, PixelRn
             }
         }
     }
-    if (lights.has_environment) {
-        float visible = 1.0f;
-        if (frame.ao_samples > 0) {
-            const Frame tangent(x.hit.shading_normal);
-            int escaped = 0;
-            for (int s = 0; s < frame.ao_samples; ++s) {
-                const float u1 = rng.next();
-                const float u2 = rng.next();
-                const Eigen::Vector3f w = cosine_hemisphere(tangent, u1, u2);
-                if (x.hit.geometric_normal.dot(w) <= 0.0f) continue;  // into the surface itself
-                if (!occluded(scene, x.origin, w, kInfinity, rays)) ++escaped;
-            }
-            visible = static_cast<float>(escaped) / static_cast<float>(frame.ao_samples);
-        }
-        sum += x.material.albedo.cwiseProduct(lights.environment) * visible;
-    }
+    if (lights.has_environment) sum += environment_light(frame, x, sampler, rays);
     return sum;
 }
 
 }  // namespace
 
 Eigen::Vector3f radiance_at(const FrameContext& frame, const SurfaceHit& first, const Eigen::Vector3f& first_wo,
-                            PixelRng& rng, std::uint64_t& rays) {
+                            PixelSampler& sampler, std::uint64_t& rays) {
     Eigen::Vector3f radiance = Eigen::Vector3f::Zero();
     Eigen::Vector3f throughput = Eigen::Vector3f::Ones();
     SurfaceHit hit = first;
     Eigen::Vector3f wo = first_wo;
     for (int depth = 0;; ++depth) {
-        const ShadingMaterial& material = (*frame.materials)[hit.material];
+        const ShadingMaterial& base = (*frame.materials)[hit.material];
+        ShadingMaterial tinted;
+        if (hit.tinted) tinted = tinted_material(base, hit.tint);  // untinted meshes skip the copy
+        const ShadingMaterial& material = hit.tinted ? tinted : base;
         const Vertex x{hit, material, wo, offset_ray_origin(hit.position, hit.geometric_normal)};
-        radiance += throughput.cwiseProduct(direct_light(frame, x, rng, rays));
+        radiance += throughput.cwiseProduct(direct_light(frame, x, sampler, rays));
         if (depth == frame.max_bounces) break;
 
-        const float u1 = rng.next();
-        const float u2 = rng.next();
-        const Eigen::Vector3f wi = cosine_hemisphere(Frame(hit.shading_normal), u1, u2);
+        const Eigen::Vector2f u = sampler.next2d();
+        const Eigen::Vector3f wi = cosine_hemisphere(Frame(hit.shading_normal), u.x(), u.y());
         if (hit.geometric_normal.dot(wi) <= 0.0f) break;
-        throughput = throughput.cwiseProduct(material.albedo);
+        // f cosθ / pdf with pdf = cosθ/π (PBRT 4th ed. §13.1).
+        throughput =
+            throughput.cwiseProduct(eval_brdf(material, hit.shading_normal, wo, wi)) * std::numbers::pi_v<float>;
         if (!(throughput.maxCoeff() > 0.0f)) break;
 
         RTCIntersectContext context;

@@ -15,6 +15,11 @@ namespace {
 
 void validate_mesh_indices(const Scene& scene, std::size_t index, const Mesh& mesh) {
     const auto vertex_count = mesh.positions.size();
+    if ((!mesh.colors.empty() && mesh.colors.size() != vertex_count) ||
+        (!mesh.uvs.empty() && mesh.uvs.size() != vertex_count)) {
+        invalid(scene, "mesh " + std::to_string(index) + " has colours or uvs not matching its " +
+                           std::to_string(vertex_count) + " positions");
+    }
     if (!mesh.normals.empty() && mesh.normals.size() != vertex_count) {
         invalid(scene, "mesh " + std::to_string(index) + " has " + std::to_string(mesh.normals.size()) +
                            " normals for " + std::to_string(vertex_count) + " positions");
@@ -91,7 +96,9 @@ RenderScene::RenderScene(const Scene& scene, const std::string& embree_config)
         data.mesh = &mesh;
         data.material = static_cast<std::uint32_t>(inst.material);
         data.smooth = !mesh.normals.empty();
-        data.object_to_world = inst.object_to_world;
+        data.tinted = !mesh.colors.empty() || (mesh.texture != nullptr && !mesh.uvs.empty());
+        // Mesh positions are offsets from mesh.origin (mesh.h); 0 for recentred meshes.
+        data.object_to_world = inst.object_to_world * Eigen::Translation3d(mesh.origin);
         data.normal_matrix = inst.object_to_world.linear().inverse().transpose().cast<float>();
         instances_.push_back(data);
 
@@ -130,6 +137,18 @@ void RenderScene::commit_transforms() {
     device_.check("rtcCommitScene(instances)");
 }
 
+Eigen::Vector3f RenderScene::tint_at(const Mesh& mesh, std::uint32_t primitive, float u, float v) {
+    const auto& tri = mesh.triangles[primitive];
+    const float w = 1.0f - u - v;
+    Eigen::Vector3f tint = Eigen::Vector3f::Ones();
+    if (!mesh.colors.empty()) tint = w * mesh.colors[tri[0]] + u * mesh.colors[tri[1]] + v * mesh.colors[tri[2]];
+    if (mesh.texture && !mesh.uvs.empty()) {
+        const Eigen::Vector2f uv = w * mesh.uvs[tri[0]] + u * mesh.uvs[tri[1]] + v * mesh.uvs[tri[2]];
+        tint = tint.cwiseProduct(mesh.texture->sample(uv));
+    }
+    return tint;
+}
+
 SurfaceHit RenderScene::surface(const Eigen::Vector3f& org, const Eigen::Vector3f& dir, float t,
                                 std::uint32_t instance, std::uint32_t primitive, float u, float v,
                                 const Eigen::Vector3f& ng_object) const {
@@ -140,6 +159,10 @@ SurfaceHit RenderScene::surface(const Eigen::Vector3f& org, const Eigen::Vector3
     Eigen::Vector3f ng = (inst.normal_matrix * ng_object).normalized();
     if (ng.dot(dir) > 0.0f) ng = -ng;  // face the incoming ray: meshes are two-sided
     hit.geometric_normal = ng;
+    if (inst.tinted) {
+        hit.tinted = true;
+        hit.tint = tint_at(*inst.mesh, primitive, u, v);
+    }
     if (!inst.smooth) {
         hit.shading_normal = ng;
         return hit;

@@ -36,6 +36,10 @@ struct SurfaceHit {
     Eigen::Vector3f shading_normal;    // unit; interpolated vertex normal or = geometric_normal,
                                        // flipped to the geometric normal's side
     std::uint32_t material = 0;        // index into Scene::materials
+    bool tinted = false;               // the mesh has vertex colours or a texture
+    Eigen::Vector3f tint = Eigen::Vector3f::Ones();  // linear RGB multiplying the albedo: the
+                                                     // interpolated vertex colour times the bilinear texture
+                                                     // sample at the interpolated uv (texture.h)
 };
 
 class RenderScene {
@@ -64,11 +68,13 @@ private:
         const Mesh* mesh = nullptr;
         std::uint32_t material = 0;
         bool smooth = false;                  // mesh has vertex normals
+        bool tinted = false;                  // mesh has vertex colours or a texture
         Eigen::Affine3d object_to_world;      // double, world metres
         Eigen::Matrix3f normal_matrix;        // inverse transpose of the linear part
     };
 
     void commit_transforms();
+    [[nodiscard]] static Eigen::Vector3f tint_at(const Mesh& mesh, std::uint32_t primitive, float u, float v);
 
     EmbreeDevice device_;
     std::vector<EmbreeScene> blas_;           // per mesh; empty owner for unused meshes

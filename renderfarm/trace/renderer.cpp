@@ -10,6 +10,7 @@
 
 #include <embree3/rtcore.h>
 
+#include "common/request_limits.h"
 #include "renderfarm/trace/camera.h"
 #include "renderfarm/trace/integrator.h"
 #include "renderfarm/trace/light_set.h"
@@ -17,7 +18,7 @@
 #include "renderfarm/trace/rng.h"
 #include "renderfarm/trace/sampling.h"
 #include "renderfarm/trace/shading.h"
-#include "common/request_limits.h"
+#include "renderfarm/trace/sobol.h"
 
 namespace mogao {
 namespace {
@@ -77,7 +78,8 @@ struct Renderer::Impl {
     }
 
     // Fills the camera rays of one sample index for the lanes of `block` and their random streams.
-    void fill_packet(const Block& block, int sample, RTCRayHit16& packet, std::array<PixelRng, kLanes>& rngs) const {
+    void fill_packet(const Block& block, int sample, RTCRayHit16& packet,
+                     std::array<PixelSampler, kLanes>& rngs) const {
         const Eigen::Vector3d& origin = geometry.origin();
         for (int lane = 0; lane < kLanes; ++lane) {
             const auto l = static_cast<std::size_t>(lane);
@@ -86,13 +88,10 @@ struct Renderer::Impl {
             if (block.valid[l] == 0) continue;
             const int x = block.x0 + lane % kBlock;
             const int y = block.y0 + lane / kBlock;
-            rngs[l] = PixelRng(key, x, y, sample);
+            rngs[l] = PixelSampler(key, x, y, sample);
+            // spp == 1 keeps the pixel centre; otherwise the pixel's samples are one Sobol' net.
             Eigen::Vector2f jitter(0.5f, 0.5f);
-            if (spp > 1) {
-                const float u1 = rngs[l].next();
-                const float u2 = rngs[l].next();
-                jitter = stratified_jitter(sample, spp, u1, u2);
-            }
+            if (spp > 1) jitter = rngs[l].next2d();
             const Ray ray = generate_ray(*camera, x + static_cast<double>(jitter.x()), y + static_cast<double>(jitter.y()));
             const Eigen::Vector3f org = (ray.origin - origin).cast<float>();
             const Eigen::Vector3f dir = ray.direction.cast<float>();
@@ -179,7 +178,7 @@ TileStats Renderer::render(const PixelRect& rect, RgbFloatImage& frame) const {
         sum.fill(Eigen::Vector3f::Zero());
         for (int sample = 0; sample < s.spp; ++sample) {
             RTCRayHit16 packet{};  // masked lanes stay zero (defined for tools like valgrind)
-            std::array<PixelRng, kLanes> rngs;
+            std::array<PixelSampler, kLanes> rngs;
             s.fill_packet(block, sample, packet, rngs);
             s.intersect(block, packet);
             stats.rays += static_cast<std::uint64_t>(block.active);
@@ -216,7 +215,7 @@ TileStats Renderer::trace_camera_rays(const PixelRect& rect) const {
     Impl::for_each_block(rect, [&](const Block& block) {
         for (int sample = 0; sample < s.spp; ++sample) {
             RTCRayHit16 packet{};  // masked lanes stay zero (defined for tools like valgrind)
-            std::array<PixelRng, kLanes> rngs;
+            std::array<PixelSampler, kLanes> rngs;
             s.fill_packet(block, sample, packet, rngs);
             s.intersect(block, packet);
             stats.rays += static_cast<std::uint64_t>(block.active);

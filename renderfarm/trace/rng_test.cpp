@@ -60,12 +60,5 @@ TEST(Sampling, CosineHemisphereHasCosineMean) {
     EXPECT_NEAR(sum / count, 2.0 / 3.0, 0.005);
 }
 
-TEST(Sampling, StratifiedJitterCoversCells) {
-    EXPECT_EQ(stratified_jitter(0, 1, 0.9f, 0.1f), Eigen::Vector2f(0.5f, 0.5f));
-    // spp = 4: a 2x2 grid.
-    EXPECT_EQ(stratified_jitter(3, 4, 0.5f, 0.5f), Eigen::Vector2f(0.75f, 0.75f));
-    EXPECT_EQ(stratified_jitter(1, 4, 0.0f, 0.0f), Eigen::Vector2f(0.5f, 0.0f));
-}
-
 }  // namespace
 }  // namespace mogao

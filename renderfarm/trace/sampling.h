@@ -51,15 +51,4 @@ struct Frame {
     return frame.to_world(Eigen::Vector3f(d.x(), d.y(), z));
 }
 
-// Position of sample `sample` of `spp` inside the unit pixel square: the pixel is split into a
-// cols x rows grid (cols = ceil(sqrt(spp)), rows = ceil(spp / cols)), sample s is jittered by
-// (u1, u2) inside cell (s % cols, s / cols). spp == 1 returns the pixel centre (no jitter).
-[[nodiscard]] inline Eigen::Vector2f stratified_jitter(int sample, int spp, float u1, float u2) {
-    if (spp <= 1) return {0.5f, 0.5f};
-    const int cols = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(spp))));
-    const int rows = (spp + cols - 1) / cols;
-    return {(static_cast<float>(sample % cols) + u1) / static_cast<float>(cols),
-            (static_cast<float>(sample / cols) + u2) / static_cast<float>(rows)};
-}
-
 }  // namespace mogao
