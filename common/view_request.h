@@ -50,9 +50,9 @@ using CameraModel = std::variant<PinholeCamera, CylinderScreen>;
 
 // Quality knobs: every one trades time for error (see docs/benchmarks.md).
 struct Quality {
-    int spp = 1;                  // samples per pixel (stratified jitter; 1 = pixel centre)
+    int spp = 1;                  // samples per pixel (Owen-scrambled Sobol' points; 1 = pixel centre)
     int max_bounces = 0;          // indirect bounces of the path tracer; 0 = direct light only
-    int ao_samples = 0;           // cosine-weighted occlusion rays for the environment light; 0 = unoccluded
+    int ao_samples = 0;           // cosine-weighted occlusion rays for the environment light; 0 traces 1
     int area_light_samples = 1;   // shadow rays per area light per sample
     double resolution_scale = 1.0;  // render at width*scale x height*scale, (0, 1]
     int jpeg_quality = 85;        // 1..100, TurboJPEG
