@@ -16,8 +16,9 @@
 //
 // Errors: a manual value outside the device's range is EINVAL naming `name` (the kiosk passes its
 // config key, e.g. "[navigation].camera_exposure_us"), the value and the range in the same unit; a
-// control the device lacks is ENOTSUP naming `name` when `required`, and is skipped otherwise (the
-// capture's description() says so).
+// control the device lacks is ENOTSUP naming `name` when `required`, and is skipped otherwise; a
+// value outside the range of a setting that is not required (a default) is clamped into it. The
+// capture's description() names what was skipped or clamped.
 #pragma once
 
 #include <string>

@@ -453,10 +453,16 @@ Status LibcameraCapture::Impl::apply_controls(const CameraControls& wanted, libc
         skipped_controls += (skipped_controls.empty() ? "" : ", ") + s.name + " (no " + what + ")";
         return {};
     };
-    const auto range_check = [&](const ControlSetting& s, const libcamera::ControlInfo& ci, double lo, double hi,
-                                 const std::string& unit) -> Status {
-        if (s.value >= lo && s.value <= hi) return {};
-        (void)ci;
+    // A value within the camera's range; a default (not required) outside it is clamped and noted.
+    const auto in_range = [&](const ControlSetting& s, double lo, double hi,
+                              const std::string& unit) -> Result<double> {
+        if (s.value >= lo && s.value <= hi) return s.value;
+        if (!s.required) {
+            const double clamped = s.value < lo ? lo : hi;
+            skipped_controls +=
+                (skipped_controls.empty() ? "" : ", ") + s.name + " clamped to " + std::to_string(clamped) + unit;
+            return clamped;
+        }
         return make_error(EINVAL, "libcamera camera " + id + ": " + s.name + " = " + std::to_string(s.value) +
                                       " is outside the camera's range [" + std::to_string(lo) + ", " +
                                       std::to_string(hi) + "]" + unit);
@@ -473,17 +479,25 @@ Status LibcameraCapture::Impl::apply_controls(const CameraControls& wanted, libc
     }
     if (e.mode == Mode::manual) {
         const auto it = info.find(&libcamera::controls::ExposureTime);
-        if (it == info.end()) return missing(e, "ExposureTime control");
-        const libcamera::ControlInfo& ci = it->second;
-        if (Status s = range_check(e, ci, ci.min().get<int32_t>(), ci.max().get<int32_t>(), " us"); !s) return s;
-        out.set(libcamera::controls::ExposureTime, static_cast<int32_t>(std::lround(e.value)));
+        if (it == info.end()) {
+            if (Status s = missing(e, "ExposureTime control"); !s) return s;
+        } else {
+            const libcamera::ControlInfo& ci = it->second;
+            auto v = in_range(e, ci.min().get<int32_t>(), ci.max().get<int32_t>(), " us");
+            if (!v) return v.error();
+            out.set(libcamera::controls::ExposureTime, static_cast<int32_t>(std::lround(*v)));
+        }
     }
     if (g.mode == Mode::manual) {
         const auto it = info.find(&libcamera::controls::AnalogueGain);
-        if (it == info.end()) return missing(g, "AnalogueGain control");
-        const libcamera::ControlInfo& ci = it->second;
-        if (Status s = range_check(g, ci, ci.min().get<float>(), ci.max().get<float>(), ""); !s) return s;
-        out.set(libcamera::controls::AnalogueGain, static_cast<float>(g.value));
+        if (it == info.end()) {
+            if (Status s = missing(g, "AnalogueGain control"); !s) return s;
+        } else {
+            const libcamera::ControlInfo& ci = it->second;
+            auto v = in_range(g, ci.min().get<float>(), ci.max().get<float>(), "");
+            if (!v) return v.error();
+            out.set(libcamera::controls::AnalogueGain, static_cast<float>(*v));
+        }
     }
     const ControlSetting& w = wanted.white_balance;
     if (w.mode == Mode::manual) {

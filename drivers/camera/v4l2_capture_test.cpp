@@ -173,6 +173,14 @@ TEST(V4l2CaptureVivid, GainIsSetCheckedAndLocked) {
               std::string::npos)
         << cam.error().message;
 
+    config.controls.gain.required = false;  // a default: clamped into the range, and said so
+    cam = V4l2Capture::open(config);
+    ASSERT_TRUE(cam.ok()) << cam.error().message;
+    EXPECT_EQ((*cam)->control_values().gain, 255.0);
+    EXPECT_NE((*cam)->description().find("[navigation].camera_gain clamped to 255"), std::string::npos)
+        << (*cam)->description();
+    cam = Result<std::unique_ptr<V4l2Capture>>(make_error(EIO, "closed"));
+
     config.controls.gain = {ControlSetting::Mode::automatic, 0, true, "gain"};
     cam = V4l2Capture::open(config);
     ASSERT_TRUE(cam.ok()) << cam.error().message;

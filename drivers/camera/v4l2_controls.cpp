@@ -70,8 +70,12 @@ public:
         if (s.required) {
             return make_error(ENOTSUP, device_ + ": " + s.name + " = " + describe(s) + ": the device has no " + what);
         }
-        if (skipped_ != nullptr) *skipped_ += (skipped_->empty() ? "" : ", ") + s.name + " (no " + what + ")";
+        note(s.name + " (no " + what + ")");
         return {};
+    }
+
+    void note(const std::string& text) {
+        if (skipped_ != nullptr) *skipped_ += (skipped_->empty() ? "" : ", ") + text;
     }
 
     // The automatic switch's value for "on" and "off" (exposure is a menu, the others booleans).
@@ -103,8 +107,17 @@ public:
             const ControlRange range{value_ctrl->minimum, value_ctrl->maximum,
                                      static_cast<long long>(value_ctrl->step)};
             auto v = to_device_value(s.name, s.value, range, b.unit, b.unit_name);
-            if (!v) return make_error(EINVAL, device_ + ": " + v.error().message + " (" + b.value_cid + ")");
-            target = *v;
+            if (!v && s.required) {
+                return make_error(EINVAL, device_ + ": " + v.error().message + " (" + b.value_cid + ")");
+            }
+            if (!v) {  // a default the device cannot reach: the nearest it can, noted for description()
+                const double wanted = s.value / b.unit;
+                target = wanted < static_cast<double>(range.minimum) ? range.minimum : range.maximum;
+                note(s.name + " clamped to " + std::to_string(static_cast<double>(target) * b.unit) + " " +
+                     b.unit_name);
+            } else {
+                target = *v;
+            }
         }
         if (Status st = set_auto(b, s, false); !st) return st;
         if (s.mode == Mode::lock) {

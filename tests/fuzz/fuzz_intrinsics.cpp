@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// Fuzz target: a camera intrinsics JSON file read by read_intrinsics (the tracker'\''s camera.json). Documented errors are caught; anything
-// else (a crash, a sanitizer report, an exception of another type) is a finding.
+// Fuzz target: a camera intrinsics JSON file read by read_intrinsics (the tracker'\''s camera.json). Documented errors
+// are caught; anything else (a crash, a sanitizer report, an exception of another type) is a finding.
 #include <cstddef>
 #include <cstdint>
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Fuzz target: a Motion-JPEG camera frame decoded by MjpegDecoder, grey and colour; the
-// decoder is reused across inputs as on a real camera, so a frame that poisons it shows. Documented errors are caught; anything
-// else (a crash, a sanitizer report, an exception of another type) is a finding.
+// decoder is reused across inputs as on a real camera, so a frame that poisons it shows. Documented errors are caught;
+// anything else (a crash, a sanitizer report, an exception of another type) is a finding.
 #include <cstddef>
 #include <cstdint>
 

@@ -14,7 +14,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (!file.valid()) return 0;
     try {
         static_cast<void>(mogao::read_mpcdi(file.path()));
-    } catch (const mogao::MpcdiError&) {
-    }
+    } catch (const mogao::MpcdiError&) {}
     return 0;
 }

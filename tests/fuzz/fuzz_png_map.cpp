@@ -10,7 +10,6 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     try {
         static_cast<void>(mogao::decode_png_map({data, size}, "fuzz"));
-    } catch (const mogao::MpcdiError&) {
-    }
+    } catch (const mogao::MpcdiError&) {}
     return 0;
 }

@@ -13,9 +13,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     mogao::SceneLoadOptions options;
     options.scans_dir = "/nonexistent/mogao-fuzz-scans";
     try {
-        static_cast<void>(mogao::parse_scene(std::string(mogao::fuzz::text(data, size)), "/nonexistent/mogao-fuzz/scene.json", options));
+        static_cast<void>(mogao::parse_scene(std::string(mogao::fuzz::text(data, size)),
+                                             "/nonexistent/mogao-fuzz/scene.json", options));
     } catch (const mogao::SceneError&) {
-    } catch (const mogao::MeshLoadError&) {
-    }
+    } catch (const mogao::MeshLoadError&) {}
     return 0;
 }
