@@ -1,0 +1,152 @@
+// SPDX-License-Identifier: Apache-2.0
+// The calibrate command's job: rig -> patterns -> calibration -> MPCDI, report, preview (calibrate_job.h).
+#include "appliance/autocal/calibrate_job.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <stdexcept>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "appliance/autocal/rig_bridge.h"
+#include "appliance/calibration/mpcdi_screen.h"
+#include "appliance/calibration/mpcdi_writer.h"
+#include "appliance/rig/rig_file.h"
+#include "appliance/warp/response_curve.h"
+#include "appliance/warp/warp_sampling.h"
+
+namespace mogao::autocal {
+namespace {
+
+// Image position of screen point (theta, h) in a fitted model, or NaN.
+Eigen::Vector2d model_pixel(const DeviceModel& d, const ScreenModel& s, double theta, double h) {
+    const Eigen::Vector3d p(s.radius_m * std::sin(theta), h, -s.radius_m * std::cos(theta));
+    const Eigen::Vector3d q = d.rotation.transpose() * (p - d.position_m);
+    const Eigen::Vector2d xy(d.fx_px * q.x() / q.z() + d.cx_px, d.fy_px * q.y() / q.z() + d.cy_px);
+    if (q.z() <= 0.0 ||
+        !(xy.x() >= 0.0 && xy.x() < d.resolution.width && xy.y() >= 0.0 && xy.y() < d.resolution.height)) {
+        return {std::nan(""), std::nan("")};
+    }
+    return xy;
+}
+
+// The calibration's own prediction of its seams: max |sum of blend weights - 1| where the fitted
+// models put two or more projectors (content grid of 401 x 101 points inset by 1 %).
+double predicted_seam(const AutocalResult& r, const ScreenModel& s) {
+    const double arc = s.arc_deg * std::numbers::pi / 180.0;
+    double worst = 0.0;
+    for (int j = 0; j <= 100; ++j) {
+        for (int i = 0; i <= 400; ++i) {
+            const double u = 0.01 + 0.98 * i / 400.0;
+            const double v = 0.01 + 0.98 * j / 100.0;
+            double sum = 0.0;
+            int lit = 0;
+            for (std::size_t k = 0; k < r.projectors.size(); ++k) {
+                const Eigen::Vector2d xy =
+                    model_pixel(r.projectors[k], s, u * arc - arc / 2.0, s.top_m - v * (s.top_m - s.bottom_m));
+                if (!xy.allFinite()) continue;
+                const ProjectorCalibration& pc = r.calibration.projectors[k];
+                const float w = sample_blend(pc.blend, pc.output, static_cast<int>(xy.x()), static_cast<int>(xy.y()));
+                sum += w;
+                lit += w > 0.0f;
+            }
+            if (lit >= 2) worst = std::max(worst, std::abs(sum - 1.0));
+        }
+    }
+    return worst;
+}
+
+// The screen as the viewer sees it: per content pixel of a size x size/aspect image, the light of
+// every projector whose (ground-truth) pixel lands there, showing white content with grid lines.
+cv::Mat1b preview(const rig::VirtualRig& rig, const ScreenCalibration& c, int width) {
+    const int height = std::max(1, width * c.content.height / c.content.width);
+    cv::Mat1f light(height, width, 0.0f);
+    for (int y = 0; y < height; ++y) {
+        for (int x = 0; x < width; ++x) {
+            const rig::ScreenPoint s = rig::screen_of(rig.screen, {(x + 0.5) / width, (y + 0.5) / height});
+            double l = 0.0;
+            for (std::size_t k = 0; k < c.projectors.size(); ++k) {
+                const auto p = rig::screen_to_projector(rig, static_cast<int>(k), s);
+                if (!p) continue;
+                const ProjectorCalibration& pc = c.projectors[k];
+                const int px = static_cast<int>(p->x());
+                const int py = static_cast<int>(p->y());
+                const ContentUv uv = sample_warp(pc.warp, pc.output, px, py);
+                if (!uv.valid()) continue;
+                const double gu = uv.u * 16.0 - std::round(uv.u * 16.0);
+                const double gv = uv.v * 16.0 - std::round(uv.v * 16.0);
+                const double content = (std::abs(gu) < 0.01 || std::abs(gv) < 0.01) ? 0.1 : 1.0;
+                const double signal = apply_response(
+                    pc.response, 0, static_cast<float>(content) * sample_blend(pc.blend, pc.output, px, py));
+                const rig::RigProjector& rp = rig.projectors[k];
+                l += rp.brightness[0] * std::pow(signal, rp.gamma[0]);
+            }
+            light(y, x) = static_cast<float>(l);
+        }
+    }
+    cv::Mat1b out(height, width);
+    for (int y = 0; y < height; ++y) {
+        for (int x = 0; x < width; ++x) {
+            out(y, x) = cv::saturate_cast<uchar>(255.0 * std::pow(std::clamp(light(y, x) / 1.1, 0.0, 1.0), 1.0 / 2.2));
+        }
+    }
+    return out;
+}
+
+}  // namespace
+
+nlohmann::json run_calibrate_job(const CalibrateJob& job) {
+    const rig::VirtualRig rig = scaled_rig(rig::load_rig(job.rig), job.scale, job.scale);
+    RigPatternSource source(rig);
+    const CalibrationPrior prior = prior_from_rig(rig);
+    const AutocalResult r = calibrate(source, prior, job.content, job.options);  // throws before any write
+    const GeometryError g = measure_geometry(rig, r.calibration, 4);
+    const LuminanceError l = measure_luminance(rig, r.calibration);
+    nlohmann::json report = {
+        {"rig", rig.name},
+        {"rig_file", job.rig.string()},
+        {"scale", job.scale},
+        {"content", {job.content.width, job.content.height}},
+        {"captures", r.report.captures},
+        {"camera", {{"edge_points", r.report.edge_points}, {"edge_rms_mm", r.report.edge_rms_m * 1e3}}},
+        {"predicted", {{"seam_weight_sum_max_deviation", predicted_seam(r, prior.screen)}}},
+        {"ground_truth",
+         {{"geometry_mean_px", g.mean_px},
+          {"geometry_p95_px", g.p95_px},
+          {"geometry_max_px", g.max_px},
+          {"geometry_samples", g.samples},
+          {"missing", g.missing},
+          {"outside", g.outside},
+          {"luminance_max_deviation", l.max_deviation},
+          {"seam_luminance_max_deviation", l.seam_max_deviation},
+          {"camera_position_error_mm", (r.camera.position_m - rig.camera.pose.position_m).norm() * 1e3}}}};
+    for (std::size_t k = 0; k < r.report.projectors.size(); ++k) {
+        const ProjectorReport& p = r.report.projectors[k];
+        report["projectors"].push_back(
+            {{"id", p.id},
+             {"resolution", {r.projectors[k].resolution.width, r.projectors[k].resolution.height}},
+             {"column_bits", p.column_bits},
+             {"row_bits", p.row_bits},
+             {"correspondences", p.cells},
+             {"reprojection_rms_px", p.rms_px},
+             {"mean_view_angle_deg", p.mean_view_angle_deg},
+             {"camera_coverage", source.simulator().camera_coverage(static_cast<int>(k))}});
+    }
+    std::filesystem::create_directories(job.out);
+    MpcdiExportOptions mo;
+    mo.alpha_bit_depth = job.alpha_bits;
+    write_mpcdi(job.out / "calibration.mpcdi", to_mpcdi(r.calibration, mo));
+    const std::filesystem::path png = job.out / "preview.png";
+    if (!cv::imwrite(png.string(), preview(rig, r.calibration, 960))) {
+        throw std::runtime_error("calibrate: cannot write '" + png.string() + "'");
+    }
+    const std::filesystem::path json = job.out / "report.json";
+    std::ofstream f(json);
+    f << report.dump(2) << "\n";
+    if (!f) throw std::runtime_error("calibrate: cannot write '" + json.string() + "'");
+    return report;
+}
+
+}  // namespace mogao::autocal

@@ -1,0 +1,39 @@
+// SPDX-License-Identifier: Apache-2.0
+// `mogao-autocal calibrate`: the camera-based calibration of a virtual rig (rigs/*.toml) from
+// patterns to files (docs/calibration.md, "The calibrate command"): writes into the output folder
+//   calibration.mpcdi  the ScreenCalibration as a 2d-profile MPCDI file (appliance/calibration's
+//                      writer, atomic; 16-bit alpha by default),
+//   report.json        per projector: decoded bits, correspondences, reprojection rms (the fit's
+//                      own residual), view angle, camera coverage, the blend's predicted seam
+//                      (max |sum of weights - 1| over the overlaps from the fitted models), and the
+//                      accuracy against the rig's ground truth (geometry in projector pixels,
+//                      luminance), clearly apart,
+//   preview.png        the screen as a viewer sees it (ground-truth light paths): a white field with
+//                      a content grid every 1/16 of the frame, linear light -> gamma 2.2, 8 bits.
+// A refused calibration (CalibrationRefused) writes nothing: whatever the folder held stays.
+#pragma once
+
+#include <filesystem>
+#include <iosfwd>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "appliance/autocal/autocal.h"
+
+namespace mogao::autocal {
+
+struct CalibrateJob {
+    std::filesystem::path rig;  // rigs/*.toml
+    std::filesystem::path out;  // folder, created if missing
+    double scale = 1.0;         // projector and camera resolution scale, (0, 1] (scaled_rig)
+    ImageSize content{1920, 1080};
+    int alpha_bits = 16;  // 8 or 16
+    AutocalOptions options;
+};
+
+// Runs the job; returns the report (also written as report.json). Throws rig::RigError,
+// CalibrationRefused (nothing written), MpcdiError or std::runtime_error naming the file.
+nlohmann::json run_calibrate_job(const CalibrateJob& job);
+
+}  // namespace mogao::autocal
