@@ -5,7 +5,8 @@
 //   (b) the full renderer with direct light and shadows (sun + its shadow rays);
 //   (c) "model only what the scene requires": a sun without shadows and nothing else, vs the same
 //       scene carrying present-but-unused features (zero-power area/point/environment lights,
-//       an uninstanced mesh, a zero-specular material), vs a shadowing sun plus a used area light.
+//       an uninstanced mesh, a zero-specular material), vs a shadowing sun plus a used area light;
+//       (c4) an unplaced mesh with vertex colours and a texture, (c5) the field carrying them.
 // The scene is built in code: a ~1M-triangle smooth height field plus a sphere.
 // Usage: mogao_bench_render [--width W] [--height H] [--spp N] [--reps N] [--grid N] [--json FILE]
 // The table goes to stdout; --json FILE also writes every figure as JSON (for bench/regenerate-docs).
@@ -16,6 +17,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <memory>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -92,6 +94,35 @@ Scene with_unused_features(Scene scene) {
     return scene;
 }
 
+// A copy of mesh `m` carrying vertex colours, uvs and a 256² texture (what a painted scan has).
+Mesh with_colour(Mesh mesh) {
+    auto texture = std::make_shared<Texture>();
+    texture->source = "bench:checker";
+    texture->image = Rgb8Image({256, 256});
+    for (int y = 0; y < 256; ++y)
+        for (int x = 0; x < 256; ++x)
+            for (int c = 0; c < 3; ++c)
+                texture->image.at(x, y)[c] = static_cast<std::uint8_t>(((x / 16 + y / 16) % 2) ? 230 : 60 + 40 * c);
+    for (const Eigen::Vector3f& p : mesh.positions) {
+        mesh.colors.emplace_back(0.9f, 0.8f, 0.7f);
+        mesh.uvs.emplace_back(0.1f * p.x(), 0.1f * p.z());
+    }
+    mesh.texture = texture;
+    return mesh;
+}
+
+// Colour and texture present but unused: a coloured, textured mesh no instance places.
+Scene with_unused_colour(Scene scene) {
+    scene.meshes.push_back(with_colour(scene.meshes[0]));
+    return scene;
+}
+
+// Colour and texture used: the height field carries them.
+Scene with_used_colour(Scene scene) {
+    scene.meshes[0] = with_colour(scene.meshes[0]);
+    return scene;
+}
+
 Scene with_used_area_light(Scene scene) {
     scene.area_lights = {AreaLight{{-1.0, 4.0, -4.0}, {2.0, 0.0, 0.0}, {0.0, 0.0, 2.0}, Rgb(4.0f, 4.0f, 4.0f), true}};
     return scene;
@@ -160,11 +191,19 @@ int main(int argc, char** argv) {
         const RenderTimings plain = run(base_scene(grid, false));
         const RenderTimings unused = run(with_unused_features(base_scene(grid, false)));
         const RenderTimings used = run(with_used_area_light(base_scene(grid, true)));
+        const RenderTimings colour_unused = run(with_unused_colour(base_scene(grid, false)));
+        const RenderTimings colour_used = run(with_used_colour(base_scene(grid, false)));
         print("(c1) sun, no shadows, nothing else", plain, plain.camera_rays_s);
         print("(c2) (c1) + unused lights/mesh/material", unused, unused.camera_rays_s);
         print("(c3) sun + shadows + used area light", used, used.camera_rays_s);
+        print("(c4) (c1) + unplaced coloured mesh", colour_unused, colour_unused.camera_rays_s);
+        print("(c5) (c1), field coloured + textured", colour_used, colour_used.camera_rays_s);
         std::printf("    (c2)/(c1) = %.3f  (unused features should cost nothing: ~1.0)\n", unused.render_s / plain.render_s);
         std::printf("    (c3)/(c1) = %.3f  (what shadows and an area light cost when used)\n", used.render_s / plain.render_s);
+        std::printf("    (c4)/(c1) = %.3f  (a scene without colour or texture pays nothing: ~1.0)\n",
+                    colour_unused.render_s / plain.render_s);
+        std::printf("    (c5)/(c1) = %.3f  (what vertex colours and a bilinear texture cost when used)\n",
+                    colour_used.render_s / plain.render_s);
         std::printf("    BVH build (c1): %.2f s\n", plain.build_s);
         if (!json_file.empty()) {
             const nlohmann::json out = {
@@ -181,7 +220,11 @@ int main(int argc, char** argv) {
                 {"c3", timing_json("sun + shadows + used area light", used)},
                 {"ratio_b_over_a", direct.ratio()},
                 {"ratio_c2_over_c1", unused.render_s / plain.render_s},
-                {"ratio_c3_over_c1", used.render_s / plain.render_s}};
+                {"ratio_c3_over_c1", used.render_s / plain.render_s},
+                {"c4", timing_json("(c1) + an unplaced coloured, textured mesh", colour_unused)},
+                {"c5", timing_json("(c1) with vertex colours + a texture", colour_used)},
+                {"ratio_c4_over_c1", colour_unused.render_s / plain.render_s},
+                {"ratio_c5_over_c1", colour_used.render_s / plain.render_s}};
             std::ofstream file(json_file);
             file << out.dump(1) << '\n';
             if (!file.flush()) throw std::runtime_error("cannot write " + json_file);
