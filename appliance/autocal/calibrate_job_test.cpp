@@ -1,0 +1,100 @@
+// SPDX-License-Identifier: Apache-2.0
+// The calibrate command's job: MPCDI round trip of the calibration it computes, its report and
+// preview, and a refused rig leaving the previous calibration untouched.
+#include "appliance/autocal/calibrate_job.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include "appliance/autocal/rig_bridge.h"
+#include "appliance/calibration/mpcdi_reader.h"
+#include "appliance/calibration/mpcdi_screen.h"
+#include "appliance/rig/rig_file.h"
+
+namespace mogao::autocal {
+namespace {
+
+std::filesystem::path temp_dir(const std::string& name) {
+    const auto d =
+        std::filesystem::temp_directory_path() / ("mogao-autocal-" + name + "-" + std::to_string(::getpid()));
+    std::filesystem::remove_all(d);
+    return d;
+}
+
+std::string slurp(const std::filesystem::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+TEST(CalibrateJob, MpcdiRoundTripGivesTheSameMaps) {
+    CalibrateJob job;
+    job.rig = std::string(MOGAO_SOURCE_DIR) + "/rigs/standard.toml";
+    job.out = temp_dir("roundtrip");
+    job.scale = 0.25;
+    job.content = {960, 540};
+    job.options.warp_step_px = 4;
+    const nlohmann::json report = run_calibrate_job(job);
+    // The same calibration again (the rig is deterministic), to compare with what the file holds.
+    const rig::VirtualRig rig = scaled_rig(rig::load_rig(job.rig), job.scale, job.scale);
+    RigPatternSource source(rig);
+    const AutocalResult direct = calibrate(source, prior_from_rig(rig), job.content, job.options);
+    const ScreenCalibration back = to_screen_calibration(read_mpcdi(job.out / "calibration.mpcdi"));
+    ASSERT_EQ(back.projectors.size(), direct.calibration.projectors.size());
+    EXPECT_EQ(back.content.width, job.content.width);
+    const double alpha_bound = alpha_quantisation_bound(16, 2.2);
+    for (std::size_t k = 0; k < back.projectors.size(); ++k) {
+        const ProjectorCalibration& a = direct.calibration.projectors[k];
+        const ProjectorCalibration& b = back.projectors[k];
+        EXPECT_EQ(a.id, b.id);
+        ASSERT_EQ(a.warp.uv.size(), b.warp.uv.size());
+        ASSERT_EQ(a.blend.weight.size(), b.blend.weight.size());
+        double warp_err = 0.0;
+        for (std::size_t i = 0; i < a.warp.uv.size(); ++i) {
+            ASSERT_EQ(std::isnan(a.warp.uv[i]), std::isnan(b.warp.uv[i])) << "sample " << i;
+            if (!std::isnan(a.warp.uv[i])) warp_err = std::max(warp_err, double(std::abs(a.warp.uv[i] - b.warp.uv[i])));
+        }
+        double blend_err = 0.0;
+        for (std::size_t i = 0; i < a.blend.weight.size(); ++i) {
+            blend_err = std::max(blend_err, double(std::abs(a.blend.weight[i] - b.blend.weight[i])));
+        }
+        EXPECT_LE(warp_err, 2e-7) << a.id;  // float rounding of the region-relative positions
+        EXPECT_LE(blend_err, alpha_bound) << a.id;
+    }
+    EXPECT_EQ(report["projectors"].size(), 3u);
+    EXPECT_LE(report["ground_truth"]["geometry_p95_px"].get<double>(), 0.8);
+    EXPECT_TRUE(std::filesystem::file_size(job.out / "preview.png") > 1000);
+    std::filesystem::remove_all(job.out);
+}
+
+TEST(CalibrateJob, RefusedRigLeavesThePreviousCalibration) {
+    CalibrateJob job;
+    job.out = temp_dir("refused");
+    std::filesystem::create_directories(job.out);
+    std::ofstream(job.out / "calibration.mpcdi") << "last good";
+    // A projector turned away so that only a sliver of it lands on the arc's end.
+    std::string text = slurp(std::string(MOGAO_SOURCE_DIR) + "/rigs/standard.toml");
+    text.replace(text.find("yaw_deg = -52.0"), 15, "yaw_deg = -120.0");
+    job.rig = job.out / "sliver.toml";
+    std::ofstream(job.rig) << text;
+    job.scale = 0.25;
+    job.content = {960, 540};
+    try {
+        (void)run_calibrate_job(job);
+        FAIL() << "calibrated a projector the camera barely sees";
+    } catch (const CalibrationRefused& e) {
+        EXPECT_NE(std::string(e.what()).find("proj2"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(slurp(job.out / "calibration.mpcdi"), "last good");
+    EXPECT_FALSE(std::filesystem::exists(job.out / "report.json"));
+    std::filesystem::remove_all(job.out);
+}
+
+}  // namespace
+}  // namespace mogao::autocal
