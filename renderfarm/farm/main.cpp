@@ -96,10 +96,17 @@ int main(int argc, char** argv) {
     CLI::App* serve = app.add_subcommand("serve", "Serve live tours to authenticated appliances over IPv6 (gRPC, mutual TLS)");
     add_farm_flags(*serve, setup, scans);
     serve->add_option("--listen", serve_options.link.listen, "IPv6 endpoint [addr]:port");
-    serve->add_option("--tls-dir", tls_dir, "TLS folder: ca.pem, farm-NAME.pem, farm-NAME.key, optional crl.pem; never ca.key (mogao-farm pki export-farm)")->required()->check(CLI::ExistingDirectory);
+    serve
+        ->add_option("--tls-dir", tls_dir,
+                     "TLS folder: ca.pem, farm-NAME.pem, farm-NAME.key, optional crl.pem; never ca.key (mogao-farm pki "
+                     "export-farm)")
+        ->required()
+        ->check(CLI::ExistingDirectory);
     serve->add_option("--name", farm_name, "Farm certificate name in --tls-dir");
     serve->add_option("--allow", serve_options.link.allowed_appliances, "Only these appliance certificate names (default: any the CA issued)");
-    serve->add_option("--crl", serve_options.link.crl_path, "Revocation list (PEM CRL of the farm CA, re-read when it changes; default: --tls-dir/crl.pem if present)");
+    serve->add_option(
+        "--crl", serve_options.link.crl_path,
+        "Revocation list (PEM CRL of the farm CA, re-read when it changes; default: --tls-dir/crl.pem if present)");
     serve->add_option("--max-sessions", serve_options.link.max_sessions, "Concurrent appliance sessions")->check(CLI::Range(1, 256));
     serve
         ->add_option("--max-sessions-per-appliance", serve_options.link.max_sessions_per_appliance,

@@ -11,11 +11,11 @@
 #include <fstream>
 #include <thread>
 
+#include "common/unique_fd.h"
 #include "renderfarm/link/link_client.h"
 #include "renderfarm/link/link_server.h"
 #include "renderfarm/link/link_test_support.h"
 #include "renderfarm/link/revocation.h"
-#include "common/unique_fd.h"
 #include "renderfarm/link/wire_convert.h"
 
 namespace mogao {

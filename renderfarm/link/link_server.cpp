@@ -168,9 +168,9 @@ grpc::Status LinkServer::Impl::admit(grpc::ServerContext* ctx, std::shared_ptr<S
         s->serial = peer_serial(*ctx);
         s->revocation_generation = revocation->generation();
         if (s->serial.empty() || revocation->revoked(s->serial)) {
-            return refuse(grpc::StatusCode::PERMISSION_DENIED,
-                          "certificate " + s->serial + " of '" + s->identity + "' is revoked (" +
-                              revocation->path().string() + ")");
+            return refuse(grpc::StatusCode::PERMISSION_DENIED, "certificate " + s->serial + " of '" + s->identity +
+                                                                   "' is revoked (" + revocation->path().string() +
+                                                                   ")");
         }
     }
     {

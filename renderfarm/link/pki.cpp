@@ -8,12 +8,12 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <ctime>
 #include <cstring>
+#include <ctime>
 
-#include "renderfarm/link/openssl_util.h"
 #include "common/link_types.h"
 #include "common/unique_fd.h"
+#include "renderfarm/link/openssl_util.h"
 
 namespace mogao {
 namespace {
@@ -292,7 +292,8 @@ std::vector<fs::path> pki_revoke(const fs::path& dir, const fs::path& cert, int 
     }
     if (serial.empty()) throw PkiError(cert.string() + ": not a PEM certificate");
     std::vector<RevokedCert> revoked = current_revocations(dir, ca);
-    const bool listed = std::any_of(revoked.begin(), revoked.end(), [&](const auto& r) { return r.serial_hex == serial; });
+    const bool listed =
+        std::any_of(revoked.begin(), revoked.end(), [&](const auto& r) { return r.serial_hex == serial; });
     if (!listed) revoked.push_back({serial, static_cast<std::int64_t>(std::time(nullptr))});
     write_crl(dir, ca, revoked, days);
     return {crl_path(dir)};
@@ -307,7 +308,8 @@ std::vector<fs::path> pki_refresh_crl(const fs::path& dir, int days) {
 std::vector<fs::path> pki_export_farm(const fs::path& dir, const std::string& name, const fs::path& to, bool force) {
     if (auto why = check_pki_name(name); !why.empty()) throw PkiError(why);
     std::error_code ec;
-    if (fs::equivalent(dir, to, ec)) throw PkiError("export-farm: --to must be another folder than --dir (it holds ca.key)");
+    if (fs::equivalent(dir, to, ec))
+        throw PkiError("export-farm: --to must be another folder than --dir (it holds ca.key)");
     std::vector<std::pair<fs::path, fs::path>> copies{{ca_cert_path(dir), ca_cert_path(to)},
                                                       {farm_cert_path(dir, name), farm_cert_path(to, name)},
                                                       {farm_key_path(dir, name), farm_key_path(to, name)}};

@@ -23,9 +23,10 @@ std::vector<std::string> split_sans(const std::string& text) {
 }  // namespace
 
 int run_pki_command(int argc, char** argv) {
-    CLI::App app{"mogao link PKI: the farm CA, the farm's server certificate, one client certificate per "
-                 "appliance and the revocation list (files mode 0600; docs/link.md)",
-                 "pki"};
+    CLI::App app{
+        "mogao link PKI: the farm CA, the farm's server certificate, one client certificate per "
+        "appliance and the revocation list (files mode 0600; docs/link.md)",
+        "pki"};
     app.require_subcommand(1);
     std::string dir, name, san, key = "ec";
     int days = 0;
@@ -54,10 +55,14 @@ int run_pki_command(int argc, char** argv) {
     revoke->add_option("--dir", dir, "PKI folder (with ca.key)")->required();
     auto* by_name = revoke->add_option("--name", name, "Appliance name: revokes appliance-NAME.pem in --dir");
     revoke->add_option("--cert", cert, "Or the certificate file to revoke")->excludes(by_name);
-    revoke->add_option("--days", days, "The list's validity (nextUpdate) in days")->default_val(30)->check(CLI::Range(1, 36500));
+    revoke->add_option("--days", days, "The list's validity (nextUpdate) in days")
+        ->default_val(30)
+        ->check(CLI::Range(1, 36500));
     CLI::App* crl = app.add_subcommand("crl", "Re-issue crl.pem with the same entries and a fresh nextUpdate");
     crl->add_option("--dir", dir, "PKI folder (with ca.key)")->required();
-    crl->add_option("--days", days, "The list's validity (nextUpdate) in days")->default_val(30)->check(CLI::Range(1, 36500));
+    crl->add_option("--days", days, "The list's validity (nextUpdate) in days")
+        ->default_val(30)
+        ->check(CLI::Range(1, 36500));
     CLI::App* export_farm = app.add_subcommand(
         "export-farm", "Copy what the farm serves with (ca.pem, crl.pem, farm-NAME.pem/.key; never ca.key) to --to");
     common(export_farm);
@@ -79,7 +84,8 @@ int run_pki_command(int argc, char** argv) {
             written = pki_issue_appliance(dir, name, days, force);
         } else if (revoke->parsed()) {
             if (name.empty() && cert.empty()) throw PkiError("revoke: give --name or --cert");
-            written = pki_revoke(dir, cert.empty() ? appliance_cert_path(dir, name) : std::filesystem::path(cert), days);
+            written =
+                pki_revoke(dir, cert.empty() ? appliance_cert_path(dir, name) : std::filesystem::path(cert), days);
         } else if (crl->parsed()) {
             written = pki_refresh_crl(dir, days);
         } else {

@@ -55,8 +55,7 @@ bool is_revoked(const RevocationList& list, const std::string& serial_hex) {
                        [&](const RevokedCert& r) { return r.serial_hex == serial_hex; });
 }
 
-RevocationWatcher::RevocationWatcher(std::filesystem::path path, std::string ca_pem,
-                                     std::chrono::milliseconds recheck)
+RevocationWatcher::RevocationWatcher(std::filesystem::path path, std::string ca_pem, std::chrono::milliseconds recheck)
     : path_(std::move(path)), ca_pem_(std::move(ca_pem)), recheck_(recheck) {
     struct stat st {};
     if (::stat(path_.c_str(), &st) != 0) throw LinkError(path_.string() + ": cannot read the revocation list");

@@ -24,8 +24,8 @@
 namespace mogao {
 
 struct RevokedCert {
-    std::string serial_hex;      // upper-case hexadecimal, no leading zeros (OpenSSL's BN_bn2hex)
-    std::int64_t revoked_at_s;   // revocationDate, seconds since the Unix epoch
+    std::string serial_hex;     // upper-case hexadecimal, no leading zeros (OpenSSL's BN_bn2hex)
+    std::int64_t revoked_at_s;  // revocationDate, seconds since the Unix epoch
 };
 
 struct RevocationList {

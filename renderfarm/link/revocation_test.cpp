@@ -119,8 +119,8 @@ TEST(Revocation, PkiRevokeAddsTheCertificateOnce) {
     ASSERT_EQ(run({"crl", "--dir", dir.string(), "--days", "7"}), 0);
     EXPECT_EQ(parse_crl(read_pem_file(crl_path(dir)), ca, "crl").revoked.size(), 1u);
 
-    EXPECT_EQ(run({"revoke", "--dir", dir.string()}), 1);                          // neither --name nor --cert
-    EXPECT_EQ(run({"revoke", "--dir", dir.string(), "--name", "nobody"}), 1);      // no such certificate
+    EXPECT_EQ(run({"revoke", "--dir", dir.string()}), 1);                      // neither --name nor --cert
+    EXPECT_EQ(run({"revoke", "--dir", dir.string(), "--name", "nobody"}), 1);  // no such certificate
     EXPECT_EQ(run({"revoke", "--dir", (tmp.path() / "none").string(), "--name", "museum-1"}), 1);  // no CA
 }
 
