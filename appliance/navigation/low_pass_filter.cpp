@@ -17,6 +17,7 @@ LowPassFilter::LowPassFilter(double cutoff_hz) : cutoff_hz_(cutoff_hz) {
 }
 
 double LowPassFilter::filter(double x, double t_s) {
+    if (!std::isfinite(x) || !std::isfinite(t_s)) return y_;  // ignored: would poison the state
     if (!initialized_) {
         initialized_ = true;
         y_ = x;

@@ -11,7 +11,8 @@ public:
     // Throws std::invalid_argument unless cutoff_hz is finite and > 0.
     explicit LowPassFilter(double cutoff_hz);
 
-    // First sample passes unchanged; a sample not later than the previous one changes nothing.
+    // First sample passes unchanged; a sample not later than the previous one changes nothing, nor
+    // does a NaN or infinite x or t_s (returns the current value, 0 before the first sample).
     double filter(double x, double t_s);
     void reset() { initialized_ = false; }
     [[nodiscard]] double value() const { return y_; }

@@ -28,6 +28,9 @@ OneEuroFilter::OneEuroFilter(const OneEuroParams& params) : params_(params) {
 }
 
 double OneEuroFilter::filter(double x, double t_s) {
+    // A non-finite sample would make x^ infinite (then inf - inf = NaN forever); a non-finite time
+    // would freeze the filter (every later dt negative).
+    if (!std::isfinite(x) || !std::isfinite(t_s)) return x_;
     if (!initialized_) {
         initialized_ = true;
         x_ = x;

@@ -35,7 +35,9 @@ public:
     explicit OneEuroFilter(const OneEuroParams& params);
 
     // Filters x sampled at t_s (seconds, any origin). A sample not later than the previous one
-    // leaves the state unchanged and returns the current value.
+    // leaves the state unchanged and returns the current value, and so does a NaN or infinite x or
+    // t_s (0 before the first sample). Outputs stay within the range of the accepted samples at
+    // any dt > 0 (alpha in (0, 1]); filter_time_step_test.cpp checks dt = 0, 1 us and 1 s.
     double filter(double x, double t_s);
 
     void reset() { initialized_ = false; }
