@@ -130,10 +130,12 @@ public:
     Scene parse(const json& root) {
         if (!root.is_object()) fields_.fail("(root)", "expected a JSON object");
         fields_.only_keys(root, "(root)",
-                          {"name", "exposure", "tone_map", "meshes", "materials", "objects", "lights", "viewer"});
+                          {"name", "exposure", "tone_map", "robust_intersection", "meshes", "materials", "objects",
+                           "lights", "viewer"});
         scene_.source = origin_.string();
         scene_.exposure = static_cast<float>(fields_.number_or(root, "(root)", "exposure", 1.0, 1e-6, 1e6));
         if (root.contains("tone_map")) scene_.tone_map = parse_tone_map_field(root["tone_map"]);
+        scene_.robust_intersection = fields_.boolean_or(root, "(root)", "robust_intersection", false);
         parse_meshes(fields_.member(root, "(root)", "meshes"));
         parse_materials(root.contains("materials") ? root["materials"] : json::object());
         parse_objects(fields_.member(root, "(root)", "objects"));
@@ -422,6 +424,8 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& ori
         root = json::parse(json_text);
     } catch (const json::parse_error& e) {
         throw SceneError(fmt::format("{}: not valid JSON: {}", origin.string(), e.what()));
+    } catch (const json::out_of_range& e) {  // 1e999: beyond double range (would be infinite)
+        throw SceneError(fmt::format("{}: number out of range (beyond ±1.8e308): {}", origin.string(), e.what()));
     }
     Scene scene = SceneParser(origin, options, report).parse(root);
     if (report) {

@@ -17,7 +17,8 @@ std::string minimal(const std::string& objects, const std::string& extra = "") {
     return R"({ "meshes": { "ball": { "procedural": "uv_sphere", "radius": 0.5, "segments": 16, "rings": 8 },
                             "box": { "procedural": "box", "size": [1, 2, 3] } },
                "materials": { "red": { "albedo": [0.8, 0.1, 0.1] } },
-               "objects": )" + objects + extra + "}";
+               "objects": )" +
+           objects + extra + "}";
 }
 
 // Expects a SceneError whose message contains every fragment.
@@ -28,7 +29,8 @@ void expect_error(const std::string& text, std::initializer_list<std::string> fr
     } catch (const SceneError& e) {
         const std::string message = e.what();
         EXPECT_NE(message.find(kOrigin.string()), std::string::npos) << message;
-        for (const std::string& f : fragments) EXPECT_NE(message.find(f), std::string::npos) << "missing '" << f << "' in: " << message;
+        for (const std::string& f : fragments)
+            EXPECT_NE(message.find(f), std::string::npos) << "missing '" << f << "' in: " << message;
     }
 }
 
@@ -63,7 +65,8 @@ TEST(SceneFile, ToneMapIsReadAndCheckedByName) {
 
 TEST(SceneFile, TransformAppliesScaleRotationTranslationInOrder) {
     const Scene scene = parse_scene(
-        minimal(R"([ { "mesh": "box", "transform": { "scale": 2, "rotate_deg": [0, 90, 0], "translate": [10, 0, 0] } } ])"),
+        minimal(
+            R"([ { "mesh": "box", "transform": { "scale": 2, "rotate_deg": [0, 90, 0], "translate": [10, 0, 0] } } ])"),
         kOrigin);
     const Eigen::Affine3d& m = scene.instances[0].object_to_world;
     // A file point (1, 0, 0): scaled to (2, 0, 0), turned 90° about +y to (0, 0, -2), moved by +10 x.
@@ -74,7 +77,8 @@ TEST(SceneFile, TransformAppliesScaleRotationTranslationInOrder) {
 
 TEST(SceneFile, BaseAnchorPutsTheBottomCentreOnTheTranslation) {
     const Scene scene = parse_scene(
-        minimal(R"([ { "mesh": "box", "transform": { "scale": 0.5, "anchor": "base", "translate": [3, 1, -2] } } ])"), kOrigin);
+        minimal(R"([ { "mesh": "box", "transform": { "scale": 0.5, "anchor": "base", "translate": [3, 1, -2] } } ])"),
+        kOrigin);
     Eigen::AlignedBox3d box;
     for (const auto& p : scene.meshes[1].positions) box.extend(scene.instances[0].object_to_world * p.cast<double>());
     EXPECT_NEAR(box.min().y(), 1.0, 1e-6);
@@ -94,7 +98,8 @@ TEST(SceneFile, FarFromOriginMeshesAreRecentredWithoutLosingPlacement) {
 
 TEST(SceneFile, RingMakesCopiesFacingTheAxis) {
     const Scene scene = parse_scene(
-        minimal(R"([ { "mesh": "ball", "ring": { "count": 5, "radius": 4, "start_deg": -90, "end_deg": 90, "heights": [0, 2] } } ])"),
+        minimal(
+            R"([ { "mesh": "ball", "ring": { "count": 5, "radius": 4, "start_deg": -90, "end_deg": 90, "heights": [0, 2] } } ])"),
         kOrigin);
     ASSERT_EQ(scene.instances.size(), 10u);
     for (const Instance& instance : scene.instances) {
@@ -107,27 +112,73 @@ TEST(SceneFile, RingMakesCopiesFacingTheAxis) {
     EXPECT_NEAR(scene.instances[5].object_to_world.translation().y(), 2.0, 1e-12);
 }
 
+// Numerical stability (issue 12): NaN and Infinity are not JSON; a number beyond double range
+// (1e999) is refused by the JSON reader naming the file and the literal (it used to escape as a
+// bare nlohmann out_of_range without the file); the largest finite doubles are refused naming the
+// field and its limit in every kind of number the scene reads (root scalar, transform, material,
+// light, procedural parameter, viewer).
+TEST(SceneFile, NonFiniteAndHugeNumbersAreRefused) {
+    const std::string ball = R"([ { "mesh": "ball" } ])";
+    expect_error(minimal(ball, R"(, "exposure": NaN)"), {"not valid JSON"});
+    expect_error(minimal(ball, R"(, "exposure": Infinity)"), {"not valid JSON"});
+    expect_error(minimal(ball, R"(, "exposure": 1e999)"), {"out of range", "1e999"});
+    expect_error(minimal(R"([ { "mesh": "ball", "transform": { "translate": [0, -1e999, 0] } } ])"),
+                 {"out of range", "1e999"});
+    expect_error(minimal(ball, R"(, "exposure": 1e308)"), {"exposure", "outside"});
+    expect_error(minimal(R"([ { "mesh": "ball", "transform": { "rotate_deg": [0, -1e308, 0] } } ])"),
+                 {"objects[0].transform.rotate_deg[1]"});
+    expect_error(minimal(R"([ { "mesh": "ball", "transform": { "scale": 1e308 } } ])"), {"objects[0].transform.scale"});
+    expect_error(
+        R"({ "meshes": { "b": { "procedural": "uv_sphere", "radius": 1e308 } }, "objects": [ { "mesh": "b" } ] })",
+        {"meshes.b", "radius"});
+    expect_error(
+        R"({ "meshes": { "b": { "procedural": "box", "size": [1, 1e308, 1] } }, "objects": [ { "mesh": "b" } ] })",
+        {"meshes.b", "size"});
+    expect_error(minimal(ball, R"(, "materials": { "m": { "albedo": [0.5, 1e308, 0.5] } })"), {"albedo"});
+    expect_error(
+        minimal(ball, R"(, "lights": [ { "type": "sun", "direction_to_light": [0, 1e308, 0], "irradiance": 1 } ])"),
+        {"lights[0]"});
+    expect_error(minimal(ball, R"(, "lights": [ { "type": "point", "position": [0, 1, 0], "intensity": 1e308 } ])"),
+                 {"lights[0].intensity"});
+    expect_error(minimal(ball, R"(, "viewer": { "start": [0, 1e308, 0] })"), {"viewer.start"});
+    expect_error(minimal(ball, R"(, "viewer": { "start_yaw_deg": -1e308 })"), {"viewer.start_yaw_deg"});
+}
+
+TEST(SceneFile, RobustIntersectionFlagIsReadAndChecked) {
+    EXPECT_FALSE(parse_scene(minimal(R"([ { "mesh": "ball" } ])"), kOrigin).robust_intersection);
+    EXPECT_TRUE(parse_scene(minimal(R"([ { "mesh": "ball" } ])", R"(, "robust_intersection": true)"), kOrigin)
+                    .robust_intersection);
+    expect_error(minimal(R"([ { "mesh": "ball" } ])", R"(, "robust_intersection": 1)"),
+                 {"robust_intersection", "true or false"});
+}
+
 TEST(SceneFile, BadInputNamesTheFieldAndTheRule) {
     expect_error("{ not json", {"not valid JSON"});
     expect_error(R"({ "objects": [] })", {"meshes", "missing"});
     expect_error(minimal("[]"), {"objects", "non-empty"});
     expect_error(minimal(R"([ { "mesh": "teapot" } ])"), {"objects[0].mesh", "teapot"});
     expect_error(minimal(R"([ { "mesh": "ball", "material": "gold" } ])"), {"objects[0].material", "gold"});
-    expect_error(minimal(R"([ { "mesh": "ball", "transform": { "scale": 0 } } ])"), {"objects[0].transform.scale", "outside"});
+    expect_error(minimal(R"([ { "mesh": "ball", "transform": { "scale": 0 } } ])"),
+                 {"objects[0].transform.scale", "outside"});
     expect_error(minimal(R"([ { "mesh": "ball", "transform": { "scale": -1 } } ])"), {"objects[0].transform.scale"});
     expect_error(minimal(R"([ { "mesh": "ball", "transform": { "translate": [0, 1e300, 0] } } ])"),
                  {"objects[0].transform.translate[1]", "outside"});
-    expect_error(minimal(R"([ { "mesh": "ball", "transform": { "translate": [0, 0] } } ])"), {"translate", "3 numbers"});
+    expect_error(minimal(R"([ { "mesh": "ball", "transform": { "translate": [0, 0] } } ])"),
+                 {"translate", "3 numbers"});
     expect_error(minimal(R"([ { "mesh": "ball", "transform": { "anchor": "top" } } ])"), {"anchor"});
     expect_error(minimal(R"([ { "mesh": "ball", "colour": 1 } ])"), {"objects[0].colour", "unknown key"});
-    expect_error(minimal(R"([ { "mesh": "ball" } ])", R"(, "lights": [ { "type": "laser" } ])"), {"lights[0].type", "laser"});
-    expect_error(minimal(R"([ { "mesh": "ball" } ])", R"(, "lights": [ { "type": "sun", "direction_to_light": [0, 0, 0] } ])"),
-                 {"lights[0].direction_to_light", "zero"});
-    expect_error(minimal(R"([ { "mesh": "ball" } ])",
-                         R"(, "lights": [ { "type": "area", "corner": [0,0,0], "edge_u": [1,0,0], "edge_v": [2,0,0] } ])"),
-                 {"lights[0]", "area"});
-    expect_error(R"({ "meshes": { "room": { "procedural": "grotto_room", "radius": -3 } }, "objects": [ { "mesh": "room" } ] })",
-                 {"meshes.room", "radius"});
+    expect_error(minimal(R"([ { "mesh": "ball" } ])", R"(, "lights": [ { "type": "laser" } ])"),
+                 {"lights[0].type", "laser"});
+    expect_error(
+        minimal(R"([ { "mesh": "ball" } ])", R"(, "lights": [ { "type": "sun", "direction_to_light": [0, 0, 0] } ])"),
+        {"lights[0].direction_to_light", "zero"});
+    expect_error(
+        minimal(R"([ { "mesh": "ball" } ])",
+                R"(, "lights": [ { "type": "area", "corner": [0,0,0], "edge_u": [1,0,0], "edge_v": [2,0,0] } ])"),
+        {"lights[0]", "area"});
+    expect_error(
+        R"({ "meshes": { "room": { "procedural": "grotto_room", "radius": -3 } }, "objects": [ { "mesh": "room" } ] })",
+        {"meshes.room", "radius"});
     expect_error(R"({ "meshes": { "m": { "procedural": "torus" } }, "objects": [ { "mesh": "m" } ] })",
                  {"meshes.m.procedural", "torus"});
     expect_error(R"({ "meshes": { "m": { "file": "missing.obj" } }, "objects": [ { "mesh": "m" } ] })",
@@ -160,7 +211,8 @@ TEST(Procedural, GrottoRoomIsClosedExceptTheEntranceAndFacesInward) {
 
 TEST(SceneFile, GrottoScenesHaveTheRequiredTriangleCounts) {
     const std::filesystem::path scans = MOGAO_SCANS_DIR;
-    if (!std::filesystem::exists(scans)) GTEST_SKIP() << "real scans not found at " << scans << " (../shared/data/scans)";
+    if (!std::filesystem::exists(scans))
+        GTEST_SKIP() << "real scans not found at " << scans << " (../shared/data/scans)";
     const std::filesystem::path scenes = std::filesystem::path(MOGAO_SOURCE_DIR) / "scenes";
     SceneLoadReport report;
     const Scene grotto = load_scene(scenes / "grotto.json", {scans}, &report);

@@ -24,6 +24,11 @@ void validate_mesh_indices(const Scene& scene, std::size_t index, const Mesh& me
         invalid(scene, "mesh " + std::to_string(index) + " has " + std::to_string(mesh.normals.size()) +
                            " normals for " + std::to_string(vertex_count) + " positions");
     }
+    for (std::size_t i = 0; i < vertex_count; ++i) {  // meshes built in code skip validate_mesh
+        if (!mesh.positions[i].allFinite()) {
+            invalid(scene, "mesh " + std::to_string(index) + " vertex " + std::to_string(i) + " is not finite");
+        }
+    }
     for (const auto& tri : mesh.triangles) {
         if (tri[0] >= vertex_count || tri[1] >= vertex_count || tri[2] >= vertex_count) {
             invalid(scene, "mesh " + std::to_string(index) + " has a triangle index >= " +
@@ -32,7 +37,7 @@ void validate_mesh_indices(const Scene& scene, std::size_t index, const Mesh& me
     }
 }
 
-EmbreeScene build_blas(const EmbreeDevice& device, const Mesh& mesh) {
+EmbreeScene build_blas(const EmbreeDevice& device, const Mesh& mesh, bool robust) {
     EmbreeGeometry geometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
     const RTCGeometry g = geometry.get();
     // Embree allocates and pads the vertex buffer itself (see header for why this is a copy).
@@ -52,6 +57,7 @@ EmbreeScene build_blas(const EmbreeDevice& device, const Mesh& mesh) {
 
     EmbreeScene blas(device);
     rtcSetSceneBuildQuality(blas.get(), RTC_BUILD_QUALITY_HIGH);
+    if (robust) rtcSetSceneFlags(blas.get(), RTC_SCENE_FLAG_ROBUST);  // Scene::robust_intersection
     rtcAttachGeometryByID(blas.get(), g, 0);
     rtcCommitScene(blas.get());
     device.check("rtcCommitScene(mesh '" + mesh.source + "')");
@@ -78,7 +84,7 @@ RenderScene::RenderScene(const Scene& scene, const std::string& embree_config)
     for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
         if (used[m]) {
             validate_mesh_indices(scene, m, scene.meshes[m]);
-            blas_.push_back(build_blas(device_, scene.meshes[m]));
+            blas_.push_back(build_blas(device_, scene.meshes[m], scene.robust_intersection));
         } else {
             blas_.emplace_back(device_);  // never built: unused meshes cost nothing
         }
