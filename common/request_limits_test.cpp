@@ -3,6 +3,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <variant>
 
 #include <gtest/gtest.h>
 
@@ -53,6 +54,33 @@ TEST(ViewValidation, RejectsEachOutOfRangeFieldByName) {
                     "camera.arc_deg", "(0, 360]");
     expect_rejected([](ViewRequest& r) { r.camera = CylinderScreen{3.0, 180.0, 2.5, 2.5, {0.0, 1.6, 0.0}}; },
                     "camera.top_m", "(bottom_m, inf)");
+}
+
+// Numerical stability (issue 12): NaN and +-inf in every floating-point field of a view request
+// are refused naming the field (a NaN fails every comparison, so a check written as `v <= 0` would
+// let it through).
+TEST(ViewValidation, RejectsNanAndInfinityInEveryFloatingPointField) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const double inf = std::numeric_limits<double>::infinity();
+    const auto cylinder = [](ViewRequest& r) -> CylinderScreen& {
+        r.camera = CylinderScreen{};
+        return std::get<CylinderScreen>(r.camera);
+    };
+    for (const double bad : {nan, inf, -inf}) {
+        expect_rejected([bad](ViewRequest& r) { r.pose.eye.x() = bad; }, "pose.eye.x", "");
+        expect_rejected([bad](ViewRequest& r) { r.pose.eye.z() = bad; }, "pose.eye.z", "");
+        expect_rejected([bad](ViewRequest& r) { r.pose.yaw_deg = bad; }, "pose.yaw_deg", "");
+        expect_rejected([bad](ViewRequest& r) { r.pose.pitch_deg = bad; }, "pose.pitch_deg", "");
+        expect_rejected([bad](ViewRequest& r) { r.quality.resolution_scale = bad; }, "quality.resolution_scale", "");
+        expect_rejected([bad](ViewRequest& r) { r.camera = PinholeCamera{bad}; }, "camera.vertical_fov_deg", "");
+        expect_rejected([&](ViewRequest& r) { cylinder(r).radius_m = bad; }, "camera.radius_m", "");
+        expect_rejected([&](ViewRequest& r) { cylinder(r).arc_deg = bad; }, "camera.arc_deg", "");
+        expect_rejected([&](ViewRequest& r) { cylinder(r).bottom_m = bad; }, "camera.", "");
+        expect_rejected([&](ViewRequest& r) { cylinder(r).top_m = bad; }, "camera.top_m", "");
+        expect_rejected([&](ViewRequest& r) { cylinder(r).eye_m.x() = bad; }, "camera.eye_m.x", "");
+        expect_rejected([&](ViewRequest& r) { cylinder(r).eye_m.y() = bad; }, "camera.eye_m.y", "");
+        expect_rejected([&](ViewRequest& r) { cylinder(r).eye_m.z() = bad; }, "camera.eye_m.z", "");
+    }
 }
 
 TEST(ViewValidation, AcceptsLimitsAndScalesRenderSize) {

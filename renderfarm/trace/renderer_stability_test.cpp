@@ -339,5 +339,81 @@ TEST(RendererStability, NonFiniteVertexIsRefusedNamingTheMesh) {
     }
 }
 
+// --- cameras at the extremes --------------------------------------------------------------------
+
+// Guard: the cylindrical camera's ray maths (camera.h) at arcs from 1 to 360 degrees, the eye on
+// the screen axis, off-axis inside and outside the cylinder, for a 1x1 frame and every column of
+// three rows of an 8K (7680x4320) frame (checked directly, not rendered): every direction is
+// finite and unit, passes through its pixel's screen point (angle < 1e-9 rad), and neighbouring
+// columns are arc/W apart on the screen.
+TEST(RendererStability, CylinderCameraRaysAtExtremeArcsEyesAndSizes) {
+    const double kPi = 3.14159265358979323846;
+    const std::vector<Eigen::Vector3d> eyes = {{0.0, 1.25, 0.0}, {0.5, 0.3, 1.0}, {0.0, 1.6, 10.0}, {-7.0, 4.0, -7.0}};
+    long checked = 0;
+    for (const double arc : {1.0, 90.0, 359.0, 360.0}) {
+        for (const Eigen::Vector3d& eye : eyes) {
+            for (const ImageSize size : {ImageSize{1, 1}, ImageSize{7680, 4320}}) {
+                ViewRequest request;
+                request.size = size;
+                request.pose.yaw_deg = 37.0;
+                request.pose.pitch_deg = -12.0;
+                const CylinderScreen screen{3.0, arc, 0.0, 2.5, eye};
+                request.camera = screen;
+                const CameraSetup camera = make_camera_setup(request, size);
+                for (const int row : {0, size.height / 2, size.height - 1}) {
+                    for (int col = 0; col < size.width; ++col) {
+                        const double px = col + 0.5;
+                        const double py = row + 0.5;
+                        const Ray ray = generate_ray(camera, px, py);
+                        const double theta = (-arc / 2.0 + arc * px / size.width) * kPi / 180.0;
+                        const double y = screen.top_m - (screen.top_m - screen.bottom_m) * py / size.height;
+                        const Eigen::Vector3d on_screen(3.0 * std::sin(theta), y, -3.0 * std::cos(theta));
+                        const Eigen::Vector3d expected = camera.rotation * (on_screen - eye).normalized();
+                        ASSERT_TRUE(ray.direction.allFinite()) << "arc " << arc << " col " << col;
+                        ASSERT_NEAR(ray.direction.norm(), 1.0, 1e-12) << "arc " << arc << " col " << col;
+                        ASSERT_LT((ray.direction - expected).norm(), 1e-9) << "arc " << arc << " col " << col;
+                        ++checked;
+                    }
+                }
+            }
+        }
+    }
+    std::printf("cylinder camera: %ld rays checked\n", checked);
+}
+
+// Guard: renders at the extremes give finite pixels: a 1x1 frame (pinhole and cylinder), a
+// 7680x4 cylinder frame (8K wide) at 1 and 360 degrees, pinhole fields of view of 1e-6 and
+// 179.9999 degrees, and the physical eye exactly on the screen (the pixel's ray direction is then
+// undefined: the pixel must still be finite).
+TEST(RendererStability, ExtremeCamerasRenderFinitePixels) {
+    Scene scene = scaled_world(1.0, Eigen::Vector3d::Zero(), 1.0);
+    Renderer renderer(scene, RendererOptions{"threads=1", true});
+    const auto check = [&](const ViewRequest& request, PixelRect rect, const std::string& what) {
+        renderer.begin_frame(request);
+        RgbFloatImage frame(renderer.render_size());
+        if (rect.x1 == 0) rect = PixelRect::whole(frame.size);
+        renderer.render(rect, frame);
+        expect_finite_non_negative(frame, what);
+    };
+    ViewRequest one = test::look_at({0.0, 1.0, 3.0}, {0.0, 0.5, 0.0}, {1, 1}, 60.0);
+    check(one, {}, "pinhole 1x1");
+    for (const double fov : {1e-6, 179.9999}) {
+        ViewRequest r = test::look_at({0.0, 1.0, 3.0}, {0.0, 0.5, 0.0}, {16, 16}, fov);
+        check(r, {}, "pinhole fov " + std::to_string(fov));
+    }
+    ViewRequest cyl;
+    cyl.pose.eye = {0.0, 0.0, 2.0};
+    cyl.size = {1, 1};
+    cyl.camera = CylinderScreen{3.0, 180.0, 0.0, 2.5, {0.0, 1.6, 0.0}};
+    check(cyl, {}, "cylinder 1x1");
+    cyl.camera = CylinderScreen{3.0, 180.0, 0.0, 2.5, {0.0, 1.25, -3.0}};  // eye on the pixel's screen point
+    check(cyl, {}, "eye on the screen");
+    for (const double arc : {1.0, 360.0}) {
+        cyl.size = {7680, 4};  // the full 8K width; 4 rows spanning the screen's height
+        cyl.camera = CylinderScreen{3.0, arc, 0.0, 2.5, {0.0, 1.6, 0.0}};
+        check(cyl, {}, "8K strip, arc " + std::to_string(arc));
+    }
+}
+
 }  // namespace
 }  // namespace mogao
