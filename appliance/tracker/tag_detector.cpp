@@ -38,6 +38,16 @@ TagDetector::TagDetector(TagDetector&&) noexcept = default;
 TagDetector& TagDetector::operator=(TagDetector&&) noexcept = default;
 TagDetector::~TagDetector() = default;
 
+void TagDetector::set_quad_search(float decimation, float blur_sigma) {
+    DetectorSettings s = settings_;
+    s.decimation = decimation;
+    s.blur_sigma = blur_sigma;
+    validate(s);
+    settings_ = s;
+    engine_->detector->quad_decimate = decimation;
+    engine_->detector->quad_sigma = blur_sigma;
+}
+
 const TagFamily& TagDetector::family() const { return engine_->family; }
 
 std::vector<TagDetection> TagDetector::detect(const GrayImage& image) {

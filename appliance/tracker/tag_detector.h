@@ -49,6 +49,11 @@ public:
     // kMaxCaptureDimension.
     [[nodiscard]] std::vector<TagDetection> detect(const GrayImage& image);
 
+    // Changes the quad search's decimation and blur (DetectorSettings::decimation, blur_sigma) for
+    // the next detect() calls, keeping the decode tables (building those for max_hamming 2 costs
+    // far more than a detection). Throws std::invalid_argument as validate(), naming the field.
+    void set_quad_search(float decimation, float blur_sigma);
+
     [[nodiscard]] const DetectorSettings& settings() const { return settings_; }
     [[nodiscard]] const TagFamily& family() const;
 

@@ -89,6 +89,43 @@ TEST(TagDetector, NeverModifiesTheImage) {
     }
 }
 
+// set_quad_search switches decimation and blur on the same detector: each setting behaves as a
+// detector built with it (the image is still never modified), and a bad value is refused, naming
+// the field, with the settings left as they were.
+TEST(TagDetector, QuadSearchCanBeSwitchedInPlace) {
+    const GrayImage image = render_target(tag_target(make_tag_bitmap(TagFamily("tag36h11"), 9), 0.1),
+                                          tag_pose_facing_camera(0.5, 10.0), ideal_camera());
+    TagDetector switched;
+    for (const float decimation : {2.0f, 1.0f, 3.0f}) {
+        for (const float blur : {0.0f, 0.8f}) {
+            switched.set_quad_search(decimation, blur);
+            EXPECT_EQ(switched.settings().decimation, decimation);
+            EXPECT_EQ(switched.settings().blur_sigma, blur);
+            DetectorSettings s;
+            s.decimation = decimation;
+            s.blur_sigma = blur;
+            TagDetector fresh(s);
+            GrayImage copy = image;
+            const auto a = switched.detect(copy);
+            const auto b = fresh.detect(image);
+            EXPECT_EQ(copy.pixels, image.pixels) << decimation << " " << blur;
+            ASSERT_EQ(a.size(), 1U) << decimation << " " << blur;
+            ASSERT_EQ(b.size(), 1U) << decimation << " " << blur;
+            for (std::size_t k = 0; k < 4; ++k)
+                EXPECT_EQ(a[0].corners[k], b[0].corners[k]) << decimation << " " << blur;
+        }
+    }
+    try {
+        switched.set_quad_search(9.0f, 0.0f);
+        FAIL() << "expected invalid_argument";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_EQ(std::string(e.what()), "DetectorSettings.decimation = 9 outside [1, 8]");
+    }
+    EXPECT_THROW(switched.set_quad_search(1.0f, 6.0f), std::invalid_argument);
+    EXPECT_EQ(switched.settings().decimation, 3.0f);
+    EXPECT_EQ(switched.settings().blur_sigma, 0.8f);
+}
+
 TEST(TagDetector, NothingInAFlatImage) {
     TagDetector detector;
     EXPECT_TRUE(detector.detect(GrayImage(320, 240, 128)).empty());

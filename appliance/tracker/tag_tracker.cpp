@@ -38,25 +38,16 @@ void validate(const RoiSettings& r) {
     check_roi("full_search_every", r.full_search_every, 0, 100000);
     check_roi("search_decimation", r.search_decimation, 1.0f, 8.0f);
     check_roi("search_blur_sigma", r.search_blur_sigma, -5.0f, 5.0f);
-}
-
-DetectorSettings search_settings(const TrackerConfig& config) {
-    validate(config.roi);  // here, before the search detector is built from it
-    DetectorSettings s = config.detector;
-    if (config.roi.enabled) {
-        s.decimation = config.roi.search_decimation;
-        s.blur_sigma = config.roi.search_blur_sigma;
-    }
-    return s;
+    if (r.window_tag_px != 0.0) check_roi("window_tag_px", r.window_tag_px, 4.0, 1000.0);
+    check_roi("window_max_decimation", r.window_max_decimation, 1, 8);
+    check_roi("window_blur_sigma", r.window_blur_sigma, -5.0f, 5.0f);
 }
 
 }  // namespace
 
 TagTracker::TagTracker(const TrackerConfig& config)
-    : config_(config),
-      detector_(config.detector),
-      search_detector_(search_settings(config)),
-      disambiguator_(config.disambiguation) {
+    : config_(config), detector_(config.detector), disambiguator_(config.disambiguation) {
+    validate(config_.roi);
     validate(config_.camera);
     if (!(config_.tag_size_m > 0.0 && config_.tag_size_m <= 10.0)) {
         throw std::invalid_argument("TrackerConfig.tag_size_m " + std::to_string(config_.tag_size_m) +
@@ -82,7 +73,7 @@ const TagDetection* TagTracker::pick(const std::vector<TagDetection>& detections
 std::vector<TagDetection> TagTracker::detect_in_window(const GrayImage& image, std::int64_t timestamp_ns) {
     // Constant-velocity prediction of the corners (velocity from the last two sightings).
     const double dt = static_cast<double>(timestamp_ns - last_corners_ns_) * 1e-9;
-    double x0 = image.width, y0 = image.height, x1 = 0.0, y1 = 0.0, side = 0.0;
+    double x0 = image.width, y0 = image.height, x1 = 0.0, y1 = 0.0, side = 0.0, shortest = 1e300;
     for (std::size_t i = 0; i < 4; ++i) {
         const Eigen::Vector2d& c = last_corners_[i];
         const Eigen::Vector2d p = sightings_ >= 2 ? Eigen::Vector2d(c + velocity_px_s_[i] * dt) : c;
@@ -90,7 +81,9 @@ std::vector<TagDetection> TagTracker::detect_in_window(const GrayImage& image, s
         y0 = std::min({y0, c.y(), p.y()});
         x1 = std::max({x1, c.x(), p.x()});
         y1 = std::max({y1, c.y(), p.y()});
-        side = std::max(side, (last_corners_[(i + 1) % 4] - c).norm());
+        const double edge = (last_corners_[(i + 1) % 4] - c).norm();
+        side = std::max(side, edge);
+        shortest = std::min(shortest, edge);
     }
     const double grow = std::max(config_.roi.margin * side, config_.roi.min_margin_px);
     const int left = std::clamp(static_cast<int>(std::floor(x0 - grow)), 0, image.width);
@@ -107,6 +100,20 @@ std::vector<TagDetection> TagTracker::detect_in_window(const GrayImage& image, s
                         static_cast<std::size_t>(left),
                     static_cast<std::size_t>(window_.width));
     }
+    // The quad search's resolution from the tag's size (tag_tracker.h); never finer than the
+    // detector's own settings.
+    const DetectorSettings& base = config_.detector;
+    int decimation = 1;
+    if (config_.roi.window_tag_px > 0.0) {
+        decimation = std::clamp(static_cast<int>(std::floor(shortest / config_.roi.window_tag_px)), 1,
+                                config_.roi.window_max_decimation);
+    }
+    if (static_cast<float>(decimation) > base.decimation) {
+        detector_.set_quad_search(static_cast<float>(decimation), config_.roi.window_blur_sigma);
+    } else {
+        detector_.set_quad_search(base.decimation, base.blur_sigma);
+    }
+    last_window_decimation_ = static_cast<int>(detector_.settings().decimation);
     auto found = detector_.detect(window_);
     const Eigen::Vector2d origin(left, top);  // pixel (i, j) of the window is (i + left, j + top)
     for (auto& d : found) {
@@ -124,6 +131,7 @@ TrackedTag TagTracker::track(const CameraFrame& frame) {
     }
     TrackedTag out;
     out.timestamp_ns = frame.timestamp_ns;
+    last_window_decimation_ = 0;
     std::vector<TagDetection> detections;
     std::optional<TagDetection> chosen;
     if (config_.roi.enabled && sightings_ > 0) {
@@ -137,7 +145,12 @@ TrackedTag TagTracker::track(const CameraFrame& frame) {
     ++frames_since_search_;
     const bool cadence = config_.roi.full_search_every > 0 && frames_since_search_ >= config_.roi.full_search_every;
     if (!config_.roi.enabled || !chosen || cadence) {
-        detections = (config_.roi.enabled ? search_detector_ : detector_).detect(frame.image);
+        if (config_.roi.enabled) {
+            detector_.set_quad_search(config_.roi.search_decimation, config_.roi.search_blur_sigma);
+        } else {
+            detector_.set_quad_search(config_.detector.decimation, config_.detector.blur_sigma);
+        }
+        detections = detector_.detect(frame.image);
         ++full_searches_;
         frames_since_search_ = 0;
         const TagDetection* p = pick(detections);

@@ -4,13 +4,18 @@
 // tag: with tag_id < 0 the largest detected tag of the family is used, else only that id.
 //
 // Region-of-interest tracking (RoiSettings, on by default): while the tag is followed, each frame
-// is searched at full resolution (the detector settings) only in a window around the tag's
-// predicted position -- its last corners moved by their velocity over the last two sightings
-// (constant velocity) -- grown by `margin` tag sides. A whole-frame search, with the cheaper
-// search settings (decimated), runs only when the window misses the tag (lost) and every
-// `full_search_every` frames (to notice a second, larger tag). Corners are in full-frame pixels
-// either way (the window's origin is added back exactly); with refine_edges the decimated
-// search's corners are fitted on the full-resolution image too.
+// is searched only in a window around the tag's predicted position -- its last corners moved by
+// their velocity over the last two sightings (constant velocity) -- grown by `margin` tag sides.
+// Inside the window the quad search's decimation follows the tag's apparent size: the largest
+// integer d <= window_max_decimation that leaves the tag's shortest side >= window_tag_px pixels
+// after decimating (a near, large tag is searched at a low resolution, a small or far one at full
+// resolution, the detector settings), with a window_blur_sigma blur when d > 1 (AprilTag decimates
+// by keeping every d-th pixel, so without it the sensor noise stays). Either way AprilTag decodes
+// the bits and, with refine_edges, fits the edges on the full-resolution image, so the corners
+// keep their accuracy (docs/tracking.md, "Region-of-interest tracking"). A whole-frame search,
+// with the cheaper search settings (decimated), runs only when the window misses the tag (lost)
+// and every `full_search_every` frames (to notice a second, larger tag). Corners are in
+// full-frame pixels either way (the window's origin is added back exactly).
 #pragma once
 
 #include <array>
@@ -40,10 +45,19 @@ struct RoiSettings {
     // frames (docs/tracking.md); the tag is then followed at full resolution in the window.
     float search_decimation = 2.0f;  // [1, 8]
     float search_blur_sigma = 0.8f;  // [-5, 5]
+    // Window decimation from the tag's apparent size (above). window_tag_px: the shortest side
+    // (pixels) the decimated tag keeps, [4, 1000]; 0 = the window at the detector's settings
+    // (full resolution by default). window_max_decimation: [1, 8]. window_blur_sigma: the blur
+    // (pixels of the decimated image) when decimating, [-5, 5].
+    double window_tag_px = 40.0;
+    int window_max_decimation = 4;
+    float window_blur_sigma = 0.8f;
 };
 
 struct TrackerConfig {
-    DetectorSettings detector;  // the full-resolution detector of the window (or of every frame without ROI)
+    // The detector: every frame's without ROI; with ROI the window's for small tags, and the rest
+    // of the settings (family, refine_edges, ...) of every search.
+    DetectorSettings detector;
     RoiSettings roi;
     CameraIntrinsics camera;   // must match the frames' size (use rescale() for a binned mode)
     double tag_size_m = 0.10;  // side of the black border square
@@ -76,14 +90,17 @@ public:
 
     // Whole-frame searches so far (the first frame, losses and the cadence): for tests and benches.
     [[nodiscard]] long full_searches() const { return full_searches_; }
+    // The quad decimation of the last window search (0: none ran in the last frame).
+    [[nodiscard]] int last_window_decimation() const { return last_window_decimation_; }
 
 private:
     const TagDetection* pick(const std::vector<TagDetection>& detections) const;
     std::vector<TagDetection> detect_in_window(const GrayImage& image, std::int64_t timestamp_ns);
 
     TrackerConfig config_;
+    // One detector for the window and the whole-frame search (set_quad_search switches between
+    // their decimations): one set of decode tables.
     TagDetector detector_;
-    TagDetector search_detector_;  // decimated whole-frame search (ROI mode)
     PoseDisambiguator disambiguator_;
     // The followed tag's last two sightings (ROI prediction); cleared when it is lost.
     int followed_id_ = -1;
@@ -93,6 +110,7 @@ private:
     std::int64_t last_corners_ns_ = 0;
     int frames_since_search_ = 0;
     long full_searches_ = 0;
+    int last_window_decimation_ = 0;
     GrayImage window_;  // reused crop buffer
     std::int64_t last_seen_ns_ = 0;
     bool seen_ = false;

@@ -40,6 +40,8 @@ int run_reference(const ReferenceOptions& options);
 struct RoiOptions {
     double seconds = 12.0;  // of the hand-held sequence (hand_sequence.h), 30 fps, 800x600
     int repeat = 3;         // timing: fastest of this many passes per frame
+    // Extra ROI modes with these RoiSettings::window_tag_px (a sweep; the defaults always run).
+    std::vector<double> window_tag_px;
 };
 int run_roi(const RoiOptions& options);
 
