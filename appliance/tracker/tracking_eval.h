@@ -40,6 +40,7 @@ int run_reference(const ReferenceOptions& options);
 struct RoiOptions {
     double seconds = 12.0;  // of the hand-held sequence (hand_sequence.h), 30 fps, 800x600
     int repeat = 3;         // timing: fastest of this many passes per frame
+    int stride = 1;         // track every stride-th frame only (a busy tracker skips frames)
     // Extra ROI modes with these RoiSettings::window_tag_px (a sweep; the defaults always run).
     std::vector<double> window_tag_px;
 };
