@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "appliance/tracker/detector_settings.h"
+#include "appliance/tracker/tag_tracker.h"
 
 namespace mogao::track {
 
@@ -64,6 +65,8 @@ struct NavigateOptions {
     double fps = 30.0;          // replay rate when the folder has no timestamps.txt
     std::filesystem::path out;  // JSON lines of ViewerPose; default stdout
     DetectorSettings detector;
+    bool roi = true;  // RoiSettings::enabled (false: every frame searched whole, `detector`)
+    double window_tag_px = RoiSettings{}.window_tag_px;  // RoiSettings::window_tag_px (0: window at `detector`)
 };
 // Frames (replay folder or V4L2 camera) -> TagTracker -> Navigator -> ViewerPose JSON lines.
 int navigate(const NavigateOptions& options);

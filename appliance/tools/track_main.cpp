@@ -109,6 +109,11 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(0.1, 1000.0))
         ->capture_default_str();
     n->add_option("--out", nav.out, "JSON lines file (default stdout)");
+    n->add_flag("!--no-roi", nav.roi, "search every frame whole with the detector settings (no window)");
+    n->add_option("--window-tag-px", nav.window_tag_px,
+                  "ROI window: decimate while the tag keeps this shortest side (px); 0 = detector settings")
+        ->check(CLI::Range(0.0, 1000.0))  // (0, 4) is refused by TagTracker, naming the field
+        ->capture_default_str();
     add_detector_flags(*n, nav.detector);
 
     try {
