@@ -64,6 +64,9 @@ void add_render_flags(CLI::App& render, mogao::PathTour& job, CameraFlags& camer
     render.add_option("--scale", q.resolution_scale, "Resolution scale (0, 1]")->check(CLI::Range(0.01, 1.0));
     render.add_option("--jpeg-quality", q.jpeg_quality, "TurboJPEG quality 1..100")->check(CLI::Range(L::kJpegQuality.min, L::kJpegQuality.max));
     render.add_option("--seed", job.view_template.seed, "Sampling seed (same seed, same pixels)");
+    render.add_option(
+        "--first-frame-id", job.first_frame_id,
+        "frame_id of the first frame (sampling depends on seed and frame_id; a live frame's is its request id)");
     render.add_flag("--save-raw", job.save_raw, "Also write lossless frame-NNNN.ppm");
     render.add_option("--contact-sheet", job.contact_sheet_frames, "Frames on the contact sheet (0 = none)")->check(CLI::Range(0, 64));
 }

@@ -45,7 +45,7 @@ int run_path_tour(const PathTour& tour, FrameDispatcher& farm, const Scene& scen
     for (std::size_t f = 0; f < poses.size(); ++f) {
         const auto frame_start = Clock::now();
         ViewRequest view = tour.view_template;
-        view.frame_id = f;
+        view.frame_id = tour.first_frame_id + f;
         view.pose = poses[f];
         view.request_time_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
                                    std::chrono::system_clock::now().time_since_epoch()).count();

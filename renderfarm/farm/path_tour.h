@@ -5,6 +5,7 @@
 // bench/balance_sim) and contact-sheet.png.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 
@@ -22,6 +23,9 @@ struct PathTour {
     std::filesystem::path out_dir;
     bool save_raw = false;            // also write lossless frame-NNNN.ppm
     int contact_sheet_frames = 12;    // 0: no contact sheet
+    // ViewRequest::frame_id of the first frame (then +1 per frame). Sampling depends on (seed,
+    // frame_id) (renderer.h): a live frame is reproduced with frame_id = its request id.
+    std::uint64_t first_frame_id = 0;
 };
 
 // Returns the exit code; throws PathError / FarmError / file errors, which run_farm reports.

@@ -154,7 +154,7 @@ PY
 }
 
 # check_psnr CONTENT_DIR REF_DIR: every dumped content frame against the farm's lossless render of
-# its pose (PSNR >= PSNR_MIN_DB), and one frame against another pose's render (must be below: the
+# its pose with the same samples (seed, and frame_id = the request id; PSNR >= PSNR_MIN_DB), and one frame against another pose's render (must be below: the
 # comparison can fail).
 check_psnr() {
   local dumps=$1 refs=$2 n=0 worst=inf first_ppm="" last_ref=""
@@ -173,7 +173,7 @@ json.dump({"keyframes": [{"position": [e[0], e[1] - 1.6, e[2]], "yaw_deg": m["ya
           open(sys.argv[2], "w"))
 PY
     "$MPIEXEC" --oversubscribe -n 1 "$farm" render --scene "$src/scenes/test-room.json" --frames 1 \
-      --path "$refs/pose-$id.json" --width "$CONTENT_W" --height "$CONTENT_H" --spp 1 --jpeg-quality "$JPEG_QUALITY" \
+      --path "$refs/pose-$id.json" --width "$CONTENT_W" --height "$CONTENT_H" --spp 1 --jpeg-quality "$JPEG_QUALITY" --first-frame-id "$id" \
       "${SCREEN_ARGS[@]}" --save-raw --contact-sheet 0 --out "$refs/req$id" >"$refs/render-$id.log" 2>&1 \
       || { cat "$refs/render-$id.log"; fail "reference render of request $id"; }
     local db
