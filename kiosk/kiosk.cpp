@@ -130,6 +130,8 @@ void Kiosk::on_tick() {
         check_frames_shown();
     }
     shown_since_tick_ = false;
+    // A flip event may be waiting behind this tick in the same poll round: take it first.
+    if (parts_.display.overdue_output(now, options_.flip_timeout)) on_flip();
     if (const auto stuck = parts_.display.overdue_output(now, options_.flip_timeout)) {
         return fail("output", fmt::format("{}: its page flip has not completed for over {:.1f} s; stopping so that "
                                           "the service manager restarts the kiosk",
