@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "kiosk/kiosk.h"
 
+#include <poll.h>
+
 #include <csignal>
 #include <stdexcept>
 
@@ -130,9 +132,7 @@ void Kiosk::on_tick() {
         check_frames_shown();
     }
     shown_since_tick_ = false;
-    // A flip event may be waiting behind this tick in the same poll round: take it first.
-    if (parts_.display.overdue_output(now, options_.flip_timeout)) on_flip();
-    if (const auto stuck = parts_.display.overdue_output(now, options_.flip_timeout)) {
+    if (const auto stuck = flip_overdue(now)) {
         return fail("output", fmt::format("{}: its page flip has not completed for over {:.1f} s; stopping so that "
                                           "the service manager restarts the kiosk",
                                           parts_.display.output_name(*stuck),
@@ -176,6 +176,16 @@ void Kiosk::note_link_state(const LinkClientStats& link) {
     const char* state = connected_ ? "connected" : "disconnected";
     spdlog::info("farm {} {}; showing {}", config_.farm.endpoint, state, showing(last_good_));
     parts_.display.stats().event(realtime_ns(), state, last_good_.current() ? last_good_.current()->request_id : 0);
+}
+
+std::optional<std::size_t> Kiosk::flip_overdue(std::chrono::steady_clock::time_point now) {
+    if (options_.flip_timeout <= std::chrono::steady_clock::duration::zero()) return std::nullopt;  // off
+    if (!parts_.display.overdue_output(now, options_.flip_timeout)) return std::nullopt;
+    // A flip event may be waiting behind this tick in the same poll round: take it first, but only
+    // if one is there (dispatching reads the DRM fd, which would block otherwise).
+    pollfd events{parts_.display.event_fd(), POLLIN, 0};
+    if (::poll(&events, 1, 0) == 1 && (events.revents & POLLIN) != 0) on_flip();
+    return parts_.display.overdue_output(now, options_.flip_timeout);
 }
 
 void Kiosk::on_flip() {
