@@ -98,8 +98,8 @@ public:
 private:
     void fail(const char* what, const std::string& message);  // logs, exit code 1, stops the loop
     [[nodiscard]] std::optional<std::size_t> flip_overdue(std::chrono::steady_clock::time_point now);
-    [[nodiscard]] bool accept(const LinkFrame& frame);        // decode into last_good_, or log the drop
-    void check_frames_shown();                                // --frames
+    [[nodiscard]] bool accept(const LinkFrame& frame);  // decode into last_good_, or log the drop
+    void check_frames_shown();                          // --frames
     void submit_next_view();
     void note_link_state(const LinkClientStats& link);
     void write_pose(const PoseLogEntry& entry);
