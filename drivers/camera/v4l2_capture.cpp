@@ -12,18 +12,10 @@
 #include <optional>
 
 #include "drivers/camera/pixel_format.h"
+#include "drivers/camera/v4l2_ioctl.h"
 
 namespace mogao {
 namespace {
-
-// ioctl that retries when a signal interrupts it (V4L2 uAPI "xioctl").
-int xioctl(int fd, unsigned long request, void* arg) {
-    int r = 0;
-    do {
-        r = ::ioctl(fd, request, arg);
-    } while (r == -1 && errno == EINTR);
-    return r;
-}
 
 // The one-buffer fourcc of a format (0 for image_file).
 std::uint32_t fourcc_of(CaptureFormat format) {

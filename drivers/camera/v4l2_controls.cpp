@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "drivers/camera/v4l2_controls.h"
+#include "drivers/camera/v4l2_ioctl.h"
 
 #include <linux/videodev2.h>
 #include <sys/ioctl.h>
@@ -9,14 +10,6 @@
 
 namespace mogao {
 namespace {
-
-int xioctl(int fd, unsigned long request, void* arg) {
-    int r = 0;
-    do {
-        r = ::ioctl(fd, request, arg);
-    } while (r == -1 && errno == EINTR);
-    return r;
-}
 
 // The control's description, or nullopt if the device lacks it (or has it disabled).
 std::optional<v4l2_query_ext_ctrl> query(int fd, std::uint32_t id) {

@@ -11,17 +11,10 @@
 
 #include "common/unique_fd.h"
 #include "drivers/camera/pixel_format.h"
+#include "drivers/camera/v4l2_ioctl.h"
 
 namespace mogao {
 namespace {
-
-int xioctl(int fd, unsigned long request, void* arg) {
-    int r = 0;
-    do {
-        r = ::ioctl(fd, request, arg);
-    } while (r == -1 && errno == EINTR);
-    return r;
-}
 
 std::string text_of(const std::uint8_t* bytes, std::size_t size) {
     const auto* chars = reinterpret_cast<const char*>(bytes);
