@@ -48,6 +48,9 @@ Kiosk::Kiosk(const KioskConfig& config, KioskParts parts, KioskRunOptions option
     loop_.watch(parts_.inbox.fd(), [this] { on_frame(); });
     loop_.watch(tick_.fd(), [this] { on_tick(); });
     loop_.watch(parts_.display.event_fd(), [this] { on_flip(); });  // -1 headless: ignored
+    // Every output drawn is progress: one round of several outputs may outlast WatchdogSec on a
+    // software rasteriser while the loop is healthy (screen_presenter.h).
+    parts_.display.on_output_presented([this] { parts_.notifier.watchdog(); });
 }
 
 int Kiosk::run() {

@@ -64,6 +64,8 @@ public:
     [[nodiscard]] const KioskStats& stats() const { return stats_; }
     [[nodiscard]] int event_fd() const { return backend_->event_fd(); }
     [[nodiscard]] const ScreenPresenter& presenter() const { return presenter_; }
+    // See ScreenPresenter::on_output_presented (the kiosk feeds its watchdog there).
+    void on_output_presented(std::function<void()> callback) { presenter_.on_output_presented(std::move(callback)); }
 
 private:
     KioskDisplay(std::unique_ptr<OutputBackend> backend, ScreenPresenter presenter, ScreenCalibration screen)

@@ -74,6 +74,7 @@ Status ScreenPresenter::present_dirty() {
             continue;
         }
         ++last_presents_;
+        if (output_presented_) output_presented_();
         o.dirty = false;
         if (backend_->ready(i)) {
             o.shown_tag = tag_;  // synchronous (headless) or the blocking first modeset

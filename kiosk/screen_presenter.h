@@ -19,6 +19,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -55,6 +56,12 @@ public:
     [[nodiscard]] std::uint64_t current_tag() const { return tag_; }
     [[nodiscard]] const std::vector<std::optional<std::size_t>>& projector_of() const { return projector_of_; }
 
+    // Called after each output is presented, so that a caller can show progress within one round:
+    // the kiosk feeds the service watchdog here, because a round of several outputs on a slow
+    // software rasteriser (llvmpipe under QEMU's TCG: 7 s for three outputs) can outlast WatchdogSec
+    // while every single output takes a fraction of it.
+    void on_output_presented(std::function<void()> callback) { output_presented_ = std::move(callback); }
+
 private:
     struct OutputState {
         bool lit = false;
@@ -77,6 +84,7 @@ private:
     std::uint64_t tag_ = 0;
     std::optional<std::uint64_t> completed_;
     std::size_t last_presents_ = 0;
+    std::function<void()> output_presented_;
 };
 
 }  // namespace mogao

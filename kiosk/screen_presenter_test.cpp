@@ -172,8 +172,11 @@ TEST(ScreenPresenter, PendingFlipsGetTheNewestContentAndCompleteInOrder) {
     auto created = ScreenPresenter::create(backend, screen, nullptr);
     ASSERT_TRUE(created);
     ScreenPresenter& p = *created;
+    int presented_calls = 0;
+    p.on_output_presented([&presented_calls] { ++presented_calls; });
 
     ASSERT_TRUE(p.show(uniform(kContent, 50), 1));  // modeset: on screen at once
+    EXPECT_EQ(presented_calls, 3) << "one progress call per output presented";
     EXPECT_EQ(p.take_completed(), std::optional<std::uint64_t>(1));
     ASSERT_TRUE(p.show(uniform(kContent, 60), 2));  // flips pending on all three
     EXPECT_EQ(p.last_presents(), 3u);
@@ -196,6 +199,7 @@ TEST(ScreenPresenter, PendingFlipsGetTheNewestContentAndCompleteInOrder) {
     EXPECT_EQ(p.take_completed(), std::optional<std::uint64_t>(3));
     EXPECT_EQ(backend.presents(0), 3);
     EXPECT_EQ(backend.presents(2), 3);
+    EXPECT_EQ(presented_calls, 3 + 3 + 2 + 1) << "one per present: both show()s, then 0+1, then 2";
     EXPECT_NEAR(inner->last_frame(1).at(48, 36)[0], 70, 12);  // the newest content, not 60
 }
 
