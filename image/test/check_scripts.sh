@@ -37,4 +37,31 @@ if [[ -n "$farm" && -x "$farm" ]]; then
   out=$("$dir/provision" "$tmp/none.img" "$tmp/cfg" 2>&1) && { echo "provision accepted a renamed CA key"; exit 1; }
   grep -q "appliance-museum-1.key: this is a CA's private key" <<< "$out" || { echo "provision: unexpected message: $out"; exit 1; }
 fi
+# provision derives the kiosk's network allow-list from kiosk.toml's farm endpoint and refuses a
+# name or a bad --allow, before it needs root or an image.
+rm -f "$tmp/cfg/pki/"*.key
+printf '[farm]\nendpoint = "farm.example:7443"\n' > "$tmp/cfg/kiosk.toml"
+out=$("$dir/provision" "$tmp/none.img" "$tmp/cfg" 2>&1) && { echo "provision accepted a farm name"; exit 1; }
+grep -q 'endpoint .farm.example:7443. is not "\[address\]:port"' <<< "$out" || { echo "provision: unexpected message: $out"; exit 1; }
+printf '[farm]\nendpoint = "[2001:db8::7]:7443"\n' > "$tmp/cfg/kiosk.toml"
+out=$("$dir/provision" --allow 10.1.0.0/16 --allow not-an-address "$tmp/none.img" "$tmp/cfg" 2>&1) && { echo "provision accepted --allow not-an-address"; exit 1; }
+grep -q "allow 'not-an-address' is not an IP address or prefix" <<< "$out" || { echo "provision: unexpected message: $out"; exit 1; }
+# kiosk-ip-allow turns farm-addresses into runtime IPAddressAllow properties (systemctl stand-in),
+# and refuses a missing file, an empty list and a line that is not an address, naming the line.
+mkdir -p "$tmp/bin"
+printf '#!/bin/sh\necho "$@" > "%s/systemctl.args"\n' "$tmp" > "$tmp/bin/systemctl"
+chmod +x "$tmp/bin/systemctl"
+allow=$dir/rootfs/usr/lib/mogao/kiosk-ip-allow
+printf '# comment\n2001:db8::7\n\n10.1.0.0/16  # lab\n' > "$tmp/addrs"
+PATH="$tmp/bin:$PATH" "$allow" "$tmp/addrs" > /dev/null
+[[ $(cat "$tmp/systemctl.args") == "set-property --runtime mogao-kiosk.service IPAddressAllow=2001:db8::7 IPAddressAllow=10.1.0.0/16" ]] \
+  || { echo "kiosk-ip-allow: unexpected systemctl call: $(cat "$tmp/systemctl.args")"; exit 1; }
+rm -f "$tmp/systemctl.args"
+printf '2001:db8::7\nfarm.example\n' > "$tmp/addrs"
+out=$(PATH="$tmp/bin:$PATH" "$allow" "$tmp/addrs" 2>&1) && { echo "kiosk-ip-allow accepted a name"; exit 1; }
+grep -q "addrs:2: 'farm.example' is not an IP address" <<< "$out" || { echo "kiosk-ip-allow: unexpected message: $out"; exit 1; }
+printf '# nothing\n' > "$tmp/addrs"
+PATH="$tmp/bin:$PATH" "$allow" "$tmp/addrs" 2> /dev/null && { echo "kiosk-ip-allow accepted an empty list"; exit 1; }
+PATH="$tmp/bin:$PATH" "$allow" "$tmp/missing" 2> /dev/null && { echo "kiosk-ip-allow accepted a missing file"; exit 1; }
+[[ ! -e "$tmp/systemctl.args" ]] || { echo "kiosk-ip-allow called systemctl on bad input"; exit 1; }
 echo "image scripts: ok"

@@ -58,6 +58,35 @@ say "boot firmware_us=$(systemctl show -P FirmwareTimestampMonotonic) loader_us=
 journalctl -b -u mogao-kiosk.service --no-pager -o cat 2>/dev/null | grep -E "output |outputs|KMS|calibration" | head -n 12 |
   while read -r line; do say "kiosk-log $line"; done
 
+# --- unit limits and the kiosk's network allow-list (docs/services.md) -----------------------------
+kl="MemoryMax=$(prop mogao-kiosk.service MemoryMax) TasksMax=$(prop mogao-kiosk.service TasksMax) LimitNOFILE=$(prop mogao-kiosk.service LimitNOFILE)"
+case $kl in
+  "MemoryMax=1610612736 TasksMax=256 LimitNOFILE=1024") ok "kiosk-limits $kl" ;;
+  *) bad "kiosk-limits $kl (expected MemoryMax=1536M TasksMax=256 LimitNOFILE=1024)" ;;
+esac
+farm_addr=$(grep -v '^#' /etc/mogao/farm-addresses 2>/dev/null | head -n1)
+allow=$(prop mogao-kiosk.service IPAddressAllow)
+deny=$(prop mogao-kiosk.service IPAddressDeny)
+if [ -n "$farm_addr" ] && [ "$(systemctl is-active mogao-kiosk-ip-allow.service)" = active ] &&
+   echo " $allow " | grep -q " $farm_addr/" && echo " $deny " | grep -q " ::/0 "; then
+  ok "kiosk-ip-allow farm=$farm_addr allow='$allow' deny='$deny'"
+else
+  bad "kiosk-ip-allow farm='$farm_addr' allow='$allow' deny='$deny' unit=$(systemctl is-active mogao-kiosk-ip-allow.service)"
+fi
+# Enforced, not only configured: from inside the kiosk's cgroup a connection to another address is
+# refused by the cgroup's filter (EPERM at once), one to the farm's address is not (here nothing
+# listens on port 9, so the host refuses it: ECONNREFUSED).
+probe() {
+  (echo $$ > /sys/fs/cgroup/system.slice/mogao-kiosk.service/cgroup.procs &&
+     exec timeout 5 bash -c "exec 3<>/dev/tcp/$1/9" 2>&1) | tail -n1
+}
+other=$(probe fec0::99)
+to_farm=$(probe "$farm_addr")
+case "$other|$to_farm" in
+  *"not permitted"*"|"*"refused"*) ok "kiosk-ip-enforced other='$other' farm='$to_farm'" ;;
+  *) bad "kiosk-ip-enforced other='$other' farm='$to_farm' (expected: not permitted | refused)" ;;
+esac
+
 # --- the host takes screendumps of every output, then (maybe) starts the farm ---------------------
 say "screens-ready"
 answer=$(host_wait 900)
