@@ -51,6 +51,27 @@ CostMap CostMap::uniform(ImageSize image, int cell_size, double seconds_per_pixe
     return map;
 }
 
+CostMap CostMap::resampled(ImageSize image, int cell_size) const {
+    CostMap map(image, cell_size);
+    if (size_.pixel_count() == 0) return map;
+    const auto to_old = [](int v, int from, int to) {
+        return static_cast<int>(std::lround(static_cast<double>(v) * to / std::max(1, from)));
+    };
+    for (int cy = 0; cy < map.cells_y_; ++cy) {
+        for (int cx = 0; cx < map.cells_x_; ++cx) {
+            const PixelRect r = map.cell_rect(cx, cy);
+            PixelRect old{to_old(r.x0, image.width, size_.width), to_old(r.y0, image.height, size_.height),
+                          to_old(r.x1, image.width, size_.width), to_old(r.y1, image.height, size_.height)};
+            old.x1 = std::min(size_.width, std::max(old.x1, old.x0 + 1));
+            old.y1 = std::min(size_.height, std::max(old.y1, old.y0 + 1));
+            old.x0 = std::min(old.x0, old.x1 - 1);
+            old.y0 = std::min(old.y0, old.y1 - 1);
+            map.cells_[map.cell_index(cx, cy)] = sum(old);
+        }
+    }
+    return map;
+}
+
 CostMap CostMap::from_tile_times(ImageSize image, int cell_size, std::span<const TileTime> tiles) {
     CostMap map(image, cell_size);
     for (std::size_t t = 0; t < tiles.size(); ++t) {

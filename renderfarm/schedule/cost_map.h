@@ -48,6 +48,13 @@ public:
     // seconds > 0 is empty (its time could not be placed).
     [[nodiscard]] static CostMap from_tile_times(ImageSize image, int cell_size, std::span<const TileTime> tiles);
 
+    // The same predicted costs for the same view rendered at another size (a live session's
+    // resolution scale changes from frame to frame, frame_time_controller.h): each cell of the new
+    // map takes sum() over the corresponding rect of this map (edges scaled by the size ratio and
+    // rounded to pixels), so relative costs carry over and the total stays close to this map's.
+    // image: width, height >= 0; cell_size >= 1 (else throws like the constructor).
+    [[nodiscard]] CostMap resampled(ImageSize image, int cell_size) const;
+
     [[nodiscard]] ImageSize size() const { return size_; }
     [[nodiscard]] int cell_size() const { return cell_size_; }
     [[nodiscard]] int cells_x() const { return cells_x_; }

@@ -168,5 +168,21 @@ TEST(CostMap, BadInputsNameTheFieldAndLimit) {
     EXPECT_THROW((void)CostMap::from_tile_times({32, 32}, 0, {}), std::invalid_argument);
 }
 
+TEST(CostMap, ResampledKeepsWhereTheCostIs) {
+    // 64x32, left half ten times dearer than the right; the same view at half and at 1.5x size.
+    CostMap map({64, 32}, 16);
+    for (int cy = 0; cy < 2; ++cy)
+        for (int cx = 0; cx < 4; ++cx) map.set_cell(cx, cy, cx < 2 ? 10.0 : 1.0);
+    const CostMap half = map.resampled({32, 16}, 16);
+    ASSERT_EQ(half.cells_x(), 2);
+    EXPECT_NEAR(half.cell(0, 0), 40.0, 1e-9);  // the whole left half of the old map
+    EXPECT_NEAR(half.cell(1, 0), 4.0, 1e-9);
+    EXPECT_NEAR(half.total(), map.total(), 1e-9);
+    const CostMap larger = map.resampled({96, 48}, 16);
+    EXPECT_NEAR(larger.total(), map.total(), 1e-6);
+    EXPECT_GT(larger.sum({0, 0, 48, 48}), 9.0 * larger.sum({48, 0, 96, 48}));
+    EXPECT_EQ(CostMap({0, 0}, 16).resampled({8, 8}, 16).total(), 0.0);
+}
+
 }  // namespace
 }  // namespace mogao
