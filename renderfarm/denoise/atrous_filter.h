@@ -1,0 +1,87 @@
+// SPDX-License-Identifier: Apache-2.0
+// Edge-avoiding à-trous wavelet filter for low-spp frames, guided by albedo, normal and depth.
+//
+// Sources:
+//   [D] H. Dammertz, D. Sewtz, J. Hanika, H. Lensch, "Edge-Avoiding À-Trous Wavelet Transform for
+//       fast Global Illumination Filtering", HPG 2010: the filter structure (iterated 5x5 B3-spline
+//       kernel h = (1/16, 1/4, 3/8, 1/4, 1/16) ⊗ h with holes, step 2^i at iteration i) and the
+//       edge-stopping Gaussian on normals, w_n = exp(-|n_p - n_q|² / σ_n²).
+//   [S] C. Schied et al., "Spatiotemporal Variance-Guided Filtering", HPG 2017 (the spatial part):
+//       demodulation by albedo before filtering and re-modulation after (§4.1, so texture is not
+//       blurred), the luminance weight normalised by the local noise (eq. 5)
+//           w_l = exp(-|l_p - l_q| / (σ_l sqrt(g3x3(Var(l_p))) + ε)),
+//       the depth weight scaled by the screen-space depth gradient (eq. 3)
+//           w_z = exp(-|z_p - z_q| / (σ_z |∇z_p · (p - q)| + ε_z)),
+//       and the variance filtered alongside the signal, Var' = Σ w² Var / (Σ w)² (eq. 2, end of §4.2).
+//       Without temporal history the per-pixel luminance variance is estimated spatially (§4.2:
+//       the 7x7 bilateral estimate for short histories; here 5x5, weighted by normal and depth).
+// Each tap weighs h(dx) h(dy) w_l w_n w_z; the weights are not separable, so every iteration is a
+// 25-tap sparse kernel. Cost: 25 · iterations taps per surface pixel (one fast exp per tap).
+//
+// Conventions:
+//   noisy   linear RGB radiance (RgbFloatImage, common/image.h: row-major, top row first, pixel
+//           (x, y) centred at (x + 0.5, y + 0.5)), any non-negative scale. NaN/inf samples are
+//           treated as 0 (a firefly must not poison its neighbours).
+//   guides  GuideBuffers of the same size (guide_buffers.h). Sky pixels (hit 0) are copied through
+//           unchanged and never used as a neighbour of a surface pixel, nor vice versa.
+//   l       luminance of the demodulated colour, Rec. 709 weights (0.2126, 0.7152, 0.0722).
+//   Demodulation divides each channel by max(albedo, kMinAlbedo) and re-modulation multiplies by
+//   the same value, so a pixel that no neighbour may touch is returned unchanged (to float rounding).
+// Parameters (AtrousParams): every σ is a tolerance; 0 = only exactly equal values may mix (with
+// σ_colour = 0 the output equals the input); larger = more smoothing. iterations = 0 returns the input.
+//
+// Errors (Result / Status, common/result.h, code EINVAL): an empty image, a pixel buffer whose
+// length is not W·H·3, guides of another size or with buffers of the wrong length, iterations
+// outside [0, kMaxIterations], a σ that is negative or not finite, threads < 0. The message names
+// the field and the limit.
+#pragma once
+
+#include <vector>
+
+#include "common/image.h"
+#include "common/result.h"
+#include "renderfarm/denoise/guide_buffers.h"
+
+namespace mogao {
+
+struct AtrousParams {
+    static constexpr int kMaxIterations = 10;  // step 2^9 = 512 px at the last one
+    int iterations = 5;                        // à-trous levels; steps 1, 2, 4, ..., 2^(iterations-1) pixels
+    float sigma_colour = 4.0f;                 // σ_l [S]: in standard deviations of the local luminance noise
+    float sigma_normal = 0.5f;                 // σ_n [D]: on |n_p - n_q| (unit normals: 0.5 ≈ weight 1/e at 29°)
+    float sigma_depth = 1.0f;                  // σ_z [S]: in multiples of the depth change the local slope predicts
+    int threads = 1;  // row bands run on this many threads; 0 = std::thread::hardware_concurrency
+};
+
+// Reusable scratch buffers: keep one AtrousDenoiser per stream of frames so that per-frame calls
+// allocate nothing once the size is stable. Not thread-safe (one frame at a time per object).
+class AtrousDenoiser {
+public:
+    // Filters `noisy` into `out` (resized to noisy.size). On error, `out` is left untouched.
+    Status run(const RgbFloatImage& noisy, const GuideBuffers& guides, const AtrousParams& params, RgbFloatImage& out);
+
+    // Per-pixel scratch (public only so the .cpp's helpers can name it).
+    struct Texel {
+        float r, g, b, variance;  // demodulated colour and its luminance variance
+    };
+    struct Geometry {
+        float nx, ny, nz;  // unit normal
+        float depth;       // metres, 0 = sky
+        float dzdx, dzdy;  // screen-space depth gradient, metres per pixel
+    };
+
+private:
+    std::vector<Texel> ping_, pong_;
+    std::vector<Geometry> geometry_;
+    std::vector<float> blurred_variance_;
+};
+
+// One-shot convenience: a fresh AtrousDenoiser, the filtered image or the error.
+[[nodiscard]] Result<RgbFloatImage> denoise_atrous(const RgbFloatImage& noisy, const GuideBuffers& guides,
+                                                   const AtrousParams& params = {});
+
+// Checks sizes and parameters without filtering (the errors listed above).
+[[nodiscard]] Status validate_denoise_input(const RgbFloatImage& noisy, const GuideBuffers& guides,
+                                            const AtrousParams& params);
+
+}  // namespace mogao

@@ -1,0 +1,209 @@
+// SPDX-License-Identifier: Apache-2.0
+// The à-trous denoiser on synthetic frames with known edges: it removes noise, keeps normal and
+// depth edges and albedo texture, is the identity when told to be, and names the field of bad input.
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "renderfarm/denoise/atrous_filter.h"
+
+namespace mogao {
+namespace {
+
+constexpr int kW = 96, kH = 64;
+
+// Ground truth: irradiance piecewise constant over three surfaces that share no guide values:
+//   x <  48, y <  32: wall A, normal +z, depth 3 m, irradiance 1.0
+//   x >= 48, y <  32: wall B, normal +x (a normal edge at x = 48, same depth), irradiance 0.25
+//   y >= 32         : floor, normal +z, depth 6 m (a depth edge at y = 32, same normal as A), irradiance 0.5
+// and sky (hit 0, radiance 0.3) in the bottom-right 16x16 corner. Albedo: wall A is a 4-pixel
+// checker of 0.8 / 0.2 (texture the filter must keep), the rest 0.6 grey.
+struct Synthetic {
+    RgbFloatImage truth{ImageSize{kW, kH}};
+    RgbFloatImage noisy{ImageSize{kW, kH}};
+    GuideBuffers guides{ImageSize{kW, kH}};
+};
+
+float irradiance_at(int x, int y) { return y >= 32 ? 0.5f : (x < 48 ? 1.0f : 0.25f); }
+
+Synthetic make_synthetic(float noise_sigma, unsigned seed = 7) {
+    Synthetic s;
+    std::mt19937 rng(seed);
+    std::normal_distribution<float> noise(0.0f, 1.0f);
+    for (int y = 0; y < kH; ++y) {
+        for (int x = 0; x < kW; ++x) {
+            const std::size_t i = s.guides.pixel(x, y);
+            const bool sky = x >= kW - 16 && y >= kH - 16;
+            for (int c = 0; c < 3; ++c) {
+                float value = 0.3f;
+                if (!sky) {
+                    const bool wall_a = x < 48 && y < 32;
+                    const float albedo = wall_a ? (((x / 4 + y / 4) % 2) != 0 ? 0.8f : 0.2f) : 0.6f;
+                    s.guides.albedo[3 * i + c] = albedo;
+                    value = albedo * irradiance_at(x, y);
+                }
+                s.truth.at(x, y)[c] = value;
+                // Monte Carlo-like noise: proportional to the signal; the sky is noise-free.
+                s.noisy.at(x, y)[c] = sky ? value : std::max(0.0f, value * (1.0f + noise_sigma * noise(rng)));
+            }
+            if (sky) continue;
+            s.guides.hit[i] = 1;
+            s.guides.depth[i] = y >= 32 ? 6.0f : 3.0f;
+            const bool wall_b = x >= 48 && y < 32;
+            s.guides.normal[3 * i + (wall_b ? 0 : 2)] = 1.0f;
+        }
+    }
+    return s;
+}
+
+double linear_psnr(const RgbFloatImage& a, const RgbFloatImage& b, double peak = 1.0) {
+    double se = 0.0;
+    for (std::size_t i = 0; i < a.pixels.size(); ++i) {
+        const double d = double(a.pixels[i]) - double(b.pixels[i]);
+        se += d * d;
+    }
+    return 10.0 * std::log10(peak * peak / (se / double(a.pixels.size())));
+}
+
+// Mean of the irradiance (radiance / albedo) over the pixels of one column/row segment.
+double mean_irradiance(const RgbFloatImage& image, const GuideBuffers& guides, int x0, int x1, int y0, int y1) {
+    double sum = 0.0;
+    int n = 0;
+    for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+            const std::size_t i = guides.pixel(x, y);
+            for (int c = 0; c < 3; ++c) sum += image.at(x, y)[c] / guides.albedo[3 * i + c];
+            n += 3;
+        }
+    return sum / n;
+}
+
+TEST(AtrousFilter, RemovesNoiseAndKeepsNormalAndDepthEdges) {
+    const Synthetic s = make_synthetic(0.5f);
+    const Result<RgbFloatImage> out = denoise_atrous(s.noisy, s.guides);
+    ASSERT_TRUE(out.ok()) << out.error().message;
+    const double before = linear_psnr(s.noisy, s.truth), after = linear_psnr(*out, s.truth);
+    std::printf(
+        "synthetic 96x64, 50 %% noise: PSNR noisy %.2f dB, denoised %.2f dB; edge means A|B %.4f %.4f, "
+        "A/floor %.4f %.4f\n",
+        before, after, mean_irradiance(*out, s.guides, 47, 48, 0, 32), mean_irradiance(*out, s.guides, 48, 49, 0, 32),
+        mean_irradiance(*out, s.guides, 0, 48, 31, 32), mean_irradiance(*out, s.guides, 0, 48, 32, 33));
+    EXPECT_GE(after, before + 10.0) << "PSNR noisy " << before << " dB, denoised " << after << " dB";
+
+    // Bleeding across an edge biases the columns/rows right beside it toward the other side. Allowed:
+    // 2 % of the step between the two sides (noise alone moves a 32-pixel mean by well under 1 %).
+    const double step_ab = 1.0 - 0.25, step_floor = 1.0 - 0.5;
+    EXPECT_NEAR(mean_irradiance(*out, s.guides, 47, 48, 0, 32), 1.0, 0.02 * step_ab) << "wall A beside B";
+    EXPECT_NEAR(mean_irradiance(*out, s.guides, 48, 49, 0, 32), 0.25, 0.02 * step_ab) << "wall B beside A";
+    EXPECT_NEAR(mean_irradiance(*out, s.guides, 0, 48, 31, 32), 1.0, 0.02 * step_floor) << "wall A above floor";
+    EXPECT_NEAR(mean_irradiance(*out, s.guides, 0, 48, 32, 33), 0.5, 0.02 * step_floor) << "floor below A";
+    // Texture: the checker survives (demodulation), so radiance of a bright and a dark texel of
+    // wall A stays in the 4:1 albedo ratio within 10 %.
+    const double dark = out->at(5, 5)[1], bright = out->at(5 + 4, 5)[1];  // albedo 0.2, 0.8
+    EXPECT_NEAR(bright / dark, 4.0, 0.4) << "bright " << bright << " dark " << dark;
+    // The sky is passed through.
+    EXPECT_EQ(out->at(kW - 1, kH - 1)[0], s.noisy.at(kW - 1, kH - 1)[0]);
+}
+
+TEST(AtrousFilter, GuidesAreWhatKeepsTheEdges) {
+    // Control for the test above: with every pixel on one plane (same normal and depth) and a
+    // colour tolerance far above the noise, the same filter does blur wall A into wall B.
+    Synthetic s = make_synthetic(0.5f);
+    for (std::size_t i = 0; i < s.guides.hit.size(); ++i) {
+        if (s.guides.hit[i] == 0) continue;
+        s.guides.depth[i] = 3.0f;
+        s.guides.normal[3 * i] = 0.0f, s.guides.normal[3 * i + 1] = 0.0f, s.guides.normal[3 * i + 2] = 1.0f;
+    }
+    AtrousParams params;
+    params.sigma_colour = 1e6f;
+    const Result<RgbFloatImage> out = denoise_atrous(s.noisy, s.guides, params);
+    ASSERT_TRUE(out.ok()) << out.error().message;
+    EXPECT_LT(mean_irradiance(*out, s.guides, 47, 48, 0, 32), 1.0 - 0.1 * 0.75);
+}
+
+TEST(AtrousFilter, IdentityWithoutIterationsOrColourTolerance) {
+    const Synthetic s = make_synthetic(0.5f);
+    AtrousParams none;
+    none.iterations = 0;
+    const Result<RgbFloatImage> same = denoise_atrous(s.noisy, s.guides, none);
+    ASSERT_TRUE(same.ok()) << same.error().message;
+    EXPECT_EQ(same->pixels, s.noisy.pixels);
+
+    AtrousParams strict;
+    strict.sigma_colour = 0.0f;
+    const Result<RgbFloatImage> out = denoise_atrous(s.noisy, s.guides, strict);
+    ASSERT_TRUE(out.ok()) << out.error().message;
+    for (std::size_t i = 0; i < out->pixels.size(); ++i)
+        ASSERT_NEAR(out->pixels[i], s.noisy.pixels[i], 1e-6f * std::max(1.0f, s.noisy.pixels[i])) << "sample " << i;
+}
+
+TEST(AtrousFilter, ThreadsDoNotChangeTheResultAndScratchIsReused) {
+    const Synthetic s = make_synthetic(0.5f);
+    AtrousParams one, three;
+    three.threads = 3;
+    AtrousDenoiser denoiser;
+    RgbFloatImage a, b, c;
+    ASSERT_TRUE(denoiser.run(s.noisy, s.guides, one, a).ok());
+    ASSERT_TRUE(denoiser.run(s.noisy, s.guides, three, b).ok());
+    ASSERT_TRUE(denoiser.run(s.noisy, s.guides, one, c).ok());
+    EXPECT_EQ(a.pixels, b.pixels);
+    EXPECT_EQ(a.pixels, c.pixels);
+}
+
+TEST(AtrousFilter, NonFiniteSamplesDoNotSpread) {
+    Synthetic s = make_synthetic(0.2f);
+    s.noisy.at(10, 10)[0] = std::numeric_limits<float>::quiet_NaN();
+    s.noisy.at(20, 10)[1] = std::numeric_limits<float>::infinity();
+    const Result<RgbFloatImage> out = denoise_atrous(s.noisy, s.guides);
+    ASSERT_TRUE(out.ok()) << out.error().message;
+    for (float v : out->pixels) ASSERT_TRUE(std::isfinite(v));
+}
+
+void expect_error(const RgbFloatImage& image, const GuideBuffers& guides, const AtrousParams& params,
+                  const std::string& needle) {
+    const Status status = validate_denoise_input(image, guides, params);
+    ASSERT_FALSE(status.ok()) << "expected an error naming " << needle;
+    EXPECT_EQ(status.code(), EINVAL);
+    EXPECT_NE(status.error().message.find(needle), std::string::npos) << status.error().message;
+    RgbFloatImage out(ImageSize{1, 1}, 42.0f);
+    AtrousDenoiser denoiser;
+    EXPECT_FALSE(denoiser.run(image, guides, params, out).ok());
+    EXPECT_EQ(out.pixels[0], 42.0f) << "output touched on error";
+}
+
+TEST(AtrousFilter, BadInputIsNamed) {
+    const Synthetic s = make_synthetic(0.1f);
+    const AtrousParams ok;
+    expect_error(s.noisy, GuideBuffers(ImageSize{kW, kH - 1}), ok, "guides are 96x63, the image is 96x64");
+    GuideBuffers short_normal = s.guides;
+    short_normal.normal.pop_back();
+    expect_error(s.noisy, short_normal, ok, "normal");
+    RgbFloatImage short_image = s.noisy;
+    short_image.pixels.pop_back();
+    expect_error(short_image, s.guides, ok, "W*H*3");
+    expect_error(RgbFloatImage{}, GuideBuffers{}, ok, "empty");
+    GuideBuffers no_depth = s.guides;
+    no_depth.depth[5] = 0.0f;
+    expect_error(s.noisy, no_depth, ok, "guides.depth at pixel 5");
+    for (const auto& [field, value] :
+         {std::pair{"sigma_colour", -1.0f}, std::pair{"sigma_normal", std::numeric_limits<float>::quiet_NaN()},
+          std::pair{"sigma_depth", std::numeric_limits<float>::infinity()}}) {
+        AtrousParams bad;
+        if (std::string(field) == "sigma_colour") bad.sigma_colour = value;
+        if (std::string(field) == "sigma_normal") bad.sigma_normal = value;
+        if (std::string(field) == "sigma_depth") bad.sigma_depth = value;
+        expect_error(s.noisy, s.guides, bad, std::string("params.") + field);
+    }
+    AtrousParams many;
+    many.iterations = 11;
+    expect_error(s.noisy, s.guides, many, "params.iterations = 11 is outside [0, 10]");
+    AtrousParams threads;
+    threads.threads = -1;
+    expect_error(s.noisy, s.guides, threads, "params.threads");
+}
+
+}  // namespace
+}  // namespace mogao
