@@ -171,12 +171,23 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
         result.report.projectors[k].rms_px = ba.rms_px[k];
         result.report.projectors[k].cells = ba.inliers[k];
     }
-    result.calibration.content = content;
-    for (std::size_t k = 0; k < n; ++k) {
-        result.calibration.projectors.push_back(build_projector(result.projectors, k, prior.screen, options));
-    }
-    validate_screen(result.calibration);
+    result.calibration = calibration_from_models(result.projectors, prior.screen, content, options);
     return result;
+}
+
+ScreenCalibration calibration_from_models(const std::vector<DeviceModel>& projectors, const ScreenModel& screen,
+                                          ImageSize content, const AutocalOptions& options) {
+    CalibrationPrior prior;
+    prior.screen = screen;
+    prior.projectors = projectors;
+    check_inputs(prior, content, options);
+    ScreenCalibration out;
+    out.content = content;
+    for (std::size_t k = 0; k < projectors.size(); ++k) {
+        out.projectors.push_back(build_projector(projectors, k, screen, options));
+    }
+    validate_screen(out);
+    return out;
 }
 
 }  // namespace mogao::autocal

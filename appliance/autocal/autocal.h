@@ -149,6 +149,15 @@ struct AutocalResult {
 [[nodiscard]] AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, ImageSize content,
                                       const AutocalOptions& options = {});
 
+// Steps 5 and 6 alone: the warp maps and blend masks (and the gamma 2.2 response) that fitted
+// projector models give, exactly as calibrate() builds them (AutocalOptions::warp_step_px and
+// blend_ramp are used). Lets a later step (appliance/selfcal) rebuild the calibration from
+// re-estimated poses. Throws std::invalid_argument for an empty model list, a bad content size or
+// options, and whatever validate_screen rejects.
+[[nodiscard]] ScreenCalibration calibration_from_models(const std::vector<DeviceModel>& projectors,
+                                                        const ScreenModel& screen, ImageSize content,
+                                                        const AutocalOptions& options = {});
+
 // Screen point where a pinhole projector's image position (x, y) lands, as content (u, v)
 // (unclamped), or nullopt-like NaN when the ray misses the cylinder.
 [[nodiscard]] Eigen::Vector2d projector_content(const DeviceModel& projector, const ScreenModel& screen, double x,

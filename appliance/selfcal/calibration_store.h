@@ -1,0 +1,24 @@
+// SPDX-License-Identifier: Apache-2.0
+// The corrected calibration on the config partition: written atomically as MPCDI (appliance/
+// calibration's writer: temporary file, fsync, rename), the previous good one kept beside it.
+#pragma once
+
+#include <filesystem>
+
+#include "common/projector_calibration.h"
+
+namespace mogao::selfcal {
+
+// `<path>.last-good`: where save_calibration keeps the calibration it replaced.
+[[nodiscard]] std::filesystem::path last_good_path(const std::filesystem::path& path);
+
+// If `path` holds a readable calibration, first copies it (atomically) to last_good_path(path),
+// then writes `calibration` to `path` atomically. A write that fails or is interrupted at any
+// point leaves `path` holding the previous complete calibration. Throws MpcdiError /
+// std::system_error naming the file, std::invalid_argument for an invalid calibration.
+void save_calibration(const std::filesystem::path& path, const ScreenCalibration& calibration);
+
+// Reads a calibration written by save_calibration (MPCDI 2d profile). Throws MpcdiError.
+[[nodiscard]] ScreenCalibration load_calibration(const std::filesystem::path& path);
+
+}  // namespace mogao::selfcal

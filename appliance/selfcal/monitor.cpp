@@ -1,0 +1,260 @@
+// SPDX-License-Identifier: Apache-2.0
+// Prediction, feature matching and per-frame pose fits (monitor.h).
+#include "appliance/selfcal/monitor.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "appliance/autocal/bundle_adjust.h"
+#include "appliance/warp/warp_sampling.h"
+
+namespace mogao::selfcal {
+
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+cv::Mat camera_matrix(const autocal::DeviceModel& c) {
+    return (cv::Mat_<double>(3, 3) << c.fx_px, 0.0, c.cx_px, 0.0, c.fy_px, c.cy_px, 0.0, 0.0, 1.0);
+}
+
+// Undistorted normalised coordinates of camera image positions (same convention for points and cx).
+std::vector<cv::Point2d> undistort(const autocal::DeviceModel& c, const std::vector<cv::Point2d>& image) {
+    std::vector<cv::Point2d> out;
+    if (image.empty()) return out;
+    cv::undistortPoints(image, out, camera_matrix(c), cv::Mat(c.distortion, true));
+    return out;
+}
+
+// Exposure-independent 8-bit view for the detector: scaled so the 99th percentile of the lit
+// pixels is full scale, then gamma 1/2.2 (features in the darks count as much as in the lights).
+cv::Mat1b to_u8(const cv::Mat1f& img) {
+    std::vector<float> v;
+    for (int y = 0; y < img.rows; y += 4)
+        for (int x = 0; x < img.cols; x += 4) v.push_back(img(y, x));
+    std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() * 99 / 100), v.end());
+    const float p = std::max(1e-4f, v[v.size() * 99 / 100]);
+    cv::Mat1f s;
+    cv::max(img * (1.0f / p), 0.0f, s);
+    cv::min(s, 1.0f, s);
+    cv::pow(s, 1.0 / 2.2, s);
+    cv::Mat1b out;
+    s.convertTo(out, CV_8U, 255.0);
+    return out;
+}
+
+double bilinear(const cv::Mat1f& m, double x, double y) {
+    const int x0 = static_cast<int>(std::floor(x));
+    const int y0 = static_cast<int>(std::floor(y));
+    if (x0 < 0 || y0 < 0 || x0 + 1 >= m.cols || y0 + 1 >= m.rows) return std::nan("");
+    const double fx = x - x0;
+    const double fy = y - y0;
+    return (1 - fy) * ((1 - fx) * m(y0, x0) + fx * m(y0, x0 + 1)) +
+           fy * ((1 - fx) * m(y0 + 1, x0) + fx * m(y0 + 1, x0 + 1));
+}
+
+// Blend weight of projector k at screen point s under its reference model (0 outside its image).
+double blend_at(const autocal::DeviceModel& d, const ProjectorCalibration& pc, const Eigen::Vector3d& s) {
+    const Eigen::Vector2d n = project_normalised(d.rotation, d.position_m, s);
+    if (!n.allFinite()) return 0.0;
+    const double x = n.x() * d.fx_px + d.cx_px;
+    const double y = n.y() * d.fy_px + d.cy_px;
+    if (!(x >= 0.0 && y >= 0.0 && x < d.resolution.width && y < d.resolution.height)) return 0.0;
+    return sample_blend(pc.blend, pc.output, static_cast<int>(x), static_cast<int>(y));
+}
+
+struct Match {
+    cv::Point2d predicted;  // image positions
+    cv::Point2d observed;
+};
+
+// Sub-pixel refinement of a match (ORB's keypoints sit on pyramid-level grids): the predicted
+// patch around the predicted keypoint's pixel is correlated (normalised cross-correlation) with the
+// camera frame around the observed keypoint, and the peak located to sub-pixel by a parabola
+// through it and its neighbours on each axis (the usual 3-point fit, e.g. Szeliski, "Computer
+// Vision", 2nd ed., 9.1). Returns false where the patch leaves the image or the peak is weak.
+bool refine_match(const cv::Mat1b& pred, const cv::Mat1b& obs, cv::Point2f a, cv::Point2f b, Match& out) {
+    constexpr int kHalf = 8;
+    constexpr int kSearch = 3;
+    const cv::Point ia(cvRound(a.x), cvRound(a.y));
+    const cv::Point ib(cvRound(b.x), cvRound(b.y));
+    const cv::Rect pr(ia.x - kHalf, ia.y - kHalf, 2 * kHalf + 1, 2 * kHalf + 1);
+    const cv::Rect sr(ib.x - kHalf - kSearch, ib.y - kHalf - kSearch, 2 * (kHalf + kSearch) + 1,
+                      2 * (kHalf + kSearch) + 1);
+    const cv::Rect img(0, 0, pred.cols, pred.rows);
+    if ((pr & img) != pr || (sr & img) != sr) return false;
+    cv::Mat1f score;
+    cv::matchTemplate(obs(sr), pred(pr), score, cv::TM_CCOEFF_NORMED);
+    cv::Point peak;
+    double best = 0.0;
+    cv::minMaxLoc(score, nullptr, &best, nullptr, &peak);
+    if (best < 0.7 || peak.x < 1 || peak.y < 1 || peak.x >= score.cols - 1 || peak.y >= score.rows - 1) return false;
+    const auto vertex = [](float l, float c, float r) {
+        const float d = l - 2.0f * c + r;
+        return d < 0.0f ? 0.5f * (l - r) / d : 0.0f;
+    };
+    const float dx = vertex(score(peak.y, peak.x - 1), score(peak.y, peak.x), score(peak.y, peak.x + 1));
+    const float dy = vertex(score(peak.y - 1, peak.x), score(peak.y, peak.x), score(peak.y + 1, peak.x));
+    out.predicted = {ia.x + 0.5, ia.y + 0.5};
+    out.observed = {ib.x - kSearch + peak.x + static_cast<double>(dx) + 0.5,
+                    ib.y - kSearch + peak.y + static_cast<double>(dy) + 0.5};
+    return true;
+}
+
+std::vector<Match> match_features(const cv::Mat1b& pred, const cv::Mat1b& mask, const cv::Mat1b& obs,
+                                  const MonitorOptions& o, FrameMeasurement& m) {
+    cv::Ptr<cv::ORB> orb = cv::ORB::create(o.orb_features);
+    std::vector<cv::KeyPoint> kp, ko;
+    cv::Mat dp, dob;
+    orb->detectAndCompute(pred, mask, kp, dp);
+    orb->detectAndCompute(obs, cv::noArray(), ko, dob);
+    m.predicted_features = static_cast<int>(kp.size());
+    m.observed_features = static_cast<int>(ko.size());
+    std::vector<Match> out;
+    if (kp.size() < 2 || ko.size() < 2) return out;
+    cv::BFMatcher matcher(cv::NORM_HAMMING);
+    std::vector<std::vector<cv::DMatch>> knn;
+    matcher.knnMatch(dp, dob, knn, 2);
+    for (const auto& k : knn) {
+        if (k.size() < 2 || !(k[0].distance < o.ratio * k[1].distance)) continue;
+        const cv::Point2f a = kp[static_cast<std::size_t>(k[0].queryIdx)].pt;
+        const cv::Point2f b = ko[static_cast<std::size_t>(k[0].trainIdx)].pt;
+        Match refined;
+        if (cv::norm(a - b) > o.max_shift_px || !refine_match(pred, obs, a, b, refined)) continue;
+        out.push_back(refined);
+    }
+    m.matches = static_cast<int>(out.size());
+    return out;
+}
+
+}  // namespace
+
+Eigen::Vector3d screen_point(const autocal::ScreenModel& s, double u, double v) {
+    const double arc = s.arc_deg * kDeg;
+    const double theta = u * arc - arc / 2.0;
+    const double h = s.top_m - v * (s.top_m - s.bottom_m);
+    return {s.radius_m * std::sin(theta), h, -s.radius_m * std::cos(theta)};
+}
+
+Monitor::Monitor(const SystemModel& model, const ScreenCalibration& calibration, const MonitorOptions& options)
+    : options_(options) {
+    set_reference(model, calibration);
+}
+
+void Monitor::set_reference(const SystemModel& model, const ScreenCalibration& calibration) {
+    if (model.projectors.size() != calibration.projectors.size() || model.projectors.empty() ||
+        model.projectors.size() > 254) {
+        throw std::invalid_argument("Monitor: the calibration and the models must have the same 1..254 projectors");
+    }
+    model_ = model;
+    const autocal::DeviceModel& c = model.camera;
+    const int w = c.resolution.width;
+    const int h = c.resolution.height;
+    std::vector<cv::Point2d> px;
+    px.reserve(static_cast<std::size_t>(w) * h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) px.emplace_back(x + 0.5, y + 0.5);
+    const std::vector<cv::Point2d> n = undistort(c, px);
+    map_u_.create(h, w);
+    map_v_.create(h, w);
+    owner_.create(h, w);
+    mask_.create(h, w);
+    const autocal::ScreenModel& s = model.screen;
+    const double arc = s.arc_deg * kDeg;
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            const cv::Point2d& q = n[static_cast<std::size_t>(y) * w + x];
+            const Eigen::Vector3d p = autocal::ray_on_screen(s, c, Eigen::Vector3d(q.x, q.y, 1.0));
+            const double theta = std::atan2(p.x(), -p.z());
+            const bool on = p.allFinite() && std::abs(theta) <= arc / 2 && p.y() >= s.bottom_m && p.y() <= s.top_m;
+            double best = 0.0;
+            int who = 255;
+            double sum = 0.0;
+            for (std::size_t k = 0; k < model.projectors.size() && on; ++k) {
+                const double b = blend_at(model.projectors[k], calibration.projectors[k], p);
+                sum += b;
+                if (b > best) {
+                    best = b;
+                    who = static_cast<int>(k);
+                }
+            }
+            const bool lit = sum > 0.0;
+            map_u_(y, x) = lit ? static_cast<float>((theta + arc / 2) / arc) : std::nanf("");
+            map_v_(y, x) = lit ? static_cast<float>((s.top_m - p.y()) / (s.top_m - s.bottom_m)) : std::nanf("");
+            owner_(y, x) = static_cast<std::uint8_t>(best >= options_.owner_min_blend ? who : 255);
+            mask_(y, x) = lit ? 255 : 0;
+        }
+    }
+    // Features need their whole patch on the lit screen: keep them off its border.
+    cv::erode(mask_, mask_, cv::Mat(), cv::Point(-1, -1), 8);
+}
+
+cv::Mat1f Monitor::predict(const cv::Mat1f& content) const {
+    if (content.empty()) throw std::invalid_argument("Monitor::predict: empty content frame");
+    cv::Mat1f mx(map_u_.size());
+    cv::Mat1f my(map_u_.size());
+    for (int y = 0; y < mx.rows; ++y) {
+        for (int x = 0; x < mx.cols; ++x) {
+            const float u = map_u_(y, x);
+            mx(y, x) = std::isfinite(u) ? u * static_cast<float>(content.cols) - 0.5f : -1e4f;
+            my(y, x) = std::isfinite(u) ? map_v_(y, x) * static_cast<float>(content.rows) - 0.5f : -1e4f;
+        }
+    }
+    cv::Mat1f out;
+    cv::remap(content, out, mx, my, cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0.0);
+    return out;
+}
+
+FrameMeasurement Monitor::measure(const cv::Mat1f& content, const cv::Mat1f& camera_frame) const {
+    const autocal::DeviceModel& cam = model_.camera;
+    if (camera_frame.cols != cam.resolution.width || camera_frame.rows != cam.resolution.height) {
+        throw std::invalid_argument("Monitor::measure: camera frame must be " + std::to_string(cam.resolution.width) +
+                                    "x" + std::to_string(cam.resolution.height));
+    }
+    FrameMeasurement m;
+    m.projectors.resize(model_.projectors.size());
+    const std::vector<Match> matches = match_features(to_u8(predict(content)), mask_, to_u8(camera_frame), options_, m);
+    std::vector<Eigen::Vector3d> s_pred;
+    std::vector<cv::Point2d> observed;
+    std::vector<int> owner;
+    for (const Match& mt : matches) {
+        const double u = bilinear(map_u_, mt.predicted.x - 0.5, mt.predicted.y - 0.5);
+        const double v = bilinear(map_v_, mt.predicted.x - 0.5, mt.predicted.y - 0.5);
+        if (!std::isfinite(u) || !std::isfinite(v)) continue;
+        s_pred.push_back(screen_point(model_.screen, u, v));
+        observed.push_back(mt.observed);
+        owner.push_back(owner_(static_cast<int>(mt.predicted.y), static_cast<int>(mt.predicted.x)));
+    }
+    const std::vector<cv::Point2d> n = undistort(cam, observed);
+    std::vector<Eigen::Vector2d> obs_n;
+    for (const cv::Point2d& p : n) obs_n.emplace_back(p.x, p.y);
+    m.camera = fit_pose_robust(cam, s_pred, obs_n, options_.camera_fit);
+    const autocal::DeviceModel camera = m.camera.ok ? m.camera.model : cam;
+    if (m.camera.ok) m.camera_delta = pose_delta(cam, m.camera.model);
+    for (std::size_t k = 0; k < model_.projectors.size(); ++k) {
+        const autocal::DeviceModel& d = model_.projectors[k];
+        std::vector<Eigen::Vector3d> s_obs;
+        std::vector<Eigen::Vector2d> x_k;
+        for (std::size_t i = 0; i < s_pred.size(); ++i) {
+            if (owner[i] != static_cast<int>(k)) continue;
+            const Eigen::Vector3d so = autocal::ray_on_screen(model_.screen, camera, {obs_n[i].x(), obs_n[i].y(), 1.0});
+            const Eigen::Vector2d xn = project_normalised(d.rotation, d.position_m, s_pred[i]);
+            if (!so.allFinite() || !xn.allFinite()) continue;
+            s_obs.push_back(so);
+            x_k.push_back(xn);
+        }
+        ProjectorMeasurement& pm = m.projectors[k];
+        pm.matches = static_cast<int>(s_obs.size());
+        pm.fit = fit_pose_robust(d, s_obs, x_k, options_.projector_fit);
+        if (pm.fit.ok) pm.delta = pose_delta(d, pm.fit.model);
+    }
+    return m;
+}
+
+}  // namespace mogao::selfcal

@@ -1,0 +1,94 @@
+// SPDX-License-Identifier: Apache-2.0
+// The monitor's per-frame measurement (docs/calibration.md, "Self-recalibration"): from the
+// content being projected, predict what the camera should see under the current calibration,
+// match features between prediction and camera frame (ORB: Rublee, Rabaud, Konolige, Bradski 2011;
+// Lowe's ratio test, Lowe 2004), and turn the matches into a robust pose of the camera and of each
+// projector (robust_pose.h), using what is known: the screen is the cylinder, devices are rigid
+// pinholes with fixed intrinsics.
+//
+// Model of a match. A feature of content point c (normalised u, v) is predicted at camera image
+// position q_pred (the current models: c's screen point S(c) seen by the camera) and observed at
+// q_obs. Projector k shows c at its pixel x_k = P_k(S(c)) (its warp was built from its model), so
+//   - if only the camera moved: q_obs = camera'(S(c)): a pose fit of the camera on (S(c), q_obs);
+//   - if projector k moved: its pixel x_k now lands on S_obs = camera ray through q_obs hit with
+//     the cylinder, so a pose fit of projector k on (S_obs, x_k) gives its new pose.
+// The camera is fitted first on all matches (RANSAC: the projectors that did not move are the
+// consensus, which assumes fewer than half the matched features belong to moved projectors),
+// and the projectors against that camera: a bumped camera is not seen as every projector moving.
+// A match counts for projector k only where k's blend weight at the predicted point is at least
+// `owner_min_blend` (in overlaps a moved projector shows a double image).
+// Images: camera frames CV_32FC1 linear in [0, 1], camera resolution, pixel-index coordinates of
+// OpenCV keypoints + 0.5 = image positions. Content frames CV_32FC1 linear grey, any size.
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "appliance/autocal/autocal.h"
+#include "appliance/selfcal/robust_pose.h"
+#include "common/projector_calibration.h"
+
+namespace mogao::selfcal {
+
+// The calibrated system: screen, camera (intrinsics and pose) and each projector's model, in the
+// order of the calibration's projectors.
+struct SystemModel {
+    autocal::ScreenModel screen;
+    autocal::DeviceModel camera;
+    std::vector<autocal::DeviceModel> projectors;
+};
+
+struct MonitorOptions {
+    int orb_features = 3000;       // per image
+    double ratio = 0.8;            // Lowe's ratio test
+    double max_shift_px = 80.0;    // predicted -> observed, camera pixels
+    double owner_min_blend = 0.9;  // a match belongs to a projector above this blend weight
+    RobustPoseOptions camera_fit{2.0, 300, 1.345, 12, 20};
+    RobustPoseOptions projector_fit{6.0, 300, 1.345, 12, 12, 0.002};
+};
+
+struct ProjectorMeasurement {
+    int matches = 0;              // matches owned by this projector
+    PoseFit fit;                  // fit.ok = false: no measurement this frame
+    Pose6 delta = Pose6::Zero();  // fitted pose against the reference model
+};
+
+struct FrameMeasurement {
+    int predicted_features = 0;
+    int observed_features = 0;
+    int matches = 0;
+    PoseFit camera;  // camera.ok = false: the reference camera was used
+    Pose6 camera_delta = Pose6::Zero();
+    std::vector<ProjectorMeasurement> projectors;
+};
+
+class Monitor {
+public:
+    // Throws std::invalid_argument when the calibration's projectors and the models differ.
+    Monitor(const SystemModel& model, const ScreenCalibration& calibration, const MonitorOptions& options = {});
+
+    // New reference (after a correction or a re-based camera): rebuilds the camera -> content maps.
+    void set_reference(const SystemModel& model, const ScreenCalibration& calibration);
+
+    // What the camera should see of `content` (linear, unscaled by exposure; 0 off the screen).
+    [[nodiscard]] cv::Mat1f predict(const cv::Mat1f& content) const;
+
+    // One frame's matches and fits. Throws std::invalid_argument for a camera frame of the wrong size.
+    [[nodiscard]] FrameMeasurement measure(const cv::Mat1f& content, const cv::Mat1f& camera_frame) const;
+
+    [[nodiscard]] const SystemModel& model() const { return model_; }
+
+private:
+    SystemModel model_;
+    MonitorOptions options_;
+    cv::Mat1f map_u_;  // per camera pixel: content u under the reference (NaN: not on the lit screen)
+    cv::Mat1f map_v_;
+    cv::Mat1b owner_;  // projector index, 255 none (off screen or overlap)
+    cv::Mat1b mask_;   // 255 where the lit screen is predicted
+};
+
+// Screen point (x, y, z) of content (u, v) on the cylinder.
+[[nodiscard]] Eigen::Vector3d screen_point(const autocal::ScreenModel& screen, double u, double v);
+
+}  // namespace mogao::selfcal

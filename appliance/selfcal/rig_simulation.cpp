@@ -1,0 +1,281 @@
+// SPDX-License-Identifier: Apache-2.0
+// Self-recalibration scenarios on the virtual rig, measured against its ground truth (rig_simulation.h).
+#include "appliance/selfcal/rig_simulation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+
+#include <opencv2/imgproc.hpp>
+
+#include "appliance/autocal/rig_bridge.h"
+
+namespace mogao::selfcal {
+
+namespace {
+
+autocal::DeviceModel device_of(const std::string& id, ImageSize res, const rig::RigIntrinsics& in,
+                               const rig::RigPose& pose) {
+    return {
+        id, res, in.fx_px, in.fy_px, in.cx_px, in.cy_px, in.distortion, rig::device_to_screen(pose), pose.position_m};
+}
+
+void apply_bump(rig::VirtualRig& rig, const Bump& b) {
+    rig::RigPose& p = b.device < 0 ? rig.camera.pose : rig.projectors[static_cast<std::size_t>(b.device)].pose;
+    p.yaw_deg += b.yaw_deg;
+    p.pitch_deg += b.pitch_deg;
+    p.roll_deg += b.roll_deg;
+    p.position_m += b.shift_m;
+}
+
+// Visitors: dark-clothed rectangles standing in front of the screen, each showing the content
+// that lands on them displaced (they are nearer the projectors than the screen is).
+void occlude(cv::Mat1f& cam, double fraction, cv::RNG& rng) {
+    if (fraction <= 0.0) return;
+    const double target = fraction * cam.rows * cam.cols;
+    double covered = 0.0;
+    cv::Mat1b hidden(cam.size(), 0);
+    const cv::Mat1f source = cam.clone();
+    for (int tries = 0; tries < 200 && covered < target; ++tries) {
+        const int w = rng.uniform(cam.cols / 12, cam.cols / 5);
+        const int h = rng.uniform(cam.rows / 3, cam.rows);
+        const cv::Rect r(rng.uniform(0, cam.cols - w), cam.rows - h, w, h);
+        const int dx = rng.uniform(-40, 40);
+        for (int y = r.y; y < r.y + r.height; ++y) {
+            for (int x = r.x; x < r.x + r.width; ++x) {
+                if (hidden(y, x)) continue;
+                const int sx = std::clamp(x + dx, 0, cam.cols - 1);
+                cam(y, x) = 0.4f * source(y, sx) + 0.01f;
+                hidden(y, x) = 1;
+                covered += 1.0;
+                if (covered >= target) return;
+            }
+        }
+    }
+}
+
+// Ground truth per projector: the rig and the calibration cut down to projector k alone.
+std::vector<autocal::GeometryError> projector_errors(const rig::VirtualRig& truth, const ScreenCalibration& wall) {
+    std::vector<autocal::GeometryError> out;
+    for (std::size_t k = 0; k < wall.projectors.size(); ++k) {
+        rig::VirtualRig one = truth;
+        one.projectors = {truth.projectors[k]};
+        ScreenCalibration c;
+        c.content = wall.content;
+        c.projectors = {wall.projectors[k]};
+        out.push_back(autocal::measure_geometry(one, c, 8));
+    }
+    return out;
+}
+
+}  // namespace
+
+Bump parse_bump(const rig::VirtualRig& rig, const std::string& text) {
+    const auto fail = [&](const std::string& why) {
+        throw std::invalid_argument("--bump '" + text + "': " + why +
+                                    " (form: proj1:yaw=1deg,pitch=0.2deg,roll=0deg,x=5mm,y=0mm,z=0mm or camera:...)");
+    };
+    const auto colon = text.find(':');
+    if (colon == std::string::npos) fail("no ':'");
+    Bump b;
+    const std::string who = text.substr(0, colon);
+    b.device = -2;
+    if (who == "camera") b.device = -1;
+    for (std::size_t k = 0; k < rig.projectors.size(); ++k) {
+        if (rig.projectors[k].id == who) b.device = static_cast<int>(k);
+    }
+    if (b.device == -2) fail("unknown device '" + who + "'");
+    std::size_t pos = colon + 1;
+    while (pos < text.size()) {
+        const auto comma = std::min(text.find(',', pos), text.size());
+        const std::string part = text.substr(pos, comma - pos);
+        pos = comma + 1;
+        const auto eq = part.find('=');
+        if (eq == std::string::npos) fail("'" + part + "' has no '='");
+        const std::string key = part.substr(0, eq);
+        std::string value = part.substr(eq + 1);
+        double scale = 1.0;
+        const auto strip = [&](const std::string& unit, double s) {
+            if (value.size() > unit.size() && value.compare(value.size() - unit.size(), unit.size(), unit) == 0) {
+                value.resize(value.size() - unit.size());
+                scale = s;
+                return true;
+            }
+            return false;
+        };
+        const bool angle = key == "yaw" || key == "pitch" || key == "roll";
+        if (angle) (void)strip("deg", 1.0);
+        else if (!strip("mm", 1e-3)) (void)strip("m", 1.0);
+        std::size_t used = 0;
+        double v = 0.0;
+        try {
+            v = std::stod(value, &used) * scale;
+        } catch (const std::exception&) {
+            used = 0;
+        }
+        if (used != value.size() || value.empty() || !std::isfinite(v)) fail("bad number in '" + part + "'");
+        if (key == "yaw") b.yaw_deg = v;
+        else if (key == "pitch") b.pitch_deg = v;
+        else if (key == "roll") b.roll_deg = v;
+        else if (key == "x") b.shift_m.x() = v;
+        else if (key == "y") b.shift_m.y() = v;
+        else if (key == "z") b.shift_m.z() = v;
+        else fail("unknown key '" + key + "'");
+    }
+    return b;
+}
+
+SystemModel models_of_rig(const rig::VirtualRig& rig) {
+    SystemModel m;
+    m.screen = {rig.screen.radius_m, rig.screen.arc_deg, rig.screen.bottom_m, rig.screen.top_m};
+    m.camera = device_of("camera", rig.camera.resolution, rig.camera.intrinsics, rig.camera.pose);
+    for (const rig::RigProjector& p : rig.projectors) {
+        m.projectors.push_back(device_of(p.id, p.resolution, p.intrinsics, p.pose));
+    }
+    return m;
+}
+
+cv::Mat1f make_content(ContentKind kind, double t_s, bool moving, std::uint64_t seed) {
+    const cv::Size size(960, 540);
+    if (kind == ContentKind::plain) return cv::Mat1f(size, 0.3f);
+    cv::Mat1f img(size, 0.25f);
+    cv::RNG rng(seed);
+    if (kind == ContentKind::repetitive) {
+        for (int y = 12; y < size.height; y += 24)
+            for (int x = 12; x < size.width; x += 24) cv::circle(img, {x, y}, 5, 0.8f, cv::FILLED, cv::LINE_AA);
+    } else {
+        for (int octave = 8; octave <= 128; octave *= 2) {
+            cv::Mat1f noise(octave * 9 / 16 + 1, octave);
+            rng.fill(noise, cv::RNG::UNIFORM, -0.5, 0.5);
+            cv::Mat1f up;
+            cv::resize(noise, up, size, 0, 0, cv::INTER_CUBIC);
+            img += up * (0.5 / std::sqrt(static_cast<double>(octave)));
+        }
+        for (int i = 0; i < 300; ++i) {
+            const cv::Point c(rng.uniform(0, size.width), rng.uniform(0, size.height));
+            const float v = static_cast<float>(rng.uniform(0.05, 0.95));
+            if (i % 3 == 0) cv::circle(img, c, rng.uniform(3, 14), v, cv::FILLED, cv::LINE_AA);
+            else if (i % 3 == 1)
+                cv::rectangle(img, cv::Rect(c.x, c.y, rng.uniform(4, 30), rng.uniform(4, 30)), v, cv::FILLED);
+            else cv::line(img, c, c + cv::Point(rng.uniform(-40, 40), rng.uniform(-40, 40)), v, 2, cv::LINE_AA);
+        }
+    }
+    if (moving) {
+        const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, 6.0 * t_s, 0, 1, 0);
+        cv::warpAffine(img, img, shift, size, cv::INTER_LINEAR, cv::BORDER_WRAP);
+    }
+    cv::max(img, 0.02f, img);
+    cv::min(img, 0.98f, img);
+    return img;
+}
+
+cv::Mat1f projector_signal(const ProjectorCalibration& pc, const cv::Mat1f& content) {
+    const ImageSize g = pc.warp.size;
+    cv::Mat1f gu(g.height, g.width);
+    cv::Mat1f gv(g.height, g.width);
+    for (int y = 0; y < g.height; ++y) {
+        for (int x = 0; x < g.width; ++x) {
+            const std::size_t i = 2 * (static_cast<std::size_t>(y) * g.width + x);
+            const float u = pc.warp.uv[i];
+            const float v = pc.warp.uv[i + 1];
+            // No content: far outside the frame (black), after the bilinear resize too.
+            gu(y, x) = std::isfinite(u) ? u * static_cast<float>(content.cols) - 0.5f : -1e4f;
+            gv(y, x) = std::isfinite(v) ? v * static_cast<float>(content.rows) - 0.5f : -1e4f;
+        }
+    }
+    const cv::Size out(pc.output.width, pc.output.height);
+    cv::Mat1f mx, my, blend;
+    // cv::resize's bilinear maps output centre x + 0.5 to grid position (x + 0.5) * M / W - 0.5,
+    // clamped at the edges: exactly sample_warp's convention (projector_calibration.h).
+    cv::resize(gu, mx, out, 0, 0, cv::INTER_LINEAR);
+    cv::resize(gv, my, out, 0, 0, cv::INTER_LINEAR);
+    const cv::Mat1f bl(pc.blend.size.height, pc.blend.size.width, const_cast<float*>(pc.blend.weight.data()));
+    cv::resize(bl, blend, out, 0, 0, cv::INTER_LINEAR);
+    cv::Mat1f signal;
+    cv::remap(content, signal, mx, my, cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0.0);
+    signal = signal.mul(blend);
+    cv::max(signal, 0.0f, signal);
+    cv::min(signal, 1.0f, signal);
+    cv::pow(signal, 1.0 / 2.2, signal);  // the response autocal builds: gamma 2.2
+    return signal;
+}
+
+SimulationReport simulate(const rig::VirtualRig& input, const SimulationOptions& o) {
+    if (!(o.rate_hz > 0.0) || o.frames < 1 || !(o.occlusion >= 0.0 && o.occlusion <= 0.9) ||
+        !(o.exposure_jitter >= 0.0 && o.exposure_jitter < 1.0)) {
+        throw std::invalid_argument(
+            "simulate: rate_hz > 0, frames >= 1, occlusion in [0, 0.9], exposure_jitter in [0, 1)");
+    }
+    rig::VirtualRig truth = autocal::scaled_rig(input, o.projector_scale, o.camera_scale);
+    for (const Bump& b : o.bumps) {
+        if (b.device < -1 || b.device >= static_cast<int>(truth.projectors.size())) {
+            throw std::invalid_argument("simulate: bump device out of range");
+        }
+    }
+    const SystemModel model = models_of_rig(truth);
+    ScreenCalibration wall =
+        autocal::calibration_from_models(model.projectors, model.screen, {1920, 1080}, o.selfcal.build);
+    SelfCalibrator sc(model, wall, o.selfcal);
+    auto sim = std::make_unique<rig::CameraSimulator>(truth);
+    std::vector<bool> applied(o.bumps.size(), false);
+    double first_bump = o.bumps.empty() ? std::nan("") : o.bumps.front().at_s;
+    for (const Bump& b : o.bumps) first_bump = std::min(first_bump, b.at_s);
+    cv::RNG rng(o.seed);
+    SimulationReport rep;
+    double cpu = 0.0;
+    bool measured_before = false;
+    for (int i = 0; i < o.frames; ++i) {
+        const double t = i / o.rate_hz;
+        bool changed = false;
+        for (std::size_t b = 0; b < o.bumps.size(); ++b) {
+            if (!applied[b] && t >= o.bumps[b].at_s) {
+                apply_bump(truth, o.bumps[b]);
+                applied[b] = true;
+                changed = true;
+            }
+        }
+        if (changed) sim = std::make_unique<rig::CameraSimulator>(truth);
+        const cv::Mat1f content = make_content(o.content, t, o.moving_content, o.seed);
+        std::vector<cv::Mat> signals;
+        for (const ProjectorCalibration& pc : wall.projectors) signals.emplace_back(projector_signal(pc, content));
+        cv::Mat1f cam = sim->capture(signals, static_cast<std::uint64_t>(i) + o.seed * 100000);
+        const double gain = 1.0 + rng.uniform(-o.exposure_jitter, o.exposure_jitter + 1e-12);
+        cam *= gain;
+        cv::min(cam, 1.0f, cam);
+        occlude(cam, o.occlusion, rng);
+        const StepResult r = sc.step(content, cam, t);
+        if (r.calibration) wall = *r.calibration;
+        for (const std::string& line : r.journal) rep.journal.push_back(line);
+        if (r.status.state == SelfcalState::correcting &&
+            (rep.frames.empty() || rep.frames.back().state != SelfcalState::correcting)) {
+            ++rep.corrections;
+        }
+        autocal::GeometryError g;  // the worst projector's
+        for (const autocal::GeometryError& e : projector_errors(truth, wall)) {
+            if (e.mean_px >= g.mean_px) g = e;
+        }
+        rep.frames.push_back({t, r.status.state, r.status.waiting, g.mean_px, r.cpu_ms});
+        rep.waiting_frames += r.status.waiting ? 1 : 0;
+        cpu += r.cpu_ms;
+        rep.final_error_px = g.mean_px;
+        rep.final_p95_px = g.p95_px;
+        rep.final_state = r.status.state;
+        if (std::isfinite(first_bump) && t >= first_bump) {
+            if (!measured_before) {
+                rep.error_before_px = g.mean_px;
+                measured_before = true;
+            }
+            if (!rep.detected_after_s && r.status.state != SelfcalState::calibrated)
+                rep.detected_after_s = t - first_bump;
+            if (!rep.corrected_after_s && rep.corrections > 0 && r.status.state == SelfcalState::calibrated &&
+                g.mean_px < o.error_threshold_px) {
+                rep.corrected_after_s = t - first_bump;
+            }
+        }
+    }
+    rep.mean_cpu_ms = cpu / o.frames;
+    return rep;
+}
+
+}  // namespace mogao::selfcal

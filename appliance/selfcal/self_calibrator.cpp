@@ -1,0 +1,297 @@
+// SPDX-License-Identifier: Apache-2.0
+// The self-recalibration state machine (self_calibrator.h).
+#include "appliance/selfcal/self_calibrator.h"
+
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <numbers>
+#include <stdexcept>
+
+#include "appliance/autocal/bundle_adjust.h"
+#include "appliance/selfcal/calibration_store.h"
+
+namespace mogao::selfcal {
+
+namespace {
+
+constexpr double kRad2Deg = 180.0 / std::numbers::pi;
+// A matched feature's position error is not independent of its neighbours' (same blur, same
+// content edge), so the fit's covariance is optimistic: its variance is inflated by this factor.
+constexpr double kCovarianceInflation = 4.0;
+
+double thread_cpu_ms() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+}
+
+void check_options(const SelfcalOptions& o) {
+    const auto fail = [](const std::string& what) { throw std::invalid_argument("SelfcalOptions: " + what); };
+    if (!(o.drift_threshold_px > 0.0)) fail("drift_threshold_px > 0");
+    if (!(o.hold_s >= 0.0) || !std::isfinite(o.hold_s)) fail("hold_s >= 0");
+    if (!(o.transition_s >= 0.0) || !std::isfinite(o.transition_s)) fail("transition_s >= 0");
+    if (o.min_matches < 6) fail("min_matches >= 6");
+    if (!(o.max_offscreen_loss > 0.0 && o.max_offscreen_loss <= 1.0)) fail("max_offscreen_loss in (0, 1]");
+    if (!(o.camera_rebase_deg >= 0.0)) fail("camera_rebase_deg >= 0");
+}
+
+std::string fmt(const char* f, double a, double b = 0.0, double c = 0.0) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, f, a, b, c);
+    return buf;
+}
+
+}  // namespace
+
+ScreenCalibration interpolate_calibration(const ScreenCalibration& a, const ScreenCalibration& b, double s) {
+    if (a.projectors.size() != b.projectors.size()) throw std::invalid_argument("interpolate_calibration: layouts");
+    ScreenCalibration out = b;
+    const float t = static_cast<float>(std::clamp(s, 0.0, 1.0));
+    for (std::size_t k = 0; k < a.projectors.size(); ++k) {
+        const ProjectorCalibration& pa = a.projectors[k];
+        ProjectorCalibration& po = out.projectors[k];
+        if (pa.warp.uv.size() != po.warp.uv.size() || pa.blend.weight.size() != po.blend.weight.size()) {
+            throw std::invalid_argument("interpolate_calibration: projector " + pa.id + " grids differ");
+        }
+        for (std::size_t i = 0; i < po.warp.uv.size(); ++i) {
+            const float x = pa.warp.uv[i];
+            const float y = po.warp.uv[i];
+            if (std::isfinite(x) && std::isfinite(y)) {
+                po.warp.uv[i] = x + t * (y - x);
+            } else if (t < 0.5f) {
+                po.warp.uv[i] = x;
+            }
+        }
+        for (std::size_t i = 0; i < po.blend.weight.size(); ++i) {
+            po.blend.weight[i] = pa.blend.weight[i] + t * (po.blend.weight[i] - pa.blend.weight[i]);
+        }
+    }
+    return out;
+}
+
+SelfCalibrator::SelfCalibrator(const SystemModel& model, const ScreenCalibration& calibration,
+                               const SelfcalOptions& options)
+    : options_(options),
+      monitor_(model, calibration, options.monitor),
+      wall_(calibration),
+      camera_filter_(options.camera_kalman) {
+    check_options(options);
+    filters_.assign(model.projectors.size(), PoseKalman(options.kalman));
+}
+
+double SelfCalibrator::drift_px(int k, const Pose6& delta) const {
+    const SystemModel& m = monitor_.model();
+    const autocal::DeviceModel& d = m.projectors[static_cast<std::size_t>(k)];
+    const autocal::DeviceModel moved = apply_delta(d, delta);
+    double sum = 0.0;
+    int n = 0;
+    constexpr int kGx = 16;
+    constexpr int kGy = 9;
+    for (int j = 0; j < kGy; ++j) {
+        for (int i = 0; i < kGx; ++i) {
+            const double x = (i + 0.5) * d.resolution.width / kGx;
+            const double y = (j + 0.5) * d.resolution.height / kGy;
+            const Eigen::Vector3d ray((x - d.cx_px) / d.fx_px, (y - d.cy_px) / d.fy_px, 1.0);
+            const Eigen::Vector3d s = autocal::ray_on_screen(m.screen, d, ray);
+            if (!s.allFinite()) continue;
+            const Eigen::Vector2d q = project_normalised(moved.rotation, moved.position_m, s);
+            if (!q.allFinite()) continue;
+            sum += std::hypot(q.x() * d.fx_px + d.cx_px - x, q.y() * d.fy_px + d.cy_px - y);
+            ++n;
+        }
+    }
+    return n > 0 ? sum / n : 0.0;
+}
+
+double SelfCalibrator::on_screen_fraction(const autocal::DeviceModel& d) const {
+    const autocal::ScreenModel& s = monitor_.model().screen;
+    const double half_arc = s.arc_deg / 2.0 / kRad2Deg;
+    int on = 0;
+    constexpr int kG = 24;
+    for (int j = 0; j < kG; ++j) {
+        for (int i = 0; i < kG; ++i) {
+            const double x = (i + 0.5) * d.resolution.width / kG;
+            const double y = (j + 0.5) * d.resolution.height / kG;
+            const Eigen::Vector3d p =
+                autocal::ray_on_screen(s, d, {(x - d.cx_px) / d.fx_px, (y - d.cy_px) / d.fy_px, 1.0});
+            if (!p.allFinite()) continue;
+            const double theta = std::atan2(p.x(), -p.z());
+            if (std::abs(theta) <= half_arc && p.y() >= s.bottom_m && p.y() <= s.top_m) ++on;
+        }
+    }
+    return static_cast<double>(on) / (kG * kG);
+}
+
+void SelfCalibrator::filter(const FrameMeasurement& m, double dt, StepResult& r) {
+    int short_of_evidence = 0;
+    for (std::size_t k = 0; k < filters_.size(); ++k) {
+        filters_[k].predict(dt);
+        const ProjectorMeasurement& pm = m.projectors[k];
+        ProjectorStatus& ps = r.status.projectors[k];
+        ps.matches = pm.matches;
+        if (pm.matches < options_.min_matches || !pm.fit.ok) {
+            ++short_of_evidence;
+            continue;
+        }
+        (void)filters_[k].update(pm.delta, kCovarianceInflation * pm.fit.covariance);
+        ps.measured = true;
+    }
+    camera_filter_.predict(dt);
+    if (m.camera.ok) (void)camera_filter_.update(m.camera_delta, kCovarianceInflation * m.camera.covariance);
+    if (short_of_evidence > 0) {
+        r.status.waiting = true;
+        r.status.reason = std::to_string(short_of_evidence) + " projector(s) under " +
+                          std::to_string(options_.min_matches) + " matches (" + std::to_string(m.matches) + " in all)";
+    }
+}
+
+void SelfCalibrator::start_correction(double t_s, const std::vector<int>& drifting, StepResult& r) {
+    const SystemModel& m = monitor_.model();
+    after_models_ = m.projectors;
+    for (int k : drifting) {
+        const auto uk = static_cast<std::size_t>(k);
+        after_models_[uk] = apply_delta(m.projectors[uk], filters_[uk].state());
+        const Cov6& p = filters_[uk].covariance();
+        r.journal.push_back("selfcal: correcting " + m.projectors[uk].id +
+                            fmt(": before: drift %.2f px (rotation %.3f deg, ", r.status.projectors[uk].drift_px,
+                                r.status.projectors[uk].rotation_deg) +
+                            fmt("shift %.1f mm); estimate sd %.4f deg, %.2f mm", r.status.projectors[uk].shift_mm,
+                                std::sqrt(p.topLeftCorner<3, 3>().trace()) * kRad2Deg,
+                                std::sqrt(p.bottomRightCorner<3, 3>().trace()) * 1e3) +
+                            fmt(", blended in over %.1f s", options_.transition_s));
+    }
+    before_ = wall_;
+    after_ = autocal::calibration_from_models(after_models_, m.screen, wall_.content, options_.build);
+    correction_start_ = t_s;
+    state_ = SelfcalState::correcting;
+    advance_correction(t_s, r);
+}
+
+void SelfCalibrator::advance_correction(double t_s, StepResult& r) {
+    const double s = options_.transition_s > 0.0 ? (t_s - correction_start_) / options_.transition_s : 1.0;
+    if (s < 1.0) {
+        wall_ = interpolate_calibration(before_, after_, s);
+        r.calibration = wall_;
+        return;
+    }
+    wall_ = after_;
+    r.calibration = wall_;
+    SystemModel m = monitor_.model();
+    m.projectors = after_models_;
+    monitor_.set_reference(m, wall_);
+    for (PoseKalman& f : filters_) f.reset();
+    state_ = SelfcalState::calibrated;
+    std::string saved = "not saved (no store)";
+    if (!options_.store.empty()) {
+        try {
+            save_calibration(options_.store, wall_);
+            saved = "saved to '" + options_.store.string() + "' (previous kept as .last-good)";
+        } catch (const std::exception& e) {
+            saved = std::string("NOT saved: ") + e.what();
+        }
+    }
+    r.journal.push_back(fmt("selfcal: correction applied at t=%.2f s; ", t_s) + saved +
+                        "; after-correction drift follows in the next measured frames");
+    report_after_ = true;
+}
+
+void SelfCalibrator::decide(double t_s, StepResult& r) {
+    const SystemModel& m = monitor_.model();
+    std::vector<int> drifting;
+    for (std::size_t k = 0; k < filters_.size(); ++k) {
+        ProjectorStatus& ps = r.status.projectors[k];
+        const Pose6& x = filters_[k].state();
+        ps.drift_px = drift_px(static_cast<int>(k), x);
+        ps.rotation_deg = x.head<3>().norm() * kRad2Deg;
+        ps.shift_mm = x.tail<3>().norm() * 1e3;
+        if (ps.drift_px > options_.drift_threshold_px && filters_[k].significance() > options_.kalman.gate_chi2) {
+            drifting.push_back(static_cast<int>(k));
+        }
+    }
+    if (report_after_ && !r.status.waiting) {
+        std::string line = "selfcal: after correction:";
+        for (const ProjectorStatus& ps : r.status.projectors) line += fmt(" %.2f px", ps.drift_px) + " (" + ps.id + ")";
+        r.journal.push_back(line);
+        report_after_ = false;
+    }
+    if (drifting.empty()) {
+        if (state_ != SelfcalState::calibrated) r.journal.push_back(fmt("selfcal: t=%.2f s: drift gone", t_s));
+        state_ = SelfcalState::calibrated;
+        reason_.clear();
+        return;
+    }
+    if (state_ == SelfcalState::calibrated) {
+        state_ = SelfcalState::drift_detected;
+        drift_since_ = t_s;
+        for (int k : drifting) {
+            r.journal.push_back(fmt("selfcal: t=%.2f s: drift detected on ", t_s) +
+                                m.projectors[static_cast<std::size_t>(k)].id +
+                                fmt(": %.2f px", r.status.projectors[static_cast<std::size_t>(k)].drift_px));
+        }
+    }
+    if (state_ != SelfcalState::drift_detected || t_s - drift_since_ < options_.hold_s) return;
+    for (int k : drifting) {
+        const auto uk = static_cast<std::size_t>(k);
+        const double before = on_screen_fraction(m.projectors[uk]);
+        const double after = on_screen_fraction(apply_delta(m.projectors[uk], filters_[uk].state()));
+        if (after < (1.0 - options_.max_offscreen_loss) * before) {
+            state_ = SelfcalState::cannot_correct;
+            reason_ = m.projectors[uk].id +
+                      fmt(" on-screen share %.0f %% of its calibrated %.0f %%", 100.0 * after, 100.0 * before);
+            r.journal.push_back("selfcal: cannot correct (needs a full calibration): " + reason_);
+            return;
+        }
+    }
+    start_correction(t_s, drifting, r);
+}
+
+void SelfCalibrator::rebase_camera(double t_s, StepResult& r) {
+    const Pose6& x = camera_filter_.state();
+    const double deg = x.head<3>().norm() * kRad2Deg;
+    r.status.camera_rotation_deg = deg;
+    const bool moved = (deg > options_.camera_rebase_deg || x.tail<3>().norm() > 1e-3) &&
+                       camera_filter_.significance() > options_.camera_kalman.gate_chi2;
+    if (!moved) {
+        camera_since_ = -1.0;
+        return;
+    }
+    if (camera_since_ < 0.0) camera_since_ = t_s;
+    if (t_s - camera_since_ < options_.hold_s) return;
+    SystemModel m = monitor_.model();
+    m.camera = apply_delta(m.camera, x);
+    monitor_.set_reference(m, wall_);
+    camera_filter_.reset();
+    camera_since_ = -1.0;
+    r.journal.push_back(
+        fmt("selfcal: t=%.2f s: camera moved by %.3f deg, %.1f mm: monitor re-based on it "
+            "(the projectors are unaffected)",
+            t_s, deg, x.tail<3>().norm() * 1e3));
+}
+
+StepResult SelfCalibrator::step(const cv::Mat1f& content, const cv::Mat1f& camera_frame, double t_s) {
+    if (!std::isfinite(t_s) || (started_ && t_s < last_t_)) {
+        throw std::invalid_argument("SelfCalibrator::step: t_s must be finite and non-decreasing");
+    }
+    const double cpu0 = thread_cpu_ms();
+    const double dt = started_ ? t_s - last_t_ : 0.0;
+    started_ = true;
+    last_t_ = t_s;
+    StepResult r;
+    r.status.t_s = t_s;
+    for (const autocal::DeviceModel& d : monitor_.model().projectors) r.status.projectors.push_back({d.id});
+    if (state_ == SelfcalState::correcting) {
+        advance_correction(t_s, r);
+    } else {
+        const FrameMeasurement m = monitor_.measure(content, camera_frame);
+        filter(m, dt, r);
+        rebase_camera(t_s, r);
+        decide(t_s, r);
+    }
+    r.status.state = state_;
+    if (state_ == SelfcalState::cannot_correct) r.status.reason = reason_;
+    r.cpu_ms = thread_cpu_ms() - cpu0;
+    return r;
+}
+
+}  // namespace mogao::selfcal

@@ -1,0 +1,108 @@
+// SPDX-License-Identifier: Apache-2.0
+// Continuous self-recalibration (issue 14; docs/calibration.md, "Self-recalibration"): the
+// kiosk-facing object. Each monitored frame, step(content, camera_frame, t) measures (monitor.h),
+// filters each projector's and the camera's pose change (pose_kalman.h) and decides:
+//   calibrated -> drift detected: a projector's filtered drift is above `drift_threshold_px`
+//     (mean displacement of its image on the screen, in its own pixels) and significant (outside
+//     the filter's own uncertainty, x^T P^-1 x > gate);
+//   drift detected -> correcting: that lasted `hold_s` seconds; the corrected warp maps and blend
+//     masks (autocal::calibration_from_models on the re-estimated poses, intrinsics fixed) are
+//     blended in linearly over `transition_s`; step() returns each intermediate calibration;
+//   correcting -> calibrated: the corrected calibration becomes the reference, is saved
+//     (calibration_store.h) when `store` is set, and the filters restart from zero;
+//   drift detected -> cannot correct: the re-estimated pose puts less than
+//     (1 - max_offscreen_loss) of the projector's on-screen image of its reference on the screen;
+//     nothing is changed, the state stays until the drift is gone (the projector put back) or a
+//     full calibration replaces the reference.
+// A frame with fewer than `min_matches` matches for a projector gives that projector no
+// measurement (its filter only predicts): waiting, "insufficient evidence". A camera whose filtered
+// pose change is significant and above `camera_rebase_deg` for hold_s re-bases the monitor's
+// camera (the projectors' estimates are made against the per-frame camera fit already).
+// Every decision is a journal line with before/after figures.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "appliance/autocal/autocal.h"
+#include "appliance/selfcal/monitor.h"
+#include "appliance/selfcal/pose_kalman.h"
+#include "appliance/selfcal/selfcal_status.h"
+#include "common/projector_calibration.h"
+
+namespace mogao::selfcal {
+
+struct SelfcalOptions {
+    double drift_threshold_px = 0.5;  // > 0
+    double hold_s = 2.0;              // >= 0
+    double transition_s = 3.0;        // >= 0
+    int min_matches = 30;             // per projector, >= 6
+    double max_offscreen_loss = 0.5;  // (0, 1]
+    double camera_rebase_deg = 0.05;  // >= 0
+    std::filesystem::path store;      // empty: corrected calibrations are not written
+    MonitorOptions monitor;
+    KalmanOptions kalman;
+    KalmanOptions camera_kalman;
+    autocal::AutocalOptions build;  // warp_step_px, blend_ramp of the rebuilt calibration
+};
+
+struct StepResult {
+    SelfcalStatus status;
+    std::optional<ScreenCalibration> calibration;  // set when the wall must change this frame
+    std::vector<std::string> journal;              // lines for the journal (decisions, corrections)
+    double cpu_ms = 0.0;                           // this call's CPU time (thread)
+};
+
+class SelfCalibrator {
+public:
+    // `model`: the calibrated system (e.g. autocal's AutocalResult camera and projectors);
+    // `calibration`: what the wall shows now (built from `model`). Throws std::invalid_argument for
+    // bad options or mismatched projectors.
+    SelfCalibrator(const SystemModel& model, const ScreenCalibration& calibration, const SelfcalOptions& options = {});
+
+    // One monitored frame: the content being projected (CV_32FC1 linear grey, any size), the
+    // camera frame of the screen (CV_32FC1 linear [0, 1], camera resolution) and its time in
+    // seconds (non-decreasing). Throws std::invalid_argument for bad sizes or time going back.
+    [[nodiscard]] StepResult step(const cv::Mat1f& content, const cv::Mat1f& camera_frame, double t_s);
+
+    [[nodiscard]] const ScreenCalibration& calibration() const { return wall_; }  // on the wall now
+    [[nodiscard]] const SystemModel& model() const { return monitor_.model(); }
+    [[nodiscard]] SelfcalState state() const { return state_; }
+
+private:
+    void filter(const FrameMeasurement& m, double dt, StepResult& r);
+    void decide(double t_s, StepResult& r);
+    void start_correction(double t_s, const std::vector<int>& drifting, StepResult& r);
+    void advance_correction(double t_s, StepResult& r);
+    void rebase_camera(double t_s, StepResult& r);
+    [[nodiscard]] double drift_px(int k, const Pose6& delta) const;
+    [[nodiscard]] double on_screen_fraction(const autocal::DeviceModel& d) const;
+
+    SelfcalOptions options_;
+    Monitor monitor_;
+    ScreenCalibration wall_;
+    ScreenCalibration before_;
+    ScreenCalibration after_;
+    std::vector<autocal::DeviceModel> after_models_;
+    std::vector<PoseKalman> filters_;
+    PoseKalman camera_filter_;
+    SelfcalState state_ = SelfcalState::calibrated;
+    double last_t_ = 0.0;
+    bool started_ = false;
+    double drift_since_ = 0.0;
+    double camera_since_ = -1.0;
+    double correction_start_ = 0.0;
+    std::string reason_;
+    bool report_after_ = false;
+};
+
+// Linear blend of two calibrations of the same layout: warps (where both finite; otherwise the
+// nearer end's) and blend masks, s in [0, 1]. Throws std::invalid_argument when layouts differ.
+[[nodiscard]] ScreenCalibration interpolate_calibration(const ScreenCalibration& a, const ScreenCalibration& b,
+                                                        double s);
+
+}  // namespace mogao::selfcal
