@@ -5,40 +5,40 @@
 #include <bit>
 #include <cerrno>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <thread>
+#include <utility>
+#include <vector>
 
 namespace mogao {
 namespace {
-
-using Texel = AtrousDenoiser::Texel;
-using Geometry = AtrousDenoiser::Geometry;
 
 constexpr float kMinAlbedo = 1e-3f;     // demodulation divides by max(albedo, this)
 constexpr float kHuge = 1e30f;          // the scale of a term whose σ is 0: any difference stops
 constexpr float kLuminanceEps = 1e-6f;  // ε of w_l [S eq. 5], in radiance units
 constexpr float kDepthEps = 1e-3f;      // ε_z of w_z [S eq. 3], relative to the centre's depth
+constexpr float kMaxExponent = 40.0f;   // exp(-40) = 4e-18: a weight of 0 for any purpose
 constexpr float kB3[5] = {1.0f / 16, 1.0f / 4, 3.0f / 8, 1.0f / 4, 1.0f / 16};  // [D] §3, B3 spline
 
 std::string size_text(ImageSize s) { return std::to_string(s.width) + "x" + std::to_string(s.height); }
 
-// exp(-x) for x >= 0 (NaN and x >= 40 give 0): 2^y by splitting y = -x log2(e) into its integer
-// part (the float's exponent field) and its fraction (degree-5 Taylor series of 2^f, relative error
-// < 2e-4 — ample for filter weights, which are renormalised).
+// exp(-x) for x in [0, kMaxExponent] (callers clamp): 2^y, y = -x log2(e), split into the integer
+// part t = trunc(y) (the float's exponent field) and f = y - t in (-1, 0] (degree-5 Taylor series of
+// 2^f, relative error < 2e-4 — ample for filter weights, which are renormalised). Branch-free, so
+// the row loops below vectorise.
 inline float fast_exp_neg(float x) {
-    if (!(x < 40.0f)) return 0.0f;
     const float y = -x * 1.44269504f;
-    const float whole = std::floor(y);
-    const float f = y - whole;
+    const int whole = static_cast<int>(y);
+    const float f = y - static_cast<float>(whole);
     const float p =
         1.0f + f * (0.69314718f + f * (0.24022651f + f * (0.05550411f + f * (0.00961813f + f * 0.00133336f))));
-    const auto exponent = static_cast<std::uint32_t>(static_cast<int>(whole) + 127);  // >= 69
-    return p * std::bit_cast<float>(exponent << 23);
+    return p * std::bit_cast<float>(static_cast<std::uint32_t>(whole + 127) << 23);
 }
 
-inline float luminance(const Texel& t) { return 0.2126f * t.r + 0.7152f * t.g + 0.0722f * t.b; }
 inline float finite_or_zero(float v) { return std::isfinite(v) ? v : 0.0f; }
+inline float luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; }
 
 // Runs body(y0, y1) over [0, height) split into `threads` bands; the caller's thread takes the last.
 template <typename Body>
@@ -54,30 +54,6 @@ void for_row_bands(int height, int threads, const Body& body) {
         workers.emplace_back([&body, t, threads, height] { body(height * t / threads, height * (t + 1) / threads); });
     body(height * (threads - 1) / threads, height);
     for (std::thread& w : workers) w.join();
-}
-
-// The normal and depth factors of one tap as an exponent: ||n_p - n_q||² / σ_n² [D] plus
-// |z_p - z_q| / (σ_z |∇z_p · (p - q)| + ε_z) [S].
-struct GeometryWeight {
-    float inv_sigma_normal2 = 0.0f;
-    float sigma_depth = 0.0f;
-
-    [[nodiscard]] float exponent(const Geometry& p, const Geometry& q, float dx, float dy) const {
-        const float ex = p.nx - q.nx, ey = p.ny - q.ny, ez = p.nz - q.nz;
-        const float normal_term = (ex * ex + ey * ey + ez * ez) * inv_sigma_normal2;
-        const float dz = std::abs(p.depth - q.depth);
-        if (dz == 0.0f) return normal_term;
-        if (sigma_depth == 0.0f) return kHuge;
-        const float allowed = sigma_depth * std::abs(p.dzdx * dx + p.dzdy * dy) + kDepthEps * p.depth;
-        return normal_term + dz / allowed;
-    }
-};
-
-GeometryWeight make_geometry_weight(const AtrousParams& params) {
-    GeometryWeight g;
-    g.inv_sigma_normal2 = params.sigma_normal > 0.0f ? 1.0f / (params.sigma_normal * params.sigma_normal) : kHuge;
-    g.sigma_depth = params.sigma_depth;
-    return g;
 }
 
 // One-sided depth difference of smaller magnitude (so an edge beside p does not inflate its slope);
@@ -149,151 +125,250 @@ Status validate_denoise_input(const RgbFloatImage& noisy, const GuideBuffers& gu
 
 namespace {
 
+// The planes of AtrousDenoiser::planes_ (W*H floats each).
+struct Signal {
+    float* r;
+    float* g;
+    float* b;
+    float* var;  // luminance variance
+    float* lum;
+};
+struct Geometry {
+    float* nx;
+    float* ny;
+    float* nz;
+    float* z;     // metres, 0 = sky
+    float* dzdx;  // depth slope, metres per pixel
+    float* dzdy;
+    float* mask;  // 1 = surface, 0 = sky
+};
+constexpr std::size_t kPlanes = 5 + 5 + 7 + 1;
+
+struct Planes {
+    Signal ping, pong;
+    Geometry geometry;
+    float* colour_scale;  // 1 / (σ_l sqrt(g3x3(Var)) + ε) of the current level
+};
+
+Planes make_planes(std::vector<float>& storage, std::size_t n) {
+    storage.resize(kPlanes * n);
+    float* p = storage.data();
+    const auto next = [&] { return std::exchange(p, p + n); };
+    Planes planes{};
+    planes.ping = {next(), next(), next(), next(), next()};
+    planes.pong = {next(), next(), next(), next(), next()};
+    planes.geometry = {next(), next(), next(), next(), next(), next(), next()};
+    planes.colour_scale = next();
+    return planes;
+}
+
+// The exponent of the normal and depth factors: ||n_p - n_q||² / σ_n² [D] plus
+// |z_p - z_q| / (σ_z |∇z_p · (p - q)| + ε_z) [S]. σ = 0 turns a factor into "exactly equal only".
+struct GeometryWeight {
+    float inv_sigma_normal2 = 0.0f;
+    float sigma_depth = 0.0f;
+    float depth_eps = kDepthEps;
+};
+
+GeometryWeight make_geometry_weight(const AtrousParams& params) {
+    GeometryWeight g;
+    g.inv_sigma_normal2 = params.sigma_normal > 0.0f ? 1.0f / (params.sigma_normal * params.sigma_normal) : kHuge;
+    g.sigma_depth = params.sigma_depth;
+    g.depth_eps = params.sigma_depth > 0.0f ? kDepthEps : 1e-30f;
+    return g;
+}
+
 // Demodulates the colour and fills the geometry (normal, depth and its slope) of every pixel.
-void prepare(const RgbFloatImage& noisy, const GuideBuffers& guides, std::vector<Texel>& texels,
-             std::vector<Geometry>& geometry, int threads) {
+void prepare(const RgbFloatImage& noisy, const GuideBuffers& guides, const Planes& planes, int threads) {
     const int w = noisy.size.width, h = noisy.size.height;
     const auto depth_at = [&](int x, int y) {
         if (x < 0 || y < 0 || x >= w || y >= h) return 0.0f;
         const std::size_t i = guides.pixel(x, y);
         return guides.hit[i] != 0 ? guides.depth[i] : 0.0f;
     };
+    const Signal& s = planes.ping;
+    const Geometry& g = planes.geometry;
     for_row_bands(h, threads, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             for (int x = 0; x < w; ++x) {
                 const std::size_t i = guides.pixel(x, y);
                 const float* c = noisy.pixels.data() + 3 * i;
-                Texel t{finite_or_zero(c[0]), finite_or_zero(c[1]), finite_or_zero(c[2]), 0.0f};
-                Geometry g{};
-                if (guides.hit[i] != 0) {
+                float r = finite_or_zero(c[0]), gr = finite_or_zero(c[1]), b = finite_or_zero(c[2]);
+                const bool hit = guides.hit[i] != 0;
+                if (hit) {
                     const float* a = guides.albedo.data() + 3 * i;
-                    t.r /= std::max(a[0], kMinAlbedo);
-                    t.g /= std::max(a[1], kMinAlbedo);
-                    t.b /= std::max(a[2], kMinAlbedo);
-                    const float* n = guides.normal.data() + 3 * i;
-                    const float z = guides.depth[i];
-                    g = {n[0],
-                         n[1],
-                         n[2],
-                         z,
-                         depth_slope(z, depth_at(x - 1, y), depth_at(x + 1, y)),
-                         depth_slope(z, depth_at(x, y - 1), depth_at(x, y + 1))};
+                    r /= std::max(a[0], kMinAlbedo);
+                    gr /= std::max(a[1], kMinAlbedo);
+                    b /= std::max(a[2], kMinAlbedo);
                 }
-                texels[i] = t;
-                geometry[i] = g;
+                s.r[i] = r, s.g[i] = gr, s.b[i] = b, s.var[i] = 0.0f, s.lum[i] = luminance(r, gr, b);
+                const float* n = guides.normal.data() + 3 * i;
+                const float z = hit ? guides.depth[i] : 0.0f;
+                g.nx[i] = hit ? n[0] : 0.0f, g.ny[i] = hit ? n[1] : 0.0f, g.nz[i] = hit ? n[2] : 0.0f;
+                g.z[i] = z;
+                g.dzdx[i] = hit ? depth_slope(z, depth_at(x - 1, y), depth_at(x + 1, y)) : 0.0f;
+                g.dzdy[i] = hit ? depth_slope(z, depth_at(x, y - 1), depth_at(x, y + 1)) : 0.0f;
+                g.mask[i] = hit ? 1.0f : 0.0f;
             }
         }
     });
+}
+
+// exp(-(geometry exponent)) of taps q = p + (ox, oy) for p in row [i, i + count), q at j = i + offset.
+// Writes the weights (times hw and q's surface mask) to `out`. The loop vectorises.
+void geometry_weights(const Geometry& g, const GeometryWeight& gw, std::size_t i, std::ptrdiff_t offset, int count,
+                      float ox, float oy, float hw, float* __restrict out) {
+    const float* __restrict nx = g.nx;
+    const float* __restrict ny = g.ny;
+    const float* __restrict nz = g.nz;
+    const float* __restrict z = g.z;
+    const float* __restrict gx = g.dzdx;
+    const float* __restrict gy = g.dzdy;
+    const float* __restrict mask = g.mask;
+    for (int k = 0; k < count; ++k) {
+        const std::size_t p = i + static_cast<std::size_t>(k);
+        const std::size_t q = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(p) + offset);
+        const float ex = nx[p] - nx[q], ey = ny[p] - ny[q], ez = nz[p] - nz[q];
+        const float allowed = gw.sigma_depth * std::abs(gx[p] * ox + gy[p] * oy) + gw.depth_eps * z[p];
+        float e = (ex * ex + ey * ey + ez * ez) * gw.inv_sigma_normal2 + std::abs(z[p] - z[q]) / allowed;
+        e = e < kMaxExponent ? e : kMaxExponent;  // also maps NaN (sky p: 0/0) to the limit
+        out[k] = hw * mask[q] * fast_exp_neg(e);
+    }
 }
 
 // Spatial luminance variance of each surface pixel over its 5x5 neighbourhood on the same surface
 // (weights: the geometry terms only) — [S] §4.2's estimate for frames without history.
-void estimate_variance(ImageSize size, const GeometryWeight& gw, const std::vector<Geometry>& geometry,
-                       std::vector<Texel>& texels, int threads) {
+void estimate_variance(ImageSize size, const GeometryWeight& gw, const Planes& planes, int threads) {
     const int w = size.width, h = size.height;
+    const Signal& s = planes.ping;
     for_row_bands(h, threads, [&](int y0, int y1) {
+        std::vector<float> sw(w), s1(w), s2(w), wt(w);
         for (int y = y0; y < y1; ++y) {
-            for (int x = 0; x < w; ++x) {
-                const std::size_t i = static_cast<std::size_t>(y) * w + x;
-                const Geometry& gp = geometry[i];
-                if (gp.depth == 0.0f) continue;
-                float sw = 0.0f, s1 = 0.0f, s2 = 0.0f;
-                for (int qy = std::max(0, y - 2); qy <= std::min(h - 1, y + 2); ++qy) {
-                    for (int qx = std::max(0, x - 2); qx <= std::min(w - 1, x + 2); ++qx) {
-                        const std::size_t j = static_cast<std::size_t>(qy) * w + qx;
-                        if (geometry[j].depth == 0.0f) continue;
-                        const float wt = fast_exp_neg(gw.exponent(gp, geometry[j], float(qx - x), float(qy - y)));
-                        const float l = luminance(texels[j]);
-                        sw += wt;
-                        s1 += wt * l;
-                        s2 += wt * l * l;
+            std::fill(sw.begin(), sw.end(), 0.0f), std::fill(s1.begin(), s1.end(), 0.0f);
+            std::fill(s2.begin(), s2.end(), 0.0f);
+            const std::size_t row = static_cast<std::size_t>(y) * w;
+            for (int oy = -2; oy <= 2; ++oy) {
+                if (y + oy < 0 || y + oy >= h) continue;
+                for (int ox = -2; ox <= 2; ++ox) {
+                    const int xa = std::max(0, -ox), xb = std::min(w, w - ox);
+                    const std::ptrdiff_t offset = static_cast<std::ptrdiff_t>(oy) * w + ox;
+                    geometry_weights(planes.geometry, gw, row + xa, offset, xb - xa, float(ox), float(oy), 1.0f,
+                                     wt.data() + xa);
+                    const float* lq = s.lum + static_cast<std::ptrdiff_t>(row) + offset;
+                    for (int x = xa; x < xb; ++x) {
+                        sw[x] += wt[x];
+                        s1[x] += wt[x] * lq[x];
+                        s2[x] += wt[x] * lq[x] * lq[x];
                     }
                 }
-                const float mean = s1 / sw;
-                texels[i].variance = std::max(0.0f, s2 / sw - mean * mean);
+            }
+            for (int x = 0; x < w; ++x) {
+                if (planes.geometry.mask[row + x] == 0.0f) continue;
+                const float mean = s1[x] / sw[x];
+                s.var[row + x] = std::max(0.0f, s2[x] / sw[x] - mean * mean);
             }
         }
     });
 }
 
-// g3x3(Var) of [S] eq. 5: the variance blurred by (1/4, 1/2, 1/4)² over surface pixels.
-void blur_variance(ImageSize size, const std::vector<Texel>& texels, const std::vector<Geometry>& geometry,
-                   std::vector<float>& out, int threads) {
+// colour_scale = 1 / (σ_l sqrt(g3x3(Var)) + ε) [S eq. 5], g3x3 = (1/4, 1/2, 1/4)² over surface pixels.
+void colour_scales(ImageSize size, float sigma_colour, const Signal& s, const Planes& planes, int threads) {
     constexpr float k[3] = {0.25f, 0.5f, 0.25f};
     const int w = size.width, h = size.height;
+    const float* mask = planes.geometry.mask;
     for_row_bands(h, threads, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             for (int x = 0; x < w; ++x) {
                 const std::size_t i = static_cast<std::size_t>(y) * w + x;
-                if (geometry[i].depth == 0.0f) continue;
                 float sw = 0.0f, sv = 0.0f;
-                for (int dy = -1; dy <= 1; ++dy) {
-                    const int qy = y + dy;
-                    if (qy < 0 || qy >= h) continue;
-                    for (int dx = -1; dx <= 1; ++dx) {
-                        const int qx = x + dx;
-                        if (qx < 0 || qx >= w) continue;
-                        const std::size_t j = static_cast<std::size_t>(qy) * w + qx;
-                        if (geometry[j].depth == 0.0f) continue;
-                        const float wt = k[dx + 1] * k[dy + 1];
+                for (int dy = std::max(-1, -y); dy <= std::min(1, h - 1 - y); ++dy) {
+                    for (int dx = std::max(-1, -x); dx <= std::min(1, w - 1 - x); ++dx) {
+                        const std::size_t j = i + static_cast<std::size_t>(static_cast<std::ptrdiff_t>(dy) * w + dx);
+                        const float wt = k[dx + 1] * k[dy + 1] * mask[j];
                         sw += wt;
-                        sv += wt * texels[j].variance;
+                        sv += wt * s.var[j];
                     }
                 }
-                out[i] = sv / sw;
+                const float sd = sw > 0.0f ? std::sqrt(sv / sw) : 0.0f;
+                planes.colour_scale[i] = sigma_colour > 0.0f ? 1.0f / (sigma_colour * sd + kLuminanceEps) : kHuge;
             }
         }
     });
 }
 
-struct Level {
-    int step = 1;
-    float sigma_colour = 0.0f;
-    GeometryWeight geometry;
+// Accumulators of one row's weighted sums.
+struct RowSums {
+    std::vector<float> w, r, g, b, v, tap;
+    explicit RowSums(int width) : w(width), r(width), g(width), b(width), v(width), tap(width) {}
+    void clear() {
+        for (std::vector<float>* a : {&w, &r, &g, &b, &v}) std::fill(a->begin(), a->end(), 0.0f);
+    }
 };
 
+// Adds one tap (offset ox, oy in pixels, kernel weight hw) of row `row` [xa, xb) to the sums.
+void add_tap(const Signal& src, const Planes& planes, const GeometryWeight& gw, std::size_t row, int xa, int xb, int ox,
+             int oy, int width, float hw, RowSums& sums) {
+    const std::ptrdiff_t offset = static_cast<std::ptrdiff_t>(oy) * width + ox;
+    float* tap = sums.tap.data();
+    geometry_weights(planes.geometry, gw, row + xa, offset, xb - xa, float(ox), float(oy), hw, tap + xa);
+    const std::size_t p0 = row + static_cast<std::size_t>(xa);
+    const auto q0 = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(p0) + offset);
+    const float* __restrict lp = src.lum + p0;
+    const float* __restrict cs = planes.colour_scale + p0;
+    const float* __restrict lq = src.lum + q0;
+    const float* __restrict rq = src.r + q0;
+    const float* __restrict gq = src.g + q0;
+    const float* __restrict bq = src.b + q0;
+    const float* __restrict vq = src.var + q0;
+    const float* __restrict tw = tap + xa;
+    float* __restrict sw = sums.w.data() + xa;
+    float* __restrict sr = sums.r.data() + xa;
+    float* __restrict sg = sums.g.data() + xa;
+    float* __restrict sb = sums.b.data() + xa;
+    float* __restrict sv = sums.v.data() + xa;
+    const int count = xb - xa;
+#pragma GCC ivdep  // the sums never alias the inputs; spares GCC 35 run-time alias checks it refuses to emit
+    for (int k = 0; k < count; ++k) {
+        float e = std::abs(lp[k] - lq[k]) * cs[k];  // cs <= kHuge is finite, so 0 difference gives 0
+        e = e < kMaxExponent ? e : kMaxExponent;    // and overflow to inf gives the limit
+        const float wt = tw[k] * fast_exp_neg(e);
+        sw[k] += wt;
+        sr[k] += wt * rq[k];
+        sg[k] += wt * gq[k];
+        sb[k] += wt * bq[k];
+        sv[k] += wt * wt * vq[k];
+    }
+}
+
 // One à-trous level [D]: every surface pixel becomes the weighted mean of its 5x5 taps at `step`.
-void filter_level(ImageSize size, const Level& level, const std::vector<Texel>& src,
-                  const std::vector<Geometry>& geometry, const std::vector<float>& blurred_variance,
-                  std::vector<Texel>& dst, int threads) {
-    const int w = size.width, h = size.height, step = level.step;
+void filter_level(ImageSize size, int step, const GeometryWeight& gw, const Signal& src, const Signal& dst,
+                  const Planes& planes, int threads) {
+    const int w = size.width, h = size.height;
     for_row_bands(h, threads, [&](int y0, int y1) {
+        RowSums sums(w);
         for (int y = y0; y < y1; ++y) {
+            sums.clear();
+            const std::size_t row = static_cast<std::size_t>(y) * w;
+            for (int ky = -2; ky <= 2; ++ky) {
+                const int oy = ky * step;
+                if (y + oy < 0 || y + oy >= h) continue;
+                for (int kx = -2; kx <= 2; ++kx) {
+                    const int ox = kx * step;
+                    const int xa = std::max(0, -ox), xb = std::min(w, w - ox);
+                    if (xa < xb) add_tap(src, planes, gw, row, xa, xb, ox, oy, w, kB3[kx + 2] * kB3[ky + 2], sums);
+                }
+            }
             for (int x = 0; x < w; ++x) {
-                const std::size_t i = static_cast<std::size_t>(y) * w + x;
-                const Geometry& gp = geometry[i];
-                if (gp.depth == 0.0f) {
-                    dst[i] = src[i];
+                const std::size_t i = row + x;
+                if (planes.geometry.mask[i] == 0.0f) {
+                    dst.r[i] = src.r[i], dst.g[i] = src.g[i], dst.b[i] = src.b[i], dst.var[i] = 0.0f;
+                    dst.lum[i] = src.lum[i];
                     continue;
                 }
-                const float lp = luminance(src[i]);
-                const float colour_scale =
-                    level.sigma_colour > 0.0f
-                        ? 1.0f / (level.sigma_colour * std::sqrt(blurred_variance[i]) + kLuminanceEps)
-                        : kHuge;
-                float sw = 0.0f, sr = 0.0f, sg = 0.0f, sb = 0.0f, sv = 0.0f;
-                for (int ky = -2; ky <= 2; ++ky) {
-                    const int qy = y + ky * step;
-                    if (qy < 0 || qy >= h) continue;
-                    for (int kx = -2; kx <= 2; ++kx) {
-                        const int qx = x + kx * step;
-                        if (qx < 0 || qx >= w) continue;
-                        const std::size_t j = static_cast<std::size_t>(qy) * w + qx;
-                        const Geometry& gq = geometry[j];
-                        if (gq.depth == 0.0f) continue;
-                        const Texel& q = src[j];
-                        const float dl = std::abs(lp - luminance(q));
-                        const float e = (dl == 0.0f ? 0.0f : dl * colour_scale) +
-                                        level.geometry.exponent(gp, gq, float(kx * step), float(ky * step));
-                        const float wt = kB3[kx + 2] * kB3[ky + 2] * fast_exp_neg(e);
-                        sw += wt;
-                        sr += wt * q.r;
-                        sg += wt * q.g;
-                        sb += wt * q.b;
-                        sv += wt * wt * q.variance;
-                    }
-                }
-                dst[i] = {sr / sw, sg / sw, sb / sw, sv / (sw * sw)};
+                const float inv = 1.0f / sums.w[x];
+                dst.r[i] = sums.r[x] * inv, dst.g[i] = sums.g[x] * inv, dst.b[i] = sums.b[x] * inv;
+                dst.var[i] = sums.v[x] * inv * inv;
+                dst.lum[i] = luminance(dst.r[i], dst.g[i], dst.b[i]);
             }
         }
     });
@@ -304,40 +379,33 @@ void filter_level(ImageSize size, const Level& level, const std::vector<Texel>& 
 Status AtrousDenoiser::run(const RgbFloatImage& noisy, const GuideBuffers& guides, const AtrousParams& params,
                            RgbFloatImage& out) {
     if (Status s = validate_denoise_input(noisy, guides, params); !s.ok()) return s;
-    const ImageSize size = noisy.size;
-    const auto n = static_cast<std::size_t>(size.pixel_count());
-    const int threads =
-        params.threads > 0 ? params.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
     if (params.iterations == 0) {
         out = noisy;
         return {};
     }
-    ping_.resize(n);
-    pong_.resize(n);
-    geometry_.resize(n);
-    blurred_variance_.resize(n);
+    const ImageSize size = noisy.size;
+    const auto n = static_cast<std::size_t>(size.pixel_count());
+    const int threads =
+        params.threads > 0 ? params.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+    Planes planes = make_planes(planes_, n);
     const GeometryWeight gw = make_geometry_weight(params);
-    prepare(noisy, guides, ping_, geometry_, threads);
-    estimate_variance(size, gw, geometry_, ping_, threads);
+    prepare(noisy, guides, planes, threads);
+    estimate_variance(size, gw, planes, threads);
     for (int level = 0; level < params.iterations; ++level) {
-        blur_variance(size, ping_, geometry_, blurred_variance_, threads);
-        filter_level(size, Level{1 << level, params.sigma_colour, gw}, ping_, geometry_, blurred_variance_, pong_,
-                     threads);
-        std::swap(ping_, pong_);
+        colour_scales(size, params.sigma_colour, planes.ping, planes, threads);
+        filter_level(size, 1 << level, gw, planes.ping, planes.pong, planes, threads);
+        std::swap(planes.ping, planes.pong);
     }
     out.size = size;
     out.pixels.resize(3 * n);
+    const Signal& s = planes.ping;
     for (std::size_t i = 0; i < n; ++i) {
-        const Texel& t = ping_[i];
         float* o = out.pixels.data() + 3 * i;
-        if (guides.hit[i] == 0) {
-            o[0] = t.r, o[1] = t.g, o[2] = t.b;
-            continue;
-        }
+        const bool hit = guides.hit[i] != 0;
         const float* a = guides.albedo.data() + 3 * i;
-        o[0] = t.r * std::max(a[0], kMinAlbedo);
-        o[1] = t.g * std::max(a[1], kMinAlbedo);
-        o[2] = t.b * std::max(a[2], kMinAlbedo);
+        o[0] = hit ? s.r[i] * std::max(a[0], kMinAlbedo) : s.r[i];
+        o[1] = hit ? s.g[i] * std::max(a[1], kMinAlbedo) : s.g[i];
+        o[2] = hit ? s.b[i] * std::max(a[2], kMinAlbedo) : s.b[i];
     }
     return {};
 }

@@ -60,20 +60,11 @@ public:
     // Filters `noisy` into `out` (resized to noisy.size). On error, `out` is left untouched.
     Status run(const RgbFloatImage& noisy, const GuideBuffers& guides, const AtrousParams& params, RgbFloatImage& out);
 
-    // Per-pixel scratch (public only so the .cpp's helpers can name it).
-    struct Texel {
-        float r, g, b, variance;  // demodulated colour and its luminance variance
-    };
-    struct Geometry {
-        float nx, ny, nz;  // unit normal
-        float depth;       // metres, 0 = sky
-        float dzdx, dzdy;  // screen-space depth gradient, metres per pixel
-    };
-
 private:
-    std::vector<Texel> ping_, pong_;
-    std::vector<Geometry> geometry_;
-    std::vector<float> blurred_variance_;
+    // Planes of W*H floats, structure of arrays so the per-tap loops over a row vectorise:
+    // two sets of (r, g, b, variance, luminance) for ping-pong, the geometry (normal x, y, z, depth,
+    // depth slope x, y, surface mask) and the per-level colour scale. Layout in atrous_filter.cpp.
+    std::vector<float> planes_;
 };
 
 // One-shot convenience: a fresh AtrousDenoiser, the filtered image or the error.
