@@ -16,6 +16,8 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,6 +52,21 @@ public:
     // commits it (first frame: blocking modeset, ready on return; later: non-blocking flip, ready
     // after its flip event was dispatched).
     [[nodiscard]] virtual Status present(std::size_t i) = 0;
+
+    // Rounds. stage(i): what was drawn since begin_frame(i) waits for commit_round(); the output is
+    // not ready until the round completes. commit_round(): puts every staged output on screen in
+    // one step -- KMS: one atomic commit carrying every staged plane (the first one a blocking
+    // modeset, later ones DRM_MODE_ATOMIC_NONBLOCK | DRM_MODE_PAGE_FLIP_EVENT; each output is ready
+    // again after its CRTC's flip event); headless: reads every staged output back, complete on
+    // return. A failed commit leaves nothing staged and the outputs showing what they showed. No-op
+    // when nothing is staged. The defaults present at once (a backend without rounds).
+    [[nodiscard]] virtual Status stage(std::size_t i) { return present(i); }
+    [[nodiscard]] virtual Status commit_round() { return {}; }
+
+    // When output `i`'s latest completed present reached the screen, CLOCK_REALTIME nanoseconds:
+    // KMS: the kernel's page-flip event timestamp (converted from CLOCK_MONOTONIC); headless: the
+    // end of its read-back. nullopt before the first, or when the backend cannot tell.
+    [[nodiscard]] virtual std::optional<std::int64_t> presented_ns(std::size_t /*i*/) const { return std::nullopt; }
 
     // True when output `i` can begin a new frame.
     [[nodiscard]] virtual bool ready(std::size_t i) const = 0;

@@ -37,6 +37,8 @@ uniform sampler2D u_lut;      // GL_RGB32F, N x 1: display value per channel at 
 uniform vec2 u_output_size;   // projector pixels
 uniform vec2 u_warp_scale;    // warp size / output size (exactly 1.0 when equal)
 uniform vec2 u_blend_scale;   // blend size / output size
+uniform vec2 u_content_scale;   // late warp: content uv' = uv * scale + offset
+uniform vec2 u_content_offset;
 
 out vec4 o_color;
 
@@ -117,7 +119,7 @@ void main() {
         o_color = vec4(0.0, 0.0, 0.0, 1.0);
         return;
     }
-    o_color = vec4(apply_lut(content_at(uv) * blend_at(p)), 1.0);
+    o_color = vec4(apply_lut(content_at(uv * u_content_scale + u_content_offset) * blend_at(p)), 1.0);
 }
 )";
 
@@ -175,6 +177,8 @@ Result<WarpBlendRenderer> WarpBlendRenderer::create() {
     r.loc_output_size_ = glGetUniformLocation(r.program_.get(), "u_output_size");
     r.loc_warp_scale_ = glGetUniformLocation(r.program_.get(), "u_warp_scale");
     r.loc_blend_scale_ = glGetUniformLocation(r.program_.get(), "u_blend_scale");
+    r.loc_content_scale_ = glGetUniformLocation(r.program_.get(), "u_content_scale");
+    r.loc_content_offset_ = glGetUniformLocation(r.program_.get(), "u_content_offset");
     GLint max_texture = 0;
     GLint max_renderbuffer = 0;
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture);
@@ -295,6 +299,8 @@ Status WarpBlendRenderer::draw(std::size_t index, ImageSize target) {
                 static_cast<float>(p.warp_size.height) / out_h);
     glUniform2f(loc_blend_scale_, static_cast<float>(p.blend_size.width) / out_w,
                 static_cast<float>(p.blend_size.height) / out_h);
+    glUniform2f(loc_content_scale_, transform_.scale_u, transform_.scale_v);
+    glUniform2f(loc_content_offset_, transform_.offset_u, transform_.offset_v);
     const GLuint textures[] = {content_.get(), p.warp.get(), p.blend.get(), p.lut.get()};
     for (GLuint unit = 0; unit < 4; ++unit) {
         glActiveTexture(GL_TEXTURE0 + unit);

@@ -6,7 +6,8 @@
 //   p      = (x + 0.5, y + 0.5)                       output pixel centre, y down from the top row
 //   uv     = bilinear(warp,  p * warp.size / output - 0.5)   in warp texel-centre coordinates
 //   w      = bilinear(blend, p * blend.size / output - 0.5)
-//   linear = bilinear over the 4 content texels around uv * content.size - 0.5, each texel
+//   uv'    = uv * content_scale + content_offset  (per axis; identity unless set_content_transform)
+//   linear = bilinear over the 4 content texels around uv' * content.size - 0.5, each texel
 //            decoded sRGB -> linear first (GL_SRGB8 + texelFetch), so the filtering is in linear light
 //   out    = lut_c(clamp(linear_c * w, 0, 1))  per channel c; lut_c is piecewise linear over its N
 //            entries at linear positions i / (N - 1)
@@ -56,6 +57,18 @@ public:
     // or a blend weight is not finite.
     [[nodiscard]] Result<std::size_t> add_projector(const ProjectorCalibration& calibration);
 
+    // The late warp's content-space affine map (appliance/warp/late_warp.h): the warp map's content
+    // coordinates uv (normalised, [0, 1] across the content the calibration was made for) are
+    // fetched at uv * scale + offset of the content frame set by set_content, per axis. Identity
+    // (scale 1, offset 0) by default; with it the draw is exactly the untransformed one. Used by
+    // draw()/render() from the next call on. Content texel indices clamp at the frame's edge.
+    struct ContentTransform {
+        float scale_u = 1.0f, scale_v = 1.0f;
+        float offset_u = 0.0f, offset_v = 0.0f;
+    };
+    void set_content_transform(const ContentTransform& transform) { transform_ = transform; }
+    [[nodiscard]] const ContentTransform& content_transform() const { return transform_; }
+
     [[nodiscard]] std::size_t projector_count() const { return projectors_.size(); }
     // Output size of projector `index` (< projector_count()).
     [[nodiscard]] ImageSize output_size(std::size_t index) const { return projectors_.at(index).output; }
@@ -91,6 +104,9 @@ private:
     GLint loc_output_size_ = -1;
     GLint loc_warp_scale_ = -1;
     GLint loc_blend_scale_ = -1;
+    GLint loc_content_scale_ = -1;
+    GLint loc_content_offset_ = -1;
+    ContentTransform transform_;
     GLint max_texture_size_ = 0;
     GlTexture content_;
     ImageSize content_size_;

@@ -61,7 +61,8 @@ std::size_t at(ImageSize s, int x, int y) {
 }
 
 // The CPU reference: see the maths in warp_blend_renderer.h.
-Rgb8Image reference_render(const Rgb8Image& content, const ProjectorCalibration& c) {
+Rgb8Image reference_render(const Rgb8Image& content, const ProjectorCalibration& c,
+                           const WarpBlendRenderer::ContentTransform& late = {}) {
     Rgb8Image out(c.output);
     // Scales in float, as the renderer passes them to the shader.
     const double wsx = static_cast<float>(c.warp.size.width) / static_cast<float>(c.output.width);
@@ -95,6 +96,8 @@ Rgb8Image reference_render(const Rgb8Image& content, const ProjectorCalibration&
             const Taps bt = taps_at(px * bsx - 0.5, py * bsy - 0.5, c.blend.size);
             double weight = 0.0;
             for (int k = 0; k < 4; ++k) weight += bt.w(k) * c.blend.weight[at(c.blend.size, bt.x(k), bt.y(k))];
+            u = u * double{late.scale_u} + double{late.offset_u};  // the late warp's map (float inputs)
+            v = v * double{late.scale_v} + double{late.offset_v};
             const Taps ct = taps_at(u * content.size.width - 0.5, v * content.size.height - 0.5, content.size);
             for (int ch = 0; ch < 3; ++ch) {
                 double linear = 0.0;
@@ -315,6 +318,36 @@ TEST_F(WarpBlendRendererTest, Gamma22ResponseIsApplied) {
     }
     // Where gamma 2.2 and sRGB differ most (dark codes), the output is not the identity.
     for (int x = 10; x <= 30; ++x) EXPECT_GE(out.at(x, 0)[0], x + 3) << "code " << x;
+}
+
+// The late rotational warp (appliance/warp/late_warp.h): a guarded frame 340 columns wide for a
+// 300-column screen (20 each side), shifted by 4 columns. The draw matches the CPU reference with
+// the same map, and equals drawing the 300 columns starting at 16 cut out on the CPU.
+TEST_F(WarpBlendRendererTest, ContentTransformShiftsLikeTheCpuReference) {
+    const Rgb8Image guarded = noise_content({340, 30}, 11);
+    WarpBlendRenderer::ContentTransform t;
+    t.scale_u = 300.0f / 340.0f;
+    t.offset_u = 16.0f / 340.0f;
+    const ProjectorCalibration busy = busy_calibration({64, 48});
+    renderer_->set_content_transform(t);
+    const Rgb8Image out = render(guarded, busy);
+    Diff d = max_abs_diff(out, reference_render(guarded, busy, t));
+    EXPECT_LE(d.max, 2) << "at (" << d.x << ", " << d.y << ")";
+
+    Rgb8Image window({300, 30});
+    for (int y = 0; y < 30; ++y) {
+        for (int x = 0; x < 300; ++x) {
+            for (int ch = 0; ch < 3; ++ch) window.at(x, y)[ch] = guarded.at(x + 16, y)[ch];
+        }
+    }
+    const ProjectorCalibration identity = identity_calibration("window", {300, 30});
+    const Rgb8Image shifted = render(guarded, identity);
+    renderer_->set_content_transform({});
+    const Rgb8Image cut = render(window, identity);
+    d = max_abs_diff(shifted, cut);
+    EXPECT_LE(d.max, 1) << "at (" << d.x << ", " << d.y << ")";
+    d = max_abs_diff(cut, window);
+    EXPECT_LE(d.max, 1) << "identity transform: the content itself, at (" << d.x << ", " << d.y << ")";
 }
 
 TEST_F(WarpBlendRendererTest, BusyCalibrationMatchesCpuReference) {

@@ -1,13 +1,26 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "drivers/headless/headless_output.h"
 
+#include <time.h>
+
 #include <cstdio>
 #include <exception>
 #include <string>
+#include <utility>
 
 #include "common/png_io.h"
 
 namespace mogao {
+
+namespace {
+
+std::int64_t now_realtime_ns() {
+    timespec ts{};
+    clock_gettime(CLOCK_REALTIME, &ts);
+    return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+}  // namespace
 
 Result<std::unique_ptr<HeadlessOutputBackend>> HeadlessOutputBackend::create(HeadlessOptions options) {
     if (options.outputs.empty()) return make_error(EINVAL, "headless backend: no outputs requested");
@@ -32,7 +45,7 @@ Result<std::unique_ptr<HeadlessOutputBackend>> HeadlessOutputBackend::create(Hea
         }
         auto target = make_render_target(size);
         if (!target) return with_context(target.error(), name);
-        backend->targets_.push_back(Target{std::move(target.value()), Rgb8Image{}, 0, false});
+        backend->targets_.push_back(Target{std::move(target.value()), Rgb8Image{}, 0, false, false, std::nullopt});
         backend->infos_.push_back(OutputInfo{name, size, 0.0});
     }
     backend->png_dir_ = std::move(options.png_dir);
@@ -75,6 +88,7 @@ Status HeadlessOutputBackend::present(std::size_t i) {
     t.begun = false;
     glBindFramebuffer(GL_READ_FRAMEBUFFER, t.gl.fbo.get());
     if (auto s = read_rgb8(t.gl.size, t.last, scratch_); !s) return with_context(s.error(), infos_[i].name);
+    t.presented_ns = now_realtime_ns();
     const std::uint64_t frame = t.frames++;
     if (png_dir_.empty()) return {};
     char number[32];
@@ -86,6 +100,31 @@ Status HeadlessOutputBackend::present(std::size_t i) {
         return make_error(EIO, e.what());
     }
     return {};
+}
+
+}  // namespace mogao
+
+namespace mogao {
+
+Status HeadlessOutputBackend::stage(std::size_t i) {
+    if (auto s = check_index(i); !s) return s;
+    const std::uint64_t before = targets_[i].frames;
+    Status s = present(i);
+    // Staged once read back, even when only its PNG failed (the frame is kept, as present()).
+    if (targets_[i].frames != before) targets_[i].staged = true;
+    return s;
+}
+
+Status HeadlessOutputBackend::commit_round() {
+    const std::int64_t now = now_realtime_ns();
+    for (Target& t : targets_) {
+        if (std::exchange(t.staged, false)) t.presented_ns = now;
+    }
+    return {};
+}
+
+std::optional<std::int64_t> HeadlessOutputBackend::presented_ns(std::size_t i) const {
+    return i < targets_.size() ? targets_[i].presented_ns : std::nullopt;
 }
 
 }  // namespace mogao

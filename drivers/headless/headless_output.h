@@ -3,7 +3,10 @@
 // llvmpipe on machines without a GPU). For the render farm's previews, CI and the kiosk's
 // --headless mode. present() reads each frame back (RGB8, rows top first) and, when png_dir is
 // set, writes it as <png_dir>/<name>-<NNNNNN>.png (NNNNNN = that output's frame counter from 0).
-// Every present completes synchronously: ready() is always true and event_fd() is -1.
+// Every present completes synchronously: ready() is always true and event_fd() is -1. Rounds
+// (drivers/output.h): stage(i) reads output i back like present(i); commit_round() completes the
+// round, stamping presented_ns() of every staged output with the same CLOCK_REALTIME time (the
+// presented round's time, what motion-to-photon ends at headless).
 //
 // Threading: the backend's context is made current on the creating thread; use the backend (and
 // destroy it) on that thread.
@@ -39,6 +42,9 @@ public:
     [[nodiscard]] Status begin_frame(std::size_t i) override;
     // EINVAL without begin_frame(i); EIO if the PNG cannot be written (the frame is kept anyway).
     [[nodiscard]] Status present(std::size_t i) override;
+    [[nodiscard]] Status stage(std::size_t i) override;
+    [[nodiscard]] Status commit_round() override;
+    [[nodiscard]] std::optional<std::int64_t> presented_ns(std::size_t i) const override;
     [[nodiscard]] bool ready(std::size_t i) const override { return i < targets_.size(); }
     [[nodiscard]] int event_fd() const override { return -1; }
     [[nodiscard]] Result<std::vector<std::size_t>> dispatch_events() override { return std::vector<std::size_t>{}; }
@@ -54,6 +60,8 @@ private:
         Rgb8Image last;
         std::uint64_t frames = 0;
         bool begun = false;
+        bool staged = false;
+        std::optional<std::int64_t> presented_ns;
     };
 
     HeadlessOutputBackend(EglDisplay display, EglContext context, WarpBlendRenderer renderer);

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <optional>
+
 #include <cstdlib>
 #include <filesystem>
 #include <string>
@@ -85,6 +87,32 @@ TEST(HeadlessOutputBackend, BeginFrameClearsToBlack) {
     ASSERT_TRUE(backend->begin_frame(0).ok());
     ASSERT_TRUE(backend->present(0).ok());
     EXPECT_EQ(max_abs_diff(backend->last_frame(0), Rgb8Image({8, 8}, 0)), 0);
+}
+
+// A round (drivers/output.h): every output staged, then one commit that stamps them all with the
+// same presentation time, later than the previous round's.
+TEST(HeadlessOutputBackend, RoundStampsEveryStagedOutputWithOneTime) {
+    auto backend = make_backend({{{8, 8}, {6, 4}}, {}});
+    if (!backend) return;
+    EXPECT_FALSE(backend->presented_ns(0).has_value()) << "nothing presented yet";
+    std::optional<std::int64_t> previous;
+    for (int round = 0; round < 2; ++round) {
+        for (std::size_t i = 0; i < 2; ++i) {
+            ASSERT_TRUE(backend->begin_frame(i).ok());
+            ASSERT_TRUE(backend->stage(i).ok());
+        }
+        ASSERT_TRUE(backend->commit_round().ok());
+        const auto t0 = backend->presented_ns(0);
+        ASSERT_TRUE(t0.has_value());
+        EXPECT_EQ(backend->presented_ns(1), t0) << "one round, one time";
+        if (previous) {
+            EXPECT_GE(*t0, *previous);
+        }
+        previous = t0;
+    }
+    EXPECT_EQ(backend->frame_count(1), 2u);
+    EXPECT_EQ(backend->stage(0).code(), EINVAL) << "stage without begin_frame";
+    EXPECT_FALSE(backend->presented_ns(5).has_value());
 }
 
 TEST(HeadlessOutputBackend, ReportsMisuseAndFileErrors) {

@@ -5,6 +5,8 @@
 
 #include <GLES3/gl3.h>
 
+#include <time.h>
+
 #include <algorithm>
 #include <string>
 
@@ -33,6 +35,9 @@ struct KmsOutputBackend::Output {
     EglSurface egl_surface;
     LockedBo on_screen;  // scanned out now
     LockedBo pending;    // committed, waiting for its flip event
+    LockedBo staged;     // drawn and locked, waiting for commit_round()
+    std::uint32_t staged_fb = 0;
+    std::optional<std::int64_t> presented_ns;  // CLOCK_REALTIME of the latest completed present
     bool modeset_done = false;
     bool begun = false;
     bool flipped = false;  // set by the page-flip handler, collected by dispatch_events()
@@ -79,14 +84,13 @@ Result<KmsProps> lookup_props(int fd, const OutputPlan& plan) {
     return k;
 }
 
-Status commit(int fd, KmsOutputBackend::Output& o, std::uint32_t fb_id, bool modeset) {
-    DrmAtomicRequest req(drmModeAtomicAlloc());
-    if (!req) return make_error(ENOMEM, "drmModeAtomicAlloc");
+// Adds output `o`'s plane (and, for its first frame, its connector and CRTC mode) to `req`.
+bool add_output(drmModeAtomicReq* req, const KmsOutputBackend::Output& o, std::uint32_t fb_id, bool modeset) {
     const KmsProps& p = o.props;
     const OutputPlan& plan = o.plan;
     bool ok = true;
     const auto add = [&](std::uint32_t object, std::uint32_t prop, std::uint64_t value) {
-        ok = ok && drmModeAtomicAddProperty(req.get(), object, prop, value) >= 0;
+        ok = ok && drmModeAtomicAddProperty(req, object, prop, value) >= 0;
     };
     if (modeset) {
         add(plan.connector_id, p.connector_crtc_id, plan.crtc_id);
@@ -105,23 +109,53 @@ Status commit(int fd, KmsOutputBackend::Output& o, std::uint32_t fb_id, bool mod
     add(plan.plane_id, p.crtc_y, 0);
     add(plan.plane_id, p.crtc_w, w);
     add(plan.plane_id, p.crtc_h, h);
-    if (!ok) return make_error(ENOMEM, "drmModeAtomicAddProperty");
-    // The modeset blocks (once, at start-up); flips never do: their completion is an event.
+    return ok;
+}
+
+std::int64_t clock_ns(clockid_t clock) {
+    timespec ts{};
+    clock_gettime(clock, &ts);
+    return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+// One atomic commit of every output in `round` (each holding its staged bo). When any of them has
+// not been modeset yet, the commit is a blocking modeset of all of them (once, at start-up);
+// otherwise a non-blocking flip whose completion is one page-flip event per CRTC, carrying
+// `user_data`.
+Status commit(int fd, const std::vector<KmsOutputBackend::Output*>& round, void* user_data, bool* modeset) {
+    DrmAtomicRequest req(drmModeAtomicAlloc());
+    if (!req) return make_error(ENOMEM, "drmModeAtomicAlloc");
+    *modeset = std::any_of(round.begin(), round.end(), [](const auto* o) { return !o->modeset_done; });
+    std::string names;
+    for (const auto* o : round) {
+        if (!add_output(req.get(), *o, o->staged_fb, !o->modeset_done)) {
+            return make_error(ENOMEM, "drmModeAtomicAddProperty");
+        }
+        names += (names.empty() ? "" : ", ") + o->plan.name;
+    }
     const std::uint32_t flags =
-        modeset ? DRM_MODE_ATOMIC_ALLOW_MODESET : DRM_MODE_ATOMIC_NONBLOCK | DRM_MODE_PAGE_FLIP_EVENT;
-    if (drmModeAtomicCommit(fd, req.get(), flags, modeset ? nullptr : &o) != 0) {
-        Error e = errno_error(std::string(modeset ? "modeset" : "page flip") + " commit on " + plan.name);
+        *modeset ? DRM_MODE_ATOMIC_ALLOW_MODESET : DRM_MODE_ATOMIC_NONBLOCK | DRM_MODE_PAGE_FLIP_EVENT;
+    if (drmModeAtomicCommit(fd, req.get(), flags, *modeset ? nullptr : user_data) != 0) {
+        Error e = errno_error(std::string(*modeset ? "modeset" : "page flip") + " commit on " + names);
         if (e.code == EACCES || e.code == EPERM) e.message += " (not DRM master: is a compositor running?)";
         return e;
     }
     return {};
 }
 
-void on_page_flip(int /*fd*/, unsigned /*sequence*/, unsigned /*sec*/, unsigned /*usec*/, unsigned /*crtc*/,
-                  void* user_data) {
-    auto* o = static_cast<KmsOutputBackend::Output*>(user_data);
-    o->on_screen = std::move(o->pending);  // releases the bo that was on screen until now
-    o->flipped = true;
+// page_flip_handler2: one call per CRTC of a commit; `sec`/`usec` is when the new frame started
+// scanning out (the kernel's vblank timestamp, CLOCK_MONOTONIC: DRM_CAP_TIMESTAMP_MONOTONIC is 1 on
+// every kernel since 3.x), kept as CLOCK_REALTIME for the kiosk's motion-to-photon.
+void on_page_flip(int /*fd*/, unsigned /*sequence*/, unsigned sec, unsigned usec, unsigned crtc, void* user_data) {
+    auto* outputs = static_cast<std::vector<std::unique_ptr<KmsOutputBackend::Output>>*>(user_data);
+    const std::int64_t flip_mono = static_cast<std::int64_t>(sec) * 1'000'000'000 + std::int64_t{usec} * 1000;
+    const std::int64_t realtime = clock_ns(CLOCK_REALTIME) - (clock_ns(CLOCK_MONOTONIC) - flip_mono);
+    for (auto& o : *outputs) {
+        if (o->plan.crtc_id != crtc || !o->pending.valid()) continue;
+        o->on_screen = std::move(o->pending);  // releases the bo that was on screen until now
+        o->flipped = true;
+        o->presented_ns = realtime;
+    }
 }
 
 Result<DrmDevice> open_card(const std::filesystem::path& path, std::vector<OutputPlan>& plans) {
@@ -268,7 +302,12 @@ Status KmsOutputBackend::check_index(std::size_t i) const {
 }
 
 bool KmsOutputBackend::ready(std::size_t i) const {
-    return i < outputs_.size() && !outputs_[i]->pending.valid() && outputs_[i]->gbm_surface.has_free_buffers();
+    return i < outputs_.size() && !outputs_[i]->pending.valid() && !outputs_[i]->staged.valid() &&
+           outputs_[i]->gbm_surface.has_free_buffers();
+}
+
+std::optional<std::int64_t> KmsOutputBackend::presented_ns(std::size_t i) const {
+    return i < outputs_.size() ? outputs_[i]->presented_ns : std::nullopt;
 }
 
 Status KmsOutputBackend::begin_frame(std::size_t i) {
@@ -285,7 +324,7 @@ Status KmsOutputBackend::begin_frame(std::size_t i) {
     return gl_check(o.plan.name + ": begin_frame");
 }
 
-Status KmsOutputBackend::present(std::size_t i) {
+Status KmsOutputBackend::stage(std::size_t i) {
     if (auto s = check_index(i); !s) return s;
     Output& o = *outputs_[i];
     if (!o.begun) return make_error(EINVAL, o.plan.name + ": present() without begin_frame()");
@@ -296,22 +335,48 @@ Status KmsOutputBackend::present(std::size_t i) {
     auto bo = LockedBo::lock_front(o.gbm_surface);
     if (!bo) return with_context(bo.error(), o.plan.name);
     auto fb = framebuffer_for(bo->get(), drm_.fd());
-    if (!fb) return with_context(fb.error(), o.plan.name);
-    const bool modeset = !o.modeset_done;
-    if (auto s = commit(drm_.fd(), o, *fb, modeset); !s) return s;  // `bo` goes back to the surface
-    if (modeset) {
-        o.on_screen = std::move(bo.value());
-        o.modeset_done = true;
-    } else {
-        o.pending = std::move(bo.value());
-    }
+    if (!fb) return with_context(fb.error(), o.plan.name);  // `bo` goes back to the surface
+    o.staged = std::move(bo.value());
+    o.staged_fb = *fb;
     return {};
+}
+
+Status KmsOutputBackend::commit_outputs(const std::vector<Output*>& round) {
+    if (round.empty()) return {};
+    bool modeset = false;
+    Status s = commit(drm_.fd(), round, &outputs_, &modeset);
+    const std::int64_t now = clock_ns(CLOCK_REALTIME);
+    for (Output* o : round) {
+        if (!s) {
+            o->staged = LockedBo{};  // back to its surface; the screen keeps what it showed
+        } else if (modeset) {
+            o->on_screen = std::move(o->staged);
+            o->modeset_done = true;
+            o->presented_ns = now;
+        } else {
+            o->pending = std::move(o->staged);
+        }
+    }
+    return s;
+}
+
+Status KmsOutputBackend::present(std::size_t i) {
+    if (auto s = stage(i); !s) return s;
+    return commit_outputs({outputs_[i].get()});
+}
+
+Status KmsOutputBackend::commit_round() {
+    std::vector<Output*> round;
+    for (auto& o : outputs_) {
+        if (o->staged.valid()) round.push_back(o.get());
+    }
+    return commit_outputs(round);
 }
 
 Result<std::vector<std::size_t>> KmsOutputBackend::dispatch_events() {
     drmEventContext ev{};
     ev.version = 3;  // page_flip_handler2
-    ev.page_flip_handler2 = &on_page_flip;
+    ev.page_flip_handler2 = &on_page_flip;  // user data: &outputs_ (commit_outputs)
     // The fd is non-blocking: read until the kernel has nothing more (EAGAIN). Bounded, as a
     // 60 Hz flip per output cannot outrun a few reads.
     for (int reads = 0; reads < 64; ++reads) {

@@ -6,12 +6,16 @@
 // Per output frame (the non-fence path: llvmpipe/virgl may lack EGL_ANDROID_native_fence_sync):
 //   begin_frame   eglMakeCurrent(output's surface), bind framebuffer 0, clear
 //   (draw)        renderer().draw(projector)
-//   present       eglSwapBuffers -> gbm_surface_lock_front_buffer -> DRM framebuffer of the bo
-//                 first frame:  atomic commit with ALLOW_MODESET (connector CRTC_ID, CRTC MODE_ID
-//                               blob + ACTIVE, plane FB_ID/CRTC_ID/SRC_*/CRTC_*), blocking
-//                 later frames: atomic commit NONBLOCK | PAGE_FLIP_EVENT of the plane's FB_ID
-//   flip event    (dispatch_events after poll(event_fd()) says POLLIN) the new bo is on screen;
-//                 the previous one is released to the GBM surface; the output is ready again.
+//   stage         eglSwapBuffers -> gbm_surface_lock_front_buffer -> DRM framebuffer of the bo
+//   commit_round  ONE atomic commit carrying the plane of every staged output (drivers/output.h):
+//                 first frame:  with ALLOW_MODESET (connector CRTC_ID, CRTC MODE_ID blob + ACTIVE,
+//                               plane FB_ID/CRTC_ID/SRC_*/CRTC_*), blocking
+//                 later frames: NONBLOCK | PAGE_FLIP_EVENT, so all CRTCs flip in the same commit
+//   flip event    (dispatch_events after poll(event_fd()) says POLLIN) one per CRTC of the commit,
+//                 matched to its output by CRTC id: the new bo is on screen; the previous one is
+//                 released to the GBM surface; the output is ready again; presented_ns() is the
+//                 event's timestamp (tv_sec/tv_usec, CLOCK_MONOTONIC, stored as CLOCK_REALTIME).
+//   present       stage + a commit of that output alone (probes).
 //
 // The backend needs DRM master (no other compositor on the card) and the thread that created it.
 // Errors: ENODEV (no card / no connected output / no GBM or EGL), EOPNOTSUPP (no atomic KMS),
@@ -62,6 +66,9 @@ public:
     [[nodiscard]] WarpBlendRenderer& renderer() override { return *renderer_; }
     [[nodiscard]] Status begin_frame(std::size_t i) override;
     [[nodiscard]] Status present(std::size_t i) override;
+    [[nodiscard]] Status stage(std::size_t i) override;
+    [[nodiscard]] Status commit_round() override;
+    [[nodiscard]] std::optional<std::int64_t> presented_ns(std::size_t i) const override;
     [[nodiscard]] bool ready(std::size_t i) const override;
     [[nodiscard]] int event_fd() const override { return drm_.fd(); }
     [[nodiscard]] Result<std::vector<std::size_t>> dispatch_events() override;
@@ -73,6 +80,8 @@ public:
 private:
     KmsOutputBackend(DrmDevice drm, GbmDevice gbm, EglDisplay egl, EglContext context);
     [[nodiscard]] Status check_index(std::size_t i) const;
+    // One atomic commit of `round`'s staged bos; on failure they go back to their surfaces.
+    [[nodiscard]] Status commit_outputs(const std::vector<Output*>& round);
 
     // Declaration order is destruction order reversed: renderer (with the context current), the
     // outputs (locked bos, EGL surfaces, GBM surfaces and with them the DRM framebuffers, mode
