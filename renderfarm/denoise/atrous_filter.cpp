@@ -214,25 +214,26 @@ void prepare(const RgbFloatImage& noisy, const GuideBuffers& guides, const Plane
     });
 }
 
-// exp(-(geometry exponent)) of taps q = p + (ox, oy) for p in row [i, i + count), q at j = i + offset.
-// Writes the weights (times hw and q's surface mask) to `out`. The loop vectorises.
+// The geometry exponent of tap q for pixel p, offset (ox, oy) pixels (GeometryWeight's formula);
+// NaN for a sky p (0/0), which callers clamp to kMaxExponent.
+inline float geometry_exponent(const Geometry& g, const GeometryWeight& gw, std::size_t p, std::size_t q, float ox,
+                               float oy) {
+    const float ex = g.nx[p] - g.nx[q], ey = g.ny[p] - g.ny[q], ez = g.nz[p] - g.nz[q];
+    const float allowed = gw.sigma_depth * std::abs(g.dzdx[p] * ox + g.dzdy[p] * oy) + gw.depth_eps * g.z[p];
+    return (ex * ex + ey * ey + ez * ez) * gw.inv_sigma_normal2 + std::abs(g.z[p] - g.z[q]) / allowed;
+}
+
+// exp(-(geometry exponent)) of taps q = p + offset for p in [i, i + count), times hw and q's
+// surface mask, into `out`. The loop vectorises.
 void geometry_weights(const Geometry& g, const GeometryWeight& gw, std::size_t i, std::ptrdiff_t offset, int count,
-                      float ox, float oy, float hw, float* __restrict out) {
-    const float* __restrict nx = g.nx;
-    const float* __restrict ny = g.ny;
-    const float* __restrict nz = g.nz;
-    const float* __restrict z = g.z;
-    const float* __restrict gx = g.dzdx;
-    const float* __restrict gy = g.dzdy;
-    const float* __restrict mask = g.mask;
+                      float ox, float oy, float hw, float* out) {
+#pragma GCC ivdep  // out never aliases the geometry planes
     for (int k = 0; k < count; ++k) {
         const std::size_t p = i + static_cast<std::size_t>(k);
         const std::size_t q = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(p) + offset);
-        const float ex = nx[p] - nx[q], ey = ny[p] - ny[q], ez = nz[p] - nz[q];
-        const float allowed = gw.sigma_depth * std::abs(gx[p] * ox + gy[p] * oy) + gw.depth_eps * z[p];
-        float e = (ex * ex + ey * ey + ez * ez) * gw.inv_sigma_normal2 + std::abs(z[p] - z[q]) / allowed;
-        e = e < kMaxExponent ? e : kMaxExponent;  // also maps NaN (sky p: 0/0) to the limit
-        out[k] = hw * mask[q] * fast_exp_neg(e);
+        float e = geometry_exponent(g, gw, p, q, ox, oy);
+        e = e < kMaxExponent ? e : kMaxExponent;  // also maps NaN to the limit
+        out[k] = hw * g.mask[q] * fast_exp_neg(e);
     }
 }
 
@@ -298,8 +299,8 @@ void colour_scales(ImageSize size, float sigma_colour, const Signal& s, const Pl
 
 // Accumulators of one row's weighted sums.
 struct RowSums {
-    std::vector<float> w, r, g, b, v, tap;
-    explicit RowSums(int width) : w(width), r(width), g(width), b(width), v(width), tap(width) {}
+    std::vector<float> w, r, g, b, v;
+    explicit RowSums(int width) : w(width), r(width), g(width), b(width), v(width) {}
     void clear() {
         for (std::vector<float>* a : {&w, &r, &g, &b, &v}) std::fill(a->begin(), a->end(), 0.0f);
     }
@@ -309,34 +310,30 @@ struct RowSums {
 void add_tap(const Signal& src, const Planes& planes, const GeometryWeight& gw, std::size_t row, int xa, int xb, int ox,
              int oy, int width, float hw, RowSums& sums) {
     const std::ptrdiff_t offset = static_cast<std::ptrdiff_t>(oy) * width + ox;
-    float* tap = sums.tap.data();
-    geometry_weights(planes.geometry, gw, row + xa, offset, xb - xa, float(ox), float(oy), hw, tap + xa);
     const std::size_t p0 = row + static_cast<std::size_t>(xa);
-    const auto q0 = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(p0) + offset);
-    const float* __restrict lp = src.lum + p0;
-    const float* __restrict cs = planes.colour_scale + p0;
-    const float* __restrict lq = src.lum + q0;
-    const float* __restrict rq = src.r + q0;
-    const float* __restrict gq = src.g + q0;
-    const float* __restrict bq = src.b + q0;
-    const float* __restrict vq = src.var + q0;
-    const float* __restrict tw = tap + xa;
-    float* __restrict sw = sums.w.data() + xa;
-    float* __restrict sr = sums.r.data() + xa;
-    float* __restrict sg = sums.g.data() + xa;
-    float* __restrict sb = sums.b.data() + xa;
-    float* __restrict sv = sums.v.data() + xa;
+    const Geometry& g = planes.geometry;
+    const float* lum = src.lum;
+    const float* cs = planes.colour_scale;
+    float* sw = sums.w.data() + xa;
+    float* sr = sums.r.data() + xa;
+    float* sg = sums.g.data() + xa;
+    float* sb = sums.b.data() + xa;
+    float* sv = sums.v.data() + xa;
     const int count = xb - xa;
-#pragma GCC ivdep  // the sums never alias the inputs; spares GCC 35 run-time alias checks it refuses to emit
+    const float fx = static_cast<float>(ox), fy = static_cast<float>(oy);
+#pragma GCC ivdep  // the sums never alias the inputs; spares GCC the run-time alias checks it refuses to emit
     for (int k = 0; k < count; ++k) {
-        float e = std::abs(lp[k] - lq[k]) * cs[k];  // cs <= kHuge is finite, so 0 difference gives 0
-        e = e < kMaxExponent ? e : kMaxExponent;    // and overflow to inf gives the limit
-        const float wt = tw[k] * fast_exp_neg(e);
+        const std::size_t p = p0 + static_cast<std::size_t>(k);
+        const std::size_t q = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(p) + offset);
+        // One exp for all three factors; cs <= kHuge is finite, so an equal luminance adds 0.
+        float e = geometry_exponent(g, gw, p, q, fx, fy) + std::abs(lum[p] - lum[q]) * cs[p];
+        e = e < kMaxExponent ? e : kMaxExponent;  // inf and NaN (sky p) give the limit
+        const float wt = hw * g.mask[q] * fast_exp_neg(e);
         sw[k] += wt;
-        sr[k] += wt * rq[k];
-        sg[k] += wt * gq[k];
-        sb[k] += wt * bq[k];
-        sv[k] += wt * wt * vq[k];
+        sr[k] += wt * src.r[q];
+        sg[k] += wt * src.g[q];
+        sb[k] += wt * src.b[q];
+        sv[k] += wt * wt * src.var[q];
     }
 }
 
