@@ -66,6 +66,9 @@ struct ViewRequest {
     Quality quality;
     std::uint64_t seed = 1;             // same seed + same request = same pixels
     std::int64_t request_time_ns = 0;   // CLOCK_REALTIME of the sender, for latency accounting
+    // Farm-internal, never on the link's wire: the link server's id of the session that sent the
+    // request (0 = none), so the farm keeps per-session state (cost map, accumulation, frame time).
+    std::uint64_t session = 0;
 };
 
 // The size actually traced: size scaled by quality.resolution_scale, rounded to nearest, at least

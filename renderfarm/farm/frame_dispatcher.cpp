@@ -59,6 +59,7 @@ struct ReplyHeader {
     std::uint64_t payload_bytes;  // pixels, or the error message when ok == 0
     std::uint64_t tiles;
     double render_seconds;
+    double cpu_seconds;
     std::int32_t ok;
 };
 
@@ -121,12 +122,13 @@ void serve_render_rank(Renderer* renderer, const DispatchSettings& settings, con
         broadcast_view(wire);
         if (wire.stop) return;
         const std::vector<PixelRect> rects = receive_rects();
-        ReplyHeader header{wire.frame_id, 0, 0, 0, 0.0, 1};
+        ReplyHeader header{wire.frame_id, 0, 0, 0, 0.0, 0.0, 1};
         try {
             if (!renderer) throw std::runtime_error(load_error);
             renderer->begin_frame(from_wire(wire));
-            const TilePassResult pass = render_tile_pass(*renderer, rects, settings.cell_size, settings.threads,
-                                                         settings.exposure, settings.tone_map);
+            const TilePassResult pass =
+                render_tile_pass(*renderer, rects, settings.cell_size, settings.threads, settings.exposure,
+                                 settings.tone_map, wire.linear ? PackedPixels::linear : PackedPixels::srgb8);
             std::vector<double> tiles_flat;
             tiles_flat.reserve(pass.tile_times.size() * 5);
             for (const TileTime& t : pass.tile_times)
@@ -136,6 +138,7 @@ void serve_render_rank(Renderer* renderer, const DispatchSettings& settings, con
             header.payload_bytes = pass.packed_pixels.size();
             header.tiles = pass.tile_times.size();
             header.render_seconds = pass.render_seconds;
+            header.cpu_seconds = pass.cpu_seconds;
             send_reply(header, pass.packed_pixels.data(), pass.packed_pixels.size(), tiles_flat);
         } catch (const std::exception& e) {
             int rank = 0;
@@ -168,39 +171,76 @@ void FrameDispatcher::stop() {
     broadcast_view(stop_view);
 }
 
-DispatchedFrame FrameDispatcher::render(const ViewRequest& view, std::uint64_t stream) {
+CostMap& FrameDispatcher::stream_map(std::uint64_t stream, ImageSize size) {
+    auto found = predicted_.find(stream);
+    if (found == predicted_.end()) {
+        if (predicted_.size() >= std::max<std::size_t>(1, settings_.max_streams)) {
+            const auto oldest =
+                std::min_element(predicted_.begin(), predicted_.end(),
+                                 [](const auto& a, const auto& b) { return a.second.last_used < b.second.last_used; });
+            predicted_.erase(oldest);
+        }
+        found = predicted_.insert_or_assign(stream, StreamMap{CostMap::uniform(size, settings_.cell_size), 0}).first;
+    } else if (found->second.map.size() != size) {
+        // The same stream at another resolution scale: what was dear stays dear.
+        found->second.map = found->second.map.total() > 0 ? found->second.map.resampled(size, settings_.cell_size)
+                                                          : CostMap::uniform(size, settings_.cell_size);
+    }
+    found->second.last_used = ++frames_;
+    return found->second.map;
+}
+
+DispatchedFrame FrameDispatcher::render(const ViewRequest& view, std::uint64_t stream, PackedPixels format) {
     if (stopped_) throw FarmError("the farm was stopped");
     const ImageSize size = render_size(view);
-    auto predicted = predicted_.find(stream);
-    if (predicted == predicted_.end() || predicted->second.size() != size)
-        predicted = predicted_.insert_or_assign(stream, CostMap::uniform(size, settings_.cell_size)).first;
-    const Assignment assignment = balancer_->assign(predicted->second, render_ranks());
+    CostMap& predicted = stream_map(stream, size);
+    const Assignment assignment = balancer_->assign(predicted, render_ranks());
 
     DispatchedFrame frame;
-    frame.image = Rgb8Image(size);
+    if (format == PackedPixels::linear) {
+        frame.radiance = RgbFloatImage(size);
+    } else {
+        frame.image = Rgb8Image(size);
+    }
     frame.stats.frame = view.frame_id;
     frame.stats.rank_predicted_seconds = assignment.predicted_cost;
     const auto start = Clock::now();
-    if (!gather(view, assignment, frame)) throw FarmError(fmt::format("frame {} failed on a render rank", view.frame_id));
+    std::vector<TileTime> normalised;
+    if (!gather(view, assignment, format, frame, normalised))
+        throw FarmError(fmt::format("frame {} failed on a render rank", view.frame_id));
     frame.stats.render_phase_seconds = seconds_since(start);
     finish_stats(frame.stats);
     // Re-balance: this frame's measured tile times predict the stream's next frame.
-    predicted->second = CostMap::from_tile_times(size, settings_.cell_size, frame.tiles);
+    predicted = CostMap::from_tile_times(size, settings_.cell_size, normalised);
     return frame;
 }
 
-bool FrameDispatcher::gather(const ViewRequest& view, const Assignment& assignment, DispatchedFrame& frame) {
+bool FrameDispatcher::gather(const ViewRequest& view, const Assignment& assignment, PackedPixels format,
+                             DispatchedFrame& frame, std::vector<TileTime>& normalised) {
+    // Tiles of rank `r` as the PBT should see them: at the rank's smoothed speed, or raw.
+    const auto add_tiles = [&](int r, const std::vector<TileTime>& tiles, double cpu, double wall) {
+        speeds_.observe(r, cpu, wall, settings_.threads);
+        const double speed = settings_.normalise_rank_speed ? speeds_.speed(r) : 1.0;
+        const std::vector<TileTime> scaled = normalise_tile_times(tiles, speed);
+        normalised.insert(normalised.end(), scaled.begin(), scaled.end());
+    };
     if (local_) {  // a one-process farm: the admin traces the whole frame itself
         local_->begin_frame(view);
         TilePassResult pass = render_tile_pass(*local_, assignment.rects[0], settings_.cell_size, settings_.threads,
-                                               settings_.exposure, settings_.tone_map);
-        unpack_rects(assignment.rects[0], pass.packed_pixels, frame.image);
+                                               settings_.exposure, settings_.tone_map, format);
+        if (format == PackedPixels::linear) {
+            unpack_linear_rects(assignment.rects[0], pass.packed_pixels, frame.radiance);
+        } else {
+            unpack_rects(assignment.rects[0], pass.packed_pixels, frame.image);
+        }
+        add_tiles(0, pass.tile_times, pass.cpu_seconds, pass.render_seconds);
         frame.tiles = std::move(pass.tile_times);
         frame.stats.rays = pass.rays;
         frame.stats.rank_render_seconds = {pass.render_seconds};
         return true;
     }
     WireView wire = to_wire(view);
+    wire.linear = format == PackedPixels::linear ? 1 : 0;
     broadcast_view(wire);
     for (int r = 0; r < mpi_.render_ranks(); ++r) {
         std::vector<int> flat;
@@ -219,16 +259,25 @@ bool FrameDispatcher::gather(const ViewRequest& view, const Assignment& assignme
             ok = false;
             continue;
         }
+        const std::vector<PixelRect>& rects = assignment.rects[static_cast<std::size_t>(source - 1)];
         try {
-            unpack_rects(assignment.rects[static_cast<std::size_t>(source - 1)], reply.payload, frame.image);
+            if (format == PackedPixels::linear) {
+                unpack_linear_rects(rects, reply.payload, frame.radiance);
+            } else {
+                unpack_rects(rects, reply.payload, frame.image);
+            }
         } catch (const std::exception& e) {
             spdlog::error("rank {}: frame {}: bad reply: {}", source, view.frame_id, e.what());
             ok = false;
             continue;
         }
+        std::vector<TileTime> tiles;
         for (std::size_t i = 0; i + 4 < reply.tiles.size(); i += 5)
-            frame.tiles.push_back({{int(reply.tiles[i]), int(reply.tiles[i + 1]), int(reply.tiles[i + 2]), int(reply.tiles[i + 3])},
-                                   reply.tiles[i + 4]});
+            tiles.push_back(
+                {{int(reply.tiles[i]), int(reply.tiles[i + 1]), int(reply.tiles[i + 2]), int(reply.tiles[i + 3])},
+                 reply.tiles[i + 4]});
+        add_tiles(source - 1, tiles, reply.header.cpu_seconds, reply.header.render_seconds);
+        frame.tiles.insert(frame.tiles.end(), tiles.begin(), tiles.end());
         frame.stats.rays += reply.header.rays;
         frame.stats.rank_render_seconds[static_cast<std::size_t>(source - 1)] = reply.header.render_seconds;
     }

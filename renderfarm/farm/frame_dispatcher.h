@@ -2,7 +2,8 @@
 // The MPI side of one sort-first frame, both ends of it:
 //  - FrameDispatcher (admin, rank 0): assigns rects with the load balancer from the stream's
 //    predicted cost map, broadcasts the view, gathers sRGB8 pixels and per-tile times from the render
-//    ranks, composites the frame and updates the stream's cost map from the measured times (PBT).
+//    ranks, composites the frame and updates the stream's cost map from the measured times (PBT),
+//    each rank's tile times normalised by its measured speed (schedule/rank_speed.h).
 //  - serve_render_rank (ranks 1..N-1): the loop that answers the dispatcher until it stops.
 // With one process the dispatcher traces the frame itself with a local Renderer.
 //
@@ -18,13 +19,15 @@
 #include <stdexcept>
 #include <vector>
 
-#include "renderfarm/farm/frame_stats.h"
-#include "renderfarm/farm/mpi_session.h"
-#include "renderfarm/schedule/cost_map.h"
-#include "renderfarm/schedule/load_balancer.h"
-#include "renderfarm/trace/renderer.h"
 #include "common/image.h"
 #include "common/view_request.h"
+#include "renderfarm/farm/frame_stats.h"
+#include "renderfarm/farm/mpi_session.h"
+#include "renderfarm/farm/tile_pass.h"
+#include "renderfarm/schedule/cost_map.h"
+#include "renderfarm/schedule/load_balancer.h"
+#include "renderfarm/schedule/rank_speed.h"
+#include "renderfarm/trace/renderer.h"
 
 namespace mogao {
 
@@ -40,10 +43,14 @@ struct DispatchSettings {
     int threads = 1;               // render threads per rank
     float exposure = 1.f;          // the scene's exposure (sRGB8 conversion happens on the ranks)
     ToneMap tone_map = ToneMap::clamp;  // the scene's tone map (film.h)
+    // Feed the PBT with tile times x the rank's speed (its share of a core) instead of wall time.
+    bool normalise_rank_speed = true;
+    std::size_t max_streams = 64;  // cost maps kept; the least recently used goes beyond it
 };
 
 struct DispatchedFrame {
-    Rgb8Image image;               // render_size(view), sRGB8
+    Rgb8Image image;               // render_size(view), sRGB8 (PackedPixels::srgb8 frames)
+    RgbFloatImage radiance;        // render_size(view), linear (PackedPixels::linear frames)
     std::vector<TileTime> tiles;   // measured per-tile times of every rank
     FrameStats stats;              // all but encode figures
 };
@@ -57,23 +64,37 @@ public:
     FrameDispatcher& operator=(const FrameDispatcher&) = delete;
 
     // Renders one frame; `stream` keys the predicted cost map (one per camera path or appliance
-    // session: consecutive frames of a stream predict each other).
-    DispatchedFrame render(const ViewRequest& view, std::uint64_t stream = 0);
+    // session: consecutive frames of a stream predict each other; a frame of another size than the
+    // stream's last one predicts from its map resampled, CostMap::resampled). `format` picks what
+    // the ranks send: sRGB8 pixels (DispatchedFrame::image) or linear radiance (::radiance).
+    DispatchedFrame render(const ViewRequest& view, std::uint64_t stream = 0,
+                           PackedPixels format = PackedPixels::srgb8);
 
     // Releases the render ranks (they leave serve_render_rank). Idempotent.
     void stop();
 
     [[nodiscard]] int render_ranks() const;
     [[nodiscard]] int cell_size() const { return settings_.cell_size; }
+    [[nodiscard]] const DispatchSettings& settings() const { return settings_; }
+    // Benchmarks compare raw and speed-normalised tile times in one run.
+    void set_normalise_rank_speed(bool on) { settings_.normalise_rank_speed = on; }
 
 private:
-    bool gather(const ViewRequest& view, const Assignment& assignment, DispatchedFrame& frame);
+    bool gather(const ViewRequest& view, const Assignment& assignment, PackedPixels format, DispatchedFrame& frame,
+                std::vector<TileTime>& normalised);
+    CostMap& stream_map(std::uint64_t stream, ImageSize size);
 
     const MpiSession& mpi_;
     DispatchSettings settings_;
     Renderer* local_;
     std::unique_ptr<LoadBalancer> balancer_;
-    std::map<std::uint64_t, CostMap> predicted_;
+    struct StreamMap {
+        CostMap map;
+        std::uint64_t last_used;
+    };
+    std::map<std::uint64_t, StreamMap> predicted_;
+    std::uint64_t frames_ = 0;
+    RankSpeeds speeds_;
     bool stopped_ = false;
 };
 

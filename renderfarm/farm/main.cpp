@@ -41,6 +41,34 @@ void add_farm_flags(CLI::App& command, mogao::FarmSetup& setup, std::string& sca
     command.add_option("--snap", setup.dispatch.snap, "PBT/equal split snap in pixels")->check(CLI::IsMember({4, 8, 16, 32}));
     command.add_option("--rr-tile", setup.dispatch.roundrobin_tile, "Round-robin tile size in pixels")->check(CLI::Range(8, 1024));
     command.add_option("--threads", setup.dispatch.threads, "Render threads per rank")->check(CLI::Range(1, 256));
+    command.add_flag("--rank-speed,!--no-rank-speed", setup.dispatch.normalise_rank_speed,
+                     "Normalise each rank's tile times by its measured speed before the PBT (default; --no-rank-speed: "
+                     "raw wall time)");
+}
+
+// Live frame scheduling of serve mode (docs/services.md, live_frames.h).
+void add_live_flags(CLI::App& serve, mogao::ServeOptions& options, double& frame_time_ms) {
+    auto& live = options.live;
+    serve
+        .add_option("--frame-time-ms", frame_time_ms,
+                    "Frame-time target per session in ms: resolution scale and spp of moving views are chosen to "
+                    "meet it (0 = render each request as asked)")
+        ->check(CLI::Range(0.0, 10000.0));
+    serve
+        .add_option("--min-scale", live.controller.min_scale,
+                    "Smallest resolution scale the frame-time target may pick")
+        ->check(CLI::Range(0.01, 1.0));
+    serve.add_option("--max-spp", live.controller.max_spp, "Largest spp the frame-time target may pick")
+        ->check(CLI::Range(L::kSpp.min, L::kSpp.max));
+    serve.add_flag("--progressive,!--no-progressive", live.progressive,
+                   "Refine still views over successive requests (frames then differ from a lone render of the request; "
+                   "default off: every request alone)");
+    serve.add_option("--converged-spp", live.converged_spp, "Samples at which a still view stops refining")
+        ->check(CLI::Range(1, 1 << 20));
+    serve.add_flag("--per-session-cost-maps,!--shared-cost-map", live.per_session_maps,
+                   "One PBT cost map per session (default; --shared-cost-map: one for all)");
+    serve.add_flag("--pipeline,!--no-pipeline", options.pipeline,
+                   "Encode off the main thread (default; --no-pipeline: encode before taking the next request)");
 }
 
 void add_render_flags(CLI::App& render, mogao::PathTour& job, CameraFlags& camera) {
@@ -115,6 +143,11 @@ int main(int argc, char** argv) {
         ->add_option("--max-sessions-per-appliance", serve_options.link.max_sessions_per_appliance,
                      "Concurrent sessions of one appliance certificate")
         ->check(CLI::Range(1, 256));
+    double frame_time_ms = 0.0;
+    // Off unless asked: a refined frame is not the lone render of its request that the kiosk's
+    // end-to-end tests compare against.
+    serve_options.live.progressive = false;
+    add_live_flags(*serve, serve_options, frame_time_ms);
     serve->add_option("--duration", serve_options.duration_s, "Stop after this many seconds (0 = until SIGTERM)")->check(CLI::Range(0.0, 1e9));
     try {
         app.parse(argc, argv);
@@ -122,6 +155,7 @@ int main(int argc, char** argv) {
         return mpi.is_admin() ? app.exit(e) : (e.get_exit_code() == 0 ? 0 : 2);
     }
     setup.scene_options.scans_dir = scans;
+    serve_options.live.frame_time_s = frame_time_ms / 1e3;
     if (serve->parsed()) {
         try {
             serve_options.link.tls = mogao::load_farm_tls(tls_dir, farm_name);

@@ -1,19 +1,17 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "renderfarm/farm/serve.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
 #include <csignal>
-#include <deque>
-#include <future>
-#include <mutex>
 #include <optional>
 
 #include <spdlog/spdlog.h>
 
 #include "common/jpeg_codec.h"
 #include "common/service_notify.h"
+#include "renderfarm/farm/main_thread_queue.h"
 
 namespace mogao {
 namespace {
@@ -23,55 +21,38 @@ using Clock = std::chrono::steady_clock;
 std::atomic<bool> g_stop{false};
 extern "C" void on_stop_signal(int) { g_stop = true; }
 
-// Hands renderer calls from gRPC threads to the main thread.
-class MainThreadQueue {
-public:
-    struct Job {
-        ViewRequest view;
-        std::promise<RenderedFrame> result;
-    };
-
-    // Called on gRPC threads: blocks until the main thread has rendered the view.
-    RenderedFrame submit(const ViewRequest& view) {
-        std::future<RenderedFrame> done;
-        {
-            const std::lock_guard lock(mutex_);
-            if (closed_) throw std::runtime_error("the farm is stopping");
-            jobs_.push_back({view, {}});
-            done = jobs_.back().result.get_future();
-        }
-        ready_.notify_one();
-        return done.get();
-    }
-
-    // Main thread: the next job, or nothing after `wait` or once closed.
-    std::optional<Job> next(std::chrono::milliseconds wait) {
-        std::unique_lock lock(mutex_);
-        ready_.wait_for(lock, wait, [&] { return !jobs_.empty() || closed_; });
-        if (jobs_.empty()) return std::nullopt;
-        Job job = std::move(jobs_.front());
-        jobs_.pop_front();
-        return job;
-    }
-
-    // Refuses new jobs and fails the waiting ones, so no gRPC thread stays blocked.
-    void close() {
-        std::deque<Job> left;
-        {
-            const std::lock_guard lock(mutex_);
-            closed_ = true;
-            left.swap(jobs_);
-        }
-        for (Job& job : left) job.result.set_exception(std::make_exception_ptr(std::runtime_error("the farm is stopping")));
-        ready_.notify_all();
-    }
-
-private:
-    std::mutex mutex_;
-    std::condition_variable ready_;
-    std::deque<Job> jobs_;
-    bool closed_ = false;
+// What the main thread hands back: the frame, encoded already unless pipelining.
+struct ServedFrame {
+    Rgb8Image image;
+    int jpeg_quality = 85;
+    std::int64_t render_end_ns = 0;
+    std::optional<RenderedFrame> encoded;
 };
+
+RenderedFrame encode(const ServedFrame& frame, JpegEncoder& encoder) {
+    RenderedFrame out;
+    out.size = frame.image.size;
+    out.render_end_ns = frame.render_end_ns;
+    out.jpeg = encoder.encode(frame.image, frame.jpeg_quality);
+    return out;
+}
+
+// Runs on a gRPC thread: waits for the main thread, then encodes there when pipelining.
+RenderedFrame serve_request(MainThreadQueue<ServedFrame>& queue, const ViewRequest& view) {
+    ServedFrame frame = queue.push(view).get();
+    if (frame.encoded) return std::move(*frame.encoded);
+    thread_local JpegEncoder encoder;
+    return encode(frame, encoder);
+}
+
+void log_stats(const LinkServer& server, const MainThreadQueue<ServedFrame>& queue) {
+    const LinkServerStats s = server.stats();
+    spdlog::info(
+        "link: {} sessions active, {} frames sent, {} requests ({} dropped as stale, {} superseded in the "
+        "farm's queue, {} invalid), {} MB",
+        s.sessions_active, s.frames_sent, s.requests_received, s.requests_dropped, queue.superseded(),
+        s.requests_invalid, static_cast<double>(s.jpeg_bytes_sent) / 1e6);
+}
 
 }  // namespace
 
@@ -81,10 +62,20 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene&, 
     sigaction(SIGINT, &action, nullptr);
     sigaction(SIGTERM, &action, nullptr);
 
-    MainThreadQueue queue;
-    LinkServer server(options.link, [&queue](const ViewRequest& view) { return queue.submit(view); });
-    spdlog::info("serving {} ({} render ranks, {}) on {}", run.scene, run.render_ranks, run.balancer,
-                 server.endpoint().to_string());
+    MainThreadQueue<ServedFrame> queue;
+    LiveFrames live(farm, options.live);
+    LinkServerOptions link = options.link;
+    // Pipelining needs a second call in flight (another session's) while one frame is encoded; each
+    // session still has at most one, and the queue serialises them onto the main thread.
+    if (options.pipeline) link.render_threads = std::clamp(link.max_sessions, std::max(2, link.render_threads), 64);
+    LinkServer server(link, [&queue](const ViewRequest& view) { return serve_request(queue, view); });
+    spdlog::info(
+        "serving {} ({} render ranks, {}) on {}; progressive {}, frame-time target {}, {} cost maps, "
+        "pipeline {}",
+        run.scene, run.render_ranks, run.balancer, server.endpoint().to_string(),
+        options.live.progressive ? "on" : "off",
+        options.live.frame_time_s > 0 ? std::to_string(options.live.frame_time_s * 1e3) + " ms" : "off",
+        options.live.per_session_maps ? "per-session" : "shared", options.pipeline ? "on" : "off");
     ServiceNotifier notifier;
     notifier.ready();
 
@@ -95,20 +86,15 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene&, 
     while (!g_stop && (options.duration_s <= 0 || elapsed() < options.duration_s)) {
         notifier.watchdog();
         if (std::chrono::duration<double>(Clock::now() - last_stats).count() >= options.stats_period_s) {
-            const LinkServerStats s = server.stats();
-            spdlog::info("link: {} sessions active, {} frames sent, {} requests ({} dropped as stale, {} invalid), {} MB",
-                         s.sessions_active, s.frames_sent, s.requests_received, s.requests_dropped, s.requests_invalid,
-                         static_cast<double>(s.jpeg_bytes_sent) / 1e6);
+            log_stats(server, queue);
             last_stats = Clock::now();
         }
-        std::optional<MainThreadQueue::Job> job = queue.next(std::chrono::milliseconds(100));
+        std::optional<MainThreadQueue<ServedFrame>::Job> job = queue.next(std::chrono::milliseconds(100));
         if (!job) continue;
         try {
-            DispatchedFrame frame = farm.render(job->view);
-            RenderedFrame out;
-            out.size = frame.image.size;
-            out.render_end_ns = realtime_ns();
-            out.jpeg = encoder.encode(frame.image, job->view.quality.jpeg_quality);
+            LiveFrame frame = live.render(job->view);
+            ServedFrame out{std::move(frame.image), job->view.quality.jpeg_quality, realtime_ns(), std::nullopt};
+            if (!options.pipeline) out.encoded = encode(out, encoder);
             job->result.set_value(std::move(out));
         } catch (...) {
             // One bad request fails alone: the link reports it to its session and goes on.

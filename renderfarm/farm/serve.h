@@ -3,8 +3,12 @@
 // renderfarm/link) and renders each session's newest view request on the MPI farm.
 //
 // Threads: gRPC calls the frame renderer from its own threads, but MPI may only be used from the
-// main thread (MPI_THREAD_FUNNELED), so renderer calls are queued to the main thread, which renders
-// them one at a time on the FrameDispatcher, encodes with TurboJPEG and hands the frame back.
+// main thread (MPI_THREAD_FUNNELED), so renderer calls are queued to the main thread
+// (main_thread_queue.h: only a session's newest request waits there), which renders them one at a
+// time through LiveFrames (live_frames.h: progressive refinement, frame-time target, per-session
+// cost maps). With `pipeline` the JPEG is encoded on the calling gRPC thread, so the main thread
+// sends the ranks the next request while the previous frame is encoded; without it the main thread
+// encodes before taking the next request (the serial loop of before).
 // Errors: a request that fails (bad view, a rank's error) fails that request only — the link logs
 // it and the session goes on; SIGINT/SIGTERM stop the service cleanly (exit 0).
 #pragma once
@@ -13,6 +17,7 @@
 
 #include "renderfarm/farm/frame_dispatcher.h"
 #include "renderfarm/farm/frame_stats.h"
+#include "renderfarm/farm/live_frames.h"
 #include "renderfarm/link/link_server.h"
 #include "renderfarm/scene/scene.h"
 
@@ -20,6 +25,8 @@ namespace mogao {
 
 struct ServeOptions {
     LinkServerOptions link;
+    LiveOptions live;
+    bool pipeline = true;        // encode off the main thread (see above)
     double duration_s = 0.0;     // stop after this long (tests); 0 = until SIGINT/SIGTERM
     double stats_period_s = 10;  // log the link's counters this often
 };

@@ -4,7 +4,9 @@
 //
 // Tiles are cost-map cells (cell_size x cell_size pixels, aligned to the global image grid) clipped
 // to each rect, so a tile's time maps onto exactly one cell. Pixels are packed rect by rect, row by
-// row, RGB8 — the order unpack_rects() expects.
+// row, RGB8 — the order unpack_rects() expects — or, for PackedPixels::linear, three native
+// floats per pixel of linear radiance (before exposure and tone map) in the same order, for the
+// admin's progressive accumulation (unpack_linear_rects()).
 #pragma once
 
 #include <cstdint>
@@ -17,23 +19,32 @@
 
 namespace mogao {
 
+enum class PackedPixels { srgb8, linear };
+
 struct TilePassResult {
     std::vector<std::uint8_t> packed_pixels;
-    std::vector<TileTime> tile_times;
+    std::vector<TileTime> tile_times;  // wall-clock seconds per tile
     std::uint64_t rays = 0;
     double render_seconds = 0.0;  // wall time of the whole pass on this rank
+    double cpu_seconds = 0.0;     // thread CPU time of all render threads (CLOCK_THREAD_CPUTIME_ID)
 };
 
 // Renders `rects` of the frame begun on `renderer` with `threads` worker threads (>= 1).
 // Throws what the renderer throws (std::invalid_argument for rects outside the image).
 [[nodiscard]] TilePassResult render_tile_pass(const Renderer& renderer, const std::vector<PixelRect>& rects,
                                               int cell_size, int threads, float exposure,
-                                              ToneMap tone_map = ToneMap::clamp);
+                                              ToneMap tone_map = ToneMap::clamp,
+                                              PackedPixels format = PackedPixels::srgb8);
 
 // Copies packed pixels of `rects` into `frame`. Throws std::invalid_argument when the byte count
 // does not match the rects or a rect lies outside the frame.
 void unpack_rects(const std::vector<PixelRect>& rects, const std::vector<std::uint8_t>& packed, Rgb8Image& frame);
 
-[[nodiscard]] std::size_t packed_size(const std::vector<PixelRect>& rects);
+// The same for PackedPixels::linear into a linear radiance frame.
+void unpack_linear_rects(const std::vector<PixelRect>& rects, const std::vector<std::uint8_t>& packed,
+                         RgbFloatImage& frame);
+
+// Bytes of `rects` packed: 3 per pixel (srgb8) or 3 floats per pixel (linear).
+[[nodiscard]] std::size_t packed_size(const std::vector<PixelRect>& rects, PackedPixels format = PackedPixels::srgb8);
 
 }  // namespace mogao

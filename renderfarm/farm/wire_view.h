@@ -19,7 +19,8 @@ struct WireView {
     double fov_deg, radius_m, arc_deg, bottom_m, top_m, screen_eye[3];
     std::int32_t width, height, spp, max_bounces, ao_samples, area_light_samples, jpeg_quality;
     double resolution_scale;
-    std::int32_t stop;  // 1: no more frames, render ranks leave their loop
+    std::int32_t stop;    // 1: no more frames, render ranks leave their loop
+    std::int32_t linear;  // 1: reply with linear radiance (PackedPixels::linear), 0: sRGB8
 };
 static_assert(std::is_trivially_copyable_v<WireView>);
 

@@ -350,6 +350,7 @@ void LinkServer::Impl::render_loop() {
             work_cv.wait(lock, [&] { return stopping || (s = pick_ready()) != nullptr; });
             if (stopping) return;
             request = std::move(*s->pending);
+            request.session = s->id;  // the farm keys its per-session state on it
             s->pending.reset();
             received_ns = s->pending_received_ns;
             s->rendering = true;

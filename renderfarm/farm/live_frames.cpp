@@ -1,0 +1,102 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "renderfarm/farm/live_frames.h"
+
+#include <algorithm>
+#include <chrono>
+#include <stdexcept>
+
+#include "renderfarm/trace/film.h"
+
+namespace mogao {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+}  // namespace
+
+LiveFrames::LiveFrames(FrameDispatcher& farm, LiveOptions options)
+    : LiveFrames([&farm](const ViewRequest& view, std::uint64_t stream,
+                         PackedPixels format) { return farm.render(view, stream, format); },
+                 std::move(options), farm.settings().exposure, farm.settings().tone_map) {}
+
+LiveFrames::LiveFrames(FrameSource source, LiveOptions options, float exposure, ToneMap tone_map)
+    : source_(std::move(source)), options_(std::move(options)), exposure_(exposure), tone_map_(tone_map) {
+    if (!source_) throw std::invalid_argument("LiveFrames: no frame source");
+    if (options_.frame_time_s < 0) throw std::invalid_argument("LiveOptions.frame_time_s must be >= 0");
+    if (options_.converged_spp < 1) throw std::invalid_argument("LiveOptions.converged_spp must be >= 1");
+    options_.controller.target_seconds = options_.frame_time_s > 0 ? options_.frame_time_s : 1.0;
+    (void)FrameTimeController(options_.controller);  // validates the controller's settings now
+}
+
+LiveFrames::Session& LiveFrames::session(std::uint64_t id) {
+    auto found = sessions_.find(id);
+    if (found == sessions_.end()) {
+        if (sessions_.size() >= std::max<std::size_t>(1, options_.max_sessions)) {
+            sessions_.erase(std::min_element(sessions_.begin(), sessions_.end(), [](const auto& a, const auto& b) {
+                return a.second.last_used < b.second.last_used;
+            }));
+        }
+        found = sessions_.try_emplace(id).first;
+        if (options_.frame_time_s > 0) found->second.controller.emplace(options_.controller);
+    }
+    found->second.last_used = ++frames_;
+    return found->second;
+}
+
+// The view to trace for `request`: still views at the request's own scale (to accumulate), moving
+// ones at the controller's choice; the pass's frame_id when it continues an accumulation.
+ViewRequest LiveFrames::plan(Session& s, const ViewRequest& request, FrameChoice& choice) const {
+    choice = {request.quality.resolution_scale, request.quality.spp};
+    if (s.controller) choice = s.controller->choose(request);
+    const bool still = options_.progressive && s.last_request && same_view(request, *s.last_request);
+    if (still) choice.resolution_scale = request.quality.resolution_scale;
+    ViewRequest view = request;
+    view.quality.resolution_scale = choice.resolution_scale;
+    view.quality.spp = choice.spp;
+    if (options_.progressive && s.accumulation.continues(view)) {
+        choice.spp = std::max(choice.spp, 2);
+        view.quality.spp = choice.spp;
+        view.frame_id = pass_frame_id(s.accumulation.first_frame_id(), s.accumulation.passes());
+    }
+    return view;
+}
+
+Rgb8Image LiveFrames::to_display(const RgbFloatImage& radiance) const {
+    Rgb8Image out(radiance.size);
+    to_srgb8(radiance, PixelRect::whole(radiance.size), exposure_, out, tone_map_);
+    return out;
+}
+
+LiveFrame LiveFrames::render(const ViewRequest& request) {
+    const auto start = Clock::now();
+    Session& s = session(request.session);
+    FrameChoice choice;
+    LiveFrame frame;
+    frame.rendered = plan(s, request, choice);
+    const bool continues = options_.progressive && s.accumulation.continues(frame.rendered);
+    if (continues && s.accumulation.samples() >= options_.converged_spp) {
+        frame.rendered_now = false;
+    } else {
+        const std::uint64_t stream = options_.per_session_maps ? request.session : 0;
+        DispatchedFrame f =
+            source_(frame.rendered, stream, options_.progressive ? PackedPixels::linear : PackedPixels::srgb8);
+        frame.stats = std::move(f.stats);
+        if (options_.progressive) {
+            s.accumulation.add(frame.rendered, f.radiance);
+        } else {
+            frame.image = std::move(f.image);
+            frame.samples = choice.spp;
+        }
+    }
+    if (options_.progressive) {
+        frame.image = to_display(s.accumulation.mean());
+        frame.samples = s.accumulation.samples();
+        frame.passes = s.accumulation.passes();
+    }
+    frame.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    if (s.controller && frame.rendered_now) s.controller->observe(choice, frame.seconds);
+    s.last_request = request;
+    return frame;
+}
+
+}  // namespace mogao

@@ -1,0 +1,89 @@
+// SPDX-License-Identifier: Apache-2.0
+// Live frame scheduling of serve mode: what the farm renders for each appliance session's request.
+//
+// Per session (ViewRequest::session, set by the link server):
+//  - Progressive refinement: while the session asks for the same view (same_view(): pose, camera,
+//    size and quality unchanged), each request renders one more pass at the request's full scale
+//    with new random numbers (pass_frame_id) and the frame sent is the mean of all passes so far, in
+//    linear float (progressive_accumulator.h). Any change starts over. Passes after the first use
+//    at least 2 spp: at 1 spp the renderer samples the pixel centre (renderer.h), which would never
+//    converge to the pixel's area average. Once `converged_spp` samples are in, the mean is sent
+//    without rendering.
+//  - A frame-time target (schedule/frame_time_controller.h): while the view moves, the resolution
+//    scale and spp of each frame are chosen to take `frame_time_s`; the appliance upsamples the
+//    smaller frame (its warp takes content of any size).
+//  - Its own predicted cost map (FrameDispatcher stream = session), so sessions looking at
+//    different places do not mislead each other's PBT.
+// Sessions are forgotten least-recently-used beyond `max_sessions`.
+//
+// Threads: main thread only (it drives the FrameDispatcher, MPI_THREAD_FUNNELED).
+// Errors: what FrameDispatcher::render throws (std::invalid_argument for a bad view, FarmError);
+// the session's state is left as it was (the failed frame is not accumulated).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <optional>
+
+#include "renderfarm/farm/frame_dispatcher.h"
+#include "renderfarm/farm/progressive_accumulator.h"
+#include "renderfarm/schedule/frame_time_controller.h"
+
+namespace mogao {
+
+struct LiveOptions {
+    bool progressive = true;       // accumulate still views
+    int converged_spp = 1024;      // stop rendering a still view once it has this many samples
+    double frame_time_s = 0.0;     // per-session frame-time target, seconds; 0 = render requests as asked
+    FrameTimeTarget controller;    // its other settings (target_seconds is taken from frame_time_s)
+    bool per_session_maps = true;  // one PBT cost map per session; false = all share one (stream 0)
+    std::size_t max_sessions = 64;
+};
+
+struct LiveFrame {
+    Rgb8Image image;           // what to encode and send: render_size(rendered)
+    ViewRequest rendered;      // the view as traced: scale, spp and frame_id of the pass
+    int samples = 0;           // samples per pixel in `image` (all accumulated passes)
+    int passes = 1;            // passes in `image`
+    bool rendered_now = true;  // false: a converged still view, sent from the accumulation
+    double seconds = 0.0;      // render + composite (+ accumulate) on the admin, wall
+    FrameStats stats;
+};
+
+// Renders one frame: FrameDispatcher::render, or a stand-in in tests.
+using FrameSource = std::function<DispatchedFrame(const ViewRequest&, std::uint64_t stream, PackedPixels)>;
+
+class LiveFrames {
+public:
+    // Frames from `farm`, displayed with its exposure and tone map.
+    LiveFrames(FrameDispatcher& farm, LiveOptions options);
+    // Frames from `source`; accumulated radiance is displayed with `exposure` and `tone_map` (film.h).
+    // Throws std::invalid_argument for bad options (naming the field).
+    LiveFrames(FrameSource source, LiveOptions options, float exposure, ToneMap tone_map);
+
+    // Renders the frame answering `request` (validated by the renderer). Main thread only.
+    LiveFrame render(const ViewRequest& request);
+
+    [[nodiscard]] const LiveOptions& options() const { return options_; }
+
+private:
+    struct Session {
+        std::optional<ViewRequest> last_request;
+        ProgressiveAccumulator accumulation;
+        std::optional<FrameTimeController> controller;
+        std::uint64_t last_used = 0;
+    };
+    Session& session(std::uint64_t id);
+    [[nodiscard]] ViewRequest plan(Session& s, const ViewRequest& request, FrameChoice& choice) const;
+    [[nodiscard]] Rgb8Image to_display(const RgbFloatImage& radiance) const;
+
+    FrameSource source_;
+    LiveOptions options_;
+    float exposure_;
+    ToneMap tone_map_;
+    std::map<std::uint64_t, Session> sessions_;
+    std::uint64_t frames_ = 0;
+};
+
+}  // namespace mogao
