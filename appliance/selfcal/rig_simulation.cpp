@@ -243,7 +243,9 @@ SimulationReport simulate(const rig::VirtualRig& input, const SimulationOptions&
         const double gain = 1.0 + rng.uniform(-o.exposure_jitter, o.exposure_jitter + 1e-12);
         cam *= gain;
         cv::min(cam, 1.0f, cam);
-        occlude(cam, o.occlusion, rng);
+        occlude(cam,
+                o.occlusion_max > o.occlusion ? rng.uniform(o.occlusion, std::min(0.9, o.occlusion_max)) : o.occlusion,
+                rng);
         const StepResult r = sc.step(content, cam, t);
         if (r.calibration) wall = *r.calibration;
         for (const std::string& line : r.journal) rep.journal.push_back(line);

@@ -46,6 +46,7 @@ struct SimulationOptions {
     bool moving_content = true;
     double exposure_jitter = 0.0;     // camera gain uniform in [1 - j, 1 + j] per frame
     double occlusion = 0.0;           // fraction of the camera view hidden by visitors, [0, 0.9]
+    double occlusion_max = 0.0;       // > occlusion: each frame's fraction uniform in [occlusion, occlusion_max]
     double error_threshold_px = 1.0;  // "corrected" = mean geometric error below this
     std::uint64_t seed = 7;
     SelfcalOptions selfcal;

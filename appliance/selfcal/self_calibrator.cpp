@@ -78,6 +78,37 @@ SelfCalibrator::SelfCalibrator(const SystemModel& model, const ScreenCalibration
       camera_filter_(options.camera_kalman) {
     check_options(options);
     filters_.assign(model.projectors.size(), PoseKalman(options.kalman));
+    typical_matches_.assign(model.projectors.size(), -1.0);
+    lost_since_.assign(model.projectors.size(), -1.0);
+}
+
+bool SelfCalibrator::check_lost(double t_s, StepResult& r) {
+    const std::size_t n = filters_.size();
+    for (std::size_t k = 0; k < n; ++k) {
+        const ProjectorStatus& ps = r.status.projectors[k];
+        bool others_fine = n > 1;
+        for (std::size_t j = 0; j < n; ++j) {
+            if (j != k && !(typical_matches_[j] > 0.0 && r.status.projectors[j].matches >= 0.5 * typical_matches_[j])) {
+                others_fine = false;
+            }
+        }
+        const bool lost = typical_matches_[k] > 0.0 && ps.matches < 0.2 * typical_matches_[k] && others_fine;
+        if (!lost) {
+            lost_since_[k] = -1.0;
+            continue;
+        }
+        if (lost_since_[k] < 0.0) lost_since_[k] = t_s;
+        if (t_s - lost_since_[k] < options_.hold_s) continue;
+        if (state_ != SelfcalState::cannot_correct) {
+            reason_ = ps.id + " lost: " + std::to_string(ps.matches) + " matches, typically " +
+                      std::to_string(static_cast<int>(typical_matches_[k])) +
+                      ", while the others see theirs (moved beyond what the monitor can follow)";
+            r.journal.push_back("selfcal: cannot correct (needs a full calibration): " + reason_);
+        }
+        state_ = SelfcalState::cannot_correct;
+        return true;
+    }
+    return false;
 }
 
 double SelfCalibrator::drift_px(int k, const Pose6& delta) const {
@@ -136,6 +167,8 @@ void SelfCalibrator::filter(const FrameMeasurement& m, double dt, StepResult& r)
         }
         (void)filters_[k].update(pm.delta, kCovarianceInflation * pm.fit.covariance);
         ps.measured = true;
+        const double seen = static_cast<double>(pm.matches);
+        typical_matches_[k] = typical_matches_[k] < 0.0 ? seen : 0.8 * typical_matches_[k] + 0.2 * seen;
     }
     camera_filter_.predict(dt);
     if (m.camera.ok) (void)camera_filter_.update(m.camera_delta, kCovarianceInflation * m.camera.covariance);
@@ -215,6 +248,7 @@ void SelfCalibrator::decide(double t_s, StepResult& r) {
         r.journal.push_back(line);
         report_after_ = false;
     }
+    if (check_lost(t_s, r)) return;
     if (drifting.empty()) {
         if (state_ != SelfcalState::calibrated) r.journal.push_back(fmt("selfcal: t=%.2f s: drift gone", t_s));
         state_ = SelfcalState::calibrated;

@@ -13,7 +13,10 @@
 //   drift detected -> cannot correct: the re-estimated pose puts less than
 //     (1 - max_offscreen_loss) of the projector's on-screen image of its reference on the screen;
 //     nothing is changed, the state stays until the drift is gone (the projector put back) or a
-//     full calibration replaces the reference.
+//     full calibration replaces the reference. Also when a projector is lost: for hold_s its
+//     matches fall under a fifth of its typical count while every other projector keeps at least
+//     half of its own (the content is not to blame: its image moved beyond what the monitor can
+//     follow, e.g. mostly off the screen).
 // A frame with fewer than `min_matches` matches for a projector gives that projector no
 // measurement (its filter only predicts): waiting, "insufficient evidence". A camera whose filtered
 // pose change is significant and above `camera_rebase_deg` for hold_s re-bases the monitor's
@@ -79,6 +82,7 @@ private:
     void start_correction(double t_s, const std::vector<int>& drifting, StepResult& r);
     void advance_correction(double t_s, StepResult& r);
     void rebase_camera(double t_s, StepResult& r);
+    bool check_lost(double t_s, StepResult& r);
     [[nodiscard]] double drift_px(int k, const Pose6& delta) const;
     [[nodiscard]] double on_screen_fraction(const autocal::DeviceModel& d) const;
 
@@ -98,6 +102,8 @@ private:
     double correction_start_ = 0.0;
     std::string reason_;
     bool report_after_ = false;
+    std::vector<double> typical_matches_;  // per projector: running mean of its matches when measured
+    std::vector<double> lost_since_;       // per projector: since when it is lost, -1 if not
 };
 
 // Linear blend of two calibrations of the same layout: warps (where both finite; otherwise the

@@ -73,6 +73,12 @@ int main(int argc, char** argv) {
     sim->add_option("--camera-scale", o.camera_scale, "camera resolution scale")->check(CLI::Range(0.05, 1.0));
     sim->add_option("--occlusion", o.occlusion, "fraction of the camera view hidden by visitors")
         ->check(CLI::Range(0.0, 0.9));
+    sim->add_option("--occlusion-max", o.occlusion_max, "each frame's occlusion uniform in [occlusion, this]")
+        ->check(CLI::Range(0.0, 0.9));
+    sim->add_option("--hold", o.selfcal.hold_s, "seconds a drift must last before correcting")
+        ->check(CLI::NonNegativeNumber);
+    sim->add_option("--transition", o.selfcal.transition_s, "seconds a correction is blended in over")
+        ->check(CLI::NonNegativeNumber);
     sim->add_option("--exposure-jitter", o.exposure_jitter, "camera gain varies in [1-j, 1+j]")
         ->check(CLI::Range(0.0, 0.9));
     sim->add_option("--content", content, "textured | plain | repetitive")
