@@ -1,0 +1,261 @@
+// SPDX-License-Identifier: Apache-2.0
+// Serve mode's live frame scheduling on the farm alone (no link, no kiosk): frames/s served for a
+// moving view and the still-view convergence curve, with every new part on, with each part off,
+// and with all of them off (the serial loop of before), all in ONE run so only ratios are read.
+//
+//   mpirun -n 3 mogao_bench_serve --scene scenes/grotto.json [--width 960] [--height 540]
+//          [--move-seconds 4] [--still-seconds 5] [--frame-time-ms 66.7] [--reference-spp 64]
+//          [--json FILE]
+//
+// A session looks at the screen (the kiosk's cylinder: radius 3 m, 150 degrees, 0.2-2.8 m) from the
+// scene's viewer. Moving: the yaw turns a little every request, so nothing accumulates; frames/s =
+// frames served (rendered, composited, encoded to JPEG) / wall time. Still: the last moving pose is
+// requested again and again; after every frame the served image (upsampled to full size when the
+// frame-time target had shrunk it) is compared with the reference (the same view at
+// --reference-spp, one render) by PSNR of the sRGB8 frames; comparison time is not counted.
+// The error of a moving frame is that of the last moving frame against the same reference.
+// Exits 77 when the scene's scans are absent.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <future>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
+
+#include "common/image_compare.h"
+#include "common/jpeg_codec.h"
+#include "renderfarm/farm/farm.h"
+#include "renderfarm/farm/live_frames.h"
+
+namespace {
+
+using namespace mogao;
+using Clock = std::chrono::steady_clock;
+
+struct Config {
+    std::string name;
+    LiveOptions live;
+    bool pipeline = true;
+    bool rank_speed = true;
+};
+
+struct BenchArgs {
+    int width = 960, height = 540;
+    double move_seconds = 4.0, still_seconds = 5.0, frame_time_ms = 1000.0 / 15.0;
+    int reference_spp = 64;
+    std::string json;
+};
+
+std::vector<Config> configs(const BenchArgs& a) {
+    Config all{"all new parts", {}, true, true};
+    all.live.frame_time_s = a.frame_time_ms / 1e3;
+    Config today{"none (serial, as before)", {}, false, false};
+    today.live.progressive = false;
+    today.live.per_session_maps = false;
+    std::vector<Config> out{today, all};
+    Config c = all;
+    c.name = "all but progressive";
+    c.live.progressive = false;
+    out.push_back(c);
+    c = all;
+    c.name = "all but frame-time target";
+    c.live.frame_time_s = 0;
+    out.push_back(c);
+    c = all;
+    c.name = "all but pipelining";
+    c.pipeline = false;
+    out.push_back(c);
+    c = all;
+    c.name = "all but rank-speed normalisation";
+    c.rank_speed = false;
+    out.push_back(c);
+    return out;
+}
+
+// Bilinear resampling of an sRGB8 frame to `size` (what the kiosk's warp does to a smaller frame).
+Rgb8Image upsample(const Rgb8Image& in, ImageSize size) {
+    if (in.size == size) return in;
+    Rgb8Image out(size);
+    const double sx = double(in.size.width) / size.width, sy = double(in.size.height) / size.height;
+    for (int y = 0; y < size.height; ++y) {
+        const double fy = std::clamp((y + 0.5) * sy - 0.5, 0.0, in.size.height - 1.0);
+        const int y0 = int(fy), y1 = std::min(y0 + 1, in.size.height - 1);
+        for (int x = 0; x < size.width; ++x) {
+            const double fx = std::clamp((x + 0.5) * sx - 0.5, 0.0, in.size.width - 1.0);
+            const int x0 = int(fx), x1 = std::min(x0 + 1, in.size.width - 1);
+            const double wx = fx - x0, wy = fy - y0;
+            for (int c = 0; c < 3; ++c) {
+                const double top = in.at(x0, y0)[c] * (1 - wx) + in.at(x1, y0)[c] * wx;
+                const double bottom = in.at(x0, y1)[c] * (1 - wx) + in.at(x1, y1)[c] * wx;
+                out.at(x, y)[c] = static_cast<std::uint8_t>(std::lround(top * (1 - wy) + bottom * wy));
+            }
+        }
+    }
+    return out;
+}
+
+// Encodes one frame, inline or on a worker while the next frame renders (one encode in flight).
+class Encoder {
+public:
+    explicit Encoder(bool pipeline) : pipeline_(pipeline) {}
+    ~Encoder() { finish(); }
+    void submit(Rgb8Image image) {
+        finish();
+        if (!pipeline_) {
+            bytes_ += encoder_.encode(image, 85).size();
+            return;
+        }
+        pending_ =
+            std::async(std::launch::async, [this, im = std::move(image)] { return encoder_.encode(im, 85).size(); });
+    }
+    void finish() {
+        if (pending_.valid()) bytes_ += pending_.get();
+    }
+
+private:
+    bool pipeline_;
+    JpegEncoder encoder_;
+    std::future<std::size_t> pending_;
+    std::size_t bytes_ = 0;
+};
+
+ViewRequest session_view(const Scene& scene, const BenchArgs& a) {
+    ViewRequest v;
+    v.size = {a.width, a.height};
+    v.camera = CylinderScreen{3.0, 150.0, 0.2, 2.8, {0.0, 1.6, 0.0}};
+    v.pose.eye = scene.viewer.start + Eigen::Vector3d(0.0, scene.viewer.eye_height_m, 0.0);
+    v.pose.yaw_deg = scene.viewer.start_yaw_deg;
+    v.session = 1;
+    return v;
+}
+
+nlohmann::json run_config(const Config& c, FrameDispatcher& farm, const Scene& scene, const BenchArgs& a,
+                          const Rgb8Image& reference, std::uint64_t& next_id) {
+    farm.set_normalise_rank_speed(c.rank_speed);
+    LiveFrames live(farm, c.live);
+    Encoder encoder(c.pipeline);
+    ViewRequest request = session_view(scene, a);
+    const double base_yaw = request.pose.yaw_deg;
+    int moved = 0;
+    const auto start = Clock::now();
+    const auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
+    LiveFrame last;
+    while (since(start) < a.move_seconds) {
+        request.frame_id = next_id++;
+        request.pose.yaw_deg = base_yaw + 0.5 * (moved % 2 == 0 ? 1 : -1) * (1 + moved % 7);
+        last = live.render(request);
+        encoder.submit(last.image);
+        ++moved;
+    }
+    encoder.finish();
+    const double move_fps = moved / since(start);
+    // The still view starts where the visitor stopped: the reference's pose.
+    request.pose.yaw_deg = base_yaw;
+    request.frame_id = next_id++;
+    last = live.render(request);  // the first frame at the new pose: a moving frame's error
+    const double moving_psnr = psnr(upsample(last.image, reference.size), reference);
+    nlohmann::json curve = nlohmann::json::array();
+    double served = 0.0, to38 = -1.0;
+    int still_frames = 0;
+    while (served < a.still_seconds) {
+        const auto t0 = Clock::now();
+        request.frame_id = next_id++;
+        last = live.render(request);
+        encoder.submit(last.image);
+        served += since(t0);
+        ++still_frames;
+        const double p = psnr(upsample(last.image, reference.size), reference);
+        if (to38 < 0 && p >= 38.0) to38 = served;
+        curve.push_back({{"seconds", served}, {"psnr_db", p}, {"samples", last.samples}});
+    }
+    encoder.finish();
+    std::printf("| %-34s | %7.2f | %6.2f | %6.2f | %s | %4d |\n", c.name.c_str(), move_fps, moving_psnr,
+                curve.back()["psnr_db"].get<double>(), to38 < 0 ? "  never" : fmt::format("{:7.2f}", to38).c_str(),
+                last.samples);
+    std::fflush(stdout);
+    return {{"config", c.name},     {"move_frames_per_second", move_fps}, {"moving_frame_psnr_db", moving_psnr},
+            {"still_curve", curve}, {"still_seconds_to_38db", to38},      {"still_frames", still_frames}};
+}
+
+Rgb8Image render_reference(FrameDispatcher& farm, const Scene& scene, const BenchArgs& a, std::uint64_t id) {
+    ViewRequest v = session_view(scene, a);
+    v.quality.spp = a.reference_spp;
+    v.frame_id = id;
+    return farm.render(v, 999).image;
+}
+
+int admin(FrameDispatcher& farm, const Scene& scene, const BenchArgs& a) {
+    std::uint64_t next_id = 1;
+    const auto t0 = Clock::now();
+    const Rgb8Image reference = render_reference(farm, scene, a, 1u << 30);
+    std::printf("reference: %dx%d at %d spp in %.1f s; %d render ranks; frame-time target %.1f ms\n\n", a.width,
+                a.height, a.reference_spp, std::chrono::duration<double>(Clock::now() - t0).count(),
+                farm.render_ranks(), a.frame_time_ms);
+    std::printf("| %-34s | %7s | %6s | %6s | %7s | %4s |\n", "parts on", "move/s", "dB mov", "dB 5s", "s to 38", "spp");
+    std::printf("|%s|%s|%s|%s|%s|%s|\n", std::string(36, '-').c_str(), std::string(9, '-').c_str(),
+                std::string(8, '-').c_str(), std::string(8, '-').c_str(), std::string(9, '-').c_str(),
+                std::string(6, '-').c_str());
+    nlohmann::json results = nlohmann::json::array();
+    double today_fps = 0.0;
+    for (const Config& c : configs(a)) {
+        results.push_back(run_config(c, farm, scene, a, reference, next_id));
+        if (results.size() == 1) today_fps = results[0]["move_frames_per_second"].get<double>();
+    }
+    std::printf("\nratio frames/s all new parts / none = %.2f\n",
+                results[1]["move_frames_per_second"].get<double>() / std::max(1e-9, today_fps));
+    if (!a.json.empty()) {
+        std::ofstream(a.json) << nlohmann::json{
+            {"width", a.width},
+            {"height", a.height},
+            {"render_ranks", farm.render_ranks()},
+            {"frame_time_ms", a.frame_time_ms},
+            {"reference_spp", a.reference_spp},
+            {"configs", results}}.dump(2);
+    }
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    MpiSession mpi(&argc, &argv);
+    spdlog::set_level(spdlog::level::warn);
+    CLI::App app{"mogao_bench_serve: serve mode's live scheduling, each part on and off, in one run"};
+    FarmSetup setup;
+    setup.scene_file = "scenes/grotto.json";
+    BenchArgs a;
+    std::string scans;
+    app.add_option("--scene", setup.scene_file, "Scene file");
+    app.add_option("--scans", scans, "Folder of the real scans");
+    app.add_option("--width", a.width)->check(CLI::Range(16, 16384));
+    app.add_option("--height", a.height)->check(CLI::Range(16, 16384));
+    app.add_option("--move-seconds", a.move_seconds)->check(CLI::Range(0.1, 600.0));
+    app.add_option("--still-seconds", a.still_seconds)->check(CLI::Range(0.1, 600.0));
+    app.add_option("--frame-time-ms", a.frame_time_ms)->check(CLI::Range(1.0, 10000.0));
+    app.add_option("--reference-spp", a.reference_spp)->check(CLI::Range(1, 4096));
+    app.add_option("--json", a.json, "Write every figure (and the curves) as JSON");
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return mpi.is_admin() ? app.exit(e) : 2;
+    }
+    setup.scene_options.scans_dir = scans;
+    const std::filesystem::path scans_dir = resolve_scans_dir(setup.scene_file, setup.scene_options);
+    std::ifstream scene_text(setup.scene_file);
+    const std::string text((std::istreambuf_iterator<char>(scene_text)), std::istreambuf_iterator<char>());
+    if (text.find("{scans}") != std::string::npos && !std::filesystem::exists(scans_dir)) {
+        if (mpi.is_admin()) std::printf("SKIP: real scans not found at %s\n", scans_dir.c_str());
+        return 77;
+    }
+    return run_farm(mpi, setup,
+                    [&](FrameDispatcher& farm, const Scene& scene, RunInfo&) { return admin(farm, scene, a); });
+}
