@@ -8,24 +8,43 @@
 //       an uninstanced mesh, a zero-specular material), vs a shadowing sun plus a used area light;
 //       (c4) an unplaced mesh with vertex colours and a texture, (c5) the field carrying them.
 // The scene is built in code: a ~1M-triangle smooth height field plus a sphere.
+//   (d) with --scene FILE (e.g. scenes/grotto.json): issue 11's speed-ups on a real scene, the
+//       grotto's cylinder view at --scene-width x --scene-height (960x540), 1 spp: for today's path
+//       (every RendererOptions switch off), each part alone, the defaults and everything on, the
+//       renderer's Mrays/s, raw Embree tracing the same ray mix with
+//       no shading (the camera packets plus the secondary rays that very render traced, recorded
+//       and replayed as it traced them: packets or single rays), renderer/Embree throughput, the
+//       frame time ratio new/legacy, and the PSNR of each 1 spp frame (sRGB8, the scene's exposure
+//       and tone map) against a converged reference (--ref-spp, default 64, legacy estimator,
+//       rendered on all cores), so speed is never bought with error.
 // Usage: mogao_bench_render [--width W] [--height H] [--spp N] [--reps N] [--grid N] [--json FILE]
+//                           [--scene FILE [--scans DIR] [--scene-width W] [--scene-height H] [--ref-spp N]]
 // The table goes to stdout; --json FILE also writes every figure as JSON (for bench/regenerate-docs).
 // Timings use Renderer/RenderTimings from renderfarm/trace/render_timing.h, which the farm can
 // reuse on a real scene: time_render_vs_embree(scene, request).
+#include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <stdexcept>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "common/camera_path.h"
 #include "renderfarm/scene/procedural.h"
 #include "renderfarm/scene/scene.h"
+#include "renderfarm/scene/scene_file.h"
+#include "renderfarm/trace/film.h"
 #include "renderfarm/trace/render_timing.h"
 #include "renderfarm/trace/renderer.h"
 
@@ -159,6 +178,153 @@ void print(const char* label, const RenderTimings& t, double baseline_s) {
                 t.render_s / baseline_s);
 }
 
+double thread_cpu_seconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// One path of (d): its frame, CPU time, rays, and raw Embree on the same ray mix.
+struct PathFigures {
+    RgbFloatImage frame;
+    double render_s = 1e300;
+    double embree_s = 1e300;
+    std::uint64_t rays = 0;
+    std::uint64_t embree_rays = 0;
+    double psnr_db = 0.0;
+    [[nodiscard]] double mrays() const { return 1e-6 * static_cast<double>(rays) / render_s; }
+    [[nodiscard]] double embree_mrays() const { return 1e-6 * static_cast<double>(embree_rays) / embree_s; }
+};
+
+PathFigures time_path(Renderer& renderer, const ViewRequest& view, const RendererOptions& options, int reps) {
+    renderer.set_path_options(options);
+    renderer.begin_frame(view);
+    PathFigures f;
+    f.frame = RgbFloatImage(renderer.render_size());
+    const PixelRect whole = PixelRect::whole(f.frame.size);
+    RecordedRays log;
+    f.rays = renderer.render_recording(whole, f.frame, log).rays;
+    for (int r = 0; r < std::max(1, reps); ++r) {
+        double t0 = thread_cpu_seconds();
+        (void)renderer.render(whole, f.frame);
+        f.render_s = std::min(f.render_s, thread_cpu_seconds() - t0);
+        t0 = thread_cpu_seconds();
+        f.embree_rays = renderer.trace_camera_rays(whole).rays + renderer.trace_recorded(log).rays;
+        f.embree_s = std::min(f.embree_s, thread_cpu_seconds() - t0);
+    }
+    return f;
+}
+
+// The converged reference, rendered in row bands on every hardware thread.
+RgbFloatImage reference_frame(Renderer& renderer, ViewRequest view, int spp) {
+    RendererOptions legacy;
+    legacy.legacy_light_sampling = true;
+    renderer.set_path_options(legacy);
+    view.quality.spp = spp;
+    renderer.begin_frame(view);
+    RgbFloatImage frame(renderer.render_size());
+    const int threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+    const int band = 8;
+    std::atomic<int> next{0};
+    const auto work = [&] {
+        for (int y0 = band * next++; y0 < frame.size.height; y0 = band * next++) {
+            (void)renderer.render(PixelRect{0, y0, frame.size.width, std::min(frame.size.height, y0 + band)}, frame);
+        }
+    };
+    std::vector<std::jthread> pool;
+    for (int t = 1; t < threads; ++t) pool.emplace_back(work);
+    work();
+    return frame;
+}
+
+// PSNR of 8-bit images over all samples, 10 log10(255² / MSE) (dB; +inf when identical).
+double psnr(const Rgb8Image& a, const Rgb8Image& b) {
+    double sum = 0.0;
+    for (std::size_t i = 0; i < a.pixels.size(); ++i) {
+        const double d = static_cast<double>(a.pixels[i]) - static_cast<double>(b.pixels[i]);
+        sum += d * d;
+    }
+    const double mse = sum / static_cast<double>(a.pixels.size());
+    return mse > 0.0 ? 10.0 * std::log10(255.0 * 255.0 / mse) : std::numeric_limits<double>::infinity();
+}
+
+Rgb8Image display(const RgbFloatImage& in, const Scene& scene) {
+    Rgb8Image out(in.size);
+    to_srgb8(in, PixelRect::whole(in.size), scene.exposure, out, scene.tone_map);
+    return out;
+}
+
+void print_path(const char* label, const PathFigures& f, const PathFigures& legacy) {
+    std::printf(
+        "%-52s %8.1f ms %10llu rays %6.2f Mrays/s | Embree same mix %6.2f Mrays/s | renderer/Embree %.2f | "
+        "time/legacy %.3f | PSNR %.2f dB\n",
+        label, 1e3 * f.render_s, static_cast<unsigned long long>(f.rays), f.mrays(), f.embree_mrays(),
+        f.mrays() / f.embree_mrays(), f.render_s / legacy.render_s, f.psnr_db);
+}
+
+// (d): see the header comment.
+nlohmann::json scene_section(int argc, char** argv, int reps) {
+    SceneLoadOptions load;
+    load.scans_dir = arg_str(argc, argv, "--scans", "");
+    const Scene scene = load_scene(arg_str(argc, argv, "--scene", ""), load);
+    ViewRequest view;
+    view.size = {arg_int(argc, argv, "--scene-width", 960), arg_int(argc, argv, "--scene-height", 540)};
+    view.camera = CylinderScreen{3.0, 150.0, 0.2, 2.8, {0.0, 1.6, 0.0}};
+    view.pose = make_camera_path("walk", scene.viewer, 60)[30];
+    view.quality.spp = 1;
+    const int ref_spp = arg_int(argc, argv, "--ref-spp", 64);
+    Renderer renderer(scene, RendererOptions{"threads=1"});
+    RendererOptions legacy_options;  // today's path: every switch off
+    legacy_options.legacy_light_sampling = true;
+    legacy_options.packet_secondary_rays = false;
+    legacy_options.camera_column_table = false;
+    legacy_options.native_packet_width = false;
+    RendererOptions sampling_only = legacy_options;
+    sampling_only.legacy_light_sampling = false;
+    RendererOptions packets_only = legacy_options;
+    packets_only.packet_secondary_rays = true;
+    packets_only.native_packet_width = true;
+    RendererOptions everything;
+    everything.legacy_light_sampling = false;
+    PathFigures legacy = time_path(renderer, view, legacy_options, reps);
+    PathFigures sampling = time_path(renderer, view, sampling_only, reps);
+    PathFigures packets = time_path(renderer, view, packets_only, reps);
+    PathFigures current = time_path(renderer, view, RendererOptions{}, reps);
+    PathFigures all = time_path(renderer, view, everything, reps);
+    const Rgb8Image reference = display(reference_frame(renderer, view, ref_spp), scene);
+    for (PathFigures* f : {&legacy, &sampling, &packets, &current, &all}) {
+        f->psnr_db = psnr(display(f->frame, scene), reference);
+    }
+    std::printf("(d) %s, %zu instanced triangles, cylinder %dx%d, 1 spp, one thread, best of %d; reference %d spp\n",
+                arg_str(argc, argv, "--scene", ""), scene.triangle_count(), view.size.width, view.size.height, reps,
+                ref_spp);
+    print_path("(d1) today: ray per light, single rays, emulated x16", legacy, legacy);
+    print_path("(d2) (d1) + light selection + MIS", sampling, legacy);
+    print_path("(d3) (d1) + native-width packets, secondary too", packets, legacy);
+    print_path("(d4) defaults: (d3) + column table", current, legacy);
+    print_path("(d5) (d4) + light selection + MIS", all, legacy);
+    std::printf(
+        "    frame time defaults/today = %.3f, renderer/Embree throughput defaults = %.2f (goal >= 0.60), "
+        "PSNR defaults %.2f dB vs today %.2f dB\n",
+        current.render_s / legacy.render_s, current.mrays() / current.embree_mrays(), current.psnr_db, legacy.psnr_db);
+    const auto figures = [](const PathFigures& f) {
+        return nlohmann::json{{"renderer_ms", 1e3 * f.render_s},
+                              {"rays", f.rays},
+                              {"renderer_mrays_per_s", f.mrays()},
+                              {"embree_same_mix_mrays_per_s", f.embree_mrays()},
+                              {"renderer_vs_embree_throughput", f.mrays() / f.embree_mrays()},
+                              {"psnr_db", f.psnr_db}};
+    };
+    return {{"width", view.size.width},
+            {"height", view.size.height},
+            {"reference_spp", ref_spp},
+            {"d1_legacy", figures(legacy)},
+            {"d2_light_selection", figures(sampling)},
+            {"d3_packets", figures(packets)},
+            {"d4_new", figures(current)},
+            {"frame_time_new_over_legacy", current.render_s / legacy.render_s}};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -174,6 +340,15 @@ int main(int argc, char** argv) {
     const std::string json_file = arg_str(argc, argv, "--json", "");
 
     try {
+        if (std::strlen(arg_str(argc, argv, "--scene", "")) > 0) {
+            const nlohmann::json d = scene_section(argc, argv, reps);
+            if (!json_file.empty()) {
+                std::ofstream file(json_file);
+                file << nlohmann::json{{"bench", "render_vs_embree_scene"}, {"d", d}}.dump(1) << '\n';
+                if (!file.flush()) throw std::runtime_error("cannot write " + json_file);
+            }
+            return 0;
+        }
         const Scene shadowed = base_scene(grid, true);
         std::printf("scene: %zu + %zu triangles, %dx%d, spp %d, best of %d, one thread\n",
                     shadowed.meshes[0].triangle_count(), shadowed.meshes[1].triangle_count(), request.size.width,

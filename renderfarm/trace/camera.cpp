@@ -29,20 +29,54 @@ CameraSetup make_camera_setup(const ViewRequest& request, ImageSize render_size)
     return setup;
 }
 
+namespace {
+
+// The screen angle of image column position px (camera.h).
+double cylinder_theta(const CylinderScreen& screen, double px, double width) {
+    const double arc = screen.arc_deg * kDegToRad;
+    return -0.5 * arc + arc * px / width;
+}
+
+Ray cylinder_ray(const CameraSetup& camera, const CylinderScreen& screen, double sin_theta, double cos_theta,
+                 double py) {
+    const double y = screen.top_m - (screen.top_m - screen.bottom_m) * py / camera.size.height;
+    const Eigen::Vector3d on_screen(screen.radius_m * sin_theta, y, -screen.radius_m * cos_theta);
+    return {camera.eye, (camera.rotation * (on_screen - screen.eye_m)).normalized()};
+}
+
+}  // namespace
+
+CylinderColumns make_cylinder_columns(const CameraSetup& camera) {
+    CylinderColumns columns;
+    const auto* screen = std::get_if<CylinderScreen>(&camera.model);
+    if (screen == nullptr) return columns;
+    const auto width = static_cast<std::size_t>(camera.size.width);
+    columns.sin_theta.resize(width);
+    columns.cos_theta.resize(width);
+    for (std::size_t x = 0; x < width; ++x) {
+        const double theta = cylinder_theta(*screen, static_cast<double>(x) + 0.5, camera.size.width);
+        columns.sin_theta[x] = std::sin(theta);
+        columns.cos_theta[x] = std::cos(theta);
+    }
+    return columns;
+}
+
+Ray generate_column_ray(const CameraSetup& camera, const CylinderColumns& columns, int x, double py) {
+    const auto* screen = std::get_if<CylinderScreen>(&camera.model);
+    const auto column = static_cast<std::size_t>(x);
+    if (screen == nullptr || column >= columns.sin_theta.size()) return generate_ray(camera, x + 0.5, py);
+    return cylinder_ray(camera, *screen, columns.sin_theta[column], columns.cos_theta[column], py);
+}
+
 Ray generate_ray(const CameraSetup& camera, double px, double py) {
     const double w = camera.size.width;
     const double h = camera.size.height;
-    Eigen::Vector3d local;
     if (const auto* screen = std::get_if<CylinderScreen>(&camera.model)) {
-        const double arc = screen->arc_deg * kDegToRad;
-        const double theta = -0.5 * arc + arc * px / w;
-        const double y = screen->top_m - (screen->top_m - screen->bottom_m) * py / h;
-        const Eigen::Vector3d on_screen(screen->radius_m * std::sin(theta), y, -screen->radius_m * std::cos(theta));
-        local = on_screen - screen->eye_m;
-    } else {
-        const double t = camera.tan_half_fov;
-        local = Eigen::Vector3d((2.0 * px / w - 1.0) * t * (w / h), (1.0 - 2.0 * py / h) * t, -1.0);
+        const double theta = cylinder_theta(*screen, px, w);
+        return cylinder_ray(camera, *screen, std::sin(theta), std::cos(theta), py);
     }
+    const double t = camera.tan_half_fov;
+    const Eigen::Vector3d local((2.0 * px / w - 1.0) * t * (w / h), (1.0 - 2.0 * py / h) * t, -1.0);
     return {camera.eye, (camera.rotation * local).normalized()};
 }
 

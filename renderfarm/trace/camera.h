@@ -18,6 +18,8 @@
 // With px = u + 0.5, py = v + 0.5 these are exactly the documented per-pixel formulas.
 #pragma once
 
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "common/pixel_rect.h"
@@ -46,5 +48,16 @@ struct CameraSetup {
 [[nodiscard]] CameraSetup make_camera_setup(const ViewRequest& request, ImageSize render_size);
 
 [[nodiscard]] Ray generate_ray(const CameraSetup& camera, double px, double py);
+
+// Cylinder screen: sin θ and cos θ of every column's centre (px = x + 0.5), computed once per
+// frame so that rays through column centres (spp 1) need no trigonometry. Empty for a pinhole.
+struct CylinderColumns {
+    std::vector<double> sin_theta, cos_theta;  // size render width
+};
+[[nodiscard]] CylinderColumns make_cylinder_columns(const CameraSetup& camera);
+
+// The ray of generate_ray(camera, x + 0.5, py), bit for bit, from the table (x in [0, width)).
+// Falls back to generate_ray for a pinhole or an empty table.
+[[nodiscard]] Ray generate_column_ray(const CameraSetup& camera, const CylinderColumns& columns, int x, double py);
 
 }  // namespace mogao

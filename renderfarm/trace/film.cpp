@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 
 namespace mogao {
@@ -24,13 +26,37 @@ const std::array<double, 255>& code_thresholds() {
     return thresholds;
 }
 
+// Lookup table over the float bit pattern: floats in [0, 1] are the bit patterns 0..0x3F800000,
+// monotonic in value; entry i holds the code of the smallest float of the bucket of 2^kShift
+// consecutive patterns starting at i << kShift. A bucket spans a relative width of 2^-7 (the top
+// 7 mantissa bits stay in the index), narrower than one code step (>= 0.9 % of the value above
+// code 1), so the exact code is the entry plus the thresholds the value still passes: at most one
+// comparison in practice, instead of a binary search over 255 thresholds per channel.
+constexpr int kShift = 16;
+constexpr std::uint32_t kOneBits = 0x3F800000u;
+
+struct SrgbTable {
+    std::array<std::uint8_t, (kOneBits >> kShift) + 1> code{};
+    SrgbTable() {
+        const auto& t = code_thresholds();
+        for (std::size_t i = 0; i < code.size(); ++i) {
+            const double v = std::bit_cast<float>(static_cast<std::uint32_t>(i << kShift));
+            code[i] = static_cast<std::uint8_t>(std::upper_bound(t.begin(), t.end(), v) - t.begin());
+        }
+    }
+};
+
 }  // namespace
 
 std::uint8_t encode_srgb8(float linear) {
+    static const SrgbTable table;
     // NaN fails the comparison and ends at 0; +inf clamps to 1.
-    const double v = linear > 0.0f ? std::min(static_cast<double>(linear), 1.0) : 0.0;
+    const float v = linear > 0.0f ? std::min(linear, 1.0f) : 0.0f;
+    const auto bits = std::bit_cast<std::uint32_t>(v);
+    std::uint8_t code = table.code[bits >> kShift];
     const auto& t = code_thresholds();
-    return static_cast<std::uint8_t>(std::upper_bound(t.begin(), t.end(), v) - t.begin());
+    while (code < 255 && static_cast<double>(v) >= t[code]) ++code;
+    return code;
 }
 
 float tone_map(ToneMap op, float x) {

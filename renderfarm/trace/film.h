@@ -13,9 +13,9 @@
 //   V = 12.92 v                      for v <= 0.0031308
 //   V = 1.055 v^(1/2.4) - 0.055      otherwise,
 // stored as round-to-nearest(255 V) (evaluated exactly via 255 precomputed code thresholds in
-// linear space). Only pixels inside rect are written.
-// Throws std::invalid_argument if in.size != out.size, rect is not inside the image, or exposure
-// is negative or not finite.
+// linear space, reached through a lookup table indexed by the float's top bits, film.cpp). Only pixels inside rect are
+// written. Throws std::invalid_argument if in.size != out.size, rect is not inside the image, or exposure is negative
+// or not finite.
 #pragma once
 
 #include <cstdint>

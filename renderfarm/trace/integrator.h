@@ -25,6 +25,29 @@
 // found by a bounce ray.
 // Random numbers: one PixelSampler pair (sobol.h) per light sample set, environment and bounce,
 // so each is a stratified Owen-scrambled Sobol' net over the pixel's samples.
+//
+// Light selection (FrameContext::legacy_light_sampling = false; RendererOptions keeps the legacy
+// estimator by default, renderer.h says why): the point, directional
+// and area lights above are not each given a shadow ray; instead N = area_light_samples light
+// samples per vertex each pick ONE light with the probabilities of light_selection.h and weight
+// it by 1/p(light) (unbiased; PBRT 4th ed. §12.6 and §13.4). For area lights the point on the
+// light is uniform (pdf 1/A) and, where a bounce follows (depth < max_bounces), combined with the
+// bounce's cosine-sampled direction by multiple importance sampling with the power heuristic
+// (Veach 1997, §9.2.4, β = 2; PBRT 4th ed. §13.4.1): a light sample at direction ω has weight
+//   w_l = (N p_l)² / ((N p_l)² + p_b²),  p_l = p(light) d² / (cosθ_l A),  p_b = cosθ / π,
+// and a bounce ray that reaches the front of an area light before any geometry adds
+// throughput · L · w_b with w_b = p_b² / ((N p_l)² + p_b²) (so area lights are found by bounce
+// rays in this mode; the weights of both strategies sum to 1 for every direction). Emission of
+// a light whose cast_shadows is false is counted by a bounce ray whatever geometry lies in front,
+// as its shadow rays are never traced. legacy_light_sampling = true is the estimator above
+// (one ray per light, area_light_samples per area light, no MIS), kept for comparison.
+//
+// Secondary rays: every vertex turns its light, environment and bounce samples into a list of
+// shadow queries (origin, direction, end, the radiance added if unoccluded) before any is traced.
+// The single-ray path traces them with rtcOccluded1; the packet path (packet_integrator.h) traces
+// the queries of a 4x4 pixel block together with rtcOccluded16, grouped per light, and its bounce
+// rays with rtcIntersect16. Both draw the same random numbers and add the same terms in the same
+// order, so they differ only where Embree's packet and single-ray kernels disagree on a hit.
 #pragma once
 
 #include <cstdint>
@@ -34,6 +57,7 @@
 
 #include "common/view_request.h"
 #include "renderfarm/trace/light_set.h"
+#include "renderfarm/trace/recorded_rays.h"
 #include "renderfarm/trace/render_scene.h"
 #include "renderfarm/trace/shading.h"
 #include "renderfarm/trace/sobol.h"
@@ -47,11 +71,54 @@ struct FrameContext {
     int max_bounces = 0;
     int ao_samples = 0;
     int area_light_samples = 1;
+    bool legacy_light_sampling = false;  // one shadow ray per light (see above)
+    int packet_width = 16;               // Embree packet width of the packet path (embree_packets.h)
 };
 
+// One shadow ray and what it adds (already multiplied by the path throughput) when unoccluded.
+struct ShadowQuery {
+    Eigen::Vector3f origin;
+    Eigen::Vector3f direction;  // unit
+    float tfar = 0.0f;
+    Eigen::Vector3f contribution;
+    int group = 0;  // which light (index of light_selection.h) or environment (-1): packets group by it
+};
+
+// A path vertex ready for shading.
+struct ShadingVertex {
+    const SurfaceHit* hit = nullptr;
+    ShadingMaterial material;  // with the hit's tint applied
+    Eigen::Vector3f wo;
+    Eigen::Vector3f origin;  // offset along the geometric normal (ray_offset.h)
+};
+
+[[nodiscard]] ShadingVertex make_vertex(const FrameContext& frame, const SurfaceHit& hit, const Eigen::Vector3f& wo);
+
+// Appends the shadow queries of next-event estimation at `x` (lights, then environment), each
+// contribution scaled by `throughput`; unshadowed light terms go straight into `unshadowed`.
+void direct_light_queries(const FrameContext& frame, const ShadingVertex& x, const Eigen::Vector3f& throughput,
+                          bool bounce_follows, PixelSampler& sampler, std::vector<ShadowQuery>& queries,
+                          Eigen::Vector3f& unshadowed);
+
+// The bounce of a vertex: direction and new throughput, or false when the path ends.
+struct Bounce {
+    Eigen::Vector3f direction;
+    Eigen::Vector3f throughput;
+};
+[[nodiscard]] bool sample_bounce(const ShadingVertex& x, const Eigen::Vector3f& throughput, PixelSampler& sampler,
+                                 Bounce& out);
+
+// MIS-weighted area-light emission seen by a bounce ray from `x` along `dir` whose nearest
+// geometry hit is at `t_hit` (infinity if it escapes); 0 in legacy mode. `throughput` is the
+// path throughput after the bounce.
+[[nodiscard]] Eigen::Vector3f bounce_emission(const FrameContext& frame, const ShadingVertex& x,
+                                              const Eigen::Vector3f& dir, float t_hit,
+                                              const Eigen::Vector3f& throughput);
+
 // Radiance leaving `hit` toward the ray origin (wo = -ray direction, unit). `rays` is incremented
-// for every shadow, occlusion and bounce ray traced.
+// for every shadow, occlusion and bounce ray traced. Single rays (rtcOccluded1/rtcIntersect1);
+// `log` (benchmarks only, may be null) receives every ray traced.
 [[nodiscard]] Eigen::Vector3f radiance_at(const FrameContext& frame, const SurfaceHit& hit, const Eigen::Vector3f& wo,
-                                          PixelSampler& sampler, std::uint64_t& rays);
+                                          PixelSampler& sampler, std::uint64_t& rays, RecordedRays* log = nullptr);
 
 }  // namespace mogao

@@ -12,8 +12,10 @@
 
 #include "common/request_limits.h"
 #include "renderfarm/trace/camera.h"
+#include "renderfarm/trace/embree_packets.h"
 #include "renderfarm/trace/integrator.h"
 #include "renderfarm/trace/light_set.h"
+#include "renderfarm/trace/packet_integrator.h"
 #include "renderfarm/trace/render_scene.h"
 #include "renderfarm/trace/rng.h"
 #include "renderfarm/trace/sampling.h"
@@ -55,7 +57,10 @@ std::string describe(const PixelRect& r) {
 
 struct Renderer::Impl {
     Impl(const Scene& scene, const RendererOptions& opts)
-        : options(opts), geometry(scene, opts.embree_config), lights(LightSet::from_scene(scene)) {
+        : options(opts),
+          geometry(scene, opts.embree_config),
+          lights(LightSet::from_scene(scene)),
+          native_width(native_packet_width(geometry.root())) {
         materials.reserve(scene.materials.size());
         for (const Material& m : scene.materials) materials.push_back(make_shading_material(m));
     }
@@ -64,14 +69,18 @@ struct Renderer::Impl {
     RenderScene geometry;
     LightSet lights;
     std::vector<ShadingMaterial> materials;
+    int native_width = 16;
 
     // Current frame (set by begin_frame).
     bool ready = false;
     ImageSize size;
     std::optional<CameraSetup> camera;
+    CylinderColumns columns;  // filled when options.camera_column_table and spp == 1
     std::uint64_t key = 0;
     int spp = 1;
     FrameContext context;
+
+    [[nodiscard]] int packet_width() const { return options.native_packet_width ? native_width : 16; }
 
     void check_ready() const {
         if (!ready) throw std::logic_error("Renderer: begin_frame() must be called before rendering");
@@ -92,7 +101,10 @@ struct Renderer::Impl {
             // spp == 1 keeps the pixel centre; otherwise the pixel's samples are one Sobol' net.
             Eigen::Vector2f jitter(0.5f, 0.5f);
             if (spp > 1) jitter = rngs[l].next2d();
-            const Ray ray = generate_ray(*camera, x + static_cast<double>(jitter.x()), y + static_cast<double>(jitter.y()));
+            const Ray ray =
+                spp == 1 && !columns.sin_theta.empty()
+                    ? generate_column_ray(*camera, columns, x, y + 0.5)
+                    : generate_ray(*camera, x + static_cast<double>(jitter.x()), y + static_cast<double>(jitter.y()));
             const Eigen::Vector3f org = (ray.origin - origin).cast<float>();
             const Eigen::Vector3f dir = ray.direction.cast<float>();
             packet.ray.org_x[l] = org.x();
@@ -114,7 +126,7 @@ struct Renderer::Impl {
         RTCIntersectContext context_flags;
         rtcInitIntersectContext(&context_flags);
         context_flags.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-        rtcIntersect16(block.valid.data(), geometry.root(), &context_flags, &packet);
+        intersect16_at(packet_width(), block.valid.data(), geometry.root(), &context_flags, packet);
     }
 
     void check_target(const PixelRect& rect, const RgbFloatImage* frame) const {
@@ -127,6 +139,61 @@ struct Renderer::Impl {
             throw std::invalid_argument("Renderer::render: frame is " + std::to_string(frame->size.width) + "x" +
                                         std::to_string(frame->size.height) + ", render size is " +
                                         std::to_string(size.width) + "x" + std::to_string(size.height));
+        }
+    }
+
+    // Primary hits of a traced camera packet; sky lanes get the environment in `sum`.
+    void resolve_hits(const Block& block, const RTCRayHit16& packet, PacketHits& hits,
+                      std::array<Eigen::Vector3f, kLanes>& sum) const {
+        for (std::size_t l = 0; l < kLanes; ++l) {
+            hits.alive[l] = false;
+            if (block.valid[l] == 0) continue;
+            if (packet.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID) {
+                sum[l] += lights.environment;  // the sky behind everything
+                continue;
+            }
+            const Eigen::Vector3f org(packet.ray.org_x[l], packet.ray.org_y[l], packet.ray.org_z[l]);
+            const Eigen::Vector3f dir(packet.ray.dir_x[l], packet.ray.dir_y[l], packet.ray.dir_z[l]);
+            hits.hit[l] = geometry.surface(org, dir, packet.ray.tfar[l], packet.hit.instID[0][l], packet.hit.primID[l],
+                                           packet.hit.u[l], packet.hit.v[l],
+                                           Eigen::Vector3f(packet.hit.Ng_x[l], packet.hit.Ng_y[l], packet.hit.Ng_z[l]));
+            hits.wo[l] = -dir;
+            hits.alive[l] = true;
+        }
+    }
+
+    // Renders every sample of one block into `frame` (render()'s body; `log` for benchmarks).
+    void render_block(const Block& block, RgbFloatImage& frame, TileStats& stats, RecordedRays* log) const {
+        std::array<Eigen::Vector3f, kLanes> sum;
+        sum.fill(Eigen::Vector3f::Zero());
+        PacketHits hits;
+        for (int sample = 0; sample < spp; ++sample) {
+            RTCRayHit16 packet{};  // masked lanes stay zero (defined for tools like valgrind)
+            std::array<PixelSampler, kLanes> rngs;
+            fill_packet(block, sample, packet, rngs);
+            intersect(block, packet);
+            stats.rays += static_cast<std::uint64_t>(block.active);
+            resolve_hits(block, packet, hits, sum);
+            if (options.packet_secondary_rays) {
+                std::array<Eigen::Vector3f, kLanes> radiance;
+                radiance.fill(Eigen::Vector3f::Zero());
+                radiance_packet(context, hits, rngs, radiance, stats.rays, log);
+                for (std::size_t l = 0; l < kLanes; ++l)
+                    if (hits.alive[l]) sum[l] += radiance[l];
+                continue;
+            }
+            for (std::size_t l = 0; l < kLanes; ++l) {
+                if (hits.alive[l]) sum[l] += radiance_at(context, hits.hit[l], hits.wo[l], rngs[l], stats.rays, log);
+            }
+        }
+        const float inv_spp = 1.0f / static_cast<float>(spp);
+        for (int lane = 0; lane < kLanes; ++lane) {
+            if (block.valid[static_cast<std::size_t>(lane)] == 0) continue;
+            float* out = frame.at(block.x0 + lane % kBlock, block.y0 + lane / kBlock);
+            const Eigen::Vector3f value = sum[static_cast<std::size_t>(lane)] * inv_spp;
+            out[0] = value.x();
+            out[1] = value.y();
+            out[2] = value.z();
         }
     }
 
@@ -147,6 +214,13 @@ Renderer::~Renderer() = default;
 Renderer::Renderer(Renderer&&) noexcept = default;
 Renderer& Renderer::operator=(Renderer&&) noexcept = default;
 
+void Renderer::set_path_options(const RendererOptions& options) {
+    impl_->options.legacy_light_sampling = options.legacy_light_sampling;
+    impl_->options.packet_secondary_rays = options.packet_secondary_rays;
+    impl_->options.camera_column_table = options.camera_column_table;
+    impl_->options.native_packet_width = options.native_packet_width;
+}
+
 void Renderer::begin_frame(const ViewRequest& request) {
     Impl& s = *impl_;
     const ImageSize size = render_size_for(request);  // validates before any state changes
@@ -157,8 +231,15 @@ void Renderer::begin_frame(const ViewRequest& request) {
     s.camera = make_camera_setup(request, size);
     s.key = frame_key(request.seed, request.frame_id);
     s.spp = request.quality.spp;
-    s.context = FrameContext{&s.geometry, &s.lights, &s.materials, request.quality.max_bounces,
-                             request.quality.ao_samples, request.quality.area_light_samples};
+    s.context = FrameContext{&s.geometry,
+                             &s.lights,
+                             &s.materials,
+                             request.quality.max_bounces,
+                             request.quality.ao_samples,
+                             request.quality.area_light_samples,
+                             s.options.legacy_light_sampling,
+                             s.packet_width()};
+    s.columns = s.options.camera_column_table && s.spp == 1 ? make_cylinder_columns(*s.camera) : CylinderColumns{};
     s.ready = true;
 }
 
@@ -171,40 +252,69 @@ TileStats Renderer::render(const PixelRect& rect, RgbFloatImage& frame) const {
     const Impl& s = *impl_;
     s.check_target(rect, &frame);
     TileStats stats;
-    if (rect.empty()) return stats;
-    const float inv_spp = 1.0f / static_cast<float>(s.spp);
-    Impl::for_each_block(rect, [&](const Block& block) {
-        std::array<Eigen::Vector3f, kLanes> sum;
-        sum.fill(Eigen::Vector3f::Zero());
-        for (int sample = 0; sample < s.spp; ++sample) {
-            RTCRayHit16 packet{};  // masked lanes stay zero (defined for tools like valgrind)
-            std::array<PixelSampler, kLanes> rngs;
-            s.fill_packet(block, sample, packet, rngs);
-            s.intersect(block, packet);
-            stats.rays += static_cast<std::uint64_t>(block.active);
+    Impl::for_each_block(rect, [&](const Block& block) { s.render_block(block, frame, stats, nullptr); });
+    return stats;
+}
+
+TileStats Renderer::render_recording(const PixelRect& rect, RgbFloatImage& frame, RecordedRays& log) const {
+    const Impl& s = *impl_;
+    s.check_target(rect, &frame);
+    TileStats stats;
+    Impl::for_each_block(rect, [&](const Block& block) { s.render_block(block, frame, stats, &log); });
+    return stats;
+}
+
+TileStats Renderer::trace_recorded(const RecordedRays& log) const {
+    const Impl& s = *impl_;
+    s.check_ready();
+    TileStats stats;
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    for (const RecordedPacket& p : log.packets) {
+        context.flags = p.coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+        if (p.packet) {
+            RTCRayHit16 packet{};
             for (std::size_t l = 0; l < kLanes; ++l) {
-                if (block.valid[l] == 0) continue;
-                if (packet.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID) {
-                    sum[l] += s.lights.environment;  // the sky behind everything
-                    continue;
-                }
-                const Eigen::Vector3f org(packet.ray.org_x[l], packet.ray.org_y[l], packet.ray.org_z[l]);
-                const Eigen::Vector3f dir(packet.ray.dir_x[l], packet.ray.dir_y[l], packet.ray.dir_z[l]);
-                const SurfaceHit hit = s.geometry.surface(
-                    org, dir, packet.ray.tfar[l], packet.hit.instID[0][l], packet.hit.primID[l], packet.hit.u[l],
-                    packet.hit.v[l], Eigen::Vector3f(packet.hit.Ng_x[l], packet.hit.Ng_y[l], packet.hit.Ng_z[l]));
-                sum[l] += radiance_at(s.context, hit, -dir, rngs[l], stats.rays);
+                packet.ray.org_x[l] = p.org_x[l];
+                packet.ray.org_y[l] = p.org_y[l];
+                packet.ray.org_z[l] = p.org_z[l];
+                packet.ray.dir_x[l] = p.dir_x[l];
+                packet.ray.dir_y[l] = p.dir_y[l];
+                packet.ray.dir_z[l] = p.dir_z[l];
+                packet.ray.tfar[l] = p.tfar[l];
+                packet.ray.mask[l] = 0xFFFFFFFFu;
+                packet.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
+                packet.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
+                stats.rays += p.valid[l] != 0 ? 1u : 0u;
             }
+            if (p.occlusion) {
+                occluded16_at(s.packet_width(), p.valid.data(), s.geometry.root(), &context, packet.ray);
+            } else {
+                intersect16_at(s.packet_width(), p.valid.data(), s.geometry.root(), &context, packet);
+            }
+            continue;
         }
-        for (int lane = 0; lane < kLanes; ++lane) {
-            if (block.valid[static_cast<std::size_t>(lane)] == 0) continue;
-            float* out = frame.at(block.x0 + lane % kBlock, block.y0 + lane / kBlock);
-            const Eigen::Vector3f value = sum[static_cast<std::size_t>(lane)] * inv_spp;
-            out[0] = value.x();
-            out[1] = value.y();
-            out[2] = value.z();
+        for (std::size_t l = 0; l < kLanes; ++l) {
+            if (p.valid[l] == 0) continue;
+            RTCRayHit one{};
+            one.ray.org_x = p.org_x[l];
+            one.ray.org_y = p.org_y[l];
+            one.ray.org_z = p.org_z[l];
+            one.ray.dir_x = p.dir_x[l];
+            one.ray.dir_y = p.dir_y[l];
+            one.ray.dir_z = p.dir_z[l];
+            one.ray.tfar = p.tfar[l];
+            one.ray.mask = 0xFFFFFFFFu;
+            one.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+            one.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+            if (p.occlusion) {
+                rtcOccluded1(s.geometry.root(), &context, &one.ray);
+            } else {
+                rtcIntersect1(s.geometry.root(), &context, &one);
+            }
+            ++stats.rays;
         }
-    });
+    }
     return stats;
 }
 

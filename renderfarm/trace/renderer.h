@@ -23,10 +23,11 @@
 #include <memory>
 #include <string>
 
-#include "renderfarm/scene/scene.h"
 #include "common/image.h"
 #include "common/pixel_rect.h"
 #include "common/view_request.h"
+#include "renderfarm/scene/scene.h"
+#include "renderfarm/trace/recorded_rays.h"
 
 namespace mogao {
 
@@ -37,6 +38,25 @@ struct RendererOptions {
     // Rebase the world on the eye every frame (render_scene.h). Only benchmarks and the precision
     // test turn this off, to measure what it buys.
     bool rebase_on_eye = true;
+    // Issue 11's speed-ups, each of which can be turned off so a benchmark times today's path and
+    // the new one in one run (docs/renderer.md, "Performance"). None changes what the renderer
+    // converges to; legacy_light_sampling = false changes the noise (a different unbiased
+    // estimator), the others give the same image up to Embree's packet and single-ray kernels
+    // disagreeing on a hit.
+    // One shadow ray per light per sample instead of one light chosen per sample (integrator.h).
+    // On by default: light selection is unbiased but, with an occlusion-blind estimate, noisier
+    // per sample where a strong light is mostly shadowed (the grotto's sun); the benchmark prints
+    // its PSNR and time against this path (docs/renderer.md).
+    bool legacy_light_sampling = true;
+    // Shadow, environment and bounce rays of a 4x4 block traced as 16-wide packets
+    // (packet_integrator.h) instead of one rtcOccluded1 / rtcIntersect1 at a time.
+    bool packet_secondary_rays = true;
+    // Cylinder camera at 1 spp: the per-column sin/cos of the screen angle computed once per frame
+    // (camera.h, CylinderColumns) instead of per ray; bit-identical rays.
+    bool camera_column_table = true;
+    // Camera and secondary packets traced at the CPU's native width (embree_packets.h: two
+    // rtcIntersect8 / rtcOccluded8 halves on AVX2, where Embree would run a 16-wide call ray by ray).
+    bool native_packet_width = true;
 };
 
 struct TileStats {
@@ -54,6 +74,11 @@ public:
     Renderer(Renderer&&) noexcept;
     Renderer& operator=(Renderer&&) noexcept;
 
+    // Replaces the speed switches (legacy_light_sampling, packet_secondary_rays,
+    // camera_column_table) from the next begin_frame on, so a benchmark times both paths on one
+    // BVH; embree_config and rebase_on_eye keep their constructor values. Not thread-safe.
+    void set_path_options(const RendererOptions& options);
+
     // Validates the request (std::invalid_argument naming the field and limit, see
     // view_validation.h), rebases the world on the eye and prepares cameras and lights. Not
     // thread-safe: no render() may run concurrently. On throw, the previous frame stays current.
@@ -69,6 +94,11 @@ public:
     // Benchmark baseline: generates and intersects exactly the camera ray packets render() would
     // (same grid, masks and samples) with rtcIntersect16, without any shading or secondary rays.
     TileStats trace_camera_rays(const PixelRect& rect) const;
+
+    // Benchmark support: render() that also keeps every secondary ray it traced, and raw Embree
+    // tracing such a log (same packets or single rays, same context flags) without any shading.
+    TileStats render_recording(const PixelRect& rect, RgbFloatImage& frame, RecordedRays& log) const;
+    TileStats trace_recorded(const RecordedRays& log) const;
 
 private:
     struct Impl;
