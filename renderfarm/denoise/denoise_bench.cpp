@@ -2,7 +2,8 @@
 // Error at equal time, with and without the denoiser, on the real grotto (docs/renderer.md, "Denoiser").
 //
 //   mogao_bench_denoise [--scene scenes/grotto.json] [--scans DIR] [--width 480] [--height 270]
-//                       [--reps 2] [--ref-spp 128] [--threads 1]
+//                       [--reps 2] [--ref-spp 128] [--threads 1] [--iterations 5] [--sigma-colour 4]
+//                       [--sigma-normal 0.5] [--sigma-depth 1]   (AtrousParams, atrous_filter.h)
 //
 // One view (the grotto walk's frame 30 on the bench cylinder screen, default quality knobs but spp).
 // Raw frames at 1, 2, 4, ... 32 spp and denoised frames at 1, 2, 4 spp (render + guide pass + filter)
@@ -84,7 +85,8 @@ double interpolate_log(const std::vector<Point>& raw, double x, bool by_time) {
 struct Options {
     std::filesystem::path scene_file = std::filesystem::path(MOGAO_SOURCE_DIR) / "scenes" / "grotto.json";
     SceneLoadOptions load;
-    int width = 480, height = 270, reps = 2, ref_spp = 128, threads = 1;
+    int width = 480, height = 270, reps = 2, ref_spp = 128;
+    AtrousParams params;  // --threads, --iterations, --sigma-colour, --sigma-normal, --sigma-depth
 };
 
 bool scene_uses_scans(const std::filesystem::path& scene_file) {
@@ -126,7 +128,7 @@ int run(const Options& o) {
     GuidePass pass(scene, "threads=1");
     std::printf(
         "# denoiser at equal time: %s, %dx%d cylinder frame, render on one thread, filter on %d, best of %d\n\n",
-        o.scene_file.filename().c_str(), o.width, o.height, o.threads, o.reps);
+        o.scene_file.filename().c_str(), o.width, o.height, o.params.threads, o.reps);
     ViewRequest reference_view = view;
     reference_view.seed = view.seed + 1;  // independent samples: no raw frame is a prefix of the reference
     const Timed reference = render(renderer, reference_view, o.ref_spp, 1);
@@ -142,8 +144,7 @@ int run(const Options& o) {
         raw.push_back({spp, raw_frames.back().seconds, db(raw_frames.back().image)});
         std::printf("| raw | %d | %.1f | %.2f |\n", spp, 1e3 * raw.back().seconds, raw.back().db);
     }
-    AtrousParams params;
-    params.threads = o.threads;
+    const AtrousParams& params = o.params;
     std::vector<Point> denoised;
     double filter_s = 0.0;
     for (std::size_t k = 0; k < 3 && k < raw.size(); ++k) {
@@ -180,7 +181,11 @@ int main(int argc, char** argv) {
         else if (flag == "--height") o.height = std::stoi(value);
         else if (flag == "--reps") o.reps = std::stoi(value);
         else if (flag == "--ref-spp") o.ref_spp = std::stoi(value);
-        else if (flag == "--threads") o.threads = std::stoi(value);
+        else if (flag == "--threads") o.params.threads = std::stoi(value);
+        else if (flag == "--iterations") o.params.iterations = std::stoi(value);
+        else if (flag == "--sigma-colour") o.params.sigma_colour = std::stof(value);
+        else if (flag == "--sigma-normal") o.params.sigma_normal = std::stof(value);
+        else if (flag == "--sigma-depth") o.params.sigma_depth = std::stof(value);
         else {
             std::fprintf(stderr, "unknown flag %s\n", flag.c_str());
             return 2;
