@@ -46,8 +46,10 @@ std::string fmt(const char* f, double a, double b = 0.0, double c = 0.0) {
 
 ScreenCalibration interpolate_calibration(const ScreenCalibration& a, const ScreenCalibration& b, double s) {
     if (a.projectors.size() != b.projectors.size()) throw std::invalid_argument("interpolate_calibration: layouts");
+    if (!(s > 0.0)) return a;  // the ends exactly (x + 1 * (y - x) need not round to y)
+    if (s >= 1.0) return b;
     ScreenCalibration out = b;
-    const float t = static_cast<float>(std::clamp(s, 0.0, 1.0));
+    const auto t = static_cast<float>(s);
     for (std::size_t k = 0; k < a.projectors.size(); ++k) {
         const ProjectorCalibration& pa = a.projectors[k];
         ProjectorCalibration& po = out.projectors[k];

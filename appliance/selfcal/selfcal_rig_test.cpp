@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "appliance/autocal/rig_bridge.h"
 #include "appliance/rig/rig_file.h"
 
 namespace mogao::selfcal {
@@ -115,6 +116,47 @@ TEST(SelfcalRig, ParseBumpNamesTheBadPart) {
     EXPECT_THROW((void)parse_bump(rig, "proj9:yaw=1deg"), std::invalid_argument);
     EXPECT_THROW((void)parse_bump(rig, "proj1:yaw=abc"), std::invalid_argument);
     EXPECT_THROW((void)parse_bump(rig, "proj1:spin=1deg"), std::invalid_argument);
+}
+
+TEST(SelfcalRig, StepRefusesTimeGoingBackAndWrongFrames) {
+    const rig::VirtualRig rig = autocal::scaled_rig(standard(), 0.25, 0.25);
+    const SystemModel model = models_of_rig(rig);
+    autocal::AutocalOptions build;
+    build.warp_step_px = 8;
+    const ScreenCalibration wall = autocal::calibration_from_models(model.projectors, model.screen, {960, 540}, build);
+    SelfCalibrator sc(model, wall);
+    const cv::Mat1f content = make_content(ContentKind::plain, 0.0, false, 1);
+    const cv::Mat1f camera(rig.camera.resolution.height, rig.camera.resolution.width, 0.2f);
+    const StepResult r = sc.step(content, camera, 1.0);
+    EXPECT_TRUE(r.status.waiting);  // a uniform frame has no features
+    EXPECT_FALSE(r.calibration.has_value());
+    const std::string text = r.status.text();
+    EXPECT_NE(text.find("state=calibrated"), std::string::npos) << text;
+    EXPECT_NE(text.find("insufficient evidence"), std::string::npos) << text;
+    EXPECT_NE(text.find("proj2"), std::string::npos) << text;
+    EXPECT_THROW((void)sc.step(content, camera, 0.5), std::invalid_argument);
+    EXPECT_THROW((void)sc.step(content, cv::Mat1f(10, 10, 0.0f), 2.0), std::invalid_argument);
+    SelfcalOptions bad;
+    bad.drift_threshold_px = 0.0;
+    EXPECT_THROW(SelfCalibrator(model, wall, bad), std::invalid_argument);
+}
+
+TEST(SelfcalRig, InterpolatedCalibrationGoesFromBeforeToAfter) {
+    const rig::VirtualRig rig = autocal::scaled_rig(standard(), 0.25, 0.25);
+    SystemModel model = models_of_rig(rig);
+    autocal::AutocalOptions build;
+    build.warp_step_px = 8;
+    const ScreenCalibration a = autocal::calibration_from_models(model.projectors, model.screen, {960, 540}, build);
+    Pose6 d = Pose6::Zero();
+    d(1) = 0.01;
+    model.projectors[1] = apply_delta(model.projectors[1], d);
+    const ScreenCalibration b = autocal::calibration_from_models(model.projectors, model.screen, {960, 540}, build);
+    const ScreenCalibration h = interpolate_calibration(a, b, 0.5);
+    const std::size_t i = 2 * (static_cast<std::size_t>(a.projectors[1].warp.size.width) * 10 + 20);
+    EXPECT_NEAR(h.projectors[1].warp.uv[i], 0.5f * (a.projectors[1].warp.uv[i] + b.projectors[1].warp.uv[i]), 1e-6f);
+    EXPECT_EQ(interpolate_calibration(a, b, 0.0).projectors[1].warp.uv, a.projectors[1].warp.uv);
+    EXPECT_EQ(interpolate_calibration(a, b, 1.0).projectors[1].warp.uv, b.projectors[1].warp.uv);
+    EXPECT_NE(a.projectors[1].warp.uv[i], b.projectors[1].warp.uv[i]);
 }
 
 }  // namespace
