@@ -4,12 +4,13 @@
 // and with all of them off (the serial loop of before), all in ONE run so only ratios are read.
 //
 //   mpirun -n 3 mogao_bench_serve --scene scenes/grotto.json [--width 960] [--height 540]
-//          [--move-seconds 4] [--still-seconds 5] [--frame-time-ms 66.7] [--reference-spp 64]
+//          [--warmup-seconds 3] [--move-seconds 4] [--still-seconds 5] [--frame-time-ms 66.7] [--reference-spp 64]
 //          [--json FILE]
 //
 // A session looks at the screen (the kiosk's cylinder: radius 3 m, 150 degrees, 0.2-2.8 m) from the
-// scene's viewer. Moving: the yaw turns a little every request, so nothing accumulates; frames/s =
-// frames served (rendered, composited, encoded to JPEG) / wall time. Still: the last moving pose is
+// scene's viewer. Moving: the yaw turns a little every request, so nothing accumulates; after a
+// warm-up (the frame-time target settles, the PBT learns), frames/s = frames served (rendered,
+// composited, encoded to JPEG) / wall time. Still: the last moving pose is
 // requested again and again; after every frame the served image (upsampled to full size when the
 // frame-time target had shrunk it) is compared with the reference (the same view at
 // --reference-spp, one render) by PSNR of the sRGB8 frames; comparison time is not counted.
@@ -50,7 +51,7 @@ struct Config {
 
 struct BenchArgs {
     int width = 960, height = 540;
-    double move_seconds = 4.0, still_seconds = 5.0, frame_time_ms = 1000.0 / 15.0;
+    double warmup_seconds = 3.0, move_seconds = 4.0, still_seconds = 5.0, frame_time_ms = 1000.0 / 15.0;
     int reference_spp = 64;
     std::string json;
 };
@@ -146,9 +147,19 @@ nlohmann::json run_config(const Config& c, FrameDispatcher& farm, const Scene& s
     ViewRequest request = session_view(scene, a);
     const double base_yaw = request.pose.yaw_deg;
     int moved = 0;
-    const auto start = Clock::now();
     const auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
     LiveFrame last;
+    // Warm-up (not counted): the frame-time target settles, the PBT learns the view.
+    for (const auto warm = Clock::now(); since(warm) < a.warmup_seconds;) {
+        request.frame_id = next_id++;
+        request.pose.yaw_deg = base_yaw + 0.5 * (moved % 2 == 0 ? 1 : -1) * (1 + moved % 7);
+        last = live.render(request);
+        encoder.submit(last.image);
+        ++moved;
+    }
+    encoder.finish();
+    moved = 0;
+    const auto start = Clock::now();
     while (since(start) < a.move_seconds) {
         request.frame_id = next_id++;
         request.pose.yaw_deg = base_yaw + 0.5 * (moved % 2 == 0 ? 1 : -1) * (1 + moved % 7);
@@ -238,6 +249,8 @@ int main(int argc, char** argv) {
     app.add_option("--scans", scans, "Folder of the real scans");
     app.add_option("--width", a.width)->check(CLI::Range(16, 16384));
     app.add_option("--height", a.height)->check(CLI::Range(16, 16384));
+    app.add_option("--warmup-seconds", a.warmup_seconds, "Moving frames before the count starts")
+        ->check(CLI::Range(0.0, 600.0));
     app.add_option("--move-seconds", a.move_seconds)->check(CLI::Range(0.1, 600.0));
     app.add_option("--still-seconds", a.still_seconds)->check(CLI::Range(0.1, 600.0));
     app.add_option("--frame-time-ms", a.frame_time_ms)->check(CLI::Range(1.0, 10000.0));
