@@ -16,24 +16,25 @@
 //       Without temporal history the per-pixel luminance variance is estimated spatially (§4.2:
 //       the 7x7 bilateral estimate for short histories; here 5x5, weighted by normal and depth).
 // Each tap weighs h(dx) h(dy) w_l w_n w_z; the weights are not separable, so every iteration is a
-// 25-tap sparse kernel. Cost: 25 · iterations taps per surface pixel (one fast exp per tap).
+// 25-tap sparse kernel (the three factors share one exp).
 //
 // Conventions:
 //   noisy   linear RGB radiance (RgbFloatImage, common/image.h: row-major, top row first, pixel
 //           (x, y) centred at (x + 0.5, y + 0.5)), any non-negative scale. NaN/inf samples are
 //           treated as 0 (a firefly must not poison its neighbours).
 //   guides  GuideBuffers of the same size (guide_buffers.h). Sky pixels (hit 0) are copied through
-//           unchanged and never used as a neighbour of a surface pixel, nor vice versa.
+//           unchanged (NaN/inf as 0) and never mix with surface pixels in either direction.
 //   l       luminance of the demodulated colour, Rec. 709 weights (0.2126, 0.7152, 0.0722).
-//   Demodulation divides each channel by max(albedo, kMinAlbedo) and re-modulation multiplies by
+//   Demodulation divides each channel by max(albedo, 1e-3) and re-modulation multiplies by
 //   the same value, so a pixel that no neighbour may touch is returned unchanged (to float rounding).
 // Parameters (AtrousParams): every σ is a tolerance; 0 = only exactly equal values may mix (with
 // σ_colour = 0 the output equals the input); larger = more smoothing. iterations = 0 returns the input.
 //
 // Errors (Result / Status, common/result.h, code EINVAL): an empty image, a pixel buffer whose
 // length is not W·H·3, guides of another size or with buffers of the wrong length, iterations
-// outside [0, kMaxIterations], a σ that is negative or not finite, threads < 0. The message names
-// the field and the limit.
+// outside [0, kMaxIterations], a σ that is negative or not finite, threads < 0, a hit pixel whose
+// depth is not finite and > 0. The message names the field and the limit; `out` is not touched.
+// Cost: (25 + 25 · iterations) taps per surface pixel, each one exp; threads split rows.
 #pragma once
 
 #include <vector>
