@@ -11,14 +11,16 @@ Result<std::unique_ptr<FrameInbox>> FrameInbox::create() {
     return std::unique_ptr<FrameInbox>(new FrameInbox(std::move(*wake)));
 }
 
-void FrameInbox::put(LinkFrame&& frame) {
-    slot_.put(std::move(frame));
-    if (Status s = wake_.signal(); !s) spdlog::error("frame wake-up: {}", s.error().message);
-}
+FrameInbox::FrameInbox(EventFd wake)
+    : wake_(std::move(wake)), worker_([this] {
+          if (Status s = wake_.signal(); !s) spdlog::error("frame wake-up: {}", s.error().message);
+      }) {}
 
-std::optional<LinkFrame> FrameInbox::take() {
+void FrameInbox::put(LinkFrame&& frame) { worker_.put(std::move(frame)); }
+
+DecodeWorker::Taken FrameInbox::take() {
     if (auto n = wake_.drain(); !n) spdlog::error("frame wake-up: {}", n.error().message);
-    return slot_.take();
+    return worker_.take();
 }
 
 }  // namespace mogao

@@ -25,8 +25,8 @@ TimerFd armed_tick(double rate_hz) {
 
 const char* signal_name(int sig) { return sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "signal"; }
 
-std::string showing(const LastGoodFrame& last_good) {
-    const std::uint64_t last = last_good.current() ? last_good.current()->request_id : 0;
+std::string showing(const ContentFrame* current) {
+    const std::uint64_t last = current ? current->request_id : 0;
     return last == 0 ? std::string("the connecting screen") : fmt::format("request {}", last);
 }
 
@@ -44,6 +44,11 @@ Kiosk::Kiosk(const KioskConfig& config, KioskParts parts, KioskRunOptions option
       tick_(armed_tick(config.outputs.rate_hz)),
       start_(std::chrono::steady_clock::now()),
       last_log_(start_) {
+    if (config.guard_deg > 0) {
+        auto guarded = guard_band(config.screen, config.quality.content, config.guard_deg);
+        if (!guarded) throw KioskSetupError(1, "[screen].guard_deg: " + guarded.error().message);
+        if (guarded->guard_px > 0) guard_.emplace(std::move(guarded).value());
+    }
     loop_.watch(parts_.signals.fd(), [this] { on_signal(); });
     loop_.watch(parts_.inbox.fd(), [this] { on_frame(); });
     loop_.watch(tick_.fd(), [this] { on_tick(); });
@@ -76,10 +81,12 @@ void Kiosk::on_signal() {
 }
 
 void Kiosk::on_frame() {
-    std::optional<LinkFrame> frame = parts_.inbox.take();
+    DecodeWorker::Taken taken = parts_.inbox.take();  // decoded on the inbox's worker thread
     parts_.display.stats().superseded(parts_.inbox.replaced());
-    if (!frame || !accept(*frame)) return;
-    const ContentFrame& f = *last_good_.current();
+    note_rejections(taken.rejections);
+    if (!taken.frame) return;  // nothing new: the last good frame stays
+    current_ = std::move(taken.frame);
+    const ContentFrame& f = *current_;
     if (options_.dump) {
         try {
             options_.dump->dump(f);
@@ -87,22 +94,23 @@ void Kiosk::on_frame() {
             spdlog::warn("--dump-content: {}", e.what());
         }
     }
+    (void)update_late_warp();  // this frame's shift for the yaw turned since its request
     parts_.display.show(f);
     shown_since_tick_ = true;
     check_frames_shown();
 }
 
-bool Kiosk::accept(const LinkFrame& frame) {
-    const std::uint64_t on_screen = last_good_.current() ? last_good_.current()->request_id : 0;
-    const std::string why = last_good_.accept(frame);
-    if (why.empty()) return true;
-    parts_.display.stats().rejected();
-    // The first ten, then every hundredth: a farm sending garbage must not flood the journal.
-    if (last_good_.rejected() <= 10 || last_good_.rejected() % 100 == 0) {
-        spdlog::warn("frame dropped ({} so far): {}; keeping request {} on screen", last_good_.rejected(), why,
-                     on_screen);
+void Kiosk::note_rejections(const std::vector<DecodeWorker::Rejection>& rejections) {
+    // Counted from the worker's total: take() keeps only the latest reasons.
+    const std::uint64_t total = parts_.inbox.rejected();
+    for (; rejections_seen_ < total; ++rejections_seen_) parts_.display.stats().rejected();
+    const std::uint64_t on_screen = current_ ? current_->request_id : 0;
+    for (const auto& r : rejections) {
+        // The first ten, then every hundredth: a farm sending garbage must not flood the journal.
+        if (r.number <= 10 || r.number % 100 == 0) {
+            spdlog::warn("frame dropped ({} so far): {}; keeping request {} on screen", r.number, r.why, on_screen);
+        }
     }
-    return false;
 }
 
 void Kiosk::check_frames_shown() {
@@ -128,9 +136,10 @@ void Kiosk::on_tick() {
     submit_next_view();
     const LinkClientStats link = parts_.link.stats();
     note_link_state(link);
-    if (!shown_since_tick_) {
-        // Nothing new this tick: show the current frame again (headless PNGs keep coming, a KMS
-        // output is refreshed).
+    const bool turned = update_late_warp();
+    if (!shown_since_tick_ || turned) {
+        // Nothing new this tick, or the view turned since: show the current frame again (headless
+        // PNGs keep coming, a KMS output is refreshed, the late warp's new shift reaches the wall).
         parts_.display.repaint();
         check_frames_shown();
     }
@@ -149,8 +158,30 @@ void Kiosk::on_tick() {
     parts_.notifier.watchdog();
 }
 
+bool Kiosk::update_late_warp() {
+    WarpBlendRenderer::ContentTransform t;  // identity: no band
+    // Every request carries the band, so every farm frame spans its arc (whatever pixel size the
+    // farm rendered it at: the transform is in normalised content coordinates).
+    if (guard_ && current_) {
+        const ContentShift shift =
+            late_rotational_shift(config_.screen.arc_deg, guard_->guard_deg, latest_yaw_deg_ - current_->pose.yaw_deg);
+        t.scale_u = static_cast<float>(shift.scale);
+        t.offset_u = static_cast<float>(shift.offset);
+        if (shift.clamped) ++late_warp_clamped_;
+    }
+    const WarpBlendRenderer::ContentTransform before = parts_.display.content_transform();
+    parts_.display.set_content_transform(t);
+    return t.scale_u != before.scale_u || t.offset_u != before.offset_u;
+}
+
 void Kiosk::submit_next_view() {
     KioskNavigation::Step step = parts_.navigation.next();
+    latest_yaw_deg_ = step.request.pose.yaw_deg;
+    if (guard_ && std::holds_alternative<CylinderScreen>(step.request.camera)) {
+        // The farm renders the band too: the same degrees per column, wider (late_warp.h).
+        std::get<CylinderScreen>(step.request.camera).arc_deg = guard_->camera.arc_deg;
+        step.request.size.width = guard_->size.width;
+    }
     std::string why;
     step.entry.request_id = parts_.link.submit(step.request, &why);
     if (step.entry.request_id == 0) spdlog::error("view request refused: {}", why);
@@ -177,8 +208,8 @@ void Kiosk::note_link_state(const LinkClientStats& link) {
     if (link.connected == connected_) return;
     connected_ = link.connected;
     const char* state = connected_ ? "connected" : "disconnected";
-    spdlog::info("farm {} {}; showing {}", config_.farm.endpoint, state, showing(last_good_));
-    parts_.display.stats().event(realtime_ns(), state, last_good_.current() ? last_good_.current()->request_id : 0);
+    spdlog::info("farm {} {}; showing {}", config_.farm.endpoint, state, showing(current()));
+    parts_.display.stats().event(realtime_ns(), state, current_ ? current_->request_id : 0);
 }
 
 std::optional<std::size_t> Kiosk::flip_overdue(std::chrono::steady_clock::time_point now) {

@@ -2,10 +2,12 @@
 // Kiosk: the appliance's display loop (docs/kiosk.md, "The event loop"). One poll(2) loop on the main
 // thread over four fds, one handler each:
 //   on_signal  signalfd: SIGINT/SIGTERM -> clean stop
-//   on_frame   the FrameInbox's eventfd: decode the newest farm frame (or drop it and keep the last
-//              good one) and show it on every output
+//   on_frame   the FrameInbox's eventfd: take the newest farm frame its worker thread decoded (a
+//              frame that failed was dropped there; the last good one stays) and show it on every
+//              output
 //   on_tick    timerfd ([display].rate_hz): --duration; next pose from the navigation; submit the view
-//              request; link state changes; idle repaint; periodic stats line; WATCHDOG=1
+//              request; link state changes; idle repaint (also when the late warp's shift changed:
+//              [screen].guard_deg > 0, appliance/warp/late_warp.h); periodic stats line; WATCHDOG=1
 //   on_flip    the backend's event fd (KMS page flips): pending content onto outputs ready again
 // The handlers are public so that tests can drive them one at a time (kiosk/kiosk_test.cpp).
 // run() loops until a stop (signal, --frames N on screen, --duration, end of a tracking replay), then
@@ -21,8 +23,10 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "appliance/decode/last_good_frame.h"
+#include "appliance/warp/late_warp.h"
 #include "common/service_notify.h"
 #include "common/view_request.h"
 #include "kiosk/content_dump.h"
@@ -89,8 +93,10 @@ public:
     [[nodiscard]] bool stopping() const { return loop_.stopping(); }
     [[nodiscard]] int exit_code() const { return exit_code_; }
     [[nodiscard]] std::uint64_t ticks() const { return ticks_; }
-    [[nodiscard]] const LastGoodFrame& last_good() const { return last_good_; }
+    // The frame on screen; nullptr before the first good farm frame.
+    [[nodiscard]] const ContentFrame* current() const { return current_ ? &*current_ : nullptr; }
     [[nodiscard]] int tick_fd() const { return tick_.fd(); }
+    [[nodiscard]] std::uint64_t late_warp_clamped() const { return late_warp_clamped_; }
 
     // The clean stop after the loop (run() calls it); returns the exit code.
     [[nodiscard]] int finish();
@@ -98,8 +104,11 @@ public:
 private:
     void fail(const char* what, const std::string& message);  // logs, exit code 1, stops the loop
     [[nodiscard]] std::optional<std::size_t> flip_overdue(std::chrono::steady_clock::time_point now);
-    [[nodiscard]] bool accept(const LinkFrame& frame);  // decode into last_good_, or log the drop
-    void check_frames_shown();                          // --frames
+    // Sets the display's content transform for the yaw turned since the current frame's request
+    // (identity without a guard band); true when it changed.
+    [[nodiscard]] bool update_late_warp();
+    void note_rejections(const std::vector<DecodeWorker::Rejection>& rejections);  // counts and logs
+    void check_frames_shown();                                                     // --frames
     void submit_next_view();
     void note_link_state(const LinkClientStats& link);
     void write_pose(const PoseLogEntry& entry);
@@ -110,7 +119,11 @@ private:
     KioskRunOptions options_;
     EventLoop loop_;
     TimerFd tick_;
-    LastGoodFrame last_good_;
+    std::optional<ContentFrame> current_;
+    std::optional<GuardedScreen> guard_;   // [screen].guard_deg > 0: the band the farm renders
+    double latest_yaw_deg_ = 0;            // the navigation's yaw at the latest tick
+    std::uint64_t late_warp_clamped_ = 0;  // updates whose turn exceeded the band
+    std::uint64_t rejections_seen_ = 0;
     std::uint64_t ticks_ = 0;
     std::uint64_t frames_seen_ = 0;
     bool connected_ = false;

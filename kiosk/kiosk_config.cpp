@@ -13,6 +13,7 @@
 #include <toml.hpp>
 
 #include "appliance/tracker/tag_family.h"
+#include "appliance/warp/late_warp.h"
 #include "common/request_limits.h"
 #include "renderfarm/link/endpoint.h"
 
@@ -271,7 +272,7 @@ void read_quality(const Section& s, QualityConfig& q) {
     q.area_light_samples = s.integer("area_light_samples", q.area_light_samples, request_limits::kAreaLightSamples);
 }
 
-void read_screen(const Section& s, CylinderScreen& screen) {
+void read_screen(const Section& s, CylinderScreen& screen, double& guard_deg) {
     screen.radius_m = s.number("radius_m", screen.radius_m, [](double x) { return x > 0 && x <= 1000; }, "(0, 1000] m");
     screen.arc_deg = s.number("arc_deg", screen.arc_deg, [](double x) { return x > 0 && x <= 360; }, "(0, 360] degrees");
     const auto height = [](double x) { return std::abs(x) <= 1000; };
@@ -280,6 +281,22 @@ void read_screen(const Section& s, CylinderScreen& screen) {
     if (!(screen.top_m > screen.bottom_m)) {
         s.fail(s.find("top_m") != nullptr ? s.find("top_m") : s.find("bottom_m"), "top_m",
                fmt::format(" = {} must be above [screen].bottom_m = {}", screen.top_m, screen.bottom_m));
+    }
+    // The late warp's guard band (appliance/warp/late_warp.h): the widened arc must stay a cylinder.
+    const double max_guard = (360.0 - screen.arc_deg) / 2.0;
+    guard_deg = s.number(
+        "guard_deg", guard_deg, [max_guard](double x) { return x >= 0 && x <= max_guard; },
+        fmt::format("[0, {}] degrees: arc_deg + 2 * guard_deg <= 360", max_guard));
+}
+
+// The guarded frame the farm is asked for must fit the link's image limit.
+void check_guarded_width(const Section& s, const KioskConfig& config) {
+    const auto guarded = guard_band(config.screen, config.quality.content, config.guard_deg);
+    if (!guarded) s.fail(s.find("guard_deg"), "guard_deg", ": " + guarded.error().message);
+    if (guarded->size.width > request_limits::kLinkImageSide.max) {
+        s.fail(s.find("guard_deg"), "guard_deg",
+               fmt::format(" = {} widens [quality].content to {} columns, beyond the link's {}", config.guard_deg,
+                           guarded->size.width, request_limits::kLinkImageSide.max));
     }
 }
 
@@ -601,8 +618,9 @@ KioskConfig parse_kiosk_config(std::string_view text, const std::filesystem::pat
     read_calibration(calibration, config.calibration);
     const Section quality = section(ctx, root, "quality", {"content", "spp", "jpeg_quality", "bounces", "ao_samples", "area_light_samples"});
     read_quality(quality, config.quality);
-    const Section screen = section(ctx, root, "screen", {"radius_m", "arc_deg", "bottom_m", "top_m"});
-    read_screen(screen, config.screen);
+    const Section screen = section(ctx, root, "screen", {"radius_m", "arc_deg", "bottom_m", "top_m", "guard_deg"});
+    read_screen(screen, config.screen, config.guard_deg);
+    check_guarded_width(screen, config);
     const Section navigation =
         section(ctx, root, "navigation",
                 {"source", "path", "path_frames", "start", "start_yaw_deg", "eye_height_m", "camera", "camera_size",

@@ -138,6 +138,9 @@ struct KioskConfig {
     CalibrationConfig calibration;
     QualityConfig quality;
     CylinderScreen screen{3.0, 150.0, 0.2, 2.8, {0.0, 1.6, 0.0}};  // [screen]; eye_m from navigation
+    // [screen].guard_deg: the late rotational warp's band each side of the arc (appliance/warp/
+    // late_warp.h), [0, (360 - arc_deg) / 2] degrees; 0 = off (the farm renders the arc only).
+    double guard_deg = 0.0;
     NavigationConfig navigation;
     StatsConfig stats;
 };

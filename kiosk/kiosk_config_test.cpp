@@ -97,6 +97,7 @@ const std::vector<std::string> kGood = {R"(farm.endpoint="[fd00:6d6f::1]:7443")"
                                         "screen.arc_deg=160",
                                         "screen.bottom_m=0.1",
                                         "screen.top_m=2.9",
+                                        "screen.guard_deg=5",
                                         R"(navigation.path="orbit")",
                                         "navigation.path_frames=120",
                                         "navigation.start=[0.0, 0.0, 4.0]",
@@ -146,6 +147,7 @@ TEST_F(KioskConfigTest, ReadsEveryFieldAndResolvesPathsAgainstTheFile) {
     EXPECT_DOUBLE_EQ(c.screen.arc_deg, 160.0);
     EXPECT_DOUBLE_EQ(c.screen.bottom_m, 0.1);
     EXPECT_DOUBLE_EQ(c.screen.top_m, 2.9);
+    EXPECT_DOUBLE_EQ(c.guard_deg, 5.0);
     EXPECT_DOUBLE_EQ(c.screen.eye_m.y(), 1.5);  // the camera's eye is the visitor's eye height
     EXPECT_EQ(c.navigation.path, "orbit");
     EXPECT_EQ(c.navigation.path_frames, 120);
@@ -259,6 +261,9 @@ INSTANTIATE_TEST_SUITE_P(
         BadField{"arc_deg = 160", "arc_deg = 400", "[screen].arc_deg = 400 is outside (0, 360] degrees"},
         BadField{"bottom_m = 0.1", "bottom_m = inf", "[screen].bottom_m = inf is outside"},
         BadField{"top_m = 2.9", "top_m = 0.1", "[screen].top_m = 0.1 must be above [screen].bottom_m = 0.1"},
+        BadField{"guard_deg = 5", "guard_deg = 101",
+                 "[screen].guard_deg = 101 is outside [0, 100] degrees: arc_deg + 2 * guard_deg <= 360"},
+        BadField{"guard_deg = 5", "guard_deg = -1", "[screen].guard_deg = -1 is outside [0, 100] degrees"},
         BadField{R"(path = "orbit")", R"(path = "nowhere.json")", "[navigation].path: '"},
         BadField{R"(path = "orbit")", R"(path = "")", "[navigation].path: empty"},
         BadField{"path_frames = 120", "path_frames = 1", "[navigation].path_frames = 1 is outside [2, 1000000]"},

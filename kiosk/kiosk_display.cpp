@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "kiosk/kiosk_display.h"
 
+#include <algorithm>
 #include <iterator>
 
 #include <spdlog/spdlog.h>
@@ -18,6 +19,7 @@ Result<KioskDisplay> KioskDisplay::create(std::unique_ptr<OutputBackend> backend
 }
 
 Status KioskDisplay::show_connecting_screen(ImageSize content, const std::string& endpoint) {
+    set_content_transform({});  // the card is made for the screen itself
     if (Status s = presenter_.show(make_connecting_screen(content, "FARM " + endpoint), 0); !s) return s;
     account();
     return {};
@@ -70,11 +72,24 @@ void KioskDisplay::account() {
         const auto it = pending_.find(*tag);
         if (it == pending_.end()) continue;  // the connecting screen (tag 0)
         PresentedFrame done = it->second;
-        done.presented_ns = realtime_ns();
+        done.presented_ns = on_screen_ns();
         stats_.presented(done);
         ++frames_on_screen_;
         pending_.erase(pending_.begin(), std::next(it));  // older ones were overtaken on some output
     }
+}
+
+std::int64_t KioskDisplay::on_screen_ns() const {
+    // The round's latest output: KMS flip events of one commit may arrive a vblank apart.
+    std::optional<std::int64_t> latest;
+    const auto& projector_of = presenter_.projector_of();
+    for (std::size_t i = 0; i < projector_of.size(); ++i) {
+        if (!projector_of[i]) continue;
+        const auto t = backend_->presented_ns(i);
+        if (!t) return realtime_ns();  // the backend cannot tell: now, when the loop learnt it
+        latest = latest ? std::max(*latest, *t) : *t;
+    }
+    return latest ? *latest : realtime_ns();
 }
 
 std::optional<std::size_t> KioskDisplay::overdue_output(std::chrono::steady_clock::time_point now,

@@ -5,7 +5,8 @@
 // motion-to-photon ends there), display rounds, PNGs per round.
 //
 // After every show / repaint / flip: a round that presented anything is counted (and recorded as
-// PNGs), and every frame that is now on screen on all outputs is passed to KioskStats. Frames shown
+// PNGs), and every frame that is now on screen on all outputs is passed to KioskStats, stamped
+// with the time its round reached the screen (KMS: the kernel's page-flip timestamp). Frames shown
 // but not yet on screen everywhere (KMS flips pending) wait in a map by request id; a frame overtaken
 // on some output by a newer one is dropped from it when the newer one completes.
 //
@@ -64,6 +65,14 @@ public:
     [[nodiscard]] const KioskStats& stats() const { return stats_; }
     [[nodiscard]] int event_fd() const { return backend_->event_fd(); }
     [[nodiscard]] const ScreenPresenter& presenter() const { return presenter_; }
+    // The late warp's content transform for the rounds from now on (WarpBlendRenderer); the
+    // connecting screen resets it to the identity.
+    void set_content_transform(const WarpBlendRenderer::ContentTransform& t) {
+        backend_->renderer().set_content_transform(t);
+    }
+    [[nodiscard]] WarpBlendRenderer::ContentTransform content_transform() const {
+        return backend_->renderer().content_transform();
+    }
     // See ScreenPresenter::on_output_presented (the kiosk feeds its watchdog there).
     void on_output_presented(std::function<void()> callback) { presenter_.on_output_presented(std::move(callback)); }
 
@@ -71,6 +80,10 @@ private:
     KioskDisplay(std::unique_ptr<OutputBackend> backend, ScreenPresenter presenter, ScreenCalibration screen)
         : backend_(std::move(backend)), presenter_(std::move(presenter)), screen_(std::move(screen)) {}
     void account();  // after every present: rounds, PNGs, frames now on screen
+    // When the completed round reached the screen (CLOCK_REALTIME ns): the latest
+    // OutputBackend::presented_ns of the lit outputs (KMS: page-flip timestamps; headless: the
+    // round), or now when the backend cannot tell. Motion-to-photon ends here.
+    [[nodiscard]] std::int64_t on_screen_ns() const;
 
     // Frames on some outputs but not yet on screen everywhere, by request id; bounded, so that an
     // output that never completes cannot grow it.

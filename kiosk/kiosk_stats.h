@@ -4,8 +4,9 @@
 //
 // Per frame (times are CLOCK_REALTIME nanoseconds of the appliance, common/link_types.h):
 //   motion-to-photon = presented_ns - request_ns: the view request was stamped (pose sampled) ->
-//                      every output presented the frame (headless: present() returned; KMS: its
-//                      page flip completed, i.e. the frame is being scanned out)
+//                      every output presented the frame in one round (headless: the round's
+//                      read-backs completed; KMS: the latest page-flip event timestamp of the
+//                      round's atomic commit, the kernel's time scan-out of the frame began)
 //   link             = receive_ns - request_ns (request upstream + render + encode + downstream)
 //   kiosk            = presented_ns - receive_ns (slot hand-over + decode + warp/blend + flip)
 //   bytes            = JPEG bytes of the frame

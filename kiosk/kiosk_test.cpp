@@ -130,6 +130,11 @@ protected:
                        std::move(options));
         return *kiosk_;
     }
+    // What the link does, then waits for the inbox's worker to decode it (the loop would be woken).
+    void deliver(LinkFrame&& frame) {
+        inbox_->put(std::move(frame));
+        inbox_->wait_decoded();
+    }
     [[nodiscard]] std::vector<Rgb8Image> outputs() const {
         std::vector<Rgb8Image> out;
         for (std::size_t i = 0; i < headless_->outputs().size(); ++i) out.push_back(headless_->last_frame(i));
@@ -152,10 +157,10 @@ protected:
 TEST_F(KioskTest, OnFrameShowsTheFrameInTheSlotOnEveryOutput) {
     Kiosk& k = kiosk();
     const std::vector<Rgb8Image> connecting = outputs();
-    inbox_->put(jpeg_frame(1, 120));
+    deliver(jpeg_frame(1, 120));
     k.on_frame();
-    ASSERT_NE(k.last_good().current(), nullptr);
-    EXPECT_EQ(k.last_good().current()->request_id, 1u);
+    ASSERT_NE(k.current(), nullptr);
+    EXPECT_EQ(k.current()->request_id, 1u);
     EXPECT_EQ(display_->frames_on_screen(), 1u);
     EXPECT_EQ(display_->stats().frames(), 1u);
     const std::vector<Rgb8Image> shown = outputs();
@@ -171,24 +176,24 @@ TEST_F(KioskTest, OnFrameShowsTheFrameInTheSlotOnEveryOutput) {
 
 TEST_F(KioskTest, OnFrameShowsTheNewestFrameAndCountsTheReplacedOne) {
     Kiosk& k = kiosk();
-    inbox_->put(jpeg_frame(1, 40));
-    inbox_->put(jpeg_frame(2, 200));
+    deliver(jpeg_frame(1, 40));
+    deliver(jpeg_frame(2, 200));
     k.on_frame();
-    EXPECT_EQ(k.last_good().current()->request_id, 2u);
+    EXPECT_EQ(k.current()->request_id, 2u);
     EXPECT_EQ(display_->frames_on_screen(), 1u);
     EXPECT_EQ(display_->stats().to_json()["frames_superseded"], 1);
 }
 
 TEST_F(KioskTest, ACorruptJpegKeepsTheLastGoodFrameOnEveryOutput) {
     Kiosk& k = kiosk();
-    inbox_->put(jpeg_frame(1, 90));
+    deliver(jpeg_frame(1, 90));
     k.on_frame();
     const std::vector<Rgb8Image> before = outputs();
     LinkFrame corrupt = jpeg_frame(2, 200);
     corrupt.jpeg.resize(corrupt.jpeg.size() * 2 / 3);
-    inbox_->put(std::move(corrupt));
+    deliver(std::move(corrupt));
     k.on_frame();
-    EXPECT_EQ(k.last_good().current()->request_id, 1u);
+    EXPECT_EQ(k.current()->request_id, 1u);
     EXPECT_EQ(display_->frames_on_screen(), 1u);
     EXPECT_EQ(display_->stats().to_json()["frames_rejected"], 1);
     const std::vector<Rgb8Image> after = outputs();
@@ -199,10 +204,10 @@ TEST_F(KioskTest, FramesOptionStopsOnceThatManyFramesAreOnScreen) {
     KioskRunOptions options;
     options.frames = 2;
     Kiosk& k = kiosk(std::move(options));
-    inbox_->put(jpeg_frame(1, 60));
+    deliver(jpeg_frame(1, 60));
     k.on_frame();
     EXPECT_FALSE(k.stopping());
-    inbox_->put(jpeg_frame(2, 70));
+    deliver(jpeg_frame(2, 70));
     k.on_frame();
     EXPECT_TRUE(k.stopping());
     EXPECT_EQ(k.exit_code(), 0);
@@ -243,7 +248,7 @@ TEST_F(KioskTest, OnTickRepaintsOnlyWhenNoFrameCameSinceThePreviousTick) {
     wait_readable(k.tick_fd());
     k.on_tick();
     EXPECT_EQ(display_->stats().rounds(), rounds + 1);
-    inbox_->put(jpeg_frame(1, 80));
+    deliver(jpeg_frame(1, 80));
     k.on_frame();
     wait_readable(k.tick_fd());
     k.on_tick();
@@ -301,7 +306,7 @@ TEST_F(KioskTest, AnOutputWhoseFlipNeverCompletesStopsTheKioskForARestart) {
     // From now on no flip completes: the kiosk stops with a failure (systemd restarts it) after
     // the timeout, not before, and feeds the watchdog no more.
     backend.withhold = true;
-    inbox_->put(jpeg_frame(1, 150));
+    deliver(jpeg_frame(1, 150));
     k.on_frame();
     const auto hung = std::chrono::steady_clock::now();
     while (!k.stopping() && std::chrono::steady_clock::now() - hung < std::chrono::seconds(10)) {
@@ -313,9 +318,40 @@ TEST_F(KioskTest, AnOutputWhoseFlipNeverCompletesStopsTheKioskForARestart) {
     EXPECT_EQ(k.exit_code(), 1);
 }
 
+// [screen].guard_deg: requests carry the band (arc and width widened alike), and a frame is shown
+// shifted by the yaw turned since its request (appliance/warp/late_warp.h).
+TEST_F(KioskTest, GuardBandWidensTheRequestAndTheFrameIsShiftedByTheYawSinceItsRequest) {
+    config_.guard_deg = 10;  // 160 columns over 150 degrees: 11 columns = 10.3125 degrees each side
+    Kiosk& k = kiosk();
+    wait_readable(k.tick_fd());
+    k.on_tick();
+    ASSERT_EQ(link_.requests.size(), 1u);
+    const ViewRequest& request = link_.requests.back();
+    EXPECT_EQ(request.size, (ImageSize{182, 90}));
+    ASSERT_TRUE(std::holds_alternative<CylinderScreen>(request.camera));
+    EXPECT_DOUBLE_EQ(std::get<CylinderScreen>(request.camera).arc_deg, 150.0 * 182 / 160);
+
+    LinkFrame frame = jpeg_frame(101, 90);
+    Rgb8Image wide({182, 90}, 90);
+    frame.size = wide.size;
+    frame.jpeg = JpegEncoder().encode(wide, 90);
+    frame.pose = request.pose;
+    frame.pose.yaw_deg -= 2.0;  // the visitor turned 2 degrees left since this frame's request
+    deliver(std::move(frame));
+    k.on_frame();
+    ASSERT_NE(k.current(), nullptr);
+    const WarpBlendRenderer::ContentTransform t = display_->content_transform();
+    const double guarded_arc = 150.0 * 182 / 160;
+    EXPECT_NEAR(t.scale_u, 150.0 / guarded_arc, 1e-6);
+    EXPECT_NEAR(t.offset_u, (10.3125 - 2.0) / guarded_arc, 1e-6);
+    EXPECT_FLOAT_EQ(t.scale_v, 1.0f);
+    EXPECT_FLOAT_EQ(t.offset_v, 0.0f);
+    EXPECT_EQ(k.late_warp_clamped(), 0u);
+}
+
 TEST_F(KioskTest, RunShowsFramesUntilASignalThenWritesTheStatistics) {
     Kiosk& k = kiosk();
-    inbox_->put(jpeg_frame(7, 100));
+    deliver(jpeg_frame(7, 100));
     ASSERT_EQ(::raise(SIGUSR1), 0);
     link_.stats.sessions_opened = 1;
     EXPECT_EQ(k.run(), 0);

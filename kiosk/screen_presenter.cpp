@@ -2,6 +2,7 @@
 #include "kiosk/screen_presenter.h"
 
 #include <algorithm>
+#include <string>
 
 #include "kiosk/projector_assignment.h"
 
@@ -32,56 +33,64 @@ Result<ScreenPresenter> ScreenPresenter::create(OutputBackend& backend, const Sc
 Status ScreenPresenter::show(const Rgb8Image& content, std::uint64_t tag) {
     last_presents_ = 0;
     if (has_content_ && tag < tag_) return make_error(EINVAL, "content tags must not decrease");
+    // Safe while a round is in flight: its outputs were drawn already; the next round reads this.
     if (Status s = backend_->renderer().set_content(content); !s) return s;
     has_content_ = true;
+    dirty_ = true;
     tag_ = tag;
-    for (OutputState& o : states_) o.dirty = o.lit;
-    return present_dirty();
+    return present_round();
 }
 
 Status ScreenPresenter::repaint() {
     last_presents_ = 0;
-    if (!has_content_) return {};
-    for (std::size_t i = 0; i < states_.size(); ++i) {
-        if (states_[i].lit && !states_[i].in_flight && backend_->ready(i)) states_[i].dirty = true;
-    }
-    return present_dirty();
+    if (!has_content_ || round_in_flight()) return {};
+    dirty_ = true;
+    return present_round();
 }
 
 Status ScreenPresenter::on_ready(const std::vector<std::size_t>& outputs) {
     last_presents_ = 0;
     for (const std::size_t i : outputs) {
-        if (i >= states_.size()) continue;
-        OutputState& o = states_[i];
-        if (o.in_flight) {
-            o.in_flight = false;
-            o.shown_tag = o.flight_tag;
-        }
+        if (i >= states_.size() || !states_[i].in_flight) continue;
+        states_[i].in_flight = false;  // its flip of the round completed
+        states_[i].shown_tag = flight_tag_;
     }
-    return present_dirty();
+    return present_round();  // once the whole round completed
 }
 
-Status ScreenPresenter::present_dirty() {
-    Status first_error;
+bool ScreenPresenter::round_in_flight() const {
+    return std::any_of(states_.begin(), states_.end(), [](const OutputState& o) { return o.in_flight; });
+}
+
+Status ScreenPresenter::present_round() {
+    if (!dirty_ || round_in_flight()) return {};
     for (std::size_t i = 0; i < states_.size(); ++i) {
-        OutputState& o = states_[i];
-        if (!o.lit || !o.dirty || o.in_flight || !backend_->ready(i)) continue;
+        if (states_[i].lit && !backend_->ready(i)) return {};  // a round starts on every output or on none
+    }
+    Status first_error;
+    std::vector<std::size_t> staged;
+    for (std::size_t i = 0; i < states_.size(); ++i) {
+        const OutputState& o = states_[i];
+        if (!o.lit) continue;
         Status s = backend_->begin_frame(i);
         if (s) s = backend_->renderer().draw(o.projector, backend_->outputs()[i].size);
-        if (s) s = backend_->present(i);
+        if (s) s = backend_->stage(i);
         if (!s) {
             if (first_error.ok()) first_error = with_context(s.error(), backend_->outputs()[i].name);
-            continue;
+            continue;  // left out of this round; the next one retries it
         }
-        ++last_presents_;
+        staged.push_back(i);
         if (output_presented_) output_presented_();
-        o.dirty = false;
-        if (backend_->ready(i)) {
-            o.shown_tag = tag_;  // synchronous (headless) or the blocking first modeset
-        } else {
-            o.in_flight = true;
-            o.flight_tag = tag_;
-        }
+    }
+    if (staged.empty()) return first_error;
+    if (Status s = backend_->commit_round(); !s) return with_context(s.error(), "round of " + std::to_string(tag_));
+    dirty_ = false;
+    last_presents_ = staged.size();
+    flight_tag_ = tag_;
+    for (const std::size_t i : staged) {
+        // Ready again at once: synchronous (headless) or the blocking first modeset.
+        if (backend_->ready(i)) states_[i].shown_tag = tag_;
+        else states_[i].in_flight = true;
     }
     return first_error;
 }

@@ -3,12 +3,14 @@
 // each output's projector calibration (warp, blend, response: drivers/egl/warp_blend_renderer.h),
 // and tells when a frame has reached the screen.
 //
-// show(content, tag) uploads the frame once and presents it on every output that is ready;
-// outputs still waiting for a page flip are marked and get the newest content as soon as
-// on_ready() reports them (after OutputBackend::dispatch_events). An output therefore never shows
-// an older frame after a newer one, and never gets a frame queued behind a pending flip.
-// A frame is "on screen" when every lit output has presented it or a newer one and, for KMS, its
-// flip completed (headless presents complete on return): take_completed() then returns its tag.
+// Rounds: a content frame is presented on all lit outputs together, in one round
+// (OutputBackend::stage on each, then one commit_round: on KMS one atomic commit for every CRTC).
+// A new round starts only when the previous one has completed on every output (all its flip
+// events reported through on_ready()); until then show() only records the newest content, and the
+// next round presents it. So outputs never show different content frames (no shear at the seams
+// while the view turns), an output never shows an older frame after a newer one, and no frame is
+// queued behind a pending flip. A frame is "on screen" when its round completed on every lit
+// output (headless rounds complete on return): take_completed() then returns its tag.
 // Tags must increase from show() to show() (the kiosk uses 0 for its own screens and the request
 // id for farm frames).
 //
@@ -41,22 +43,23 @@ public:
     // New content (sRGB RGB8, rows top first) with a tag newer than the previous one.
     [[nodiscard]] Status show(const Rgb8Image& content, std::uint64_t tag);
 
-    // Presents the current content again on every ready output that has nothing newer pending
-    // (the idle repaint of the display tick). No-op before the first show().
+    // Presents the current content again, as a round on every lit output, when no round is in
+    // flight (the idle repaint of the display tick). No-op before the first show().
     [[nodiscard]] Status repaint();
 
-    // Outputs that became ready (dispatch_events); presents pending content on them.
+    // Outputs that became ready (dispatch_events); once the round in flight completed on all of
+    // them, presents pending content as the next round.
     [[nodiscard]] Status on_ready(const std::vector<std::size_t>& outputs);
 
     // The newest tag now on screen on every lit output, once per tag; nullopt when nothing new.
     [[nodiscard]] std::optional<std::uint64_t> take_completed();
 
-    // Presents performed by the last show/repaint/on_ready call (one per output).
+    // Presents performed by the last show/repaint/on_ready call (one per output of its round).
     [[nodiscard]] std::size_t last_presents() const { return last_presents_; }
     [[nodiscard]] std::uint64_t current_tag() const { return tag_; }
     [[nodiscard]] const std::vector<std::optional<std::size_t>>& projector_of() const { return projector_of_; }
 
-    // Called after each output is presented, so that a caller can show progress within one round:
+    // Called after each output of a round is drawn and staged, so that a caller can show progress within one round:
     // the kiosk feeds the service watchdog here, because a round of several outputs on a slow
     // software rasteriser (llvmpipe under QEMU's TCG: 7 s for three outputs) can outlast WatchdogSec
     // while every single output takes a fraction of it.
@@ -66,22 +69,23 @@ private:
     struct OutputState {
         bool lit = false;
         std::size_t projector = 0;   // renderer index
-        bool dirty = false;          // current content not yet presented here
-        bool in_flight = false;      // presented, flip pending
-        std::uint64_t flight_tag = 0;
+        bool in_flight = false;      // in the round in flight, its flip pending
         std::optional<std::uint64_t> shown_tag;  // on screen
     };
 
     ScreenPresenter(OutputBackend& backend, std::vector<std::optional<std::size_t>> projector_of,
                     std::vector<OutputState> states)
         : backend_(&backend), projector_of_(std::move(projector_of)), states_(std::move(states)) {}
-    [[nodiscard]] Status present_dirty();
+    [[nodiscard]] Status present_round();  // when dirty_ and no round in flight
+    [[nodiscard]] bool round_in_flight() const;
 
     OutputBackend* backend_;
     std::vector<std::optional<std::size_t>> projector_of_;
     std::vector<OutputState> states_;
     bool has_content_ = false;
+    bool dirty_ = false;  // the current content has not started a round yet
     std::uint64_t tag_ = 0;
+    std::uint64_t flight_tag_ = 0;  // content of the round in flight
     std::optional<std::uint64_t> completed_;
     std::size_t last_presents_ = 0;
     std::function<void()> output_presented_;
