@@ -9,9 +9,9 @@
 //
 // A session looks at the screen (the kiosk's cylinder: radius 3 m, 150 degrees, 0.2-2.8 m) from the
 // scene's viewer. Moving: the yaw turns a little every request, so nothing accumulates; after a
-// warm-up (the frame-time target settles, the PBT learns), frames/s = frames served (rendered,
-// composited, encoded to JPEG) / wall time. Still: the last moving pose is
-// requested again and again; after every frame the served image (upsampled to full size when the
+// warm-up of at least 10 frames (the frame-time target settles, the PBT learns), frames/s over at
+// least 5 frames = frames served (rendered, composited, encoded to JPEG) / wall time. Still: the
+// last moving pose is requested again and again; after every frame the served image (upsampled to full size when the
 // frame-time target had shrunk it) is compared with the reference (the same view at
 // --reference-spp, one render) by PSNR of the sRGB8 frames; comparison time is not counted.
 // The error of a moving frame is that of the last moving frame against the same reference.
@@ -150,7 +150,8 @@ nlohmann::json run_config(const Config& c, FrameDispatcher& farm, const Scene& s
     const auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
     LiveFrame last;
     // Warm-up (not counted): the frame-time target settles, the PBT learns the view.
-    for (const auto warm = Clock::now(); since(warm) < a.warmup_seconds;) {
+    // At least 10 frames: from full scale the target needs about 5 to reach the smallest scale.
+    for (const auto warm = Clock::now(); moved < 10 || since(warm) < a.warmup_seconds;) {
         request.frame_id = next_id++;
         request.pose.yaw_deg = base_yaw + 0.5 * (moved % 2 == 0 ? 1 : -1) * (1 + moved % 7);
         last = live.render(request);
@@ -160,7 +161,7 @@ nlohmann::json run_config(const Config& c, FrameDispatcher& farm, const Scene& s
     encoder.finish();
     moved = 0;
     const auto start = Clock::now();
-    while (since(start) < a.move_seconds) {
+    while (moved < 5 || since(start) < a.move_seconds) {  // 5 frames at least, however slow
         request.frame_id = next_id++;
         request.pose.yaw_deg = base_yaw + 0.5 * (moved % 2 == 0 ? 1 : -1) * (1 + moved % 7);
         last = live.render(request);
