@@ -11,9 +11,9 @@
 // scene's viewer. Moving: the yaw turns a little every request, so nothing accumulates; after a
 // warm-up of at least 10 frames (the frame-time target settles, the PBT learns), frames/s over at
 // least 5 frames = frames served (rendered, composited, encoded to JPEG) / wall time. Still: the
-// last moving pose is requested again and again; after every frame the served image (upsampled to full size when the
-// frame-time target had shrunk it) is compared with the reference (the same view at
-// --reference-spp, one render) by PSNR of the sRGB8 frames; comparison time is not counted.
+// last moving pose is requested again and again; after every frame the served image (upsampled to
+// full size when the frame-time target had shrunk it) is compared with the reference (the same view
+// at --reference-spp, one render) by PSNR of the sRGB8 frames; comparison time is not counted.
 // The error of a moving frame is that of the last moving frame against the same reference.
 // Exits 77 when the scene's scans are absent.
 #include <algorithm>
