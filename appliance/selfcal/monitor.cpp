@@ -211,7 +211,8 @@ cv::Mat1f Monitor::predict(const cv::Mat1f& content) const {
     return out;
 }
 
-FrameMeasurement Monitor::measure(const cv::Mat1f& content, const cv::Mat1f& camera_frame) const {
+FrameMeasurement Monitor::measure(const cv::Mat1f& content, const cv::Mat1f& camera_frame,
+                                  const std::vector<bool>& suspects) const {
     const autocal::DeviceModel& cam = model_.camera;
     if (camera_frame.cols != cam.resolution.width || camera_frame.rows != cam.resolution.height) {
         throw std::invalid_argument("Monitor::measure: camera frame must be " + std::to_string(cam.resolution.width) +
@@ -234,7 +235,18 @@ FrameMeasurement Monitor::measure(const cv::Mat1f& content, const cv::Mat1f& cam
     const std::vector<cv::Point2d> n = undistort(cam, observed);
     std::vector<Eigen::Vector2d> obs_n;
     for (const cv::Point2d& p : n) obs_n.emplace_back(p.x, p.y);
-    m.camera = fit_pose_robust(cam, s_pred, obs_n, options_.camera_fit);
+    const bool any_suspect = std::find(suspects.begin(), suspects.end(), true) != suspects.end();
+    std::vector<Eigen::Vector3d> cam_points;
+    std::vector<Eigen::Vector2d> cam_image;
+    for (std::size_t i = 0; i < s_pred.size(); ++i) {
+        const bool suspect = owner[i] == 255 ? any_suspect
+                                             : (static_cast<std::size_t>(owner[i]) < suspects.size() &&
+                                                suspects[static_cast<std::size_t>(owner[i])]);
+        if (suspect) continue;
+        cam_points.push_back(s_pred[i]);
+        cam_image.push_back(obs_n[i]);
+    }
+    m.camera = fit_pose_robust(cam, cam_points, cam_image, options_.camera_fit);
     const autocal::DeviceModel camera = m.camera.ok ? m.camera.model : cam;
     if (m.camera.ok) m.camera_delta = pose_delta(cam, m.camera.model);
     for (std::size_t k = 0; k < model_.projectors.size(); ++k) {

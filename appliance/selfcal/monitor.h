@@ -12,13 +12,12 @@
 //   - if only the camera moved: q_obs = camera'(S(c)): a pose fit of the camera on (S(c), q_obs);
 //   - if projector k moved: its pixel x_k now lands on S_obs = camera ray through q_obs hit with
 //     the cylinder, so a pose fit of projector k on (S_obs, x_k) gives its new pose.
-// The camera is fitted first on all matches (RANSAC: the projectors that did not move are the
-// consensus, which assumes fewer than half the matched features belong to moved projectors),
-// and the projectors against that camera: a bumped camera is not seen as every projector moving.
-// A match counts for projector k only where k's blend weight at the predicted point is at least
-// `owner_min_blend` (in overlaps a moved projector shows a double image).
-// Images: camera frames CV_32FC1 linear in [0, 1], camera resolution, pixel-index coordinates of
-// OpenCV keypoints + 0.5 = image positions. Content frames CV_32FC1 linear grey, any size.
+// The camera is fitted first on all matches but those of suspected projectors (RANSAC: the projectors that did not move
+// are the consensus, which assumes fewer than half the matched features belong to moved projectors), and the projectors
+// against that camera: a bumped camera is not seen as every projector moving. A match counts for projector k only where
+// k's blend weight at the predicted point is at least `owner_min_blend` (in overlaps a moved projector shows a double
+// image). Images: camera frames CV_32FC1 linear in [0, 1], camera resolution, pixel-index coordinates of OpenCV
+// keypoints + 0.5 = image positions. Content frames CV_32FC1 linear grey, any size.
 #pragma once
 
 #include <vector>
@@ -43,8 +42,8 @@ struct MonitorOptions {
     int orb_features = 3000;       // per image
     double ratio = 0.8;            // Lowe's ratio test
     double max_shift_px = 80.0;    // predicted -> observed, camera pixels
-    double owner_min_blend = 0.9;  // a match belongs to a projector above this blend weight
-    RobustPoseOptions camera_fit{2.0, 300, 1.345, 12, 20};
+    double owner_min_blend = 0.6;  // a match belongs to a projector above this blend weight
+    RobustPoseOptions camera_fit{1.0, 300, 1.345, 12, 20};
     RobustPoseOptions projector_fit{6.0, 300, 1.345, 12, 12, 0.002};
 };
 
@@ -74,8 +73,12 @@ public:
     // What the camera should see of `content` (linear, unscaled by exposure; 0 off the screen).
     [[nodiscard]] cv::Mat1f predict(const cv::Mat1f& content) const;
 
-    // One frame's matches and fits. Throws std::invalid_argument for a camera frame of the wrong size.
-    [[nodiscard]] FrameMeasurement measure(const cv::Mat1f& content, const cv::Mat1f& camera_frame) const;
+    // One frame's matches and fits. `suspects` (empty or one flag per projector): projectors
+    // believed to be moving, whose matches (and the overlaps' unowned ones) the camera fit leaves
+    // out, so that a small projector move inside the camera's RANSAC threshold cannot pull the
+    // camera. Throws std::invalid_argument for a camera frame of the wrong size.
+    [[nodiscard]] FrameMeasurement measure(const cv::Mat1f& content, const cv::Mat1f& camera_frame,
+                                           const std::vector<bool>& suspects = {}) const;
 
     [[nodiscard]] const SystemModel& model() const { return model_; }
 

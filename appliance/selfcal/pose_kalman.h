@@ -56,6 +56,8 @@ public:
     [[nodiscard]] const Cov6& covariance() const { return p_; }
     // x^T P^-1 x: how far the state is from "no change" in its own uncertainty.
     [[nodiscard]] double significance() const;
+    // Rejected measurements waiting to become a step (0 when the last one was accepted).
+    [[nodiscard]] int pending() const { return static_cast<int>(pending_.size()); }
 
 private:
     struct Pending {

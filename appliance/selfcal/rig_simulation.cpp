@@ -257,7 +257,7 @@ SimulationReport simulate(const rig::VirtualRig& input, const SimulationOptions&
         for (const autocal::GeometryError& e : projector_errors(truth, wall)) {
             if (e.mean_px >= g.mean_px) g = e;
         }
-        rep.frames.push_back({t, r.status.state, r.status.waiting, g.mean_px, r.cpu_ms});
+        rep.frames.push_back({t, r.status.state, r.status.waiting, g.mean_px, r.cpu_ms, r.status.text()});
         rep.waiting_frames += r.status.waiting ? 1 : 0;
         cpu += r.cpu_ms;
         rep.final_error_px = g.mean_px;

@@ -58,6 +58,7 @@ struct SimulationFrame {
     bool waiting = false;
     double geometry_mean_px = 0.0;  // ground truth: the worst projector's mean error, its pixels
     double cpu_ms = 0.0;
+    std::string status;  // SelfcalStatus::text()
 };
 
 struct SimulationReport {

@@ -319,7 +319,13 @@ StepResult SelfCalibrator::step(const cv::Mat1f& content, const cv::Mat1f& camer
     if (state_ == SelfcalState::correcting) {
         advance_correction(t_s, r);
     } else {
-        const FrameMeasurement m = monitor_.measure(content, camera_frame);
+        // Projectors moving (or about to step) stay out of the camera fit.
+        std::vector<bool> suspects;
+        for (std::size_t k = 0; k < filters_.size(); ++k) {
+            suspects.push_back(filters_[k].pending() > 0 ||
+                               drift_px(static_cast<int>(k), filters_[k].state()) > 0.5 * options_.drift_threshold_px);
+        }
+        const FrameMeasurement m = monitor_.measure(content, camera_frame, suspects);
         filter(m, dt, r);
         rebase_camera(t_s, r);
         decide(t_s, r);

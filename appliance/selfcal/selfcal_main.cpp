@@ -28,8 +28,8 @@ int run_simulate(const std::string& rig_path, const std::vector<std::string>& bu
     const mogao::selfcal::SimulationReport r = mogao::selfcal::simulate(rig, o);
     if (verbose) {
         for (const auto& f : r.frames) {
-            std::printf("t=%6.2f s  %-42s%s  error %.3f px  cpu %.1f ms\n", f.t_s, mogao::selfcal::to_string(f.state),
-                        f.waiting ? " (waiting)" : "", f.geometry_mean_px, f.cpu_ms);
+            std::printf("t=%6.2f s  ground-truth error %.3f px  cpu %.1f ms  %s\n", f.t_s, f.geometry_mean_px, f.cpu_ms,
+                        f.status.c_str());
         }
     }
     for (const std::string& line : r.journal) std::printf("journal: %s\n", line.c_str());
