@@ -61,8 +61,8 @@ TEST(CalibrationStore, KeepsTheLastGoodOne) {
 TEST(CalibrationStore, AWriteKilledMidwayLeavesTheLastGoodCalibration) {
     const auto dir = temp_dir("kill");
     const auto path = dir / "calibration.mpcdi";
-    const ScreenCalibration a = calibration_with_overlap(0.1, {640, 480});
-    const ScreenCalibration b = calibration_with_overlap(0.3, {640, 480});
+    const ScreenCalibration a = calibration_with_overlap(0.1, {320, 240});
+    const ScreenCalibration b = calibration_with_overlap(0.3, {320, 240});
     save_calibration(path, b);
     save_calibration(path, a);  // now a last good one exists too
     // A child writes b again and again; it is killed (SIGKILL: no cleanup) after a varying delay,
@@ -74,7 +74,7 @@ TEST(CalibrationStore, AWriteKilledMidwayLeavesTheLastGoodCalibration) {
         if (pid == 0) {
             for (;;) save_calibration(path, (trial % 2) != 0 ? a : b);
         }
-        std::this_thread::sleep_for(std::chrono::milliseconds(15 + 23 * trial));
+        std::this_thread::sleep_for(std::chrono::milliseconds(5 + 11 * trial));
         ::kill(pid, SIGKILL);
         int status = 0;
         ::waitpid(pid, &status, 0);

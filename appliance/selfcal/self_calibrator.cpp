@@ -240,7 +240,13 @@ void SelfCalibrator::decide(double t_s, StepResult& r) {
         ps.drift_px = drift_px(static_cast<int>(k), x);
         ps.rotation_deg = x.head<3>().norm() * kRad2Deg;
         ps.shift_mm = x.tail<3>().norm() * 1e3;
-        if (ps.drift_px > options_.drift_threshold_px && filters_[k].significance() > options_.kalman.gate_chi2) {
+        // Hysteresis: once detected, a drift stays until it falls under half the threshold, so a
+        // drift near the threshold cannot restart the hold time frame after frame.
+        const bool holding = state_ == SelfcalState::drift_detected || state_ == SelfcalState::cannot_correct;
+        const bool above = holding ? ps.drift_px > 0.5 * options_.drift_threshold_px
+                                   : ps.drift_px > options_.drift_threshold_px &&
+                                         filters_[k].significance() > options_.kalman.gate_chi2;
+        if (above) {
             drifting.push_back(static_cast<int>(k));
         }
     }

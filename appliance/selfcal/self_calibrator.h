@@ -4,7 +4,7 @@
 // filters each projector's and the camera's pose change (pose_kalman.h) and decides:
 //   calibrated -> drift detected: a projector's filtered drift is above `drift_threshold_px`
 //     (mean displacement of its image on the screen, in its own pixels) and significant (outside
-//     the filter's own uncertainty, x^T P^-1 x > gate);
+//     the filter's own uncertainty, x^T P^-1 x > gate); it stays detected until under half the threshold;
 //   drift detected -> correcting: that lasted `hold_s` seconds; the corrected warp maps and blend
 //     masks (autocal::calibration_from_models on the re-estimated poses, intrinsics fixed) are
 //     blended in linearly over `transition_s`; step() returns each intermediate calibration;

@@ -41,7 +41,7 @@ std::string journal(const SimulationReport& r) {
 
 TEST(SelfcalRig, ProjectorBumpedOneDegreeIsDetectedAndCorrectedBelowOnePixel) {
     const rig::VirtualRig rig = standard();
-    SimulationOptions o = quick(14);
+    SimulationOptions o = quick(12);
     Bump b = parse_bump(rig, "proj1:yaw=1deg");
     b.at_s = 0.5;
     o.bumps = {b};
@@ -58,25 +58,25 @@ TEST(SelfcalRig, ProjectorBumpedOneDegreeIsDetectedAndCorrectedBelowOnePixel) {
 }
 
 TEST(SelfcalRig, NoFalseCorrectionWithNoiseExposureChangesAndVisitors) {
-    SimulationOptions o = quick(16);
+    SimulationOptions o = quick(12);
     o.exposure_jitter = 0.3;
     o.occlusion = 0.1;
     o.occlusion_max = 0.4;
     const SimulationReport r = simulate(standard(), o);
     EXPECT_EQ(r.corrections, 0) << journal(r);
-    EXPECT_EQ(frames_in(r, SelfcalState::calibrated), 16) << journal(r);
+    EXPECT_EQ(frames_in(r, SelfcalState::calibrated), 12) << journal(r);
     EXPECT_LT(r.final_error_px, 0.1);
 }
 
 TEST(SelfcalRig, BumpedCameraIsNotTakenForEveryProjectorMoving) {
     const rig::VirtualRig rig = standard();
-    SimulationOptions o = quick(10);
+    SimulationOptions o = quick(8);
     Bump b = parse_bump(rig, "camera:yaw=1deg,pitch=0.5deg,x=10mm");
     b.at_s = 0.5;
     o.bumps = {b};
     const SimulationReport r = simulate(rig, o);
     EXPECT_EQ(r.corrections, 0) << journal(r);
-    EXPECT_EQ(frames_in(r, SelfcalState::calibrated), 10) << journal(r);
+    EXPECT_EQ(frames_in(r, SelfcalState::calibrated), 8) << journal(r);
     EXPECT_NE(journal(r).find("camera moved"), std::string::npos) << journal(r);
     EXPECT_LT(r.final_error_px, 0.1);
 }
