@@ -76,9 +76,12 @@ fi
 # Enforced, not only configured: from inside the kiosk's cgroup a connection to another address is
 # refused by the cgroup's filter (EPERM at once), one to the farm's address is not (here nothing
 # listens on port 9, so the host refuses it: ECONNREFUSED).
+# Only the probe moves into the kiosk's cgroup (a child shell: $$ of a ( ) subshell would be this
+# script, which would then lose the serial ports to the kiosk's device policy); its output goes
+# through a pipe, not a device.
 probe() {
-  (echo $$ > /sys/fs/cgroup/system.slice/mogao-kiosk.service/cgroup.procs &&
-     exec timeout 5 bash -c "exec 3<>/dev/tcp/$1/9" 2>&1) | tail -n1
+  sh -c 'echo $$ > /sys/fs/cgroup/system.slice/mogao-kiosk.service/cgroup.procs &&
+         exec timeout 5 bash -c "exec 3<>/dev/tcp/$1/9"' probe "$1" 2>&1 | tail -n1
 }
 other=$(probe fec0::99)
 to_farm=$(probe "$farm_addr")
