@@ -26,8 +26,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "common/image_compare.h"
 #include "common/camera_path.h"
+#include "common/image_compare.h"
+#include "common/thread_clock.h"
 #include "renderfarm/scene/scene_file.h"
 #include "renderfarm/trace/film.h"
 #include "renderfarm/trace/render_timing.h"
@@ -36,12 +37,6 @@
 namespace {
 
 using namespace mogao;
-
-double thread_cpu_seconds() {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
 
 struct Frame {
     RgbFloatImage radiance;

@@ -41,6 +41,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/camera_path.h"
+#include "common/thread_clock.h"
 #include "renderfarm/scene/procedural.h"
 #include "renderfarm/scene/scene.h"
 #include "renderfarm/scene/scene_file.h"
@@ -176,12 +177,6 @@ void print(const char* label, const RenderTimings& t, double baseline_s) {
     std::printf("%-44s %9.2f ms  %11llu rays  %6.2f Mrays/s  x%.2f vs (a)\n", label, 1e3 * t.render_s,
                 static_cast<unsigned long long>(t.render_rays), 1e-6 * static_cast<double>(t.render_rays) / t.render_s,
                 t.render_s / baseline_s);
-}
-
-double thread_cpu_seconds() {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
 // One path of (d): its frame, CPU time, rays, and raw Embree on the same ray mix.

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "common/camera_path.h"
+#include "common/thread_clock.h"
 #include "renderfarm/denoise/atrous_filter.h"
 #include "renderfarm/denoise/frame_error.h"
 #include "renderfarm/denoise/guide_pass.h"
@@ -30,18 +31,6 @@
 namespace {
 
 using namespace mogao;
-
-double cpu_seconds() {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-double wall_seconds() {
-    timespec ts{};
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
 
 struct Timed {
     RgbFloatImage image;
@@ -54,9 +43,9 @@ Timed render(Renderer& renderer, ViewRequest view, int spp, int reps) {
     for (int r = 0; r < reps; ++r) {
         renderer.begin_frame(view);
         RgbFloatImage image(renderer.render_size());
-        const double t0 = cpu_seconds();
+        const double t0 = thread_cpu_seconds();
         (void)renderer.render(PixelRect::whole(image.size), image);
-        const double t = cpu_seconds() - t0;
+        const double t = thread_cpu_seconds() - t0;
         if (t < best.seconds) best = {std::move(image), t};
     }
     return best;
@@ -101,14 +90,14 @@ Timed denoise(GuidePass& pass, const ViewRequest& view, const RgbFloatImage& raw
     Timed best;
     AtrousDenoiser denoiser;
     for (int r = 0; r < reps; ++r) {
-        const double t0 = cpu_seconds();
+        const double t0 = thread_cpu_seconds();
         Result<GuideBuffers> guides = pass.render_frame(view);
-        const double t1 = cpu_seconds(), w1 = wall_seconds();
+        const double t1 = thread_cpu_seconds(), w1 = monotonic_seconds();
         RgbFloatImage out;
         if (!guides.ok()) throw std::runtime_error(guides.error().message);
         if (Status s = denoiser.run(raw, *guides, params, out); !s.ok()) throw std::runtime_error(s.error().message);
         // The filter may run on several threads: charge its wall time (it is the frame's latency).
-        const double filter = params.threads == 1 ? cpu_seconds() - t1 : wall_seconds() - w1;
+        const double filter = params.threads == 1 ? thread_cpu_seconds() - t1 : monotonic_seconds() - w1;
         if (t1 - t0 + filter < best.seconds) {
             best = {std::move(out), t1 - t0 + filter};
             *filter_seconds = filter;

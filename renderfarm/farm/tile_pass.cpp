@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "renderfarm/farm/tile_pass.h"
+#include "common/thread_clock.h"
 
 #include <atomic>
 #include <chrono>
@@ -25,12 +26,6 @@ std::vector<PixelRect> split_into_cells(const std::vector<PixelRect>& rects, int
                 tiles.push_back(intersect(r, PixelRect{x, y, x + cell, y + cell}));
     }
     return tiles;
-}
-
-double thread_cpu_seconds() {
-    timespec t{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
 std::size_t bytes_per_pixel(PackedPixels format) { return format == PackedPixels::linear ? 3 * sizeof(float) : 3; }
