@@ -28,7 +28,6 @@
 
 #include "common/camera_path.h"
 #include "common/image_compare.h"
-#include "common/thread_clock.h"
 #include "renderfarm/scene/scene_file.h"
 #include "renderfarm/trace/film.h"
 #include "renderfarm/trace/render_timing.h"
@@ -37,25 +36,6 @@
 namespace {
 
 using namespace mogao;
-
-struct Frame {
-    RgbFloatImage radiance;
-    double seconds = 0.0;
-};
-
-Frame render(Renderer& renderer, const ViewRequest& view, int reps) {
-    Frame best;
-    best.seconds = 1e300;
-    for (int r = 0; r < reps; ++r) {
-        renderer.begin_frame(view);
-        RgbFloatImage image(renderer.render_size());
-        const double t0 = thread_cpu_seconds();
-        (void)renderer.render(PixelRect::whole(image.size), image);
-        const double t = thread_cpu_seconds() - t0;
-        if (t < best.seconds) best = {std::move(image), t};
-    }
-    return best;
-}
 
 // Nearest-neighbour upscale so a reduced-resolution frame can be compared with the reference.
 RgbFloatImage upscale(const RgbFloatImage& in, ImageSize to) {
@@ -94,13 +74,13 @@ void knobs_table(Renderer& renderer, const Scene& scene, const ViewRequest& view
     reference_view.quality.ao_samples = 16;
     reference_view.quality.max_bounces = 2;
     reference_view.quality.area_light_samples = 8;
-    const Frame reference = render(renderer, reference_view, 1);
-    const Rgb8Image reference_8 = to_display(reference.radiance, scene.exposure);
+    const TimedFrame reference = render_fastest_of(renderer, reference_view, 1);
+    const Rgb8Image reference_8 = to_display(reference.image, scene.exposure);
     ViewRequest base = view;
     base.quality.spp = 4;
     base.quality.ao_samples = 2;
     base.quality.max_bounces = 1;
-    const Frame base_frame = render(renderer, base, reps);
+    const TimedFrame base_frame = render_fastest_of(renderer, base, reps);
     std::printf(
         "## Quality knobs: time against error\n\nReference: spp 64, AO 16, 2 bounces, 8 area samples (%.1f s). "
         "Baseline: spp 4, AO 2, 1 bounce, 1 area sample, scale 1 (%.1f ms). One knob changes per row.\n\n",
@@ -117,10 +97,10 @@ void knobs_table(Renderer& renderer, const Scene& scene, const ViewRequest& view
     std::printf(
         "| knob | value | CPU ms | time / baseline | relative RMSE | PSNR dB (sRGB8) |\n|---|--:|--:|--:|--:|--:|\n");
     const auto row = [&](const char* knob, const std::string& value, ViewRequest v) {
-        const Frame f = render(renderer, v, reps);
+        const TimedFrame f = render_fastest_of(renderer, v, reps);
         const RgbFloatImage full =
-            f.radiance.size == reference.radiance.size ? f.radiance : upscale(f.radiance, reference.radiance.size);
-        const double rmse = relative_rmse(full, reference.radiance);
+            f.image.size == reference.image.size ? f.image : upscale(f.image, reference.image.size);
+        const double rmse = relative_rmse(full, reference.image);
         const double db = psnr(to_display(full, scene.exposure), reference_8);
         std::printf("| %s | %s | %.1f | %.2f | %.4f | %.2f |\n", knob, value.c_str(), 1e3 * f.seconds,
                     f.seconds / base_frame.seconds, rmse, db);

@@ -26,6 +26,7 @@
 #include "renderfarm/denoise/frame_error.h"
 #include "renderfarm/denoise/guide_pass.h"
 #include "renderfarm/scene/scene_file.h"
+#include "renderfarm/trace/render_timing.h"
 #include "renderfarm/trace/renderer.h"
 
 namespace {
@@ -39,16 +40,8 @@ struct Timed {
 
 Timed render(Renderer& renderer, ViewRequest view, int spp, int reps) {
     view.quality.spp = spp;
-    Timed best;
-    for (int r = 0; r < reps; ++r) {
-        renderer.begin_frame(view);
-        RgbFloatImage image(renderer.render_size());
-        const double t0 = thread_cpu_seconds();
-        (void)renderer.render(PixelRect::whole(image.size), image);
-        const double t = thread_cpu_seconds() - t0;
-        if (t < best.seconds) best = {std::move(image), t};
-    }
-    return best;
+    TimedFrame f = render_fastest_of(renderer, view, reps);
+    return {std::move(f.image), f.seconds};
 }
 
 struct Point {

@@ -54,4 +54,18 @@ RenderTimings time_render_vs_embree(const Scene& scene, const ViewRequest& reque
     return t;
 }
 
+TimedFrame render_fastest_of(Renderer& renderer, const ViewRequest& request, int repetitions) {
+    TimedFrame best;
+    best.seconds = std::numeric_limits<double>::infinity();
+    for (int r = 0; r < repetitions; ++r) {
+        renderer.begin_frame(request);
+        RgbFloatImage image(renderer.render_size());
+        const double t0 = thread_cpu_seconds();
+        (void)renderer.render(PixelRect::whole(image.size), image);
+        const double t = thread_cpu_seconds() - t0;
+        if (t < best.seconds) best = {std::move(image), t};
+    }
+    return best;
+}
+
 }  // namespace mogao

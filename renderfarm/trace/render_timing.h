@@ -26,6 +26,14 @@ struct RenderTimings {
 // Uses an existing renderer (calls begin_frame(request)).
 [[nodiscard]] RenderTimings time_frame(Renderer& renderer, const ViewRequest& request, int repetitions = 3);
 
+// A whole frame of `request` (linear radiance, the renderer's render_size) and the calling thread's
+// CPU seconds it took: the fastest of `repetitions` renders (the benchmarks' way of timing a frame).
+struct TimedFrame {
+    RgbFloatImage image;
+    double seconds = 0.0;
+};
+[[nodiscard]] TimedFrame render_fastest_of(Renderer& renderer, const ViewRequest& request, int repetitions);
+
 // Builds a renderer for `scene` (timed as build_s) and times one frame of `request`.
 [[nodiscard]] RenderTimings time_render_vs_embree(const Scene& scene, const ViewRequest& request,
                                                   const RendererOptions& options = {}, int repetitions = 3);
