@@ -70,10 +70,14 @@ void DecodeWorker::run() {
                 rejections_.push_back({++rejected_, why});
                 if (rejections_.size() > kMaxRejections) rejections_.erase(rejections_.begin());
             }
+        }
+        if (on_decoded_) on_decoded_();
+        {
+            // Idle only after on_decoded ran, so wait_idle() also waits for the callback.
+            const std::lock_guard lock(mutex_);
             busy_ = false;
         }
         idle_.notify_all();
-        if (on_decoded_) on_decoded_();
     }
 }
 

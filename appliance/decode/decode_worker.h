@@ -61,7 +61,8 @@ public:
     [[nodiscard]] std::uint64_t superseded() const;
     [[nodiscard]] std::uint64_t rejected() const;
 
-    // Blocks until every frame put so far has been decoded or rejected (tests, clean stop).
+    // Blocks until every frame put so far has been decoded or rejected and its on_decoded has
+    // returned (tests, clean stop).
     void wait_idle();
 
 private:
