@@ -50,12 +50,25 @@ struct ResponseCurve {
     std::array<std::vector<float>, 3> lut;  // each of the same length >= 2, values in [0, 1]
 };
 
+// Per output pixel and channel: black-level offset (MPCDI beta map) in linear light, in the same
+// units as the content (1 = the matched full white), added after the blend weight and before the
+// response curve, so that the screen's black is as bright everywhere as in the brightest overlap
+// (Majumder & Stevens, "Color nonuniformity in projection-based displays", IEEE TVCG 10(2), 2004).
+// Empty (size 0 x 0) = no offset. Sampled like the blend mask (sample_beta in warp_sampling.h).
+struct BlackOffset {
+    ImageSize size;          // grid samples: the output size, or coarser; 0 x 0 = none
+    std::vector<float> rgb;  // size.width * size.height * 3, row-major, r g b interleaved
+};
+
+// Per channel c of one output pixel (appliance/warp/composite.h, render_output):
+//   linear_c = clamp(content_c * blend + beta_c, 0, 1); signal_c = response.lut[c](linear_c).
 struct ProjectorCalibration {
     std::string id;                 // region id (MPCDI) e.g. "proj0"
     ImageSize output;               // projector resolution in pixels
     WarpMap warp;
     BlendMask blend;
     ResponseCurve response;
+    BlackOffset beta;  // optional (empty = none)
 };
 
 struct ScreenCalibration {

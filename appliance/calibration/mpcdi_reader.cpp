@@ -62,6 +62,12 @@ MpcdiFile read_mpcdi(const std::filesystem::path& path, std::vector<std::string>
                 r.distortion->map = load_pfm(zip, who, r.distortion->path);
                 used.insert(r.distortion->path);
             }
+            const std::string lut = response_lut_entry(r.id);
+            if (zip.contains(lut)) {
+                r.response = MpcdiResponseLut{lut, load_pfm(zip, who, lut)};
+                check_response_lut(r.response->map, entry_who(who, lut));
+                used.insert(lut);
+            }
         }
     }
     if (notes != nullptr) {

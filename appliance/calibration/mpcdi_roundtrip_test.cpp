@@ -12,6 +12,7 @@
 #include "appliance/calibration/mpcdi_test_util.h"
 #include "appliance/calibration/mpcdi_writer.h"
 #include "appliance/warp/ideal_calibration.h"
+#include "appliance/warp/response_curve.h"
 
 namespace mogao {
 namespace {
@@ -97,6 +98,53 @@ TEST(MpcdiRoundTrip, IdealCalibrationSurvivesMpcdi) {
             EXPECT_LE(blend_err, blend_bound);
         }
     }
+}
+
+TEST(MpcdiRoundTrip, BetaMapsAndMeasuredResponsesSurviveMpcdi) {
+    test::ScratchDir dir;
+    ScreenCalibration screen = make_ideal_calibration(IdealCalibrationParams{});
+    for (std::size_t k = 0; k < screen.projectors.size(); ++k) {
+        ProjectorCalibration& p = screen.projectors[k];
+        p.beta.size = {p.output.width / 4, p.output.height / 4};
+        p.beta.rgb.resize(static_cast<std::size_t>(p.beta.size.pixel_count()) * 3);
+        for (std::size_t i = 0; i < p.beta.rgb.size(); ++i) {
+            p.beta.rgb[i] = static_cast<float>(0.01 * static_cast<double>((i * 7 + k) % 101) / 100.0);
+        }
+        p.response = make_gamma_response(2.2, 256);
+        p.response.lut[1] = make_gamma_response(1.8 + 0.2 * static_cast<double>(k), 256).lut[1];
+    }
+    MpcdiExportOptions options;
+    options.write_response = true;
+    write_mpcdi(dir / "colour.mpcdi", to_mpcdi(screen, options));
+    const MpcdiFile file = read_mpcdi(dir / "colour.mpcdi");
+    ASSERT_TRUE(file.buffers[0].regions[0].beta.has_value());
+    ASSERT_TRUE(file.buffers[0].regions[0].response.has_value());
+    EXPECT_EQ(file.buffers[0].regions[0].response->path, "ResponseLUT-proj0.pfm");
+    const ScreenCalibration back = to_screen_calibration(file);
+    for (std::size_t k = 0; k < screen.projectors.size(); ++k) {
+        const ProjectorCalibration& a = screen.projectors[k];
+        const ProjectorCalibration& b = back.projectors[k];
+        EXPECT_EQ(b.response.lut, a.response.lut);  // float32 PFM: bit-identical
+        ASSERT_EQ(b.beta.size, a.beta.size);
+        ASSERT_EQ(b.beta.rgb.size(), a.beta.rgb.size());
+        double err = 0.0;
+        for (std::size_t i = 0; i < a.beta.rgb.size(); ++i) {
+            err = std::max(err, std::abs(static_cast<double>(a.beta.rgb[i]) - b.beta.rgb[i]));
+        }
+        EXPECT_LE(err, 0.5 / 65535.0 + 1e-8);  // half a 16-bit code
+    }
+    // Second pass: the quantised maps are a fixed point, so the files' maps are identical.
+    write_mpcdi(dir / "again.mpcdi", to_mpcdi(back, options));
+    const MpcdiFile again = read_mpcdi(dir / "again.mpcdi");
+    for (std::size_t k = 0; k < 3; ++k) {
+        EXPECT_TRUE(again.buffers[0].regions[k].beta == file.buffers[0].regions[k].beta);
+        EXPECT_TRUE(again.buffers[0].regions[k].response == file.buffers[0].regions[k].response);
+    }
+    // A corrupt LUT (decreasing) is refused by name.
+    MpcdiFile bad = file;
+    bad.buffers[0].regions[0].response->map.values[3] = 0.9F;
+    bad.buffers[0].regions[0].response->map.values[6] = 0.1F;
+    EXPECT_THROW(write_mpcdi(dir / "bad.mpcdi", bad), MpcdiError);
 }
 
 TEST(MpcdiRoundTrip, WriteIsAtomicAndKeepsTheLastGoodFile) {

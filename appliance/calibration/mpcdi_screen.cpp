@@ -73,8 +73,66 @@ BlendMask convert_alpha(const MpcdiRegion& r, double assumed_gamma, const std::s
     return b;
 }
 
+// Beta map code / (2^bits - 1) = offset in linear light, content units (BlackOffset); gray maps
+// apply to all three channels.
+BlackOffset convert_beta(const MpcdiRegion& r, const std::string& who) {
+    BlackOffset b;
+    if (!r.beta) return b;
+    const PngMap& m = r.beta->map;
+    if (m.size.width > r.resolution.width || m.size.height > r.resolution.height) {
+        throw MpcdiError(who + ": beta map " + size_text(m.size) + " is larger than the region resolution " +
+                         size_text(r.resolution));
+    }
+    const double max = std::ldexp(1.0, m.bit_depth) - 1.0;
+    b.size = m.size;
+    const auto count = static_cast<std::size_t>(m.size.pixel_count());
+    const auto ch = static_cast<std::size_t>(m.channels);
+    b.rgb.resize(count * 3);
+    for (std::size_t i = 0; i < count; ++i) {
+        for (std::size_t c = 0; c < 3; ++c) {
+            b.rgb[i * 3 + c] = static_cast<float>(m.values[i * ch + (ch == 3 ? c : 0)] / max);
+        }
+    }
+    return b;
+}
+
+ResponseCurve convert_response(const MpcdiResponseLut& lut) {
+    ResponseCurve curve;
+    const auto n = static_cast<std::size_t>(lut.map.size.width);
+    for (std::size_t c = 0; c < 3; ++c) {
+        curve.lut[c].resize(n);
+        for (std::size_t k = 0; k < n; ++k) curve.lut[c][k] = lut.map.values[k * 3 + c];
+    }
+    return curve;
+}
+
 bool any_nonzero(const std::vector<float>& v) {
     return std::any_of(v.begin(), v.end(), [](float x) { return x != 0.0F; });
+}
+
+MpcdiBetaMap beta_map(const BlackOffset& beta) {
+    MpcdiBetaMap m;
+    m.map.size = beta.size;
+    m.map.channels = 3;
+    m.map.bit_depth = 16;
+    m.map.values.resize(beta.rgb.size());
+    for (std::size_t i = 0; i < beta.rgb.size(); ++i) {
+        m.map.values[i] = static_cast<std::uint16_t>(std::clamp(std::round(65535.0 * beta.rgb[i]), 0.0, 65535.0));
+    }
+    return m;
+}
+
+MpcdiResponseLut response_lut(const ResponseCurve& curve, const std::string& id) {
+    MpcdiResponseLut m;
+    m.path = response_lut_entry(id);
+    const std::size_t n = curve.lut[0].size();
+    m.map.size = {static_cast<int>(n), 1};
+    m.map.channels = 3;
+    m.map.values.resize(n * 3);
+    for (std::size_t k = 0; k < n; ++k) {
+        for (std::size_t c = 0; c < 3; ++c) m.map.values[k * 3 + c] = curve.lut[c][k];
+    }
+    return m;
 }
 
 }  // namespace
@@ -102,14 +160,12 @@ ScreenCalibration to_screen_calibration(const MpcdiFile& file, const ScreenConve
         p.output = r.resolution;
         p.warp = convert_warp(r, options.warp_space, who);
         p.blend = convert_alpha(r, options.assumed_gamma, who, notes);
-        p.response = options.response;
+        p.response = r.response ? convert_response(*r.response) : options.response;
+        p.beta = convert_beta(r, who);
         if (notes != nullptr) {
             if (r.alpha.gamma_embedded == 0.0) {
                 notes->push_back("region \"" + r.id + "\": gammaEmbedded 0, alpha decoded with gamma " +
                                  std::to_string(options.assumed_gamma));
-            }
-            if (r.beta && std::any_of(r.beta->map.values.begin(), r.beta->map.values.end(), [](auto v) { return v != 0; })) {
-                notes->push_back("region \"" + r.id + "\": non-zero beta map ignored (no black-level model)");
             }
             if (r.distortion && any_nonzero(r.distortion->map.values)) {
                 notes->push_back("region \"" + r.id + "\": non-zero distortion map ignored");
@@ -199,6 +255,8 @@ MpcdiFile to_mpcdi(const ScreenCalibration& screen, const MpcdiExportOptions& op
             const double code = std::round(max * std::pow(static_cast<double>(p.blend.weight[i]), 1.0 / options.alpha_gamma));
             r.alpha.map.values[i] = static_cast<std::uint16_t>(std::clamp(code, 0.0, max));
         }
+        if (!p.beta.rgb.empty()) r.beta = beta_map(p.beta);
+        if (options.write_response) r.response = response_lut(p.response, r.id);
         buffer.regions.push_back(std::move(r));
     }
     file.level = all_per_pixel ? 3 : 1;

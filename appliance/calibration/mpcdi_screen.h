@@ -14,14 +14,22 @@
 //     SampleMPCDI) uses options.assumed_gamma (2.2, the reference examples' value). RGB alpha maps
 //     become the mean of the three channel weights (BlendMask has one weight; per-channel blending
 //     is lost, with a note).
-//   * response: MPCDI does not carry the projector's response; options.response (gamma 2.2).
-//   * beta (black-level offset) and distortion maps have no place in ScreenCalibration and are
-//     ignored, with a note when they hold non-zero data.
+//   * response: MPCDI v1.0 does not carry the projector's response: the region's ResponseLUT
+//     extension entry when present (MpcdiResponseLut in mpcdi_types.h), else options.response
+//     (gamma 2.2).
+//   * beta (black-level offset, BlackOffset in projector_calibration.h): code / (2^bitDepth - 1)
+//     is the offset in linear light in content units, no gamma (black offsets are small; a gamma
+//     would spend the codes where they are not needed); gray maps apply to r, g and b. MPCDI v1.0
+//     names the beta map the black-level offset map but leaves its encoding to the profile; this
+//     is the encoding mogao writes and reads (docs/calibration.md, "Black level").
+//   * distortion maps have no place in ScreenCalibration and are ignored, with a note when they
+//     hold non-zero data.
 // ScreenCalibration -> MPCDI 2d profile (to_mpcdi): the inverse with region = bounding box of the
 // projector's finite warp positions (clamped to [0, 1], rounded to 6 significant digits as "%g"
 // prints them), warp relative to it, alpha gray at the
-// chosen bit depth and gamma, level 3 for per-pixel warps (warp grid larger than a tenth of the
-// region, the reference library's rule) and 1 for coarse ones.
+// chosen bit depth and gamma, beta as a 16-bit RGB map when the projector has one, the response as
+// the ResponseLUT extension entry when options.write_response, level 3 for per-pixel warps (warp
+// grid larger than a tenth of the region, the reference library's rule) and 1 for coarse ones.
 #pragma once
 
 #include <string>
@@ -52,6 +60,7 @@ struct MpcdiExportOptions {
     double alpha_gamma = 2.2;   // gammaEmbedded written and applied, (0, 10]
     std::string buffer_id = "buffer1";
     std::string date;           // empty = the time of writing
+    bool write_response = false;  // write each projector's response LUT (mogao extension entry)
 };
 
 // Throws std::invalid_argument for an invalid screen (validate_screen) or options.

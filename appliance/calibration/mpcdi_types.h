@@ -5,7 +5,8 @@
 // Converting to the appliance's ScreenCalibration is mpcdi_screen.h.
 //
 // Layout: an MPCDI file is a ZIP holding mpcdi.xml and per region a geometry warp (PFM), an alpha
-// map (PNG), optionally a beta map (PNG) and a distortion map (PFM). Maps here are converted to the
+// map (PNG), optionally a beta map (PNG) and a distortion map (PFM), and (mogao's extension) a
+// response LUT (PFM, see MpcdiResponseLut). Maps here are converted to the
 // project's image convention: row-major, TOP row first (PFM stores rows bottom-to-top; the reader
 // flips them), channels interleaved, (0, 0) = top-left.
 //
@@ -102,6 +103,23 @@ struct MpcdiDistortionMap {
     friend bool operator==(const MpcdiDistortionMap&, const MpcdiDistortionMap&) = default;
 };
 
+// mogao's extension (not in MPCDI v1.0): the projector's measured inverse response, entry
+// "ResponseLUT-<regionId>.pfm" in the same ZIP, found by that name (mpcdi.xml does not reference
+// it, so other readers ignore it as an unreferenced entry). A PF map of n x 1 samples (n >= 2):
+// sample k holds, per channel r, g, b, the input signal in [0, 1] that gives linear light
+// k / (n - 1) of the matched white (ResponseCurve in common/projector_calibration.h).
+struct MpcdiResponseLut {
+    std::string path;  // always "ResponseLUT-<regionId>.pfm" (the reader finds it by that name)
+    PfmMap map;
+    friend bool operator==(const MpcdiResponseLut&, const MpcdiResponseLut&) = default;
+};
+
+// "ResponseLUT-<regionId>.pfm".
+[[nodiscard]] std::string response_lut_entry(const std::string& region_id);
+// Throws MpcdiError starting with `who` unless the map is 3 channels, n x 1 with n in
+// [2, 1048576], every value finite, in [0, 1] and non-decreasing along the table.
+void check_response_lut(const PfmMap& map, const std::string& who);
+
 struct MpcdiRegion {
     std::string id;
     ImageSize resolution;            // Xresolution, Yresolution: the projector's pixels
@@ -113,6 +131,7 @@ struct MpcdiRegion {
     MpcdiAlphaMap alpha;
     std::optional<MpcdiBetaMap> beta;
     std::optional<MpcdiDistortionMap> distortion;
+    std::optional<MpcdiResponseLut> response;  // extension, see MpcdiResponseLut
     friend bool operator==(const MpcdiRegion&, const MpcdiRegion&) = default;
 };
 

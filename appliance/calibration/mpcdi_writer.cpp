@@ -29,6 +29,7 @@ void fill_default_paths(MpcdiFile& file) {
             if (r.alpha.path.empty()) r.alpha.path = "AlphaMap-" + r.id + ".png";
             if (r.beta && r.beta->path.empty()) r.beta->path = "BetaMap-" + r.id + ".png";
             if (r.distortion && r.distortion->path.empty()) r.distortion->path = "DistortionMapFile-" + r.id + ".pfm";
+            if (r.response && r.response->path.empty()) r.response->path = response_lut_entry(r.id);
         }
     }
 }
@@ -92,6 +93,14 @@ void validate(const MpcdiFile& file, const std::string& who) {
             add_path(r.alpha.path);
             if (r.beta) add_path(r.beta->path);
             if (r.distortion) add_path(r.distortion->path);
+            if (r.response) {
+                if (r.response->path != response_lut_entry(r.id)) {
+                    throw MpcdiError(rw + ": response LUT entry '" + r.response->path + "' must be named '" +
+                                     response_lut_entry(r.id) + "' (the reader finds it by that name)");
+                }
+                add_path(r.response->path);
+                check_response_lut(r.response->map, rw + ": response LUT");
+            }
         }
     }
 }
@@ -110,6 +119,9 @@ Entries encode_entries(const MpcdiFile& file, const std::string& who) {
         if (r->beta) entries.emplace_back(r->beta->path, encode_png_map(r->beta->map, entry(r->beta->path)));
         if (r->distortion) {
             entries.emplace_back(r->distortion->path, encode_pfm(r->distortion->map, entry(r->distortion->path)));
+        }
+        if (r->response) {
+            entries.emplace_back(r->response->path, encode_pfm(r->response->map, entry(r->response->path)));
         }
     }
     const std::string xml = print_mpcdi_xml(file);

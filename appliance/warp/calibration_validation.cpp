@@ -65,6 +65,25 @@ void validate_blend(const BlendMask& blend, std::string_view what) {
     }
 }
 
+void validate_beta(const BlackOffset& beta, std::string_view what) {
+    const std::string who = std::string(what) + ".beta";
+    if (beta.size.width == 0 && beta.size.height == 0 && beta.rgb.empty()) return;
+    validate_size(beta.size, who);
+    const auto count = static_cast<std::size_t>(beta.size.pixel_count()) * 3;
+    if (beta.rgb.size() != count) {
+        throw std::invalid_argument(who + ": rgb holds " + std::to_string(beta.rgb.size()) + " values, " +
+                                    size_text(beta.size) + " x 3 = " + std::to_string(count) + " expected");
+    }
+    for (std::size_t i = 0; i < count; ++i) {
+        const float b = beta.rgb[i];
+        if (!(b >= 0.0F && b <= 1.0F)) {
+            throw std::invalid_argument(who + ": offset " + pixel_text(i / 3, beta.size.width) + " channel " +
+                                        std::to_string(i % 3) + " = " + std::to_string(b) +
+                                        " is outside [0, 1] (or not finite)");
+        }
+    }
+}
+
 void validate_projector(const ProjectorCalibration& projector, std::string_view what) {
     const std::string who(what);
     if (projector.id.empty()) throw std::invalid_argument(who + ": id is empty");
@@ -79,6 +98,8 @@ void validate_projector(const ProjectorCalibration& projector, std::string_view 
     };
     no_finer(projector.warp.size, "warp");
     no_finer(projector.blend.size, "blend");
+    validate_beta(projector.beta, who);
+    no_finer(projector.beta.size, "beta");
     validate_response(projector.response, who + ".response");
 }
 

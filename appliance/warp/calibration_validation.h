@@ -27,6 +27,10 @@ void validate_warp(const WarpMap& warp, std::string_view what);
 // size valid; weight holds width*height values, each finite and in [0, 1].
 void validate_blend(const BlendMask& blend, std::string_view what);
 
+// Either empty (size 0 x 0, no values) or: size valid; rgb holds width*height*3 values, each finite
+// and in [0, 1].
+void validate_beta(const BlackOffset& beta, std::string_view what);
+
 // id non-empty; output size valid; warp and blend valid and not larger than the output (a grid
 // finer than the output has no sample-to-pixel meaning); response valid (validate_response).
 void validate_projector(const ProjectorCalibration& projector, std::string_view what);

@@ -62,9 +62,10 @@ RgbFloatImage render_output(const ProjectorCalibration& projector, const RgbFloa
             if (!uv.valid()) continue;  // no content: signal 0
             const std::array<float, 3> rgb = sample_content(content_linear, uv.u, uv.v);
             const float weight = sample_blend(projector.blend, projector.output, x, y);
+            const std::array<float, 3> beta = sample_beta(projector.beta, projector.output, x, y);
             float* dst = out.at(x, y);
-            for (int c = 0; c < 3; ++c) {
-                dst[c] = apply_response(projector.response, c, rgb[static_cast<std::size_t>(c)] * weight);
+            for (std::size_t c = 0; c < 3; ++c) {
+                dst[c] = apply_response(projector.response, static_cast<int>(c), rgb[c] * weight + beta[c]);
             }
         }
     }

@@ -30,7 +30,8 @@ namespace mogao {
 [[nodiscard]] std::array<float, 3> sample_content(const RgbFloatImage& content, double u, double v);
 
 // The projector's input signal: per output pixel, warp (sample_warp) -> sample_content ->
-// x blend weight (sample_blend) -> clamp to [0, 1] -> response LUT per channel. Pixels with no
+// x blend weight (sample_blend) + black offset (sample_beta, per channel) -> clamp to [0, 1] ->
+// response LUT per channel. Pixels with no
 // content (NaN warp) are signal 0 (black). Returns an image of projector.output size.
 // Throws std::invalid_argument for an invalid projector (validate_projector) or content image.
 [[nodiscard]] RgbFloatImage render_output(const ProjectorCalibration& projector, const RgbFloatImage& content_linear);

@@ -10,6 +10,8 @@
 
 #include "appliance/warp/composite_check.h"
 #include "appliance/warp/ideal_calibration.h"
+#include "appliance/warp/response_curve.h"
+#include "appliance/warp/warp_sampling.h"
 
 namespace mogao {
 namespace {
@@ -168,6 +170,36 @@ TEST(Composite, MismatchedOutputsAreRejected) {
     outputs.emplace_back(ImageSize{8, 5});
     EXPECT_THROW((void)composite_on_screen(s, outputs), std::invalid_argument);
     EXPECT_THROW((void)render_output(s.projectors[0], RgbFloatImage()), std::invalid_argument);
+}
+
+TEST(RenderOutput, BlackOffsetIsAddedPerChannelAfterTheBlendAndBeforeTheResponse) {
+    ScreenCalibration s = make_ideal_calibration(IdealCalibrationParams{});
+    ProjectorCalibration p = s.projectors[1];
+    p.beta.size = {2, 1};  // coarse grid: left sample, right sample
+    p.beta.rgb = {0.01F, 0.02F, 0.03F, 0.05F, 0.0F, 0.5F};
+    RgbFloatImage content(s.content, 0.25F);
+    const RgbFloatImage out = render_output(p, content);
+    const RgbFloatImage plain = render_output(s.projectors[1], content);
+    const int y = p.output.height / 2;
+    const int xl = 0;  // clamps to the left sample
+    const int xr = p.output.width - 1;
+    for (int c = 0; c < 3; ++c) {
+        for (const int x : {xl, xr}) {
+            const float weight = sample_blend(p.blend, p.output, x, y);
+            const float beta = sample_beta(p.beta, p.output, x, y)[static_cast<std::size_t>(c)];
+            EXPECT_NEAR(out.at(x, y)[c], apply_response(p.response, c, 0.25F * weight + beta), 1e-6F);
+        }
+        EXPECT_GT(out.at(xl, y)[c], plain.at(xl, y)[c]);
+    }
+    EXPECT_NEAR(sample_beta(p.beta, p.output, xl, y)[2], 0.03F, 1e-6F);
+    EXPECT_NEAR(sample_beta(p.beta, p.output, xr, y)[2], 0.5F, 1e-6F);
+    p.beta.rgb[4] = 1.5F;  // outside [0, 1]: refused by name
+    try {
+        (void)render_output(p, content);
+        FAIL() << "beta 1.5 accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find(".beta"), std::string::npos) << e.what();
+    }
 }
 
 }  // namespace

@@ -78,4 +78,24 @@ float sample_blend(const BlendMask& blend, ImageSize output, int x, int y) {
     return static_cast<float>(top * (1.0 - ty.f) + bottom * ty.f);
 }
 
+std::array<float, 3> sample_beta(const BlackOffset& beta, ImageSize output, int x, int y) {
+    if (beta.size.width == 0 || beta.size.height == 0) return {0.0F, 0.0F, 0.0F};
+    const Taps tx = taps_at(x, output.width, beta.size.width);
+    const Taps ty = taps_at(y, output.height, beta.size.height);
+    std::array<float, 3> out{};
+    for (std::size_t c = 0; c < 3; ++c) {
+        const auto at = [&](int gx, int gy) {
+            return static_cast<double>(
+                beta.rgb[(static_cast<std::size_t>(gy) * static_cast<std::size_t>(beta.size.width) +
+                          static_cast<std::size_t>(gx)) *
+                             3 +
+                         c]);
+        };
+        const double top = at(tx.i0, ty.i0) * (1.0 - tx.f) + at(tx.i1, ty.i0) * tx.f;
+        const double bottom = at(tx.i0, ty.i1) * (1.0 - tx.f) + at(tx.i1, ty.i1) * tx.f;
+        out[c] = static_cast<float>(top * (1.0 - ty.f) + bottom * ty.f);
+    }
+    return out;
+}
+
 }  // namespace mogao

@@ -10,6 +10,8 @@
 // MPCDI level-1 grid of a tenth of the resolution).
 #pragma once
 
+#include <array>
+
 #include "common/projector_calibration.h"
 
 namespace mogao {
@@ -38,5 +40,9 @@ struct ContentUv {
 
 // Bilinear blend weight at output pixel (x, y). Preconditions: validate_blend passed.
 [[nodiscard]] float sample_blend(const BlendMask& blend, ImageSize output, int x, int y);
+
+// Bilinear black offset (beta) at output pixel (x, y), per channel, same grid convention as the
+// blend; an empty offset (0 x 0) gives 0. Preconditions: validate_beta passed.
+[[nodiscard]] std::array<float, 3> sample_beta(const BlackOffset& beta, ImageSize output, int x, int y);
 
 }  // namespace mogao
