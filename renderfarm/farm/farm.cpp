@@ -89,12 +89,19 @@ int run_farm(const MpiSession& mpi, const FarmSetup& setup, const AdminJob& admi
     // 3. The admin job. One boundary catches what it throws; the dispatcher's destructor releases
     //    the render ranks on every path out.
     FrameDispatcher dispatcher(mpi, dispatch, renderer ? &*renderer : nullptr);
+    int status = 1;
     try {
-        return admin_job(dispatcher, *scene, run);
+        status = admin_job(dispatcher, *scene, run);
     } catch (const std::exception& e) {
         spdlog::error("admin: {}", e.what());
-        return 1;
     }
+    if (dispatcher.broken()) {
+        // A rank stopped answering mid-frame: the others wait in a collective that never ends, and
+        // MPI_Finalize would wait for them. End the whole job so that systemd restarts the farm.
+        spdlog::critical("admin: a render rank was lost; aborting the MPI job (exit code {})", kRankLostExitCode);
+        MPI_Abort(MPI_COMM_WORLD, kRankLostExitCode);
+    }
+    return status;
 }
 
 }  // namespace mogao

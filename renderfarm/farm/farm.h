@@ -5,7 +5,8 @@
 //
 // Errors: a rank that cannot load the scene or build its BVH reports it (stderr, naming the rank and
 // reason) and the whole job stops cleanly with exit code 1 — never a hang: setup ends in collective
-// status checks, and frame failures travel back to the admin in the frame reply (FarmError).
+// status checks, frame failures travel back to the admin in the frame reply (FarmError), and a rank
+// that does not reply within the frame deadline aborts the job (kRankLostExitCode).
 #pragma once
 
 #include <filesystem>
@@ -28,7 +29,12 @@ struct FarmSetup {
 // What the admin does once the farm stands: returns the process exit code.
 using AdminJob = std::function<int(FrameDispatcher&, const Scene&, RunInfo&)>;
 
-// Runs on every rank; returns the process exit code (0 = success, 1 = the job failed).
+// The exit code of a job aborted because a render rank stopped answering (RankTimeout).
+inline constexpr int kRankLostExitCode = 3;
+
+// Runs on every rank; returns the process exit code (0 = success, 1 = the job failed). A lost
+// render rank (frame_dispatcher.h, RankTimeout) ends the whole MPI job with MPI_Abort and
+// kRankLostExitCode, so mpirun exits and systemd restarts the service.
 int run_farm(const MpiSession& mpi, const FarmSetup& setup, const AdminJob& admin_job);
 
 }  // namespace mogao

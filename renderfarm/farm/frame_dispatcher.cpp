@@ -165,7 +165,7 @@ int FrameDispatcher::render_ranks() const { return std::max(1, mpi_.render_ranks
 void FrameDispatcher::stop() {
     if (stopped_) return;
     stopped_ = true;
-    if (mpi_.size() < 2) return;
+    if (mpi_.size() < 2 || broken_) return;  // broken: a rank would never take the broadcast
     WireView stop_view{};
     stop_view.stop = 1;
     broadcast_view(stop_view);
@@ -191,6 +191,7 @@ CostMap& FrameDispatcher::stream_map(std::uint64_t stream, ImageSize size) {
 }
 
 DispatchedFrame FrameDispatcher::render(const ViewRequest& view, std::uint64_t stream, PackedPixels format) {
+    if (broken_) throw RankTimeout("the farm lost a render rank; the MPI job must restart");
     if (stopped_) throw FarmError("the farm was stopped");
     const ImageSize size = render_size(view);
     CostMap& predicted = stream_map(stream, size);
@@ -213,6 +214,33 @@ DispatchedFrame FrameDispatcher::render(const ViewRequest& view, std::uint64_t s
     // Re-balance: this frame's measured tile times predict the stream's next frame.
     predicted = CostMap::from_tile_times(size, settings_.cell_size, normalised);
     return frame;
+}
+
+// The next rank whose reply header has arrived; RankTimeout once `deadline` has passed.
+int FrameDispatcher::probe_reply_until(Clock::time_point deadline, const std::vector<bool>& replied,
+                                       std::uint64_t frame_id) {
+    auto next_beat = Clock::now() + std::chrono::seconds(1);
+    for (int found = 0;;) {
+        MPI_Status status;
+        MPI_Iprobe(MPI_ANY_SOURCE, kTagReplyHeader, MPI_COMM_WORLD, &found, &status);
+        if (found) return status.MPI_SOURCE;
+        const auto now = Clock::now();
+        if (now >= deadline) {
+            std::string silent;
+            for (std::size_t r = 0; r < replied.size(); ++r)
+                if (!replied[r]) silent += (silent.empty() ? "" : ", ") + std::to_string(r + 1);
+            broken_ = true;
+            throw RankTimeout(
+                fmt::format("render rank(s) {} did not reply to frame {} within {} s (rank_deadline_s): "
+                            "host down, process stopped or link cut",
+                            silent, frame_id, settings_.rank_deadline_s));
+        }
+        if (heartbeat_ && now >= next_beat) {
+            heartbeat_();
+            next_beat = now + std::chrono::seconds(1);
+        }
+        sleep_briefly();
+    }
 }
 
 bool FrameDispatcher::gather(const ViewRequest& view, const Assignment& assignment, PackedPixels format,
@@ -250,9 +278,15 @@ bool FrameDispatcher::gather(const ViewRequest& view, const Assignment& assignme
     }
     frame.stats.rank_render_seconds.assign(static_cast<std::size_t>(mpi_.render_ranks()), 0.0);
     bool ok = true;
+    const auto deadline = settings_.rank_deadline_s > 0
+                              ? Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                                   std::chrono::duration<double>(settings_.rank_deadline_s))
+                              : Clock::time_point::max();
+    std::vector<bool> replied(static_cast<std::size_t>(mpi_.render_ranks()), false);
     for (int k = 0; k < mpi_.render_ranks(); ++k) {
         // Replies in arrival order: a slow rank does not hold up compositing the others.
-        const int source = probe_politely(MPI_ANY_SOURCE, kTagReplyHeader).MPI_SOURCE;
+        const int source = probe_reply_until(deadline, replied, view.frame_id);
+        replied[static_cast<std::size_t>(source - 1)] = true;
         RankReply reply = receive_reply(source);
         if (!reply.header.ok) {
             spdlog::error("{}", std::string(reply.payload.begin(), reply.payload.end()));

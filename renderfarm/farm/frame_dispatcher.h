@@ -11,9 +11,15 @@
 // Errors: a rank's failure (its message names rank, frame and reason) is thrown as FarmError by
 // render() after every rank's reply was collected, so no rank is left blocked; the caller then calls
 // stop(). Bad views are rejected on the ranks by the renderer's validation (std::invalid_argument).
+// A rank that does not reply within `rank_deadline_s` (dead host, SIGSTOP, cut link) makes render()
+// throw RankTimeout naming the silent ranks; the MPI job is then unusable (a collective is half
+// done): broken() turns true, stop() no longer talks to the ranks, and the process must end the
+// job with MPI_Abort so that the service restarts (run_farm does this; docs/services.md).
 #pragma once
 
+#include <chrono>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <stdexcept>
@@ -35,6 +41,11 @@ struct FarmError : std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
+// A render rank did not reply in time; the MPI job must be aborted (see above).
+struct RankTimeout : FarmError {
+    using FarmError::FarmError;
+};
+
 struct DispatchSettings {
     std::string balancer = "pbt";  // pbt | equal | roundrobin
     int snap = 16;                 // PBT/equal split snap, pixels
@@ -46,6 +57,8 @@ struct DispatchSettings {
     // Feed the PBT with tile times x the rank's speed (its share of a core) instead of wall time.
     bool normalise_rank_speed = true;
     std::size_t max_streams = 64;  // cost maps kept; the least recently used goes beyond it
+    // Seconds from sending a frame to the ranks until the last reply; 0 = wait forever.
+    double rank_deadline_s = 30.0;
 };
 
 struct DispatchedFrame {
@@ -76,6 +89,11 @@ public:
     [[nodiscard]] int render_ranks() const;
     [[nodiscard]] int cell_size() const { return settings_.cell_size; }
     [[nodiscard]] const DispatchSettings& settings() const { return settings_; }
+    // Called about once a second while render() waits for the ranks (serve pets systemd's
+    // watchdog from it, so a long frame within the deadline is not mistaken for a hang).
+    void set_heartbeat(std::function<void()> heartbeat) { heartbeat_ = std::move(heartbeat); }
+    // True after a RankTimeout: the MPI job must be aborted.
+    [[nodiscard]] bool broken() const { return broken_; }
     // Benchmarks compare raw and speed-normalised tile times in one run.
     void set_normalise_rank_speed(bool on) { settings_.normalise_rank_speed = on; }
 
@@ -83,6 +101,8 @@ private:
     bool gather(const ViewRequest& view, const Assignment& assignment, PackedPixels format, DispatchedFrame& frame,
                 std::vector<TileTime>& normalised);
     CostMap& stream_map(std::uint64_t stream, ImageSize size);
+    int probe_reply_until(std::chrono::steady_clock::time_point deadline, const std::vector<bool>& replied,
+                          std::uint64_t frame_id);
 
     const MpiSession& mpi_;
     DispatchSettings settings_;
@@ -96,6 +116,8 @@ private:
     std::uint64_t frames_ = 0;
     RankSpeeds speeds_;
     bool stopped_ = false;
+    bool broken_ = false;
+    std::function<void()> heartbeat_;
 };
 
 // Render ranks: answer frames until the dispatcher stops. `renderer` is null when this rank could

@@ -41,6 +41,11 @@ void add_farm_flags(CLI::App& command, mogao::FarmSetup& setup, std::string& sca
     command.add_option("--snap", setup.dispatch.snap, "PBT/equal split snap in pixels")->check(CLI::IsMember({4, 8, 16, 32}));
     command.add_option("--rr-tile", setup.dispatch.roundrobin_tile, "Round-robin tile size in pixels")->check(CLI::Range(8, 1024));
     command.add_option("--threads", setup.dispatch.threads, "Render threads per rank")->check(CLI::Range(1, 256));
+    command
+        .add_option("--rank-deadline", setup.dispatch.rank_deadline_s,
+                    "Seconds a frame may wait for a render rank's reply; a rank that misses it is taken as lost and "
+                    "the MPI job is aborted (exit 3) so that systemd restarts the farm (0 = wait forever)")
+        ->check(CLI::Range(0.0, 86400.0));
     command.add_flag("--rank-speed,!--no-rank-speed", setup.dispatch.normalise_rank_speed,
                      "Normalise each rank's tile times by its measured speed before the PBT (default; --no-rank-speed: "
                      "raw wall time)");
@@ -143,6 +148,15 @@ int main(int argc, char** argv) {
         ->add_option("--max-sessions-per-appliance", serve_options.link.max_sessions_per_appliance,
                      "Concurrent sessions of one appliance certificate")
         ->check(CLI::Range(1, 256));
+    serve
+        ->add_option("--max-request-megapixels", serve_options.policy.max_megapixels,
+                     "Rendered pixels per request, millions; a larger request is rendered at a lower resolution scale")
+        ->check(CLI::Range(0.001, 268.5));
+    serve
+        ->add_option("--max-request-gigarays", serve_options.policy.max_gigarays,
+                     "Estimated rays per request, billions; a dearer request is degraded (spp, then light samples, "
+                     "bounces, resolution scale)")
+        ->check(CLI::Range(1e-6, 1e6));
     double frame_time_ms = 0.0;
     // Off unless asked: a refined frame is not the lone render of its request that the kiosk's
     // end-to-end tests compare against.

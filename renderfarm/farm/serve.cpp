@@ -5,13 +5,16 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <map>
 #include <optional>
+#include <string>
 
 #include <spdlog/spdlog.h>
 
 #include "common/jpeg_codec.h"
 #include "common/service_notify.h"
 #include "renderfarm/farm/main_thread_queue.h"
+#include "renderfarm/farm/request_policy.h"
 
 namespace mogao {
 namespace {
@@ -45,24 +48,56 @@ RenderedFrame serve_request(MainThreadQueue<ServedFrame>& queue, const ViewReque
     return encode(frame, encoder);
 }
 
-void log_stats(const LinkServer& server, const MainThreadQueue<ServedFrame>& queue) {
+void log_stats(const LinkServer& server, const MainThreadQueue<ServedFrame>& queue, std::uint64_t degraded) {
     const LinkServerStats s = server.stats();
     spdlog::info(
         "link: {} sessions active, {} frames sent, {} requests ({} dropped as stale, {} superseded in the "
-        "farm's queue, {} invalid), {} MB",
+        "farm's queue, {} invalid, {} degraded by the request policy), {} MB",
         s.sessions_active, s.frames_sent, s.requests_received, s.requests_dropped, queue.superseded(),
-        s.requests_invalid, static_cast<double>(s.jpeg_bytes_sent) / 1e6);
+        s.requests_invalid, degraded, static_cast<double>(s.jpeg_bytes_sent) / 1e6);
 }
+
+// The request policy (request_policy.h), logged once per session and change of decision.
+class PolicyGate {
+public:
+    PolicyGate(const Scene& scene, RequestPolicy policy) : lights_(LightCounts::of(scene)), policy_(policy) {
+        policy_.validate();
+    }
+    ViewRequest apply(const ViewRequest& request) {
+        const PolicyDecision d = apply_request_policy(request, lights_, policy_);
+        if (!d.degraded) return d.view;
+        ++degraded_;
+        std::string& last = logged_[request.session];
+        if (last != d.changes) {
+            spdlog::warn(
+                "session {}: request over the farm's bounds ({:.3g} rays estimated, limit {:.3g}; {:.3g} "
+                "Mpixels, limit {:.3g}): rendered with {}",
+                request.session, d.requested_rays, policy_.max_gigarays * 1e9,
+                double(request.size.width) * request.size.height * 1e-6, policy_.max_megapixels, d.changes);
+            last = d.changes;
+        }
+        if (logged_.size() > 1024) logged_.clear();  // bounded: sessions come and go
+        return d.view;
+    }
+    [[nodiscard]] std::uint64_t degraded() const { return degraded_; }
+
+private:
+    LightCounts lights_;
+    RequestPolicy policy_;
+    std::map<std::uint64_t, std::string> logged_;
+    std::uint64_t degraded_ = 0;
+};
 
 }  // namespace
 
-int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene&, RunInfo& run) {
+int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& scene, RunInfo& run) {
     struct sigaction action {};
     action.sa_handler = on_stop_signal;
     sigaction(SIGINT, &action, nullptr);
     sigaction(SIGTERM, &action, nullptr);
 
     MainThreadQueue<ServedFrame> queue;
+    PolicyGate policy(scene, options.policy);
     LiveFrames live(farm, options.live);
     LinkServerOptions link = options.link;
     // Pipelining needs a second call in flight (another session's) while one frame is encoded; each
@@ -78,6 +113,7 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene&, 
         options.live.per_session_maps ? "per-session" : "shared", options.pipeline ? "on" : "off");
     ServiceNotifier notifier;
     notifier.ready();
+    farm.set_heartbeat([&notifier] { notifier.watchdog(); });  // a long frame is not a hang
 
     JpegEncoder encoder;
     const auto start = Clock::now();
@@ -86,27 +122,33 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene&, 
     while (!g_stop && (options.duration_s <= 0 || elapsed() < options.duration_s)) {
         notifier.watchdog();
         if (std::chrono::duration<double>(Clock::now() - last_stats).count() >= options.stats_period_s) {
-            log_stats(server, queue);
+            log_stats(server, queue, policy.degraded());
             last_stats = Clock::now();
         }
         std::optional<MainThreadQueue<ServedFrame>::Job> job = queue.next(std::chrono::milliseconds(100));
         if (!job) continue;
         try {
-            LiveFrame frame = live.render(job->view);
+            LiveFrame frame = live.render(policy.apply(job->view));
             ServedFrame out{std::move(frame.image), job->view.quality.jpeg_quality, realtime_ns(), std::nullopt};
             if (!options.pipeline) out.encoded = encode(out, encoder);
             job->result.set_value(std::move(out));
+        } catch (const RankTimeout& e) {
+            // A render rank is gone: no later frame can be rendered by this MPI job.
+            spdlog::critical("{}", e.what());
+            job->result.set_exception(std::current_exception());
+            break;
         } catch (...) {
             // One bad request fails alone: the link reports it to its session and goes on.
             job->result.set_exception(std::current_exception());
         }
     }
+    const bool lost_rank = farm.broken();
     notifier.stopping();
-    spdlog::info("stopping: {}", g_stop ? "signal" : "duration reached");
+    spdlog::info("stopping: {}", lost_rank ? "a render rank was lost" : g_stop ? "signal" : "duration reached");
     queue.close();
     server.stop();
     farm.stop();
-    return 0;
+    return lost_rank ? 1 : 0;
 }
 
 }  // namespace mogao

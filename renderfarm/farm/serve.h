@@ -9,8 +9,13 @@
 // cost maps). With `pipeline` the JPEG is encoded on the calling gRPC thread, so the main thread
 // sends the ranks the next request while the previous frame is encoded; without it the main thread
 // encodes before taking the next request (the serial loop of before).
+// Each request first passes the farm's request policy (request_policy.h): one over the farm's
+// pixel or ray bound is degraded to fit (logged once per session and decision, counted in the stats).
+// While a frame renders, systemd's watchdog is petted about once a second (FrameDispatcher
+// heartbeat), so a long frame within the rank deadline is not taken for a hang.
 // Errors: a request that fails (bad view, a rank's error) fails that request only — the link logs
-// it and the session goes on; SIGINT/SIGTERM stop the service cleanly (exit 0).
+// it and the session goes on; SIGINT/SIGTERM stop the service cleanly (exit 0); a render rank that
+// misses the frame deadline (RankTimeout) stops serving (exit 1, then run_farm aborts the MPI job).
 #pragma once
 
 #include <cstdint>
@@ -18,6 +23,7 @@
 #include "renderfarm/farm/frame_dispatcher.h"
 #include "renderfarm/farm/frame_stats.h"
 #include "renderfarm/farm/live_frames.h"
+#include "renderfarm/farm/request_policy.h"
 #include "renderfarm/link/link_server.h"
 #include "renderfarm/scene/scene.h"
 
@@ -26,6 +32,7 @@ namespace mogao {
 struct ServeOptions {
     LinkServerOptions link;
     LiveOptions live;
+    RequestPolicy policy;        // bounds per request (request_policy.h)
     bool pipeline = true;        // encode off the main thread (see above)
     double duration_s = 0.0;     // stop after this long (tests); 0 = until SIGINT/SIGTERM
     double stats_period_s = 10;  // log the link's counters this often

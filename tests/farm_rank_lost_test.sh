@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
+# A render rank that stops answering mid-job ends the whole MPI job within the frame deadline,
+# naming the rank, instead of leaving the admin polling forever (issue 16, render-node failure):
+#   stop   SIGSTOP of rank 2 (a hung process; before the deadline existed the job never ended)
+#   kill   SIGKILL of rank 2 (a dead host: Open MPI's own error handling ends the job)
+# The farm's exit code is non-zero either way, so systemd restarts the service (docs/services.md).
+set -euo pipefail
+farm=$1 MPIEXEC=$2 scene=$3 work=$4
+source "$(dirname "$0")/mpi_env.sh"
+rm -rf "$work" && mkdir -p "$work"
+deadline=3
+
+# The pid of the mogao-farm process that is rank $1 of the job started by mpirun $2.
+rank_pid() {
+  local rank=$1 parent=$2 pid
+  for pid in $(pgrep -f "mogao-farm render" || true); do
+    [ "$pid" = "$parent" ] && continue
+    if tr '\0' '\n' < "/proc/$pid/environ" 2>/dev/null | grep -qx "OMPI_COMM_WORLD_RANK=$rank"; then
+      echo "$pid"; return 0
+    fi
+  done
+  return 1
+}
+
+run_case() {
+  local how=$1 out="$work/$1" log="$work/$1.log"
+  mkdir -p "$out"
+  mpirun_n 4 "$farm" render --scene "$scene" --frames 100000 --path orbit --width 64 --height 48 --spp 1 \
+    --contact-sheet 0 --rank-deadline "$deadline" --out "$out" 2> "$log" &
+  local mpirun_pid=$!
+  # Wait until frames flow, then take rank 2 away.
+  for _ in $(seq 600); do [ -e "$out/frame-0002.jpg" ] && break; sleep 0.1; done
+  [ -e "$out/frame-0002.jpg" ] || { echo "FAIL($how): no frames"; cat "$log"; kill -9 $mpirun_pid; return 1; }
+  local victim
+  victim=$(rank_pid 2 $mpirun_pid) || { echo "FAIL($how): rank 2 not found"; kill -9 $mpirun_pid; return 1; }
+  local start=$SECONDS
+  if [ "$how" = stop ]; then kill -STOP "$victim"; else kill -KILL "$victim"; fi
+  # The job must end by itself; 60 s is the watchdog systemd would otherwise use.
+  local status=0 ended=0
+  for _ in $(seq 600); do
+    if ! kill -0 $mpirun_pid 2>/dev/null; then ended=1; break; fi
+    sleep 0.1
+  done
+  if [ $ended -eq 0 ]; then
+    echo "FAIL($how): the job still runs $((SECONDS - start)) s after rank 2 was lost"
+    kill -CONT "$victim" 2>/dev/null || true
+    kill -9 $mpirun_pid 2>/dev/null || true
+    pkill -9 -f "mogao-farm render --scene $scene" || true
+    cat "$log"
+    return 1
+  fi
+  wait $mpirun_pid || status=$?
+  kill -CONT "$victim" 2>/dev/null || true
+  echo "$how: job ended $((SECONDS - start)) s after rank 2 was lost, exit status $status"
+  [ $status -ne 0 ] || { echo "FAIL($how): exit status 0 after losing a rank"; cat "$log"; return 1; }
+  if [ "$how" = stop ]; then
+    grep -q "render rank(s) 2 did not reply to frame" "$log" ||
+      { echo "FAIL(stop): the log does not name rank 2"; cat "$log"; return 1; }
+    grep -q "aborting the MPI job" "$log" || { echo "FAIL(stop): no abort logged"; cat "$log"; return 1; }
+  fi
+}
+
+fail=0
+run_case stop || fail=1
+run_case kill || fail=1
+[ $fail -eq 0 ] && echo "PASS: a lost render rank ends the job (SIGSTOP within the ${deadline} s deadline, SIGKILL)"
+exit $fail
