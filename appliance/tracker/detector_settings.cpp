@@ -26,6 +26,8 @@ void validate(const DetectorSettings& s) {
     check_range("decode_sharpening", s.decode_sharpening, 0.0, 1.0);
     check_range("max_hamming", s.max_hamming, 0, 2);
     check_range("threads", s.threads, 1, 64);
+    check_range("max_line_fit_mse", s.max_line_fit_mse, 0.1f, 1000.0f);
+    if (s.coarse_pass_decimation != 0.0f) check_range("coarse_pass_decimation", s.coarse_pass_decimation, 1.5f, 8.0f);
 }
 
 }  // namespace mogao

@@ -35,6 +35,22 @@ struct DetectorSettings {
     // Hamming distance 11) at no measurable false-positive rate. [0, 2]: AprilTag's decode table
     // for 3 bits takes hundreds of megabytes.
     int max_hamming = 2;
+    // Lowers max_hamming per family to what the family affords (safe_max_hamming, tag_detector.h):
+    // 0 for tag16h5, whose 30 codes of 16 bits accept a random pattern with 2 bits corrected one
+    // time in four (two false tags in its real photograph). false: max_hamming as given.
+    bool cap_hamming_by_family = true;
+    // qtp.max_line_fit_mse: largest mean squared residual (pixels^2) of the points along a quad's
+    // side from its fitted line (AprilTag's 10). Alone, 20 finds 4 more tags of the oblique sheet in
+    // ../shared/data/tags-real, but with the coarse pass below it finds none more, so AprilTag's
+    // value stays (docs/tracking.md, "Real photographs"). [0.1, 1000].
+    float max_line_fit_mse = 10.0f;
+    // A second, coarse quad search at this decimation (0 = none), run when the first searched at
+    // full resolution (decimation <= 1); its tags not found by the first are added. Edges blurred
+    // over several pixels (defocus, grazing angles) break up in the full-resolution adaptive
+    // threshold (4-pixel tiles) but hold at half resolution; AprilTag still decodes the bits and
+    // refines the edges on the full-resolution image. Costs about a third of the full-resolution
+    // search; TagTracker's window search skips it (single pass). 0 or [1.5, 8].
+    float coarse_pass_decimation = 2.0f;
     // Worker threads of the detector. 1 on the appliance (the other core renders). [1, 64].
     int threads = 1;
 };

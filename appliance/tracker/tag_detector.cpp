@@ -4,6 +4,7 @@
 #include <apriltag.h>
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -25,13 +26,17 @@ TagDetector::TagDetector(const DetectorSettings& settings)
     validate(settings_);
     apriltag_detector* detector = engine_->detector.get();
     if (detector == nullptr) throw std::runtime_error("AprilTag could not allocate a detector");
-    apriltag_detector_add_family_bits(detector, engine_->family.get(), settings_.max_hamming);
+    int max_hamming = settings_.max_hamming;
+    if (settings_.cap_hamming_by_family)
+        max_hamming = std::max(0, std::min(max_hamming, safe_max_hamming(engine_->family)));
+    apriltag_detector_add_family_bits(detector, engine_->family.get(), max_hamming);
     detector->quad_decimate = settings_.decimation;
     detector->quad_sigma = settings_.blur_sigma;
     detector->refine_edges = settings_.refine_edges;
     detector->decode_sharpening = settings_.decode_sharpening;
     detector->nthreads = settings_.threads;
     detector->qtp.min_white_black_diff = settings_.min_white_black_diff;
+    detector->qtp.max_line_fit_mse = settings_.max_line_fit_mse;
 }
 
 TagDetector::TagDetector(TagDetector&&) noexcept = default;
@@ -50,7 +55,52 @@ void TagDetector::set_quad_search(float decimation, float blur_sigma) {
 
 const TagFamily& TagDetector::family() const { return engine_->family; }
 
-std::vector<TagDetection> TagDetector::detect(const GrayImage& image) {
+int safe_max_hamming(const TagFamily& family) {
+    const apriltag_family* f = family.get();
+    const double patterns = std::ldexp(1.0, static_cast<int>(f->nbits));
+    double within = 0.0;  // bit patterns within h bits of one code: sum_{k<=h} C(nbits, k)
+    double binomial = 1.0;
+    int best = -1;
+    for (int h = 0; h <= 2; ++h) {
+        if (h > 0) binomial = binomial * static_cast<double>(static_cast<int>(f->nbits) - h + 1) / h;
+        within += binomial;
+        if (static_cast<double>(f->ncodes) * 4.0 * within / patterns > 0.01) break;
+        best = h;
+    }
+    return best;
+}
+
+std::vector<TagDetection> TagDetector::detect(const GrayImage& image, Passes passes) {
+    std::vector<TagDetection> out = detect_once(image);
+    if (passes == Passes::single || settings_.coarse_pass_decimation == 0.0f || settings_.decimation > 1.0f) return out;
+    // The coarse pass (DetectorSettings::coarse_pass_decimation): its tags that the first pass did
+    // not find (another id, or the same id more than half a side away) are added.
+    apriltag_detector* detector = engine_->detector.get();
+    detector->quad_decimate = settings_.coarse_pass_decimation;
+    detector->quad_sigma = 0.0f;
+    std::vector<TagDetection> coarse;
+    try {
+        coarse = detect_once(image);
+    } catch (...) {
+        detector->quad_decimate = settings_.decimation;
+        detector->quad_sigma = settings_.blur_sigma;
+        throw;
+    }
+    detector->quad_decimate = settings_.decimation;
+    detector->quad_sigma = settings_.blur_sigma;
+    const std::size_t first = out.size();
+    for (const auto& c : coarse) {
+        const bool seen =
+            std::any_of(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(first), [&](const TagDetection& d) {
+                return d.id == c.id && (d.centre - c.centre).norm() < 0.5 * (d.corners[1] - d.corners[0]).norm();
+            });
+        if (!seen) out.push_back(c);
+    }
+    std::stable_sort(out.begin(), out.end(), [](const TagDetection& a, const TagDetection& b) { return a.id < b.id; });
+    return out;
+}
+
+std::vector<TagDetection> TagDetector::detect_once(const GrayImage& image) {
     if (!image.valid()) {
         throw std::invalid_argument("TagDetector::detect: image " + std::to_string(image.width) + "x" +
                                     std::to_string(image.height) + " with " + std::to_string(image.pixels.size()) +

@@ -34,8 +34,20 @@ struct TagDetection {
     Eigen::Vector2d centre;                  // pixels, image of the tag centre (homography)
 };
 
+// The largest number of corrected bits (<= 2) at which a random bit pattern inside a candidate quad
+// decodes to one of the family's codes, in any of 4 rotations, with probability at most 1 %:
+// codes * 4 * sum_{k<=h} C(bits, k) / 2^bits (the false-positive analysis of Olson, "AprilTag: A
+// robust and flexible visual fiducial system", ICRA 2011, Sec. IV). tag36h11: 2 (2.3e-5);
+// tag25h9: 2 (1.4e-3); tag16h5: 0 (1.8e-3; 3.1 % at 1 bit, 25 % at 2). -1 when even an exact match
+// is that likely.
+[[nodiscard]] int safe_max_hamming(const TagFamily& family);
+
 class TagDetector {
 public:
+    // How much of the quad search detect() runs: `full` adds DetectorSettings::coarse_pass_decimation's
+    // second search when the first is at full resolution; `single` never does (a small window).
+    enum class Passes { full, single };
+
     // Throws std::invalid_argument for bad settings (validate()) or an unknown family.
     explicit TagDetector(const DetectorSettings& settings = {});
     TagDetector(TagDetector&&) noexcept;
@@ -47,7 +59,7 @@ public:
     // Every tag of the family in `image`, sorted by id; `image` is not modified. Throws
     // std::invalid_argument for an image that is not valid() or wider/taller than
     // kMaxCaptureDimension.
-    [[nodiscard]] std::vector<TagDetection> detect(const GrayImage& image);
+    [[nodiscard]] std::vector<TagDetection> detect(const GrayImage& image, Passes passes = Passes::full);
 
     // Changes the quad search's decimation and blur (DetectorSettings::decimation, blur_sigma) for
     // the next detect() calls, keeping the decode tables (building those for max_hamming 2 costs
@@ -58,6 +70,7 @@ public:
     [[nodiscard]] const TagFamily& family() const;
 
 private:
+    std::vector<TagDetection> detect_once(const GrayImage& image);
     // The family and the detector that hangs its decode tables on it, together on the heap: the
     // family's address must not change while the detector uses it, and the detector must be
     // destroyed before the family (tag_detector.cpp). As one pointer they also move and are

@@ -185,12 +185,41 @@ TEST(TagDetector, BadSettingsAndImagesNameTheProblem) {
     s = {};
     s.family = "tag37h11";
     EXPECT_THROW(TagDetector{s}, std::invalid_argument);
+    s = {};
+    s.coarse_pass_decimation = 1.0f;  // 0 (none) or [1.5, 8]
+    EXPECT_THROW(TagDetector{s}, std::invalid_argument);
+    s.coarse_pass_decimation = 0.0f;
+    EXPECT_NO_THROW(TagDetector{s});
+    s.max_line_fit_mse = 0.0f;
+    EXPECT_THROW(TagDetector{s}, std::invalid_argument);
 
     TagDetector detector;
     GrayImage broken(10, 10);
     broken.pixels.resize(5);
     EXPECT_THROW((void)detector.detect(broken), std::invalid_argument);
     EXPECT_THROW((void)detector.detect(GrayImage{}), std::invalid_argument);
+}
+
+// Olson 2011's false-accept probability of a random pattern, at most 1 %: tag16h5 (30 codes of 16
+// bits) affords no corrected bit (3.1 % at 1), tag36h11 (587 codes of 36 bits) and tag25h9 the 2
+// that max_hamming allows.
+TEST(TagDetector, SafeHammingFollowsTheFamilysSize) {
+    EXPECT_EQ(safe_max_hamming(TagFamily("tag16h5")), 0);
+    EXPECT_EQ(safe_max_hamming(TagFamily("tag25h9")), 2);
+    EXPECT_EQ(safe_max_hamming(TagFamily("tag36h11")), 2);
+}
+
+// The coarse pass adds tags, never removes or repeats one: on a clean synthetic tag both passes
+// find it once, at the same corners.
+TEST(TagDetector, CoarsePassAddsNoDuplicate) {
+    TagDetector detector;
+    const GrayImage image = render_target(tag_target(make_tag_bitmap(detector.family(), 36), 0.1),
+                                          tag_pose_facing_camera(0.5, 15.0, -5.0, 10.0), ideal_camera(), {});
+    const auto both = detector.detect(image);
+    const auto single = detector.detect(image, TagDetector::Passes::single);
+    ASSERT_EQ(both.size(), 1u);
+    ASSERT_EQ(single.size(), 1u);
+    for (std::size_t k = 0; k < 4; ++k) EXPECT_LT((both[0].corners[k] - single[0].corners[k]).norm(), 1e-9);
 }
 
 }  // namespace

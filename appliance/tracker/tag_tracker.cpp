@@ -114,7 +114,7 @@ std::vector<TagDetection> TagTracker::detect_in_window(const GrayImage& image, s
         detector_.set_quad_search(base.decimation, base.blur_sigma);
     }
     last_window_decimation_ = static_cast<int>(detector_.settings().decimation);
-    auto found = detector_.detect(window_);
+    auto found = detector_.detect(window_, TagDetector::Passes::single);
     const Eigen::Vector2d origin(left, top);  // pixel (i, j) of the window is (i + left, j + top)
     for (auto& d : found) {
         for (auto& c : d.corners) c += origin;

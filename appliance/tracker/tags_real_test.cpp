@@ -16,10 +16,12 @@ namespace mogao {
 namespace {
 
 // Achieved by the defaults when they were chosen (docs/tracking.md, "Real photographs"), less a
-// margin of one tag on the issue's set; the issue's goal (95 % everywhere) is not met on the
-// oblique sheet and the tiny distant tags (the doc says which).
+// margin of one tag on the issue's set and of about four tags on the whole set (227 of 271 with the
+// coarse pass, no false positive; AprilTag's stock settings find 215 with 2 false tags in the
+// tag16h5 photograph, 78.6 %); the issue's goal (95 % everywhere) is not met on the far half of
+// the oblique sheet and the tiny distant tags (the doc says which).
 constexpr double kMinRateIssueSet = 42.0 / 47.0;
-constexpr double kMinRateAll = 0.75;
+constexpr double kMinRateAll = 0.82;
 constexpr double kMaxMedianCornerErrorPx = 0.6;
 
 TEST(TagsReal, DefaultsFindTheTagsWithAccurateCorners) {
@@ -43,6 +45,7 @@ TEST(TagsReal, DefaultsFindTheTagsWithAccurateCorners) {
         << issue.found << " found, " << issue.false_positives << " false positives of " << issue.tags;
     EXPECT_GE(all.rate(), kMinRateAll) << all.found << " found, " << all.false_positives << " false positives of "
                                        << all.tags;
+    EXPECT_EQ(all.false_positives, 0) << "a wrong or repeated id, or a tag where there is none";
     EXPECT_LE(all.median_corner_error_px(), kMaxMedianCornerErrorPx);
     EXPECT_LE(issue.median_corner_error_px(), kMaxMedianCornerErrorPx);
     EXPECT_GT(all.corner_errors_px.size(), 400u);  // the reference covers most found tags

@@ -18,8 +18,10 @@ struct NamedSettings {
     std::string name;
     DetectorSettings settings;
 };
-// The configurations every table compares: the defaults, AprilTag's stock (decimation 1, no blur),
-// the old defaults (2, 0.8) and the tracker's whole-frame search (RoiSettings).
+// The configurations the real-photograph table compares: the defaults, AprilTag's stock (decimation
+// 1, no blur, no coarse pass, max_hamming not capped per family), the defaults without the coarse
+// pass and with max_line_fit_mse 20 (with and without it), the old defaults (2, 0.8) and the
+// tracker's whole-frame search (RoiSettings).
 [[nodiscard]] std::vector<NamedSettings> compared_settings();
 
 struct RealOptions {

@@ -17,13 +17,25 @@ namespace mogao::eval {
 std::vector<NamedSettings> compared_settings() {
     std::vector<NamedSettings> out;
     out.push_back({"defaults", DetectorSettings{}});
-    DetectorSettings stock;
+    DetectorSettings stock;  // AprilTag's own settings throughout
     stock.decimation = 1.0f;
     stock.blur_sigma = 0.0f;
+    stock.coarse_pass_decimation = 0.0f;
+    stock.cap_hamming_by_family = false;
     out.push_back({"AprilTag stock (1, 0)", stock});
+    DetectorSettings no_coarse;
+    no_coarse.coarse_pass_decimation = 0.0f;
+    out.push_back({"defaults, no coarse pass", no_coarse});
+    DetectorSettings mse20;
+    mse20.max_line_fit_mse = 20.0f;
+    out.push_back({"defaults, line fit mse 20", mse20});
+    mse20.coarse_pass_decimation = 0.0f;
+    out.push_back({"defaults, line fit mse 20, no coarse pass", mse20});
     DetectorSettings old;
     old.decimation = 2.0f;
     old.blur_sigma = 0.8f;
+    old.coarse_pass_decimation = 0.0f;
+    old.cap_hamming_by_family = false;
     out.push_back({"old defaults (2, 0.8)", old});
     const RoiSettings roi;
     DetectorSettings search;
