@@ -36,6 +36,16 @@ public:
     // drop a frame whose successor is already due, as a live camera would have overwritten it.
     [[nodiscard]] virtual std::optional<std::int64_t> next_capture_time_ns() const { return std::nullopt; }
 
+    // Drops, WITHOUT decoding them, the frames next_frame() would return next whose successor was
+    // captured at or before `now_ns` (CameraFrame::timestamp_ns's clock): the frames a pacing
+    // caller would drop anyway, skipped before the decoding that costs a replay several times the
+    // tracking. Returns how many were dropped; 0 for sources that cannot tell (live cameras, which
+    // drop stale frames themselves).
+    virtual std::uint64_t skip_frames_due_by(std::int64_t now_ns) {
+        (void)now_ns;
+        return 0;
+    }
+
     // One line for logs: device or folder, size, format.
     [[nodiscard]] virtual std::string description() const = 0;
 };

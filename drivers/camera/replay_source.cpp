@@ -118,6 +118,39 @@ std::optional<std::int64_t> ReplaySource::next_capture_time_ns() const {
     return stamps_.front() + static_cast<std::int64_t>(pass_ + 1) * pass_duration_ns_;  // the next pass's first
 }
 
+std::uint64_t ReplaySource::skip_frames_due_by(std::int64_t now_ns) {
+    const std::size_t n = files_.size();
+    std::uint64_t skipped = 0;
+    for (;;) {
+        // (i, pass): the frame next_frame() would return; (j, pass_j): its successor.
+        std::size_t i = next_;
+        std::uint64_t pass = pass_;
+        if (i == n) {
+            if (!config_.loop) break;
+            i = 0;
+            ++pass;
+        }
+        std::size_t j = i + 1;
+        std::uint64_t pass_j = pass;
+        if (j == n) {
+            if (!config_.loop) break;  // the last frame has no successor: it is never stale
+            j = 0;
+            ++pass_j;
+        }
+        if (stamp_ns(j, pass_j) > now_ns) break;
+        // Far behind while looping: whole passes at once (no loop over millions of frames).
+        if (config_.loop && pass_duration_ns_ > 0 && stamp_ns(j, pass_j) + pass_duration_ns_ <= now_ns) {
+            const auto passes = static_cast<std::uint64_t>((now_ns - stamp_ns(j, pass_j)) / pass_duration_ns_);
+            pass_j += passes;
+            skipped += passes * n;
+        }
+        next_ = j;
+        pass_ = pass_j;
+        ++skipped;
+    }
+    return skipped;
+}
+
 std::string ReplaySource::description() const {
     return "replay " + config_.folder.string() + " (" + std::to_string(files_.size()) + " images" +
            (config_.loop ? ", looping)" : ")");

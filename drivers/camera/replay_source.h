@@ -11,7 +11,8 @@
 // pass continues after the last stamp plus one frame period (the mean period of timestamps.txt).
 //
 // Playback is as fast as next_frame() is called; pacing to real time is the caller's business.
-// Images are decoded on demand, so a long sequence costs no memory up front.
+// Images are decoded on demand, so a long sequence costs no memory up front, and
+// skip_frames_due_by() drops the frames a slow caller would discard without decoding them.
 //
 // Errors (common/result.h): open() gives ENOENT for a missing folder or one without images,
 // EINVAL for a bad config or timestamps.txt (naming the file, the line and the rule);
@@ -40,6 +41,7 @@ public:
 
     [[nodiscard]] Result<CameraFrame> next_frame() override;
     [[nodiscard]] std::optional<std::int64_t> next_capture_time_ns() const override;
+    std::uint64_t skip_frames_due_by(std::int64_t now_ns) override;
     [[nodiscard]] std::string description() const override;
 
     [[nodiscard]] const std::vector<std::filesystem::path>& files() const { return files_; }
@@ -47,6 +49,10 @@ public:
 
 private:
     ReplaySource() = default;
+    // Timestamp of file `index` on loop pass `pass`.
+    [[nodiscard]] std::int64_t stamp_ns(std::size_t index, std::uint64_t pass) const {
+        return stamps_[index] + static_cast<std::int64_t>(pass) * pass_duration_ns_;
+    }
 
     ReplayConfig config_;
     std::vector<std::filesystem::path> files_;

@@ -122,5 +122,50 @@ TEST_F(ReplayFolder, MissingOrEmptyFolderAndBadRate) {
     EXPECT_NE(src.error().message.find("frames_per_second"), std::string::npos);
 }
 
+// skip-before-decode: a frame whose successor is due is dropped without being read, so a corrupt
+// file among the dropped ones costs nothing and raises no EBADMSG; the last frame, with no
+// successor, is never dropped.
+TEST_F(ReplayFolder, SkippingDueFramesDoesNotDecodeThem) {
+    write("f0.png", 10);
+    write_text("f1.png", "not a PNG: decoding this would fail");
+    write_text("f2.png", "nor this");
+    write("f3.png", 40);
+    auto probe = ReplaySource::open({dir_, 10.0, false});  // 100 ms per frame
+    ASSERT_TRUE(probe.ok()) << probe.error().message;
+    ASSERT_TRUE((*probe)->next_frame().ok());
+    EXPECT_EQ((*probe)->next_frame().code(), EBADMSG);  // f1 really cannot be decoded
+
+    auto src = ReplaySource::open({dir_, 10.0, false});
+    ASSERT_TRUE(src.ok());
+    auto first = (*src)->next_frame();
+    ASSERT_TRUE(first.ok()) << first.error().message;
+    EXPECT_EQ((*src)->skip_frames_due_by(199'999'999), 0U);  // f1's successor f2 is due at 200 ms
+    EXPECT_EQ((*src)->skip_frames_due_by(300'000'000), 2U);  // f1 and f2; f3 is the last
+    EXPECT_EQ((*src)->skip_frames_due_by(900'000'000), 0U);
+    auto last = (*src)->next_frame();
+    ASSERT_TRUE(last.ok()) << last.error().message;
+    EXPECT_EQ(last->sequence, 3U);
+    EXPECT_EQ(last->timestamp_ns, 300'000'000);
+    EXPECT_NEAR(last->image.at(3, 3), 40, 1);
+}
+
+// Looping, far behind: whole passes are skipped at once and the frame handed out next is the one
+// being captured at `now` (its successor not yet due), with the sequence number of its pass.
+TEST_F(ReplayFolder, SkippingWhileLoopingLandsOnTheCurrentFrame) {
+    write("a.png", 1);
+    write("b.png", 2);
+    write("c.png", 3);
+    auto src = ReplaySource::open({dir_, 10.0, true});  // a pass is 300 ms
+    ASSERT_TRUE(src.ok());
+    const std::int64_t now = 1'000'000LL * 300'000'000 + 150'000'000;  // a million passes + 150 ms
+    const std::uint64_t skipped = (*src)->skip_frames_due_by(now);
+    EXPECT_EQ(skipped, 3'000'001U);  // frames 0 .. 3e6: the frame at now - 50 ms is next
+    ASSERT_EQ((*src)->next_capture_time_ns(), std::optional<std::int64_t>(now - 50'000'000));
+    auto frame = (*src)->next_frame();
+    ASSERT_TRUE(frame.ok()) << frame.error().message;
+    EXPECT_EQ(frame->sequence, 3'000'001U);
+    EXPECT_NEAR(frame->image.at(3, 3), 2, 1);  // b.png
+}
+
 }  // namespace
 }  // namespace mogao
