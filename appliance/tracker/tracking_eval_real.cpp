@@ -4,7 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <set>
+#include <string>
 
 #include "appliance/tracker/tag_detector.h"
 #include "appliance/tracker/tag_reference.h"
@@ -49,6 +51,23 @@ namespace {
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// One row per source, one column per setting: "found of tags (false positives)".
+void print_by_source(const std::vector<NamedSettings>& settings,
+                     const std::map<std::string, std::vector<SetScore>>& by_source) {
+    std::printf("\nPer source (found, + false positives):\n\n| source | tags |");
+    for (const auto& named : settings) std::printf(" %s |", named.name.c_str());
+    std::printf("\n|---|--:|");
+    for (std::size_t k = 0; k < settings.size(); ++k) std::printf("--:|");
+    std::printf("\n");
+    for (const auto& [source, scores] : by_source) {
+        std::printf("| %s | %d |", source.c_str(), scores.front().tags);
+        for (const auto& sc : scores)
+            std::printf(" %d%s |", sc.found,
+                        sc.false_positives > 0 ? (" +" + std::to_string(sc.false_positives)).c_str() : "");
+        std::printf("\n");
+    }
 }
 
 }  // namespace
@@ -109,7 +128,11 @@ int run_real(const RealOptions& options) {
         "all images) | time/defaults |\n");
     std::printf("|---|---|--:|--:|--:|--:|--:|--:|--:|--:|\n");
     double default_ms = 0.0;
-    for (const auto& named : compared_settings()) {
+    const auto settings = compared_settings();
+    // found / false positives per source (the file-name prefix: PROVENANCE.md's six repositories)
+    // and setting, for the per-source table below (a change that helps one source only shows).
+    std::map<std::string, std::vector<SetScore>> by_source;
+    for (const auto& named : settings) {
         SetScore all, issue;
         double total_ms = 0.0;
         for (std::size_t i = 0; i < truth.size(); ++i) {
@@ -127,6 +150,9 @@ int run_real(const RealOptions& options) {
             const auto score = score_image(truth[i], found);
             all.add(score);
             if (truth[i].subset == "issue15") issue.add(score);
+            auto& per_setting = by_source[truth[i].file.substr(0, truth[i].file.find('_'))];
+            per_setting.resize(settings.size());
+            per_setting[static_cast<std::size_t>(&named - settings.data())].add(score);
             if (options.per_image)
                 std::fprintf(stderr, "%-24s %-40s %3d/%3d fp %d %.1f ms\n", named.name.c_str(), truth[i].file.c_str(),
                              score.found, score.tags, score.false_positives, best);
@@ -141,6 +167,7 @@ int run_real(const RealOptions& options) {
                         100.0 * set->rate(), set->median_corner_error_px(), p90, total_ms, total_ms / default_ms);
         }
     }
+    print_by_source(settings, by_source);
     return 0;
 }
 
