@@ -41,6 +41,8 @@ void validate(const RoiSettings& r) {
     if (r.window_tag_px != 0.0) check_roi("window_tag_px", r.window_tag_px, 4.0, 1000.0);
     check_roi("window_max_decimation", r.window_max_decimation, 1, 8);
     check_roi("window_blur_sigma", r.window_blur_sigma, -5.0f, 5.0f);
+    check_roi("idle_after_s", r.idle_after_s, 0.0, 3600.0);
+    check_roi("idle_search_period_s", r.idle_search_period_s, 0.0, 3600.0);
 }
 
 }  // namespace
@@ -123,6 +125,17 @@ std::vector<TagDetection> TagTracker::detect_in_window(const GrayImage& image, s
     return found;
 }
 
+bool TagTracker::idle_throttled(std::int64_t timestamp_ns) const {
+    const RoiSettings& r = config_.roi;
+    if (!r.enabled || r.idle_search_period_s <= 0.0 || sightings_ > 0 || full_searches_ == 0) return false;
+    if (timestamp_ns < last_search_ns_) return false;
+    const std::int64_t unseen_since = seen_ ? std::max(last_seen_ns_, first_search_ns_) : first_search_ns_;
+    if (static_cast<double>(timestamp_ns - unseen_since) * 1e-9 < r.idle_after_s) return false;
+    // Due once the period has passed, give or take 1 ms of timestamp rounding (3 frames stamped
+    // 33'333'333 ns apart are a period of 0.1 s).
+    return static_cast<double>(timestamp_ns - last_search_ns_) * 1e-9 + 1e-3 < r.idle_search_period_s;
+}
+
 TrackedTag TagTracker::track(const CameraFrame& frame) {
     if (frame.image.width != config_.camera.width || frame.image.height != config_.camera.height) {
         throw std::invalid_argument("TagTracker: frame " + std::to_string(frame.image.width) + "x" +
@@ -132,6 +145,7 @@ TrackedTag TagTracker::track(const CameraFrame& frame) {
     TrackedTag out;
     out.timestamp_ns = frame.timestamp_ns;
     last_window_decimation_ = 0;
+    if (idle_throttled(frame.timestamp_ns)) return out;  // idle: not this frame (RoiSettings)
     std::vector<TagDetection> detections;
     std::optional<TagDetection> chosen;
     if (config_.roi.enabled && sightings_ > 0) {
@@ -151,6 +165,8 @@ TrackedTag TagTracker::track(const CameraFrame& frame) {
             detector_.set_quad_search(config_.detector.decimation, config_.detector.blur_sigma);
         }
         detections = detector_.detect(frame.image);
+        if (full_searches_ == 0) first_search_ns_ = frame.timestamp_ns;
+        last_search_ns_ = frame.timestamp_ns;
         ++full_searches_;
         frames_since_search_ = 0;
         const TagDetection* p = pick(detections);

@@ -166,6 +166,47 @@ TEST(TagTrackerRoi, SearchesTheWholeFrameOnItsCadence) {
     EXPECT_EQ(tracker.full_searches(), 3);  // frames 0, 4 and 8
 }
 
+// An empty view: the whole frame is searched in every frame for idle_after_s (1 s), then once per
+// idle_search_period_s (0.1 s); a tag coming into view is found within that period, and then
+// followed in every frame.
+TEST(TagTrackerRoi, IdleSearchIsThrottledAndStillFindsATagComingIntoView) {
+    TagTracker tracker(config(true));
+    Shot empty = shot(0, 0.0, 0.0, 0.5, 0.0, true);
+    const auto at = [](int index) { return static_cast<std::int64_t>(index) * 33'333'333; };  // 30 fps
+    int index = 0;
+    for (; index < 30; ++index) {  // up to 0.97 s: not idle yet
+        empty.frame.timestamp_ns = at(index);
+        ASSERT_FALSE(tracker.track(empty.frame).visible);
+    }
+    EXPECT_EQ(tracker.full_searches(), 30);
+    for (; index < 90; ++index) {  // 1 s .. 3 s idle: a search every 0.1 s, 20 +- 1 of 60 frames
+        empty.frame.timestamp_ns = at(index);
+        ASSERT_FALSE(tracker.track(empty.frame).visible);
+    }
+    EXPECT_GE(tracker.full_searches(), 30 + 19);
+    EXPECT_LE(tracker.full_searches(), 30 + 21);
+    Shot tag = shot(90, 0.0, 0.0, 0.5, 0.0);
+    int found_at = -1;
+    for (; index < 94 && found_at < 0; ++index) {
+        tag.frame.timestamp_ns = at(index);
+        if (tracker.track(tag.frame).visible) found_at = index;
+    }
+    ASSERT_GE(found_at, 90) << "not found within 4 frames (0.13 s)";
+    for (int i = 0; i < 5; ++i) {  // followed again: every frame sees it
+        tag.frame.timestamp_ns = at(index++);
+        EXPECT_TRUE(tracker.track(tag.frame).visible);
+    }
+    // Off: every frame is searched.
+    TrackerConfig c = config(true);
+    c.roi.idle_search_period_s = 0.0;
+    TagTracker eager(c);
+    for (int i = 0; i < 45; ++i) {
+        empty.frame.timestamp_ns = at(i);
+        (void)eager.track(empty.frame);
+    }
+    EXPECT_EQ(eager.full_searches(), 45);
+}
+
 TEST(TagTrackerRoi, RejectsBadSettingsNamingTheField) {
     const auto message = [](TrackerConfig c) {
         try {
@@ -193,6 +234,9 @@ TEST(TagTrackerRoi, RejectsBadSettingsNamingTheField) {
     c = config(true);
     c.roi.window_blur_sigma = 6.0f;
     EXPECT_EQ(message(c), "RoiSettings.window_blur_sigma = 6 outside [-5, 5]");
+    c = config(true);
+    c.roi.idle_search_period_s = -1.0;
+    EXPECT_EQ(message(c), "RoiSettings.idle_search_period_s = -1 outside [0, 3600]");
 }
 
 }  // namespace
