@@ -120,9 +120,19 @@ Eigen::Vector2d projector_content(const DeviceModel& projector, const ScreenMode
     return {(th.x() + arc / 2.0) / arc, (screen.top_m - th.y()) / (screen.top_m - screen.bottom_m)};
 }
 
+void require_locked_exposure(const PatternSource& source) {
+    if (!source.exposure_locked()) {
+        throw CalibrationRefused(
+            "camera auto-exposure is not locked: every image is metered on its own, so patterns cannot be compared "
+            "(lock exposure, gain and white balance: V4L2 exposure_auto = manual, libcamera AeEnable = false; "
+            "virtual rig: camera.auto_exposure = false)");
+    }
+}
+
 AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, ImageSize content,
                         const AutocalOptions& options) {
     check_inputs(prior, content, options);
+    require_locked_exposure(source);
     const std::size_t n = prior.projectors.size();
     std::vector<ImageSize> sizes;
     for (const DeviceModel& p : prior.projectors) sizes.push_back(p.resolution);

@@ -37,6 +37,7 @@
 //     cylinder.
 //  5. Warp: grid samples at texel centres (warp_sampling.h) -> fitted projector ray -> cylinder
 //     -> content (u, v), left unclamped past the screen's edges (the blend is 0 there).
+//  0. The camera's auto-exposure must be locked (refused otherwise, before any pattern is shown).
 //  6. Blend (linear light; Raskar et al. 1999): w_k = f(d_k) / sum_j f(d_j), d_j = distance in
 //     projector j's pixels of the screen point from the parts of j's image border that lie on the
 //     screen (borders beyond the screen's top, bottom or ends are no overlap edges), f =
@@ -99,13 +100,24 @@ struct AutocalOptions {
     double max_view_angle_deg = 75.0;  // camera rays steeper than this to the screen normal: grazing
 };
 
-// Shows one signal image per projector (CV_32FC1 in [0, 1], projector resolution; empty = black)
-// and returns the camera image (CV_32FC1, [0, 1]).
+// Shows one signal image per projector (CV_32FC1 grey or CV_32FC3 RGB in [0, 1], projector
+// resolution; empty = black) and returns the camera image (CV_32FC1, [0, 1]).
+// The camera's exposure, gain and white balance must be locked (V4L2 exposure_auto = manual,
+// libcamera AeEnable = false): images of different patterns are compared value by value.
 class PatternSource {
 public:
     virtual ~PatternSource() = default;
     [[nodiscard]] virtual cv::Mat1f show(const std::vector<cv::Mat>& signals) = 0;
+    // False while the camera meters each image itself (auto-exposure): calibrate() and
+    // calibrate_colour() refuse then, naming it.
+    [[nodiscard]] virtual bool exposure_locked() const = 0;
+    // Manual exposure relative to the one the source was set up with (1 = that one); the colour
+    // step lengthens it for black levels and sets it back.
+    virtual void set_relative_exposure(double factor) = 0;
 };
+
+// Throws CalibrationRefused naming the camera's auto-exposure unless source.exposure_locked().
+void require_locked_exposure(const PatternSource& source);
 
 // The calibration cannot give a good result; the message says why (which projector, which gate,
 // the measured value and its limit). The caller keeps its last good calibration.

@@ -25,8 +25,11 @@ int main(int argc, char** argv) {
     cmd->add_option("--content", content, "Content frame WIDTHxHEIGHT (the farm's frame)");
     cmd->add_option("--alpha-bits", job.alpha_bits, "Alpha map bits, 8 or 16")->check(CLI::IsMember({8, 16}));
     cmd->add_option("--warp-step", job.options.warp_step_px, "Warp grid step, output pixels")->check(CLI::Range(1, 64));
+    bool no_colour = false;
+    cmd->add_flag("--no-colour", no_colour, "Geometry only: no response, black-level and colour matching step");
     try {
         app.parse(argc, argv);
+        job.colour = !no_colour;
         if (std::sscanf(content.c_str(), "%dx%d", &job.content.width, &job.content.height) != 2 ||
             job.content.width < 1 || job.content.height < 1 || job.content.width > 16384 ||
             job.content.height > 16384) {
@@ -42,6 +45,12 @@ int main(int argc, char** argv) {
                     r["rig"].get<std::string>().c_str(), t["geometry_mean_px"].get<double>(),
                     t["geometry_p95_px"].get<double>(), 100.0 * t["seam_luminance_max_deviation"].get<double>(),
                     job.out.c_str());
+        for (const auto& s : t["seams"]) {
+            std::printf(
+                "  content %.2f: seam luminance deviation %.2f %%, seam Delta E76 %.2f (max over the screen %.2f)\n",
+                s["level"].get<double>(), 100.0 * s["seam_luminance_deviation"].get<double>(),
+                s["seam_delta_e76"].get<double>(), s["delta_e76_max"].get<double>());
+        }
         return 0;
     } catch (const std::exception& e) {
         std::cerr << "mogao-autocal calibrate: " << e.what() << "\n";

@@ -6,10 +6,12 @@
 #include <cmath>
 #include <fstream>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "appliance/autocal/colour_truth.h"
 #include "appliance/autocal/rig_bridge.h"
 #include "appliance/calibration/mpcdi_screen.h"
 #include "appliance/calibration/mpcdi_writer.h"
@@ -19,18 +21,6 @@
 
 namespace mogao::autocal {
 namespace {
-
-// Image position of screen point (theta, h) in a fitted model, or NaN.
-Eigen::Vector2d model_pixel(const DeviceModel& d, const ScreenModel& s, double theta, double h) {
-    const Eigen::Vector3d p(s.radius_m * std::sin(theta), h, -s.radius_m * std::cos(theta));
-    const Eigen::Vector3d q = d.rotation.transpose() * (p - d.position_m);
-    const Eigen::Vector2d xy(d.fx_px * q.x() / q.z() + d.cx_px, d.fy_px * q.y() / q.z() + d.cy_px);
-    if (q.z() <= 0.0 ||
-        !(xy.x() >= 0.0 && xy.x() < d.resolution.width && xy.y() >= 0.0 && xy.y() < d.resolution.height)) {
-        return {std::nan(""), std::nan("")};
-    }
-    return xy;
-}
 
 // The calibration's own prediction of its seams: max |sum of blend weights - 1| where the fitted
 // models put two or more projectors (content grid of 401 x 101 points inset by 1 %).
@@ -95,13 +85,53 @@ cv::Mat1b preview(const rig::VirtualRig& rig, const ScreenCalibration& c, int wi
     return out;
 }
 
+// Seams against the rig's ground truth at black, dark, mid grey and white content.
+nlohmann::json seam_figures(const rig::VirtualRig& rig, const ScreenCalibration& c) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const double level : {0.0, 0.05, 0.5, 1.0}) {
+        const SeamColour s = measure_seam_colour(rig, c, level);
+        out.push_back({{"level", level},
+                       {"reference_luminance", s.reference_luminance},
+                       {"seam_luminance_deviation", s.seam_luminance_deviation},
+                       {"luminance_max_deviation", s.luminance_max_deviation},
+                       {"seam_delta_e76", s.seam_delta_e},
+                       {"seam_luminance_p95", s.seam_luminance_p95},
+                       {"seam_delta_e76_p95", s.seam_delta_e_p95},
+                       {"delta_e76_max", s.delta_e_max},
+                       {"seam_samples", s.seam_samples}});
+    }
+    return out;
+}
+
+nlohmann::json colour_report(const ColourResult& c) {
+    nlohmann::json out = {{"captures", c.captures},
+                          {"matched_white", c.matched_white},
+                          {"black_floor", c.black_floor},
+                          {"ambient", c.ambient},
+                          {"alpha_scale", c.alpha_scale}};
+    for (const ProjectorPhotometry& p : c.projectors) {
+        nlohmann::json ch = nlohmann::json::array();
+        for (const ChannelResponse& r : p.channels) {
+            ch.push_back({{"amplitude", r.amplitude}, {"gamma", r.gamma}, {"gamma_fit_rms", r.gamma_rms}});
+        }
+        out["projectors"].push_back({{"id", p.id}, {"black", p.black}, {"gain", p.gain}, {"channels", ch}});
+    }
+    return out;
+}
+
 }  // namespace
 
 nlohmann::json run_calibrate_job(const CalibrateJob& job) {
     const rig::VirtualRig rig = scaled_rig(rig::load_rig(job.rig), job.scale, job.scale);
     RigPatternSource source(rig);
     const CalibrationPrior prior = prior_from_rig(rig);
-    const AutocalResult r = calibrate(source, prior, job.content, job.options);  // throws before any write
+    AutocalResult r = calibrate(source, prior, job.content, job.options);  // throws before any write
+    nlohmann::json seams_before;
+    std::optional<ColourResult> colour;
+    if (job.colour) {
+        seams_before = seam_figures(rig, r.calibration);
+        colour = calibrate_colour(source, prior.screen, r.projectors, r.calibration, job.colour_options);  // throws
+    }
     const GeometryError g = measure_geometry(rig, r.calibration, 4);
     const LuminanceError l = measure_luminance(rig, r.calibration);
     nlohmann::json report = {
@@ -122,6 +152,12 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
           {"luminance_max_deviation", l.max_deviation},
           {"seam_luminance_max_deviation", l.seam_max_deviation},
           {"camera_position_error_mm", (r.camera.position_m - rig.camera.pose.position_m).norm() * 1e3}}}};
+    if (colour) {
+        report["colour"] = colour_report(*colour);
+        report["captures"] = r.report.captures + colour->captures;
+        report["ground_truth"]["seams_before_colour"] = seams_before;
+    }
+    report["ground_truth"]["seams"] = seam_figures(rig, r.calibration);
     for (std::size_t k = 0; k < r.report.projectors.size(); ++k) {
         const ProjectorReport& p = r.report.projectors[k];
         report["projectors"].push_back(
@@ -137,6 +173,7 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
     std::filesystem::create_directories(job.out);
     MpcdiExportOptions mo;
     mo.alpha_bit_depth = job.alpha_bits;
+    mo.write_response = job.colour;
     write_mpcdi(job.out / "calibration.mpcdi", to_mpcdi(r.calibration, mo));
     const std::filesystem::path png = job.out / "preview.png";
     if (!cv::imwrite(png.string(), preview(rig, r.calibration, 960))) {

@@ -2,12 +2,15 @@
 // `mogao-autocal calibrate`: the camera-based calibration of a virtual rig (rigs/*.toml) from
 // patterns to files (docs/calibration.md, "The calibrate command"): writes into the output folder
 //   calibration.mpcdi  the ScreenCalibration as a 2d-profile MPCDI file (appliance/calibration's
-//                      writer, atomic; 16-bit alpha by default),
+//                      writer, atomic; 16-bit alpha by default; with the colour step, 16-bit RGB
+//                      beta maps and the ResponseLUT extension entries),
 //   report.json        per projector: decoded bits, correspondences, reprojection rms (the fit's
 //                      own residual), view angle, camera coverage, the blend's predicted seam
 //                      (max |sum of weights - 1| over the overlaps from the fitted models), and the
 //                      accuracy against the rig's ground truth (geometry in projector pixels,
-//                      luminance), clearly apart,
+//                      luminance), clearly apart; with the colour step, the measured responses,
+//                      blacks and gains ("colour") and the seams before and after it at black,
+//                      dark, mid-grey and white content (ground_truth.seams_before_colour, .seams),
 //   preview.png        the screen as a viewer sees it (ground-truth light paths): a white field with
 //                      a content grid every 1/16 of the frame, linear light -> gamma 2.2, 8 bits.
 // A refused calibration (CalibrationRefused) writes nothing: whatever the folder held stays.
@@ -20,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "appliance/autocal/autocal.h"
+#include "appliance/autocal/colour_calibration.h"
 
 namespace mogao::autocal {
 
@@ -30,6 +34,8 @@ struct CalibrateJob {
     ImageSize content{1920, 1080};
     int alpha_bits = 16;  // 8 or 16
     AutocalOptions options;
+    bool colour = true;  // the photometric step (colour_calibration.h) after the geometry
+    ColourOptions colour_options;
 };
 
 // Runs the job; returns the report (also written as report.json). Throws rig::RigError,

@@ -44,7 +44,8 @@ TEST(CalibrateJob, MpcdiRoundTripGivesTheSameMaps) {
     // The same calibration again (the rig is deterministic), to compare with what the file holds.
     const rig::VirtualRig rig = scaled_rig(rig::load_rig(job.rig), job.scale, job.scale);
     RigPatternSource source(rig);
-    const AutocalResult direct = calibrate(source, prior_from_rig(rig), job.content, job.options);
+    AutocalResult direct = calibrate(source, prior_from_rig(rig), job.content, job.options);
+    (void)calibrate_colour(source, prior_from_rig(rig).screen, direct.projectors, direct.calibration);
     const ScreenCalibration back = to_screen_calibration(read_mpcdi(job.out / "calibration.mpcdi"));
     ASSERT_EQ(back.projectors.size(), direct.calibration.projectors.size());
     EXPECT_EQ(back.content.width, job.content.width);
@@ -66,10 +67,43 @@ TEST(CalibrateJob, MpcdiRoundTripGivesTheSameMaps) {
         }
         EXPECT_LE(warp_err, 2e-7) << a.id;  // float rounding of the region-relative positions
         EXPECT_LE(blend_err, alpha_bound) << a.id;
+        EXPECT_EQ(a.response.lut, b.response.lut) << a.id;  // ResponseLUT entry: float32, exact
+        ASSERT_EQ(a.beta.size, b.beta.size) << a.id;
+        ASSERT_EQ(a.beta.rgb.size(), b.beta.rgb.size()) << a.id;
+        double beta_err = 0.0;
+        double beta_max = 0.0;
+        for (std::size_t i = 0; i < a.beta.rgb.size(); ++i) {
+            beta_err = std::max(beta_err, double(std::abs(a.beta.rgb[i] - b.beta.rgb[i])));
+            beta_max = std::max(beta_max, double(a.beta.rgb[i]));
+        }
+        EXPECT_LE(beta_err, 0.5 / 65535.0 + 1e-8) << a.id;  // half a 16-bit code
+        EXPECT_GT(beta_max, 1e-3) << a.id;                  // black-level compensation present
     }
     EXPECT_EQ(report["projectors"].size(), 3u);
     EXPECT_LE(report["ground_truth"]["geometry_p95_px"].get<double>(), 0.8);
     EXPECT_TRUE(std::filesystem::file_size(job.out / "preview.png") > 1000);
+    std::filesystem::remove_all(job.out);
+}
+
+TEST(CalibrateJob, AutoExposureIsRefusedAndKeepsThePreviousCalibration) {
+    CalibrateJob job;
+    job.out = temp_dir("auto-exposure");
+    std::filesystem::create_directories(job.out);
+    std::ofstream(job.out / "calibration.mpcdi") << "last good";
+    std::string text = slurp(std::string(MOGAO_SOURCE_DIR) + "/rigs/standard.toml");
+    text.replace(text.find("gain = 1.0"), 10, "gain = 1.0\nauto_exposure = true");
+    job.rig = job.out / "auto.toml";
+    std::ofstream(job.rig) << text;
+    job.scale = 0.25;
+    job.content = {960, 540};
+    try {
+        (void)run_calibrate_job(job);
+        FAIL() << "calibrated with the camera's auto-exposure on";
+    } catch (const CalibrationRefused& e) {
+        EXPECT_NE(std::string(e.what()).find("camera auto-exposure is not locked"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(slurp(job.out / "calibration.mpcdi"), "last good");
+    EXPECT_FALSE(std::filesystem::exists(job.out / "report.json"));
     std::filesystem::remove_all(job.out);
 }
 

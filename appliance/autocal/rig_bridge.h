@@ -14,14 +14,17 @@ namespace mogao::autocal {
 // Shows patterns on the virtual rig and returns its camera image (a new noise seed per image).
 class RigPatternSource : public PatternSource {
 public:
-    explicit RigPatternSource(const rig::VirtualRig& rig) : sim_(rig) {}
+    explicit RigPatternSource(const rig::VirtualRig& rig) : sim_(rig), base_exposure_(rig.camera.exposure) {}
     [[nodiscard]] cv::Mat1f show(const std::vector<cv::Mat>& signals) override {
         return sim_.capture(signals, frame_++);
     }
+    [[nodiscard]] bool exposure_locked() const override { return !sim_.rig().camera.auto_exposure; }
+    void set_relative_exposure(double factor) override { sim_.set_exposure(base_exposure_ * factor); }
     [[nodiscard]] const rig::CameraSimulator& simulator() const { return sim_; }
 
 private:
     rig::CameraSimulator sim_;
+    double base_exposure_ = 1.0;
     std::uint64_t frame_ = 0;
 };
 

@@ -46,6 +46,13 @@ public:
         return static_cast<int>(v->as_integer());
     }
 
+    bool boolean(const std::string& key, bool fallback) {
+        const toml::value* v = find(key);
+        if (v == nullptr) return fallback;
+        if (!v->is_boolean()) fail(key, "must be true or false");
+        return v->as_boolean();
+    }
+
     std::string string(const std::string& key, const std::string& fallback) {
         const toml::value* v = find(key);
         if (v == nullptr) return fallback;
@@ -137,6 +144,7 @@ RigCamera read_camera(Table& t) {
     c.pose = read_pose(t);
     c.exposure = t.number("exposure", c.exposure);
     c.gain = t.number("gain", c.gain);
+    c.auto_exposure = t.boolean("auto_exposure", c.auto_exposure);
     c.read_noise = t.number("read_noise", c.read_noise);
     c.shot_noise = t.number("shot_noise", c.shot_noise);
     c.blur_sigma_px = t.number("blur_sigma_px", c.blur_sigma_px);

@@ -252,6 +252,10 @@ cv::Mat1f CameraSimulator::capture(const std::vector<cv::Mat>& signals, std::uin
     if (cam.blur_sigma_px > 0.0)
         cv::GaussianBlur(img, img, cv::Size(0, 0), cam.blur_sigma_px, cam.blur_sigma_px, cv::BORDER_REPLICATE);
     img *= cam.exposure * cam.gain;
+    if (cam.auto_exposure) {
+        const double mean = cv::mean(img)[0];
+        if (mean > 0.0) img *= kAutoExposureTarget / mean;
+    }
     cv::Mat1f noise(img.size());
     cv::RNG rng(cam.seed * 0x9E3779B97F4A7C15ULL + frame * 0xD1B54A32D192ED03ULL + 1);
     rng.fill(noise, cv::RNG::NORMAL, 0.0, 1.0);
@@ -266,6 +270,11 @@ cv::Mat1f CameraSimulator::capture(const std::vector<cv::Mat>& signals, std::uin
         }
     }
     return img;
+}
+
+void CameraSimulator::set_exposure(double exposure) {
+    check_range(exposure, 1e-3, 100.0, "camera.exposure");
+    rig_.camera.exposure = exposure;
 }
 
 double CameraSimulator::camera_coverage(int k) const {

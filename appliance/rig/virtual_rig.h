@@ -30,6 +30,9 @@
 // integrated over each pixel by `supersample`^2 point samples, blurred by a Gaussian of
 // `blur_sigma_px`, scaled by exposure * gain, with Gaussian noise of standard deviation
 // sqrt(read_noise^2 + shot_noise^2 * value), clipped to [0, 1] and quantised to `bits`.
+// Auto-exposure (camera.auto_exposure, what a webcam does unless told otherwise): before the noise,
+// each image is rescaled so that its mean is kAutoExposureTarget of full scale, whatever the
+// exposure, so images of different patterns are not comparable (a calibration must refuse it).
 #pragma once
 
 #include <array>
@@ -84,6 +87,7 @@ struct RigCamera {
     RigPose pose;
     double exposure = 1.0;       // (0, 100]
     double gain = 1.0;           // (0, 100]
+    bool auto_exposure = false;  // true: each image is metered (see the header comment), exposure not locked
     double read_noise = 0.003;   // standard deviation of the signal, fraction of full scale, [0, 0.5]
     double shot_noise = 0.0;     // signal-dependent part, see the header comment, [0, 0.5]
     double blur_sigma_px = 0.7;  // Gaussian blur, camera pixels, [0, 20]
@@ -136,6 +140,8 @@ void validate_rig(const VirtualRig& rig);
 [[nodiscard]] Eigen::Vector2d content_of(const RigScreen& screen, ScreenPoint p);
 [[nodiscard]] ScreenPoint screen_of(const RigScreen& screen, Eigen::Vector2d uv);
 
+inline constexpr double kAutoExposureTarget = 0.45;
+
 // Forms camera images of the rig. Building it traces every camera sample once (ray -> screen ->
 // each projector's pixel); capture() then only looks up the projectors' images.
 class CameraSimulator {
@@ -149,6 +155,10 @@ public:
     [[nodiscard]] cv::Mat1f capture(const std::vector<cv::Mat>& signals, std::uint64_t frame) const;
 
     [[nodiscard]] const VirtualRig& rig() const { return rig_; }
+    // The camera's manual exposure (what a locked camera lets the calibration set, e.g. a long
+    // exposure for black levels); (0, 100], else std::invalid_argument. Has no effect while
+    // auto-exposure is on (the metering overrides it).
+    void set_exposure(double exposure);
     // Fraction of projector k's 8x8-pixel blocks that some camera sample sees (ground truth coverage).
     [[nodiscard]] double camera_coverage(int k) const;
 

@@ -109,6 +109,32 @@ TEST(VirtualRig, CaptureIsDeterministicAndNoisy) {
     EXPECT_THROW((void)sim.capture(std::vector<cv::Mat>(2), 0), std::invalid_argument);
 }
 
+TEST(VirtualRig, LockedExposureScalesLightAndAutoExposureMetersEveryImage) {
+    VirtualRig rig = standard();
+    rig.camera.read_noise = 0.0;
+    rig.camera.shot_noise = 0.0;
+    rig.camera.bits = 16;
+    CameraSimulator sim(rig);
+    const std::vector<cv::Mat> off(3);
+    const double dark = cv::mean(sim.capture(off, 0))[0];
+    sim.set_exposure(20.0);
+    EXPECT_NEAR(cv::mean(sim.capture(off, 0))[0], 20.0 * dark, 1e-3);  // linear in the exposure
+    EXPECT_THROW(sim.set_exposure(0.0), std::invalid_argument);
+
+    rig.camera.auto_exposure = true;
+    const CameraSimulator metered(rig);
+    std::vector<cv::Mat> white(3);
+    for (int k = 0; k < 3; ++k) white[static_cast<std::size_t>(k)] = cv::Mat1f(1080, 1920, 1.0f);
+    // Black comes out at the metering target and white barely brighter (clipped where lit): the
+    // images are not comparable, where the locked camera sees white far brighter than black.
+    const double auto_black = cv::mean(metered.capture(off, 0))[0];
+    EXPECT_NEAR(auto_black, kAutoExposureTarget, 1e-3);
+    EXPECT_LT(cv::mean(metered.capture(white, 0))[0] / auto_black, 1.5);
+    sim.set_exposure(1.0);
+    EXPECT_GT(cv::mean(sim.capture(white, 0))[0] / cv::mean(sim.capture(off, 0))[0], 10.0);
+    EXPECT_TRUE(parse_rig("[camera]\nauto_exposure = true\n[[projectors]]\n", "x.toml").camera.auto_exposure);
+}
+
 TEST(RigFile, ErrorsNameTheField) {
     const auto message = [](const std::string& text) {
         try {
@@ -129,6 +155,9 @@ TEST(RigFile, ErrorsNameTheField) {
         message("[camera]\n[[projectors]]\ngamma = [2.2, 2.2]\n").find("projectors[0].gamma: must be an array of 3"),
         std::string::npos);
     EXPECT_NE(message("[camera\n").find("not valid TOML"), std::string::npos);
+    EXPECT_NE(
+        message("[camera]\nauto_exposure = 1\n[[projectors]]\n").find("camera.auto_exposure: must be true or false"),
+        std::string::npos);
     EXPECT_THROW((void)load_rig("/nonexistent/rig.toml"), RigError);
 }
 

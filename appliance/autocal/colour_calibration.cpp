@@ -1,0 +1,352 @@
+// SPDX-License-Identifier: Apache-2.0
+// Response, black level and matching of the projectors (colour_calibration.h, method there).
+#include "appliance/autocal/colour_calibration.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include <Eigen/Dense>
+#include <opencv2/imgproc.hpp>
+
+#include "appliance/warp/calibration_validation.h"
+#include "appliance/warp/response_curve.h"
+#include "appliance/warp/warp_sampling.h"
+
+namespace mogao::autocal {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+std::string channel_name(std::size_t c) { return std::string(1, "RGB"[c]); }
+
+void check_options(const ColourOptions& o) {
+    const auto fail = [](const std::string& what) { throw std::invalid_argument("calibrate_colour: " + what); };
+    if (o.ramp_steps < 3 || o.ramp_steps > 64) fail("ramp_steps must be 3..64");
+    if (o.dark_frames < 1 || o.dark_frames > 64) fail("dark_frames must be 1..64");
+    if (!(o.dark_exposure >= 1.0 && o.dark_exposure <= 1000.0)) fail("dark_exposure must be in [1, 1000]");
+    if (o.lut_entries < 2 || o.lut_entries > kMaxResponseEntries) fail("lut_entries must be 2..2^20");
+    if (!(o.min_amplitude > 0.0 && o.min_amplitude < 1.0)) fail("min_amplitude must be in (0, 1)");
+    if (!(o.max_fit_rms > 0.0)) fail("max_fit_rms must be > 0");
+    if (o.mask_erode_px < 0 || o.mask_erode_px > 32) fail("mask_erode_px must be 0..32");
+}
+
+// Projector k shows channel c at level s (the other channels and projectors black).
+std::vector<cv::Mat> channel_signal(const std::vector<DeviceModel>& projectors, std::size_t k, std::size_t c,
+                                    double s) {
+    std::vector<cv::Mat> signals(projectors.size());
+    const ImageSize r = projectors[k].resolution;
+    cv::Scalar v(0.0, 0.0, 0.0);
+    v[static_cast<int>(c)] = s;
+    signals[k] = cv::Mat(r.height, r.width, CV_32FC3, v);
+    return signals;
+}
+
+double masked_mean(const cv::Mat1f& image, const cv::Mat1b& mask) { return cv::mean(image, mask)[0]; }
+
+double fit_gamma(const ChannelResponse& r, double* rms) {
+    // Golden-section search of sum (R_i - s_i^g)^2 over g in [0.2, 8] (unimodal for monotone data).
+    const auto cost = [&](double g) {
+        double e = 0.0;
+        for (std::size_t i = 0; i < r.levels.size(); ++i) e += std::pow(r.measured[i] - std::pow(r.levels[i], g), 2);
+        return e;
+    };
+    double lo = 0.2;
+    double hi = 8.0;
+    const double phi = (std::sqrt(5.0) - 1.0) / 2.0;
+    for (int it = 0; it < 80; ++it) {
+        const double a = hi - phi * (hi - lo);
+        const double b = lo + phi * (hi - lo);
+        (cost(a) < cost(b) ? hi : lo) = (cost(a) < cost(b) ? b : a);
+    }
+    const double g = (lo + hi) / 2.0;
+    *rms = std::sqrt(cost(g) / static_cast<double>(r.levels.size()));
+    return g;
+}
+
+struct Captured {
+    cv::Mat1f black;
+    std::vector<cv::Mat1b> inside;   // per projector: camera pixels it clearly lights
+    std::vector<cv::Mat1b> outside;  // per projector: camera pixels it clearly does not light
+};
+
+// Step 1 for projector k: ramps per channel, the coverage masks from the full-level images.
+ProjectorPhotometry measure_projector(PatternSource& source, const std::vector<DeviceModel>& projectors, std::size_t k,
+                                      const ColourOptions& o, Captured& cap, int& captures) {
+    ProjectorPhotometry pp;
+    pp.id = projectors[k].id;
+    const int n = o.ramp_steps;
+    std::array<std::vector<cv::Mat1f>, 3> diffs;
+    cv::Mat1f full(cap.black.size(), 0.0f);
+    for (std::size_t c = 0; c < 3; ++c) {
+        for (int i = 1; i < n; ++i) {
+            const double s = static_cast<double>(i) / (n - 1);
+            cv::Mat1f d;
+            cv::subtract(source.show(channel_signal(projectors, k, c, s)), cap.black, d);
+            ++captures;
+            diffs[c].push_back(d);
+        }
+        full += diffs[c].back();
+    }
+    // Coverage: above half the bright end (99th percentile) of the summed full-level difference.
+    std::vector<float> values(full.begin(), full.end());
+    std::nth_element(values.begin(), values.begin() + static_cast<long>(values.size() * 99 / 100), values.end());
+    const double top = values[values.size() * 99 / 100];
+    const cv::Mat kernel =
+        cv::getStructuringElement(cv::MORPH_RECT, {2 * o.mask_erode_px + 1, 2 * o.mask_erode_px + 1});
+    cv::Mat1b in;
+    cv::Mat1b out;
+    cv::compare(full, 0.5 * top, in, cv::CMP_GT);
+    cv::compare(full, 0.1 * top, out, cv::CMP_LT);
+    cv::erode(in, in, kernel);
+    cv::erode(out, out, kernel);
+    cap.inside.push_back(in);
+    cap.outside.push_back(out);
+    if (cv::countNonZero(in) < 100) {
+        throw CalibrationRefused("projector " + std::to_string(k) + " '" + pp.id + "': the camera sees only " +
+                                 std::to_string(cv::countNonZero(in)) +
+                                 " pixels of it (need >= 100) to measure its response");
+    }
+    for (std::size_t c = 0; c < 3; ++c) {
+        ChannelResponse& r = pp.channels[c];
+        r.levels.push_back(0.0);
+        r.measured.push_back(0.0);
+        for (int i = 1; i < n; ++i) {
+            r.levels.push_back(static_cast<double>(i) / (n - 1));
+            r.measured.push_back(masked_mean(diffs[c][static_cast<std::size_t>(i - 1)], in));
+        }
+        r.amplitude = r.measured.back();
+        if (!(r.amplitude >= o.min_amplitude)) {
+            throw CalibrationRefused("projector " + std::to_string(k) + " '" + pp.id + "' channel " + channel_name(c) +
+                                     ": full white reaches " + std::to_string(r.amplitude) +
+                                     " of the camera's range (need >= " + std::to_string(o.min_amplitude) +
+                                     "): raise the camera's locked exposure");
+        }
+        double running = 0.0;
+        for (double& v : r.measured) {
+            v = std::max(running, std::clamp(v / r.amplitude, 0.0, 1.0));  // non-decreasing (noise)
+            running = v;
+        }
+        r.gamma = fit_gamma(r, &r.gamma_rms);
+        if (!(r.gamma_rms <= o.max_fit_rms)) {
+            throw CalibrationRefused("projector " + std::to_string(k) + " '" + pp.id + "' channel " + channel_name(c) +
+                                     ": measured response is " + std::to_string(r.gamma_rms) +
+                                     " rms from the nearest gamma (gate " + std::to_string(o.max_fit_rms) +
+                                     "): not a projector response (saturation, changing exposure?)");
+        }
+    }
+    return pp;
+}
+
+// Step 2: betas and ambient by least squares on the long-exposure black image.
+void measure_black(PatternSource& source, const ColourOptions& o, const Captured& cap,
+                   std::vector<ProjectorPhotometry>& pps, double& ambient, int& captures) {
+    const std::size_t n = pps.size();
+    source.set_relative_exposure(o.dark_exposure);
+    cv::Mat1f dark(cap.black.size(), 0.0f);
+    std::vector<cv::Mat> off(n);
+    try {
+        for (int f = 0; f < o.dark_frames; ++f) dark += source.show(off);
+    } catch (...) {
+        source.set_relative_exposure(1.0);
+        throw;
+    }
+    source.set_relative_exposure(1.0);
+    captures += o.dark_frames;
+    dark /= static_cast<float>(o.dark_frames);
+    Eigen::MatrixXd ata = Eigen::MatrixXd::Zero(static_cast<long>(n) + 1, static_cast<long>(n) + 1);
+    Eigen::VectorXd atb = Eigen::VectorXd::Zero(static_cast<long>(n) + 1);
+    long rows = 0;
+    long overlaps = 0;
+    long saturated = 0;
+    for (int y = 0; y < dark.rows; ++y) {
+        for (int x = 0; x < dark.cols; ++x) {
+            Eigen::VectorXd a = Eigen::VectorXd::Zero(static_cast<long>(n) + 1);
+            a[0] = 1.0;
+            int lit = 0;
+            bool clear = true;
+            for (std::size_t k = 0; k < n && clear; ++k) {
+                const bool in = cap.inside[k](y, x) != 0;
+                clear = in || cap.outside[k](y, x) != 0;
+                a[static_cast<long>(k) + 1] = in ? 1.0 : 0.0;
+                lit += in;
+            }
+            if (!clear || lit == 0) continue;
+            if (dark(y, x) >= 0.999f) {
+                ++saturated;
+                continue;
+            }
+            ata += a * a.transpose();
+            atb += a * (static_cast<double>(dark(y, x)) / o.dark_exposure);
+            ++rows;
+            overlaps += lit >= 2;
+        }
+    }
+    if (saturated > rows / 100) {
+        throw CalibrationRefused("black level: " + std::to_string(saturated) +
+                                 " camera pixels saturate at the black exposure x" + std::to_string(o.dark_exposure) +
+                                 " (lower ColourOptions::dark_exposure)");
+    }
+    ambient = 0.0;
+    for (ProjectorPhotometry& pp : pps) pp.black = 0.0;
+    if (overlaps < 50) return;  // no overlap seen: the betas are not separable, and nothing to compensate
+    const Eigen::VectorXd sol = ata.ldlt().solve(atb);
+    ambient = sol[0];
+    for (std::size_t k = 0; k < n; ++k) pps[k].black = std::max(0.0, sol[static_cast<long>(k) + 1]);
+}
+
+// Inverse of the normalised response at target t in [0, 1] by bisection (response_at is monotone).
+double invert_measured(const ChannelResponse& r, double t) {
+    double lo = 0.0;
+    double hi = 1.0;
+    for (int it = 0; it < 40; ++it) {
+        const double mid = (lo + hi) / 2.0;
+        (response_at(r, mid) < t ? lo : hi) = mid;
+    }
+    return (lo + hi) / 2.0;
+}
+
+// Black light per channel at screen point (theta, h): sum of the blacks of the projectors there.
+std::array<double, 3> black_at(const std::vector<DeviceModel>& models, const ScreenModel& screen,
+                               const std::vector<std::array<double, 3>>& blacks, double theta, double h,
+                               std::size_t always) {
+    std::array<double, 3> b{};
+    for (std::size_t j = 0; j < models.size(); ++j) {
+        if (j != always && !model_pixel(models[j], screen, theta, h).allFinite()) continue;
+        for (std::size_t c = 0; c < 3; ++c) b[c] += blacks[j][c];
+    }
+    return b;
+}
+
+// Step 4 for one projector: LUT, beta grid (blend-sized), alpha not yet scaled.
+double apply_projector(const ProjectorPhotometry& pp, std::size_t k, const ColourResult& res,
+                       const std::vector<DeviceModel>& models, const ScreenModel& screen,
+                       const std::vector<std::array<double, 3>>& blacks, const ColourOptions& o,
+                       ProjectorCalibration& pc) {
+    for (std::size_t c = 0; c < 3; ++c) {
+        std::vector<float>& lut = pc.response.lut[c];
+        lut.assign(static_cast<std::size_t>(o.lut_entries), 0.0F);
+        for (int j = 0; j < o.lut_entries; ++j) {
+            const double x = static_cast<double>(j) / (o.lut_entries - 1);
+            lut[static_cast<std::size_t>(j)] = static_cast<float>(invert_measured(pp.channels[c], x * pp.gain[c]));
+        }
+        for (std::size_t j = 1; j < lut.size(); ++j) lut[j] = std::max(lut[j], lut[j - 1]);
+    }
+    // Beta per output pixel: black steps are as sharp as the other projectors' image edges, so a
+    // coarser grid would smear the compensating step over several pixels.
+    const double arc = screen.arc_deg * kDeg;
+    pc.beta.size = pc.output;
+    pc.beta.rgb.assign(static_cast<std::size_t>(pc.output.pixel_count()) * 3, 0.0F);
+    double worst = 0.0;  // max D_c / W_c
+    for (int y = 0; y < pc.output.height; ++y) {
+        for (int x = 0; x < pc.output.width; ++x) {
+            const ContentUv uv = sample_warp(pc.warp, pc.output, x, y);
+            const float alpha = sample_blend(pc.blend, pc.output, x, y);
+            if (!uv.valid() || alpha <= 0.0F) continue;
+            const double theta = uv.u * arc - arc / 2.0;
+            const double h = screen.top_m - uv.v * (screen.top_m - screen.bottom_m);
+            const std::array<double, 3> b = black_at(models, screen, blacks, theta, h, k);
+            const std::size_t g = (static_cast<std::size_t>(y) * static_cast<std::size_t>(pc.output.width) +
+                                   static_cast<std::size_t>(x)) *
+                                  3;
+            for (std::size_t c = 0; c < 3; ++c) {
+                const double deficit = std::max(0.0, res.black_floor[c] - b[c]) / res.matched_white[c];
+                worst = std::max(worst, deficit);
+                pc.beta.rgb[g + c] = static_cast<float>(std::clamp(alpha * deficit, 0.0, 1.0));
+            }
+        }
+    }
+    return worst;
+}
+
+}  // namespace
+
+Eigen::Vector2d model_pixel(const DeviceModel& d, const ScreenModel& s, double theta, double h) {
+    const Eigen::Vector3d p(s.radius_m * std::sin(theta), h, -s.radius_m * std::cos(theta));
+    const Eigen::Vector3d q = d.rotation.transpose() * (p - d.position_m);
+    const Eigen::Vector2d xy(d.fx_px * q.x() / q.z() + d.cx_px, d.fy_px * q.y() / q.z() + d.cy_px);
+    if (q.z() <= 0.0 ||
+        !(xy.x() >= 0.0 && xy.x() < d.resolution.width && xy.y() >= 0.0 && xy.y() < d.resolution.height)) {
+        return {std::nan(""), std::nan("")};
+    }
+    return xy;
+}
+
+double response_at(const ChannelResponse& r, double s) {
+    s = std::clamp(s, 0.0, 1.0);
+    const std::vector<double>& l = r.levels;
+    const std::vector<double>& m = r.measured;
+    std::size_t i = 1;
+    while (i + 1 < l.size() && s > l[i + 1]) ++i;
+    // Segment [l[i], l[i + 1]] (i >= 1); below l[1] the first segment's power law continues.
+    if (i + 1 >= l.size()) return m.back();
+    const double a = m[i];
+    const double b = m[i + 1];
+    if (s <= 0.0) return 0.0;
+    if (a > 0.0 && b > a) {
+        const double e = std::log(b / a) / std::log(l[i + 1] / l[i]);
+        return std::min(1.0, a * std::pow(s / l[i], e));
+    }
+    return s <= l[i] ? a * s / l[i] : a + (b - a) * (s - l[i]) / (l[i + 1] - l[i]);
+}
+
+ColourResult calibrate_colour(PatternSource& source, const ScreenModel& screen,
+                              const std::vector<DeviceModel>& projectors, ScreenCalibration& calibration,
+                              const ColourOptions& options) {
+    check_options(options);
+    if (projectors.size() != calibration.projectors.size() || projectors.empty()) {
+        throw std::invalid_argument("calibrate_colour: " + std::to_string(projectors.size()) + " models for " +
+                                    std::to_string(calibration.projectors.size()) + " projectors");
+    }
+    require_locked_exposure(source);
+    const std::size_t n = projectors.size();
+    ColourResult res;
+    Captured cap;
+    cap.black = source.show(std::vector<cv::Mat>(n));
+    res.captures = 1;
+    for (std::size_t k = 0; k < n; ++k) {
+        res.projectors.push_back(measure_projector(source, projectors, k, options, cap, res.captures));
+    }
+    measure_black(source, options, cap, res.projectors, res.ambient, res.captures);
+    // Step 3: matched white, blacks per channel, black floor over the screen.
+    std::vector<std::array<double, 3>> blacks(n);
+    for (std::size_t c = 0; c < 3; ++c) {
+        res.matched_white[c] = res.projectors[0].channels[c].amplitude;
+        for (const ProjectorPhotometry& pp : res.projectors) {
+            res.matched_white[c] = std::min(res.matched_white[c], pp.channels[c].amplitude);
+        }
+    }
+    for (std::size_t k = 0; k < n; ++k) {
+        ProjectorPhotometry& pp = res.projectors[k];
+        // The mono camera sees the mean of the channels: black (mono) = sum_c black_c / 3 in the
+        // units A_kc is in (one channel's light / 3), so black_c = beta A_c / sum_c A_c.
+        const double sum = pp.channels[0].amplitude + pp.channels[1].amplitude + pp.channels[2].amplitude;
+        for (std::size_t c = 0; c < 3; ++c) {
+            blacks[k][c] = pp.black * pp.channels[c].amplitude / sum;
+            pp.gain[c] = res.matched_white[c] / pp.channels[c].amplitude;
+        }
+    }
+    const double arc = screen.arc_deg * kDeg;
+    for (int j = 0; j <= 100; ++j) {
+        for (int i = 0; i <= 800; ++i) {
+            const double theta = (i / 800.0 - 0.5) * arc;
+            const double h = screen.bottom_m + (screen.top_m - screen.bottom_m) * j / 100.0;
+            const std::array<double, 3> b = black_at(projectors, screen, blacks, theta, h, n);
+            for (std::size_t c = 0; c < 3; ++c) res.black_floor[c] = std::max(res.black_floor[c], b[c]);
+        }
+    }
+    double worst = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {
+        worst = std::max(worst, apply_projector(res.projectors[k], k, res, projectors, screen, blacks, options,
+                                                calibration.projectors[k]));
+    }
+    res.alpha_scale = 1.0 - worst;
+    for (ProjectorCalibration& pc : calibration.projectors) {
+        for (float& w : pc.blend.weight) w = static_cast<float>(w * res.alpha_scale);
+    }
+    validate_screen(calibration);
+    return res;
+}
+
+}  // namespace mogao::autocal

@@ -1,0 +1,98 @@
+// SPDX-License-Identifier: Apache-2.0
+// Photometric calibration after the geometric one (issue 13; seed paper II.B "colour calibration
+// from channel response functions"): each projector's per-channel response measured from camera
+// images of grey ramps with the camera's exposure locked, inverse LUTs, luminance and white point
+// matched across projectors, and black-level compensation (beta maps) so that the overlaps and the
+// rest of the screen show the same black. docs/calibration.md, "Colour and black level".
+//
+// Camera: monochrome with a flat spectral response (the virtual rig's; a colour camera's channels
+// summed the same way): one channel of one projector is shown at a time, so the camera measures
+// that channel's light. Camera units are its image values at the base (locked) exposure.
+//
+// Method (Majumder & Stevens, "Color nonuniformity in projection-based displays: analysis and
+// solutions", IEEE TVCG 10(2) 2004: the display's range at a point is [black, white]; make it the
+// same everywhere by per-pixel attenuation of the white and offset of the black. This is its
+// simpler documented form for projectors whose light is spatially uniform, as on the virtual rig:
+// one gain per projector and channel instead of a per-pixel luminance attenuation map):
+//  1. Response: projector k, channel c at levels s_i = i / (ramp_steps - 1), the others black;
+//     y_kc(s) = mean over the camera pixels k lights (its coverage mask, eroded) of the image
+//     minus the all-black image. A_kc = y_kc(1) is the channel's full-white amplitude; the
+//     normalised response R_kc(s) = y_kc(s) / A_kc (made non-decreasing) is interpolated as a
+//     power law between measured levels (linear in log s - log R, so a pure gamma is exact) and
+//     continued below s_1 with the first segment's exponent.
+//  2. Black: `dark_frames` all-black images at `dark_exposure` x the base exposure (black levels are
+//     ~0.2 % of white, below one 8-bit code at the base exposure), averaged; least squares over
+//     the camera pixels inside the screen: L0(p) = a + sum_k beta_k M_k(p) with M_k the coverage
+//     masks (a = ambient, beta_k = projector k's black). Needs at least one overlap to separate
+//     a from the betas. Black's chromaticity is taken to be the projector's white's (light leaking
+//     through the same filters): black_kc = beta_k A_kc / sum_c A_kc (the mono camera sees the
+//     mean of the channels, and A_kc is one channel's light as it sees it).
+//  3. Matching: matched white W_c = min_k A_kc per channel (the largest white every projector can
+//     show, so the white point is the same everywhere; it is the per-channel minimum, not a chosen
+//     standard white). Black floor: T_c = max over screen points of B_c(p) = sum_{k lighting p}
+//     black_kc; deficit D_c(p) = T_c - B_c(p) >= 0.
+//  4. Per projector: LUT_kc(x) = R_kc^-1(x W_c / A_kc) (the ResponseCurve, x in matched-white
+//     units); beta_kc(p) = alpha_k(p) D_c(p) / W_c (the BlackOffset, one sample per output pixel, split between the
+//     projectors lighting p by their blend weights); alpha_k scaled by s = 1 - max_c,p D_c(p) / W_c so that x = alpha s
+//     c + beta stays <= 1. The screen then shows T_c + s W_c c everywhere for content c.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "appliance/autocal/autocal.h"
+
+namespace mogao::autocal {
+
+struct ColourOptions {
+    int ramp_steps = 9;           // levels per channel including 0 and 1, 3..64
+    int dark_frames = 8;          // averaged black images, 1..64
+    double dark_exposure = 40.0;  // exposure multiplier for the black images, [1, 1000]
+    int lut_entries = 1024;       // ResponseCurve samples, 2..kMaxResponseEntries
+    double min_amplitude = 0.05;  // a channel's full white must reach this much of full scale
+    double max_fit_rms = 0.03;    // rms of the measured response around a pure gamma, gate
+    int mask_erode_px = 2;        // coverage masks shrunk by this many camera pixels (blur, seams)
+};
+
+struct ChannelResponse {
+    std::vector<double> levels;    // s_i
+    std::vector<double> measured;  // R(s_i), normalised, non-decreasing, 0 at s = 0, 1 at s = 1
+    double amplitude = 0.0;        // A_kc, camera units
+    double gamma = 0.0;            // least-squares pure gamma of R (reported, not used)
+    double gamma_rms = 0.0;        // rms of R - s^gamma
+};
+
+struct ProjectorPhotometry {
+    std::string id;
+    std::array<ChannelResponse, 3> channels;
+    double black = 0.0;            // beta_k, camera units (mono)
+    std::array<double, 3> gain{};  // W_c / A_kc
+};
+
+struct ColourResult {
+    std::vector<ProjectorPhotometry> projectors;
+    std::array<double, 3> matched_white{};  // W_c, camera units
+    std::array<double, 3> black_floor{};    // T_c, camera units
+    double ambient = 0.0;                   // a, camera units (mono)
+    double alpha_scale = 1.0;               // s
+    int captures = 0;
+};
+
+// Measures (steps 1-2) and applies (steps 3-4) to `calibration` (from calibrate(): its warps,
+// blends and the fitted `projectors` give each output pixel's screen point and which projectors
+// light it). Throws CalibrationRefused when the camera's exposure is not locked, a channel is
+// too dark for the camera, a response is not monotone or far from any gamma (max_fit_rms), or the
+// black levels cannot be separated (no overlap seen); std::invalid_argument for bad options.
+[[nodiscard]] ColourResult calibrate_colour(PatternSource& source, const ScreenModel& screen,
+                                            const std::vector<DeviceModel>& projectors, ScreenCalibration& calibration,
+                                            const ColourOptions& options = {});
+
+// Step 1's interpolation: normalised light R(s) of a measured channel, s in [0, 1].
+[[nodiscard]] double response_at(const ChannelResponse& r, double s);
+
+// Image position of screen point (theta, h) in a fitted pinhole model, or NaN when it is behind the
+// projector or outside its image.
+[[nodiscard]] Eigen::Vector2d model_pixel(const DeviceModel& d, const ScreenModel& s, double theta, double h);
+
+}  // namespace mogao::autocal

@@ -1,0 +1,107 @@
+// SPDX-License-Identifier: Apache-2.0
+// The photometric step against the virtual rig's ground truth: responses measured within the
+// rig's true gammas, seams on the rig with projectors of different brightness and colour
+// temperature before and after (luminance and CIE76 Delta E, at black, dark, grey and white), and
+// the refusals (auto-exposure not locked, a channel too dark for the camera).
+#include "appliance/autocal/colour_calibration.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "appliance/autocal/colour_truth.h"
+#include "appliance/autocal/rig_bridge.h"
+#include "appliance/rig/rig_file.h"
+
+namespace mogao::autocal {
+namespace {
+
+rig::VirtualRig colour_rig() {
+    return scaled_rig(rig::load_rig(std::string(MOGAO_SOURCE_DIR) + "/rigs/colour.toml"), 0.25, 0.25);
+}
+
+AutocalOptions fast_options() {
+    AutocalOptions o;
+    o.warp_step_px = 4;
+    return o;
+}
+
+TEST(ColourCalibration, PiecewisePowerResponseIsExactForAPureGamma) {
+    ChannelResponse r;
+    for (int i = 0; i <= 8; ++i) {
+        r.levels.push_back(i / 8.0);
+        r.measured.push_back(std::pow(i / 8.0, 2.4));
+    }
+    for (const double s : {0.01, 0.05, 0.2, 0.33, 0.77, 1.0}) EXPECT_NEAR(response_at(r, s), std::pow(s, 2.4), 1e-12);
+    EXPECT_EQ(response_at(r, 0.0), 0.0);
+}
+
+TEST(ColourCalibration, MatchesProjectorsOfDifferentBrightnessAndColourTemperature) {
+    const rig::VirtualRig rig = colour_rig();
+    RigPatternSource source(rig);
+    const CalibrationPrior prior = prior_from_rig(rig);
+    AutocalResult r = calibrate(source, prior, {960, 540}, fast_options());
+    const ScreenCalibration before = r.calibration;
+    const ColourResult c = calibrate_colour(source, prior.screen, r.projectors, r.calibration);
+    // Responses against the rig's true gammas; blacks against brightness x black level (mono).
+    for (std::size_t k = 0; k < 3; ++k) {
+        const rig::RigProjector& p = rig.projectors[k];
+        double mean_brightness = 0.0;
+        for (std::size_t ch = 0; ch < 3; ++ch) {
+            EXPECT_NEAR(c.projectors[k].channels[ch].gamma, p.gamma[ch], 0.02) << p.id << " channel " << ch;
+            mean_brightness += p.brightness[ch] / 3.0;
+        }
+        EXPECT_NEAR(c.projectors[k].black / (p.black_level * mean_brightness), 1.0, 0.1) << p.id;
+    }
+    EXPECT_NEAR(c.ambient, rig.ambient, 0.002);
+    for (const double level : {0.0, 0.05, 0.5, 1.0}) {
+        SCOPED_TRACE(level);
+        const SeamColour b = measure_seam_colour(rig, before, level);
+        const SeamColour a = measure_seam_colour(rig, r.calibration, level);
+        std::printf("content %.2f: seam luminance p95 %.2f %% -> %.2f %%, seam Delta E76 p95 %.2f -> %.2f\n", level,
+                    100.0 * b.seam_luminance_p95, 100.0 * a.seam_luminance_p95, b.seam_delta_e_p95, a.seam_delta_e_p95);
+        EXPECT_GT(b.seam_luminance_p95, 0.15);  // the uncalibrated rig shows its seams
+        EXPECT_LT(a.seam_delta_e_p95, 0.6);     // well under a just-noticeable difference
+        EXPECT_LT(a.seam_luminance_p95, level == 0.0 ? 0.03 : (level < 0.1 ? 0.02 : 0.015));
+        if (level >= 0.5) {
+            EXPECT_GT(b.seam_delta_e_p95, 5.0);
+        }
+    }
+}
+
+TEST(ColourCalibration, RefusesAutoExposureAndAChannelTooDarkForTheCamera) {
+    rig::VirtualRig rig = colour_rig();
+    RigPatternSource locked(rig);
+    const CalibrationPrior prior = prior_from_rig(rig);
+    AutocalResult r = calibrate(locked, prior, {960, 540}, fast_options());
+    const ScreenCalibration good = r.calibration;
+
+    rig.camera.auto_exposure = true;
+    RigPatternSource metered(rig);
+    try {
+        (void)calibrate_colour(metered, prior.screen, r.projectors, r.calibration);
+        FAIL() << "calibrated with auto-exposure on";
+    } catch (const CalibrationRefused& e) {
+        EXPECT_NE(std::string(e.what()).find("auto-exposure is not locked"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW((void)calibrate(metered, prior, {960, 540}, fast_options()), CalibrationRefused);
+
+    rig.camera.auto_exposure = false;
+    rig.projectors[1].brightness[2] = 0.05;  // a blue channel the camera barely sees
+    RigPatternSource dim(rig);
+    try {
+        (void)calibrate_colour(dim, prior.screen, r.projectors, r.calibration);
+        FAIL() << "calibrated a channel below the camera's reach";
+    } catch (const CalibrationRefused& e) {
+        EXPECT_NE(std::string(e.what()).find("proj1' channel B"), std::string::npos) << e.what();
+    }
+    // Refused: the calibration passed in is untouched.
+    ASSERT_EQ(r.calibration.projectors.size(), good.projectors.size());
+    for (std::size_t k = 0; k < good.projectors.size(); ++k) {
+        EXPECT_EQ(r.calibration.projectors[k].blend.weight, good.projectors[k].blend.weight);
+        EXPECT_TRUE(r.calibration.projectors[k].beta.rgb.empty());
+    }
+}
+
+}  // namespace
+}  // namespace mogao::autocal

@@ -1,0 +1,137 @@
+// SPDX-License-Identifier: Apache-2.0
+// Seam luminance and colour against the rig's ground truth (colour_truth.h).
+#include "appliance/autocal/colour_truth.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "appliance/warp/response_curve.h"
+#include "appliance/warp/warp_sampling.h"
+
+namespace mogao::autocal {
+namespace {
+
+struct Point {
+    std::array<double, 3> rgb{};
+    int lit = 0;
+};
+
+// The light at every grid point for flat content `level`.
+std::vector<Point> screen_light(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double level,
+                                double inset) {
+    std::vector<Point> points;
+    constexpr int kSteps = 400;
+    for (int j = 0; j <= kSteps / 4; ++j) {
+        for (int i = 0; i <= kSteps; ++i) {
+            const Eigen::Vector2d uv(inset + (1.0 - 2.0 * inset) * i / kSteps,
+                                     inset + (1.0 - 2.0 * inset) * j / (kSteps / 4));
+            const rig::ScreenPoint s = rig::screen_of(rig.screen, uv);
+            Point pt;
+            pt.rgb = {rig.ambient, rig.ambient, rig.ambient};
+            for (std::size_t k = 0; k < calibration.projectors.size(); ++k) {
+                const auto p = rig::screen_to_projector(rig, static_cast<int>(k), s);
+                if (!p) continue;
+                const ProjectorCalibration& pc = calibration.projectors[k];
+                const int x = std::clamp(static_cast<int>(std::floor(p->x())), 0, pc.output.width - 1);
+                const int y = std::clamp(static_cast<int>(std::floor(p->y())), 0, pc.output.height - 1);
+                const bool shown = sample_warp(pc.warp, pc.output, x, y).valid();
+                const float w = shown ? sample_blend(pc.blend, pc.output, x, y) : 0.0F;
+                const std::array<float, 3> beta = sample_beta(pc.beta, pc.output, x, y);
+                if (w > 0.0F) ++pt.lit;
+                const rig::RigProjector& rp = rig.projectors[k];
+                for (std::size_t c = 0; c < 3; ++c) {
+                    const double signal = shown ? apply_response(pc.response, static_cast<int>(c),
+                                                                 static_cast<float>(level) * w + beta[c])
+                                                : 0.0;
+                    pt.rgb[c] +=
+                        rp.brightness[c] * (rp.black_level + (1.0 - rp.black_level) * std::pow(signal, rp.gamma[c]));
+                }
+            }
+            points.push_back(pt);
+        }
+    }
+    return points;
+}
+
+double median(std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+}
+
+double percentile(std::vector<double> v, double q) {
+    if (v.empty()) return 0.0;
+    const auto i = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1));
+    std::nth_element(v.begin(), v.begin() + static_cast<long>(i), v.end());
+    return v[i];
+}
+
+double luminance(const std::array<double, 3>& rgb) { return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]; }
+
+double lab_f(double t) {
+    constexpr double d = 6.0 / 29.0;
+    return t > d * d * d ? std::cbrt(t) : t / (3.0 * d * d) + 4.0 / 29.0;
+}
+
+// Per-channel median over points lit by one projector (or all points when none is).
+std::array<double, 3> reference_rgb(const std::vector<Point>& pts) {
+    std::array<double, 3> ref{};
+    bool any_single = false;
+    for (const Point& p : pts) any_single = any_single || p.lit == 1;
+    for (std::size_t c = 0; c < 3; ++c) {
+        std::vector<double> v;
+        for (const Point& p : pts) {
+            if (p.lit == 1 || !any_single) v.push_back(p.rgb[c]);
+        }
+        ref[c] = median(v);
+    }
+    return ref;
+}
+
+}  // namespace
+
+std::array<double, 3> rgb_to_xyz(const std::array<double, 3>& c) {
+    return {0.4124 * c[0] + 0.3576 * c[1] + 0.1805 * c[2], 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2],
+            0.0193 * c[0] + 0.1192 * c[1] + 0.9505 * c[2]};
+}
+
+std::array<double, 3> rgb_to_lab(const std::array<double, 3>& rgb, const std::array<double, 3>& white_xyz) {
+    const std::array<double, 3> xyz = rgb_to_xyz(rgb);
+    const double fx = lab_f(xyz[0] / white_xyz[0]);
+    const double fy = lab_f(xyz[1] / white_xyz[1]);
+    const double fz = lab_f(xyz[2] / white_xyz[2]);
+    return {116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz)};
+}
+
+SeamColour measure_seam_colour(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double level,
+                               double inset) {
+    const std::array<double, 3> white = rgb_to_xyz(reference_rgb(screen_light(rig, calibration, 1.0, inset)));
+    const std::vector<Point> pts = screen_light(rig, calibration, level, inset);
+    const std::array<double, 3> ref = reference_rgb(pts);
+    const std::array<double, 3> ref_lab = rgb_to_lab(ref, white);
+    SeamColour out;
+    std::vector<double> seam_dev;
+    std::vector<double> seam_de;
+    out.level = level;
+    out.samples = static_cast<int>(pts.size());
+    out.reference_luminance = luminance(ref);
+    for (const Point& p : pts) {
+        const double dev = std::abs(luminance(p.rgb) / out.reference_luminance - 1.0);
+        const std::array<double, 3> lab = rgb_to_lab(p.rgb, white);
+        const double de = std::hypot(lab[0] - ref_lab[0], lab[1] - ref_lab[1], lab[2] - ref_lab[2]);
+        out.luminance_max_deviation = std::max(out.luminance_max_deviation, dev);
+        out.delta_e_max = std::max(out.delta_e_max, de);
+        if (p.lit >= 2) {
+            ++out.seam_samples;
+            out.seam_luminance_deviation = std::max(out.seam_luminance_deviation, dev);
+            out.seam_delta_e = std::max(out.seam_delta_e, de);
+            seam_dev.push_back(dev);
+            seam_de.push_back(de);
+        }
+    }
+    out.seam_luminance_p95 = percentile(seam_dev, 0.95);
+    out.seam_delta_e_p95 = percentile(seam_de, 0.95);
+    return out;
+}
+
+}  // namespace mogao::autocal

@@ -1,0 +1,45 @@
+// SPDX-License-Identifier: Apache-2.0
+// Seams as the viewer sees them, against the virtual rig's ground truth (never the calibration's
+// own prediction): flat grey content through a ScreenCalibration (warp validity, blend, beta,
+// response, as render_output computes them) onto the rig's true light paths and responses
+// (virtual_rig.h: brightness_c (black + (1 - black) s^gamma_c) per projector, plus ambient).
+//
+// Colour: the rig's linear RGB light is read as ITU-R BT.709 / sRGB primaries with D65 white
+// (IEC 61966-2-1 matrix to CIE XYZ), luminance Y = 0.2126 R + 0.7152 G + 0.0722 B; CIELAB (CIE
+// 15:2004) relative to the screen's own white (the median XYZ of full-white content, to which a
+// viewer adapts); colour difference CIE76 Delta E*ab = Euclidean distance in L*a*b* (CIE 1976; a
+// Delta E near 1 is about a just-noticeable difference, Sharma, Digital Color Imaging Handbook 2003).
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "appliance/rig/virtual_rig.h"
+#include "common/projector_calibration.h"
+
+namespace mogao::autocal {
+
+struct SeamColour {
+    double level = 0.0;                     // content value (linear, all channels)
+    int samples = 0;                        // content points measured
+    int seam_samples = 0;                   // of those, lit by two or more projectors (blend > 0)
+    double reference_luminance = 0.0;       // median Y over points lit by one projector
+    double luminance_max_deviation = 0.0;   // max |Y / reference - 1| over all points
+    double seam_luminance_deviation = 0.0;  // the same over the seam points
+    double delta_e_max = 0.0;               // max CIE76 Delta E from the reference colour, all points
+    double seam_delta_e = 0.0;              // the same over the seam points
+    double seam_luminance_p95 = 0.0;        // 95th percentile of the seam points' |Y / reference - 1|
+    double seam_delta_e_p95 = 0.0;          // 95th percentile of the seam points' Delta E
+};
+
+// Points: a grid of 401 x 101 content points inset by `inset` of the frame on each side. The
+// reference colour is the per-channel median over points lit by one projector.
+[[nodiscard]] SeamColour measure_seam_colour(const rig::VirtualRig& rig, const ScreenCalibration& calibration,
+                                             double level, double inset = 0.01);
+
+// Linear RGB (BT.709 primaries) -> CIELAB against white `white_xyz`.
+[[nodiscard]] std::array<double, 3> rgb_to_lab(const std::array<double, 3>& rgb,
+                                               const std::array<double, 3>& white_xyz);
+[[nodiscard]] std::array<double, 3> rgb_to_xyz(const std::array<double, 3>& rgb);
+
+}  // namespace mogao::autocal
