@@ -127,44 +127,53 @@ int run_real(const RealOptions& options) {
         "| settings | subset | tags | found | false positives | rate | corner error median (px) | p90 (px) | time (ms, "
         "all images) | time/defaults |\n");
     std::printf("|---|---|--:|--:|--:|--:|--:|--:|--:|--:|\n");
-    double default_ms = 0.0;
     const auto settings = compared_settings();
+    const std::size_t n = settings.size();
+    // Per setting: all, the issue's subset, time. Timing is interleaved -- for each image, each
+    // repeat runs every setting in turn -- so a shared machine's changing load biases no setting.
+    std::vector<SetScore> all(n), issue(n);
+    std::vector<double> total_ms(n, 0.0);
     // found / false positives per source (the file-name prefix: PROVENANCE.md's six repositories)
     // and setting, for the per-source table below (a change that helps one source only shows).
     std::map<std::string, std::vector<SetScore>> by_source;
-    for (const auto& named : settings) {
-        SetScore all, issue;
-        double total_ms = 0.0;
-        for (std::size_t i = 0; i < truth.size(); ++i) {
+    for (std::size_t i = 0; i < truth.size(); ++i) {
+        std::vector<TagDetector> detectors;
+        for (const auto& named : settings) {
             DetectorSettings s = named.settings;
             s.family = truth[i].family;
-            TagDetector detector(s);
-            std::vector<TagDetection> found;
-            double best = 1e300;
-            for (int r = 0; r < options.repeat; ++r) {
-                const auto t0 = std::chrono::steady_clock::now();
-                found = detector.detect(images[i]);
-                best = std::min(best, ms_since(t0));
-            }
-            total_ms += best;
-            const auto score = score_image(truth[i], found);
-            all.add(score);
-            if (truth[i].subset == "issue15") issue.add(score);
-            auto& per_setting = by_source[truth[i].file.substr(0, truth[i].file.find('_'))];
-            per_setting.resize(settings.size());
-            per_setting[static_cast<std::size_t>(&named - settings.data())].add(score);
-            if (options.per_image)
-                std::fprintf(stderr, "%-24s %-40s %3d/%3d fp %d %.1f ms\n", named.name.c_str(), truth[i].file.c_str(),
-                             score.found, score.tags, score.false_positives, best);
+            detectors.emplace_back(s);
         }
-        if (default_ms == 0.0) default_ms = total_ms;
-        for (const auto* set : {&issue, &all}) {
+        std::vector<std::vector<TagDetection>> found(n);
+        std::vector<double> best(n, 1e300);
+        for (int r = 0; r < options.repeat; ++r) {
+            for (std::size_t k = 0; k < n; ++k) {
+                const auto t0 = std::chrono::steady_clock::now();
+                found[k] = detectors[k].detect(images[i]);
+                best[k] = std::min(best[k], ms_since(t0));
+            }
+        }
+        auto& per_setting = by_source[truth[i].file.substr(0, truth[i].file.find('_'))];
+        per_setting.resize(n);
+        for (std::size_t k = 0; k < n; ++k) {
+            total_ms[k] += best[k];
+            const auto score = score_image(truth[i], found[k]);
+            all[k].add(score);
+            if (truth[i].subset == "issue15") issue[k].add(score);
+            per_setting[k].add(score);
+            if (options.per_image)
+                std::fprintf(stderr, "%-24s %-40s %3d/%3d fp %d %.1f ms\n", settings[k].name.c_str(),
+                             truth[i].file.c_str(), score.found, score.tags, score.false_positives, best[k]);
+        }
+    }
+    for (std::size_t k = 0; k < n; ++k) {
+        for (const auto* set : {&issue[k], &all[k]}) {
             auto e = set->corner_errors_px;
             std::sort(e.begin(), e.end());
             const double p90 = e.empty() ? NAN : e[static_cast<std::size_t>(0.9 * static_cast<double>(e.size() - 1))];
-            std::printf("| %s | %s | %d | %d | %d | %.1f %% | %.3f | %.3f | %.0f | %.2f |\n", named.name.c_str(),
-                        set == &issue ? "issue's 47" : "all 36h11 + 16h5", set->tags, set->found, set->false_positives,
-                        100.0 * set->rate(), set->median_corner_error_px(), p90, total_ms, total_ms / default_ms);
+            std::printf("| %s | %s | %d | %d | %d | %.1f %% | %.3f | %.3f | %.0f | %.2f |\n", settings[k].name.c_str(),
+                        set == &issue[k] ? "issue's 47" : "all 36h11 + 16h5", set->tags, set->found,
+                        set->false_positives, 100.0 * set->rate(), set->median_corner_error_px(), p90, total_ms[k],
+                        total_ms[k] / total_ms[0]);
         }
     }
     print_by_source(settings, by_source);
