@@ -26,6 +26,7 @@ void check_options(const ColourOptions& o) {
     if (o.ramp_steps < 3 || o.ramp_steps > 64) fail("ramp_steps must be 3..64");
     if (o.dark_frames < 1 || o.dark_frames > 64) fail("dark_frames must be 1..64");
     if (!(o.dark_exposure >= 1.0 && o.dark_exposure <= 1000.0)) fail("dark_exposure must be in [1, 1000]");
+    if (!(o.low_end_exposure >= 1.0 && o.low_end_exposure <= 1000.0)) fail("low_end_exposure must be in [1, 1000]");
     if (o.lut_entries < 2 || o.lut_entries > kMaxResponseEntries) fail("lut_entries must be 2..2^20");
     if (!(o.min_amplitude > 0.0 && o.min_amplitude < 1.0)) fail("min_amplitude must be in (0, 1)");
     if (!(o.max_fit_rms > 0.0)) fail("max_fit_rms must be > 0");
@@ -67,9 +68,50 @@ double fit_gamma(const ChannelResponse& r, double* rms) {
 
 struct Captured {
     cv::Mat1f black;
+    cv::Mat1f black_low;             // all-black at low_end_exposure, averaged
     std::vector<cv::Mat1b> inside;   // per projector: camera pixels it clearly lights
     std::vector<cv::Mat1b> outside;  // per projector: camera pixels it clearly does not light
 };
+
+// Step 1's low end for channel c of projector k: levels up to 1/4 again, and 1/32, 1/16, at
+// low_end_exposure x the locked exposure (a few camera codes at the base exposure), in base
+// exposure units; replaces or adds to the measured levels unless the camera saturates there.
+void measure_low_end(PatternSource& source, const std::vector<DeviceModel>& projectors, std::size_t k, std::size_t c,
+                     const ColourOptions& o, const Captured& cap, const cv::Mat1b& in, ChannelResponse& r,
+                     int& captures) {
+    std::vector<double> low{1.0 / 32.0, 1.0 / 16.0};
+    for (const double s : r.levels) {
+        if (s > 0.0 && s <= 0.25 && s != low[0] && s != low[1]) low.push_back(s);
+    }
+    std::vector<std::pair<double, double>> got;
+    source.set_relative_exposure(o.low_end_exposure);
+    try {
+        for (const double s : low) {
+            const cv::Mat1f img = source.show(channel_signal(projectors, k, c, s));
+            ++captures;
+            double peak = 0.0;
+            cv::minMaxLoc(img, nullptr, &peak, nullptr, nullptr, in);
+            if (peak >= 0.98) continue;  // saturated: keep the base-exposure value
+            cv::Mat1f d;
+            cv::subtract(img, cap.black_low, d);
+            got.emplace_back(s, masked_mean(d, in) / o.low_end_exposure);
+        }
+    } catch (...) {
+        source.set_relative_exposure(1.0);
+        throw;
+    }
+    source.set_relative_exposure(1.0);
+    for (const auto& [s, v] : got) {
+        const auto it = std::find(r.levels.begin(), r.levels.end(), s);
+        if (it != r.levels.end()) {
+            r.measured[static_cast<std::size_t>(it - r.levels.begin())] = v;
+            continue;
+        }
+        const auto pos = std::upper_bound(r.levels.begin(), r.levels.end(), s) - r.levels.begin();
+        r.levels.insert(r.levels.begin() + pos, s);
+        r.measured.insert(r.measured.begin() + pos, v);
+    }
+}
 
 // Step 1 for projector k: ramps per channel, the coverage masks from the full-level images.
 ProjectorPhotometry measure_projector(PatternSource& source, const std::vector<DeviceModel>& projectors, std::size_t k,
@@ -117,6 +159,7 @@ ProjectorPhotometry measure_projector(PatternSource& source, const std::vector<D
             r.measured.push_back(masked_mean(diffs[c][static_cast<std::size_t>(i - 1)], in));
         }
         r.amplitude = r.measured.back();
+        measure_low_end(source, projectors, k, c, o, cap, in, r, captures);
         if (!(r.amplitude >= o.min_amplitude)) {
             throw CalibrationRefused("projector " + std::to_string(k) + " '" + pp.id + "' channel " + channel_name(c) +
                                      ": full white reaches " + std::to_string(r.amplitude) +
@@ -305,6 +348,12 @@ ColourResult calibrate_colour(PatternSource& source, const ScreenModel& screen,
     Captured cap;
     cap.black = source.show(std::vector<cv::Mat>(n));
     res.captures = 1;
+    source.set_relative_exposure(options.low_end_exposure);
+    cap.black_low = cv::Mat1f(cap.black.size(), 0.0f);
+    for (int f = 0; f < 4; ++f) cap.black_low += source.show(std::vector<cv::Mat>(n));
+    cap.black_low /= 4.0f;
+    source.set_relative_exposure(1.0);
+    res.captures += 4;
     for (std::size_t k = 0; k < n; ++k) {
         res.projectors.push_back(measure_projector(source, projectors, k, options, cap, res.captures));
     }

@@ -16,7 +16,9 @@
 // one gain per projector and channel instead of a per-pixel luminance attenuation map):
 //  1. Response: projector k, channel c at levels s_i = i / (ramp_steps - 1), the others black;
 //     y_kc(s) = mean over the camera pixels k lights (its coverage mask, eroded) of the image
-//     minus the all-black image. A_kc = y_kc(1) is the channel's full-white amplitude; the
+//     minus the all-black image; levels up to 1/4, and 1/32 and 1/16, again at low_end_exposure x
+//     the locked exposure (they are a few camera codes at the base exposure, and the black-level
+//     offsets live there), unless the camera saturates. A_kc = y_kc(1) is the full-white amplitude; the
 //     normalised response R_kc(s) = y_kc(s) / A_kc (made non-decreasing) is interpolated as a
 //     power law between measured levels (linear in log s - log R, so a pure gamma is exact) and
 //     continued below s_1 with the first segment's exponent.
@@ -46,13 +48,14 @@
 namespace mogao::autocal {
 
 struct ColourOptions {
-    int ramp_steps = 9;           // levels per channel including 0 and 1, 3..64
-    int dark_frames = 8;          // averaged black images, 1..64
-    double dark_exposure = 40.0;  // exposure multiplier for the black images, [1, 1000]
-    int lut_entries = 1024;       // ResponseCurve samples, 2..kMaxResponseEntries
-    double min_amplitude = 0.05;  // a channel's full white must reach this much of full scale
-    double max_fit_rms = 0.03;    // rms of the measured response around a pure gamma, gate
-    int mask_erode_px = 2;        // coverage masks shrunk by this many camera pixels (blur, seams)
+    int ramp_steps = 9;             // levels per channel including 0 and 1, 3..64
+    int dark_frames = 8;            // averaged black images, 1..64
+    double dark_exposure = 40.0;    // exposure multiplier for the black images, [1, 1000]
+    double low_end_exposure = 8.0;  // exposure multiplier for the ramp's low end (levels <= 1/4), [1, 1000]
+    int lut_entries = 4096;         // ResponseCurve samples, 2..kMaxResponseEntries (fine: x^(1/gamma) is steep near 0)
+    double min_amplitude = 0.05;    // a channel's full white must reach this much of full scale
+    double max_fit_rms = 0.03;      // rms of the measured response around a pure gamma, gate
+    int mask_erode_px = 2;          // coverage masks shrunk by this many camera pixels (blur, seams)
 };
 
 struct ChannelResponse {

@@ -60,9 +60,9 @@ TEST(ColourCalibration, MatchesProjectorsOfDifferentBrightnessAndColourTemperatu
         const SeamColour a = measure_seam_colour(rig, r.calibration, level);
         std::printf("content %.2f: seam luminance p95 %.2f %% -> %.2f %%, seam Delta E76 p95 %.2f -> %.2f\n", level,
                     100.0 * b.seam_luminance_p95, 100.0 * a.seam_luminance_p95, b.seam_delta_e_p95, a.seam_delta_e_p95);
-        EXPECT_GT(b.seam_luminance_p95, 0.15);  // the uncalibrated rig shows its seams
-        EXPECT_LT(a.seam_delta_e_p95, 0.6);     // well under a just-noticeable difference
-        EXPECT_LT(a.seam_luminance_p95, level == 0.0 ? 0.03 : (level < 0.1 ? 0.02 : 0.015));
+        EXPECT_GT(b.seam_luminance_p95, 0.15);                         // the uncalibrated rig shows its seams
+        EXPECT_LT(a.seam_delta_e_p95, 0.6);                            // well under a just-noticeable difference
+        EXPECT_LT(a.seam_luminance_p95, level == 0.0 ? 0.01 : 0.015);  // issue 13: 1 %; scale 0.25 adds edge pixels
         if (level >= 0.5) {
             EXPECT_GT(b.seam_delta_e_p95, 5.0);
         }
