@@ -157,6 +157,9 @@ int main(int argc, char** argv) {
                      "Estimated rays per request, billions; a dearer request is degraded (spp, then light samples, "
                      "bounces, resolution scale)")
         ->check(CLI::Range(1e-6, 1e6));
+    serve->add_option("--metrics-file", serve_options.metrics_file,
+                      "Prometheus textfile to rewrite every second (node_exporter's textfile collector, e.g. "
+                      "/var/lib/prometheus/node-exporter/mogao-farm.prom; docs/services.md)");
     double frame_time_ms = 0.0;
     // Off unless asked: a refined frame is not the lone render of its request that the kiosk's
     // end-to-end tests compare against.

@@ -13,6 +13,7 @@
 
 #include "common/jpeg_codec.h"
 #include "common/service_notify.h"
+#include "renderfarm/farm/farm_metrics.h"
 #include "renderfarm/farm/main_thread_queue.h"
 #include "renderfarm/farm/request_policy.h"
 
@@ -88,6 +89,27 @@ private:
     std::uint64_t degraded_ = 0;
 };
 
+// Writes the metrics file when one is configured; a failure is logged once per kind of error and
+// never stops serving.
+class MetricsWriter {
+public:
+    explicit MetricsWriter(std::filesystem::path file) : file_(std::move(file)) {}
+    void write(const FarmMetrics& metrics, FarmCounters counters) {
+        if (file_.empty()) return;
+        try {
+            metrics.write(file_, counters);
+            last_error_.clear();
+        } catch (const std::exception& e) {
+            if (last_error_ != e.what()) spdlog::warn("metrics: {}", e.what());
+            last_error_ = e.what();
+        }
+    }
+
+private:
+    std::filesystem::path file_;
+    std::string last_error_;
+};
+
 }  // namespace
 
 int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& scene, RunInfo& run) {
@@ -116,8 +138,14 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& s
     farm.set_heartbeat([&notifier] { notifier.watchdog(); });  // a long frame is not a hang
 
     JpegEncoder encoder;
+    FarmMetrics metrics;
+    MetricsWriter metrics_writer(options.metrics_file);
+    const auto counters = [&](bool up) {
+        return FarmCounters{up, server.stats(), queue.superseded(), policy.degraded(), run.render_ranks};
+    };
     const auto start = Clock::now();
     auto last_stats = start;
+    auto last_metrics = start - std::chrono::seconds(1);
     const auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
     while (!g_stop && (options.duration_s <= 0 || elapsed() < options.duration_s)) {
         notifier.watchdog();
@@ -125,10 +153,15 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& s
             log_stats(server, queue, policy.degraded());
             last_stats = Clock::now();
         }
+        if (Clock::now() - last_metrics >= std::chrono::seconds(1)) {
+            metrics_writer.write(metrics, counters(true));
+            last_metrics = Clock::now();
+        }
         std::optional<MainThreadQueue<ServedFrame>::Job> job = queue.next(std::chrono::milliseconds(100));
         if (!job) continue;
         try {
             LiveFrame frame = live.render(policy.apply(job->view));
+            metrics.observe_frame(frame.stats, frame.seconds, double(realtime_ns()) * 1e-9);
             ServedFrame out{std::move(frame.image), job->view.quality.jpeg_quality, realtime_ns(), std::nullopt};
             if (!options.pipeline) out.encoded = encode(out, encoder);
             job->result.set_value(std::move(out));
@@ -143,6 +176,7 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& s
         }
     }
     const bool lost_rank = farm.broken();
+    metrics_writer.write(metrics, counters(false));
     notifier.stopping();
     spdlog::info("stopping: {}", lost_rank ? "a render rank was lost" : g_stop ? "signal" : "duration reached");
     queue.close();

@@ -19,6 +19,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 
 #include "renderfarm/farm/frame_dispatcher.h"
 #include "renderfarm/farm/frame_stats.h"
@@ -36,6 +37,8 @@ struct ServeOptions {
     bool pipeline = true;        // encode off the main thread (see above)
     double duration_s = 0.0;     // stop after this long (tests); 0 = until SIGINT/SIGTERM
     double stats_period_s = 10;  // log the link's counters this often
+    // Prometheus textfile (farm_metrics.h), rewritten about once a second; empty = none.
+    std::filesystem::path metrics_file;
 };
 
 int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& scene, RunInfo& run);

@@ -1,0 +1,153 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "renderfarm/farm/farm_metrics.h"
+
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "tests/support/scratch_dir.h"
+
+namespace mogao {
+namespace {
+
+FrameStats frame(double render, std::vector<double> ranks) {
+    FrameStats s;
+    s.render_phase_seconds = render;
+    s.rank_render_seconds = std::move(ranks);
+    s.balance_efficiency = 0.75;
+    s.rays = 1000;
+    s.rays_per_second = 2.5e6;
+    return s;
+}
+
+FarmCounters counters() {
+    FarmCounters c;
+    c.link.sessions_active = 2;
+    c.link.requests_received = 40;
+    c.link.requests_invalid = 1;
+    c.link.frames_sent = 37;
+    c.link.jpeg_bytes_sent = 123456789;
+    c.degraded = 3;
+    c.superseded = 5;
+    c.render_ranks = 2;
+    return c;
+}
+
+// Sample lines "name{labels} value" -> value.
+std::map<std::string, std::string> samples(const std::string& text) {
+    std::map<std::string, std::string> out;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) {
+        if (line.empty() || line[0] == '#') continue;
+        const auto space = line.rfind(' ');
+        out[line.substr(0, space)] = line.substr(space + 1);
+    }
+    return out;
+}
+
+TEST(FarmMetrics, ExpositionTextHasEveryFamilyWithItsTypeAndValue) {
+    FarmMetrics m;
+    m.observe_frame(frame(0.1, {0.08, 0.06}), 0.2, 1.7e9);
+    m.observe_frame(frame(0.3, {0.2, 0.3}), 0.4, 1.7e9 + 1);
+    const std::string text = m.text(counters());
+    // Every line is a comment or a sample as the format defines them.
+    const std::regex sample(R"(^[a-zA-Z_:][a-zA-Z0-9_:]*(\{[a-z_]+="[^"]*"\})? (NaN|[+-]Inf|-?[0-9.e+-]+)$)");
+    const std::regex comment(R"(^# (HELP|TYPE) mogao_farm_[a-z_]+ .+$)");
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);)
+        EXPECT_TRUE(std::regex_match(line, sample) || std::regex_match(line, comment)) << line;
+    const auto s = samples(text);
+    EXPECT_EQ(s.at("mogao_farm_frames_total"), "2");
+    EXPECT_EQ(s.at("mogao_farm_frame_seconds"), "0.4");
+    EXPECT_DOUBLE_EQ(std::stod(s.at("mogao_farm_frame_seconds_mean")), 0.3);
+    EXPECT_EQ(s.at("mogao_farm_rank_render_seconds{rank=\"1\"}"), "0.2");
+    EXPECT_EQ(s.at("mogao_farm_rank_render_seconds{rank=\"2\"}"), "0.3");
+    EXPECT_EQ(s.at("mogao_farm_requests_degraded_total"), "3");
+    EXPECT_EQ(s.at("mogao_farm_jpeg_bytes_sent_total"), "123456789");
+    EXPECT_NE(text.find("# TYPE mogao_farm_frames_total counter"), std::string::npos);
+    EXPECT_NE(text.find("# TYPE mogao_farm_balance_efficiency gauge"), std::string::npos);
+}
+
+TEST(FarmMetrics, NonFiniteValuesUseTheFormatsSpelling) {
+    FarmMetrics m;
+    FrameStats f = frame(0.1, {std::numeric_limits<double>::quiet_NaN()});
+    f.rays_per_second = std::numeric_limits<double>::infinity();
+    m.observe_frame(f, 0.1, 0);
+    const auto s = samples(m.text(counters()));
+    EXPECT_EQ(s.at("mogao_farm_rank_render_seconds{rank=\"1\"}"), "NaN");
+    EXPECT_EQ(s.at("mogao_farm_rays_per_second"), "+Inf");
+}
+
+TEST(FarmMetrics, MeanCoversTheLastWindowOnly) {
+    FarmMetrics m;
+    for (int i = 0; i < 100; ++i) m.observe_frame(frame(0, {}), i < 36 ? 10.0 : 1.0, 0);
+    EXPECT_DOUBLE_EQ(std::stod(samples(m.text(counters())).at("mogao_farm_frame_seconds_mean")), 1.0);
+}
+
+std::string run(const std::string& command) {
+    std::string out;
+    FILE* pipe = ::popen(command.c_str(), "r");
+    if (!pipe) return out;
+    std::array<char, 4096> buffer{};
+    for (std::size_t n; (n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0;) out.append(buffer.data(), n);
+    ::pclose(pipe);
+    return out;
+}
+
+int free_tcp_port() {
+    const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    socklen_t len = sizeof a;
+    ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
+    ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
+    ::close(fd);
+    return ntohs(a.sin_port);
+}
+
+// The real consumer: Debian's prometheus-node-exporter reads the file through its textfile
+// collector and serves it; a file it cannot parse shows as node_textfile_scrape_error 1.
+TEST(FarmMetrics, NodeExporterTextfileCollectorReadsTheFile) {
+    if (run("command -v prometheus-node-exporter").empty())
+        GTEST_SKIP() << "prometheus-node-exporter is not installed (.ci/deps installs it)";
+    const testing::ScratchDir dir("farm-metrics");
+    FarmMetrics m;
+    m.observe_frame(frame(0.1, {0.08, 0.06}), 0.2, 1.7e9);
+    m.write(dir.path() / "mogao-farm.prom", counters());
+    const int port = free_tcp_port();
+    const std::string exporter =
+        "prometheus-node-exporter --collector.disable-defaults --collector.textfile "
+        "--collector.textfile.directory=" +
+        dir.path().string() + " --web.listen-address=127.0.0.1:" + std::to_string(port) + " > " +
+        (dir.path() / "exporter.log").string() + " 2>&1 & echo $!";
+    const std::string pid = run(exporter);
+    std::string scraped;
+    for (int i = 0; i < 100 && scraped.find("mogao_farm_up") == std::string::npos; ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        scraped = run("curl -s http://127.0.0.1:" + std::to_string(port) + "/metrics");
+    }
+    run("kill " + pid);
+    std::ifstream log(dir.path() / "exporter.log");
+    const std::string log_text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+    ASSERT_NE(scraped.find("mogao_farm_up 1"), std::string::npos) << "exporter log:\n" << log_text;
+    EXPECT_NE(scraped.find("mogao_farm_rank_render_seconds{rank=\"2\"} 0.06"), std::string::npos);
+    EXPECT_NE(scraped.find("mogao_farm_jpeg_bytes_sent_total 1.23456789e+08"), std::string::npos) << scraped;
+    EXPECT_NE(scraped.find("node_textfile_scrape_error 0"), std::string::npos) << scraped;
+}
+
+}  // namespace
+}  // namespace mogao
