@@ -3,6 +3,7 @@
 #include "appliance/autocal/calibrate_job.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <numbers>
@@ -68,10 +69,17 @@ cv::Mat1b preview(const rig::VirtualRig& rig, const ScreenCalibration& c, int wi
                 const double gu = uv.u * 16.0 - std::round(uv.u * 16.0);
                 const double gv = uv.v * 16.0 - std::round(uv.v * 16.0);
                 const double content = (std::abs(gu) < 0.01 || std::abs(gv) < 0.01) ? 0.1 : 1.0;
-                const double signal = apply_response(
-                    pc.response, 0, static_cast<float>(content) * sample_blend(pc.blend, pc.output, px, py));
+                // The rig's light (mean of the channels, black level included) for the signal
+                // render_output gives: content x blend + beta -> response LUT, per channel.
+                const float w = sample_blend(pc.blend, pc.output, px, py);
+                const std::array<float, 3> beta = sample_beta(pc.beta, pc.output, px, py);
                 const rig::RigProjector& rp = rig.projectors[k];
-                l += rp.brightness[0] * std::pow(signal, rp.gamma[0]);
+                for (std::size_t ch = 0; ch < 3; ++ch) {
+                    const double signal =
+                        apply_response(pc.response, static_cast<int>(ch), static_cast<float>(content) * w + beta[ch]);
+                    l += rp.brightness[ch] *
+                         (rp.black_level + (1.0 - rp.black_level) * std::pow(signal, rp.gamma[ch])) / 3.0;
+                }
             }
             light(y, x) = static_cast<float>(l);
         }

@@ -11,8 +11,9 @@
 //                      luminance), clearly apart; with the colour step, the measured responses,
 //                      blacks and gains ("colour") and the seams before and after it at black,
 //                      dark, mid-grey and white content (ground_truth.seams_before_colour, .seams),
-//   preview.png        the screen as a viewer sees it (ground-truth light paths): a white field with
-//                      a content grid every 1/16 of the frame, linear light -> gamma 2.2, 8 bits.
+//   preview.png        the screen as a viewer sees it (ground-truth light paths, the rig's
+//                      responses and black levels, mean of the channels): a white field with a
+//                      content grid every 1/16 of the frame, linear light -> gamma 2.2, 8 bits.
 // A refused calibration (CalibrationRefused) writes nothing: whatever the folder held stays.
 #pragma once
 
