@@ -43,7 +43,8 @@ Kiosk::Kiosk(const KioskConfig& config, KioskParts parts, KioskRunOptions option
       options_(std::move(options)),
       tick_(armed_tick(config.outputs.rate_hz)),
       start_(std::chrono::steady_clock::now()),
-      last_log_(start_) {
+      last_log_(start_),
+      last_status_(start_) {
     if (config.guard_deg > 0) {
         auto guarded = guard_band(config.screen, config.quality.content, config.guard_deg);
         if (!guarded) throw KioskSetupError(1, "[screen].guard_deg: " + guarded.error().message);
@@ -53,6 +54,10 @@ Kiosk::Kiosk(const KioskConfig& config, KioskParts parts, KioskRunOptions option
     loop_.watch(parts_.inbox.fd(), [this] { on_frame(); });
     loop_.watch(tick_.fd(), [this] { on_tick(); });
     loop_.watch(parts_.display.event_fd(), [this] { on_flip(); });  // -1 headless: ignored
+    if (parts_.calibration != nullptr) loop_.watch(parts_.calibration->fd(), [this] { on_calibration(); });
+    calibration_.source = config.calibration.mpcdi.empty() ? std::string("ideal") : config.calibration.mpcdi.string();
+    calibration_.loaded_ns = realtime_ns();
+    write_status("connecting");
     // Every output drawn is progress: one round of several outputs may outlast WatchdogSec on a
     // software rasteriser while the loop is healthy (screen_presenter.h).
     parts_.display.on_output_presented([this] { parts_.notifier.watchdog(); });
@@ -144,11 +149,17 @@ void Kiosk::on_tick() {
         check_frames_shown();
     }
     shown_since_tick_ = false;
+    // A copy at the monitor's rate (2 Hz), not the display's: the worker converts it on its thread.
+    if (parts_.selfcal != nullptr && current_ && parts_.selfcal->wants_content())
+        parts_.selfcal->offer(current_->image);
     if (const auto stuck = flip_overdue(now)) {
         return fail("output", fmt::format("{}: its page flip has not completed for over {:.1f} s; stopping so that "
                                           "the service manager restarts the kiosk",
                                           parts_.display.output_name(*stuck),
                                           std::chrono::duration<double>(options_.flip_timeout).count()));
+    }
+    if (std::chrono::duration<double>(now - last_status_).count() >= config_.stats.status_period_s) {
+        write_status(running_state());
     }
     if (std::chrono::duration<double>(now - last_log_).count() >= config_.stats.log_period_s) {
         spdlog::info("stats: {} link_sessions={} link_connected={}", parts_.display.stats().log_line(),
@@ -227,6 +238,71 @@ void Kiosk::on_flip() {
     check_frames_shown();
 }
 
+void Kiosk::on_calibration() {
+    std::optional<CalibrationUpdate> update = parts_.calibration->take();
+    if (!update) return;
+    for (const auto& n : update->notes) spdlog::info("calibration: {}", n);
+    std::string why = update->error;
+    if (update->screen) {
+        if (Status s = parts_.display.swap_calibration(std::move(*update->screen)); s) {
+            calibration_.source = update->source;
+            calibration_.loaded_ns =
+                std::chrono::duration_cast<std::chrono::nanoseconds>(update->loaded_at.time_since_epoch()).count();
+            calibration_.last_error.clear();
+            ++calibration_.swaps;
+            spdlog::info("calibration: now showing {} (swap {})", update->source, calibration_.swaps);
+            check_frames_shown();
+            write_status(running_state());
+            return;
+        } else {
+            why = fmt::format("{}: cannot be put on the outputs: {}", update->source, s.error().message);
+        }
+    }
+    calibration_.last_error = why;
+    calibration_.last_error_ns = realtime_ns();
+    ++calibration_.refused;
+    spdlog::error("calibration: {}; keeping {} on the outputs", why, calibration_.source);
+    write_status(running_state());
+}
+
+const char* Kiosk::running_state() const {
+    if (!current_) return "connecting";
+    return connected_ ? "showing" : "disconnected";
+}
+
+KioskStatus Kiosk::status(const char* state) const {
+    KioskStatus s;
+    s.written_ns = realtime_ns();
+    s.uptime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    s.state = state;
+    s.endpoint = config_.farm.endpoint;
+    s.connected = connected_;
+    s.frames_shown = parts_.display.frames_on_screen();
+    s.showing_request = current_ ? current_->request_id : 0;
+    s.calibration_source = calibration_.source;
+    s.calibration_loaded_ns = calibration_.loaded_ns;
+    s.calibration_swaps = calibration_.swaps;
+    s.calibration_refused = calibration_.refused;
+    s.calibration_last_error = calibration_.last_error;
+    s.calibration_last_error_ns = calibration_.last_error_ns;
+    if (parts_.selfcal != nullptr) s.selfcal = parts_.selfcal->status();
+    return s;
+}
+
+void Kiosk::write_status(const char* state) {
+    if (config_.stats.status_file.empty()) return;
+    last_status_ = std::chrono::steady_clock::now();
+    try {
+        write_kiosk_status(config_.stats.status_file, status(state));
+        if (status_failing_) spdlog::info("status file: {} written again", config_.stats.status_file.string());
+        status_failing_ = false;
+    } catch (const std::exception& e) {
+        // Once, not every period: the display goes on either way.
+        if (!status_failing_) spdlog::warn("status file: {}; trying again every period", e.what());
+        status_failing_ = true;
+    }
+}
+
 int Kiosk::finish() {
     parts_.notifier.stopping();
     parts_.navigation.stop();
@@ -244,6 +320,7 @@ int Kiosk::finish() {
     spdlog::info("stats: {} link_sessions={}", parts_.display.stats().log_line(), link.sessions_opened);
     if (config_.outputs.composite) parts_.display.write_composite();
     write_statistics(navigation, link);
+    write_status("stopped");
     return exit_code_;
 }
 

@@ -9,6 +9,10 @@
 //              request; link state changes; idle repaint (also when the late warp's shift changed:
 //              [screen].guard_deg > 0, appliance/warp/late_warp.h); periodic stats line; WATCHDOG=1
 //   on_flip    the backend's event fd (KMS page flips): pending content onto outputs ready again
+//              and, with self-recalibration, hands the frame on the wall to its worker when it asks
+//   on_calibration  the CalibrationInbox's eventfd (when given): a calibration loaded and validated
+//              off this thread (a changed MPCDI file, self-recalibration) is swapped onto the outputs;
+//              an unusable one is logged (file and field) and the last good one stays on the wall
 // The handlers are public so that tests can drive them one at a time (kiosk/kiosk_test.cpp).
 // run() loops until a stop (signal, --frames N on screen, --duration, end of a tracking replay), then
 // makes the clean stop: STOPPING=1, navigation, link, pose log, final stats line, composite, JSON.
@@ -29,13 +33,16 @@
 #include "appliance/warp/late_warp.h"
 #include "common/service_notify.h"
 #include "common/view_request.h"
+#include "kiosk/calibration_inbox.h"
 #include "kiosk/content_dump.h"
 #include "kiosk/event_loop.h"
 #include "kiosk/frame_inbox.h"
 #include "kiosk/kiosk_config.h"
 #include "kiosk/kiosk_display.h"
 #include "kiosk/kiosk_navigation.h"
+#include "kiosk/kiosk_status.h"
 #include "kiosk/pose_log.h"
+#include "kiosk/selfcal_worker.h"
 #include "kiosk/signal_fd.h"
 #include "kiosk/timer_fd.h"
 #include "renderfarm/link/link_client.h"
@@ -58,6 +65,20 @@ struct KioskParts {
     KioskNavigation& navigation;
     const SignalFd& signals;
     ServiceNotifier& notifier;
+    CalibrationInbox* calibration = nullptr;  // run-time calibration swaps; nullptr: none
+    // Self-recalibration ([selfcal] enabled): the tick offers it the frame on the wall when it asks;
+    // its status goes into the status file; its corrections arrive through `calibration`. nullptr: off.
+    SelfcalWorker* selfcal = nullptr;
+};
+
+// The calibration on the wall, for the status file (kiosk/kiosk_status.h) and the journal.
+struct CalibrationInUse {
+    std::string source;              // the MPCDI path, "ideal", "selfcal"
+    std::int64_t loaded_ns = 0;      // CLOCK_REALTIME, when it was loaded
+    std::string last_error;          // the latest refused update since it was loaded; empty: none
+    std::int64_t last_error_ns = 0;  // when that was
+    std::uint64_t swaps = 0;         // calibrations swapped in since start
+    std::uint64_t refused = 0;       // updates refused since start
 };
 
 // What the command line adds: stop conditions and records of the run.
@@ -89,6 +110,7 @@ public:
     void on_frame();
     void on_tick();
     void on_flip();
+    void on_calibration();
 
     [[nodiscard]] bool stopping() const { return loop_.stopping(); }
     [[nodiscard]] int exit_code() const { return exit_code_; }
@@ -97,6 +119,10 @@ public:
     [[nodiscard]] const ContentFrame* current() const { return current_ ? &*current_ : nullptr; }
     [[nodiscard]] int tick_fd() const { return tick_.fd(); }
     [[nodiscard]] std::uint64_t late_warp_clamped() const { return late_warp_clamped_; }
+    [[nodiscard]] const CalibrationInUse& calibration_in_use() const { return calibration_; }
+
+    // The status file now (KioskStatus; the tick rewrites it every [stats].status_period_s).
+    [[nodiscard]] KioskStatus status(const char* state) const;
 
     // The clean stop after the loop (run() calls it); returns the exit code.
     [[nodiscard]] int finish();
@@ -113,6 +139,8 @@ private:
     void note_link_state(const LinkClientStats& link);
     void write_pose(const PoseLogEntry& entry);
     void write_statistics(const nlohmann::json& navigation, const LinkClientStats& link);
+    void write_status(const char* state);  // [stats].status_file (no-op when empty)
+    [[nodiscard]] const char* running_state() const;
 
     const KioskConfig& config_;
     KioskParts parts_;
@@ -127,9 +155,12 @@ private:
     std::uint64_t ticks_ = 0;
     std::uint64_t frames_seen_ = 0;
     bool connected_ = false;
+    CalibrationInUse calibration_;
     bool shown_since_tick_ = true;
     std::chrono::steady_clock::time_point start_;
     std::chrono::steady_clock::time_point last_log_;
+    std::chrono::steady_clock::time_point last_status_;
+    bool status_failing_ = false;  // the status file's last write failed (logged once)
     int exit_code_ = 0;
 };
 

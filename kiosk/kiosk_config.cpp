@@ -254,9 +254,11 @@ void read_calibration(const Section& s, CalibrationConfig& c) {
     const std::string text = source == nullptr ? "ideal" : s.as_string(*source, "source");
     if (text != "ideal") {
         c.mpcdi = s.existing_file(*source, "source");
+        c.watch = s.boolean("watch", c.watch);
         for (const char* key : {"projectors", "overlap", "output", "gamma"}) s.forbid(key, "with source = \"ideal\"");
         return;
     }
+    s.forbid("watch", "with an MPCDI source (the ideal layout never changes)");
     c.projectors = s.integer("projectors", c.projectors, 1, 64);
     c.overlap = s.number("overlap", c.overlap, [](double x) { return x >= 0 && x < 0.5; }, "[0, 0.5)");
     c.output = s.size("output", c.output, 1);
@@ -557,6 +559,10 @@ void read_stats(const Section& s, StatsConfig& st) {
     const std::string file = s.string("file", "");
     if (!file.empty()) st.file = s.context().resolve(file);
     st.log_period_s = s.number("log_period_s", st.log_period_s, [](double x) { return x >= 0.1 && x <= 86400; }, "[0.1, 86400] s");
+    const std::string status = s.string("status_file", "");
+    if (!status.empty()) st.status_file = s.context().resolve(status);
+    st.status_period_s = s.number(
+        "status_period_s", st.status_period_s, [](double x) { return x >= 0.1 && x <= 3600; }, "[0.1, 3600] s");
 }
 
 }  // namespace
@@ -614,7 +620,8 @@ KioskConfig parse_kiosk_config(std::string_view text, const std::filesystem::pat
     const Section display = section(ctx, root, "display", {"rate_hz"});
     const Section outputs = section(ctx, root, "outputs", {"backend", "device", "sizes", "png_dir", "png_every", "composite"});
     read_outputs(display, outputs, config.outputs);
-    const Section calibration = section(ctx, root, "calibration", {"source", "projectors", "overlap", "output", "gamma"});
+    const Section calibration =
+        section(ctx, root, "calibration", {"source", "watch", "projectors", "overlap", "output", "gamma"});
     read_calibration(calibration, config.calibration);
     const Section quality = section(ctx, root, "quality", {"content", "spp", "jpeg_quality", "bounces", "ao_samples", "area_light_samples"});
     read_quality(quality, config.quality);
@@ -628,7 +635,7 @@ KioskConfig parse_kiosk_config(std::string_view text, const std::filesystem::pat
                  "camera_exposure_us", "camera_gain", "camera_white_balance_k", "camera_colour"});
     read_navigation(navigation, config.navigation);
     config.screen.eye_m = Eigen::Vector3d(0.0, config.navigation.eye_height_m, 0.0);
-    const Section stats = section(ctx, root, "stats", {"file", "log_period_s"});
+    const Section stats = section(ctx, root, "stats", {"file", "log_period_s", "status_file", "status_period_s"});
     read_stats(stats, config.stats);
     for (const Section* s : {&farm, &display, &outputs, &calibration, &quality, &screen, &navigation, &stats}) s->finish();
     return config;

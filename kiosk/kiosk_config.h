@@ -65,6 +65,7 @@ struct OutputsConfig {
 // [calibration]: an MPCDI file (2d profile) or the ideal layout (appliance/warp/ideal_calibration.h).
 struct CalibrationConfig {
     std::filesystem::path mpcdi;            // source = FILE; empty: source = "ideal"
+    bool watch = true;                      // MPCDI: swap in the file when it changes (inotify; docs/kiosk.md)
     int projectors = 3;                     // ideal: [1, 64]
     double overlap = 0.15;                  // ideal: [0, 0.5)
     ImageSize output{1024, 768};            // ideal: each projector, [1, 16384] per side
@@ -129,6 +130,8 @@ struct NavigationConfig {
 struct StatsConfig {
     std::filesystem::path file;             // JSON written at exit; empty = none
     double log_period_s = 10.0;             // stderr summary period, [0.1, 86400]
+    std::filesystem::path status_file;      // kiosk/kiosk_status.h, rewritten while running; empty = none
+    double status_period_s = 1.0;           // its rewrite period, [0.1, 3600]
 };
 
 struct KioskConfig {

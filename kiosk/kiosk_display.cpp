@@ -34,6 +34,13 @@ void KioskDisplay::show(const ContentFrame& f) {
     account();
 }
 
+Status KioskDisplay::swap_calibration(ScreenCalibration screen) {
+    Status s = presenter_.swap_calibration(screen);
+    if (s) screen_ = std::move(screen);
+    account();
+    return s;
+}
+
 void KioskDisplay::repaint() {
     // Outputs with a flip pending are left alone; the others show the current frame again.
     if (Status s = presenter_.repaint(); !s) spdlog::warn("repaint: {}", s.error().message);

@@ -45,6 +45,11 @@ public:
     [[nodiscard]] Status show_connecting_screen(ImageSize content, const std::string& endpoint);
     // A decoded farm frame, newer than the one before.
     void show(const ContentFrame& frame);
+    // A run-time calibration swap (ScreenPresenter::swap_calibration): the current frame is shown
+    // again through `screen`, which the composite uses from now on (on success only; errors: see
+    // ScreenPresenter::swap_calibration).
+    [[nodiscard]] Status swap_calibration(ScreenCalibration screen);
+    [[nodiscard]] const ScreenCalibration& calibration() const { return screen_; }
     // The current frame again on every ready output (the tick's idle repaint).
     void repaint();
     // Page-flip events of the backend (KMS): outputs ready again get pending content.

@@ -72,6 +72,27 @@ ScreenCalibration load_calibration(const KioskConfig& config) {
     return screen;
 }
 
+std::unique_ptr<CalibrationInbox> open_calibration_inbox() {
+    auto inbox = CalibrationInbox::create();
+    if (!inbox) throw KioskSetupError(1, "event fds: " + inbox.error().message);
+    return std::move(inbox).value();
+}
+
+std::unique_ptr<CalibrationWatcher> watch_calibration(const KioskConfig& config, CalibrationInbox& inbox) {
+    if (config.calibration.mpcdi.empty() || !config.calibration.watch) return nullptr;
+    const CalibrationConfig calibration = config.calibration;
+    const ImageSize content = config.quality.content;
+    auto watcher = CalibrationWatcher::create(
+        calibration.mpcdi,
+        [calibration, content](std::vector<std::string>* notes) {
+            return load_screen_calibration(calibration, content, notes);
+        },
+        inbox);
+    if (!watcher) throw KioskSetupError(1, "calibration: watching for changes: " + watcher.error().message);
+    spdlog::info("calibration: {} is swapped in when it changes", calibration.mpcdi.string());
+    return std::move(watcher).value();
+}
+
 KioskDisplay open_display(const KioskConfig& config, ScreenCalibration screen) {
     HeadlessOutputBackend* headless = nullptr;
     std::unique_ptr<OutputBackend> backend = open_backend(config.outputs, screen, &headless);

@@ -12,6 +12,8 @@
 #include <string>
 
 #include "common/projector_calibration.h"
+#include "kiosk/calibration_inbox.h"
+#include "kiosk/calibration_watcher.h"
 #include "kiosk/content_dump.h"
 #include "kiosk/frame_inbox.h"
 #include "kiosk/kiosk_config.h"
@@ -43,6 +45,11 @@ struct KioskSetup {
 
 // MPCDI or ideal calibration ([calibration]); notes logged.
 [[nodiscard]] ScreenCalibration load_calibration(const KioskConfig& config);
+
+// The run-time calibration swap's inbox, and the watcher of [calibration]'s MPCDI file feeding it
+// (nullptr: source = "ideal" or watch = false). The watcher must be destroyed before the inbox.
+[[nodiscard]] std::unique_ptr<CalibrationInbox> open_calibration_inbox();
+[[nodiscard]] std::unique_ptr<CalibrationWatcher> watch_calibration(const KioskConfig& config, CalibrationInbox& inbox);
 
 // The [outputs] backend (headless or KMS) showing `screen`, each output logged; headless PNGs when
 // png_dir is set. Then the connecting screen on every output.

@@ -61,12 +61,14 @@ int run(const Flags& flags, const SignalFd& signals) {
     ServiceNotifier notifier;
     notifier.ready();  // outputs are up and showing something
 
+    const std::unique_ptr<CalibrationInbox> calibration = open_calibration_inbox();
+    const std::unique_ptr<CalibrationWatcher> watcher = watch_calibration(config, *calibration);
     const std::unique_ptr<FrameInbox> inbox = open_inbox();
     const std::unique_ptr<LinkClient> link = open_link(config, std::move(setup.tls), *inbox, setup.script);
     std::optional<PoseLog> pose_log = open_pose_log(flags.pose_log);
     const std::unique_ptr<KioskNavigation> navigation = start_navigation(config, std::move(setup.script));
 
-    Kiosk kiosk(config, KioskParts{display, *inbox, link_of(*link), *navigation, signals, notifier},
+    Kiosk kiosk(config, KioskParts{display, *inbox, link_of(*link), *navigation, signals, notifier, calibration.get()},
                 KioskRunOptions{flags.frames, flags.duration_s, std::move(dump), std::move(pose_log)});
     return kiosk.run();
 }

@@ -13,6 +13,7 @@ Result<ScreenPresenter> ScreenPresenter::create(OutputBackend& backend, const Sc
     std::vector<std::optional<std::size_t>> projector_of = assign_projectors(backend.outputs(), screen, notes);
     std::vector<OutputState> states(projector_of.size());
     std::vector<std::optional<std::size_t>> renderer_index(screen.projectors.size());
+    std::vector<std::string> ids;
     bool any = false;
     for (std::size_t i = 0; i < projector_of.size(); ++i) {
         if (!projector_of[i]) continue;
@@ -21,13 +22,38 @@ Result<ScreenPresenter> ScreenPresenter::create(OutputBackend& backend, const Sc
             auto added = backend.renderer().add_projector(screen.projectors[p]);
             if (!added) return with_context(added.error(), "projector '" + screen.projectors[p].id + "'");
             renderer_index[p] = *added;
+            ids.resize(*added + 1);
+            ids[*added] = screen.projectors[p].id;
         }
         states[i].lit = true;
         states[i].projector = *renderer_index[p];
         any = true;
     }
     if (!any) return make_error(EINVAL, "no output got a projector calibration");
-    return ScreenPresenter(backend, std::move(projector_of), std::move(states));
+    return ScreenPresenter(backend, std::move(projector_of), std::move(states), std::move(ids));
+}
+
+Status ScreenPresenter::swap_calibration(const ScreenCalibration& screen) {
+    last_presents_ = 0;
+    std::vector<const ProjectorCalibration*> next(renderer_ids_.size(), nullptr);
+    for (std::size_t r = 0; r < renderer_ids_.size(); ++r) {
+        for (const auto& p : screen.projectors) {
+            if (p.id == renderer_ids_[r]) next[r] = &p;
+        }
+        if (next[r] == nullptr) {
+            return make_error(EINVAL, "the new calibration has no projector '" + renderer_ids_[r] +
+                                          "', which an output shows (a new layout needs a restart of the kiosk)");
+        }
+    }
+    Status first_error;
+    for (std::size_t r = 0; r < next.size(); ++r) {
+        Status s = backend_->renderer().replace_projector(r, *next[r]);
+        if (!s && first_error.ok()) first_error = with_context(s.error(), "projector '" + renderer_ids_[r] + "'");
+    }
+    if (!has_content_) return first_error;
+    dirty_ = true;  // the current content through the new maps, as soon as no round is in flight
+    if (Status s = present_round(); !s && first_error.ok()) first_error = s;
+    return first_error;
 }
 
 Status ScreenPresenter::show(const Rgb8Image& content, std::uint64_t tag) {

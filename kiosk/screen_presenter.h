@@ -43,6 +43,14 @@ public:
     // New content (sRGB RGB8, rows top first) with a tag newer than the previous one.
     [[nodiscard]] Status show(const Rgb8Image& content, std::uint64_t tag);
 
+    // A run-time calibration swap (kiosk/calibration_inbox.h): every projector on an output gets the
+    // calibration of the projector with the same id in `screen` (warp, blend, response uploaded
+    // again), and the current content is presented again through it as the next round (at once
+    // when no round is in flight). The assignment of projectors to outputs is kept. EINVAL, with
+    // nothing changed, when a projector on an output has no counterpart in `screen` (a new layout
+    // needs a restart); an upload error leaves that projector's old calibration in use.
+    [[nodiscard]] Status swap_calibration(const ScreenCalibration& screen);
+
     // Presents the current content again, as a round on every lit output, when no round is in
     // flight (the idle repaint of the display tick). No-op before the first show().
     [[nodiscard]] Status repaint();
@@ -74,14 +82,18 @@ private:
     };
 
     ScreenPresenter(OutputBackend& backend, std::vector<std::optional<std::size_t>> projector_of,
-                    std::vector<OutputState> states)
-        : backend_(&backend), projector_of_(std::move(projector_of)), states_(std::move(states)) {}
+                    std::vector<OutputState> states, std::vector<std::string> ids)
+        : backend_(&backend),
+          projector_of_(std::move(projector_of)),
+          states_(std::move(states)),
+          renderer_ids_(std::move(ids)) {}
     [[nodiscard]] Status present_round();  // when dirty_ and no round in flight
     [[nodiscard]] bool round_in_flight() const;
 
     OutputBackend* backend_;
     std::vector<std::optional<std::size_t>> projector_of_;
     std::vector<OutputState> states_;
+    std::vector<std::string> renderer_ids_;  // per renderer index: the projector id it draws
     bool has_content_ = false;
     bool dirty_ = false;  // the current content has not started a round yet
     std::uint64_t tag_ = 0;

@@ -209,6 +209,24 @@ Status WarpBlendRenderer::set_content(const Rgb8Image& frame) {
 }
 
 Result<std::size_t> WarpBlendRenderer::add_projector(const ProjectorCalibration& c) {
+    auto p = make_projector(c);
+    if (!p) return p.error();
+    projectors_.push_back(std::move(p).value());
+    return projectors_.size() - 1;
+}
+
+Status WarpBlendRenderer::replace_projector(std::size_t index, const ProjectorCalibration& c) {
+    if (index >= projectors_.size()) {
+        return make_error(EINVAL, "projector index " + std::to_string(index) + " out of range (have " +
+                                      std::to_string(projectors_.size()) + ")");
+    }
+    auto p = make_projector(c);  // the old textures stay in use until this succeeded
+    if (!p) return p.error();
+    projectors_[index] = std::move(p).value();
+    return {};
+}
+
+Result<WarpBlendRenderer::Projector> WarpBlendRenderer::make_projector(const ProjectorCalibration& c) const {
     const std::string who = "projector '" + c.id + "'";
     if (auto s = check_size(who + " output", c.output, max_texture_size_); !s) return s.error();
     if (auto s = check_size(who + " warp map", c.warp.size, max_texture_size_); !s) return s.error();
@@ -267,8 +285,7 @@ Result<std::size_t> WarpBlendRenderer::add_projector(const ProjectorCalibration&
     p.warp = std::move(warp.value());
     p.blend = std::move(blend.value());
     p.lut = std::move(lut_texture.value());
-    projectors_.push_back(std::move(p));
-    return projectors_.size() - 1;
+    return p;
 }
 
 Status WarpBlendRenderer::check_index(std::size_t index) const {

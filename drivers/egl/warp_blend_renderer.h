@@ -56,6 +56,10 @@ public:
     // is empty or does not match its data, the LUT channels differ in length or have < 2 entries,
     // or a blend weight is not finite.
     [[nodiscard]] Result<std::size_t> add_projector(const ProjectorCalibration& calibration);
+    // Replaces projector `index`'s calibration (a run-time calibration swap, kiosk/calibration_reload.h):
+    // the same checks and uploads as add_projector; on any error the old textures stay in use.
+    // EINVAL also for an index >= projector_count().
+    [[nodiscard]] Status replace_projector(std::size_t index, const ProjectorCalibration& calibration);
 
     // The late warp's content-space affine map (appliance/warp/late_warp.h): the warp map's content
     // coordinates uv (normalised, [0, 1] across the content the calibration was made for) are
@@ -98,6 +102,7 @@ private:
     };
 
     WarpBlendRenderer() = default;
+    [[nodiscard]] Result<Projector> make_projector(const ProjectorCalibration& calibration) const;  // checks, uploads
     [[nodiscard]] Status check_index(std::size_t index) const;
 
     GlProgram program_;

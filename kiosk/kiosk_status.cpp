@@ -1,0 +1,88 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "kiosk/kiosk_status.h"
+
+#include <ctime>
+#include <span>
+
+#include <fmt/format.h>
+
+#include "common/file_io.h"
+
+namespace mogao {
+
+std::string utc_text(std::int64_t realtime_ns) {
+    const std::time_t seconds = static_cast<std::time_t>(realtime_ns / 1'000'000'000);
+    std::tm utc{};
+    if (::gmtime_r(&seconds, &utc) == nullptr) return "";
+    return fmt::format("{:04}-{:02}-{:02}T{:02}:{:02}:{:02}Z", utc.tm_year + 1900, utc.tm_mon + 1, utc.tm_mday,
+                       utc.tm_hour, utc.tm_min, utc.tm_sec);
+}
+
+namespace {
+
+// The state as a key a program can compare (selfcal::to_string is the journal's wording).
+const char* state_key(selfcal::SelfcalState state) {
+    switch (state) {
+        case selfcal::SelfcalState::calibrated:
+            return "calibrated";
+        case selfcal::SelfcalState::drift_detected:
+            return "drift_detected";
+        case selfcal::SelfcalState::correcting:
+            return "correcting";
+        case selfcal::SelfcalState::cannot_correct:
+            return "cannot_correct";
+    }
+    return "unknown";
+}
+
+nlohmann::json selfcal_json(const std::optional<selfcal::SelfcalStatus>& s) {
+    if (!s) return {{"enabled", false}};
+    nlohmann::json projectors = nlohmann::json::array();
+    for (const auto& p : s->projectors) {
+        projectors.push_back({{"id", p.id},
+                              {"matches", p.matches},
+                              {"measured", p.measured},
+                              {"drift_px", p.drift_px},
+                              {"rotation_deg", p.rotation_deg},
+                              {"shift_mm", p.shift_mm}});
+    }
+    return {{"enabled", true},
+            {"state", state_key(s->state)},
+            {"t_s", s->t_s},
+            {"waiting", s->waiting},
+            {"reason", s->reason},
+            {"camera_rotation_deg", s->camera_rotation_deg},
+            {"projectors", projectors},
+            {"line", s->text()}};
+}
+
+}  // namespace
+
+nlohmann::json kiosk_status_json(const KioskStatus& s) {
+    nlohmann::json calibration = {{"source", s.calibration_source},
+                                  {"loaded_ns", s.calibration_loaded_ns},
+                                  {"loaded_utc", utc_text(s.calibration_loaded_ns)},
+                                  {"swaps", s.calibration_swaps},
+                                  {"refused", s.calibration_refused},
+                                  {"last_error", s.calibration_last_error}};
+    if (!s.calibration_last_error.empty()) {
+        calibration["last_error_ns"] = s.calibration_last_error_ns;
+        calibration["last_error_utc"] = utc_text(s.calibration_last_error_ns);
+    }
+    return {{"written_ns", s.written_ns},
+            {"written_utc", utc_text(s.written_ns)},
+            {"uptime_s", s.uptime_s},
+            {"state", s.state},
+            {"farm", {{"endpoint", s.endpoint}, {"connected", s.connected}}},
+            {"frames_shown", s.frames_shown},
+            {"showing_request", s.showing_request},
+            {"calibration", calibration},
+            {"selfcal", selfcal_json(s.selfcal)}};
+}
+
+void write_kiosk_status(const std::filesystem::path& file, const KioskStatus& status) {
+    const std::string text = kiosk_status_json(status).dump(2) + "\n";
+    write_file_atomically(file, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+}
+
+}  // namespace mogao

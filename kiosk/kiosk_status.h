@@ -1,0 +1,54 @@
+// SPDX-License-Identifier: Apache-2.0
+// The kiosk's status file (docs/kiosk.md, "Status file"): what a technician (or a monitoring
+// agent) reads to see the appliance's state without the journal -- the farm connection, the frames
+// on screen, the calibration on the wall (file, when it was loaded, the last refused update) and
+// the self-recalibration state (appliance/selfcal/selfcal_status.h). One JSON object, rewritten
+// atomically (common/file_io.h: temporary + fsync + rename) every [stats].status_period_s by the
+// display loop and once at the clean stop, so a reader never sees half a file.
+//
+// Times: "*_ns" are CLOCK_REALTIME nanoseconds since the epoch, "*_utc" the same as ISO 8601 UTC
+// ("2026-11-22T12:30:05Z"); "uptime_s" is seconds since the kiosk's loop started.
+// Errors: write_kiosk_status throws std::system_error naming the file (the kiosk logs it as a
+// warning, once per kind of failure, and goes on showing).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "appliance/selfcal/selfcal_status.h"
+
+namespace mogao {
+
+// Everything the status file shows, gathered by the loop.
+struct KioskStatus {
+    std::int64_t written_ns = 0;
+    double uptime_s = 0.0;
+    std::string
+        state;  // "connecting" (no farm frame yet), "showing", "disconnected" (showing the last frame), "stopped"
+    std::string endpoint;
+    bool connected = false;
+    std::uint64_t frames_shown = 0;     // farm frames on screen on every output since start
+    std::uint64_t showing_request = 0;  // the request id on screen (0: the connecting screen)
+    std::string calibration_source;     // MPCDI path, "ideal", "selfcal"
+    std::int64_t calibration_loaded_ns = 0;
+    std::uint64_t calibration_swaps = 0;
+    std::uint64_t calibration_refused = 0;
+    std::string calibration_last_error;  // empty: none since the calibration in use was loaded
+    std::int64_t calibration_last_error_ns = 0;
+    std::optional<selfcal::SelfcalStatus> selfcal;  // nullopt: self-recalibration off
+};
+
+// "2026-11-22T12:30:05Z" (seconds, UTC) for CLOCK_REALTIME nanoseconds.
+[[nodiscard]] std::string utc_text(std::int64_t realtime_ns);
+
+// The file's JSON (schema in docs/kiosk.md). Pure.
+[[nodiscard]] nlohmann::json kiosk_status_json(const KioskStatus& status);
+
+// Writes kiosk_status_json(status) to `file` atomically (the folder must exist).
+void write_kiosk_status(const std::filesystem::path& file, const KioskStatus& status);
+
+}  // namespace mogao
