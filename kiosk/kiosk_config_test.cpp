@@ -185,6 +185,22 @@ TEST_F(KioskConfigTest, AcceptsAnMpcdiSourceAPathFileAndKmsDevice) {
     EXPECT_EQ(c.outputs.device, fs::path("/dev/dri/card1"));
 }
 
+TEST_F(KioskConfigTest, CalibrationWatchAndTheStatusFile) {
+    const KioskConfig plain = parse(good());
+    EXPECT_TRUE(plain.stats.status_file.empty()) << "no status file unless configured";
+    EXPECT_DOUBLE_EQ(plain.stats.status_period_s, 1.0);
+    const std::string mpcdi =
+        good({R"(calibration.source="screen.mpcdi")",
+              "calibration.projectors=", "calibration.overlap=", "calibration.output=", "calibration.gamma="});
+    EXPECT_TRUE(parse(mpcdi).calibration.watch) << "an MPCDI file is swapped in when it changes by default";
+    const KioskConfig c = parse(good({R"(stats.status_file="run/kiosk-status.json")", "stats.status_period_s=0.5"}));
+    EXPECT_EQ(c.stats.status_file, dir_ / "run/kiosk-status.json");
+    EXPECT_DOUBLE_EQ(c.stats.status_period_s, 0.5);
+    EXPECT_NE(error_of(good({"stats.status_period_s=0.01"})).find("[stats].status_period_s"), std::string::npos);
+    EXPECT_NE(error_of(good({"calibration.watch=false"})).find("[calibration].watch"), std::string::npos)
+        << "watch means nothing for the ideal layout";
+}
+
 struct BadField {
     const char* from;
     const char* to;
