@@ -91,6 +91,14 @@ void TrackingThread::run() {
             spdlog::info("tracking: camera re-opened: {}", source_->description());
             continue;
         }
+        if (rebased) {
+            // A replay behind its clock: drop what is already stale before decoding it (a PNG
+            // decode costs several times the tracking); the check below catches the rest.
+            if (const std::uint64_t dropped = source_->skip_frames_due_by(monotonic_ns() - offset_ns); dropped > 0) {
+                const std::lock_guard lock(mutex_);
+                counters_.skipped += dropped;
+            }
+        }
         auto frame = source_->next_frame();
         if (!frame) {
             const int code = frame.code();
