@@ -9,6 +9,13 @@ if(MOGAO_SANITIZE)
   target_compile_options(mogao_warnings INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   target_link_options(mogao_warnings INTERFACE -fsanitize=address,undefined)
 endif()
+if(MOGAO_TSAN)
+  if(MOGAO_SANITIZE)
+    message(FATAL_ERROR "MOGAO_TSAN and MOGAO_SANITIZE cannot be combined (ThreadSanitizer excludes ASan)")
+  endif()
+  target_compile_options(mogao_warnings INTERFACE -fsanitize=thread -fno-omit-frame-pointer)
+  target_link_options(mogao_warnings INTERFACE -fsanitize=thread)
+endif()
 # Fuzzing build (tests/fuzz, .ci/fuzz): clang only; every mogao library instrumented for libFuzzer's
 # coverage and checked by ASan+UBSan (the fuzz executables add -fsanitize=fuzzer).
 if(MOGAO_FUZZ)
