@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <numeric>
 
 #include <time.h>
@@ -91,18 +92,34 @@ struct RankReply {
     std::vector<double> tiles;
 };
 
-RankReply receive_reply(int source) {
+// One rank's reply (header, payload, tile times), every receive non-blocking under the deadline:
+// a rank stopped half-way through its reply (a rendezvous transfer waits for the sender) cannot
+// block the admin either.
+// `wait(done)` polls `done` until true, under the frame's deadline (FrameDispatcher::poll_until).
+RankReply receive_reply(int source, const std::function<void(const std::function<bool()>&)>& wait) {
+    const auto receive = [&](void* data, int count, MPI_Datatype type, int tag) {
+        MPI_Request request;
+        MPI_Irecv(data, count, type, source, tag, MPI_COMM_WORLD, &request);
+        wait([&] {
+            int done = 0;
+            MPI_Test(&request, &done, MPI_STATUS_IGNORE);
+            return done != 0;
+        });
+    };
     RankReply reply;
-    MPI_Recv(&reply.header, sizeof reply.header, MPI_BYTE, source, kTagReplyHeader, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    receive(&reply.header, sizeof reply.header, MPI_BYTE, kTagReplyHeader);
     reply.payload.resize(reply.header.payload_bytes);
-    MPI_Recv(reply.payload.data(), static_cast<int>(reply.payload.size()), MPI_BYTE, source, kTagReplyPixels,
-             MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    receive(reply.payload.data(), static_cast<int>(reply.payload.size()), MPI_BYTE, kTagReplyPixels);
     MPI_Status status;
-    MPI_Probe(source, kTagReplyTiles, MPI_COMM_WORLD, &status);
+    int found = 0;
+    wait([&] {
+        MPI_Iprobe(source, kTagReplyTiles, MPI_COMM_WORLD, &found, &status);
+        return found != 0;
+    });
     int count = 0;
     MPI_Get_count(&status, MPI_DOUBLE, &count);
     reply.tiles.resize(static_cast<std::size_t>(count));
-    MPI_Recv(reply.tiles.data(), count, MPI_DOUBLE, source, kTagReplyTiles, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    receive(reply.tiles.data(), count, MPI_DOUBLE, kTagReplyTiles);
     return reply;
 }
 
@@ -216,24 +233,20 @@ DispatchedFrame FrameDispatcher::render(const ViewRequest& view, std::uint64_t s
     return frame;
 }
 
-// The next rank whose reply header has arrived; RankTimeout once `deadline` has passed.
-int FrameDispatcher::probe_reply_until(Clock::time_point deadline, const std::vector<bool>& replied,
-                                       std::uint64_t frame_id) {
+// Polls `done()` until it is true; past `deadline` marks the farm broken and throws RankTimeout
+// naming `who` (heartbeat about once a second meanwhile).
+template <typename Done>
+void FrameDispatcher::poll_until(Clock::time_point deadline, const Done& done, const std::string& who,
+                                 std::uint64_t frame_id) {
     auto next_beat = Clock::now() + std::chrono::seconds(1);
-    for (int found = 0;;) {
-        MPI_Status status;
-        MPI_Iprobe(MPI_ANY_SOURCE, kTagReplyHeader, MPI_COMM_WORLD, &found, &status);
-        if (found) return status.MPI_SOURCE;
+    while (!done()) {
         const auto now = Clock::now();
         if (now >= deadline) {
-            std::string silent;
-            for (std::size_t r = 0; r < replied.size(); ++r)
-                if (!replied[r]) silent += (silent.empty() ? "" : ", ") + std::to_string(r + 1);
             broken_ = true;
             throw RankTimeout(
                 fmt::format("render rank(s) {} did not reply to frame {} within {} s (rank_deadline_s): "
                             "host down, process stopped or link cut",
-                            silent, frame_id, settings_.rank_deadline_s));
+                            who, frame_id, settings_.rank_deadline_s));
         }
         if (heartbeat_ && now >= next_beat) {
             heartbeat_();
@@ -241,6 +254,24 @@ int FrameDispatcher::probe_reply_until(Clock::time_point deadline, const std::ve
         }
         sleep_briefly();
     }
+}
+
+// The next rank whose reply header has arrived.
+int FrameDispatcher::probe_reply_until(Clock::time_point deadline, const std::vector<bool>& replied,
+                                       std::uint64_t frame_id) {
+    MPI_Status status;
+    int found = 0;
+    std::string silent;
+    for (std::size_t r = 0; r < replied.size(); ++r)
+        if (!replied[r]) silent += (silent.empty() ? "" : ", ") + std::to_string(r + 1);
+    poll_until(
+        deadline,
+        [&] {
+            MPI_Iprobe(MPI_ANY_SOURCE, kTagReplyHeader, MPI_COMM_WORLD, &found, &status);
+            return found != 0;
+        },
+        silent, frame_id);
+    return status.MPI_SOURCE;
 }
 
 bool FrameDispatcher::gather(const ViewRequest& view, const Assignment& assignment, PackedPixels format,
@@ -269,7 +300,20 @@ bool FrameDispatcher::gather(const ViewRequest& view, const Assignment& assignme
     }
     WireView wire = to_wire(view);
     wire.linear = format == PackedPixels::linear ? 1 : 0;
-    broadcast_view(wire);
+    const auto deadline = settings_.rank_deadline_s > 0
+                              ? Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                                   std::chrono::duration<double>(settings_.rank_deadline_s))
+                              : Clock::time_point::max();
+    MPI_Request broadcast;
+    MPI_Ibcast(&wire, sizeof wire, MPI_BYTE, 0, MPI_COMM_WORLD, &broadcast);
+    poll_until(
+        deadline,
+        [&] {
+            int done = 0;
+            MPI_Test(&broadcast, &done, MPI_STATUS_IGNORE);
+            return done != 0;
+        },
+        "(view broadcast)", view.frame_id);
     for (int r = 0; r < mpi_.render_ranks(); ++r) {
         std::vector<int> flat;
         for (const PixelRect& rect : assignment.rects[static_cast<std::size_t>(r)])
@@ -278,16 +322,14 @@ bool FrameDispatcher::gather(const ViewRequest& view, const Assignment& assignme
     }
     frame.stats.rank_render_seconds.assign(static_cast<std::size_t>(mpi_.render_ranks()), 0.0);
     bool ok = true;
-    const auto deadline = settings_.rank_deadline_s > 0
-                              ? Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                                   std::chrono::duration<double>(settings_.rank_deadline_s))
-                              : Clock::time_point::max();
     std::vector<bool> replied(static_cast<std::size_t>(mpi_.render_ranks()), false);
     for (int k = 0; k < mpi_.render_ranks(); ++k) {
         // Replies in arrival order: a slow rank does not hold up compositing the others.
         const int source = probe_reply_until(deadline, replied, view.frame_id);
         replied[static_cast<std::size_t>(source - 1)] = true;
-        RankReply reply = receive_reply(source);
+        RankReply reply = receive_reply(source, [&](const std::function<bool()>& done) {
+            poll_until(deadline, done, std::to_string(source), view.frame_id);
+        });
         if (!reply.header.ok) {
             spdlog::error("{}", std::string(reply.payload.begin(), reply.payload.end()));
             ok = false;

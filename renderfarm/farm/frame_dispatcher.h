@@ -11,7 +11,8 @@
 // Errors: a rank's failure (its message names rank, frame and reason) is thrown as FarmError by
 // render() after every rank's reply was collected, so no rank is left blocked; the caller then calls
 // stop(). Bad views are rejected on the ranks by the renderer's validation (std::invalid_argument).
-// A rank that does not reply within `rank_deadline_s` (dead host, SIGSTOP, cut link) makes render()
+// A rank that does not reply within `rank_deadline_s` (dead host, SIGSTOP, cut link; every receive
+// of the reply is non-blocking under that deadline) makes render()
 // throw RankTimeout naming the silent ranks; the MPI job is then unusable (a collective is half
 // done): broken() turns true, stop() no longer talks to the ranks, and the process must end the
 // job with MPI_Abort so that the service restarts (run_farm does this; docs/services.md).
@@ -23,6 +24,7 @@
 #include <map>
 #include <memory>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "common/image.h"
@@ -101,6 +103,9 @@ private:
     bool gather(const ViewRequest& view, const Assignment& assignment, PackedPixels format, DispatchedFrame& frame,
                 std::vector<TileTime>& normalised);
     CostMap& stream_map(std::uint64_t stream, ImageSize size);
+    template <typename Done>
+    void poll_until(std::chrono::steady_clock::time_point deadline, const Done& done, const std::string& who,
+                    std::uint64_t frame_id);
     int probe_reply_until(std::chrono::steady_clock::time_point deadline, const std::vector<bool>& replied,
                           std::uint64_t frame_id);
 
