@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "appliance/autocal/rig_bridge.h"
 #include "appliance/warp/response_curve.h"
 #include "appliance/warp/warp_sampling.h"
 
@@ -20,35 +21,28 @@ struct Point {
 std::vector<Point> screen_light(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double level,
                                 double inset) {
     std::vector<Point> points;
-    constexpr int kSteps = 400;
-    for (int j = 0; j <= kSteps / 4; ++j) {
-        for (int i = 0; i <= kSteps; ++i) {
-            const Eigen::Vector2d uv(inset + (1.0 - 2.0 * inset) * i / kSteps,
-                                     inset + (1.0 - 2.0 * inset) * j / (kSteps / 4));
-            const rig::ScreenPoint s = rig::screen_of(rig.screen, uv);
-            Point pt;
-            pt.rgb = {rig.ambient, rig.ambient, rig.ambient};
-            for (std::size_t k = 0; k < calibration.projectors.size(); ++k) {
-                const auto p = rig::screen_to_projector(rig, static_cast<int>(k), s);
-                if (!p) continue;
-                const ProjectorCalibration& pc = calibration.projectors[k];
-                const int x = std::clamp(static_cast<int>(std::floor(p->x())), 0, pc.output.width - 1);
-                const int y = std::clamp(static_cast<int>(std::floor(p->y())), 0, pc.output.height - 1);
-                const bool shown = sample_warp(pc.warp, pc.output, x, y).valid();
-                const float w = shown ? sample_blend(pc.blend, pc.output, x, y) : 0.0F;
-                const std::array<float, 3> beta = sample_beta(pc.beta, pc.output, x, y);
-                if (w > 0.0F) ++pt.lit;
-                const rig::RigProjector& rp = rig.projectors[k];
-                for (std::size_t c = 0; c < 3; ++c) {
-                    const double signal = shown ? apply_response(pc.response, static_cast<int>(c),
-                                                                 static_cast<float>(level) * w + beta[c])
-                                                : 0.0;
-                    pt.rgb[c] +=
-                        rp.brightness[c] * (rp.black_level + (1.0 - rp.black_level) * std::pow(signal, rp.gamma[c]));
-                }
+    for (const rig::ScreenPoint& s : seam_grid(rig, inset)) {
+        Point pt;
+        pt.rgb = {rig.ambient, rig.ambient, rig.ambient};
+        for (std::size_t k = 0; k < calibration.projectors.size(); ++k) {
+            const ProjectorCalibration& pc = calibration.projectors[k];
+            const auto xy = output_pixel(rig, static_cast<int>(k), pc, s);
+            if (!xy) continue;
+            const auto [x, y] = *xy;
+            const bool shown = sample_warp(pc.warp, pc.output, x, y).valid();
+            const float w = shown ? sample_blend(pc.blend, pc.output, x, y) : 0.0F;
+            const std::array<float, 3> beta = sample_beta(pc.beta, pc.output, x, y);
+            if (w > 0.0F) ++pt.lit;
+            const rig::RigProjector& rp = rig.projectors[k];
+            for (std::size_t c = 0; c < 3; ++c) {
+                const double signal =
+                    shown ? apply_response(pc.response, static_cast<int>(c), static_cast<float>(level) * w + beta[c])
+                          : 0.0;
+                pt.rgb[c] +=
+                    rp.brightness[c] * (rp.black_level + (1.0 - rp.black_level) * std::pow(signal, rp.gamma[c]));
             }
-            points.push_back(pt);
         }
+        points.push_back(pt);
     }
     return points;
 }

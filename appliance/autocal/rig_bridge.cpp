@@ -106,35 +106,49 @@ GeometryError measure_geometry(const rig::VirtualRig& rig, const ScreenCalibrati
     return out;
 }
 
-LuminanceError measure_luminance(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double inset) {
-    std::vector<double> lum;
-    std::vector<bool> seam;
+std::vector<rig::ScreenPoint> seam_grid(const rig::VirtualRig& rig, double inset) {
     constexpr int kSteps = 400;
+    std::vector<rig::ScreenPoint> grid;
+    grid.reserve(static_cast<std::size_t>((kSteps + 1) * (kSteps / 4 + 1)));
     for (int j = 0; j <= kSteps / 4; ++j) {
         for (int i = 0; i <= kSteps; ++i) {
             const Eigen::Vector2d uv(inset + (1.0 - 2.0 * inset) * i / kSteps,
                                      inset + (1.0 - 2.0 * inset) * j / (kSteps / 4));
-            const rig::ScreenPoint s = rig::screen_of(rig.screen, uv);
-            double l = 0.0;
-            int lit = 0;
-            for (std::size_t k = 0; k < calibration.projectors.size(); ++k) {
-                const auto p = rig::screen_to_projector(rig, static_cast<int>(k), s);
-                if (!p) continue;
-                const ProjectorCalibration& pc = calibration.projectors[k];
-                const int x = std::clamp(static_cast<int>(std::floor(p->x())), 0, pc.output.width - 1);
-                const int y = std::clamp(static_cast<int>(std::floor(p->y())), 0, pc.output.height - 1);
-                const float w = sample_blend(pc.blend, pc.output, x, y);
-                if (w > 0.0f) ++lit;
-                const rig::RigProjector& rp = rig.projectors[k];
-                for (int c = 0; c < 3; ++c) {
-                    const double signal = apply_response(pc.response, c, w);
-                    l += rp.brightness[static_cast<std::size_t>(c)] *
-                         std::pow(signal, rp.gamma[static_cast<std::size_t>(c)]) / 3.0;
-                }
-            }
-            lum.push_back(l);
-            seam.push_back(lit >= 2);
+            grid.push_back(rig::screen_of(rig.screen, uv));
         }
+    }
+    return grid;
+}
+
+std::optional<std::array<int, 2>> output_pixel(const rig::VirtualRig& rig, int k, const ProjectorCalibration& pc,
+                                               const rig::ScreenPoint& s) {
+    const auto p = rig::screen_to_projector(rig, k, s);
+    if (!p) return std::nullopt;
+    return std::array<int, 2>{std::clamp(static_cast<int>(std::floor(p->x())), 0, pc.output.width - 1),
+                              std::clamp(static_cast<int>(std::floor(p->y())), 0, pc.output.height - 1)};
+}
+
+LuminanceError measure_luminance(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double inset) {
+    std::vector<double> lum;
+    std::vector<bool> seam;
+    for (const rig::ScreenPoint& s : seam_grid(rig, inset)) {
+        double l = 0.0;
+        int lit = 0;
+        for (std::size_t k = 0; k < calibration.projectors.size(); ++k) {
+            const ProjectorCalibration& pc = calibration.projectors[k];
+            const auto xy = output_pixel(rig, static_cast<int>(k), pc, s);
+            if (!xy) continue;
+            const float w = sample_blend(pc.blend, pc.output, (*xy)[0], (*xy)[1]);
+            if (w > 0.0f) ++lit;
+            const rig::RigProjector& rp = rig.projectors[k];
+            for (int c = 0; c < 3; ++c) {
+                const double signal = apply_response(pc.response, c, w);
+                l += rp.brightness[static_cast<std::size_t>(c)] *
+                     std::pow(signal, rp.gamma[static_cast<std::size_t>(c)]) / 3.0;
+            }
+        }
+        lum.push_back(l);
+        seam.push_back(lit >= 2);
     }
     LuminanceError out;
     out.samples = static_cast<int>(lum.size());

@@ -3,7 +3,9 @@
 // ground truth (never against the calibration's own prediction): docs/calibration.md.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "appliance/autocal/autocal.h"
@@ -53,6 +55,15 @@ struct GeometryError {
 // than `margin_px` projector pixels of border distance.
 [[nodiscard]] GeometryError measure_geometry(const rig::VirtualRig& rig, const ScreenCalibration& calibration,
                                              int step);
+
+// The content grid the seam measurements walk: 401 x 101 content points (u, v) inset by `inset`
+// of the frame on every side, row by row, each as the screen point showing it.
+[[nodiscard]] std::vector<rig::ScreenPoint> seam_grid(const rig::VirtualRig& rig, double inset);
+
+// Projector k's output pixel (floor of the ground-truth projection, clamped to the output) that
+// lights screen point `s`; nullopt where projector k does not reach it.
+[[nodiscard]] std::optional<std::array<int, 2>> output_pixel(const rig::VirtualRig& rig, int k,
+                                                             const ProjectorCalibration& pc, const rig::ScreenPoint& s);
 
 struct LuminanceError {
     int samples = 0;
