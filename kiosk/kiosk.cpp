@@ -279,12 +279,7 @@ KioskStatus Kiosk::status(const char* state) const {
     s.connected = connected_;
     s.frames_shown = parts_.display.frames_on_screen();
     s.showing_request = current_ ? current_->request_id : 0;
-    s.calibration_source = calibration_.source;
-    s.calibration_loaded_ns = calibration_.loaded_ns;
-    s.calibration_swaps = calibration_.swaps;
-    s.calibration_refused = calibration_.refused;
-    s.calibration_last_error = calibration_.last_error;
-    s.calibration_last_error_ns = calibration_.last_error_ns;
+    s.calibration = calibration_;
     if (parts_.selfcal != nullptr) s.selfcal = parts_.selfcal->status();
     return s;
 }

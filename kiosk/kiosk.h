@@ -71,16 +71,6 @@ struct KioskParts {
     SelfcalWorker* selfcal = nullptr;
 };
 
-// The calibration on the wall, for the status file (kiosk/kiosk_status.h) and the journal.
-struct CalibrationInUse {
-    std::string source;              // the MPCDI path, "ideal", "selfcal"
-    std::int64_t loaded_ns = 0;      // CLOCK_REALTIME, when it was loaded
-    std::string last_error;          // the latest refused update since it was loaded; empty: none
-    std::int64_t last_error_ns = 0;  // when that was
-    std::uint64_t swaps = 0;         // calibrations swapped in since start
-    std::uint64_t refused = 0;       // updates refused since start
-};
-
 // What the command line adds: stop conditions and records of the run.
 struct KioskRunOptions {
     std::uint64_t frames = 0;         // --frames: stop once this many farm frames are on screen (0: never)

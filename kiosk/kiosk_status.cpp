@@ -59,15 +59,15 @@ nlohmann::json selfcal_json(const std::optional<selfcal::SelfcalStatus>& s) {
 }  // namespace
 
 nlohmann::json kiosk_status_json(const KioskStatus& s) {
-    nlohmann::json calibration = {{"source", s.calibration_source},
-                                  {"loaded_ns", s.calibration_loaded_ns},
-                                  {"loaded_utc", utc_text(s.calibration_loaded_ns)},
-                                  {"swaps", s.calibration_swaps},
-                                  {"refused", s.calibration_refused},
-                                  {"last_error", s.calibration_last_error}};
-    if (!s.calibration_last_error.empty()) {
-        calibration["last_error_ns"] = s.calibration_last_error_ns;
-        calibration["last_error_utc"] = utc_text(s.calibration_last_error_ns);
+    nlohmann::json calibration = {{"source", s.calibration.source},
+                                  {"loaded_ns", s.calibration.loaded_ns},
+                                  {"loaded_utc", utc_text(s.calibration.loaded_ns)},
+                                  {"swaps", s.calibration.swaps},
+                                  {"refused", s.calibration.refused},
+                                  {"last_error", s.calibration.last_error}};
+    if (!s.calibration.last_error.empty()) {
+        calibration["last_error_ns"] = s.calibration.last_error_ns;
+        calibration["last_error_utc"] = utc_text(s.calibration.last_error_ns);
     }
     return {{"written_ns", s.written_ns},
             {"written_utc", utc_text(s.written_ns)},

@@ -23,6 +23,16 @@
 
 namespace mogao {
 
+// The calibration on the wall (the kiosk keeps it; the status file and the journal show it).
+struct CalibrationInUse {
+    std::string source;              // the MPCDI path, "ideal", "selfcal"
+    std::int64_t loaded_ns = 0;      // CLOCK_REALTIME, when it was loaded
+    std::string last_error;          // the latest refused update since it was loaded; empty: none
+    std::int64_t last_error_ns = 0;  // when that was
+    std::uint64_t swaps = 0;         // calibrations swapped in since start
+    std::uint64_t refused = 0;       // updates refused since start
+};
+
 // Everything the status file shows, gathered by the loop.
 struct KioskStatus {
     std::int64_t written_ns = 0;
@@ -33,12 +43,7 @@ struct KioskStatus {
     bool connected = false;
     std::uint64_t frames_shown = 0;     // farm frames on screen on every output since start
     std::uint64_t showing_request = 0;  // the request id on screen (0: the connecting screen)
-    std::string calibration_source;     // MPCDI path, "ideal", "selfcal"
-    std::int64_t calibration_loaded_ns = 0;
-    std::uint64_t calibration_swaps = 0;
-    std::uint64_t calibration_refused = 0;
-    std::string calibration_last_error;  // empty: none since the calibration in use was loaded
-    std::int64_t calibration_last_error_ns = 0;
+    CalibrationInUse calibration;
     std::optional<selfcal::SelfcalStatus> selfcal;  // nullopt: self-recalibration off
 };
 

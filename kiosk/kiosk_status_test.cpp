@@ -25,11 +25,11 @@ TEST(KioskStatus, JsonHoldsConnectionFramesCalibrationAndSelfcalOff) {
     s.connected = true;
     s.frames_shown = 42;
     s.showing_request = 57;
-    s.calibration_source = "/etc/mogao/screen.mpcdi";
-    s.calibration_loaded_ns = 2'000'000'000;
-    s.calibration_refused = 1;
-    s.calibration_last_error = "/etc/mogao/screen.mpcdi: not a zip archive";
-    s.calibration_last_error_ns = 3'000'000'000;
+    s.calibration.source = "/etc/mogao/screen.mpcdi";
+    s.calibration.loaded_ns = 2'000'000'000;
+    s.calibration.refused = 1;
+    s.calibration.last_error = "/etc/mogao/screen.mpcdi: not a zip archive";
+    s.calibration.last_error_ns = 3'000'000'000;
     const nlohmann::json j = kiosk_status_json(s);
     EXPECT_EQ(j["state"], "showing");
     EXPECT_EQ(j["farm"]["connected"], true);
@@ -39,7 +39,7 @@ TEST(KioskStatus, JsonHoldsConnectionFramesCalibrationAndSelfcalOff) {
     EXPECT_EQ(j["calibration"]["source"], "/etc/mogao/screen.mpcdi");
     EXPECT_EQ(j["calibration"]["loaded_utc"], "1970-01-01T00:00:02Z");
     EXPECT_EQ(j["calibration"]["refused"], 1);
-    EXPECT_EQ(j["calibration"]["last_error"], s.calibration_last_error);
+    EXPECT_EQ(j["calibration"]["last_error"], s.calibration.last_error);
     EXPECT_EQ(j["calibration"]["last_error_ns"], 3'000'000'000);
     EXPECT_EQ(j["selfcal"]["enabled"], false);
     EXPECT_FALSE(j["selfcal"].contains("state"));
