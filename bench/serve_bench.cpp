@@ -5,7 +5,7 @@
 //
 //   mpirun -n 3 mogao_bench_serve --scene scenes/grotto.json [--width 960] [--height 540]
 //          [--warmup-seconds 3] [--move-seconds 4] [--still-seconds 5] [--frame-time-ms 66.7] [--reference-spp 64]
-//          [--json FILE]
+//          [--configs today,all,...] [--json FILE] [--side-by-side FILE.png]
 //
 // A session looks at the screen (the kiosk's cylinder: radius 3 m, 150 degrees, 0.2-2.8 m) from the
 // scene's viewer. Moving: the yaw turns a little every request, so nothing accumulates; after a
@@ -15,6 +15,12 @@
 // full size when the frame-time target had shrunk it) is compared with the reference (the same view
 // at --reference-spp, one render) by PSNR of the sRGB8 frames; comparison time is not counted.
 // The error of a moving frame is that of the last moving frame against the same reference.
+// The reference is the mean, in linear light, of two independent halves (reference-spp / 2 each,
+// distinct RNG keys): the PSNR between the halves is printed as its noise floor. The reference's own
+// error is about 6 dB below that floor's (each half has twice the reference's variance, their
+// difference four times), so a served frame's PSNR above floor + 6 dB cannot be measured with it.
+// --side-by-side writes one PNG: the moving frame (upsampled), the still view after
+// --still-seconds and the reference, left to right, from the "all new parts" configuration.
 // Exits 77 when the scene's scans are absent.
 #include <algorithm>
 #include <chrono>
@@ -34,8 +40,10 @@
 
 #include "common/image_compare.h"
 #include "common/jpeg_codec.h"
+#include "common/png_io.h"
 #include "renderfarm/farm/farm.h"
 #include "renderfarm/farm/live_frames.h"
+#include "renderfarm/trace/film.h"
 
 namespace {
 
@@ -43,6 +51,7 @@ using namespace mogao;
 using Clock = std::chrono::steady_clock;
 
 struct Config {
+    std::string key;  // --configs names it
     std::string name;
     LiveOptions live;
     bool pipeline = true;
@@ -53,32 +62,42 @@ struct BenchArgs {
     int width = 960, height = 540;
     double warmup_seconds = 3.0, move_seconds = 4.0, still_seconds = 5.0, frame_time_ms = 1000.0 / 15.0;
     int reference_spp = 64;
-    std::string json;
+    std::vector<std::string> configs;  // keys; empty = all
+    std::string json, side_by_side;
 };
 
-std::vector<Config> configs(const BenchArgs& a) {
-    Config all{"all new parts", {}, true, true};
+// The three images of the side-by-side PNG.
+struct Snapshots {
+    Rgb8Image moving, still;
+};
+
+std::vector<Config> all_configs(const BenchArgs& a) {
+    Config all{"all", "all new parts", {}, true, true};
     all.live.frame_time_s = a.frame_time_ms / 1e3;
-    Config today{"none (serial, as before)", {}, false, false};
+    Config today{"today", "none (serial, as before)", {}, false, false};
     today.live.progressive = false;
     today.live.per_session_maps = false;
     std::vector<Config> out{today, all};
-    Config c = all;
-    c.name = "all but progressive";
-    c.live.progressive = false;
-    out.push_back(c);
-    c = all;
-    c.name = "all but frame-time target";
-    c.live.frame_time_s = 0;
-    out.push_back(c);
-    c = all;
-    c.name = "all but pipelining";
-    c.pipeline = false;
-    out.push_back(c);
-    c = all;
-    c.name = "all but rank-speed normalisation";
-    c.rank_speed = false;
-    out.push_back(c);
+    const auto without = [&](const char* key, const char* name, auto change) {
+        Config c = all;
+        c.key = key;
+        c.name = name;
+        change(c);
+        out.push_back(c);
+    };
+    without("no-progressive", "all but progressive", [](Config& c) { c.live.progressive = false; });
+    without("no-target", "all but frame-time target", [](Config& c) { c.live.frame_time_s = 0; });
+    without("no-pipeline", "all but pipelining", [](Config& c) { c.pipeline = false; });
+    without("no-rank-speed", "all but rank-speed normalisation", [](Config& c) { c.rank_speed = false; });
+    return out;
+}
+
+// The configurations --configs names, in the order of all_configs() (today first: the baseline).
+std::vector<Config> configs(const BenchArgs& a) {
+    std::vector<Config> out;
+    for (const Config& c : all_configs(a))
+        if (a.configs.empty() || std::find(a.configs.begin(), a.configs.end(), c.key) != a.configs.end())
+            out.push_back(c);
     return out;
 }
 
@@ -140,7 +159,7 @@ ViewRequest session_view(const Scene& scene, const BenchArgs& a) {
 }
 
 nlohmann::json run_config(const Config& c, FrameDispatcher& farm, const Scene& scene, const BenchArgs& a,
-                          const Rgb8Image& reference, std::uint64_t& next_id) {
+                          const Rgb8Image& reference, std::uint64_t& next_id, Snapshots& shots) {
     farm.set_normalise_rank_speed(c.rank_speed);
     LiveFrames live(farm, c.live);
     Encoder encoder(c.pipeline);
@@ -174,7 +193,8 @@ nlohmann::json run_config(const Config& c, FrameDispatcher& farm, const Scene& s
     request.pose.yaw_deg = base_yaw;
     request.frame_id = next_id++;
     last = live.render(request);  // the first frame at the new pose: a moving frame's error
-    const double moving_psnr = psnr(upsample(last.image, reference.size), reference);
+    shots.moving = upsample(last.image, reference.size);
+    const double moving_psnr = psnr(shots.moving, reference);
     nlohmann::json curve = nlohmann::json::array();
     double served = 0.0, to38 = -1.0;
     int still_frames = 0;
@@ -190,40 +210,83 @@ nlohmann::json run_config(const Config& c, FrameDispatcher& farm, const Scene& s
         curve.push_back({{"seconds", served}, {"psnr_db", p}, {"samples", last.samples}});
     }
     encoder.finish();
+    shots.still = upsample(last.image, reference.size);
     std::printf("| %-34s | %7.2f | %6.2f | %6.2f | %s | %4d |\n", c.name.c_str(), move_fps, moving_psnr,
                 curve.back()["psnr_db"].get<double>(), to38 < 0 ? "  never" : fmt::format("{:7.2f}", to38).c_str(),
                 last.samples);
     std::fflush(stdout);
-    return {{"config", c.name},     {"move_frames_per_second", move_fps}, {"moving_frame_psnr_db", moving_psnr},
-            {"still_curve", curve}, {"still_seconds_to_38db", to38},      {"still_frames", still_frames}};
+    return {{"config", c.name},
+            {"key", c.key},
+            {"move_frames_per_second", move_fps},
+            {"moving_frame_psnr_db", moving_psnr},
+            {"still_curve", curve},
+            {"still_seconds_to_38db", to38},
+            {"still_frames", still_frames}};
 }
 
-Rgb8Image render_reference(FrameDispatcher& farm, const Scene& scene, const BenchArgs& a, std::uint64_t id) {
+struct Reference {
+    Rgb8Image image;
+    double floor_psnr_db = 0.0;  // PSNR between the two independent halves
+};
+
+// The mean of two independent halves in linear light, tone-mapped as the farm does.
+Reference render_reference(FrameDispatcher& farm, const Scene& scene, const BenchArgs& a, std::uint64_t id) {
     ViewRequest v = session_view(scene, a);
-    v.quality.spp = a.reference_spp;
-    v.frame_id = id;
-    return farm.render(v, 999).image;
+    v.quality.spp = std::max(1, a.reference_spp / 2);
+    RgbFloatImage half[2];
+    Rgb8Image half8[2];
+    for (int h = 0; h < 2; ++h) {
+        v.frame_id = id + std::uint64_t(h) * 7919u;  // distinct RNG keys (rng.h keys on seed and frame_id)
+        half[h] = farm.render(v, 999, PackedPixels::linear).radiance;
+        half8[h] = Rgb8Image(half[h].size);
+        to_srgb8(half[h], PixelRect::whole(half[h].size), farm.settings().exposure, half8[h], farm.settings().tone_map);
+    }
+    RgbFloatImage mean = half[0];
+    for (std::size_t i = 0; i < mean.pixels.size(); ++i)
+        mean.pixels[i] = 0.5f * (half[0].pixels[i] + half[1].pixels[i]);
+    Reference r;
+    r.image = Rgb8Image(mean.size);
+    to_srgb8(mean, PixelRect::whole(mean.size), farm.settings().exposure, r.image, farm.settings().tone_map);
+    r.floor_psnr_db = psnr(half8[0], half8[1]);
+    return r;
+}
+
+// Moving frame | still view after --still-seconds | reference, side by side.
+void write_side_by_side(const std::string& path, const Snapshots& shots, const Rgb8Image& reference) {
+    const ImageSize one = reference.size;
+    Rgb8Image out({3 * one.width, one.height});
+    const Rgb8Image* panels[3] = {&shots.moving, &shots.still, &reference};
+    for (int p = 0; p < 3; ++p)
+        for (int y = 0; y < one.height; ++y) std::copy_n(panels[p]->at(0, y), 3 * one.width, out.at(p * one.width, y));
+    write_png(path, out);
 }
 
 int admin(FrameDispatcher& farm, const Scene& scene, const BenchArgs& a) {
     std::uint64_t next_id = 1;
     const auto t0 = Clock::now();
-    const Rgb8Image reference = render_reference(farm, scene, a, 1u << 30);
-    std::printf("reference: %dx%d at %d spp in %.1f s; %d render ranks; frame-time target %.1f ms\n\n", a.width,
-                a.height, a.reference_spp, std::chrono::duration<double>(Clock::now() - t0).count(),
-                farm.render_ranks(), a.frame_time_ms);
+    const Reference ref = render_reference(farm, scene, a, 1u << 30);
+    const Rgb8Image& reference = ref.image;
+    std::printf(
+        "reference: %dx%d at %d spp in %.1f s (two halves %.2f dB apart: PSNR above ~%.0f dB is not "
+        "measurable); %d render ranks; frame-time target %.1f ms\n\n",
+        a.width, a.height, a.reference_spp, std::chrono::duration<double>(Clock::now() - t0).count(), ref.floor_psnr_db,
+        ref.floor_psnr_db + 6.0, farm.render_ranks(), a.frame_time_ms);
     std::printf("| %-34s | %7s | %6s | %6s | %7s | %4s |\n", "parts on", "move/s", "dB mov", "dB 5s", "s to 38", "spp");
     std::printf("|%s|%s|%s|%s|%s|%s|\n", std::string(36, '-').c_str(), std::string(9, '-').c_str(),
                 std::string(8, '-').c_str(), std::string(8, '-').c_str(), std::string(9, '-').c_str(),
                 std::string(6, '-').c_str());
     nlohmann::json results = nlohmann::json::array();
-    double today_fps = 0.0;
+    double today_fps = 0.0, all_fps = 0.0;
     for (const Config& c : configs(a)) {
-        results.push_back(run_config(c, farm, scene, a, reference, next_id));
-        if (results.size() == 1) today_fps = results[0]["move_frames_per_second"].get<double>();
+        Snapshots shots;
+        results.push_back(run_config(c, farm, scene, a, reference, next_id, shots));
+        const double fps = results.back()["move_frames_per_second"].get<double>();
+        if (c.key == "today") today_fps = fps;
+        if (c.key == "all") all_fps = fps;
+        if (c.key == "all" && !a.side_by_side.empty()) write_side_by_side(a.side_by_side, shots, reference);
     }
-    std::printf("\nratio frames/s all new parts / none = %.2f\n",
-                results[1]["move_frames_per_second"].get<double>() / std::max(1e-9, today_fps));
+    if (today_fps > 0 && all_fps > 0)
+        std::printf("\nratio frames/s all new parts / none = %.2f\n", all_fps / today_fps);
     if (!a.json.empty()) {
         std::ofstream(a.json) << nlohmann::json{
             {"width", a.width},
@@ -231,6 +294,8 @@ int admin(FrameDispatcher& farm, const Scene& scene, const BenchArgs& a) {
             {"render_ranks", farm.render_ranks()},
             {"frame_time_ms", a.frame_time_ms},
             {"reference_spp", a.reference_spp},
+            {"reference_floor_psnr_db", ref.floor_psnr_db},
+            {"still_seconds", a.still_seconds},
             {"configs", results}}.dump(2);
     }
     return 0;
@@ -255,8 +320,14 @@ int main(int argc, char** argv) {
     app.add_option("--move-seconds", a.move_seconds)->check(CLI::Range(0.1, 600.0));
     app.add_option("--still-seconds", a.still_seconds)->check(CLI::Range(0.1, 600.0));
     app.add_option("--frame-time-ms", a.frame_time_ms)->check(CLI::Range(1.0, 10000.0));
-    app.add_option("--reference-spp", a.reference_spp)->check(CLI::Range(1, 4096));
+    app.add_option("--reference-spp", a.reference_spp, "Reference samples per pixel (two halves)")
+        ->check(CLI::Range(2, 8192));
+    app.add_option("--configs", a.configs, "today, all, no-progressive, no-target, no-pipeline, no-rank-speed")
+        ->delimiter(',')
+        ->check(CLI::IsMember({"today", "all", "no-progressive", "no-target", "no-pipeline", "no-rank-speed"}));
     app.add_option("--json", a.json, "Write every figure (and the curves) as JSON");
+    app.add_option("--side-by-side", a.side_by_side,
+                   "PNG: moving frame | still view after --still-seconds | reference");
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -27,5 +27,16 @@ expect_failure truncated-ply "truncated.ply" render --scene "$work/truncated.jso
 printf '{ "meshes": { "m": { "procedural": "box", "size": [1, 1, 1] } }, "objects": [ { "mesh": "m" } ] }' > "$work/ok.json"
 expect_failure bad-path "nonexistent-path.json" render --scene "$work/ok.json" --out "$work/o4" --frames 2 --path "$work/nonexistent-path.json"
 expect_failure bad-spp "spp" render --scene "$work/ok.json" --out "$work/o5" --frames 1 --spp 0
+expect_failure bad-preset "unknown preset 'fast' (known: interactive, balanced, exhibit)" render --scene "$work/ok.json" \
+  --out "$work/o6" --frames 1 --quality fast
+# A preset sets every knob not given explicitly; an explicit flag wins.
+if timeout 120 "$MPIEXEC" --oversubscribe -n 2 "$farm" render --scene "$work/ok.json" --out "$work/o7" --frames 1 \
+    --width 32 --height 18 --quality exhibit --spp 3 > "$work/preset.log" 2>&1; then
+  run=$(python3 -c "import json,sys; r=json.load(open(sys.argv[1]))['run']; print(r['spp'], r['max_bounces'], r['ao_samples'], r['jpeg_quality'])" "$work/o7/stats.json")
+  if [ "$run" = "3 2 2 92" ]; then echo "ok: --quality exhibit --spp 3 renders spp, bounces, AO, JPEG quality: $run"
+  else echo "FAIL: --quality exhibit --spp 3 gave spp bounces AO JPEG = $run, expected 3 2 2 92"; fail=1; fi
+else
+  echo "FAIL: --quality exhibit did not render"; cat "$work/preset.log"; fail=1
+fi
 [ $fail -eq 0 ] && echo "PASS: bad input fails cleanly"
 exit $fail

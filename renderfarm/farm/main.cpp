@@ -15,13 +15,14 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include "common/quality_preset.h"
 #include "common/request_limits.h"
 #include "renderfarm/farm/farm.h"
+#include "renderfarm/farm/mpi_session.h"
 #include "renderfarm/farm/path_tour.h"
 #include "renderfarm/farm/serve.h"
 #include "renderfarm/link/pki.h"
 #include "renderfarm/link/tls_material.h"
-#include "renderfarm/farm/mpi_session.h"
 
 namespace {
 
@@ -104,6 +105,38 @@ void add_render_flags(CLI::App& render, mogao::PathTour& job, CameraFlags& camer
     render.add_option("--contact-sheet", job.contact_sheet_frames, "Frames on the contact sheet (0 = none)")->check(CLI::Range(0, 64));
 }
 
+// --quality NAME: the preset's values for every knob not given explicitly on the command line.
+void add_quality_flag(CLI::App& command, std::string& preset) {
+    command
+        .add_option(
+            "--quality", preset,
+            "Preset (" + mogao::quality_preset_names() + ", docs/quality.md); explicit flags override its values")
+        ->check([](const std::string& name) {
+            return mogao::quality_preset(name) != nullptr
+                       ? std::string()
+                       : "unknown preset '" + name + "' (known: " + mogao::quality_preset_names() + ")";
+        });
+}
+
+void apply_render_preset(const CLI::App& render, const mogao::QualityPreset& p, mogao::Quality& q) {
+    const auto unset = [&](const char* flag) { return render.count(flag) == 0; };
+    if (unset("--spp")) q.spp = p.request.spp;
+    if (unset("--bounces")) q.max_bounces = p.request.max_bounces;
+    if (unset("--ao")) q.ao_samples = p.request.ao_samples;
+    if (unset("--area-samples")) q.area_light_samples = p.request.area_light_samples;
+    if (unset("--scale")) q.resolution_scale = p.request.resolution_scale;
+    if (unset("--jpeg-quality")) q.jpeg_quality = p.request.jpeg_quality;
+}
+
+// Serve schedules what appliances ask for: the preset sets the scheduling, not the requests.
+void apply_serve_preset(const CLI::App& serve, const mogao::QualityPreset& p, mogao::LiveOptions& live,
+                        double& frame_time_ms) {
+    const auto unset = [&](const char* flag) { return serve.count(flag) == 0; };
+    if (unset("--frame-time-ms")) frame_time_ms = p.frame_time_ms;
+    if (unset("--progressive") && unset("--no-progressive")) live.progressive = p.progressive;
+    if (unset("--converged-spp")) live.converged_spp = p.converged_spp;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -125,6 +158,8 @@ int main(int argc, char** argv) {
     CLI::App* render = app.add_subcommand("render", "Render a camera path headless into numbered JPEG frames");
     add_farm_flags(*render, setup, scans);
     add_render_flags(*render, job, camera);
+    std::string render_preset, serve_preset;
+    add_quality_flag(*render, render_preset);
 
     mogao::ServeOptions serve_options;
     std::filesystem::path tls_dir;
@@ -165,6 +200,7 @@ int main(int argc, char** argv) {
     // end-to-end tests compare against.
     serve_options.live.progressive = false;
     add_live_flags(*serve, serve_options, frame_time_ms);
+    add_quality_flag(*serve, serve_preset);
     serve->add_option("--duration", serve_options.duration_s, "Stop after this many seconds (0 = until SIGTERM)")->check(CLI::Range(0.0, 1e9));
     try {
         app.parse(argc, argv);
@@ -172,6 +208,10 @@ int main(int argc, char** argv) {
         return mpi.is_admin() ? app.exit(e) : (e.get_exit_code() == 0 ? 0 : 2);
     }
     setup.scene_options.scans_dir = scans;
+    if (!serve_preset.empty())
+        apply_serve_preset(*serve, *mogao::quality_preset(serve_preset), serve_options.live, frame_time_ms);
+    if (!render_preset.empty())
+        apply_render_preset(*render, *mogao::quality_preset(render_preset), job.view_template.quality);
     serve_options.live.frame_time_s = frame_time_ms / 1e3;
     if (serve->parsed()) {
         try {
