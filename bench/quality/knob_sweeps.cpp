@@ -19,9 +19,9 @@ namespace mogao::quality {
 const std::vector<Preset>& quality_presets() {
     // Chosen from the curves (docs/quality.md, "Presets"): see there for the reasoning.
     static const std::vector<Preset> presets{
-        {"interactive", 1, 0, 0, 1.0, 80, true},
-        {"balanced", 4, 1, 1, 1.0, 85, true},
-        {"exhibit", 64, 3, 1, 1.0, 95, false},
+        {"interactive", 1, 1, 0, 1.0, 80, true},
+        {"balanced", 4, 2, 0, 1.0, 85, true},
+        {"exhibit", 64, 4, 0, 1.0, 95, false},
     };
     return presets;
 }
@@ -142,9 +142,9 @@ void path_knobs(const Context& c, int spp) {
 }
 
 // Render + guide pass + à-trous filter (renderfarm/denoise), one thread; best of reps.
-TimedFrame denoised(const Context& c, GuidePass& pass, int spp) {
+TimedFrame denoised(const Context& c, GuidePass& pass, const Quality& q) {
     ViewRequest r = c.view.request;
-    r.quality = with_spp(spp);
+    r.quality = q;
     TimedFrame best{{}, 1e300};
     for (int k = 0; k < c.options.reps; ++k) {
         const TimedFrame raw = render_fastest_of(c.renderer, r, 1);
@@ -159,11 +159,23 @@ TimedFrame denoised(const Context& c, GuidePass& pass, int spp) {
     return best;
 }
 
+// The denoiser at the default knobs (0 bounces: bias-dominated in a closed grotto) and at 2 bounces,
+// with the raw 2-bounce series beside it.
 void denoiser_series(const Context& c) {
     GuidePass pass(c.scene, "threads=1");
-    for (int spp = 1; spp <= 16; spp *= 2) {
-        const TimedFrame f = denoised(c, pass, spp);
-        c.out.linear("denoiser on", std::to_string(spp), spp, f.seconds, f.image, false, "render + guides + filter");
+    for (int bounces : {0, 2}) {
+        const std::string suffix = bounces == 0 ? "" : " (2 bounces)";
+        for (int spp = 1; spp <= 16; spp *= 2) {
+            Quality q = with_spp(spp);
+            q.max_bounces = bounces;
+            if (bounces > 0) {
+                const TimedFrame raw = c.render(q);
+                c.out.linear("spp" + suffix, std::to_string(spp), spp, raw.seconds, raw.image, false);
+            }
+            const TimedFrame f = denoised(c, pass, q);
+            c.out.linear("denoiser on" + suffix, std::to_string(spp), spp, f.seconds, f.image, false,
+                         "render + guides + filter");
+        }
     }
 }
 

@@ -82,7 +82,9 @@ CachedReference obtain_reference(Renderer& renderer, const QualityView& view, co
     const double start = monotonic_seconds();
     RgbFloatImage batch(size);
     const int batch_spp = std::min(plan.batch_spp, 4096);
-    while (ref.spp_per_half < plan.spp_per_half && monotonic_seconds() - start < plan.budget_seconds) {
+    // At least one pair of batches, so a reference always exists, then until the spp or the budget.
+    while (ref.spp_per_half < plan.spp_per_half &&
+           (ref.spp_per_half == 0 || monotonic_seconds() - start < plan.budget_seconds)) {
         const int k0 = 2 * (ref.spp_per_half / batch_spp);  // batches already in each half, as pairs
         for (int half = 0; half < 2; ++half) {
             request.seed = kReferenceSeedBase + std::uint64_t(k0 + half);
