@@ -164,6 +164,7 @@ void Monitor::set_reference(const SystemModel& model, const ScreenCalibration& c
     map_u_.create(h, w);
     map_v_.create(h, w);
     owner_.create(h, w);
+    owner_weight_.create(h, w);
     mask_.create(h, w);
     const autocal::ScreenModel& s = model.screen;
     const double arc = s.arc_deg * kDeg;
@@ -188,6 +189,7 @@ void Monitor::set_reference(const SystemModel& model, const ScreenCalibration& c
             map_u_(y, x) = lit ? static_cast<float>((theta + arc / 2) / arc) : std::nanf("");
             map_v_(y, x) = lit ? static_cast<float>((s.top_m - p.y()) / (s.top_m - s.bottom_m)) : std::nanf("");
             owner_(y, x) = static_cast<std::uint8_t>(best >= options_.owner_min_blend ? who : 255);
+            owner_weight_(y, x) = best >= options_.owner_min_blend ? static_cast<float>(best) : 0.0f;
             mask_(y, x) = lit ? 255 : 0;
         }
     }
@@ -224,13 +226,19 @@ FrameMeasurement Monitor::measure(const cv::Mat1f& content, const cv::Mat1f& cam
     std::vector<Eigen::Vector3d> s_pred;
     std::vector<cv::Point2d> observed;
     std::vector<int> owner;
+    std::vector<double> unmix;  // per match: 1 / the owner's blend weight where un-mixed, else 1
     for (const Match& mt : matches) {
         const double u = bilinear(map_u_, mt.predicted.x - 0.5, mt.predicted.y - 0.5);
         const double v = bilinear(map_v_, mt.predicted.x - 0.5, mt.predicted.y - 0.5);
         if (!std::isfinite(u) || !std::isfinite(v)) continue;
         s_pred.push_back(screen_point(model_.screen, u, v));
         observed.push_back(mt.observed);
-        owner.push_back(owner_(static_cast<int>(mt.predicted.y), static_cast<int>(mt.predicted.x)));
+        const int px = static_cast<int>(mt.predicted.x);
+        const int py = static_cast<int>(mt.predicted.y);
+        owner.push_back(owner_(py, px));
+        const double w = owner_weight_(py, px);
+        const bool small = cv::norm(mt.observed - mt.predicted) < options_.unmix_max_shift_px;
+        unmix.push_back(small && w > 0.0 && w < 1.0 ? 1.0 / w : 1.0);
     }
     const std::vector<cv::Point2d> n = undistort(cam, observed);
     std::vector<Eigen::Vector2d> obs_n;
@@ -255,7 +263,10 @@ FrameMeasurement Monitor::measure(const cv::Mat1f& content, const cv::Mat1f& cam
         std::vector<Eigen::Vector2d> x_k;
         for (std::size_t i = 0; i < s_pred.size(); ++i) {
             if (owner[i] != static_cast<int>(k)) continue;
-            const Eigen::Vector3d so = autocal::ray_on_screen(model_.screen, camera, {obs_n[i].x(), obs_n[i].y(), 1.0});
+            Eigen::Vector3d so = autocal::ray_on_screen(model_.screen, camera, {obs_n[i].x(), obs_n[i].y(), 1.0});
+            // Un-mixing (MonitorOptions::unmix_max_shift_px); the cylinder's curvature over a
+            // sub-pixel step is negligible, so the scaled point stays on the screen to ~1e-7 m.
+            so = s_pred[i] + unmix[i] * (so - s_pred[i]);
             const Eigen::Vector2d xn = project_normalised(d.rotation, d.position_m, s_pred[i]);
             if (!so.allFinite() || !xn.allFinite()) continue;
             s_obs.push_back(so);

@@ -43,6 +43,12 @@ struct MonitorOptions {
     double ratio = 0.8;            // Lowe's ratio test
     double max_shift_px = 80.0;    // predicted -> observed, camera pixels
     double owner_min_blend = 0.6;  // a match belongs to a projector above this blend weight
+    // In an overlap the camera sees the blend of the projectors' images: for a small move of
+    // projector k alone, a feature where k's weight is w appears displaced by about w times k's
+    // displacement (the weighted mean of two nearly coincident copies). Matches whose observed
+    // shift is under this many camera pixels are un-mixed (screen displacement divided by w);
+    // larger shifts separate the copies (the stronger one is matched) and are left as seen. 0: off.
+    double unmix_max_shift_px = 1.5;
     RobustPoseOptions camera_fit{1.0, 300, 1.345, 12, 20};
     RobustPoseOptions projector_fit{6.0, 300, 1.345, 12, 12, 0.002};
 };
@@ -87,8 +93,9 @@ private:
     MonitorOptions options_;
     cv::Mat1f map_u_;  // per camera pixel: content u under the reference (NaN: not on the lit screen)
     cv::Mat1f map_v_;
-    cv::Mat1b owner_;  // projector index, 255 none (off screen or overlap)
-    cv::Mat1b mask_;   // 255 where the lit screen is predicted
+    cv::Mat1b owner_;         // projector index, 255 none (off screen or overlap)
+    cv::Mat1f owner_weight_;  // the owner's blend weight (0 where none)
+    cv::Mat1b mask_;          // 255 where the lit screen is predicted
 };
 
 // Screen point (x, y, z) of content (u, v) on the cylinder.

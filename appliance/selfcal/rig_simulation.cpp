@@ -203,9 +203,9 @@ cv::Mat1f projector_signal(const ProjectorCalibration& pc, const cv::Mat1f& cont
 
 SimulationReport simulate(const rig::VirtualRig& input, const SimulationOptions& o) {
     if (!(o.rate_hz > 0.0) || o.frames < 1 || !(o.occlusion >= 0.0 && o.occlusion <= 0.9) ||
-        !(o.exposure_jitter >= 0.0 && o.exposure_jitter < 1.0)) {
+        !(o.exposure_jitter >= 0.0 && o.exposure_jitter < 1.0) || o.truth_every < 1) {
         throw std::invalid_argument(
-            "simulate: rate_hz > 0, frames >= 1, occlusion in [0, 0.9], exposure_jitter in [0, 1)");
+            "simulate: rate_hz > 0, frames >= 1, occlusion in [0, 0.9], exposure_jitter in [0, 1), truth_every >= 1");
     }
     rig::VirtualRig truth = autocal::scaled_rig(input, o.projector_scale, o.camera_scale);
     for (const Bump& b : o.bumps) {
@@ -225,6 +225,7 @@ SimulationReport simulate(const rig::VirtualRig& input, const SimulationOptions&
     SimulationReport rep;
     double cpu = 0.0;
     bool measured_before = false;
+    autocal::GeometryError g;
     for (int i = 0; i < o.frames; ++i) {
         const double t = i / o.rate_hz;
         bool changed = false;
@@ -253,9 +254,15 @@ SimulationReport simulate(const rig::VirtualRig& input, const SimulationOptions&
             (rep.frames.empty() || rep.frames.back().state != SelfcalState::correcting)) {
             ++rep.corrections;
         }
-        autocal::GeometryError g;  // the worst projector's
-        for (const autocal::GeometryError& e : projector_errors(truth, wall)) {
-            if (e.mean_px >= g.mean_px) g = e;
+        if (r.status.state == SelfcalState::drift_detected &&
+            (rep.frames.empty() || rep.frames.back().state != SelfcalState::drift_detected)) {
+            ++rep.detections;
+        }
+        if (i % o.truth_every == 0 || i + 1 == o.frames || changed || r.calibration || rep.frames.empty()) {
+            g = autocal::GeometryError{};  // the worst projector's
+            for (const autocal::GeometryError& e : projector_errors(truth, wall)) {
+                if (e.mean_px >= g.mean_px) g = e;
+            }
         }
         rep.frames.push_back({t, r.status.state, r.status.waiting, g.mean_px, r.cpu_ms, r.status.text()});
         rep.waiting_frames += r.status.waiting ? 1 : 0;

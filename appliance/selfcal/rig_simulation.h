@@ -48,6 +48,9 @@ struct SimulationOptions {
     double occlusion = 0.0;           // fraction of the camera view hidden by visitors, [0, 0.9]
     double occlusion_max = 0.0;       // > occlusion: each frame's fraction uniform in [occlusion, occlusion_max]
     double error_threshold_px = 1.0;  // "corrected" = mean geometric error below this
+    // Ground truth measured every this many frames (and at the last and around corrections):
+    // the long static run's cost is then the monitor's, not the ground truth's. >= 1.
+    int truth_every = 1;
     std::uint64_t seed = 7;
     SelfcalOptions selfcal;
 };
@@ -56,7 +59,7 @@ struct SimulationFrame {
     double t_s = 0.0;
     SelfcalState state = SelfcalState::calibrated;
     bool waiting = false;
-    double geometry_mean_px = 0.0;  // ground truth: the worst projector's mean error, its pixels
+    double geometry_mean_px = 0.0;  // ground truth: the worst projector's mean error, its pixels (last measured)
     double cpu_ms = 0.0;
     std::string status;  // SelfcalStatus::text()
 };
@@ -68,6 +71,7 @@ struct SimulationReport {
     double final_error_px = 0.0;              // ground truth, last frame: the worst projector's mean
     double final_p95_px = 0.0;                // and its p95
     int corrections = 0;                      // times the state entered "correcting"
+    int detections = 0;                       // times the state entered "drift detected"
     int waiting_frames = 0;
     double mean_cpu_ms = 0.0;  // per monitored frame (SelfCalibrator::step)
     SelfcalState final_state = SelfcalState::calibrated;

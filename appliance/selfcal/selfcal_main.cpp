@@ -43,8 +43,8 @@ int run_simulate(const std::string& rig_path, const std::vector<std::string>& bu
     if (r.corrected_after_s)
         std::printf("corrected (< %.2f px) after: %.2f s\n", o.error_threshold_px, *r.corrected_after_s);
     else std::printf("corrected after: never\n");
-    std::printf("final state: %s; corrections: %d; waiting frames: %d\n", mogao::selfcal::to_string(r.final_state),
-                r.corrections, r.waiting_frames);
+    std::printf("final state: %s; corrections: %d; detections: %d; waiting frames: %d\n",
+                mogao::selfcal::to_string(r.final_state), r.corrections, r.detections, r.waiting_frames);
     std::printf("final geometric error vs ground truth: mean %.3f px, p95 %.3f px\n", r.final_error_px, r.final_p95_px);
     std::printf("CPU per monitored frame: %.1f ms (%.1f %% of one core at %.2f Hz)\n", r.mean_cpu_ms,
                 r.mean_cpu_ms * o.rate_hz / 10.0, o.rate_hz);
@@ -86,12 +86,25 @@ int main(int argc, char** argv) {
     sim->add_option("--seed", o.seed, "noise and content seed");
     sim->add_option("--threshold", o.selfcal.drift_threshold_px, "drift threshold, projector pixels")
         ->check(CLI::PositiveNumber);
+    sim->add_option("--owner-min-blend", o.selfcal.monitor.owner_min_blend,
+                    "a match belongs to a projector from this blend weight")
+        ->check(CLI::Range(0.5, 1.0));
+    sim->add_option("--unmix-max-shift", o.selfcal.monitor.unmix_max_shift_px,
+                    "overlap matches shifted less than this (camera px) are un-mixed; 0 off")
+        ->check(CLI::NonNegativeNumber);
+    double prior_mm = o.selfcal.monitor.projector_fit.prior_position_sd_m * 1e3;
+    sim->add_option("--position-prior-mm", prior_mm,
+                    "projector fit's position prior, mm per pixel of residual (0 none)")
+        ->check(CLI::NonNegativeNumber);
+    sim->add_option("--truth-every", o.truth_every, "ground truth every N frames (and at the last, around changes)")
+        ->check(CLI::Range(1, 100000));
     sim->add_flag("--verbose", verbose, "one line per monitored frame");
     CLI11_PARSE(app, argc, argv);
     o.content = content == "plain"        ? ContentKind::plain
                 : content == "repetitive" ? ContentKind::repetitive
                                           : ContentKind::textured;
     o.selfcal.build.warp_step_px = 4;
+    o.selfcal.monitor.projector_fit.prior_position_sd_m = prior_mm * 1e-3;
     try {
         return run_simulate(rig, bumps, bump_at, o, verbose);
     } catch (const std::invalid_argument& e) {
