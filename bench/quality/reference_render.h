@@ -35,10 +35,10 @@ struct ReferencePlan {
 // Cached or rendered (and saved) reference; prints what it did to stderr.
 [[nodiscard]] CachedReference obtain_reference(Renderer& renderer, const QualityView& view, const ReferencePlan& plan);
 
-// Noise floor of a reference from its two halves: the halves' relMSE and PSNR against each other,
-// and the same for the full reference against the (unknown) converged image, estimated as the
-// halves' error variance / 4 (each half has half the samples: variance 2 s^2 each, the difference
-// 4 s^2 ... see docs/quality.md), i.e. relMSE / 4 and PSNR + 6.02 dB.
+// Noise floor of a reference from its two halves. Each half has n samples (variance s^2 / n per
+// pixel), the reference 2n (s^2 / 2n), and the difference of the halves 2 s^2 / n: so the reference's
+// own error is a quarter of the halves' relMSE against each other, and its PSNR 10 log10 4 = 6.02 dB
+// above theirs (docs/quality.md, "References").
 struct ReferenceFloor {
     double halves_relmse = 0, halves_psnr_db = 0, halves_ssim = 0;
     double floor_relmse = 0, floor_psnr_db = 0;
