@@ -17,33 +17,74 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::vector<PixelRect> split_into_cells(const std::vector<PixelRect>& rects, int cell) {
-    std::vector<PixelRect> tiles;
+std::size_t bytes_per_pixel(PackedPixels format) { return format == PackedPixels::linear ? 3 * sizeof(float) : 3; }
+
+// A tile and where its rect's pixels start in the packed buffer.
+struct TileJob {
+    PixelRect tile;
+    PixelRect rect;           // the assigned rect the tile lies in
+    std::size_t rect_offset;  // byte offset of that rect's first pixel in the packed buffer
+};
+
+std::vector<TileJob> split_into_cells(const std::vector<PixelRect>& rects, int cell, PackedPixels format) {
+    std::vector<TileJob> tiles;
+    std::size_t offset = 0;
     for (const PixelRect& r : rects) {
         if (r.empty()) continue;
         for (int y = (r.y0 / cell) * cell; y < r.y1; y += cell)
             for (int x = (r.x0 / cell) * cell; x < r.x1; x += cell)
-                tiles.push_back(intersect(r, PixelRect{x, y, x + cell, y + cell}));
+                tiles.push_back({intersect(r, PixelRect{x, y, x + cell, y + cell}), r, offset});
+        offset += static_cast<std::size_t>(r.area()) * bytes_per_pixel(format);
     }
     return tiles;
 }
 
-std::size_t bytes_per_pixel(PackedPixels format) { return format == PackedPixels::linear ? 3 * sizeof(float) : 3; }
+// A tile's pixels, rendered into a window of the tile's own size (never a whole frame: a rank
+// holds only its share) and copied into the packed buffer at the tile's place in its rect.
+class TileWriter {
+public:
+    TileWriter(float exposure, ToneMap tone_map, PackedPixels format)
+        : exposure_(exposure), tone_map_(tone_map), format_(format) {}
 
-// Copies the rows of `rects` out of `image` (one of the two frame types) into `out`, rect by rect.
-template <typename Image>
-std::vector<std::uint8_t> pack(const std::vector<PixelRect>& rects, const Image& image, PackedPixels format) {
-    std::vector<std::uint8_t> out(packed_size(rects, format));
-    std::uint8_t* cursor = out.data();
-    for (const PixelRect& r : rects) {
-        for (int y = r.y0; y < r.y1; ++y) {
-            const std::size_t row = static_cast<std::size_t>(r.width()) * bytes_per_pixel(format);
-            std::memcpy(cursor, image.at(r.x0, y), row);
-            cursor += row;
+    TileStats render(const Renderer& renderer, const TileJob& job, std::vector<std::uint8_t>& packed) {
+        const ImageSize size{job.tile.width(), job.tile.height()};
+        resize(radiance_, size);
+        const TileStats stats = renderer.render(job.tile, radiance_, job.tile.x0, job.tile.y0);
+        if (format_ == PackedPixels::srgb8) {
+            resize(display_, size);
+            to_srgb8(radiance_, PixelRect::whole(size), exposure_, display_, tone_map_);
+            copy_rows(job, display_, packed);
+        } else {
+            copy_rows(job, radiance_, packed);
+        }
+        return stats;
+    }
+
+private:
+    template <typename Image>
+    static void resize(Image& image, ImageSize size) {  // keeps the capacity: no allocation per tile
+        image.size = size;
+        image.pixels.resize(static_cast<std::size_t>(size.pixel_count()) * 3);
+    }
+
+    template <typename Image>
+    void copy_rows(const TileJob& job, const Image& window, std::vector<std::uint8_t>& packed) const {
+        const std::size_t bpp = bytes_per_pixel(format_);
+        const std::size_t row = static_cast<std::size_t>(job.tile.width()) * bpp;
+        for (int y = job.tile.y0; y < job.tile.y1; ++y) {
+            const std::size_t at =
+                job.rect_offset +
+                (static_cast<std::size_t>(y - job.rect.y0) * job.rect.width() + (job.tile.x0 - job.rect.x0)) * bpp;
+            std::memcpy(packed.data() + at, window.at(0, y - job.tile.y0), row);
         }
     }
-    return out;
-}
+
+    float exposure_;
+    ToneMap tone_map_;
+    PackedPixels format_;
+    RgbFloatImage radiance_;
+    Rgb8Image display_;
+};
 
 template <typename Image>
 void unpack(const std::vector<PixelRect>& rects, const std::vector<std::uint8_t>& packed, PackedPixels format,
@@ -81,10 +122,9 @@ TilePassResult render_tile_pass(const Renderer& renderer, const std::vector<Pixe
             throw std::invalid_argument("rect outside the render size");
 
     TilePassResult result;
-    const std::vector<PixelRect> tiles = split_into_cells(rects, cell_size);
+    const std::vector<TileJob> tiles = split_into_cells(rects, cell_size, format);
     result.tile_times.resize(tiles.size());
-    RgbFloatImage radiance(size);
-    Rgb8Image display(format == PackedPixels::srgb8 ? size : ImageSize{0, 0});
+    result.packed_pixels.resize(packed_size(rects, format));
 
     std::atomic<std::size_t> next{0};
     std::atomic<std::uint64_t> rays{0};
@@ -94,11 +134,11 @@ TilePassResult render_tile_pass(const Renderer& renderer, const std::vector<Pixe
     const auto worker = [&] {
         const double cpu_start = thread_cpu_seconds();
         try {
+            TileWriter writer(exposure, tone_map, format);
             for (std::size_t i = next++; i < tiles.size(); i = next++) {
                 const auto t0 = Clock::now();
-                const TileStats stats = renderer.render(tiles[i], radiance);
-                if (format == PackedPixels::srgb8) to_srgb8(radiance, tiles[i], exposure, display, tone_map);
-                result.tile_times[i] = {tiles[i], std::chrono::duration<double>(Clock::now() - t0).count()};
+                const TileStats stats = writer.render(renderer, tiles[i], result.packed_pixels);
+                result.tile_times[i] = {tiles[i].tile, std::chrono::duration<double>(Clock::now() - t0).count()};
                 rays += stats.rays;
             }
         } catch (...) {
@@ -116,8 +156,6 @@ TilePassResult render_tile_pass(const Renderer& renderer, const std::vector<Pixe
     }
     if (failure) std::rethrow_exception(failure);
 
-    result.packed_pixels =
-        format == PackedPixels::linear ? pack(rects, radiance, format) : pack(rects, display, format);
     result.rays = rays;
     result.cpu_seconds = cpu_seconds;
     result.render_seconds = std::chrono::duration<double>(Clock::now() - start).count();

@@ -2,6 +2,11 @@
 // One rank's share of a frame: render its rects tile by tile, time every tile, and pack the
 // sRGB8 pixels for the admin. This is the measured input of the PBT (schedule/).
 //
+// Memory: a rank holds only its share. Each tile is rendered into a window of the tile's size
+// (Renderer::render with an origin) and copied straight into the packed buffer, so no rank
+// allocates a full-frame film: a request for a huge frame costs each rank its rects' bytes, not
+// the frame's (issue: "allocates only its share of the frame on each rank").
+//
 // Tiles are cost-map cells (cell_size x cell_size pixels, aligned to the global image grid) clipped
 // to each rect, so a tile's time maps onto exactly one cell. Pixels are packed rect by rect, row by
 // row, RGB8 — the order unpack_rects() expects — or, for PackedPixels::linear, three native

@@ -1,7 +1,14 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "renderfarm/farm/tile_pass.h"
 
+#include <fstream>
+#include <new>
 #include <random>
+#include <string>
+
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <gtest/gtest.h>
 
@@ -64,6 +71,51 @@ TEST(TilePass, SplitRectsWithThreadsGiveTheSamePixelsAsOneRect) {
     EXPECT_EQ(whole.tile_times.size(), 6u * 4u);
     for (const TileTime& t : split.tile_times) EXPECT_GE(t.seconds, 0.0);
     EXPECT_THROW((void)render_tile_pass(renderer, {{0, 0, 97, 64}}, 16, 1, 1.f), std::invalid_argument);
+}
+
+// Kilobytes of this process's data segment (VmData: heap and private mappings), what RLIMIT_DATA
+// bounds (Linux >= 4.7 counts mmap'ed private memory too).
+long vm_data_kib() {
+    std::ifstream status("/proc/self/status");
+    for (std::string line; std::getline(status, line);)
+        if (line.rfind("VmData:", 0) == 0) return std::stol(line.substr(7));
+    return -1;
+}
+
+// A rank holds only its share of a frame: one 32x32 rect of a 16384x16384 request (the largest the
+// request limits allow; a whole-frame float film would be 3 GiB) renders in a child process whose
+// data segment may grow by 256 MiB at most. Before tile_pass rendered into tile-sized windows,
+// each rank allocated the whole frame's film and display buffer, and this child failed.
+TEST(TilePass, ARankAllocatesOnlyItsShareOfAHugeFrame) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+    GTEST_SKIP() << "a sanitizer's shadow memory counts against RLIMIT_DATA (not run in the CI suite)";
+#endif
+    const Scene scene = small_scene();
+    Renderer renderer(scene, RendererOptions{});
+    ViewRequest view;
+    view.size = {16384, 16384};
+    view.pose.eye = {0, 1.5, 5};
+    renderer.begin_frame(view);
+    const long before = vm_data_kib();
+    ASSERT_GT(before, 0) << "no VmData in /proc/self/status";
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+        const rlim_t limit = static_cast<rlim_t>(before + 256 * 1024) * 1024;
+        const rlimit data{limit, limit};
+        if (::setrlimit(RLIMIT_DATA, &data) != 0) ::_exit(3);
+        try {
+            const TilePassResult r = render_tile_pass(renderer, {{8192, 8192, 8224, 8224}}, 32, 1, 1.f);
+            ::_exit(r.packed_pixels.size() == 32u * 32u * 3u ? 0 : 2);
+        } catch (const std::bad_alloc&) {
+            ::_exit(1);
+        }
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFEXITED(status)) << "the child died of signal " << WTERMSIG(status);
+    EXPECT_EQ(WEXITSTATUS(status), 0)
+        << "1: out of memory under a 256 MiB data limit, 2: wrong byte count, 3: setrlimit";
 }
 
 }  // namespace

@@ -142,6 +142,17 @@ struct Renderer::Impl {
         }
     }
 
+    void check_window(const PixelRect& rect, const RgbFloatImage& window, int origin_x, int origin_y) const {
+        check_target(rect, nullptr);
+        const PixelRect placed{origin_x, origin_y, origin_x + window.size.width, origin_y + window.size.height};
+        if (rect.empty()) return;
+        if (rect.x0 < placed.x0 || rect.y0 < placed.y0 || rect.x1 > placed.x1 || rect.y1 > placed.y1 ||
+            window.pixels.size() != static_cast<std::size_t>(window.size.pixel_count()) * 3) {
+            throw std::invalid_argument("Renderer::render: rect " + describe(rect) + " is outside the window " +
+                                        describe(placed));
+        }
+    }
+
     // Primary hits of a traced camera packet; sky lanes get the environment in `sum`.
     void resolve_hits(const Block& block, const RTCRayHit16& packet, PacketHits& hits,
                       std::array<Eigen::Vector3f, kLanes>& sum) const {
@@ -163,7 +174,9 @@ struct Renderer::Impl {
     }
 
     // Renders every sample of one block into `frame` (render()'s body; `log` for benchmarks).
-    void render_block(const Block& block, RgbFloatImage& frame, TileStats& stats, RecordedRays* log) const {
+    // `frame` holds the frame's pixels from (origin_x, origin_y) on (0, 0 for a whole frame).
+    void render_block(const Block& block, RgbFloatImage& frame, TileStats& stats, RecordedRays* log, int origin_x = 0,
+                      int origin_y = 0) const {
         std::array<Eigen::Vector3f, kLanes> sum;
         sum.fill(Eigen::Vector3f::Zero());
         PacketHits hits;
@@ -189,7 +202,7 @@ struct Renderer::Impl {
         const float inv_spp = 1.0f / static_cast<float>(spp);
         for (int lane = 0; lane < kLanes; ++lane) {
             if (block.valid[static_cast<std::size_t>(lane)] == 0) continue;
-            float* out = frame.at(block.x0 + lane % kBlock, block.y0 + lane / kBlock);
+            float* out = frame.at(block.x0 + lane % kBlock - origin_x, block.y0 + lane / kBlock - origin_y);
             const Eigen::Vector3f value = sum[static_cast<std::size_t>(lane)] * inv_spp;
             out[0] = value.x();
             out[1] = value.y();
@@ -253,6 +266,15 @@ TileStats Renderer::render(const PixelRect& rect, RgbFloatImage& frame) const {
     s.check_target(rect, &frame);
     TileStats stats;
     Impl::for_each_block(rect, [&](const Block& block) { s.render_block(block, frame, stats, nullptr); });
+    return stats;
+}
+
+TileStats Renderer::render(const PixelRect& rect, RgbFloatImage& window, int origin_x, int origin_y) const {
+    const Impl& s = *impl_;
+    s.check_window(rect, window, origin_x, origin_y);
+    TileStats stats;
+    Impl::for_each_block(
+        rect, [&](const Block& block) { s.render_block(block, window, stats, nullptr, origin_x, origin_y); });
     return stats;
 }
 

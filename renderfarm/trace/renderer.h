@@ -91,6 +91,12 @@ public:
     // [0, render_size()) or frame.size != render_size(), std::logic_error before begin_frame.
     TileStats render(const PixelRect& rect, RgbFloatImage& frame) const;
 
+    // The same pixels into a window of the frame: pixel (x, y) goes to
+    // window.at(x - origin_x, y - origin_y), so a render rank holds only its share (a tile) instead
+    // of a whole frame. The values are bit-identical to render()'s. Throws std::invalid_argument if
+    // rect is not inside [0, render_size()) or not inside the window placed at the origin.
+    TileStats render(const PixelRect& rect, RgbFloatImage& window, int origin_x, int origin_y) const;
+
     // Benchmark baseline: generates and intersects exactly the camera ray packets render() would
     // (same grid, masks and samples) with rtcIntersect16, without any shading or secondary rays.
     TileStats trace_camera_rays(const PixelRect& rect) const;

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cstring>
 #include <random>
+#include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -133,6 +135,37 @@ TEST(RendererDeterminismSeed, RenderWritesOnlyInsideRect) {
                 EXPECT_EQ(v, -7.0f) << x << "," << y;
             }
         }
+    }
+}
+
+// A rank renders into windows of its share (tile_pass.h): every rect rendered into a window of its
+// own size, at an odd origin, gives the very bytes of the whole-frame render; a window that does
+// not contain the rect is refused, naming both.
+TEST(RendererDeterminismSeed, WindowRenderIsBitIdenticalToTheWholeFrame) {
+    const Scene scene = lit_scene();  // the renderer keeps referring to the scene's meshes
+    Renderer renderer(scene);
+    renderer.begin_frame(noisy_request());
+    const ImageSize size = renderer.render_size();
+    RgbFloatImage whole(size);
+    renderer.render(PixelRect::whole(size), whole);
+    std::mt19937 rng(5);
+    std::vector<PixelRect> rects;
+    random_split(PixelRect::whole(size), 1, rng, rects);  // any alignment, as tiles clipped to rects are
+    ASSERT_GT(rects.size(), 4u);
+    for (const PixelRect& r : rects) {
+        RgbFloatImage window({r.width(), r.height()}, -1.0f);
+        renderer.render(r, window, r.x0, r.y0);
+        for (int y = r.y0; y < r.y1; ++y)
+            ASSERT_EQ(std::memcmp(window.at(0, y - r.y0), whole.at(r.x0, y), sizeof(float) * 3 * r.width()), 0)
+                << "rect row " << y;
+    }
+    const PixelRect r{8, 8, 24, 20};
+    RgbFloatImage small({16, 11}, 0.0f);  // one row short
+    try {
+        renderer.render(r, small, 8, 8);
+        ADD_FAILURE() << "a window one row short was accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("outside the window"), std::string::npos) << e.what();
     }
 }
 
