@@ -263,11 +263,13 @@ std::vector<Measurement> sweep_knobs(const Scene& scene, Renderer& renderer, con
                                      const RgbFloatImage& reference, const SweepOptions& options) {
     Recorder out(scene, view, reference);
     const Context c{scene, renderer, view, options, out};
-    spp_series(c);
-    for (int spp : options.base_spp) path_knobs(c, spp);
-    denoiser_series(c);
-    jpeg_series(c);
-    tile_series(c);
+    if (!options.presets_only) {
+        spp_series(c);
+        for (int spp : options.base_spp) path_knobs(c, spp);
+        denoiser_series(c);
+        jpeg_series(c);
+        tile_series(c);
+    }
     preset_rows(c);
     return std::move(out.rows);
 }

@@ -37,6 +37,7 @@ struct SweepOptions {
     int max_spp = 256;                 // spp series 1, 2, 4, ... max_spp at the default knobs
     int max_reference_knob_spp = 64;   // spp series at the reference knobs (unbiased: the 1/sqrt(spp) line)
     std::vector<int> base_spp{1, 16};  // other knobs are swept from the defaults at each of these spp
+    bool presets_only = false;         // only the preset rows (after quality_presets() changed)
 };
 
 // All rows for `view` against `reference` (linear radiance of the view's full render size).

@@ -5,7 +5,7 @@
 //   mogao_quality_bench [--scene scenes/grotto.json] [--scans DIR] [--width 240] [--height 136]
 //       [--views walk,mask,still] [--ref-spp 1024] [--ref-budget-s 1e9] [--threads 2]
 //       [--cache-dir DIR] [--renderer-version TEXT] [--reps 1] [--max-spp 256] [--max-ref-knob-spp 64]
-//       [--base-spp 1,16] [--references-only] --out DIR
+//       [--base-spp 1,16] [--references-only | --presets-only] --out DIR
 //
 // Writes DIR/curves.csv (one row per frame: view, knob, value, spp, CPU ms, PSNR dB, relMSE, SSIM,
 // default, note) and DIR/references.csv (per view: reference spp, seconds, the noise floor measured
@@ -59,6 +59,10 @@ Options parse(int argc, char** argv) {
         const std::string flag = argv[i];
         if (flag == "--references-only") {
             o.references_only = true;
+            continue;
+        }
+        if (flag == "--presets-only") {
+            o.sweep.presets_only = true;
             continue;
         }
         if (i + 1 >= argc) throw std::invalid_argument("flag " + flag + " needs a value");
