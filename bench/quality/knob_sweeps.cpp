@@ -19,9 +19,9 @@ namespace mogao::quality {
 const std::vector<Preset>& quality_presets() {
     // Chosen from the curves (docs/quality.md, "Presets"): see there for the reasoning.
     static const std::vector<Preset> presets{
-        {"interactive", 1, 1, 0, 1.0, 80, true},
-        {"balanced", 4, 2, 0, 1.0, 85, true},
-        {"exhibit", 64, 4, 0, 1.0, 95, false},
+        {"interactive", 1, 1, 0, 1.0, 80, true, false},
+        {"balanced", 4, 2, 0, 1.0, 85, true, false},
+        {"exhibit", 64, 4, 0, 1.0, 95, false, true},
     };
     return presets;
 }
@@ -250,10 +250,12 @@ void preset_rows(const Context& c) {
                                  ? f.image
                                  : resize_bilinear(f.image, c.out.reference().size);
         const std::vector<std::uint8_t> bytes =
-            encoder.encode(display_frame(full, c.scene.exposure, c.scene.tone_map), p.jpeg_quality);
+            encoder.encode(display_frame(full, c.scene.exposure, c.scene.tone_map), p.jpeg_quality,
+                           p.chroma_444 ? Subsampling::yuv444 : Subsampling::yuv420);
         seconds += thread_cpu_seconds() - t0;
-        c.out.display("preset", p.name, p.spp, seconds, decoder.decode(bytes), relative_mse(full, c.out.reference()),
-                      false, std::to_string(bytes.size()) + " bytes; relMSE before JPEG");
+        c.out.display(
+            "preset", p.name, p.spp, seconds, decoder.decode(bytes), relative_mse(full, c.out.reference()), false,
+            std::to_string(bytes.size()) + (p.chroma_444 ? " bytes, 4:4:4" : " bytes, 4:2:0") + "; relMSE before JPEG");
     }
 }
 

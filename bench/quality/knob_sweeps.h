@@ -29,6 +29,7 @@ struct Preset {
     double resolution_scale;
     int jpeg_quality;
     bool denoise;
+    bool chroma_444;  // JPEG 4:4:4 instead of the farm's 4:2:0 (painted texture: see the JPEG curves)
 };
 [[nodiscard]] const std::vector<Preset>& quality_presets();
 
