@@ -34,7 +34,7 @@ std::vector<cv::Point2d> undistort(const autocal::DeviceModel& c, const std::vec
 
 // Exposure-independent 8-bit view for the detector: scaled so the 99th percentile of the lit
 // pixels is full scale, then gamma 1/2.2 (features in the darks count as much as in the lights).
-cv::Mat1b to_u8(const cv::Mat1f& img) {
+cv::Mat1b to_u8(const cv::Mat1f& img, double gamma = 1.0 / 2.2) {
     std::vector<float> v;
     for (int y = 0; y < img.rows; y += 4)
         for (int x = 0; x < img.cols; x += 4) v.push_back(img(y, x));
@@ -43,7 +43,7 @@ cv::Mat1b to_u8(const cv::Mat1f& img) {
     cv::Mat1f s;
     cv::max(img * (1.0f / p), 0.0f, s);
     cv::min(s, 1.0f, s);
-    cv::pow(s, 1.0 / 2.2, s);
+    if (gamma != 1.0) cv::pow(s, gamma, s);
     cv::Mat1b out;
     s.convertTo(out, CV_8U, 255.0);
     return out;
@@ -214,7 +214,7 @@ cv::Mat1f Monitor::predict(const cv::Mat1f& content) const {
 }
 
 FrameMeasurement Monitor::measure(const cv::Mat1f& content, const cv::Mat1f& camera_frame,
-                                  const std::vector<bool>& suspects) const {
+                                  const std::vector<bool>& suspects, bool pattern_pair) const {
     const autocal::DeviceModel& cam = model_.camera;
     if (camera_frame.cols != cam.resolution.width || camera_frame.rows != cam.resolution.height) {
         throw std::invalid_argument("Monitor::measure: camera frame must be " + std::to_string(cam.resolution.width) +
@@ -222,7 +222,19 @@ FrameMeasurement Monitor::measure(const cv::Mat1f& content, const cv::Mat1f& cam
     }
     FrameMeasurement m;
     m.projectors.resize(model_.projectors.size());
-    const std::vector<Match> matches = match_features(to_u8(predict(content)), mask_, to_u8(camera_frame), options_, m);
+    std::vector<Match> matches;
+    if (pattern_pair) {
+        // A difference of two frames: the dots on a zero background with the noise of two frames.
+        // Linear mapping (a gamma would lift the background's noise to half scale) after a
+        // Gaussian of 1 camera pixel on both images (the dots are wider; it halves the noise).
+        cv::Mat1f pred;
+        cv::Mat1f seen;
+        cv::GaussianBlur(predict(content), pred, cv::Size(), 1.0);
+        cv::GaussianBlur(camera_frame, seen, cv::Size(), 1.0);
+        matches = match_features(to_u8(pred, 1.0), mask_, to_u8(seen, 1.0), options_, m);
+    } else {
+        matches = match_features(to_u8(predict(content)), mask_, to_u8(camera_frame), options_, m);
+    }
     std::vector<Eigen::Vector3d> s_pred;
     std::vector<cv::Point2d> observed;
     std::vector<int> owner;

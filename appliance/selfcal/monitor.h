@@ -83,8 +83,11 @@ public:
     // believed to be moving, whose matches (and the overlaps' unowned ones) the camera fit leaves
     // out, so that a small projector move inside the camera's RANSAC threshold cannot pull the
     // camera. Throws std::invalid_argument for a camera frame of the wrong size.
+    // pattern_pair: `content` is the fallback's pattern P and `camera_frame` the difference of
+    // the +a P and -a P frames (SelfCalibrator::step_pattern): both are smoothed and mapped
+    // linearly for the detector.
     [[nodiscard]] FrameMeasurement measure(const cv::Mat1f& content, const cv::Mat1f& camera_frame,
-                                           const std::vector<bool>& suspects = {}) const;
+                                           const std::vector<bool>& suspects = {}, bool pattern_pair = false) const;
 
     [[nodiscard]] const SystemModel& model() const { return model_; }
 

@@ -55,6 +55,20 @@ void occlude(cv::Mat1f& cam, double fraction, cv::RNG& rng) {
     }
 }
 
+// One camera frame of what the wall shows for `content` (linear, clipped to [0, 1] by the
+// projectors' signal), with the camera gain and visitors hiding `hidden` of the view.
+cv::Mat1f capture(const rig::CameraSimulator& sim, const ScreenCalibration& wall, const cv::Mat1f& content, double gain,
+                  double hidden, std::uint64_t visitors_seed, std::uint64_t noise_seed) {
+    std::vector<cv::Mat> signals;
+    for (const ProjectorCalibration& pc : wall.projectors) signals.emplace_back(projector_signal(pc, content));
+    cv::Mat1f cam = sim.capture(signals, noise_seed);
+    cam *= gain;
+    cv::min(cam, 1.0f, cam);
+    cv::RNG rng(visitors_seed);
+    occlude(cam, hidden, rng);
+    return cam;
+}
+
 // Ground truth per projector: the rig and the calibration cut down to projector k alone.
 std::vector<autocal::GeometryError> projector_errors(const rig::VirtualRig& truth, const ScreenCalibration& wall) {
     std::vector<autocal::GeometryError> out;
@@ -238,16 +252,26 @@ SimulationReport simulate(const rig::VirtualRig& input, const SimulationOptions&
         }
         if (changed) sim = std::make_unique<rig::CameraSimulator>(truth);
         const cv::Mat1f content = make_content(o.content, t, o.moving_content, o.seed);
-        std::vector<cv::Mat> signals;
-        for (const ProjectorCalibration& pc : wall.projectors) signals.emplace_back(projector_signal(pc, content));
-        cv::Mat1f cam = sim->capture(signals, static_cast<std::uint64_t>(i) + o.seed * 100000);
         const double gain = 1.0 + rng.uniform(-o.exposure_jitter, o.exposure_jitter + 1e-12);
-        cam *= gain;
-        cv::min(cam, 1.0f, cam);
-        occlude(cam,
-                o.occlusion_max > o.occlusion ? rng.uniform(o.occlusion, std::min(0.9, o.occlusion_max)) : o.occlusion,
-                rng);
-        const StepResult r = sc.step(content, cam, t);
+        const double hidden =
+            o.occlusion_max > o.occlusion ? rng.uniform(o.occlusion, std::min(0.9, o.occlusion_max)) : o.occlusion;
+        const std::uint64_t frame_seed = static_cast<std::uint64_t>(i) + o.seed * 100000;
+        const std::optional<cv::Mat1f> plus = sc.pattern_for_refresh(0, content.size());
+        StepResult r;
+        if (plus) {
+            // The pattern pair: two refreshes 1/60 s apart, same exposure, the visitors where they were.
+            const std::uint64_t visitors = rng.next();
+            cv::Mat1f shown_plus;
+            cv::Mat1f shown_minus;
+            cv::add(content, *plus, shown_plus);
+            cv::add(content, *sc.pattern_for_refresh(1, content.size()), shown_minus);
+            const cv::Mat1f cam_plus = capture(*sim, wall, shown_plus, gain, hidden, visitors, frame_seed);
+            const cv::Mat1f cam_minus =
+                capture(*sim, wall, shown_minus, gain, hidden, visitors, frame_seed + (1ULL << 40));
+            r = sc.step_pattern(content, cam_plus, cam_minus, t);
+        } else {
+            r = sc.step(content, capture(*sim, wall, content, gain, hidden, rng.next(), frame_seed), t);
+        }
         if (r.calibration) wall = *r.calibration;
         for (const std::string& line : r.journal) rep.journal.push_back(line);
         if (r.status.state == SelfcalState::correcting &&

@@ -34,6 +34,7 @@ void check_options(const SelfcalOptions& o) {
     if (o.min_matches < 6) fail("min_matches >= 6");
     if (!(o.max_offscreen_loss > 0.0 && o.max_offscreen_loss <= 1.0)) fail("max_offscreen_loss in (0, 1]");
     if (!(o.camera_rebase_deg >= 0.0)) fail("camera_rebase_deg >= 0");
+    if (o.pattern.enabled) check_pattern_options(o.pattern);
 }
 
 std::string fmt(const char* f, double a, double b = 0.0, double c = 0.0) {
@@ -312,6 +313,48 @@ void SelfCalibrator::rebase_camera(double t_s, StepResult& r) {
 }
 
 StepResult SelfCalibrator::step(const cv::Mat1f& content, const cv::Mat1f& camera_frame, double t_s) {
+    StepResult r = run_step(content, camera_frame, t_s);
+    // Too little texture: the pattern pair is asked for (only if configured) from the next frame on.
+    if (options_.pattern.enabled && r.status.waiting && state_ != SelfcalState::correcting && !pattern_mode_) {
+        pattern_mode_ = true;
+        pattern_since_ = t_s;
+        r.journal.push_back(fmt("selfcal: t=%.2f s: too little texture in the content: asking for the ", t_s) +
+                            fmt("imperceptible pattern pair (amplitude %.3f) for %.0f s", options_.pattern.amplitude,
+                                options_.pattern.recheck_s));
+    }
+    return r;
+}
+
+std::optional<cv::Mat1f> SelfCalibrator::pattern_for_refresh(std::int64_t k, cv::Size content_size) const {
+    if (!pattern_mode_) return std::nullopt;
+    if (pattern_.size() != content_size) pattern_ = fallback_pattern(content_size, options_.pattern);
+    const double a = options_.pattern.amplitude * (k % 2 == 0 ? 1.0 : -1.0);
+    cv::Mat1f out;
+    pattern_.convertTo(out, CV_32F, a);
+    return out;
+}
+
+StepResult SelfCalibrator::step_pattern(const cv::Mat1f& content, const cv::Mat1f& camera_plus,
+                                        const cv::Mat1f& camera_minus, double t_s) {
+    if (!options_.pattern.enabled) {
+        throw std::invalid_argument("SelfCalibrator::step_pattern: the pattern fallback is off (pattern.enabled)");
+    }
+    if (camera_plus.size() != camera_minus.size()) {
+        throw std::invalid_argument("SelfCalibrator::step_pattern: the two camera frames differ in size");
+    }
+    if (content.empty()) throw std::invalid_argument("SelfCalibrator::step_pattern: empty content frame");
+    // The difference holds 2a P as the screen shows it: the prediction is P's, not the content's.
+    if (pattern_.size() != content.size()) pattern_ = fallback_pattern(content.size(), options_.pattern);
+    cv::Mat1f difference;
+    cv::subtract(camera_plus, camera_minus, difference);
+    StepResult r = run_step(pattern_, difference, t_s, true);
+    r.status.from_pattern = true;
+    if (pattern_mode_ && t_s - pattern_since_ >= options_.pattern.recheck_s) pattern_mode_ = false;
+    return r;
+}
+
+StepResult SelfCalibrator::run_step(const cv::Mat1f& content, const cv::Mat1f& camera_frame, double t_s,
+                                    bool pattern_pair) {
     if (!std::isfinite(t_s) || (started_ && t_s < last_t_)) {
         throw std::invalid_argument("SelfCalibrator::step: t_s must be finite and non-decreasing");
     }
@@ -331,7 +374,7 @@ StepResult SelfCalibrator::step(const cv::Mat1f& content, const cv::Mat1f& camer
             suspects.push_back(filters_[k].pending() > 0 ||
                                drift_px(static_cast<int>(k), filters_[k].state()) > 0.5 * options_.drift_threshold_px);
         }
-        const FrameMeasurement m = monitor_.measure(content, camera_frame, suspects);
+        const FrameMeasurement m = monitor_.measure(content, camera_frame, suspects, pattern_pair);
         filter(m, dt, r);
         rebase_camera(t_s, r);
         decide(t_s, r);

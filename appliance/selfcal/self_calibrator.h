@@ -24,6 +24,7 @@
 // Every decision is a journal line with before/after figures.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -32,6 +33,7 @@
 #include <opencv2/core.hpp>
 
 #include "appliance/autocal/autocal.h"
+#include "appliance/selfcal/fallback_pattern.h"
 #include "appliance/selfcal/monitor.h"
 #include "appliance/selfcal/pose_kalman.h"
 #include "appliance/selfcal/selfcal_status.h"
@@ -51,6 +53,7 @@ struct SelfcalOptions {
     KalmanOptions kalman;
     KalmanOptions camera_kalman;
     autocal::AutocalOptions build;  // warp_step_px, blend_ramp of the rebuilt calibration
+    PatternOptions pattern;         // the content-independent fallback; off by default
 };
 
 struct StepResult {
@@ -72,11 +75,29 @@ public:
     // seconds (non-decreasing). Throws std::invalid_argument for bad sizes or time going back.
     [[nodiscard]] StepResult step(const cv::Mat1f& content, const cv::Mat1f& camera_frame, double t_s);
 
+    // Content-independent fallback (fallback_pattern.h; only with options.pattern.enabled).
+    // After a step() that waited for evidence, the monitor asks for a complementary pattern pair
+    // for options.pattern.recheck_s seconds: the display adds pattern_for_refresh(k, its content
+    // size) to the linear content at two consecutive refreshes k = 0, 1 (+a P, then -a P; CV_32FC1,
+    // signed, the content's size) and passes the camera frames of the two to step_pattern.
+    // nullopt: no pattern wanted (fallback off, or the content gives enough evidence).
+    [[nodiscard]] std::optional<cv::Mat1f> pattern_for_refresh(std::int64_t k, cv::Size content_size) const;
+
+    // One monitored frame from a pattern pair: the content (any size; only its size is used),
+    // the camera frames of the refresh with +a P and of the one with -a P (same exposure, camera
+    // resolution). The monitor works on their difference, 2a P as the screen shows it, under the
+    // same evidence rules as step() (min_matches per projector, the filters' gates, hold_s): it
+    // never corrects from too little evidence. Throws std::invalid_argument when the fallback is
+    // off, for frames of different or wrong sizes or time going back.
+    [[nodiscard]] StepResult step_pattern(const cv::Mat1f& content, const cv::Mat1f& camera_plus,
+                                          const cv::Mat1f& camera_minus, double t_s);
+
     [[nodiscard]] const ScreenCalibration& calibration() const { return wall_; }  // on the wall now
     [[nodiscard]] const SystemModel& model() const { return monitor_.model(); }
     [[nodiscard]] SelfcalState state() const { return state_; }
 
 private:
+    StepResult run_step(const cv::Mat1f& content, const cv::Mat1f& camera_frame, double t_s, bool pattern_pair = false);
     void filter(const FrameMeasurement& m, double dt, StepResult& r);
     void decide(double t_s, StepResult& r);
     void start_correction(double t_s, const std::vector<int>& drifting, StepResult& r);
@@ -104,6 +125,9 @@ private:
     bool report_after_ = false;
     std::vector<double> typical_matches_;  // per projector: running mean of its matches when measured
     std::vector<double> lost_since_;       // per projector: since when it is lost, -1 if not
+    bool pattern_mode_ = false;            // the pattern pair is wanted
+    double pattern_since_ = 0.0;
+    mutable cv::Mat1f pattern_;  // the unit pattern P at the last content size (a cache)
 };
 
 // Linear blend of two calibrations of the same layout: warps (where both finite; otherwise the

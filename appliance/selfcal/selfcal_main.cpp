@@ -96,6 +96,11 @@ int main(int argc, char** argv) {
     sim->add_option("--position-prior-mm", prior_mm,
                     "projector fit's position prior, mm per pixel of residual (0 none)")
         ->check(CLI::NonNegativeNumber);
+    sim->add_flag(
+        "--pattern", o.selfcal.pattern.enabled,
+        "content-independent fallback: an imperceptible pattern pair when the content has too little texture");
+    sim->add_option("--pattern-amplitude", o.selfcal.pattern.amplitude, "the pattern's amplitude, linear content")
+        ->check(CLI::Range(0.001, 0.2));
     sim->add_option("--truth-every", o.truth_every, "ground truth every N frames (and at the last, around changes)")
         ->check(CLI::Range(1, 100000));
     sim->add_flag("--verbose", verbose, "one line per monitored frame");

@@ -112,6 +112,76 @@ TEST(SelfcalRig, TooLittleTextureWaitsAndNeverCorrects) {
     EXPECT_EQ(frames_in(r, SelfcalState::calibrated), 6);
 }
 
+// The content-independent fallback: plain content gives no features; with the pattern pair
+// configured (amplitude 0.02 of full white, about 4 codes at the content's grey) the bump is
+// corrected from the difference of the two camera frames (the test above: without it, it waits).
+TEST(SelfcalRig, TooLittleTextureWithThePatternFallbackIsCorrectedBelowOnePixel) {
+    const rig::VirtualRig rig = standard();
+    SimulationOptions o = quick(14);
+    o.content = ContentKind::plain;
+    o.selfcal.pattern.enabled = true;
+    Bump b = parse_bump(rig, "proj1:yaw=1deg");
+    b.at_s = 0.5;
+    o.bumps = {b};
+    const SimulationReport r = simulate(rig, o);
+    EXPECT_GT(r.error_before_px, 5.0);
+    EXPECT_NE(journal(r).find("pattern pair"), std::string::npos) << journal(r);
+    ASSERT_TRUE(r.corrected_after_s.has_value()) << journal(r);
+    EXPECT_EQ(r.corrections, 1) << journal(r);
+    EXPECT_LT(r.final_error_px, 1.0) << journal(r);
+    EXPECT_EQ(r.final_state, SelfcalState::calibrated);
+}
+
+// The pattern alone must not make evidence out of nothing: unbumped, plain content with the
+// fallback on never detects or corrects.
+TEST(SelfcalRig, ThePatternFallbackMakesNoFalseCorrection) {
+    SimulationOptions o = quick(8);
+    o.content = ContentKind::plain;
+    o.selfcal.pattern.enabled = true;
+    o.exposure_jitter = 0.1;
+    const SimulationReport r = simulate(standard(), o);
+    EXPECT_EQ(r.corrections, 0) << journal(r);
+    EXPECT_EQ(r.detections, 0) << journal(r);
+    EXPECT_LT(r.final_error_px, 0.1);
+}
+
+TEST(SelfcalRig, PatternForRefreshIsOffByDefaultAndComplementary) {
+    const rig::VirtualRig rig = autocal::scaled_rig(standard(), 0.25, 0.25);
+    const SystemModel model = models_of_rig(rig);
+    autocal::AutocalOptions build;
+    build.warp_step_px = 8;
+    const ScreenCalibration wall = autocal::calibration_from_models(model.projectors, model.screen, {960, 540}, build);
+    const cv::Mat1f content = make_content(ContentKind::plain, 0.0, false, 1);
+    const cv::Mat1f camera(rig.camera.resolution.height, rig.camera.resolution.width, 0.2f);
+    SelfCalibrator off(model, wall);
+    (void)off.step(content, camera, 0.0);
+    EXPECT_FALSE(off.pattern_for_refresh(0, content.size()).has_value());
+    EXPECT_THROW((void)off.step_pattern(content, camera, camera, 1.0), std::invalid_argument);
+    SelfcalOptions with;
+    with.pattern.enabled = true;
+    SelfCalibrator on(model, wall, with);
+    EXPECT_FALSE(on.pattern_for_refresh(0, content.size()).has_value()) << "nothing asked before any waiting";
+    const StepResult r = on.step(content, camera, 0.0);
+    EXPECT_TRUE(r.status.waiting);
+    const auto plus = on.pattern_for_refresh(0, content.size());
+    const auto minus = on.pattern_for_refresh(1, content.size());
+    ASSERT_TRUE(plus.has_value() && minus.has_value());
+    EXPECT_EQ(plus->size(), content.size());
+    cv::Mat1f sum;
+    cv::add(*plus, *minus, sum);
+    EXPECT_EQ(cv::norm(sum, cv::NORM_INF), 0.0);
+    double lo = 0.0;
+    double hi = 0.0;
+    cv::minMaxLoc(*plus, &lo, &hi);
+    EXPECT_GE(lo, 0.0);
+    EXPECT_LE(hi, with.pattern.amplitude + 1e-6);
+    EXPECT_GT(hi, 0.5 * with.pattern.amplitude);
+    EXPECT_THROW((void)on.step_pattern(content, camera, cv::Mat1f(10, 10, 0.0f), 1.0), std::invalid_argument);
+    SelfcalOptions bad = with;
+    bad.pattern.amplitude = 0.0;
+    EXPECT_THROW(SelfCalibrator(model, wall, bad), std::invalid_argument);
+}
+
 TEST(SelfcalRig, ProjectorPushedOffTheScreenCannotBeCorrected) {
     const rig::VirtualRig rig = standard();
     SimulationOptions o = quick(6);

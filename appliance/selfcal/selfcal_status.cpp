@@ -24,6 +24,7 @@ std::string SelfcalStatus::text() const {
     char buf[160];
     std::snprintf(buf, sizeof buf, "selfcal t=%.2fs state=%s", t_s, to_string(state));
     std::string out = buf;
+    if (from_pattern) out += " measured=pattern pair";
     if (waiting) out += " waiting=insufficient evidence";
     if (!reason.empty()) out += " (" + reason + ")";
     std::snprintf(buf, sizeof buf, " camera %.3f deg", camera_rotation_deg);

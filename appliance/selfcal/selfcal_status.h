@@ -30,6 +30,7 @@ struct SelfcalStatus {
     SelfcalState state = SelfcalState::calibrated;
     double t_s = 0.0;
     bool waiting = false;              // too few features this frame: insufficient evidence, nothing decided
+    bool from_pattern = false;         // measured on the fallback's pattern pair (SelfCalibrator::step_pattern)
     std::string reason;                // why waiting / cannot correct, empty otherwise
     double camera_rotation_deg = 0.0;  // camera's filtered pose change against the reference
     std::vector<ProjectorStatus> projectors;
