@@ -13,6 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "appliance/autocal/colour_truth.h"
+#include "appliance/autocal/model_store.h"
 #include "appliance/autocal/rig_bridge.h"
 #include "appliance/calibration/mpcdi_screen.h"
 #include "appliance/calibration/mpcdi_writer.h"
@@ -182,6 +183,9 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
     MpcdiExportOptions mo;
     mo.alpha_bit_depth = job.alpha_bits;
     mo.write_response = job.colour;
+    // The fitted models first, so that whoever sees the new MPCDI (the kiosk's watcher) finds its models.
+    write_models(models_path_for(job.out / "calibration.mpcdi"),
+                 CalibrationModels{prior.screen, r.camera, r.projectors});
     write_mpcdi(job.out / "calibration.mpcdi", to_mpcdi(r.calibration, mo));
     const std::filesystem::path png = job.out / "preview.png";
     if (!cv::imwrite(png.string(), preview(rig, r.calibration, 960))) {

@@ -4,6 +4,8 @@
 //   calibration.mpcdi  the ScreenCalibration as a 2d-profile MPCDI file (appliance/calibration's
 //                      writer, atomic; 16-bit alpha by default; with the colour step, 16-bit RGB
 //                      beta maps and the ResponseLUT extension entries),
+//   calibration.models.json  the fitted screen, camera and projector models (model_store.h),
+//                      written atomically just before the MPCDI: self-recalibration's starting point,
 //   report.json        per projector: decoded bits, correspondences, reprojection rms (the fit's
 //                      own residual), view angle, camera coverage, the blend's predicted seam
 //                      (max |sum of weights - 1| over the overlaps from the fitted models), and the

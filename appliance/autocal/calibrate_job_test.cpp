@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "appliance/autocal/model_store.h"
 #include "appliance/autocal/rig_bridge.h"
 #include "appliance/calibration/mpcdi_reader.h"
 #include "appliance/calibration/mpcdi_screen.h"
@@ -79,6 +80,15 @@ TEST(CalibrateJob, MpcdiRoundTripGivesTheSameMaps) {
         EXPECT_LE(beta_err, 0.5 / 65535.0 + 1e-8) << a.id;  // half a 16-bit code
         EXPECT_GT(beta_max, 1e-3) << a.id;                  // black-level compensation present
     }
+    // The fitted models beside the MPCDI: the same models as the direct run, matching the MPCDI.
+    const CalibrationModels models = read_models(job.out / "calibration.models.json");
+    EXPECT_NO_THROW(check_models_match(models, back, "calibration.models.json"));
+    ASSERT_EQ(models.projectors.size(), direct.projectors.size());
+    for (std::size_t k = 0; k < models.projectors.size(); ++k) {
+        EXPECT_NEAR(models.projectors[k].fx_px, direct.projectors[k].fx_px, 1e-9);
+        EXPECT_LE((models.projectors[k].position_m - direct.projectors[k].position_m).norm(), 1e-12);
+    }
+    EXPECT_LE((models.camera.position_m - direct.camera.position_m).norm(), 1e-12);
     EXPECT_EQ(report["projectors"].size(), 3u);
     EXPECT_LE(report["ground_truth"]["geometry_p95_px"].get<double>(), 0.8);
     EXPECT_TRUE(std::filesystem::file_size(job.out / "preview.png") > 1000);
