@@ -7,9 +7,11 @@
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include "kiosk/kiosk_setup.h"
+#include "kiosk/on_wall_status.h"
 
 namespace mogao {
 
@@ -24,6 +26,11 @@ TimerFd armed_tick(double rate_hz) {
 }
 
 const char* signal_name(int sig) { return sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "signal"; }
+
+bool file_exists(const std::filesystem::path& p) {
+    std::error_code ec;
+    return !p.empty() && std::filesystem::exists(p, ec);
+}
 
 std::string showing(const ContentFrame* current) {
     const std::uint64_t last = current ? current->request_id : 0;
@@ -44,7 +51,8 @@ Kiosk::Kiosk(const KioskConfig& config, KioskParts parts, KioskRunOptions option
       tick_(armed_tick(config.outputs.rate_hz)),
       start_(std::chrono::steady_clock::now()),
       last_log_(start_),
-      last_status_(start_) {
+      last_status_(start_),
+      last_frame_at_(start_) {
     if (config.guard_deg > 0) {
         auto guarded = guard_band(config.screen, config.quality.content, config.guard_deg);
         if (!guarded) throw KioskSetupError(1, "[screen].guard_deg: " + guarded.error().message);
@@ -81,6 +89,17 @@ void Kiosk::on_signal() {
     auto sig = parts_.signals.read();
     if (!sig) return fail("signals", sig.error().message);
     if (!sig->has_value()) return;
+    if (**sig == SIGUSR2) {
+        if (config_.status.on_wall != OnWall::on_demand) {
+            spdlog::info("SIGUSR2: the status panel is {} ([status].on_wall)",
+                         config_.status.on_wall == OnWall::off ? "off" : "always shown");
+            return;
+        }
+        panel_toggled_ = !panel_toggled_;
+        spdlog::info("SIGUSR2: status panel {} on the wall", panel_toggled_ ? "shown" : "taken off");
+        update_wall(std::chrono::steady_clock::now());
+        return;
+    }
     spdlog::info("stopping: {}", signal_name(**sig));
     loop_.stop();
 }
@@ -100,7 +119,15 @@ void Kiosk::on_frame() {
         }
     }
     (void)update_late_warp();  // this frame's shift for the yaw turned since its request
-    parts_.display.show(f);
+    last_frame_at_ = std::chrono::steady_clock::now();
+    wall_lines_ = wall_lines(last_frame_at_);
+    if (wall_lines_.empty()) {
+        parts_.display.show(f);
+    } else {
+        ContentFrame marked = f;  // the copy only while something is on the wall
+        marked.image = with_wall_lines(f.image);
+        parts_.display.show(marked);
+    }
     shown_since_tick_ = true;
     check_frames_shown();
 }
@@ -149,6 +176,7 @@ void Kiosk::on_tick() {
         check_frames_shown();
     }
     shown_since_tick_ = false;
+    update_wall(now);
     // A copy at the monitor's rate (2 Hz), not the display's: the worker converts it on its thread.
     if (parts_.selfcal != nullptr && current_ && parts_.selfcal->wants_content())
         parts_.selfcal->offer(current_->image);
@@ -265,6 +293,48 @@ void Kiosk::on_calibration() {
     write_status(running_state());
 }
 
+bool Kiosk::status_panel_wanted() const {
+    switch (config_.status.on_wall) {
+        case OnWall::off:
+            return false;
+        case OnWall::always:
+            return true;
+        case OnWall::on_demand:
+            return panel_toggled_ || file_exists(config_.status.trigger_file);
+    }
+    return false;
+}
+
+std::vector<std::string> Kiosk::wall_lines(std::chrono::steady_clock::time_point now) const {
+    std::vector<std::string> lines;
+    if (status_panel_wanted()) lines = status_panel_lines(status(running_state()));
+    const double silent_s = std::chrono::duration<double>(now - last_frame_at_).count();
+    const double lost_after = config_.status.farm_lost_after_s;
+    if (current_ && lost_after > 0 && silent_s >= lost_after) lines.push_back(farm_lost_line(silent_s));
+    if (config_.status.on_wall != OnWall::off) {
+        for (const StartFallback& f : options_.fallbacks) lines.push_back(f.wall);
+    }
+    return lines;
+}
+
+Rgb8Image Kiosk::with_wall_lines(const Rgb8Image& content) const {
+    Rgb8Image out = content;
+    draw_on_wall(out, parts_.display.calibration(), wall_lines_);
+    return out;
+}
+
+void Kiosk::update_wall(std::chrono::steady_clock::time_point now) {
+    if (!current_) return;  // the connecting card says enough
+    std::vector<std::string> lines = wall_lines(now);
+    if (lines == wall_lines_) return;
+    if (lines.empty() != wall_lines_.empty()) {
+        spdlog::info("on-wall status: {}",
+                     lines.empty() ? std::string("off") : fmt::format("{}", fmt::join(lines, " | ")));
+    }
+    wall_lines_ = std::move(lines);
+    parts_.display.refresh_content(with_wall_lines(current_->image));
+}
+
 const char* Kiosk::running_state() const {
     if (!current_) return "connecting";
     return connected_ ? "showing" : "disconnected";
@@ -281,6 +351,10 @@ KioskStatus Kiosk::status(const char* state) const {
     s.showing_request = current_ ? current_->request_id : 0;
     s.calibration = calibration_;
     if (parts_.selfcal != nullptr) s.selfcal = parts_.selfcal->status();
+    s.on_wall = wall_lines_;
+    for (const StartFallback& f : options_.fallbacks) s.fallbacks.push_back(f.message);
+    if (current_)
+        s.farm_silent_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_frame_at_).count();
     return s;
 }
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Kiosk: the appliance's display loop (docs/kiosk.md, "The event loop"). One poll(2) loop on the main
 // thread over four fds, one handler each:
-//   on_signal  signalfd: SIGINT/SIGTERM -> clean stop
+//   on_signal  signalfd: SIGINT/SIGTERM -> clean stop; SIGUSR2 -> the status panel on/off on the wall
 //   on_frame   the FrameInbox's eventfd: take the newest farm frame its worker thread decoded (a
 //              frame that failed was dropped there; the last good one stays) and show it on every
 //              output
@@ -41,6 +41,7 @@
 #include "kiosk/kiosk_display.h"
 #include "kiosk/kiosk_navigation.h"
 #include "kiosk/kiosk_status.h"
+#include "kiosk/last_loaded.h"
 #include "kiosk/pose_log.h"
 #include "kiosk/selfcal_worker.h"
 #include "kiosk/signal_fd.h"
@@ -83,6 +84,9 @@ struct KioskRunOptions {
     // flip event waits behind it) a 3 s limit restarted a healthy kiosk, and a longer one has not
     // been proven there yet (docs/kiosk.md).
     std::chrono::steady_clock::duration flip_timeout{0};
+    // Start-up files that were bad and replaced by their last good copies (kiosk_setup.h): shown on
+    // the wall (unless [status].on_wall = "off") and in the status file for the whole run.
+    std::vector<StartFallback> fallbacks{};
 };
 
 class Kiosk {
@@ -110,6 +114,7 @@ public:
     [[nodiscard]] int tick_fd() const { return tick_.fd(); }
     [[nodiscard]] std::uint64_t late_warp_clamped() const { return late_warp_clamped_; }
     [[nodiscard]] const CalibrationInUse& calibration_in_use() const { return calibration_; }
+    [[nodiscard]] const std::vector<std::string>& on_wall() const { return wall_lines_; }
 
     // The status file now (KioskStatus; the tick rewrites it every [stats].status_period_s).
     [[nodiscard]] KioskStatus status(const char* state) const;
@@ -130,6 +135,13 @@ private:
     void write_pose(const PoseLogEntry& entry);
     void write_statistics(const nlohmann::json& navigation, const LinkClientStats& link);
     void write_status(const char* state);  // [stats].status_file (no-op when empty)
+    // The on-wall lines wanted now: the status panel when asked for ([status].on_wall, SIGUSR2,
+    // trigger file) and the farm-lost indicator; empty: the picture alone.
+    [[nodiscard]] std::vector<std::string> wall_lines(std::chrono::steady_clock::time_point now) const;
+    [[nodiscard]] bool status_panel_wanted() const;
+    // Redraws the current frame when the wanted lines changed (the tick).
+    void update_wall(std::chrono::steady_clock::time_point now);
+    [[nodiscard]] Rgb8Image with_wall_lines(const Rgb8Image& content) const;
     [[nodiscard]] const char* running_state() const;
 
     const KioskConfig& config_;
@@ -150,7 +162,10 @@ private:
     std::chrono::steady_clock::time_point start_;
     std::chrono::steady_clock::time_point last_log_;
     std::chrono::steady_clock::time_point last_status_;
-    bool status_failing_ = false;  // the status file's last write failed (logged once)
+    bool status_failing_ = false;                          // the status file's last write failed (logged once)
+    bool panel_toggled_ = false;                           // SIGUSR2 with [status].on_wall = "on_demand"
+    std::vector<std::string> wall_lines_;                  // drawn on the frame on the wall now
+    std::chrono::steady_clock::time_point last_frame_at_;  // the latest new farm frame
     int exit_code_ = 0;
 };
 

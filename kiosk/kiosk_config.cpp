@@ -565,6 +565,110 @@ void read_stats(const Section& s, StatsConfig& st) {
         "status_period_s", st.status_period_s, [](double x) { return x >= 0.1 && x <= 3600; }, "[0.1, 3600] s");
 }
 
+void read_status(const Section& s, StatusConfig& st) {
+    if (const Value* on_wall = s.find("on_wall")) {
+        const std::string text = s.as_string(*on_wall, "on_wall");
+        if (text == "off") {
+            st.on_wall = OnWall::off;
+        } else if (text == "on_demand") {
+            st.on_wall = OnWall::on_demand;
+        } else if (text == "always") {
+            st.on_wall = OnWall::always;
+        } else {
+            s.fail(on_wall, "on_wall", fmt::format(": '{}' is not one of off, on_demand, always", text));
+        }
+    }
+    const std::string trigger = s.string("trigger_file", "");
+    if (!trigger.empty()) {
+        if (st.on_wall != OnWall::on_demand) s.forbid("trigger_file", "with on_wall = \"on_demand\"");
+        st.trigger_file = s.context().resolve(trigger);
+    }
+    st.farm_lost_after_s = s.number(
+        "farm_lost_after_s", st.farm_lost_after_s, [](double x) { return x >= 0 && x <= 86400; },
+        "[0, 86400] s (0 = never)");
+}
+
+// A screen camera's exposure or gain: "lock" (default: hold what the automatic loop reached) or a
+// manual value; never automatic, never left as the device has it (the monitor compares frames
+// taken minutes apart: a camera re-metering each frame would change what it sees).
+ControlSetting locked_control(const Section& s, std::string_view key, const std::function<bool(double)>& ok,
+                              std::string_view range) {
+    ControlSetting setting = read_control_setting(s, key, {ControlSetting::Mode::lock, 0.0, true, ""}, ok, range);
+    setting.required = true;  // a screen camera without the control cannot be trusted to hold still
+    if (setting.mode == ControlSetting::Mode::automatic || setting.mode == ControlSetting::Mode::keep) {
+        s.fail(s.find(key), key, fmt::format(": the screen camera's {} must be \"lock\" or a value in {}", key, range));
+    }
+    return setting;
+}
+
+void read_selfcal_camera(const Section& s, SelfcalConfig& sc) {
+    const Value& camera =
+        s.require("camera", "with enabled = true: \"v4l2:/dev/videoN\", or \"rig:<rig.toml>\" (a simulation)");
+    sc.camera = s.as_string(camera, "camera");
+    const std::string_view text = sc.camera;
+    if (text.starts_with("rig:")) {
+        sc.kind = SelfcalConfig::CameraKind::rig;
+        const std::string file(text.substr(4));
+        if (file.empty()) s.fail(&camera, "camera", ": \"rig:\" needs the virtual rig's file (rig:<rig.toml>)");
+        sc.rig = s.context().resolve(file);
+        std::error_code ec;
+        if (!fs::is_regular_file(sc.rig, ec)) {
+            s.fail(&camera, "camera", fmt::format(": rig file '{}' does not exist", sc.rig.string()));
+        }
+        for (const char* key : {"camera_size", "camera_exposure_us", "camera_gain"}) {
+            s.forbid(key, "with a \"v4l2:\" camera (the rig's camera is simulated)");
+        }
+        return;
+    }
+    std::string why;
+    if (!text.starts_with("v4l2:") || !parse_camera_source(sc.camera, sc.source, &why)) {
+        s.fail(&camera, "camera", fmt::format(": '{}' is not \"v4l2:/dev/videoN\" or \"rig:<rig.toml>\"", sc.camera));
+    }
+    sc.kind = SelfcalConfig::CameraKind::v4l2;
+    if (!fs::path(sc.source.device).is_absolute()) {
+        s.fail(&camera, "camera", fmt::format(": '{}' is not an absolute device path", sc.source.device));
+    }
+    const ImageSize size = s.size("camera_size", {0, 0}, 1);
+    sc.source.width = size.width;  // 0: the models' camera resolution (kiosk_setup)
+    sc.source.height = size.height;
+    sc.source.controls.exposure = locked_control(
+        s, "camera_exposure_us", [](double x) { return x > 0 && x <= 1e6; }, "(0, 1e6] us");
+    sc.source.controls.gain = locked_control(
+        s, "camera_gain", [](double x) { return x >= 0 && x <= 1e6; }, "[0, 1e6]");
+}
+
+void read_selfcal(const Section& s, const CalibrationConfig& calibration, SelfcalConfig& sc) {
+    sc.enabled = s.boolean("enabled", false);
+    if (!sc.enabled) return;  // the other keys may stay written while it is off (unknown ones still fail)
+    if (calibration.mpcdi.empty()) {
+        s.fail(s.find("enabled"), "enabled",
+               " = true needs [calibration].source to be an MPCDI file (the fitted calibration that "
+               "self-recalibration corrects and writes back), not \"ideal\"");
+    }
+    read_selfcal_camera(s, sc);
+    if (const Value* models = s.find("models")) {
+        sc.models = s.existing_file(*models, "models");
+    } else {
+        sc.models = calibration.mpcdi;
+        sc.models.replace_extension(".models.json");  // autocal::models_path_for
+        std::error_code ec;
+        if (!fs::is_regular_file(sc.models, ec)) {
+            s.fail(nullptr, "models",
+                   fmt::format(" is required: '{}' (beside the MPCDI, written by mogao-autocal calibrate) does not "
+                               "exist",
+                               sc.models.string()));
+        }
+    }
+    sc.rate_hz = s.number(
+        "rate_hz", sc.rate_hz, [](double x) { return x > 0 && x <= 2; }, "(0, 2] Hz");
+    sc.hold_s = s.number(
+        "hold_s", sc.hold_s, [](double x) { return x >= 0 && x <= 600; }, "[0, 600] s");
+    sc.transition_s = s.number(
+        "transition_s", sc.transition_s, [](double x) { return x >= 0 && x <= 600; }, "[0, 600] s");
+    sc.drift_threshold_px = s.number(
+        "drift_threshold_px", sc.drift_threshold_px, [](double x) { return x > 0 && x <= 100; }, "(0, 100] px");
+}
+
 }  // namespace
 
 ViewerPose start_pose(const NavigationConfig& navigation) {
@@ -604,7 +708,8 @@ KioskConfig parse_kiosk_config(std::string_view text, const std::filesystem::pat
     } catch (const std::exception& e) {
         throw KioskConfigError(fmt::format("{}: not valid TOML: {}", ctx.file, e.what()));
     }
-    const std::vector<std::string> known_sections{"farm", "display", "outputs", "calibration", "quality", "screen", "navigation", "stats"};
+    const std::vector<std::string> known_sections{"farm",   "display",    "outputs", "calibration", "quality",
+                                                  "screen", "navigation", "stats",   "status",      "selfcal"};
     for (const auto& [key, value] : root.as_table()) {
         if (std::find(known_sections.begin(), known_sections.end(), key) == known_sections.end()) {
             ctx.fail(&value, fmt::format("[{}]: unknown section (known: {})", key, fmt::join(known_sections, ", ")));
@@ -637,7 +742,15 @@ KioskConfig parse_kiosk_config(std::string_view text, const std::filesystem::pat
     config.screen.eye_m = Eigen::Vector3d(0.0, config.navigation.eye_height_m, 0.0);
     const Section stats = section(ctx, root, "stats", {"file", "log_period_s", "status_file", "status_period_s"});
     read_stats(stats, config.stats);
-    for (const Section* s : {&farm, &display, &outputs, &calibration, &quality, &screen, &navigation, &stats}) s->finish();
+    const Section status = section(ctx, root, "status", {"on_wall", "trigger_file", "farm_lost_after_s"});
+    read_status(status, config.status);
+    const Section selfcal = section(ctx, root, "selfcal",
+                                    {"enabled", "camera", "camera_size", "camera_exposure_us", "camera_gain", "models",
+                                     "rate_hz", "hold_s", "transition_s", "drift_threshold_px"});
+    read_selfcal(selfcal, config.calibration, config.selfcal);
+    for (const Section* s :
+         {&farm, &display, &outputs, &calibration, &quality, &screen, &navigation, &stats, &status, &selfcal})
+        s->finish();
     return config;
 }
 

@@ -134,6 +134,37 @@ struct StatsConfig {
     double status_period_s = 1.0;           // its rewrite period, [0.1, 3600]
 };
 
+// [status]: the state on the wall (kiosk/on_wall_status.h, docs/kiosk.md "On-wall status").
+enum class OnWall {
+    off,        // never (SIGUSR2 is logged and ignored)
+    on_demand,  // while toggled on by SIGUSR2, or while trigger_file exists
+    always,
+};
+struct StatusConfig {
+    OnWall on_wall = OnWall::on_demand;
+    std::filesystem::path trigger_file;  // on_demand: the panel shows while this file exists; empty = none
+    double farm_lost_after_s = 10.0;     // no farm frame for this long: the indicator; 0 = never, [0, 86400]
+};
+
+// [selfcal]: continuous self-recalibration (kiosk/selfcal_worker.h, docs/kiosk.md
+// "Self-recalibration"). Only read in full when enabled; then [calibration].source must be an MPCDI
+// file (the corrections are written back to it) and the models file must exist.
+struct SelfcalConfig {
+    enum class CameraKind { v4l2, rig };
+    bool enabled = false;
+    std::string camera;  // as written: "v4l2:/dev/videoN" | "rig:<rig.toml>"
+    CameraKind kind = CameraKind::v4l2;
+    CameraSourceSpec source;          // v4l2: device; size (0x0: the models' camera); controls
+                                      // (exposure and gain locked or manual, never automatic)
+    std::filesystem::path rig;        // rig: the virtual rig file -- a SIMULATED screen camera
+                                      // (tests and demos), never a measurement of the wall
+    std::filesystem::path models;     // autocal/model_store.h; default <mpcdi>.models.json
+    double rate_hz = 2.0;             // monitored frames a second, (0, 2]
+    double hold_s = 2.0;              // drift held this long before correcting, [0, 600]
+    double transition_s = 3.0;        // correction blended in over this long, [0, 600]
+    double drift_threshold_px = 0.5;  // (0, 100] projector pixels
+};
+
 struct KioskConfig {
     std::filesystem::path source;           // the file it was read from
     FarmConfig farm;
@@ -146,6 +177,8 @@ struct KioskConfig {
     double guard_deg = 0.0;
     NavigationConfig navigation;
     StatsConfig stats;
+    StatusConfig status;
+    SelfcalConfig selfcal;
 };
 
 // Reads and validates `file`. Throws KioskConfigError.

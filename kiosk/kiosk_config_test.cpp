@@ -201,6 +201,67 @@ TEST_F(KioskConfigTest, CalibrationWatchAndTheStatusFile) {
         << "watch means nothing for the ideal layout";
 }
 
+TEST_F(KioskConfigTest, SelfcalIsOffByDefaultAndNeedsAnMpcdiItsModelsAndALockedCamera) {
+    EXPECT_FALSE(parse(good()).selfcal.enabled);
+    std::ofstream(dir_ / "rig.toml") << "x";
+    const std::vector<std::string> mpcdi = {R"(calibration.source="screen.mpcdi")", "calibration.projectors=",
+                                            "calibration.overlap=", "calibration.output=", "calibration.gamma="};
+    const auto with = [&](std::vector<std::string> more) {
+        std::vector<std::string> all = mpcdi;
+        all.insert(all.end(), more.begin(), more.end());
+        return good(all);
+    };
+    // Enabled without the models file beside the MPCDI: refused naming the key and the path.
+    const std::string no_models = error_of(with({"selfcal.enabled=true", R"(selfcal.camera="rig:rig.toml")"}));
+    EXPECT_NE(no_models.find("[selfcal].models is required: '" + (dir_ / "screen.models.json").string()),
+              std::string::npos)
+        << no_models;
+    std::ofstream(dir_ / "screen.models.json") << "x";
+    const KioskConfig rig =
+        parse(with({"selfcal.enabled=true", R"(selfcal.camera="rig:rig.toml")", "selfcal.rate_hz=1", "selfcal.hold_s=1",
+                    "selfcal.transition_s=0.5", "selfcal.drift_threshold_px=0.8"}));
+    EXPECT_TRUE(rig.selfcal.enabled);
+    EXPECT_EQ(rig.selfcal.kind, SelfcalConfig::CameraKind::rig);
+    EXPECT_EQ(rig.selfcal.rig, dir_ / "rig.toml");
+    EXPECT_EQ(rig.selfcal.models, dir_ / "screen.models.json");
+    EXPECT_DOUBLE_EQ(rig.selfcal.rate_hz, 1.0);
+    EXPECT_DOUBLE_EQ(rig.selfcal.hold_s, 1.0);
+    EXPECT_DOUBLE_EQ(rig.selfcal.transition_s, 0.5);
+    EXPECT_DOUBLE_EQ(rig.selfcal.drift_threshold_px, 0.8);
+    // A V4L2 camera: exposure and gain locked unless given a value; "auto" and "keep" refused.
+    const KioskConfig v4l2 = parse(with({"selfcal.enabled=true", R"(selfcal.camera="v4l2:/dev/video7")"}));
+    EXPECT_EQ(v4l2.selfcal.kind, SelfcalConfig::CameraKind::v4l2);
+    EXPECT_EQ(v4l2.selfcal.source.device, "/dev/video7");
+    EXPECT_EQ(v4l2.selfcal.source.controls.exposure.mode, ControlSetting::Mode::lock);
+    EXPECT_EQ(v4l2.selfcal.source.controls.gain.mode, ControlSetting::Mode::lock);
+    EXPECT_TRUE(v4l2.selfcal.source.controls.exposure.required);
+    const KioskConfig manual = parse(
+        with({"selfcal.enabled=true", R"(selfcal.camera="v4l2:/dev/video7")", "selfcal.camera_exposure_us=20000"}));
+    EXPECT_EQ(manual.selfcal.source.controls.exposure.mode, ControlSetting::Mode::manual);
+    EXPECT_DOUBLE_EQ(manual.selfcal.source.controls.exposure.value, 20000.0);
+    const std::vector<std::pair<std::vector<std::string>, std::string>> bad = {
+        {{"selfcal.enabled=true", R"(selfcal.camera="v4l2:/dev/video7")", R"(selfcal.camera_exposure_us="auto")"},
+         "[selfcal].camera_exposure_us: the screen camera's camera_exposure_us must be \"lock\" or a value"},
+        {{"selfcal.enabled=true", R"(selfcal.camera="v4l2:/dev/video7")", R"(selfcal.camera_gain="keep")"},
+         "[selfcal].camera_gain: the screen camera's camera_gain must be"},
+        {{"selfcal.enabled=true", R"(selfcal.camera="rig:rig.toml")", "selfcal.rate_hz=5"},
+         "[selfcal].rate_hz = 5 is outside (0, 2] Hz"},
+        {{"selfcal.enabled=true", R"(selfcal.camera="rig:absent.toml")"}, "[selfcal].camera: rig file"},
+        {{"selfcal.enabled=true", R"(selfcal.camera="libcamera:")"}, "[selfcal].camera: 'libcamera:' is not"},
+        {{"selfcal.enabled=true"}, "[selfcal].camera is required"},
+        {{"selfcal.enabled=true", R"(selfcal.camera="rig:rig.toml")", R"(selfcal.camera_size="640x480")"},
+         "[selfcal].camera_size: only with a \"v4l2:\" camera"},
+    };
+    for (const auto& [overrides, expected] : bad) {
+        const std::string message = error_of(with(overrides));
+        EXPECT_NE(message.find(expected), std::string::npos) << "got: " << message << "\nexpected: " << expected;
+    }
+    // The ideal layout cannot be self-recalibrated (nothing to write back, no fitted models).
+    const std::string ideal = error_of(good({"selfcal.enabled=true", R"(selfcal.camera="rig:rig.toml")"}));
+    EXPECT_NE(ideal.find("[selfcal].enabled = true needs [calibration].source to be an MPCDI file"), std::string::npos)
+        << ideal;
+}
+
 struct BadField {
     const char* from;
     const char* to;
@@ -621,6 +682,40 @@ TEST_F(KioskConfigTest, TheExampleFilesTrackingBlockIsValid) {
     EXPECT_EQ(c.navigation.tracking.tag_id, 0);
     EXPECT_EQ(c.navigation.tracking.detector.family, "tag36h11");
     EXPECT_DOUBLE_EQ(c.navigation.tracking.params.turn.max_rate, 45.0);
+}
+
+// The example's commented [selfcal] block, uncommented and enabled, is valid: every "# key = value"
+// line between "[selfcal]" and the end of the file.
+TEST_F(KioskConfigTest, TheExampleFilesSelfcalBlockIsValid) {
+    std::string text = read_source_file("kiosk/kiosk.example.toml");
+    const std::string prefix = "/etc/mogao/";
+    for (auto at = text.find(prefix); at != std::string::npos; at = text.find(prefix, at)) {
+        text.replace(at, prefix.size(), (dir_ / "etc").string() + "/");
+    }
+    fs::create_directories(dir_ / "etc/pki");
+    for (const char* f : {"etc/pki/ca.pem", "etc/pki/appliance-museum-1.pem", "etc/pki/appliance-museum-1.key",
+                          "etc/screen.mpcdi", "etc/screen.models.json"}) {
+        std::ofstream(dir_ / f) << "x";
+    }
+    const auto from = text.find("[selfcal]");
+    ASSERT_NE(from, std::string::npos);
+    std::string block;
+    std::istringstream lines(text.substr(from));
+    for (std::string line; std::getline(lines, line);) {
+        const auto eq = line.find(" = ");
+        const bool key = line.rfind("# ", 0) == 0 && eq != std::string::npos && line.find_first_of(" ", 2) == eq;
+        block += (key ? line.substr(2) : line) + "\n";
+    }
+    text = replace(text.substr(0, from) + block, "enabled = false", "enabled = true");
+    const KioskConfig c = parse(text);
+    EXPECT_TRUE(c.selfcal.enabled);
+    EXPECT_EQ(c.selfcal.source.device, "/dev/video1");
+    EXPECT_EQ(c.selfcal.source.width, 1280);
+    EXPECT_EQ(c.selfcal.models, dir_ / "etc/screen.models.json");
+    EXPECT_EQ(c.selfcal.source.controls.exposure.mode, ControlSetting::Mode::lock);
+    EXPECT_DOUBLE_EQ(c.selfcal.rate_hz, 2.0);
+    EXPECT_EQ(c.status.on_wall, OnWall::on_demand);
+    EXPECT_DOUBLE_EQ(c.status.farm_lost_after_s, 10.0);
 }
 
 // kiosk/tour-tracking.overrides applied to the example, placed as the README's live tour uses it:

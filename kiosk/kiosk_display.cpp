@@ -41,6 +41,13 @@ Status KioskDisplay::swap_calibration(ScreenCalibration screen) {
     return s;
 }
 
+void KioskDisplay::refresh_content(const Rgb8Image& content) {
+    if (Status s = presenter_.show(content, presenter_.current_tag()); !s) {
+        spdlog::warn("present: {}", s.error().message);
+    }
+    account();
+}
+
 void KioskDisplay::repaint() {
     // Outputs with a flip pending are left alone; the others show the current frame again.
     if (Status s = presenter_.repaint(); !s) spdlog::warn("repaint: {}", s.error().message);

@@ -50,6 +50,9 @@ public:
     // ScreenPresenter::swap_calibration).
     [[nodiscard]] Status swap_calibration(ScreenCalibration screen);
     [[nodiscard]] const ScreenCalibration& calibration() const { return screen_; }
+    // The same frame with different pixels (the on-wall status drawn over it, or taken off): shown at
+    // once as the current content under the current frame's tag (not counted as a new farm frame).
+    void refresh_content(const Rgb8Image& content);
     // The current frame again on every ready output (the tick's idle repaint).
     void repaint();
     // Page-flip events of the backend (KMS): outputs ready again get pending content.

@@ -38,12 +38,23 @@ std::unique_ptr<OutputBackend> open_backend(const OutputsConfig& outputs, const 
 }  // namespace
 
 KioskSetup load_setup(const std::filesystem::path& file, const std::string& path,
-                      const std::filesystem::path& stats_file) {
+                      const std::filesystem::path& stats_file, bool fall_back) {
     KioskSetup setup;
     try {
         setup.config = load_kiosk_config(file);
+        if (fall_back) keep_last_loaded(file);
     } catch (const KioskConfigError& e) {
-        throw KioskSetupError(2, e.what());
+        const std::filesystem::path copy = last_loaded_path(file);
+        std::error_code ec;
+        if (!fall_back || !std::filesystem::exists(copy, ec)) throw KioskSetupError(2, e.what());
+        try {
+            setup.config = load_kiosk_config(copy);  // the same folder: relative paths resolve alike
+        } catch (const KioskConfigError& again) {
+            throw KioskSetupError(2, fmt::format("{} (its last good copy is bad too: {})", e.what(), again.what()));
+        }
+        const std::string message = fmt::format("{}; running on its last good copy {}", e.what(), copy.string());
+        spdlog::error("configuration: {}", message);
+        setup.fallbacks.push_back({"CONFIG ERROR - LAST GOOD IN USE", message});
     }
     KioskConfig& config = setup.config;
     if (!path.empty()) {
@@ -60,13 +71,29 @@ KioskSetup load_setup(const std::filesystem::path& file, const std::string& path
     return setup;
 }
 
-ScreenCalibration load_calibration(const KioskConfig& config) {
+ScreenCalibration load_calibration(const KioskConfig& config, std::vector<StartFallback>* fallbacks) {
     std::vector<std::string> notes;
     ScreenCalibration screen;
+    const std::filesystem::path& mpcdi = config.calibration.mpcdi;
     try {
         screen = load_screen_calibration(config.calibration, config.quality.content, &notes);
+        if (fallbacks != nullptr && !mpcdi.empty()) keep_last_loaded(mpcdi);
     } catch (const std::exception& e) {
-        throw KioskSetupError(1, fmt::format("calibration: {}", e.what()));
+        std::error_code ec;
+        if (fallbacks == nullptr || mpcdi.empty() || !std::filesystem::exists(last_loaded_path(mpcdi), ec)) {
+            throw KioskSetupError(1, fmt::format("calibration: {}", e.what()));
+        }
+        CalibrationConfig copy = config.calibration;
+        copy.mpcdi = last_loaded_path(mpcdi);
+        try {
+            screen = load_screen_calibration(copy, config.quality.content, &notes);
+        } catch (const std::exception& again) {
+            throw KioskSetupError(
+                1, fmt::format("calibration: {} (its last good copy is bad too: {})", e.what(), again.what()));
+        }
+        const std::string message = fmt::format("{}; running on its last good copy {}", e.what(), copy.mpcdi.string());
+        spdlog::error("calibration: {}", message);
+        fallbacks->push_back({"CALIBRATION ERROR - LAST GOOD IN USE", message});
     }
     for (const auto& n : notes) spdlog::info("calibration: {}", n);
     return screen;

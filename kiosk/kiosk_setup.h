@@ -10,6 +10,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "common/projector_calibration.h"
 #include "kiosk/calibration_inbox.h"
@@ -19,6 +20,7 @@
 #include "kiosk/kiosk_config.h"
 #include "kiosk/kiosk_display.h"
 #include "kiosk/kiosk_navigation.h"
+#include "kiosk/last_loaded.h"
 #include "kiosk/pose_log.h"
 #include "kiosk/view_script.h"
 #include "renderfarm/link/link_client.h"
@@ -37,14 +39,20 @@ struct KioskSetup {
     KioskConfig config;
     TlsMaterial tls;
     std::optional<ViewScript> script;
+    std::vector<StartFallback> fallbacks;  // the configuration came from its last good copy
 };
 
 // --path (non-empty: the scripted visitor on that path) and --stats (non-empty) override the file.
+// With `fall_back` (not for --check-config): a file that loads is kept as its last good copy
+// (kiosk/last_loaded.h); a bad file with such a copy runs on the copy, noted in `fallbacks`.
 [[nodiscard]] KioskSetup load_setup(const std::filesystem::path& file, const std::string& path,
-                                    const std::filesystem::path& stats_file);
+                                    const std::filesystem::path& stats_file, bool fall_back = false);
 
-// MPCDI or ideal calibration ([calibration]); notes logged.
-[[nodiscard]] ScreenCalibration load_calibration(const KioskConfig& config);
+// MPCDI or ideal calibration ([calibration]); notes logged. With `fallbacks` (non-null): an MPCDI
+// file that loads is kept as its last good copy; a bad one with such a copy loads the copy, noted
+// there. Throws KioskSetupError(1) otherwise.
+[[nodiscard]] ScreenCalibration load_calibration(const KioskConfig& config,
+                                                 std::vector<StartFallback>* fallbacks = nullptr);
 
 // The run-time calibration swap's inbox, and the watcher of [calibration]'s MPCDI file feeding it
 // (nullptr: source = "ideal" or watch = false). The watcher must be destroyed before the inbox.

@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -45,6 +46,9 @@ struct KioskStatus {
     std::uint64_t showing_request = 0;  // the request id on screen (0: the connecting screen)
     CalibrationInUse calibration;
     std::optional<selfcal::SelfcalStatus> selfcal;  // nullopt: self-recalibration off
+    std::vector<std::string> on_wall;               // the lines drawn on the wall now (kiosk/on_wall_status.h)
+    double farm_silent_s = 0.0;                     // since the last farm frame (0 before the first)
+    std::vector<std::string> fallbacks;             // bad start-up files replaced by last good copies
 };
 
 // "2026-11-22T12:30:05Z" (seconds, UTC) for CLOCK_REALTIME nanoseconds.

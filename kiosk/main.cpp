@@ -3,6 +3,7 @@
 // appliance's stages are wired, in pipeline order (docs/kiosk.md):
 //
 //   config (TOML) -> calibration (MPCDI | ideal) -> outputs (KMS | headless, connecting screen)
+//   -> calibration swap (watcher of the MPCDI; self-recalibration worker when [selfcal] is on)
 //   -> link (gRPC + mutual TLS over IPv6; frames into the FrameInbox) -> navigation (scripted
 //   visitor | tracking thread -> Navigator) -> the Kiosk's poll loop (kiosk/kiosk.h: signals, frames,
 //   display tick, page flips) -> clean stop and statistics
@@ -13,6 +14,8 @@
 //
 // Exit codes: 0 stopped (signal, --frames, --duration, end of a tracking replay), 1 the appliance
 // could not run (outputs, calibration, link set-up, loop failure), 2 bad command line or configuration.
+// A bad configuration or MPCDI file with a last good copy (kiosk/last_loaded.h) runs on the copy
+// and says so on the wall and in the status file instead of exiting.
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -28,6 +31,7 @@
 #include "kiosk/kiosk.h"
 #include "kiosk/kiosk_log.h"
 #include "kiosk/kiosk_setup.h"
+#include "kiosk/selfcal_setup.h"
 #include "kiosk/signal_fd.h"
 
 namespace {
@@ -47,13 +51,15 @@ struct Flags {
 };
 
 int run(const Flags& flags, const SignalFd& signals) {
-    KioskSetup setup = load_setup(flags.config, flags.path, flags.stats_file);
+    // --check-config judges the file itself: no falling back to its last good copy.
+    KioskSetup setup = load_setup(flags.config, flags.path, flags.stats_file, !flags.check_only);
     const KioskConfig& config = setup.config;
     if (flags.check_only) {
         spdlog::info("{}: configuration is valid", config.source.string());
         return 0;
     }
-    KioskDisplay display = open_display(config, load_calibration(config));
+    std::vector<StartFallback> fallbacks = setup.fallbacks;
+    KioskDisplay display = open_display(config, load_calibration(config, &fallbacks));
     std::optional<ContentDump> dump = open_content_dump(flags.dump_dir, flags.dump_every);
     if (Status s = display.show_connecting_screen(config.quality.content, config.farm.endpoint); !s) {
         throw KioskSetupError(1, "outputs: cannot show the connecting screen: " + s.error().message);
@@ -63,13 +69,17 @@ int run(const Flags& flags, const SignalFd& signals) {
 
     const std::unique_ptr<CalibrationInbox> calibration = open_calibration_inbox();
     const std::unique_ptr<CalibrationWatcher> watcher = watch_calibration(config, *calibration);
+    const std::unique_ptr<SelfcalWorker> selfcal = start_selfcal(config, display.calibration(), *calibration);
     const std::unique_ptr<FrameInbox> inbox = open_inbox();
     const std::unique_ptr<LinkClient> link = open_link(config, std::move(setup.tls), *inbox, setup.script);
     std::optional<PoseLog> pose_log = open_pose_log(flags.pose_log);
     const std::unique_ptr<KioskNavigation> navigation = start_navigation(config, std::move(setup.script));
 
-    Kiosk kiosk(config, KioskParts{display, *inbox, link_of(*link), *navigation, signals, notifier, calibration.get()},
-                KioskRunOptions{flags.frames, flags.duration_s, std::move(dump), std::move(pose_log)});
+    KioskParts parts{display, *inbox, link_of(*link), *navigation, signals, notifier, calibration.get()};
+    parts.selfcal = selfcal.get();
+    KioskRunOptions options{flags.frames, flags.duration_s, std::move(dump), std::move(pose_log)};
+    options.fallbacks = std::move(fallbacks);
+    Kiosk kiosk(config, std::move(parts), std::move(options));
     return kiosk.run();
 }
 
@@ -90,8 +100,8 @@ int print_config(std::vector<std::string> overrides) {
 int main(int argc, char** argv) {
     mogao::setup_kiosk_logging();
     // Before any thread exists (gRPC, llvmpipe): every thread inherits SIGINT/SIGTERM blocked and
-    // they reach the loop through the signalfd only.
-    auto signals = mogao::SignalFd::create({SIGINT, SIGTERM});
+    // they reach the loop through the signalfd only (SIGUSR2: the status panel on the wall).
+    auto signals = mogao::SignalFd::create({SIGINT, SIGTERM, SIGUSR2});  // USR2: the on-wall status panel
     if (!signals) {
         spdlog::error("signals: {}", signals.error().message);
         return 1;
