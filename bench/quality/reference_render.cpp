@@ -60,7 +60,9 @@ void render_threaded(Renderer& renderer, const ViewRequest& request, int threads
 
 CachedReference obtain_reference(Renderer& renderer, const QualityView& view, const ReferencePlan& plan) {
     const std::string description = key_description(view, plan);
-    const std::filesystem::path file = plan.cache_dir / (view.name + ".ref");
+    // Named by its key: a reference made stale by a scene, camera or renderer change stays on disk
+    // (for a change that cannot alter a pixel, or to go back) instead of being overwritten.
+    const std::filesystem::path file = plan.cache_dir / (view.name + "-" + cache_key(description) + ".ref");
     CachedReference ref;
     if (std::filesystem::exists(file)) {
         Result<CachedReference> cached = load_reference(file, description);

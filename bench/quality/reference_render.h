@@ -6,8 +6,8 @@
 // the curves' seed 1), batch k going to half A when k is even and half B when odd, until each half
 // has the requested spp or the wall-time budget is spent (then it stops after a whole pair of
 // batches, and says so). A cached reference with the same key but fewer spp is extended, so a long
-// reference can be built over several runs. Rows of each batch are split over `threads` threads
-// (Renderer::render is const and thread-safe; the frame is bit-identical for any split).
+// reference can be built over several runs. The file is <cache_dir>/<view>-<key>.ref. Rows of each batch are split over
+// `threads` threads (Renderer::render is const and thread-safe; the frame is bit-identical for any split).
 #pragma once
 
 #include <filesystem>
