@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <spdlog/sinks/stdout_color_sinks.h>
@@ -103,6 +104,26 @@ void add_render_flags(CLI::App& render, mogao::PathTour& job, CameraFlags& camer
         "frame_id of the first frame (sampling depends on seed and frame_id; a live frame's is its request id)");
     render.add_flag("--save-raw", job.save_raw, "Also write lossless frame-NNNN.ppm");
     render.add_option("--contact-sheet", job.contact_sheet_frames, "Frames on the contact sheet (0 = none)")->check(CLI::Range(0, 64));
+}
+
+// Which views appliances may have (view_policy.h).
+void add_view_policy_flags(CLI::App& serve, mogao::ViewPolicy& policy, std::vector<double>& screen) {
+    serve.add_flag("--visitable-area,!--no-visitable-area", policy.visitable_area,
+                   "Move each requested eye into the scene's viewer.visitable area (default, when the scene has one)");
+    serve
+        .add_option("--view-screen", screen,
+                    "The appliances' screen RADIUS,ARC,BOTTOM,TOP[,EYE_HEIGHT] (metres, degrees): cylinder requests "
+                    "get its shape and at most its arc plus the guard band, pinhole requests its camera")
+        ->delimiter(',')
+        ->expected(4, 5);
+    serve
+        .add_option("--view-max-guard-deg", policy.max_guard_deg,
+                    "Arc allowed beyond the screen's on each side (the kiosk's late-warp guard band)")
+        ->check(CLI::Range(0.0, 179.999));
+    serve
+        .add_option("--view-min-fov-deg", policy.min_fov_deg,
+                    "Without --view-screen: narrower pinhole requests are widened to this (0 = off)")
+        ->check(CLI::Range(0.0, 179.0));
 }
 
 // --quality NAME: the preset's values for every knob not given explicitly on the command line.
@@ -201,6 +222,8 @@ int main(int argc, char** argv) {
     serve_options.live.progressive = false;
     add_live_flags(*serve, serve_options, frame_time_ms);
     add_quality_flag(*serve, serve_preset);
+    std::vector<double> view_screen;
+    add_view_policy_flags(*serve, serve_options.view_policy, view_screen);
     serve->add_option("--duration", serve_options.duration_s, "Stop after this many seconds (0 = until SIGTERM)")->check(CLI::Range(0.0, 1e9));
     try {
         app.parse(argc, argv);
@@ -213,6 +236,19 @@ int main(int argc, char** argv) {
     if (!render_preset.empty())
         apply_render_preset(*render, *mogao::quality_preset(render_preset), job.view_template.quality);
     serve_options.live.frame_time_s = frame_time_ms / 1e3;
+    if (!view_screen.empty()) {
+        serve_options.view_policy.screen = mogao::CylinderScreen{
+            view_screen[0], view_screen[1], view_screen[2], view_screen[3],
+            {0.0, view_screen.size() > 4 ? view_screen[4] : 1.6, 0.0}};
+    }
+    if (serve->parsed()) {
+        try {
+            serve_options.view_policy.validate();
+        } catch (const std::invalid_argument& e) {
+            if (mpi.is_admin()) spdlog::error("--view-screen / --view-*: {}", e.what());
+            return 2;
+        }
+    }
     if (serve->parsed()) {
         try {
             serve_options.link.tls = mogao::load_farm_tls(tls_dir, farm_name);

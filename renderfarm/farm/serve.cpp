@@ -53,29 +53,37 @@ void log_stats(const LinkServer& server, const MainThreadQueue<ServedFrame>& que
     const LinkServerStats s = server.stats();
     spdlog::info(
         "link: {} sessions active, {} frames sent, {} requests ({} dropped as stale, {} superseded in the "
-        "farm's queue, {} invalid, {} degraded by the request policy), {} MB",
+        "farm's queue, {} invalid, {} changed by the view or request policy), {} MB",
         s.sessions_active, s.frames_sent, s.requests_received, s.requests_dropped, queue.superseded(),
         s.requests_invalid, degraded, static_cast<double>(s.jpeg_bytes_sent) / 1e6);
 }
 
-// The request policy (request_policy.h), logged once per session and change of decision.
+// The view policy (view_policy.h), then the request policy (request_policy.h); each change is
+// logged once per session and change of decision.
 class PolicyGate {
 public:
-    PolicyGate(const Scene& scene, RequestPolicy policy) : lights_(LightCounts::of(scene)), policy_(policy) {
+    PolicyGate(const Scene& scene, RequestPolicy policy, ViewPolicy view_policy)
+        : lights_(LightCounts::of(scene)), viewer_(scene.viewer), policy_(policy), view_policy_(std::move(view_policy)) {
         policy_.validate();
+        view_policy_.validate();
     }
     ViewRequest apply(const ViewRequest& request) {
-        const PolicyDecision d = apply_request_policy(request, lights_, policy_);
-        if (!d.degraded) return d.view;
+        const ViewDecision v = apply_view_policy(request, viewer_, view_policy_);
+        const PolicyDecision d = apply_request_policy(v.view, lights_, policy_);
+        if (v.changes.empty() && !d.degraded) return d.view;
         ++degraded_;
         std::string& last = logged_[request.session];
-        if (last != d.changes) {
-            spdlog::warn(
-                "session {}: request over the farm's bounds ({:.3g} rays estimated, limit {:.3g}; {:.3g} "
-                "Mpixels, limit {:.3g}): rendered with {}",
-                request.session, d.requested_rays, policy_.max_gigarays * 1e9,
-                double(request.size.width) * request.size.height * 1e-6, policy_.max_megapixels, d.changes);
-            last = d.changes;
+        if (last != v.changes + d.changes) {
+            if (!v.changes.empty())
+                spdlog::warn("session {}: view outside the farm's view policy: rendered with {}", request.session,
+                             v.changes);
+            if (d.degraded)
+                spdlog::warn(
+                    "session {}: request over the farm's bounds ({:.3g} rays estimated, limit {:.3g}; {:.3g} "
+                    "Mpixels, limit {:.3g}): rendered with {}",
+                    request.session, d.requested_rays, policy_.max_gigarays * 1e9,
+                    double(request.size.width) * request.size.height * 1e-6, policy_.max_megapixels, d.changes);
+            last = v.changes + d.changes;
         }
         if (logged_.size() > 1024) logged_.clear();  // bounded: sessions come and go
         return d.view;
@@ -84,7 +92,9 @@ public:
 
 private:
     LightCounts lights_;
+    Viewer viewer_;
     RequestPolicy policy_;
+    ViewPolicy view_policy_;
     std::map<std::uint64_t, std::string> logged_;
     std::uint64_t degraded_ = 0;
 };
@@ -119,7 +129,7 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& s
     sigaction(SIGTERM, &action, nullptr);
 
     MainThreadQueue<ServedFrame> queue;
-    PolicyGate policy(scene, options.policy);
+    PolicyGate policy(scene, options.policy, options.view_policy);
     LiveFrames live(farm, options.live);
     LinkServerOptions link = options.link;
     // Pipelining needs a second call in flight (another session's) while one frame is encoded; each

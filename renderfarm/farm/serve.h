@@ -25,6 +25,7 @@
 #include "renderfarm/farm/frame_stats.h"
 #include "renderfarm/farm/live_frames.h"
 #include "renderfarm/farm/request_policy.h"
+#include "renderfarm/farm/view_policy.h"
 #include "renderfarm/link/link_server.h"
 #include "renderfarm/scene/scene.h"
 
@@ -34,6 +35,7 @@ struct ServeOptions {
     LinkServerOptions link;
     LiveOptions live;
     RequestPolicy policy;        // bounds per request (request_policy.h)
+    ViewPolicy view_policy;      // which views may be had (view_policy.h), applied before `policy`
     bool pipeline = true;        // encode off the main thread (see above)
     double duration_s = 0.0;     // stop after this long (tests); 0 = until SIGINT/SIGTERM
     double stats_period_s = 10;  // log the link's counters this often

@@ -391,10 +391,45 @@ private:
 
     void parse_viewer(const json& v) {
         if (!v.is_object()) fields_.fail("viewer", "expected an object");
-        fields_.only_keys(v, "viewer", {"eye_height", "start", "start_yaw_deg"});
+        fields_.only_keys(v, "viewer", {"eye_height", "start", "start_yaw_deg", "visitable"});
         scene_.viewer.eye_height_m = fields_.number_or(v, "viewer", "eye_height", scene_.viewer.eye_height_m, 0.01, 100);
         scene_.viewer.start = fields_.vec3_or(v, "viewer", "start", scene_.viewer.start, -kMaxCoordinate, kMaxCoordinate);
         scene_.viewer.start_yaw_deg = fields_.number_or(v, "viewer", "start_yaw_deg", 0, -3600, 3600);
+        if (v.contains("visitable")) scene_.viewer.visitable = parse_visitable(v["visitable"]);
+    }
+
+    // "visitable": { "min": [x, z], "max": [x, z] } or { "centre": [x, z], "radius": r }, with
+    // "eye_height": [low, high] (the eye's world y), metres.
+    VisitableArea parse_visitable(const json& v) const {
+        const std::string field = "viewer.visitable";
+        fields_.only_keys(v, field, {"min", "max", "centre", "radius", "eye_height"});
+        const auto pair = [&](const char* key) {
+            const json& a = fields_.member(v, field, key);
+            if (!a.is_array() || a.size() != 2) fields_.fail(field + "." + key, "expected an array of two numbers");
+            return Eigen::Vector2d(fields_.number(a[0], field + "." + key + "[0]", -kMaxCoordinate, kMaxCoordinate),
+                                   fields_.number(a[1], field + "." + key + "[1]", -kMaxCoordinate, kMaxCoordinate));
+        };
+        VisitableArea area;
+        const Eigen::Vector2d start(scene_.viewer.start.x(), scene_.viewer.start.z());
+        bool inside = false;
+        if (v.contains("radius")) {
+            if (v.contains("min") || v.contains("max")) fields_.fail(field, "either min/max or centre/radius, not both");
+            area.centre_xz = pair("centre");
+            area.radius_m = fields_.number(v["radius"], field + ".radius", 0.01, kMaxCoordinate);
+            inside = (start - area.centre_xz).norm() <= area.radius_m;
+        } else {
+            area.min_xz = pair("min");
+            area.max_xz = pair("max");
+            if (!(area.min_xz.array() <= area.max_xz.array()).all())
+                fields_.fail(field, "min must not exceed max in x or z");
+            inside = (start.array() >= area.min_xz.array()).all() && (start.array() <= area.max_xz.array()).all();
+        }
+        const Eigen::Vector2d eye = pair("eye_height");
+        area.eye_min_m = eye.x();
+        area.eye_max_m = eye.y();
+        if (!(area.eye_min_m <= area.eye_max_m)) fields_.fail(field + ".eye_height", "low must not exceed high");
+        if (!inside) fields_.fail(field, "viewer.start lies outside the visitable area");
+        return area;
     }
 
     std::filesystem::path origin_;

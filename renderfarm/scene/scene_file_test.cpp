@@ -52,6 +52,37 @@ TEST(SceneFile, ParsesMeshesMaterialsObjectsAndLights) {
     EXPECT_EQ(scene.triangle_count(), scene.meshes[0].triangle_count() + scene.meshes[1].triangle_count());
 }
 
+// viewer.visitable: where a visitor may stand (the farm's view policy keeps requested eyes in it).
+TEST(SceneFile, VisitableAreaIsARectangleOrADiscAroundTheStart) {
+    const std::string objects = R"([ { "mesh": "ball" } ])";
+    const Scene rect = parse_scene(
+        minimal(objects, R"(, "viewer": { "start": [1, 0, 2], "visitable": { "min": [-3, -1], "max": [3, 4],
+                                                                             "eye_height": [1, 2] } })"),
+        kOrigin);
+    ASSERT_TRUE(rect.viewer.visitable.has_value());
+    EXPECT_EQ(rect.viewer.visitable->max_xz, Eigen::Vector2d(3, 4));
+    EXPECT_EQ(rect.viewer.visitable->radius_m, 0.0);
+    const Scene disc = parse_scene(
+        minimal(objects, R"(, "viewer": { "start": [1, 0, 2], "visitable": { "centre": [0, 0], "radius": 6.5,
+                                                                             "eye_height": [0.5, 2.5] } })"),
+        kOrigin);
+    ASSERT_TRUE(disc.viewer.visitable.has_value());
+    EXPECT_EQ(disc.viewer.visitable->radius_m, 6.5);
+    EXPECT_EQ(disc.viewer.visitable->eye_max_m, 2.5);
+    EXPECT_FALSE(parse_scene(minimal(objects), kOrigin).viewer.visitable.has_value());
+
+    expect_error(minimal(objects, R"(, "viewer": { "start": [9, 0, 2], "visitable": { "centre": [0, 0], "radius": 2,
+                                                                                      "eye_height": [1, 2] } })"),
+                 {"viewer.visitable", "viewer.start lies outside"});
+    expect_error(minimal(objects, R"(, "viewer": { "visitable": { "min": [1, 1], "max": [0, 9], "eye_height": [1, 2] } })"),
+                 {"viewer.visitable", "min must not exceed max"});
+    expect_error(minimal(objects, R"(, "viewer": { "visitable": { "min": [-1, -1], "max": [1, 9] } })"),
+                 {"viewer.visitable.eye_height", "missing"});
+    expect_error(minimal(objects, R"(, "viewer": { "visitable": { "centre": [0, 0], "radius": -1,
+                                                                   "eye_height": [1, 2] } })"),
+                 {"viewer.visitable.radius", "outside"});
+}
+
 TEST(SceneFile, ToneMapIsReadAndCheckedByName) {
     EXPECT_EQ(parse_scene(minimal(R"([ { "mesh": "ball" } ])"), kOrigin).tone_map, ToneMap::clamp);
     EXPECT_EQ(parse_scene(minimal(R"([ { "mesh": "ball" } ])", R"(, "tone_map": "aces")"), kOrigin).tone_map,
