@@ -2,11 +2,13 @@
 // The quality presets, one table for both sides: what an appliance asks for per frame (the
 // request's Quality) and how the farm schedules a session's frames in serve mode.
 //
-//   interactive  fluid motion first: the frame-time target shrinks moving frames, still views
+//   interactive  fluid motion first: 1 spp and one bounce (0 bounces is by far the largest error in
+//                the closed grotto), the frame-time target shrinks moving frames, still views
 //                refine progressively (a visitor who stops sees the wall converge)
-//   balanced     a slower frame-time target, one bounce and one AO ray
-//   exhibit      what a curator wants when visitors stop: no frame-time target (every request at
-//                its full size), two bounces, refinement to many samples
+//   balanced     4 spp, two bounces, a slower frame-time target
+//   exhibit      what a curator wants when visitors stop: 64 spp, four bounces, no frame-time
+//                target (every request at its full size), refinement to many samples
+// No preset traces AO rays: in the grotto they buy at most 0.1 dB (docs/quality.md).
 //
 // The figures behind each choice (time against error for spp, bounces, AO, resolution scale and
 // JPEG quality, against converged references) are in docs/quality.md; the presets' own measured
@@ -30,6 +32,10 @@ struct QualityPreset {
     double frame_time_ms = 0;  // serve: per-session frame-time target, ms (0 = none)
     bool progressive = true;   // serve: still views accumulate samples over requests
     int converged_spp = 1024;  // serve: a still view stops refining at this many samples
+    // Measured in docs/quality.md but not applied by the farm yet: the à-trous denoiser
+    // (renderfarm/denoise) on each frame, and JPEG 4:4:4 instead of the link's 4:2:0.
+    bool denoise = false;
+    bool chroma_444 = false;
 };
 
 // Every preset, from the fastest to the most accurate.

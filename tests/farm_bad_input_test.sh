@@ -33,8 +33,8 @@ expect_failure bad-preset "unknown preset 'fast' (known: interactive, balanced, 
 if timeout 120 "$MPIEXEC" --oversubscribe -n 2 "$farm" render --scene "$work/ok.json" --out "$work/o7" --frames 1 \
     --width 32 --height 18 --quality exhibit --spp 3 > "$work/preset.log" 2>&1; then
   run=$(python3 -c "import json,sys; r=json.load(open(sys.argv[1]))['run']; print(r['spp'], r['max_bounces'], r['ao_samples'], r['jpeg_quality'])" "$work/o7/stats.json")
-  if [ "$run" = "3 2 2 92" ]; then echo "ok: --quality exhibit --spp 3 renders spp, bounces, AO, JPEG quality: $run"
-  else echo "FAIL: --quality exhibit --spp 3 gave spp bounces AO JPEG = $run, expected 3 2 2 92"; fail=1; fi
+  if [ "$run" = "3 4 0 95" ]; then echo "ok: --quality exhibit --spp 3 renders spp, bounces, AO, JPEG quality: $run"
+  else echo "FAIL: --quality exhibit --spp 3 gave spp bounces AO JPEG = $run, expected 3 4 0 95 (common/quality_preset.cpp)"; fail=1; fi
 else
   echo "FAIL: --quality exhibit did not render"; cat "$work/preset.log"; fail=1
 fi

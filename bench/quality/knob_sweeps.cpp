@@ -8,6 +8,7 @@
 
 #include "bench/quality/image_metrics.h"
 #include "common/jpeg_codec.h"
+#include "common/quality_preset.h"
 #include "common/thread_clock.h"
 #include "renderfarm/denoise/atrous_filter.h"
 #include "renderfarm/denoise/frame_error.h"
@@ -15,16 +16,6 @@
 #include "renderfarm/trace/render_timing.h"
 
 namespace mogao::quality {
-
-const std::vector<Preset>& quality_presets() {
-    // Chosen from the curves (docs/quality.md, "Presets"): see there for the reasoning.
-    static const std::vector<Preset> presets{
-        {"interactive", 1, 1, 0, 1.0, 80, true, false},
-        {"balanced", 4, 2, 0, 1.0, 85, true, false},
-        {"exhibit", 64, 4, 0, 1.0, 95, false, true},
-    };
-    return presets;
-}
 
 namespace {
 
@@ -228,12 +219,13 @@ void preset_rows(const Context& c) {
     GuidePass pass(c.scene, "threads=1");
     JpegEncoder encoder;
     JpegDecoder decoder;
-    for (const Preset& p : quality_presets()) {
-        Quality q = with_spp(p.spp);
-        q.max_bounces = p.max_bounces;
-        q.ao_samples = p.ao_samples;
-        q.resolution_scale = p.resolution_scale;
-        q.jpeg_quality = p.jpeg_quality;
+    for (const QualityPreset& p : quality_presets()) {  // common/quality_preset.h: the farm's own table
+        Quality q = with_spp(p.request.spp);
+        q.max_bounces = p.request.max_bounces;
+        q.ao_samples = p.request.ao_samples;
+        q.area_light_samples = p.request.area_light_samples;
+        q.resolution_scale = p.request.resolution_scale;
+        q.jpeg_quality = p.request.jpeg_quality;
         ViewRequest r = c.view.request;
         r.quality = q;
         TimedFrame f = render_fastest_of(c.renderer, r, 1);
@@ -250,11 +242,12 @@ void preset_rows(const Context& c) {
                                  ? f.image
                                  : resize_bilinear(f.image, c.out.reference().size);
         const std::vector<std::uint8_t> bytes =
-            encoder.encode(display_frame(full, c.scene.exposure, c.scene.tone_map), p.jpeg_quality,
+            encoder.encode(display_frame(full, c.scene.exposure, c.scene.tone_map), q.jpeg_quality,
                            p.chroma_444 ? Subsampling::yuv444 : Subsampling::yuv420);
         seconds += thread_cpu_seconds() - t0;
         c.out.display(
-            "preset", p.name, p.spp, seconds, decoder.decode(bytes), relative_mse(full, c.out.reference()), false,
+            "preset", std::string(p.name), q.spp, seconds, decoder.decode(bytes), relative_mse(full, c.out.reference()),
+            false,
             std::to_string(bytes.size()) + (p.chroma_444 ? " bytes, 4:4:4" : " bytes, 4:2:0") + "; relMSE before JPEG");
     }
 }

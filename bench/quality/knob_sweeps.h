@@ -23,16 +23,6 @@ struct Measurement {
 };
 
 // The quality presets proposed in docs/quality.md (for the farm's --quality).
-struct Preset {
-    const char* name;
-    int spp, max_bounces, ao_samples;
-    double resolution_scale;
-    int jpeg_quality;
-    bool denoise;
-    bool chroma_444;  // JPEG 4:4:4 instead of the farm's 4:2:0 (painted texture: see the JPEG curves)
-};
-[[nodiscard]] const std::vector<Preset>& quality_presets();
-
 struct SweepOptions {
     int reps = 1;
     int max_spp = 256;                 // spp series 1, 2, 4, ... max_spp at the default knobs
