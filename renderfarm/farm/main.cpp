@@ -237,9 +237,12 @@ int main(int argc, char** argv) {
         apply_render_preset(*render, *mogao::quality_preset(render_preset), job.view_template.quality);
     serve_options.live.frame_time_s = frame_time_ms / 1e3;
     if (!view_screen.empty()) {
-        serve_options.view_policy.screen = mogao::CylinderScreen{
-            view_screen[0], view_screen[1], view_screen[2], view_screen[3],
-            {0.0, view_screen.size() > 4 ? view_screen[4] : 1.6, 0.0}};
+        serve_options.view_policy.screen =
+            mogao::CylinderScreen{view_screen[0],
+                                  view_screen[1],
+                                  view_screen[2],
+                                  view_screen[3],
+                                  {0.0, view_screen.size() > 4 ? view_screen[4] : 1.6, 0.0}};
     }
     if (serve->parsed()) {
         try {

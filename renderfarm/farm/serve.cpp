@@ -63,7 +63,10 @@ void log_stats(const LinkServer& server, const MainThreadQueue<ServedFrame>& que
 class PolicyGate {
 public:
     PolicyGate(const Scene& scene, RequestPolicy policy, ViewPolicy view_policy)
-        : lights_(LightCounts::of(scene)), viewer_(scene.viewer), policy_(policy), view_policy_(std::move(view_policy)) {
+        : lights_(LightCounts::of(scene)),
+          viewer_(scene.viewer),
+          policy_(policy),
+          view_policy_(std::move(view_policy)) {
         policy_.validate();
         view_policy_.validate();
     }

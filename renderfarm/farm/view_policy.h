@@ -29,10 +29,10 @@
 namespace mogao {
 
 struct ViewPolicy {
-    bool visitable_area = true;           // keep the eye in the scene's visitable area, if it has one
+    bool visitable_area = true;            // keep the eye in the scene's visitable area, if it has one
     std::optional<CylinderScreen> screen;  // the appliances' screen; none: any camera
-    double max_guard_deg = 30.0;          // extra arc allowed on each side of the screen's, [0, 180)
-    double min_fov_deg = 0.0;             // pinhole requests below are widened to it, [0, 179]; 0 = off
+    double max_guard_deg = 30.0;           // extra arc allowed on each side of the screen's, [0, 180)
+    double min_fov_deg = 0.0;              // pinhole requests below are widened to it, [0, 179]; 0 = off
     void validate() const;
 };
 
@@ -42,6 +42,7 @@ struct ViewDecision {
 };
 
 // Applies `policy` to a validated request for a scene whose visitor is `viewer`.
-[[nodiscard]] ViewDecision apply_view_policy(const ViewRequest& request, const Viewer& viewer, const ViewPolicy& policy);
+[[nodiscard]] ViewDecision apply_view_policy(const ViewRequest& request, const Viewer& viewer,
+                                             const ViewPolicy& policy);
 
 }  // namespace mogao

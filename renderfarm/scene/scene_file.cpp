@@ -413,7 +413,8 @@ private:
         const Eigen::Vector2d start(scene_.viewer.start.x(), scene_.viewer.start.z());
         bool inside = false;
         if (v.contains("radius")) {
-            if (v.contains("min") || v.contains("max")) fields_.fail(field, "either min/max or centre/radius, not both");
+            if (v.contains("min") || v.contains("max"))
+                fields_.fail(field, "either min/max or centre/radius, not both");
             area.centre_xz = pair("centre");
             area.radius_m = fields_.number(v["radius"], field + ".radius", 0.01, kMaxCoordinate);
             inside = (start - area.centre_xz).norm() <= area.radius_m;

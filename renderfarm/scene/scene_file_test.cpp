@@ -55,10 +55,10 @@ TEST(SceneFile, ParsesMeshesMaterialsObjectsAndLights) {
 // viewer.visitable: where a visitor may stand (the farm's view policy keeps requested eyes in it).
 TEST(SceneFile, VisitableAreaIsARectangleOrADiscAroundTheStart) {
     const std::string objects = R"([ { "mesh": "ball" } ])";
-    const Scene rect = parse_scene(
-        minimal(objects, R"(, "viewer": { "start": [1, 0, 2], "visitable": { "min": [-3, -1], "max": [3, 4],
+    const Scene rect =
+        parse_scene(minimal(objects, R"(, "viewer": { "start": [1, 0, 2], "visitable": { "min": [-3, -1], "max": [3, 4],
                                                                              "eye_height": [1, 2] } })"),
-        kOrigin);
+                    kOrigin);
     ASSERT_TRUE(rect.viewer.visitable.has_value());
     EXPECT_EQ(rect.viewer.visitable->max_xz, Eigen::Vector2d(3, 4));
     EXPECT_EQ(rect.viewer.visitable->radius_m, 0.0);
@@ -74,8 +74,9 @@ TEST(SceneFile, VisitableAreaIsARectangleOrADiscAroundTheStart) {
     expect_error(minimal(objects, R"(, "viewer": { "start": [9, 0, 2], "visitable": { "centre": [0, 0], "radius": 2,
                                                                                       "eye_height": [1, 2] } })"),
                  {"viewer.visitable", "viewer.start lies outside"});
-    expect_error(minimal(objects, R"(, "viewer": { "visitable": { "min": [1, 1], "max": [0, 9], "eye_height": [1, 2] } })"),
-                 {"viewer.visitable", "min must not exceed max"});
+    expect_error(
+        minimal(objects, R"(, "viewer": { "visitable": { "min": [1, 1], "max": [0, 9], "eye_height": [1, 2] } })"),
+        {"viewer.visitable", "min must not exceed max"});
     expect_error(minimal(objects, R"(, "viewer": { "visitable": { "min": [-1, -1], "max": [1, 9] } })"),
                  {"viewer.visitable.eye_height", "missing"});
     expect_error(minimal(objects, R"(, "viewer": { "visitable": { "centre": [0, 0], "radius": -1,
