@@ -17,6 +17,9 @@ struct StartFallback {
     std::string message;  // the journal's and the status file's: the error and the copy used
 };
 
+// `<file>.last-loaded`; or, when the environment names MOGAO_LAST_GOOD_DIR (the appliance's unit:
+// /var/lib/mogao/last-good, since /etc/mogao is read-only there), that folder's
+// `<absolute path with '/' as '%'>.last-loaded`.
 [[nodiscard]] std::filesystem::path last_loaded_path(const std::filesystem::path& file);
 
 // Copies `file` to last_loaded_path(file) when the copy is missing or differs. A failure (read-only

@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <fstream>
+#include <string>
 
 #include "appliance/calibration/mpcdi_screen.h"
 #include "appliance/calibration/mpcdi_writer.h"
@@ -40,6 +42,24 @@ protected:
 
     fs::path dir_;
 };
+
+// On the appliance /etc/mogao is read-only: the unit names a writable folder for the copies.
+TEST_F(LastLoadedTest, CopiesGoToMogaoLastGoodDirWhenTheEnvironmentNamesOne) {
+    std::ofstream(dir_ / "cal.mpcdi") << "bytes";
+    EXPECT_EQ(last_loaded_path(dir_ / "cal.mpcdi"), dir_ / "cal.mpcdi.last-loaded");
+    const fs::path state = dir_ / "state" / "last-good";
+    ASSERT_EQ(::setenv("MOGAO_LAST_GOOD_DIR", state.c_str(), 1), 0);
+    const fs::path copy = last_loaded_path(dir_ / "cal.mpcdi");
+    keep_last_loaded(dir_ / "cal.mpcdi");
+    ::unsetenv("MOGAO_LAST_GOOD_DIR");
+    EXPECT_EQ(copy.parent_path(), state);
+    EXPECT_NE(copy.filename().string().find("cal.mpcdi.last-loaded"), std::string::npos) << copy;
+    std::ifstream in(copy);
+    std::string bytes;
+    in >> bytes;
+    EXPECT_EQ(bytes, "bytes") << "no copy at " << copy;
+    EXPECT_FALSE(fs::exists(dir_ / "cal.mpcdi.last-loaded"));
+}
 
 TEST_F(LastLoadedTest, ABadConfigurationRunsOnItsLastGoodCopy) {
     write_config({R"(calibration.source="ideal")", "quality.spp=3"});
