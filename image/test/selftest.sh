@@ -165,6 +165,9 @@ opts=$(findmnt -no OPTIONS /)
 case ",$opts," in *,ro,*) ok "root-readonly options=$opts" ;; *) bad "root-readonly options=$opts" ;; esac
 if touch /.mogao-write-probe 2>/dev/null; then bad "root-write (a file could be created in /)"; rm -f /.mogao-write-probe; else ok "root-write refused"; fi
 ok "mounts $(findmnt -rno TARGET,FSTYPE,OPTIONS /var/lib/mogao | tr ' ' ':') $(findmnt -rno TARGET,OPTIONS /etc/mogao | tr ' ' ':') $(findmnt -rno TARGET,FSTYPE /tmp | tr ' ' ':')"
+# The kiosk keeps a last good copy of its configuration on the writable partition (kiosk/last_loaded.h).
+lg='/var/lib/mogao/last-good/%etc%mogao%kiosk.toml.last-loaded'
+if cmp -s "$lg" /etc/mogao/kiosk.toml; then ok "last-good-copy $lg"; else bad "last-good-copy: $lg missing or not /etc/mogao/kiosk.toml"; fi
 failed=$(systemctl --failed --plain --no-legend 2>/dev/null | awk '{print $1}' | tr '\n' ' ')
 [ -z "$failed" ] && ok "no-failed-units" || bad "failed-units $failed"
 gettys=$(systemctl list-units --plain --no-legend --state=active 'getty@*' 'serial-getty@*' 'autovt@*' 'console-getty*' 2>/dev/null | awk '{print $1}' | tr '\n' ' ')
