@@ -220,12 +220,7 @@ void preset_rows(const Context& c) {
     JpegEncoder encoder;
     JpegDecoder decoder;
     for (const QualityPreset& p : quality_presets()) {  // common/quality_preset.h: the farm's own table
-        Quality q = with_spp(p.request.spp);
-        q.max_bounces = p.request.max_bounces;
-        q.ao_samples = p.request.ao_samples;
-        q.area_light_samples = p.request.area_light_samples;
-        q.resolution_scale = p.request.resolution_scale;
-        q.jpeg_quality = p.request.jpeg_quality;
+        const Quality q = p.request;
         ViewRequest r = c.view.request;
         r.quality = q;
         TimedFrame f = render_fastest_of(c.renderer, r, 1);
