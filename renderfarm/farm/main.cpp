@@ -126,6 +126,42 @@ void add_view_policy_flags(CLI::App& serve, mogao::ViewPolicy& policy, std::vect
         ->check(CLI::Range(0.0, 179.0));
 }
 
+// Who may connect and how much one request may cost (docs/link.md, request_policy.h).
+void add_link_flags(CLI::App& serve, mogao::ServeOptions& serve_options, std::filesystem::path& tls_dir,
+                    std::string& farm_name) {
+    serve.add_option("--listen", serve_options.link.listen, "IPv6 endpoint [addr]:port");
+    serve
+        .add_option("--tls-dir", tls_dir,
+                    "TLS folder: ca.pem, farm-NAME.pem, farm-NAME.key, optional crl.pem; never ca.key (mogao-farm pki "
+                    "export-farm)")
+        ->required()
+        ->check(CLI::ExistingDirectory);
+    serve.add_option("--name", farm_name, "Farm certificate name in --tls-dir");
+    serve.add_option("--allow", serve_options.link.allowed_appliances,
+                     "Only these appliance certificate names (default: any the CA issued)");
+    serve.add_option(
+        "--crl", serve_options.link.crl_path,
+        "Revocation list (PEM CRL of the farm CA, re-read when it changes; default: --tls-dir/crl.pem if present)");
+    serve.add_option("--max-sessions", serve_options.link.max_sessions, "Concurrent appliance sessions")
+        ->check(CLI::Range(1, 256));
+    serve
+        .add_option("--max-sessions-per-appliance", serve_options.link.max_sessions_per_appliance,
+                    "Concurrent sessions of one appliance certificate")
+        ->check(CLI::Range(1, 256));
+    serve
+        .add_option("--max-request-megapixels", serve_options.policy.max_megapixels,
+                    "Rendered pixels per request, millions; a larger request is rendered at a lower resolution scale")
+        ->check(CLI::Range(0.001, 268.5));
+    serve
+        .add_option("--max-request-gigarays", serve_options.policy.max_gigarays,
+                    "Estimated rays per request, billions; a dearer request is degraded (spp, then light samples, "
+                    "bounces, resolution scale)")
+        ->check(CLI::Range(1e-6, 1e6));
+    serve.add_option("--metrics-file", serve_options.metrics_file,
+                     "Prometheus textfile to rewrite every second (node_exporter's textfile collector, e.g. "
+                     "/var/lib/prometheus/node-exporter/mogao-farm.prom; docs/services.md)");
+}
+
 // --quality NAME: the preset's values for every knob not given explicitly on the command line.
 void add_quality_flag(CLI::App& command, std::string& preset) {
     command
@@ -187,35 +223,7 @@ int main(int argc, char** argv) {
     std::string farm_name = "farm";
     CLI::App* serve = app.add_subcommand("serve", "Serve live tours to authenticated appliances over IPv6 (gRPC, mutual TLS)");
     add_farm_flags(*serve, setup, scans);
-    serve->add_option("--listen", serve_options.link.listen, "IPv6 endpoint [addr]:port");
-    serve
-        ->add_option("--tls-dir", tls_dir,
-                     "TLS folder: ca.pem, farm-NAME.pem, farm-NAME.key, optional crl.pem; never ca.key (mogao-farm pki "
-                     "export-farm)")
-        ->required()
-        ->check(CLI::ExistingDirectory);
-    serve->add_option("--name", farm_name, "Farm certificate name in --tls-dir");
-    serve->add_option("--allow", serve_options.link.allowed_appliances, "Only these appliance certificate names (default: any the CA issued)");
-    serve->add_option(
-        "--crl", serve_options.link.crl_path,
-        "Revocation list (PEM CRL of the farm CA, re-read when it changes; default: --tls-dir/crl.pem if present)");
-    serve->add_option("--max-sessions", serve_options.link.max_sessions, "Concurrent appliance sessions")->check(CLI::Range(1, 256));
-    serve
-        ->add_option("--max-sessions-per-appliance", serve_options.link.max_sessions_per_appliance,
-                     "Concurrent sessions of one appliance certificate")
-        ->check(CLI::Range(1, 256));
-    serve
-        ->add_option("--max-request-megapixels", serve_options.policy.max_megapixels,
-                     "Rendered pixels per request, millions; a larger request is rendered at a lower resolution scale")
-        ->check(CLI::Range(0.001, 268.5));
-    serve
-        ->add_option("--max-request-gigarays", serve_options.policy.max_gigarays,
-                     "Estimated rays per request, billions; a dearer request is degraded (spp, then light samples, "
-                     "bounces, resolution scale)")
-        ->check(CLI::Range(1e-6, 1e6));
-    serve->add_option("--metrics-file", serve_options.metrics_file,
-                      "Prometheus textfile to rewrite every second (node_exporter's textfile collector, e.g. "
-                      "/var/lib/prometheus/node-exporter/mogao-farm.prom; docs/services.md)");
+    add_link_flags(*serve, serve_options, tls_dir, farm_name);
     double frame_time_ms = 0.0;
     // Off unless asked: a refined frame is not the lone render of its request that the kiosk's
     // end-to-end tests compare against.
