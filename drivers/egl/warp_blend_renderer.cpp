@@ -34,9 +34,12 @@ uniform sampler2D u_content;  // GL_SRGB8: texelFetch returns linear light
 uniform sampler2D u_warp;     // GL_RG32F (u, v); u < kNoContent marks "no content"
 uniform sampler2D u_blend;    // GL_R32F weight in linear light
 uniform sampler2D u_lut;      // GL_RGB32F, N x 1: display value per channel at linear i / (N - 1)
+uniform sampler2D u_beta;     // GL_RGB32F black offset per channel, linear light (read only if u_has_beta)
+uniform bool u_has_beta;      // false: the projector has no beta map, no texel is fetched
 uniform vec2 u_output_size;   // projector pixels
 uniform vec2 u_warp_scale;    // warp size / output size (exactly 1.0 when equal)
 uniform vec2 u_blend_scale;   // blend size / output size
+uniform vec2 u_beta_scale;    // beta size / output size
 uniform vec2 u_content_scale;   // late warp: content uv' = uv * scale + offset
 uniform vec2 u_content_offset;
 
@@ -90,6 +93,15 @@ float blend_at(vec2 p) {
            texelFetch(u_blend, ivec2(t.lo.x, t.hi.y), 0).r * w.z + texelFetch(u_blend, t.hi, 0).r * w.w;
 }
 
+// Same grid convention as the blend (sample_beta in appliance/warp/warp_sampling.h), per channel.
+vec3 beta_at(vec2 p) {
+    if (!u_has_beta) return vec3(0.0);
+    Taps t = taps_at(p * u_beta_scale - 0.5, textureSize(u_beta, 0));
+    vec4 w = weights(t.f);
+    return texelFetch(u_beta, t.lo, 0).rgb * w.x + texelFetch(u_beta, ivec2(t.hi.x, t.lo.y), 0).rgb * w.y +
+           texelFetch(u_beta, ivec2(t.lo.x, t.hi.y), 0).rgb * w.z + texelFetch(u_beta, t.hi, 0).rgb * w.w;
+}
+
 // Bilinear in linear light: each texel is decoded from sRGB by the texture unit before weighting.
 vec3 content_at(vec2 uv) {
     ivec2 size = textureSize(u_content, 0);
@@ -119,7 +131,9 @@ void main() {
         o_color = vec4(0.0, 0.0, 0.0, 1.0);
         return;
     }
-    o_color = vec4(apply_lut(content_at(uv * u_content_scale + u_content_offset) * blend_at(p)), 1.0);
+    // Beta is added after the blend and is not scaled by the content (docs/calibration.md).
+    vec3 linear = content_at(uv * u_content_scale + u_content_offset) * blend_at(p) + beta_at(p);
+    o_color = vec4(apply_lut(linear), 1.0);
 }
 )";
 
@@ -158,6 +172,26 @@ Result<GlTexture> upload(std::string_view what, GLenum internal_format, ImageSiz
     return texture;
 }
 
+// The black offset (beta) map: RGB32F, or an empty texture when the calibration has none (0 x 0
+// and no values; the draw then binds the renderer's placeholder and skips the lookups).
+Result<GlTexture> upload_beta(const std::string& who, const BlackOffset& beta, GLint max_size) {
+    if (beta.size.width == 0 && beta.size.height == 0 && beta.rgb.empty()) return GlTexture{};
+    if (auto s = check_size(who + " beta map", beta.size, max_size); !s) return s.error();
+    if (beta.rgb.size() != static_cast<std::size_t>(beta.size.pixel_count()) * 3) {
+        return make_error(EINVAL, who + ": beta map " + size_text(beta.size) + " holds " +
+                                      std::to_string(beta.rgb.size()) + " values, expected width*height*3");
+    }
+    const auto bad = std::find_if(beta.rgb.begin(), beta.rgb.end(), [](float b) { return !std::isfinite(b); });
+    if (bad != beta.rgb.end()) {
+        const auto i = static_cast<std::size_t>(bad - beta.rgb.begin());
+        const auto texel = static_cast<int>(i / 3);
+        return make_error(EINVAL, who + ": beta map has a non-finite offset at (" +
+                                      std::to_string(texel % beta.size.width) + ", " +
+                                      std::to_string(texel / beta.size.width) + ") channel " + std::to_string(i % 3));
+    }
+    return upload(who + " beta map", GL_RGB32F, beta.size, GL_RGB, GL_FLOAT, beta.rgb.data());
+}
+
 }  // namespace
 
 Result<WarpBlendRenderer> WarpBlendRenderer::create() {
@@ -174,9 +208,12 @@ Result<WarpBlendRenderer> WarpBlendRenderer::create() {
     glUniform1i(glGetUniformLocation(r.program_.get(), "u_warp"), 1);
     glUniform1i(glGetUniformLocation(r.program_.get(), "u_blend"), 2);
     glUniform1i(glGetUniformLocation(r.program_.get(), "u_lut"), 3);
+    glUniform1i(glGetUniformLocation(r.program_.get(), "u_beta"), 4);
     r.loc_output_size_ = glGetUniformLocation(r.program_.get(), "u_output_size");
     r.loc_warp_scale_ = glGetUniformLocation(r.program_.get(), "u_warp_scale");
     r.loc_blend_scale_ = glGetUniformLocation(r.program_.get(), "u_blend_scale");
+    r.loc_beta_scale_ = glGetUniformLocation(r.program_.get(), "u_beta_scale");
+    r.loc_has_beta_ = glGetUniformLocation(r.program_.get(), "u_has_beta");
     r.loc_content_scale_ = glGetUniformLocation(r.program_.get(), "u_content_scale");
     r.loc_content_offset_ = glGetUniformLocation(r.program_.get(), "u_content_offset");
     GLint max_texture = 0;
@@ -184,6 +221,12 @@ Result<WarpBlendRenderer> WarpBlendRenderer::create() {
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture);
     glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_renderbuffer);
     r.max_texture_size_ = std::min(max_texture, max_renderbuffer);
+    // Bound on the beta unit for projectors without a beta map, so the unit never holds an
+    // incomplete texture; the shader does not read it then (u_has_beta false).
+    const float zero[3] = {0.0f, 0.0f, 0.0f};
+    auto no_beta = upload("no-beta placeholder", GL_RGB32F, ImageSize{1, 1}, GL_RGB, GL_FLOAT, zero);
+    if (!no_beta) return no_beta.error();
+    r.no_beta_ = std::move(no_beta.value());
     if (auto s = gl_check("WarpBlendRenderer::create"); !s) return s.error();
     return r;
 }
@@ -282,6 +325,10 @@ Result<WarpBlendRenderer::Projector> WarpBlendRenderer::make_projector(const Pro
     auto lut_texture = upload(who + " response LUT", GL_RGB32F, ImageSize{static_cast<int>(n), 1}, GL_RGB, GL_FLOAT,
                               lut.data());
     if (!lut_texture) return lut_texture.error();
+    auto beta = upload_beta(who, c.beta, max_texture_size_);
+    if (!beta) return beta.error();
+    p.beta_size = c.beta.size;
+    p.beta = std::move(beta.value());
     p.warp = std::move(warp.value());
     p.blend = std::move(blend.value());
     p.lut = std::move(lut_texture.value());
@@ -316,10 +363,15 @@ Status WarpBlendRenderer::draw(std::size_t index, ImageSize target) {
                 static_cast<float>(p.warp_size.height) / out_h);
     glUniform2f(loc_blend_scale_, static_cast<float>(p.blend_size.width) / out_w,
                 static_cast<float>(p.blend_size.height) / out_h);
+    const bool has_beta = p.beta.valid();
+    glUniform1i(loc_has_beta_, has_beta ? 1 : 0);
+    glUniform2f(loc_beta_scale_, has_beta ? static_cast<float>(p.beta_size.width) / out_w : 0.0f,
+                has_beta ? static_cast<float>(p.beta_size.height) / out_h : 0.0f);
     glUniform2f(loc_content_scale_, transform_.scale_u, transform_.scale_v);
     glUniform2f(loc_content_offset_, transform_.offset_u, transform_.offset_v);
-    const GLuint textures[] = {content_.get(), p.warp.get(), p.blend.get(), p.lut.get()};
-    for (GLuint unit = 0; unit < 4; ++unit) {
+    const GLuint textures[] = {content_.get(), p.warp.get(), p.blend.get(), p.lut.get(),
+                               has_beta ? p.beta.get() : no_beta_.get()};
+    for (GLuint unit = 0; unit < 5; ++unit) {
         glActiveTexture(GL_TEXTURE0 + unit);
         glBindTexture(GL_TEXTURE_2D, textures[unit]);
     }

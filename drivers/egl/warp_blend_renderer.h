@@ -6,15 +6,20 @@
 //   p      = (x + 0.5, y + 0.5)                       output pixel centre, y down from the top row
 //   uv     = bilinear(warp,  p * warp.size / output - 0.5)   in warp texel-centre coordinates
 //   w      = bilinear(blend, p * blend.size / output - 0.5)
+//   beta_c = bilinear(beta,  p * beta.size / output - 0.5)   per channel c; 0 when beta is empty
 //   uv'    = uv * content_scale + content_offset  (per axis; identity unless set_content_transform)
 //   linear = bilinear over the 4 content texels around uv' * content.size - 0.5, each texel
 //            decoded sRGB -> linear first (GL_SRGB8 + texelFetch), so the filtering is in linear light
-//   out    = lut_c(clamp(linear_c * w, 0, 1))  per channel c; lut_c is piecewise linear over its N
-//            entries at linear positions i / (N - 1)
+//   out    = lut_c(clamp(linear_c * w + beta_c, 0, 1))  per channel c; lut_c is piecewise linear
+//            over its N entries at linear positions i / (N - 1). beta (the MPCDI beta map, black-level
+//            offset in linear light) is added after the blend and is not scaled by the content, so
+//            black content still shows beta (Majumder & Stevens, IEEE TVCG 10(2), 2004). This is
+//            render_output's formula (appliance/warp/composite.h; docs/calibration.md)
 //   out    = 0 (black) when a warp texel with non-zero bilinear weight is NaN/non-finite
 //
 // Bilinear lookups clamp texel indices to the map's edge (GL_CLAMP_TO_EDGE semantics); with
-// map size == output size the warp and blend are read exactly per pixel. All filtering is done in
+// map size == output size the warp, blend and beta are read exactly per pixel. The grid convention
+// is sample_warp/sample_blend/sample_beta's (appliance/warp/warp_sampling.h). All filtering is done in
 // the shader with texelFetch, so results do not depend on a GPU's filtering precision or on
 // whether it supports linear filtering of float textures. Output values are written to an 8-bit
 // UNORM target (x * 255 rounded to nearest).
@@ -51,10 +56,12 @@ public:
     // Call once per frame before draw()/render(); the texture is reallocated only on a size change.
     [[nodiscard]] Status set_content(const Rgb8Image& frame);
 
-    // Validates and uploads one projector's warp map (RG32F), blend mask (R32F) and response LUT
-    // (N x 1 RGB32F), once. Returns the projector's index for draw()/render(). EINVAL when a size
-    // is empty or does not match its data, the LUT channels differ in length or have < 2 entries,
-    // or a blend weight is not finite.
+    // Validates and uploads one projector's warp map (RG32F), blend mask (R32F), response LUT
+    // (N x 1 RGB32F) and black offset (beta, RGB32F; nothing is uploaded or fetched when it is
+    // empty, 0 x 0), once. Returns the projector's index for draw()/render(). EINVAL when a size
+    // is empty or does not match its data (beta: width*height*3 values), the LUT channels differ
+    // in length or have < 2 entries, or a blend weight, LUT entry or beta offset is not finite;
+    // the message names the projector id and the map.
     [[nodiscard]] Result<std::size_t> add_projector(const ProjectorCalibration& calibration);
     // Replaces projector `index`'s calibration (a run-time calibration swap, kiosk/calibration_reload.h):
     // the same checks and uploads as add_projector; on any error the old textures stay in use.
@@ -78,7 +85,7 @@ public:
     [[nodiscard]] ImageSize output_size(std::size_t index) const { return projectors_.at(index).output; }
 
     // Draws projector `index` into the framebuffer bound to GL_DRAW_FRAMEBUFFER, viewport
-    // (0, 0, output size). Leaves its program, textures (units 0-3) and viewport bound.
+    // (0, 0, output size). Leaves its program, textures (units 0-4) and viewport bound.
     [[nodiscard]] Status draw(std::size_t index);
     // The same picture resampled to fill a framebuffer of `target` pixels: for an output whose mode
     // differs from the projector's calibrated output size. In the formulas above `output` becomes
@@ -95,9 +102,11 @@ private:
         ImageSize output;
         ImageSize warp_size;
         ImageSize blend_size;
+        ImageSize beta_size;  // 0 x 0 when the calibration has no beta map
         GlTexture warp;
         GlTexture blend;
         GlTexture lut;
+        GlTexture beta;         // empty (not valid) when the calibration has no beta map
         GlRenderTarget target;  // render()'s FBO, made on first use
     };
 
@@ -109,11 +118,14 @@ private:
     GLint loc_output_size_ = -1;
     GLint loc_warp_scale_ = -1;
     GLint loc_blend_scale_ = -1;
+    GLint loc_beta_scale_ = -1;
+    GLint loc_has_beta_ = -1;
     GLint loc_content_scale_ = -1;
     GLint loc_content_offset_ = -1;
     ContentTransform transform_;
     GLint max_texture_size_ = 0;
     GlTexture content_;
+    GlTexture no_beta_;  // 1x1 zero RGB32F, bound on unit 4 for projectors without beta
     ImageSize content_size_;
     std::vector<Projector> projectors_;
     std::vector<std::uint8_t> readback_;  // RGBA scratch for render()

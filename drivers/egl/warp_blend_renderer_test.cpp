@@ -96,13 +96,23 @@ Rgb8Image reference_render(const Rgb8Image& content, const ProjectorCalibration&
             const Taps bt = taps_at(px * bsx - 0.5, py * bsy - 0.5, c.blend.size);
             double weight = 0.0;
             for (int k = 0; k < 4; ++k) weight += bt.w(k) * c.blend.weight[at(c.blend.size, bt.x(k), bt.y(k))];
+            double beta[3] = {0.0, 0.0, 0.0};
+            if (c.beta.size.width > 0) {
+                const double tsx = static_cast<float>(c.beta.size.width) / static_cast<float>(c.output.width);
+                const double tsy = static_cast<float>(c.beta.size.height) / static_cast<float>(c.output.height);
+                const Taps t = taps_at(px * tsx - 0.5, py * tsy - 0.5, c.beta.size);
+                for (int k = 0; k < 4; ++k) {
+                    for (int ch = 0; ch < 3; ++ch)
+                        beta[ch] += t.w(k) * c.beta.rgb[at(c.beta.size, t.x(k), t.y(k)) * 3 + ch];
+                }
+            }
             u = u * double{late.scale_u} + double{late.offset_u};  // the late warp's map (float inputs)
             v = v * double{late.scale_v} + double{late.offset_v};
             const Taps ct = taps_at(u * content.size.width - 0.5, v * content.size.height - 0.5, content.size);
             for (int ch = 0; ch < 3; ++ch) {
                 double linear = 0.0;
                 for (int k = 0; k < 4; ++k) linear += ct.w(k) * srgb_decode(content.at(ct.x(k), ct.y(k))[ch]);
-                const double pos = std::clamp(linear * weight, 0.0, 1.0) * static_cast<double>(n - 1);
+                const double pos = std::clamp(linear * weight + beta[ch], 0.0, 1.0) * static_cast<double>(n - 1);
                 const auto i = std::min(static_cast<std::size_t>(pos), n - 2);
                 const double f = pos - static_cast<double>(i);
                 const auto& lut = c.response.lut[static_cast<std::size_t>(ch)];
@@ -149,6 +159,23 @@ ProjectorCalibration with_uniform_blend(ProjectorCalibration c, float weight) {
     c.blend.size = {1, 1};
     c.blend.weight = {weight};
     return c;
+}
+
+// A coarse (1/8 resolution) black offset, brighter to the right (the overlap) and per channel.
+BlackOffset ramp_beta(ImageSize output) {
+    BlackOffset b;
+    b.size = {output.width / 8, output.height / 8};
+    b.rgb.resize(static_cast<std::size_t>(b.size.pixel_count()) * 3);
+    for (int y = 0; y < b.size.height; ++y) {
+        for (int x = 0; x < b.size.width; ++x) {
+            const double t = (x + 0.5) / b.size.width;
+            for (int ch = 0; ch < 3; ++ch) {
+                b.rgb[at(b.size, x, y) * 3 + static_cast<std::size_t>(ch)] =
+                    static_cast<float>((0.002 + 0.01 * t) * (1.0 + 0.5 * ch) + 0.001 * y);
+            }
+        }
+    }
+    return b;
 }
 
 // A realistic calibration: a coarse (1/4 resolution) barrel-ish warp over part of the content
@@ -384,6 +411,68 @@ TEST_F(WarpBlendRendererTest, DrawIntoLargerOrSmallerTargetResamplesTheWholePict
         EXPECT_GT(int{far[0]} + far[1] + far[2], 0);
     }
     EXPECT_FALSE(renderer_->draw(*index, ImageSize{0, 10}).ok());
+}
+
+// Beta is added in linear light after the blend and before the LUT, also where the content is
+// black; the channels get their own offsets.
+TEST_F(WarpBlendRendererTest, BetaLiftsBlackBeforeTheResponse) {
+    const ImageSize size{12, 6};
+    ProjectorCalibration c = with_uniform_blend(identity_calibration("beta", size), 0.5f);
+    c.response = gamma_response(2.2, 4096);
+    c.beta.size = {1, 1};
+    c.beta.rgb = {0.004f, 0.01f, 0.03f};
+    const Rgb8Image black = render(uniform_content(size, 0), c);
+    const Rgb8Image grey = render(uniform_content(size, 200), c);
+    for (int ch = 0; ch < 3; ++ch) {
+        const double b = c.beta.rgb[static_cast<std::size_t>(ch)];
+        EXPECT_NEAR(black.at(5, 3)[ch], to_code(std::pow(b, 1.0 / 2.2)), 1) << "channel " << ch;
+        EXPECT_NEAR(grey.at(5, 3)[ch], to_code(std::pow(0.5 * srgb_decode(200) + b, 1.0 / 2.2)), 1) << "channel " << ch;
+    }
+    EXPECT_GE(black.at(0, 0)[2], 50);  // 0.03^(1/2.2) = 0.20: black is lifted, not 0
+}
+
+TEST_F(WarpBlendRendererTest, BusyCalibrationWithBetaMatchesCpuReference) {
+    const Rgb8Image content = noise_content({80, 50}, 9);
+    ProjectorCalibration c = busy_calibration({64, 48});
+    c.beta = ramp_beta(c.output);
+    const Rgb8Image out = render(content, c);
+    Diff d = max_abs_diff(out, reference_render(content, c));
+    EXPECT_LE(d.max, 2) << "at (" << d.x << ", " << d.y << ")";
+    const Rgb8Image dark = render(uniform_content({80, 50}, 0), c);
+    d = max_abs_diff(dark, reference_render(uniform_content({80, 50}, 0), c));
+    EXPECT_LE(d.max, 2) << "black content, at (" << d.x << ", " << d.y << ")";
+    EXPECT_GT(dark.at(40, 24)[0], 10);  // lifted black, visible in the output
+    EXPECT_EQ(dark.at(0, 0)[0], 0);     // no content (NaN warp): black, beta or not
+}
+
+TEST_F(WarpBlendRendererTest, RejectsBadBetaNamingProjectorAndMap) {
+    ProjectorCalibration c = identity_calibration("pb", {8, 8});
+    c.beta.size = {4, 4};
+    c.beta.rgb.assign(4 * 4 * 3 - 1, 0.0f);
+    auto r = renderer_->add_projector(c);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.code(), EINVAL);
+    EXPECT_NE(r.error().message.find("projector 'pb': beta map 4x4"), std::string::npos) << r.error().message;
+    c.beta.rgb.assign(4 * 4 * 3, 0.0f);
+    c.beta.rgb[5 * 3 + 2] = kNaN;
+    r = renderer_->add_projector(c);
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("beta map has a non-finite offset at (1, 1) channel 2"), std::string::npos)
+        << r.error().message;
+    c.beta.size = {0, 3};
+    c.beta.rgb.clear();
+    EXPECT_EQ(renderer_->add_projector(c).code(), EINVAL);
+    c.beta.size = {1 << 20, 1};
+    EXPECT_EQ(renderer_->add_projector(c).code(), E2BIG);
+    EXPECT_EQ(renderer_->projector_count(), 0u);
+    // A replace with a bad beta keeps the old calibration.
+    auto ok = renderer_->add_projector(identity_calibration("pb", {8, 8}));
+    ASSERT_TRUE(ok);
+    EXPECT_FALSE(renderer_->replace_projector(*ok, c).ok());
+    ASSERT_TRUE(renderer_->set_content(uniform_content({8, 8}, 0)).ok());
+    auto out = renderer_->render(*ok);
+    ASSERT_TRUE(out);
+    EXPECT_EQ(max_abs_diff(*out, uniform_content({8, 8}, 0)).max, 0);
 }
 
 TEST_F(WarpBlendRendererTest, MatchesGoldenPng) {
