@@ -133,6 +133,110 @@ std::vector<Match> match_features(const cv::Mat1b& pred, const cv::Mat1b& mask, 
     return out;
 }
 
+constexpr double kWitnessNcc = 0.8;
+
+// Occluders (visitors in front of the screen) are where the observed image disagrees with the
+// predicted one in a spatially coherent blob: the photometric test of occluder and shadow
+// detection in projector-camera displays (Sukthankar, Cham, Sukthankar 2001, "Dynamic shadow
+// elimination for multi-projector displays", CVPR; Jaynes et al. 2004, "Camera-based detection
+// and removal of shadows from interactive multiprojector displays", IEEE TVCG 10(3)). Compared on
+// cells of `occluder_cell_px` camera pixels (area means: a texture moved by a few pixels, as by a
+// bumped projector, hardly changes a cell's mean, while a body hides or replaces the light), after
+// the frame's photometric map observed = a * predicted + b (exposure and ambient light) fitted by
+// least squares on the cells within the ratio band, starting from their median ratio. Only cells
+// whose texture agrees with the prediction in place (normalised cross-correlation above
+// kWitnessNcc) pin the exposure: an occluder shows displaced or no content, so however much of
+// the view it hides it cannot set the exposure (a brightness median alone took the occluders for
+// the screen once they covered half of it). Flagged cells in connected blobs of at least `occluder_min_cells`
+// are kept and grown by one cell (a feature's patch reaches over a blob's border). Returns a
+// camera-resolution mask (255: occluded) and the share of the compared cells it covers.
+cv::Mat1b occluder_mask(const cv::Mat1f& pred, const cv::Mat1f& obs, const cv::Mat1b& lit, const MonitorOptions& o,
+                        double& fraction) {
+    fraction = 0.0;
+    const cv::Size cells(std::max(1, pred.cols / o.occluder_cell_px), std::max(1, pred.rows / o.occluder_cell_px));
+    const auto cell_mean = [&](const cv::Mat& m) {
+        cv::Mat1f out;
+        cv::resize(m, out, cells, 0, 0, cv::INTER_AREA);
+        return out;
+    };
+    cv::Mat1f litf;
+    lit.convertTo(litf, CV_32F, 1.0 / 255.0);
+    const cv::Mat1f mp = cell_mean(pred), mo = cell_mean(obs), ml = cell_mean(litf);
+    cv::Mat pp, oo, po;
+    cv::multiply(pred, pred, pp);
+    cv::multiply(obs, obs, oo);
+    cv::multiply(pred, obs, po);
+    const cv::Mat1f mpp = cell_mean(pp), moo = cell_mean(oo), mpo = cell_mean(po);
+    std::vector<cv::Point> used;
+    std::vector<cv::Point> agree;  // cells whose texture matches the prediction in place: the exposure's witnesses
+    std::vector<float> ratios;
+    for (int y = 0; y < cells.height; ++y)
+        for (int x = 0; x < cells.width; ++x) {
+            if (!(ml(y, x) > 0.99f && mp(y, x) > 0.02f)) continue;
+            used.emplace_back(x, y);
+            const double vp = mpp(y, x) - mp(y, x) * mp(y, x);
+            const double vo = moo(y, x) - mo(y, x) * mo(y, x);
+            const double ncc = (mpo(y, x) - mp(y, x) * mo(y, x)) / std::sqrt(std::max(vp * vo, 1e-20));
+            if (vp > 1e-5 && ncc > kWitnessNcc) {
+                agree.emplace_back(x, y);
+                ratios.push_back(mo(y, x) / mp(y, x));
+            }
+        }
+    cv::Mat1b out(pred.size(), 0);
+    if (agree.size() < 8) return out;  // nothing to pin the exposure on (e.g. the camera moved): no mask
+    std::nth_element(ratios.begin(), ratios.begin() + static_cast<long>(ratios.size() / 2), ratios.end());
+    double a = ratios[ratios.size() / 2];
+    double b = 0.0;
+    const auto outside = [&](cv::Point c) {
+        const double expect = a * mp(c) + b;
+        return mo(c) < o.occluder_ratio * expect || mo(c) * o.occluder_ratio > expect;
+    };
+    for (int iteration = 0; iteration < 3; ++iteration) {
+        double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+        for (const cv::Point& c : agree) {
+            if (outside(c)) continue;
+            n += 1;
+            sx += mp(c);
+            sy += mo(c);
+            sxx += static_cast<double>(mp(c)) * mp(c);
+            sxy += static_cast<double>(mp(c)) * mo(c);
+        }
+        const double det = n * sxx - sx * sx;
+        if (n < 8 || !(det > 1e-12)) break;
+        a = (n * sxy - sx * sy) / det;
+        b = (sy - a * sx) / n;
+    }
+    cv::Mat1b flagged(cells, 0);
+    for (const cv::Point& c : used) flagged(c) = outside(c) ? 255 : 0;
+    cv::Mat1i labels, stats;
+    cv::Mat1d centroids;
+    const int n = cv::connectedComponentsWithStats(flagged, labels, stats, centroids, 8, CV_32S);
+    cv::Mat1b kept(cells, 0);
+    for (int y = 0; y < cells.height; ++y)
+        for (int x = 0; x < cells.width; ++x) {
+            const int l = labels(y, x);
+            if (l > 0 && l < n && stats(l, cv::CC_STAT_AREA) >= o.occluder_min_cells) kept(y, x) = 255;
+        }
+    cv::dilate(kept, kept, cv::Mat());
+    int hidden = 0;
+    for (const cv::Point& c : used) hidden += kept(c) ? 1 : 0;
+    fraction = static_cast<double>(hidden) / static_cast<double>(used.size());
+    cv::resize(kept, out, pred.size(), 0, 0, cv::INTER_NEAREST);
+    return out;
+}
+
+// Drops the matches whose predicted or observed position lies on an occluder.
+int drop_occluded(std::vector<Match>& matches, const cv::Mat1b& occluded) {
+    const auto hit = [&](const cv::Point2d& p) {
+        const int x = std::clamp(static_cast<int>(p.x), 0, occluded.cols - 1);
+        const int y = std::clamp(static_cast<int>(p.y), 0, occluded.rows - 1);
+        return occluded(y, x) != 0;
+    };
+    const auto before = matches.size();
+    std::erase_if(matches, [&](const Match& m) { return hit(m.predicted) || hit(m.observed); });
+    return static_cast<int>(before - matches.size());
+}
+
 }  // namespace
 
 Eigen::Vector3d screen_point(const autocal::ScreenModel& s, double u, double v) {
@@ -233,7 +337,13 @@ FrameMeasurement Monitor::measure(const cv::Mat1f& content, const cv::Mat1f& cam
         cv::GaussianBlur(camera_frame, seen, cv::Size(), 1.0);
         matches = match_features(to_u8(pred, 1.0), mask_, to_u8(seen, 1.0), options_, m);
     } else {
-        matches = match_features(to_u8(predict(content)), mask_, to_u8(camera_frame), options_, m);
+        const cv::Mat1f pred = predict(content);
+        matches = match_features(to_u8(pred), mask_, to_u8(camera_frame), options_, m);
+        if (options_.occluder_ratio > 0.0) {
+            const cv::Mat1b occluded = occluder_mask(pred, camera_frame, mask_, options_, m.occluded_fraction);
+            m.occluded_matches = drop_occluded(matches, occluded);
+            m.matches = static_cast<int>(matches.size());
+        }
     }
     std::vector<Eigen::Vector3d> s_pred;
     std::vector<cv::Point2d> observed;

@@ -49,6 +49,14 @@ struct MonitorOptions {
     // shift is under this many camera pixels are un-mixed (screen displacement divided by w);
     // larger shifts separate the copies (the stronger one is matched) and are left as seen. 0: off.
     double unmix_max_shift_px = 1.5;
+    // Visitors (occluders) in front of the screen: cells of `occluder_cell_px` camera pixels whose
+    // observed mean brightness differs from the predicted one (times the frame's robust gain) by more
+    // than the factor `occluder_ratio` (below it or above its inverse), in connected blobs of at
+    // least `occluder_min_cells` cells, grown by one cell, lose their matches before any fit
+    // (monitor.cpp, occluder_mask). 0: off.
+    double occluder_ratio = 0.7;
+    int occluder_cell_px = 16;
+    int occluder_min_cells = 4;
     RobustPoseOptions camera_fit{1.0, 300, 1.345, 12, 20};
     RobustPoseOptions projector_fit{6.0, 300, 1.345, 12, 12, 0.002};
 };
@@ -63,7 +71,9 @@ struct FrameMeasurement {
     int predicted_features = 0;
     int observed_features = 0;
     int matches = 0;
-    PoseFit camera;  // camera.ok = false: the reference camera was used
+    int occluded_matches = 0;        // matches dropped because they fell on a detected occluder
+    double occluded_fraction = 0.0;  // of the lit screen's cells, the occluder mask's share
+    PoseFit camera;                  // camera.ok = false: the reference camera was used
     Pose6 camera_delta = Pose6::Zero();
     std::vector<ProjectorMeasurement> projectors;
 };

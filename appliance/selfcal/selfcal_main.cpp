@@ -92,6 +92,9 @@ int main(int argc, char** argv) {
     sim->add_option("--unmix-max-shift", o.selfcal.monitor.unmix_max_shift_px,
                     "overlap matches shifted less than this (camera px) are un-mixed; 0 off")
         ->check(CLI::NonNegativeNumber);
+    sim->add_option("--occluder-ratio", o.selfcal.monitor.occluder_ratio,
+                    "visitor mask: cells darker or brighter than predicted by this factor; 0 off")
+        ->check(CLI::Range(0.0, 0.99));
     double prior_mm = o.selfcal.monitor.projector_fit.prior_position_sd_m * 1e3;
     sim->add_option("--position-prior-mm", prior_mm,
                     "projector fit's position prior, mm per pixel of residual (0 none)")

@@ -86,6 +86,51 @@ TEST(SelfcalRig, NoFalseCorrectionWithNoiseExposureChangesAndVisitors) {
     EXPECT_LT(r.final_error_px, 0.1);
 }
 
+// Heavy visitors (20-50 % of the camera view, standing in front of the screen and showing the
+// content displaced) and exposure changes of +-30 %, nothing moved. Without the occluder mask
+// (MonitorOptions::occluder_ratio = 0) this realisation made a false correction within 15 s
+// (proj "moved" by visitor-displaced features agreeing for three frames), 8 px against the
+// ground truth; the visitors' matches must never reach the fits.
+SimulationOptions heavy_visitors(int frames) {
+    SimulationOptions o = quick(frames);
+    o.projector_scale = 0.25;
+    o.exposure_jitter = 0.3;
+    o.occlusion = 0.2;
+    o.occlusion_max = 0.5;
+    o.truth_every = 10;
+    o.seed = 2;
+    return o;
+}
+
+TEST(SelfcalRig, HeavyVisitorsMakeNoFalseDetectionOrCorrection) {
+    const SimulationReport r = simulate(standard(), heavy_visitors(30));
+    EXPECT_EQ(r.detections, 0) << journal(r);
+    EXPECT_EQ(r.corrections, 0) << journal(r);
+    EXPECT_EQ(journal(r).find("camera moved"), std::string::npos) << journal(r);
+    EXPECT_LT(r.final_error_px, 0.1) << journal(r);
+}
+
+// The same visitors must not hide a real bump: proj1 yawed 1 degree among visitors hiding 10-40 %
+// is detected within 5 s (the issue asks 10 s) and corrected below 1 px (the table's row took 25 s to detect and never
+// corrected before the occluder mask).
+TEST(SelfcalRig, BumpAmongVisitorsIsStillCorrectedBelowOnePixel) {
+    const rig::VirtualRig rig = standard();
+    SimulationOptions o = heavy_visitors(16);
+    o.occlusion = 0.1;
+    o.occlusion_max = 0.4;
+    o.truth_every = 1;
+    Bump b = parse_bump(rig, "proj1:yaw=1deg");
+    b.at_s = 0.5;
+    o.bumps = {b};
+    const SimulationReport r = simulate(rig, o);
+    EXPECT_GT(r.error_before_px, 2.0) << "the bump must be visible in the ground truth";
+    ASSERT_TRUE(r.detected_after_s.has_value()) << journal(r);
+    EXPECT_LE(*r.detected_after_s, 5.0) << journal(r);
+    ASSERT_TRUE(r.corrected_after_s.has_value()) << journal(r);
+    EXPECT_LT(r.final_error_px, 1.0) << journal(r);
+    EXPECT_EQ(r.final_state, SelfcalState::calibrated) << journal(r);
+}
+
 TEST(SelfcalRig, BumpedCameraIsNotTakenForEveryProjectorMoving) {
     const rig::VirtualRig rig = standard();
     SimulationOptions o = quick(8);
