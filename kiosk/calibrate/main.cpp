@@ -1,0 +1,242 @@
+// SPDX-License-Identifier: Apache-2.0
+// mogao-calibrate: camera-based calibration of the projector wall (docs/on-site-calibration.md).
+//
+//   On site (the kiosk stopped: it holds the outputs):
+//     mogao-calibrate --site /etc/mogao/site.toml --outputs kms --camera v4l2:/dev/video0
+//                     --out /var/lib/mogao/calibration [--install /var/lib/mogao/etc/screen.mpcdi]
+//   On a virtual rig (tests, benchmarks; what `mogao-autocal calibrate` does, ground truth reported):
+//     mogao-calibrate --rig rigs/standard.toml --out DIR [--scale 0.5]
+//   The whole on-site path without hardware (SIMULATION: the rig's camera films the headless outputs):
+//     mogao-calibrate --site rigs/standard.toml --outputs headless --camera rig:rigs/standard.toml --out DIR
+//   How many images and how long the capture takes:
+//     mogao-calibrate --site FILE --budget [--camera-fps 30 --settle-ms 150 --drop-frames 2]
+//
+// Exit codes: 0 success, 1 refused or failed (the message says why; the last good calibration is
+// untouched), 2 bad command line.
+#include <unistd.h>
+
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "appliance/autocal/calibrate_job.h"
+#include "appliance/autocal/rig_bridge.h"
+#include "appliance/rig/rig_file.h"
+#include "drivers/headless/headless_output.h"
+#include "drivers/kms/kms_backend.h"
+#include "kiosk/calibrate/on_site_job.h"
+#include "kiosk/calibrate/pattern_budget.h"
+#include "kiosk/calibrate/rig_camera.h"
+
+namespace {
+
+using namespace mogao;
+using namespace mogao::calibrate;
+
+struct Cli {
+    std::filesystem::path rig;
+    std::filesystem::path site;
+    std::string outputs;
+    std::string camera;
+    std::filesystem::path kms_device;
+    std::string content = "1920x1080";
+    std::string camera_size;
+    int camera_fps = 0;
+    double exposure_us = 0.0;
+    double gain = -1.0;
+    double white_balance_k = 0.0;
+    std::string transfer = "srgb";
+    bool grey = false;
+    bool no_colour = false;
+    bool budget = false;
+    double budget_fps = 30.0;
+};
+
+bool parse_size(const std::string& text, ImageSize& out) {
+    return std::sscanf(text.c_str(), "%dx%d", &out.width, &out.height) == 2 && out.width >= 1 && out.height >= 1 &&
+           out.width <= 16384 && out.height <= 16384;
+}
+
+void print_progress(const CaptureProgress& p) {
+    static const bool tty = ::isatty(STDERR_FILENO) != 0;
+    const int step = std::max(1, p.expected / 20);
+    if (!tty && p.done % step != 0 && p.done != p.expected) return;
+    const int bar = 30 * p.done / std::max(1, p.expected);
+    std::fprintf(stderr, "%s[%s%s] %d/%d images, %.2f s each, about %.0f s left%s", tty ? "\r" : "",
+                 std::string(static_cast<std::size_t>(bar), '#').c_str(),
+                 std::string(static_cast<std::size_t>(30 - bar), '.').c_str(), p.done, p.expected, p.seconds_per_image,
+                 p.seconds_left, tty ? "" : "\n");
+}
+
+int run_rig(const Cli& cli, autocal::CalibrateJob job) {
+    job.rig = cli.rig;
+    job.colour = !cli.no_colour;
+    const nlohmann::json r = autocal::run_calibrate_job(job);
+    const auto& t = r["ground_truth"];
+    std::printf(
+        "%s: %d images; geometry mean %.3f p95 %.3f px, seam luminance %.2f %% (against the rig's ground "
+        "truth); %s\n",
+        r["rig"].get<std::string>().c_str(), r["captures"].get<int>(), t["geometry_mean_px"].get<double>(),
+        t["geometry_p95_px"].get<double>(), 100.0 * t["seam_luminance_max_deviation"].get<double>(), job.out.c_str());
+    return 0;
+}
+
+int run_budget(const Cli& cli, const OnSiteJob& job) {
+    const autocal::CalibrationPrior prior = site_prior(job);
+    const PatternBudget b = pattern_budget(prior, job.colour, job.colour_options);
+    const double each = seconds_per_image(cli.budget_fps, job.timing.settle_ms, job.timing.drop_frames);
+    std::printf(
+        "%zu projectors: %d images (identification %d, geometry at most %d, colour %d); at %.0f fps, settle "
+        "%d ms, %d frames dropped: %.3f s per image, %.0f s (%.1f min) of capture\n",
+        prior.projectors.size(), b.total(), b.identification, b.geometry, b.colour, cli.budget_fps,
+        job.timing.settle_ms, job.timing.drop_frames, each, each * b.total(), each * b.total() / 60.0);
+    return 0;
+}
+
+std::unique_ptr<OutputBackend> open_outputs(const Cli& cli, const autocal::CalibrationPrior& prior) {
+    if (cli.outputs == "kms") {
+        auto kms = KmsOutputBackend::create(KmsOptions{cli.kms_device});
+        if (!kms) throw std::runtime_error("KMS outputs: " + kms.error().message + " (is mogao-kiosk stopped?)");
+        return std::move(kms.value());
+    }
+    HeadlessOptions h;
+    for (const autocal::DeviceModel& p : prior.projectors) h.outputs.push_back(p.resolution);
+    auto headless = HeadlessOutputBackend::create(std::move(h));
+    if (!headless) throw std::runtime_error("headless outputs: " + headless.error().message);
+    return std::move(headless.value());
+}
+
+std::unique_ptr<CalibrationCamera> open_rig_camera(const Cli& cli, const OnSiteJob& job, OutputBackend& outputs) {
+    auto* headless = dynamic_cast<HeadlessOutputBackend*>(&outputs);
+    if (headless == nullptr) throw std::invalid_argument("--camera rig:FILE films headless outputs only");
+    const rig::VirtualRig rig = autocal::scaled_rig(rig::load_rig(cli.camera.substr(4)), job.scale, job.scale);
+    std::vector<std::size_t> order(rig.projectors.size());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+    return std::make_unique<RigCamera>(*headless, rig, order);
+}
+
+std::unique_ptr<CalibrationCamera> open_live_camera(const Cli& cli, const autocal::CalibrationPrior& prior) {
+    CameraSourceSpec spec;
+    std::string why;
+    if (!parse_camera_source(cli.camera, spec, &why)) throw std::invalid_argument("--camera: " + why);
+    ImageSize size = prior.camera.resolution;
+    if (!cli.camera_size.empty() && !parse_size(cli.camera_size, size)) {
+        throw std::invalid_argument("--camera-size must be WIDTHxHEIGHT");
+    }
+    spec.width = size.width;
+    spec.height = size.height;
+    spec.fps = cli.camera_fps;
+    spec.colour = !cli.grey;
+    if (cli.exposure_us > 0)
+        spec.controls.exposure = {ControlSetting::Mode::manual, cli.exposure_us, true, "--exposure-us"};
+    if (cli.gain >= 0) spec.controls.gain = {ControlSetting::Mode::manual, cli.gain, true, "--gain"};
+    if (cli.white_balance_k > 0) {
+        spec.controls.white_balance = {ControlSetting::Mode::manual, cli.white_balance_k, true, "--white-balance-k"};
+    }
+    auto camera = open_calibration_camera(spec);
+    if (!camera) throw autocal::CalibrationRefused(camera.error().message);
+    return std::move(camera.value());
+}
+
+int run_site(const Cli& cli, OnSiteJob& job) {
+    const autocal::CalibrationPrior prior = site_prior(job);
+    // A live camera first: one whose exposure cannot be locked is refused before the outputs light.
+    const bool simulated = cli.camera.starts_with("rig:");
+    std::unique_ptr<CalibrationCamera> camera;
+    if (!simulated) camera = open_live_camera(cli, prior);
+    std::unique_ptr<OutputBackend> outputs = open_outputs(cli, prior);
+    if (simulated) camera = open_rig_camera(cli, job, *outputs);
+    std::fprintf(stderr, "mogao-calibrate: camera %s; %zu outputs\n", camera->description().c_str(),
+                 outputs->outputs().size());
+    const nlohmann::json r = run_on_site(job, *outputs, *camera, print_progress);
+    std::printf("%d images in %.1f s (%.3f s each); connectors:", r["captures"].get<int>(),
+                r["capture_seconds"].get<double>(), r["seconds_per_image"].get<double>());
+    for (const auto& c : r["connectors"]) {
+        std::printf(" %s=%s", c["projector"].get<std::string>().c_str(), c["connector"].get<std::string>().c_str());
+    }
+    std::printf("\n");
+    for (const auto& change : r["cabling_changes"])
+        std::printf("cabling changed: %s\n", change.get<std::string>().c_str());
+    for (const auto& p : r["projectors"]) {
+        std::printf("  %s: %d x %d Gray bits, %d correspondences, reprojection rms %.3f px\n",
+                    p["id"].get<std::string>().c_str(), p["column_bits"].get<int>(), p["row_bits"].get<int>(),
+                    p["correspondences"].get<int>(), p["reprojection_rms_px"].get<double>());
+    }
+    std::printf("written to %s%s%s\n", job.out.c_str(), job.install.empty() ? "" : " and ", job.install.c_str());
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"Camera-based calibration of the projector wall (docs/on-site-calibration.md)"};
+    Cli cli;
+    OnSiteJob job;
+    autocal::CalibrateJob rig_job;
+    auto* rig = app.add_option("--rig", cli.rig, "Virtual rig (rigs/*.toml): calibrate it, accuracy vs ground truth")
+                    ->check(CLI::ExistingFile);
+    auto* site = app.add_option("--site", cli.site, "Site file (rig format): the installation as measured")
+                     ->check(CLI::ExistingFile);
+    rig->excludes(site);
+    app.add_option("--out", job.out, "Output folder");
+    app.add_option("--outputs", cli.outputs, "kms or headless")->check(CLI::IsMember({"kms", "headless"}));
+    app.add_option("--camera", cli.camera, "v4l2:/dev/videoN, libcamera:[id], replay:DIR or rig:FILE (simulation)");
+    app.add_option("--install", job.install, "Also write the MPCDI here (the kiosk's [calibration].source)");
+    app.add_option("--kms-device", cli.kms_device, "DRM card (default: the first with a connected connector)");
+    app.add_option("--scale", job.scale, "Resolution scale of projectors and camera, (0, 1]")
+        ->check(CLI::Range(0.05, 1.0));
+    app.add_option("--content", cli.content, "Content frame WIDTHxHEIGHT (the farm's frame)");
+    app.add_option("--alpha-bits", job.alpha_bits, "Alpha map bits, 8 or 16")->check(CLI::IsMember({8, 16}));
+    app.add_option("--warp-step", job.options.warp_step_px, "Warp grid step, output pixels")->check(CLI::Range(1, 64));
+    app.add_flag("--no-colour", cli.no_colour, "Geometry only: no response, black-level and colour matching step");
+    app.add_option("--camera-size", cli.camera_size, "Camera WIDTHxHEIGHT (default: the site file's camera)");
+    app.add_option("--camera-fps", cli.camera_fps, "Camera frame rate to ask for (0: the driver's)")
+        ->check(CLI::Range(0, 1000));
+    app.add_option("--exposure-us", cli.exposure_us, "Manual exposure, us (default: lock the current one)")
+        ->check(CLI::Range(1.0, 1e6));
+    app.add_option("--gain", cli.gain, "Manual gain, device units (default: lock)")->check(CLI::Range(0.0, 1e6));
+    app.add_option("--white-balance-k", cli.white_balance_k, "Manual white balance, K (default: lock)")
+        ->check(CLI::Range(1000.0, 20000.0));
+    app.add_option("--camera-transfer", cli.transfer, "Camera codes: srgb (decoded) or linear")
+        ->check(CLI::IsMember({"srgb", "linear"}));
+    app.add_flag("--grey", cli.grey, "Use the camera's luma instead of colour frames");
+    app.add_option("--settle-ms", job.timing.settle_ms, "Wait after each flip, ms")->check(CLI::Range(0, 10000));
+    app.add_option("--drop-frames", job.timing.drop_frames, "Camera frames dropped after the settle")
+        ->check(CLI::Range(0, 30));
+    app.add_flag("--budget", cli.budget, "Print the image count and capture time for --site, then exit");
+    app.add_option("--budget-fps", cli.budget_fps, "Camera frame rate for --budget")->check(CLI::Range(1.0, 1000.0));
+    try {
+        app.parse(argc, argv);
+        if (!parse_size(cli.content, job.content))
+            throw CLI::ValidationError("--content", "must be WIDTHxHEIGHT, 1..16384");
+        if (cli.rig.empty() && cli.site.empty()) throw CLI::ValidationError("--rig or --site", "one is required");
+        if (!cli.budget && job.out.empty()) throw CLI::ValidationError("--out", "is required");
+        if (!cli.site.empty() && !cli.budget && (cli.outputs.empty() || cli.camera.empty())) {
+            throw CLI::ValidationError("--site", "needs --outputs and --camera (or --budget)");
+        }
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e) == 0 ? 0 : 2;
+    }
+    job.site = cli.site;
+    job.colour = !cli.no_colour;
+    job.transfer =
+        cli.transfer == "linear" || cli.camera.starts_with("rig:") ? CameraTransfer::linear : CameraTransfer::srgb;
+    try {
+        if (!cli.rig.empty()) {
+            rig_job.out = job.out;
+            rig_job.scale = job.scale;
+            rig_job.content = job.content;
+            rig_job.alpha_bits = job.alpha_bits;
+            rig_job.options = job.options;
+            return run_rig(cli, rig_job);
+        }
+        if (cli.budget) return run_budget(cli, job);
+        return run_site(cli, job);
+    } catch (const std::exception& e) {
+        std::cerr << "\nmogao-calibrate: " << e.what() << "\n";
+        return 1;
+    }
+}

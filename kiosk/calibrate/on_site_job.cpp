@@ -1,0 +1,228 @@
+// SPDX-License-Identifier: Apache-2.0
+// The on-site calibration job: outputs + camera -> calibration -> files (on_site_job.h).
+#include "kiosk/calibrate/on_site_job.h"
+
+#include <cmath>
+#include <fstream>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "appliance/autocal/model_store.h"
+#include "appliance/autocal/rig_bridge.h"
+#include "appliance/calibration/mpcdi_screen.h"
+#include "appliance/calibration/mpcdi_writer.h"
+#include "appliance/rig/rig_file.h"
+#include "kiosk/calibrate/connector_identity.h"
+#include "kiosk/calibrate/pattern_budget.h"
+
+namespace mogao::calibrate {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Identified {
+    std::vector<std::size_t> projector_output;
+    std::vector<LitOutput> lit;
+    cv::Mat1f white;  // every output white
+};
+
+// Step 1 (connector_identity.h): black, all white, each output white alone.
+Identified identify(HardwarePatternSource& source, const PatternDisplay& display,
+                    const autocal::CalibrationPrior& prior, double min_contrast, double min_lit_fraction) {
+    const std::size_t outputs = display.output_count();
+    std::vector<cv::Mat> per_output(outputs);
+    const cv::Mat1f black = source.show_outputs(per_output);
+    std::vector<cv::Mat> all(outputs);
+    for (std::size_t i = 0; i < outputs; ++i) {
+        all[i] = cv::Mat1f(display.output(i).size.height, display.output(i).size.width, 1.0f);
+    }
+    Identified id;
+    id.white = source.show_outputs(all);
+    std::vector<cv::Mat1f> alone;
+    for (std::size_t i = 0; i < outputs; ++i) {
+        per_output.assign(outputs, cv::Mat());
+        per_output[i] = all[i];
+        alone.push_back(source.show_outputs(per_output));
+    }
+    id.lit = lit_outputs(black, alone, min_contrast);
+    std::vector<std::string> names;
+    std::vector<std::string> ids;
+    for (std::size_t i = 0; i < outputs; ++i) names.push_back(display.output(i).name);
+    for (const autocal::DeviceModel& p : prior.projectors) ids.push_back(p.id);
+    id.projector_output = assign_projectors(id.lit, names, ids, min_lit_fraction);
+    for (std::size_t k = 0; k < ids.size(); ++k) {
+        const OutputInfo& o = display.output(id.projector_output[k]);
+        const ImageSize want = prior.projectors[k].resolution;
+        if (o.size.width != want.width || o.size.height != want.height) {
+            throw std::runtime_error("projector " + std::to_string(k) + " '" + ids[k] + "' is on connector " + o.name +
+                                     " whose mode is " + std::to_string(o.size.width) + "x" +
+                                     std::to_string(o.size.height) + "; the site file says " +
+                                     std::to_string(want.width) + "x" + std::to_string(want.height));
+        }
+    }
+    return id;
+}
+
+nlohmann::json connectors_json(const Identified& id, const PatternDisplay& display,
+                               const autocal::CalibrationPrior& prior) {
+    nlohmann::json out = nlohmann::json::array();
+    for (std::size_t k = 0; k < id.projector_output.size(); ++k) {
+        const std::size_t i = id.projector_output[k];
+        const LitOutput& l = id.lit[i];
+        nlohmann::json c = {{"projector", prior.projectors[k].id},
+                            {"connector", display.output(i).name},
+                            {"refresh_hz", display.output(i).refresh_hz},
+                            {"lit_fraction", l.lit_fraction},
+                            {"centroid_x_px", l.centroid_x}};
+        if (const auto edid = read_connector_edid(display.output(i).name)) {
+            c["edid"] = {{"manufacturer", edid->manufacturer},
+                         {"product", edid->product},
+                         {"serial", edid->serial},
+                         {"serial_text", edid->serial_text},
+                         {"name", edid->name}};
+        }
+        out.push_back(c);
+    }
+    return out;
+}
+
+nlohmann::json fit_json(const autocal::AutocalResult& r, std::size_t k) {
+    const autocal::ProjectorReport& p = r.report.projectors[k];
+    return {{"id", p.id},
+            {"resolution", {r.projectors[k].resolution.width, r.projectors[k].resolution.height}},
+            {"column_bits", p.column_bits},
+            {"row_bits", p.row_bits},
+            {"correspondences", p.cells},
+            {"reprojection_rms_px", p.rms_px},
+            {"mean_view_angle_deg", p.mean_view_angle_deg}};
+}
+
+nlohmann::json colour_json(const autocal::ColourResult& c) {
+    nlohmann::json out = {{"captures", c.captures},
+                          {"matched_white", c.matched_white},
+                          {"black_floor", c.black_floor},
+                          {"ambient", c.ambient},
+                          {"alpha_scale", c.alpha_scale}};
+    for (const autocal::ProjectorPhotometry& p : c.projectors) {
+        nlohmann::json ch = nlohmann::json::array();
+        for (const autocal::ChannelResponse& r : p.channels) {
+            ch.push_back({{"amplitude", r.amplitude}, {"gamma", r.gamma}, {"gamma_fit_rms", r.gamma_rms}});
+        }
+        out["projectors"].push_back({{"id", p.id}, {"black", p.black}, {"gain", p.gain}, {"channels", ch}});
+    }
+    return out;
+}
+
+nlohmann::json previous_connectors(const fs::path& report) {
+    std::ifstream f(report);
+    if (!f) return nullptr;
+    try {
+        const nlohmann::json j = nlohmann::json::parse(f);
+        return j.contains("connectors") ? j["connectors"] : nlohmann::json(nullptr);
+    } catch (const nlohmann::json::exception&) {
+        return nullptr;  // an unreadable old report only means no comparison
+    }
+}
+
+// Copies `file` (when present) to `<file>.last-good` atomically (temporary copy, rename).
+void keep_last_good(const fs::path& file) {
+    if (!fs::exists(file)) return;
+    const fs::path good = file.string() + ".last-good";
+    const fs::path tmp = file.string() + ".last-good.tmp";
+    fs::copy_file(file, tmp, fs::copy_options::overwrite_existing);
+    fs::rename(tmp, good);
+}
+
+void write_calibration(const fs::path& mpcdi, const autocal::CalibrationModels& models, const ScreenCalibration& c,
+                       const OnSiteJob& job) {
+    fs::create_directories(mpcdi.parent_path().empty() ? fs::path(".") : mpcdi.parent_path());
+    keep_last_good(autocal::models_path_for(mpcdi));
+    keep_last_good(mpcdi);
+    MpcdiExportOptions mo;
+    mo.alpha_bit_depth = job.alpha_bits;
+    mo.write_response = job.colour;
+    autocal::write_models(autocal::models_path_for(mpcdi), models);  // first: the watcher finds its models
+    write_mpcdi(mpcdi, to_mpcdi(c, mo));
+}
+
+void write_camera_png(const fs::path& png, const cv::Mat1f& linear) {
+    cv::Mat1b out(linear.size());
+    for (int y = 0; y < linear.rows; ++y) {
+        for (int x = 0; x < linear.cols; ++x) {
+            const double v = std::clamp(static_cast<double>(linear(y, x)), 0.0, 1.0);
+            const double e = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+            out(y, x) = cv::saturate_cast<uchar>(255.0 * e);
+        }
+    }
+    if (!cv::imwrite(png.string(), out)) throw std::runtime_error("calibrate: cannot write '" + png.string() + "'");
+}
+
+}  // namespace
+
+autocal::CalibrationPrior site_prior(const OnSiteJob& job) {
+    return autocal::prior_from_rig(autocal::scaled_rig(rig::load_rig(job.site), job.scale, job.scale));
+}
+
+nlohmann::json run_on_site(const OnSiteJob& job, OutputBackend& outputs, CalibrationCamera& camera,
+                           const ProgressFn& progress) {
+    const autocal::CalibrationPrior prior = site_prior(job);
+    if (outputs.outputs().size() < prior.projectors.size()) {
+        throw std::runtime_error("the site file has " + std::to_string(prior.projectors.size()) +
+                                 " projectors, the outputs only " + std::to_string(outputs.outputs().size()));
+    }
+    auto display = PatternDisplay::create(outputs, job.flip_timeout_ms);
+    if (!display) throw std::runtime_error(display.error().message);
+    const PatternBudget budget = pattern_budget(prior, job.colour, job.colour_options);
+    std::vector<std::size_t> order(prior.projectors.size());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+    HardwarePatternSource source(display.value(), camera, order, prior.camera.resolution, job.transfer, job.timing,
+                                 budget.total(), progress);
+    autocal::require_locked_exposure(source);  // step 0: before any pattern is shown
+    const Identified id = identify(source, display.value(), prior, job.options.min_contrast, job.min_lit_fraction);
+    source.set_projector_output(id.projector_output);
+    autocal::AutocalResult r = autocal::calibrate(source, prior, job.content, job.options);
+    std::optional<autocal::ColourResult> colour;
+    if (job.colour) {
+        colour = autocal::calibrate_colour(source, prior.screen, r.projectors, r.calibration, job.colour_options);
+    }
+    const double seconds = source.seconds();
+    const int images = source.images();
+    if (auto s = display.value().show_outputs(std::vector<cv::Mat>(display.value().output_count())); !s) {
+        throw std::runtime_error(s.error().message);
+    }
+    nlohmann::json report = {{"site_file", job.site.string()},
+                             {"scale", job.scale},
+                             {"content", {job.content.width, job.content.height}},
+                             {"camera",
+                              {{"source", camera.description()},
+                               {"edge_points", r.report.edge_points},
+                               {"edge_rms_mm", r.report.edge_rms_m * 1e3}}},
+                             {"captures", images},
+                             {"budget",
+                              {{"identification", budget.identification},
+                               {"geometry_at_most", budget.geometry},
+                               {"colour", budget.colour},
+                               {"total", budget.total()}}},
+                             {"capture_seconds", seconds},
+                             {"seconds_per_image", seconds / std::max(1, images)},
+                             {"settle_ms", job.timing.settle_ms},
+                             {"drop_frames", job.timing.drop_frames}};
+    report["connectors"] = connectors_json(id, display.value(), prior);
+    report["cabling_changes"] = cabling_changes(previous_connectors(job.out / "report.json"), report["connectors"]);
+    for (std::size_t k = 0; k < r.projectors.size(); ++k) report["projectors"].push_back(fit_json(r, k));
+    if (colour) report["colour"] = colour_json(*colour);
+    const autocal::CalibrationModels models{prior.screen, r.camera, r.projectors};
+    write_calibration(job.out / "calibration.mpcdi", models, r.calibration, job);
+    if (!job.install.empty()) write_calibration(job.install, models, r.calibration, job);
+    write_camera_png(job.out / "camera-white.png", id.white);
+    const fs::path json = job.out / "report.json";
+    std::ofstream f(json);
+    f << report.dump(2) << "\n";
+    if (!f) throw std::runtime_error("calibrate: cannot write '" + json.string() + "'");
+    return report;
+}
+
+}  // namespace mogao::calibrate

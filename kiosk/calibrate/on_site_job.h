@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: Apache-2.0
+// The on-site calibration job (`mogao-calibrate --outputs kms|headless --camera NAME`,
+// docs/on-site-calibration.md): the camera-based calibration of appliance/autocal run on the
+// appliance's outputs and a camera, from the site file to the files the kiosk loads.
+//
+// Site file: a rig file (rigs/*.toml, appliance/rig/rig_file.h) describing the installation as
+// measured: [screen], the camera's intrinsics (chessboard, `mogao-track calibrate-camera`) and
+// roughly measured pose, and per projector (listed left to right as the viewer sees them) its id,
+// resolution (= its output's mode), throw ratio and lens shift from the data sheet; [prior] errors
+// 0. Responses, gamma, noise and the projectors' poses are not used (they are what is measured).
+//
+// Steps: (0) the camera's exposure must be locked: refused before any pattern is shown; (1) which
+// output drives which projector, from the camera (connector_identity.h), with each connector's
+// EDID; (2) autocal::calibrate (Gray code, camera pose, projector fits, bundle adjustment, warp,
+// blend) and (3) autocal::calibrate_colour unless `colour` is off, both through
+// HardwarePatternSource; (4) all outputs black again; (5) the files, into `out`:
+//   calibration.models.json, calibration.mpcdi  as mogao-autocal writes them (atomic, the models
+//                      first); a calibration.mpcdi already there is kept as calibration.mpcdi.last-good
+//                      (and its models as calibration.models.json.last-good) before it is replaced,
+//   report.json        per projector the fit (bits, correspondences, reprojection rms, view angle),
+//                      "connectors" (projector id, connector name, EDID, lit fraction, centroid),
+//                      "cabling_changes" against the previous report.json in `out`, the captured image
+//                      count, capture seconds and seconds per image, the budget, the camera, the colour
+//                      step's figures; no ground truth (there is none on site),
+//   camera-white.png   what the camera saw with every projector white (8-bit, the camera's codes
+//                      re-encoded sRGB): where the screen and the projectors are, for the technician.
+// and, when `install` is set, the MPCDI and its models also to `install` (the kiosk's
+// [calibration].source on the config partition, e.g. /var/lib/mogao/etc/screen.mpcdi), the previous
+// ones kept as <file>.last-good; the kiosk's calibration watcher swaps it in if the kiosk runs.
+// A refusal (autocal::CalibrationRefused) or any error writes nothing: the last good calibration
+// stays where it was.
+#pragma once
+
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+#include "appliance/autocal/autocal.h"
+#include "appliance/autocal/colour_calibration.h"
+#include "drivers/output.h"
+#include "kiosk/calibrate/calibration_camera.h"
+#include "kiosk/calibrate/hardware_pattern_source.h"
+
+namespace mogao::calibrate {
+
+struct OnSiteJob {
+    std::filesystem::path site;     // rig-format site file (above)
+    double scale = 1.0;             // projector and camera resolutions scaled (tests, demos), (0, 1]
+    std::filesystem::path out;      // folder, created if missing
+    std::filesystem::path install;  // empty: none
+    ImageSize content{1920, 1080};
+    int alpha_bits = 16;
+    autocal::AutocalOptions options;
+    bool colour = true;
+    autocal::ColourOptions colour_options;
+    CaptureTiming timing;
+    CameraTransfer transfer = CameraTransfer::srgb;
+    double min_lit_fraction = 0.01;  // identification: an output must light this much of the camera image
+    int flip_timeout_ms = 2000;
+};
+
+// The calibration prior the site file gives (scaled by job.scale). Throws rig::RigError.
+[[nodiscard]] autocal::CalibrationPrior site_prior(const OnSiteJob& job);
+
+// Runs the job on `outputs` (the backend's GL context current on this thread) and `camera`; returns
+// the report (also written). Throws autocal::CalibrationRefused (nothing written), rig::RigError,
+// std::runtime_error naming the output, camera or file.
+nlohmann::json run_on_site(const OnSiteJob& job, OutputBackend& outputs, CalibrationCamera& camera,
+                           const ProgressFn& progress);
+
+}  // namespace mogao::calibrate

@@ -1,0 +1,33 @@
+// SPDX-License-Identifier: Apache-2.0
+// Captured image count and capture time of the on-site calibration (pattern_budget.h).
+#include "kiosk/calibrate/pattern_budget.h"
+
+namespace mogao::calibrate {
+
+PatternBudget pattern_budget(const autocal::CalibrationPrior& prior, bool colour,
+                             const autocal::ColourOptions& colour_options) {
+    const int n = static_cast<int>(prior.projectors.size());
+    PatternBudget b;
+    b.identification = 2 + n;
+    b.geometry = 2;
+    for (const autocal::DeviceModel& p : prior.projectors) {
+        b.geometry +=
+            2 + 2 * (autocal::gray_code_bits(p.resolution.width) + autocal::gray_code_bits(p.resolution.height));
+    }
+    if (colour) {
+        const int steps = colour_options.ramp_steps;
+        int low = 2;
+        for (int i = 1; i < steps; ++i) {
+            const double s = static_cast<double>(i) / (steps - 1);
+            if (s <= 0.25 && s != 1.0 / 32.0 && s != 1.0 / 16.0) ++low;
+        }
+        b.colour = 5 + n * 3 * ((steps - 1) + low) + colour_options.dark_frames;
+    }
+    return b;
+}
+
+double seconds_per_image(double fps, int settle_ms, int drop_frames) {
+    return settle_ms / 1000.0 + (drop_frames + 1) / fps;
+}
+
+}  // namespace mogao::calibrate
