@@ -33,7 +33,7 @@ void check_options(const SelfcalOptions& o) {
     if (!(o.transition_s >= 0.0) || !std::isfinite(o.transition_s)) fail("transition_s >= 0");
     if (o.min_matches < 6) fail("min_matches >= 6");
     if (!(o.max_offscreen_loss > 0.0 && o.max_offscreen_loss <= 1.0)) fail("max_offscreen_loss in (0, 1]");
-    if (!(o.camera_rebase_deg >= 0.0)) fail("camera_rebase_deg >= 0");
+    if (!(o.camera_rebase_px >= 0.0)) fail("camera_rebase_px >= 0");
     if (o.pattern.enabled) check_pattern_options(o.pattern);
 }
 
@@ -132,6 +132,29 @@ double SelfCalibrator::drift_px(int k, const Pose6& delta) const {
             const Eigen::Vector2d q = project_normalised(moved.rotation, moved.position_m, s);
             if (!q.allFinite()) continue;
             sum += std::hypot(q.x() * d.fx_px + d.cx_px - x, q.y() * d.fy_px + d.cy_px - y);
+            ++n;
+        }
+    }
+    return n > 0 ? sum / n : 0.0;
+}
+
+double SelfCalibrator::camera_drift_px(const Pose6& delta) const {
+    const SystemModel& m = monitor_.model();
+    const autocal::DeviceModel& c = m.camera;
+    const autocal::DeviceModel moved = apply_delta(c, delta);
+    double sum = 0.0;
+    int n = 0;
+    constexpr int kGx = 16;
+    constexpr int kGy = 9;
+    for (int j = 0; j < kGy; ++j) {
+        for (int i = 0; i < kGx; ++i) {
+            const Eigen::Vector2d q0(((i + 0.5) * c.resolution.width / kGx - c.cx_px) / c.fx_px,
+                                     ((j + 0.5) * c.resolution.height / kGy - c.cy_px) / c.fy_px);
+            const Eigen::Vector3d s = autocal::ray_on_screen(m.screen, c, {q0.x(), q0.y(), 1.0});
+            if (!s.allFinite()) continue;
+            const Eigen::Vector2d q = project_normalised(moved.rotation, moved.position_m, s);
+            if (!q.allFinite()) continue;
+            sum += std::hypot((q.x() - q0.x()) * c.fx_px, (q.y() - q0.y()) * c.fy_px);
             ++n;
         }
     }
@@ -293,7 +316,7 @@ void SelfCalibrator::rebase_camera(double t_s, StepResult& r) {
     const Pose6& x = camera_filter_.state();
     const double deg = x.head<3>().norm() * kRad2Deg;
     r.status.camera_rotation_deg = deg;
-    const bool moved = (deg > options_.camera_rebase_deg || x.tail<3>().norm() > 1e-3) &&
+    const bool moved = camera_drift_px(x) > options_.camera_rebase_px &&
                        camera_filter_.significance() > options_.camera_kalman.gate_chi2;
     if (!moved) {
         camera_since_ = -1.0;
@@ -301,15 +324,15 @@ void SelfCalibrator::rebase_camera(double t_s, StepResult& r) {
     }
     if (camera_since_ < 0.0) camera_since_ = t_s;
     if (t_s - camera_since_ < options_.hold_s) return;
+    const double shift_mm = x.tail<3>().norm() * 1e3;  // x is the filter's state: read before the reset
+    const double moved_px = camera_drift_px(x);
     SystemModel m = monitor_.model();
     m.camera = apply_delta(m.camera, x);
     monitor_.set_reference(m, wall_);
     camera_filter_.reset();
     camera_since_ = -1.0;
-    r.journal.push_back(
-        fmt("selfcal: t=%.2f s: camera moved by %.3f deg, %.1f mm: monitor re-based on it "
-            "(the projectors are unaffected)",
-            t_s, deg, x.tail<3>().norm() * 1e3));
+    r.journal.push_back(fmt("selfcal: t=%.2f s: camera moved by %.3f deg, %.1f mm", t_s, deg, shift_mm) +
+                        fmt(" (%.2f camera px): monitor re-based on it (the projectors are unaffected)", moved_px));
 }
 
 StepResult SelfCalibrator::step(const cv::Mat1f& content, const cv::Mat1f& camera_frame, double t_s) {

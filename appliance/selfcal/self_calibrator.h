@@ -19,9 +19,9 @@
 //     follow, e.g. mostly off the screen).
 // A frame with fewer than `min_matches` matches for a projector gives that projector no
 // measurement (its filter only predicts): waiting, "insufficient evidence". A camera whose filtered
-// pose change is significant and above `camera_rebase_deg` for hold_s re-bases the monitor's
-// camera (the projectors' estimates are made against the per-frame camera fit already).
-// Every decision is a journal line with before/after figures.
+// pose change is significant and moves the screen's image by more than `camera_rebase_px` for hold_s re-bases the
+// monitor's camera (the projectors' estimates are made against the per-frame camera fit already). Every decision is a
+// journal line with before/after figures.
 #pragma once
 
 #include <cstdint>
@@ -47,8 +47,11 @@ struct SelfcalOptions {
     double transition_s = 3.0;        // >= 0
     int min_matches = 30;             // per projector, >= 6
     double max_offscreen_loss = 0.5;  // (0, 1]
-    double camera_rebase_deg = 0.05;  // >= 0
-    std::filesystem::path store;      // empty: corrected calibrations are not written
+    // The camera is re-based when its filtered pose change moves the screen's image by more than
+    // this many camera pixels on average (a small shift with the rotation that compensates it
+    // hardly moves the image: a threshold in degrees or mm re-based on such noise). >= 0.
+    double camera_rebase_px = 0.5;
+    std::filesystem::path store;  // empty: corrected calibrations are not written
     MonitorOptions monitor;
     KalmanOptions kalman;
     KalmanOptions camera_kalman;
@@ -105,6 +108,7 @@ private:
     void rebase_camera(double t_s, StepResult& r);
     bool check_lost(double t_s, StepResult& r);
     [[nodiscard]] double drift_px(int k, const Pose6& delta) const;
+    [[nodiscard]] double camera_drift_px(const Pose6& delta) const;  // mean image displacement, camera pixels
     [[nodiscard]] double on_screen_fraction(const autocal::DeviceModel& d) const;
 
     SelfcalOptions options_;

@@ -95,6 +95,10 @@ int main(int argc, char** argv) {
     sim->add_option("--occluder-ratio", o.selfcal.monitor.occluder_ratio,
                     "visitor mask: cells darker or brighter than predicted by this factor; 0 off")
         ->check(CLI::Range(0.0, 0.99));
+    sim->add_option("--occluder-cell", o.selfcal.monitor.occluder_cell_px, "visitor mask: cell size, camera pixels")
+        ->check(CLI::Range(2, 256));
+    sim->add_option("--min-matches", o.selfcal.min_matches, "matches a projector needs for a measurement")
+        ->check(CLI::Range(6, 100000));
     double prior_mm = o.selfcal.monitor.projector_fit.prior_position_sd_m * 1e3;
     sim->add_option("--position-prior-mm", prior_mm,
                     "projector fit's position prior, mm per pixel of residual (0 none)")
