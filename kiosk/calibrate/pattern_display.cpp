@@ -91,6 +91,7 @@ Status PatternDisplay::show_outputs(const std::vector<cv::Mat>& per_output) {
         return make_error(EINVAL, "pattern display: " + std::to_string(per_output.size()) + " patterns for " +
                                       std::to_string(output_count()) + " outputs");
     }
+    std::vector<std::optional<Rgb8Image>> staged(output_count());
     for (std::size_t i = 0; i < output_count(); ++i) {
         const OutputInfo& info = output(i);
         Rgb8Image content;
@@ -99,6 +100,7 @@ Status PatternDisplay::show_outputs(const std::vector<cv::Mat>& per_output) {
         } catch (const std::invalid_argument& e) {
             return make_error(EINVAL, "output " + info.name + ": " + e.what());
         }
+        if (i < shown_.size() && shown_[i] && shown_[i]->pixels == content.pixels) continue;  // still on screen
         if (auto s = backend_->begin_frame(i); !s) return with_context(s.error(), "output " + info.name);
         if (auto s = backend_->renderer().set_content(content); !s)
             return with_context(s.error(), "output " + info.name);
@@ -106,8 +108,13 @@ Status PatternDisplay::show_outputs(const std::vector<cv::Mat>& per_output) {
             return with_context(s.error(), "output " + info.name);
         }
         if (auto s = backend_->stage(i); !s) return with_context(s.error(), "output " + info.name);
+        staged[i] = std::move(content);
     }
     if (auto s = backend_->commit_round(); !s) return with_context(s.error(), "pattern display");
+    shown_.resize(output_count());
+    for (std::size_t i = 0; i < output_count(); ++i) {
+        if (staged[i]) shown_[i] = std::move(staged[i]);
+    }
     return wait_for_flips();
 }
 

@@ -12,13 +12,16 @@
 // code 0..255 and reads it back). A pattern value s in [0, 1] becomes code round(255 s): the signal
 // is quantised to the outputs' 8 bits, as the kiosk's own pictures are.
 //
-// Timing: show() stages every output (black where no projector's pattern goes) and commits them in
-// one round (one atomic commit on KMS), then waits until every output's flip completed (KMS flip
-// events on the DRM fd; headless completes on commit). Errors: common/result.h; ETIMEDOUT naming
+// Timing: show() stages every output whose picture changes (black where no projector's pattern
+// goes; an output already showing its pattern is left as it is, which saves most draws: the Gray
+// code changes one projector at a time) and commits them in one round (one atomic commit on KMS),
+// then waits until every output's flip completed (KMS flip events on the DRM fd; headless
+// completes on commit). Errors: common/result.h; ETIMEDOUT naming
 // the output when a flip does not complete within the timeout.
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -62,6 +65,7 @@ private:
     OutputBackend* backend_;
     std::vector<std::size_t> renderer_index_;  // per output: its identity projector in the renderer
     int flip_timeout_ms_;
+    std::vector<std::optional<Rgb8Image>> shown_;  // per output: what it shows (nullopt: not drawn yet)
 };
 
 }  // namespace mogao::calibrate

@@ -57,6 +57,8 @@ TEST(PatternDisplay, EveryCodeReachesTheOutputExactly) {
         EXPECT_EQ(p[1], (x * 7) % 256);
         EXPECT_EQ(p[2], 255 - x);
     }
+    EXPECT_EQ(backend->frame_count(1), 1u);  // still black: not drawn again
+    EXPECT_EQ(backend->frame_count(0), 2u);
     EXPECT_FALSE(display.value().show_outputs({cv::Mat1f(2, 2, 0.0f), cv::Mat()}));  // wrong size
     EXPECT_FALSE(display.value().show_outputs({cv::Mat()}));                         // wrong count
 }

@@ -7,6 +7,29 @@
 #include <string>
 
 namespace mogao::calibrate {
+namespace {
+
+// An output's frame as the rig projector's signal, code / 255: CV_32FC1 when every pixel is grey
+// (the Gray code and identification patterns; the rig forms those images for one channel, not three).
+cv::Mat signal_of(const Rgb8Image& shown) {
+    const std::uint8_t* p = shown.pixels.data();
+    bool grey = true;
+    for (std::size_t i = 0; i + 2 < shown.pixels.size() && grey; i += 3) grey = p[i] == p[i + 1] && p[i] == p[i + 2];
+    if (grey) {
+        cv::Mat1f s(shown.size.height, shown.size.width);
+        for (int y = 0; y < s.rows; ++y) {
+            for (int x = 0; x < s.cols; ++x, p += 3) s(y, x) = p[0] / 255.0f;
+        }
+        return s;
+    }
+    cv::Mat3f s(shown.size.height, shown.size.width);
+    for (int y = 0; y < s.rows; ++y) {
+        for (int x = 0; x < s.cols; ++x, p += 3) s(y, x) = cv::Vec3f(p[0], p[1], p[2]) / 255.0f;
+    }
+    return s;
+}
+
+}  // namespace
 
 RigCamera::RigCamera(const HeadlessOutputBackend& outputs, const rig::VirtualRig& rig,
                      std::vector<std::size_t> projector_output)
@@ -25,12 +48,7 @@ Result<CameraFrame> RigCamera::next_frame() {
     for (std::size_t k = 0; k < signals.size(); ++k) {
         const Rgb8Image& shown = outputs_->last_frame(projector_output_[k]);
         if (shown.pixels.empty()) continue;  // nothing presented yet: the projector shows black
-        cv::Mat3f s(shown.size.height, shown.size.width);
-        const std::uint8_t* p = shown.pixels.data();
-        for (int y = 0; y < s.rows; ++y) {
-            for (int x = 0; x < s.cols; ++x, p += 3) s(y, x) = cv::Vec3f(p[0], p[1], p[2]) / 255.0f;
-        }
-        signals[k] = s;
+        signals[k] = signal_of(shown);
     }
     cv::Mat1f image;
     try {
