@@ -24,6 +24,8 @@
 
 #include "appliance/autocal/calibrate_job.h"
 #include "appliance/autocal/rig_bridge.h"
+#include "appliance/calibration/mpcdi_reader.h"
+#include "appliance/calibration/mpcdi_screen.h"
 #include "appliance/rig/rig_file.h"
 #include "drivers/headless/headless_output.h"
 #include "drivers/kms/kms_backend.h"
@@ -141,6 +143,16 @@ std::unique_ptr<CalibrationCamera> open_live_camera(const Cli& cli, const autoca
     return std::move(camera.value());
 }
 
+// A simulation knows the truth: the written MPCDI (as the kiosk reads it) against the rig's ground
+// truth, in projector pixels of the (scaled) rig (autocal::measure_geometry).
+void print_simulation_truth(const Cli& cli, const OnSiteJob& job) {
+    const rig::VirtualRig rig = autocal::scaled_rig(rig::load_rig(cli.camera.substr(4)), job.scale, job.scale);
+    const ScreenCalibration c = to_screen_calibration(read_mpcdi(job.out / "calibration.mpcdi"));
+    const autocal::GeometryError g = autocal::measure_geometry(rig, c, 4);
+    std::printf("SIMULATION ground truth (rig %s): geometry mean %.3f p95 %.3f px\n", rig.name.c_str(), g.mean_px,
+                g.p95_px);
+}
+
 int run_site(const Cli& cli, OnSiteJob& job) {
     const autocal::CalibrationPrior prior = site_prior(job);
     // A live camera first: one whose exposure cannot be locked is refused before the outputs light.
@@ -166,6 +178,7 @@ int run_site(const Cli& cli, OnSiteJob& job) {
                     p["correspondences"].get<int>(), p["reprojection_rms_px"].get<double>());
     }
     std::printf("written to %s%s%s\n", job.out.c_str(), job.install.empty() ? "" : " and ", job.install.c_str());
+    if (simulated) print_simulation_truth(cli, job);
     return 0;
 }
 
