@@ -175,5 +175,28 @@ TEST_F(OnSiteJobTest, CameraThatSeesNothingIsRefusedNamingTheProjector) {
     expect_last_good_untouched();
 }
 
+TEST_F(OnSiteJobTest, CameraOfAnotherSizeIsAnErrorNamingBothSizes) {
+    const fs::path rec = dir_ / "recording";
+    fs::create_directories(rec);
+    ASSERT_TRUE(cv::imwrite((rec / "000000.png").string(), cv::Mat1b(100, 100, uchar{90})));
+    CameraSourceSpec spec;
+    ASSERT_TRUE(parse_camera_source("replay:" + rec.string(), spec, nullptr));
+    spec.loop = true;
+    auto camera = open_calibration_camera(spec);
+    ASSERT_TRUE(camera) << camera.error().message;
+    plant_last_good();
+    try {
+        (void)run_on_site(job_, *backend_, *camera.value(), nullptr);
+        FAIL() << "a camera of another size than the site file's must fail";
+    } catch (const std::runtime_error& e) {
+        const std::string cam =
+            std::to_string(rig_.camera.resolution.width) + "x" + std::to_string(rig_.camera.resolution.height);
+        EXPECT_NE(std::string(e.what()).find("delivers 100x100 frames, the calibration's camera is " + cam),
+                  std::string::npos)
+            << e.what();
+    }
+    expect_last_good_untouched();
+}
+
 }  // namespace
 }  // namespace mogao::calibrate
