@@ -160,6 +160,43 @@ void write_camera_png(const fs::path& png, const cv::Mat1f& linear) {
     if (!cv::imwrite(png.string(), out)) throw std::runtime_error("calibrate: cannot write '" + png.string() + "'");
 }
 
+// Steps 4-5: the report and the files (on_site_job.h).
+nlohmann::json finish(const OnSiteJob& job, const Identified& id, const autocal::AutocalResult& r,
+                      const std::optional<autocal::ColourResult>& colour, const PatternDisplay& display,
+                      const autocal::CalibrationPrior& prior, const CalibrationCamera& camera,
+                      const PatternBudget& budget, double seconds, int images) {
+    nlohmann::json report = {{"site_file", job.site.string()},
+                             {"scale", job.scale},
+                             {"content", {job.content.width, job.content.height}},
+                             {"camera",
+                              {{"source", camera.description()},
+                               {"edge_points", r.report.edge_points},
+                               {"edge_rms_mm", r.report.edge_rms_m * 1e3}}},
+                             {"captures", images},
+                             {"budget",
+                              {{"identification", budget.identification},
+                               {"geometry_at_most", budget.geometry},
+                               {"colour", budget.colour},
+                               {"total", budget.total()}}},
+                             {"capture_seconds", seconds},
+                             {"seconds_per_image", seconds / std::max(1, images)},
+                             {"settle_ms", job.timing.settle_ms},
+                             {"drop_frames", job.timing.drop_frames}};
+    report["connectors"] = connectors_json(id, display, prior);
+    report["cabling_changes"] = cabling_changes(previous_connectors(job.out / "report.json"), report["connectors"]);
+    for (std::size_t k = 0; k < r.projectors.size(); ++k) report["projectors"].push_back(fit_json(r, k));
+    if (colour) report["colour"] = colour_json(*colour);
+    const autocal::CalibrationModels models{prior.screen, r.camera, r.projectors};
+    write_calibration(job.out / "calibration.mpcdi", models, r.calibration, job);
+    if (!job.install.empty()) write_calibration(job.install, models, r.calibration, job);
+    write_camera_png(job.out / "camera-white.png", id.white);
+    const fs::path json = job.out / "report.json";
+    std::ofstream f(json);
+    f << report.dump(2) << "\n";
+    if (!f) throw std::runtime_error("calibrate: cannot write '" + json.string() + "'");
+    return report;
+}
+
 }  // namespace
 
 autocal::CalibrationPrior site_prior(const OnSiteJob& job) {
@@ -181,48 +218,25 @@ nlohmann::json run_on_site(const OnSiteJob& job, OutputBackend& outputs, Calibra
     HardwarePatternSource source(display.value(), camera, order, prior.camera.resolution, job.transfer, job.timing,
                                  budget.total(), progress);
     autocal::require_locked_exposure(source);  // step 0: before any pattern is shown
-    const Identified id = identify(source, display.value(), prior, job.options.min_contrast, job.min_lit_fraction);
-    source.set_projector_output(id.projector_output);
-    autocal::AutocalResult r = autocal::calibrate(source, prior, job.content, job.options);
+    const std::vector<cv::Mat> dark(display.value().output_count());
+    std::optional<Identified> id;
+    std::optional<autocal::AutocalResult> r;
     std::optional<autocal::ColourResult> colour;
-    if (job.colour) {
-        colour = autocal::calibrate_colour(source, prior.screen, r.projectors, r.calibration, job.colour_options);
+    try {
+        id = identify(source, display.value(), prior, job.options.min_contrast, job.min_lit_fraction);
+        source.set_projector_output(id->projector_output);
+        r = autocal::calibrate(source, prior, job.content, job.options);
+        if (job.colour) {
+            colour = autocal::calibrate_colour(source, prior.screen, r->projectors, r->calibration, job.colour_options);
+        }
+    } catch (...) {
+        (void)display.value().show_outputs(dark);  // refused or failed: the wall goes dark, not a stripe pattern
+        throw;
     }
     const double seconds = source.seconds();
     const int images = source.images();
-    if (auto s = display.value().show_outputs(std::vector<cv::Mat>(display.value().output_count())); !s) {
-        throw std::runtime_error(s.error().message);
-    }
-    nlohmann::json report = {{"site_file", job.site.string()},
-                             {"scale", job.scale},
-                             {"content", {job.content.width, job.content.height}},
-                             {"camera",
-                              {{"source", camera.description()},
-                               {"edge_points", r.report.edge_points},
-                               {"edge_rms_mm", r.report.edge_rms_m * 1e3}}},
-                             {"captures", images},
-                             {"budget",
-                              {{"identification", budget.identification},
-                               {"geometry_at_most", budget.geometry},
-                               {"colour", budget.colour},
-                               {"total", budget.total()}}},
-                             {"capture_seconds", seconds},
-                             {"seconds_per_image", seconds / std::max(1, images)},
-                             {"settle_ms", job.timing.settle_ms},
-                             {"drop_frames", job.timing.drop_frames}};
-    report["connectors"] = connectors_json(id, display.value(), prior);
-    report["cabling_changes"] = cabling_changes(previous_connectors(job.out / "report.json"), report["connectors"]);
-    for (std::size_t k = 0; k < r.projectors.size(); ++k) report["projectors"].push_back(fit_json(r, k));
-    if (colour) report["colour"] = colour_json(*colour);
-    const autocal::CalibrationModels models{prior.screen, r.camera, r.projectors};
-    write_calibration(job.out / "calibration.mpcdi", models, r.calibration, job);
-    if (!job.install.empty()) write_calibration(job.install, models, r.calibration, job);
-    write_camera_png(job.out / "camera-white.png", id.white);
-    const fs::path json = job.out / "report.json";
-    std::ofstream f(json);
-    f << report.dump(2) << "\n";
-    if (!f) throw std::runtime_error("calibrate: cannot write '" + json.string() + "'");
-    return report;
+    if (auto s = display.value().show_outputs(dark); !s) throw std::runtime_error(s.error().message);
+    return finish(job, *id, *r, colour, display.value(), prior, camera, budget, seconds, images);
 }
 
 }  // namespace mogao::calibrate

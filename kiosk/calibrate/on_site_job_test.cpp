@@ -171,7 +171,10 @@ TEST_F(OnSiteJobTest, CameraThatSeesNothingIsRefusedNamingTheProjector) {
                   std::string::npos)
             << e.what();
     }
-    EXPECT_GT(backend_->frame_count(0), 0u);  // the patterns were shown
+    EXPECT_GT(backend_->frame_count(0), 0u);  // the patterns were shown, and the wall is dark again
+    for (std::size_t i = 0; i < 3; ++i) {
+        for (const std::uint8_t v : backend_->last_frame(i).pixels) ASSERT_EQ(v, 0) << "output " << i;
+    }
     expect_last_good_untouched();
 }
 
