@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // Prints milliseconds per projector output for this machine's GL (llvmpipe without a GPU):
-// content upload, draw (glFinish'ed) and draw + readback, for one output of --output WxH.
+// content upload, draw (glFinish'ed) and draw + readback, for one output of --output WxH; then
+// the draw of the same output with a per-pixel black offset (beta) map, and its ratio to the draw
+// without, measured interleaved in the same run.
 // Usage: mogao_warp_blend_bench [width height [content_width content_height [frames]]]
 #include <GLES3/gl3.h>
 
@@ -41,9 +43,16 @@ int main(int argc, char** argv) {
         const Rgb8Image content = make_test_pattern(content_size);
         auto index = renderer->add_projector(identity_calibration("bench", output));
         if (!index) return std::fprintf(stderr, "%s\n", index.error().message.c_str()), 1;
-        if (!renderer->set_content(content) || !renderer->render(*index)) return 1;  // warm-up (shader JIT)
+        ProjectorCalibration lifted = identity_calibration("bench-beta", output);
+        lifted.beta.size = output;
+        lifted.beta.rgb.assign(static_cast<std::size_t>(output.pixel_count()) * 3, 0.01f);
+        auto beta_index = renderer->add_projector(lifted);
+        if (!beta_index) return std::fprintf(stderr, "%s\n", beta_index.error().message.c_str()), 1;
+        if (!renderer->set_content(content) || !renderer->render(*index) || !renderer->render(*beta_index)) {
+            return 1;  // warm-up (shader JIT, both FBOs)
+        }
 
-        double upload = 0, draw = 0, readback = 0;
+        double upload = 0, draw = 0, readback = 0, draw_beta = 0;
         for (int f = 0; f < frames; ++f) {
             auto t0 = std::chrono::steady_clock::now();
             if (!renderer->set_content(content)) return 1;
@@ -56,12 +65,18 @@ int main(int argc, char** argv) {
             t0 = std::chrono::steady_clock::now();
             if (!renderer->render(*index)) return 1;
             readback += ms_since(t0);
+            if (!renderer->render(*beta_index)) return 1;  // binds its FBO; then time the draw alone
+            t0 = std::chrono::steady_clock::now();
+            if (!renderer->draw(*beta_index)) return 1;
+            glFinish();
+            draw_beta += ms_since(t0);
         }
         std::printf("renderer: %s\n", reinterpret_cast<const char*>(glGetString(GL_RENDERER)));
         std::printf("output %dx%d, content %dx%d, %d frames (mean ms)\n", output.width, output.height,
                     content_size.width, content_size.height, frames);
         std::printf("  upload content  %8.2f\n  draw            %8.2f\n  draw + readback %8.2f\n", upload / frames,
                     draw / frames, readback / frames);
+        std::printf("  draw with beta  %8.2f  (x%.2f of the draw without)\n", draw_beta / frames, draw_beta / draw);
     }
     return 0;
 }
