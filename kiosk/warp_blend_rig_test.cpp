@@ -12,7 +12,8 @@
 //    CIE76 Delta E at seam points against the single-projector reference), next to the same
 //    measurement of the CPU compositor's outputs;
 //  - the beta maps loaded from the MPCDI change the GL output (black is lifted in the overlaps'
-//    neighbours), and without them the black seams come back.
+//    neighbours), and without them the black seams come back; a calibration swapped in at run
+//    time brings its beta along.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -151,6 +152,15 @@ public:
     // Every output's frame for `content` (RGB8 codes, rows top first).
     std::vector<Rgb8Image> show(const Rgb8Image& content) {
         EXPECT_TRUE(presenter_->show(content, ++tag_).ok());
+        std::vector<Rgb8Image> out;
+        for (std::size_t i = 0; i < backend_->outputs().size(); ++i) out.push_back(backend_->last_frame(i));
+        return out;
+    }
+
+    // The run-time calibration swap (kiosk/calibration_watcher.h -> ScreenPresenter): the current
+    // content is drawn again through the new calibration.
+    std::vector<Rgb8Image> swap(const ScreenCalibration& screen) {
+        EXPECT_TRUE(presenter_->swap_calibration(screen).ok());
         std::vector<Rgb8Image> out;
         for (std::size_t i = 0; i < backend_->outputs().size(); ++i) out.push_back(backend_->last_frame(i));
         return out;
@@ -351,6 +361,22 @@ TEST(WarpBlendOnRig, BetaFromTheMpcdiChangesTheGlOutput) {
                 100.0 * seams.luminance_p95);
     EXPECT_LT(lifted.luminance_p95, 0.01);
     EXPECT_GT(seams.luminance_p95, 0.1);
+}
+
+// A calibration swapped in at run time brings its beta maps along: a kiosk started without them
+// shows the black seams, and after the swap draws what render_output computes with beta.
+TEST(WarpBlendOnRig, CalibrationSwapBringsBetaIntoTheGlOutput) {
+    const Calibrated& c = calibrated();
+    const Rgb8Image black({64, 36}, 0);
+    auto kiosk = KioskOutputs::open(without_beta(c.loaded));
+    if (!kiosk) return;
+    const std::vector<Rgb8Image> before = kiosk->show(black);
+    const std::vector<Rgb8Image> after = kiosk->swap(c.loaded);
+    const std::vector<Rgb8Image> cpu = cpu_outputs(c.loaded, black);
+    for (std::size_t k = 0; k < after.size(); ++k) {
+        EXPECT_GE(max_code_diff(before[k], cpu[k]), 8) << c.loaded.projectors[k].id << ": before the swap";
+        EXPECT_LE(max_code_diff(after[k], cpu[k]), kToleranceCodes) << c.loaded.projectors[k].id << ": after";
+    }
 }
 
 }  // namespace
