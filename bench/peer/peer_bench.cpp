@@ -1,0 +1,198 @@
+// SPDX-License-Identifier: Apache-2.0
+// Our side of the peer comparison with Blender Cycles (docs/quality.md, "A peer: Blender Cycles");
+// bench/peer/run drives it and Blender.
+//
+//   mogao_peer_bench export    --out DIR [common flags]   scene.obj, scene.mtl, peer.json of the view
+//   mogao_peer_bench ours      --out DIR --spp 1,4,16,64 [--reps 1] [common flags]
+//        renders the view at each spp on one thread (reference knobs: 6 bounces), writes
+//        DIR/ours-<spp>.pfm and prints "spp,cpu_s" rows (CPU time of the rendering thread, best of reps;
+//        the BVH is built once before, not timed)
+//   mogao_peer_bench reference --out DIR [--ref-spp 512] [--budget-s 600] [--cache-dir D] [--renderer-version V]
+//        our converged reference of the view (bench/quality's cache and its two halves), DIR/ours-ref.pfm,
+//        and prints its noise floor (relMSE of the reference against the truth, from its halves)
+//   mogao_peer_bench compare   REF.pfm IMG.pfm...   prints "image,relmse,psnr_db,ssim" rows (image_metrics.h;
+//        PSNR and SSIM on the scene's exposure and tone map)
+// Common flags: [--scene scenes/grotto.json] [--scans DIR] [--view still|mask] [--width 120] (4:3 frame).
+// Exits 77 when the scene needs the real scans and they are absent.
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "bench/peer/peer_export.h"
+#include "bench/peer/pfm_io.h"
+#include "bench/quality/image_metrics.h"
+#include "bench/quality/reference_render.h"
+#include "renderfarm/denoise/frame_error.h"
+#include "renderfarm/scene/scene_file.h"
+#include "renderfarm/trace/render_timing.h"
+
+namespace {
+
+using namespace mogao;
+using namespace mogao::quality;
+
+struct Options {
+    std::string command;
+    std::filesystem::path scene_file = std::filesystem::path(MOGAO_SOURCE_DIR) / "scenes" / "grotto.json";
+    SceneLoadOptions load;
+    std::string view = "still";
+    int width = 120;
+    std::vector<int> spp{1, 4, 16, 64};
+    int reps = 1;
+    ReferencePlan plan;
+    std::filesystem::path out_dir;
+    std::vector<std::string> positional;
+};
+
+std::vector<int> split_ints(const std::string& text) {
+    std::vector<int> values;
+    std::stringstream in(text);
+    for (std::string part; std::getline(in, part, ',');) values.push_back(std::stoi(part));
+    return values;
+}
+
+Options parse(int argc, char** argv) {
+    if (argc < 2) throw std::invalid_argument("usage: mogao_peer_bench export|ours|reference|compare [flags]");
+    Options o;
+    o.command = argv[1];
+    o.plan.cache_dir = default_cache_dir();
+    o.plan.renderer_version = "unversioned";
+    o.plan.spp_per_half = 256;
+    for (int i = 2; i < argc; ++i) {
+        const std::string flag = argv[i];
+        if (flag.rfind("--", 0) != 0) {
+            o.positional.push_back(flag);
+            continue;
+        }
+        if (i + 1 >= argc) throw std::invalid_argument("flag " + flag + " needs a value");
+        const std::string v = argv[++i];
+        if (flag == "--scene") o.scene_file = v;
+        else if (flag == "--scans") o.load.scans_dir = v;
+        else if (flag == "--view") o.view = v;
+        else if (flag == "--width") o.width = std::stoi(v);
+        else if (flag == "--spp") o.spp = split_ints(v);
+        else if (flag == "--reps") o.reps = std::stoi(v);
+        else if (flag == "--ref-spp") o.plan.spp_per_half = std::stoi(v) / 2;
+        else if (flag == "--budget-s") o.plan.budget_seconds = std::stod(v);
+        else if (flag == "--cache-dir") o.plan.cache_dir = v;
+        else if (flag == "--renderer-version") o.plan.renderer_version = v;
+        else if (flag == "--out") o.out_dir = v;
+        else throw std::invalid_argument("unknown flag " + flag);
+    }
+    if (o.width < 16) throw std::invalid_argument("--width must be >= 16 (SSIM window)");
+    if (o.plan.spp_per_half < 1) throw std::invalid_argument("--ref-spp must be >= 2");
+    if (o.reps < 1) throw std::invalid_argument("--reps must be >= 1");
+    o.plan.batch_spp = std::min(o.plan.batch_spp, o.plan.spp_per_half);
+    if (o.command != "compare" && o.out_dir.empty()) throw std::invalid_argument("--out DIR is required");
+    return o;
+}
+
+std::string read_text(const std::filesystem::path& file) {
+    std::ifstream in(file);
+    if (!in) throw std::runtime_error("cannot read " + file.string());
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+template <typename T>
+T must(Result<T> r) {
+    if (!r.ok()) throw std::runtime_error(r.error().message);
+    return std::move(r).value();
+}
+
+void must(const Status& s) {
+    if (!s.ok()) throw std::runtime_error(s.error().message);
+}
+
+QualityView find_view(const Scene& scene, const Options& o) {
+    for (const QualityView& v : quality_views(scene, o.width, o.width))
+        if (v.name == o.view) return v;
+    throw std::invalid_argument("--view " + o.view + ": not one of bench/quality's views");
+}
+
+void run_ours(const Options& o, const Scene& scene, const QualityView& view) {
+    RendererOptions options;
+    options.embree_config = "threads=1";  // the BVH build on one thread too: the same CPU as Cycles' one thread
+    Renderer renderer(scene, options);
+    std::printf("spp,cpu_s\n");
+    for (const int spp : o.spp) {
+        ViewRequest r = reference_request(view);
+        r.quality.spp = spp;
+        r.seed = 1;  // the curves' seed, disjoint from the reference's
+        const TimedFrame f = render_fastest_of(renderer, r, o.reps);
+        must(peer::write_pfm(o.out_dir / ("ours-" + std::to_string(spp) + ".pfm"), f.image));
+        std::printf("%d,%.6f\n", spp, f.seconds);
+        std::fflush(stdout);
+    }
+}
+
+void run_reference(const Options& o, const Scene& scene, const QualityView& view) {
+    ReferencePlan plan = o.plan;
+    plan.scene_text = read_text(o.scene_file);
+    Renderer renderer(scene, RendererOptions{});
+    const CachedReference ref = obtain_reference(renderer, view, plan);
+    const ReferenceFloor f = reference_floor(ref, scene.exposure, scene.tone_map);
+    must(peer::write_pfm(o.out_dir / "ours-ref.pfm", reference_image(ref)));
+    must(peer::write_pfm(o.out_dir / "ours-ref-half-a.pfm", ref.half_a));
+    must(peer::write_pfm(o.out_dir / "ours-ref-half-b.pfm", ref.half_b));
+    std::printf("spp,seconds,floor_relmse,floor_psnr_db\n%d,%.1f,%.6g,%.3f\n", 2 * ref.spp_per_half, ref.seconds,
+                f.floor_relmse, f.floor_psnr_db);
+}
+
+void run_compare(const Options& o, const Scene& scene) {
+    if (o.positional.size() < 2) throw std::invalid_argument("compare needs REF.pfm and at least one IMG.pfm");
+    const RgbFloatImage ref = must(peer::read_pfm(o.positional[0]));
+    const Rgb8Image ref8 = display_frame(ref, scene.exposure, scene.tone_map);
+    std::printf("image,relmse,psnr_db,ssim\n");
+    for (std::size_t i = 1; i < o.positional.size(); ++i) {
+        const RgbFloatImage img = must(peer::read_pfm(o.positional[i]));
+        if (img.size.width != ref.size.width || img.size.height != ref.size.height)
+            throw std::invalid_argument(o.positional[i] + ": size differs from " + o.positional[0]);
+        const Rgb8Image img8 = display_frame(img, scene.exposure, scene.tone_map);
+        std::printf("%s,%.6g,%.4f,%.5f\n", o.positional[i].c_str(), relative_mse(img, ref), display_psnr_db(img8, ref8),
+                    ssim_luminance(img8, ref8));
+    }
+}
+
+int run(const Options& o) {
+    if (read_text(o.scene_file).find("{scans}") != std::string::npos &&
+        !std::filesystem::exists(resolve_scans_dir(o.scene_file, o.load))) {
+        std::printf("SKIP: real scans not found at %s\n", resolve_scans_dir(o.scene_file, o.load).c_str());
+        return 77;
+    }
+    const Scene scene = load_scene(o.scene_file, o.load, nullptr);
+    if (o.command == "compare") {
+        run_compare(o, scene);
+        return 0;
+    }
+    std::filesystem::create_directories(o.out_dir);
+    const QualityView view = find_view(scene, o);
+    if (o.command == "export") {
+        const peer::ExportStats s = must(peer::write_obj(scene, o.out_dir));
+        must(peer::write_peer_json(scene, view.request, o.out_dir));
+        std::printf("exported %zu triangles, %zu vertices to %s\n", s.triangles, s.vertices, o.out_dir.c_str());
+    } else if (o.command == "ours") {
+        run_ours(o, scene, view);
+    } else if (o.command == "reference") {
+        run_reference(o, scene, view);
+    } else {
+        throw std::invalid_argument("unknown command " + o.command + " (export|ours|reference|compare)");
+    }
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    try {
+        return run(parse(argc, argv));
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "mogao_peer_bench: %s\n", e.what());
+        return 1;
+    }
+}
