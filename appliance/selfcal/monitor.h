@@ -4,7 +4,9 @@
 // match features between prediction and camera frame (ORB: Rublee, Rabaud, Konolige, Bradski 2011;
 // Lowe's ratio test, Lowe 2004), and turn the matches into a robust pose of the camera and of each
 // projector (robust_pose.h), using what is known: the screen is the cylinder, devices are rigid
-// pinholes with fixed intrinsics.
+// pinholes with fixed intrinsics. Visitors in front of the screen are masked first (cells whose
+// brightness disagrees with the prediction in a coherent blob; monitor.cpp, occluder_mask) so
+// that the content they carry displaced never reaches a fit.
 //
 // Model of a match. A feature of content point c (normalised u, v) is predicted at camera image
 // position q_pred (the current models: c's screen point S(c) seen by the camera) and observed at

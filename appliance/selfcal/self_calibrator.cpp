@@ -202,6 +202,10 @@ void SelfCalibrator::filter(const FrameMeasurement& m, double dt, StepResult& r)
         r.status.waiting = true;
         r.status.reason = std::to_string(short_of_evidence) + " projector(s) under " +
                           std::to_string(options_.min_matches) + " matches (" + std::to_string(m.matches) + " in all)";
+        if (m.occluded_fraction > 0.0) {
+            r.status.reason += fmt("; visitors hide %.0f %% of the screen (%.0f matches dropped)",
+                                   100.0 * m.occluded_fraction, m.occluded_matches);
+        }
     }
 }
 

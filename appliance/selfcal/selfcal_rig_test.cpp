@@ -9,6 +9,7 @@
 #include <algorithm>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "appliance/autocal/rig_bridge.h"
 #include "appliance/rig/rig_file.h"
@@ -129,6 +130,38 @@ TEST(SelfcalRig, BumpAmongVisitorsIsStillCorrectedBelowOnePixel) {
     ASSERT_TRUE(r.corrected_after_s.has_value()) << journal(r);
     EXPECT_LT(r.final_error_px, 1.0) << journal(r);
     EXPECT_EQ(r.final_state, SelfcalState::calibrated) << journal(r);
+}
+
+// The visitor mask on its own: a clean camera frame of the wall (exposure 0.7) loses nothing; with
+// a dark band over a third of the screen's width, showing the content displaced as a visitor
+// would, the mask covers about that share (grown by a cell) and drops the matches on it.
+TEST(SelfcalRig, OccluderMaskFindsADarkBandAndNothingInACleanFrame) {
+    const rig::VirtualRig rig = autocal::scaled_rig(standard(), 0.25, 0.5);
+    const SystemModel model = models_of_rig(rig);
+    autocal::AutocalOptions build;
+    build.warp_step_px = 8;
+    const ScreenCalibration wall = autocal::calibration_from_models(model.projectors, model.screen, {960, 540}, build);
+    const cv::Mat1f content = make_content(ContentKind::textured, 0.0, false, 3);
+    std::vector<cv::Mat> signals;
+    for (const ProjectorCalibration& pc : wall.projectors) signals.emplace_back(projector_signal(pc, content));
+    cv::Mat1f clean;
+    rig::CameraSimulator(rig).capture(signals, 1).convertTo(clean, CV_32F, 0.7);
+    const Monitor monitor(model, wall);
+    const FrameMeasurement a = monitor.measure(content, clean);
+    EXPECT_LT(a.occluded_fraction, 0.02);
+    EXPECT_EQ(a.occluded_matches, 0);
+    cv::Mat1f hidden = clean.clone();
+    const cv::Rect band(clean.cols / 3, 0, clean.cols / 6, clean.rows);
+    cv::Mat1f shifted;
+    const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, 25, 0, 1, 0);
+    cv::warpAffine(clean, shifted, shift, clean.size());
+    cv::Mat1f inside = hidden(band);
+    shifted(band).convertTo(inside, CV_32F, 0.4, 0.01);  // in place: same size and type
+    const FrameMeasurement b = monitor.measure(content, hidden);
+    EXPECT_GT(b.occluded_fraction, 0.15);
+    EXPECT_LT(b.occluded_fraction, 0.5);
+    EXPECT_GT(b.occluded_matches, 0);
+    EXPECT_GT(b.matches, a.matches / 3);
 }
 
 TEST(SelfcalRig, BumpedCameraIsNotTakenForEveryProjectorMoving) {
