@@ -8,7 +8,7 @@ command -v systemd-analyze >/dev/null || { echo "SKIP: systemd-analyze not insta
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 mkdir -p "$work/root/usr/bin"
-for b in mpirun mogao-farm mogao-kiosk; do printf '#!/bin/sh\n' > "$work/root/usr/bin/$b"; chmod +x "$work/root/usr/bin/$b"; done
+for b in mpirun mogao-farm mogao-farm-launch mogao-kiosk; do printf '#!/bin/sh\n' > "$work/root/usr/bin/$b"; chmod +x "$work/root/usr/bin/$b"; done
 fail=0
 for unit in "$dir"/*.service; do
   cp "$unit" "$work/"

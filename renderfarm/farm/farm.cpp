@@ -1,9 +1,17 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "renderfarm/farm/farm.h"
 
+#include <fcntl.h>
+#include <signal.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
+#include <cstring>
+#include <ctime>
+#include <fstream>
 #include <optional>
+#include <string>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -12,6 +20,55 @@
 
 namespace mogao {
 namespace {
+
+// Open MPI 4.1's mpirun ends an aborted job only when every remote daemon has confirmed it; the
+// daemon of a host behind a cut link never does, and TCP would take minutes to give up on it. The
+// admin is started by mpirun itself (its parent: the launcher's mpirun, systemd's main process),
+// and MPI_Abort has that mpirun kill it, so the admin cannot wait itself: before MPI_Abort it forks
+// a reaper in its own session (out of reach of the kill of the rank's process group), holding no
+// descriptor (the link's listening socket must be free for the restarted farm), which ends mpirun
+// if it still runs `grace_ms` later (an abort over hosts that answer takes well under that). The ranks on hosts that
+// still answer lose their daemon's connection and are ended by it; systemd restarts the farm over the hosts that answer
+// (systemd/mogao-farm-launch). Nothing happens when the admin's parent is not mpirun.
+constexpr long kAbortGraceMs = 500;
+
+bool process_is_mpirun(pid_t pid) {
+    std::ifstream comm_file("/proc/" + std::to_string(pid) + "/comm");
+    std::string comm;
+    std::getline(comm_file, comm);
+    return comm == "mpirun" || comm == "mpiexec" || comm == "orterun";
+}
+
+void end_mpirun_if_abort_hangs(long grace_ms) {
+    const pid_t mpirun = getppid();
+    if (!process_is_mpirun(mpirun)) return;
+    const std::string message = fmt::format(
+        "mogao-farm[0] critical: admin: mpirun (pid {}) did not end the aborted job within {} s (a host "
+        "unreachable?): ending it\n",
+        mpirun, double(grace_ms) / 1e3);
+    const std::string comm_path = "/proc/" + std::to_string(mpirun) + "/comm";
+    if (fork() != 0) return;  // the admin (or no reaper when fork failed) goes on to MPI_Abort
+    // The reaper: only async-signal-safe calls from here on (the admin has threads).
+    setsid();
+    close_range(3, ~0U, 0);
+    timespec wait{grace_ms / 1000, (grace_ms % 1000) * 1000 * 1000};
+    while (nanosleep(&wait, &wait) != 0) {}
+    char comm[16] = {};
+    const int fd = open(comm_path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd >= 0) {
+        const ssize_t n = read(fd, comm, sizeof comm - 1);
+        close(fd);
+        // Still that mpirun (not a reused pid): "mpirun\n" etc.
+        if (n > 0 && (std::strncmp(comm, "mpirun", 6) == 0 || std::strncmp(comm, "mpiexec", 7) == 0 ||
+                      std::strncmp(comm, "orterun", 7) == 0)) {
+            (void)write(STDERR_FILENO, message.data(), message.size());
+            timespec flush{0, 200 * 1000 * 1000};  // mpirun forwards the line before it ends
+            nanosleep(&flush, nullptr);
+            kill(mpirun, SIGKILL);
+        }
+    }
+    _exit(0);
+}
 
 using Clock = std::chrono::steady_clock;
 
@@ -99,6 +156,7 @@ int run_farm(const MpiSession& mpi, const FarmSetup& setup, const AdminJob& admi
         // A rank stopped answering mid-frame: the others wait in a collective that never ends, and
         // MPI_Finalize would wait for them. End the whole job so that systemd restarts the farm.
         spdlog::critical("admin: a render rank was lost; aborting the MPI job (exit code {})", kRankLostExitCode);
+        end_mpirun_if_abort_hangs(kAbortGraceMs);
         MPI_Abort(MPI_COMM_WORLD, kRankLostExitCode);
     }
     return status;

@@ -169,9 +169,12 @@ void serve_render_rank(Renderer* renderer, const DispatchSettings& settings, con
 }
 
 FrameDispatcher::FrameDispatcher(const MpiSession& mpi, DispatchSettings settings, Renderer* local)
-    : mpi_(mpi), settings_(std::move(settings)), local_(mpi.size() == 1 ? local : nullptr),
+    : mpi_(mpi),
+      settings_(std::move(settings)),
+      local_(mpi.size() == 1 ? local : nullptr),
       balancer_(make_load_balancer(settings_.balancer,
-                                   settings_.balancer == "roundrobin" ? settings_.roundrobin_tile : settings_.snap)) {
+                                   settings_.balancer == "roundrobin" ? settings_.roundrobin_tile : settings_.snap)),
+      deadline_({settings_.rank_deadline_s, settings_.rank_deadline_min_s, settings_.rank_deadline_factor}) {
     if (mpi.size() == 1 && !local) throw std::invalid_argument("a one-process farm needs a local renderer");
 }
 
@@ -244,9 +247,10 @@ void FrameDispatcher::poll_until(Clock::time_point deadline, const Done& done, c
         if (now >= deadline) {
             broken_ = true;
             throw RankTimeout(
-                fmt::format("render rank(s) {} did not reply to frame {} within {} s (rank_deadline_s): "
-                            "host down, process stopped or link cut",
-                            who, frame_id, settings_.rank_deadline_s));
+                fmt::format("render rank(s) {} did not reply to frame {} within {:.1f} s (frame deadline: {} x "
+                            "its expected time, {}..{} s): host down, process stopped or link cut",
+                            who, frame_id, frame_deadline_s_, settings_.rank_deadline_factor,
+                            settings_.rank_deadline_min_s, settings_.rank_deadline_s));
         }
         if (heartbeat_ && now >= next_beat) {
             heartbeat_();
@@ -300,10 +304,13 @@ bool FrameDispatcher::gather(const ViewRequest& view, const Assignment& assignme
     }
     WireView wire = to_wire(view);
     wire.linear = format == PackedPixels::linear ? 1 : 0;
-    const auto deadline = settings_.rank_deadline_s > 0
-                              ? Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                                   std::chrono::duration<double>(settings_.rank_deadline_s))
-                              : Clock::time_point::max();
+    const double cost = frame_cost_units(view);
+    frame_deadline_s_ = deadline_.seconds_for(cost);
+    const auto sent = Clock::now();
+    const auto deadline =
+        frame_deadline_s_ > 0
+            ? sent + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(frame_deadline_s_))
+            : Clock::time_point::max();
     MPI_Request broadcast;
     MPI_Ibcast(&wire, sizeof wire, MPI_BYTE, 0, MPI_COMM_WORLD, &broadcast);
     poll_until(
@@ -357,6 +364,7 @@ bool FrameDispatcher::gather(const ViewRequest& view, const Assignment& assignme
         frame.stats.rays += reply.header.rays;
         frame.stats.rank_render_seconds[static_cast<std::size_t>(source - 1)] = reply.header.render_seconds;
     }
+    if (ok) deadline_.observe(cost, std::chrono::duration<double>(Clock::now() - sent).count());
     return ok;
 }
 

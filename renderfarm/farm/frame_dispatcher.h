@@ -11,8 +11,9 @@
 // Errors: a rank's failure (its message names rank, frame and reason) is thrown as FarmError by
 // render() after every rank's reply was collected, so no rank is left blocked; the caller then calls
 // stop(). Bad views are rejected on the ranks by the renderer's validation (std::invalid_argument).
-// A rank that does not reply within `rank_deadline_s` (dead host, SIGSTOP, cut link; every receive
-// of the reply is non-blocking under that deadline) makes render()
+// A rank that does not reply within the frame's deadline (frame_deadline.h: a multiple of the
+// frame's expected time from recent frames, between `rank_deadline_min_s` and `rank_deadline_s`;
+// dead host, SIGSTOP, cut link; every receive of the reply is non-blocking under it) makes render()
 // throw RankTimeout naming the silent ranks; the MPI job is then unusable (a collective is half
 // done): broken() turns true, stop() no longer talks to the ranks, and the process must end the
 // job with MPI_Abort so that the service restarts (run_farm does this; docs/services.md).
@@ -29,6 +30,7 @@
 
 #include "common/image.h"
 #include "common/view_request.h"
+#include "renderfarm/farm/frame_deadline.h"
 #include "renderfarm/farm/frame_stats.h"
 #include "renderfarm/farm/mpi_session.h"
 #include "renderfarm/farm/tile_pass.h"
@@ -59,8 +61,12 @@ struct DispatchSettings {
     // Feed the PBT with tile times x the rank's speed (its share of a core) instead of wall time.
     bool normalise_rank_speed = true;
     std::size_t max_streams = 64;  // cost maps kept; the least recently used goes beyond it
-    // Seconds from sending a frame to the ranks until the last reply; 0 = wait forever.
+    // Seconds from sending a frame to the ranks until the last reply (frame_deadline.h): at most
+    // rank_deadline_s (0 = wait forever), rank_deadline_factor x the frame's expected time, at least
+    // rank_deadline_min_s. Factor 0: always rank_deadline_s.
     double rank_deadline_s = 30.0;
+    double rank_deadline_min_s = 2.0;
+    double rank_deadline_factor = 4.0;
 };
 
 struct DispatchedFrame {
@@ -120,6 +126,8 @@ private:
     std::map<std::uint64_t, StreamMap> predicted_;
     std::uint64_t frames_ = 0;
     RankSpeeds speeds_;
+    FrameDeadline deadline_;
+    double frame_deadline_s_ = 0.0;  // the deadline of the frame being gathered, for messages
     bool stopped_ = false;
     bool broken_ = false;
     std::function<void()> heartbeat_;

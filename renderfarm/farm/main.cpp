@@ -6,10 +6,14 @@
 //   mpirun -n 3 mogao-farm render --scene scenes/grotto.json --frames 60 --out out/tour
 //   mpirun -n 3 mogao-farm serve --scene scenes/grotto.json --listen [::]:7443 --tls-dir /etc/mogao/pki --name farm
 //   mogao-farm pki init-ca --dir /etc/mogao/pki        (no MPI; see docs/link.md)
+//   mogao-farm health                                  (no MPI; the launcher's per-host check)
+#include <unistd.h>
+
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <thread>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -45,8 +49,17 @@ void add_farm_flags(CLI::App& command, mogao::FarmSetup& setup, std::string& sca
     command.add_option("--threads", setup.dispatch.threads, "Render threads per rank")->check(CLI::Range(1, 256));
     command
         .add_option("--rank-deadline", setup.dispatch.rank_deadline_s,
-                    "Seconds a frame may wait for a render rank's reply; a rank that misses it is taken as lost and "
-                    "the MPI job is aborted (exit 3) so that systemd restarts the farm (0 = wait forever)")
+                    "Most seconds a frame may wait for a render rank's reply; a rank that misses its frame's "
+                    "deadline is taken as lost and the MPI job is aborted (exit 3) so that systemd restarts the farm "
+                    "over the hosts that answer (0 = wait forever)")
+        ->check(CLI::Range(0.0, 86400.0));
+    command
+        .add_option("--rank-deadline-factor", setup.dispatch.rank_deadline_factor,
+                    "A frame's deadline is this many times its expected time from recent frames, within "
+                    "--rank-deadline-min and --rank-deadline (0 = always --rank-deadline)")
+        ->check(CLI::Range(0.0, 1000.0));
+    command
+        .add_option("--rank-deadline-min", setup.dispatch.rank_deadline_min_s, "Least seconds of a frame's deadline")
         ->check(CLI::Range(0.0, 86400.0));
     command.add_flag("--rank-speed,!--no-rank-speed", setup.dispatch.normalise_rank_speed,
                      "Normalise each rank's tile times by its measured speed before the PBT (default; --no-rank-speed: "
@@ -194,11 +207,22 @@ void apply_serve_preset(const CLI::App& serve, const mogao::QualityPreset& p, mo
     if (unset("--converged-spp")) live.converged_spp = p.converged_spp;
 }
 
+// `mogao-farm health`: what mogao-farm-launch runs on each render host (over the same rsh agent
+// mpirun uses) before it starts the job. Reaching this line proves the host answers, the binary and
+// every library it links (Embree, Open MPI, gRPC, OpenSSL) load there; MPI itself is not started.
+int run_health() {
+    char host[256] = {};
+    if (gethostname(host, sizeof host - 1) != 0) std::snprintf(host, sizeof host, "?");
+    std::printf("mogao-farm health: ok on %s, %u hardware threads\n", host, std::thread::hardware_concurrency());
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
     // The PKI needs no farm: handle it before MPI starts.
     if (argc >= 2 && std::string_view(argv[1]) == "pki") return mogao::run_pki_command(argc - 1, argv + 1);
+    if (argc == 2 && std::string_view(argv[1]) == "health") return run_health();
     mogao::MpiSession mpi(&argc, &argv);
     auto logger = spdlog::stderr_color_mt("mogao-farm");
     spdlog::set_default_logger(logger);
