@@ -138,7 +138,7 @@ def add_light(spec, factors):
     """One light of peer.json; factors[type] = Blender strength per unit of our quantity (calibrated; for
     area lights per unit radiance and per m^2 of the 1 m^2 calibration light)."""
     t = spec["type"]
-    factor = factors[t]
+    factor = factors.get(t, 1.0)
     if t == "environment":
         world = bpy.context.scene.world or bpy.data.worlds.new("world")
         bpy.context.scene.world = world
@@ -249,19 +249,23 @@ def calibrate(spp=256):
 
 
 def obj_bounds(path):
-    lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
+    """Bounds of the file's vertices and its face count."""
+    faces, verts = 0, []
     with open(path) as f:
-        chunk = [list(map(float, line.split()[1:4])) for line in f if line.startswith("v ")]
-    v = np.array(chunk)
-    return v.min(axis=0), v.max(axis=0)
+        for line in f:
+            if line.startswith("v "):
+                verts.append(line.split()[1:4])
+            elif line.startswith("f "):
+                faces += 1
+    v = np.array(verts, dtype=float)
+    return v.min(axis=0), v.max(axis=0), faces
 
 
 def build_scene(d, peer, factors):
     clear()
     obj_path = os.path.join(d, "scene.obj")
     bpy.ops.wm.obj_import(filepath=obj_path, forward_axis="Y", up_axis="Z")  # no axis change: +y stays up
-    lo = np.full(3, np.inf)
-    hi = -lo
+    lo, hi, faces = np.full(3, np.inf), np.full(3, -np.inf), 0
     for obj in bpy.context.scene.objects:
         if obj.type != "MESH":
             continue
@@ -270,12 +274,16 @@ def build_scene(d, peer, factors):
         w = np.array(obj.matrix_world)
         co = co.reshape(-1, 3) @ w[:3, :3].T + w[:3, 3]
         lo, hi = np.minimum(lo, co.min(axis=0)), np.maximum(hi, co.max(axis=0))
+        faces += len(obj.data.polygons)
         if obj.data.has_custom_normals:
             obj.data.use_auto_smooth = True
             obj.data.polygons.foreach_set("use_smooth", [True] * len(obj.data.polygons))
-    flo, fhi = obj_bounds(obj_path)
-    if np.abs(lo - flo).max() > 1e-4 or np.abs(hi - fhi).max() > 1e-4:
-        raise SystemExit(f"OBJ import moved the scene: bounds {lo} {hi}, file {flo} {fhi}")
+    # The importer drops vertices no face uses (the file keeps every loaded vertex), so the imported bounds
+    # must lie inside the file's, and every face must arrive: a moved, scaled or rotated import fails.
+    flo, fhi, ffaces = obj_bounds(obj_path)
+    if (lo < flo - 1e-4).any() or (hi > fhi + 1e-4).any() or faces != ffaces:
+        raise SystemExit(f"OBJ import changed the scene: bounds {lo} {hi} faces {faces}, file {flo} {fhi} {ffaces}")
+    print("imported %d triangles, bounds %s %s" % (faces, lo, hi), flush=True)
     for name, spec in peer["materials"].items():
         make_material(name, spec)
     for spec in peer["lights"]:
