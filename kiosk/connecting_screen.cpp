@@ -29,8 +29,12 @@ int fit_scale(std::string_view text, int width, int preferred) {
 }  // namespace
 
 Rgb8Image make_connecting_screen(ImageSize content, std::string_view detail) {
+    return make_title_card(content, "CONNECTING", detail);
+}
+
+Rgb8Image make_title_card(ImageSize content, std::string_view title, std::string_view detail) {
     if (content.width < 1 || content.width > kMaxSide || content.height < 1 || content.height > kMaxSide) {
-        throw std::invalid_argument("make_connecting_screen: content size " + std::to_string(content.width) + "x" +
+        throw std::invalid_argument("make_title_card: content size " + std::to_string(content.width) + "x" +
                                     std::to_string(content.height) + " is outside [1, 16384] per side");
     }
     const int w = content.width;
@@ -58,8 +62,7 @@ Rgb8Image make_connecting_screen(ImageSize content, std::string_view detail) {
             if (x < border || y < border || x >= w - border || y >= h - border) set(image, x, y, 110, 116, 130);
         }
     }
-    // "CONNECTING" across about half the width, centred; the detail line at a third of that size.
-    const std::string title = "CONNECTING";
+    // The title across about half the width, centred; the detail line at a third of that size.
     const int title_scale = fit_scale(title, w - 2 * border, w / 2 / (static_cast<int>(title.size()) * kGlyphAdvance));
     const int title_h = kGlyphHeight * title_scale;
     const int detail_scale = fit_scale(detail, w - 2 * border, std::max(1, title_scale / 3));

@@ -21,4 +21,7 @@ namespace mogao {
 // Throws std::invalid_argument for a size outside [1, 16384] per side.
 [[nodiscard]] Rgb8Image make_connecting_screen(ImageSize content, std::string_view detail);
 
+// The same card with another title (the service card, kiosk/service_screen.h).
+[[nodiscard]] Rgb8Image make_title_card(ImageSize content, std::string_view title, std::string_view detail);
+
 }  // namespace mogao

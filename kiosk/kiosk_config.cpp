@@ -696,18 +696,57 @@ bool parse_size(std::string_view text, ImageSize& out) {
     return true;
 }
 
-KioskConfig parse_kiosk_config(std::string_view text, const std::filesystem::path& name) {
-    const Context ctx{name.string(), name.has_parent_path() ? name.parent_path() : fs::path(".")};
-    Value root;
+namespace {
+
+Value parse_toml(std::string_view text, const Context& ctx) {
     try {
         std::istringstream in{std::string(text)};
-        root = toml::parse(in, name.string());
+        return toml::parse(in, ctx.file);
     } catch (const toml::syntax_error& e) {
         // toml11's message already names the file, line and column, with the offending text.
         throw KioskConfigError(fmt::format("{}: not valid TOML: {}", ctx.file, e.what()));
     } catch (const std::exception& e) {
         throw KioskConfigError(fmt::format("{}: not valid TOML: {}", ctx.file, e.what()));
     }
+}
+
+std::string read_config_text(const std::filesystem::path& file) {
+    std::error_code ec;
+    if (!fs::is_regular_file(file, ec)) {
+        throw KioskConfigError(
+            fmt::format("{}: {}", file.string(), fs::exists(file, ec) ? "not a regular file" : "no such file"));
+    }
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw KioskConfigError(fmt::format("{}: cannot open for reading", file.string()));
+    std::ostringstream text;
+    text << in.rdbuf();
+    if (text.str().size() > (1u << 20))
+        throw KioskConfigError(fmt::format("{}: larger than 1 MiB, not a kiosk configuration", file.string()));
+    return text.str();
+}
+
+}  // namespace
+
+OutputsConfig parse_outputs_config(std::string_view text, const std::filesystem::path& name) {
+    const Context ctx{name.string(), name.has_parent_path() ? name.parent_path() : fs::path(".")};
+    const Value root = parse_toml(text, ctx);
+    OutputsConfig outputs;
+    const Section display = section(ctx, root, "display", {"rate_hz"});
+    const Section section_outputs =
+        section(ctx, root, "outputs", {"backend", "device", "sizes", "png_dir", "png_every", "composite"});
+    read_outputs(display, section_outputs, outputs);
+    display.finish();
+    section_outputs.finish();
+    return outputs;
+}
+
+OutputsConfig load_outputs_config(const std::filesystem::path& file) {
+    return parse_outputs_config(read_config_text(file), file);
+}
+
+KioskConfig parse_kiosk_config(std::string_view text, const std::filesystem::path& name) {
+    const Context ctx{name.string(), name.has_parent_path() ? name.parent_path() : fs::path(".")};
+    const Value root = parse_toml(text, ctx);
     const std::vector<std::string> known_sections{"farm",   "display",    "outputs", "calibration", "quality",
                                                   "screen", "navigation", "stats",   "status",      "selfcal"};
     for (const auto& [key, value] : root.as_table()) {
@@ -755,16 +794,7 @@ KioskConfig parse_kiosk_config(std::string_view text, const std::filesystem::pat
 }
 
 KioskConfig load_kiosk_config(const std::filesystem::path& file) {
-    std::error_code ec;
-    if (!fs::is_regular_file(file, ec)) {
-        throw KioskConfigError(fmt::format("{}: {}", file.string(), fs::exists(file, ec) ? "not a regular file" : "no such file"));
-    }
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw KioskConfigError(fmt::format("{}: cannot open for reading", file.string()));
-    std::ostringstream text;
-    text << in.rdbuf();
-    if (text.str().size() > (1u << 20)) throw KioskConfigError(fmt::format("{}: larger than 1 MiB, not a kiosk configuration", file.string()));
-    return parse_kiosk_config(text.str(), file);
+    return parse_kiosk_config(read_config_text(file), file);
 }
 
 }  // namespace mogao

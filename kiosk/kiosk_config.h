@@ -183,6 +183,10 @@ struct KioskConfig {
 
 // Reads and validates `file`. Throws KioskConfigError.
 [[nodiscard]] KioskConfig load_kiosk_config(const std::filesystem::path& file);
+// Only [display] and [outputs] of a kiosk configuration (other sections are not read: the service
+// card's fallback configuration, kiosk/service_screen.h). Same errors as load_kiosk_config.
+[[nodiscard]] OutputsConfig load_outputs_config(const std::filesystem::path& file);
+[[nodiscard]] OutputsConfig parse_outputs_config(std::string_view text, const std::filesystem::path& name);
 
 // Validates TOML `text` as if read from `name` (messages and relative paths use it).
 [[nodiscard]] KioskConfig parse_kiosk_config(std::string_view text, const std::filesystem::path& name);

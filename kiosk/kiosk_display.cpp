@@ -19,8 +19,12 @@ Result<KioskDisplay> KioskDisplay::create(std::unique_ptr<OutputBackend> backend
 }
 
 Status KioskDisplay::show_connecting_screen(ImageSize content, const std::string& endpoint) {
+    return show_card(make_connecting_screen(content, "FARM " + endpoint));
+}
+
+Status KioskDisplay::show_card(const Rgb8Image& card) {
     set_content_transform({});  // the card is made for the screen itself
-    if (Status s = presenter_.show(make_connecting_screen(content, "FARM " + endpoint), 0); !s) return s;
+    if (Status s = presenter_.show(card, 0); !s) return s;
     account();
     return {};
 }

@@ -43,6 +43,8 @@ public:
 
     // The card shown until the first farm frame (tag 0: never counted as a farm frame).
     [[nodiscard]] Status show_connecting_screen(ImageSize content, const std::string& endpoint);
+    // A card made for the screen itself (no late warp), under tag 0 like the connecting card.
+    [[nodiscard]] Status show_card(const Rgb8Image& card);
     // A decoded farm frame, newer than the one before.
     void show(const ContentFrame& frame);
     // A run-time calibration swap (ScreenPresenter::swap_calibration): the current frame is shown

@@ -10,11 +10,8 @@
 
 namespace mogao {
 
-namespace {
-
-// The headless backend (its PNGs need it) or KMS.
-std::unique_ptr<OutputBackend> open_backend(const OutputsConfig& outputs, const ScreenCalibration& screen,
-                                            HeadlessOutputBackend** headless) {
+std::unique_ptr<OutputBackend> open_output_backend(const OutputsConfig& outputs, const ScreenCalibration& screen,
+                                                   HeadlessOutputBackend** headless) {
     if (outputs.backend == OutputKind::headless) {
         HeadlessOptions options;
         options.outputs = outputs.sizes;
@@ -34,8 +31,6 @@ std::unique_ptr<OutputBackend> open_backend(const OutputsConfig& outputs, const 
     }
     return std::move(created).value();
 }
-
-}  // namespace
 
 KioskSetup load_setup(const std::filesystem::path& file, const std::string& path,
                       const std::filesystem::path& stats_file, bool fall_back) {
@@ -122,7 +117,7 @@ std::unique_ptr<CalibrationWatcher> watch_calibration(const KioskConfig& config,
 
 KioskDisplay open_display(const KioskConfig& config, ScreenCalibration screen) {
     HeadlessOutputBackend* headless = nullptr;
-    std::unique_ptr<OutputBackend> backend = open_backend(config.outputs, screen, &headless);
+    std::unique_ptr<OutputBackend> backend = open_output_backend(config.outputs, screen, &headless);
     for (const auto& o : backend->outputs()) {
         spdlog::info("output {}: {}x{}{}", o.name, o.size.width, o.size.height,
                      o.refresh_hz > 0 ? fmt::format(" @ {:.2f} Hz", o.refresh_hz) : std::string());

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "common/projector_calibration.h"
+#include "drivers/output.h"
 #include "kiosk/calibration_inbox.h"
 #include "kiosk/calibration_watcher.h"
 #include "kiosk/content_dump.h"
@@ -27,6 +28,8 @@
 #include "renderfarm/link/tls_material.h"
 
 namespace mogao {
+
+class HeadlessOutputBackend;
 
 struct KioskSetupError : std::runtime_error {
     KioskSetupError(int code, const std::string& message) : std::runtime_error(message), exit_code(code) {}
@@ -58,6 +61,12 @@ struct KioskSetup {
 // (nullptr: source = "ideal" or watch = false). The watcher must be destroyed before the inbox.
 [[nodiscard]] std::unique_ptr<CalibrationInbox> open_calibration_inbox();
 [[nodiscard]] std::unique_ptr<CalibrationWatcher> watch_calibration(const KioskConfig& config, CalibrationInbox& inbox);
+
+// The [outputs] backend: headless (sizes from [outputs].sizes, else `screen`'s projectors; its
+// backend in *headless for PNG recording) or KMS. Throws KioskSetupError(1) naming the failure.
+[[nodiscard]] std::unique_ptr<OutputBackend> open_output_backend(const OutputsConfig& outputs,
+                                                                 const ScreenCalibration& screen,
+                                                                 HeadlessOutputBackend** headless);
 
 // The [outputs] backend (headless or KMS) showing `screen`, each output logged; headless PNGs when
 // png_dir is set. Then the connecting screen on every output.

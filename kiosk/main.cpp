@@ -32,6 +32,7 @@
 #include "kiosk/kiosk_log.h"
 #include "kiosk/kiosk_setup.h"
 #include "kiosk/selfcal_setup.h"
+#include "kiosk/service_screen.h"
 #include "kiosk/signal_fd.h"
 
 namespace {
@@ -48,6 +49,7 @@ struct Flags {
     std::filesystem::path stats_file; // overrides [stats].file
     std::filesystem::path pose_log;   // every submitted pose, JSON lines
     bool check_only = false;
+    std::filesystem::path service_config;  // [outputs] of the service card (empty: built-in defaults)
 };
 
 int run(const Flags& flags, const SignalFd& signals) {
@@ -83,6 +85,25 @@ int run(const Flags& flags, const SignalFd& signals) {
     return kiosk.run();
 }
 
+// The show cannot start (no configuration or calibration, nor a last good copy): the service card
+// says so on the wall until the configuration loads again (kiosk/service_screen.h). Other errors,
+// and outputs that cannot show the card either, keep their exit code.
+int show_service_card(const Flags& flags, const KioskSetupError& error, const SignalFd& signals) {
+    const bool config = error.exit_code == 2;
+    if (!config && !std::string_view(error.what()).starts_with("calibration:")) return error.exit_code;
+    ServiceScreenOptions options;
+    options.config = flags.config;
+    options.reason = error.what();
+    options.duration_s = flags.duration_s;
+    try {
+        options.outputs = service_outputs(flags.service_config);
+    } catch (const std::exception& e) {
+        spdlog::error("--service-config: {}", e.what());
+        return error.exit_code;
+    }
+    return run_service_screen(options, signals).value_or(error.exit_code);
+}
+
 // --print-config [KEY=VALUE | @FILE]...: kiosk.example.toml with the overrides applied, on stdout.
 int print_config(std::vector<std::string> overrides) {
     if (overrides == std::vector<std::string>{""}) overrides.clear();  // CLI11's value of a bare --print-config
@@ -109,7 +130,12 @@ int main(int argc, char** argv) {
     CLI::App app{"mogao-kiosk: the appliance's projector outputs, fed by the render farm (docs/kiosk.md)"};
     Flags flags;
     std::vector<std::string> overrides;
-    app.add_option("--config", flags.config, "Configuration file (TOML)")->check(CLI::ExistingFile);
+    // Not CLI::ExistingFile: a missing file (an unmounted configuration partition) is reported on the
+    // wall by the service card, not by an exit into a restart loop (kiosk/service_screen.h).
+    app.add_option("--config", flags.config, "Configuration file (TOML)");
+    app.add_option("--service-config", flags.service_config,
+                   "Configuration whose [outputs] show the service card when --config and its last good copy "
+                   "cannot be loaded (default: built-in, KMS)");
     app.add_option("--path", flags.path,
                    "Scripted visitor: walk | orbit | a JSON path file (overrides [navigation].path and .source)");
     app.add_option("--frames", flags.frames, "Stop after this many farm frames are on screen")->check(CLI::Range(1, 100000000));
@@ -134,7 +160,7 @@ int main(int argc, char** argv) {
         return run(flags, *signals);
     } catch (const KioskSetupError& e) {
         spdlog::error("{}", e.what());
-        return e.exit_code;
+        return flags.check_only ? e.exit_code : show_service_card(flags, e, *signals);
     } catch (const std::exception& e) {
         spdlog::critical("{}", e.what());
         return 1;
