@@ -114,9 +114,10 @@ bool SelfCalibrator::check_lost(double t_s, StepResult& r) {
     return false;
 }
 
-double SelfCalibrator::drift_px(int k, const Pose6& delta) const {
+// Mean displacement, in the device's pixels, of a 16x9 grid of its pixel centres when it moves by
+// `delta`: each pixel's ray meets the screen, and the moved device sees that point elsewhere.
+double SelfCalibrator::device_drift_px(const autocal::DeviceModel& d, const Pose6& delta) const {
     const SystemModel& m = monitor_.model();
-    const autocal::DeviceModel& d = m.projectors[static_cast<std::size_t>(k)];
     const autocal::DeviceModel moved = apply_delta(d, delta);
     double sum = 0.0;
     int n = 0;
@@ -138,27 +139,12 @@ double SelfCalibrator::drift_px(int k, const Pose6& delta) const {
     return n > 0 ? sum / n : 0.0;
 }
 
+double SelfCalibrator::drift_px(int k, const Pose6& delta) const {
+    return device_drift_px(monitor_.model().projectors[static_cast<std::size_t>(k)], delta);
+}
+
 double SelfCalibrator::camera_drift_px(const Pose6& delta) const {
-    const SystemModel& m = monitor_.model();
-    const autocal::DeviceModel& c = m.camera;
-    const autocal::DeviceModel moved = apply_delta(c, delta);
-    double sum = 0.0;
-    int n = 0;
-    constexpr int kGx = 16;
-    constexpr int kGy = 9;
-    for (int j = 0; j < kGy; ++j) {
-        for (int i = 0; i < kGx; ++i) {
-            const Eigen::Vector2d q0(((i + 0.5) * c.resolution.width / kGx - c.cx_px) / c.fx_px,
-                                     ((j + 0.5) * c.resolution.height / kGy - c.cy_px) / c.fy_px);
-            const Eigen::Vector3d s = autocal::ray_on_screen(m.screen, c, {q0.x(), q0.y(), 1.0});
-            if (!s.allFinite()) continue;
-            const Eigen::Vector2d q = project_normalised(moved.rotation, moved.position_m, s);
-            if (!q.allFinite()) continue;
-            sum += std::hypot((q.x() - q0.x()) * c.fx_px, (q.y() - q0.y()) * c.fy_px);
-            ++n;
-        }
-    }
-    return n > 0 ? sum / n : 0.0;
+    return device_drift_px(monitor_.model().camera, delta);
 }
 
 double SelfCalibrator::on_screen_fraction(const autocal::DeviceModel& d) const {

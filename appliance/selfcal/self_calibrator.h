@@ -107,6 +107,7 @@ private:
     void advance_correction(double t_s, StepResult& r);
     void rebase_camera(double t_s, StepResult& r);
     bool check_lost(double t_s, StepResult& r);
+    [[nodiscard]] double device_drift_px(const autocal::DeviceModel& d, const Pose6& delta) const;
     [[nodiscard]] double drift_px(int k, const Pose6& delta) const;
     [[nodiscard]] double camera_drift_px(const Pose6& delta) const;  // mean image displacement, camera pixels
     [[nodiscard]] double on_screen_fraction(const autocal::DeviceModel& d) const;
