@@ -54,7 +54,9 @@ enum class TimestampSource {
 // The pixel format the frame had on the wire, before conversion (pixel_format.h has the layouts).
 // nv12/nv21/yuv420/yvu420 are 4:2:0 and cover both the one-buffer V4L2 formats (NV12, NV21, YU12,
 // YV12) and their multi-plane variants (NV12M, NV21M, YUV420M, YVU420M).
-enum class CaptureFormat { grey, yuyv, mjpeg, image_file, nv12, nv21, yuv420, yvu420 };
+// rgb24/bgr24 are packed 8-bit R'G'B', 3 bytes per pixel in memory order R G B (V4L2 RGB3, libcamera
+// BGR888) or B G R (V4L2 BGR3, libcamera RGB888: DRM names list the components from the high byte).
+enum class CaptureFormat { grey, yuyv, mjpeg, image_file, nv12, nv21, yuv420, yvu420, rgb24, bgr24 };
 
 struct CameraFrame {
     GrayImage image;

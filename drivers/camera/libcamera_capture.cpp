@@ -31,6 +31,8 @@ static_assert(libcamera_fourcc(CaptureFormat::nv12) == libcamera::formats::NV12.
 static_assert(libcamera_fourcc(CaptureFormat::nv21) == libcamera::formats::NV21.fourcc());
 static_assert(libcamera_fourcc(CaptureFormat::yuv420) == libcamera::formats::YUV420.fourcc());
 static_assert(libcamera_fourcc(CaptureFormat::yvu420) == libcamera::formats::YVU420.fourcc());
+static_assert(libcamera_fourcc(CaptureFormat::rgb24) == libcamera::formats::BGR888.fourcc());
+static_assert(libcamera_fourcc(CaptureFormat::bgr24) == libcamera::formats::RGB888.fourcc());
 
 namespace {
 
@@ -206,6 +208,10 @@ struct LibcameraCapture::Impl {
             case CaptureFormat::yvu420:
                 return convert_yuv420(format, planes, width, height, encoding, frame.image,
                                       colour ? &*frame.colour : nullptr);
+            case CaptureFormat::rgb24:
+            case CaptureFormat::bgr24:
+                return convert_rgb24(format, bytes, width, height, stride, frame.image,
+                                     colour ? &*frame.colour : nullptr);
             case CaptureFormat::image_file:
                 break;
         }
@@ -284,7 +290,9 @@ Status LibcameraCapture::Impl::configure(const LibcameraConfig& config) {
     for (const libcamera::PixelFormat& f : offered_formats) offered.push_back(f.fourcc());
     const std::optional<CaptureFormat> chosen = choose_libcamera_format(config.formats, offered, config.colour);
     if (!chosen) {
-        return make_error(ENOTSUP, name + ": none of the wanted formats (R8/YUYV/NV12/NV21/YUV420/YVU420/MJPEG" +
+        std::string wanted_list;
+        for (CaptureFormat f : config.formats) wanted_list += (wanted_list.empty() ? "" : "/") + pixel_format_name(f);
+        return make_error(ENOTSUP, name + ": none of the wanted formats (" + wanted_list +
                                        (config.colour ? std::string(", in colour") : std::string()) +
                                        ") is offered; camera has: " + format_list(offered_formats));
     }

@@ -7,9 +7,10 @@
 //
 // Pipeline: CameraManager::start, the configured camera (or the first one) acquired, one
 // Viewfinder stream in the first format of `formats` the camera offers (GREY = libcamera R8,
-// YUYV, MJPEG), FrameBufferAllocator buffers (2-4 asked; the pipeline may adjust), one Request per
-// buffer, Camera::start, all requests queued. Each buffer's plane is mmapped read-only from its
-// dmabuf fd (MappedBuffer; libcamera's MappedFrameBuffer is internal).
+// YUYV, NV12/NV21/YUV420/YVU420, packed RGB = BGR888/RGB888, MJPEG), FrameBufferAllocator
+// buffers (2-4 asked; the pipeline may adjust), one Request per buffer, Camera::start, all
+// requests queued. Each buffer's plane is mmapped read-only from its dmabuf fd (MappedBuffer;
+// libcamera's MappedFrameBuffer is internal).
 //
 // Threading: libcamera emits requestCompleted on its own thread. The slot only appends the
 // request to a list under a mutex (capacity reserved at open, so it never allocates or throws)
@@ -51,9 +52,11 @@ struct LibcameraConfig {
     int width = 800;        // requested; the pipeline may adjust it (see size())
     int height = 600;
     // Formats to try, in order of preference (GREY needs no conversion, MJPEG the most CPU).
-    std::vector<CaptureFormat> formats{CaptureFormat::grey, CaptureFormat::yuyv,   CaptureFormat::nv12,
-                                       CaptureFormat::nv21, CaptureFormat::yuv420, CaptureFormat::yvu420,
-                                       CaptureFormat::mjpeg};
+    // Packed RGB (rgb24/bgr24) is what libcamera's vimc pipeline (the kernel's virtual media
+    // controller camera) offers.
+    std::vector<CaptureFormat> formats{CaptureFormat::grey,  CaptureFormat::yuyv,   CaptureFormat::nv12,
+                                       CaptureFormat::nv21,  CaptureFormat::yuv420, CaptureFormat::yvu420,
+                                       CaptureFormat::rgb24, CaptureFormat::bgr24,  CaptureFormat::mjpeg};
     bool colour = false;      // also deliver CameraFrame::colour (R'G'B'); GREY (R8) is then not used
     CameraControls controls;  // applied when the camera starts (camera_controls.h)
     int buffer_count = 3;   // [2, 4]
@@ -64,8 +67,8 @@ struct LibcameraConfig {
 [[nodiscard]] bool libcamera_built_in() noexcept;
 
 // libcamera's (DRM) fourcc for a capture format: GREY -> R8 ("R8  "), YUYV, MJPEG ("MJPG"), NV12,
-// NV21, YUV420 ("YU12"), YVU420 ("YV12"); 0 for image_file. Pure; the .cpp checks these against libcamera::formats at
-// compile time.
+// NV21, YUV420 ("YU12"), YVU420 ("YV12"), rgb24 -> BGR888 ("BG24"), bgr24 -> RGB888 ("RG24");
+// 0 for image_file. Pure; the .cpp checks these against libcamera::formats at compile time.
 [[nodiscard]] constexpr std::uint32_t libcamera_fourcc(CaptureFormat format) noexcept {
     constexpr auto cc = [](char a, char b, char c, char d) {
         return static_cast<std::uint32_t>(static_cast<unsigned char>(a)) |
@@ -88,6 +91,10 @@ struct LibcameraConfig {
             return cc('Y', 'U', '1', '2');
         case CaptureFormat::yvu420:
             return cc('Y', 'V', '1', '2');
+        case CaptureFormat::rgb24:  // bytes R G B: DRM's BGR888 (components named from the high byte)
+            return cc('B', 'G', '2', '4');
+        case CaptureFormat::bgr24:
+            return cc('R', 'G', '2', '4');
         case CaptureFormat::image_file:
             break;
     }

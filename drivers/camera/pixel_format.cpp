@@ -180,6 +180,10 @@ std::string pixel_format_name(CaptureFormat format) {
             return "YU12";
         case CaptureFormat::yvu420:
             return "YV12";
+        case CaptureFormat::rgb24:
+            return "RGB3";
+        case CaptureFormat::bgr24:
+            return "BGR3";
     }
     return "?";
 }
@@ -330,6 +334,35 @@ void rgb_from_grey(const GrayImage& grey, Rgb8Image& out) {
     for (std::size_t i = 0; i < grey.pixels.size(); ++i) {
         std::fill_n(out.pixels.data() + 3 * i, 3, grey.pixels[i]);
     }
+}
+
+Status convert_rgb24(CaptureFormat format, std::span<const std::uint8_t> data, int width, int height,
+                     int bytes_per_line, GrayImage& grey, Rgb8Image* colour) {
+    if (format != CaptureFormat::rgb24 && format != CaptureFormat::bgr24) {
+        return make_error(EINVAL, "convert_rgb24: " + pixel_format_name(format) + " is not RGB3 or BGR3");
+    }
+    const char* name = format == CaptureFormat::rgb24 ? "RGB3" : "BGR3";
+    if (Status s = check_layout(name, data.size(), width, height, bytes_per_line, 3); !s) return s;
+    resize(grey, width, height);
+    if (colour != nullptr) resize(*colour, width, height);
+    const int r = format == CaptureFormat::rgb24 ? 0 : 2;  // byte offset of R' in a pixel
+    const int b = 2 - r;
+    for (int y = 0; y < height; ++y) {
+        const std::uint8_t* row = data.data() + static_cast<std::ptrdiff_t>(y) * bytes_per_line;
+        const std::size_t first = static_cast<std::size_t>(y) * static_cast<std::size_t>(width);
+        for (int x = 0; x < width; ++x) {
+            const std::uint8_t* p = row + 3 * x;
+            // 0.299, 0.587, 0.114 in 16.16 fixed point (sum 65536), as grey_from_rgb.
+            grey.pixels[first + static_cast<std::size_t>(x)] =
+                static_cast<std::uint8_t>((19595 * p[r] + 38470 * p[1] + 7471 * p[b] + 32768) >> 16);
+            if (colour == nullptr) continue;
+            std::uint8_t* out = colour->pixels.data() + 3 * (first + static_cast<std::size_t>(x));
+            out[0] = p[r];
+            out[1] = p[1];
+            out[2] = p[b];
+        }
+    }
+    return {};
 }
 
 void grey_from_rgb(const Rgb8Image& rgb, GrayImage& out) {

@@ -11,6 +11,7 @@
 //          rows are bytes_per_line / 2 apart
 //   NV12M, NV21M, YUV420M, YVU420M: the same planes in separate buffers, each with its own
 //          bytes_per_line (V4L2_BUF_TYPE_VIDEO_CAPTURE_MPLANE)
+//   RGB3   packed R'G'B', bytes R G B per pixel (BGR3: B G R)
 //   MJPEG  see mjpeg_decoder.h
 // Odd sizes: a 4:2:0 chroma plane has ceil(width / 2) x ceil(height / 2) samples.
 //
@@ -45,7 +46,7 @@ namespace mogao {
 // enough that a corrupt header cannot make the appliance allocate gigabytes.
 inline constexpr int kMaxCaptureDimension = 8192;
 
-// "GREY", "YUYV", "MJPG", "file", "NV12", "NV21", "YU12", "YV12" (the V4L2 fourccs).
+// "GREY", "YUYV", "MJPG", "file", "NV12", "NV21", "YU12", "YV12", "RGB3", "BGR3" (the V4L2 fourccs).
 [[nodiscard]] std::string pixel_format_name(CaptureFormat format);
 
 // A V4L2 fourcc as four characters ("YUYV"); non-printable bytes become '?'.
@@ -98,6 +99,11 @@ struct PlaneBytes {
 // YUV420M/YVU420M). Y' into `grey`; with `colour` non-null, also R'G'B' into *colour.
 [[nodiscard]] Status convert_yuv420(CaptureFormat format, std::span<const PlaneBytes> planes, int width, int height,
                                     YcbcrEncoding encoding, GrayImage& grey, Rgb8Image* colour);
+
+// A packed 24-bit frame (format rgb24 or bgr24): the BT.601 luma (as grey_from_rgb) into `grey`;
+// with `colour` non-null, also the R'G'B' (in R G B order) into *colour.
+[[nodiscard]] Status convert_rgb24(CaptureFormat format, std::span<const std::uint8_t> data, int width, int height,
+                                   int bytes_per_line, GrayImage& grey, Rgb8Image* colour);
 
 // GREY to R'G'B' (R' = G' = B' = Y').
 void rgb_from_grey(const GrayImage& grey, Rgb8Image& out);

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <utility>
 #include <vector>
 
 namespace mogao {
@@ -27,6 +28,27 @@ TEST(PixelConversion, YuyvKeepsLumaAndSkipsRowPadding) {
     for (int y = 0; y < height; ++y) {
         for (int x = 0; x < width; ++x) EXPECT_EQ(out.at(x, y), 10 * y + x) << x << "," << y;
     }
+}
+
+TEST(PixelConversion, PackedRgbInBothByteOrders) {
+    // 2x2 pixels, rows 8 bytes apart (2 bytes of padding); bytes R G B (RGB3) or B G R (BGR3).
+    const std::vector<std::uint8_t> rgb{255, 0, 0, 0, 255, 0, 9, 9, 0, 0, 255, 10, 20, 30, 9, 9};
+    std::vector<std::uint8_t> bgr = rgb;
+    for (std::size_t i = 0; i + 2 < bgr.size(); i += (i % 8 == 3 ? 5 : 3)) std::swap(bgr[i], bgr[i + 2]);
+    for (const auto& [format, bytes] : {std::pair{CaptureFormat::rgb24, rgb}, std::pair{CaptureFormat::bgr24, bgr}}) {
+        GrayImage grey;
+        Rgb8Image colour;
+        ASSERT_TRUE(convert_rgb24(format, bytes, 2, 2, 8, grey, &colour).ok()) << pixel_format_name(format);
+        EXPECT_EQ(colour.pixels, (std::vector<std::uint8_t>{255, 0, 0, 0, 255, 0, 0, 0, 255, 10, 20, 30}));
+        // BT.601 luma: red 0.299 * 255 = 76.2, green 149.7, blue 29.1, (10, 20, 30) 17.9.
+        EXPECT_EQ(grey.pixels, (std::vector<std::uint8_t>{76, 150, 29, 18})) << pixel_format_name(format);
+    }
+    GrayImage grey;
+    EXPECT_EQ(convert_rgb24(CaptureFormat::rgb24, rgb, 2, 2, 5, grey, nullptr).code(), EINVAL);  // stride < 6
+    EXPECT_EQ(convert_rgb24(CaptureFormat::rgb24, std::span(rgb).first(13), 2, 2, 8, grey, nullptr).code(), EINVAL);
+    EXPECT_EQ(convert_rgb24(CaptureFormat::yuyv, rgb, 2, 2, 8, grey, nullptr).code(), EINVAL);
+    EXPECT_EQ(pixel_format_name(CaptureFormat::rgb24), "RGB3");
+    EXPECT_EQ(pixel_format_name(CaptureFormat::bgr24), "BGR3");
 }
 
 TEST(PixelConversion, GreyCopiesRowsAndAcceptsAShortLastRow) {

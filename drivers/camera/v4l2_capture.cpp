@@ -34,6 +34,10 @@ std::uint32_t fourcc_of(CaptureFormat format) {
             return V4L2_PIX_FMT_YUV420;
         case CaptureFormat::yvu420:
             return V4L2_PIX_FMT_YVU420;
+        case CaptureFormat::rgb24:
+            return V4L2_PIX_FMT_RGB24;
+        case CaptureFormat::bgr24:
+            return V4L2_PIX_FMT_BGR24;
         case CaptureFormat::image_file:
             break;
     }
@@ -343,6 +347,11 @@ Status V4l2Capture::convert(std::uint32_t index, const std::uint32_t* bytes_used
         case CaptureFormat::yvu420:
             s = convert_yuv420(format_, std::span<const PlaneBytes>(planes, static_cast<std::size_t>(plane_count_)),
                                width_, height_, encoding_, frame.image, colour_ ? &*frame.colour : nullptr);
+            break;
+        case CaptureFormat::rgb24:
+        case CaptureFormat::bgr24:
+            s = convert_rgb24(format_, bytes, width_, height_, bytes_per_line_, frame.image,
+                              colour_ ? &*frame.colour : nullptr);
             break;
         case CaptureFormat::image_file:
             s = make_error(EINVAL, "image_file is not a capture format");
