@@ -48,4 +48,30 @@ struct RoiOptions {
 };
 int run_roi(const RoiOptions& options);
 
+// The rendered grotto set (bench/tracking-grotto/make-grotto-set writes SETDIR/set.json and the
+// ray-traced sub-frames; docs/tracking.md, "Rendered grotto set").
+struct GrottoDevelopOptions {
+    std::filesystem::path set;  // SETDIR
+    // The camera's sensor model applied to the average of the sub-frames (linear light, 1 = white):
+    // Gaussian noise of variance shot * signal + read^2 (a Poisson-Gaussian model's normal
+    // approximation; Foi et al., "Practical Poissonian-Gaussian noise modeling", IEEE TIP 2008),
+    // then the frame's gain, clipping, sRGB encoding and JPEG (TurboJPEG, 4:2:0) at jpeg_quality.
+    double shot = 0.001;
+    double read = 0.0015;
+    int jpeg_quality = 75;
+};
+// Writes SETDIR/frames/<variant>-NNNN.jpg; seeded per frame (set.json noise_seed), so reruns give
+// the same bytes with the same standard library.
+int run_grotto_develop(const GrottoDevelopOptions& options);
+
+struct GrottoOptions {
+    std::filesystem::path set;  // SETDIR, developed
+    int repeat = 2;             // timing: fastest of this many runs per frame
+    // Checks (the integration test): exit 1 when the defaults' rate is below min_rate or their
+    // median corner error exceeds max_median_px (against the exact corners). Negative: no check.
+    double min_rate = -1.0;
+    double max_median_px = -1.0;
+};
+int run_grotto(const GrottoOptions& options);
+
 }  // namespace mogao::eval

@@ -40,6 +40,28 @@ int main(int argc, char** argv) {
                   "extra ROI modes with these window_tag_px (0 = full resolution)")
         ->check(CLI::Range(0.0, 1000.0));
 
+    mogao::eval::GrottoDevelopOptions develop;
+    auto* d = app.add_subcommand("grotto-develop",
+                                 "rendered grotto set: sub-frames -> motion blur, noise, gain, JPEG frames");
+    d->add_option("--set", develop.set, "folder of bench/tracking-grotto/make-grotto-set")->required();
+    d->add_option("--shot", develop.shot, "shot-noise variance per unit signal (linear)")
+        ->check(CLI::Range(0.0, 1.0))
+        ->capture_default_str();
+    d->add_option("--read", develop.read, "read-noise sigma (linear)")
+        ->check(CLI::Range(0.0, 1.0))
+        ->capture_default_str();
+    d->add_option("--jpeg-quality", develop.jpeg_quality, "TurboJPEG quality")
+        ->check(CLI::Range(1, 100))
+        ->capture_default_str();
+
+    mogao::eval::GrottoOptions grotto;
+    auto* g = app.add_subcommand("grotto", "rendered grotto set: detection, corner error, reference, ROI tracking");
+    g->add_option("--set", grotto.set, "developed set folder")->required();
+    g->add_option("--repeat", grotto.repeat, "timing runs per frame")->check(CLI::Range(1, 100))->capture_default_str();
+    g->add_option("--min-rate", grotto.min_rate, "exit 1 if the defaults' rate is below")->check(CLI::Range(0.0, 1.0));
+    g->add_option("--max-median-px", grotto.max_median_px, "exit 1 if the defaults' median corner error exceeds")
+        ->check(CLI::Range(0.0, 1000.0));
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -55,6 +77,8 @@ int main(int argc, char** argv) {
         if (*r) return mogao::eval::run_real(real);
         if (*f) return mogao::eval::run_reference(ref);
         if (*o) return mogao::eval::run_roi(roi);
+        if (*d) return mogao::eval::run_grotto_develop(develop);
+        if (*g) return mogao::eval::run_grotto(grotto);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "mogao_tracking_eval: %s\n", e.what());
         return 1;
