@@ -51,6 +51,23 @@ struct DetectorSettings {
     // refines the edges on the full-resolution image. Costs about a third of the full-resolution
     // search; TagTracker's window search skips it (single pass). 0 or [1.5, 8].
     float coarse_pass_decimation = 2.0f;
+    // A third search for tags too small for the first two (about 8-14 px across: under 2 px per
+    // cell of tag36h11), run like the coarse pass when the first searched at full resolution: the
+    // image is up-sampled by this integer factor with bicubic interpolation (Keys, "Cubic
+    // convolution interpolation for digital image processing", IEEE TASSP 1981; OpenCV
+    // INTER_CUBIC), then searched and decoded there, so that a small tag's edges span whole
+    // threshold tiles (AprilTag's are 4 px) and its bits are sampled between the blurred cells'
+    // centres. Corners are scaled back (pixel centres stay at +0.5: the factor maps the image's
+    // corner (0, 0) to itself). Its tags not found by the earlier passes are added. On synthetic
+    // 10-12 px tags it doubles the tags found (x2; x3 adds a few more 8-10 px tags at 1.6x the
+    // time), with no wrong id; on the real photographs it finds one more tag
+    // (docs/tracking.md, "Small tags", mogao_small_tag_study). TagTracker never runs it.
+    // 0 = none, or [2, 4].
+    int upsample_pass_factor = 2;
+    // The up-sampled search runs only on images of at most this many pixels (before up-sampling):
+    // it costs about 3x (x2) the rest of detect() on such frames, and small tags are what camera
+    // frames (640x480, 800x600) lose, not multi-megapixel photographs. [0, 67108864].
+    int upsample_pass_max_pixels = 800 * 600;
     // Worker threads of the detector. 1 on the appliance (the other core renders). [1, 64].
     int threads = 1;
 };

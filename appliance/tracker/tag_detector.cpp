@@ -3,8 +3,11 @@
 
 #include <apriltag.h>
 
+#include <opencv2/imgproc.hpp>
+
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 
@@ -70,17 +73,59 @@ int safe_max_hamming(const TagFamily& family) {
     return best;
 }
 
+namespace {
+
+// Adds the tags of a later pass that the earlier passes did not find: another id, or the same id
+// more than half a tag side away (a second tag with that id).
+void add_unseen(std::vector<TagDetection>& out, const std::vector<TagDetection>& later) {
+    const std::size_t earlier = out.size();
+    for (const auto& c : later) {
+        const bool seen =
+            std::any_of(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(earlier), [&](const TagDetection& d) {
+                return d.id == c.id && (d.centre - c.centre).norm() < 0.5 * (d.corners[1] - d.corners[0]).norm();
+            });
+        if (!seen) out.push_back(c);
+    }
+}
+
+// `image` up-sampled by `factor` with bicubic interpolation (DetectorSettings::upsample_pass_factor).
+GrayImage upsampled(const GrayImage& image, int factor) {
+    GrayImage up(image.width * factor, image.height * factor);
+    const cv::Mat src(image.height, image.width, CV_8UC1, const_cast<std::uint8_t*>(image.pixels.data()));
+    cv::Mat dst(up.height, up.width, CV_8UC1, up.pixels.data());
+    cv::resize(src, dst, dst.size(), 0, 0, cv::INTER_CUBIC);
+    return up;
+}
+
+}  // namespace
+
 std::vector<TagDetection> TagDetector::detect(const GrayImage& image, Passes passes) {
     std::vector<TagDetection> out = detect_once(image);
-    if (passes == Passes::single || settings_.coarse_pass_decimation == 0.0f || settings_.decimation > 1.0f) return out;
-    // The coarse pass (DetectorSettings::coarse_pass_decimation): its tags that the first pass did
-    // not find (another id, or the same id more than half a side away) are added.
+    if (passes == Passes::single || settings_.decimation > 1.0f) return out;
+    if (settings_.coarse_pass_decimation != 0.0f)
+        add_unseen(out, detect_with_quad_search(image, settings_.coarse_pass_decimation));
+    const auto pixels = static_cast<std::int64_t>(image.width) * image.height;
+    const int factor = settings_.upsample_pass_factor;
+    if (factor != 0 && pixels <= settings_.upsample_pass_max_pixels &&
+        std::max(image.width, image.height) * factor <= kMaxCaptureDimension) {
+        std::vector<TagDetection> small = detect_with_quad_search(upsampled(image, factor), 1.0f);
+        for (auto& d : small) {
+            for (auto& c : d.corners) c /= factor;
+            d.centre /= factor;
+        }
+        add_unseen(out, small);
+    }
+    std::stable_sort(out.begin(), out.end(), [](const TagDetection& a, const TagDetection& b) { return a.id < b.id; });
+    return out;
+}
+
+std::vector<TagDetection> TagDetector::detect_with_quad_search(const GrayImage& image, float decimation) {
     apriltag_detector* detector = engine_->detector.get();
-    detector->quad_decimate = settings_.coarse_pass_decimation;
+    detector->quad_decimate = decimation;
     detector->quad_sigma = 0.0f;
-    std::vector<TagDetection> coarse;
+    std::vector<TagDetection> found;
     try {
-        coarse = detect_once(image);
+        found = detect_once(image);
     } catch (...) {
         detector->quad_decimate = settings_.decimation;
         detector->quad_sigma = settings_.blur_sigma;
@@ -88,16 +133,7 @@ std::vector<TagDetection> TagDetector::detect(const GrayImage& image, Passes pas
     }
     detector->quad_decimate = settings_.decimation;
     detector->quad_sigma = settings_.blur_sigma;
-    const std::size_t first = out.size();
-    for (const auto& c : coarse) {
-        const bool seen =
-            std::any_of(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(first), [&](const TagDetection& d) {
-                return d.id == c.id && (d.centre - c.centre).norm() < 0.5 * (d.corners[1] - d.corners[0]).norm();
-            });
-        if (!seen) out.push_back(c);
-    }
-    std::stable_sort(out.begin(), out.end(), [](const TagDetection& a, const TagDetection& b) { return a.id < b.id; });
-    return out;
+    return found;
 }
 
 std::vector<TagDetection> TagDetector::detect_once(const GrayImage& image) {

@@ -71,6 +71,8 @@ public:
 
 private:
     std::vector<TagDetection> detect_once(const GrayImage& image);
+    // detect_once with the quad search at `decimation` and no blur; the settings' own are restored.
+    std::vector<TagDetection> detect_with_quad_search(const GrayImage& image, float decimation);
     // The family and the detector that hangs its decode tables on it, together on the heap: the
     // family's address must not change while the detector uses it, and the detector must be
     // destroyed before the family (tag_detector.cpp). As one pointer they also move and are

@@ -222,5 +222,42 @@ TEST(TagDetector, CoarsePassAddsNoDuplicate) {
     for (std::size_t k = 0; k < 4; ++k) EXPECT_LT((both[0].corners[k] - single[0].corners[k]).norm(), 1e-9);
 }
 
+// The up-sampled search (DetectorSettings::upsample_pass_factor) finds tags of about 10 px that the
+// full-resolution and coarse searches miss, with the right id and corners scaled back to the image
+// (against the projected truth); it adds nothing wrong, and it does not run on images over
+// upsample_pass_max_pixels.
+TEST(TagDetector, UpsampledPassFindsTinyTagsTheOtherPassesMiss) {
+    DetectorSettings without;
+    without.upsample_pass_factor = 0;
+    DetectorSettings too_big;  // the pass is on, but the frame has more pixels than it allows
+    too_big.upsample_pass_max_pixels = 640 * 480 - 1;
+    TagDetector with_pass, without_pass(without), limited(too_big);
+    const CameraIntrinsics camera = ideal_camera(640, 480, 500.0);
+    int found_with = 0, found_without = 0, found_limited = 0;
+    for (int i = 0; i < 8; ++i) {
+        const int id = 11 + 37 * i;
+        RenderEffects fx;
+        fx.clutter_seed = 5 + static_cast<std::uint64_t>(i);
+        fx.noise_sigma = 2.0;
+        fx.seed = 100 + static_cast<std::uint64_t>(i);
+        fx.motion_blur_px = 1.0;
+        fx.motion_blur_deg = 30.0 * i;
+        // 0.1 m at 5 m and f = 500 px: 10 px across, turned 20 degrees.
+        const TagPose pose = tag_pose_facing_camera(5.0, 20.0, -10.0, 40.0 * i, 0.3 * (i % 3 - 1), 0.2 * (i % 2));
+        const GrayImage image =
+            render_target(tag_target(make_tag_bitmap(with_pass.family(), id), 0.1), pose, camera, fx);
+        const auto truth = project_tag_corners(pose, camera, 0.1);
+        for (const auto& d : with_pass.detect(image)) {
+            ASSERT_EQ(d.id, id) << "frame " << i;
+            for (std::size_t k = 0; k < 4; ++k) EXPECT_LT((d.corners[k] - truth[k]).norm(), 1.0) << "frame " << i;
+            ++found_with;
+        }
+        for (const auto& d : without_pass.detect(image)) found_without += d.id == id ? 1 : 100;
+        for (const auto& d : limited.detect(image)) found_limited += d.id == id ? 1 : 100;
+    }
+    EXPECT_GE(found_with, found_without + 3) << "with " << found_with << ", without " << found_without;
+    EXPECT_EQ(found_limited, found_without);
+}
+
 }  // namespace
 }  // namespace mogao

@@ -45,10 +45,18 @@ void validate(const RoiSettings& r) {
     check_roi("idle_search_period_s", r.idle_search_period_s, 0.0, 3600.0);
 }
 
+// The tracker's detector never runs the up-sampled search (DetectorSettings::upsample_pass_factor):
+// it is for tags under ~20 px, i.e. a 10 cm tag more than ~3.5 m from a 700 px camera, not a
+// hand-held one, and it costs several times a full-resolution search per frame.
+DetectorSettings without_upsampled_pass(DetectorSettings s) {
+    s.upsample_pass_factor = 0;
+    return s;
+}
+
 }  // namespace
 
 TagTracker::TagTracker(const TrackerConfig& config)
-    : config_(config), detector_(config.detector), disambiguator_(config.disambiguation) {
+    : config_(config), detector_(without_upsampled_pass(config.detector)), disambiguator_(config.disambiguation) {
     validate(config_.roi);
     validate(config_.camera);
     if (!(config_.tag_size_m > 0.0 && config_.tag_size_m <= 10.0)) {

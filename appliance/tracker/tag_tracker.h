@@ -64,7 +64,8 @@ struct RoiSettings {
 
 struct TrackerConfig {
     // The detector: every frame's without ROI; with ROI the window's for small tags, and the rest
-    // of the settings (family, refine_edges, ...) of every search.
+    // of the settings (family, refine_edges, ...) of every search. Its up-sampled search for tiny
+    // tags (upsample_pass_factor) is never run by the tracker (tag_tracker.cpp).
     DetectorSettings detector;
     RoiSettings roi;
     CameraIntrinsics camera;   // must match the frames' size (use rescale() for a binned mode)

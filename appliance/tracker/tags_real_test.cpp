@@ -16,11 +16,11 @@ namespace mogao {
 namespace {
 
 // Achieved by the defaults when they were chosen (docs/tracking.md, "Real photographs"), less a
-// margin of one tag on the issue's set and of about four tags on the whole set (227 of 271 with the
-// coarse pass, no false positive; AprilTag's stock settings find 215 with 2 false tags in the
-// tag16h5 photograph, 78.6 %); the issue's goal (95 % everywhere) is not met on the far half of
-// the oblique sheet and the tiny distant tags (the doc says which).
-constexpr double kMinRateIssueSet = 42.0 / 47.0;
+// margin of one tag on the issue's set (44 of 47 with the coarse and up-sampled passes) and of about
+// four tags on the whole set (228 of 271, no false positive; AprilTag's stock settings find 215
+// with 2 false tags in the tag16h5 photograph, 78.6 %); the issue's goal (95 %) is not met on the
+// far half of the oblique sheet and the tiny or cut distant tags (the doc says which).
+constexpr double kMinRateIssueSet = 43.0 / 47.0;
 constexpr double kMinRateAll = 0.82;
 constexpr double kMaxMedianCornerErrorPx = 0.6;
 
