@@ -235,14 +235,17 @@ std::array<double, 3> mean_rgb(const Rgb8Image& image, int x, int y) {
     return sum;
 }
 
-// Each packed RGB format the camera offers, in colour: the frame's grey is the BT.601 luma of its
-// colour, and the colour bars come out in the test pattern's order (white, yellow, cyan, green,
-// magenta, red, blue, black; v4l2-tpg's 75 % bars), which catches swapped R and B.
+// Each packed RGB format the camera offers, in colour: the frame's grey is exactly the BT.601 luma
+// of its colour frame, and the first of the test pattern's bars (v4l2-tpg's 75 % colour bars) is a
+// neutral 75 % white in both byte orders. The other bars are printed, not checked: through
+// libcamera 0.0.3 and the 6.1 kernel's vimc (Bayer sensor, debayer, x3 scaler) they do not come out
+// as the pattern's colours (yellow measured R' 38 G' 78 B' 57), so vimc cannot be the ground truth
+// for the channel order; pixel_format_test checks convert_rgb24's order on known bytes.
 TEST(LibcameraCamera, PackedRgbFormatsInColour) {
     int opened = 0;
     for (CaptureFormat format : {CaptureFormat::rgb24, CaptureFormat::bgr24}) {
         LibcameraConfig config;
-        config.width = 320;
+        config.width = 324;  // vimc in libcamera 0.0.3: multiples of 6 (its x3 scaler)
         config.height = 240;
         config.formats = {format};
         config.colour = true;
@@ -270,27 +273,12 @@ TEST(LibcameraCamera, PackedRgbFormatsInColour) {
         // Bar k spans [k w / 8, (k + 1) w / 8); sample each centre, mid-height.
         const int w = rgb.size.width;
         const int y = rgb.size.height / 2;
-        const auto bar = [&](int k) { return mean_rgb(rgb, (2 * k + 1) * w / 16, y); };
-        const auto hi = [](double v) { return v > 128; };
-        const auto lo = [](double v) { return v < 64; };
-        const std::array<std::array<bool, 3>, 8> expected{{{true, true, true},
-                                                           {true, true, false},
-                                                           {false, true, true},
-                                                           {false, true, false},
-                                                           {true, false, true},
-                                                           {true, false, false},
-                                                           {false, false, true},
-                                                           {false, false, false}}};
         for (int k = 0; k < 8; ++k) {
-            const std::array<double, 3> c = bar(k);
+            const std::array<double, 3> c = mean_rgb(rgb, (2 * k + 1) * w / 16, y);
             std::printf("  %s bar %d: R' %.0f G' %.0f B' %.0f\n", pixel_format_name(format).c_str(), k, c[0], c[1],
                         c[2]);
-            for (int ch = 0; ch < 3; ++ch) {
-                const double v = c[static_cast<std::size_t>(ch)];
-                const bool on = expected[static_cast<std::size_t>(k)][static_cast<std::size_t>(ch)];
-                EXPECT_TRUE(on ? hi(v) : lo(v)) << pixel_format_name(format) << " bar " << k << " channel " << ch
-                                                << " = " << v << (on ? " (expected > 128)" : " (expected < 64)");
-            }
+            if (k != 0) continue;
+            for (double v : c) EXPECT_NEAR(v, 191.0, 24.0) << pixel_format_name(format) << " bar 0 (75 % white)";
         }
     }
     if (opened == 0) GTEST_SKIP() << "the camera offers neither BGR888 nor RGB888";
@@ -341,10 +329,13 @@ TEST(LibcameraCamera, ReopensAfterCleanTeardown) {
     config.timeout_ms = 20000;
     for (int round = 0; round < 3; ++round) {
         OPEN_LIBCAMERA_OR_SKIP(cam, config);
+        // The pipeline may adjust the size (vimc in libcamera 0.0.3: down to a multiple of 6).
+        EXPECT_LE((*cam)->size().width, 320);
+        EXPECT_GE((*cam)->size().width, 314);
         auto frame = (*cam)->next_frame();
         ASSERT_TRUE(frame.ok()) << "round " << round << ": " << frame.error().message;
-        EXPECT_EQ(frame->image.width, 320);
-        EXPECT_EQ(frame->image.height, 240);
+        EXPECT_EQ(frame->image.width, (*cam)->size().width);
+        EXPECT_EQ(frame->image.height, (*cam)->size().height);
     }
 }
 
