@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 # CTest entry of the opt-in image tests (labels "image;qemu"); see image/CMakeLists.txt.
 #   image_tests.sh build REPO OUTDIR KIOSK
-#   image_tests.sh boot  REPO OUTDIR KIOSK FARM IMAGE_TOOL MPIEXEC [CAMERA_TEST]
+#   image_tests.sh boot  REPO OUTDIR KIOSK FARM IMAGE_TOOL MPIEXEC [CAMERA_TEST [LIBCAMERA_TEST]]
 # Exit 77 (skipped) with a message when not enabled (MOGAO_IMAGE_TESTS=1) or not possible here.
 set -u
 mode=$1 repo=$2 outdir=$3 kiosk=$4
@@ -23,13 +23,14 @@ case $mode in
     echo "image_build: $(( $(date +%s) - start )) s"
     ;;
   boot)
-    farm=$5 tool=$6 mpiexec=$7 camera=${8:-}
+    farm=$5 tool=$6 mpiexec=$7 camera=${8:-} libcamera=${9:-}
     image=${MOGAO_IMAGE:-$outdir/mogao-kiosk.img}
     [[ -f "$image" ]] || skip "no image at $image (the image_build test builds it)"
     args=(--image "$image" --repo "$repo" --kiosk "$kiosk" --farm "$farm" --image-tool "$tool"
           --work "$outdir/qemu-test" --results "$outdir/qemu-test-results.json")
     [[ -n "$mpiexec" ]] && args+=(--mpiexec "$mpiexec")
     [[ -n "$camera" ]] && args+=(--camera-test "$camera")
+    [[ -n "$libcamera" ]] && args+=(--libcamera-test "$libcamera")
     exec python3 "$repo/image/test/qemu_boot_test.py" "${args[@]}"
     ;;
   *) echo "unknown mode $mode" >&2; exit 2 ;;

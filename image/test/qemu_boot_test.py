@@ -3,7 +3,8 @@
 """Boots the appliance image in QEMU (real kernel, real drivers) and checks it end to end.
 
     qemu_boot_test.py --image mogao-kiosk.img --repo SRC --kiosk BIN --farm BIN --image-tool BIN
-                      [--mpiexec MPIEXEC] [--camera-test BIN] [--work DIR] [--accel tcg|kvm]
+                      [--mpiexec MPIEXEC] [--camera-test BIN] [--libcamera-test BIN] [--work DIR]
+                      [--accel tcg|kvm]
                       [--no-farm] [--no-tco] [--results FILE]
 
 A copy of the image is provisioned (image/provision) with a test PKI and a kiosk.toml whose farm is
@@ -25,7 +26,12 @@ Assertions (each printed; any failure fails the test):
   * a SIGSTOPped kiosk is killed by its watchdog (WatchdogSec) and restarted by systemd;
   * the hardware watchdog (iTCO_wdt) is used by PID 1 and resets a hung (panicked) kernel;
   * lock-down: read-only root, no failed units, no login prompt, no passwords, no listening sockets;
-  * V4L2 capture test of drivers/camera against vivid, when its test binary is given.
+  * V4L2 capture test of drivers/camera against vivid, when its test binary is given;
+  * libcamera capture test of drivers/camera against vimc through libcamera's vimc pipeline handler
+    and IPA, when its test binary is given (qemu_libcamera.py puts vimc.ko, built for the image's
+    kernel by build_vimc.sh, and the IPA on the test disk). Its result is required once staged; a
+    host that cannot stage it (no kernel headers/source of the image's version, no libcamera-ipa)
+    is a skip, and a failure with CI=true.
 Exit 77 (skip) with a message when QEMU, OVMF, mtools or the image are missing.
 """
 import argparse
@@ -39,6 +45,7 @@ import sys
 import tempfile
 import time
 
+import qemu_libcamera  # noqa: E402 (this folder)
 from qemu_common import T0, Failures, Serial, log, set_name  # noqa: E402 (this folder)
 
 SKIP = 77
@@ -202,6 +209,8 @@ def main():
     ap.add_argument("--image-tool", required=True, help="mogao_kiosk_image_tool (PSNR of PNG/PPM)")
     ap.add_argument("--mpiexec", default=shutil.which("mpirun") or "mpirun")
     ap.add_argument("--camera-test", default="", help="drivers/camera test binary (mogao_camera_test), optional")
+    ap.add_argument("--libcamera-test", default="",
+                    help="drivers/camera libcamera test binary (mogao_libcamera_test), optional")
     ap.add_argument("--work", default="")
     ap.add_argument("--accel", default=os.environ.get("MOGAO_IMAGE_QEMU_ACCEL", "tcg"), choices=["tcg", "kvm"])
     ap.add_argument("--no-farm", action="store_true")
@@ -349,6 +358,11 @@ def main():
         log(f"camera test on the test disk: {a.camera_test}")
     else:
         log("no drivers/camera test binary given: the V4L2 capture test is skipped")
+    run(["mcopy", "-o", "-i", esp, "::/mogao/vmlinuz", os.path.join(work, "vmlinuz")], env=env)
+    libcamera_staged, what = qemu_libcamera.stage(a.repo, work, disk, os.path.join(work, "vmlinuz"), a.libcamera_test)
+    log(f"libcamera test on the test disk: {what}" if libcamera_staged else f"libcamera test not staged: {what}")
+    if not libcamera_staged and os.environ.get("CI") == "true":
+        fails.check(False, f"the libcamera capture test against vimc could not be staged (CI=true): {what}")
     size_mib = int(run(["du", "-sm", disk]).stdout.split()[0]) * 12 // 10 + 16
     testimg = os.path.join(work, "testdisk.img")
     if os.path.exists(testimg):
@@ -490,7 +504,7 @@ def main():
             m = re.search(r"seconds=([\d.]+)", text)
             if m:
                 results["watchdog_restart_s"] = float(m.group(1))
-        t_done, text = serial.wait(r"done ", 300, alive)
+        t_done, text = serial.wait(r"done ", 540 if libcamera_staged else 300, alive)
         fails.check(t_done is not None, "the self-test finished")
         for _, mark in serial.marks:
             if mark.startswith("FAIL "):
@@ -499,10 +513,13 @@ def main():
                 name = mark.split()[1]
                 if name in ("hw-watchdog", "root-readonly", "root-write", "no-failed-units", "no-login-prompt",
                             "no-passwords", "no-listening-sockets", "v4l2-capture-test", "vivid-loaded",
-                            "farm-frames-presented"):
+                            "farm-frames-presented", "vimc-loaded", "libcamera-capture-test"):
                     fails.check(True, f"guest: {mark[3:]}")
             elif mark.startswith("skip "):
                 log(f"SKIPPED {mark[5:]}")
+        if libcamera_staged and t_done is not None:
+            fails.check(any(m.startswith("ok libcamera-capture-test") for _, m in serial.marks),
+                        "guest: the libcamera capture test streamed from vimc (ok libcamera-capture-test)")
 
         # Hardware watchdog: the guest panics with panic=0; the TCO timer must reset the machine.
         if not a.no_tco and t_done is not None:

@@ -197,6 +197,37 @@ else
   say "skip v4l2-capture-test (no drivers/camera test binary on the test disk)"
 fi
 
+# --- libcamera capture test of drivers/camera against vimc, when the host put it on the test disk ----
+# vimc (the kernel's virtual media-controller camera; Debian's kernel lacks it, the host built
+# vimc.ko for this kernel: image/test/build_vimc.sh) through libcamera's vimc pipeline handler and
+# its IPA (from the test disk, not the image). The test must stream: a missing camera is a failure
+# here (MOGAO_REQUIRE_LIBCAMERA_CAMERA=1), not a skip.
+if [ -f /mnt/vimc.ko ] && [ -x /mnt/bin/mogao_libcamera_test ]; then
+  modprobe -a videobuf2-vmalloc videobuf2-v4l2 v4l2-tpg videodev mc 2>/dev/null
+  if insmod /mnt/vimc.ko 2>/tmp/vimc.err; then
+    udevadm settle 2>/dev/null; sleep 1
+    ok "vimc-loaded nodes=$(ls /dev/media* /dev/v4l-subdev* 2>/dev/null | tr '\n' ',')"
+  else
+    bad "vimc-loaded (insmod: $(tr '\n' ' ' < /tmp/vimc.err))"
+  fi
+  t0=$(uptime_s)
+  LD_LIBRARY_PATH=/mnt/lib LIBCAMERA_IPA_MODULE_PATH=/mnt/libcamera/ipa LIBCAMERA_IPA_PROXY_PATH=/mnt/libcamera/ipa \
+    LIBCAMERA_IPA_CONFIG_PATH=/mnt/libcamera/conf LIBCAMERA_LOG_LEVELS='*:ERROR' MOGAO_REQUIRE_LIBCAMERA_CAMERA=1 \
+    timeout 400 /mnt/bin/mogao_libcamera_test --gtest_filter='LibcameraCamera*' > /tmp/libcamera.log 2>&1
+  rc=$?
+  grep -v '^\[ RUN' /tmp/libcamera.log | grep -E "OK|FAILED|SKIPPED|PASSED|Skipped|error|Failure|: libcamera|bar|frames|not offered|exposure|ERROR|WARN|Expected|Which|  " |
+    head -n 80 | sed 's/^/MOGAO-SELFTEST libcamera-log /' > "$out"
+  passed=$(grep -c '^\[       OK \] LibcameraCamera' /tmp/libcamera.log)
+  skipped=$(grep -c '^\[  SKIPPED \] LibcameraCamera' /tmp/libcamera.log)
+  if [ $rc -eq 0 ] && [ "$passed" -ge 5 ] && [ "$skipped" -eq 0 ]; then
+    ok "libcamera-capture-test vimc passed=$passed skipped=$skipped seconds=$(echo "$(uptime_s) $t0" | awk '{print $1 - $2}')"
+  else
+    bad "libcamera-capture-test rc=$rc passed=$passed skipped=$skipped"
+  fi
+else
+  say "skip libcamera-capture-test (no vimc.ko or libcamera test binary on the test disk)"
+fi
+
 say "done fails=$fails uptime=$(uptime_s)"
 
 # --- hardware watchdog reset: hang the kernel (panic, no automatic reboot); iTCO must reset ---------
