@@ -67,6 +67,7 @@ Score score_frame(const GrottoSet& set, const GrottoFrame& frame, const std::vec
 
 struct SettingResult {
     Score all;
+    std::vector<Score> per_frame;
     std::map<std::string, Score> by_variant;
     double total_ms = 0.0;
 };
@@ -95,6 +96,7 @@ std::vector<SettingResult> evaluate_settings(const GrottoSet& set, const std::ve
         for (std::size_t k = 0; k < settings.size(); ++k) {
             const Score s = score_frame(set, set.frames[i], found[k]);
             results[k].all.add(s);
+            results[k].per_frame.push_back(s);
             results[k].by_variant[set.frames[i].variant].add(s);
             results[k].total_ms += best[k];
         }
@@ -194,6 +196,25 @@ void print_roi_table(const GrottoSet& set, const std::vector<GrayImage>& images,
     }
 }
 
+// The defaults by the motion blur of the tag centre over the exposure (pixels).
+void print_by_blur(const GrottoSet& set, const SettingResult& defaults) {
+    const std::vector<std::pair<double, double>> bins{{0.0, 1.0}, {1.0, 2.0}, {2.0, 4.0}, {4.0, 8.0}, {8.0, 1e9}};
+    std::printf("\n| motion blur (px) | frames | found (defaults) | corner error median (px) | p90 (px) |\n");
+    std::printf("|---|--:|--:|--:|--:|\n");
+    for (const auto& [lo, hi] : bins) {
+        Score bin;
+        for (std::size_t i = 0; i < set.frames.size(); ++i) {
+            if (set.frames[i].blur_px >= lo && set.frames[i].blur_px < hi) bin.add(defaults.per_frame[i]);
+        }
+        if (bin.tags == 0) continue;
+        const std::string range =
+            hi > 1e8 ? "≥ " + std::to_string(static_cast<int>(lo))
+                     : std::to_string(static_cast<int>(lo)) + "–" + std::to_string(static_cast<int>(hi));
+        std::printf("| %s | %d | %d | %.3f | %.3f |\n", range.c_str(), bin.tags, bin.found,
+                    quantile(bin.errors_px, 0.5), quantile(bin.errors_px, 0.9));
+    }
+}
+
 void print_variants(const GrottoSet& set) {
     std::map<std::string, std::vector<const GrottoFrame*>> by_variant;
     for (const auto& f : set.frames) by_variant[f.variant].push_back(&f);
@@ -228,6 +249,7 @@ int run_grotto(const GrottoOptions& options) {
     const auto settings = compared_settings();
     const auto results = evaluate_settings(set, images, settings, options.repeat);
     print_settings_table(settings, results, images.size());
+    print_by_blur(set, results.front());
     print_reference_check(set, images);
     print_roi_table(set, images, options.repeat);
     print_variants(set);
