@@ -4,7 +4,9 @@
 #include <EGL/egl.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <string>
 
@@ -25,15 +27,16 @@ void main() {
 }
 )";
 
-constexpr const char* kFragmentShader = R"(#version 300 es
+// The fragment shader after its #version line; fragment_source() puts the variant's #define between.
+constexpr const char* kFragmentShader = R"(
 precision highp float;
 precision highp int;
 precision highp sampler2D;
 
-uniform sampler2D u_content;  // GL_SRGB8: texelFetch returns linear light
+uniform sampler2D u_content;  // GL_RGB32F, linear light (decoded from sRGB once per frame on upload)
 uniform sampler2D u_warp;     // GL_RG32F (u, v); u < kNoContent marks "no content"
 uniform sampler2D u_blend;    // GL_R32F weight in linear light
-uniform sampler2D u_lut;      // GL_RGB32F, N x 1: display value per channel at linear i / (N - 1)
+uniform sampler2D u_lut;      // GL_RG32F, (N - 1) x 3: row c, texel i = (lut_c[i], lut_c[i + 1])
 uniform sampler2D u_beta;     // GL_RGB32F black offset per channel, linear light (read only if u_has_beta)
 uniform bool u_has_beta;      // false: the projector has no beta map, no texel is fetched
 uniform vec2 u_output_size;   // projector pixels
@@ -65,6 +68,20 @@ vec4 weights(vec2 f) {
     return vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
 }
 
+#ifdef EXACT_MAPS
+// Every map has the target's size: p * scale - 0.5 is the integer texel index itself, so the
+// bilinear weights are (1, 0, 0, 0) and one fetch gives bit for bit what four would.
+ivec2 texel_of(vec2 p) { return ivec2(floor(p)); }
+
+bool warp_at(vec2 p, out vec2 uv) {
+    uv = texelFetch(u_warp, texel_of(p), 0).rg;
+    return uv.x >= kNoContent;
+}
+
+float blend_at(vec2 p) { return texelFetch(u_blend, texel_of(p), 0).r; }
+
+vec3 beta_at(vec2 p) { return u_has_beta ? texelFetch(u_beta, texel_of(p), 0).rgb : vec3(0.0); }
+#else
 // False when a texel with non-zero weight has no content.
 bool warp_at(vec2 p, out vec2 uv) {
     Taps t = taps_at(p * u_warp_scale - 0.5, textureSize(u_warp, 0));
@@ -101,6 +118,7 @@ vec3 beta_at(vec2 p) {
     return texelFetch(u_beta, t.lo, 0).rgb * w.x + texelFetch(u_beta, ivec2(t.hi.x, t.lo.y), 0).rgb * w.y +
            texelFetch(u_beta, ivec2(t.lo.x, t.hi.y), 0).rgb * w.z + texelFetch(u_beta, t.hi, 0).rgb * w.w;
 }
+#endif
 
 // Bilinear in linear light: each texel is decoded from sRGB by the texture unit before weighting.
 vec3 content_at(vec2 uv) {
@@ -111,16 +129,17 @@ vec3 content_at(vec2 uv) {
            texelFetch(u_content, ivec2(t.lo.x, t.hi.y), 0).rgb * w.z + texelFetch(u_content, t.hi, 0).rgb * w.w;
 }
 
+// Each texel holds an entry and its successor, so one fetch per channel gives both ends of the
+// linear piece (three fetches instead of six; the same values, the same arithmetic).
 vec3 apply_lut(vec3 x) {
-    int n = textureSize(u_lut, 0).x;
+    int n = textureSize(u_lut, 0).x + 1;
     vec3 pos = clamp(x, 0.0, 1.0) * float(n - 1);
     ivec3 i = min(ivec3(floor(pos)), ivec3(n - 2));
     vec3 f = pos - vec3(i);
-    vec3 lo = vec3(texelFetch(u_lut, ivec2(i.r, 0), 0).r, texelFetch(u_lut, ivec2(i.g, 0), 0).g,
-                   texelFetch(u_lut, ivec2(i.b, 0), 0).b);
-    vec3 hi = vec3(texelFetch(u_lut, ivec2(i.r + 1, 0), 0).r, texelFetch(u_lut, ivec2(i.g + 1, 0), 0).g,
-                   texelFetch(u_lut, ivec2(i.b + 1, 0), 0).b);
-    return lo * (1.0 - f) + hi * f;
+    vec2 r = texelFetch(u_lut, ivec2(i.r, 0), 0).rg;
+    vec2 g = texelFetch(u_lut, ivec2(i.g, 1), 0).rg;
+    vec2 b = texelFetch(u_lut, ivec2(i.b, 2), 0).rg;
+    return vec3(r.x, g.x, b.x) * (1.0 - f) + vec3(r.y, g.y, b.y) * f;
 }
 
 void main() {
@@ -136,6 +155,20 @@ void main() {
     o_color = vec4(apply_lut(linear), 1.0);
 }
 )";
+
+// The sRGB decoding function (IEC 61966-2-1) of each 8-bit code, computed in double: what GL_SRGB8
+// texels decode to, without an implementation's approximation.
+const std::array<float, 256>& srgb8_to_linear_table() {
+    static const std::array<float, 256> table = [] {
+        std::array<float, 256> t{};
+        for (std::size_t c = 0; c < t.size(); ++c) {
+            const double s = static_cast<double>(c) / 255.0;
+            t[c] = static_cast<float>(s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4));
+        }
+        return t;
+    }();
+    return table;
+}
 
 std::string size_text(ImageSize s) { return std::to_string(s.width) + "x" + std::to_string(s.height); }
 
@@ -194,28 +227,43 @@ Result<GlTexture> upload_beta(const std::string& who, const BlackOffset& beta, G
 
 }  // namespace
 
+Result<WarpBlendRenderer::Program> WarpBlendRenderer::make_program(bool exact_maps) {
+    const std::string fragment =
+        std::string("#version 300 es\n") + (exact_maps ? "#define EXACT_MAPS 1\n" : "") + kFragmentShader;
+    auto linked = link_program(kVertexShader, fragment);
+    if (!linked)
+        return with_context(linked.error(), exact_maps ? "WarpBlendRenderer (exact maps)" : "WarpBlendRenderer");
+    Program p;
+    p.program = std::move(linked.value());
+    const GLuint id = p.program.get();
+    glUseProgram(id);
+    glUniform1i(glGetUniformLocation(id, "u_content"), 0);
+    glUniform1i(glGetUniformLocation(id, "u_warp"), 1);
+    glUniform1i(glGetUniformLocation(id, "u_blend"), 2);
+    glUniform1i(glGetUniformLocation(id, "u_lut"), 3);
+    glUniform1i(glGetUniformLocation(id, "u_beta"), 4);
+    p.output_size = glGetUniformLocation(id, "u_output_size");
+    p.warp_scale = glGetUniformLocation(id, "u_warp_scale");
+    p.blend_scale = glGetUniformLocation(id, "u_blend_scale");
+    p.beta_scale = glGetUniformLocation(id, "u_beta_scale");
+    p.has_beta = glGetUniformLocation(id, "u_has_beta");
+    p.content_scale = glGetUniformLocation(id, "u_content_scale");
+    p.content_offset = glGetUniformLocation(id, "u_content_offset");
+    return p;
+}
+
 Result<WarpBlendRenderer> WarpBlendRenderer::create() {
     // Without a current context every GL call is silently ignored; say so instead.
     if (eglGetCurrentContext() == EGL_NO_CONTEXT) {
         return make_error(EINVAL, "WarpBlendRenderer::create: no EGL context is current on this thread");
     }
     WarpBlendRenderer r;
-    auto program = link_program(kVertexShader, kFragmentShader);
-    if (!program) return with_context(program.error(), "WarpBlendRenderer");
-    r.program_ = std::move(program.value());
-    glUseProgram(r.program_.get());
-    glUniform1i(glGetUniformLocation(r.program_.get(), "u_content"), 0);
-    glUniform1i(glGetUniformLocation(r.program_.get(), "u_warp"), 1);
-    glUniform1i(glGetUniformLocation(r.program_.get(), "u_blend"), 2);
-    glUniform1i(glGetUniformLocation(r.program_.get(), "u_lut"), 3);
-    glUniform1i(glGetUniformLocation(r.program_.get(), "u_beta"), 4);
-    r.loc_output_size_ = glGetUniformLocation(r.program_.get(), "u_output_size");
-    r.loc_warp_scale_ = glGetUniformLocation(r.program_.get(), "u_warp_scale");
-    r.loc_blend_scale_ = glGetUniformLocation(r.program_.get(), "u_blend_scale");
-    r.loc_beta_scale_ = glGetUniformLocation(r.program_.get(), "u_beta_scale");
-    r.loc_has_beta_ = glGetUniformLocation(r.program_.get(), "u_has_beta");
-    r.loc_content_scale_ = glGetUniformLocation(r.program_.get(), "u_content_scale");
-    r.loc_content_offset_ = glGetUniformLocation(r.program_.get(), "u_content_offset");
+    auto general = make_program(false);
+    if (!general) return general.error();
+    r.general_ = std::move(general.value());
+    auto exact = make_program(true);
+    if (!exact) return exact.error();
+    r.exact_ = std::move(exact.value());
     GLint max_texture = 0;
     GLint max_renderbuffer = 0;
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture);
@@ -237,14 +285,20 @@ Status WarpBlendRenderer::set_content(const Rgb8Image& frame) {
         return make_error(EINVAL, "content frame " + size_text(frame.size) + " holds " +
                                       std::to_string(frame.pixels.size()) + " values, expected width*height*3");
     }
+    // Decoded to linear light here, once per frame, rather than by the texture unit at each of the
+    // four fetches of every output pixel of every draw (a software rasteriser's largest cost).
+    const std::array<float, 256>& decode = srgb8_to_linear_table();
+    content_linear_.resize(frame.pixels.size());
+    std::transform(frame.pixels.begin(), frame.pixels.end(), content_linear_.begin(),
+                   [&decode](std::uint8_t code) { return decode[code]; });
     if (content_.valid() && frame.size == content_size_) {
         glBindTexture(GL_TEXTURE_2D, content_.get());
-        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, frame.size.width, frame.size.height, GL_RGB, GL_UNSIGNED_BYTE,
-                        frame.pixels.data());
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, frame.size.width, frame.size.height, GL_RGB, GL_FLOAT,
+                        content_linear_.data());
         return gl_check("upload content frame");
     }
-    auto texture = upload("content frame", GL_SRGB8, frame.size, GL_RGB, GL_UNSIGNED_BYTE, frame.pixels.data());
+    auto texture = upload("content frame", GL_RGB32F, frame.size, GL_RGB, GL_FLOAT, content_linear_.data());
     if (!texture) return texture.error();
     content_ = std::move(texture.value());
     content_size_ = frame.size;
@@ -305,12 +359,16 @@ Result<WarpBlendRenderer::Projector> WarpBlendRenderer::make_projector(const Pro
         uv[i] = valid ? std::clamp(u, -1.0f, 2.0f) : kNoContentUpload;
         uv[i + 1] = valid ? std::clamp(v, -1.0f, 2.0f) : kNoContentUpload;
     }
-    std::vector<float> lut(n * 3);
-    for (std::size_t i = 0; i < n; ++i) {
-        for (std::size_t ch = 0; ch < 3; ++ch) {
-            const float value = c.response.lut[ch][i];
-            if (!std::isfinite(value)) return make_error(EINVAL, who + ": response LUT has a non-finite entry");
-            lut[i * 3 + ch] = value;
+    // Row ch, texel i: (lut[ch][i], lut[ch][i + 1]), the two ends of linear piece i (see apply_lut).
+    std::vector<float> lut((n - 1) * 3 * 2);
+    for (std::size_t ch = 0; ch < 3; ++ch) {
+        const auto& entries = c.response.lut[ch];
+        if (!std::all_of(entries.begin(), entries.end(), [](float v) { return std::isfinite(v); })) {
+            return make_error(EINVAL, who + ": response LUT has a non-finite entry");
+        }
+        for (std::size_t i = 0; i + 1 < n; ++i) {
+            lut[(ch * (n - 1) + i) * 2] = entries[i];
+            lut[(ch * (n - 1) + i) * 2 + 1] = entries[i + 1];
         }
     }
 
@@ -322,8 +380,8 @@ Result<WarpBlendRenderer::Projector> WarpBlendRenderer::make_projector(const Pro
     if (!warp) return warp.error();
     auto blend = upload(who + " blend mask", GL_R32F, c.blend.size, GL_RED, GL_FLOAT, c.blend.weight.data());
     if (!blend) return blend.error();
-    auto lut_texture = upload(who + " response LUT", GL_RGB32F, ImageSize{static_cast<int>(n), 1}, GL_RGB, GL_FLOAT,
-                              lut.data());
+    auto lut_texture =
+        upload(who + " response LUT", GL_RG32F, ImageSize{static_cast<int>(n - 1), 3}, GL_RG, GL_FLOAT, lut.data());
     if (!lut_texture) return lut_texture.error();
     auto beta = upload_beta(who, c.beta, max_texture_size_);
     if (!beta) return beta.error();
@@ -353,22 +411,24 @@ Status WarpBlendRenderer::draw(std::size_t index, ImageSize target) {
     if (auto s = check_index(index); !s) return s;
     if (auto s = check_size("draw target", target, max_texture_size_); !s) return s;
     const Projector& p = projectors_[index];
-    glUseProgram(program_.get());
+    const bool has_beta = p.beta.valid();
+    const bool exact = p.warp_size == target && p.blend_size == target && (!has_beta || p.beta_size == target);
+    const Program& program = exact ? exact_ : general_;
+    glUseProgram(program.program.get());
     // The shader maps each target pixel centre to warp/blend coordinates by size ratios, so a
     // target larger or smaller than the calibration's output is the same picture resampled.
     const auto out_w = static_cast<float>(target.width);
     const auto out_h = static_cast<float>(target.height);
-    glUniform2f(loc_output_size_, out_w, out_h);
-    glUniform2f(loc_warp_scale_, static_cast<float>(p.warp_size.width) / out_w,
+    glUniform2f(program.output_size, out_w, out_h);
+    glUniform2f(program.warp_scale, static_cast<float>(p.warp_size.width) / out_w,
                 static_cast<float>(p.warp_size.height) / out_h);
-    glUniform2f(loc_blend_scale_, static_cast<float>(p.blend_size.width) / out_w,
+    glUniform2f(program.blend_scale, static_cast<float>(p.blend_size.width) / out_w,
                 static_cast<float>(p.blend_size.height) / out_h);
-    const bool has_beta = p.beta.valid();
-    glUniform1i(loc_has_beta_, has_beta ? 1 : 0);
-    glUniform2f(loc_beta_scale_, has_beta ? static_cast<float>(p.beta_size.width) / out_w : 0.0f,
+    glUniform1i(program.has_beta, has_beta ? 1 : 0);
+    glUniform2f(program.beta_scale, has_beta ? static_cast<float>(p.beta_size.width) / out_w : 0.0f,
                 has_beta ? static_cast<float>(p.beta_size.height) / out_h : 0.0f);
-    glUniform2f(loc_content_scale_, transform_.scale_u, transform_.scale_v);
-    glUniform2f(loc_content_offset_, transform_.offset_u, transform_.offset_v);
+    glUniform2f(program.content_scale, transform_.scale_u, transform_.scale_v);
+    glUniform2f(program.content_offset, transform_.offset_u, transform_.offset_v);
     const GLuint textures[] = {content_.get(), p.warp.get(), p.blend.get(), p.lut.get(),
                                has_beta ? p.beta.get() : no_beta_.get()};
     for (GLuint unit = 0; unit < 5; ++unit) {

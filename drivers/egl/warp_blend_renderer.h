@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 // WarpBlendRenderer: the GL layer of one projector output. It only uploads and draws: the content
 // frame once per frame, each projector's calibration once, then one full-screen triangle per
-// projector per frame. The maths (fragment shader, GLSL ES 3.00), per output pixel (x, y):
+// projector per frame (the shader is linked twice: the general one and, for the common case of
+// maps as large as the target, one that fetches each map once per pixel). The maths (fragment
+// shader, GLSL ES 3.00), per output pixel (x, y):
 //
 //   p      = (x + 0.5, y + 0.5)                       output pixel centre, y down from the top row
 //   uv     = bilinear(warp,  p * warp.size / output - 0.5)   in warp texel-centre coordinates
@@ -9,7 +11,8 @@
 //   beta_c = bilinear(beta,  p * beta.size / output - 0.5)   per channel c; 0 when beta is empty
 //   uv'    = uv * content_scale + content_offset  (per axis; identity unless set_content_transform)
 //   linear = bilinear over the 4 content texels around uv' * content.size - 0.5, each texel
-//            decoded sRGB -> linear first (GL_SRGB8 + texelFetch), so the filtering is in linear light
+//            decoded sRGB -> linear first (on the CPU once per frame, uploaded as GL_RGB32F), so the
+//            filtering is in linear light
 //   out    = lut_c(clamp(linear_c * w + beta_c, 0, 1))  per channel c; lut_c is piecewise linear
 //            over its N entries at linear positions i / (N - 1). beta (the MPCDI beta map, black-level
 //            offset in linear light) is added after the blend and is not scaled by the content, so
@@ -57,11 +60,11 @@ public:
     [[nodiscard]] Status set_content(const Rgb8Image& frame);
 
     // Validates and uploads one projector's warp map (RG32F), blend mask (R32F), response LUT
-    // (N x 1 RGB32F) and black offset (beta, RGB32F; nothing is uploaded or fetched when it is
-    // empty, 0 x 0), once. Returns the projector's index for draw()/render(). EINVAL when a size
-    // is empty or does not match its data (beta: width*height*3 values), the LUT channels differ
-    // in length or have < 2 entries, or a blend weight, LUT entry or beta offset is not finite;
-    // the message names the projector id and the map.
+    // ((N - 1) x 3 RG32F: each entry with its successor) and black offset (beta, RGB32F; nothing
+    // is uploaded or fetched when it is empty, 0 x 0), once. Returns the projector's index for
+    // draw()/render(). EINVAL when a size is empty or does not match its data (beta:
+    // width*height*3 values), the LUT channels differ in length or have < 2 entries, or a blend
+    // weight, LUT entry or beta offset is not finite; the message names the projector id and the map.
     [[nodiscard]] Result<std::size_t> add_projector(const ProjectorCalibration& calibration);
     // Replaces projector `index`'s calibration (a run-time calibration swap, kiosk/calibration_reload.h):
     // the same checks and uploads as add_projector; on any error the old textures stay in use.
@@ -114,14 +117,21 @@ private:
     [[nodiscard]] Result<Projector> make_projector(const ProjectorCalibration& calibration) const;  // checks, uploads
     [[nodiscard]] Status check_index(std::size_t index) const;
 
-    GlProgram program_;
-    GLint loc_output_size_ = -1;
-    GLint loc_warp_scale_ = -1;
-    GLint loc_blend_scale_ = -1;
-    GLint loc_beta_scale_ = -1;
-    GLint loc_has_beta_ = -1;
-    GLint loc_content_scale_ = -1;
-    GLint loc_content_offset_ = -1;
+    // One linked variant of the fragment shader and its uniform locations.
+    struct Program {
+        GlProgram program;
+        GLint output_size = -1;
+        GLint warp_scale = -1;
+        GLint blend_scale = -1;
+        GLint beta_scale = -1;
+        GLint has_beta = -1;
+        GLint content_scale = -1;
+        GLint content_offset = -1;
+    };
+    [[nodiscard]] static Result<Program> make_program(bool exact_maps);
+
+    Program general_;  // maps of any size: bilinear warp, blend and beta
+    Program exact_;    // every map the target's size: one fetch each (the same result, fewer fetches)
     ContentTransform transform_;
     GLint max_texture_size_ = 0;
     GlTexture content_;
@@ -129,6 +139,7 @@ private:
     ImageSize content_size_;
     std::vector<Projector> projectors_;
     std::vector<std::uint8_t> readback_;  // RGBA scratch for render()
+    std::vector<float> content_linear_;   // set_content's frame in linear light, for the upload
 };
 
 }  // namespace mogao
