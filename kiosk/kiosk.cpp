@@ -168,10 +168,14 @@ void Kiosk::on_tick() {
     submit_next_view();
     const LinkClientStats link = parts_.link.stats();
     note_link_state(link);
-    const bool turned = update_late_warp();
-    if (!shown_since_tick_ || turned) {
-        // Nothing new this tick, or the view turned since: show the current frame again (headless
-        // PNGs keep coming, a KMS output is refreshed, the late warp's new shift reaches the wall).
+    (void)update_late_warp();
+    // Nothing new since the previous tick: show the current frame again (headless PNGs keep
+    // coming, a KMS output is refreshed, the late warp's new shift reaches the wall). A frame shown
+    // since then already carried the shift of its own round, and a frame already decoded and
+    // waiting is shown next, with this tick's shift: a repaint first would only delay it by a whole
+    // round (on a software rasteriser, hundreds of ms for three outputs). A turn after that round
+    // reaches the wall with the next frame or at the next tick, whichever comes first.
+    if (!shown_since_tick_ && !frame_waiting()) {
         parts_.display.repaint();
         check_frames_shown();
     }
@@ -195,6 +199,11 @@ void Kiosk::on_tick() {
         last_log_ = now;
     }
     parts_.notifier.watchdog();
+}
+
+bool Kiosk::frame_waiting() const {
+    pollfd inbox{parts_.inbox.fd(), POLLIN, 0};
+    return ::poll(&inbox, 1, 0) == 1 && (inbox.revents & POLLIN) != 0;
 }
 
 bool Kiosk::update_late_warp() {

@@ -128,6 +128,8 @@ private:
     // Sets the display's content transform for the yaw turned since the current frame's request
     // (identity without a guard band); true when it changed.
     [[nodiscard]] bool update_late_warp();
+    // A decoded frame is waiting in the inbox (its eventfd is readable): on_frame() shows it next.
+    [[nodiscard]] bool frame_waiting() const;
     void note_rejections(const std::vector<DecodeWorker::Rejection>& rejections);  // counts and logs
     void check_frames_shown();                                                     // --frames
     void submit_next_view();

@@ -255,6 +255,28 @@ TEST_F(KioskTest, OnTickRepaintsOnlyWhenNoFrameCameSinceThePreviousTick) {
     EXPECT_EQ(display_->stats().rounds(), rounds + 2) << "a frame came: the tick must not repaint";
 }
 
+// A frame already decoded and waiting is shown next, with the tick's shift: a repaint of the old
+// frame first would only delay it by a whole round.
+TEST_F(KioskTest, OnTickDoesNotRepaintWhileADecodedFrameWaits) {
+    Kiosk& k = kiosk();
+    const std::uint64_t rounds = display_->stats().rounds();
+    wait_readable(k.tick_fd());
+    k.on_tick();  // the connecting screen was shown since start: no repaint
+    deliver(jpeg_frame(1, 80));
+    wait_readable(k.tick_fd());
+    k.on_tick();  // nothing shown since the previous tick, but a frame waits
+    EXPECT_EQ(display_->stats().rounds(), rounds) << "the waiting frame must not wait behind a repaint";
+    k.on_frame();
+    EXPECT_EQ(display_->stats().rounds(), rounds + 1);
+    ASSERT_NE(k.current(), nullptr);
+    EXPECT_EQ(k.current()->request_id, 1u);
+    wait_readable(k.tick_fd());
+    k.on_tick();  // a frame came: no repaint
+    wait_readable(k.tick_fd());
+    k.on_tick();  // nothing new and nothing waiting: the idle repaint
+    EXPECT_EQ(display_->stats().rounds(), rounds + 2);
+}
+
 TEST_F(KioskTest, OnTickRecordsLinkStateChanges) {
     Kiosk& k = kiosk();
     link_.stats.connected = true;
