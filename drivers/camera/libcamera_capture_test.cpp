@@ -239,8 +239,9 @@ std::array<double, 3> mean_rgb(const Rgb8Image& image, int x, int y) {
 // of its colour frame, and the first of the test pattern's bars (v4l2-tpg's 75 % colour bars) is a
 // neutral 75 % white in both byte orders. The other bars are printed, not checked: through
 // libcamera 0.0.3 and the 6.1 kernel's vimc (Bayer sensor, debayer, x3 scaler) they do not come out
-// as the pattern's colours (yellow measured R' 38 G' 78 B' 57), so vimc cannot be the ground truth
-// for the channel order; pixel_format_test checks convert_rgb24's order on known bytes.
+// as the pattern's colours (yellow measured R' 57 G' 80 B' 38 at 324x240; the same in both byte
+// orders), so vimc cannot be the ground truth for the channel order; pixel_format_test checks
+// convert_rgb24's order on known bytes.
 TEST(LibcameraCamera, PackedRgbFormatsInColour) {
     int opened = 0;
     for (CaptureFormat format : {CaptureFormat::rgb24, CaptureFormat::bgr24}) {
