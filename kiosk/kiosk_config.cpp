@@ -14,6 +14,7 @@
 
 #include "appliance/tracker/tag_family.h"
 #include "appliance/warp/late_warp.h"
+#include "common/quality_preset.h"
 #include "common/request_limits.h"
 #include "renderfarm/link/endpoint.h"
 
@@ -266,6 +267,19 @@ void read_calibration(const Section& s, CalibrationConfig& c) {
 }
 
 void read_quality(const Section& s, QualityConfig& q) {
+    // A preset (common/quality_preset.h, the farm's table) first; the explicit keys below override it.
+    if (const Value* preset = s.find("preset"); preset != nullptr) {
+        const std::string name = s.as_string(*preset, "preset");
+        const QualityPreset* p = quality_preset(name);
+        if (p == nullptr)
+            s.fail(preset, "preset", fmt::format(": '{}' is not one of {}", name, quality_preset_names()));
+        q.preset = name;
+        q.spp = p->request.spp;
+        q.jpeg_quality = p->request.jpeg_quality;
+        q.max_bounces = p->request.max_bounces;
+        q.ao_samples = p->request.ao_samples;
+        q.area_light_samples = p->request.area_light_samples;
+    }
     q.content = s.size("content", q.content, request_limits::kLinkImageSide.min);
     q.spp = s.integer("spp", q.spp, request_limits::kSpp);
     q.jpeg_quality = s.integer("jpeg_quality", q.jpeg_quality, request_limits::kJpegQuality);
@@ -767,7 +781,9 @@ KioskConfig parse_kiosk_config(std::string_view text, const std::filesystem::pat
     const Section calibration =
         section(ctx, root, "calibration", {"source", "watch", "projectors", "overlap", "output", "gamma"});
     read_calibration(calibration, config.calibration);
-    const Section quality = section(ctx, root, "quality", {"content", "spp", "jpeg_quality", "bounces", "ao_samples", "area_light_samples"});
+    const Section quality =
+        section(ctx, root, "quality",
+                {"preset", "content", "spp", "jpeg_quality", "bounces", "ao_samples", "area_light_samples"});
     read_quality(quality, config.quality);
     const Section screen = section(ctx, root, "screen", {"radius_m", "arc_deg", "bottom_m", "top_m", "guard_deg"});
     read_screen(screen, config.screen, config.guard_deg);

@@ -74,6 +74,8 @@ struct CalibrationConfig {
 
 // [quality]: the render the kiosk requests (common/view_request.h).
 struct QualityConfig {
+    std::string preset;                     // "": none; else a name of common/quality_preset.h, whose
+                                            // request quality fills the fields below unless set
     ImageSize content{1920, 1080};          // content frame, [16, 16384] per side
     int spp = 1;                            // [1, 4096]
     int jpeg_quality = 85;                  // [1, 100]

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "kiosk/kiosk_config.h"
 
+#include "common/quality_preset.h"
+
 #include "kiosk/config_overrides.h"
 
 #include "appliance/tracker/camera_intrinsics.h"
@@ -169,6 +171,35 @@ key = "pki/appliance-a.key"
     EXPECT_EQ(c.navigation.path, "walk");
     EXPECT_EQ(c.quality.content, (ImageSize{1920, 1080}));
     EXPECT_TRUE(c.stats.file.empty());
+}
+
+// [quality].preset takes the farm's preset table (common/quality_preset.h); a key written in the
+// file overrides its preset's value; an unknown name is an error naming the known ones.
+TEST_F(KioskConfigTest, QualityPresetSetsTheRequestAndExplicitKeysOverrideIt) {
+    const std::string farm = R"([farm]
+endpoint = "[::1]:7443"
+ca = "pki/ca.pem"
+cert = "pki/appliance-a.pem"
+key = "pki/appliance-a.key"
+)";
+    const KioskConfig exhibit = parse(farm + "[quality]\npreset = \"exhibit\"\n");
+    const QualityPreset* table = quality_preset("exhibit");
+    ASSERT_NE(table, nullptr);
+    EXPECT_EQ(exhibit.quality.preset, "exhibit");
+    EXPECT_EQ(exhibit.quality.spp, table->request.spp);
+    EXPECT_EQ(exhibit.quality.max_bounces, table->request.max_bounces);
+    EXPECT_EQ(exhibit.quality.jpeg_quality, table->request.jpeg_quality);
+    EXPECT_EQ(exhibit.quality.ao_samples, table->request.ao_samples);
+    EXPECT_EQ(exhibit.quality.area_light_samples, table->request.area_light_samples);
+    EXPECT_NE(exhibit.quality.spp, QualityConfig{}.spp) << "the preset must change something";
+
+    const KioskConfig overridden = parse(farm + "[quality]\npreset = \"exhibit\"\nspp = 3\n");
+    EXPECT_EQ(overridden.quality.spp, 3);
+    EXPECT_EQ(overridden.quality.max_bounces, table->request.max_bounces);
+
+    const std::string message = error_of(farm + "[quality]\npreset = \"cinema\"\n");
+    EXPECT_NE(message.find("[quality].preset"), std::string::npos) << message;
+    EXPECT_NE(message.find("'cinema' is not one of interactive, balanced, exhibit"), std::string::npos) << message;
 }
 
 TEST_F(KioskConfigTest, AcceptsAnMpcdiSourceAPathFileAndKmsDevice) {
