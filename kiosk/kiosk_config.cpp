@@ -325,10 +325,20 @@ Section subsection(const Section& parent, std::string_view key, const std::strin
 
 const std::vector<std::string> kCameraControlKeys{"camera_exposure_us", "camera_gain", "camera_white_balance_k",
                                                   "camera_colour"};
-const std::vector<std::string> kTrackingKeys{
-    "camera",       "camera_size", "camera_fps", "intrinsics",         "tag_size_m",  "tag_id",
-    "replay_end",   "detector",    "control",    "camera_exposure_us", "camera_gain", "camera_white_balance_k",
-    "camera_colour"};
+const std::vector<std::string> kTrackingKeys{"camera",
+                                             "camera_size",
+                                             "camera_fps",
+                                             "intrinsics",
+                                             "tag_size_m",
+                                             "tag_id",
+                                             "replay_end",
+                                             "detector",
+                                             "roi",
+                                             "control",
+                                             "camera_exposure_us",
+                                             "camera_gain",
+                                             "camera_white_balance_k",
+                                             "camera_colour"};
 
 // One camera control key: "auto", "lock", "keep" or a number within `range` (the device's own range
 // is checked when the camera opens; the setting carries the key's name for that message). Written:
@@ -390,6 +400,19 @@ void read_detector(const Section& s, DetectorSettings& d) {
     } catch (const std::invalid_argument& e) {
         s.context().fail(nullptr, fmt::format("[navigation.detector]: {}", e.what()));
     }
+}
+
+// [navigation.roi]: the keys an operator may need (a busy or an idle hall); the window's geometry
+// stays as tag_tracker.h measured it.
+void read_roi(const Section& s, RoiSettings& r) {
+    r.enabled = s.boolean("enabled", r.enabled);
+    r.full_search_every = s.integer("full_search_every", r.full_search_every, 0, 100000);
+    r.window_tag_px = s.number(
+        "window_tag_px", r.window_tag_px, [](double x) { return x == 0 || (x >= 4 && x <= 1000); },
+        "0 or [4, 1000] px");
+    const auto seconds = [](double x) { return x >= 0 && x <= 3600; };
+    r.idle_after_s = s.number("idle_after_s", r.idle_after_s, seconds, "[0, 3600] s");
+    r.idle_search_period_s = s.number("idle_search_period_s", r.idle_search_period_s, seconds, "[0, 3600] s");
 }
 
 void read_control(const Section& s, NavigationParams& p) {
@@ -516,6 +539,11 @@ void read_tracking(const Section& s, TrackingConfig& t, double eye_height_m) {
                                          "decode_sharpening", "max_hamming", "threads"});
     read_detector(detector, t.detector);
     detector.finish();
+    const Section roi =
+        subsection(s, "roi", "navigation.roi",
+                   {"enabled", "full_search_every", "window_tag_px", "idle_after_s", "idle_search_period_s"});
+    read_roi(roi, t.roi);
+    roi.finish();
     const Section control = subsection(s, "control", "navigation.control",
                                        {"rest_yaw_deg", "rest_pitch_deg", "rest_distance_m", "rest_lateral_m",
                                         "turn_dead_zone_deg", "turn_full_scale_deg", "turn_max_deg_s", "turn_exponent",
@@ -788,11 +816,27 @@ KioskConfig parse_kiosk_config(std::string_view text, const std::filesystem::pat
     const Section screen = section(ctx, root, "screen", {"radius_m", "arc_deg", "bottom_m", "top_m", "guard_deg"});
     read_screen(screen, config.screen, config.guard_deg);
     check_guarded_width(screen, config);
-    const Section navigation =
-        section(ctx, root, "navigation",
-                {"source", "path", "path_frames", "start", "start_yaw_deg", "eye_height_m", "camera", "camera_size",
-                 "camera_fps", "intrinsics", "tag_size_m", "tag_id", "replay_end", "detector", "control",
-                 "camera_exposure_us", "camera_gain", "camera_white_balance_k", "camera_colour"});
+    const Section navigation = section(ctx, root, "navigation",
+                                       {"source",
+                                        "path",
+                                        "path_frames",
+                                        "start",
+                                        "start_yaw_deg",
+                                        "eye_height_m",
+                                        "camera",
+                                        "camera_size",
+                                        "camera_fps",
+                                        "intrinsics",
+                                        "tag_size_m",
+                                        "tag_id",
+                                        "replay_end",
+                                        "detector",
+                                        "roi",
+                                        "control",
+                                        "camera_exposure_us",
+                                        "camera_gain",
+                                        "camera_white_balance_k",
+                                        "camera_colour"});
     read_navigation(navigation, config.navigation);
     config.screen.eye_m = Eigen::Vector3d(0.0, config.navigation.eye_height_m, 0.0);
     const Section stats = section(ctx, root, "stats", {"file", "log_period_s", "status_file", "status_period_s"});

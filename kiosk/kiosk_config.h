@@ -29,10 +29,11 @@
 
 #include "appliance/navigation/navigator.h"
 #include "appliance/tracker/camera_intrinsics.h"
-#include "drivers/camera/camera_source.h"
 #include "appliance/tracker/detector_settings.h"
+#include "appliance/tracker/tag_tracker.h"
 #include "common/pixel_rect.h"
 #include "common/view_request.h"
+#include "drivers/camera/camera_source.h"
 
 namespace mogao {
 
@@ -108,6 +109,7 @@ struct TrackingConfig {
     double tag_size_m = 0.10;           // (0, 10]: side of the tag's black border square
     int tag_id = -1;                    // -1 (omitted): the largest tag of the family
     DetectorSettings detector;          // [navigation.detector]
+    RoiSettings roi;                    // [navigation.roi]: region-of-interest tracking (tag_tracker.h)
     NavigationParams params;            // [navigation.control]; eye_height_m from [navigation]
     ReplayEnd replay_end = ReplayEnd::stop;  // replay only
 };

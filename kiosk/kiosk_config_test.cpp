@@ -465,6 +465,11 @@ std::string full_tracking() {
                      "navigation.detector.decode_sharpening=0.5",
                      "navigation.detector.max_hamming=1",
                      "navigation.detector.threads=2",
+                     "navigation.roi.enabled=false",
+                     "navigation.roi.full_search_every=30",
+                     "navigation.roi.window_tag_px=0",
+                     "navigation.roi.idle_after_s=2.5",
+                     "navigation.roi.idle_search_period_s=0.25",
                      "navigation.control.rest_distance_m=0.45",
                      "navigation.control.rest_yaw_deg=2",
                      "navigation.control.turn_dead_zone_deg=5",
@@ -502,6 +507,12 @@ TEST_F(KioskConfigTest, ReadsTheTrackingFields) {
     EXPECT_DOUBLE_EQ(t.detector.decode_sharpening, 0.5);
     EXPECT_EQ(t.detector.max_hamming, 1);
     EXPECT_EQ(t.detector.threads, 2);
+    EXPECT_FALSE(t.roi.enabled);
+    EXPECT_EQ(t.roi.full_search_every, 30);
+    EXPECT_DOUBLE_EQ(t.roi.window_tag_px, 0.0);
+    EXPECT_DOUBLE_EQ(t.roi.idle_after_s, 2.5);
+    EXPECT_DOUBLE_EQ(t.roi.idle_search_period_s, 0.25);
+    EXPECT_DOUBLE_EQ(t.roi.margin, RoiSettings{}.margin);  // not a key: as tag_tracker.h measured it
     EXPECT_DOUBLE_EQ(t.params.rest.distance_m, 0.45);
     EXPECT_DOUBLE_EQ(t.params.rest.yaw_deg, 2.0);
     EXPECT_DOUBLE_EQ(t.params.turn.dead_zone, 5.0);
@@ -661,6 +672,12 @@ INSTANTIATE_TEST_SUITE_P(
         BadField{"decimation = 1.5", "decimation = 9", "[navigation.detector].decimation = 9 is outside [1, 8]"},
         BadField{"max_hamming = 1", "max_hamming = 3", "[navigation.detector].max_hamming = 3 is outside [0, 2]"},
         BadField{"threads = 2", "thread = 2", "[navigation.detector].thread: unknown field (known: family"},
+        BadField{"window_tag_px = 0", "window_tag_px = 2",
+                 "[navigation.roi].window_tag_px = 2 is outside 0 or [4, 1000] px"},
+        BadField{"idle_search_period_s = 0.25", "idle_search_period_s = -1",
+                 "[navigation.roi].idle_search_period_s = -1 is outside [0, 3600] s"},
+        BadField{"full_search_every = 30", "full_search_every = 1.5", "[navigation.roi].full_search_every"},
+        BadField{"enabled = false", "enable = false", "[navigation.roi].enable: unknown field (known: enabled"},
         BadField{"rest_distance_m = 0.45", "rest_distance_m = 0",
                  "[navigation.control].rest_distance_m = 0 is outside (0, 1e6] m"},
         BadField{"turn_dead_zone_deg = 5", "turn_dead_zone_deg = 40", "[navigation.control]: NavigationParams.turn"},

@@ -16,6 +16,7 @@ namespace {
 TrackerConfig tracker_config(const TrackingConfig& c) {
     TrackerConfig t;
     t.detector = c.detector;
+    t.roi = c.roi;
     t.camera = c.intrinsics;
     t.tag_size_m = c.tag_size_m;
     t.tag_id = c.tag_id;
