@@ -325,20 +325,18 @@ Section subsection(const Section& parent, std::string_view key, const std::strin
 
 const std::vector<std::string> kCameraControlKeys{"camera_exposure_us", "camera_gain", "camera_white_balance_k",
                                                   "camera_colour"};
-const std::vector<std::string> kTrackingKeys{"camera",
-                                             "camera_size",
-                                             "camera_fps",
-                                             "intrinsics",
-                                             "tag_size_m",
-                                             "tag_id",
-                                             "replay_end",
-                                             "detector",
-                                             "roi",
-                                             "control",
-                                             "camera_exposure_us",
-                                             "camera_gain",
-                                             "camera_white_balance_k",
-                                             "camera_colour"};
+// clang-format off
+const std::vector<std::string> kTrackingKeys{
+    "camera", "camera_size", "camera_fps", "intrinsics", "tag_size_m", "tag_id", "replay_end", "detector", "roi",
+    "control", "camera_exposure_us", "camera_gain", "camera_white_balance_k", "camera_colour"};
+// clang-format on
+
+// [navigation]'s keys: the scripted visitor's and the start pose, then the tracking keys.
+std::vector<std::string> navigation_keys() {
+    std::vector<std::string> keys{"source", "path", "path_frames", "start", "start_yaw_deg", "eye_height_m"};
+    keys.insert(keys.end(), kTrackingKeys.begin(), kTrackingKeys.end());
+    return keys;
+}
 
 // One camera control key: "auto", "lock", "keep" or a number within `range` (the device's own range
 // is checked when the camera opens; the setting carries the key's name for that message). Written:
@@ -816,27 +814,7 @@ KioskConfig parse_kiosk_config(std::string_view text, const std::filesystem::pat
     const Section screen = section(ctx, root, "screen", {"radius_m", "arc_deg", "bottom_m", "top_m", "guard_deg"});
     read_screen(screen, config.screen, config.guard_deg);
     check_guarded_width(screen, config);
-    const Section navigation = section(ctx, root, "navigation",
-                                       {"source",
-                                        "path",
-                                        "path_frames",
-                                        "start",
-                                        "start_yaw_deg",
-                                        "eye_height_m",
-                                        "camera",
-                                        "camera_size",
-                                        "camera_fps",
-                                        "intrinsics",
-                                        "tag_size_m",
-                                        "tag_id",
-                                        "replay_end",
-                                        "detector",
-                                        "roi",
-                                        "control",
-                                        "camera_exposure_us",
-                                        "camera_gain",
-                                        "camera_white_balance_k",
-                                        "camera_colour"});
+    const Section navigation = section(ctx, root, "navigation", navigation_keys());
     read_navigation(navigation, config.navigation);
     config.screen.eye_m = Eigen::Vector3d(0.0, config.navigation.eye_height_m, 0.0);
     const Section stats = section(ctx, root, "stats", {"file", "log_period_s", "status_file", "status_period_s"});
