@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "appliance/tracker/synthetic_view.h"
@@ -75,6 +76,12 @@ Frame make_frame(std::mt19937& rng, const TagFamily& family, double width_px) {
     f.centre = 0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
     for (std::size_t k = 0; k < 4; ++k) f.side_px = std::max(f.side_px, (corners[k] - corners[(k + 1) % 4]).norm());
     return f;
+}
+
+std::string fmt_margin(double m) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f", m);
+    return text;
 }
 
 void score(const Frame& f, const std::vector<TagDetection>& found, Tally& t) {
@@ -142,9 +149,12 @@ int main(int argc, char** argv) {
         std::printf(" %.1f, %.1f, %.1f |\n", row[1].ms / row[0].ms, row[2].ms / row[0].ms, row[3].ms / row[0].ms);
     }
     std::printf("\nDecision margins (AprilTag's): ");
-    for (std::size_t k = 0; k < settings.size(); ++k)
-        std::printf("%s: lowest correct %.1f, highest wrong %.1f; ", settings[k].first, overall[k].min_correct_margin,
-                    overall[k].max_wrong_margin);
+    for (std::size_t k = 0; k < settings.size(); ++k) {
+        const std::string wrong =
+            overall[k].wrong > 0 ? "highest " + fmt_margin(overall[k].max_wrong_margin) : std::string("none");
+        std::printf("%s: lowest correct %.1f, wrong %s; ", settings[k].first, overall[k].min_correct_margin,
+                    wrong.c_str());
+    }
     std::printf("\n");
     return 0;
 }
