@@ -12,6 +12,7 @@
 #include "appliance/autocal/rig_bridge.h"
 #include "appliance/rig/rig_file.h"
 #include "appliance/selfcal/rig_simulation.h"
+#include "common/srgb.h"
 #include "drivers/camera/camera_source.h"
 #include "kiosk/kiosk_setup.h"
 
@@ -71,11 +72,7 @@ SelfcalWorker::Camera v4l2_camera(const KioskConfig& config, const selfcal::Syst
     std::shared_ptr<FrameSource> source = std::move(opened).value();
     spdlog::info("selfcal: screen camera {} (exposure {}, gain {})", source->description(),
                  describe(spec.controls.exposure), describe(spec.controls.gain));
-    std::array<float, 256> decode{};  // IEC 61966-2-1
-    for (int c = 0; c < 256; ++c) {
-        const double v = c / 255.0;
-        decode[c] = static_cast<float>(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
-    }
+    const std::array<float, 256>& decode = srgb8_decode_table();
     return [source, decode, want](const cv::Mat1f&, const ScreenCalibration&, std::uint64_t) {
         auto frame = source->next_frame();
         if (!frame) throw std::runtime_error("screen camera: " + frame.error().message);

@@ -8,14 +8,12 @@
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
+#include "common/srgb.h"
+
 namespace mogao {
 
 cv::Mat1f linear_grey(const Rgb8Image& srgb, int max_width) {
-    std::array<float, 256> decode{};
-    for (int c = 0; c < 256; ++c) {
-        const double v = c / 255.0;
-        decode[c] = static_cast<float>(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
-    }
+    const std::array<float, 256>& decode = srgb8_decode_table();
     cv::Mat1f grey(srgb.size.height, srgb.size.width);
     for (int y = 0; y < srgb.size.height; ++y) {
         for (int x = 0; x < srgb.size.width; ++x) {

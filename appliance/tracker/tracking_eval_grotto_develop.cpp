@@ -16,17 +16,14 @@
 #include "common/image.h"
 #include "common/jpeg_codec.h"
 #include "common/png_io.h"
+#include "common/srgb.h"
 
 namespace mogao::eval {
 namespace {
 
-// sRGB transfer functions (IEC 61966-2-1).
-double srgb_to_linear(double v) { return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4); }
-double linear_to_srgb(double l) { return l <= 0.0031308 ? 12.92 * l : 1.055 * std::pow(l, 1.0 / 2.4) - 0.055; }
-
 Rgb8Image develop_frame(const GrottoFrame& frame, const GrottoDevelopOptions& options) {
     std::array<double, 256> to_linear{};
-    for (int v = 0; v < 256; ++v) to_linear[static_cast<std::size_t>(v)] = srgb_to_linear(v / 255.0);
+    for (int v = 0; v < 256; ++v) to_linear[static_cast<std::size_t>(v)] = srgb_decode(v / 255.0);
     std::vector<double> sum;
     ImageSize size{};
     for (const auto& path : frame.subframes) {
@@ -47,7 +44,7 @@ Rgb8Image develop_frame(const GrottoFrame& frame, const GrottoDevelopOptions& op
         const double signal = sum[i] / n;
         const double sigma = std::sqrt(options.shot * signal + options.read * options.read);
         const double l = std::clamp(frame.gain * (signal + sigma * normal(rng)), 0.0, 1.0);
-        out.pixels[i] = static_cast<std::uint8_t>(std::lround(255.0 * linear_to_srgb(l)));
+        out.pixels[i] = static_cast<std::uint8_t>(std::lround(255.0 * srgb_encode(l)));
     }
     return out;
 }

@@ -10,6 +10,8 @@
 #include <cstring>
 #include <string>
 
+#include "common/srgb.h"
+
 namespace mogao {
 namespace {
 
@@ -156,20 +158,6 @@ void main() {
 }
 )";
 
-// The sRGB decoding function (IEC 61966-2-1) of each 8-bit code, computed in double: what GL_SRGB8
-// texels decode to, without an implementation's approximation.
-const std::array<float, 256>& srgb8_to_linear_table() {
-    static const std::array<float, 256> table = [] {
-        std::array<float, 256> t{};
-        for (std::size_t c = 0; c < t.size(); ++c) {
-            const double s = static_cast<double>(c) / 255.0;
-            t[c] = static_cast<float>(s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4));
-        }
-        return t;
-    }();
-    return table;
-}
-
 std::string size_text(ImageSize s) { return std::to_string(s.width) + "x" + std::to_string(s.height); }
 
 bool fits(ImageSize s, GLint max_size) {
@@ -287,7 +275,7 @@ Status WarpBlendRenderer::set_content(const Rgb8Image& frame) {
     }
     // Decoded to linear light here, once per frame, rather than by the texture unit at each of the
     // four fetches of every output pixel of every draw (a software rasteriser's largest cost).
-    const std::array<float, 256>& decode = srgb8_to_linear_table();
+    const std::array<float, 256>& decode = srgb8_decode_table();
     content_linear_.resize(frame.pixels.size());
     std::transform(frame.pixels.begin(), frame.pixels.end(), content_linear_.begin(),
                    [&decode](std::uint8_t code) { return decode[code]; });
