@@ -27,6 +27,13 @@ void check_inputs(const CalibrationPrior& prior, ImageSize content, const Autoca
         fail("content: 1..16384 per side");
     if (o.warp_step_px < 1 || o.warp_step_px > 64) fail("options.warp_step_px: 1..64");
     if (!(o.blend_ramp > 0.0 && o.blend_ramp <= 0.5)) fail("options.blend_ramp: (0, 0.5]");
+    if (o.max_gray_bits != 0 && (o.max_gray_bits < o.min_bits || o.max_gray_bits > 16)) {
+        fail("options.max_gray_bits: 0 (all) or min_bits (" + std::to_string(o.min_bits) + ")..16, got " +
+             std::to_string(o.max_gray_bits));
+    }
+    if (o.frames_per_pattern < 1 || o.frames_per_pattern > 64) {
+        fail("options.frames_per_pattern: 1..64, got " + std::to_string(o.frames_per_pattern));
+    }
     if (!(prior.screen.radius_m > 0.0 && prior.screen.arc_deg > 0.0 && prior.screen.top_m > prior.screen.bottom_m)) {
         fail("prior.screen: radius_m > 0, arc_deg > 0, top_m > bottom_m");
     }
@@ -129,6 +136,16 @@ void require_locked_exposure(const PatternSource& source) {
     }
 }
 
+cv::Mat1f show_averaged(PatternSource& source, const std::vector<cv::Mat>& signals, int frames) {
+    if (frames < 1) throw std::invalid_argument("show_averaged: frames >= 1, got " + std::to_string(frames));
+    cv::Mat1f sum = source.show(signals);
+    if (frames == 1) return sum;
+    sum = sum.clone();  // the source may hand out a buffer it reuses
+    for (int f = 1; f < frames; ++f) sum += source.show(signals);
+    sum *= 1.0f / static_cast<float>(frames);
+    return sum;
+}
+
 AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, ImageSize content,
                         const AutocalOptions& options) {
     check_inputs(prior, content, options);
@@ -139,10 +156,11 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
     AutocalResult result;
     // Step 2 first: all projectors white minus all black shows the screen's lit edges.
     std::vector<cv::Mat> signals(n);
-    const cv::Mat1f black = source.show(signals);
+    const int frames = options.frames_per_pattern;
+    const cv::Mat1f black = show_averaged(source, signals, frames);
     for (std::size_t k = 0; k < n; ++k) signals[k] = cv::Mat1f(sizes[k].height, sizes[k].width, 1.0f);
-    const cv::Mat1f white = source.show(signals);
-    result.report.captures = 2;
+    const cv::Mat1f white = show_averaged(source, signals, frames);
+    result.report.captures = 2 * frames;
     cv::Mat1f lit;
     cv::subtract(white, black, lit);
     const EdgeFit edge = fit_camera_pose(lit, prior, options);

@@ -19,11 +19,11 @@
 //     (per-pixel threshold), a pixel counts where white - black exceeds `min_contrast` (shadow
 //     mask); bits are captured from the coarsest down and stop at the first one the camera cannot
 //     resolve (fewer than `min_bit_fraction` of the pixels with |pattern - inverse| > half the
-//     contrast). Per camera pixel, bits are taken until its first one below half its contrast; in
-//     the reflected Gray code that bit flips at the middle of the pixel's block, so the block's
-//     centre is the pixel's position. Each decoded camera pixel (all but at most two of the
-//     resolved bits per axis) gives a correspondence: its centre <-> the block's centre, with the
-//     block's size / sqrt(12) as its uncertainty (a uniform error over the block).
+//     contrast) or at `max_gray_bits`; every image is the mean of `frames_per_pattern` frames. Per camera pixel, bits
+//     are taken until its first one below half its contrast; in the reflected Gray code that bit flips at the middle of
+//     the pixel's block, so the block's centre is the pixel's position. Each decoded camera pixel (all but at most two
+//     of the resolved bits per axis) gives a correspondence: its centre <-> the block's centre, with the block's size /
+//     sqrt(12) as its uncertainty (a uniform error over the block).
 //  2. Camera pose: the lit region of all projectors at full white ends at the screen's edges
 //     (projectors overfill them). Edge points are located to sub-pixel as the crossing of the local
 //     half level; Gauss-Newton on the camera's 6 pose parameters minimises the distance, on the
@@ -88,13 +88,17 @@ struct CalibrationPrior {
 };
 
 struct AutocalOptions {
-    int warp_step_px = 2;              // warp/blend grid: one sample per this many output pixels, 1..64
-    double blend_ramp = 0.12;          // blend ramp width, fraction of the projector's width, (0, 0.5]
-    double min_contrast = 0.04;        // white - black for a camera pixel to count (shadow mask), (0, 1)
-    double min_bit_fraction = 0.6;     // fraction of pixels a Gray bit must resolve to be used, (0, 1]
-    int min_cells = 150;               // correspondences per projector, below: refused
-    int max_correspondences = 20000;   // per projector (decoded camera pixels, evenly strided), >= min_cells
-    int min_bits = 4;                  // resolved Gray bits per axis, below: decoding failed
+    int warp_step_px = 2;             // warp/blend grid: one sample per this many output pixels, 1..64
+    double blend_ramp = 0.12;         // blend ramp width, fraction of the projector's width, (0, 0.5]
+    double min_contrast = 0.04;       // white - black for a camera pixel to count (shadow mask), (0, 1)
+    double min_bit_fraction = 0.6;    // fraction of pixels a Gray bit must resolve to be used, (0, 1]
+    int min_cells = 150;              // correspondences per projector, below: refused
+    int max_correspondences = 20000;  // per projector (decoded camera pixels, evenly strided), >= min_cells
+    int min_bits = 4;                 // resolved Gray bits per axis, below: decoding failed
+    // Speed/accuracy knobs (docs/calibration.md, "Speed against accuracy"):
+    int max_gray_bits = 0;             // Gray bits shown per axis, 0 = all (gray_code_bits of the extent); else
+                                       // min_bits..16: the finest stripe is 2^(bits of the extent - max_gray_bits) px
+    int frames_per_pattern = 1;        // camera frames averaged per pattern (noise / sqrt(frames)), 1..64
     double max_edge_rms_m = 0.01;      // camera pose fit gate
     double max_projector_rms = 3.0;    // projector fit gate, rms in units of the decoding uncertainty, > 0
     double max_view_angle_deg = 75.0;  // camera rays steeper than this to the screen normal: grazing
@@ -115,6 +119,10 @@ public:
     // step lengthens it for black levels and sets it back.
     virtual void set_relative_exposure(double factor) = 0;
 };
+
+// The mean of `frames` camera images of the same signals (frames >= 1): the camera's temporal
+// noise falls as 1/sqrt(frames); each frame is one capture.
+[[nodiscard]] cv::Mat1f show_averaged(PatternSource& source, const std::vector<cv::Mat>& signals, int frames);
 
 // Throws CalibrationRefused naming the camera's auto-exposure unless source.exposure_locked().
 void require_locked_exposure(const PatternSource& source);

@@ -2,6 +2,7 @@
 // mogao-autocal: camera-based calibration of a virtual rig (calibrate_job.h, docs/calibration.md).
 //
 //   mogao-autocal calibrate --rig rigs/standard.toml --out DIR [--scale 0.5] [--content 1920x1080]
+//                 [--alpha-bits 16] [--warp-step 2] [--gray-bits N] [--frames-per-pattern 1] [--no-colour]
 //
 // Exit codes: 0 success, 1 the job failed or the calibration was refused (the message says why;
 // nothing in DIR changes), 2 bad command line.
@@ -25,6 +26,12 @@ int main(int argc, char** argv) {
     cmd->add_option("--content", content, "Content frame WIDTHxHEIGHT (the farm's frame)");
     cmd->add_option("--alpha-bits", job.alpha_bits, "Alpha map bits, 8 or 16")->check(CLI::IsMember({8, 16}));
     cmd->add_option("--warp-step", job.options.warp_step_px, "Warp grid step, output pixels")->check(CLI::Range(1, 64));
+    cmd->add_option("--gray-bits", job.options.max_gray_bits,
+                    "Gray-code bits shown per axis, 0 = all (finest stripe 1 px); else 4..16")
+        ->check(CLI::Range(0, 16));
+    cmd->add_option("--frames-per-pattern", job.options.frames_per_pattern,
+                    "Camera frames averaged per structured-light pattern, 1..64")
+        ->check(CLI::Range(1, 64));
     bool no_colour = false;
     cmd->add_flag("--no-colour", no_colour, "Geometry only: no response, black-level and colour matching step");
     try {

@@ -3,6 +3,8 @@
 #include "appliance/autocal/autocal.h"
 
 #include <cstdlib>
+#include <stdexcept>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -53,6 +55,86 @@ TEST(Autocal, RefusesAProjectorTheCameraBarelySees) {
     } catch (const CalibrationRefused& e) {
         EXPECT_NE(std::string(e.what()).find("proj2"), std::string::npos) << e.what();
     }
+}
+
+// The speed/accuracy knobs (docs/calibration.md, "Speed against accuracy"): refused out of range,
+// naming the option, before any pattern is shown.
+TEST(Autocal, SpeedKnobsOutOfRangeAreRefusedByName) {
+    const rig::VirtualRig rig = scaled_rig(load("standard"), 0.25, 0.25);
+    RigPatternSource source(rig);
+    const auto message = [&](const AutocalOptions& o) {
+        try {
+            (void)calibrate(source, prior_from_rig(rig), {960, 540}, o);
+        } catch (const std::invalid_argument& e) {
+            return std::string(e.what());
+        }
+        return std::string("accepted");
+    };
+    AutocalOptions o;
+    o.max_gray_bits = o.min_bits - 1;  // fewer bits than decoding needs
+    EXPECT_NE(message(o).find("options.max_gray_bits"), std::string::npos) << message(o);
+    o = {};
+    o.frames_per_pattern = 0;
+    EXPECT_NE(message(o).find("options.frames_per_pattern"), std::string::npos) << message(o);
+    EXPECT_DOUBLE_EQ(source.simulate_s(), 0.0);  // nothing was shown
+}
+
+// A source whose frame f is the constant f: the mean of frames 0..n-1 is (n - 1) / 2.
+class CountingSource : public PatternSource {
+public:
+    cv::Mat1f show(const std::vector<cv::Mat>&) override { return cv::Mat1f(2, 2, static_cast<float>(frame_++)); }
+    bool exposure_locked() const override { return true; }
+    void set_relative_exposure(double) override {}
+    int frame_ = 0;
+};
+
+TEST(Autocal, ShowAveragedTakesTheMeanOfThatManyFrames) {
+    CountingSource source;
+    EXPECT_FLOAT_EQ(show_averaged(source, {}, 1)(0, 0), 0.0f);
+    EXPECT_FLOAT_EQ(show_averaged(source, {}, 4)(1, 1), 2.5f);  // frames 1..4
+    EXPECT_EQ(source.frame_, 5);
+    EXPECT_THROW((void)show_averaged(source, {}, 0), std::invalid_argument);
+}
+
+// Averaging frames on the noisy rig: the difference of two means of 4 frames has about half the
+// noise of the difference of two single frames (1/sqrt(4); 8-bit quantisation aside).
+TEST(Autocal, AveragedFramesLowerTheCameraNoise) {
+    const rig::VirtualRig rig = scaled_rig(load("noisy"), 0.25, 0.25);
+    RigPatternSource source(rig);
+    const std::vector<cv::Mat> grey(rig.projectors.size(), cv::Mat1f(270, 480, 0.5f));
+    const auto noise = [&](int frames) {
+        const cv::Mat1f a = show_averaged(source, grey, frames);
+        const cv::Mat1f b = show_averaged(source, grey, frames);
+        cv::Mat1f d;
+        cv::subtract(a, b, d);
+        cv::Scalar mean, sd;
+        cv::meanStdDev(d, mean, sd);
+        return sd[0];
+    };
+    const double one = noise(1);
+    const double four = noise(4);
+    std::printf("noise of a frame difference: 1 frame %.4f, 4 frames %.4f\n", one, four);
+    EXPECT_GT(one, 0.01);
+    EXPECT_LT(four, 0.65 * one);
+}
+
+// Fewer Gray bits: fewer captures and a coarser decode, still within a bound against the rig's
+// ground truth.
+TEST(Autocal, FewerGrayBitsCaptureLessAndStayWithinABound) {
+    const rig::VirtualRig rig = scaled_rig(load("standard"), 0.25, 0.5);  // 480x270 projectors: 9 bits
+    AutocalOptions o;
+    o.max_gray_bits = 6;  // finest stripe 8 projector pixels
+    RigPatternSource coarse_source(rig);
+    const AutocalResult coarse = calibrate(coarse_source, prior_from_rig(rig), {960, 540}, o);
+    for (const ProjectorReport& p : coarse.report.projectors) {
+        EXPECT_EQ(p.column_bits, 6) << p.id;
+        EXPECT_EQ(p.row_bits, 6) << p.id;
+    }
+    EXPECT_EQ(coarse.report.captures, 2 + 3 * (2 + 2 * (6 + 6)));
+    const GeometryError g = measure_geometry(rig, coarse.calibration, 4);
+    std::printf("6 bits: captures %d, geometry mean %.3f p95 %.3f px\n", coarse.report.captures, g.mean_px, g.p95_px);
+    EXPECT_LE(g.mean_px, 0.6);  // measured 0.13 (p95 0.27) at this scale
+    EXPECT_LE(g.p95_px, 1.5);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <numbers>
@@ -134,12 +135,16 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
     const rig::VirtualRig rig = scaled_rig(rig::load_rig(job.rig), job.scale, job.scale);
     RigPatternSource source(rig);
     const CalibrationPrior prior = prior_from_rig(rig);
+    const auto t0 = std::chrono::steady_clock::now();
     AutocalResult r = calibrate(source, prior, job.content, job.options);  // throws before any write
+    double calibrate_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     nlohmann::json seams_before;
     std::optional<ColourResult> colour;
     if (job.colour) {
         seams_before = seam_figures(rig, r.calibration);
+        const auto t1 = std::chrono::steady_clock::now();
         colour = calibrate_colour(source, prior.screen, r.projectors, r.calibration, job.colour_options);  // throws
+        calibrate_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
     }
     const GeometryError g = measure_geometry(rig, r.calibration, 4);
     const LuminanceError l = measure_luminance(rig, r.calibration);
@@ -149,6 +154,17 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
         {"scale", job.scale},
         {"content", {job.content.width, job.content.height}},
         {"captures", r.report.captures},
+        {"geometry_captures", r.report.captures},
+        {"knobs",
+         {{"max_gray_bits", job.options.max_gray_bits},
+          {"frames_per_pattern", job.options.frames_per_pattern},
+          {"warp_step_px", job.options.warp_step_px}}},
+        // Wall seconds: the calibration's own compute (calibrate and the colour step, without the
+        // rig's camera simulation, which a real camera replaces) and the simulation apart.
+        {"timing",
+         {{"compute_s", calibrate_s - source.simulate_s()},
+          {"simulate_s", source.simulate_s()},
+          {"calibrate_wall_s", calibrate_s}}},
         {"camera", {{"edge_points", r.report.edge_points}, {"edge_rms_mm", r.report.edge_rms_m * 1e3}}},
         {"predicted", {{"seam_weight_sum_max_deviation", predicted_seam(r, prior.screen)}}},
         {"ground_truth",

@@ -6,13 +6,15 @@
 //                      beta maps and the ResponseLUT extension entries),
 //   calibration.models.json  the fitted screen, camera and projector models (model_store.h),
 //                      written atomically just before the MPCDI: self-recalibration's starting point,
-//   report.json        per projector: decoded bits, correspondences, reprojection rms (the fit's
-//                      own residual), view angle, camera coverage, the blend's predicted seam
-//                      (max |sum of weights - 1| over the overlaps from the fitted models), and the
-//                      accuracy against the rig's ground truth (geometry in projector pixels,
-//                      luminance), clearly apart; with the colour step, the measured responses,
-//                      blacks and gains ("colour") and the seams before and after it at black,
-//                      dark, mid-grey and white content (ground_truth.seams_before_colour, .seams),
+//   report.json        the knobs (max_gray_bits, frames_per_pattern, warp_step_px), captures
+//                      (geometry_captures: the geometric step's alone), timing (compute_s: the
+//                      calibration's wall seconds without the rig's camera simulation), per projector: decoded bits,
+//                      correspondences, reprojection rms (the fit's own residual), view angle, camera coverage, the
+//                      blend's predicted seam (max |sum of weights - 1| over the overlaps from the fitted models), and
+//                      the accuracy against the rig's ground truth (geometry in projector pixels, luminance), clearly
+//                      apart; with the colour step, the measured responses, blacks and gains ("colour") and the seams
+//                      before and after it at black, dark, mid-grey and white content
+//                      (ground_truth.seams_before_colour, .seams),
 //   preview.png        the screen as a viewer sees it (ground-truth light paths, the rig's
 //                      responses and black levels, mean of the channels): a white field with a
 //                      content grid every 1/16 of the frame, linear light -> gamma 2.2, 8 bits.

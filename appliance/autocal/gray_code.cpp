@@ -32,26 +32,29 @@ cv::Mat1f gray_code_pattern(ImageSize size, bool rows, int bit, bool inverted) {
 
 namespace {
 
-// Decodes one axis: captures bits from the coarsest while the camera resolves them. Returns the
-// number of bits used. Per camera pixel, `gray` gets the Gray-code prefix and `depth` the number of
-// bits it resolved: a pixel stops at its first bit with |pattern - inverse| below half its
-// contrast. For the reflected Gray code that bit changes at the middle of the pixel's block of
-// `depth` bits, so the block's centre is where the pixel is (Inokuchi et al. 1984; the same
-// property makes Gray code robust at stripe edges). Pixels below `shadow` contrast stay at -1.
+// Decodes one axis: captures bits from the coarsest while the camera resolves them, at most
+// options.max_gray_bits of them (0 = all), each pattern and inverse the mean of
+// options.frames_per_pattern frames. Returns the number of bits used. Per camera pixel, `gray` gets the Gray-code
+// prefix and `depth` the number of bits it resolved: a pixel stops at its first bit with |pattern - inverse| below half
+// its contrast. For the reflected Gray code that bit changes at the middle of the pixel's block of `depth` bits, so the
+// block's centre is where the pixel is (Inokuchi et al. 1984; the same property makes Gray code robust at stripe
+// edges). Pixels below `shadow` contrast stay at -1.
 int decode_axis(PatternSource& source, int k, std::size_t projectors, ImageSize size, bool rows,
                 const cv::Mat1f& contrast, const AutocalOptions& options, cv::Mat1i& code, cv::Mat1i& depth,
                 int& captures) {
-    const int n = gray_code_bits(rows ? size.height : size.width);
+    const int all = gray_code_bits(rows ? size.height : size.width);
+    const int n = options.max_gray_bits > 0 ? std::min(all, options.max_gray_bits) : all;
+    const int frames = options.frames_per_pattern;
     cv::Mat1i gray(contrast.size(), 0);
     cv::Mat1b open(contrast.size(), 1);  // the pixel still takes bits
     int used = 0;
     for (int bit = 0; bit < n; ++bit) {
         std::vector<cv::Mat> signals(projectors);
         signals[static_cast<std::size_t>(k)] = gray_code_pattern(size, rows, bit, false);
-        const cv::Mat1f on = source.show(signals);
+        const cv::Mat1f on = show_averaged(source, signals, frames);
         signals[static_cast<std::size_t>(k)] = gray_code_pattern(size, rows, bit, true);
-        const cv::Mat1f off = source.show(signals);
-        captures += 2;
+        const cv::Mat1f off = show_averaged(source, signals, frames);
+        captures += 2 * frames;
         long valid = 0;
         long resolved = 0;
         for (int y = 0; y < on.rows; ++y) {
@@ -96,11 +99,11 @@ Correspondences decode_projector(PatternSource& source, int k, const std::vector
     const ImageSize size = projectors.at(static_cast<std::size_t>(k));
     std::vector<cv::Mat> signals(projectors.size());
     signals[static_cast<std::size_t>(k)] = cv::Mat1f(size.height, size.width, 1.0f);
-    const cv::Mat1f white = source.show(signals);
+    const cv::Mat1f white = show_averaged(source, signals, options.frames_per_pattern);
     signals[static_cast<std::size_t>(k)] = cv::Mat();
-    const cv::Mat1f black = source.show(signals);
+    const cv::Mat1f black = show_averaged(source, signals, options.frames_per_pattern);
     Correspondences out;
-    out.captures = 2;
+    out.captures = 2 * options.frames_per_pattern;
     cv::Mat1f contrast;
     cv::subtract(white, black, contrast);
     cv::Mat1i col(contrast.size(), -1);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -14,12 +15,18 @@
 namespace mogao::autocal {
 
 // Shows patterns on the virtual rig and returns its camera image (a new noise seed per image).
+// Keeps the wall time spent simulating the camera, so that a job can report the calibration's own
+// compute time apart from the rig's.
 class RigPatternSource : public PatternSource {
 public:
     explicit RigPatternSource(const rig::VirtualRig& rig) : sim_(rig), base_exposure_(rig.camera.exposure) {}
     [[nodiscard]] cv::Mat1f show(const std::vector<cv::Mat>& signals) override {
-        return sim_.capture(signals, frame_++);
+        const auto t0 = std::chrono::steady_clock::now();
+        cv::Mat1f img = sim_.capture(signals, frame_++);
+        simulate_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        return img;
     }
+    [[nodiscard]] double simulate_s() const { return simulate_s_; }  // seconds inside show()
     [[nodiscard]] bool exposure_locked() const override { return !sim_.rig().camera.auto_exposure; }
     void set_relative_exposure(double factor) override { sim_.set_exposure(base_exposure_ * factor); }
     [[nodiscard]] const rig::CameraSimulator& simulator() const { return sim_; }
@@ -28,6 +35,7 @@ private:
     rig::CameraSimulator sim_;
     double base_exposure_ = 1.0;
     std::uint64_t frame_ = 0;
+    double simulate_s_ = 0.0;
 };
 
 // The rig at reduced resolution: projector and camera sizes and intrinsics scaled (errors in
