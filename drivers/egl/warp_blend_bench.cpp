@@ -2,9 +2,13 @@
 // Prints milliseconds per projector output for this machine's GL (llvmpipe without a GPU):
 // content upload, draw (glFinish'ed) and draw + readback, for one output of --output WxH; then
 // the draw of the same output with a per-pixel black offset (beta) map, and its ratio to the draw
-// without, measured interleaved in the same run.
+// without, measured interleaved in the same run. The draw is also given in CPU milliseconds of the
+// whole process (llvmpipe's rasteriser threads included): on a machine shared with other work the
+// wall time grows with the load, the CPU time much less, so two builds compare by it.
 // Usage: mogao_warp_blend_bench [width height [content_width content_height [frames]]]
 #include <GLES3/gl3.h>
+
+#include <time.h>
 
 #include <chrono>
 #include <cstdio>
@@ -18,6 +22,12 @@ namespace {
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+double process_cpu_ms() {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
 }
 
 int arg(int argc, char** argv, int i, int fallback) { return argc > i ? std::atoi(argv[i]) : fallback; }
@@ -52,16 +62,18 @@ int main(int argc, char** argv) {
             return 1;  // warm-up (shader JIT, both FBOs)
         }
 
-        double upload = 0, draw = 0, readback = 0, draw_beta = 0;
+        double upload = 0, draw = 0, draw_cpu = 0, readback = 0, draw_beta = 0;
         for (int f = 0; f < frames; ++f) {
             auto t0 = std::chrono::steady_clock::now();
             if (!renderer->set_content(content)) return 1;
             glFinish();
             upload += ms_since(t0);
             t0 = std::chrono::steady_clock::now();
+            const double cpu0 = process_cpu_ms();
             if (!renderer->draw(*index)) return 1;  // into render()'s FBO, still bound
             glFinish();
             draw += ms_since(t0);
+            draw_cpu += process_cpu_ms() - cpu0;
             t0 = std::chrono::steady_clock::now();
             if (!renderer->render(*index)) return 1;
             readback += ms_since(t0);
@@ -74,8 +86,10 @@ int main(int argc, char** argv) {
         std::printf("renderer: %s\n", reinterpret_cast<const char*>(glGetString(GL_RENDERER)));
         std::printf("output %dx%d, content %dx%d, %d frames (mean ms)\n", output.width, output.height,
                     content_size.width, content_size.height, frames);
-        std::printf("  upload content  %8.2f\n  draw            %8.2f\n  draw + readback %8.2f\n", upload / frames,
-                    draw / frames, readback / frames);
+        std::printf(
+            "  upload content  %8.2f\n  draw            %8.2f  (CPU ms, all threads: %.2f)\n"
+            "  draw + readback %8.2f\n",
+            upload / frames, draw / frames, draw_cpu / frames, readback / frames);
         std::printf("  draw with beta  %8.2f  (x%.2f of the draw without)\n", draw_beta / frames, draw_beta / draw);
     }
     return 0;

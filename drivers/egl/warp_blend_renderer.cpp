@@ -35,12 +35,12 @@ precision highp float;
 precision highp int;
 precision highp sampler2D;
 
-uniform sampler2D u_content;  // GL_RGB32F, linear light (decoded from sRGB once per frame on upload)
-uniform sampler2D u_warp;     // GL_RG32F (u, v); u < kNoContent marks "no content"
-uniform sampler2D u_blend;    // GL_R32F weight in linear light
-uniform sampler2D u_lut;      // GL_RG32F, (N - 1) x 3: row c, texel i = (lut_c[i], lut_c[i + 1])
-uniform sampler2D u_beta;     // GL_RGB32F black offset per channel, linear light (read only if u_has_beta)
-uniform bool u_has_beta;      // false: the projector has no beta map, no texel is fetched
+uniform sampler2D u_content;  // GL_RGB16F, linear light (decoded from sRGB once per frame on upload), GL_LINEAR
+uniform sampler2D u_warp;     // GL_RGB32F (u, v, blend weight when the blend mask has the warp's size);
+                              // u < kNoContent marks "no content"
+uniform sampler2D u_blend;    // GL_R32F weight in linear light (the general variant's bilinear blend)
+uniform sampler2D u_lut;      // GL_RGB16F, N x 1, GL_LINEAR: texel i = (lut_r[i], lut_g[i], lut_b[i])
+uniform sampler2D u_beta;     // GL_RGB32F black offset per channel, linear light (read only with HAS_BETA)
 uniform vec2 u_output_size;   // projector pixels
 uniform vec2 u_warp_scale;    // warp size / output size (exactly 1.0 when equal)
 uniform vec2 u_blend_scale;   // blend size / output size
@@ -75,14 +75,17 @@ vec4 weights(vec2 f) {
 // bilinear weights are (1, 0, 0, 0) and one fetch gives bit for bit what four would.
 ivec2 texel_of(vec2 p) { return ivec2(floor(p)); }
 
-bool warp_at(vec2 p, out vec2 uv) {
-    uv = texelFetch(u_warp, texel_of(p), 0).rg;
+// The warp texel carries the blend weight too (the maps have the same size): one fetch for both.
+bool warp_blend_at(vec2 p, out vec2 uv, out float weight) {
+    vec3 t = texelFetch(u_warp, texel_of(p), 0).rgb;
+    uv = t.rg;
+    weight = t.b;
     return uv.x >= kNoContent;
 }
 
-float blend_at(vec2 p) { return texelFetch(u_blend, texel_of(p), 0).r; }
-
-vec3 beta_at(vec2 p) { return u_has_beta ? texelFetch(u_beta, texel_of(p), 0).rgb : vec3(0.0); }
+#ifdef HAS_BETA
+vec3 beta_at(vec2 p) { return texelFetch(u_beta, texel_of(p), 0).rgb; }
+#endif
 #else
 // False when a texel with non-zero weight has no content.
 bool warp_at(vec2 p, out vec2 uv) {
@@ -112,24 +115,27 @@ float blend_at(vec2 p) {
            texelFetch(u_blend, ivec2(t.lo.x, t.hi.y), 0).r * w.z + texelFetch(u_blend, t.hi, 0).r * w.w;
 }
 
+bool warp_blend_at(vec2 p, out vec2 uv, out float weight) {
+    if (!warp_at(p, uv)) return false;
+    weight = blend_at(p);
+    return true;
+}
+
 // Same grid convention as the blend (sample_beta in appliance/warp/warp_sampling.h), per channel.
+#ifdef HAS_BETA
 vec3 beta_at(vec2 p) {
-    if (!u_has_beta) return vec3(0.0);
     Taps t = taps_at(p * u_beta_scale - 0.5, textureSize(u_beta, 0));
     vec4 w = weights(t.f);
     return texelFetch(u_beta, t.lo, 0).rgb * w.x + texelFetch(u_beta, ivec2(t.hi.x, t.lo.y), 0).rgb * w.y +
            texelFetch(u_beta, ivec2(t.lo.x, t.hi.y), 0).rgb * w.z + texelFetch(u_beta, t.hi, 0).rgb * w.w;
 }
 #endif
+#endif
 
-// Bilinear in linear light: each texel is decoded from sRGB by the texture unit before weighting.
-vec3 content_at(vec2 uv) {
-    ivec2 size = textureSize(u_content, 0);
-    Taps t = taps_at(uv * vec2(size) - 0.5, size);
-    vec4 w = weights(t.f);
-    return texelFetch(u_content, t.lo, 0).rgb * w.x + texelFetch(u_content, ivec2(t.hi.x, t.lo.y), 0).rgb * w.y +
-           texelFetch(u_content, ivec2(t.lo.x, t.hi.y), 0).rgb * w.z + texelFetch(u_content, t.hi, 0).rgb * w.w;
-}
+// Bilinear in linear light by the texture unit (GL_LINEAR on a half-float texture, filterable in
+// core GLES 3.0): the same taps and weights as taps_at with edge clamping, the texels already
+// decoded to linear light on upload. One filtered fetch instead of four fetches and the weighting.
+vec3 content_at(vec2 uv) { return texture(u_content, uv).rgb; }
 
 // Each texel holds an entry and its successor, so one fetch per channel gives both ends of the
 // linear piece (three fetches instead of six; the same values, the same arithmetic).
@@ -148,13 +154,15 @@ void main() {
     // Output pixel centre with y down from the top row (GL window y grows up).
     vec2 p = vec2(gl_FragCoord.x, u_output_size.y - gl_FragCoord.y);
     vec2 uv;
-    if (!warp_at(p, uv)) {
-        o_color = vec4(0.0, 0.0, 0.0, 1.0);
-        return;
-    }
-    // Beta is added after the blend and is not scaled by the content (docs/calibration.md).
-    vec3 linear = content_at(uv * u_content_scale + u_content_offset) * blend_at(p) + beta_at(p);
-    o_color = vec4(apply_lut(linear), 1.0);
+    float weight;
+    // A select rather than an early return: a software rasteriser runs both sides of a divergent
+    // branch anyway, and the no-content marker's uv is clamped to the content's edge by the fetch.
+    bool content = warp_blend_at(p, uv, weight);
+    vec3 linear = content_at(uv * u_content_scale + u_content_offset) * weight;
+#ifdef HAS_BETA
+    linear += beta_at(p);  // added after the blend, not scaled by the content (docs/calibration.md)
+#endif
+    o_color = content ? vec4(apply_lut(linear), 1.0) : vec4(0.0, 0.0, 0.0, 1.0);
 }
 )";
 
@@ -175,14 +183,15 @@ Status check_size(std::string_view what, ImageSize s, GLint max_size) {
     return {};
 }
 
-// A 2D texture with one level, nearest filtering (all filtering is in the shader; float formats
-// are not filterable in GLES 3.0) and edge clamping.
+// A 2D texture with one level and edge clamping. Nearest filtering for the 32-bit float maps
+// (filtered in the shader: GLES 3.0 does not filter 32-bit float formats); GL_LINEAR only for
+// half-float textures, which core GLES 3.0 filters.
 Result<GlTexture> upload(std::string_view what, GLenum internal_format, ImageSize size, GLenum format, GLenum type,
-                         const void* data) {
+                         const void* data, GLint filter = GL_NEAREST) {
     GlTexture texture = make_texture();
     glBindTexture(GL_TEXTURE_2D, texture.get());
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
@@ -213,14 +222,51 @@ Result<GlTexture> upload_beta(const std::string& who, const BlackOffset& beta, G
     return upload(who + " beta map", GL_RGB32F, beta.size, GL_RGB, GL_FLOAT, beta.rgb.data());
 }
 
+// IEEE 754 binary32 -> binary16, round to nearest even; finite inputs within the half range
+// (the sRGB decode table: 0 and normal numbers in [3e-4, 1]).
+std::uint16_t to_half(float value) {
+    std::uint32_t x = 0;
+    std::memcpy(&x, &value, sizeof x);
+    const std::uint32_t sign = (x >> 16) & 0x8000u;
+    const int exponent = static_cast<int>((x >> 23) & 0xffu) - 127 + 15;
+    std::uint32_t mantissa = x & 0x7fffffu;
+    if (exponent >= 31) return static_cast<std::uint16_t>(sign | 0x7c00u);  // beyond the range: infinity
+    int shift = 13;
+    std::uint32_t bits = (static_cast<std::uint32_t>(std::max(exponent, 0)) << 10);
+    if (exponent <= 0) {  // subnormal half (or zero): the implicit 1 becomes explicit
+        if (exponent < -10) return static_cast<std::uint16_t>(sign);
+        mantissa |= 0x800000u;
+        shift = 14 - exponent;
+        bits = 0;
+    }
+    bits |= mantissa >> shift;
+    const std::uint32_t rest = mantissa & ((1u << shift) - 1u);
+    const std::uint32_t halfway = 1u << (shift - 1);
+    if (rest > halfway || (rest == halfway && (bits & 1u) != 0)) ++bits;  // a carry moves into the exponent
+    return static_cast<std::uint16_t>(sign | bits);
+}
+
+// srgb8_decode_table() as half floats: what the content texture holds for each 8-bit code.
+const std::array<std::uint16_t, 256>& srgb8_decode_half_table() {
+    static const std::array<std::uint16_t, 256> table = [] {
+        std::array<std::uint16_t, 256> t{};
+        const std::array<float, 256>& decode = srgb8_decode_table();
+        std::transform(decode.begin(), decode.end(), t.begin(), to_half);
+        return t;
+    }();
+    return table;
+}
+
 }  // namespace
 
-Result<WarpBlendRenderer::Program> WarpBlendRenderer::make_program(bool exact_maps) {
-    const std::string fragment =
-        std::string("#version 300 es\n") + (exact_maps ? "#define EXACT_MAPS 1\n" : "") + kFragmentShader;
+Result<WarpBlendRenderer::Program> WarpBlendRenderer::make_program(bool exact_maps, bool has_beta) {
+    const std::string fragment = std::string("#version 300 es\n") + (exact_maps ? "#define EXACT_MAPS 1\n" : "") +
+                                 (has_beta ? "#define HAS_BETA 1\n" : "") + kFragmentShader;
     auto linked = link_program(kVertexShader, fragment);
-    if (!linked)
-        return with_context(linked.error(), exact_maps ? "WarpBlendRenderer (exact maps)" : "WarpBlendRenderer");
+    if (!linked) {
+        return with_context(linked.error(), std::string("WarpBlendRenderer (") + (exact_maps ? "exact" : "general") +
+                                                " maps, " + (has_beta ? "with" : "without") + " beta)");
+    }
     Program p;
     p.program = std::move(linked.value());
     const GLuint id = p.program.get();
@@ -234,7 +280,6 @@ Result<WarpBlendRenderer::Program> WarpBlendRenderer::make_program(bool exact_ma
     p.warp_scale = glGetUniformLocation(id, "u_warp_scale");
     p.blend_scale = glGetUniformLocation(id, "u_blend_scale");
     p.beta_scale = glGetUniformLocation(id, "u_beta_scale");
-    p.has_beta = glGetUniformLocation(id, "u_has_beta");
     p.content_scale = glGetUniformLocation(id, "u_content_scale");
     p.content_offset = glGetUniformLocation(id, "u_content_offset");
     return p;
@@ -246,19 +291,20 @@ Result<WarpBlendRenderer> WarpBlendRenderer::create() {
         return make_error(EINVAL, "WarpBlendRenderer::create: no EGL context is current on this thread");
     }
     WarpBlendRenderer r;
-    auto general = make_program(false);
-    if (!general) return general.error();
-    r.general_ = std::move(general.value());
-    auto exact = make_program(true);
-    if (!exact) return exact.error();
-    r.exact_ = std::move(exact.value());
+    for (const bool exact : {false, true}) {
+        for (const bool beta : {false, true}) {
+            auto program = make_program(exact, beta);
+            if (!program) return program.error();
+            r.programs_[program_index(exact, beta)] = std::move(program.value());
+        }
+    }
     GLint max_texture = 0;
     GLint max_renderbuffer = 0;
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture);
     glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_renderbuffer);
     r.max_texture_size_ = std::min(max_texture, max_renderbuffer);
     // Bound on the beta unit for projectors without a beta map, so the unit never holds an
-    // incomplete texture; the shader does not read it then (u_has_beta false).
+    // incomplete texture; the shader does not read it then (the variant without HAS_BETA).
     const float zero[3] = {0.0f, 0.0f, 0.0f};
     auto no_beta = upload("no-beta placeholder", GL_RGB32F, ImageSize{1, 1}, GL_RGB, GL_FLOAT, zero);
     if (!no_beta) return no_beta.error();
@@ -273,20 +319,22 @@ Status WarpBlendRenderer::set_content(const Rgb8Image& frame) {
         return make_error(EINVAL, "content frame " + size_text(frame.size) + " holds " +
                                       std::to_string(frame.pixels.size()) + " values, expected width*height*3");
     }
-    // Decoded to linear light here, once per frame, rather than by the texture unit at each of the
-    // four fetches of every output pixel of every draw (a software rasteriser's largest cost).
-    const std::array<float, 256>& decode = srgb8_decode_table();
+    // Decoded to linear light here, once per frame, rather than by the texture unit at every fetch
+    // of every output pixel of every draw (a software rasteriser's largest cost); half floats, so
+    // that the texture unit may filter them (docs/outputs.md: precision).
+    const std::array<std::uint16_t, 256>& decode = srgb8_decode_half_table();
     content_linear_.resize(frame.pixels.size());
     std::transform(frame.pixels.begin(), frame.pixels.end(), content_linear_.begin(),
                    [&decode](std::uint8_t code) { return decode[code]; });
     if (content_.valid() && frame.size == content_size_) {
         glBindTexture(GL_TEXTURE_2D, content_.get());
-        glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, frame.size.width, frame.size.height, GL_RGB, GL_FLOAT,
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 2);
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, frame.size.width, frame.size.height, GL_RGB, GL_HALF_FLOAT,
                         content_linear_.data());
         return gl_check("upload content frame");
     }
-    auto texture = upload("content frame", GL_RGB32F, frame.size, GL_RGB, GL_FLOAT, content_linear_.data());
+    auto texture =
+        upload("content frame", GL_RGB16F, frame.size, GL_RGB, GL_HALF_FLOAT, content_linear_.data(), GL_LINEAR);
     if (!texture) return texture.error();
     content_ = std::move(texture.value());
     content_size_ = frame.size;
@@ -339,13 +387,17 @@ Result<WarpBlendRenderer::Projector> WarpBlendRenderer::make_projector(const Pro
                                      " entries, more than GL_MAX_TEXTURE_SIZE " + std::to_string(max_texture_size_));
     }
 
-    std::vector<float> uv(c.warp.uv.size());
-    for (std::size_t i = 0; i < uv.size(); i += 2) {
+    // (u, v, blend weight): the exact-maps shader reads both maps with one fetch; the weight is
+    // only there (and only read) when the blend mask has the warp map's size.
+    const bool weight_in_warp = c.blend.size == c.warp.size;
+    std::vector<float> uvw(c.warp.uv.size() / 2 * 3);
+    for (std::size_t i = 0, k = 0; i < c.warp.uv.size(); i += 2, k += 3) {
         const float u = c.warp.uv[i];
         const float v = c.warp.uv[i + 1];
         const bool valid = std::isfinite(u) && std::isfinite(v);
-        uv[i] = valid ? std::clamp(u, -1.0f, 2.0f) : kNoContentUpload;
-        uv[i + 1] = valid ? std::clamp(v, -1.0f, 2.0f) : kNoContentUpload;
+        uvw[k] = valid ? std::clamp(u, -1.0f, 2.0f) : kNoContentUpload;
+        uvw[k + 1] = valid ? std::clamp(v, -1.0f, 2.0f) : kNoContentUpload;
+        uvw[k + 2] = weight_in_warp ? c.blend.weight[i / 2] : 0.0f;
     }
     // Row ch, texel i: (lut[ch][i], lut[ch][i + 1]), the two ends of linear piece i (see apply_lut).
     std::vector<float> lut((n - 1) * 3 * 2);
@@ -364,7 +416,7 @@ Result<WarpBlendRenderer::Projector> WarpBlendRenderer::make_projector(const Pro
     p.output = c.output;
     p.warp_size = c.warp.size;
     p.blend_size = c.blend.size;
-    auto warp = upload(who + " warp map", GL_RG32F, c.warp.size, GL_RG, GL_FLOAT, uv.data());
+    auto warp = upload(who + " warp map", GL_RGB32F, c.warp.size, GL_RGB, GL_FLOAT, uvw.data());
     if (!warp) return warp.error();
     auto blend = upload(who + " blend mask", GL_R32F, c.blend.size, GL_RED, GL_FLOAT, c.blend.weight.data());
     if (!blend) return blend.error();
@@ -401,7 +453,7 @@ Status WarpBlendRenderer::draw(std::size_t index, ImageSize target) {
     const Projector& p = projectors_[index];
     const bool has_beta = p.beta.valid();
     const bool exact = p.warp_size == target && p.blend_size == target && (!has_beta || p.beta_size == target);
-    const Program& program = exact ? exact_ : general_;
+    const Program& program = programs_[program_index(exact, has_beta)];
     glUseProgram(program.program.get());
     // The shader maps each target pixel centre to warp/blend coordinates by size ratios, so a
     // target larger or smaller than the calibration's output is the same picture resampled.
@@ -412,7 +464,6 @@ Status WarpBlendRenderer::draw(std::size_t index, ImageSize target) {
                 static_cast<float>(p.warp_size.height) / out_h);
     glUniform2f(program.blend_scale, static_cast<float>(p.blend_size.width) / out_w,
                 static_cast<float>(p.blend_size.height) / out_h);
-    glUniform1i(program.has_beta, has_beta ? 1 : 0);
     glUniform2f(program.beta_scale, has_beta ? static_cast<float>(p.beta_size.width) / out_w : 0.0f,
                 has_beta ? static_cast<float>(p.beta_size.height) / out_h : 0.0f);
     glUniform2f(program.content_scale, transform_.scale_u, transform_.scale_v);

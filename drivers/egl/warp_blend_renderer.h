@@ -11,8 +11,8 @@
 //   beta_c = bilinear(beta,  p * beta.size / output - 0.5)   per channel c; 0 when beta is empty
 //   uv'    = uv * content_scale + content_offset  (per axis; identity unless set_content_transform)
 //   linear = bilinear over the 4 content texels around uv' * content.size - 0.5, each texel
-//            decoded sRGB -> linear first (on the CPU once per frame, uploaded as GL_RGB32F), so the
-//            filtering is in linear light
+//            decoded sRGB -> linear first (on the CPU once per frame, uploaded as half floats,
+//            GL_RGB16F), so the filtering is in linear light; the texture unit filters (GL_LINEAR)
 //   out    = lut_c(clamp(linear_c * w + beta_c, 0, 1))  per channel c; lut_c is piecewise linear
 //            over its N entries at linear positions i / (N - 1). beta (the MPCDI beta map, black-level
 //            offset in linear light) is added after the blend and is not scaled by the content, so
@@ -22,10 +22,12 @@
 //
 // Bilinear lookups clamp texel indices to the map's edge (GL_CLAMP_TO_EDGE semantics); with
 // map size == output size the warp, blend and beta are read exactly per pixel. The grid convention
-// is sample_warp/sample_blend/sample_beta's (appliance/warp/warp_sampling.h). All filtering is done in
-// the shader with texelFetch, so results do not depend on a GPU's filtering precision or on
-// whether it supports linear filtering of float textures. Output values are written to an 8-bit
-// UNORM target (x * 255 rounded to nearest).
+// is sample_warp/sample_blend/sample_beta's (appliance/warp/warp_sampling.h). The warp, blend, beta
+// and LUT (32-bit floats, not filterable in core GLES 3.0) are filtered in the shader with
+// texelFetch, so the geometry does not depend on a GPU's filtering precision; the content is
+// filtered by the texture unit, a GPU's own precision (half-float texels, often 8-bit filter
+// weights: docs/outputs.md, "Precision") within the 2-code tolerance the tests hold it to. Output
+// values are written to an 8-bit UNORM target (x * 255 rounded to nearest).
 //
 // Targets: render() draws into the projector's own FBO (GL_RGBA8 renderbuffer) and reads it back;
 // the headless backend never touches a default framebuffer (the surfaceless context has none).
@@ -40,7 +42,9 @@
 // beyond GL_MAX_TEXTURE_SIZE, EIO for GL failures.
 #pragma once
 
+#include <array>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "common/projector_calibration.h"
@@ -59,7 +63,8 @@ public:
     // Call once per frame before draw()/render(); the texture is reallocated only on a size change.
     [[nodiscard]] Status set_content(const Rgb8Image& frame);
 
-    // Validates and uploads one projector's warp map (RG32F), blend mask (R32F), response LUT
+    // Validates and uploads one projector's warp map (RGB32F: u, v and, when the blend mask has
+    // the warp's size, the blend weight, so that one fetch reads both), blend mask (R32F), response LUT
     // ((N - 1) x 3 RG32F: each entry with its successor) and black offset (beta, RGB32F; nothing
     // is uploaded or fetched when it is empty, 0 x 0), once. Returns the projector's index for
     // draw()/render(). EINVAL when a size is empty or does not match its data (beta:
@@ -124,14 +129,19 @@ private:
         GLint warp_scale = -1;
         GLint blend_scale = -1;
         GLint beta_scale = -1;
-        GLint has_beta = -1;
         GLint content_scale = -1;
         GLint content_offset = -1;
     };
-    [[nodiscard]] static Result<Program> make_program(bool exact_maps);
+    // Linked variants: exact_maps (every map the target's size: one fetch for warp and blend, one
+    // for beta; the same result as the general bilinear lookups) and has_beta (the beta map is read
+    // at all; without it the shader has no beta code, rather than a uniform test that a software
+    // rasteriser would pay at every pixel).
+    [[nodiscard]] static Result<Program> make_program(bool exact_maps, bool has_beta);
+    static constexpr std::size_t program_index(bool exact_maps, bool has_beta) {
+        return (exact_maps ? 2U : 0U) + (has_beta ? 1U : 0U);
+    }
 
-    Program general_;  // maps of any size: bilinear warp, blend and beta
-    Program exact_;    // every map the target's size: one fetch each (the same result, fewer fetches)
+    std::array<Program, 4> programs_;
     ContentTransform transform_;
     GLint max_texture_size_ = 0;
     GlTexture content_;
@@ -139,7 +149,7 @@ private:
     ImageSize content_size_;
     std::vector<Projector> projectors_;
     std::vector<std::uint8_t> readback_;  // RGBA scratch for render()
-    std::vector<float> content_linear_;   // set_content's frame in linear light, for the upload
+    std::vector<std::uint16_t> content_linear_;  // set_content's frame in linear light (half floats)
 };
 
 }  // namespace mogao
