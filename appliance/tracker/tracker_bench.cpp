@@ -6,18 +6,21 @@
 //   1. Per scenario (random poses around a nominal one, seeded): detection rate, corner error
 //      (px, against the projected truth), pose error of the best IPPE solution (mm, degrees).
 //   2. Detection time per 800x600 frame with the default settings (median).
-//   3. The speed/accuracy trade of decimation and blur: time, corner error and detection rate
-//      relative to the defaults, on the same images.
+//   3. The speed/accuracy trade of the settings (the extra passes, decimation and blur): time,
+//      corner error and detection rate relative to the defaults, on the same images; --csv FILE
+//      writes it for bench/tracking-eval's plot.
 //
 // Camera: 800x600, f = 700 px, no distortion; tag36h11, 10 cm on a white card, in front of a
 // cluttered background (synthetic_view.h). Usage:
-//   mogao_tracker_bench [--frames N] [--quick]
+//   mogao_tracker_bench [--frames N] [--quick] [--csv FILE]
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <functional>
 #include <random>
 #include <string>
@@ -143,35 +146,131 @@ struct Outcome {
     std::vector<double> corner_px, translation_mm, rotation_deg, time_ms;
 };
 
-// Detects every sample with `settings`; each image is detected `repeats` times and the fastest
-// time kept (the machine is shared: the minimum is the least disturbed).
-Outcome run(const std::vector<Sample>& samples, const DetectorSettings& settings, int repeats) {
-    TagDetector detector(settings);
-    Outcome o;
-    for (const Sample& s : samples) {
-        std::vector<TagDetection> found;
-        double best_ms = 1e300;
-        for (int i = 0; i < repeats; ++i) {
-            const auto t0 = std::chrono::steady_clock::now();
-            found = detector.detect(s.image);
-            best_ms = std::min(
-                best_ms, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+// Scores one sample's detections into `o` (the first detection of the tag's id; other ids are
+// false positives).
+void score(const Sample& s, const std::vector<TagDetection>& found, Outcome& o) {
+    for (const TagDetection& d : found) {
+        if (d.id != kTagId) {
+            ++o.wrong;
+            continue;
         }
-        o.time_ms.push_back(best_ms);
-        for (const TagDetection& d : found) {
-            if (d.id != kTagId) {
-                ++o.wrong;
-                continue;
+        ++o.found;
+        for (std::size_t k = 0; k < 4; ++k) o.corner_px.push_back((d.corners[k] - s.corners[k]).norm());
+        const TagPose best = solve_tag_pose(d.corners, ideal_camera(), kTagSize)[0];
+        o.translation_mm.push_back((best.translation_m - s.truth.translation_m).norm() * 1000.0);
+        o.rotation_deg.push_back(rotation_angle_deg(best.rotation, s.truth.rotation));
+        break;
+    }
+}
+
+// Detects every sample with each of `settings`, interleaved (every setting in turn on each image,
+// so the load of a shared machine biases none of them); each image is detected `repeats` times per
+// setting and the fastest time kept (the minimum is the least disturbed).
+std::vector<Outcome> run(const std::vector<Sample>& samples, const std::vector<DetectorSettings>& settings,
+                         int repeats) {
+    std::vector<TagDetector> detectors;
+    for (const DetectorSettings& s : settings) detectors.emplace_back(s);
+    std::vector<Outcome> outcomes(settings.size());
+    for (const Sample& s : samples) {
+        for (std::size_t v = 0; v < detectors.size(); ++v) {
+            std::vector<TagDetection> found;
+            double best_ms = 1e300;
+            for (int i = 0; i < repeats; ++i) {
+                const auto t0 = std::chrono::steady_clock::now();
+                found = detectors[v].detect(s.image);
+                best_ms = std::min(
+                    best_ms, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
             }
-            ++o.found;
-            for (std::size_t k = 0; k < 4; ++k) o.corner_px.push_back((d.corners[k] - s.corners[k]).norm());
-            const TagPose best = solve_tag_pose(d.corners, ideal_camera(), kTagSize)[0];
-            o.translation_mm.push_back((best.translation_m - s.truth.translation_m).norm() * 1000.0);
-            o.rotation_deg.push_back(rotation_angle_deg(best.rotation, s.truth.rotation));
-            break;
+            outcomes[v].time_ms.push_back(best_ms);
+            score(s, found, outcomes[v]);
         }
     }
-    return o;
+    return outcomes;
+}
+
+Outcome run(const std::vector<Sample>& samples, const DetectorSettings& settings, int repeats) {
+    return run(samples, std::vector<DetectorSettings>{settings}, repeats).front();
+}
+
+// One point of the settings sweep: a label, whether it is the defaults, and the settings.
+struct Variant {
+    std::string label;
+    bool is_default = false;
+    DetectorSettings settings;
+};
+
+// The quad search's decimation and blur on their own (no second or third pass, as AprilTag runs
+// them), then the defaults with each extra pass turned off in turn, and the defaults of before
+// issue 15 (decimation 2, blur 0.8): the same images for every row.
+std::vector<Variant> settings_variants(const DetectorSettings& defaults, bool quick) {
+    std::vector<Variant> v{{"defaults", true, defaults}};
+    DetectorSettings tracker = defaults;
+    tracker.upsample_pass_factor = 0;
+    v.push_back({"defaults without the up-sampled pass (TagTracker)", false, tracker});
+    DetectorSettings single = tracker;
+    single.coarse_pass_decimation = 0;
+    v.push_back({"defaults without the coarse or up-sampled pass", false, single});
+    DetectorSettings no_refine = defaults;
+    no_refine.refine_edges = false;
+    v.push_back({"defaults, refine_edges off", false, no_refine});
+    const std::vector<float> decimations =
+        quick ? std::vector<float>{1.0f, 2.0f} : std::vector<float>{1.0f, 1.5f, 2.0f, 3.0f, 4.0f};
+    const std::vector<float> blurs = quick ? std::vector<float>{0.0f} : std::vector<float>{0.0f, 0.8f};
+    for (float dec : decimations) {
+        for (float blur : blurs) {
+            DetectorSettings s = single;
+            s.decimation = dec;
+            s.blur_sigma = blur;
+            char label[96];
+            std::snprintf(label, sizeof label, "single pass, decimation %.1f, blur %.1f%s", static_cast<double>(dec),
+                          static_cast<double>(blur),
+                          dec == 2.0f && blur == 0.8f ? " (the defaults before issue 15)" : "");
+            v.push_back({label, false, s});
+        }
+    }
+    return v;
+}
+
+void print_sweep(const std::vector<Variant>& variants, const std::vector<Outcome>& outcomes, std::size_t images) {
+    const double base_time = percentile(outcomes[0].time_ms, 0.5);
+    const double base_corner = percentile(outcomes[0].corner_px, 0.5);
+    std::printf(
+        "speed/accuracy of the detector settings on %zu images (frontal, 70 deg, 20 px, noise, low contrast), "
+        "relative to the defaults (%.2f ms median in this run):\n\n",
+        images, base_time);
+    std::printf(
+        "| settings | median time (ms) | time/default | detected | wrong id | corner error median (px) | corner "
+        "error/default |\n");
+    std::printf("|---|--:|--:|--:|--:|--:|--:|\n");
+    for (std::size_t i = 0; i < variants.size(); ++i) {
+        const Outcome& o = outcomes[i];
+        const double t = percentile(o.time_ms, 0.5);
+        const double c = percentile(o.corner_px, 0.5);
+        const char* b = variants[i].is_default ? "**" : "";
+        std::printf("| %s%s%s | %.2f | %.2f | %d/%zu | %d | %.3f | %.2f |\n", b, variants[i].label.c_str(), b, t,
+                    t / base_time, o.found, images, o.wrong, c, c / base_corner);
+    }
+}
+
+// CSV for the plot (bench/tracking-eval): one row per variant, the defaults flagged.
+std::string write_sweep_csv(const std::string& path, const std::vector<Variant>& variants,
+                            const std::vector<Outcome>& outcomes, std::size_t images) {
+    std::FILE* f = std::fopen(path.c_str(), "we");
+    if (!f) return path + ": cannot open for writing: " + std::strerror(errno);
+    std::fprintf(f,
+                 "label,is_default,decimation,blur_sigma,coarse_pass_decimation,upsample_pass_factor,refine_edges,"
+                 "median_time_ms,detected,images,wrong,corner_median_px,corner_p95_px\n");
+    for (std::size_t i = 0; i < variants.size(); ++i) {
+        const DetectorSettings& s = variants[i].settings;
+        const Outcome& o = outcomes[i];
+        std::fprintf(f, "\"%s\",%d,%.2f,%.2f,%.2f,%d,%d,%.4f,%d,%zu,%d,%.4f,%.4f\n", variants[i].label.c_str(),
+                     variants[i].is_default ? 1 : 0, static_cast<double>(s.decimation),
+                     static_cast<double>(s.blur_sigma), static_cast<double>(s.coarse_pass_decimation),
+                     s.upsample_pass_factor, s.refine_edges ? 1 : 0, percentile(o.time_ms, 0.5), o.found, images,
+                     o.wrong, percentile(o.corner_px, 0.5), percentile(o.corner_px, 0.95));
+    }
+    const bool ok = std::fclose(f) == 0;
+    return ok ? std::string() : path + ": write failed";
 }
 
 }  // namespace
@@ -184,6 +283,8 @@ int main(int argc, char** argv) {
     bool quick = false;
     app.add_option("--frames", frames, "images per scenario")->check(CLI::Range(1, 10000))->capture_default_str();
     app.add_flag("--quick", quick, "a few images, fewer settings (smoke test)");
+    std::string csv_path;
+    app.add_option("--csv", csv_path, "also write the settings sweep as CSV to this file");
     CLI11_PARSE(app, argc, argv);
     if (quick) frames = 3;
     const int repeats = quick ? 1 : 3;
@@ -201,10 +302,11 @@ int main(int argc, char** argv) {
     const DetectorSettings defaults;
     std::printf(
         "camera 800x600, f = 700 px; tag36h11 id %d, %.0f mm, cluttered background; %d images per scenario; default "
-        "settings: decimation %.1f, "
-        "blur %.1f, refine_edges %s, min_white_black_diff %d, max_hamming %d, 1 thread\n\n",
+        "settings: decimation %.1f, blur %.1f, coarse pass at decimation %.1f, up-sampled pass x%d (frames up to %d "
+        "pixels), refine_edges %s, max_hamming %d, 1 thread\n\n",
         kTagId, kTagSize * 1000, frames, static_cast<double>(defaults.decimation),
-        static_cast<double>(defaults.blur_sigma), defaults.refine_edges ? "on" : "off", defaults.min_white_black_diff,
+        static_cast<double>(defaults.blur_sigma), static_cast<double>(defaults.coarse_pass_decimation),
+        defaults.upsample_pass_factor, defaults.upsample_pass_max_pixels, defaults.refine_edges ? "on" : "off",
         defaults.max_hamming);
 
     std::printf(
@@ -232,40 +334,16 @@ int main(int argc, char** argv) {
     // The trade-off, on frontal, small, noisy and tilted views together.
     std::vector<Sample> mixed;
     for (std::size_t i : {0UL, 2UL, 3UL, 5UL, 6UL}) mixed.insert(mixed.end(), sets[i].begin(), sets[i].end());
-    const Outcome base = run(mixed, defaults, repeats);
-    const double base_time = percentile(base.time_ms, 0.5);
-    const double base_corner = percentile(base.corner_px, 0.5);
-    std::printf(
-        "speed/accuracy of the quad search on %zu images (frontal, 70 deg, 20 px, noise, low contrast), relative to "
-        "the defaults:\n\n",
-        mixed.size());
-    std::printf(
-        "| decimation | blur sigma | median time (ms) | time/default | detected | corner error median (px) | corner "
-        "error/default |\n");
-    std::printf("|---|---|---|---|---|---|---|\n");
-    const std::vector<float> decimations =
-        quick ? std::vector<float>{1.0f, 2.0f} : std::vector<float>{1.0f, 1.5f, 2.0f, 3.0f, 4.0f};
-    const std::vector<float> blurs = quick ? std::vector<float>{0.0f} : std::vector<float>{0.0f, 0.8f};
-    for (float dec : decimations) {
-        for (float blur : blurs) {
-            DetectorSettings s = defaults;
-            s.decimation = dec;
-            s.blur_sigma = blur;
-            const Outcome o =
-                (dec == defaults.decimation && blur == defaults.blur_sigma) ? base : run(mixed, s, repeats);
-            const double t = percentile(o.time_ms, 0.5);
-            const double c = percentile(o.corner_px, 0.5);
-            std::printf("| %.1f | %.1f | %.2f | %.2f | %d/%zu | %.3f | %.2f |\n", static_cast<double>(dec),
-                        static_cast<double>(blur), t, t / base_time, o.found, mixed.size(), c, c / base_corner);
+    const std::vector<Variant> variants = settings_variants(defaults, quick);
+    std::vector<DetectorSettings> settings;
+    for (const Variant& v : variants) settings.push_back(v.settings);
+    const std::vector<Outcome> outcomes = run(mixed, settings, repeats);
+    print_sweep(variants, outcomes, mixed.size());
+    if (!csv_path.empty()) {
+        if (auto s = write_sweep_csv(csv_path, variants, outcomes, mixed.size()); !s.empty()) {
+            std::fprintf(stderr, "mogao_tracker_bench: %s\n", s.c_str());
+            return 1;
         }
     }
-    DetectorSettings no_refine = defaults;
-    no_refine.refine_edges = false;
-    const Outcome nr = run(mixed, no_refine, repeats);
-    std::printf("| %.1f, refine_edges off | %.1f | %.2f | %.2f | %d/%zu | %.3f | %.2f |\n",
-                static_cast<double>(defaults.decimation), static_cast<double>(defaults.blur_sigma),
-                percentile(nr.time_ms, 0.5), percentile(nr.time_ms, 0.5) / base_time, nr.found, mixed.size(),
-                percentile(nr.corner_px, 0.5), percentile(nr.corner_px, 0.5) / base_corner);
-    std::printf("\n(time/default: median detection time relative to the defaults' %.2f ms in this run)\n", base_time);
     return 0;
 }

@@ -25,6 +25,7 @@
 #include <assimp/scene.h>
 #include <fmt/format.h>
 
+#include "common/srgb.h"
 #include "renderfarm/scene/ply_reader.h"
 #include "renderfarm/scene/texture_io.h"
 
@@ -56,7 +57,7 @@ struct Attributes {
 
 float srgb_to_linear(float v) {
     const double c = std::clamp(static_cast<double>(v), 0.0, 1.0);
-    return static_cast<float>(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
+    return static_cast<float>(srgb_decode(c));
 }
 
 // Appends the triangles of one aiMesh placed by `to_file` (the node's accumulated transform).

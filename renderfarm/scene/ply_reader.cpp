@@ -16,6 +16,7 @@
 
 #include <fmt/format.h>
 
+#include "common/srgb.h"
 #include "renderfarm/scene/mesh_io.h"
 
 namespace mogao {
@@ -338,7 +339,7 @@ double colour_channel(double raw, const Property& p) {
     else if (is_integer(p.type))
         throw ParseFailure(fmt::format("colour '{}' must be uchar, ushort, float or double", p.name));
     if (!(v >= 0.0 && v <= 1.0)) throw ParseFailure(fmt::format("colour {} = {} is outside [0, 1]", p.name, raw));
-    return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
+    return srgb_decode(v);
 }
 
 // Positions are read in double and re-centred on their bounding-box centre (mesh.origin) before

@@ -26,6 +26,7 @@
 #include <Eigen/Core>
 
 #include "common/image.h"
+#include "common/srgb.h"
 
 namespace mogao {
 
@@ -56,17 +57,7 @@ inline int wrap_index(int i, int n, TextureWrap mode) {
 
 }  // namespace texture_detail
 
-inline const std::array<float, 256>& srgb8_to_linear_table() {
-    static const std::array<float, 256> table = [] {
-        std::array<float, 256> t{};
-        for (std::size_t k = 0; k < t.size(); ++k) {
-            const double v = static_cast<double>(k) / 255.0;
-            t[k] = static_cast<float>(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
-        }
-        return t;
-    }();
-    return table;
-}
+inline const std::array<float, 256>& srgb8_to_linear_table() { return srgb8_decode_table(); }
 
 inline Eigen::Vector3f Texture::sample(const Eigen::Vector2f& uv) const {
     const int w = image.size.width;

@@ -8,11 +8,10 @@
 #include <cstdint>
 #include <stdexcept>
 
+#include "common/srgb.h"
+
 namespace mogao {
 namespace {
-
-
-double srgb_oetf_inverse(double e) { return e <= 0.04045 ? e / 12.92 : std::pow((e + 0.055) / 1.055, 2.4); }
 
 // thresholds[k] = smallest linear value whose code is k + 1, i.e. OETF⁻¹((k + 0.5) / 255): the
 // code is the number of thresholds <= v. Same result as lround(255 * OETF(v)) without a pow per
@@ -20,7 +19,7 @@ double srgb_oetf_inverse(double e) { return e <= 0.04045 ? e / 12.92 : std::pow(
 const std::array<double, 255>& code_thresholds() {
     static const std::array<double, 255> thresholds = [] {
         std::array<double, 255> t{};
-        for (std::size_t k = 0; k < t.size(); ++k) t[k] = srgb_oetf_inverse((static_cast<double>(k) + 0.5) / 255.0);
+        for (std::size_t k = 0; k < t.size(); ++k) t[k] = srgb_decode((static_cast<double>(k) + 0.5) / 255.0);
         return t;
     }();
     return thresholds;
