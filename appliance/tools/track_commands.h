@@ -57,7 +57,7 @@ int make_tag(const TagImageOptions& options);
 
 struct NavigateOptions {
     std::filesystem::path replay;  // a replay folder, or
-    std::string device;            // a V4L2 device (then `camera` is required; runs until killed)
+    std::string device;  // /dev/videoN, v4l2:..., libcamera:[<id>] (then `camera` is required; runs until killed)
     std::filesystem::path camera;  // default: <replay>/camera.json
     double tag_size_mm = 100.0;
     int id = -1;

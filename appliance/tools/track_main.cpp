@@ -93,7 +93,9 @@ int main(int argc, char** argv) {
     auto* n = app.add_subcommand("navigate", "frames through tracker and navigation; print ViewerPoses (JSON lines)");
     auto* replay =
         n->add_option("REPLAY", nav.replay, "folder of frames (see make-sequence)")->check(CLI::ExistingDirectory);
-    auto* device = n->add_option("--device", nav.device, "V4L2 camera instead of a folder (runs until killed)");
+    auto* device = n->add_option(
+        "--device", nav.device,
+        "camera instead of a folder: /dev/videoN, v4l2:/dev/videoN or libcamera:[<id>] (runs until killed)");
     replay->excludes(device);
     n->add_option("--camera", nav.camera, "calibration file (default REPLAY/camera.json; required with --device)");
     n->add_option("--tag-size-mm", nav.tag_size_mm, "tag size (black border)")

@@ -57,8 +57,14 @@ int navigate(const NavigateOptions& o) {
         spec.folder = o.replay;
         spec.replay_fps = o.fps;
     } else {
-        spec.kind = CameraSourceSpec::Kind::v4l2;
-        spec.device = o.device;
+        // "/dev/videoN" alone is V4L2; otherwise any camera the kiosk accepts (v4l2:, libcamera:).
+        const std::string named = o.device.starts_with("/") ? "v4l2:" + o.device : o.device;
+        std::string why;
+        if (!parse_camera_source(named, spec, &why) || spec.kind == CameraSourceSpec::Kind::replay) {
+            std::fprintf(stderr, "mogao-track navigate: --device '%s': %s\n", o.device.c_str(),
+                         why.empty() ? "give /dev/videoN, v4l2:/dev/videoN or libcamera:[<id>]" : why.c_str());
+            return 2;
+        }
         spec.width = config.camera.width;  // the calibrated size; the tracker refuses any other
         spec.height = config.camera.height;
     }

@@ -2,6 +2,7 @@
 // mogao-camera: what the cameras on this machine support, to choose the kiosk's camera keys.
 //   mogao-camera list                          every V4L2 capture node (device, driver, card)
 //   mogao-camera info v4l2:/dev/videoN|/dev/videoN   formats, sizes, frame rates, controls with ranges
+//   mogao-camera info libcamera:[<id>]         the same through libcamera (every camera without an id)
 // Exit codes (docs/architecture.md): 0 success, 1 the device could not be queried, 2 bad command line.
 #include <CLI/CLI.hpp>
 
@@ -9,6 +10,7 @@
 #include <string>
 
 #include "drivers/camera/camera_source.h"
+#include "drivers/camera/libcamera_capture.h"
 #include "drivers/camera/v4l2_info.h"
 
 namespace {
@@ -22,10 +24,18 @@ int run_info(const std::string& camera) {
             std::cerr << "mogao-camera info: " << why << "\n";
             return 2;
         }
+        if (spec.kind == mogao::CameraSourceSpec::Kind::libcamera) {
+            auto text = mogao::describe_libcamera_cameras(spec.camera_id);
+            if (!text) {
+                std::cerr << "mogao-camera info: " << text.error().message << "\n";
+                return 1;
+            }
+            std::cout << *text;
+            return 0;
+        }
         if (spec.kind != mogao::CameraSourceSpec::Kind::v4l2) {
             std::cerr << "mogao-camera info: '" << camera
-                      << "': only V4L2 cameras (\"v4l2:/dev/videoN\") can be listed; a replay has no controls, "
-                         "and libcamera's are listed by `cam --list-controls` (libcamera-tools)\n";
+                      << "': a replay folder has no formats or controls; give v4l2:/dev/videoN or libcamera:[<id>]\n";
             return 2;
         }
         device = spec.device;
@@ -48,7 +58,7 @@ int main(int argc, char** argv) {
     CLI::App* info =
         app.add_subcommand("info", "formats, sizes, frame rates and controls (ranges, values) of one camera");
     std::string camera;
-    info->add_option("camera", camera, "v4l2:/dev/videoN or /dev/videoN")->required();
+    info->add_option("camera", camera, "v4l2:/dev/videoN, /dev/videoN or libcamera:[<id>]")->required();
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

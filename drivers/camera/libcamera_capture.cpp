@@ -8,6 +8,7 @@
 #include <libcamera/formats.h>
 #include <libcamera/framebuffer.h>
 #include <libcamera/framebuffer_allocator.h>
+#include <libcamera/property_ids.h>
 #include <libcamera/request.h>
 #include <libcamera/stream.h>
 
@@ -52,7 +53,80 @@ std::string format_list(const std::vector<libcamera::PixelFormat>& formats) {
     return list.empty() ? std::string("none") : list;
 }
 
+// Claims the process-wide CameraManager slot for a scope (false: another holder has it).
+class ManagerClaim {
+public:
+    ManagerClaim() {
+        const std::lock_guard<std::mutex> lock(g_manager_mutex);
+        held_ = !g_manager_in_use;
+        g_manager_in_use = true;
+    }
+    ManagerClaim(const ManagerClaim&) = delete;
+    ManagerClaim& operator=(const ManagerClaim&) = delete;
+    ~ManagerClaim() {
+        if (!held_) return;
+        const std::lock_guard<std::mutex> lock(g_manager_mutex);
+        g_manager_in_use = false;
+    }
+    [[nodiscard]] bool held() const { return held_; }
+
+private:
+    bool held_ = false;
+};
+
+std::string describe_camera(libcamera::Camera& camera) {
+    std::string out = "libcamera:" + camera.id() + "\n";
+    if (const auto model = camera.properties().get(libcamera::properties::Model)) out += "  model: " + *model + "\n";
+    const std::unique_ptr<libcamera::CameraConfiguration> config =
+        camera.generateConfiguration({libcamera::StreamRole::Viewfinder});
+    if (config && !config->empty()) {
+        const libcamera::StreamFormats& formats = config->at(0).formats();
+        out += "  Viewfinder stream formats (default " + config->at(0).toString() + "):\n";
+        for (const libcamera::PixelFormat& f : formats.pixelformats())
+            out += "    " + f.toString() + "  " + formats.range(f).toString() + "\n";
+    } else {
+        out += "  no Viewfinder stream configuration\n";
+    }
+    out += "  controls:\n";
+    std::map<std::string, std::string> controls;  // sorted by name
+    for (const auto& [id, info] : camera.controls()) controls[id->name()] = info.toString();
+    for (const auto& [name, range] : controls) out += "    " + name + ": " + range + "\n";
+    return out;
+}
+
 }  // namespace
+
+Result<std::string> describe_libcamera_cameras(const std::string& camera_id) {
+    const ManagerClaim claim;
+    if (!claim.held()) {
+        return make_error(EBUSY,
+                          "libcamera: a LibcameraCapture is open in this process (libcamera 0.0.x allows "
+                          "one CameraManager per process)");
+    }
+    libcamera::CameraManager manager;
+    if (const int ret = manager.start(); ret < 0) return libcamera_error(ret, "libcamera: CameraManager::start");
+    std::string out;
+    std::string error;
+    {
+        std::vector<std::shared_ptr<libcamera::Camera>> cameras = manager.cameras();
+        if (!camera_id.empty()) {
+            std::shared_ptr<libcamera::Camera> one = manager.get(camera_id);
+            std::string list;
+            for (const auto& c : cameras) list += (list.empty() ? "" : ", ") + c->id();
+            if (!one)
+                error = "libcamera camera " + camera_id + ": not found; cameras: " + (list.empty() ? "none" : list);
+            cameras = one ? std::vector{one} : std::vector<std::shared_ptr<libcamera::Camera>>{};
+        } else if (cameras.empty()) {
+            error =
+                "libcamera: no camera found (CameraManager lists none: no supported camera attached, or its "
+                "pipeline handler or IPA module is missing)";
+        }
+        for (const auto& c : cameras) out += describe_camera(*c);
+    }  // every Camera reference is dropped before the manager stops
+    manager.stop();
+    if (!error.empty()) return make_error(ENODEV, error);
+    return out;
+}
 
 bool libcamera_built_in() noexcept { return true; }
 

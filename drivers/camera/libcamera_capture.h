@@ -116,6 +116,14 @@ struct LibcameraConfig {
 [[nodiscard]] std::int64_t libcamera_frame_timestamp_ns(std::optional<std::int64_t> sensor_timestamp_ns,
                                                         std::uint64_t buffer_timestamp_ns) noexcept;
 
+// What `mogao-camera info libcamera:[<id>]` prints: for the camera `camera_id` (empty: every
+// camera libcamera lists) its id and model, the Viewfinder stream's pixel formats with their size
+// ranges, and every control with its range and default (libcamera's ControlInfo text, e.g.
+// "ExposureTime: [100..33000]" in microseconds). Starts and stops its own CameraManager, so it
+// fails with EBUSY while a LibcameraCapture is open in this process; ENODEV when no camera (or not
+// that id) is found; ENOTSUP when built without libcamera.
+[[nodiscard]] Result<std::string> describe_libcamera_cameras(const std::string& camera_id);
+
 class LibcameraCapture final : public FrameSource {
 public:
     // Starts libcamera, acquires and configures the camera, allocates and maps buffers, starts

@@ -9,6 +9,12 @@ struct LibcameraCapture::Impl {};
 
 bool libcamera_built_in() noexcept { return false; }
 
+Result<std::string> describe_libcamera_cameras(const std::string& camera_id) {
+    return make_error(ENOTSUP, "libcamera " + (camera_id.empty() ? std::string("cameras") : camera_id) +
+                                   ": built without libcamera (configure with -DMOGAO_LIBCAMERA=ON and "
+                                   "install libcamera-dev)");
+}
+
 LibcameraCapture::LibcameraCapture() = default;
 LibcameraCapture::~LibcameraCapture() = default;
 

@@ -114,6 +114,18 @@ TEST(LibcameraBuild, OpenReportsHowItWasBuilt) {
     std::printf("libcamera open without camera: %s (code %d)\n", cam.error().message.c_str(), cam.code());
 }
 
+TEST(LibcameraBuild, DescribeReportsHowItWasBuilt) {
+    auto text = describe_libcamera_cameras("");
+    if (!kBuiltWithLibcamera) {
+        ASSERT_FALSE(text.ok());
+        EXPECT_EQ(text.code(), ENOTSUP);
+        return;
+    }
+    if (text.ok()) GTEST_SKIP() << "a libcamera camera is present:\n" << *text;
+    EXPECT_EQ(text.code(), ENODEV) << text.error().message;
+    EXPECT_NE(text.error().message.find("libcamera"), std::string::npos) << text.error().message;
+}
+
 TEST(LibcameraBuild, BadConfigIsRejectedBeforeLibcamera) {
     LibcameraConfig c;
     c.buffer_count = 9;
@@ -323,6 +335,30 @@ TEST(LibcameraCamera, ExposureAndGainControls) {
 
 // Teardown gives everything back: the camera can be opened, streamed and closed again and again
 // (a leaked acquire would be EBUSY, a leaked CameraManager slot EBUSY from this process).
+// `mogao-camera info libcamera:` lists the camera, its Viewfinder formats and its controls, and
+// refuses (EBUSY, not libcamera's abort) while a capture holds the process's CameraManager.
+TEST(LibcameraCamera, DescribeListsFormatsAndControls) {
+    LibcameraConfig config;
+    config.width = 320;
+    config.height = 240;
+    {
+        OPEN_LIBCAMERA_OR_SKIP(cam, config);
+        auto busy = describe_libcamera_cameras("");
+        ASSERT_FALSE(busy.ok());
+        EXPECT_EQ(busy.code(), EBUSY) << busy.error().message;
+    }
+    auto text = describe_libcamera_cameras("");
+    ASSERT_TRUE(text.ok()) << text.error().message;
+    std::printf("%s", text->c_str());
+    EXPECT_EQ(text->rfind("libcamera:", 0), 0U) << *text;
+    EXPECT_NE(text->find("Viewfinder stream formats"), std::string::npos) << *text;
+    EXPECT_NE(text->find("controls:"), std::string::npos) << *text;
+    auto missing = describe_libcamera_cameras("/base/no/such/camera");
+    ASSERT_FALSE(missing.ok());
+    EXPECT_EQ(missing.code(), ENODEV);
+    EXPECT_NE(missing.error().message.find("/base/no/such/camera"), std::string::npos) << missing.error().message;
+}
+
 TEST(LibcameraCamera, ReopensAfterCleanTeardown) {
     LibcameraConfig config;
     config.width = 320;

@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """The libcamera part of the QEMU test's test disk (qemu_boot_test.py): vimc.ko built for the image's
-kernel (build_vimc.sh), mogao_libcamera_test with the libraries it needs, and libcamera's vimc IPA
-(module, signature, proxy, vimc.conf) from the host's libcamera-ipa package. The guest side is
+kernel (build_vimc.sh), mogao_libcamera_test, mogao-camera and mogao-track with the libraries they
+need, and libcamera's vimc IPA (module, signature, proxy, vimc.conf) from the host's libcamera-ipa
+package. The guest side is
 selftest.sh ("libcamera-capture-test"). Nothing of this is in the shipped image.
 """
 import os
@@ -39,6 +40,20 @@ def copy_with_libraries(binary, disk, name):
                 shutil.copy(m.group(1), dest)
 
 
+def stage_tools(test_binary, disk):
+    """The commands a technician points at a libcamera camera, from the build the test binary is in
+    (BUILD/drivers/camera/mogao_libcamera_test): mogao-camera (info libcamera:) and mogao-track
+    (navigate --device libcamera:). selftest.sh runs each one it finds. Returns their names."""
+    build = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(test_binary))))
+    staged = []
+    for rel in (os.path.join("drivers", "camera", "mogao-camera"), os.path.join("appliance", "tools", "mogao-track")):
+        path = os.path.join(build, rel)
+        if os.access(path, os.X_OK):
+            copy_with_libraries(path, disk, os.path.basename(rel))
+            staged.append(os.path.basename(rel))
+    return staged
+
+
 def stage(repo, work, disk, vmlinuz, test_binary):
     """Puts vimc.ko, the test and the IPA on the test disk. Returns (True, what) or (False, why)."""
     if not test_binary or not os.access(test_binary, os.X_OK):
@@ -55,6 +70,7 @@ def stage(repo, work, disk, vmlinuz, test_binary):
         return False, f"vimc.ko for {kver} not built: {build.stderr.strip()[-600:]}"
     shutil.copy(build.stdout.strip().splitlines()[-1], os.path.join(disk, "vimc.ko"))
     copy_with_libraries(test_binary, disk, "mogao_libcamera_test")
+    tools = stage_tools(test_binary, disk)
     ipa = os.path.join(disk, "libcamera", "ipa")
     conf = os.path.join(disk, "libcamera", "conf", "vimc")
     os.makedirs(ipa)
@@ -62,4 +78,4 @@ def stage(repo, work, disk, vmlinuz, test_binary):
     for n in IPA_FILES:
         shutil.copy(os.path.join(IPA_DIR, n), os.path.join(ipa, n))
     shutil.copy(IPA_CONF, os.path.join(conf, "vimc.conf"))
-    return True, f"vimc.ko for {kver}, {test_binary}, libcamera's vimc IPA"
+    return True, f"vimc.ko for {kver}, {test_binary}, {', '.join(tools) or 'no tools'}, libcamera's vimc IPA"

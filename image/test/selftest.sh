@@ -224,6 +224,33 @@ if [ -f /mnt/vimc.ko ] && [ -x /mnt/bin/mogao_libcamera_test ]; then
   else
     bad "libcamera-capture-test rc=$rc passed=$passed skipped=$skipped"
   fi
+  # The technician's commands against the same camera: what it supports, then tracking from it.
+  lc_env="LD_LIBRARY_PATH=/mnt/lib LIBCAMERA_IPA_MODULE_PATH=/mnt/libcamera/ipa LIBCAMERA_IPA_PROXY_PATH=/mnt/libcamera/ipa LIBCAMERA_IPA_CONFIG_PATH=/mnt/libcamera/conf LIBCAMERA_LOG_LEVELS=*:ERROR"
+  if [ -x /mnt/bin/mogao-camera ]; then
+    env $lc_env timeout 120 /mnt/bin/mogao-camera info libcamera: > /tmp/lcinfo.log 2>&1
+    rc=$?
+    head -n 40 /tmp/lcinfo.log | sed 's/^/MOGAO-SELFTEST libcamera-info-log /' > "$out"
+    if [ $rc -eq 0 ] && grep -q '^libcamera:' /tmp/lcinfo.log && grep -q 'Viewfinder stream formats' /tmp/lcinfo.log; then
+      ok "libcamera-info cameras=$(grep -c '^libcamera:' /tmp/lcinfo.log) controls=$(sed -n '/controls:/,$p' /tmp/lcinfo.log | grep -c ': ')"
+    else
+      bad "libcamera-info rc=$rc"
+    fi
+  fi
+  if [ -x /mnt/bin/mogao-track ]; then
+    # vimc's pipeline in libcamera 0.0.3 keeps widths that are multiples of 6: 960x540 is kept.
+    printf '{"fx": 700, "fy": 700, "cx": 479.5, "cy": 269.5, "distortion": [], "image_width": 960, "image_height": 540}\n' > /tmp/lc-camera.json
+    env $lc_env timeout -s INT 60 /mnt/bin/mogao-track navigate --device libcamera: --camera /tmp/lc-camera.json \
+      --display-hz 10 --out /tmp/lc-poses.jsonl 2> /tmp/lc-track.err
+    rc=$?
+    tail -n 5 /tmp/lc-track.err | sed 's/^/MOGAO-SELFTEST libcamera-track-log /' > "$out"
+    poses=$(wc -l < /tmp/lc-poses.jsonl 2>/dev/null || echo 0)
+    # timeout's SIGINT ends it (124, or 130 if the command itself reports the signal): it ran.
+    if grep -q '^source: libcamera' /tmp/lc-track.err && [ "${poses:-0}" -gt 0 ]; then
+      ok "libcamera-track poses=$poses rc=$rc"
+    else
+      bad "libcamera-track rc=$rc poses=${poses:-0}"
+    fi
+  fi
 else
   say "skip libcamera-capture-test (no vimc.ko or libcamera test binary on the test disk)"
 fi
