@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include "appliance/warp/composite.h"
 #include "common/png_io.h"
@@ -21,22 +22,76 @@ std::uint8_t linear_to_srgb8(float linear) {
 
 }  // namespace
 
+HeadlessRecorder::Writer::Writer() : thread_([this] { run(); }) {}
+
+HeadlessRecorder::Writer::~Writer() {
+    {
+        std::lock_guard lock(mutex_);
+        stop_ = true;
+    }
+    changed_.notify_all();
+    thread_.join();
+}
+
+void HeadlessRecorder::Writer::push(std::vector<std::pair<std::filesystem::path, Rgb8Image>> round) {
+    std::unique_lock lock(mutex_);
+    changed_.wait(lock, [this] { return queue_.size() < kMaxQueuedRounds; });
+    queue_.push_back(std::move(round));
+    changed_.notify_all();
+}
+
+void HeadlessRecorder::Writer::flush() {
+    std::unique_lock lock(mutex_);
+    changed_.wait(lock, [this] { return queue_.empty() && !busy_; });
+}
+
+void HeadlessRecorder::Writer::run() {
+    std::unique_lock lock(mutex_);
+    for (;;) {
+        changed_.wait(lock, [this] { return stop_ || !queue_.empty(); });
+        if (queue_.empty()) return;  // stopping, and everything queued is written
+        auto round = std::move(queue_.front());
+        queue_.pop_front();
+        busy_ = true;
+        changed_.notify_all();  // room in the queue
+        lock.unlock();
+        for (const auto& [file, image] : round) {
+            try {
+                write_png(file, image);
+            } catch (const std::exception& e) {
+                spdlog::warn("PNG output: {}", e.what());
+            }
+        }
+        lock.lock();
+        busy_ = false;
+        changed_.notify_all();  // flush() may be waiting
+    }
+}
+
 HeadlessRecorder::HeadlessRecorder(const HeadlessOutputBackend& backend, std::filesystem::path dir, int every)
     : backend_(&backend), dir_(std::move(dir)), every_(every) {
     if (every_ < 1) throw std::invalid_argument("HeadlessRecorder: every must be >= 1");
     std::filesystem::create_directories(dir_);
+    writer_ = std::make_unique<Writer>();
 }
 
 std::size_t HeadlessRecorder::write_round(std::uint64_t round, std::uint64_t request_id) {
     if (round % static_cast<std::uint64_t>(every_) != 0) return 0;
-    std::size_t written = 0;
+    std::vector<std::pair<std::filesystem::path, Rgb8Image>> files;
     for (std::size_t i = 0; i < backend_->outputs().size(); ++i) {
         const Rgb8Image& frame = backend_->last_frame(i);
         if (frame.size.pixel_count() == 0) continue;
-        write_png(dir_ / fmt::format("{}-{:06}-req{}.png", backend_->outputs()[i].name, round, request_id), frame);
-        ++written;
+        // A copy: the backend reads the next round back into the same image.
+        files.emplace_back(dir_ / fmt::format("{}-{:06}-req{}.png", backend_->outputs()[i].name, round, request_id),
+                           frame);
     }
-    return written;
+    const std::size_t queued = files.size();
+    if (queued > 0) writer_->push(std::move(files));
+    return queued;
+}
+
+void HeadlessRecorder::flush() {
+    if (writer_) writer_->flush();
 }
 
 void HeadlessRecorder::write_composite(const ScreenCalibration& screen,
