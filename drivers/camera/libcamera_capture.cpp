@@ -131,25 +131,15 @@ Result<std::string> describe_libcamera_cameras(const std::string& camera_id) {
 bool libcamera_built_in() noexcept { return true; }
 
 struct LibcameraCapture::Impl {
-    // Holds the process-wide CameraManager slot; declared first so it is given back last.
-    struct ManagerSlot {
-        bool held = false;
-        ManagerSlot() = default;
-        ManagerSlot(const ManagerSlot&) = delete;
-        ManagerSlot& operator=(const ManagerSlot&) = delete;
-        ~ManagerSlot() {
-            if (!held) return;
-            const std::lock_guard<std::mutex> lock(g_manager_mutex);
-            g_manager_in_use = false;
-        }
-    };
     struct Mapping {
         MappedBuffer map;  // [0, offset + length) of the plane's dmabuf
         std::size_t offset = 0;
         std::size_t length = 0;
     };
 
-    ManagerSlot slot;
+    // The process-wide CameraManager slot, claimed when the capture is made (open() gives EBUSY if
+    // another holder has it); declared first so it is given back last.
+    ManagerClaim slot;
     std::unique_ptr<libcamera::CameraManager> manager;
     bool manager_started = false;
     std::shared_ptr<libcamera::Camera> camera;
@@ -305,14 +295,10 @@ Result<std::unique_ptr<LibcameraCapture>> LibcameraCapture::open(const Libcamera
     std::unique_ptr<LibcameraCapture> cam(new LibcameraCapture());
     Impl& d = *cam->impl_;
     d.timeout_ms = config.timeout_ms;
-    {
-        const std::lock_guard<std::mutex> lock(g_manager_mutex);
-        if (g_manager_in_use) {
-            return make_error(EBUSY, "libcamera: another LibcameraCapture is open (libcamera 0.0.x allows one "
-                                     "CameraManager per process)");
-        }
-        g_manager_in_use = true;
-        d.slot.held = true;
+    if (!d.slot.held()) {
+        return make_error(EBUSY,
+                          "libcamera: another LibcameraCapture is open (libcamera 0.0.x allows one "
+                          "CameraManager per process)");
     }
 
     d.manager = std::make_unique<libcamera::CameraManager>();
