@@ -91,6 +91,37 @@ struct ColourResult {
                                             const std::vector<DeviceModel>& projectors, ScreenCalibration& calibration,
                                             const ColourOptions& options = {});
 
+// The colour a calibration measured, in the part that does not depend on where the projectors
+// point: what a bumped projector keeps (self-recalibration, appliance/selfcal, re-applies it to the
+// corrected geometry). A projector's response and its black light are properties of its lamp,
+// panel and filters, not of its pose; the black floor T_c, the beta maps and the blend scale s are
+// defined on the screen's overlaps and so follow the geometry (step 3-4 redone for it).
+struct MeasuredColour {
+    std::vector<ResponseCurve> responses;      // per projector: LUT_kc of step 4 (input in matched-white units)
+    std::vector<std::array<double, 3>> black;  // per projector and channel: black_kc / W_c (matched-white units, >= 0)
+};
+
+// Steps 3 (black floor) and 4 (maps) for the geometry of `models`: every projector's response
+// becomes colour.responses[k], its beta (one sample per output pixel, as calibrate_colour) the
+// compensation of the blacks at the overlaps `models` give, and the blend masks are scaled by s =
+// 1 - max D/W. `calibration` must be the unscaled one calibration_from_models(models) builds (no
+// beta). All-zero blacks: no beta map (empty) and s = 1, only the responses change. Returns s.
+// Throws std::invalid_argument when the sizes do not match (projector count, response validity).
+double apply_measured_colour(const MeasuredColour& colour, const std::vector<DeviceModel>& models,
+                             const ScreenModel& screen, ScreenCalibration& calibration);
+
+// The inverse, for a calibration that calibrate_colour or apply_measured_colour made with `models`
+// (e.g. read back from its MPCDI file): responses copied; s = the largest blend weight (1 before
+// scaling wherever one projector alone lights the screen); the blacks by linear least squares on
+//   beta_kc(p) = (w_k(p) / s) (t_c - sum over projectors j lighting p of b_jc)
+// over every other output pixel (x and y) with w_k > 0, for the unknowns t_c (the black floor)
+// and b_jc. A calibration without beta maps (or all-zero ones) gives zero blacks. Throws
+// std::invalid_argument naming the cause when the models do not match the calibration, or when it
+// has beta maps that this does not explain: the blacks not separable (no overlap), or an rms
+// residual above 10 % of the maps' rms (maps made some other way; re-deriving them is not possible).
+[[nodiscard]] MeasuredColour measured_colour(const ScreenCalibration& calibration,
+                                             const std::vector<DeviceModel>& models, const ScreenModel& screen);
+
 // Step 1's interpolation: normalised light R(s) of a measured channel, s in [0, 1].
 [[nodiscard]] double response_at(const ChannelResponse& r, double s);
 

@@ -7,6 +7,7 @@
 #include "appliance/calibration/mpcdi_reader.h"
 #include "appliance/calibration/mpcdi_screen.h"
 #include "appliance/calibration/mpcdi_writer.h"
+#include "appliance/warp/response_curve.h"
 #include "common/file_io.h"
 
 namespace mogao::selfcal {
@@ -22,6 +23,10 @@ ScreenCalibration load_calibration(const std::filesystem::path& path) {
 void save_calibration(const std::filesystem::path& path, const ScreenCalibration& calibration) {
     MpcdiExportOptions options;
     options.alpha_bit_depth = 16;
+    const ResponseCurve assumed = make_gamma_response();  // what the reader uses without the entry
+    for (const ProjectorCalibration& pc : calibration.projectors) {
+        options.write_response = options.write_response || pc.response.lut != assumed.lut;
+    }
     const MpcdiFile file = to_mpcdi(calibration, options);  // throws before anything is touched
     std::error_code ec;
     if (std::filesystem::is_regular_file(path, ec)) {

@@ -13,7 +13,10 @@ namespace mogao::selfcal {
 [[nodiscard]] std::filesystem::path last_good_path(const std::filesystem::path& path);
 
 // If `path` holds a readable calibration, first copies it (atomically) to last_good_path(path),
-// then writes `calibration` to `path` atomically. A write that fails or is interrupted at any
+// then writes `calibration` to `path` atomically: 16-bit alpha maps, beta maps where a projector
+// has one, and each projector's response LUT (mogao's ResponseLUT entry) unless every response is
+// the gamma 2.2 the reader assumes without it, so a measured colour survives the file (docs/
+// calibration.md, "Self-recalibration"). A write that fails or is interrupted at any
 // point leaves `path` holding the previous complete calibration. Throws MpcdiError /
 // std::system_error naming the file, std::invalid_argument for an invalid calibration.
 void save_calibration(const std::filesystem::path& path, const ScreenCalibration& calibration);

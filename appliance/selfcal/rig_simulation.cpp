@@ -4,12 +4,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 
 #include <opencv2/imgproc.hpp>
 
 #include "appliance/autocal/rig_bridge.h"
+#include "appliance/warp/response_curve.h"
 
 namespace mogao::selfcal {
 
@@ -150,6 +152,35 @@ SystemModel models_of_rig(const rig::VirtualRig& rig) {
     return m;
 }
 
+autocal::MeasuredColour colour_of_rig(const rig::VirtualRig& rig, int entries) {
+    if (entries < 2 || entries > kMaxResponseEntries) throw std::invalid_argument("colour_of_rig: entries 2..2^20");
+    std::array<double, 3> white{};  // W_c
+    for (std::size_t c = 0; c < 3; ++c) {
+        white[c] = std::numeric_limits<double>::infinity();
+        for (const rig::RigProjector& p : rig.projectors) {
+            white[c] = std::min(white[c], p.brightness[c] * (1.0 - p.black_level));
+        }
+    }
+    autocal::MeasuredColour out;
+    for (const rig::RigProjector& p : rig.projectors) {
+        ResponseCurve r;
+        std::array<double, 3> black{};
+        for (std::size_t c = 0; c < 3; ++c) {
+            const double amplitude = p.brightness[c] * (1.0 - p.black_level);
+            r.lut[c].resize(static_cast<std::size_t>(entries));
+            for (int j = 0; j < entries; ++j) {
+                const double x = static_cast<double>(j) / (entries - 1);
+                r.lut[c][static_cast<std::size_t>(j)] =
+                    static_cast<float>(std::pow(std::min(1.0, x * white[c] / amplitude), 1.0 / p.gamma[c]));
+            }
+            black[c] = p.brightness[c] * p.black_level / white[c];
+        }
+        out.responses.push_back(std::move(r));
+        out.black.push_back(black);
+    }
+    return out;
+}
+
 cv::Mat1f make_content(ContentKind kind, double t_s, bool moving, std::uint64_t seed) {
     const cv::Size size(960, 540);
     if (kind == ContentKind::plain) return cv::Mat1f(size, 0.3f);
@@ -184,7 +215,36 @@ cv::Mat1f make_content(ContentKind kind, double t_s, bool moving, std::uint64_t 
     return img;
 }
 
-cv::Mat1f projector_signal(const ProjectorCalibration& pc, const cv::Mat1f& content) {
+namespace {
+
+bool is_default_response(const ResponseCurve& r) {
+    static const ResponseCurve kDefault = make_gamma_response();
+    return r.lut == kDefault.lut;
+}
+
+// The calibration's colour: linear x blend + beta (bilinear on its grid like the blend), clamped,
+// through the per-channel response LUT (render_output's formula, composite.h): CV_32FC3.
+cv::Mat3f coloured_signal(const ProjectorCalibration& pc, const cv::Mat1f& linear) {
+    cv::Mat3f beta(linear.size(), cv::Vec3f(0.0f, 0.0f, 0.0f));
+    if (!pc.beta.rgb.empty()) {
+        const cv::Mat3f grid(pc.beta.size.height, pc.beta.size.width,
+                             reinterpret_cast<cv::Vec3f*>(const_cast<float*>(pc.beta.rgb.data())));
+        cv::resize(grid, beta, linear.size(), 0, 0, cv::INTER_LINEAR);
+    }
+    cv::Mat3f out(linear.size());
+    for (int y = 0; y < linear.rows; ++y) {
+        for (int x = 0; x < linear.cols; ++x) {
+            for (int c = 0; c < 3; ++c) {
+                out(y, x)[c] = apply_response(pc.response, c, linear(y, x) + beta(y, x)[c]);
+            }
+        }
+    }
+    return out;
+}
+
+}  // namespace
+
+cv::Mat projector_signal(const ProjectorCalibration& pc, const cv::Mat1f& content) {
     const ImageSize g = pc.warp.size;
     cv::Mat1f gu(g.height, g.width);
     cv::Mat1f gv(g.height, g.width);
@@ -209,10 +269,13 @@ cv::Mat1f projector_signal(const ProjectorCalibration& pc, const cv::Mat1f& cont
     cv::Mat1f signal;
     cv::remap(content, signal, mx, my, cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0.0);
     signal = signal.mul(blend);
-    cv::max(signal, 0.0f, signal);
-    cv::min(signal, 1.0f, signal);
-    cv::pow(signal, 1.0 / 2.2, signal);  // the response autocal builds: gamma 2.2
-    return signal;
+    if (pc.beta.rgb.empty() && is_default_response(pc.response)) {
+        cv::max(signal, 0.0f, signal);
+        cv::min(signal, 1.0f, signal);
+        cv::pow(signal, 1.0 / 2.2, signal);  // the response calibration_from_models builds: gamma 2.2
+        return signal;
+    }
+    return coloured_signal(pc, signal);
 }
 
 SimulationReport simulate(const rig::VirtualRig& input, const SimulationOptions& o) {
@@ -228,15 +291,18 @@ SimulationReport simulate(const rig::VirtualRig& input, const SimulationOptions&
         }
     }
     const SystemModel model = models_of_rig(truth);
+    SimulationReport rep;
     ScreenCalibration wall =
         autocal::calibration_from_models(model.projectors, model.screen, {1920, 1080}, o.selfcal.build);
+    if (o.measured_colour)
+        (void)autocal::apply_measured_colour(colour_of_rig(truth), model.projectors, model.screen, wall);
+    rep.initial_calibration = wall;
     SelfCalibrator sc(model, wall, o.selfcal);
     auto sim = std::make_unique<rig::CameraSimulator>(truth);
     std::vector<bool> applied(o.bumps.size(), false);
     double first_bump = o.bumps.empty() ? std::nan("") : o.bumps.front().at_s;
     for (const Bump& b : o.bumps) first_bump = std::min(first_bump, b.at_s);
     cv::RNG rng(o.seed);
-    SimulationReport rep;
     double cpu = 0.0;
     bool measured_before = false;
     autocal::GeometryError g;
@@ -308,6 +374,8 @@ SimulationReport simulate(const rig::VirtualRig& input, const SimulationOptions&
         }
     }
     rep.mean_cpu_ms = cpu / o.frames;
+    rep.final_calibration = std::move(wall);
+    rep.final_rig = std::move(truth);
     return rep;
 }
 

@@ -14,6 +14,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "appliance/autocal/colour_calibration.h"
 #include "appliance/rig/virtual_rig.h"
 #include "appliance/selfcal/self_calibrator.h"
 
@@ -52,6 +53,9 @@ struct SimulationOptions {
     // the long static run's cost is then the monitor's, not the ground truth's. >= 1.
     int truth_every = 1;
     std::uint64_t seed = 7;
+    // The wall starts with the rig's true colour applied as a colour calibration would
+    // (colour_of_rig, autocal::apply_measured_colour): per-channel LUTs, beta maps, scaled blends.
+    bool measured_colour = false;
     SelfcalOptions selfcal;
 };
 
@@ -77,6 +81,9 @@ struct SimulationReport {
     SelfcalState final_state = SelfcalState::calibrated;
     std::vector<SimulationFrame> frames;
     std::vector<std::string> journal;
+    ScreenCalibration initial_calibration;  // the wall at the start
+    ScreenCalibration final_calibration;    // the wall after the last frame
+    rig::VirtualRig final_rig;              // the true (scaled, bumped) rig at the end
 };
 
 // Runs the scenario. Throws std::invalid_argument for bad options.
@@ -89,8 +96,17 @@ struct SimulationReport {
 // The rig's exact models (screen, camera, projectors) as the monitor's starting point.
 [[nodiscard]] SystemModel models_of_rig(const rig::VirtualRig& rig);
 
-// Projector k's input signal for a grey linear content frame: warp -> content -> x blend -> the
-// calibration's response (gamma 2.2 LUT), CV_32FC1 at the projector's resolution.
-[[nodiscard]] cv::Mat1f projector_signal(const ProjectorCalibration& pc, const cv::Mat1f& content);
+// Projector k's input signal for a grey linear content frame, at the projector's resolution:
+// warp -> content -> x blend (+ beta) -> the calibration's response (render_output's formula,
+// appliance/warp/composite.h). CV_32FC1 (exactly x^(1/2.2)) for calibration_from_models' plain
+// gamma 2.2 LUT without beta; CV_32FC3 (per-channel LUT and beta) for a calibration with colour.
+[[nodiscard]] cv::Mat projector_signal(const ProjectorCalibration& pc, const cv::Mat1f& content);
+
+// The rig's true photometry as a colour calibration would measure it (autocal::MeasuredColour;
+// colour_calibration.h step 3-4 with the rig's exact light model, virtual_rig.h): amplitude
+// A_kc = brightness_kc (1 - black_k), response R_kc(s) = s^gamma_kc, black_kc = brightness_kc
+// black_k, matched white W_c = min_k A_kc; LUT_kc(x) = (x W_c / A_kc)^(1 / gamma_kc) with `entries`
+// samples, black in W units. The colour counterpart of models_of_rig.
+[[nodiscard]] autocal::MeasuredColour colour_of_rig(const rig::VirtualRig& rig, int entries = 4096);
 
 }  // namespace mogao::selfcal

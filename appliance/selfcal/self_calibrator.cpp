@@ -7,8 +7,10 @@
 #include <ctime>
 #include <numbers>
 #include <stdexcept>
+#include <utility>
 
 #include "appliance/autocal/bundle_adjust.h"
+#include "appliance/autocal/colour_calibration.h"
 #include "appliance/selfcal/calibration_store.h"
 
 namespace mogao::selfcal {
@@ -43,6 +45,11 @@ std::string fmt(const char* f, double a, double b = 0.0, double c = 0.0) {
     return buf;
 }
 
+ScreenCalibration without_beta(ScreenCalibration calibration) {
+    for (ProjectorCalibration& pc : calibration.projectors) pc.beta = {};
+    return calibration;
+}
+
 }  // namespace
 
 ScreenCalibration interpolate_calibration(const ScreenCalibration& a, const ScreenCalibration& b, double s) {
@@ -69,6 +76,13 @@ ScreenCalibration interpolate_calibration(const ScreenCalibration& a, const Scre
         for (std::size_t i = 0; i < po.blend.weight.size(); ++i) {
             po.blend.weight[i] = pa.blend.weight[i] + t * (po.blend.weight[i] - pa.blend.weight[i]);
         }
+        if (pa.beta.rgb.size() == po.beta.rgb.size()) {
+            for (std::size_t i = 0; i < po.beta.rgb.size(); ++i) {
+                po.beta.rgb[i] = pa.beta.rgb[i] + t * (po.beta.rgb[i] - pa.beta.rgb[i]);
+            }
+        } else if (t < 0.5f) {
+            po.beta = pa.beta;
+        }
     }
     return out;
 }
@@ -80,6 +94,14 @@ SelfCalibrator::SelfCalibrator(const SystemModel& model, const ScreenCalibration
       wall_(calibration),
       camera_filter_(options.camera_kalman) {
     check_options(options);
+    try {
+        colour_ = autocal::measured_colour(calibration, model.projectors, model.screen);
+    } catch (const std::invalid_argument& e) {
+        // Beta maps made some other way: kept as they are through corrections (the responses still are).
+        colour_ = autocal::measured_colour(without_beta(calibration), model.projectors, model.screen);
+        for (const ProjectorCalibration& pc : calibration.projectors) kept_beta_.push_back(pc.beta);
+        pending_journal_ = std::string("selfcal: ") + e.what() + "; corrections keep those maps as they are";
+    }
     filters_.assign(model.projectors.size(), PoseKalman(options.kalman));
     typical_matches_.assign(model.projectors.size(), -1.0);
     lost_since_.assign(model.projectors.size(), -1.0);
@@ -211,10 +233,29 @@ void SelfCalibrator::start_correction(double t_s, const std::vector<int>& drifti
                             fmt(", blended in over %.1f s", options_.transition_s));
     }
     before_ = wall_;
-    after_ = autocal::calibration_from_models(after_models_, m.screen, wall_.content, options_.build);
+    after_ = corrected_calibration(after_models_, r);
     correction_start_ = t_s;
     state_ = SelfcalState::correcting;
     advance_correction(t_s, r);
+}
+
+// The geometry from the corrected models, with the calibration's measured colour re-derived for it
+// (self_calibrator.h: responses kept, black-level maps and blend scale from the new overlaps).
+ScreenCalibration SelfCalibrator::corrected_calibration(const std::vector<autocal::DeviceModel>& models,
+                                                        StepResult& r) const {
+    const SystemModel& m = monitor_.model();
+    ScreenCalibration out = autocal::calibration_from_models(models, m.screen, wall_.content, options_.build);
+    const double scale = autocal::apply_measured_colour(colour_, models, m.screen, out);
+    for (std::size_t k = 0; k < kept_beta_.size(); ++k) out.projectors[k].beta = kept_beta_[k];
+    bool black = false;
+    for (const auto& b : colour_.black) black = black || b[0] > 0.0 || b[1] > 0.0 || b[2] > 0.0;
+    if (black) {
+        r.journal.push_back(
+            fmt("selfcal: measured colour kept: responses as calibrated, black-level maps "
+                "re-derived for the new overlaps (blend scale %.4f)",
+                scale));
+    }
+    return out;
 }
 
 void SelfCalibrator::advance_correction(double t_s, StepResult& r) {
@@ -377,6 +418,7 @@ StepResult SelfCalibrator::run_step(const cv::Mat1f& content, const cv::Mat1f& c
     last_t_ = t_s;
     StepResult r;
     r.status.t_s = t_s;
+    if (!pending_journal_.empty()) r.journal.push_back(std::exchange(pending_journal_, std::string()));
     for (const autocal::DeviceModel& d : monitor_.model().projectors) r.status.projectors.push_back({d.id});
     if (state_ == SelfcalState::correcting) {
         advance_correction(t_s, r);

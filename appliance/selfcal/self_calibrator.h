@@ -6,8 +6,9 @@
 //     (mean displacement of its image on the screen, in its own pixels) and significant (outside
 //     the filter's own uncertainty, x^T P^-1 x > gate); it stays detected until under half the threshold;
 //   drift detected -> correcting: that lasted `hold_s` seconds; the corrected warp maps and blend
-//     masks (autocal::calibration_from_models on the re-estimated poses, intrinsics fixed) are
-//     blended in linearly over `transition_s`; step() returns each intermediate calibration;
+//     masks (autocal::calibration_from_models on the re-estimated poses, intrinsics fixed) with the
+//     calibration's measured colour re-applied (below) are blended in linearly over `transition_s`
+//     (warps, blends and beta maps); step() returns each intermediate calibration;
 //   correcting -> calibrated: the corrected calibration becomes the reference, is saved
 //     (calibration_store.h) when `store` is set, and the filters restart from zero;
 //   drift detected -> cannot correct: the re-estimated pose puts less than
@@ -22,6 +23,18 @@
 // pose change is significant and moves the screen's image by more than `camera_rebase_px` for hold_s re-bases the
 // monitor's camera (the projectors' estimates are made against the per-frame camera fit already). Every decision is a
 // journal line with before/after figures.
+//
+// Colour through a correction (docs/calibration.md, "Self-recalibration", "Colour"): the
+// calibration's measured colour (autocal::calibrate_colour: per-projector per-channel response
+// LUTs, black-level beta maps, blend masks scaled by s) is recovered once, at construction, as
+// autocal::measured_colour of `calibration` and the model: each projector's response and its
+// black light per channel. Those are the projector's own (lamp, panel, filters) and survive a bump;
+// the beta maps, the black floor and s are defined on the screen's overlaps (Majumder & Stevens,
+// IEEE TVCG 10(2) 2004: compensate each point's black up to the brightest black anywhere), so each
+// correction re-derives them for the corrected geometry (autocal::apply_measured_colour, the same
+// code calibrate_colour ends with), never copies them pixel for pixel. A calibration whose beta maps
+// this cannot explain (made some other way) keeps them unchanged through corrections, with a
+// journal line at the first step saying so.
 #pragma once
 
 #include <cstdint>
@@ -33,6 +46,7 @@
 #include <opencv2/core.hpp>
 
 #include "appliance/autocal/autocal.h"
+#include "appliance/autocal/colour_calibration.h"
 #include "appliance/selfcal/fallback_pattern.h"
 #include "appliance/selfcal/monitor.h"
 #include "appliance/selfcal/pose_kalman.h"
@@ -106,6 +120,8 @@ private:
     void start_correction(double t_s, const std::vector<int>& drifting, StepResult& r);
     void advance_correction(double t_s, StepResult& r);
     void rebase_camera(double t_s, StepResult& r);
+    [[nodiscard]] ScreenCalibration corrected_calibration(const std::vector<autocal::DeviceModel>& models,
+                                                          StepResult& r) const;
     bool check_lost(double t_s, StepResult& r);
     [[nodiscard]] double device_drift_px(const autocal::DeviceModel& d, const Pose6& delta) const;
     [[nodiscard]] double drift_px(int k, const Pose6& delta) const;
@@ -118,6 +134,9 @@ private:
     ScreenCalibration before_;
     ScreenCalibration after_;
     std::vector<autocal::DeviceModel> after_models_;
+    autocal::MeasuredColour colour_;      // the calibration's measured colour (see the header comment)
+    std::vector<BlackOffset> kept_beta_;  // beta maps measured_colour could not explain, kept as they are
+    std::string pending_journal_;         // said at the next step
     std::vector<PoseKalman> filters_;
     PoseKalman camera_filter_;
     SelfcalState state_ = SelfcalState::calibrated;
@@ -136,7 +155,8 @@ private:
 };
 
 // Linear blend of two calibrations of the same layout: warps (where both finite; otherwise the
-// nearer end's) and blend masks, s in [0, 1]. Throws std::invalid_argument when layouts differ.
+// nearer end's), blend masks and beta maps (where both have one of the same size; otherwise the
+// nearer end's); the responses are b's. s in [0, 1]. Throws std::invalid_argument when layouts differ.
 [[nodiscard]] ScreenCalibration interpolate_calibration(const ScreenCalibration& a, const ScreenCalibration& b,
                                                         double s);
 

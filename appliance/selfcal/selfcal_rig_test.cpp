@@ -6,13 +6,18 @@
 // projector pixels).
 #include "appliance/selfcal/rig_simulation.h"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <filesystem>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "appliance/autocal/colour_truth.h"
 #include "appliance/autocal/rig_bridge.h"
 #include "appliance/rig/rig_file.h"
+#include "appliance/selfcal/calibration_store.h"
 
 namespace mogao::selfcal {
 namespace {
@@ -162,6 +167,86 @@ TEST(SelfcalRig, OccluderMaskFindsADarkBandAndNothingInACleanFrame) {
     EXPECT_LT(b.occluded_fraction, 0.5);
     EXPECT_GT(b.occluded_matches, 0);
     EXPECT_GT(b.matches, a.matches / 3);
+}
+
+// Issue 14 with the colour calibration of issue 13: the wall carries the measured colour of
+// rigs/colour.toml (projectors of different brightness, colour temperature, per-channel gamma and
+// black level: per-channel LUTs, beta maps, blends scaled by s). After proj1 is yawed 1 degree and
+// corrected, the wall must still show one black and one colour everywhere, judged on the bumped
+// rig's GROUND TRUTH light (colour_truth.h), and keep the projectors' responses. Before the fix a
+// correction rebuilt gamma 2.2 LUTs and no beta maps: seam black off by about a third, grey seams
+// about 10 Delta E76 (docs/calibration.md's "before" column).
+TEST(SelfcalRig, ACorrectionKeepsTheMeasuredColour) {
+    const rig::VirtualRig rig = rig::load_rig(std::string(MOGAO_SOURCE_DIR) + "/rigs/colour.toml");
+    SimulationOptions o = quick(12);
+    o.measured_colour = true;
+    Bump b = parse_bump(rig, "proj1:yaw=1deg");
+    b.at_s = 0.5;
+    o.bumps = {b};
+    const SimulationReport r = simulate(rig, o);
+    EXPECT_GT(r.error_before_px, 5.0);
+    ASSERT_TRUE(r.corrected_after_s.has_value()) << journal(r);
+    EXPECT_EQ(r.corrections, 1) << journal(r);
+    EXPECT_LT(r.final_error_px, 1.0) << journal(r);
+    const ScreenCalibration& before = r.initial_calibration;
+    const ScreenCalibration& after = r.final_calibration;
+    ASSERT_EQ(after.projectors.size(), 3U);
+    for (std::size_t k = 0; k < 3; ++k) {
+        EXPECT_TRUE(after.projectors[k].response.lut == before.projectors[k].response.lut)
+            << "the projector's own response";
+        EXPECT_FALSE(after.projectors[k].beta.rgb.empty()) << k;
+    }
+    // Re-derived for the new overlaps, not copied: proj1's black-level map moved with its image.
+    EXPECT_NE(after.projectors[1].beta.rgb, before.projectors[1].beta.rgb);
+    for (const double level : {0.0, 0.05, 0.5}) {
+        const autocal::SeamColour c = autocal::measure_seam_colour(r.final_rig, after, level);
+        std::printf("after the correction, content %.2f: seam luminance p95 %.2f %%, seam Delta E76 p95 %.2f\n", level,
+                    100.0 * c.seam_luminance_p95, c.seam_delta_e_p95);
+        EXPECT_LT(c.seam_luminance_p95, 0.02) << level;  // the colour test holds 1-1.5 % at quarter scale
+        EXPECT_LT(c.seam_delta_e_p95, 0.6) << level;
+    }
+}
+
+// measured_colour recovers what apply_measured_colour applied (responses, blacks), also after the
+// MPCDI round trip the kiosk's store makes (16-bit alpha and beta maps), and refuses beta maps that
+// are not a black-level compensation of the models' overlaps.
+TEST(SelfcalRig, MeasuredColourIsRecoveredFromACalibrationAndItsFile) {
+    const rig::VirtualRig rig =
+        autocal::scaled_rig(rig::load_rig(std::string(MOGAO_SOURCE_DIR) + "/rigs/colour.toml"), 0.25, 0.25);
+    const SystemModel model = models_of_rig(rig);
+    autocal::AutocalOptions build;
+    build.warp_step_px = 8;
+    const autocal::MeasuredColour truth = colour_of_rig(rig);
+    ScreenCalibration wall = autocal::calibration_from_models(model.projectors, model.screen, {960, 540}, build);
+    const double s = autocal::apply_measured_colour(truth, model.projectors, model.screen, wall);
+    EXPECT_GT(s, 0.98);
+    EXPECT_LT(s, 1.0);
+    const std::filesystem::path file =
+        std::filesystem::temp_directory_path() / ("mogao-selfcal-colour-" + std::to_string(::getpid()) + ".mpcdi");
+    save_calibration(file, wall);
+    const ScreenCalibration read = load_calibration(file);
+    std::filesystem::remove(file);
+    for (const ScreenCalibration* c : {static_cast<const ScreenCalibration*>(&wall), &read}) {
+        const autocal::MeasuredColour got = autocal::measured_colour(*c, model.projectors, model.screen);
+        for (std::size_t k = 0; k < 3; ++k) {
+            EXPECT_TRUE(got.responses[k].lut == truth.responses[k].lut) << k;
+            for (std::size_t ch = 0; ch < 3; ++ch) {
+                EXPECT_NEAR(got.black[k][ch], truth.black[k][ch], 0.01 * truth.black[k][ch]) << k << " " << ch;
+            }
+        }
+    }
+    const ScreenCalibration plain = autocal::calibration_from_models(model.projectors, model.screen, {960, 540}, build);
+    const autocal::MeasuredColour none = autocal::measured_colour(plain, model.projectors, model.screen);
+    EXPECT_EQ(none.black[1][0], 0.0);
+    ScreenCalibration foreign = wall;
+    cv::RNG rng(3);
+    for (float& v : foreign.projectors[1].beta.rgb) v = static_cast<float>(rng.uniform(0.0, 0.01));
+    try {
+        (void)autocal::measured_colour(foreign, model.projectors, model.screen);
+        FAIL() << "explained random beta maps";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("cannot be re-derived"), std::string::npos) << e.what();
+    }
 }
 
 TEST(SelfcalRig, BumpedCameraIsNotTakenForEveryProjectorMoving) {
