@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 
 #include <opencv2/calib3d.hpp>
@@ -237,6 +238,13 @@ int drop_occluded(std::vector<Match>& matches, const cv::Mat1b& occluded) {
     return static_cast<int>(before - matches.size());
 }
 
+// Whether the camera ray (normalised, undistorted) meets the screen inside its edges.
+bool sees_screen(const autocal::ScreenModel& s, const autocal::DeviceModel& c, const cv::Point2d& q) {
+    const Eigen::Vector3d p = autocal::ray_on_screen(s, c, Eigen::Vector3d(q.x, q.y, 1.0));
+    const double theta = std::atan2(p.x(), -p.z());
+    return p.allFinite() && std::abs(theta) <= s.arc_deg * kDeg / 2 && p.y() >= s.bottom_m && p.y() <= s.top_m;
+}
+
 }  // namespace
 
 Eigen::Vector3d screen_point(const autocal::ScreenModel& s, double u, double v) {
@@ -297,8 +305,52 @@ void Monitor::set_reference(const SystemModel& model, const ScreenCalibration& c
             mask_(y, x) = lit ? 255 : 0;
         }
     }
+    // The screen's edges in the camera image (pixels within kEdgeBand of them), for edges_moved().
+    cv::Mat1b on(h, w);
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) on(y, x) = sees_screen(s, c, n[static_cast<std::size_t>(y) * w + x]) ? 255 : 0;
+    }
+    cv::Mat1b grown;
+    cv::Mat1b shrunk;
+    const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * kEdgeBand + 1, 2 * kEdgeBand + 1));
+    cv::dilate(on, grown, kernel);
+    cv::erode(on, shrunk, kernel);
+    edge_band_.clear();
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            if (grown(y, x) != shrunk(y, x)) {
+                edge_band_.push_back({x, y, n[static_cast<std::size_t>(y) * w + x], on(y, x) != 0});
+            }
+        }
+    }
     // Features need their whole patch on the lit screen: keep them off its border.
     cv::erode(mask_, mask_, cv::Mat(), cv::Point(-1, -1), 8);
+}
+
+std::optional<bool> Monitor::edges_moved(const autocal::DeviceModel& camera, const cv::Mat1f& frame) const {
+    double gained = 0.0;  // pixels the moved camera would see the screen at and the reference not
+    double lost = 0.0;    // and the other way round
+    int n_gained = 0;
+    int n_lost = 0;
+    for (const EdgePixel& e : edge_band_) {
+        const bool on = sees_screen(model_.screen, camera, e.ray);
+        if (on == e.on_reference) continue;
+        const double v = frame(e.y, e.x);
+        if (on) {
+            gained += v;
+            ++n_gained;
+        } else {
+            lost += v;
+            ++n_lost;
+        }
+    }
+    if (n_gained < kMinEdgePixels || n_lost < kMinEdgePixels) return std::nullopt;  // edges not seen or not moved
+    gained /= n_gained;
+    lost /= n_lost;
+    // Moved: the gained strip is the lit screen now and the lost one off it; not moved: the reverse.
+    if (lost > 2.0 * gained + kEdgeContrast) return false;
+    if (gained > 2.0 * lost + kEdgeContrast) return true;
+    return std::nullopt;
 }
 
 cv::Mat1f Monitor::predict(const cv::Mat1f& content) const {
@@ -377,6 +429,12 @@ FrameMeasurement Monitor::measure(const cv::Mat1f& content, const cv::Mat1f& cam
         cam_image.push_back(obs_n[i]);
     }
     m.camera = fit_pose_robust(cam, cam_points, cam_image, options_.camera_fit);
+    // The screen does not move: a camera fit whose screen edges the frame shows where they were is
+    // projectors moving together (e.g. two of three by the same yaw), not the camera.
+    if (m.camera.ok && !pattern_pair && options_.check_edges && edges_moved(m.camera.model, camera_frame) == false) {
+        m.camera.ok = false;
+        m.camera_edges_disagree = true;
+    }
     const autocal::DeviceModel camera = m.camera.ok ? m.camera.model : cam;
     if (m.camera.ok) m.camera_delta = pose_delta(cam, m.camera.model);
     for (std::size_t k = 0; k < model_.projectors.size(); ++k) {

@@ -15,13 +15,15 @@
 //   - if projector k moved: its pixel x_k now lands on S_obs = camera ray through q_obs hit with
 //     the cylinder, so a pose fit of projector k on (S_obs, x_k) gives its new pose.
 // The camera is fitted first on all matches but those of suspected projectors (RANSAC: the projectors that did not move
-// are the consensus, which assumes fewer than half the matched features belong to moved projectors), and the projectors
+// are the consensus, which assumes fewer than half the matched features belong to moved projectors; a fit that moves
+// the camera while the screen's edges in the frame stay put is rejected, edges_moved), and the projectors
 // against that camera: a bumped camera is not seen as every projector moving. A match counts for projector k only where
 // k's blend weight at the predicted point is at least `owner_min_blend` (in overlaps a moved projector shows a double
 // image). Images: camera frames CV_32FC1 linear in [0, 1], camera resolution, pixel-index coordinates of OpenCV
 // keypoints + 0.5 = image positions. Content frames CV_32FC1 linear grey, any size.
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -59,6 +61,9 @@ struct MonitorOptions {
     double occluder_ratio = 0.7;
     int occluder_cell_px = 16;
     int occluder_min_cells = 4;
+    // The camera fit is checked against the screen's edges (Monitor::edges_moved): a fitted camera
+    // move whose edges the frame shows unmoved is rejected (the frame gives no camera measurement).
+    bool check_edges = true;
     RobustPoseOptions camera_fit{1.0, 300, 1.345, 12, 20};
     RobustPoseOptions projector_fit{6.0, 300, 1.345, 12, 12, 0.002};
 };
@@ -73,9 +78,10 @@ struct FrameMeasurement {
     int predicted_features = 0;
     int observed_features = 0;
     int matches = 0;
-    int occluded_matches = 0;        // matches dropped because they fell on a detected occluder
-    double occluded_fraction = 0.0;  // of the lit screen's cells, the occluder mask's share
-    PoseFit camera;                  // camera.ok = false: the reference camera was used
+    int occluded_matches = 0;            // matches dropped because they fell on a detected occluder
+    double occluded_fraction = 0.0;      // of the lit screen's cells, the occluder mask's share
+    PoseFit camera;                      // camera.ok = false: the reference camera was used
+    bool camera_edges_disagree = false;  // the camera fit moved, the screen's edges in the frame did not: rejected
     Pose6 camera_delta = Pose6::Zero();
     std::vector<ProjectorMeasurement> projectors;
 };
@@ -103,7 +109,26 @@ public:
 
     [[nodiscard]] const SystemModel& model() const { return model_; }
 
+    // The absolute check of a camera fit: the screen is fixed, so if the camera moved to `camera`
+    // its edges (top, bottom, ends; projectors overfill them, beyond is unlit) moved in the image
+    // with it. Over the camera pixels within kEdgeBand pixels of the reference's edges, those that
+    // `camera` would see on the screen and the reference not ("gained") and the reverse ("lost"):
+    // true when the gained strip is lit and the lost one dark (mean > 2x the other + kEdgeContrast),
+    // false for the reverse (the edges are where the reference has them), nullopt when either strip
+    // has under kMinEdgePixels pixels (the edges not in view, or a move under a pixel) or neither holds.
+    [[nodiscard]] std::optional<bool> edges_moved(const autocal::DeviceModel& camera, const cv::Mat1f& frame) const;
+    static constexpr int kEdgeBand = 12;  // camera pixels
+    static constexpr int kMinEdgePixels = 40;
+    static constexpr double kEdgeContrast = 0.002;  // linear camera units (about half an 8-bit code)
+
 private:
+    struct EdgePixel {
+        int x = 0;
+        int y = 0;
+        cv::Point2d ray;            // normalised, undistorted
+        bool on_reference = false;  // the reference camera sees the screen there
+    };
+    std::vector<EdgePixel> edge_band_;
     SystemModel model_;
     MonitorOptions options_;
     cv::Mat1f map_u_;  // per camera pixel: content u under the reference (NaN: not on the lit screen)

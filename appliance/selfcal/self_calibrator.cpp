@@ -206,6 +206,12 @@ void SelfCalibrator::filter(const FrameMeasurement& m, double dt, StepResult& r)
     }
     camera_filter_.predict(dt);
     if (m.camera.ok) (void)camera_filter_.update(m.camera_delta, kCovarianceInflation * m.camera.covariance);
+    if (m.camera_edges_disagree && !edges_disagree_) {
+        r.journal.push_back(
+            fmt("selfcal: t=%.2f s: the camera fit moved but the screen's edges did not: ", r.status.t_s) +
+            "projectors moving together, not the camera (no camera measurement)");
+    }
+    edges_disagree_ = m.camera_edges_disagree;
     if (short_of_evidence > 0) {
         r.status.waiting = true;
         r.status.reason = std::to_string(short_of_evidence) + " projector(s) under " +

@@ -18,6 +18,10 @@
 //     matches fall under a fifth of its typical count while every other projector keeps at least
 //     half of its own (the content is not to blame: its image moved beyond what the monitor can
 //     follow, e.g. mostly off the screen).
+// The camera fit is checked against the screen's edges in the frame (Monitor::edges_moved): the
+// screen does not move, so a fit that moves the camera while the edges stay where they were is
+// projectors moving together (two of three by the same yaw make such a consensus) and gives no
+// camera measurement; the projectors are then fitted against the reference camera.
 // A frame with fewer than `min_matches` matches for a projector gives that projector no
 // measurement (its filter only predicts): waiting, "insufficient evidence". A camera whose filtered
 // pose change is significant and moves the screen's image by more than `camera_rebase_px` for hold_s re-bases the
@@ -136,6 +140,7 @@ private:
     std::vector<autocal::DeviceModel> after_models_;
     autocal::MeasuredColour colour_;      // the calibration's measured colour (see the header comment)
     std::vector<BlackOffset> kept_beta_;  // beta maps measured_colour could not explain, kept as they are
+    bool edges_disagree_ = false;         // the last frame's camera fit was rejected by the screen's edges
     std::string pending_journal_;         // said at the next step
     std::vector<PoseKalman> filters_;
     PoseKalman camera_filter_;

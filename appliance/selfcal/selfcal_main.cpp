@@ -92,6 +92,9 @@ int main(int argc, char** argv) {
     sim->add_option("--unmix-max-shift", o.selfcal.monitor.unmix_max_shift_px,
                     "overlap matches shifted less than this (camera px) are un-mixed; 0 off")
         ->check(CLI::NonNegativeNumber);
+    bool no_edge_check = false;
+    sim->add_flag("--no-edge-check", no_edge_check,
+                  "do not check the camera fit against the screen's edges (Monitor::edges_moved)");
     sim->add_option("--occluder-ratio", o.selfcal.monitor.occluder_ratio,
                     "visitor mask: cells darker or brighter than predicted by this factor; 0 off")
         ->check(CLI::Range(0.0, 0.99));
@@ -116,6 +119,7 @@ int main(int argc, char** argv) {
                 : content == "repetitive" ? ContentKind::repetitive
                                           : ContentKind::textured;
     o.selfcal.build.warp_step_px = 4;
+    o.selfcal.monitor.check_edges = !no_edge_check;
     o.selfcal.monitor.projector_fit.prior_position_sd_m = prior_mm * 1e-3;
     try {
         return run_simulate(rig, bumps, bump_at, o, verbose);

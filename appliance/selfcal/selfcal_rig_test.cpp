@@ -262,6 +262,27 @@ TEST(SelfcalRig, BumpedCameraIsNotTakenForEveryProjectorMoving) {
     EXPECT_LT(r.final_error_px, 0.1);
 }
 
+// Two of three projectors bumped by the same yaw move two thirds of the matched content as a
+// camera yaw would, so the camera fit's RANSAC consensus follows them. Before the check against
+// the screen's edges the camera was re-based (1.2 deg, 28 mm), the unmoved proj1 "corrected" by
+// 1 degree and the wall ended 18.8 px off. The screen's edges in the frame stay put: the camera is
+// not re-based and both projectors are corrected.
+TEST(SelfcalRig, TwoProjectorsBumpedAlikeAreNotTakenForTheCamera) {
+    const rig::VirtualRig rig = standard();
+    SimulationOptions o = quick(16);
+    for (const char* text : {"proj0:yaw=1deg", "proj2:yaw=1deg"}) {
+        Bump b = parse_bump(rig, text);
+        b.at_s = 1.0;
+        o.bumps.push_back(b);
+    }
+    const SimulationReport r = simulate(rig, o);
+    EXPECT_GT(r.error_before_px, 5.0);
+    EXPECT_EQ(journal(r).find("camera moved"), std::string::npos) << journal(r);
+    ASSERT_TRUE(r.corrected_after_s.has_value()) << journal(r);
+    EXPECT_LT(r.final_error_px, 1.0) << journal(r);
+    EXPECT_EQ(r.final_state, SelfcalState::calibrated) << journal(r);
+}
+
 TEST(SelfcalRig, TooLittleTextureWaitsAndNeverCorrects) {
     const rig::VirtualRig rig = standard();
     SimulationOptions o = quick(6);
