@@ -6,10 +6,15 @@
 // farm -- a LinkServer whose renderer answers every view request with the same textured content
 // frame instead of rendering a scene -- and the screen camera "rig:<bumped rig>": a SIMULATION of
 // the camera seeing the rig's projectors with the middle one knocked by 1 degree of yaw.
+// The rig is rigs/colour.toml (the standard geometry with projectors of different brightness,
+// colour temperature, gamma and black level) and the calibration carries its measured colour
+// (per-channel response LUTs, black-level beta maps, scaled blends: selfcal::colour_of_rig, what
+// `mogao-autocal calibrate` measures, written with 16-bit alpha and the LUT entries as it writes).
 // Checks, from outside the process: the status file goes through drift detected / correcting to
 // calibrated, the drift it reports falls, the corrected calibration is written back to the MPCDI
-// (the previous one kept as .last-good) and its ground-truth geometric error against the bumped rig
-// is under 1 projector pixel.
+// (the previous one kept as .last-good), its ground-truth geometric error against the bumped rig
+// is under 1 projector pixel, and it kept the colour: the same response LUTs, beta maps, and on the
+// bumped rig's ground-truth light one black and one colour across the seams.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <spawn.h>
@@ -26,6 +31,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "appliance/autocal/colour_calibration.h"
+#include "appliance/autocal/colour_truth.h"
 #include "appliance/autocal/model_store.h"
 #include "appliance/autocal/rig_bridge.h"
 #include "appliance/calibration/mpcdi_screen.h"
@@ -118,16 +125,20 @@ TEST(SelfcalKioskEndToEnd, ABumpedProjectorIsCorrectedAndWrittenBackByMogaoKiosk
     const fs::path dir = tmp.path();
     // The calibration as mogao-autocal calibrate leaves it: MPCDI + models beside it.
     const rig::VirtualRig truth =
-        autocal::scaled_rig(rig::load_rig(std::string(MOGAO_SOURCE_DIR) + "/rigs/standard.toml"), 0.5, 0.5);
+        autocal::scaled_rig(rig::load_rig(std::string(MOGAO_SOURCE_DIR) + "/rigs/colour.toml"), 0.5, 0.5);
     const selfcal::SystemModel model = selfcal::models_of_rig(truth);
     autocal::AutocalOptions build;
     build.warp_step_px = 4;
-    const ScreenCalibration wall = autocal::calibration_from_models(model.projectors, model.screen, kContent, build);
-    write_mpcdi(dir / "screen.mpcdi", to_mpcdi(wall));
+    ScreenCalibration wall = autocal::calibration_from_models(model.projectors, model.screen, kContent, build);
+    (void)autocal::apply_measured_colour(selfcal::colour_of_rig(truth), model.projectors, model.screen, wall);
+    MpcdiExportOptions export_options;
+    export_options.alpha_bit_depth = 16;
+    export_options.write_response = true;
+    write_mpcdi(dir / "screen.mpcdi", to_mpcdi(wall, export_options));
     autocal::write_models(autocal::models_path_for(dir / "screen.mpcdi"),
                           {model.screen, model.camera, model.projectors});
     // The true hardware: proj1 knocked by 1 degree (the full-resolution rig file; the kiosk scales it to the models).
-    std::string rig_text = slurp(std::string(MOGAO_SOURCE_DIR) + "/rigs/standard.toml");
+    std::string rig_text = slurp(std::string(MOGAO_SOURCE_DIR) + "/rigs/colour.toml");
     const auto at = rig_text.find("yaw_deg = 0.3");  // proj1, the middle projector
     ASSERT_NE(at, std::string::npos);
     rig_text.replace(at, 13, "yaw_deg = 1.3");
@@ -190,8 +201,22 @@ TEST(SelfcalKioskEndToEnd, ABumpedProjectorIsCorrectedAndWrittenBackByMogaoKiosk
     EXPECT_EQ(kiosk.stop(), 0);
     // Written back: the previous calibration kept, the new one right against the bumped rig's ground truth.
     EXPECT_TRUE(fs::exists(selfcal::last_good_path(dir / "screen.mpcdi")));
-    const double after_px = projector_error_px(bumped, selfcal::load_calibration(dir / "screen.mpcdi"), 1);
+    const ScreenCalibration written = selfcal::load_calibration(dir / "screen.mpcdi");
+    const double after_px = projector_error_px(bumped, written, 1);
     EXPECT_LT(after_px, 1.0) << "before " << before_px << " px";
+    // The colour kept: the projectors' responses unchanged, beta maps re-derived, and the bumped
+    // rig's true light showing one black and one grey across the seams.
+    ASSERT_EQ(written.projectors.size(), wall.projectors.size());
+    for (std::size_t k = 0; k < wall.projectors.size(); ++k) {
+        EXPECT_TRUE(written.projectors[k].response.lut == wall.projectors[k].response.lut) << k;
+        EXPECT_FALSE(written.projectors[k].beta.rgb.empty()) << k;
+    }
+    const autocal::SeamColour black = autocal::measure_seam_colour(bumped, written, 0.0);
+    const autocal::SeamColour grey = autocal::measure_seam_colour(bumped, written, 0.5);
+    EXPECT_LT(black.seam_luminance_p95, 0.02);
+    EXPECT_LT(grey.seam_delta_e_p95, 0.6);
+    std::cout << "written back: seam black luminance p95 " << 100.0 * black.seam_luminance_p95
+              << " %, seam grey Delta E76 p95 " << grey.seam_delta_e_p95 << "\n";
     std::cout << "proj1 mean geometric error (ground truth, its pixels): " << before_px << " px in the MPCDI before, "
               << after_px << " px in the MPCDI mogao-kiosk wrote; reported drift max " << max_drift << " px, last "
               << last_drift << " px\n";
