@@ -247,6 +247,14 @@ TEST(SelfcalRig, MeasuredColourIsRecoveredFromACalibrationAndItsFile) {
     } catch (const std::invalid_argument& e) {
         EXPECT_NE(std::string(e.what()).find("cannot be re-derived"), std::string::npos) << e.what();
     }
+    // The self-calibrator still runs on such a calibration, keeping those maps, and says so once.
+    SelfCalibrator sc(model, foreign);
+    const cv::Mat1f content = make_content(ContentKind::plain, 0.0, false, 1);
+    const cv::Mat1f camera(rig.camera.resolution.height, rig.camera.resolution.width, 0.2f);
+    const StepResult first = sc.step(content, camera, 0.0);
+    ASSERT_EQ(first.journal.size(), 1U);
+    EXPECT_NE(first.journal[0].find("corrections keep those maps as they are"), std::string::npos) << first.journal[0];
+    EXPECT_TRUE(sc.step(content, camera, 0.5).journal.empty());
 }
 
 TEST(SelfcalRig, BumpedCameraIsNotTakenForEveryProjectorMoving) {
