@@ -5,7 +5,16 @@
 //
 //   mpirun -n 3 mogao_bench_serve --scene scenes/grotto.json [--width 960] [--height 540]
 //          [--warmup-seconds 3] [--move-seconds 4] [--still-seconds 5] [--frame-time-ms 66.7] [--reference-spp 64]
-//          [--configs today,all,...] [--json FILE] [--side-by-side FILE.png]
+//          [--configs today,all,denoise,...] [--quality PRESET] [--denoise-max-spp 4]
+//          [--denoise-iterations 3] [--json FILE] [--side-by-side FILE.png]
+//
+// Configurations: today (the serial loop of before: every request alone, full size, sRGB8 from the
+// ranks), all (every new scheduling part), denoise (all + the à-trous denoiser on frames of at most
+// --denoise-max-spp samples, its guides traced by the ranks: live_frames.h), and all minus one part.
+// With both all and denoise in the run, the denoiser's ratios are printed: frames/s on / off and the
+// moving frame's PSNR on - off. --quality takes a preset's request quality (spp, bounces, AO, area
+// samples, JPEG; common/quality_preset.h) for every request and the reference; without it the
+// request's defaults (1 spp, 0 bounces).
 //
 // A session looks at the screen (the kiosk's cylinder: radius 3 m, 150 degrees, 0.2-2.8 m) from the
 // scene's viewer. Moving: the yaw turns a little every request, so nothing accumulates; after a
@@ -30,7 +39,9 @@
 #include <fstream>
 #include <future>
 #include <iterator>
+#include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -41,6 +52,7 @@
 #include "common/image_compare.h"
 #include "common/jpeg_codec.h"
 #include "common/png_io.h"
+#include "common/quality_preset.h"
 #include "renderfarm/farm/farm.h"
 #include "renderfarm/farm/live_frames.h"
 #include "renderfarm/trace/film.h"
@@ -64,6 +76,8 @@ struct BenchArgs {
     int reference_spp = 64;
     std::vector<std::string> configs;  // keys; empty = all
     std::string json, side_by_side;
+    std::string quality;  // preset name; empty = Quality{}
+    int denoise_max_spp = 4, denoise_iterations = AtrousParams{}.iterations;
 };
 
 // The three images of the side-by-side PNG.
@@ -77,7 +91,13 @@ std::vector<Config> all_configs(const BenchArgs& a) {
     Config today{"today", "none (serial, as before)", {}, false, false};
     today.live.progressive = false;
     today.live.per_session_maps = false;
-    std::vector<Config> out{today, all};
+    Config denoise = all;
+    denoise.key = "denoise";
+    denoise.name = "all new parts + denoiser";
+    denoise.live.denoise = true;
+    denoise.live.denoise_max_spp = a.denoise_max_spp;
+    denoise.live.denoise_params.iterations = a.denoise_iterations;
+    std::vector<Config> out{today, all, denoise};
     const auto without = [&](const char* key, const char* name, auto change) {
         Config c = all;
         c.key = key;
@@ -155,6 +175,10 @@ ViewRequest session_view(const Scene& scene, const BenchArgs& a) {
     v.pose.eye = scene.viewer.start + Eigen::Vector3d(0.0, scene.viewer.eye_height_m, 0.0);
     v.pose.yaw_deg = scene.viewer.start_yaw_deg;
     v.session = 1;
+    if (!a.quality.empty()) {
+        v.quality = quality_preset(a.quality)->request;
+        v.quality.resolution_scale = 1.0;
+    }
     return v;
 }
 
@@ -271,6 +295,21 @@ void write_side_by_side(const std::string& path, const Snapshots& shots, const R
     write_png(path, out);
 }
 
+// Ratios of configurations measured in this run.
+void print_ratios(const std::map<std::string, std::pair<double, double>>& figures) {
+    const auto today = figures.find("today"), all = figures.find("all"), denoise = figures.find("denoise");
+    if (today != figures.end() && all != figures.end() && today->second.first > 0 && all->second.first > 0)
+        std::printf("\nratio frames/s all new parts / none = %.2f\n", all->second.first / today->second.first);
+    if (all != figures.end() && denoise != figures.end() && all->second.first > 0) {
+        std::printf("ratio frames/s denoiser on / off = %.2f; moving frame PSNR denoiser on - off = %+.2f dB\n",
+                    denoise->second.first / all->second.first, denoise->second.second - all->second.second);
+    }
+    if (today != figures.end() && denoise != figures.end() && today->second.first > 0) {
+        std::printf("ratio frames/s all + denoiser / none = %.2f; moving frame PSNR all + denoiser - none = %+.2f dB\n",
+                    denoise->second.first / today->second.first, denoise->second.second - today->second.second);
+    }
+}
+
 int admin(FrameDispatcher& farm, const Scene& scene, const BenchArgs& a) {
     std::uint64_t next_id = 1;
     const auto t0 = Clock::now();
@@ -286,17 +325,19 @@ int admin(FrameDispatcher& farm, const Scene& scene, const BenchArgs& a) {
                 std::string(8, '-').c_str(), std::string(8, '-').c_str(), std::string(9, '-').c_str(),
                 std::string(6, '-').c_str());
     nlohmann::json results = nlohmann::json::array();
-    double today_fps = 0.0, all_fps = 0.0;
-    for (const Config& c : configs(a)) {
+    std::map<std::string, std::pair<double, double>> figures;  // key -> (moving frames/s, moving PSNR)
+    const std::vector<Config> chosen = configs(a);
+    const bool has_denoise =
+        std::any_of(chosen.begin(), chosen.end(), [](const Config& c) { return c.key == "denoise"; });
+    for (const Config& c : chosen) {
         Snapshots shots;
         results.push_back(run_config(c, farm, scene, a, reference, next_id, shots));
-        const double fps = results.back()["move_frames_per_second"].get<double>();
-        if (c.key == "today") today_fps = fps;
-        if (c.key == "all") all_fps = fps;
-        if (c.key == "all" && !a.side_by_side.empty()) write_side_by_side(a.side_by_side, shots, reference);
+        figures[c.key] = {results.back()["move_frames_per_second"].get<double>(),
+                          results.back()["moving_frame_psnr_db"].get<double>()};
+        const std::string pictured = has_denoise ? "denoise" : "all";
+        if (c.key == pictured && !a.side_by_side.empty()) write_side_by_side(a.side_by_side, shots, reference);
     }
-    if (today_fps > 0 && all_fps > 0)
-        std::printf("\nratio frames/s all new parts / none = %.2f\n", all_fps / today_fps);
+    print_ratios(figures);
     if (!a.json.empty()) {
         std::ofstream(a.json) << nlohmann::json{
             {"width", a.width},
@@ -306,6 +347,9 @@ int admin(FrameDispatcher& farm, const Scene& scene, const BenchArgs& a) {
             {"reference_spp", a.reference_spp},
             {"reference_floor_psnr_db", ref.floor_psnr_db},
             {"still_seconds", a.still_seconds},
+            {"quality", a.quality.empty() ? "request defaults" : a.quality},
+            {"denoise_max_spp", a.denoise_max_spp},
+            {"denoise_iterations", a.denoise_iterations},
             {"configs", results}}.dump(2);
     }
     return 0;
@@ -332,9 +376,21 @@ int main(int argc, char** argv) {
     app.add_option("--frame-time-ms", a.frame_time_ms)->check(CLI::Range(1.0, 10000.0));
     app.add_option("--reference-spp", a.reference_spp, "Reference samples per pixel (two halves)")
         ->check(CLI::Range(2, 8192));
-    app.add_option("--configs", a.configs, "today, all, no-progressive, no-target, no-pipeline, no-rank-speed")
+    app.add_option("--configs", a.configs, "today, all, denoise, no-progressive, no-target, no-pipeline, no-rank-speed")
         ->delimiter(',')
-        ->check(CLI::IsMember({"today", "all", "no-progressive", "no-target", "no-pipeline", "no-rank-speed"}));
+        ->check(
+            CLI::IsMember({"today", "all", "denoise", "no-progressive", "no-target", "no-pipeline", "no-rank-speed"}));
+    app.add_option("--quality", a.quality,
+                   "Preset whose request quality every request uses (" + quality_preset_names() +
+                       "); default: the request's defaults")
+        ->check([](const std::string& name) {
+            return quality_preset(name) ? std::string()
+                                        : "unknown preset '" + name + "' (known: " + quality_preset_names() + ")";
+        });
+    app.add_option("--denoise-max-spp", a.denoise_max_spp, "denoise configuration: filter frames up to this spp")
+        ->check(CLI::Range(1, 1 << 20));
+    app.add_option("--denoise-iterations", a.denoise_iterations, "denoise configuration: a-trous levels")
+        ->check(CLI::Range(0, AtrousParams::kMaxIterations));
     app.add_option("--json", a.json, "Write every figure (and the curves) as JSON");
     app.add_option("--side-by-side", a.side_by_side,
                    "PNG: moving frame | still view after --still-seconds | reference");

@@ -32,9 +32,12 @@ struct QualityPreset {
     double frame_time_ms = 0;  // serve: per-session frame-time target, ms (0 = none)
     bool progressive = true;   // serve: still views accumulate samples over requests
     int converged_spp = 1024;  // serve: a still view stops refining at this many samples
-    // Measured in docs/quality.md but not applied by the farm yet: the à-trous denoiser
-    // (renderfarm/denoise) on each frame, and JPEG 4:4:4 instead of the link's 4:2:0.
+    // serve: the à-trous denoiser (renderfarm/denoise) on every frame of few samples (moving frames,
+    // a still view's first passes; renderfarm/farm/live_frames.h). `mogao-farm render` does not
+    // apply it.
     bool denoise = false;
+    // Measured in docs/quality.md but not applied by the farm yet: JPEG 4:4:4 instead of the
+    // link's 4:2:0.
     bool chroma_444 = false;
 };
 

@@ -24,10 +24,13 @@ std::string size_text(ImageSize s) { return std::to_string(s.width) + "x" + std:
 }  // namespace
 
 struct GuidePass::Impl {
-    Impl(const Scene& s, const std::string& config) : scene(s), geometry(s, config) {}
+    Impl(const Scene& s, const std::string& config)
+        : scene(s), owned(std::make_unique<RenderScene>(s, config)), geometry(*owned) {}
+    Impl(const Scene& s, const RenderScene& shared) : scene(s), geometry(shared) {}
 
     const Scene& scene;
-    RenderScene geometry;
+    std::unique_ptr<RenderScene> owned;  // null when the geometry is a Renderer's
+    const RenderScene& geometry;
     std::optional<CameraSetup> camera;
     ImageSize size;
 
@@ -55,11 +58,13 @@ struct GuidePass::Impl {
         return valid;
     }
 
-    void store(int x0, int y0, const std::array<int, kLanes>& valid, const RTCRayHit16& packet,
+    // Stores the hits of block (x0, y0) at their pixels less (ox, oy) (the window's origin).
+    void store(int x0, int y0, int ox, int oy, const std::array<int, kLanes>& valid, const RTCRayHit16& packet,
                GuideBuffers& guides) const {
         for (std::size_t l = 0; l < kLanes; ++l) {
             if (valid[l] == 0) continue;
-            const std::size_t i = guides.pixel(x0 + static_cast<int>(l) % kBlock, y0 + static_cast<int>(l) / kBlock);
+            const std::size_t i =
+                guides.pixel(x0 + static_cast<int>(l) % kBlock - ox, y0 + static_cast<int>(l) / kBlock - oy);
             float* albedo = guides.albedo.data() + 3 * i;
             float* normal = guides.normal.data() + 3 * i;
             if (packet.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID) {
@@ -87,6 +92,8 @@ struct GuidePass::Impl {
 
 GuidePass::GuidePass(const Scene& scene, const std::string& embree_config)
     : impl_(std::make_unique<Impl>(scene, embree_config)) {}
+GuidePass::GuidePass(const Scene& scene, const RenderScene& geometry)
+    : impl_(std::make_unique<Impl>(scene, geometry)) {}
 GuidePass::~GuidePass() = default;
 
 Status GuidePass::begin_frame(const ViewRequest& request) {
@@ -96,7 +103,7 @@ Status GuidePass::begin_frame(const ViewRequest& request) {
     } catch (const std::invalid_argument& e) {
         return make_error(EINVAL, std::string("guide pass: ") + e.what());
     }
-    impl_->geometry.rebase(request.pose.eye);
+    if (impl_->owned) impl_->owned->rebase(request.pose.eye);
     impl_->camera = make_camera_setup(request, size);
     impl_->size = size;
     return {};
@@ -105,20 +112,32 @@ Status GuidePass::begin_frame(const ViewRequest& request) {
 ImageSize GuidePass::render_size() const { return impl_->size; }
 
 Status GuidePass::render(const PixelRect& rect, GuideBuffers& guides) const {
+    if (impl_->camera && guides.size != impl_->size) {
+        return make_error(EINVAL, "guide pass: guides are " + size_text(guides.size) + ", the render size is " +
+                                      size_text(impl_->size));
+    }
+    return render(rect, guides, 0, 0);
+}
+
+Status GuidePass::render(const PixelRect& rect, GuideBuffers& window, int origin_x, int origin_y) const {
     const Impl& s = *impl_;
     if (!s.camera) return make_error(EINVAL, "guide pass: begin_frame() must succeed before render()");
-    const auto n = static_cast<std::size_t>(s.size.pixel_count());
-    if (guides.size != s.size || guides.hit.size() != n || guides.depth.size() != n || guides.albedo.size() != 3 * n ||
-        guides.normal.size() != 3 * n) {
-        return make_error(EINVAL, "guide pass: guides are " + size_text(guides.size) +
-                                      " (or have buffers of the wrong length), the render size is " +
-                                      size_text(s.size));
+    const auto n = static_cast<std::size_t>(window.size.pixel_count());
+    if (window.size.width < 0 || window.size.height < 0 || window.hit.size() != n || window.depth.size() != n ||
+        window.albedo.size() != 3 * n || window.normal.size() != 3 * n) {
+        return make_error(EINVAL, "guide pass: the guide buffers do not hold " + size_text(window.size) +
+                                      " pixels (hit, depth: W*H; albedo, normal: W*H*3)");
     }
-    if (rect.x0 < 0 || rect.y0 < 0 || rect.x1 > s.size.width || rect.y1 > s.size.height) {
+    const PixelRect placed{origin_x, origin_y, origin_x + window.size.width, origin_y + window.size.height};
+    if (rect.x0 < 0 || rect.y0 < 0 || rect.x1 > s.size.width || rect.y1 > s.size.height ||
+        intersect(rect, placed) != rect) {
         return make_error(EINVAL, "guide pass: rect [" + std::to_string(rect.x0) + ", " + std::to_string(rect.x1) +
                                       ") x [" + std::to_string(rect.y0) + ", " + std::to_string(rect.y1) +
-                                      ") is outside the render size " + size_text(s.size));
+                                      ") is outside the render size " + size_text(s.size) + " or the " +
+                                      size_text(window.size) + " window at (" + std::to_string(origin_x) + ", " +
+                                      std::to_string(origin_y) + ")");
     }
+    if (rect.empty()) return {};
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
@@ -127,7 +146,7 @@ Status GuidePass::render(const PixelRect& rect, GuideBuffers& guides) const {
             RTCRayHit16 packet{};
             alignas(64) const std::array<int, kLanes> valid = s.fill(bx, by, rect, packet);
             rtcIntersect16(valid.data(), s.geometry.root(), &context, &packet);
-            s.store(bx, by, valid, packet, guides);
+            s.store(bx, by, origin_x, origin_y, valid, packet, window);
         }
     }
     return {};

@@ -12,8 +12,11 @@
 //
 // Usage: GuidePass pass(scene); per frame: pass.begin_frame(request); then render(rect, guides) on
 // any split of the frame into rects, from several threads at once if wished (render is const).
-// Lifetime: the Scene must outlive the GuidePass. The pass builds its own BVHs (the Renderer keeps
-// its RenderScene private), so it costs the scene's BVH build time and memory once more.
+// Lifetime: the Scene must outlive the GuidePass. Built from a Scene alone, the pass builds its own
+// BVHs (the scene's BVH build time and memory once more); built on a Renderer's geometry
+// (Renderer::render_scene()), it shares that BVH and its rebase: the Renderer must outlive the pass
+// and renderer.begin_frame(request) must precede begin_frame(request) of the same frame (the farm's
+// render ranks do this, renderfarm/farm/tile_pass.h).
 #pragma once
 
 #include <memory>
@@ -26,12 +29,19 @@
 #include "renderfarm/scene/scene.h"
 
 namespace mogao {
+class RenderScene;
+}
+
+namespace mogao {
 
 class GuidePass {
 public:
     // Builds the Embree BVHs. Throws what RenderScene's constructor throws (std::invalid_argument for
     // an inconsistent scene, std::runtime_error for Embree). embree_config as RendererOptions.
     explicit GuidePass(const Scene& scene, const std::string& embree_config = "");
+    // Shares `geometry` (a Renderer's, built from the same `scene`): no BVH is built, begin_frame
+    // does not rebase it.
+    GuidePass(const Scene& scene, const RenderScene& geometry);
     ~GuidePass();
     GuidePass(const GuidePass&) = delete;
     GuidePass& operator=(const GuidePass&) = delete;
@@ -46,6 +56,11 @@ public:
     // Fills the pixels of `rect` in `guides` (other pixels untouched). EINVAL if no frame was begun,
     // guides.size != render_size() (or its buffers have the wrong length), or rect is not inside it.
     Status render(const PixelRect& rect, GuideBuffers& guides) const;
+
+    // The same pixels into a window: pixel (x, y) goes to window pixel (x - origin_x, y - origin_y),
+    // so a render rank holds only its tile. EINVAL if no frame was begun, the window's buffers do not
+    // match window.size, or rect is not inside both the render size and the window at the origin.
+    Status render(const PixelRect& rect, GuideBuffers& window, int origin_x, int origin_y) const;
 
     // begin_frame + render of the whole frame into a fresh GuideBuffers.
     [[nodiscard]] Result<GuideBuffers> render_frame(const ViewRequest& request);

@@ -123,6 +123,21 @@ RankReply receive_reply(int source, const std::function<void(const std::function
     return reply;
 }
 
+void unpack_reply(const std::vector<PixelRect>& rects, const std::vector<std::uint8_t>& packed, PackedPixels format,
+                  DispatchedFrame& frame) {
+    switch (format) {
+        case PackedPixels::srgb8:
+            unpack_rects(rects, packed, frame.image);
+            break;
+        case PackedPixels::linear:
+            unpack_linear_rects(rects, packed, frame.radiance);
+            break;
+        case PackedPixels::linear_guided:
+            unpack_guided_rects(rects, packed, frame.radiance, frame.guides);
+            break;
+    }
+}
+
 void finish_stats(FrameStats& stats) {
     const auto& t = stats.rank_render_seconds;
     const double max_rank = t.empty() ? 0.0 : *std::max_element(t.begin(), t.end());
@@ -131,9 +146,23 @@ void finish_stats(FrameStats& stats) {
     stats.rays_per_second = stats.render_phase_seconds > 0 ? double(stats.rays) / stats.render_phase_seconds : 0.0;
 }
 
+// What the wire's `linear` field asks for (0 sRGB8, 1 linear, 2 linear with guides).
+PackedPixels wire_format(std::int32_t linear) {
+    return linear == 2 ? PackedPixels::linear_guided : linear == 1 ? PackedPixels::linear : PackedPixels::srgb8;
+}
+
+// Begins the guide pass's frame when `format` needs guides; throws when it cannot.
+const GuidePass* begin_guides(GuidePass* guides, PackedPixels format, const ViewRequest& view) {
+    if (format != PackedPixels::linear_guided) return nullptr;
+    if (!guides) throw std::runtime_error("this farm has no guide pass: it cannot send the denoiser's guides");
+    if (Status s = guides->begin_frame(view); !s.ok()) throw std::invalid_argument(s.error().message);
+    return guides;
+}
+
 }  // namespace
 
-void serve_render_rank(Renderer* renderer, const DispatchSettings& settings, const std::string& load_error) {
+void serve_render_rank(Renderer* renderer, const DispatchSettings& settings, const std::string& load_error,
+                       GuidePass* guides) {
     for (;;) {
         WireView wire{};
         broadcast_view(wire);
@@ -142,10 +171,12 @@ void serve_render_rank(Renderer* renderer, const DispatchSettings& settings, con
         ReplyHeader header{wire.frame_id, 0, 0, 0, 0.0, 0.0, 1};
         try {
             if (!renderer) throw std::runtime_error(load_error);
-            renderer->begin_frame(from_wire(wire));
+            const ViewRequest view = from_wire(wire);
+            renderer->begin_frame(view);
+            const PackedPixels format = wire_format(wire.linear);
             const TilePassResult pass =
                 render_tile_pass(*renderer, rects, settings.cell_size, settings.threads, settings.exposure,
-                                 settings.tone_map, wire.linear ? PackedPixels::linear : PackedPixels::srgb8);
+                                 settings.tone_map, format, begin_guides(guides, format, view));
             std::vector<double> tiles_flat;
             tiles_flat.reserve(pass.tile_times.size() * 5);
             for (const TileTime& t : pass.tile_times)
@@ -168,10 +199,12 @@ void serve_render_rank(Renderer* renderer, const DispatchSettings& settings, con
     }
 }
 
-FrameDispatcher::FrameDispatcher(const MpiSession& mpi, DispatchSettings settings, Renderer* local)
+FrameDispatcher::FrameDispatcher(const MpiSession& mpi, DispatchSettings settings, Renderer* local,
+                                 GuidePass* local_guides)
     : mpi_(mpi),
       settings_(std::move(settings)),
       local_(mpi.size() == 1 ? local : nullptr),
+      local_guides_(mpi.size() == 1 ? local_guides : nullptr),
       balancer_(make_load_balancer(settings_.balancer,
                                    settings_.balancer == "roundrobin" ? settings_.roundrobin_tile : settings_.snap)),
       deadline_({settings_.rank_deadline_s, settings_.rank_deadline_min_s, settings_.rank_deadline_factor}) {
@@ -218,11 +251,12 @@ DispatchedFrame FrameDispatcher::render(const ViewRequest& view, std::uint64_t s
     const Assignment assignment = balancer_->assign(predicted, render_ranks());
 
     DispatchedFrame frame;
-    if (format == PackedPixels::linear) {
-        frame.radiance = RgbFloatImage(size);
-    } else {
+    if (format == PackedPixels::srgb8) {
         frame.image = Rgb8Image(size);
+    } else {
+        frame.radiance = RgbFloatImage(size);
     }
+    if (format == PackedPixels::linear_guided) frame.guides = GuideBuffers(size);
     frame.stats.frame = view.frame_id;
     frame.stats.rank_predicted_seconds = assignment.predicted_cost;
     const auto start = Clock::now();
@@ -289,13 +323,15 @@ bool FrameDispatcher::gather(const ViewRequest& view, const Assignment& assignme
     };
     if (local_) {  // a one-process farm: the admin traces the whole frame itself
         local_->begin_frame(view);
-        TilePassResult pass = render_tile_pass(*local_, assignment.rects[0], settings_.cell_size, settings_.threads,
-                                               settings_.exposure, settings_.tone_map, format);
-        if (format == PackedPixels::linear) {
-            unpack_linear_rects(assignment.rects[0], pass.packed_pixels, frame.radiance);
-        } else {
-            unpack_rects(assignment.rects[0], pass.packed_pixels, frame.image);
+        const GuidePass* guides = nullptr;
+        try {
+            guides = begin_guides(local_guides_, format, view);
+        } catch (const std::runtime_error& e) {
+            throw FarmError(e.what());
         }
+        TilePassResult pass = render_tile_pass(*local_, assignment.rects[0], settings_.cell_size, settings_.threads,
+                                               settings_.exposure, settings_.tone_map, format, guides);
+        unpack_reply(assignment.rects[0], pass.packed_pixels, format, frame);
         add_tiles(0, pass.tile_times, pass.cpu_seconds, pass.render_seconds);
         frame.tiles = std::move(pass.tile_times);
         frame.stats.rays = pass.rays;
@@ -303,7 +339,7 @@ bool FrameDispatcher::gather(const ViewRequest& view, const Assignment& assignme
         return true;
     }
     WireView wire = to_wire(view);
-    wire.linear = format == PackedPixels::linear ? 1 : 0;
+    wire.linear = format == PackedPixels::linear_guided ? 2 : format == PackedPixels::linear ? 1 : 0;
     const double cost = frame_cost_units(view);
     frame_deadline_s_ = deadline_.seconds_for(cost);
     const auto sent = Clock::now();
@@ -344,11 +380,7 @@ bool FrameDispatcher::gather(const ViewRequest& view, const Assignment& assignme
         }
         const std::vector<PixelRect>& rects = assignment.rects[static_cast<std::size_t>(source - 1)];
         try {
-            if (format == PackedPixels::linear) {
-                unpack_linear_rects(rects, reply.payload, frame.radiance);
-            } else {
-                unpack_rects(rects, reply.payload, frame.image);
-            }
+            unpack_reply(rects, reply.payload, format, frame);
         } catch (const std::exception& e) {
             spdlog::error("rank {}: frame {}: bad reply: {}", source, view.frame_id, e.what());
             ok = false;

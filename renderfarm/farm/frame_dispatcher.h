@@ -30,6 +30,8 @@
 
 #include "common/image.h"
 #include "common/view_request.h"
+#include "renderfarm/denoise/guide_buffers.h"
+#include "renderfarm/denoise/guide_pass.h"
 #include "renderfarm/farm/frame_deadline.h"
 #include "renderfarm/farm/frame_stats.h"
 #include "renderfarm/farm/mpi_session.h"
@@ -71,15 +73,18 @@ struct DispatchSettings {
 
 struct DispatchedFrame {
     Rgb8Image image;               // render_size(view), sRGB8 (PackedPixels::srgb8 frames)
-    RgbFloatImage radiance;        // render_size(view), linear (PackedPixels::linear frames)
+    RgbFloatImage radiance;        // render_size(view), linear (PackedPixels::linear, ::linear_guided frames)
+    GuideBuffers guides;           // render_size(view), the denoiser's guides (PackedPixels::linear_guided)
     std::vector<TileTime> tiles;   // measured per-tile times of every rank
     FrameStats stats;              // all but encode figures
 };
 
 class FrameDispatcher {
 public:
-    // `local` renders when the world has one process (may be null otherwise).
-    FrameDispatcher(const MpiSession& mpi, DispatchSettings settings, Renderer* local);
+    // `local` renders when the world has one process (may be null otherwise); `local_guides` (a
+    // GuidePass on local's geometry, may be null) traces its guides for PackedPixels::linear_guided.
+    FrameDispatcher(const MpiSession& mpi, DispatchSettings settings, Renderer* local,
+                    GuidePass* local_guides = nullptr);
     ~FrameDispatcher();  // stops the render ranks if stop() was not called
     FrameDispatcher(const FrameDispatcher&) = delete;
     FrameDispatcher& operator=(const FrameDispatcher&) = delete;
@@ -87,7 +92,9 @@ public:
     // Renders one frame; `stream` keys the predicted cost map (one per camera path or appliance
     // session: consecutive frames of a stream predict each other; a frame of another size than the
     // stream's last one predicts from its map resampled, CostMap::resampled). `format` picks what
-    // the ranks send: sRGB8 pixels (DispatchedFrame::image) or linear radiance (::radiance).
+    // the ranks send: sRGB8 pixels (DispatchedFrame::image), linear radiance (::radiance), or linear
+    // radiance and the denoiser's guides (::radiance, ::guides; FarmError from a one-process farm
+    // without a guide pass).
     DispatchedFrame render(const ViewRequest& view, std::uint64_t stream = 0,
                            PackedPixels format = PackedPixels::srgb8);
 
@@ -118,6 +125,7 @@ private:
     const MpiSession& mpi_;
     DispatchSettings settings_;
     Renderer* local_;
+    GuidePass* local_guides_;
     std::unique_ptr<LoadBalancer> balancer_;
     struct StreamMap {
         CostMap map;
@@ -134,7 +142,9 @@ private:
 };
 
 // Render ranks: answer frames until the dispatcher stops. `renderer` is null when this rank could
-// not build one (then every frame is answered with `load_error`).
-void serve_render_rank(Renderer* renderer, const DispatchSettings& settings, const std::string& load_error);
+// not build one (then every frame is answered with `load_error`). `guides` (a GuidePass on the
+// renderer's geometry) answers PackedPixels::linear_guided frames; null: such frames fail.
+void serve_render_rank(Renderer* renderer, const DispatchSettings& settings, const std::string& load_error,
+                       GuidePass* guides = nullptr);
 
 }  // namespace mogao

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <stdexcept>
+#include <string>
 
 #include "renderfarm/trace/film.h"
 
@@ -26,6 +27,10 @@ LiveFrames::LiveFrames(FrameSource source, LiveOptions options, float exposure, 
     if (options_.converged_spp < 1) throw std::invalid_argument("LiveOptions.converged_spp must be >= 1");
     options_.controller.target_seconds = options_.frame_time_s > 0 ? options_.frame_time_s : 1.0;
     (void)FrameTimeController(options_.controller);  // validates the controller's settings now
+    if (options_.denoise_max_spp < 1) throw std::invalid_argument("LiveOptions.denoise_max_spp must be >= 1");
+    const RgbFloatImage probe(ImageSize{1, 1});
+    if (Status st = validate_denoise_input(probe, GuideBuffers(probe.size), options_.denoise_params); !st.ok())
+        throw std::invalid_argument("LiveOptions.denoise_params: " + st.error().message);
 }
 
 LiveFrames::Session& LiveFrames::session(std::uint64_t id) {
@@ -67,6 +72,49 @@ Rgb8Image LiveFrames::to_display(const RgbFloatImage& radiance) const {
     return out;
 }
 
+// Renders `request`'s pass (the guides too on the first pass of a view when denoising) and adds it
+// to the session's accumulation; `radiance` gets the frame to display in linear light, or stays
+// empty when the source sent sRGB8 (frame.image).
+void LiveFrames::dispatch(Session& s, const ViewRequest& request, int spp, LiveFrame& frame, RgbFloatImage& radiance) {
+    const bool continues = options_.progressive && s.accumulation.continues(frame.rendered);
+    const bool guided = options_.denoise && !continues;  // the guides are the view's, not the pass's
+    const PackedPixels format = guided                 ? PackedPixels::linear_guided
+                                : options_.progressive ? PackedPixels::linear
+                                                       : PackedPixels::srgb8;
+    const std::uint64_t stream = options_.per_session_maps ? request.session : 0;
+    DispatchedFrame f = source_(frame.rendered, stream, format);
+    if (guided && f.guides.size != f.radiance.size) {
+        throw std::runtime_error("denoise: the frame's guides are " + std::to_string(f.guides.size.width) + "x" +
+                                 std::to_string(f.guides.size.height) + ", its radiance " +
+                                 std::to_string(f.radiance.size.width) + "x" + std::to_string(f.radiance.size.height));
+    }
+    frame.stats = std::move(f.stats);
+    frame.samples = spp;
+    if (options_.progressive) {
+        s.accumulation.add(frame.rendered, f.radiance);
+    } else if (guided) {
+        radiance = std::move(f.radiance);
+    } else {
+        frame.image = std::move(f.image);
+    }
+    if (guided) s.guides = std::move(f.guides);
+}
+
+// The frame served: `radiance` filtered when denoising and few samples are in it, then displayed.
+void LiveFrames::display(const Session& s, const RgbFloatImage& radiance, LiveFrame& frame) {
+    if (!options_.denoise || frame.samples > options_.denoise_max_spp || s.guides.size != radiance.size) {
+        frame.image = to_display(radiance);
+        return;
+    }
+    const auto start = Clock::now();
+    RgbFloatImage filtered;
+    if (Status st = denoiser_.run(radiance, s.guides, options_.denoise_params, filtered); !st.ok())
+        throw std::runtime_error(st.error().message);
+    frame.image = to_display(filtered);
+    frame.denoised = true;
+    frame.denoise_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+}
+
 LiveFrame LiveFrames::render(const ViewRequest& request) {
     const auto start = Clock::now();
     Session& s = session(request.session);
@@ -74,25 +122,18 @@ LiveFrame LiveFrames::render(const ViewRequest& request) {
     LiveFrame frame;
     frame.rendered = plan(s, request, choice);
     const bool continues = options_.progressive && s.accumulation.continues(frame.rendered);
+    RgbFloatImage radiance;
     if (continues && s.accumulation.samples() >= options_.converged_spp) {
         frame.rendered_now = false;
     } else {
-        const std::uint64_t stream = options_.per_session_maps ? request.session : 0;
-        DispatchedFrame f =
-            source_(frame.rendered, stream, options_.progressive ? PackedPixels::linear : PackedPixels::srgb8);
-        frame.stats = std::move(f.stats);
-        if (options_.progressive) {
-            s.accumulation.add(frame.rendered, f.radiance);
-        } else {
-            frame.image = std::move(f.image);
-            frame.samples = choice.spp;
-        }
+        dispatch(s, request, choice.spp, frame, radiance);
     }
     if (options_.progressive) {
-        frame.image = to_display(s.accumulation.mean());
+        radiance = s.accumulation.mean();
         frame.samples = s.accumulation.samples();
         frame.passes = s.accumulation.passes();
     }
+    if (!radiance.pixels.empty()) display(s, radiance, frame);
     frame.seconds = std::chrono::duration<double>(Clock::now() - start).count();
     if (s.controller && frame.rendered_now) s.controller->observe(choice, frame.seconds);
     s.last_request = request;

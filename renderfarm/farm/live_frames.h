@@ -14,6 +14,16 @@
 //    smaller frame (its warp takes content of any size).
 //  - Its own predicted cost map (FrameDispatcher stream = session), so sessions looking at
 //    different places do not mislead each other's PBT.
+//  - With `denoise`: every frame served with at most `denoise_max_spp` samples per pixel (moving
+//    frames, the first passes of a still view) is filtered by the edge-avoiding à-trous denoiser
+//    (renderfarm/denoise/atrous_filter.h) in linear light before the display transform. The first
+//    pass of each view asks the ranks for the guides too (PackedPixels::linear_guided: albedo,
+//    normal, depth of each pixel centre, traced on the ranks' own BVHs beside the tiles); later
+//    passes of the same view reuse them (the guides do not depend on the samples). The admin
+//    filters the composited frame, so the served frame is the same for any split of the frame over
+//    any number of ranks; the accumulation keeps the raw samples (never filtered ones). The
+//    filter's time is part of LiveFrame::seconds, which the frame-time target observes, so the
+//    target still holds with it (it shrinks the frame to pay for the filter).
 // Sessions are forgotten least-recently-used beyond `max_sessions`.
 //
 // Threads: main thread only (it drives the FrameDispatcher, MPI_THREAD_FUNNELED).
@@ -26,6 +36,7 @@
 #include <map>
 #include <optional>
 
+#include "renderfarm/denoise/atrous_filter.h"
 #include "renderfarm/farm/frame_dispatcher.h"
 #include "renderfarm/farm/progressive_accumulator.h"
 #include "renderfarm/schedule/frame_time_controller.h"
@@ -39,15 +50,28 @@ struct LiveOptions {
     FrameTimeTarget controller;    // its other settings (target_seconds is taken from frame_time_s)
     bool per_session_maps = true;  // one PBT cost map per session; false = all share one (stream 0)
     std::size_t max_sessions = 64;
+    bool denoise = false;     // filter frames of at most denoise_max_spp samples (see above)
+    int denoise_max_spp = 4;  // >= 1
+    AtrousParams denoise_params = default_denoise_params();  // threads 0 = every core of the admin
+
+    // The filter's settings for served frames: AtrousParams' defaults (chosen at 1 spp) on every
+    // core of the admin, which waits for the ranks meanwhile.
+    [[nodiscard]] static AtrousParams default_denoise_params() {
+        AtrousParams p;
+        p.threads = 0;
+        return p;
+    }
 };
 
 struct LiveFrame {
-    Rgb8Image image;           // what to encode and send: render_size(rendered)
-    ViewRequest rendered;      // the view as traced: scale, spp and frame_id of the pass
-    int samples = 0;           // samples per pixel in `image` (all accumulated passes)
-    int passes = 1;            // passes in `image`
-    bool rendered_now = true;  // false: a converged still view, sent from the accumulation
-    double seconds = 0.0;      // render + composite (+ accumulate) on the admin, wall
+    Rgb8Image image;               // what to encode and send: render_size(rendered)
+    ViewRequest rendered;          // the view as traced: scale, spp and frame_id of the pass
+    int samples = 0;               // samples per pixel in `image` (all accumulated passes)
+    int passes = 1;                // passes in `image`
+    bool rendered_now = true;      // false: a converged still view, sent from the accumulation
+    bool denoised = false;         // `image` is the filtered frame
+    double seconds = 0.0;          // render + composite (+ accumulate, + denoise) on the admin, wall
+    double denoise_seconds = 0.0;  // the filter's part of `seconds`
     FrameStats stats;
 };
 
@@ -59,10 +83,12 @@ public:
     // Frames from `farm`, displayed with its exposure and tone map.
     LiveFrames(FrameDispatcher& farm, LiveOptions options);
     // Frames from `source`; accumulated radiance is displayed with `exposure` and `tone_map` (film.h).
-    // Throws std::invalid_argument for bad options (naming the field).
+    // Throws std::invalid_argument for bad options (naming the field; a bad denoise_params names
+    // it as atrous_filter.h's validation does).
     LiveFrames(FrameSource source, LiveOptions options, float exposure, ToneMap tone_map);
 
-    // Renders the frame answering `request` (validated by the renderer). Main thread only.
+    // Renders the frame answering `request` (validated by the renderer). Main thread only. Throws
+    // std::runtime_error when the denoiser refuses the frame's guides (its message).
     LiveFrame render(const ViewRequest& request);
 
     [[nodiscard]] const LiveOptions& options() const { return options_; }
@@ -72,11 +98,14 @@ private:
         std::optional<ViewRequest> last_request;
         ProgressiveAccumulator accumulation;
         std::optional<FrameTimeController> controller;
+        GuideBuffers guides;  // of the accumulated view (denoise), or of the last frame
         std::uint64_t last_used = 0;
     };
     Session& session(std::uint64_t id);
     [[nodiscard]] ViewRequest plan(Session& s, const ViewRequest& request, FrameChoice& choice) const;
     [[nodiscard]] Rgb8Image to_display(const RgbFloatImage& radiance) const;
+    void dispatch(Session& s, const ViewRequest& request, int spp, LiveFrame& frame, RgbFloatImage& radiance);
+    void display(const Session& s, const RgbFloatImage& radiance, LiveFrame& frame);
 
     FrameSource source_;
     LiveOptions options_;
@@ -84,6 +113,7 @@ private:
     ToneMap tone_map_;
     std::map<std::uint64_t, Session> sessions_;
     std::uint64_t frames_ = 0;
+    AtrousDenoiser denoiser_;  // scratch planes reused frame to frame
 };
 
 }  // namespace mogao

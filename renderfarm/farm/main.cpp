@@ -85,6 +85,12 @@ void add_live_flags(CLI::App& serve, mogao::ServeOptions& options, double& frame
                    "default off: every request alone)");
     serve.add_option("--converged-spp", live.converged_spp, "Samples at which a still view stops refining")
         ->check(CLI::Range(1, 1 << 20));
+    serve.add_flag(
+        "--denoise,!--no-denoise", live.denoise,
+        "Filter frames of few samples (moving views, a still view's first passes) with the a-trous "
+        "denoiser; the ranks trace its guides (default off; the interactive and balanced presets turn it on)");
+    serve.add_option("--denoise-max-spp", live.denoise_max_spp, "Largest samples per pixel of a frame still filtered")
+        ->check(CLI::Range(1, 1 << 20));
     serve.add_flag("--per-session-cost-maps,!--shared-cost-map", live.per_session_maps,
                    "One PBT cost map per session (default; --shared-cost-map: one for all)");
     serve.add_flag("--pipeline,!--no-pipeline", options.pipeline,
@@ -205,6 +211,7 @@ void apply_serve_preset(const CLI::App& serve, const mogao::QualityPreset& p, mo
     if (unset("--frame-time-ms")) frame_time_ms = p.frame_time_ms;
     if (unset("--progressive") && unset("--no-progressive")) live.progressive = p.progressive;
     if (unset("--converged-spp")) live.converged_spp = p.converged_spp;
+    if (unset("--denoise") && unset("--no-denoise")) live.denoise = p.denoise;
 }
 
 // `mogao-farm health`: what mogao-farm-launch runs on each render host (over the same rsh agent

@@ -17,7 +17,19 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::size_t bytes_per_pixel(PackedPixels format) { return format == PackedPixels::linear ? 3 * sizeof(float) : 3; }
+constexpr std::size_t kGuidedFloats = 10;  // radiance 3, albedo 3, normal 3, depth 1
+
+std::size_t bytes_per_pixel(PackedPixels format) {
+    switch (format) {
+        case PackedPixels::srgb8:
+            return 3;
+        case PackedPixels::linear:
+            return 3 * sizeof(float);
+        case PackedPixels::linear_guided:
+            return kGuidedFloats * sizeof(float);
+    }
+    return 3;
+}
 
 // A tile and where its rect's pixels start in the packed buffer.
 struct TileJob {
@@ -43,14 +55,17 @@ std::vector<TileJob> split_into_cells(const std::vector<PixelRect>& rects, int c
 // holds only its share) and copied into the packed buffer at the tile's place in its rect.
 class TileWriter {
 public:
-    TileWriter(float exposure, ToneMap tone_map, PackedPixels format)
-        : exposure_(exposure), tone_map_(tone_map), format_(format) {}
+    TileWriter(float exposure, ToneMap tone_map, PackedPixels format, const GuidePass* guides)
+        : exposure_(exposure), tone_map_(tone_map), format_(format), guide_pass_(guides) {}
 
     TileStats render(const Renderer& renderer, const TileJob& job, std::vector<std::uint8_t>& packed) {
         const ImageSize size{job.tile.width(), job.tile.height()};
         resize(radiance_, size);
         const TileStats stats = renderer.render(job.tile, radiance_, job.tile.x0, job.tile.y0);
-        if (format_ == PackedPixels::srgb8) {
+        if (format_ == PackedPixels::linear_guided) {
+            render_guides(job, size);
+            copy_guided_rows(job, packed);
+        } else if (format_ == PackedPixels::srgb8) {
             resize(display_, size);
             to_srgb8(radiance_, PixelRect::whole(size), exposure_, display_, tone_map_);
             copy_rows(job, display_, packed);
@@ -79,23 +94,63 @@ private:
         }
     }
 
+    void render_guides(const TileJob& job, ImageSize size) {
+        const auto n = static_cast<std::size_t>(size.pixel_count());
+        guides_.size = size;
+        guides_.hit.resize(n), guides_.depth.resize(n), guides_.albedo.resize(3 * n), guides_.normal.resize(3 * n);
+        if (Status st = guide_pass_->render(job.tile, guides_, job.tile.x0, job.tile.y0); !st.ok())
+            throw std::runtime_error(st.error().message);
+    }
+
+    // Radiance and guides of the tile, kGuidedFloats per pixel, at the tile's place in its rect.
+    void copy_guided_rows(const TileJob& job, std::vector<std::uint8_t>& packed) const {
+        const int w = job.tile.width();
+        std::vector<float> row(static_cast<std::size_t>(w) * kGuidedFloats);
+        for (int y = job.tile.y0; y < job.tile.y1; ++y) {
+            for (int x = 0; x < w; ++x) {
+                const std::size_t i = guides_.pixel(x, y - job.tile.y0);
+                float* out = row.data() + static_cast<std::size_t>(x) * kGuidedFloats;
+                const float* c = radiance_.at(x, y - job.tile.y0);
+                const bool hit = guides_.hit[i] != 0;
+                for (std::size_t k = 0; k < 3; ++k) {
+                    out[k] = c[k];
+                    out[3 + k] = hit ? guides_.albedo[3 * i + k] : 0.0f;
+                    out[6 + k] = hit ? guides_.normal[3 * i + k] : 0.0f;
+                }
+                out[9] = hit ? guides_.depth[i] : 0.0f;
+            }
+            const std::size_t at = job.rect_offset + (static_cast<std::size_t>(y - job.rect.y0) * job.rect.width() +
+                                                      (job.tile.x0 - job.rect.x0)) *
+                                                         bytes_per_pixel(format_);
+            std::memcpy(packed.data() + at, row.data(), row.size() * sizeof(float));
+        }
+    }
+
     float exposure_;
     ToneMap tone_map_;
     PackedPixels format_;
+    const GuidePass* guide_pass_;
     RgbFloatImage radiance_;
     Rgb8Image display_;
+    GuideBuffers guides_;
 };
+
+void check_packed(const std::vector<PixelRect>& rects, const std::vector<std::uint8_t>& packed, PackedPixels format,
+                  ImageSize frame) {
+    if (packed.size() != packed_size(rects, format))
+        throw std::invalid_argument("packed pixel count does not match the assigned rects");
+    for (const PixelRect& r : rects)
+        if (!r.empty() && (r.x0 < 0 || r.y0 < 0 || r.x1 > frame.width || r.y1 > frame.height))
+            throw std::invalid_argument("rect outside the frame");
+}
 
 template <typename Image>
 void unpack(const std::vector<PixelRect>& rects, const std::vector<std::uint8_t>& packed, PackedPixels format,
             Image& frame) {
-    if (packed.size() != packed_size(rects, format))
-        throw std::invalid_argument("packed pixel count does not match the assigned rects");
+    check_packed(rects, packed, format, frame.size);
     const std::uint8_t* in = packed.data();
     for (const PixelRect& r : rects) {
         if (r.empty()) continue;
-        if (r.x0 < 0 || r.y0 < 0 || r.x1 > frame.size.width || r.y1 > frame.size.height)
-            throw std::invalid_argument("rect outside the frame");
         for (int y = r.y0; y < r.y1; ++y) {
             const std::size_t row = static_cast<std::size_t>(r.width()) * bytes_per_pixel(format);
             std::memcpy(frame.at(r.x0, y), in, row);
@@ -113,8 +168,11 @@ std::size_t packed_size(const std::vector<PixelRect>& rects, PackedPixels format
 }
 
 TilePassResult render_tile_pass(const Renderer& renderer, const std::vector<PixelRect>& rects, int cell_size,
-                                int threads, float exposure, ToneMap tone_map, PackedPixels format) {
+                                int threads, float exposure, ToneMap tone_map, PackedPixels format,
+                                const GuidePass* guides) {
     if (cell_size < 1) throw std::invalid_argument("cell_size must be >= 1");
+    if (format == PackedPixels::linear_guided && !guides)
+        throw std::invalid_argument("PackedPixels::linear_guided needs a guide pass");
     const auto start = Clock::now();
     const ImageSize size = renderer.render_size();
     for (const PixelRect& r : rects)
@@ -134,7 +192,7 @@ TilePassResult render_tile_pass(const Renderer& renderer, const std::vector<Pixe
     const auto worker = [&] {
         const double cpu_start = thread_cpu_seconds();
         try {
-            TileWriter writer(exposure, tone_map, format);
+            TileWriter writer(exposure, tone_map, format, guides);
             for (std::size_t i = next++; i < tiles.size(); i = next++) {
                 const auto t0 = Clock::now();
                 const TileStats stats = writer.render(renderer, tiles[i], result.packed_pixels);
@@ -169,6 +227,30 @@ void unpack_rects(const std::vector<PixelRect>& rects, const std::vector<std::ui
 void unpack_linear_rects(const std::vector<PixelRect>& rects, const std::vector<std::uint8_t>& packed,
                          RgbFloatImage& frame) {
     unpack(rects, packed, PackedPixels::linear, frame);
+}
+
+void unpack_guided_rects(const std::vector<PixelRect>& rects, const std::vector<std::uint8_t>& packed,
+                         RgbFloatImage& frame, GuideBuffers& guides) {
+    if (guides.size != frame.size || guides.hit.size() != static_cast<std::size_t>(frame.size.pixel_count()))
+        throw std::invalid_argument("guide buffers do not match the frame's size");
+    check_packed(rects, packed, PackedPixels::linear_guided, frame.size);
+    const auto* in = reinterpret_cast<const float*>(packed.data());  // packed as native floats
+    for (const PixelRect& r : rects) {
+        if (r.empty()) continue;
+        for (int y = r.y0; y < r.y1; ++y) {
+            for (int x = r.x0; x < r.x1; ++x, in += kGuidedFloats) {
+                const std::size_t i = guides.pixel(x, y);
+                float* c = frame.at(x, y);
+                for (std::size_t k = 0; k < 3; ++k) {
+                    c[k] = in[k];
+                    guides.albedo[3 * i + k] = in[3 + k];
+                    guides.normal[3 * i + k] = in[6 + k];
+                }
+                guides.depth[i] = in[9];
+                guides.hit[i] = in[9] > 0.0f ? 1 : 0;
+            }
+        }
+    }
 }
 
 }  // namespace mogao

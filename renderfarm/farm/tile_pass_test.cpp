@@ -73,6 +73,81 @@ TEST(TilePass, SplitRectsWithThreadsGiveTheSamePixelsAsOneRect) {
     EXPECT_THROW((void)render_tile_pass(renderer, {{0, 0, 97, 64}}, 16, 1, 1.f), std::invalid_argument);
 }
 
+// The denoiser's guides travel beside the radiance: any split of the frame over ranks and threads
+// composites to the same radiance and guides, and those are the guide pass's own for the frame
+// (traced there on its own BVH).
+TEST(TilePass, GuidedPackingOfAnySplitEqualsTheGuidePassOfTheWholeFrame) {
+    const Scene scene = small_scene();
+    Renderer renderer(scene, RendererOptions{});
+    GuidePass shared(scene, renderer.render_scene());
+    ViewRequest view;
+    view.size = {96, 64};
+    view.pose.eye = {0, 1.5, 5};
+    view.quality.max_bounces = 1;
+    renderer.begin_frame(view);
+    ASSERT_TRUE(shared.begin_frame(view).ok());
+    const PixelRect all{0, 0, 96, 64};
+    const std::vector<PixelRect> parts{{0, 0, 40, 64}, {40, 0, 96, 24}, {40, 24, 96, 64}};
+    const TilePassResult whole =
+        render_tile_pass(renderer, {all}, 16, 1, 1.f, ToneMap::clamp, PackedPixels::linear_guided, &shared);
+    const TilePassResult split =
+        render_tile_pass(renderer, parts, 16, 3, 1.f, ToneMap::clamp, PackedPixels::linear_guided, &shared);
+    EXPECT_EQ(whole.packed_pixels.size(), packed_size({all}, PackedPixels::linear_guided));
+    EXPECT_EQ(whole.packed_pixels.size(), 96u * 64u * 10u * sizeof(float));
+    RgbFloatImage a({96, 64}), b({96, 64});
+    GuideBuffers ga({96, 64}), gb({96, 64});
+    unpack_guided_rects({all}, whole.packed_pixels, a, ga);
+    unpack_guided_rects(parts, split.packed_pixels, b, gb);
+    EXPECT_EQ(a.pixels, b.pixels);
+    EXPECT_EQ(ga.hit, gb.hit);
+    EXPECT_EQ(ga.albedo, gb.albedo);
+    EXPECT_EQ(ga.normal, gb.normal);
+    EXPECT_EQ(ga.depth, gb.depth);
+    // The radiance is the linear pass's.
+    const TilePassResult linear = render_tile_pass(renderer, {all}, 16, 1, 1.f, ToneMap::clamp, PackedPixels::linear);
+    RgbFloatImage c({96, 64});
+    unpack_linear_rects({all}, linear.packed_pixels, c);
+    EXPECT_EQ(a.pixels, c.pixels);
+    // The guides are the guide pass's of the whole frame, on its own BVH.
+    GuidePass own(scene);
+    Result<GuideBuffers> expected = own.render_frame(view);
+    ASSERT_TRUE(expected.ok()) << expected.error().message;
+    EXPECT_EQ(ga.hit, expected->hit);
+    int hits = 0;
+    for (std::size_t i = 0; i < ga.depth.size(); ++i) {
+        hits += ga.hit[i];
+        EXPECT_NEAR(ga.depth[i], expected->depth[i], 1e-4f * (1.0f + expected->depth[i])) << i;
+        EXPECT_NEAR(ga.normal[3 * i], expected->normal[3 * i], 1e-4f) << i;
+        EXPECT_NEAR(ga.albedo[3 * i], expected->albedo[3 * i], 1e-6f) << i;
+    }
+    EXPECT_GT(hits, 0);
+    EXPECT_LT(hits, 96 * 64);  // sky too
+}
+
+TEST(TilePass, GuidedPackingRefusesAMissingGuidePassAndMismatchedBuffers) {
+    const Scene scene = small_scene();
+    Renderer renderer(scene, RendererOptions{});
+    ViewRequest view;
+    view.size = {32, 16};
+    renderer.begin_frame(view);
+    EXPECT_THROW((void)render_tile_pass(renderer, {{0, 0, 32, 16}}, 16, 1, 1.f, ToneMap::clamp,
+                                        PackedPixels::linear_guided, nullptr),
+                 std::invalid_argument);
+    GuidePass guides(scene, renderer.render_scene());  // never begun: the tile pass reports its error
+    EXPECT_THROW((void)render_tile_pass(renderer, {{0, 0, 32, 16}}, 16, 1, 1.f, ToneMap::clamp,
+                                        PackedPixels::linear_guided, &guides),
+                 std::runtime_error);
+    RgbFloatImage frame({32, 16});
+    GuideBuffers ok({32, 16}), wrong({16, 16});
+    std::vector<std::uint8_t> packed(packed_size({{0, 0, 32, 16}}, PackedPixels::linear_guided));
+    EXPECT_NO_THROW(unpack_guided_rects({{0, 0, 32, 16}}, packed, frame, ok));
+    EXPECT_THROW(unpack_guided_rects({{0, 0, 32, 16}}, packed, frame, wrong), std::invalid_argument);
+    packed.pop_back();
+    EXPECT_THROW(unpack_guided_rects({{0, 0, 32, 16}}, packed, frame, ok), std::invalid_argument);
+    EXPECT_THROW(unpack_guided_rects({{0, 0, 33, 16}}, std::vector<std::uint8_t>(33 * 16 * 40), frame, ok),
+                 std::invalid_argument);
+}
+
 // Kilobytes of this process's data segment (VmData: heap and private mappings), what RLIMIT_DATA
 // bounds (Linux >= 4.7 counts mmap'ed private memory too).
 long vm_data_kib() {

@@ -20,7 +20,7 @@ struct WireView {
     std::int32_t width, height, spp, max_bounces, ao_samples, area_light_samples, jpeg_quality;
     double resolution_scale;
     std::int32_t stop;    // 1: no more frames, render ranks leave their loop
-    std::int32_t linear;  // 1: reply with linear radiance (PackedPixels::linear), 0: sRGB8
+    std::int32_t linear;  // 0: sRGB8, 1: linear radiance (PackedPixels::linear), 2: and guides (::linear_guided)
 };
 static_assert(std::is_trivially_copyable_v<WireView>);
 

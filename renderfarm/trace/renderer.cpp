@@ -256,6 +256,8 @@ void Renderer::begin_frame(const ViewRequest& request) {
     s.ready = true;
 }
 
+const RenderScene& Renderer::render_scene() const { return impl_->geometry; }
+
 ImageSize Renderer::render_size() const {
     impl_->check_ready();
     return impl_->size;

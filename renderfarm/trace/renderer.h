@@ -31,6 +31,8 @@
 
 namespace mogao {
 
+class RenderScene;
+
 struct RendererOptions {
     // rtcNewDevice configuration, e.g. "threads=1" to build BVHs on one thread; "" = Embree default
     // (all hardware threads for BVH builds; rendering itself runs on the caller's threads).
@@ -105,6 +107,13 @@ public:
     // tracing such a log (same packets or single rays, same context flags) without any shading.
     TileStats render_recording(const PixelRect& rect, RgbFloatImage& frame, RecordedRays& log) const;
     TileStats trace_recorded(const RecordedRays& log) const;
+
+    // The renderer's Embree geometry, rebased by begin_frame() on the current frame's eye (or not
+    // at all when rebase_on_eye is off), for passes that trace the same frame's primary hits
+    // without a second BVH (the denoiser's guide pass, renderfarm/denoise/guide_pass.h). Lives as
+    // long as the Renderer; the same thread-safety as render(): const use only between frames'
+    // begin_frame() calls.
+    [[nodiscard]] const RenderScene& render_scene() const;
 
 private:
     struct Impl;
