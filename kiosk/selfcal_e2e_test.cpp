@@ -12,9 +12,9 @@
 // `mogao-autocal calibrate` measures, written with 16-bit alpha and the LUT entries as it writes).
 // Checks, from outside the process: the status file goes through drift detected / correcting to
 // calibrated, the drift it reports falls, the corrected calibration is written back to the MPCDI
-// (the previous one kept as .last-good), its ground-truth geometric error against the bumped rig
-// is under 1 projector pixel, and it kept the colour: the same response LUTs, beta maps, and on the
-// bumped rig's ground-truth light one black and one colour across the seams.
+// (the previous one kept as .last-good) with the corrected poses in the models file beside it, its
+// ground-truth geometric error against the bumped rig is under 1 projector pixel, and it kept the colour: the same
+// response LUTs, beta maps, and on the bumped rig's ground-truth light one black and one colour across the seams.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <spawn.h>
@@ -29,6 +29,7 @@
 #include <sstream>
 #include <thread>
 
+#include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
 #include "appliance/autocal/colour_calibration.h"
@@ -201,6 +202,17 @@ TEST(SelfcalKioskEndToEnd, ABumpedProjectorIsCorrectedAndWrittenBackByMogaoKiosk
     EXPECT_EQ(kiosk.stop(), 0);
     // Written back: the previous calibration kept, the new one right against the bumped rig's ground truth.
     EXPECT_TRUE(fs::exists(selfcal::last_good_path(dir / "screen.mpcdi")));
+    // The models beside it hold the corrected pose (a restart monitors the corrected warps with
+    // it): proj1's rotation against the bumped rig's true one, the old models kept as .last-good.
+    const fs::path models_file = autocal::models_path_for(dir / "screen.mpcdi");
+    EXPECT_TRUE(fs::exists(selfcal::last_good_path(models_file)));
+    const autocal::CalibrationModels models = autocal::read_models(models_file);
+    const selfcal::SystemModel bumped_model = selfcal::models_of_rig(bumped);
+    const auto angle_deg = [](const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+        return Eigen::AngleAxisd(a.transpose() * b).angle() * 180.0 / M_PI;
+    };
+    const double pose_error_deg = angle_deg(models.projectors[1].rotation, bumped_model.projectors[1].rotation);
+    EXPECT_LT(pose_error_deg, 0.1) << "was 1 degree before the correction";
     const ScreenCalibration written = selfcal::load_calibration(dir / "screen.mpcdi");
     const double after_px = projector_error_px(bumped, written, 1);
     EXPECT_LT(after_px, 1.0) << "before " << before_px << " px";
@@ -215,7 +227,8 @@ TEST(SelfcalKioskEndToEnd, ABumpedProjectorIsCorrectedAndWrittenBackByMogaoKiosk
     const autocal::SeamColour grey = autocal::measure_seam_colour(bumped, written, 0.5);
     EXPECT_LT(black.seam_luminance_p95, 0.02);
     EXPECT_LT(grey.seam_delta_e_p95, 0.6);
-    std::cout << "written back: seam black luminance p95 " << 100.0 * black.seam_luminance_p95
+    std::cout << "written back: proj1 rotation in the models file " << pose_error_deg
+              << " deg from the bumped truth; seam black luminance p95 " << 100.0 * black.seam_luminance_p95
               << " %, seam grey Delta E76 p95 " << grey.seam_delta_e_p95 << "\n";
     std::cout << "proj1 mean geometric error (ground truth, its pixels): " << before_px << " px in the MPCDI before, "
               << after_px << " px in the MPCDI mogao-kiosk wrote; reported drift max " << max_drift << " px, last "

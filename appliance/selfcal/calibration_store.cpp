@@ -41,4 +41,19 @@ void save_calibration(const std::filesystem::path& path, const ScreenCalibration
     write_mpcdi(path, file);
 }
 
+void save_models(const std::filesystem::path& path, const autocal::CalibrationModels& models) {
+    (void)autocal::models_json(models, path.filename().string());  // throws before anything is touched
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(path, ec)) {
+        bool readable = true;
+        try {
+            (void)autocal::read_models(path);
+        } catch (const std::exception&) {
+            readable = false;  // never replace the last good one with a broken file
+        }
+        if (readable) write_file_atomically(last_good_path(path), read_file_bytes(path));
+    }
+    autocal::write_models(path, models);
+}
+
 }  // namespace mogao::selfcal

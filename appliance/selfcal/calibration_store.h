@@ -5,6 +5,7 @@
 
 #include <filesystem>
 
+#include "appliance/autocal/model_store.h"
 #include "common/projector_calibration.h"
 
 namespace mogao::selfcal {
@@ -20,6 +21,13 @@ namespace mogao::selfcal {
 // point leaves `path` holding the previous complete calibration. Throws MpcdiError /
 // std::system_error naming the file, std::invalid_argument for an invalid calibration.
 void save_calibration(const std::filesystem::path& path, const ScreenCalibration& calibration);
+
+// The models the calibration at `path` was built from (autocal/model_store.h's file, e.g.
+// `<name>.models.json`), saved the same way: a readable file at `path` is first copied to
+// last_good_path(path), then `models` written atomically. After a correction the models file must
+// hold the corrected poses, or a restart would monitor the corrected warps with the old poses.
+// Throws autocal::ModelStoreError / std::system_error naming the file.
+void save_models(const std::filesystem::path& path, const autocal::CalibrationModels& models);
 
 // Reads a calibration written by save_calibration (MPCDI 2d profile). Throws MpcdiError.
 [[nodiscard]] ScreenCalibration load_calibration(const std::filesystem::path& path);

@@ -283,6 +283,10 @@ void SelfCalibrator::advance_correction(double t_s, StepResult& r) {
         try {
             save_calibration(options_.store, wall_);
             saved = "saved to '" + options_.store.string() + "' (previous kept as .last-good)";
+            if (!options_.models_store.empty()) {
+                save_models(options_.models_store, {m.screen, m.camera, m.projectors});
+                saved += ", models to '" + options_.models_store.string() + "'";
+            }
         } catch (const std::exception& e) {
             saved = std::string("NOT saved: ") + e.what();
         }

@@ -69,7 +69,8 @@ struct SelfcalOptions {
     // this many camera pixels on average (a small shift with the rotation that compensates it
     // hardly moves the image: a threshold in degrees or mm re-based on such noise). >= 0.
     double camera_rebase_px = 0.5;
-    std::filesystem::path store;  // empty: corrected calibrations are not written
+    std::filesystem::path store;         // empty: corrected calibrations are not written
+    std::filesystem::path models_store;  // empty: not written; else the corrected models (save_models) too
     MonitorOptions monitor;
     KalmanOptions kalman;
     KalmanOptions camera_kalman;
