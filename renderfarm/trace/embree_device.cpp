@@ -36,11 +36,15 @@ const char* error_name(RTCError code) {
 
 }  // namespace
 
-EmbreeDevice::EmbreeDevice(const std::string& config)
-    : device_(rtcNewDevice(config.empty() ? nullptr : config.c_str())) {
+std::string EmbreeDevice::effective_config(const std::string& config) {
+    if (config.find("isa=") != std::string::npos) return config;  // "isa=" or "max_isa=": the caller's choice
+    return config.empty() ? std::string("max_isa=avx2") : config + ",max_isa=avx2";
+}
+
+EmbreeDevice::EmbreeDevice(const std::string& config) : device_(rtcNewDevice(effective_config(config).c_str())) {
     if (!device_) {
         // Creation errors are only reported through the null device's error code.
-        throw_error("rtcNewDevice(\"" + config + "\")", rtcGetDeviceError(nullptr));
+        throw_error("rtcNewDevice(\"" + effective_config(config) + "\")", rtcGetDeviceError(nullptr));
     }
     rtcSetDeviceErrorFunction(device_.get(), record_error, nullptr);
 }

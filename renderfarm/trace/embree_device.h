@@ -6,8 +6,14 @@
 // and clears the calling thread's error code and throws std::runtime_error("<what>: <code>: <message>").
 // Call check() after Embree calls that can fail (device/scene/geometry creation, commits).
 //
-// Reference: Embree 3 API, rtcNewDevice / rtcSetDeviceErrorFunction / rtcGetDeviceError
-// (https://www.embree.org/api.html).
+// ISA: every device is created with "max_isa=avx2" unless the configuration names an ISA itself
+// ("isa=" or "max_isa="). Debian 12's Embree 3.13.5 never returned from rtcOccluded16 in its
+// AVX-512 kernels on an AMD EPYC with AVX-512 (seen 2026-11-23: every render, from a 160x90 test
+// room up, spun in libembree3 forever, so the farm's ranks missed their frame deadline); with the
+// AVX2 kernels the same renders pass. On a CPU without AVX2, max_isa lets Embree pick a lower one.
+//
+// Reference: Embree 3 API, rtcNewDevice / rtcSetDeviceErrorFunction / rtcGetDeviceError, and the
+// device configuration keys isa / max_isa (https://www.embree.org/api.html).
 #pragma once
 
 #include <string>
@@ -21,8 +27,9 @@ namespace mogao {
 
 class EmbreeDevice {
 public:
-    // config: Embree device configuration, e.g. "threads=1" (BVH builds on one thread); "" = defaults.
-    // Throws std::runtime_error if the device cannot be created (bad config, unsupported CPU).
+    // config: Embree device configuration, e.g. "threads=1" (BVH builds on one thread); "" = defaults
+    // (either way with max_isa=avx2 added unless it names an ISA, see above). Throws std::runtime_error if the device
+    // cannot be created (bad config, unsupported CPU).
     explicit EmbreeDevice(const std::string& config = "");
 
     [[nodiscard]] RTCDevice get() const noexcept { return device_.get(); }
@@ -30,6 +37,9 @@ public:
     // Throws std::runtime_error naming `what` if an Embree call on this thread failed since the
     // last check(); no-op otherwise.
     void check(std::string_view what) const;
+
+    // The configuration rtcNewDevice gets for `config` (the ISA cap added where it names none).
+    [[nodiscard]] static std::string effective_config(const std::string& config);
 
 private:
     struct Traits {

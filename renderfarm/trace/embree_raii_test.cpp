@@ -161,3 +161,20 @@ TEST(EmbreeRaii, BadDeviceConfigThrows) {
 
 }  // namespace
 }  // namespace mogao
+
+namespace mogao {
+namespace {
+
+// embree_device.h: AVX-512 kernels are never used unless a configuration asks for an ISA itself
+// (Debian 12's Embree 3.13.5 hung in its AVX-512 rtcOccluded16 on an AMD EPYC).
+TEST(EmbreeDeviceIsa, CapsTheIsaAtAvx2UnlessTheConfigurationNamesOne) {
+    EXPECT_EQ(EmbreeDevice::effective_config(""), "max_isa=avx2");
+    EXPECT_EQ(EmbreeDevice::effective_config("threads=2"), "threads=2,max_isa=avx2");
+    EXPECT_EQ(EmbreeDevice::effective_config("threads=1,isa=sse4.2"), "threads=1,isa=sse4.2");
+    EXPECT_EQ(EmbreeDevice::effective_config("max_isa=avx"), "max_isa=avx");
+    const EmbreeDevice device("threads=1");
+    EXPECT_EQ(rtcGetDeviceProperty(device.get(), RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED), 0);
+}
+
+}  // namespace
+}  // namespace mogao
