@@ -5,6 +5,10 @@
 // without, measured interleaved in the same run. The draw is also given in CPU milliseconds of the
 // whole process (llvmpipe's rasteriser threads included): on a machine shared with other work the
 // wall time grows with the load, the CPU time much less, so two builds compare by it.
+// The first projector's blend mask is 1x1, so its draws run the general shader variant (bilinear
+// warp and blend, four fetches each); a third projector with maps of the output's size runs the
+// exact variant that a calibration made for its output (the kiosk's ideal one, an MPCDI at the
+// projector's resolution) gets, timed interleaved too, with its ratio to the general draw.
 // Usage: mogao_warp_blend_bench [width height [content_width content_height [frames]]]
 #include <GLES3/gl3.h>
 
@@ -58,11 +62,17 @@ int main(int argc, char** argv) {
         lifted.beta.rgb.assign(static_cast<std::size_t>(output.pixel_count()) * 3, 0.01f);
         auto beta_index = renderer->add_projector(lifted);
         if (!beta_index) return std::fprintf(stderr, "%s\n", beta_index.error().message.c_str()), 1;
-        if (!renderer->set_content(content) || !renderer->render(*index) || !renderer->render(*beta_index)) {
-            return 1;  // warm-up (shader JIT, both FBOs)
+        ProjectorCalibration exact = identity_calibration("bench-exact", output);
+        exact.blend.size = output;
+        exact.blend.weight.assign(static_cast<std::size_t>(output.pixel_count()), 1.0f);
+        auto exact_index = renderer->add_projector(exact);
+        if (!exact_index) return std::fprintf(stderr, "%s\n", exact_index.error().message.c_str()), 1;
+        if (!renderer->set_content(content) || !renderer->render(*index) || !renderer->render(*beta_index) ||
+            !renderer->render(*exact_index)) {
+            return 1;  // warm-up (shader JIT, all three FBOs)
         }
 
-        double upload = 0, draw = 0, draw_cpu = 0, readback = 0, draw_beta = 0;
+        double upload = 0, draw = 0, draw_cpu = 0, readback = 0, draw_beta = 0, draw_exact = 0, draw_exact_cpu = 0;
         for (int f = 0; f < frames; ++f) {
             auto t0 = std::chrono::steady_clock::now();
             if (!renderer->set_content(content)) return 1;
@@ -82,6 +92,13 @@ int main(int argc, char** argv) {
             if (!renderer->draw(*beta_index)) return 1;
             glFinish();
             draw_beta += ms_since(t0);
+            if (!renderer->render(*exact_index)) return 1;  // binds its FBO; then time the draw alone
+            t0 = std::chrono::steady_clock::now();
+            const double exact_cpu0 = process_cpu_ms();
+            if (!renderer->draw(*exact_index)) return 1;
+            glFinish();
+            draw_exact += ms_since(t0);
+            draw_exact_cpu += process_cpu_ms() - exact_cpu0;
         }
         std::printf("renderer: %s\n", reinterpret_cast<const char*>(glGetString(GL_RENDERER)));
         std::printf("output %dx%d, content %dx%d, %d frames (mean ms)\n", output.width, output.height,
@@ -91,6 +108,8 @@ int main(int argc, char** argv) {
             "  draw + readback %8.2f\n",
             upload / frames, draw / frames, draw_cpu / frames, readback / frames);
         std::printf("  draw with beta  %8.2f  (x%.2f of the draw without)\n", draw_beta / frames, draw_beta / draw);
+        std::printf("  draw, exact maps %7.2f  (CPU ms, all threads: %.2f; x%.2f of the general draw's CPU)\n",
+                    draw_exact / frames, draw_exact_cpu / frames, draw_exact_cpu / draw_cpu);
     }
     return 0;
 }
