@@ -11,6 +11,7 @@
 
 #include "common/request_limits.h"
 #include "renderfarm/trace/camera.h"
+#include "renderfarm/trace/embree_packets.h"
 #include "renderfarm/trace/render_scene.h"
 
 namespace mogao {
@@ -141,11 +142,14 @@ Status GuidePass::render(const PixelRect& rect, GuideBuffers& window, int origin
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    // At the native width, as the renderer traces its camera packets: Embree runs a 16-wide call
+    // ray by ray where it has no 16-wide kernels (embree_packets.h), the usual case (embree_device.h).
+    const int width = native_packet_width(s.geometry.root());
     for (int by = rect.y0 - rect.y0 % kBlock; by < rect.y1; by += kBlock) {
         for (int bx = rect.x0 - rect.x0 % kBlock; bx < rect.x1; bx += kBlock) {
             RTCRayHit16 packet{};
             alignas(64) const std::array<int, kLanes> valid = s.fill(bx, by, rect, packet);
-            rtcIntersect16(valid.data(), s.geometry.root(), &context, &packet);
+            intersect16_at(width, valid.data(), s.geometry.root(), &context, packet);
             s.store(bx, by, origin_x, origin_y, valid, packet, window);
         }
     }
