@@ -11,7 +11,9 @@
 #include <poll.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
+#include <cstdlib>
 #include <fstream>
 
 #include "common/jpeg_codec.h"
@@ -369,6 +371,90 @@ TEST_F(KioskTest, GuardBandWidensTheRequestAndTheFrameIsShiftedByTheYawSinceItsR
     EXPECT_FLOAT_EQ(t.scale_v, 1.0f);
     EXPECT_FLOAT_EQ(t.offset_v, 0.0f);
     EXPECT_EQ(k.late_warp_clamped(), 0u);
+}
+
+// A grey content frame of the guarded width whose column u is the pattern's column u - shift: a
+// frame rendered after the view turned by `shift` columns' worth of yaw (late_warp.h: a left turn
+// moves the world right). Grey keeps both chroma planes at 128, and a shift by whole 8-column JPEG
+// blocks keeps every luma block's pixels, so both frames decode to the same columns, shifted.
+LinkFrame striped_frame(std::uint64_t request_id, ImageSize size, int shift, const ViewerPose& pose) {
+    Rgb8Image content(size);
+    for (int y = 0; y < size.height; ++y) {
+        for (int x = 0; x < size.width; ++x) {
+            const int u = x - shift;
+            const auto v = static_cast<std::uint8_t>(30 + ((u + 64) * 53) % 190);
+            for (int c = 0; c < 3; ++c) content.at(x, y)[c] = v;
+        }
+    }
+    LinkFrame frame;
+    frame.frame_id = request_id;
+    frame.request_id = request_id;
+    frame.size = size;
+    frame.jpeg = JpegEncoder().encode(content, 95);
+    frame.pose = pose;
+    return frame;
+}
+
+int max_abs_difference(const std::vector<Rgb8Image>& a, const std::vector<Rgb8Image>& b) {
+    int worst = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        for (std::size_t k = 0; k < a[i].pixels.size(); ++k) worst = std::max(worst, std::abs(a[i].pixels[k] - b[i].pixels[k]));
+    }
+    return worst;
+}
+
+// Issue 11: a yaw-only turn is on the wall within one display round whatever the farm's latency.
+// No new farm frame comes after the turn, yet the outputs of the next round are those a frame
+// rendered at the new yaw gives (checked against such a frame, through the same GL outputs), and a
+// turn right after a frame was shown is on the wall one round later.
+TEST_F(KioskTest, AYawOnlyTurnReachesTheWallWithinOneDisplayRoundWithoutANewFrame) {
+    config_.guard_deg = 10;          // 11 columns of 150/160 degrees each side: 182 columns in all
+    constexpr int kTurnColumns = 8;  // 7.5 degrees, inside the band
+    ViewerPose ahead;
+    ViewerPose turned = ahead;
+    turned.yaw_deg += kTurnColumns * 150.0 / 160.0;
+    // The visitor's pose at ticks 1..5: still, still, turned left, back, back.
+    navigation_ = std::make_unique<KioskNavigation>(
+        ViewScript({ahead, ahead, turned, ahead, ahead}, make_view_template(config_)));
+    Kiosk& k = kiosk();
+    const ImageSize guarded{182, 90};
+
+    wait_readable(k.tick_fd());
+    k.on_tick();  // tick 1, request 101 looking ahead
+    deliver(striped_frame(101, guarded, 0, link_.requests.back().pose));
+    k.on_frame();
+    const std::vector<Rgb8Image> before = outputs();
+    const std::uint64_t rounds = display_->stats().rounds();
+    wait_readable(k.tick_fd());
+    k.on_tick();  // tick 2, still: a frame came since tick 1, nothing to repaint
+    ASSERT_EQ(display_->stats().rounds(), rounds);
+
+    wait_readable(k.tick_fd());
+    k.on_tick();  // tick 3: the visitor turned; the farm has not answered
+    ASSERT_EQ(link_.requests.size(), 3u);
+    EXPECT_EQ(display_->stats().rounds(), rounds + 1) << "the turn must reach the wall in this round";
+    const std::vector<Rgb8Image> on_wall = outputs();
+    EXPECT_GT(max_abs_difference(on_wall, before), 60) << "the wall did not move with the turn";
+    EXPECT_EQ(k.late_warp_clamped(), 0u);
+
+    // What the farm's frame for the turned view shows (request 103, no shift left to apply).
+    deliver(striped_frame(103, guarded, kTurnColumns, link_.requests.back().pose));
+    k.on_frame();
+    const std::vector<Rgb8Image> rendered_turned = outputs();
+    EXPECT_LE(max_abs_difference(on_wall, rendered_turned), 1)
+        << "the late warp's shift differs from a frame rendered at the new yaw";
+
+    // Turning back right after that frame was shown: tick 4 has nothing to repaint (a frame came),
+    // so the turn is on the wall at tick 5, one round later, again without a new frame.
+    wait_readable(k.tick_fd());
+    k.on_tick();
+    EXPECT_EQ(display_->stats().rounds(), rounds + 2);
+    wait_readable(k.tick_fd());
+    k.on_tick();
+    EXPECT_EQ(display_->stats().rounds(), rounds + 3);
+    // 2 codes: the right edge of the screen now falls in the turned frame's last JPEG block, a partial
+    // one (182 columns), which decodes a little differently from the full block it repeats.
+    EXPECT_LE(max_abs_difference(outputs(), before), 2) << "turning back must show the view ahead again";
 }
 
 TEST_F(KioskTest, RunShowsFramesUntilASignalThenWritesTheStatistics) {
