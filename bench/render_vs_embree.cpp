@@ -310,13 +310,16 @@ nlohmann::json scene_section(int argc, char** argv, int reps) {
                               {"renderer_vs_embree_throughput", f.mrays() / f.embree_mrays()},
                               {"psnr_db", f.psnr_db}};
     };
-    return {{"width", view.size.width},
+    return {{"scene", arg_str(argc, argv, "--scene", "")},
+            {"width", view.size.width},
             {"height", view.size.height},
+            {"reps", reps},
             {"reference_spp", ref_spp},
             {"d1_legacy", figures(legacy)},
             {"d2_light_selection", figures(sampling)},
             {"d3_packets", figures(packets)},
             {"d4_new", figures(current)},
+            {"d5_all", figures(all)},
             {"frame_time_new_over_legacy", current.render_s / legacy.render_s}};
 }
 

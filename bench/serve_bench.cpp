@@ -10,7 +10,9 @@
 //
 // Configurations: today (the serial loop of before: every request alone, full size, sRGB8 from the
 // ranks), all (every new scheduling part), denoise (all + the à-trous denoiser on frames of at most
-// --denoise-max-spp samples, its guides traced by the ranks: live_frames.h), and all minus one part.
+// --denoise-max-spp samples, its guides traced by the ranks: live_frames.h), and all minus one part
+// (no-rate-aim: the frame-time controller aims at the target itself, without the jitter allowance,
+// the hand-off charge and the headroom of schedule/frame_time_controller.h).
 // With both all and denoise in the run, the denoiser's ratios are printed: frames/s on / off and the
 // moving frame's PSNR on - off. --quality takes a preset's request quality (spp, bounces, AO, area
 // samples, JPEG; common/quality_preset.h) for every request and the reference; without it the
@@ -109,6 +111,11 @@ std::vector<Config> all_configs(const BenchArgs& a) {
     without("no-target", "all but frame-time target", [](Config& c) { c.live.frame_time_s = 0; });
     without("no-pipeline", "all but pipelining", [](Config& c) { c.pipeline = false; });
     without("no-rank-speed", "all but rank-speed normalisation", [](Config& c) { c.rank_speed = false; });
+    without("no-rate-aim", "all but aiming at the served rate", [](Config& c) {
+        c.live.controller.jitter_weight = 0;  // aim at the target itself, as before
+        c.live.controller.max_handoff = 0;
+        c.live.controller.headroom = 0;
+    });
     return out;
 }
 
@@ -376,10 +383,11 @@ int main(int argc, char** argv) {
     app.add_option("--frame-time-ms", a.frame_time_ms)->check(CLI::Range(1.0, 10000.0));
     app.add_option("--reference-spp", a.reference_spp, "Reference samples per pixel (two halves)")
         ->check(CLI::Range(2, 8192));
-    app.add_option("--configs", a.configs, "today, all, denoise, no-progressive, no-target, no-pipeline, no-rank-speed")
+    app.add_option("--configs", a.configs,
+                   "today, all, denoise, no-progressive, no-target, no-pipeline, no-rank-speed, no-rate-aim")
         ->delimiter(',')
-        ->check(
-            CLI::IsMember({"today", "all", "denoise", "no-progressive", "no-target", "no-pipeline", "no-rank-speed"}));
+        ->check(CLI::IsMember(
+            {"today", "all", "denoise", "no-progressive", "no-target", "no-pipeline", "no-rank-speed", "no-rate-aim"}));
     app.add_option("--quality", a.quality,
                    "Preset whose request quality every request uses (" + quality_preset_names() +
                        "); default: the request's defaults")

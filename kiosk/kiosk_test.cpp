@@ -398,7 +398,8 @@ LinkFrame striped_frame(std::uint64_t request_id, ImageSize size, int shift, con
 int max_abs_difference(const std::vector<Rgb8Image>& a, const std::vector<Rgb8Image>& b) {
     int worst = 0;
     for (std::size_t i = 0; i < a.size(); ++i) {
-        for (std::size_t k = 0; k < a[i].pixels.size(); ++k) worst = std::max(worst, std::abs(a[i].pixels[k] - b[i].pixels[k]));
+        for (std::size_t k = 0; k < a[i].pixels.size(); ++k)
+            worst = std::max(worst, std::abs(a[i].pixels[k] - b[i].pixels[k]));
     }
     return worst;
 }

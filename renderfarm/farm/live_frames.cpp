@@ -120,6 +120,7 @@ LiveFrame LiveFrames::render(const ViewRequest& request) {
     Session& s = session(request.session);
     FrameChoice choice;
     LiveFrame frame;
+    if (s.handed_back) frame.gap_seconds = std::chrono::duration<double>(start - *s.handed_back).count();
     frame.rendered = plan(s, request, choice);
     const bool continues = options_.progressive && s.accumulation.continues(frame.rendered);
     RgbFloatImage radiance;
@@ -135,8 +136,9 @@ LiveFrame LiveFrames::render(const ViewRequest& request) {
     }
     if (!radiance.pixels.empty()) display(s, radiance, frame);
     frame.seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    if (s.controller && frame.rendered_now) s.controller->observe(choice, frame.seconds);
+    if (s.controller && frame.rendered_now) s.controller->observe(choice, frame.seconds, frame.gap_seconds);
     s.last_request = request;
+    s.handed_back = Clock::now();
     return frame;
 }
 

@@ -11,7 +11,10 @@
 //    without rendering.
 //  - A frame-time target (schedule/frame_time_controller.h): while the view moves, the resolution
 //    scale and spp of each frame are chosen to take `frame_time_s`; the appliance upsamples the
-//    smaller frame (its warp takes content of any size).
+//    smaller frame (its warp takes content of any size). The controller also sees the gap since
+//    the session's previous frame was handed back, and charges it when it is a hand-off (frames
+//    back to back: the caller's encode and the next request), so that frames plus hand-offs meet
+//    the target (frame_time_controller.h).
 //  - Its own predicted cost map (FrameDispatcher stream = session), so sessions looking at
 //    different places do not mislead each other's PBT.
 //  - With `denoise`: every frame served with at most `denoise_max_spp` samples per pixel (moving
@@ -31,6 +34,7 @@
 // the session's state is left as it was (the failed frame is not accumulated).
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -72,6 +76,7 @@ struct LiveFrame {
     bool denoised = false;         // `image` is the filtered frame
     double seconds = 0.0;          // render + composite (+ accumulate, + denoise) on the admin, wall
     double denoise_seconds = 0.0;  // the filter's part of `seconds`
+    double gap_seconds = 0.0;      // since the session's previous frame was handed back (0: its first)
     FrameStats stats;
 };
 
@@ -100,6 +105,7 @@ private:
         std::optional<FrameTimeController> controller;
         GuideBuffers guides;  // of the accumulated view (denoise), or of the last frame
         std::uint64_t last_used = 0;
+        std::optional<std::chrono::steady_clock::time_point> handed_back;  // the previous render() returned
     };
     Session& session(std::uint64_t id);
     [[nodiscard]] ViewRequest plan(Session& s, const ViewRequest& request, FrameChoice& choice) const;

@@ -268,8 +268,8 @@ TEST_F(LiveFramesTest, StillViewIsDenoisedUpToDenoiseMaxSppWithTheFirstPassesGui
 }
 
 // The frame-time target sees the filter's time: a controller fed each frame's seconds (render +
-// filter) chooses exactly the scale LiveFrames renders next, and those seconds hold the source's
-// render and the filter one after the other.
+// filter) and the hand-off gap before it chooses exactly the scale LiveFrames renders next, and
+// those seconds hold the source's render and the filter one after the other.
 TEST_F(LiveFramesTest, FrameTimeTargetIsChargedTheFilterTime) {
     LiveOptions options;
     options.denoise = true;
@@ -286,7 +286,7 @@ TEST_F(LiveFramesTest, FrameTimeTargetIsChargedTheFilterTime) {
         ASSERT_TRUE(frame.denoised);
         EXPECT_GT(frame.denoise_seconds, 0.0);
         EXPECT_GE(frame.seconds, calls_.back().seconds + frame.denoise_seconds);
-        replica.observe(expected, frame.seconds);
+        replica.observe(expected, frame.seconds, frame.gap_seconds);
     }
 }
 

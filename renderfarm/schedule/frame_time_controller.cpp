@@ -29,6 +29,25 @@ FrameTimeController::FrameTimeController(FrameTimeTarget target) : target_(targe
     require(std::isfinite(target_.max_step) && target_.max_step >= 1, "max_step must be >= 1");
     require(target_.min_scale > 0 && target_.min_scale <= 1, "min_scale must be in (0, 1]");
     require(request_limits::kSpp.contains(target_.max_spp), "max_spp must be in " + request_limits::kSpp.text());
+    require(target_.jitter_weight >= 0 && target_.jitter_weight < 1, "jitter_weight must be in [0, 1)");
+    require(target_.min_aim > 0 && target_.min_aim <= 1, "min_aim must be in (0, 1]");
+    require(target_.headroom >= 0 && target_.headroom <= 1 - target_.min_aim, "headroom must be in [0, 1 - min_aim]");
+    require(target_.max_handoff >= 0 && target_.max_handoff < 1, "max_handoff must be in [0, 1)");
+}
+
+double FrameTimeController::charged_gap(double gap_seconds) const {
+    const bool handoff =
+        std::isfinite(gap_seconds) && gap_seconds > 0 && gap_seconds < target_.max_handoff * target_.target_seconds;
+    return handoff ? gap_seconds : 0.0;
+}
+
+double FrameTimeController::jitter_allowance() const {
+    if (!timed_ || arithmetic_ <= 0) return 1.0;
+    return std::min(1.0, std::exp(log_mean_) / arithmetic_);
+}
+
+double FrameTimeController::aim_seconds() const {
+    return target_.target_seconds * std::max(target_.min_aim, (1.0 - target_.headroom) * jitter_allowance());
 }
 
 FrameChoice FrameTimeController::choose(const ViewRequest& request) const {
@@ -47,13 +66,28 @@ FrameChoice FrameTimeController::choose(const ViewRequest& request) const {
     return choice;
 }
 
-void FrameTimeController::observe(const FrameChoice& used, double seconds) {
+void FrameTimeController::observe(const FrameChoice& used, double frame_seconds, double gap_seconds) {
     const double step = target_.max_step;
-    const double ratio =
-        (std::isfinite(seconds) && seconds > 0) ? std::clamp(target_.target_seconds / seconds, 1.0 / step, step) : step;
+    const bool timed = std::isfinite(frame_seconds) && frame_seconds > 0;
+    const double seconds = timed ? frame_seconds + charged_gap(gap_seconds) : frame_seconds;
+    const double wanted = timed ? aim_seconds() / seconds : step;
+    const double ratio = std::clamp(wanted, 1.0 / step, step);
+    if (timed && ratio == wanted) note_time(seconds);
     const double next = used.work() * std::pow(ratio, target_.gain);
     // Bounded so a long run of extreme frames cannot wind w up beyond what choose() can use.
     work_ = std::clamp(next, 1e-8, static_cast<double>(target_.max_spp) + 1.0);
+}
+
+void FrameTimeController::note_time(double seconds) {
+    const double a = target_.jitter_weight;
+    if (!timed_) {
+        log_mean_ = std::log(seconds);
+        arithmetic_ = seconds;
+        timed_ = true;
+        return;
+    }
+    log_mean_ += a * (std::log(seconds) - log_mean_);
+    arithmetic_ += a * (seconds - arithmetic_);
 }
 
 }  // namespace mogao

@@ -14,6 +14,30 @@
 // request_limits::kLinkImageSide.min pixels, and spp in [1, max_spp] (request_limits::kSpp).
 // The scale is spent first: spp (= round(w / scale^2)) rises above 1 only at the request's full scale.
 //
+// The rate served is frames over the SUM of their times, so it is the arithmetic mean frame time
+// that must meet the target. The step above drives the mean of log(measured) to log(aim), i.e. the
+// geometric mean; with frame-to-frame jitter the arithmetic mean is larger (the AM-GM inequality;
+// for log-normal times E[t] = exp(E[log t] + Var(log t) / 2)), and the rate falls short of
+// 1 / target (mogao_bench_serve showed it on the grotto). So the controller aims at
+//     aim = target * (1 - headroom) * G / A
+// where G and A are the geometric and arithmetic means of the recent measured times, exponentially
+// weighted alike (weight `jitter_weight` per frame): with the geometric mean at target * G / A, the
+// arithmetic one is at the target. G / A is measured, not modelled, so it holds for any
+// distribution of the jitter and includes what the damped step adds to it and any correlation
+// between frames. Frames whose step was clamped by max_step (a new view, a stall) are not jitter
+// and are left out; the aim never drops below `min_aim` * target. jitter_weight = 0 leaves G / A
+// out (the geometric mean at the aim, as before). `headroom` is a margin: even with G / A measured
+// exactly, the mean is only at the aim on average, and a rate measured over a few seconds (a hundred
+// frames or so) scatters by about 2 % around it; with a 2 % margin the rate a visitor gets stays
+// at or above 1 / target.
+//
+// A frame's share of the period is also the caller's hand-off after it (encoding on the pipeline,
+// queueing the next request), which the farm's own clock does not see. observe() takes the gap
+// between the session's previous frame and this one: a gap shorter than `max_handoff` * target
+// (the caller turned round at once, frames back to back) is charged to this frame; a longer one is
+// the appliance's own pace (a 10 Hz kiosk leaves the farm idle between requests) and is not.
+// max_handoff = 0 charges nothing.
+//
 // Units: seconds. Errors: the constructor throws std::invalid_argument naming a bad field.
 #pragma once
 
@@ -27,6 +51,10 @@ struct FrameTimeTarget {
     double max_step = 4.0;               // >= 1: largest change of w in one frame (factor)
     double min_scale = 0.2;              // (0, 1]
     int max_spp = 16;                    // in request_limits::kSpp
+    double jitter_weight = 0.1;          // [0, 1): weight of a frame in the jitter's variance (0 = off)
+    double headroom = 0.02;              // [0, 1 - min_aim]: margin below the target (see above)
+    double min_aim = 0.8;                // (0, 1]: the aim never drops below min_aim * target_seconds
+    double max_handoff = 0.25;           // [0, 1): longest gap charged, as a fraction of target_seconds
 };
 
 struct FrameChoice {
@@ -42,15 +70,28 @@ public:
     // Scale and spp for the next frame of `request` (its size and resolution_scale bound the scale).
     // The first call, before any observe(), returns the request's own scale and spp (clamped).
     [[nodiscard]] FrameChoice choose(const ViewRequest& request) const;
-    // The frame rendered with `used` took `seconds` (>= 0; NaN and negatives count as 0).
-    void observe(const FrameChoice& used, double seconds);
+    // The frame rendered with `used` took `seconds` (>= 0; NaN and negatives count as 0), and came
+    // `gap_seconds` after the session's previous frame was handed back (see above; NaN, negatives and
+    // gaps of max_handoff * target or more are not charged).
+    void observe(const FrameChoice& used, double seconds, double gap_seconds = 0.0);
+    // The gap observe() charges to a frame: `gap_seconds` when it is a hand-off, else 0.
+    [[nodiscard]] double charged_gap(double gap_seconds) const;
 
     [[nodiscard]] double work() const { return work_; }  // < 0 before the first observe()
+    // Seconds the next frame aims at: target_seconds less the headroom and the jitter's allowance.
+    [[nodiscard]] double aim_seconds() const;
+    // G / A of the recent unclamped frames (see above): 1 without jitter, and before the first one.
+    [[nodiscard]] double jitter_allowance() const;
     [[nodiscard]] const FrameTimeTarget& target() const { return target_; }
 
 private:
+    void note_time(double seconds);
+
     FrameTimeTarget target_;
     double work_ = -1.0;
+    bool timed_ = false;       // the means hold a first sample
+    double log_mean_ = 0.0;    // EWMA of log(measured): log G
+    double arithmetic_ = 0.0;  // EWMA of measured: A
 };
 
 }  // namespace mogao
