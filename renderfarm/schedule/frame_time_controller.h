@@ -51,7 +51,7 @@ struct FrameTimeTarget {
     double max_step = 4.0;               // >= 1: largest change of w in one frame (factor)
     double min_scale = 0.2;              // (0, 1]
     int max_spp = 16;                    // in request_limits::kSpp
-    double jitter_weight = 0.1;          // [0, 1): weight of a frame in the jitter's variance (0 = off)
+    double jitter_weight = 0.1;          // [0, 1): weight of a frame in the means G and A (0 = off)
     double headroom = 0.02;              // [0, 1 - min_aim]: margin below the target (see above)
     double min_aim = 0.8;                // (0, 1]: the aim never drops below min_aim * target_seconds
     double max_handoff = 0.25;           // [0, 1): longest gap charged, as a fraction of target_seconds
