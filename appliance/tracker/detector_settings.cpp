@@ -29,6 +29,7 @@ void validate(const DetectorSettings& s) {
     check_range("max_line_fit_mse", s.max_line_fit_mse, 0.1f, 1000.0f);
     if (s.coarse_pass_decimation != 0.0f) check_range("coarse_pass_decimation", s.coarse_pass_decimation, 1.5f, 8.0f);
     if (s.upsample_pass_factor != 0) check_range("upsample_pass_factor", s.upsample_pass_factor, 2, 4);
+    check_range("upsample_pass_sharpening", s.upsample_pass_sharpening, 0.0, 1.0);
     check_range("upsample_pass_max_pixels", s.upsample_pass_max_pixels, 0, 64 * 1024 * 1024);
 }
 

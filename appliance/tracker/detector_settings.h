@@ -58,16 +58,26 @@ struct DetectorSettings {
     // INTER_CUBIC), then searched and decoded there, so that a small tag's edges span whole
     // threshold tiles (AprilTag's are 4 px) and its bits are sampled between the blurred cells'
     // centres. Corners are scaled back (pixel centres stay at +0.5: the factor maps the image's
-    // corner (0, 0) to itself). Its tags not found by the earlier passes are added. On synthetic
-    // 10-12 px tags it doubles the tags found (x2; x3 adds a few more 8-10 px tags at 1.6x the
-    // time), with no wrong id; on the real photographs it finds one more tag
-    // (docs/tracking.md, "Small tags", mogao_small_tag_study). TagTracker never runs it.
-    // 0 = none, or [2, 4].
-    int upsample_pass_factor = 2;
+    // corner (0, 0) to itself). Its tags not found by the earlier passes are added. x3 with its
+    // own sharpening at 1 (below): on synthetic 10 px tags it finds about twice what x2 at the
+    // single passes' sharpening found (17 against 10 of 30; 12 px: 28 against 27), with no wrong
+    // id on tags or on empty frames, at about 1.5x that setting's time; on the real photographs it
+    // finds two more tags than no up-sampled search, a 12 px sign and a 10 px tag in a dark corner
+    // that x2 misses (its id checked independently: code_ranking.h). docs/tracking.md, "Small
+    // tags" and "Real photographs" (mogao_small_tag_study, mogao_tracking_eval real). TagTracker
+    // never runs it. 0 = none, or [2, 4].
+    int upsample_pass_factor = 3;
     // The up-sampled search runs only on images of at most this many pixels (before up-sampling):
     // it costs about 3x (x2) the rest of detect() on such frames, and small tags are what camera
     // frames (640x480, 800x600) lose, not multi-megapixel photographs. [0, 67108864].
     int upsample_pass_max_pixels = 800 * 600;
+    // decode_sharpening in the up-sampled search only. Interpolation spreads each cell's value over
+    // its neighbours (the bicubic kernel's support is 4 source pixels, a whole cell of a 10-px
+    // tag), which is what AprilTag's decode sharpening (a 3x3 Laplacian subtracted from the
+    // sampled bit grid, apriltag.c) undoes; at the single passes' 0.25 the tiny tags decode with
+    // more corrected bits and smaller margins (the 12 px sign of the real set: 2 bits corrected at
+    // 0.25, none at 1). [0, 1].
+    double upsample_pass_sharpening = 1.0;
     // Worker threads of the detector. 1 on the appliance (the other core renders). [1, 64].
     int threads = 1;
 };

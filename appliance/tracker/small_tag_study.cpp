@@ -114,19 +114,25 @@ int main(int argc, char** argv) {
 
     DetectorSettings without;
     without.upsample_pass_factor = 0;
-    std::vector<std::pair<const char*, DetectorSettings>> settings = {{"without (coarse pass only)", without}};
-    for (int k : {2, 3, 4}) {
+    std::vector<std::pair<std::string, DetectorSettings>> settings = {{"without (coarse pass only)", without}};
+    const DetectorSettings defaults;
+    for (const auto& [factor, sharpening] : {std::pair{2, 0.25}, {2, 1.0}, {3, 0.25}, {3, 1.0}, {4, 1.0}}) {
         DetectorSettings s;
-        s.upsample_pass_factor = k;
-        settings.emplace_back(k == 2 ? "up-sampled x2 (default)" : (k == 3 ? "up-sampled x3" : "up-sampled x4"), s);
+        s.upsample_pass_factor = factor;
+        s.upsample_pass_sharpening = sharpening;
+        const bool is_default =
+            factor == defaults.upsample_pass_factor && sharpening == defaults.upsample_pass_sharpening;
+        char name[64];
+        std::snprintf(name, sizeof name, "x%d, sharpening %.2g%s", factor, sharpening, is_default ? " (default)" : "");
+        settings.emplace_back(name, s);
     }
     std::vector<TagDetector> detectors;
     for (const auto& [name, s] : settings) detectors.emplace_back(s);
     const TagFamily family("tag36h11");
 
     std::printf("| tag width (px) | frames |");
-    for (const auto& [name, s] : settings) std::printf(" %s: correct, wrong |", name);
-    std::printf(" time x2, x3, x4 / without |\n|--:|--:|");
+    for (const auto& [name, s] : settings) std::printf(" %s: correct, wrong |", name.c_str());
+    std::printf(" time of each up-sampled setting / without |\n|--:|--:|");
     for (std::size_t k = 0; k < settings.size(); ++k) std::printf("--:|");
     std::printf("--:|\n");
     std::vector<Tally> overall(settings.size());
@@ -146,13 +152,14 @@ int main(int argc, char** argv) {
         if (width > 0.0) std::printf("| %.0f | %d |", width, frames);
         else std::printf("| no tag | %d |", frames);
         for (const auto& t : row) std::printf(" %d, %d |", t.correct, t.wrong);
-        std::printf(" %.1f, %.1f, %.1f |\n", row[1].ms / row[0].ms, row[2].ms / row[0].ms, row[3].ms / row[0].ms);
+        for (std::size_t k = 1; k < row.size(); ++k) std::printf("%s%.1f", k == 1 ? " " : ", ", row[k].ms / row[0].ms);
+        std::printf(" |\n");
     }
     std::printf("\nDecision margins (AprilTag's): ");
     for (std::size_t k = 0; k < settings.size(); ++k) {
         const std::string wrong =
             overall[k].wrong > 0 ? "highest " + fmt_margin(overall[k].max_wrong_margin) : std::string("none");
-        std::printf("%s: lowest correct %.1f, wrong %s; ", settings[k].first, overall[k].min_correct_margin,
+        std::printf("%s: lowest correct %.1f, wrong %s; ", settings[k].first.c_str(), overall[k].min_correct_margin,
                     wrong.c_str());
     }
     std::printf("\n");

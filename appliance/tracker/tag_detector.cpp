@@ -103,12 +103,13 @@ std::vector<TagDetection> TagDetector::detect(const GrayImage& image, Passes pas
     std::vector<TagDetection> out = detect_once(image);
     if (passes == Passes::single || settings_.decimation > 1.0f) return out;
     if (settings_.coarse_pass_decimation != 0.0f)
-        add_unseen(out, detect_with_quad_search(image, settings_.coarse_pass_decimation));
+        add_unseen(out, detect_with_quad_search(image, settings_.coarse_pass_decimation, settings_.decode_sharpening));
     const auto pixels = static_cast<std::int64_t>(image.width) * image.height;
     const int factor = settings_.upsample_pass_factor;
     if (factor != 0 && pixels <= settings_.upsample_pass_max_pixels &&
         std::max(image.width, image.height) * factor <= kMaxCaptureDimension) {
-        std::vector<TagDetection> small = detect_with_quad_search(upsampled(image, factor), 1.0f);
+        std::vector<TagDetection> small =
+            detect_with_quad_search(upsampled(image, factor), 1.0f, settings_.upsample_pass_sharpening);
         for (auto& d : small) {
             for (auto& c : d.corners) c /= factor;
             d.centre /= factor;
@@ -119,20 +120,25 @@ std::vector<TagDetection> TagDetector::detect(const GrayImage& image, Passes pas
     return out;
 }
 
-std::vector<TagDetection> TagDetector::detect_with_quad_search(const GrayImage& image, float decimation) {
+std::vector<TagDetection> TagDetector::detect_with_quad_search(const GrayImage& image, float decimation,
+                                                               double decode_sharpening) {
     apriltag_detector* detector = engine_->detector.get();
+    const auto restore = [&] {
+        detector->quad_decimate = settings_.decimation;
+        detector->quad_sigma = settings_.blur_sigma;
+        detector->decode_sharpening = settings_.decode_sharpening;
+    };
     detector->quad_decimate = decimation;
     detector->quad_sigma = 0.0f;
+    detector->decode_sharpening = decode_sharpening;
     std::vector<TagDetection> found;
     try {
         found = detect_once(image);
     } catch (...) {
-        detector->quad_decimate = settings_.decimation;
-        detector->quad_sigma = settings_.blur_sigma;
+        restore();
         throw;
     }
-    detector->quad_decimate = settings_.decimation;
-    detector->quad_sigma = settings_.blur_sigma;
+    restore();
     return found;
 }
 

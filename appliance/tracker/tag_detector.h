@@ -71,8 +71,10 @@ public:
 
 private:
     std::vector<TagDetection> detect_once(const GrayImage& image);
-    // detect_once with the quad search at `decimation` and no blur; the settings' own are restored.
-    std::vector<TagDetection> detect_with_quad_search(const GrayImage& image, float decimation);
+    // detect_once with the quad search at `decimation`, no blur and `decode_sharpening`; the
+    // settings' own are restored.
+    std::vector<TagDetection> detect_with_quad_search(const GrayImage& image, float decimation,
+                                                      double decode_sharpening);
     // The family and the detector that hangs its decode tables on it, together on the heap: the
     // family's address must not change while the detector uses it, and the detector must be
     // destroyed before the family (tag_detector.cpp). As one pointer they also move and are

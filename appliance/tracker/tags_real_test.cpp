@@ -9,18 +9,20 @@
 
 #include <filesystem>
 
+#include "appliance/tracker/code_ranking.h"
 #include "appliance/tracker/tag_detector.h"
 #include "drivers/camera/image_file.h"
 
 namespace mogao {
 namespace {
 
-// Achieved by the defaults when they were chosen (docs/tracking.md, "Real photographs"), less a
-// margin of one tag on the issue's set (44 of 47 with the coarse and up-sampled passes) and of about
-// four tags on the whole set (228 of 271, no false positive; AprilTag's stock settings find 215
-// with 2 false tags in the tag16h5 photograph, 78.6 %); the issue's goal (95 %) is not met on the
-// far half of the oblique sheet and the tiny or cut distant tags (the doc says which).
-constexpr double kMinRateIssueSet = 43.0 / 47.0;
+// The issue's goal on its 47 tags (issue 15: >= 95 %, i.e. 45): the defaults find 45 with no
+// false positive (docs/tracking.md, "Real photographs"); the two left are a ~9 px sign and a
+// ~20x10 px tag seen edge-on, which nothing decodes. On the whole set the defaults find 229 of 271
+// (84.5 %, no false positive; AprilTag's stock settings find 215 with 2 false tags in the tag16h5
+// photograph), less a margin of about six tags; the far half of the oblique sheet is what they
+// miss there (the doc says which).
+constexpr double kMinRateIssueSet = 0.95;
 constexpr double kMinRateAll = 0.82;
 constexpr double kMaxMedianCornerErrorPx = 0.6;
 
@@ -49,6 +51,31 @@ TEST(TagsReal, DefaultsFindTheTagsWithAccurateCorners) {
     EXPECT_LE(all.median_corner_error_px(), kMaxMedianCornerErrorPx);
     EXPECT_LE(issue.median_corner_error_px(), kMaxMedianCornerErrorPx);
     EXPECT_GT(all.corner_errors_px.size(), 400u);  // the reference covers most found tags
+}
+
+// The correlation check that confirmed the hand-labelled id of the dark-corner tag (code_ranking.h,
+// tags_real_manifest.json) agrees with ArUco on the real tags ArUco finds: at the reference's
+// corners, the referenced id ranks first (in some rotation: ArUco's first corner may differ from
+// AprilTag's) and never mirrored, for every one of them.
+TEST(TagsReal, CorrelationRanksArucosIdsFirst) {
+    const auto data = tags_real_dir(MOGAO_TAGS_REAL_DIR);
+    if (!std::filesystem::exists(data))
+        GTEST_SKIP() << "real tag photographs not found at " << data << " (../shared/data/tags-real)";
+    const auto truth =
+        read_real_truth(std::filesystem::path(MOGAO_SOURCE_DIR) / "appliance/tracker/tags_real_truth.json");
+    int checked = 0;
+    for (const auto& t : truth) {
+        const auto image = read_gray_image(data / t.file);
+        ASSERT_TRUE(image) << image.error().message;
+        const TagFamily family(t.family);
+        for (const auto& ref : t.reference) {
+            const auto ranked = rank_codes(*image, ref.corners, family);
+            EXPECT_EQ(ranked.front().id, ref.id) << t.file << " at (" << ref.corners[0].transpose() << ")";
+            EXPECT_FALSE(ranked.front().mirrored) << t.file << " tag " << ref.id;
+            ++checked;
+        }
+    }
+    EXPECT_GT(checked, 100);
 }
 
 TEST(TagsReal, ScoringCountsWrongIdsAndDuplicatesAgainstTheDetector) {

@@ -39,6 +39,19 @@ struct ReferenceOptions {
 };
 int run_reference(const ReferenceOptions& options);
 
+// rank-codes: the independent check of one decoded id (code_ranking.h). The detector defaults find
+// the tag with that id in the image; every code is then ranked by correlation with its cells.
+// Prints the best hypotheses, the best other id and the best mirrored one (chance). Exit 1 when
+// the detector does not find the id.
+struct RankCodesOptions {
+    std::filesystem::path data;  // the tags-real folder
+    std::string image;           // a file in it
+    int id = 0;
+    std::string family = "tag36h11";
+    int top = 5;
+};
+int run_rank_codes(const RankCodesOptions& options);
+
 struct RoiOptions {
     double seconds = 12.0;  // of the hand-held sequence (hand_sequence.h), 30 fps, 800x600
     int repeat = 3;         // timing: fastest of this many passes per frame

@@ -29,6 +29,15 @@ int main(int argc, char** argv) {
     f->add_option("--data", ref.data, "tags-real folder")->capture_default_str();
     f->add_option("--out", ref.out, "truth file to write")->capture_default_str();
 
+    mogao::eval::RankCodesOptions rank;
+    rank.data = data_default;
+    auto* k = app.add_subcommand("rank-codes", "independent check of a decoded id: every code ranked by correlation");
+    k->add_option("--data", rank.data, "tags-real folder")->capture_default_str();
+    k->add_option("--image", rank.image, "image file in the folder")->required();
+    k->add_option("--id", rank.id, "the decoded id to check")->required()->check(CLI::Range(0, 100000));
+    k->add_option("--family", rank.family, "tag family")->capture_default_str();
+    k->add_option("--top", rank.top, "hypotheses to print")->check(CLI::Range(1, 100))->capture_default_str();
+
     mogao::eval::RoiOptions roi;
     auto* o = app.add_subcommand("roi", "ROI tracking against full-frame detection on the hand-held sequence");
     o->add_option("--seconds", roi.seconds, "sequence length")->check(CLI::Range(0.5, 60.0))->capture_default_str();
@@ -69,13 +78,15 @@ int main(int argc, char** argv) {
         return code == 0 ? 0 : 2;
     }
     try {
-        if ((*r && !std::filesystem::exists(real.data)) || (*f && !std::filesystem::exists(ref.data))) {
+        const std::filesystem::path& needed = *r ? real.data : (*f ? ref.data : rank.data);
+        if ((*r || *f || *k) && !std::filesystem::exists(needed)) {
             std::fprintf(stderr, "mogao_tracking_eval: real photographs not found at %s (../shared/data/tags-real)\n",
-                         (*r ? real.data : ref.data).c_str());
+                         needed.c_str());
             return 77;
         }
         if (*r) return mogao::eval::run_real(real);
         if (*f) return mogao::eval::run_reference(ref);
+        if (*k) return mogao::eval::run_rank_codes(rank);
         if (*o) return mogao::eval::run_roi(roi);
         if (*d) return mogao::eval::run_grotto_develop(develop);
         if (*g) return mogao::eval::run_grotto(grotto);
