@@ -49,6 +49,11 @@ struct RankCodesOptions {
     int id = 0;
     std::string family = "tag36h11";
     int top = 5;
+    // Robustness: the ranking is repeated with every corner moved by a uniform random offset of
+    // up to +/- jitter_px in x and y, `trials` times; the count of trials where the id stays first
+    // is printed.
+    double jitter_px = 0.5;
+    int trials = 100;
 };
 int run_rank_codes(const RankCodesOptions& options);
 

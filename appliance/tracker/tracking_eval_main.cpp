@@ -37,6 +37,10 @@ int main(int argc, char** argv) {
     k->add_option("--id", rank.id, "the decoded id to check")->required()->check(CLI::Range(0, 100000));
     k->add_option("--family", rank.family, "tag family")->capture_default_str();
     k->add_option("--top", rank.top, "hypotheses to print")->check(CLI::Range(1, 100))->capture_default_str();
+    k->add_option("--jitter-px", rank.jitter_px, "corner offsets of the robustness trials")
+        ->check(CLI::Range(0.0, 5.0))
+        ->capture_default_str();
+    k->add_option("--trials", rank.trials, "robustness trials")->check(CLI::Range(0, 10000))->capture_default_str();
 
     mogao::eval::RoiOptions roi;
     auto* o = app.add_subcommand("roi", "ROI tracking against full-frame detection on the hand-held sequence");

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <random>
 #include <set>
 #include <string>
 #include <utility>
@@ -164,6 +165,17 @@ int run_rank_codes(const RankCodesOptions& options) {
                     ? "first, unrotated"
                     : "NOT first",
                 other->id, other->correlation, mirrored->correlation);
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<double> offset(-options.jitter_px, options.jitter_px);
+    int first = 0;
+    for (int trial = 0; trial < options.trials; ++trial) {
+        TagCorners moved = it->corners;
+        for (auto& c : moved) c += Eigen::Vector2d(offset(rng), offset(rng));
+        const auto again = rank_codes(*image, moved, detector.family());
+        if (again.front().id == options.id && !again.front().mirrored) ++first;
+    }
+    std::printf("with every corner moved by up to +/-%.2g px: first in %d of %d trials\n", options.jitter_px, first,
+                options.trials);
     return 0;
 }
 
