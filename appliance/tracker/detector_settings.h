@@ -61,7 +61,7 @@ struct DetectorSettings {
     // corner (0, 0) to itself). Its tags not found by the earlier passes are added. x3 with its
     // own sharpening at 1 (below): on synthetic 10 px tags it finds about twice what x2 at the
     // single passes' sharpening found (17 against 10 of 30; 12 px: 28 against 27), with no wrong
-    // id on tags or on empty frames, at about 1.5x that setting's time; on the real photographs it
+    // id on tags or on empty frames, at about 1.4x that setting's time; on the real photographs it
     // finds two more tags than no up-sampled search, a 12 px sign and a 10 px tag in a dark corner
     // that x2 misses (its id checked independently: code_ranking.h). docs/tracking.md, "Small
     // tags" and "Real photographs" (mogao_small_tag_study, mogao_tracking_eval real). TagTracker

@@ -192,6 +192,16 @@ TEST(TagDetector, BadSettingsAndImagesNameTheProblem) {
     EXPECT_NO_THROW(TagDetector{s});
     s.max_line_fit_mse = 0.0f;
     EXPECT_THROW(TagDetector{s}, std::invalid_argument);
+    s = {};
+    s.upsample_pass_sharpening = 1.5;
+    try {
+        TagDetector d(s);
+        FAIL() << "expected invalid_argument";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("DetectorSettings.upsample_pass_sharpening = 1.5 outside [0, 1]"),
+                  std::string::npos)
+            << e.what();
+    }
 
     TagDetector detector;
     GrayImage broken(10, 10);
@@ -257,6 +267,27 @@ TEST(TagDetector, UpsampledPassFindsTinyTagsTheOtherPassesMiss) {
     }
     EXPECT_GE(found_with, found_without + 3) << "with " << found_with << ", without " << found_without;
     EXPECT_EQ(found_limited, found_without);
+}
+
+// The up-sampled search decodes with its own sharpening, then gives the detector its own back: a
+// single pass after a full detect() decodes exactly as on a fresh detector (decision margins depend
+// on the sharpening).
+TEST(TagDetector, UpsampledPassRestoresTheDecodeSharpening) {
+    DetectorSettings s;
+    s.decode_sharpening = 0.0;
+    s.upsample_pass_sharpening = 1.0;
+    TagDetector used(s), fresh(s);
+    const CameraIntrinsics camera = ideal_camera(640, 480, 500.0);
+    RenderEffects fx;
+    fx.noise_sigma = 2.0;
+    const GrayImage image = render_target(tag_target(make_tag_bitmap(used.family(), 5), 0.1),
+                                          tag_pose_facing_camera(1.5, 20.0, -10.0, 0.0, 0.0, 0.0), camera, fx);
+    ASSERT_FALSE(used.detect(image).empty());
+    const auto after = used.detect(image, TagDetector::Passes::single);
+    const auto reference = fresh.detect(image, TagDetector::Passes::single);
+    ASSERT_EQ(after.size(), 1u);
+    ASSERT_EQ(reference.size(), 1u);
+    EXPECT_EQ(after[0].decision_margin, reference[0].decision_margin);
 }
 
 }  // namespace
