@@ -368,7 +368,7 @@ ControlSetting read_control_setting(const Section& s, std::string_view key, Cont
 
 // The camera control keys of a live camera (CameraControls, drivers/camera/camera_controls.h).
 void read_camera_controls(const Section& s, CameraSourceSpec& source) {
-    // A short exposure by default: 8 ms keeps a hand moving at 1 m/s within 8 mm of blur.
+    // A short exposure by default (kDefaultExposureUs): a hand moving at 1 m/s blurs by 2 mm.
     const ControlSetting short_exposure{ControlSetting::Mode::manual, kDefaultExposureUs, false, ""};
     source.controls.exposure = read_control_setting(
         s, "camera_exposure_us", short_exposure, [](double x) { return x > 0 && x <= 1e6; }, "(0, 1e6] us");
