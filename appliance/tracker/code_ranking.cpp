@@ -45,20 +45,37 @@ std::vector<double> data_cell_means(const GrayImage& image, const TagCorners& co
     return means;
 }
 
-double pearson(const std::vector<double>& a, const std::vector<double>& b) {
-    const double n = static_cast<double>(a.size());
-    double ma = 0, mb = 0;
-    for (std::size_t i = 0; i < a.size(); ++i) {
-        ma += a[i] / n;
-        mb += b[i] / n;
+// Cell index maps of the 8 hypotheses' orientations: orientation[o][y * inner + x] is the cell of
+// the printed code seen at (x, y); o = 4 * mirrored + quarter turns.
+std::vector<std::vector<int>> orientations(int inner) {
+    std::vector<std::vector<int>> out;
+    for (int mirrored = 0; mirrored < 2; ++mirrored) {
+        for (int rotation = 0; rotation < 4; ++rotation) {
+            std::vector<int> map;
+            for (int y = 0; y < inner; ++y) {
+                for (int x = 0; x < inner; ++x) {
+                    int u = mirrored ? inner - 1 - x : x, v = y;
+                    for (int q = 0; q < rotation; ++q) std::tie(u, v) = std::pair{inner - 1 - v, u};
+                    map.push_back(v * inner + u);
+                }
+            }
+            out.push_back(std::move(map));
+        }
     }
-    double sab = 0, saa = 0, sbb = 0;
-    for (std::size_t i = 0; i < a.size(); ++i) {
-        sab += (a[i] - ma) * (b[i] - mb);
-        saa += (a[i] - ma) * (a[i] - ma);
-        sbb += (b[i] - mb) * (b[i] - mb);
+    return out;
+}
+
+// `values` less their mean, scaled to unit norm (all zeros when they are constant): Pearson's
+// correlation of two such vectors is their dot product.
+std::vector<double> standardised(std::vector<double> values) {
+    double mean = 0, norm = 0;
+    for (double v : values) mean += v / static_cast<double>(values.size());
+    for (double& v : values) {
+        v -= mean;
+        norm += v * v;
     }
-    return saa > 0 && sbb > 0 ? sab / std::sqrt(saa * sbb) : 0.0;
+    for (double& v : values) v = norm > 0 ? v / std::sqrt(norm) : 0.0;
+    return values;
 }
 
 }  // namespace
@@ -71,25 +88,25 @@ std::vector<CodeMatch> rank_codes(const GrayImage& image, const TagCorners& corn
         if (!a.allFinite()) throw std::invalid_argument("rank_codes: a corner is not finite");
         if ((a - b).norm() < 4.0) throw std::invalid_argument("rank_codes: a quad side is under 4 px");
     }
-    const std::vector<double> means = data_cell_means(image, corners, family);
+    const std::vector<double> means = standardised(data_cell_means(image, corners, family));
     const int border = family.border_width_cells();
     const int inner = border - 2;
     const int first = (family.total_width_cells() - border) / 2 + 1;
+    const auto maps = orientations(inner);
     std::vector<CodeMatch> out;
-    std::vector<double> pattern(means.size());
+    std::vector<double> cells(means.size()), pattern(means.size());
     for (int id = 0; id < family.code_count(); ++id) {
         const TagBitmap bitmap = make_tag_bitmap(family, id);
-        for (int mirrored = 0; mirrored < 2; ++mirrored) {
-            for (int rotation = 0; rotation < 4; ++rotation) {
-                for (int y = 0; y < inner; ++y) {
-                    for (int x = 0; x < inner; ++x) {
-                        int u = mirrored ? inner - 1 - x : x, v = y;  // cell of the printed code seen at (x, y)
-                        for (int q = 0; q < rotation; ++q) std::tie(u, v) = std::pair{inner - 1 - v, u};
-                        pattern[static_cast<std::size_t>(y * inner + x)] = bitmap.at(first + u, first + v) / 255.0;
-                    }
-                }
-                out.push_back({id, rotation, mirrored == 1, pearson(means, pattern)});
-            }
+        for (int v = 0; v < inner; ++v) {
+            for (int u = 0; u < inner; ++u)
+                cells[static_cast<std::size_t>(v * inner + u)] = bitmap.at(first + u, first + v);
+        }
+        for (std::size_t o = 0; o < maps.size(); ++o) {
+            for (std::size_t i = 0; i < pattern.size(); ++i) pattern[i] = cells[static_cast<std::size_t>(maps[o][i])];
+            const std::vector<double> code = standardised(pattern);
+            double correlation = 0;
+            for (std::size_t i = 0; i < code.size(); ++i) correlation += code[i] * means[i];
+            out.push_back({id, static_cast<int>(o % 4), o >= 4, correlation});
         }
     }
     std::stable_sort(out.begin(), out.end(),
