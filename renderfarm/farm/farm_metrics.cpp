@@ -71,6 +71,19 @@ std::string FarmMetrics::text(const FarmCounters& c) const {
     counter(out, "sessions_refused_total", "sessions refused: IPv4, not allowed, revoked, over a cap",
             l.sessions_refused);
     counter(out, "sessions_revoked_total", "open sessions ended by a revocation", l.sessions_revoked);
+    const ConnectionGuardStats& k = l.connections;
+    gauge(out, "connections_open", "TCP connections open now (connection_guard.h)", static_cast<double>(k.open));
+    gauge(out, "connections_unauthenticated", "open connections without an admitted session (TLS handshakes included)",
+          static_cast<double>(k.unauthenticated));
+    counter(out, "connections_accepted_total", "TCP connections handed to gRPC", k.accepted);
+    out +=
+        "# HELP mogao_farm_connections_refused_total TCP connections closed before any TLS, by the cap they were over\n"
+        "# TYPE mogao_farm_connections_refused_total counter\n";
+    for (const auto& [cap, n] :
+         {std::pair{"max_connections", k.refused_open}, std::pair{"max_unauthenticated", k.refused_unauthenticated},
+          std::pair{"max_unauthenticated_per_address", k.refused_per_address}})
+        fmt::format_to(std::back_inserter(out), "mogao_farm_connections_refused_total{{cap=\"{}\"}} {}\n", cap, n);
+    counter(out, "connections_aged_out_total", "connections shut down for opening no session in time", k.aged_out);
     counter(out, "requests_received_total", "valid view requests read", l.requests_received);
     counter(out, "requests_invalid_total", "view requests refused by validation", l.requests_invalid);
     counter(out, "requests_dropped_total", "stale view requests dropped by the link", l.requests_dropped);

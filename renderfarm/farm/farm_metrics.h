@@ -10,6 +10,9 @@
 //   balance_efficiency (last frame, mean/max rank time)  rays_per_second (last frame)
 //   rank_render_seconds{rank="N"} (last frame, MPI rank) render_ranks
 //   sessions_active, sessions_opened_total, sessions_refused_total, sessions_revoked_total
+//   connections_open, connections_unauthenticated, connections_accepted_total,
+//   connections_refused_total{cap="max_connections|max_unauthenticated|max_unauthenticated_per_address"},
+//   connections_aged_out_total (renderfarm/link/connection_guard.h)
 //   requests_received_total, requests_invalid_total, requests_dropped_total,
 //   requests_superseded_total, requests_degraded_total (request_policy.h), render_failures_total
 //   frames_sent_total, jpeg_bytes_sent_total, last_frame_timestamp_seconds (Unix time)

@@ -40,6 +40,8 @@ FarmCounters counters() {
     c.link.requests_invalid = 1;
     c.link.frames_sent = 37;
     c.link.jpeg_bytes_sent = 123456789;
+    c.link.connections.open = 3;
+    c.link.connections.refused_per_address = 7;
     c.degraded = 3;
     c.superseded = 5;
     c.render_ranks = 2;
@@ -77,6 +79,9 @@ TEST(FarmMetrics, ExpositionTextHasEveryFamilyWithItsTypeAndValue) {
     EXPECT_EQ(s.at("mogao_farm_rank_render_seconds{rank=\"2\"}"), "0.3");
     EXPECT_EQ(s.at("mogao_farm_requests_degraded_total"), "3");
     EXPECT_EQ(s.at("mogao_farm_jpeg_bytes_sent_total"), "123456789");
+    EXPECT_EQ(s.at("mogao_farm_connections_open"), "3");
+    EXPECT_EQ(s.at("mogao_farm_connections_refused_total{cap=\"max_unauthenticated_per_address\"}"), "7");
+    EXPECT_EQ(s.at("mogao_farm_connections_refused_total{cap=\"max_connections\"}"), "0");
     EXPECT_NE(text.find("# TYPE mogao_farm_frames_total counter"), std::string::npos);
     EXPECT_NE(text.find("# TYPE mogao_farm_balance_efficiency gauge"), std::string::npos);
 }

@@ -26,6 +26,7 @@
 #include "renderfarm/farm/mpi_session.h"
 #include "renderfarm/farm/path_tour.h"
 #include "renderfarm/farm/serve.h"
+#include "renderfarm/farm/view_policy_file.h"
 #include "renderfarm/link/pki.h"
 #include "renderfarm/link/tls_material.h"
 
@@ -126,7 +127,8 @@ void add_render_flags(CLI::App& render, mogao::PathTour& job, CameraFlags& camer
 }
 
 // Which views appliances may have (view_policy.h).
-void add_view_policy_flags(CLI::App& serve, mogao::ViewPolicy& policy, std::vector<double>& screen) {
+void add_view_policy_flags(CLI::App& serve, mogao::ViewPolicy& policy, std::vector<double>& screen,
+                           std::filesystem::path& policy_file) {
     serve.add_flag("--visitable-area,!--no-visitable-area", policy.visitable_area,
                    "Move each requested eye into the scene's viewer.visitable area (default, when the scene has one)");
     serve
@@ -139,6 +141,11 @@ void add_view_policy_flags(CLI::App& serve, mogao::ViewPolicy& policy, std::vect
         .add_option("--view-max-guard-deg", policy.max_guard_deg,
                     "Arc allowed beyond the screen's on each side (the kiosk's late-warp guard band)")
         ->check(CLI::Range(0.0, 179.999));
+    serve
+        .add_option("--view-policy", policy_file,
+                    "JSON file of per-appliance view policies (screen, max_size, ...; docs/services.md); listed "
+                    "certificates get their entry, the others the --view-* flags")
+        ->check(CLI::ExistingFile);
     serve
         .add_option("--view-min-fov-deg", policy.min_fov_deg,
                     "Without --view-screen: narrower pinhole requests are widened to this (0 = off)")
@@ -167,6 +174,23 @@ void add_link_flags(CLI::App& serve, mogao::ServeOptions& serve_options, std::fi
         .add_option("--max-sessions-per-appliance", serve_options.link.max_sessions_per_appliance,
                     "Concurrent sessions of one appliance certificate")
         ->check(CLI::Range(1, 256));
+    mogao::ConnectionLimits& caps = serve_options.link.connections;
+    serve
+        .add_option("--max-connections", caps.max_connections,
+                    "Open TCP connections in all (docs/link.md, \"Connection caps\")")
+        ->check(CLI::Range(1, 65536));
+    serve
+        .add_option("--max-unauthenticated-connections", caps.max_unauthenticated,
+                    "Open connections without an admitted session (TLS handshakes in progress included)")
+        ->check(CLI::Range(1, 65536));
+    serve
+        .add_option("--max-unauthenticated-per-address", caps.max_unauthenticated_per_address,
+                    "Of those, from one source address")
+        ->check(CLI::Range(1, 65536));
+    serve
+        .add_option("--unauthenticated-max-age-s", caps.unauthenticated_max_age_s,
+                    "A connection that opened no session is closed after this many seconds")
+        ->check(CLI::Range(1.0, 3600.0));
     serve
         .add_option("--max-request-megapixels", serve_options.policy.max_megapixels,
                     "Rendered pixels per request, millions; a larger request is rendered at a lower resolution scale")
@@ -262,7 +286,8 @@ int main(int argc, char** argv) {
     add_live_flags(*serve, serve_options, frame_time_ms);
     add_quality_flag(*serve, serve_preset);
     std::vector<double> view_screen;
-    add_view_policy_flags(*serve, serve_options.view_policy, view_screen);
+    std::filesystem::path view_policy_file;
+    add_view_policy_flags(*serve, serve_options.view_policy, view_screen, view_policy_file);
     serve->add_option("--duration", serve_options.duration_s, "Stop after this many seconds (0 = until SIGTERM)")->check(CLI::Range(0.0, 1e9));
     try {
         app.parse(argc, argv);
@@ -289,6 +314,15 @@ int main(int argc, char** argv) {
         } catch (const std::invalid_argument& e) {
             if (mpi.is_admin()) spdlog::error("--view-screen / --view-*: {}", e.what());
             return 2;
+        }
+        if (!view_policy_file.empty()) {
+            try {
+                serve_options.appliance_view_policies =
+                    mogao::read_view_policies(view_policy_file, serve_options.view_policy).appliances;
+            } catch (const std::exception& e) {
+                if (mpi.is_admin()) spdlog::error("--view-policy: {}", e.what());
+                return 2;
+            }
         }
     }
     if (serve->parsed()) {

@@ -15,7 +15,7 @@
 #include "common/service_notify.h"
 #include "renderfarm/farm/farm_metrics.h"
 #include "renderfarm/farm/main_thread_queue.h"
-#include "renderfarm/farm/request_policy.h"
+#include "renderfarm/farm/policy_gate.h"
 
 namespace mogao {
 namespace {
@@ -58,50 +58,6 @@ void log_stats(const LinkServer& server, const MainThreadQueue<ServedFrame>& que
         s.requests_invalid, degraded, static_cast<double>(s.jpeg_bytes_sent) / 1e6);
 }
 
-// The view policy (view_policy.h), then the request policy (request_policy.h); each change is
-// logged once per session and change of decision.
-class PolicyGate {
-public:
-    PolicyGate(const Scene& scene, RequestPolicy policy, ViewPolicy view_policy)
-        : lights_(LightCounts::of(scene)),
-          viewer_(scene.viewer),
-          policy_(policy),
-          view_policy_(std::move(view_policy)) {
-        policy_.validate();
-        view_policy_.validate();
-    }
-    ViewRequest apply(const ViewRequest& request) {
-        const ViewDecision v = apply_view_policy(request, viewer_, view_policy_);
-        const PolicyDecision d = apply_request_policy(v.view, lights_, policy_);
-        if (v.changes.empty() && !d.degraded) return d.view;
-        ++degraded_;
-        std::string& last = logged_[request.session];
-        if (last != v.changes + d.changes) {
-            if (!v.changes.empty())
-                spdlog::warn("session {}: view outside the farm's view policy: rendered with {}", request.session,
-                             v.changes);
-            if (d.degraded)
-                spdlog::warn(
-                    "session {}: request over the farm's bounds ({:.3g} rays estimated, limit {:.3g}; {:.3g} "
-                    "Mpixels, limit {:.3g}): rendered with {}",
-                    request.session, d.requested_rays, policy_.max_gigarays * 1e9,
-                    double(request.size.width) * request.size.height * 1e-6, policy_.max_megapixels, d.changes);
-            last = v.changes + d.changes;
-        }
-        if (logged_.size() > 1024) logged_.clear();  // bounded: sessions come and go
-        return d.view;
-    }
-    [[nodiscard]] std::uint64_t degraded() const { return degraded_; }
-
-private:
-    LightCounts lights_;
-    Viewer viewer_;
-    RequestPolicy policy_;
-    ViewPolicy view_policy_;
-    std::map<std::uint64_t, std::string> logged_;
-    std::uint64_t degraded_ = 0;
-};
-
 // Writes the metrics file when one is configured; a failure is logged once per kind of error and
 // never stops serving.
 class MetricsWriter {
@@ -132,7 +88,7 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& s
     sigaction(SIGTERM, &action, nullptr);
 
     MainThreadQueue<ServedFrame> queue;
-    PolicyGate policy(scene, options.policy, options.view_policy);
+    PolicyGate policy(scene, options.policy, ViewPolicies{options.view_policy, options.appliance_view_policies});
     LiveFrames live(farm, options.live);
     LinkServerOptions link = options.link;
     // Pipelining needs a second call in flight (another session's) while one frame is encoded; each
@@ -154,7 +110,7 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& s
     FarmMetrics metrics;
     MetricsWriter metrics_writer(options.metrics_file);
     const auto counters = [&](bool up) {
-        return FarmCounters{up, server.stats(), queue.superseded(), policy.degraded(), run.render_ranks};
+        return FarmCounters{up, server.stats(), queue.superseded(), policy.changed(), run.render_ranks};
     };
     const auto start = Clock::now();
     auto last_stats = start;
@@ -163,7 +119,7 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& s
     while (!g_stop && (options.duration_s <= 0 || elapsed() < options.duration_s)) {
         notifier.watchdog();
         if (std::chrono::duration<double>(Clock::now() - last_stats).count() >= options.stats_period_s) {
-            log_stats(server, queue, policy.degraded());
+            log_stats(server, queue, policy.changed());
             last_stats = Clock::now();
         }
         if (Clock::now() - last_metrics >= std::chrono::seconds(1)) {
@@ -173,7 +129,7 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& s
         std::optional<MainThreadQueue<ServedFrame>::Job> job = queue.next(std::chrono::milliseconds(100));
         if (!job) continue;
         try {
-            LiveFrame frame = live.render(policy.apply(job->view));
+            LiveFrame frame = live.render(policy.apply(job->view, server.appliance_of(job->view.session)));
             metrics.observe_frame(frame.stats, frame.seconds, double(realtime_ns()) * 1e-9);
             ServedFrame out{std::move(frame.image), job->view.quality.jpeg_quality, realtime_ns(), std::nullopt};
             if (!options.pipeline) out.encoded = encode(out, encoder);

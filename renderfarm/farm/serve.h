@@ -20,6 +20,8 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <map>
+#include <string>
 
 #include "renderfarm/farm/frame_dispatcher.h"
 #include "renderfarm/farm/frame_stats.h"
@@ -34,8 +36,10 @@ namespace mogao {
 struct ServeOptions {
     LinkServerOptions link;
     LiveOptions live;
-    RequestPolicy policy;        // bounds per request (request_policy.h)
-    ViewPolicy view_policy;      // which views may be had (view_policy.h), applied before `policy`
+    RequestPolicy policy;    // bounds per request (request_policy.h)
+    ViewPolicy view_policy;  // which views may be had (view_policy.h), applied before `policy`
+    // Per appliance certificate (common name), replacing view_policy for it (view_policy_file.h).
+    std::map<std::string, ViewPolicy> appliance_view_policies;
     bool pipeline = true;        // encode off the main thread (see above)
     double duration_s = 0.0;     // stop after this long (tests); 0 = until SIGINT/SIGTERM
     double stats_period_s = 10;  // log the link's counters this often

@@ -56,6 +56,24 @@ void keep_to_screen(ViewRequest& v, const CylinderScreen& screen, double max_gua
         note(changes, fmt::format("arc_deg {:g} -> {:g}", requested.arc_deg, c.arc_deg));
 }
 
+void keep_to_size(ViewRequest& v, const ImageSize& max, std::string& changes) {
+    const ImageSize rendered = render_size(v);
+    if (rendered.width <= max.width && rendered.height <= max.height) return;
+    const double requested = v.quality.resolution_scale;
+    const double fit = std::min(double(max.width) / v.size.width, double(max.height) / v.size.height);
+    // render_size rounds to nearest: step down until the rounded size fits (a few ulps at most).
+    const auto fits = [&](double scale) {
+        return std::lround(v.size.width * scale) <= max.width && std::lround(v.size.height * scale) <= max.height;
+    };
+    double scale = std::min(requested, fit);
+    while (!fits(scale)) scale = std::nextafter(scale, 0.0);
+    v.quality.resolution_scale = scale;
+    const ImageSize now = render_size(v);
+    note(changes,
+         fmt::format("resolution_scale {:g} -> {:.4g} ({}x{} -> {}x{} rendered, the appliance's limit {}x{})",
+                     requested, scale, rendered.width, rendered.height, now.width, now.height, max.width, max.height));
+}
+
 }  // namespace
 
 void ViewPolicy::validate() const {
@@ -67,6 +85,10 @@ void ViewPolicy::validate() const {
                     screen->top_m > screen->bottom_m))
         throw std::invalid_argument(
             "view policy: screen needs radius > 0, arc in (0, 360] degrees and top above bottom");
+    if (max_size &&
+        !(max_size->width >= 16 && max_size->width <= 16384 && max_size->height >= 16 && max_size->height <= 16384))
+        throw std::invalid_argument(fmt::format("view policy: max_size {}x{} is outside [16, 16384] per side",
+                                                max_size->width, max_size->height));
 }
 
 ViewDecision apply_view_policy(const ViewRequest& request, const Viewer& viewer, const ViewPolicy& policy) {
@@ -80,6 +102,7 @@ ViewDecision apply_view_policy(const ViewRequest& request, const Viewer& viewer,
         note(d.changes, fmt::format("vertical_fov_deg {:g} -> {:g}", pinhole->vertical_fov_deg, policy.min_fov_deg));
         pinhole->vertical_fov_deg = policy.min_fov_deg;
     }
+    if (policy.max_size) keep_to_size(d.view, *policy.max_size, d.changes);
     return d;
 }
 

@@ -13,7 +13,11 @@
 //    side (the late rotational warp's guard band, kiosk [screen].guard_deg); a pinhole request is
 //    answered with the screen's camera (same size);
 //  - pinhole field of view: widened to `min_fov_deg` when narrower (a zoom onto a detail), when no
-//    screen is set.
+//    screen is set;
+//  - resolution, when `max_size` is set (the appliance's content resolution): a request whose
+//    rendered size (render_size) is wider or taller is rendered at a lower resolution_scale, so that
+//    it fits; the frame's nominal size is kept (the appliance scales it up).
+// A farm serving several museums holds one policy per appliance certificate (view_policy_file.h).
 // The pixel and ray bounds of request_policy.h apply after this.
 //
 // Units: metres, degrees. Errors: ViewPolicy::validate throws std::invalid_argument naming the field
@@ -33,6 +37,7 @@ struct ViewPolicy {
     std::optional<CylinderScreen> screen;  // the appliances' screen; none: any camera
     double max_guard_deg = 30.0;           // extra arc allowed on each side of the screen's, [0, 180)
     double min_fov_deg = 0.0;              // pinhole requests below are widened to it, [0, 179]; 0 = off
+    std::optional<ImageSize> max_size;     // rendered pixels at most, each side in [16, 16384]; none: any
     void validate() const;
 };
 

@@ -5,10 +5,12 @@
 #include <netinet/in.h>
 #include <sys/socket.h>
 
+#include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <thread>
 
 #include "common/unique_fd.h"
@@ -254,6 +256,34 @@ TEST_F(LinkSecurity, OneApplianceCannotTakeEverySessionSlot) {
     renderer_.release();
     const RawOutcome other = raw_session_once(tls_channel(target(), pki.appliance_tls(pki.museum2)));
     EXPECT_TRUE(other.got_frame) << other.status.error_message();
+}
+
+// The farm applies each appliance's own view policy: it must learn, for a request's session, the
+// certificate name that session was admitted with.
+TEST(LinkSessionIdentity, ARequestsSessionNamesTheCertificateItWasAdmittedWith) {
+    REQUIRE_IPV6_LOOPBACK();
+    SyntheticRenderer synthetic;
+    std::atomic<LinkServer*> server_ptr{nullptr};
+    std::mutex mutex;
+    std::vector<std::string> seen;
+    LinkServer server(test_server_options(), [&](const ViewRequest& view) {
+        const std::string name = server_ptr.load()->appliance_of(view.session);
+        {
+            const std::lock_guard lock(mutex);
+            seen.push_back(name);
+        }
+        return synthetic(view);
+    });
+    server_ptr = &server;
+    const auto& pki = TestPki::get();
+    EXPECT_TRUE(
+        raw_session_once(tls_channel(server.endpoint().grpc_target(), pki.appliance_tls(pki.museum2))).got_frame);
+    EXPECT_TRUE(
+        raw_session_once(tls_channel(server.endpoint().grpc_target(), pki.appliance_tls(pki.museum1))).got_frame);
+    const std::lock_guard lock(mutex);
+    EXPECT_EQ(seen, (std::vector<std::string>{"museum-2", "museum-1"}));
+    EXPECT_EQ(server.appliance_of(0), "");
+    EXPECT_EQ(server.appliance_of(12345), "");
 }
 
 TEST(LinkIpv6Only, Ipv4PeerOnTheDualStackWildcardIsRefused) {

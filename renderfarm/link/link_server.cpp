@@ -70,6 +70,8 @@ struct LinkServer::Impl final : v1::Tour::Service {
     LinkServerStats totals;
 
     std::unique_ptr<grpc::Server> server;  // declared after the service base: destroyed first
+    std::unique_ptr<grpc::experimental::ExternalConnectionAcceptor> acceptor;  // gRPC's end of the guard's handoff
+    std::unique_ptr<ConnectionGuard> guard;  // after server and acceptor: destroyed (stopped) before them
     std::vector<std::jthread> workers;
 
     grpc::Status Session(grpc::ServerContext* ctx, Stream* stream) override;
@@ -188,6 +190,7 @@ grpc::Status LinkServer::Impl::admit(grpc::ServerContext* ctx, std::shared_ptr<S
         if (sessions.size() < static_cast<std::size_t>(options.max_sessions)) {
             s->id = next_session_id++;
             sessions.push_back(s);
+            if (guard) guard->authenticated(s->peer);
             ++totals.sessions_opened;
             totals.sessions_active = sessions.size();
             out = s;
@@ -406,6 +409,37 @@ std::optional<v1::FrameMsg> LinkServer::Impl::render(const SessionState& s, cons
     return frame;
 }
 
+// gRPC serves only connections the guard hands over (no listening port of its own): the guard
+// binds first, so a taken port fails here, and caps what gRPC gets (connection_guard.h).
+void LinkServer::start_server(Impl& impl, const Endpoint& endpoint) {
+    grpc::ServerBuilder builder;
+    using Type = grpc::ServerBuilder::experimental_type::ExternalConnectionType;
+    impl.acceptor =
+        builder.experimental().AddExternalConnectionAcceptor(Type::FROM_FD, server_credentials(impl.options));
+    builder.RegisterService(&impl);
+    builder.SetMaxReceiveMessageSize(impl.options.max_request_bytes);
+    // A peer that connects and never finishes the TLS handshake (a port scan, garbage) is dropped
+    // after 10 s instead of gRPC's 120 s.
+    builder.AddChannelArgument(GRPC_ARG_SERVER_HANDSHAKE_TIMEOUT_MS, 10'000);
+    // Detect a vanished appliance (power cut, cable) within ~15 s, and accept its own keepalive
+    // pings (LinkClient pings every 10 s).
+    builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIME_MS, 10'000);
+    builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, 5'000);
+    builder.AddChannelArgument(GRPC_ARG_HTTP2_MIN_RECV_PING_INTERVAL_WITHOUT_DATA_MS, 5'000);
+    builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_PERMIT_WITHOUT_CALLS, 1);
+    impl.server = builder.BuildAndStart();
+    if (!impl.server || !impl.acceptor) throw LinkError("gRPC did not start (its reason is logged above)");
+    auto* acceptor = impl.acceptor.get();
+    impl.guard = std::make_unique<ConnectionGuard>(
+        endpoint, impl.options.connections, [acceptor](UniqueFd connection, int listener_fd) {
+            grpc::experimental::ExternalConnectionAcceptor::NewConnectionParameters p;
+            p.listener_fd = listener_fd;
+            p.fd = connection.release();  // gRPC owns and closes it
+            acceptor->HandleNewConnection(&p);
+        });
+    impl.endpoint.port = impl.guard->port();
+}
+
 LinkServer::LinkServer(LinkServerOptions options, FrameRenderer renderer) : impl_(std::make_unique<Impl>()) {
     check_options(options);
     if (!renderer) throw LinkError("LinkServer: no renderer");
@@ -423,28 +457,7 @@ LinkServer::LinkServer(LinkServerOptions options, FrameRenderer renderer) : impl
         impl_->revocation = std::make_unique<RevocationWatcher>(impl_->options.crl_path, impl_->options.tls.ca_pem);
     }
 
-    grpc::ServerBuilder builder;
-    int port = 0;
-    builder.AddListeningPort(endpoint->to_string(), server_credentials(impl_->options), &port);
-    builder.RegisterService(impl_.get());
-    builder.SetMaxReceiveMessageSize(impl_->options.max_request_bytes);
-    // A second farm on the same port must fail loudly, not share the port's connections.
-    builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
-    // A peer that connects and never finishes the TLS handshake (a port scan, garbage) is dropped
-    // after 10 s instead of gRPC's 120 s.
-    builder.AddChannelArgument(GRPC_ARG_SERVER_HANDSHAKE_TIMEOUT_MS, 10'000);
-    // Detect a vanished appliance (power cut, cable) within ~15 s, and accept its own keepalive
-    // pings (LinkClient pings every 10 s).
-    builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIME_MS, 10'000);
-    builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, 5'000);
-    builder.AddChannelArgument(GRPC_ARG_HTTP2_MIN_RECV_PING_INTERVAL_WITHOUT_DATA_MS, 5'000);
-    builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_PERMIT_WITHOUT_CALLS, 1);
-    impl_->server = builder.BuildAndStart();
-    if (!impl_->server || port == 0) {
-        throw LinkError("cannot listen on " + endpoint->to_string() +
-                        ": port in use, address not local, or IPv6 disabled (gRPC's reason is logged above)");
-    }
-    impl_->endpoint.port = static_cast<std::uint16_t>(port);
+    start_server(*impl_, *endpoint);
     for (int i = 0; i < impl_->options.render_threads; ++i) {
         impl_->workers.emplace_back([this] { impl_->render_loop(); });
     }
@@ -458,8 +471,21 @@ LinkServer::~LinkServer() { stop(); }
 Endpoint LinkServer::endpoint() const { return impl_->endpoint; }
 
 LinkServerStats LinkServer::stats() const {
+    LinkServerStats stats;
+    {
+        const std::lock_guard lock(impl_->mutex);
+        stats = impl_->totals;
+    }
+    if (impl_->guard) stats.connections = impl_->guard->stats();
+    return stats;
+}
+
+std::string LinkServer::appliance_of(std::uint64_t session) const {
     const std::lock_guard lock(impl_->mutex);
-    return impl_->totals;
+    for (const auto& s : impl_->sessions) {
+        if (s->id == session) return s->identity;
+    }
+    return {};
 }
 
 void LinkServer::stop() {
@@ -474,6 +500,7 @@ void LinkServer::stop() {
     }
     impl_->out_cv.notify_all();
     impl_->work_cv.notify_all();
+    if (impl_->guard) impl_->guard->stop();  // no new connections while gRPC shuts down
     // Handlers return as soon as they see their session closed; the deadline only bounds a handler
     // stuck in Write to a peer that stopped reading (gRPC then cancels its call).
     if (impl_->server) impl_->server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));

@@ -14,8 +14,11 @@
 // sessions call the renderer, picking sessions round-robin. With render_threads = 1 (the default)
 // the renderer is never called concurrently, which is what the MPI farm needs.
 //
+// Connections: the server accepts on its own socket (ConnectionGuard) and hands each connection
+// to gRPC, so that connections and TLS handshakes in progress are capped (gRPC 1.51 has no cap).
+//
 // Errors: construction throws LinkError (bad endpoint, unusable TLS material or revocation list,
-// port taken). After
+// bad connection limits, port taken). After
 // that nothing is thrown: an invalid request is refused and logged (the session continues), a
 // renderer exception costs that request its frame, a broken session ends alone; all of it is
 // logged to stderr through spdlog (logger "mogao-link").
@@ -28,10 +31,11 @@
 #include <string>
 #include <vector>
 
-#include "renderfarm/link/endpoint.h"
 #include "common/link_types.h"
-#include "renderfarm/link/tls_material.h"
 #include "common/view_request.h"
+#include "renderfarm/link/connection_guard.h"
+#include "renderfarm/link/endpoint.h"
+#include "renderfarm/link/tls_material.h"
 
 namespace mogao {
 
@@ -62,6 +66,10 @@ struct LinkServerOptions {
     // take every slot. 2 lets a reconnecting appliance overlap the session it is leaving.
     int max_sessions_per_appliance = 2;
     int max_request_bytes = 64 * 1024;  // larger messages end that session (RESOURCE_EXHAUSTED)
+    // Caps on TCP connections before gRPC sees them: in all, without an admitted session (TLS
+    // handshakes in progress, peers that opened no session) and per source address of those
+    // (connection_guard.h). Over a cap, a connection is closed before any TLS.
+    ConnectionLimits connections;
     // Refuse sessions that arrive over IPv4 (an IPv4-mapped peer on the dual-stack [::] socket)
     // with PERMISSION_DENIED: the link is specified as IPv6 and the appliances' certificates and
     // firewall rules are written for IPv6 addresses.
@@ -80,6 +88,7 @@ struct LinkServerStats {
     std::uint64_t render_failures = 0;    // renderer threw or returned an unusable frame
     std::uint64_t frames_sent = 0;
     std::uint64_t jpeg_bytes_sent = 0;
+    ConnectionGuardStats connections;  // TCP connections: accepted, refused by each cap, open now
 };
 
 class LinkServer {
@@ -93,6 +102,9 @@ public:
     // The endpoint actually bound (with the port the kernel picked for port 0).
     [[nodiscard]] Endpoint endpoint() const;
     [[nodiscard]] LinkServerStats stats() const;
+    // The certificate common name of open session `session` (ViewRequest::session), so that the
+    // farm applies that appliance's view policy; empty once the session has closed, or for 0.
+    [[nodiscard]] std::string appliance_of(std::uint64_t session) const;
 
     // Ends every session (appliances see UNAVAILABLE/CANCELLED and reconnect elsewhere or later),
     // waits for a renderer call in progress, closes the port. Idempotent.
@@ -100,6 +112,7 @@ public:
 
 private:
     struct Impl;
+    static void start_server(Impl& impl, const Endpoint& endpoint);
     std::unique_ptr<Impl> impl_;
 };
 
