@@ -327,30 +327,75 @@ void Monitor::set_reference(const SystemModel& model, const ScreenCalibration& c
     cv::erode(mask_, mask_, cv::Mat(), cv::Point(-1, -1), 8);
 }
 
-std::optional<bool> Monitor::edges_moved(const autocal::DeviceModel& camera, const cv::Mat1f& frame) const {
-    double gained = 0.0;  // pixels the moved camera would see the screen at and the reference not
-    double lost = 0.0;    // and the other way round
-    int n_gained = 0;
-    int n_lost = 0;
+std::optional<bool> Monitor::edges_prefer(const autocal::DeviceModel& a, const autocal::DeviceModel& b,
+                                          const cv::Mat1f& frame) const {
+    double only_a = 0.0;  // mean brightness where a sees the screen and b does not
+    double only_b = 0.0;  // and the other way round
+    int n_a = 0;
+    int n_b = 0;
     for (const EdgePixel& e : edge_band_) {
-        const bool on = sees_screen(model_.screen, camera, e.ray);
-        if (on == e.on_reference) continue;
+        const bool on_a = sees_screen(model_.screen, a, e.ray);
+        const bool on_b = &b == &model_.camera ? e.on_reference : sees_screen(model_.screen, b, e.ray);
+        if (on_a == on_b) continue;
         const double v = frame(e.y, e.x);
-        if (on) {
-            gained += v;
-            ++n_gained;
+        if (on_a) {
+            only_a += v;
+            ++n_a;
         } else {
-            lost += v;
-            ++n_lost;
+            only_b += v;
+            ++n_b;
         }
     }
-    if (n_gained < kMinEdgePixels || n_lost < kMinEdgePixels) return std::nullopt;  // edges not seen or not moved
-    gained /= n_gained;
-    lost /= n_lost;
-    // Moved: the gained strip is the lit screen now and the lost one off it; not moved: the reverse.
-    if (lost > 2.0 * gained + kEdgeContrast) return false;
-    if (gained > 2.0 * lost + kEdgeContrast) return true;
+    if (n_a < kMinEdgePixels || n_b < kMinEdgePixels) return std::nullopt;  // edges not seen or the same
+    only_a /= n_a;
+    only_b /= n_b;
+    // The screen is lit where the right camera says it is: a's strip lit and b's dark favours a.
+    if (only_a > 2.0 * only_b + kEdgeContrast) return true;
+    if (only_b > 2.0 * only_a + kEdgeContrast) return false;
     return std::nullopt;
+}
+
+std::optional<bool> Monitor::edges_moved(const autocal::DeviceModel& camera, const cv::Mat1f& frame) const {
+    return edges_prefer(camera, model_.camera, frame);
+}
+
+std::optional<PoseFit> Monitor::camera_from_one_projector(const autocal::DeviceModel& camera,
+                                                          const std::vector<Eigen::Vector3d>& points,
+                                                          const std::vector<Eigen::Vector2d>& image,
+                                                          const std::vector<int>& owner, const cv::Mat1f& frame) const {
+    std::vector<PoseFit> moved;  // fits whose edges moved as the frame shows
+    for (std::size_t k = 0; k < model_.projectors.size(); ++k) {
+        std::vector<Eigen::Vector3d> p;
+        std::vector<Eigen::Vector2d> q;
+        for (std::size_t i = 0; i < points.size(); ++i) {
+            if (owner[i] != static_cast<int>(k)) continue;
+            p.push_back(points[i]);
+            q.push_back(image[i]);
+        }
+        if (static_cast<int>(p.size()) < kMinHypothesisMatches) continue;
+        // One projector's part of the screen hardly tells a turn from a shift: settle that
+        // direction on "turn" (a knocked mount mostly turns) with the projectors' position prior.
+        RobustPoseOptions narrow = options_.camera_fit;
+        narrow.prior_position_sd_m = options_.projector_fit.prior_position_sd_m;
+        PoseFit fit = fit_pose_robust(camera, p, q, narrow);
+        if (fit.ok && edges_moved(fit.model, frame) == true) moved.push_back(std::move(fit));
+    }
+    if (moved.empty()) return std::nullopt;
+    // A fit that moved part of the way also moves the edges the right way: among those, the one
+    // whose edges the frame prefers to every other's (most pairwise wins; then most inliers).
+    std::size_t best = 0;
+    int best_wins = -1;
+    for (std::size_t i = 0; i < moved.size(); ++i) {
+        int wins = 0;
+        for (std::size_t j = 0; j < moved.size(); ++j) {
+            if (i != j && edges_prefer(moved[i].model, moved[j].model, frame) == true) ++wins;
+        }
+        if (wins > best_wins || (wins == best_wins && moved[i].inliers > moved[best].inliers)) {
+            best = i;
+            best_wins = wins;
+        }
+    }
+    return std::move(moved[best]);
 }
 
 cv::Mat1f Monitor::predict(const cv::Mat1f& content) const {
@@ -431,9 +476,32 @@ FrameMeasurement Monitor::measure(const cv::Mat1f& content, const cv::Mat1f& cam
     m.camera = fit_pose_robust(cam, cam_points, cam_image, options_.camera_fit);
     // The screen does not move: a camera fit whose screen edges the frame shows where they were is
     // projectors moving together (e.g. two of three by the same yaw), not the camera.
-    if (m.camera.ok && !pattern_pair && options_.check_edges && edges_moved(m.camera.model, camera_frame) == false) {
-        m.camera.ok = false;
-        m.camera_edges_disagree = true;
+    std::optional<bool> moved;
+    if (m.camera.ok && !pattern_pair && options_.check_edges) {
+        moved = edges_moved(m.camera.model, camera_frame);
+        if (moved == false) {
+            m.camera.ok = false;
+            m.camera_edges_disagree = true;
+        }
+    }
+    // The consensus can also hide a camera that did move: when the camera and two projectors
+    // moved, one of those projectors may move with the camera in the image (a yaw of each) and
+    // outvote the projector that stayed. The edges then moved while the accepted fit says they did
+    // not; a camera fitted to one projector's matches alone whose edges did move is the camera.
+    // Only where the consensus is contested (projectors suspected, or a tenth of the matches
+    // against it): a static wall pays nothing for it.
+    const bool contested = any_suspect || !m.camera.ok ||
+                           static_cast<double>(m.camera.inliers) < 0.9 * static_cast<double>(cam_points.size());
+    if (!pattern_pair && options_.check_edges && contested) {
+        auto edge_camera = camera_from_one_projector(cam, s_pred, obs_n, owner, camera_frame);
+        // A consensus fit that moved the edges too stays unless the frame prefers the other's edges.
+        if (edge_camera && moved == true && edges_prefer(edge_camera->model, m.camera.model, camera_frame) != true)
+            edge_camera.reset();
+        if (edge_camera) {
+            m.camera = std::move(*edge_camera);
+            m.camera_edges_disagree = false;
+            m.camera_from_edges = true;
+        }
     }
     const autocal::DeviceModel camera = m.camera.ok ? m.camera.model : cam;
     if (m.camera.ok) m.camera_delta = pose_delta(cam, m.camera.model);

@@ -82,6 +82,9 @@ struct FrameMeasurement {
     double occluded_fraction = 0.0;      // of the lit screen's cells, the occluder mask's share
     PoseFit camera;                      // camera.ok = false: the reference camera was used
     bool camera_edges_disagree = false;  // the camera fit moved, the screen's edges in the frame did not: rejected
+    // The consensus fit showed no camera move, but a fit to one projector's matches alone moved the
+    // screen's edges as the frame shows them: that fit is the camera (Monitor::measure).
+    bool camera_from_edges = false;
     Pose6 camera_delta = Pose6::Zero();
     std::vector<ProjectorMeasurement> projectors;
 };
@@ -117,11 +120,25 @@ public:
     // false for the reverse (the edges are where the reference has them), nullopt when either strip
     // has under kMinEdgePixels pixels (the edges not in view, or a move under a pixel) or neither holds.
     [[nodiscard]] std::optional<bool> edges_moved(const autocal::DeviceModel& camera, const cv::Mat1f& frame) const;
+    // The same test between two candidate cameras: true when the frame's lit screen agrees with a's
+    // edges over b's (a's strip lit, b's dark), false for the reverse, nullopt when undecided.
+    // edges_moved(c) is edges_prefer(c, reference).
+    [[nodiscard]] std::optional<bool> edges_prefer(const autocal::DeviceModel& a, const autocal::DeviceModel& b,
+                                                   const cv::Mat1f& frame) const;
     static constexpr int kEdgeBand = 12;  // camera pixels
     static constexpr int kMinEdgePixels = 40;
     static constexpr double kEdgeContrast = 0.002;  // linear camera units (about half an 8-bit code)
 
 private:
+    // A camera fitted to each projector's matches alone (k's own, `owner`): among those whose edges
+    // moved (edges_moved == true), the one whose edges the frame prefers to the others'; or none.
+    [[nodiscard]] std::optional<PoseFit> camera_from_one_projector(const autocal::DeviceModel& camera,
+                                                                   const std::vector<Eigen::Vector3d>& points,
+                                                                   const std::vector<Eigen::Vector2d>& image,
+                                                                   const std::vector<int>& owner,
+                                                                   const cv::Mat1f& frame) const;
+    static constexpr int kMinHypothesisMatches = 30;  // a projector's matches to fit the camera on
+
     struct EdgePixel {
         int x = 0;
         int y = 0;

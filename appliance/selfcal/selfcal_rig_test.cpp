@@ -291,6 +291,27 @@ TEST(SelfcalRig, TwoProjectorsBumpedAlikeAreNotTakenForTheCamera) {
     EXPECT_EQ(r.final_state, SelfcalState::calibrated) << journal(r);
 }
 
+// The camera and two projectors bumped at once: proj0's yaw moves its part of the image about as
+// the camera's yaw does, so the consensus of matches takes proj0 for unmoved and the camera for
+// still, and "corrected" the two projectors that look moved (before: the wall ended about 22 px
+// off and the state said calibrated). The screen's edges show the camera moved; the camera fitted
+// to proj1's matches alone moves them as the frame shows (Monitor::camera_from_one_projector).
+TEST(SelfcalRig, CameraAndTwoProjectorsBumpedAtOnceAreToldApart) {
+    const rig::VirtualRig rig = standard();
+    SimulationOptions o = quick(24);
+    for (const char* text : {"camera:yaw=1deg", "proj0:yaw=1deg", "proj2:pitch=1deg"}) {
+        Bump b = parse_bump(rig, text);
+        b.at_s = 1.0;
+        o.bumps.push_back(b);
+    }
+    const SimulationReport r = simulate(rig, o);
+    EXPECT_GT(r.error_before_px, 5.0);
+    EXPECT_NE(journal(r).find("camera moved"), std::string::npos) << journal(r);
+    ASSERT_TRUE(r.corrected_after_s.has_value()) << journal(r);
+    EXPECT_LT(r.final_error_px, 1.0) << journal(r);
+    EXPECT_EQ(r.final_state, SelfcalState::calibrated) << journal(r);
+}
+
 TEST(SelfcalRig, TooLittleTextureWaitsAndNeverCorrects) {
     const rig::VirtualRig rig = standard();
     SimulationOptions o = quick(6);
