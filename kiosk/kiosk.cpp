@@ -85,6 +85,11 @@ void Kiosk::fail(const char* what, const std::string& message) {
     loop_.stop();
 }
 
+void Kiosk::note_error(std::string what) {
+    last_error_ = std::move(what);
+    last_error_ns_ = realtime_ns();
+}
+
 void Kiosk::on_signal() {
     auto sig = parts_.signals.read();
     if (!sig) return fail("signals", sig.error().message);
@@ -116,6 +121,7 @@ void Kiosk::on_frame() {
             options_.dump->dump(f);
         } catch (const std::exception& e) {
             spdlog::warn("--dump-content: {}", e.what());
+            note_error(std::string("content dump: ") + e.what());
         }
     }
     (void)update_late_warp();  // this frame's shift for the yaw turned since its request
@@ -142,6 +148,7 @@ void Kiosk::note_rejections(const std::vector<DecodeWorker::Rejection>& rejectio
         if (r.number <= 10 || r.number % 100 == 0) {
             spdlog::warn("frame dropped ({} so far): {}; keeping request {} on screen", r.number, r.why, on_screen);
         }
+        note_error(fmt::format("frame dropped ({} so far): {}", r.number, r.why));
     }
 }
 
@@ -232,7 +239,10 @@ void Kiosk::submit_next_view() {
     }
     std::string why;
     step.entry.request_id = parts_.link.submit(step.request, &why);
-    if (step.entry.request_id == 0) spdlog::error("view request refused: {}", why);
+    if (step.entry.request_id == 0) {
+        spdlog::error("view request refused: {}", why);
+        note_error("view request refused: " + why);
+    }
     step.entry.tick = ++ticks_;
     step.entry.pose = step.request.pose;
     write_pose(step.entry);
@@ -248,6 +258,7 @@ void Kiosk::write_pose(const PoseLogEntry& entry) {
         options_.pose_log->write(entry);
     } catch (const std::exception& e) {
         spdlog::error("--pose-log: {}; no more poses are logged", e.what());
+        note_error(std::string("pose log: ") + e.what());
         options_.pose_log.reset();
     }
 }
@@ -364,6 +375,11 @@ KioskStatus Kiosk::status(const char* state) const {
     for (const StartFallback& f : options_.fallbacks) s.fallbacks.push_back(f.message);
     if (current_)
         s.farm_silent_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_frame_at_).count();
+    const StatsSummary window = parts_.display.stats().window_summary();
+    s.fps = window.fps;
+    s.latency_p95_ms = window.latency_p95_ms;
+    s.last_error = last_error_;
+    s.last_error_ns = last_error_ns_;
     return s;
 }
 
@@ -377,6 +393,7 @@ void Kiosk::write_status(const char* state) {
     } catch (const std::exception& e) {
         // Once, not every period: the display goes on either way.
         if (!status_failing_) spdlog::warn("status file: {}; trying again every period", e.what());
+        note_error(std::string("status file: ") + e.what());
         status_failing_ = true;
     }
 }

@@ -124,6 +124,7 @@ public:
 
 private:
     void fail(const char* what, const std::string& message);  // logs, exit code 1, stops the loop
+    void note_error(std::string what);                        // the status file's last_error (the caller logs it)
     [[nodiscard]] std::optional<std::size_t> flip_overdue(std::chrono::steady_clock::time_point now);
     // Sets the display's content transform for the yaw turned since the current frame's request
     // (identity without a guard band); true when it changed.
@@ -164,7 +165,9 @@ private:
     std::chrono::steady_clock::time_point start_;
     std::chrono::steady_clock::time_point last_log_;
     std::chrono::steady_clock::time_point last_status_;
-    bool status_failing_ = false;                          // the status file's last write failed (logged once)
+    bool status_failing_ = false;  // the status file's last write failed (logged once)
+    std::string last_error_;       // KioskStatus::last_error
+    std::int64_t last_error_ns_ = 0;
     bool panel_toggled_ = false;                           // SIGUSR2 with [status].on_wall = "on_demand"
     std::vector<std::string> wall_lines_;                  // drawn on the frame on the wall now
     std::chrono::steady_clock::time_point last_frame_at_;  // the latest new farm frame

@@ -157,6 +157,8 @@ std::unique_ptr<LinkClient> open_link(const KioskConfig& config, TlsMaterial tls
     options.endpoint = config.farm.endpoint;
     options.server_name = config.farm.server_name;
     options.tls = std::move(tls);
+    // Rotation without a restart: the client re-reads these when they change (docs/link.md).
+    options.tls_files = {config.farm.ca, config.farm.cert, config.farm.key};
     std::unique_ptr<LinkClient> client;
     try {
         // Runs on the link's connection thread: hand over and wake the loop, nothing else.

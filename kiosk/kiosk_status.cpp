@@ -69,6 +69,10 @@ nlohmann::json kiosk_status_json(const KioskStatus& s) {
         calibration["last_error_ns"] = s.calibration.last_error_ns;
         calibration["last_error_utc"] = utc_text(s.calibration.last_error_ns);
     }
+    nlohmann::json last_error = nullptr;
+    if (!s.last_error.empty()) {
+        last_error = {{"what", s.last_error}, {"ns", s.last_error_ns}, {"utc", utc_text(s.last_error_ns)}};
+    }
     return {{"written_ns", s.written_ns},
             {"written_utc", utc_text(s.written_ns)},
             {"uptime_s", s.uptime_s},
@@ -78,6 +82,9 @@ nlohmann::json kiosk_status_json(const KioskStatus& s) {
             {"fallbacks", s.fallbacks},
             {"frames_shown", s.frames_shown},
             {"showing_request", s.showing_request},
+            {"fps", s.fps},
+            {"latency_p95_ms", s.latency_p95_ms},
+            {"last_error", last_error},
             {"calibration", calibration},
             {"selfcal", selfcal_json(s.selfcal)}};
 }

@@ -49,6 +49,13 @@ struct KioskStatus {
     std::vector<std::string> on_wall;               // the lines drawn on the wall now (kiosk/on_wall_status.h)
     double farm_silent_s = 0.0;                     // since the last farm frame (0 before the first)
     std::vector<std::string> fallbacks;             // bad start-up files replaced by last good copies
+    // Over the display statistics' sliding window (kiosk_stats.h; 0 before two frames):
+    double fps = 0.0;             // farm frames presented per second
+    double latency_p95_ms = 0.0;  // motion-to-photon, request to presented
+    // The latest error outside the calibration's (a dropped frame, a refused view request, a file
+    // the kiosk could not write): what the journal said, and when. Empty: none since start.
+    std::string last_error;
+    std::int64_t last_error_ns = 0;
 };
 
 // "2026-11-22T12:30:05Z" (seconds, UTC) for CLOCK_REALTIME nanoseconds.

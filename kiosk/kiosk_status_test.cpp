@@ -43,6 +43,21 @@ TEST(KioskStatus, JsonHoldsConnectionFramesCalibrationAndSelfcalOff) {
     EXPECT_EQ(j["calibration"]["last_error_ns"], 3'000'000'000);
     EXPECT_EQ(j["selfcal"]["enabled"], false);
     EXPECT_FALSE(j["selfcal"].contains("state"));
+    EXPECT_TRUE(j["last_error"].is_null());  // none since start
+}
+
+TEST(KioskStatus, JsonHoldsTheFrameRateAndTheLastError) {
+    KioskStatus s;
+    s.fps = 14.5;
+    s.latency_p95_ms = 180.25;
+    s.last_error = "frame dropped (3 so far): corrupt JPEG";
+    s.last_error_ns = 4'000'000'000;
+    const nlohmann::json j = kiosk_status_json(s);
+    EXPECT_DOUBLE_EQ(j["fps"].get<double>(), 14.5);
+    EXPECT_DOUBLE_EQ(j["latency_p95_ms"].get<double>(), 180.25);
+    EXPECT_EQ(j["last_error"]["what"], s.last_error);
+    EXPECT_EQ(j["last_error"]["ns"], 4'000'000'000);
+    EXPECT_EQ(j["last_error"]["utc"], "1970-01-01T00:00:04Z");
 }
 
 TEST(KioskStatus, JsonHoldsTheSelfcalStateAndProjectors) {

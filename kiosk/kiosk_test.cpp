@@ -198,6 +198,10 @@ TEST_F(KioskTest, ACorruptJpegKeepsTheLastGoodFrameOnEveryOutput) {
     EXPECT_EQ(k.current()->request_id, 1u);
     EXPECT_EQ(display_->frames_on_screen(), 1u);
     EXPECT_EQ(display_->stats().to_json()["frames_rejected"], 1);
+    // The technician sees it in the status file without the journal.
+    const KioskStatus status = k.status("showing");
+    EXPECT_NE(status.last_error.find("frame dropped"), std::string::npos) << status.last_error;
+    EXPECT_GT(status.last_error_ns, 0);
     const std::vector<Rgb8Image> after = outputs();
     for (std::size_t i = 0; i < after.size(); ++i) EXPECT_EQ(after[i].pixels, before[i].pixels) << "output " << i;
 }

@@ -4,8 +4,10 @@
 #include <grpcpp/grpcpp.h>
 
 #include <algorithm>
+#include <array>
 #include <condition_variable>
 #include <deque>
+#include <filesystem>
 #include <mutex>
 #include <optional>
 #include <random>
@@ -53,19 +55,75 @@ struct LinkClient::Impl {
 
     std::jthread thread;
 
+    // tls_files' modification times when last looked at (connection thread and writer, under mutex).
+    std::array<std::filesystem::file_time_type, 3> tls_stamp{};
+    bool rotate = false;  // the session ended for rotated TLS material: reconnect without backoff
+    std::chrono::steady_clock::time_point next_tls_check;  // writer thread
+
     void run();
+    bool reload_tls();   // true when rotated material was taken (see LinkClientOptions::tls_files)
     bool run_session();  // true when a session was established
     void write_loop(Stream& stream);
     void on_frame_msg(v1::FrameMsg& msg);
     void record(const Sample& sample, std::uint64_t request_id);  // with mutex held
 };
 
+std::array<std::filesystem::file_time_type, 3> file_stamps(const TlsFilePaths& files) {
+    std::array<std::filesystem::file_time_type, 3> out{};
+    std::error_code ec;
+    out[0] = std::filesystem::last_write_time(files.ca, ec);
+    out[1] = std::filesystem::last_write_time(files.cert, ec);
+    out[2] = std::filesystem::last_write_time(files.key, ec);
+    return out;
+}
+
+bool LinkClient::Impl::reload_tls() {
+    if (options.tls_files.empty()) return false;
+    const auto stamp = file_stamps(options.tls_files);
+    {
+        const std::lock_guard lock(mutex);
+        if (stamp == tls_stamp) return false;
+        tls_stamp = stamp;  // a bad set is refused once, not at every look
+    }
+    TlsMaterial fresh;
+    std::string error;
+    try {
+        fresh = load_tls_files(options.tls_files.ca, options.tls_files.cert, options.tls_files.key);
+        error = check_tls_material(fresh, "rotated appliance TLS").error;
+    } catch (const std::exception& e) {
+        error = e.what();
+    }
+    const std::lock_guard lock(mutex);
+    if (!error.empty()) {
+        ++stats.tls_reloads_refused;
+        link_log().error("TLS files changed but not taken ({}); keeping the certificate in use", error);
+        return false;
+    }
+    if (fresh.cert_pem == options.tls.cert_pem && fresh.key_pem == options.tls.key_pem &&
+        fresh.ca_pem == options.tls.ca_pem)
+        return false;  // touched, not changed
+    grpc::SslCredentialsOptions ssl;
+    ssl.pem_root_certs = fresh.ca_pem;
+    ssl.pem_private_key = fresh.key_pem;
+    ssl.pem_cert_chain = fresh.cert_pem;
+    credentials = grpc::SslCredentials(ssl);
+    options.tls = std::move(fresh);
+    ++stats.tls_reloads;
+    link_log().info("TLS files changed: {} taken for the next session", options.tls_files.cert.string());
+    return true;
+}
+
 void LinkClient::Impl::run() {
     auto backoff = options.initial_backoff;
     for (;;) {
+        (void)reload_tls();
         if (run_session()) backoff = options.initial_backoff;
         std::unique_lock lock(mutex);
         if (stopping) return;
+        if (std::exchange(rotate, false)) {
+            link_log().info("reconnecting to the farm at {} with the rotated certificate", endpoint.to_string());
+            continue;
+        }
         std::uniform_real_distribution<double> jitter(1.0 - options.backoff_jitter, 1.0 + options.backoff_jitter);
         const auto wait = std::chrono::milliseconds(
             static_cast<std::int64_t>(static_cast<double>(backoff.count()) * jitter(rng)));
@@ -79,7 +137,12 @@ void LinkClient::Impl::run() {
 bool LinkClient::Impl::run_session() {
     // A fresh channel per attempt (with a private subchannel pool): our backoff alone decides when
     // to retry, not the backoff state of a shared gRPC subchannel.
-    const auto channel = grpc::CreateCustomChannel(endpoint.grpc_target(), credentials, channel_args);
+    std::shared_ptr<grpc::ChannelCredentials> creds;
+    {
+        const std::lock_guard lock(mutex);
+        creds = credentials;
+    }
+    const auto channel = grpc::CreateCustomChannel(endpoint.grpc_target(), creds, channel_args);
     const auto stub = v1::Tour::NewStub(channel);
     grpc::ClientContext ctx;
     {
@@ -139,8 +202,21 @@ void LinkClient::Impl::write_loop(Stream& stream) {
         v1::ViewRequestMsg msg;
         {
             std::unique_lock lock(mutex);
-            cv.wait(lock, [&] { return session_over || stopping || unsent || ack_due != 0; });
+            cv.wait_until(lock, next_tls_check, [&] { return session_over || stopping || unsent || ack_due != 0; });
             if (session_over || stopping) return;
+            if (std::chrono::steady_clock::now() >= next_tls_check) {
+                // Every tls_refresh_s, busy or not: look at the TLS files (three stat calls).
+                next_tls_check = std::chrono::steady_clock::now() + std::chrono::seconds(options.tls_refresh_s);
+                lock.unlock();
+                if (reload_tls()) {
+                    const std::lock_guard relock(mutex);
+                    rotate = true;
+                    if (current != nullptr) current->TryCancel();  // the reader ends the session
+                    return;
+                }
+                continue;
+            }
+            if (!unsent && ack_due == 0) continue;
             if (unsent) {
                 view_to_msg(*unsent, msg);
                 unsent.reset();
@@ -233,6 +309,8 @@ LinkClient::LinkClient(LinkClientOptions options, FrameCallback on_frame) : impl
         throw LinkError("LinkClientOptions.backoff_jitter must be in [0, 1)");
     }
     if (options.stats_window < 2) throw LinkError("LinkClientOptions.stats_window must be >= 2");
+    if (options.tls_refresh_s < 1 || options.tls_refresh_s > 86'400)
+        throw LinkError("LinkClientOptions.tls_refresh_s must be in [1, 86400]");
     const TlsCheck tls = check_tls_material(options.tls, "appliance TLS");
     if (!tls.error.empty()) throw LinkError(tls.error);
     // Expired or foreign certificates are the farm's to refuse; say why up front, keep trying
@@ -256,6 +334,7 @@ LinkClient::LinkClient(LinkClientOptions options, FrameCallback on_frame) : impl
     args.SetInt(GRPC_ARG_MIN_RECONNECT_BACKOFF_MS, 5'000);  // gRPC's connect timeout: 20 s by default
     if (!impl.options.server_name.empty()) args.SetSslTargetNameOverride(impl.options.server_name);
     impl.stats.next_backoff = impl.options.initial_backoff;
+    if (!impl.options.tls_files.empty()) impl.tls_stamp = file_stamps(impl.options.tls_files);
     impl.thread = std::jthread([&impl] { impl.run(); });
 }
 

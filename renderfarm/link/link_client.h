@@ -34,6 +34,14 @@ namespace mogao {
 struct LinkClientOptions {
     std::string endpoint;  // the farm, "[address]:port", e.g. "[2001:db8::5]:7443"
     TlsMaterial tls;       // this appliance's certificate + key; ca_pem: the farm CA
+    // Where `tls` was read from. When set, the client looks at the files' modification times every
+    // tls_refresh_s seconds (and before each connection attempt): a changed set that loads and
+    // passes check_tls_material replaces `tls`, and an open session is ended at once and
+    // re-opened with it (no backoff; the appliance keeps its last frame meanwhile), so an
+    // appliance's certificate is rotated by replacing the files, without a restart. A set that
+    // does not load or check is logged and not taken: the client keeps the last good material.
+    TlsFilePaths tls_files;
+    int tls_refresh_s = 10;  // 1..86400
     // Name the farm's certificate must carry. Empty: the endpoint's address, matched against the
     // certificate's IP SANs (pki issue-farm --san). Otherwise a DNS SAN, e.g. "farm-1".
     std::string server_name;
@@ -53,6 +61,8 @@ struct LinkClientStats {
     bool connected = false;
     std::uint64_t sessions_opened = 0;   // successful connects (reconnects = sessions_opened - 1)
     std::uint64_t attempts_failed = 0;   // connects refused or broken before the session was established
+    std::uint64_t tls_reloads = 0;       // rotated TLS material taken from tls_files
+    std::uint64_t tls_reloads_refused = 0;  // changed files that did not load or check (last good kept)
     std::uint64_t requests_submitted = 0;
     std::uint64_t requests_sent = 0;
     std::uint64_t requests_coalesced = 0;  // replaced by a newer one before they could be sent

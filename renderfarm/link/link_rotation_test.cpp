@@ -4,8 +4,14 @@
 // are replaced; the appliance streaming since before the rotation keeps its one session throughout.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <mutex>
+#include <string>
+#include <vector>
 
 #include "renderfarm/link/link_client.h"
 #include "renderfarm/link/link_server.h"
@@ -67,6 +73,64 @@ TEST(LinkRotation, FarmCertificateIsReplacedWhileServing) {
     EXPECT_TRUE(wait_until([&] { return streaming.stats().last_request_id == after; }));
     EXPECT_EQ(streaming.stats().sessions_opened, 1u);
     EXPECT_EQ(streaming.stats().attempts_failed, 0u);
+}
+
+// The appliance's side: LinkClientOptions::tls_files are looked at while streaming. Replacing them
+// ends the session at once and opens the next with the new certificate (no backoff); a set whose
+// key does not match its certificate is refused and the session goes on.
+TEST(LinkRotation, ApplianceCertificateIsReplacedWhileStreaming) {
+    if (!ipv6_loopback_available()) GTEST_SKIP() << "IPv6 loopback [::1] is not available on this host";
+    const auto& pki = TestPki::get();
+    const TempDir tmp;
+    const TlsFilePaths files{tmp.path() / "ca.pem", tmp.path() / "museum.pem", tmp.path() / "museum.key"};
+    replace_file(files.ca, pki.ca.cert_pem);
+    replace_file(files.cert, pki.museum1.cert_pem);
+    replace_file(files.key, pki.museum1.key_pem);
+
+    SyntheticRenderer synthetic;
+    std::atomic<LinkServer*> server_ptr{nullptr};
+    std::mutex mutex;
+    std::vector<std::string> names;  // the certificate name of each rendered request's session
+    LinkServer server(test_server_options(), [&](const ViewRequest& view) {
+        const std::string name = server_ptr.load()->appliance_of(view.session);
+        {
+            const std::lock_guard lock(mutex);
+            names.push_back(name);
+        }
+        return synthetic(view);
+    });
+    server_ptr = &server;
+    const auto rendered_for = [&](const std::string& name) {
+        const std::lock_guard lock(mutex);
+        return std::count(names.begin(), names.end(), name);
+    };
+
+    auto options = test_client_options(server.endpoint().port, pki.museum1);
+    options.tls_files = files;
+    options.tls_refresh_s = 1;
+    LinkClient client(options, [](LinkFrame&&) {});
+    const auto stream_until = [&](const std::function<bool()>& done) {
+        return wait_until([&] {
+            const auto id = client.submit(test_request(1.0));
+            return wait_until([&] { return client.stats().last_request_id >= id; }, std::chrono::seconds(5)) && done();
+        });
+    };
+    ASSERT_TRUE(stream_until([&] { return rendered_for("museum-1") > 0; }));
+
+    replace_file(files.key, pki.museum2.key_pem);
+    replace_file(files.cert, pki.museum2.cert_pem);
+    EXPECT_TRUE(stream_until([&] { return rendered_for("museum-2") > 0; })) << "the old certificate is still in use";
+    EXPECT_EQ(client.stats().tls_reloads, 1u);
+    EXPECT_EQ(client.stats().sessions_opened, 2u);
+    EXPECT_EQ(client.stats().attempts_failed, 0u);
+
+    // A key that does not match its certificate: refused, the session with museum-2 goes on.
+    replace_file(files.key, pki.museum1.key_pem);
+    EXPECT_TRUE(wait_until([&] { return client.stats().tls_reloads_refused == 1; }));
+    const std::size_t before = static_cast<std::size_t>(rendered_for("museum-2"));
+    EXPECT_TRUE(stream_until([&] { return static_cast<std::size_t>(rendered_for("museum-2")) > before; }));
+    EXPECT_EQ(client.stats().sessions_opened, 2u);
+    EXPECT_EQ(client.stats().tls_reloads, 1u);
 }
 
 TEST(LinkRotation, IncompleteFilePathsAreNamed) {
