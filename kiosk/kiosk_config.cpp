@@ -218,6 +218,9 @@ void read_farm(const Section& s, FarmConfig& farm) {
 
 void read_outputs(const Section& display, const Section& s, OutputsConfig& out) {
     out.rate_hz = display.number("rate_hz", out.rate_hz, [](double x) { return x >= 0.5 && x <= 240; }, "[0.5, 240] Hz");
+    out.flip_timeout_s = display.number(
+        "flip_timeout_s", out.flip_timeout_s, [](double x) { return x == 0.0 || (x >= 1.0 && x <= 600.0); },
+        "0 (off) or [1, 600] s");
     const Value* backend = s.find("backend");
     if (backend != nullptr) {
         const std::string kind = s.as_string(*backend, "backend");
@@ -771,7 +774,7 @@ OutputsConfig parse_outputs_config(std::string_view text, const std::filesystem:
     const Context ctx{name.string(), name.has_parent_path() ? name.parent_path() : fs::path(".")};
     const Value root = parse_toml(text, ctx);
     OutputsConfig outputs;
-    const Section display = section(ctx, root, "display", {"rate_hz"});
+    const Section display = section(ctx, root, "display", {"rate_hz", "flip_timeout_s"});
     const Section section_outputs =
         section(ctx, root, "outputs", {"backend", "device", "sizes", "png_dir", "png_every", "composite"});
     read_outputs(display, section_outputs, outputs);
@@ -801,7 +804,7 @@ KioskConfig parse_kiosk_config(std::string_view text, const std::filesystem::pat
     }
     const Section farm = section(ctx, root, "farm", {"endpoint", "server_name", "ca", "cert", "key"});
     read_farm(farm, config.farm);
-    const Section display = section(ctx, root, "display", {"rate_hz"});
+    const Section display = section(ctx, root, "display", {"rate_hz", "flip_timeout_s"});
     const Section outputs = section(ctx, root, "outputs", {"backend", "device", "sizes", "png_dir", "png_every", "composite"});
     read_outputs(display, outputs, config.outputs);
     const Section calibration =

@@ -55,6 +55,10 @@ enum class OutputKind { headless, kms };
 // [display] and [outputs].
 struct OutputsConfig {
     double rate_hz = 30.0;                  // [display].rate_hz: request + repaint tick, [0.5, 240]
+    // [display].flip_timeout_s: an output whose page flip has not completed after this long stops
+    // the kiosk (exit 1) for systemd to restart it and set every mode again; 0 = off, else [1, 600].
+    // 30 s: far above a healthy round anywhere measured (seconds on llvmpipe under QEMU TCG).
+    double flip_timeout_s = 30.0;
     OutputKind backend = OutputKind::kms;   // "headless" | "kms"
     std::filesystem::path device;           // kms: /dev/dri/cardN; empty = first card with an output
     std::vector<ImageSize> sizes;           // headless: one per output; empty = the projectors' sizes

@@ -79,6 +79,7 @@ const std::vector<std::string> kGood = {R"(farm.endpoint="[fd00:6d6f::1]:7443")"
                                         R"(farm.cert="pki/appliance-a.pem")",
                                         R"(farm.key="pki/appliance-a.key")",
                                         "display.rate_hz=25",
+                                        "display.flip_timeout_s=12",
                                         R"(outputs.backend="headless")",
                                         R"(outputs.sizes=["320x240", "320x240", "320x240"])",
                                         R"(outputs.png_dir="out/png")",
@@ -129,6 +130,7 @@ TEST_F(KioskConfigTest, ReadsEveryFieldAndResolvesPathsAgainstTheFile) {
     EXPECT_EQ(c.farm.ca, dir_ / "pki/ca.pem");
     EXPECT_EQ(c.farm.key, dir_ / "pki/appliance-a.key");
     EXPECT_DOUBLE_EQ(c.outputs.rate_hz, 25.0);
+    EXPECT_DOUBLE_EQ(c.outputs.flip_timeout_s, 12.0);
     EXPECT_EQ(c.outputs.backend, OutputKind::headless);
     ASSERT_EQ(c.outputs.sizes.size(), 3u);
     EXPECT_EQ(c.outputs.sizes[2], (ImageSize{320, 240}));
@@ -328,6 +330,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadField{"rate_hz = 25", "rate_hz = 0", "[display].rate_hz = 0 is outside [0.5, 240] Hz"},
         BadField{"rate_hz = 25", "rate_hz = 1000.0", "[display].rate_hz = 1000 is outside"},
         BadField{"rate_hz = 25", "rate_hz = nan", "[display].rate_hz = nan is outside"},
+        BadField{"flip_timeout_s = 12", "flip_timeout_s = 0.5", "[display].flip_timeout_s = 0.5 is outside 0 (off)"},
+        BadField{"flip_timeout_s = 12", "flip_timeout_s = 601", "[display].flip_timeout_s = 601 is outside"},
         BadField{"rate_hz = 25", "rate_hz = \"fast\"", "[display].rate_hz: expected a number, got a string"},
         BadField{R"(backend = "headless")", R"(backend = "x11")",
                  "[outputs].backend: 'x11' is not one of headless, kms"},
@@ -385,7 +389,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadField{"log_period_s = 2.5", "log_period_s = 0", "[stats].log_period_s = 0 is outside [0.1, 86400] s"},
         BadField{R"(file = "out/stats.json")", "file = 3", "[stats].file: expected a string"},
         BadField{"[display]", "[displays]", "[displays]: unknown section (known: farm, display"},
-        BadField{"rate_hz = 25", "[display.rate]\nhz = 25", "[display].rate: unknown field (known: rate_hz)"},
+        BadField{"rate_hz = 25", "[display.rate]\nhz = 25", "[display].rate: unknown field (known: rate_hz, flip_timeout_s)"},
         BadField{"rate_hz = 25", "rate_hz = = 25", "not valid TOML"}));
 
 TEST_F(KioskConfigTest, MessagesCarryTheLineOfTheOffendingValue) {

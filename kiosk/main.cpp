@@ -81,6 +81,8 @@ int run(const Flags& flags, const SignalFd& signals) {
     parts.selfcal = selfcal.get();
     KioskRunOptions options{flags.frames, flags.duration_s, std::move(dump), std::move(pose_log)};
     options.fallbacks = std::move(fallbacks);
+    options.flip_timeout = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+        std::chrono::duration<double>(config.outputs.flip_timeout_s));
     Kiosk kiosk(config, std::move(parts), std::move(options));
     return kiosk.run();
 }

@@ -9,7 +9,7 @@ bash -n "$dir/lib/common.sh"
 bash -n "$dir/test/image_tests.sh"
 bash -n "$dir/test/build_vimc.sh"
 sh -n "$dir/test/selftest.sh"
-python3 - "$dir/test/qemu_boot_test.py" "$dir/test/qemu_common.py" "$dir/test/qemu_libcamera.py" "$dir/lib/prune_modules.py" <<'PY'
+python3 - "$dir/test/qemu_boot_test.py" "$dir/test/qemu_service_card_test.py" "$dir/test/qemu_common.py" "$dir/test/qemu_libcamera.py" "$dir/lib/prune_modules.py" <<'PY'
 import sys
 for f in sys.argv[1:]:
     compile(open(f).read(), f, "exec")

@@ -3,6 +3,7 @@
 # CTest entry of the opt-in image tests (labels "image;qemu"); see image/CMakeLists.txt.
 #   image_tests.sh build REPO OUTDIR KIOSK
 #   image_tests.sh boot  REPO OUTDIR KIOSK FARM IMAGE_TOOL MPIEXEC [CAMERA_TEST [LIBCAMERA_TEST]]
+#   image_tests.sh service-card REPO OUTDIR KIOSK   the configuration partition wiped: the service card
 # Exit 77 (skipped) with a message when not enabled (MOGAO_IMAGE_TESTS=1) or not possible here.
 set -u
 mode=$1 repo=$2 outdir=$3 kiosk=$4
@@ -32,6 +33,12 @@ case $mode in
     [[ -n "$camera" ]] && args+=(--camera-test "$camera")
     [[ -n "$libcamera" ]] && args+=(--libcamera-test "$libcamera")
     exec python3 "$repo/image/test/qemu_boot_test.py" "${args[@]}"
+    ;;
+  service-card)
+    image=${MOGAO_IMAGE:-$outdir/mogao-kiosk.img}
+    [[ -f "$image" ]] || skip "no image at $image (the image_build test builds it)"
+    exec python3 "$repo/image/test/qemu_service_card_test.py" --image "$image" --repo "$repo" \
+      --work "$outdir/qemu-service-card"
     ;;
   *) echo "unknown mode $mode" >&2; exit 2 ;;
 esac

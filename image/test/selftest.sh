@@ -24,6 +24,36 @@ host_wait() { timeout "$1" head -n1 "$ctl" 2>/dev/null | tr -d '\r'; }
 stty -F "$ctl" -echo icanon 2>/dev/null
 say "start uptime=$(uptime_s) kernel=$(uname -r)"
 
+# --- mode service-card: the configuration partition is missing or corrupt ----------------------------
+# (image/test/qemu_service_card_test.py wipes it). The box must boot on, not into emergency mode, and
+# the kiosk must light every projector with its service card (kiosk/service_screen.h).
+if grep -q "mogao.selftest.mode=service-card" /proc/cmdline; then
+  i=0
+  state=""
+  while [ $i -lt 600 ]; do
+    state=$(systemctl is-active mogao-kiosk.service)
+    [ "$state" = active ] && break
+    [ $((i % 30)) -eq 0 ] && say "waiting kiosk state=$state uptime=$(uptime_s)"
+    sleep 1; i=$((i + 1))
+  done
+  if [ "$state" = active ]; then ok "service-kiosk-active uptime=$(uptime_s)"; else bad "service-kiosk-active state=$state"; fi
+  for t in emergency.target rescue.target; do
+    if [ "$(systemctl is-active $t)" = active ]; then bad "no-$t (active)"; else ok "no-$t"; fi
+  done
+  say "system-state $(systemctl is-system-running 2>/dev/null)"
+  if findmnt -n /etc/mogao > /dev/null 2>&1; then bad "config-missing (/etc/mogao is mounted)"; else ok "config-missing"; fi
+  line=$(journalctl -b -u mogao-kiosk.service --no-pager -o cat 2>/dev/null | grep -m1 "service card on every output")
+  if [ -n "$line" ]; then ok "service-card-journal $line"; else bad "service-card-journal (no 'service card on every output' line)"; fi
+  say "service-card-shown restarts=$(prop mogao-kiosk.service NRestarts)"
+  answer=$(host_wait 300)
+  # Still up after the host's screendumps, without a restart: the card feeds the watchdog.
+  sleep 15
+  say "service-card-steady state=$(systemctl is-active mogao-kiosk.service) restarts=$(prop mogao-kiosk.service NRestarts) answer=$answer"
+  say "done fails=$fails uptime=$(uptime_s)"
+  systemctl poweroff --no-block
+  exit 0
+fi
+
 # --- V4L2: vivid, the kernel's virtual capture driver -------------------------------------------
 # Two instances: a single-planar one and a multi-planar one (multiplanar=2: NV12M/YUV420M buffers).
 if modprobe vivid n_devs=2 multiplanar=1,2 2>/dev/null; then

@@ -87,23 +87,10 @@ TEST(LinkRotation, ApplianceCertificateIsReplacedWhileStreaming) {
     replace_file(files.cert, pki.museum1.cert_pem);
     replace_file(files.key, pki.museum1.key_pem);
 
-    SyntheticRenderer synthetic;
-    std::atomic<LinkServer*> server_ptr{nullptr};
-    std::mutex mutex;
-    std::vector<std::string> names;  // the certificate name of each rendered request's session
-    LinkServer server(test_server_options(), [&](const ViewRequest& view) {
-        const std::string name = server_ptr.load()->appliance_of(view.session);
-        {
-            const std::lock_guard lock(mutex);
-            names.push_back(name);
-        }
-        return synthetic(view);
-    });
-    server_ptr = &server;
-    const auto rendered_for = [&](const std::string& name) {
-        const std::lock_guard lock(mutex);
-        return std::count(names.begin(), names.end(), name);
-    };
+    SessionNameRecorder recorder;
+    LinkServer server(test_server_options(), recorder.function());
+    recorder.attach(server);
+    const auto rendered_for = [&](const std::string& name) { return recorder.count(name); };
 
     auto options = test_client_options(server.endpoint().port, pki.museum1);
     options.tls_files = files;
@@ -127,8 +114,8 @@ TEST(LinkRotation, ApplianceCertificateIsReplacedWhileStreaming) {
     // A key that does not match its certificate: refused, the session with museum-2 goes on.
     replace_file(files.key, pki.museum1.key_pem);
     EXPECT_TRUE(wait_until([&] { return client.stats().tls_reloads_refused == 1; }));
-    const std::size_t before = static_cast<std::size_t>(rendered_for("museum-2"));
-    EXPECT_TRUE(stream_until([&] { return static_cast<std::size_t>(rendered_for("museum-2")) > before; }));
+    const std::size_t before = rendered_for("museum-2");
+    EXPECT_TRUE(stream_until([&] { return rendered_for("museum-2") > before; }));
     EXPECT_EQ(client.stats().sessions_opened, 2u);
     EXPECT_EQ(client.stats().tls_reloads, 1u);
 }

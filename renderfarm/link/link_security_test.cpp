@@ -262,26 +262,15 @@ TEST_F(LinkSecurity, OneApplianceCannotTakeEverySessionSlot) {
 // certificate name that session was admitted with.
 TEST(LinkSessionIdentity, ARequestsSessionNamesTheCertificateItWasAdmittedWith) {
     REQUIRE_IPV6_LOOPBACK();
-    SyntheticRenderer synthetic;
-    std::atomic<LinkServer*> server_ptr{nullptr};
-    std::mutex mutex;
-    std::vector<std::string> seen;
-    LinkServer server(test_server_options(), [&](const ViewRequest& view) {
-        const std::string name = server_ptr.load()->appliance_of(view.session);
-        {
-            const std::lock_guard lock(mutex);
-            seen.push_back(name);
-        }
-        return synthetic(view);
-    });
-    server_ptr = &server;
+    SessionNameRecorder recorder;
+    LinkServer server(test_server_options(), recorder.function());
+    recorder.attach(server);
     const auto& pki = TestPki::get();
     EXPECT_TRUE(
         raw_session_once(tls_channel(server.endpoint().grpc_target(), pki.appliance_tls(pki.museum2))).got_frame);
     EXPECT_TRUE(
         raw_session_once(tls_channel(server.endpoint().grpc_target(), pki.appliance_tls(pki.museum1))).got_frame);
-    const std::lock_guard lock(mutex);
-    EXPECT_EQ(seen, (std::vector<std::string>{"museum-2", "museum-1"}));
+    EXPECT_EQ(recorder.names(), (std::vector<std::string>{"museum-2", "museum-1"}));
     EXPECT_EQ(server.appliance_of(0), "");
     EXPECT_EQ(server.appliance_of(12345), "");
 }

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "renderfarm/link/link_test_support.h"
 
+#include <algorithm>
+
 #include <netinet/in.h>
 #include <sys/socket.h>
 
@@ -193,6 +195,28 @@ std::shared_ptr<grpc::Channel> tls_channel(const std::string& target, const TlsM
     grpc::ChannelArguments args;
     args.SetInt(GRPC_ARG_USE_LOCAL_SUBCHANNEL_POOL, 1);
     return grpc::CreateCustomChannel(target, grpc::SslCredentials(ssl), args);
+}
+
+FrameRenderer SessionNameRecorder::function() {
+    return [this](const ViewRequest& view) {
+        const LinkServer* server = server_.load();
+        std::string name = server != nullptr ? server->appliance_of(view.session) : std::string("(not attached)");
+        {
+            const std::lock_guard lock(mutex_);
+            names_.push_back(std::move(name));
+        }
+        return synthetic_(view);
+    };
+}
+
+std::vector<std::string> SessionNameRecorder::names() const {
+    const std::lock_guard lock(mutex_);
+    return names_;
+}
+
+std::size_t SessionNameRecorder::count(const std::string& name) const {
+    const std::lock_guard lock(mutex_);
+    return static_cast<std::size_t>(std::count(names_.begin(), names_.end(), name));
 }
 
 RawOutcome raw_session_once(const std::shared_ptr<grpc::Channel>& channel) {

@@ -7,6 +7,7 @@
 
 #include <grpcpp/grpcpp.h>
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -77,6 +78,23 @@ private:
     int blocked_ = 0;
     std::chrono::microseconds delay_{0};
     std::vector<std::uint64_t> ids_;
+};
+
+// A synthetic renderer that also records, for each request it renders, the certificate name of
+// the request's session (LinkServer::appliance_of): which appliance the farm believes it serves.
+// attach() the server once it is constructed (the renderer is handed to its constructor).
+class SessionNameRecorder {
+public:
+    [[nodiscard]] FrameRenderer function();
+    void attach(const LinkServer& server) { server_.store(&server); }
+    [[nodiscard]] std::vector<std::string> names() const;
+    [[nodiscard]] std::size_t count(const std::string& name) const;
+
+private:
+    SyntheticRenderer synthetic_;
+    std::atomic<const LinkServer*> server_{nullptr};
+    mutable std::mutex mutex_;
+    std::vector<std::string> names_;
 };
 
 struct Mark {
