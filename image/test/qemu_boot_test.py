@@ -195,6 +195,23 @@ def db_json(db):
     return db if db is None or db != float("inf") else "inf"
 
 
+def require_qemu(image):
+    """qemu-system-x86_64's path; skips (exit 77) naming what is missing: QEMU, OVMF, the disk tools or
+    the image."""
+    qemu = shutil.which("qemu-system-x86_64")
+    if not qemu:
+        skip("qemu-system-x86_64 not found (apt-get install qemu-system-x86)")
+    for f in (OVMF_CODE, OVMF_VARS):
+        if not os.path.exists(f):
+            skip(f"{f} not found (apt-get install ovmf)")
+    for tool in ("mcopy", "mtype", "mke2fs", "sfdisk"):
+        if not shutil.which(tool):
+            skip(f"{tool} not found (apt-get install mtools e2fsprogs fdisk)")
+    if not os.path.isfile(image):
+        skip(f"no image at {image} (build it with image/build, or run the image_build test first)")
+    return qemu
+
+
 def run(cmd, **kw):
     return subprocess.run(cmd, check=True, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, **kw)
 
@@ -220,17 +237,7 @@ def main():
     a = ap.parse_args()
 
     # --- preconditions (skip, not fail) ---------------------------------------------------------
-    qemu = shutil.which("qemu-system-x86_64")
-    if not qemu:
-        skip("qemu-system-x86_64 not found (apt-get install qemu-system-x86)")
-    for f in (OVMF_CODE, OVMF_VARS):
-        if not os.path.exists(f):
-            skip(f"{f} not found (apt-get install ovmf)")
-    for tool in ("mcopy", "mtype", "mke2fs", "sfdisk"):
-        if not shutil.which(tool):
-            skip(f"{tool} not found (apt-get install mtools e2fsprogs fdisk)")
-    if not os.path.isfile(a.image):
-        skip(f"no image at {a.image} (build it with image/build, or run the image_build test first)")
+    qemu = require_qemu(a.image)
     if os.geteuid() != 0:
         skip("needs root (image/provision writes files owned by the kiosk user)")
     for b in (a.kiosk, a.farm, a.image_tool):

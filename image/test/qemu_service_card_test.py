@@ -30,7 +30,7 @@ import tempfile
 import time
 
 from qemu_common import T0, Failures, Serial, log, set_name  # noqa: E402 (this folder)
-from qemu_boot_test import MODES, OUTPUTS, OVMF_CODE, OVMF_VARS, Qmp, ppm_stats, run, skip  # noqa: E402
+from qemu_boot_test import MODES, OUTPUTS, OVMF_CODE, OVMF_VARS, Qmp, ppm_stats, require_qemu, run  # noqa: E402
 
 WIPE_MIB = 4  # the ext4 superblock is at 1 KiB; 4 MiB also clears the group descriptors
 
@@ -145,17 +145,7 @@ def main():
     ap.add_argument("--accel", default=os.environ.get("MOGAO_IMAGE_QEMU_ACCEL", "tcg"), choices=["tcg", "kvm"])
     ap.add_argument("--timeout", type=float, default=float(os.environ.get("MOGAO_IMAGE_BOOT_TIMEOUT", "900")))
     a = ap.parse_args()
-    qemu = shutil.which("qemu-system-x86_64")
-    if not qemu:
-        skip("qemu-system-x86_64 not found (apt-get install qemu-system-x86)")
-    for f in (OVMF_CODE, OVMF_VARS):
-        if not os.path.exists(f):
-            skip(f"{f} not found (apt-get install ovmf)")
-    for tool in ("mcopy", "mtype", "mke2fs", "sfdisk"):
-        if not shutil.which(tool):
-            skip(f"{tool} not found (apt-get install mtools e2fsprogs fdisk)")
-    if not os.path.isfile(a.image):
-        skip(f"no image at {a.image} (build it with image/build, or run the image_build test first)")
+    qemu = require_qemu(a.image)
     work = a.work or tempfile.mkdtemp(prefix="mogao-qemu-card-")
     os.makedirs(work, exist_ok=True)
     for name in ("serial.log", "qmp.sock", "ctl.sock"):
