@@ -389,7 +389,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadField{"log_period_s = 2.5", "log_period_s = 0", "[stats].log_period_s = 0 is outside [0.1, 86400] s"},
         BadField{R"(file = "out/stats.json")", "file = 3", "[stats].file: expected a string"},
         BadField{"[display]", "[displays]", "[displays]: unknown section (known: farm, display"},
-        BadField{"rate_hz = 25", "[display.rate]\nhz = 25", "[display].rate: unknown field (known: rate_hz, flip_timeout_s)"},
+        BadField{"rate_hz = 25", "[display.rate]\nhz = 25",
+                 "[display].rate: unknown field (known: rate_hz, flip_timeout_s)"},
         BadField{"rate_hz = 25", "rate_hz = = 25", "not valid TOML"}));
 
 TEST_F(KioskConfigTest, MessagesCarryTheLineOfTheOffendingValue) {
