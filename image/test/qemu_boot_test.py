@@ -212,6 +212,18 @@ def require_qemu(image):
     return qemu
 
 
+def install_selftest_entry(work, esp, title, options, extra, env):
+    """Makes a systemd-boot entry `title` with the image's kernel options plus `extra` the default of
+    the test copy's ESP (`esp`: an mtools image@@offset)."""
+    with open(os.path.join(work, "selftest.conf"), "w") as f:
+        f.write(f"title {title}\nlinux /mogao/vmlinuz\ninitrd /mogao/initrd.img\n"
+                f"options {' '.join(options.split())} {' '.join(extra)}\n")
+    with open(os.path.join(work, "loader.conf"), "w") as f:
+        f.write("default selftest.conf\ntimeout 0\neditor no\n")
+    run(["mcopy", "-o", "-i", esp, os.path.join(work, "selftest.conf"), "::/loader/entries/selftest.conf"], env=env)
+    run(["mcopy", "-o", "-i", esp, os.path.join(work, "loader.conf"), "::/loader/loader.conf"], env=env)
+
+
 def run(cmd, **kw):
     return subprocess.run(cmd, check=True, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, **kw)
 
@@ -340,14 +352,7 @@ def main():
     ]
     if not a.no_tco:
         extra.append("mogao.selftest.tco=1")
-    selftest_entry = (f"title mogao self-test (QEMU)\nlinux /mogao/vmlinuz\ninitrd /mogao/initrd.img\n"
-                      f"options {' '.join(options.split())} {' '.join(extra)}\n")
-    with open(os.path.join(work, "selftest.conf"), "w") as f:
-        f.write(selftest_entry)
-    with open(os.path.join(work, "loader.conf"), "w") as f:
-        f.write("default selftest.conf\ntimeout 0\neditor no\n")
-    run(["mcopy", "-o", "-i", esp, os.path.join(work, "selftest.conf"), "::/loader/entries/selftest.conf"], env=env)
-    run(["mcopy", "-o", "-i", esp, os.path.join(work, "loader.conf"), "::/loader/loader.conf"], env=env)
+    install_selftest_entry(work, esp, "mogao self-test (QEMU)", options, extra, env)
 
     # Test disk: the self-test script (+ the camera test and the libraries it needs, from this host).
     disk = os.path.join(work, "testdisk")

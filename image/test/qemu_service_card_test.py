@@ -30,7 +30,7 @@ import tempfile
 import time
 
 from qemu_common import T0, Failures, Serial, log, set_name  # noqa: E402 (this folder)
-from qemu_boot_test import MODES, OUTPUTS, OVMF_CODE, OVMF_VARS, Qmp, ppm_stats, require_qemu, run  # noqa: E402
+from qemu_boot_test import MODES, OUTPUTS, OVMF_CODE, OVMF_VARS, Qmp, install_selftest_entry, ppm_stats, require_qemu, run  # noqa: E402
 
 WIPE_MIB = 4  # the ext4 superblock is at 1 KiB; 4 MiB also clears the group descriptors
 
@@ -68,13 +68,7 @@ def prepare(a, work, env):
              "systemd.unit=multi-user.target", "systemd.wants=kernel-command-line.service",
              f"systemd.run=\"/bin/sh -c '{boot}'\"", "systemd.run_success_action=none",
              "systemd.run_failure_action=none", "mogao.selftest.mode=service-card"]
-    with open(os.path.join(work, "selftest.conf"), "w") as f:
-        f.write(f"title mogao self-test, service card (QEMU)\nlinux /mogao/vmlinuz\ninitrd /mogao/initrd.img\n"
-                f"options {' '.join(options.split())} {' '.join(extra)}\n")
-    with open(os.path.join(work, "loader.conf"), "w") as f:
-        f.write("default selftest.conf\ntimeout 0\neditor no\n")
-    run(["mcopy", "-o", "-i", esp, os.path.join(work, "selftest.conf"), "::/loader/entries/selftest.conf"], env=env)
-    run(["mcopy", "-o", "-i", esp, os.path.join(work, "loader.conf"), "::/loader/loader.conf"], env=env)
+    install_selftest_entry(work, esp, "mogao self-test, service card (QEMU)", options, extra, env)
     disk = os.path.join(work, "testdisk")
     shutil.rmtree(disk, ignore_errors=True)
     os.makedirs(disk)
