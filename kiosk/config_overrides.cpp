@@ -9,6 +9,8 @@
 #include <fmt/format.h>
 #include <toml.hpp>
 
+#include "common/toml_nesting.h"
+
 namespace mogao {
 namespace {
 
@@ -117,7 +119,13 @@ std::string apply_config_overrides(std::string_view toml, const std::vector<std:
     std::vector<std::string> lines = split_lines(toml);
     for (const std::string& text : overrides) {
         apply(lines, text);
-        std::istringstream in(join(lines));
+        const std::string joined = join(lines);
+        if (const auto excess = toml_nesting_excess(joined)) {
+            throw KioskConfigError(
+                fmt::format("override '{}': line {} nests arrays or inline tables deeper than {} levels", text,
+                            excess->line, excess->max_depth));
+        }
+        std::istringstream in(joined);
         try {
             (void)toml::parse(in, "kiosk.example.toml");
         } catch (const std::exception& e) {

@@ -16,6 +16,7 @@
 #include "appliance/warp/late_warp.h"
 #include "common/quality_preset.h"
 #include "common/request_limits.h"
+#include "common/toml_nesting.h"
 #include "renderfarm/link/endpoint.h"
 
 namespace mogao {
@@ -742,6 +743,11 @@ bool parse_size(std::string_view text, ImageSize& out) {
 namespace {
 
 Value parse_toml(std::string_view text, const Context& ctx) {
+    // toml11 recurses once per level and has no limit: a deep file would crash the kiosk.
+    if (const auto excess = toml_nesting_excess(text)) {
+        throw KioskConfigError(fmt::format("{}:{}: arrays or inline tables nested deeper than {} levels", ctx.file,
+                                           excess->line, excess->max_depth));
+    }
     try {
         std::istringstream in{std::string(text)};
         return toml::parse(in, ctx.file);

@@ -2,6 +2,7 @@
 #include "kiosk/kiosk_config.h"
 
 #include "common/quality_preset.h"
+#include "common/toml_nesting.h"
 
 #include "kiosk/config_overrides.h"
 
@@ -28,7 +29,8 @@ public:  // the free helpers below build on good()
         dir_ = fs::temp_directory_path() / ("mogao-kiosk-config-" + std::to_string(::getpid()));
         fs::remove_all(dir_);
         fs::create_directories(dir_ / "pki");
-        for (const char* f : {"pki/ca.pem", "pki/appliance-a.pem", "pki/appliance-a.key", "screen.mpcdi", "tour.json"}) {
+        for (const char* f :
+             {"pki/ca.pem", "pki/appliance-a.pem", "pki/appliance-a.key", "screen.mpcdi", "tour.json"}) {
             std::ofstream(dir_ / f) << "x";
         }
         // A replay folder with its camera.json (as `mogao-track make-sequence` writes it), and a
@@ -397,7 +399,27 @@ TEST_F(KioskConfigTest, MessagesCarryTheLineOfTheOffendingValue) {
     const std::string text = good();
     const std::string message = error_of(replace(text, "spp = 2", "spp = 0"));
     const auto line = 1 + std::count(text.begin(), text.begin() + static_cast<long>(text.find("spp = 2")), '\n');
-    EXPECT_NE(message.find(name().string() + ":" + std::to_string(line) + ": [quality].spp"), std::string::npos) << message;
+    EXPECT_NE(message.find(name().string() + ":" + std::to_string(line) + ": [quality].spp"), std::string::npos)
+        << message;
+}
+
+// toml11 recurses once per nesting level without a limit: 20000 levels overflowed the stack
+// (found by fuzzing, tests/fuzz kiosk_config). The guard refuses them with the file and line; at
+// the guard's limit toml11 parses the value and the field check reports it.
+TEST_F(KioskConfigTest, ADeeplyNestedValueIsRefusedWithItsLineNotACrash) {
+    const std::string text = good();
+    const std::string field = R"(file = "out/stats.json")";
+    ASSERT_NE(text.find(field), std::string::npos);
+    const auto line = 1 + std::count(text.begin(), text.begin() + static_cast<long>(text.find(field)), '\n');
+    const auto nested = [](int levels) { return std::string(levels, '[') + std::string(levels, ']'); };
+    const std::string deep = error_of(replace(text, field, "file = " + nested(20000)));
+    EXPECT_NE(deep.find(name().string() + ":" + std::to_string(line) + ": arrays or inline tables nested deeper than " +
+                        std::to_string(kMaxTomlNesting)),
+              std::string::npos)
+        << deep;
+    const std::string at_limit = error_of(replace(text, field, "file = " + nested(kMaxTomlNesting)));
+    EXPECT_NE(at_limit.find("[stats].file: expected a string"), std::string::npos) << at_limit;
+    EXPECT_THROW((void)apply_config_overrides(text, {"stats.file=" + nested(kMaxTomlNesting + 1)}), KioskConfigError);
 }
 
 TEST_F(KioskConfigTest, MissingFarmSectionAndMissingFileAreErrors) {
@@ -437,7 +459,8 @@ TEST_F(KioskConfigTest, TheExampleFileIsValid) {
         text.replace(at, prefix.size(), (dir_ / "etc").string() + "/");
     }
     fs::create_directories(dir_ / "etc/pki");
-    for (const char* f : {"etc/pki/ca.pem", "etc/pki/appliance-museum-1.pem", "etc/pki/appliance-museum-1.key", "etc/screen.mpcdi"}) {
+    for (const char* f :
+         {"etc/pki/ca.pem", "etc/pki/appliance-museum-1.pem", "etc/pki/appliance-museum-1.key", "etc/screen.mpcdi"}) {
         std::ofstream(dir_ / f) << "x";
     }
     const KioskConfig c = parse(text);
@@ -706,7 +729,8 @@ TEST_F(KioskConfigTest, TheExampleFilesTrackingBlockIsValid) {
         text.replace(at, prefix.size(), (dir_ / "etc").string() + "/");
     }
     fs::create_directories(dir_ / "etc/pki");
-    for (const char* f : {"etc/pki/ca.pem", "etc/pki/appliance-museum-1.pem", "etc/pki/appliance-museum-1.key", "etc/screen.mpcdi"}) {
+    for (const char* f :
+         {"etc/pki/ca.pem", "etc/pki/appliance-museum-1.pem", "etc/pki/appliance-museum-1.key", "etc/screen.mpcdi"}) {
         std::ofstream(dir_ / f) << "x";
     }
     fs::copy_file(dir_ / "webcam.json", dir_ / "etc/camera.json");
@@ -775,7 +799,8 @@ TEST_F(KioskConfigTest, TheExampleFilesSelfcalBlockIsValid) {
 // out/live/ with its PKI, the sequence in out/hand-sequence.
 TEST_F(KioskConfigTest, TheTourTrackingFileIsValidInItsPlace) {
     fs::create_directories(dir_ / "out/live/pki");
-    for (const char* f : {"out/live/pki/ca.pem", "out/live/pki/appliance-museum-1.pem", "out/live/pki/appliance-museum-1.key"}) {
+    for (const char* f :
+         {"out/live/pki/ca.pem", "out/live/pki/appliance-museum-1.pem", "out/live/pki/appliance-museum-1.key"}) {
         std::ofstream(dir_ / f) << "x";
     }
     fs::create_directories(dir_ / "out/hand-sequence");

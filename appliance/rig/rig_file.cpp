@@ -8,6 +8,8 @@
 
 #include <toml.hpp>
 
+#include "common/toml_nesting.h"
+
 namespace mogao::rig {
 namespace {
 
@@ -196,6 +198,11 @@ VirtualRig read_root(const toml::value& root, const std::string& file) {
 
 VirtualRig parse_rig(const std::string& toml_text, const std::string& name) {
     toml::value root;
+    // toml11 recurses once per level and has no limit: a deep file would crash the reader.
+    if (const auto excess = toml_nesting_excess(toml_text)) {
+        throw RigError("rig file '" + name + "' line " + std::to_string(excess->line) +
+                       ": arrays or inline tables nested deeper than " + std::to_string(excess->max_depth) + " levels");
+    }
     try {
         std::istringstream in(toml_text);
         root = toml::parse(in, name);

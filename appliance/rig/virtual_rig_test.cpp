@@ -166,6 +166,11 @@ TEST(RigFile, ErrorsNameTheField) {
         message("[camera]\nauto_exposure = 1\n[[projectors]]\n").find("camera.auto_exposure: must be true or false"),
         std::string::npos);
     EXPECT_THROW((void)load_rig("/nonexistent/rig.toml"), RigError);
+    // toml11 recurses once per level without a limit: 20000 levels crashed the reader.
+    const std::string deep = std::string(20000, '[') + std::string(20000, ']');
+    EXPECT_NE(message("[camera]\n[[projectors]]\ngamma = " + deep + "\n")
+                  .find("line 3: arrays or inline tables nested deeper than 32 levels"),
+              std::string::npos);
 }
 
 }  // namespace

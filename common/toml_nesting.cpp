@@ -1,0 +1,77 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "common/toml_nesting.h"
+
+#include <stdexcept>
+#include <string>
+
+namespace mogao {
+namespace {
+
+// The position just past the string that starts at `i` (at a quote), or text.size() when it is
+// not terminated. `line` counts the newlines inside (multi-line strings).
+std::size_t skip_string(std::string_view text, std::size_t i, std::size_t& line) {
+    const char quote = text[i];
+    const bool basic = quote == '"';
+    const bool multi = text.substr(i, 3) == std::string_view(basic ? "\"\"\"" : "'''");
+    std::size_t j = i + (multi ? 3 : 1);
+    while (j < text.size()) {
+        const char c = text[j];
+        if (basic && c == '\\') {
+            if (j + 1 < text.size() && text[j + 1] == '\n') ++line;
+            j += 2;
+            continue;
+        }
+        if (c == '\n') {
+            if (!multi) return j;  // a single-line string ends at the line's end (invalid TOML)
+            ++line;
+        }
+        if (c == quote && (!multi || text.substr(j, 3) == std::string_view(basic ? "\"\"\"" : "'''"))) {
+            // A multi-line string may end with up to two more quotes of its own ("""a""""").
+            j += multi ? 3 : 1;
+            while (multi && j < text.size() && text[j] == quote) ++j;
+            return j;
+        }
+        ++j;
+    }
+    return text.size();
+}
+
+}  // namespace
+
+std::optional<TomlNestingExcess> toml_nesting_excess(std::string_view text, int max_depth) {
+    if (max_depth < 1) {
+        throw std::invalid_argument("toml_nesting_excess: max_depth must be >= 1, not " + std::to_string(max_depth));
+    }
+    int depth = 0;
+    std::size_t line = 1;
+    std::size_t i = 0;
+    while (i < text.size()) {
+        const char c = text[i];
+        switch (c) {
+            case '\n':
+                ++line;
+                break;
+            case '#':
+                while (i < text.size() && text[i] != '\n') ++i;
+                continue;  // the newline is counted on the next turn
+            case '"':
+            case '\'':
+                i = skip_string(text, i, line);
+                continue;
+            case '[':
+            case '{':
+                if (++depth > max_depth) return TomlNestingExcess{line, max_depth};
+                break;
+            case ']':
+            case '}':
+                if (depth > 0) --depth;  // unbalanced closers are toml11's to report
+                break;
+            default:
+                break;
+        }
+        ++i;
+    }
+    return std::nullopt;
+}
+
+}  // namespace mogao

@@ -1,0 +1,39 @@
+// SPDX-License-Identifier: Apache-2.0
+// A guard run on TOML text before toml11 parses it: how deeply arrays and inline tables nest.
+//
+// Why: toml11 (3.7, Debian 12) parses nested arrays and inline tables by recursion, one set of
+// stack frames per level, with no limit of its own. "a = [[[[...": about 10000 levels in a file
+// of 20 kB overflow the stack (SIGSEGV), far fewer under ASan -- found by fuzzing the kiosk's
+// configuration (tests/fuzz, kiosk_config). A kiosk configuration or a rig file never needs more
+// than a few levels, so every TOML reader checks the text first and refuses it, naming the line.
+//
+// The scan follows TOML 1.0's lexical rules (https://toml.io/en/v1.0.0) only as far as needed to
+// count brackets: '[', '{' open a level and ']', '}' close one outside comments ('#' to the end of
+// the line) and outside the four kinds of string ("...", '...', """...""", '''...''', with the
+// backslash escapes of basic strings). A table header "[a]" or "[[a]]" counts as one or two
+// levels, closed on its own line. Text that is not valid TOML is not judged here (toml11 does it);
+// an unterminated string simply ends the scan.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string_view>
+
+namespace mogao {
+
+// Levels a TOML reader of this project accepts: far above any real file, far below what toml11's
+// recursion survives (tested under ASan in common/toml_nesting_test.cpp).
+inline constexpr int kMaxTomlNesting = 32;
+
+struct TomlNestingExcess {
+    std::size_t line = 0;  // 1-based line of the bracket that opened level max_depth + 1
+    int max_depth = 0;     // the limit that was passed
+};
+
+// The first place where `text` nests arrays / inline tables deeper than `max_depth` levels, or
+// nullopt when it never does. Throws std::invalid_argument when max_depth < 1. Linear in the
+// size of the text, no recursion, no allocation.
+[[nodiscard]] std::optional<TomlNestingExcess> toml_nesting_excess(std::string_view text,
+                                                                   int max_depth = kMaxTomlNesting);
+
+}  // namespace mogao

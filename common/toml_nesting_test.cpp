@@ -1,0 +1,60 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "common/toml_nesting.h"
+
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+#include <string>
+
+namespace mogao {
+namespace {
+
+std::string nested_arrays(int levels) { return "a = " + std::string(levels, '[') + std::string(levels, ']') + "\n"; }
+
+TEST(TomlNesting, ArraysDeeperThanTheLimitAreFoundOnTheirLine) {
+    const auto at_limit = toml_nesting_excess("x = 1\n" + nested_arrays(kMaxTomlNesting));
+    EXPECT_FALSE(at_limit.has_value());
+    const auto over = toml_nesting_excess("x = 1\n# comment\n" + nested_arrays(kMaxTomlNesting + 1));
+    ASSERT_TRUE(over.has_value());
+    EXPECT_EQ(over->line, 3u);
+    EXPECT_EQ(over->max_depth, kMaxTomlNesting);
+}
+
+TEST(TomlNesting, InlineTablesAndArraysCountTogether) {
+    std::string text = "a = ";
+    for (int i = 0; i < 3; ++i) text += "{ b = [";
+    text += "1";
+    for (int i = 0; i < 3; ++i) text += "] }";
+    EXPECT_FALSE(toml_nesting_excess(text, 6).has_value());
+    EXPECT_TRUE(toml_nesting_excess(text, 5).has_value());
+}
+
+TEST(TomlNesting, BracketsInStringsAndCommentsAreNotLevels) {
+    const std::string deep(100, '[');
+    const std::string text = "a = \"" + deep + "\\\"" + deep + "\"\n" +                 // basic string, escaped quote
+                             "b = '" + deep + "'\n" +                                   // literal string
+                             "c = \"\"\"\n" + deep + "\n\"\" " + deep + "\n\"\"\"\n" +  // multi-line basic
+                             "d = '''" + deep + "\n'' " + deep + "'''\n" +              // multi-line literal
+                             "# " + deep + "\n" +                                       // comment
+                             "[table]\n[[array.of.tables]]\n" +                         // headers close
+                             "e = [[1], ['[']]\n";
+    EXPECT_FALSE(toml_nesting_excess(text, 2).has_value());
+    // The same counting still sees real levels after all of that, on the right line.
+    const auto over = toml_nesting_excess(text + "f = [[[1]]]\n", 2);
+    ASSERT_TRUE(over.has_value());
+    EXPECT_EQ(over->line, 13u);
+}
+
+TEST(TomlNesting, UnterminatedStringsAndStrayClosersEndQuietly) {
+    EXPECT_FALSE(toml_nesting_excess("a = \"[[[[[[", 2).has_value());
+    EXPECT_FALSE(toml_nesting_excess("a = ''']]]]]][[", 2).has_value());
+    EXPECT_FALSE(toml_nesting_excess("]]]]]] a = [[1]]", 2).has_value());
+    EXPECT_TRUE(toml_nesting_excess("]]]]]] a = [[[1]]]", 2).has_value());
+}
+
+TEST(TomlNesting, ALimitBelowOneIsRefused) {
+    EXPECT_THROW((void)toml_nesting_excess("a = 1", 0), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace mogao
