@@ -41,6 +41,11 @@ diagnose() {
     ps -L -o tid,stat,wchan:24,time,pcpu -p "$p" | sed "s/^/MOGAO-SELFTEST diag threads $p /" > "$out"
   done
   ss -Htanp 2>/dev/null | grep -v LISTEN | sed 's/^/MOGAO-SELFTEST diag ss /' > "$out"
+  # TCP's own view of each connection (mss, rtt, retransmits, bytes acked) and the NIC's counters:
+  # tells a lost path (retransmits, nothing acked) from peers that wait on each other.
+  ss -Htinp state established 2>/dev/null | paste - - | sed 's/^/MOGAO-SELFTEST diag tcp /' > "$out"
+  ip -s -o link show 2>/dev/null | sed 's/^/MOGAO-SELFTEST diag link /' > "$out"
+  grep '^Tcp:' /proc/net/snmp | paste - - | sed 's/^/MOGAO-SELFTEST diag snmp /' > "$out"
 }
 check_common() {
   failed=$(systemctl --failed --plain --no-legend 2>/dev/null | awk '{print $1}' | tr '\n' ' ')

@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
+# mogao-farm-launch's choice of hosts, with a stand-in rsh agent and mpirun (no MPI, no network):
+#   * a render host whose sshd comes up late (the agent refuses its first 2 checks) is waited for
+#     while the machine's uptime is under MOGAO_BOOT_GRACE_S, and mpirun gets it and all 3 ranks;
+#   * with MOGAO_BOOT_GRACE_S=0 (a host lost while serving) it is left out at once, 2 ranks;
+#   * a host that never answers is left out when the grace ends (not waited for forever);
+#   * bad MOGAO_BOOT_GRACE_S / RANKS are refused with exit 2, naming the variable.
+# usage: launch_test.sh LAUNCHER
+set -euo pipefail
+launcher=$1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+
+printf 'admin slots=2 # this machine\nrender2 slots=1\n' > "$work/hosts"
+# The agent: "render2" refuses (as ssh does before sshd listens) until its ANSWER_AFTER-th check.
+cat > "$work/agent" <<AGENT
+#!/bin/sh
+n=\$(cat "$work/calls" 2>/dev/null || echo 0); n=\$((n + 1)); echo \$n > "$work/calls"
+[ "\$n" -gt "\${ANSWER_AFTER:-0}" ] && { echo ok; exit 0; }
+echo "ssh: connect to host \$1 port 22: Connection refused" >&2; exit 255
+AGENT
+printf '#!/bin/sh\necho "mpirun $*"; cat "$2"\n' > "$work/mpirun"
+chmod +x "$work/agent" "$work/mpirun"
+run() {  # run GRACE ANSWER_AFTER: the launcher's output
+  rm -f "$work/calls"
+  OMPI_MCA_plm_rsh_agent="$work/agent" MOGAO_MPIRUN="$work/mpirun" RUNTIME_DIRECTORY="$work" \
+    MOGAO_BOOT_GRACE_S=$1 ANSWER_AFTER=$2 sh "$launcher" "$work/hosts" 3 mogao-farm serve 2>&1
+}
+up=$(cut -d. -f1 /proc/uptime)
+
+out=$(run $((up + 600)) 2)
+echo "$out" | grep -q "mpirun --hostfile .* -n 3 mogao-farm serve" || fail "booting: render2 not waited for: $out"
+echo "$out" | grep -q "^render2 slots=1" || fail "booting: render2 not in the host file: $out"
+echo "$out" | grep -q "asking again every 2 s" || fail "booting: the wait is not logged: $out"
+[ "$(cat "$work/calls")" = 3 ] || fail "booting: render2 asked $(cat "$work/calls") times, expected 3"
+
+out=$(run 0 2)
+echo "$out" | grep -q "render host render2 left out: health check failed (exit 255: ssh: connect to host render2 port 22: Connection refused" \
+  || fail "serving: render2 not left out with the reason: $out"
+echo "$out" | grep -q "mpirun --hostfile .* -n 2 mogao-farm serve" || fail "serving: expected 2 ranks: $out"
+[ "$(cat "$work/calls")" = 1 ] || fail "serving: render2 asked $(cat "$work/calls") times, expected 1 (no wait)"
+
+start=$(date +%s)
+out=$(run $(($(cut -d. -f1 /proc/uptime) + 4)) 1000)
+took=$(($(date +%s) - start))
+echo "$out" | grep -q "render host render2 left out" || fail "grace over: render2 not left out: $out"
+((took >= 3 && took <= 15)) || fail "grace over: the launcher took $took s for a 4 s grace"
+
+for bad in "MOGAO_BOOT_GRACE_S=-1" "MOGAO_BOOT_GRACE_S=2m"; do
+  rc=0; err=$(env "$bad" sh "$launcher" "$work/hosts" 3 true 2>&1) || rc=$?
+  [ $rc = 2 ] && echo "$err" | grep -q "MOGAO_BOOT_GRACE_S must be whole seconds" || fail "$bad: rc $rc, '$err'"
+done
+echo "PASS: launcher waits for booting hosts only within the grace (3 checks), leaves lost ones out at once, ends the wait at the grace ($took s)"
