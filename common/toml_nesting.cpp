@@ -28,7 +28,7 @@ std::size_t skip_string(std::string_view text, std::size_t i, std::size_t& line)
         if (c == quote && (!multi || text.substr(j, 3) == std::string_view(basic ? "\"\"\"" : "'''"))) {
             // A multi-line string may end with up to two more quotes of its own ("""a""""").
             j += multi ? 3 : 1;
-            while (multi && j < text.size() && text[j] == quote) ++j;
+            for (int extra = 0; multi && extra < 2 && j < text.size() && text[j] == quote; ++extra) ++j;
             return j;
         }
         ++j;
@@ -43,13 +43,20 @@ std::optional<TomlNestingExcess> toml_nesting_excess(std::string_view text, int 
         throw std::invalid_argument("toml_nesting_excess: max_depth must be >= 1, not " + std::to_string(max_depth));
     }
     int depth = 0;
+    int dots = 0;  // dots of the dotted key (or number) being read: each is one more table level
     std::size_t line = 1;
     std::size_t i = 0;
     while (i < text.size()) {
         const char c = text[i];
+        const bool in_dotted_run = c == '.' || c == ' ' || c == '\t' || c == '_' || c == '-' || c == '+' ||
+                                   (c >= '0' && c <= '9') || (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z');
+        if (!in_dotted_run && c != '"' && c != '\'') dots = 0;
         switch (c) {
             case '\n':
                 ++line;
+                break;
+            case '.':
+                if (depth + ++dots > max_depth) return TomlNestingExcess{line, max_depth};
                 break;
             case '#':
                 while (i < text.size() && text[i] != '\n') ++i;
@@ -60,7 +67,7 @@ std::optional<TomlNestingExcess> toml_nesting_excess(std::string_view text, int 
                 continue;
             case '[':
             case '{':
-                if (++depth > max_depth) return TomlNestingExcess{line, max_depth};
+                if (++depth + dots > max_depth) return TomlNestingExcess{line, max_depth};
                 break;
             case ']':
             case '}':

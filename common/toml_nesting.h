@@ -1,18 +1,24 @@
 // SPDX-License-Identifier: Apache-2.0
-// A guard run on TOML text before toml11 parses it: how deeply arrays and inline tables nest.
+// A guard run on TOML text before toml11 parses it: how deeply tables and arrays nest.
 //
 // Why: toml11 (3.7, Debian 12) parses nested arrays and inline tables by recursion, one set of
 // stack frames per level, with no limit of its own. "a = [[[[...": about 10000 levels in a file
 // of 20 kB overflow the stack (SIGSEGV), far fewer under ASan -- found by fuzzing the kiosk's
-// configuration (tests/fuzz, kiosk_config). A kiosk configuration or a rig file never needs more
-// than a few levels, so every TOML reader checks the text first and refuses it, naming the line.
+// configuration (tests/fuzz, kiosk_config). Dotted keys nest tables without brackets: toml11
+// copies and destroys such tables recursively, and "a.a.a...= 1" with 100000 segments crashed it
+// too (an inline table of 100000 did not end within a minute). A kiosk configuration or a rig file
+// never needs more than a few levels, so every TOML reader checks the text first and refuses it,
+// naming the line.
 //
 // The scan follows TOML 1.0's lexical rules (https://toml.io/en/v1.0.0) only as far as needed to
-// count brackets: '[', '{' open a level and ']', '}' close one outside comments ('#' to the end of
-// the line) and outside the four kinds of string ("...", '...', """...""", '''...''', with the
-// backslash escapes of basic strings). A table header "[a]" or "[[a]]" counts as one or two
-// levels, closed on its own line. Text that is not valid TOML is not judged here (toml11 does it);
-// an unterminated string simply ends the scan.
+// count levels, outside comments ('#' to the end of the line) and outside the four kinds of
+// string ("...", '...', """...""", '''...''', with the backslash escapes of basic strings):
+// '[', '{' open a level and ']', '}' close one; each '.' of a dotted run (bare or quoted key
+// segments, or a number, separated by dots and blanks) adds a level until the run ends. A level
+// counts when the open brackets plus the current run's dots exceed the limit. A table header
+// "[a.b]" counts as its brackets and dots, closed on its own line. Text that is not valid TOML is
+// not judged here (toml11 does it, and stops at the first error): a single-line string ends at
+// the end of its line, an unterminated multi-line string ends the scan.
 #pragma once
 
 #include <cstddef>
@@ -22,11 +28,12 @@
 namespace mogao {
 
 // Levels a TOML reader of this project accepts: far above any real file, far below what toml11's
-// recursion survives (tested under ASan in common/toml_nesting_test.cpp).
+// recursion survives (the worst text this limit lets through, 32 inline tables each under a
+// 31-dot key, is parsed by toml11 in kiosk/kiosk_config_test.cpp, also under ASan).
 inline constexpr int kMaxTomlNesting = 32;
 
 struct TomlNestingExcess {
-    std::size_t line = 0;  // 1-based line of the bracket that opened level max_depth + 1
+    std::size_t line = 0;  // 1-based line of the bracket or dot that opened level max_depth + 1
     int max_depth = 0;     // the limit that was passed
 };
 

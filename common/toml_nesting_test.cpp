@@ -36,13 +36,36 @@ TEST(TomlNesting, BracketsInStringsAndCommentsAreNotLevels) {
                              "c = \"\"\"\n" + deep + "\n\"\" " + deep + "\n\"\"\"\n" +  // multi-line basic
                              "d = '''" + deep + "\n'' " + deep + "'''\n" +              // multi-line literal
                              "# " + deep + "\n" +                                       // comment
-                             "[table]\n[[array.of.tables]]\n" +                         // headers close
+                             "[table]\n[[array]]\n" +                                  // headers close
                              "e = [[1], ['[']]\n";
     EXPECT_FALSE(toml_nesting_excess(text, 2).has_value());
     // The same counting still sees real levels after all of that, on the right line.
     const auto over = toml_nesting_excess(text + "f = [[[1]]]\n", 2);
     ASSERT_TRUE(over.has_value());
     EXPECT_EQ(over->line, 13u);
+}
+
+TEST(TomlNesting, DottedKeysAreLevelsToo) {
+    const auto dotted = [](int segments) {
+        std::string key = "a";
+        for (int i = 1; i < segments; ++i) key += ".a";
+        return key;
+    };
+    EXPECT_FALSE(toml_nesting_excess(dotted(kMaxTomlNesting + 1) + " = 1\n").has_value());
+    EXPECT_TRUE(toml_nesting_excess(dotted(kMaxTomlNesting + 2) + " = 1\n").has_value());
+    // A header's brackets and dots, dots with blanks and quoted segments count; dots inside quotes
+    // do not. "[a.a.a]" is 1 + 2 levels, "a . "b.c.d.e" . 'f'" 2.
+    EXPECT_TRUE(toml_nesting_excess("[" + dotted(3) + "]\n", 2).has_value());
+    EXPECT_FALSE(toml_nesting_excess("[" + dotted(3) + "]\n", 3).has_value());
+    EXPECT_TRUE(toml_nesting_excess("a . \"b.c.d.e\" . 'f' = 1\n", 1).has_value());
+    EXPECT_FALSE(toml_nesting_excess("a . \"b.c.d.e\" . 'f' = 1\n", 2).has_value());
+    // Within brackets the two add up; '=' and ',' end a run, so numbers and keys do not pile up.
+    EXPECT_TRUE(toml_nesting_excess("x = {a.b = 1}\n", 1).has_value());
+    EXPECT_FALSE(toml_nesting_excess("x = {a.b = 1}\n", 2).has_value());
+    EXPECT_FALSE(toml_nesting_excess("x.y = [1.5, 2.5, 3.5]\nz = 1979-05-27T07:32:00.999\n", 2).has_value());
+    const auto over = toml_nesting_excess("x = 1\n" + dotted(100000) + " = 1\n");
+    ASSERT_TRUE(over.has_value());
+    EXPECT_EQ(over->line, 2u);
 }
 
 TEST(TomlNesting, UnterminatedStringsAndStrayClosersEndQuietly) {

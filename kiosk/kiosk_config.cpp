@@ -745,7 +745,7 @@ namespace {
 Value parse_toml(std::string_view text, const Context& ctx) {
     // toml11 recurses once per level and has no limit: a deep file would crash the kiosk.
     if (const auto excess = toml_nesting_excess(text)) {
-        throw KioskConfigError(fmt::format("{}:{}: arrays or inline tables nested deeper than {} levels", ctx.file,
+        throw KioskConfigError(fmt::format("{}:{}: tables or arrays nested deeper than {} levels", ctx.file,
                                            excess->line, excess->max_depth));
     }
     try {

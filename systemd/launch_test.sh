@@ -5,6 +5,7 @@
 #     while the machine's uptime is under MOGAO_BOOT_GRACE_S, and mpirun gets it and all 3 ranks;
 #   * with MOGAO_BOOT_GRACE_S=0 (a host lost while serving) it is left out at once, 2 ranks;
 #   * a host that never answers is left out when the grace ends (not waited for forever);
+#   * a host file whose last line lacks its newline still has that host;
 #   * bad MOGAO_BOOT_GRACE_S / RANKS are refused with exit 2, naming the variable.
 # usage: launch_test.sh LAUNCHER
 set -euo pipefail
@@ -48,6 +49,14 @@ took=$(($(date +%s) - start))
 echo "$out" | grep -q "render host render2 left out" || fail "grace over: render2 not left out: $out"
 ((took >= 3 && took <= 15)) || fail "grace over: the launcher took $took s for a 4 s grace"
 
+# A host file whose last line has no newline: its host is still asked and used.
+printf 'admin slots=2\nrender2 slots=1' > "$work/hosts"
+out=$(run 0 0)
+echo "$out" | grep -q "mpirun --hostfile .* -n 3 mogao-farm serve" || fail "no final newline: render2 dropped: $out"
+printf 'admin slots=2 # this machine\nrender2 slots=1\n' > "$work/hosts"
+
+rc=0; err=$(sh "$launcher" "$work/hosts" 0 true 2>&1) || rc=$?
+[ $rc = 2 ] && echo "$err" | grep -q "RANKS must be a number >= 1" || fail "RANKS 0: rc $rc, '$err'"
 for bad in "MOGAO_BOOT_GRACE_S=-1" "MOGAO_BOOT_GRACE_S=2m"; do
   rc=0; err=$(env "$bad" sh "$launcher" "$work/hosts" 3 true 2>&1) || rc=$?
   [ $rc = 2 ] && echo "$err" | grep -q "MOGAO_BOOT_GRACE_S must be whole seconds" || fail "$bad: rc $rc, '$err'"

@@ -201,7 +201,7 @@ VirtualRig parse_rig(const std::string& toml_text, const std::string& name) {
     // toml11 recurses once per level and has no limit: a deep file would crash the reader.
     if (const auto excess = toml_nesting_excess(toml_text)) {
         throw RigError("rig file '" + name + "' line " + std::to_string(excess->line) +
-                       ": arrays or inline tables nested deeper than " + std::to_string(excess->max_depth) + " levels");
+                       ": tables or arrays nested deeper than " + std::to_string(excess->max_depth) + " levels");
     }
     try {
         std::istringstream in(toml_text);

@@ -169,7 +169,7 @@ TEST(RigFile, ErrorsNameTheField) {
     // toml11 recurses once per level without a limit: 20000 levels crashed the reader.
     const std::string deep = std::string(20000, '[') + std::string(20000, ']');
     EXPECT_NE(message("[camera]\n[[projectors]]\ngamma = " + deep + "\n")
-                  .find("line 3: arrays or inline tables nested deeper than 32 levels"),
+                  .find("line 3: tables or arrays nested deeper than 32 levels"),
               std::string::npos);
 }
 
