@@ -36,7 +36,7 @@ TEST(TomlNesting, BracketsInStringsAndCommentsAreNotLevels) {
                              "c = \"\"\"\n" + deep + "\n\"\" " + deep + "\n\"\"\"\n" +  // multi-line basic
                              "d = '''" + deep + "\n'' " + deep + "'''\n" +              // multi-line literal
                              "# " + deep + "\n" +                                       // comment
-                             "[table]\n[[array]]\n" +                                  // headers close
+                             "[table]\n[[array]]\n" +                                   // headers close
                              "e = [[1], ['[']]\n";
     EXPECT_FALSE(toml_nesting_excess(text, 2).has_value());
     // The same counting still sees real levels after all of that, on the right line.

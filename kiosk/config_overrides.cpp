@@ -121,9 +121,8 @@ std::string apply_config_overrides(std::string_view toml, const std::vector<std:
         apply(lines, text);
         const std::string joined = join(lines);
         if (const auto excess = toml_nesting_excess(joined)) {
-            throw KioskConfigError(
-                fmt::format("override '{}': line {} nests tables or arrays deeper than {} levels", text,
-                            excess->line, excess->max_depth));
+            throw KioskConfigError(fmt::format("override '{}': line {} nests tables or arrays deeper than {} levels",
+                                               text, excess->line, excess->max_depth));
         }
         std::istringstream in(joined);
         try {
