@@ -18,6 +18,8 @@
 #include <iostream>
 #include <set>
 
+#include <opencv2/core/utility.hpp>
+
 #include "appliance/autocal/rig_bridge.h"
 #include "appliance/rig/rig_file.h"
 #include "appliance/selfcal/rig_simulation.h"
@@ -28,6 +30,14 @@
 #include "kiosk/kiosk.h"
 #include "kiosk/kiosk_setup.h"
 #include "kiosk/selfcal_worker.h"
+
+#if defined(__SANITIZE_THREAD__)
+// ThreadSanitizer cannot see the joins of OpenCV's parallel_for_ (TBB's workers, not instrumented):
+// every later use of the loop body's stack or heap by the caller was reported as a race (the
+// virtual rig's camera simulator). Under TSan OpenCV runs its loops in the calling thread; the
+// kiosk's own threads, the self-calibration worker among them, are still checked.
+[[maybe_unused]] static const bool kOpenCvSerialUnderTsan = (cv::setNumThreads(1), true);
+#endif
 
 namespace mogao {
 namespace {

@@ -9,6 +9,8 @@
 MOGAO_FARM_ROOT_LABEL=farm-root
 MOGAO_FARM_UID=971   # rootfs/usr/lib/sysusers.d/mogao-farm.conf
 MOGAO_FARM_GID=971
+# The render hosts' packet filter; provisioning checks farm-network files with its parser.
+FARM_FIREWALL="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)/rootfs/usr/lib/mogao/farm-firewall"
 
 # farm_check_host_dir DIR: dies with the file and field at fault when DIR (image/farm/provision's
 # HOST_DIR) is inconsistent. An admin host (etc/mogao/farm-hosts) needs farm.env and its PKI.
@@ -19,6 +21,17 @@ farm_check_host_dir() {
     [[ $(wc -l < "$f") -le 1 ]] && grep -qE '^[a-z0-9]([a-z0-9-]{0,62})$' "$f" \
       || img_die "$f: one host name (lower-case letters, digits, '-') expected"
   fi
+  # Every host filters its ports by it (mogao-farm-firewall.service): without it, Open MPI's
+  # ports would be closed to the other hosts too. Checked by the filter's own parser, so that
+  # what provisioning accepts is what the host loads at boot.
+  f="$dir/etc/mogao/farm-network"
+  [[ -f "$f" ]] || img_die "$f missing: the farm network's prefixes, one per line (e.g. 10.77.0.0/24), from which Open MPI's ports may be reached"
+  local why
+  if ! why=$(sh "$FARM_FIREWALL" --print "$f" 2>&1 > /dev/null); then
+    why=${why#mogao-farm-firewall: }
+    img_die "${why%%: Open MPI*}"
+  fi
+  n=0
   [[ -f "$dir/etc/mogao/farm-hosts" ]] || return 0
   f="$dir/etc/mogao/farm-hosts"
   while IFS= read -r line || [[ -n "$line" ]]; do

@@ -23,6 +23,9 @@ Assertions (each printed as PASS/FAIL; any failure fails the test):
     its rank on farm-render2 replaced;
   * hardening at run time: seccomp and no_new_privs on the ranks, listening sockets only the farm
     port, sshd and Open MPI's own port ranges; systemd-analyze security (online) recorded;
+  * the packet filter (mogao-farm-firewall.service): from the host's addresses outside the farm
+    network (fd00:6d6f:9::1, 10.77.9.1) a rank's port and mpirun's are dropped, sshd and the link
+    answer; from the farm network the rank's port answers;
   * no failed units on either host.
 Exit 77 (skip) with a message when root, QEMU, OVMF, mtools, tun, ip netns or the image are missing.
 """
@@ -49,7 +52,13 @@ HOSTS = {  # name -> (last part of both addresses, MAC, memory MiB)
 }
 V6 = "fd00:6d6f::"
 V4 = "10.77.0."
+# The host's addresses outside the farm network (a museum's, an attacker's): routed to the hosts
+# through the host's farm address (their gateway). Only sshd and the link may answer them.
+OUTSIDE_V6 = "fd00:6d6f:9::1"
+OUTSIDE_V4 = "10.77.9.1"
+FARM_NETWORK = f"{V4}0/24\n{V6}/64\n"
 RANKS = 3
+HEALTH_TIMEOUT_S = 30      # mogao-farm-launch's ssh health check of farm-render2 (TCG: slow logins)
 SCENE = "/usr/share/mogao/scenes/test-room.json"
 KIOSK_FRAMES = 4           # farm frames the host's kiosk must present before it stops
 KIOSK_TIMEOUT_S = 420
@@ -101,8 +110,10 @@ def host_dirs(work, farm, overlay, layout):
         write(f"{d}/etc/hosts", hosts_file)
         write(f"{d}/etc/systemd/network/10-farm.network",
               f"# {name}: the farm's network (written by farm_qemu_test.py)\n[Match]\nMACAddress={mac}\n\n"
-              f"[Network]\nAddress={V6}{n}/64\nAddress={V4}{n}/24\nIPv6AcceptRA=no\nLinkLocalAddressing=ipv6\n"
-              "LLMNR=no\nMulticastDNS=no\n")
+              f"[Network]\nAddress={V6}{n}/64\nAddress={V4}{n}/24\nGateway={V6}1\nGateway={V4}1\n"
+              "IPv6AcceptRA=no\nLinkLocalAddressing=ipv6\nLLMNR=no\nMulticastDNS=no\n")
+        # The packet filter's farm network (mogao-farm-firewall.service): Open MPI's ports from it only.
+        write(f"{d}/etc/mogao/farm-network", f"# the farm's network (written by farm_qemu_test.py)\n{FARM_NETWORK}")
         os.makedirs(f"{d}/etc/ssh", exist_ok=True)
         shutil.copy(os.path.join(keys, name), f"{d}/etc/ssh/ssh_host_ed25519_key")
         shutil.copy(os.path.join(keys, name + ".pub"), f"{d}/etc/ssh/ssh_host_ed25519_key.pub")
@@ -131,6 +142,9 @@ def host_dirs(work, farm, overlay, layout):
           f"MOGAO_RANKS={RANKS}\nMOGAO_SCENE={SCENE}\nMOGAO_LISTEN=[::]:{PORT}\nMOGAO_FARM_NAME=farm\n"
           "# Open MPI between the hosts: the farm's IPv4 network only.\n"
           f"OMPI_MCA_btl_tcp_if_include={V4}0/24\nOMPI_MCA_oob_tcp_if_include={V4}0/24\n"
+          "# Under TCG an ssh login takes seconds: the launcher's 2 s health check would leave\n"
+          "# farm-render2 out (mogao-farm-launch, 'no answer within 2 s').\n"
+          f"MOGAO_HEALTH_TIMEOUT_S={HEALTH_TIMEOUT_S}\n"
           + ("OMPI_MCA_btl_base_verbose=30\n" if os.environ.get("MOGAO_FARM_TEST_MPI_VERBOSE") else ""))
     for f in ("ca.pem", "farm-farm.pem", "farm-farm.key"):
         os.makedirs(f"{admin}/etc/mogao/pki", exist_ok=True)
@@ -165,6 +179,30 @@ def kiosk_config(kiosk, work, pki):
     printed = subprocess.run([kiosk, "--print-config", *overrides], check=True, stdout=subprocess.PIPE, text=True)
     write(path, "# written by image/farm/test/farm_qemu_test.py: the host plays the appliance\n" + printed.stdout)
     return out, path
+
+
+def check_packet_filter(net, serials, fails, results):
+    """Open MPI's ports answer the farm network only (mogao-farm-firewall.service): a rank's port and
+    mpirun's from outside are dropped, sshd and the link answer everyone, the same rank port answers
+    from inside the farm network (so a drop is the filter, not a missing listener)."""
+    admin, render = f"{V4}10", f"{V4}11"
+    mpirun_ports = [int(m.split()[2].rsplit(":", 1)[1]) for _, m in serials["farm-admin"].marks
+                    if m.startswith("listen tcp ") and m.split()[-1] == "mpirun" and m.split()[2].rsplit(":", 1)[1].isdigit()]
+    probes = [  # (what, source, destination, port, expected)
+        ("a rank's port from the farm network", f"{V4}1", admin, 46000, "open"),
+        ("a rank's port from outside (IPv4)", OUTSIDE_V4, admin, 46000, "timeout"),
+        ("a rank's port from outside (IPv6)", OUTSIDE_V6, f"{V6}10", 46000, "timeout"),
+        ("the link from outside", OUTSIDE_V6, f"{V6}10", PORT, "open"),
+        ("sshd on farm-render2 from outside", OUTSIDE_V4, render, 22, "open"),
+        ("a rank's port on farm-render2 from outside", OUTSIDE_V4, render, 46000, "timeout"),
+    ]
+    probes += [("mpirun's port from outside", OUTSIDE_V4, admin, p, "timeout") for p in mpirun_ports[:1]]
+    fails.check(bool(mpirun_ports), f"farm-admin: mpirun listens (its port is probed from outside): {mpirun_ports}")
+    results["packet_filter"] = {}
+    for what, src, dst, port, expected in probes:
+        got = net.tcp_probe(src, dst, port)
+        results["packet_filter"][f"{src} -> {dst}:{port}"] = got
+        fails.check(got == expected, f"packet filter: {what} ({src} -> {dst}:{port}) is {expected}: {got}")
 
 
 def main():
@@ -226,7 +264,8 @@ def main():
         log(r.stdout)
         return 1
 
-    net = farmvm.Netns(f"mogao-farmtest-{os.getpid()}", [f"{V6}1/64", f"{V4}1/24"], len(HOSTS))
+    net = farmvm.Netns(f"mogao-farmtest-{os.getpid()}",
+                       [f"{V6}1/64", f"{V4}1/24", f"{OUTSIDE_V6}/64", f"{OUTSIDE_V4}/24"], len(HOSTS))
     vms = {}
     try:
         net.up()
@@ -279,6 +318,8 @@ def main():
             bad = farmvm.unexpected_listeners(listen, PORT)
             fails.check(not bad, f"{name}: listening sockets are the farm port, sshd and Open MPI's port ranges "
                                  f"only ({len(listen)} sockets; unexpected: {bad})")
+
+        check_packet_filter(net, serials, fails, results)
 
         # --- the host's kiosk, headless, as the appliance ---------------------------------------
         if ok:

@@ -133,6 +133,26 @@ class Netns:
                 p.wait()
                 return None
 
+    def tcp_probe(self, src, dst, port, timeout_s=4.0):
+        """A TCP connection from the namespace's address src to dst:port: "open", "refused" (RST: no
+        listener, no filter), "timeout" (dropped: a packet filter) or "error:<reason>"."""
+        code = ("import socket, sys\n"
+                "src, dst, port, t = sys.argv[1], sys.argv[2], int(sys.argv[3]), float(sys.argv[4])\n"
+                "s = socket.socket(socket.AF_INET6 if ':' in dst else socket.AF_INET, socket.SOCK_STREAM)\n"
+                "s.settimeout(t)\n"
+                "s.bind((src, 0))\n"
+                "try:\n"
+                "    s.connect((dst, port)); print('open')\n"
+                "except socket.timeout:\n"
+                "    print('timeout')\n"
+                "except ConnectionRefusedError:\n"
+                "    print('refused')\n"
+                "except OSError as e:\n"
+                "    print('error:' + (e.strerror or str(e)))\n")
+        r = subprocess.run(self.prefix() + ["python3", "-c", code, src, dst, str(port), str(timeout_s)],
+                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=timeout_s + 30)
+        return r.stdout.strip().splitlines()[-1] if r.stdout.strip() else f"error:exit {r.returncode}"
+
     def down(self):
         if self.created:
             subprocess.run(["ip", "netns", "delete", self.name])

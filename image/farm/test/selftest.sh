@@ -109,7 +109,7 @@ while [ $i -lt 300 ]; do
   [ "$state" = active ] && break
   [ $((i % 30)) -eq 0 ] && say "waiting farm state=$state restarts=$(prop $unit NRestarts) uptime=$(uptime_s)"
   # Stuck starting: what the farm's processes wait for.
-  [ $i -eq 120 ] && { diagnose; dump_journal $unit 30; }
+  [ $i -eq 120 ] && { diagnose; dump_journal $unit 200; }
   [ "$state" = failed ] && break
   sleep 1; i=$((i + 1))
 done
