@@ -186,8 +186,10 @@ def check_packet_filter(net, serials, fails, results):
     mpirun's from outside are dropped, sshd and the link answer everyone, the same rank port answers
     from inside the farm network (so a drop is the filter, not a missing listener)."""
     admin, render = f"{V4}10", f"{V4}11"
-    mpirun_ports = [int(m.split()[2].rsplit(":", 1)[1]) for _, m in serials["farm-admin"].marks
-                    if m.startswith("listen tcp ") and m.split()[-1] == "mpirun" and m.split()[2].rsplit(":", 1)[1].isdigit()]
+    # Marks "listen tcp ADDR:PORT PROCESS" (selftest.sh listeners).
+    listens = [m.split() for _, m in serials["farm-admin"].marks if m.startswith("listen tcp ")]
+    ports = [(w[2].rsplit(":", 1)[1], w[-1]) for w in listens]
+    mpirun_ports = [int(p) for p, proc in ports if proc == "mpirun" and p.isdigit()]
     probes = [  # (what, source, destination, port, expected)
         ("a rank's port from the farm network", f"{V4}1", admin, 46000, "open"),
         ("a rank's port from outside (IPv4)", OUTSIDE_V4, admin, 46000, "timeout"),
