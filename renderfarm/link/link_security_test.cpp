@@ -230,6 +230,12 @@ TEST_F(LinkSecurity, RevokedApplianceIsRefusedAndItsOpenSessionEnds) {
         return server_->stats().sessions_revoked == 1;
     })) << "the revoked appliance's session is still open";
     EXPECT_TRUE(wait_until([&] { return server_->stats().sessions_active == 0; }));
+    // A frame the farm sent before the session ended may still be on its way; once the client has
+    // seen the end and been refused again, nothing more may arrive.
+    EXPECT_TRUE(wait_until([&] {
+        const auto s = client.stats();
+        return !s.connected && s.attempts_failed >= 1;
+    }));
     // It does not get back in, and is served nothing more.
     const auto served = client.stats().last_request_id;
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
