@@ -33,6 +33,7 @@ struct GuidePass::Impl {
     std::unique_ptr<RenderScene> owned;  // null when the geometry is a Renderer's
     const RenderScene& geometry;
     std::optional<CameraSetup> camera;
+    float spread = 0.0f;  // one pixel's ray-cone spread (the guide's one sample per pixel)
     ImageSize size;
 
     // Camera rays through the centres of block (x0, y0)'s pixels inside rect; returns the lane mask.
@@ -78,7 +79,8 @@ struct GuidePass::Impl {
             const Eigen::Vector3f dir(packet.ray.dir_x[l], packet.ray.dir_y[l], packet.ray.dir_z[l]);
             const SurfaceHit hit = geometry.surface(
                 org, dir, packet.ray.tfar[l], packet.hit.instID[0][l], packet.hit.primID[l], packet.hit.u[l],
-                packet.hit.v[l], Eigen::Vector3f(packet.hit.Ng_x[l], packet.hit.Ng_y[l], packet.hit.Ng_z[l]));
+                packet.hit.v[l], Eigen::Vector3f(packet.hit.Ng_x[l], packet.hit.Ng_y[l], packet.hit.Ng_z[l]),
+                spread * packet.ray.tfar[l]);
             Eigen::Vector3f a = scene.materials[hit.material].albedo;
             if (hit.tinted) a = a.cwiseProduct(hit.tint);
             guides.hit[i] = 1;
@@ -106,6 +108,7 @@ Status GuidePass::begin_frame(const ViewRequest& request) {
     }
     if (impl_->owned) impl_->owned->rebase(request.pose.eye);
     impl_->camera = make_camera_setup(request, size);
+    impl_->spread = static_cast<float>(camera_cone_spread(*impl_->camera, 1));
     impl_->size = size;
     return {};
 }

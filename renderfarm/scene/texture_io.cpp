@@ -97,6 +97,7 @@ std::shared_ptr<const Texture> load_base_color_texture(const aiScene& scene, con
         throw MeshLoadError(file, fmt::format("texture '{}': {}", chosen->path, e.what()));
     }
     if (texture->image.size.width < 1 || texture->image.size.height < 1) throw MeshLoadError(file, "texture is empty");
+    texture->mips = make_mip_chain(texture->image);
     return texture;
 }
 

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "renderfarm/trace/camera.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <variant>
@@ -27,6 +28,20 @@ CameraSetup make_camera_setup(const ViewRequest& request, ImageSize render_size)
         setup.tan_half_fov = std::tan(0.5 * pinhole->vertical_fov_deg * kDegToRad);
     }
     return setup;
+}
+
+double camera_cone_spread(const CameraSetup& camera, int spp) {
+    double spread = 0.0;
+    if (const auto* screen = std::get_if<CylinderScreen>(&camera.model)) {
+        const double pixel_m = std::max((screen->top_m - screen->bottom_m) / camera.size.height,
+                                        screen->radius_m * screen->arc_deg * kDegToRad / camera.size.width);
+        const Eigen::Vector3d centre(0.0, 0.5 * (screen->top_m + screen->bottom_m), -screen->radius_m);
+        const double distance = (centre - screen->eye_m).norm();
+        spread = distance > 0.0 ? std::atan(pixel_m / distance) : 0.0;
+    } else {
+        spread = std::atan(2.0 * camera.tan_half_fov / camera.size.height);
+    }
+    return spp > 1 ? spread * std::max(0.125, 1.0 / std::sqrt(static_cast<double>(spp))) : spread;
 }
 
 namespace {

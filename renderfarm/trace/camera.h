@@ -49,6 +49,12 @@ struct CameraSetup {
 
 [[nodiscard]] Ray generate_ray(const CameraSetup& camera, double px, double py);
 
+// The spread angle γ (radians) of one pixel's ray cone (texture_lod.h): pinhole
+// atan(2 tan(fov/2) / H) (Ray Tracing Gems eq. 20.30); cylinder screen atan(s / d) with s the larger
+// side of a pixel on the screen (metres: (top - bottom) / H, radius arc / W) and d the distance from
+// the eye to the screen's centre point (θ = 0, mid-height). Scaled by max(1/8, 1/√spp) for spp > 1.
+[[nodiscard]] double camera_cone_spread(const CameraSetup& camera, int spp);
+
 // Cylinder screen: sin θ and cos θ of every column's centre (px = x + 0.5), computed once per
 // frame so that rays through column centres (spp 1) need no trigonometry. Empty for a pinhole.
 struct CylinderColumns {

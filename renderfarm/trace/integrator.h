@@ -73,6 +73,8 @@ struct FrameContext {
     int area_light_samples = 1;
     bool legacy_light_sampling = false;  // one shadow ray per light (see above)
     int packet_width = 16;               // Embree packet width of the packet path (embree_packets.h)
+    float cone_spread = 0.0f;            // radians: a camera sample's ray-cone spread (camera_cone_spread,
+                                         // texture_lod.h); 0 filters no texture
 };
 
 // One shadow ray and what it adds (already multiplied by the path throughput) when unoccluded.

@@ -2,9 +2,12 @@
 #include "renderfarm/trace/render_scene.h"
 
 #include <array>
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 #include <string>
+
+#include "renderfarm/trace/texture_lod.h"
 
 namespace mogao {
 namespace {
@@ -106,6 +109,7 @@ RenderScene::RenderScene(const Scene& scene, const std::string& embree_config)
         // Mesh positions are offsets from mesh.origin (mesh.h); 0 for recentred meshes.
         data.object_to_world = inst.object_to_world * Eigen::Translation3d(mesh.origin);
         data.normal_matrix = inst.object_to_world.linear().inverse().transpose().cast<float>();
+        data.linear = inst.object_to_world.linear().cast<float>();
         instances_.push_back(data);
 
         EmbreeGeometry geometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
@@ -143,21 +147,35 @@ void RenderScene::commit_transforms() {
     device_.check("rtcCommitScene(instances)");
 }
 
-Eigen::Vector3f RenderScene::tint_at(const Mesh& mesh, std::uint32_t primitive, float u, float v) {
+Eigen::Vector3f RenderScene::tint_at(const InstanceData& inst, std::uint32_t primitive, float u, float v,
+                                     float cone_width, float cos_incidence) {
+    const Mesh& mesh = *inst.mesh;
     const auto& tri = mesh.triangles[primitive];
     const float w = 1.0f - u - v;
     Eigen::Vector3f tint = Eigen::Vector3f::Ones();
     if (!mesh.colors.empty()) tint = w * mesh.colors[tri[0]] + u * mesh.colors[tri[1]] + v * mesh.colors[tri[2]];
     if (mesh.texture && !mesh.uvs.empty()) {
-        const Eigen::Vector2f uv = w * mesh.uvs[tri[0]] + u * mesh.uvs[tri[1]] + v * mesh.uvs[tri[2]];
-        tint = tint.cwiseProduct(mesh.texture->sample(uv));
+        const Eigen::Vector2f& t0 = mesh.uvs[tri[0]];
+        const Eigen::Vector2f uv = w * t0 + u * mesh.uvs[tri[1]] + v * mesh.uvs[tri[2]];
+        float lod = 0.0f;
+        if (cone_width > 0.0f) {
+            const Eigen::Vector2f d1 = mesh.uvs[tri[1]] - t0, d2 = mesh.uvs[tri[2]] - t0;
+            const ImageSize size = mesh.texture->image.size;
+            const float texel_area = static_cast<float>(size.width) * static_cast<float>(size.height) *
+                                     std::abs(d1.x() * d2.y() - d1.y() * d2.x());
+            const Eigen::Vector3f& p0 = mesh.positions[tri[0]];
+            const float world_area =
+                (inst.linear * (mesh.positions[tri[1]] - p0)).cross(inst.linear * (mesh.positions[tri[2]] - p0)).norm();
+            lod = texture_lod(cone_width, cos_incidence, texel_area, world_area);
+        }
+        tint = tint.cwiseProduct(mesh.texture->sample(uv, lod));
     }
     return tint;
 }
 
-SurfaceHit RenderScene::surface(const Eigen::Vector3f& org, const Eigen::Vector3f& dir, float t,
-                                std::uint32_t instance, std::uint32_t primitive, float u, float v,
-                                const Eigen::Vector3f& ng_object) const {
+SurfaceHit RenderScene::surface(const Eigen::Vector3f& org, const Eigen::Vector3f& dir, float t, std::uint32_t instance,
+                                std::uint32_t primitive, float u, float v, const Eigen::Vector3f& ng_object,
+                                float cone_width) const {
     const InstanceData& inst = instances_[instance];
     SurfaceHit hit;
     hit.position = org + t * dir;
@@ -165,9 +183,10 @@ SurfaceHit RenderScene::surface(const Eigen::Vector3f& org, const Eigen::Vector3
     Eigen::Vector3f ng = (inst.normal_matrix * ng_object).normalized();
     if (ng.dot(dir) > 0.0f) ng = -ng;  // face the incoming ray: meshes are two-sided
     hit.geometric_normal = ng;
+    hit.cone_width = cone_width;
     if (inst.tinted) {
         hit.tinted = true;
-        hit.tint = tint_at(*inst.mesh, primitive, u, v);
+        hit.tint = tint_at(inst, primitive, u, v, cone_width, std::abs(ng.dot(dir)));
     }
     if (!inst.smooth) {
         hit.shading_normal = ng;

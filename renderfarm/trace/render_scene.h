@@ -38,8 +38,11 @@ struct SurfaceHit {
     std::uint32_t material = 0;        // index into Scene::materials
     bool tinted = false;               // the mesh has vertex colours or a texture
     Eigen::Vector3f tint = Eigen::Vector3f::Ones();  // linear RGB multiplying the albedo: the
-                                                     // interpolated vertex colour times the bilinear texture
-                                                     // sample at the interpolated uv (texture.h)
+                                                     // interpolated vertex colour times the texture
+                                                     // filtered at the interpolated uv for the ray
+                                                     // cone's footprint (texture.h, texture_lod.h)
+    float cone_width = 0.0f;  // metres: the width of the ray cone at this hit (texture_lod.h); 0:
+                              // no footprint (level 0, bilinear)
 };
 
 class RenderScene {
@@ -59,9 +62,11 @@ public:
 
     // Resolves an Embree hit: instance id, primitive id, barycentrics (u weights vertex 1, v
     // vertex 2) and the object-space geometric normal Ng as Embree reports it for instances.
+    // cone_width (metres, >= 0) is the ray cone's width at the hit; a texture is filtered over it
+    // (texture_lod.h), 0 samples level 0.
     [[nodiscard]] SurfaceHit surface(const Eigen::Vector3f& org, const Eigen::Vector3f& dir, float t,
                                      std::uint32_t instance, std::uint32_t primitive, float u, float v,
-                                     const Eigen::Vector3f& ng_object) const;
+                                     const Eigen::Vector3f& ng_object, float cone_width = 0.0f) const;
 
 private:
     struct InstanceData {
@@ -71,10 +76,12 @@ private:
         bool tinted = false;                  // mesh has vertex colours or a texture
         Eigen::Affine3d object_to_world;      // double, world metres
         Eigen::Matrix3f normal_matrix;        // inverse transpose of the linear part
+        Eigen::Matrix3f linear;               // the linear part (world triangle areas for texture_lod.h)
     };
 
     void commit_transforms();
-    [[nodiscard]] static Eigen::Vector3f tint_at(const Mesh& mesh, std::uint32_t primitive, float u, float v);
+    [[nodiscard]] static Eigen::Vector3f tint_at(const InstanceData& inst, std::uint32_t primitive, float u, float v,
+                                                 float cone_width, float cos_incidence);
 
     EmbreeDevice device_;
     std::vector<EmbreeScene> blas_;           // per mesh; empty owner for unused meshes

@@ -167,7 +167,8 @@ struct Renderer::Impl {
             const Eigen::Vector3f dir(packet.ray.dir_x[l], packet.ray.dir_y[l], packet.ray.dir_z[l]);
             hits.hit[l] = geometry.surface(org, dir, packet.ray.tfar[l], packet.hit.instID[0][l], packet.hit.primID[l],
                                            packet.hit.u[l], packet.hit.v[l],
-                                           Eigen::Vector3f(packet.hit.Ng_x[l], packet.hit.Ng_y[l], packet.hit.Ng_z[l]));
+                                           Eigen::Vector3f(packet.hit.Ng_x[l], packet.hit.Ng_y[l], packet.hit.Ng_z[l]),
+                                           context.cone_spread * packet.ray.tfar[l]);
             hits.wo[l] = -dir;
             hits.alive[l] = true;
         }
@@ -252,6 +253,7 @@ void Renderer::begin_frame(const ViewRequest& request) {
                              request.quality.area_light_samples,
                              s.options.legacy_light_sampling,
                              s.packet_width()};
+    s.context.cone_spread = static_cast<float>(camera_cone_spread(*s.camera, s.spp));
     s.columns = s.options.camera_column_table && s.spp == 1 ? make_cylinder_columns(*s.camera) : CylinderColumns{};
     s.ready = true;
 }
