@@ -127,6 +127,15 @@ void Kiosk::on_frame() {
     (void)update_late_warp();  // this frame's shift for the yaw turned since its request
     last_frame_at_ = std::chrono::steady_clock::now();
     wall_lines_ = wall_lines(last_frame_at_);
+    if (pattern_base_) {
+        frame_held_back_ = true;  // shown when the pattern pair is over (a few ticks)
+        return;
+    }
+    show_current();
+}
+
+void Kiosk::show_current() {
+    const ContentFrame& f = *current_;
     if (wall_lines_.empty()) {
         parts_.display.show(f);
     } else {
@@ -136,6 +145,35 @@ void Kiosk::on_frame() {
     }
     shown_since_tick_ = true;
     check_frames_shown();
+}
+
+void Kiosk::update_pattern_overlay() {
+    if (parts_.selfcal == nullptr || !current_) return;
+    const std::optional<SelfcalWorker::Overlay> overlay = parts_.selfcal->overlay();
+    if (!overlay) {
+        if (!pattern_base_) return;
+        pattern_base_.reset();
+        overlay_id_ = 0;
+        if (frame_held_back_) {
+            frame_held_back_ = false;
+            show_current();
+        } else {
+            parts_.display.refresh_content(wall_lines_.empty() ? current_->image : with_wall_lines(current_->image));
+        }
+        return;
+    }
+    if (overlay->id != overlay_id_) {
+        if (!pattern_base_) pattern_base_ = wall_lines_.empty() ? current_->image : with_wall_lines(current_->image);
+        overlay_id_ = overlay->id;
+        overlay_told_ = false;
+        overlay_image_ = with_pattern(*pattern_base_, overlay->signed_pattern);
+        parts_.display.refresh_content(overlay_image_);
+        return;  // told at a later tick, once every output has completed it
+    }
+    if (!overlay_told_ && parts_.display.all_outputs_ready()) {
+        parts_.selfcal->overlay_shown(overlay_id_, overlay_image_);
+        overlay_told_ = true;
+    }
 }
 
 void Kiosk::note_rejections(const std::vector<DecodeWorker::Rejection>& rejections) {
@@ -188,6 +226,7 @@ void Kiosk::on_tick() {
     }
     shown_since_tick_ = false;
     update_wall(now);
+    update_pattern_overlay();
     // A copy at the monitor's rate (2 Hz), not the display's: the worker converts it on its thread.
     if (parts_.selfcal != nullptr && current_ && parts_.selfcal->wants_content())
         parts_.selfcal->offer(current_->image);
@@ -352,6 +391,7 @@ void Kiosk::update_wall(std::chrono::steady_clock::time_point now) {
                      lines.empty() ? std::string("off") : fmt::format("{}", fmt::join(lines, " | ")));
     }
     wall_lines_ = std::move(lines);
+    if (pattern_base_) return;  // a pattern pair is on the wall: its end redraws with these lines
     parts_.display.refresh_content(with_wall_lines(current_->image));
 }
 

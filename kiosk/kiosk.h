@@ -145,6 +145,12 @@ private:
     // Redraws the current frame when the wanted lines changed (the tick).
     void update_wall(std::chrono::steady_clock::time_point now);
     [[nodiscard]] Rgb8Image with_wall_lines(const Rgb8Image& content) const;
+    // The current frame to the outputs (with the on-wall lines), counted as a farm frame.
+    void show_current();
+    // The self-calibration's pattern pair (SelfcalWorker::overlay, the tick): shows a new overlay on
+    // the held frame, tells the worker once every output has completed it, and when the overlay is
+    // withdrawn shows the content again (a frame that arrived meanwhile is shown then).
+    void update_pattern_overlay();
     [[nodiscard]] const char* running_state() const;
 
     const KioskConfig& config_;
@@ -168,8 +174,15 @@ private:
     bool status_failing_ = false;  // the status file's last write failed (logged once)
     std::string last_error_;       // KioskStatus::last_error
     std::int64_t last_error_ns_ = 0;
-    bool panel_toggled_ = false;                           // SIGUSR2 with [status].on_wall = "on_demand"
-    std::vector<std::string> wall_lines_;                  // drawn on the frame on the wall now
+    bool panel_toggled_ = false;           // SIGUSR2 with [status].on_wall = "on_demand"
+    std::vector<std::string> wall_lines_;  // drawn on the frame on the wall now
+    // While a pattern pair is shown: the frame it is drawn on (with the on-wall lines of its start),
+    // held still so that the pair's camera frames differ by the pattern alone.
+    std::optional<Rgb8Image> pattern_base_;
+    std::uint64_t overlay_id_ = 0;                         // the overlay on the wall (0: none)
+    Rgb8Image overlay_image_;                              // pattern_base_ with that overlay, as shown
+    bool overlay_told_ = false;                            // the worker was told it is shown
+    bool frame_held_back_ = false;                         // a farm frame arrived while the pair was shown
     std::chrono::steady_clock::time_point last_frame_at_;  // the latest new farm frame
     int exit_code_ = 0;
 };

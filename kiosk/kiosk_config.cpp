@@ -711,6 +711,9 @@ void read_selfcal(const Section& s, const CalibrationConfig& calibration, Selfca
         "transition_s", sc.transition_s, [](double x) { return x >= 0 && x <= 600; }, "[0, 600] s");
     sc.drift_threshold_px = s.number(
         "drift_threshold_px", sc.drift_threshold_px, [](double x) { return x > 0 && x <= 100; }, "(0, 100] px");
+    sc.pattern = s.boolean("pattern", sc.pattern);
+    sc.pattern_amplitude = s.number(
+        "pattern_amplitude", sc.pattern_amplitude, [](double x) { return x > 0 && x <= 0.2; }, "(0, 0.2]");
 }
 
 }  // namespace
@@ -830,9 +833,10 @@ KioskConfig parse_kiosk_config(std::string_view text, const std::filesystem::pat
     read_stats(stats, config.stats);
     const Section status = section(ctx, root, "status", {"on_wall", "trigger_file", "farm_lost_after_s"});
     read_status(status, config.status);
-    const Section selfcal = section(ctx, root, "selfcal",
-                                    {"enabled", "camera", "camera_size", "camera_exposure_us", "camera_gain", "models",
-                                     "rate_hz", "hold_s", "transition_s", "drift_threshold_px"});
+    const Section selfcal =
+        section(ctx, root, "selfcal",
+                {"enabled", "camera", "camera_size", "camera_exposure_us", "camera_gain", "models", "rate_hz", "hold_s",
+                 "transition_s", "drift_threshold_px", "pattern", "pattern_amplitude"});
     read_selfcal(selfcal, config.calibration, config.selfcal);
     for (const Section* s :
          {&farm, &display, &outputs, &calibration, &quality, &screen, &navigation, &stats, &status, &selfcal})

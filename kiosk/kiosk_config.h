@@ -175,6 +175,11 @@ struct SelfcalConfig {
     double hold_s = 2.0;              // drift held this long before correcting, [0, 600]
     double transition_s = 3.0;        // correction blended in over this long, [0, 600]
     double drift_threshold_px = 0.5;  // (0, 100] projector pixels
+    // The content-independent fallback (selfcal::PatternOptions): when the content gives too little
+    // evidence, a complementary dot-pattern pair of this amplitude (fraction of full white, (0, 0.2])
+    // is added to the wall for one camera frame each. Off by default: without it a plain scene waits.
+    bool pattern = false;
+    double pattern_amplitude = 0.02;
 };
 
 struct KioskConfig {

@@ -254,8 +254,11 @@ TEST_F(KioskConfigTest, SelfcalIsOffByDefaultAndNeedsAnMpcdiItsModelsAndALockedC
     std::ofstream(dir_ / "screen.models.json") << "x";
     const KioskConfig rig =
         parse(with({"selfcal.enabled=true", R"(selfcal.camera="rig:rig.toml")", "selfcal.rate_hz=1", "selfcal.hold_s=1",
-                    "selfcal.transition_s=0.5", "selfcal.drift_threshold_px=0.8"}));
+                    "selfcal.transition_s=0.5", "selfcal.drift_threshold_px=0.8", "selfcal.pattern=true",
+                    "selfcal.pattern_amplitude=0.05"}));
     EXPECT_TRUE(rig.selfcal.enabled);
+    EXPECT_TRUE(rig.selfcal.pattern);
+    EXPECT_DOUBLE_EQ(rig.selfcal.pattern_amplitude, 0.05);
     EXPECT_EQ(rig.selfcal.kind, SelfcalConfig::CameraKind::rig);
     EXPECT_EQ(rig.selfcal.rig, dir_ / "rig.toml");
     EXPECT_EQ(rig.selfcal.models, dir_ / "screen.models.json");
@@ -281,6 +284,8 @@ TEST_F(KioskConfigTest, SelfcalIsOffByDefaultAndNeedsAnMpcdiItsModelsAndALockedC
          "[selfcal].camera_gain: the screen camera's camera_gain must be"},
         {{"selfcal.enabled=true", R"(selfcal.camera="rig:rig.toml")", "selfcal.rate_hz=5"},
          "[selfcal].rate_hz = 5 is outside (0, 2] Hz"},
+        {{"selfcal.enabled=true", R"(selfcal.camera="rig:rig.toml")", "selfcal.pattern_amplitude=0.5"},
+         "[selfcal].pattern_amplitude = 0.5 is outside (0, 0.2]"},
         {{"selfcal.enabled=true", R"(selfcal.camera="rig:absent.toml")"}, "[selfcal].camera: rig file"},
         {{"selfcal.enabled=true", R"(selfcal.camera="libcamera:")"}, "[selfcal].camera: 'libcamera:' is not"},
         {{"selfcal.enabled=true"}, "[selfcal].camera is required"},

@@ -122,6 +122,13 @@ std::optional<std::size_t> KioskDisplay::overdue_output(std::chrono::steady_cloc
     return std::nullopt;
 }
 
+bool KioskDisplay::all_outputs_ready() const {
+    for (std::size_t i = 0; i < backend_->outputs().size(); ++i) {
+        if (!backend_->ready(i)) return false;
+    }
+    return true;
+}
+
 void KioskDisplay::write_composite() const {
     if (!recorder_) return;
     const auto file = recorder_->dir() / "screen-composite.png";

@@ -66,6 +66,8 @@ public:
     [[nodiscard]] std::optional<std::size_t> overdue_output(std::chrono::steady_clock::time_point now,
                                                             std::chrono::steady_clock::duration timeout);
     [[nodiscard]] const std::string& output_name(std::size_t i) const { return backend_->outputs().at(i).name; }
+    // Every output's last present has completed (KMS: its page flip; headless: always).
+    [[nodiscard]] bool all_outputs_ready() const;
 
     // Writes <png dir>/screen-composite.png when recording (logged; a failure is a warning).
     void write_composite() const;

@@ -11,6 +11,7 @@
 #include <poll.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <csignal>
@@ -24,6 +25,7 @@
 #include "appliance/rig/rig_file.h"
 #include "appliance/selfcal/rig_simulation.h"
 #include "common/jpeg_codec.h"
+#include "common/srgb.h"
 #include "drivers/egl/egl_test_support.h"
 #include "drivers/headless/headless_output.h"
 #include "kiosk/config_overrides.h"
@@ -123,8 +125,8 @@ protected:
     }
 
     // Starts the worker on a camera that sees the wall through `truth` (bumped or not) and the kiosk
-    // showing one textured content frame.
-    void start(const rig::VirtualRig& truth) {
+    // showing one content frame (textured unless said).
+    void start(const rig::VirtualRig& truth, selfcal::ContentKind kind = selfcal::ContentKind::textured) {
         auto sim = std::make_shared<rig::CameraSimulator>(truth);
         SelfcalWorker::Camera camera = [sim](const cv::Mat1f& content, const ScreenCalibration& wall,
                                              std::uint64_t frame) {
@@ -141,8 +143,7 @@ protected:
         LinkFrame frame;
         frame.frame_id = frame.request_id = 1;
         frame.size = kContent;
-        frame.jpeg =
-            JpegEncoder().encode(srgb_of(selfcal::make_content(selfcal::ContentKind::textured, 0.0, false, 7)), 95);
+        frame.jpeg = JpegEncoder().encode(srgb_of(selfcal::make_content(kind, 0.0, false, 7)), 95);
         inbox_->put(std::move(frame));
         inbox_->wait_decoded();
         kiosk_->on_frame();
@@ -219,6 +220,60 @@ TEST_F(SelfcalKioskTest, WithoutABumpNothingIsCorrected) {
     EXPECT_EQ(states_, std::set<selfcal::SelfcalState>{selfcal::SelfcalState::calibrated});
     EXPECT_EQ(kiosk_->calibration_in_use().swaps, 0u);
     EXPECT_EQ(kiosk_->calibration_in_use().source, "ideal");
+}
+
+// [selfcal] pattern = true on a plain wall: the content gives no evidence, so the worker asks for the
+// fallback's pattern pair, the kiosk draws +a P and -a P on the held frame (kiosk.cpp,
+// update_pattern_overlay), the camera sees them through the bumped rig, and the bump is corrected
+// from the pair's difference. Without the kiosk showing the pattern the worker would only wait.
+TEST_F(SelfcalKioskTest, OnAPlainWallThePatternPairIsShownAndABumpedProjectorCorrected) {
+    options_.pattern.enabled = true;
+    rig::VirtualRig bumped = truth_;
+    bumped.projectors[1].pose.yaw_deg += 1.0;
+    const double before_px = projector_error_px(bumped, display_->calibration(), 1);
+    start(bumped, selfcal::ContentKind::plain);
+    const Rgb8Image plain = kiosk_->current()->image;
+    run_loop(80, [&] {
+        return kiosk_->calibration_in_use().swaps > 0 && states_.count(selfcal::SelfcalState::correcting) > 0 &&
+               worker_->status().state == selfcal::SelfcalState::calibrated;
+    });
+    EXPECT_GT(worker_->pattern_pairs(), 0u) << worker_->status().text();
+    EXPECT_TRUE(states_.count(selfcal::SelfcalState::correcting)) << worker_->status().text();
+    EXPECT_EQ(worker_->status().state, selfcal::SelfcalState::calibrated) << worker_->status().text();
+    EXPECT_EQ(kiosk_->calibration_in_use().source, "selfcal");
+    run_loop(worker_->steps() + 1, [] { return false; });
+    const double after_px = projector_error_px(bumped, display_->calibration(), 1);
+    EXPECT_LT(after_px, 1.0) << "before " << before_px << " px";
+    std::cout << "plain wall, pattern pairs: proj1 " << before_px << " px after the bump, " << after_px << " px after "
+              << kiosk_->calibration_in_use().swaps << " swaps; " << worker_->pattern_pairs() << " of "
+              << worker_->steps() << " monitored frames were pattern pairs\n";
+    EXPECT_EQ(kiosk_->current()->image.pixels, plain.pixels);  // the content itself never carries the pattern
+}
+
+TEST(WithPattern, AddsTheSignedPatternToLinearLightAndClamps) {
+    Rgb8Image content({4, 2}, 0);
+    for (int x = 0; x < 4; ++x)
+        for (int c = 0; c < 3; ++c) content.at(x, 0)[c] = content.at(x, 1)[c] = static_cast<std::uint8_t>(60 * x);
+    cv::Mat1f pattern(2, 4, 0.0f);
+    pattern(0, 1) = 0.02f;   // +a on a mid grey
+    pattern(1, 1) = -0.02f;  // -a on the same grey
+    pattern(0, 0) = -0.5f;   // clamped at black
+    pattern(0, 3) = 1.0f;    // clamped at white
+    const Rgb8Image out = with_pattern(content, pattern);
+    const auto& decode = srgb8_decode_table();
+    const auto code_of = [](double linear) {
+        return static_cast<int>(std::lround(255.0 * srgb_encode(std::clamp(linear, 0.0, 1.0))));
+    };
+    EXPECT_EQ(out.at(1, 0)[0], code_of(decode[60] + 0.02));
+    EXPECT_EQ(out.at(1, 1)[1], code_of(decode[60] - 0.02));
+    EXPECT_EQ(out.at(0, 0)[2], 0);
+    EXPECT_EQ(out.at(3, 0)[0], 255);
+    EXPECT_EQ(out.at(2, 1)[0], 120);  // no pattern: untouched
+    // The pair averages back to the content within rounding (complementary).
+    cv::Mat1f negated;
+    pattern.convertTo(negated, CV_32F, -1.0);
+    const Rgb8Image minus = with_pattern(content, negated);
+    EXPECT_NEAR((decode[out.at(1, 0)[0]] + decode[minus.at(1, 0)[0]]) / 2.0, decode[60], 2e-3);
 }
 
 }  // namespace

@@ -125,6 +125,8 @@ std::unique_ptr<SelfcalWorker> start_selfcal(const KioskConfig& config, const Sc
     options.hold_s = sc.hold_s;
     options.transition_s = sc.transition_s;
     options.drift_threshold_px = sc.drift_threshold_px;
+    options.pattern.enabled = sc.pattern;
+    options.pattern.amplitude = sc.pattern_amplitude;
     options.store = config.calibration.mpcdi;  // corrections written back; the watcher sees the same file
     options.models_store = sc.models;          // and the corrected poses beside it, for the next start
     const std::optional<int> step = warp_step_of(wall);

@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "kiosk/selfcal_worker.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
@@ -11,6 +14,41 @@
 #include "common/srgb.h"
 
 namespace mogao {
+namespace {
+
+// Linear light -> sRGB8 code (IEC 61966-2-1, rounded), through a table of 4096 linear steps plus
+// the exact encoding below the first step (where the curve is steepest).
+std::uint8_t encode_srgb8(float linear) {
+    static const std::vector<std::uint8_t> table = [] {
+        std::vector<std::uint8_t> t(4097);
+        for (std::size_t i = 0; i < t.size(); ++i)
+            t[i] = static_cast<std::uint8_t>(std::lround(255.0 * srgb_encode(static_cast<double>(i) / 4096.0)));
+        return t;
+    }();
+    const float x = std::clamp(linear, 0.0f, 1.0f);
+    if (x < 1.0f / 4096.0f) return static_cast<std::uint8_t>(std::lround(255.0 * srgb_encode(x)));
+    return table[static_cast<std::size_t>(std::lround(x * 4096.0f))];
+}
+
+}  // namespace
+
+Rgb8Image with_pattern(const Rgb8Image& content, const cv::Mat1f& signed_pattern) {
+    cv::Mat1f pattern = signed_pattern;
+    if (pattern.cols != content.size.width || pattern.rows != content.size.height) {
+        cv::resize(signed_pattern, pattern, cv::Size(content.size.width, content.size.height), 0, 0, cv::INTER_LINEAR);
+    }
+    const std::array<float, 256>& decode = srgb8_decode_table();
+    Rgb8Image out = content;
+    for (int y = 0; y < content.size.height; ++y) {
+        for (int x = 0; x < content.size.width; ++x) {
+            const float add = pattern(y, x);
+            if (add == 0.0f) continue;
+            std::uint8_t* p = out.at(x, y);
+            for (int c = 0; c < 3; ++c) p[c] = encode_srgb8(decode[p[c]] + add);
+        }
+    }
+    return out;
+}
 
 cv::Mat1f linear_grey(const Rgb8Image& srgb, int max_width) {
     const std::array<float, 256>& decode = srgb8_decode_table();
@@ -56,6 +94,25 @@ void SelfcalWorker::offer(const Rgb8Image& content) {
     wake_.notify_all();
 }
 
+std::optional<SelfcalWorker::Overlay> SelfcalWorker::overlay() const {
+    const std::lock_guard lock(mutex_);
+    return overlay_;
+}
+
+void SelfcalWorker::overlay_shown(std::uint64_t id, const Rgb8Image& shown) {
+    {
+        const std::lock_guard lock(mutex_);
+        if (!overlay_ || overlay_->id != id) return;  // withdrawn meanwhile
+        overlay_shown_.emplace(id, shown);
+    }
+    wake_.notify_all();
+}
+
+std::uint64_t SelfcalWorker::pattern_pairs() const {
+    const std::lock_guard lock(mutex_);
+    return pattern_pairs_;
+}
+
 selfcal::SelfcalStatus SelfcalWorker::status() const {
     const std::lock_guard lock(mutex_);
     return status_;
@@ -78,31 +135,97 @@ void SelfcalWorker::run() {
         offered_.reset();
         lock.unlock();
         const auto now = std::chrono::steady_clock::now();
-        monitor(content, std::chrono::duration<double>(now - start_).count());
+        const double t_s = std::chrono::duration<double>(now - start_).count();
+        if (calibrator_.pattern_for_refresh(0, cv::Size(content.size.width, content.size.height))) {
+            monitor_pattern_pair(content, t_s);
+        } else {
+            monitor(content, t_s);
+        }
         next = std::max(next + period_, now);  // at most rate_hz; a slow step is not caught up
     }
+}
+
+cv::Mat1f SelfcalWorker::capture(const cv::Mat1f& content) {
+    // Each capture its own frame number: a simulated camera draws new noise for each.
+    return camera_(content, calibrator_.calibration(), captures_++);
 }
 
 void SelfcalWorker::monitor(const Rgb8Image& content, double t_s) {
     selfcal::StepResult r;
     try {
         const cv::Mat1f grey = linear_grey(content, kMonitorWidth);
-        const std::uint64_t frame = steps();
-        const cv::Mat1f camera = camera_(grey, calibrator_.calibration(), frame);
-        r = calibrator_.step(grey, camera, t_s);
+        r = calibrator_.step(grey, capture(grey), t_s);
     } catch (const std::exception& e) {
         spdlog::error("selfcal: t={:.1f}s: {}; frame skipped", t_s, e.what());
         return;
     }
+    publish(std::move(r), false);
+}
+
+std::optional<Rgb8Image> SelfcalWorker::show_overlay(cv::Mat1f pattern) {
+    std::unique_lock lock(mutex_);
+    const std::uint64_t id = ++overlay_ids_;
+    overlay_ = Overlay{id, std::move(pattern)};
+    overlay_shown_.reset();
+    const bool shown = wake_.wait_for(lock, kOverlayTimeout, [&] { return stop_ || overlay_shown_.has_value(); });
+    if (!shown || stop_) return std::nullopt;
+    Rgb8Image frame = std::move(overlay_shown_->second);
+    overlay_shown_.reset();
+    return frame;
+}
+
+void SelfcalWorker::withdraw_overlay() {
+    const std::lock_guard lock(mutex_);
+    overlay_.reset();
+    overlay_shown_.reset();
+}
+
+void SelfcalWorker::monitor_pattern_pair(const Rgb8Image& content, double t_s) {
+    const cv::Size size(content.size.width, content.size.height);
+    std::array<cv::Mat1f, 2> camera;
+    selfcal::StepResult r;
+    try {
+        for (int k = 0; k < 2; ++k) {
+            std::optional<cv::Mat1f> pattern = calibrator_.pattern_for_refresh(k, size);
+            if (!pattern) throw std::logic_error("the pattern is no longer wanted");
+            const std::optional<Rgb8Image> shown = show_overlay(std::move(*pattern));
+            if (!shown) {
+                withdraw_overlay();
+                if (!stopping()) {
+                    spdlog::error("selfcal: t={:.1f}s: the display did not show the pattern within {} s; pair skipped",
+                                  t_s, kOverlayTimeout.count());
+                }
+                return;
+            }
+            camera[static_cast<std::size_t>(k)] = capture(linear_grey(*shown, kMonitorWidth));
+        }
+        withdraw_overlay();
+        r = calibrator_.step_pattern(linear_grey(content, kMonitorWidth), camera[0], camera[1], t_s);
+    } catch (const std::exception& e) {
+        withdraw_overlay();
+        spdlog::error("selfcal: t={:.1f}s: pattern pair: {}; frame skipped", t_s, e.what());
+        return;
+    }
+    publish(std::move(r), true);
+}
+
+bool SelfcalWorker::stopping() const {
+    const std::lock_guard lock(mutex_);
+    return stop_;
+}
+
+void SelfcalWorker::publish(selfcal::StepResult r, bool pattern_pair) {
     for (const std::string& line : r.journal) spdlog::info("selfcal: {}", line);
     selfcal::SelfcalState before;
+    std::uint64_t steps = 0;
     {
         const std::lock_guard lock(mutex_);
         before = status_.state;
         status_ = r.status;
-        ++steps_;
+        steps = ++steps_;
+        if (pattern_pair) ++pattern_pairs_;
     }
-    if (r.status.state != before || steps() == 1) spdlog::info("{}", r.status.text());
+    if (r.status.state != before || steps == 1) spdlog::info("{}", r.status.text());
     if (r.calibration) {
         CalibrationUpdate update;
         update.source = "selfcal";
