@@ -111,8 +111,10 @@ void Kiosk::on_signal() {
 
 void Kiosk::on_frame() {
     DecodeWorker::Taken taken = parts_.inbox.take();  // decoded on the inbox's worker thread
-    parts_.display.stats().superseded(parts_.inbox.replaced());
     note_rejections(taken.rejections);
+    // A frame held back during a pattern pair and replaced before it was shown is superseded too.
+    if (taken.frame && frame_held_back_) ++held_back_replaced_;
+    parts_.display.stats().superseded(parts_.inbox.replaced() + held_back_replaced_);
     if (!taken.frame) return;  // nothing new: the last good frame stays
     current_ = std::move(taken.frame);
     const ContentFrame& f = *current_;
@@ -124,13 +126,13 @@ void Kiosk::on_frame() {
             note_error(std::string("content dump: ") + e.what());
         }
     }
-    (void)update_late_warp();  // this frame's shift for the yaw turned since its request
     last_frame_at_ = std::chrono::steady_clock::now();
     wall_lines_ = wall_lines(last_frame_at_);
     if (pattern_base_) {
-        frame_held_back_ = true;  // shown when the pattern pair is over (a few ticks)
+        frame_held_back_ = true;  // shown, with its own late warp, when the pattern pair is over
         return;
     }
+    (void)update_late_warp();  // this frame's shift for the yaw turned since its request
     show_current();
 }
 
@@ -154,6 +156,7 @@ void Kiosk::update_pattern_overlay() {
         if (!pattern_base_) return;
         pattern_base_.reset();
         overlay_id_ = 0;
+        (void)update_late_warp();  // the shift was held with the frame
         if (frame_held_back_) {
             frame_held_back_ = false;
             show_current();
@@ -168,12 +171,15 @@ void Kiosk::update_pattern_overlay() {
         overlay_told_ = false;
         overlay_image_ = with_pattern(*pattern_base_, overlay->signed_pattern);
         parts_.display.refresh_content(overlay_image_);
-        return;  // told at a later tick, once every output has completed it
+        return;  // told once every output has completed it (a later tick or flip event)
     }
-    if (!overlay_told_ && parts_.display.all_outputs_ready()) {
-        parts_.selfcal->overlay_shown(overlay_id_, overlay_image_);
-        overlay_told_ = true;
-    }
+    tell_overlay_shown();
+}
+
+void Kiosk::tell_overlay_shown() {
+    if (overlay_id_ == 0 || overlay_told_ || !parts_.display.all_outputs_ready()) return;
+    parts_.selfcal->overlay_shown(overlay_id_, overlay_image_);
+    overlay_told_ = true;
 }
 
 void Kiosk::note_rejections(const std::vector<DecodeWorker::Rejection>& rejections) {
@@ -213,14 +219,17 @@ void Kiosk::on_tick() {
     submit_next_view();
     const LinkClientStats link = parts_.link.stats();
     note_link_state(link);
-    (void)update_late_warp();
+    // A pattern pair holds the frame, its shift included: the pair's two camera frames must differ
+    // by the pattern alone (and a repaint would keep a KMS output's flip pending at every tick).
+    const bool holding = pattern_base_.has_value();
+    if (!holding) (void)update_late_warp();
     // Nothing new since the previous tick: show the current frame again (headless PNGs keep
     // coming, a KMS output is refreshed, the late warp's new shift reaches the wall). A frame shown
     // since then already carried the shift of its own round, and a frame already decoded and
     // waiting is shown next, with this tick's shift: a repaint first would only delay it by a whole
     // round (on a software rasteriser, hundreds of ms for three outputs). A turn after that round
     // reaches the wall with the next frame or at the next tick, whichever comes first.
-    if (!shown_since_tick_ && !frame_waiting()) {
+    if (!holding && !shown_since_tick_ && !frame_waiting()) {
         parts_.display.repaint();
         check_frames_shown();
     }
@@ -323,6 +332,7 @@ std::optional<std::size_t> Kiosk::flip_overdue(std::chrono::steady_clock::time_p
 void Kiosk::on_flip() {
     if (Status s = parts_.display.on_flip(); !s) return fail("output events", s.error().message);
     check_frames_shown();
+    tell_overlay_shown();
 }
 
 void Kiosk::on_calibration() {

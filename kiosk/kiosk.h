@@ -151,6 +151,7 @@ private:
     // the held frame, tells the worker once every output has completed it, and when the overlay is
     // withdrawn shows the content again (a frame that arrived meanwhile is shown then).
     void update_pattern_overlay();
+    void tell_overlay_shown();  // the worker, once every output completed the overlay's present
     [[nodiscard]] const char* running_state() const;
 
     const KioskConfig& config_;
@@ -183,6 +184,7 @@ private:
     Rgb8Image overlay_image_;                              // pattern_base_ with that overlay, as shown
     bool overlay_told_ = false;                            // the worker was told it is shown
     bool frame_held_back_ = false;                         // a farm frame arrived while the pair was shown
+    std::uint64_t held_back_replaced_ = 0;                 // held-back frames replaced before they were shown
     std::chrono::steady_clock::time_point last_frame_at_;  // the latest new farm frame
     int exit_code_ = 0;
 };

@@ -25,7 +25,7 @@ std::uint8_t encode_srgb8(float linear) {
             t[i] = static_cast<std::uint8_t>(std::lround(255.0 * srgb_encode(static_cast<double>(i) / 4096.0)));
         return t;
     }();
-    const float x = std::clamp(linear, 0.0f, 1.0f);
+    const float x = std::isfinite(linear) ? std::clamp(linear, 0.0f, 1.0f) : 0.0f;
     if (x < 1.0f / 4096.0f) return static_cast<std::uint8_t>(std::lround(255.0 * srgb_encode(x)));
     return table[static_cast<std::size_t>(std::lround(x * 4096.0f))];
 }
