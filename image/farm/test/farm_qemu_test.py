@@ -145,7 +145,9 @@ def host_dirs(work, farm, overlay, layout):
           "# Under TCG an ssh login takes seconds: the launcher's 2 s health check would leave\n"
           "# farm-render2 out (mogao-farm-launch, 'no answer within 2 s').\n"
           f"MOGAO_HEALTH_TIMEOUT_S={HEALTH_TIMEOUT_S}\n"
-          + ("OMPI_MCA_btl_base_verbose=30\n" if os.environ.get("MOGAO_FARM_TEST_MPI_VERBOSE") else ""))
+          + ("OMPI_MCA_btl_base_verbose=30\n" if os.environ.get("MOGAO_FARM_TEST_MPI_VERBOSE") else "")
+          # Diagnosis: more farm.env lines, space-separated NAME=VALUE (e.g. PMIX_MCA_gds=hash).
+          + "".join(f"{kv}\n" for kv in os.environ.get("MOGAO_FARM_TEST_FARM_ENV", "").split()))
     for f in ("ca.pem", "farm-farm.pem", "farm-farm.key"):
         os.makedirs(f"{admin}/etc/mogao/pki", exist_ok=True)
         shutil.copy(os.path.join(pki, f), f"{admin}/etc/mogao/pki/{f}")
