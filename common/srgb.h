@@ -5,9 +5,11 @@
 // formulas).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 
 namespace mogao {
 
@@ -17,6 +19,12 @@ namespace mogao {
 
 [[nodiscard]] inline double srgb_encode(double linear) {
     return linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
+}
+
+// Linear light -> the nearest 8-bit code (srgb_encode, rounded); outside [0, 1] clamps, NaN gives 0.
+[[nodiscard]] inline std::uint8_t srgb8_encode(double linear) {
+    const double x = linear > 0.0 ? std::min(linear, 1.0) : 0.0;
+    return static_cast<std::uint8_t>(std::lround(255.0 * srgb_encode(x)));
 }
 
 // Linear light of each 8-bit code c (srgb_decode(c / 255)): what a GL_SRGB8 texel decodes to,

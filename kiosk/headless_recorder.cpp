@@ -10,17 +10,9 @@
 
 #include "appliance/warp/composite.h"
 #include "common/png_io.h"
+#include "common/srgb.h"
 
 namespace mogao {
-namespace {
-
-std::uint8_t linear_to_srgb8(float linear) {
-    const double x = std::clamp(static_cast<double>(linear), 0.0, 1.0);
-    const double s = x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055;
-    return static_cast<std::uint8_t>(std::lround(s * 255.0));
-}
-
-}  // namespace
 
 HeadlessRecorder::Writer::Writer() : thread_([this] { run(); }) {}
 
@@ -111,7 +103,7 @@ void HeadlessRecorder::write_composite(const ScreenCalibration& screen,
     }
     const RgbFloatImage light = composite_on_screen(screen, signals);
     Rgb8Image out(light.size);
-    for (std::size_t k = 0; k < light.pixels.size(); ++k) out.pixels[k] = linear_to_srgb8(light.pixels[k]);
+    for (std::size_t k = 0; k < light.pixels.size(); ++k) out.pixels[k] = srgb8_encode(light.pixels[k]);
     write_png(file, out);
 }
 

@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
-#include <vector>
 
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
@@ -14,23 +13,6 @@
 #include "common/srgb.h"
 
 namespace mogao {
-namespace {
-
-// Linear light -> sRGB8 code (IEC 61966-2-1, rounded), through a table of 4096 linear steps plus
-// the exact encoding below the first step (where the curve is steepest).
-std::uint8_t encode_srgb8(float linear) {
-    static const std::vector<std::uint8_t> table = [] {
-        std::vector<std::uint8_t> t(4097);
-        for (std::size_t i = 0; i < t.size(); ++i)
-            t[i] = static_cast<std::uint8_t>(std::lround(255.0 * srgb_encode(static_cast<double>(i) / 4096.0)));
-        return t;
-    }();
-    const float x = std::isfinite(linear) ? std::clamp(linear, 0.0f, 1.0f) : 0.0f;
-    if (x < 1.0f / 4096.0f) return static_cast<std::uint8_t>(std::lround(255.0 * srgb_encode(x)));
-    return table[static_cast<std::size_t>(std::lround(x * 4096.0f))];
-}
-
-}  // namespace
 
 Rgb8Image with_pattern(const Rgb8Image& content, const cv::Mat1f& signed_pattern) {
     cv::Mat1f pattern = signed_pattern;
@@ -44,7 +26,7 @@ Rgb8Image with_pattern(const Rgb8Image& content, const cv::Mat1f& signed_pattern
             const float add = pattern(y, x);
             if (add == 0.0f) continue;
             std::uint8_t* p = out.at(x, y);
-            for (int c = 0; c < 3; ++c) p[c] = encode_srgb8(decode[p[c]] + add);
+            for (int c = 0; c < 3; ++c) p[c] = srgb8_encode(static_cast<double>(decode[p[c]] + add));
         }
     }
     return out;

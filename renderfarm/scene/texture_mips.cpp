@@ -58,10 +58,7 @@ LinearLevel halve(const LinearLevel& src) {
 
 Rgb8Image encode(const LinearLevel& level) {
     Rgb8Image image(ImageSize{level.width, level.height});
-    for (std::size_t k = 0; k < level.rgb.size(); ++k) {
-        const double code = 255.0 * srgb_encode(std::clamp(static_cast<double>(level.rgb[k]), 0.0, 1.0));
-        image.pixels[k] = static_cast<std::uint8_t>(std::lround(code));
-    }
+    for (std::size_t k = 0; k < level.rgb.size(); ++k) image.pixels[k] = srgb8_encode(level.rgb[k]);
     return image;
 }
 
