@@ -9,9 +9,11 @@ rm -rf "$work" && mkdir -p "$work"
 fail=0
 expect_failure() {  # name, expected fragment, args...
   local name=$1 fragment=$2; shift 2
-  if timeout 120 "$MPIEXEC" --oversubscribe -n 3 "$farm" "$@" > "$work/$name.log" 2>&1; then
-    echo "FAIL: $name: exit code 0"; fail=1; return
-  fi
+  timeout 120 "$MPIEXEC" --oversubscribe -n 3 "$farm" "$@" > "$work/$name.log" 2>&1
+  local rc=$?
+  [ $rc -eq 0 ] && { echo "FAIL: $name: exit code 0"; fail=1; return; }
+  # A rank that gave up alone leaves the others waiting: the message is there, the job never ends.
+  [ $rc -eq 124 ] && { echo "FAIL: $name: the job did not end within 120 s (a rank waits for one that gave up)"; fail=1; return; }
   if ! grep -q -- "$fragment" "$work/$name.log"; then
     echo "FAIL: $name: message lacks '$fragment':"; cat "$work/$name.log"; fail=1; return
   fi
@@ -38,5 +40,18 @@ if timeout 120 "$MPIEXEC" --oversubscribe -n 2 "$farm" render --scene "$work/ok.
 else
   echo "FAIL: --quality exhibit did not render"; cat "$work/preset.log"; fail=1
 fi
+# serve: the link's TLS material lives on the admin host only (render hosts hold no key). A missing
+# one on the admin ends every rank (exit 2, the path named); on render hosts it is not needed. The
+# MPMD form gives rank 0 one --tls-dir and ranks 1-2 another, as two hosts' file systems would.
+"$farm" pki init-ca --dir "$work/pki" > /dev/null && "$farm" pki issue-farm --dir "$work/pki" --name farm --san ::1 > /dev/null \
+  && "$farm" pki export-farm --dir "$work/pki" --name farm --to "$work/farm-tls" > /dev/null || { echo "FAIL: pki"; fail=1; }
+serve_args=(serve --scene "$work/ok.json" --listen "[::1]:0" --name farm --duration 2)
+expect_failure admin-without-tls "$work/absent" "${serve_args[@]}" --tls-dir "$work/absent"
+timeout 120 "$MPIEXEC" --oversubscribe -n 1 "$farm" "${serve_args[@]}" --tls-dir "$work/farm-tls" \
+  : -n 2 "$farm" "${serve_args[@]}" --tls-dir "$work/absent" > "$work/render-without-tls.log" 2>&1
+rc=$?
+if [ $rc -eq 0 ]; then echo "ok: serve with the TLS files on the admin only: 3 ranks served and ended (exit 0)"
+else echo "FAIL: serve with the TLS files on the admin only: exit $rc (124: a rank gave up alone, the others waited)"
+  cat "$work/render-without-tls.log"; fail=1; fi
 [ $fail -eq 0 ] && echo "PASS: bad input fails cleanly"
 exit $fail

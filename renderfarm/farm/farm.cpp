@@ -74,13 +74,6 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-// True on every rank when `ok` is true on every rank (a collective: all ranks must call it).
-bool all_ranks(bool ok) {
-    int mine = ok ? 1 : 0, all = 0;
-    MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
-    return all == 1;
-}
-
 }  // namespace
 
 int run_farm(const MpiSession& mpi, const FarmSetup& setup, const AdminJob& admin_job) {
@@ -95,7 +88,7 @@ int run_farm(const MpiSession& mpi, const FarmSetup& setup, const AdminJob& admi
         error = e.what();
     }
     const double load_seconds = seconds_since(load_start);
-    if (!all_ranks(scene.has_value())) {
+    if (!mpi.all(scene.has_value())) {
         if (!scene) spdlog::error("rank {}: {}", mpi.rank(), error);
         return 1;
     }
@@ -120,7 +113,7 @@ int run_farm(const MpiSession& mpi, const FarmSetup& setup, const AdminJob& admi
     }
     double max_bvh = 0.0;
     MPI_Reduce(&bvh_seconds, &max_bvh, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
-    if (!all_ranks(!renders || renderer.has_value())) return 1;
+    if (!mpi.all(!renders || renderer.has_value())) return 1;
 
     DispatchSettings dispatch = setup.dispatch;
     dispatch.exposure = scene->exposure;

@@ -141,11 +141,9 @@ void add_view_policy_flags(CLI::App& serve, mogao::ViewPolicy& policy, std::vect
         .add_option("--view-max-guard-deg", policy.max_guard_deg,
                     "Arc allowed beyond the screen's on each side (the kiosk's late-warp guard band)")
         ->check(CLI::Range(0.0, 179.999));
-    serve
-        .add_option("--view-policy", policy_file,
-                    "JSON file of per-appliance view policies (screen, max_size, ...; docs/services.md); listed "
-                    "certificates get their entry, the others the --view-* flags")
-        ->check(CLI::ExistingFile);
+    serve.add_option("--view-policy", policy_file,
+                     "JSON file of per-appliance view policies (screen, max_size, ...; docs/services.md); listed "
+                     "certificates get their entry, the others the --view-* flags (read on the admin host only)");
     serve
         .add_option("--view-min-fov-deg", policy.min_fov_deg,
                     "Without --view-screen: narrower pinhole requests are widened to this (0 = off)")
@@ -159,9 +157,8 @@ void add_link_flags(CLI::App& serve, mogao::ServeOptions& serve_options, std::fi
     serve
         .add_option("--tls-dir", tls_dir,
                     "TLS folder: ca.pem, farm-NAME.pem, farm-NAME.key, optional crl.pem; never ca.key (mogao-farm pki "
-                    "export-farm)")
-        ->required()
-        ->check(CLI::ExistingDirectory);
+                    "export-farm); read on the admin host only, render hosts need none")
+        ->required();
     serve.add_option("--name", farm_name, "Farm certificate name in --tls-dir");
     serve.add_option("--allow", serve_options.link.allowed_appliances,
                      "Only these appliance certificate names (default: any the CA issued)");
@@ -248,6 +245,37 @@ int run_health() {
     return 0;
 }
 
+// The admin's part of `serve` that reads files: the view policies and the link's TLS material.
+// Returns what is wrong (naming the flag or file), or "" when all is well.
+std::string prepare_admin_link(mogao::ServeOptions& serve_options, const std::filesystem::path& tls_dir,
+                               const std::string& farm_name, const std::filesystem::path& view_policy_file) {
+    try {
+        serve_options.view_policy.validate();
+    } catch (const std::invalid_argument& e) {
+        return fmt::format("--view-screen / --view-*: {}", e.what());
+    }
+    if (!view_policy_file.empty()) {
+        try {
+            serve_options.appliance_view_policies =
+                mogao::read_view_policies(view_policy_file, serve_options.view_policy).appliances;
+        } catch (const std::exception& e) {
+            return fmt::format("--view-policy: {}", e.what());
+        }
+    }
+    try {
+        serve_options.link.tls = mogao::load_farm_tls(tls_dir, farm_name);
+        // Re-read while serving: the farm certificate is rotated by replacing the files.
+        serve_options.link.tls_files = {mogao::ca_cert_path(tls_dir), mogao::farm_cert_path(tls_dir, farm_name),
+                                        mogao::farm_key_path(tls_dir, farm_name)};
+        if (serve_options.link.crl_path.empty() && std::filesystem::exists(mogao::crl_path(tls_dir))) {
+            serve_options.link.crl_path = mogao::crl_path(tls_dir).string();
+        }
+    } catch (const std::exception& e) {
+        return fmt::format("--tls-dir {}: {}", tls_dir.string(), e.what());
+    }
+    return "";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -309,35 +337,14 @@ int main(int argc, char** argv) {
                                   {0.0, view_screen.size() > 4 ? view_screen[4] : 1.6, 0.0}};
     }
     if (serve->parsed()) {
-        try {
-            serve_options.view_policy.validate();
-        } catch (const std::invalid_argument& e) {
-            if (mpi.is_admin()) spdlog::error("--view-screen / --view-*: {}", e.what());
-            return 2;
-        }
-        if (!view_policy_file.empty()) {
-            try {
-                serve_options.appliance_view_policies =
-                    mogao::read_view_policies(view_policy_file, serve_options.view_policy).appliances;
-            } catch (const std::exception& e) {
-                if (mpi.is_admin()) spdlog::error("--view-policy: {}", e.what());
-                return 2;
-            }
-        }
-    }
-    if (serve->parsed()) {
-        try {
-            serve_options.link.tls = mogao::load_farm_tls(tls_dir, farm_name);
-            // Re-read while serving: the farm certificate is rotated by replacing the files.
-            serve_options.link.tls_files = {mogao::ca_cert_path(tls_dir), mogao::farm_cert_path(tls_dir, farm_name),
-                                            mogao::farm_key_path(tls_dir, farm_name)};
-            if (serve_options.link.crl_path.empty() && std::filesystem::exists(mogao::crl_path(tls_dir))) {
-                serve_options.link.crl_path = mogao::crl_path(tls_dir).string();
-            }
-        } catch (const std::exception& e) {
-            if (mpi.is_admin()) spdlog::error("{}", e.what());
-            return 2;
-        }
+        // Only the admin talks to appliances, so only the admin host holds the link's key, its
+        // revocation list and the view policies (render hosts have no /etc/mogao/pki). Every rank
+        // then agrees: one that returned alone would wait in MPI_Finalize while the others wait
+        // for it in their first collective (the two-host farm hung so).
+        const std::string error =
+            mpi.is_admin() ? prepare_admin_link(serve_options, tls_dir, farm_name, view_policy_file) : std::string();
+        if (!error.empty()) spdlog::error("{}", error);
+        if (!mpi.all(error.empty())) return 2;
         return mogao::run_farm(mpi, setup, [&](mogao::FrameDispatcher& farm, const mogao::Scene& scene, mogao::RunInfo& run) {
             return mogao::run_serve(serve_options, farm, scene, run);
         });

@@ -26,6 +26,15 @@ public:
     [[nodiscard]] bool is_admin() const { return rank_ == 0; }
     [[nodiscard]] int render_ranks() const { return size_ > 1 ? size_ - 1 : 0; }
 
+    // True on every rank when `ok` is true on every rank. A collective: every rank must call it,
+    // so a rank that is about to give up calls it too instead of returning alone (a rank that
+    // returns early sits in MPI_Finalize while the others wait for it in their next collective).
+    [[nodiscard]] bool all(bool ok) const {
+        int mine = ok ? 1 : 0, every = 0;
+        MPI_Allreduce(&mine, &every, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+        return every == 1;
+    }
+
 private:
     int rank_ = 0;
     int size_ = 1;
