@@ -7,8 +7,10 @@
 #   * a host that never answers is left out when the grace ends (not waited for forever);
 #   * the wait works where /proc/uptime is hidden (the unit's ProcSubset=pid; needs a mount
 #     namespace, as root);
+#   * a host back while the farm serves without it ends the job after 2 answers in a row
+#     (MOGAO_REJOIN_CHECK_S), and not at all with 0;
 #   * a host file whose last line lacks its newline still has that host;
-#   * bad MOGAO_BOOT_GRACE_S / RANKS are refused with exit 2, naming the variable.
+#   * bad MOGAO_BOOT_GRACE_S / MOGAO_REJOIN_CHECK_S / RANKS are refused with exit 2, naming the variable.
 # usage: launch_test.sh LAUNCHER
 set -euo pipefail
 launcher=$1
@@ -28,8 +30,9 @@ printf '#!/bin/sh\necho "mpirun $*"; cat "$2"\n' > "$work/mpirun"
 chmod +x "$work/agent" "$work/mpirun"
 run() {  # run GRACE ANSWER_AFTER: the launcher's output
   rm -f "$work/calls"
-  OMPI_MCA_plm_rsh_agent="$work/agent" MOGAO_MPIRUN="$work/mpirun" RUNTIME_DIRECTORY="$work" \
-    MOGAO_BOOT_GRACE_S=$1 ANSWER_AFTER=$2 sh "$launcher" "$work/hosts" 3 mogao-farm serve 2>&1
+  OMPI_MCA_plm_rsh_agent="$work/agent" MOGAO_MPIRUN="${MPIRUN:-$work/mpirun}" RUNTIME_DIRECTORY="$work" \
+    MOGAO_BOOT_GRACE_S=$1 ANSWER_AFTER=$2 MOGAO_REJOIN_CHECK_S=${REJOIN:-0} \
+    timeout "${LIMIT:-60}" sh "$launcher" "$work/hosts" 3 mogao-farm serve 2>&1
 }
 up=$(cut -d. -f1 /proc/uptime)
 
@@ -61,6 +64,26 @@ took=$(($(date +%s) - start))
 echo "$out" | grep -q "render host render2 left out" || fail "grace over: render2 not left out: $out"
 ((took >= 3 && took <= 15)) || fail "grace over: the launcher took $took s for a 4 s grace"
 
+# Serving without render2, which comes back: with MOGAO_REJOIN_CHECK_S=1 the watcher asks it every
+# second and ends the job (SIGTERM to mpirun, which exits 1 as Open MPI's does) once it has answered
+# twice in a row: checks 2 (refused), 3 and 4 (answers). Without the watcher the job runs on.
+cat > "$work/mpirun-serving" <<'MPI'
+#!/bin/sh
+echo "mpirun $*"
+trap 'echo "mpirun: SIGTERM"; exit 1' TERM
+while :; do sleep 0.1; done
+MPI
+chmod +x "$work/mpirun-serving"
+start=$(date +%s)
+rc=0; out=$(REJOIN=1 MPIRUN="$work/mpirun-serving" LIMIT=30 run 0 2) || rc=$?
+rejoin_took=$(($(date +%s) - start))
+[ $rc = 1 ] || fail "rejoin: exit $rc, expected 1 (the job ended by SIGTERM): $out"
+echo "$out" | grep -q "mpirun: SIGTERM" || fail "rejoin: mpirun not ended: $out"
+echo "$out" | grep -q "render host(s) render2 answer again (2 checks in a row)" || fail "rejoin: not logged: $out"
+[ "$(cat "$work/calls")" = 4 ] || fail "rejoin: render2 asked $(cat "$work/calls") times, expected 4"
+rc=0; out=$(REJOIN=0 MPIRUN="$work/mpirun-serving" LIMIT=4 run 0 2) || rc=$?
+[ $rc = 124 ] || fail "no rejoin (MOGAO_REJOIN_CHECK_S=0): the job ended (exit $rc): $out"
+
 # A host file whose last line has no newline: its host is still asked and used.
 printf 'admin slots=2\nrender2 slots=1' > "$work/hosts"
 out=$(run 0 0)
@@ -69,8 +92,8 @@ printf 'admin slots=2 # this machine\nrender2 slots=1\n' > "$work/hosts"
 
 rc=0; err=$(sh "$launcher" "$work/hosts" 0 true 2>&1) || rc=$?
 [ $rc = 2 ] && echo "$err" | grep -q "RANKS must be a number >= 1" || fail "RANKS 0: rc $rc, '$err'"
-for bad in "MOGAO_BOOT_GRACE_S=-1" "MOGAO_BOOT_GRACE_S=2m"; do
+for bad in "MOGAO_BOOT_GRACE_S=-1" "MOGAO_BOOT_GRACE_S=2m" "MOGAO_REJOIN_CHECK_S=1.5"; do
   rc=0; err=$(env "$bad" sh "$launcher" "$work/hosts" 3 true 2>&1) || rc=$?
-  [ $rc = 2 ] && echo "$err" | grep -q "MOGAO_BOOT_GRACE_S must be whole seconds" || fail "$bad: rc $rc, '$err'"
+  [ $rc = 2 ] && echo "$err" | grep -q "${bad%%=*} must be whole seconds" || fail "$bad: rc $rc, '$err'"
 done
-echo "PASS: launcher waits for booting hosts only within the grace (3 checks), ${hidden:-}leaves lost ones out at once, ends the wait at the grace ($took s)"
+echo "PASS: launcher waits for booting hosts only within the grace (3 checks), ${hidden:-}leaves lost ones out at once, ends the wait at the grace ($took s), restarts for a host back after 2 checks ($rejoin_took s at 1 s a check)"

@@ -16,7 +16,9 @@ headless in the namespace against [fd00:6d6f::10]:7443.
 
 Assertions (each printed as PASS/FAIL; any failure fails the test):
   * mogao-farm.service on farm-admin reaches active (Type=notify READY) as user mogao-farm;
-  * ranks run on both hosts (rank 2 on farm-render2, started over ssh by mpirun);
+  * ranks run on both hosts (rank 2 on farm-render2, started over ssh by mpirun) and the admin
+    serves with 2 render ranks (--layout both, the default; admin-only runs every rank on
+    farm-admin, for diagnosis);
   * the host's kiosk connects over IPv6 + mutual TLS and presents farm frames (not black);
   * the farm stays up without restarts for longer than WatchdogSec (WATCHDOG=1 reaches systemd);
   * a SIGSTOPped admin rank is killed by WatchdogSec and the farm restarted (NRestarts 0 -> 1),
@@ -217,7 +219,7 @@ def main():
     ap.add_argument("--kiosk", required=True, help="mogao-kiosk (host): the appliance, headless")
     ap.add_argument("--image-tool", default="", help="mogao_kiosk_image_tool: PNG statistics")
     ap.add_argument("--work", default="")
-    ap.add_argument("--layout", choices=["both", "admin-only"], default=os.environ.get("MOGAO_FARM_TEST_LAYOUT", "admin-only"),
+    ap.add_argument("--layout", choices=["both", "admin-only"], default=os.environ.get("MOGAO_FARM_TEST_LAYOUT", "both"),
                     help="both: ranks on farm-admin and farm-render2 (the test); admin-only: every rank on "
                          "farm-admin (diagnosis: the unit and the link without MPI between the hosts)")
     ap.add_argument("--overlay", action="store_true",
@@ -246,8 +248,11 @@ def main():
     os.makedirs(work, exist_ok=True)
     log(f"work folder {work}")
     fails = farmvm.Failures()
+    commit = subprocess.run(["git", "-C", a.repo, "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
     results = {"accel": "tcg", "image_bytes": os.path.getsize(a.image),
-               "image_allocated_bytes": os.stat(a.image).st_blocks * 512}
+               "image_allocated_bytes": os.stat(a.image).st_blocks * 512,
+               "date": time.strftime("%Y-%m-%d"), "commit": commit.stdout.strip() or "unknown",
+               "host_cpus": os.cpu_count()}
     if a.build_seconds is not None:
         results["image_build_s"] = a.build_seconds
 
@@ -310,6 +315,11 @@ def main():
         a.layout == "admin-only" or fails.check(text is not None and text.startswith("ok") and [r["rank"] for r in render_ranks] == ["2"]
                     and "parent=orted" in text and "user=mogao-farm" in text,
                     f"farm-render2: rank 2 runs there, under orted, as mogao-farm (started over ssh): {text}")
+        if a.layout == "both":
+            # The admin's own word that the job spans both hosts: rank 0 serves with 2 render ranks.
+            serving = [m for _, m in admin.marks if m.startswith("log ") and " serving " in m and "render ranks" in m]
+            fails.check(any("(2 render ranks" in m for m in serving),
+                        f"farm-admin: the farm serves with 2 render ranks, one of them on farm-render2: {serving[-1:]}")
         _, text = admin.wait(r"security-online ", 60, alive)
         if text:
             m = re.search(r"exposure level.*?:\s*([\d.]+)", text)

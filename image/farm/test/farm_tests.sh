@@ -14,6 +14,8 @@ skip() { echo "SKIP: $*"; exit 77; }
 if [[ $mode == check ]]; then
   for f in build provision lib/farm.sh test/farm_tests.sh ../lib/debian.sh; do bash -n "$repo/image/farm/$f"; done
   sh -n "$repo/image/farm/test/selftest.sh"
+  # docs/services.md's table of the QEMU test is written by this script from a run's results.
+  python3 "$repo/image/farm/test/results_table.py" --check --doc "$repo/docs/services.md"
   # The packet filter's ruleset: the farm network let in, a bad network file closes it (and says so).
   fw="$repo/image/farm/rootfs/usr/lib/mogao/farm-firewall" tmp=$(mktemp -d)
   trap 'rm -rf "$tmp"' EXIT

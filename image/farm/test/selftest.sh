@@ -25,7 +25,10 @@ dump_journal() { journal "$1" | tail -n "${2:-40}" | sed 's/^/MOGAO-SELFTEST log
 proc_env() { tr '\0' '\n' < "/proc/$1/environ" 2>/dev/null | sed -n "s/^$2=//p"; }
 # Processes named mogao-farm (the ranks), as "pid:uid:rank:seccomp:nonewprivs" words.
 ranks() {
+  local p
   for p in $(pgrep -x mogao-farm); do
+    # MPI ranks only: the launcher's `mogao-farm health` check over ssh is one too, for a moment.
+    [ -n "$(proc_env "$p" OMPI_COMM_WORLD_RANK)" ] || continue
     printf '%s:%s:%s:%s:%s ' "$p" "$(awk '/^Uid:/ { print $2 }' /proc/$p/status)" "$(proc_env "$p" OMPI_COMM_WORLD_RANK)" \
       "$(awk '/^Seccomp:/ { print $2 }' /proc/$p/status)" "$(awk '/^NoNewPrivs:/ { print $2 }' /proc/$p/status)"
   done
