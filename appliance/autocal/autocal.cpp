@@ -34,6 +34,15 @@ void check_inputs(const CalibrationPrior& prior, ImageSize content, const Autoca
     if (o.frames_per_pattern < 1 || o.frames_per_pattern > 64) {
         fail("options.frames_per_pattern: 1..64, got " + std::to_string(o.frames_per_pattern));
     }
+    if (o.phase_shifts != 0 && (o.phase_shifts < 3 || o.phase_shifts > 16)) {
+        fail("options.phase_shifts: 0 (off) or 3..16, got " + std::to_string(o.phase_shifts));
+    }
+    if (!(o.phase_period_px >= 4.0 && o.phase_period_px <= 1024.0)) {
+        fail("options.phase_period_px: 4..1024, got " + std::to_string(o.phase_period_px));
+    }
+    if (!(o.phase_gamma > 0.0 && o.phase_gamma <= 10.0)) fail("options.phase_gamma: (0, 10]");
+    if (!(o.phase_sigma_floor_px > 0.0)) fail("options.phase_sigma_floor_px: > 0");
+    if (!(o.shadow_noise_sigmas >= 0.0)) fail("options.shadow_noise_sigmas: >= 0");
     if (!(prior.screen.radius_m > 0.0 && prior.screen.arc_deg > 0.0 && prior.screen.top_m > prior.screen.bottom_m)) {
         fail("prior.screen: radius_m > 0, arc_deg > 0, top_m > bottom_m");
     }
@@ -174,6 +183,9 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
         result.report.captures += c.captures;
         ProjectorReport pr{
             prior.projectors[k].id, c.column_bits, c.row_bits, static_cast<int>(c.camera.size()), 0.0, 0.0};
+        pr.lit_pixels = c.lit_pixels;
+        pr.phase_refined = std::min(c.phase_refined_columns, c.phase_refined_rows);
+        pr.noise_sigma = c.noise_sigma;
         if (c.column_bits < options.min_bits || c.row_bits < options.min_bits) {
             throw CalibrationRefused("projector " + std::to_string(k) + " '" + pr.id +
                                      "': Gray-code decoding failed: " + std::to_string(c.column_bits) + " column and " +
@@ -182,7 +194,7 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
                                      std::to_string(c.lit_pixels) + " camera pixels lit)");
         }
         ProjectorFit fit =
-            fit_projector(edge.camera, prior, static_cast<int>(k), c.camera, c.projector, c.block, options);
+            fit_projector(edge.camera, prior, static_cast<int>(k), c.camera, c.projector, c.sigma, options);
         pr.rms_px = fit.rms_px;
         pr.mean_view_angle_deg = fit.mean_view_angle_deg;
         result.projectors.push_back(fit.model);

@@ -23,7 +23,10 @@
 //     are taken until its first one below half its contrast; in the reflected Gray code that bit flips at the middle of
 //     the pixel's block, so the block's centre is the pixel's position. Each decoded camera pixel (all but at most two
 //     of the resolved bits per axis) gives a correspondence: its centre <-> the block's centre, with the block's size /
-//     sqrt(12) as its uncertainty (a uniform error over the block).
+//     sqrt(12) as its uncertainty (a uniform error over the block). The shadow mask's threshold is also
+//     `shadow_noise_sigmas` times the noise of white - black, estimated from the black image.
+//  1b. Phase shift (phase_shift.h; Gühring 2001): `phase_shifts` sinusoids per axis refine each pixel whose Gray
+//     block is at most half a period to a sub-pixel position with its own uncertainty.
 //  2. Camera pose: the lit region of all projectors at full white ends at the screen's edges
 //     (projectors overfill them). Edge points are located to sub-pixel as the crossing of the local
 //     half level; Gauss-Newton on the camera's 6 pose parameters minimises the distance, on the
@@ -96,9 +99,20 @@ struct AutocalOptions {
     int max_correspondences = 20000;  // per projector (decoded camera pixels, evenly strided), >= min_cells
     int min_bits = 4;                 // resolved Gray bits per axis, below: decoding failed
     // Speed/accuracy knobs (docs/calibration.md, "Speed against accuracy"):
-    int max_gray_bits = 0;             // Gray bits shown per axis, 0 = all (gray_code_bits of the extent); else
-                                       // min_bits..16: the finest stripe is 2^(bits of the extent - max_gray_bits) px
-    int frames_per_pattern = 1;        // camera frames averaged per pattern (noise / sqrt(frames)), 1..64
+    int max_gray_bits = 0;       // Gray bits shown per axis, 0 = all (gray_code_bits of the extent); else
+                                 // min_bits..16: the finest stripe is 2^(bits of the extent - max_gray_bits) px
+    int frames_per_pattern = 1;  // camera frames averaged per pattern (noise / sqrt(frames)), 1..64
+    // Phase shifting on top of the Gray code (phase_shift.h; docs/calibration.md): `phase_shifts` sinusoids per
+    // axis (0 = off, else 3..16) of `phase_period_px` projector pixels ([4, 1024]; unwrapped where the Gray block
+    // is at most half of it), pre-compensated for the projectors' assumed response `phase_gamma` ((0, 10]); a
+    // refined position's sigma is at least `phase_sigma_floor_px` (camera footprint and model error, > 0).
+    int phase_shifts = 4;
+    double phase_period_px = 32.0;
+    double phase_gamma = 2.2;
+    double phase_sigma_floor_px = 0.29;
+    // Shadow mask: a camera pixel counts only where white - black is also above this many sigmas of that
+    // difference's noise (estimated from the black image), so that a noisy camera's dark pixels do not pass.
+    double shadow_noise_sigmas = 5.0;  // >= 0
     double max_edge_rms_m = 0.01;      // camera pose fit gate
     double max_projector_rms = 3.0;    // projector fit gate, rms in units of the decoding uncertainty, > 0
     double max_view_angle_deg = 75.0;  // camera rays steeper than this to the screen normal: grazing
@@ -141,6 +155,9 @@ struct ProjectorReport {
     int cells = 0;        // correspondences used
     double rms_px = 0.0;  // projector fit residual, projector pixels
     double mean_view_angle_deg = 0.0;
+    int lit_pixels = 0;        // camera pixels in its shadow mask
+    int phase_refined = 0;     // of them, refined by the phase (the lesser of the two axes)
+    double noise_sigma = 0.0;  // estimated noise of one black camera image (camera units)
 };
 
 struct AutocalReport {

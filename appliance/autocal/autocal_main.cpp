@@ -32,6 +32,11 @@ int main(int argc, char** argv) {
     cmd->add_option("--frames-per-pattern", job.options.frames_per_pattern,
                     "Camera frames averaged per structured-light pattern, 1..64")
         ->check(CLI::Range(1, 64));
+    cmd->add_option("--phase-shifts", job.options.phase_shifts,
+                    "Phase-shifted sinusoids per axis on top of the Gray code, 0 = off, else 3..16")
+        ->check(CLI::Range(0, 16));
+    cmd->add_option("--phase-period", job.options.phase_period_px, "Phase-shift period, projector pixels, 4..1024")
+        ->check(CLI::Range(4.0, 1024.0));
     bool no_colour = false;
     cmd->add_flag("--no-colour", no_colour, "Geometry only: no response, black-level and colour matching step");
     try {

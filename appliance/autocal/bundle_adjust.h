@@ -14,7 +14,8 @@
 // with X(camera, ray) = forward intersection of the camera ray with the cylinder; project_k the
 // pinhole x = fx X'/Z' + cx, y = fx * aspect Y'/Z' + cy (aspect fy/fx of the prior fixed, image
 // positions with pixel centres at +0.5, X' = R_k^T (X - position_k)); sigma_i per point and axis
-// (a decoded block of b pixels: b / sqrt(12), the uniform distribution's); s_k and sigma_e are the
+// (a decoded block of b pixels: b / sqrt(12), the uniform distribution's; a phase-refined position: its own,
+// phase_shift.h); s_k and sigma_e are the
 // measured residual rms of the previous round (maximum likelihood for Gaussian noise);
 // correspondences beyond 4x the median residual of their projector are dropped between rounds.
 #pragma once

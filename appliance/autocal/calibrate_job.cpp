@@ -158,6 +158,7 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
         {"knobs",
          {{"max_gray_bits", job.options.max_gray_bits},
           {"frames_per_pattern", job.options.frames_per_pattern},
+          {"phase_shifts", job.options.phase_shifts},
           {"warp_step_px", job.options.warp_step_px}}},
         // Wall seconds: the calibration's own compute (calibrate and the colour step, without the
         // rig's camera simulation, which a real camera replaces) and the simulation apart.
@@ -190,6 +191,9 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
              {"resolution", {r.projectors[k].resolution.width, r.projectors[k].resolution.height}},
              {"column_bits", p.column_bits},
              {"row_bits", p.row_bits},
+             {"lit_pixels", p.lit_pixels},
+             {"phase_refined", p.phase_refined},
+             {"noise_sigma", p.noise_sigma},
              {"correspondences", p.cells},
              {"reprojection_rms_px", p.rms_px},
              {"mean_view_angle_deg", p.mean_view_angle_deg},

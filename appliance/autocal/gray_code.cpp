@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
+
+#include "appliance/autocal/phase_shift.h"
 
 namespace mogao::autocal {
 
@@ -51,7 +54,7 @@ int decode_axis(PatternSource& source, int k, std::size_t projectors, ImageSize 
     for (int bit = 0; bit < n; ++bit) {
         std::vector<cv::Mat> signals(projectors);
         signals[static_cast<std::size_t>(k)] = gray_code_pattern(size, rows, bit, false);
-        const cv::Mat1f on = show_averaged(source, signals, frames);
+        const cv::Mat1f on = show_averaged(source, signals, frames).clone();  // the source may reuse its buffer
         signals[static_cast<std::size_t>(k)] = gray_code_pattern(size, rows, bit, true);
         const cv::Mat1f off = show_averaged(source, signals, frames);
         captures += 2 * frames;
@@ -94,57 +97,157 @@ int decode_axis(PatternSource& source, int k, std::size_t projectors, ImageSize 
 
 }  // namespace
 
+namespace {
+
+// Image noise sigma of a nearly flat image (the all-black capture): the robust form of Immerkaer's
+// estimator (Immerkaer 1996, "Fast noise variance estimation", CVIU 64(2)): the 3x3 mask
+// [1 -2 1; -2 4 -2; 1 -2 1] cancels any locally planar signal and scales white noise by 6; the median
+// absolute response (1.4826 MAD for a Gaussian) keeps the few edges of the image out.
+double flat_image_noise(const cv::Mat1f& img) {
+    if (img.rows < 3 || img.cols < 3) return 0.0;
+    std::vector<float> r;
+    r.reserve(static_cast<std::size_t>(img.rows - 2) * static_cast<std::size_t>(img.cols - 2));
+    for (int y = 1; y + 1 < img.rows; ++y) {
+        for (int x = 1; x + 1 < img.cols; ++x) {
+            const float v = img(y - 1, x - 1) - 2 * img(y - 1, x) + img(y - 1, x + 1) - 2 * img(y, x - 1) +
+                            4 * img(y, x) - 2 * img(y, x + 1) + img(y + 1, x - 1) - 2 * img(y + 1, x) +
+                            img(y + 1, x + 1);
+            r.push_back(std::abs(v));
+        }
+    }
+    std::nth_element(r.begin(), r.begin() + static_cast<long>(r.size() / 2), r.end());
+    return 1.4826 * r[r.size() / 2] / 6.0;
+}
+
+// One axis of phase-shifted sinusoids (phase_shift.h) for projector k: the unwrapped positions and
+// their sigma replace the Gray-code block centres where the block is at most half a period and the
+// modulation clears the noise. Returns the number of pixels refined.
+struct AxisCode {
+    cv::Mat1i code;   // Gray-decoded block index, -1 = not lit
+    cv::Mat1i depth;  // bits resolved
+    int extent_bits = 0;
+};
+
+struct AxisPosition {
+    cv::Mat1f position;  // projector image position, pixels
+    cv::Mat1f sigma;     // its uncertainty, pixels
+    cv::Mat1b refined;   // by the phase
+};
+
+AxisPosition gray_positions(const AxisCode& a) {
+    AxisPosition p{cv::Mat1f(a.code.size(), 0.0f), cv::Mat1f(a.code.size(), 0.0f), cv::Mat1b(a.code.size(), 0)};
+    for (int y = 0; y < a.code.rows; ++y) {
+        for (int x = 0; x < a.code.cols; ++x) {
+            if (a.code(y, x) < 0) continue;
+            const int block = 1 << (a.extent_bits - a.depth(y, x));
+            p.position(y, x) = static_cast<float>((a.code(y, x) + 0.5) * block);
+            p.sigma(y, x) = static_cast<float>(block / std::sqrt(12.0));  // uniform over the block
+        }
+    }
+    return p;
+}
+
+int refine_by_phase(PatternSource& source, int k, std::size_t projectors, ImageSize size, bool rows, const AxisCode& a,
+                    int resolved_bits, const cv::Mat1f& contrast, const AutocalOptions& o, AxisPosition& p,
+                    int& captures) {
+    const int n = o.phase_shifts;
+    // At least 4 of the finest blocks the axis resolved: pixels that stopped one bit early still unwrap (a noisy
+    // or blurred camera resolves fewer bits, and a longer period is also less attenuated by its blur).
+    const double period = std::max(o.phase_period_px, 8.0 * (1 << (a.extent_bits - resolved_bits)));
+    std::vector<cv::Mat1f> images;
+    std::vector<cv::Mat> signals(projectors);
+    for (int i = 0; i < n; ++i) {
+        signals[static_cast<std::size_t>(k)] = phase_shift_pattern(size, rows, period, n, i, o.phase_gamma);
+        images.push_back(show_averaged(source, signals, o.frames_per_pattern).clone());
+        captures += o.frames_per_pattern;
+    }
+    const PhaseImage phase = decode_phase(images, period);
+    const cv::Mat1b lit(a.code >= 0);
+    const double noise = phase_image_noise(images, lit);
+    const double sigma_phi_b = noise * std::sqrt(2.0 / n);  // sigma_phi * b
+    int refined = 0;
+    for (int y = 0; y < a.code.rows; ++y) {
+        for (int x = 0; x < a.code.cols; ++x) {
+            if (a.code(y, x) < 0) continue;
+            const int block = 1 << (a.extent_bits - a.depth(y, x));
+            const double b = phase.modulation(y, x);
+            // Unwrapping needs the Gray position within P/2; a modulation below a quarter of the
+            // contrast (a sinusoid washed out by blur or a bad gamma) or within 4 sigma of the noise
+            // is not trusted.
+            if (block > period / 2.0 || b < 0.25 * contrast(y, x) || b < 4.0 * sigma_phi_b) continue;
+            p.position(y, x) = static_cast<float>(unwrap_position(p.position(y, x), phase.position(y, x), period));
+            p.sigma(y, x) = static_cast<float>(
+                std::max(o.phase_sigma_floor_px, period / (2.0 * std::numbers::pi) * sigma_phi_b / b));
+            p.refined(y, x) = 1;
+            ++refined;
+        }
+    }
+    return refined;
+}
+
+}  // namespace
+
 Correspondences decode_projector(PatternSource& source, int k, const std::vector<ImageSize>& projectors,
                                  const AutocalOptions& options) {
     const ImageSize size = projectors.at(static_cast<std::size_t>(k));
     std::vector<cv::Mat> signals(projectors.size());
     signals[static_cast<std::size_t>(k)] = cv::Mat1f(size.height, size.width, 1.0f);
-    const cv::Mat1f white = show_averaged(source, signals, options.frames_per_pattern);
+    const cv::Mat1f white = show_averaged(source, signals, options.frames_per_pattern).clone();
     signals[static_cast<std::size_t>(k)] = cv::Mat();
-    const cv::Mat1f black = show_averaged(source, signals, options.frames_per_pattern);
+    const cv::Mat1f black = show_averaged(source, signals, options.frames_per_pattern).clone();
     Correspondences out;
     out.captures = 2 * options.frames_per_pattern;
     cv::Mat1f contrast;
     cv::subtract(white, black, contrast);
-    cv::Mat1i col(contrast.size(), -1);
+    // Shadow mask: white - black over min_contrast and over the noise of that difference
+    // (shadow_noise_sigmas times sqrt(2) sigma of one black image), so that a noisy camera's dark
+    // pixels do not pass as lit.
+    out.noise_sigma = flat_image_noise(black);
+    out.shadow_threshold =
+        std::max(options.min_contrast, options.shadow_noise_sigmas * std::sqrt(2.0) * out.noise_sigma);
+    AxisCode col{cv::Mat1i(contrast.size(), -1), cv::Mat1i(contrast.size(), 0), gray_code_bits(size.width)};
     for (int y = 0; y < contrast.rows; ++y) {
-        for (int x = 0; x < contrast.cols; ++x) col(y, x) = contrast(y, x) > options.min_contrast ? 0 : -1;
+        for (int x = 0; x < contrast.cols; ++x) col.code(y, x) = contrast(y, x) > out.shadow_threshold ? 0 : -1;
     }
-    cv::Mat1i row = col.clone();
-    cv::Mat1i col_depth(contrast.size(), 0);
-    cv::Mat1i row_depth(contrast.size(), 0);
-    out.lit_pixels = cv::countNonZero(col == 0);
+    AxisCode row{col.code.clone(), cv::Mat1i(contrast.size(), 0), gray_code_bits(size.height)};
+    out.lit_pixels = cv::countNonZero(col.code == 0);
     out.column_bits =
-        decode_axis(source, k, projectors.size(), size, false, contrast, options, col, col_depth, out.captures);
+        decode_axis(source, k, projectors.size(), size, false, contrast, options, col.code, col.depth, out.captures);
     out.row_bits =
-        decode_axis(source, k, projectors.size(), size, true, contrast, options, row, row_depth, out.captures);
+        decode_axis(source, k, projectors.size(), size, true, contrast, options, row.code, row.depth, out.captures);
     if (out.column_bits < options.min_bits || out.row_bits < options.min_bits) return out;
-    // One correspondence per decoded camera pixel with at least all but two of the resolved bits
-    // per axis: its centre <-> the centre of the projector block its code names, with the block's
-    // size (its uncertainty). A regular stride keeps at most `max_correspondences`.
-    const int nc = gray_code_bits(size.width);
-    const int nr = gray_code_bits(size.height);
+    AxisPosition px = gray_positions(col);
+    AxisPosition py = gray_positions(row);
+    if (options.phase_shifts > 0) {
+        out.phase_refined_columns = refine_by_phase(source, k, projectors.size(), size, false, col, out.column_bits,
+                                                    contrast, options, px, out.captures);
+        out.phase_refined_rows = refine_by_phase(source, k, projectors.size(), size, true, row, out.row_bits, contrast,
+                                                 options, py, out.captures);
+    }
+    // One correspondence per decoded camera pixel whose every axis is refined by the phase or has
+    // at least all but two of the resolved Gray bits: its centre <-> the projector position, with
+    // that position's uncertainty. A regular stride keeps at most `max_correspondences`.
     const auto usable = [&](int y, int x) {
-        return col(y, x) >= 0 && row(y, x) >= 0 && col_depth(y, x) >= std::max(1, out.column_bits - 2) &&
-               row_depth(y, x) >= std::max(1, out.row_bits - 2);
+        return col.code(y, x) >= 0 && row.code(y, x) >= 0 &&
+               (px.refined(y, x) || col.depth(y, x) >= std::max(1, out.column_bits - 2)) &&
+               (py.refined(y, x) || row.depth(y, x) >= std::max(1, out.row_bits - 2));
     };
     long valid = 0;
-    for (int y = 0; y < col.rows; ++y) {
-        for (int x = 0; x < col.cols; ++x) valid += usable(y, x);
+    for (int y = 0; y < contrast.rows; ++y) {
+        for (int x = 0; x < contrast.cols; ++x) valid += usable(y, x);
     }
     const long stride = std::max<long>(1, (valid + options.max_correspondences - 1) / options.max_correspondences);
     long seen = 0;
-    for (int y = 0; y < col.rows; ++y) {
-        for (int x = 0; x < col.cols; ++x) {
+    for (int y = 0; y < contrast.rows; ++y) {
+        for (int x = 0; x < contrast.cols; ++x) {
             if (!usable(y, x) || seen++ % stride != 0) continue;
-            const int cw = 1 << (nc - col_depth(y, x));
-            const int ch = 1 << (nr - row_depth(y, x));
-            const double px = (col(y, x) + 0.5) * cw;
-            const double py = (row(y, x) + 0.5) * ch;
-            if (px >= size.width || py >= size.height) continue;  // codes past the image: decoding errors
+            const double x_p = px.position(y, x);
+            const double y_p = py.position(y, x);
+            // Codes past the image are decoding errors.
+            if (!(x_p >= 0.0 && x_p < size.width && y_p >= 0.0 && y_p < size.height)) continue;
             out.camera.emplace_back(x + 0.5, y + 0.5);
-            out.projector.emplace_back(px, py);
-            out.block.emplace_back(cw, ch);
+            out.projector.emplace_back(x_p, y_p);
+            out.sigma.emplace_back(px.sigma(y, x), py.sigma(y, x));
         }
     }
     return out;

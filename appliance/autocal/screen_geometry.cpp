@@ -202,7 +202,7 @@ EdgeFit fit_camera_pose(const cv::Mat1f& lit, const CalibrationPrior& prior, con
 
 ProjectorFit fit_projector(const DeviceModel& camera, const CalibrationPrior& prior, int k,
                            const std::vector<cv::Point2d>& camera_points,
-                           const std::vector<cv::Point2d>& projector_points, const std::vector<cv::Point2d>& blocks,
+                           const std::vector<cv::Point2d>& projector_points, const std::vector<cv::Point2d>& sigmas,
                            const AutocalOptions& options) {
     const DeviceModel& guess = prior.projectors.at(static_cast<std::size_t>(k));
     const std::string who = "projector " + std::to_string(k) + " '" + guess.id + "'";
@@ -252,7 +252,7 @@ ProjectorFit fit_projector(const DeviceModel& camera, const CalibrationPrior& pr
         if (!cylinder_hit(prior.screen, camera.position_m, camera.rotation * rays[i])) continue;
         obs.rays.push_back(rays[i]);
         obs.projector.emplace_back(projector_points[i].x, projector_points[i].y);
-        obs.sigma_px.emplace_back(blocks[i].x / std::sqrt(12.0), blocks[i].y / std::sqrt(12.0));
+        obs.sigma_px.emplace_back(sigmas[i].x, sigmas[i].y);
     }
     BundleOptions bo;
     bo.refine_camera = false;
@@ -263,7 +263,7 @@ ProjectorFit fit_projector(const DeviceModel& camera, const CalibrationPrior& pr
     fit.observations = std::move(obs);
     if (fit.rms_sigma > options.max_projector_rms) {
         throw CalibrationRefused(who + ": fit rms " + fmt(fit.rms_sigma) +
-                                 " (in units of the decoded blocks' uncertainty, 1 = as good as the decoding) above "
+                                 " (in units of the decoded positions' uncertainty, 1 = as good as the decoding) above "
                                  "its gate " +
                                  fmt(options.max_projector_rms) + " (" + fmt(fit.rms_px) +
                                  " px: decoding errors, or the screen is not the cylinder in the prior)");

@@ -48,6 +48,6 @@ struct ProjectorFit {
 [[nodiscard]] ProjectorFit fit_projector(const DeviceModel& camera, const CalibrationPrior& prior, int k,
                                          const std::vector<cv::Point2d>& camera_points,
                                          const std::vector<cv::Point2d>& projector_points,
-                                         const std::vector<cv::Point2d>& blocks, const AutocalOptions& options);
+                                         const std::vector<cv::Point2d>& sigmas, const AutocalOptions& options);
 
 }  // namespace mogao::autocal

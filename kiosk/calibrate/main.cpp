@@ -88,7 +88,7 @@ int run_rig(const Cli& cli, autocal::CalibrateJob job) {
 
 int run_budget(const Cli& cli, const OnSiteJob& job) {
     const autocal::CalibrationPrior prior = site_prior(job);
-    const PatternBudget b = pattern_budget(prior, job.colour, job.colour_options);
+    const PatternBudget b = pattern_budget(prior, job.colour, job.colour_options, job.options);
     const double each = seconds_per_image(cli.budget_fps, job.timing.settle_ms, job.timing.drop_frames);
     std::printf(
         "%zu projectors: %d images (identification %d, geometry at most %d, colour %d); at %.0f fps, settle "

@@ -212,7 +212,7 @@ nlohmann::json run_on_site(const OnSiteJob& job, OutputBackend& outputs, Calibra
     }
     auto display = PatternDisplay::create(outputs, job.flip_timeout_ms);
     if (!display) throw std::runtime_error(display.error().message);
-    const PatternBudget budget = pattern_budget(prior, job.colour, job.colour_options);
+    const PatternBudget budget = pattern_budget(prior, job.colour, job.colour_options, job.options);
     std::vector<std::size_t> order(prior.projectors.size());
     for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
     HardwarePatternSource source(display.value(), camera, order, prior.camera.resolution, job.transfer, job.timing,

@@ -2,18 +2,24 @@
 // Captured image count and capture time of the on-site calibration (pattern_budget.h).
 #include "kiosk/calibrate/pattern_budget.h"
 
+#include <algorithm>
+
 namespace mogao::calibrate {
 
 PatternBudget pattern_budget(const autocal::CalibrationPrior& prior, bool colour,
-                             const autocal::ColourOptions& colour_options) {
+                             const autocal::ColourOptions& colour_options, const autocal::AutocalOptions& options) {
     const int n = static_cast<int>(prior.projectors.size());
+    const auto bits = [&](int extent) {
+        const int all = autocal::gray_code_bits(extent);
+        return options.max_gray_bits > 0 ? std::min(all, options.max_gray_bits) : all;
+    };
     PatternBudget b;
     b.identification = 2 + n;
     b.geometry = 2;
     for (const autocal::DeviceModel& p : prior.projectors) {
-        b.geometry +=
-            2 + 2 * (autocal::gray_code_bits(p.resolution.width) + autocal::gray_code_bits(p.resolution.height));
+        b.geometry += 2 + 2 * (bits(p.resolution.width) + bits(p.resolution.height)) + 2 * options.phase_shifts;
     }
+    b.geometry *= options.frames_per_pattern;
     if (colour) {
         const int steps = colour_options.ramp_steps;
         int low = 2;

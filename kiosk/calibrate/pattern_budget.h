@@ -4,13 +4,12 @@
 //
 // Count (an upper bound: the Gray code stops at the first bit the camera cannot resolve,
 // appliance/autocal/gray_code.h): identification 2 + N (all black, all white, then each output white alone,
-// connector_identity.h); geometry 2 + sum_k (2 + 2 * (bits(width_k) + bits(height_k))) (black
-// and white of all, per projector white and black, each Gray bit and its inverse per axis;
-// bits(n) = gray_code_bits); colour 5 + N * 3 * ((ramp_steps - 1) + low) + dark_frames, low = 2 +
-// the ramp levels in (0, 1/4] other than 1/32 and 1/16 (appliance/autocal/colour_calibration.h,
-// step 1's low end).
-// Time per image = settle + (drop_frames + 1) / camera fps + exposure (the flip itself is within
-// one refresh, part of the settle).
+// connector_identity.h); geometry F * (2 + sum_k (2 + 2 * (bits(width_k) + bits(height_k)) + 2 * S)) (black
+// and white of all, per projector white and black, each Gray bit and its inverse per axis, S phase
+// shifts per axis; bits(n) = gray_code_bits, at most max_gray_bits; F frames_per_pattern); colour 5 + N * 3 *
+// ((ramp_steps - 1) + low) + dark_frames, low = 2 + the ramp levels in (0, 1/4] other than 1/32 and 1/16
+// (appliance/autocal/colour_calibration.h, step 1's low end). Time per image = settle + (drop_frames + 1) / camera fps
+// + exposure (the flip itself is within one refresh, part of the settle).
 #pragma once
 
 #include "appliance/autocal/autocal.h"
@@ -26,7 +25,8 @@ struct PatternBudget {
 };
 
 [[nodiscard]] PatternBudget pattern_budget(const autocal::CalibrationPrior& prior, bool colour,
-                                           const autocal::ColourOptions& colour_options);
+                                           const autocal::ColourOptions& colour_options,
+                                           const autocal::AutocalOptions& options);
 
 // Seconds to capture one image: settle_ms / 1000 + (drop_frames + 1) / fps. fps > 0.
 [[nodiscard]] double seconds_per_image(double fps, int settle_ms, int drop_frames);
