@@ -193,8 +193,12 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
                                      " row bits resolved (need >= " + std::to_string(options.min_bits) + "; " +
                                      std::to_string(c.lit_pixels) + " camera pixels lit)");
         }
+        // With the screen still to be fitted, a projector's fit on the prior's cylinder is only a start: its gate
+        // is applied after the bundle adjustment instead.
+        AutocalOptions start_options = options;
+        if (options.fit_screen) start_options.max_projector_rms = std::numeric_limits<double>::infinity();
         ProjectorFit fit =
-            fit_projector(edge.camera, prior, static_cast<int>(k), c.camera, c.projector, c.sigma, options);
+            fit_projector(edge.camera, prior, static_cast<int>(k), c.camera, c.projector, c.sigma, start_options);
         pr.rms_px = fit.rms_px;
         pr.mean_view_angle_deg = fit.mean_view_angle_deg;
         result.projectors.push_back(fit.model);
@@ -202,7 +206,10 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
         observations.push_back(std::move(fit.observations));
     }
     // Step 4: camera pose and projector models refined together on every observation.
-    const BundleResult ba = bundle_adjust(prior.screen, edge.camera, result.projectors, edge.edges, observations);
+    BundleOptions bo;
+    bo.refine_screen = options.fit_screen;
+    const BundleResult ba = bundle_adjust(prior.screen, edge.camera, result.projectors, edge.edges, observations, bo);
+    result.screen = ba.screen;
     result.camera = ba.camera;
     result.projectors = ba.projectors;
     result.report.camera_position_m = ba.camera.position_m;
@@ -210,8 +217,17 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
     for (std::size_t k = 0; k < n; ++k) {
         result.report.projectors[k].rms_px = ba.rms_px[k];
         result.report.projectors[k].cells = ba.inliers[k];
+        if (options.fit_screen && ba.rms_sigma[k] > options.max_projector_rms) {
+            throw CalibrationRefused("projector " + std::to_string(k) + " '" + prior.projectors[k].id +
+                                     "': fit rms " + std::to_string(ba.rms_sigma[k]) +
+                                     " (in units of the decoded positions' uncertainty) above its gate " +
+                                     std::to_string(options.max_projector_rms) +
+                                     " after fitting the screen (radius " + std::to_string(ba.screen.radius_m) +
+                                     " m, arc " + std::to_string(ba.screen.arc_deg) +
+                                     " deg): the screen is not a cylinder of the prior's heights?");
+        }
     }
-    result.calibration = calibration_from_models(result.projectors, prior.screen, content, options);
+    result.calibration = calibration_from_models(result.projectors, result.screen, content, options);
     return result;
 }
 

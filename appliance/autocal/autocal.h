@@ -116,6 +116,9 @@ struct AutocalOptions {
     double max_edge_rms_m = 0.01;      // camera pose fit gate
     double max_projector_rms = 3.0;    // projector fit gate, rms in units of the decoding uncertainty, > 0
     double max_view_angle_deg = 75.0;  // camera rays steeper than this to the screen normal: grazing
+    // Fit the cylinder's radius and arc in the bundle adjustment (bundle_adjust.h, refine_screen) when the prior's
+    // are known only roughly; the heights stay as measured. The fitted screen is AutocalResult::screen.
+    bool fit_screen = false;
 };
 
 // Shows one signal image per projector (CV_32FC1 grey or CV_32FC3 RGB in [0, 1], projector
@@ -169,6 +172,7 @@ struct AutocalReport {
 };
 
 struct AutocalResult {
+    ScreenModel screen;  // the prior's, or the fitted one with AutocalOptions::fit_screen
     ScreenCalibration calibration;
     DeviceModel camera;                   // fitted pose
     std::vector<DeviceModel> projectors;  // fitted models

@@ -37,6 +37,8 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(0, 16));
     cmd->add_option("--phase-period", job.options.phase_period_px, "Phase-shift period, projector pixels, 4..1024")
         ->check(CLI::Range(4.0, 1024.0));
+    cmd->add_flag("--fit-screen", job.options.fit_screen,
+                  "Fit the screen's radius and arc too (known only roughly; the heights are taken as measured)");
     bool no_colour = false;
     cmd->add_flag("--no-colour", no_colour, "Geometry only: no response, black-level and colour matching step");
     try {

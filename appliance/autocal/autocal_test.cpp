@@ -174,5 +174,27 @@ TEST(Autocal, NoisyRigMeetsTheGoalsWithPhaseShiftAndTheNoiseAwareMask) {
     EXPECT_GT(g0.p95_px, 1.5 * g.p95_px);  // the phase pays
 }
 
+// A screen known only roughly (told 3.1 m and 147 degrees, truly 3.0 m and 150): on the prior's cylinder the
+// projector fits are refused (the screen is not the cylinder in the prior); fitting the radius and arc in the
+// bundle adjustment finds the true screen and meets the standard rig's goals against the rig's ground truth.
+TEST(Autocal, RoughlyKnownScreenIsRefusedUnlessItIsFitted) {
+    const rig::VirtualRig rig = scaled_rig(load("roughscreen"), 0.5, 0.5);
+    const CalibrationPrior prior = prior_from_rig(rig);
+    ASSERT_NEAR(prior.screen.radius_m, 3.1, 1e-12);
+    RigPatternSource plain_source(rig);
+    EXPECT_THROW((void)calibrate(plain_source, prior, {1920, 1080}), CalibrationRefused);
+    AutocalOptions o;
+    o.fit_screen = true;
+    RigPatternSource source(rig);
+    const AutocalResult r = calibrate(source, prior, {1920, 1080}, o);
+    const GeometryError g = measure_geometry(rig, r.calibration, 4);
+    std::printf("fitted screen: radius %.4f m, arc %.3f deg; geometry mean %.3f p95 %.3f px\n", r.screen.radius_m,
+                r.screen.arc_deg, g.mean_px, g.p95_px);
+    EXPECT_NEAR(r.screen.radius_m, rig.screen.radius_m, 0.01);
+    EXPECT_NEAR(r.screen.arc_deg, rig.screen.arc_deg, 0.1);
+    EXPECT_LE(g.mean_px, 0.3);
+    EXPECT_LE(g.p95_px, 0.8);
+}
+
 }  // namespace
 }  // namespace mogao::autocal

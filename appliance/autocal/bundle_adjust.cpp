@@ -18,6 +18,7 @@ namespace {
 
 constexpr int kCam = 6;   // camera: position offset (3), rotation vector (3)
 constexpr int kProj = 9;  // projector: fx, cx, cy, rotation vector (3), position offset (3)
+constexpr int kScreen = 2;  // screen (last, when refined): radius offset (m), arc offset (rad)
 
 Eigen::Matrix3d rotation_of(const Eigen::Vector3d& w) {
     const double a = w.norm();
@@ -43,9 +44,20 @@ DeviceModel projector_at(const DeviceModel& p0, const double* q) {
     return p;
 }
 
-// Residuals of one block: the edges (block -1) or projector k's inlier correspondences.
+// The screen the parameters describe: the prior's, with the radius and arc offsets when refined.
+ScreenModel screen_at(const ScreenModel& s0, const double* qs) {
+    ScreenModel s = s0;
+    if (qs != nullptr) {
+        s.radius_m = s0.radius_m + qs[0];
+        s.arc_deg = s0.arc_deg + qs[1] * 180.0 / std::numbers::pi;
+    }
+    return s;
+}
+
+// Residuals of one block: the edges (block -1) or projector k's inlier correspondences. `qs` is the
+// screen's parameters (nullptr: the prior's screen, fixed).
 struct Problem {
-    const ScreenModel& screen;
+    const ScreenModel& screen0;
     const DeviceModel& camera0;
     const std::vector<DeviceModel>& projectors0;
     const std::vector<EdgeObservation>& edges;
@@ -53,8 +65,15 @@ struct Problem {
     std::vector<std::vector<int>> inliers;  // per projector, indices into obs[k]
     std::vector<double> sigma_px;
     double sigma_m = 0.005;
+    bool refine_screen = false;
+    Eigen::Index screen_index = 0;  // first screen parameter in q
 
-    [[nodiscard]] Eigen::VectorXd edge_residuals(const double* qc) const {
+    [[nodiscard]] const double* screen_params(const Eigen::VectorXd& q) const {
+        return refine_screen ? q.data() + screen_index : nullptr;
+    }
+
+    [[nodiscard]] Eigen::VectorXd edge_residuals(const double* qc, const double* qs) const {
+        const ScreenModel screen = screen_at(screen0, qs);
         const DeviceModel c = camera_at(camera0, qc);
         const double half = screen.arc_deg * std::numbers::pi / 360.0;
         Eigen::VectorXd r(static_cast<Eigen::Index>(edges.size()));
@@ -81,7 +100,9 @@ struct Problem {
         return r;
     }
 
-    [[nodiscard]] Eigen::VectorXd projector_residuals(std::size_t k, const double* qc, const double* qp) const {
+    [[nodiscard]] Eigen::VectorXd projector_residuals(std::size_t k, const double* qc, const double* qp,
+                                                      const double* qs) const {
+        const ScreenModel screen = screen_at(screen0, qs);
         const DeviceModel c = camera_at(camera0, qc);
         const DeviceModel p = projector_at(projectors0[k], qp);
         const Eigen::Matrix3d rt = p.rotation.transpose();
@@ -111,9 +132,9 @@ double step_of(int j) {  // forward-difference steps: pixels for intrinsics, met
 void accumulate(const Problem& pb, const Eigen::VectorXd& q, int block, bool refine_camera, Eigen::MatrixXd& jtj,
                 Eigen::VectorXd& jtr, double& cost) {
     const auto eval = [&](const Eigen::VectorXd& v) {
-        return block < 0
-                   ? pb.edge_residuals(v.data())
-                   : pb.projector_residuals(static_cast<std::size_t>(block), v.data(), v.data() + kCam + kProj * block);
+        return block < 0 ? pb.edge_residuals(v.data(), pb.screen_params(v))
+                         : pb.projector_residuals(static_cast<std::size_t>(block), v.data(),
+                                                  v.data() + kCam + kProj * block, pb.screen_params(v));
     };
     const Eigen::VectorXd r0 = eval(q);
     cost += r0.squaredNorm();
@@ -124,11 +145,14 @@ void accumulate(const Problem& pb, const Eigen::VectorXd& q, int block, bool ref
     if (block >= 0) {
         for (int j = 0; j < kProj; ++j) cols.push_back(kCam + kProj * block + j);
     }
+    if (pb.refine_screen) {
+        for (int j = 0; j < kScreen; ++j) cols.push_back(static_cast<int>(pb.screen_index) + j);
+    }
     Eigen::MatrixXd jac(r0.size(), static_cast<Eigen::Index>(cols.size()));
     for (std::size_t c = 0; c < cols.size(); ++c) {
         Eigen::VectorXd v = q;
         const int idx = cols[c];
-        const double h = idx < kCam ? 1e-8 : step_of(idx - kCam - kProj * block);
+        const double h = idx < kCam || idx >= pb.screen_index ? 1e-8 : step_of(idx - kCam - kProj * block);
         v[idx] += h;
         jac.col(static_cast<Eigen::Index>(c)) = (eval(v) - r0) / h;
     }
@@ -143,9 +167,10 @@ void accumulate(const Problem& pb, const Eigen::VectorXd& q, int block, bool ref
 }
 
 double total_cost(const Problem& pb, const Eigen::VectorXd& q, bool refine_camera) {
-    double cost = refine_camera ? pb.edge_residuals(q.data()).squaredNorm() : 0.0;
+    double cost = refine_camera ? pb.edge_residuals(q.data(), pb.screen_params(q)).squaredNorm() : 0.0;
     for (std::size_t k = 0; k < pb.obs.size(); ++k) {
-        cost += pb.projector_residuals(k, q.data(), q.data() + kCam + kProj * static_cast<int>(k)).squaredNorm();
+        cost += pb.projector_residuals(k, q.data(), q.data() + kCam + kProj * static_cast<int>(k), pb.screen_params(q))
+                    .squaredNorm();
     }
     return cost;
 }
@@ -194,7 +219,10 @@ BundleResult bundle_adjust(const ScreenModel& screen, const DeviceModel& camera,
     }
     const std::size_t n = projectors.size();
     Problem pb{screen, camera, projectors, edges, observations, {}, std::vector<double>(n, 1.0), 0.005};
-    Eigen::VectorXd q = Eigen::VectorXd::Zero(kCam + kProj * static_cast<Eigen::Index>(n));
+    // The screen needs the edges (its ends and heights) and the camera refined with it.
+    pb.refine_screen = options.refine_screen && options.refine_camera && !edges.empty();
+    pb.screen_index = kCam + kProj * static_cast<Eigen::Index>(n);
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(pb.screen_index + (pb.refine_screen ? kScreen : 0));
     for (std::size_t k = 0; k < n; ++k) {
         const ProjectorObservations& o = observations[k];
         if (o.rays.size() != o.projector.size() || o.rays.size() < 10) {
@@ -217,7 +245,8 @@ BundleResult bundle_adjust(const ScreenModel& screen, const DeviceModel& camera,
         // Re-weight from the current residuals (sigma = rms), then drop outliers (> 4x the median).
         for (std::size_t k = 0; k < n; ++k) {
             const double old_sigma = pb.sigma_px[k];
-            const Eigen::VectorXd r = pb.projector_residuals(k, q.data(), q.data() + kCam + kProj * k) * old_sigma;
+            const Eigen::VectorXd r =
+                pb.projector_residuals(k, q.data(), q.data() + kCam + kProj * k, pb.screen_params(q)) * old_sigma;
             std::vector<double> err(pb.inliers[k].size());
             for (std::size_t u = 0; u < err.size(); ++u) err[u] = r.segment<2>(2 * static_cast<Eigen::Index>(u)).norm();
             std::vector<double> sorted = err;
@@ -244,7 +273,7 @@ BundleResult bundle_adjust(const ScreenModel& screen, const DeviceModel& camera,
             pb.sigma_px[k] = std::max(out.rms_sigma[k], 1e-3);
         }
         if (refine_camera) {
-            out.edge_rms_m = pb.sigma_m * pb.edge_residuals(q.data()).norm() /
+            out.edge_rms_m = pb.sigma_m * pb.edge_residuals(q.data(), pb.screen_params(q)).norm() /
                              std::sqrt(std::max<double>(1.0, static_cast<double>(edges.size())));
             pb.sigma_m = std::max(out.edge_rms_m, 1e-5);
         }
@@ -252,6 +281,7 @@ BundleResult bundle_adjust(const ScreenModel& screen, const DeviceModel& camera,
         levenberg_marquardt(pb, q, refine_camera, options.max_iterations);
     }
     out.camera = camera_at(camera, q.data());
+    out.screen = screen_at(screen, pb.screen_params(q));
     for (std::size_t k = 0; k < n; ++k)
         out.projectors.push_back(projector_at(projectors[k], q.data() + kCam + kProj * k));
     return out;

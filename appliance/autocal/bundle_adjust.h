@@ -46,11 +46,16 @@ struct ProjectorObservations {
 
 struct BundleOptions {
     bool refine_camera = true;  // false: the camera pose stays, only projectors move (edges unused)
+    // The cylinder's radius and arc too (with the camera; the heights bottom_m / top_m stay as measured and fix
+    // the scale): for a screen whose radius and arc are known only roughly. The 3D points follow the fitted
+    // cylinder; its curvature is seen through the camera-projector baselines, its ends through the edges.
+    bool refine_screen = false;
     int rounds = 2;             // LM runs, outliers dropped between them
     int max_iterations = 40;    // LM iterations per round
 };
 
 struct BundleResult {
+    ScreenModel screen;  // the fitted screen (the given one unless refine_screen)
     DeviceModel camera;
     std::vector<DeviceModel> projectors;
     std::vector<double> rms_px;     // per projector, correspondence residual of the last round (inliers), px

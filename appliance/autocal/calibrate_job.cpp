@@ -143,7 +143,7 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
     if (job.colour) {
         seams_before = seam_figures(rig, r.calibration);
         const auto t1 = std::chrono::steady_clock::now();
-        colour = calibrate_colour(source, prior.screen, r.projectors, r.calibration, job.colour_options);  // throws
+        colour = calibrate_colour(source, r.screen, r.projectors, r.calibration, job.colour_options);  // throws
         calibrate_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
     }
     const GeometryError g = measure_geometry(rig, r.calibration, 4);
@@ -167,7 +167,13 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
           {"simulate_s", source.simulate_s()},
           {"calibrate_wall_s", calibrate_s}}},
         {"camera", {{"edge_points", r.report.edge_points}, {"edge_rms_mm", r.report.edge_rms_m * 1e3}}},
-        {"predicted", {{"seam_weight_sum_max_deviation", predicted_seam(r, prior.screen)}}},
+        {"screen",
+         {{"fitted", job.options.fit_screen},
+          {"radius_m", r.screen.radius_m},
+          {"arc_deg", r.screen.arc_deg},
+          {"prior_radius_m", prior.screen.radius_m},
+          {"prior_arc_deg", prior.screen.arc_deg}}},
+        {"predicted", {{"seam_weight_sum_max_deviation", predicted_seam(r, r.screen)}}},
         {"ground_truth",
          {{"geometry_mean_px", g.mean_px},
           {"geometry_p95_px", g.p95_px},
@@ -205,7 +211,7 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
     mo.write_response = job.colour;
     // The fitted models first, so that whoever sees the new MPCDI (the kiosk's watcher) finds its models.
     write_models(models_path_for(job.out / "calibration.mpcdi"),
-                 CalibrationModels{prior.screen, r.camera, r.projectors});
+                 CalibrationModels{r.screen, r.camera, r.projectors});
     write_mpcdi(job.out / "calibration.mpcdi", to_mpcdi(r.calibration, mo));
     const std::filesystem::path png = job.out / "preview.png";
     if (!cv::imwrite(png.string(), preview(rig, r.calibration, 960))) {

@@ -42,9 +42,10 @@ rig::VirtualRig scaled_rig(const rig::VirtualRig& rig, double projector_scale, d
 
 CalibrationPrior prior_from_rig(const rig::VirtualRig& rig) {
     CalibrationPrior prior;
-    prior.screen = {rig.screen.radius_m, rig.screen.arc_deg, rig.screen.bottom_m, rig.screen.top_m};
-    const rig::RigCamera& c = rig.camera;
     const rig::RigPrior& e = rig.prior;
+    prior.screen = {rig.screen.radius_m + e.screen_radius_error_m, rig.screen.arc_deg + e.screen_arc_error_deg,
+                    rig.screen.bottom_m, rig.screen.top_m};
+    const rig::RigCamera& c = rig.camera;
     rig::RigPose pose = c.pose;
     pose.position_m += e.camera_position_error_m;
     pose.yaw_deg += e.camera_angle_error_deg.x();

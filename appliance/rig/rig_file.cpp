@@ -182,6 +182,8 @@ VirtualRig read_root(const toml::value& root, const std::string& file) {
         rig.prior.camera_angle_error_deg = t.vector3("camera_angle_error_deg", rig.prior.camera_angle_error_deg);
         rig.prior.camera_focal_error = t.number("camera_focal_error", 0.0);
         rig.prior.projector_focal_error = t.number("projector_focal_error", 0.0);
+        rig.prior.screen_radius_error_m = t.number("screen_radius_error_m", 0.0);
+        rig.prior.screen_arc_error_deg = t.number("screen_arc_error_deg", 0.0);
         t.finish();
     }
     const toml::value* ps = top.find("projectors");

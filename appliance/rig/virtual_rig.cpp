@@ -106,6 +106,10 @@ void validate_rig(const VirtualRig& rig) {
     check_range(c.blur_sigma_px, 0.0, 20.0, "camera.blur_sigma_px");
     check(c.bits >= 1 && c.bits <= 16, "camera.bits", "1..16");
     check(c.supersample >= 1 && c.supersample <= 4, "camera.supersample", "1..4");
+    // The screen as the calibration is told it must still be a screen.
+    check_range(rig.prior.screen_radius_error_m, -0.5 * s.radius_m, 0.5 * s.radius_m, "prior.screen_radius_error_m");
+    check_range(rig.prior.screen_arc_error_deg, -0.5 * s.arc_deg, std::min(0.5 * s.arc_deg, 360.0 - s.arc_deg),
+                "prior.screen_arc_error_deg");
 }
 
 Eigen::Matrix3d device_to_screen(const RigPose& pose) {

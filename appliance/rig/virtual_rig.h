@@ -104,6 +104,8 @@ struct RigPrior {
     Eigen::Vector3d camera_angle_error_deg{0.0, 0.0, 0.0};  // yaw, pitch, roll
     double camera_focal_error = 0.0;                        // relative error of fx, fy
     double projector_focal_error = 0.0;                     // relative error of the projectors' fx, fy
+    double screen_radius_error_m = 0.0;                     // the screen's radius as the installer was told it
+    double screen_arc_error_deg = 0.0;                      // and its arc (the heights are measured: no error)
 };
 
 struct VirtualRig {

@@ -186,7 +186,7 @@ nlohmann::json finish(const OnSiteJob& job, const Identified& id, const autocal:
     report["cabling_changes"] = cabling_changes(previous_connectors(job.out / "report.json"), report["connectors"]);
     for (std::size_t k = 0; k < r.projectors.size(); ++k) report["projectors"].push_back(fit_json(r, k));
     if (colour) report["colour"] = colour_json(*colour);
-    const autocal::CalibrationModels models{prior.screen, r.camera, r.projectors};
+    const autocal::CalibrationModels models{r.screen, r.camera, r.projectors};
     write_calibration(job.out / "calibration.mpcdi", models, r.calibration, job);
     if (!job.install.empty()) write_calibration(job.install, models, r.calibration, job);
     write_camera_png(job.out / "camera-white.png", id.white);
@@ -227,7 +227,7 @@ nlohmann::json run_on_site(const OnSiteJob& job, OutputBackend& outputs, Calibra
         source.set_projector_output(id->projector_output);
         r = autocal::calibrate(source, prior, job.content, job.options);
         if (job.colour) {
-            colour = autocal::calibrate_colour(source, prior.screen, r->projectors, r->calibration, job.colour_options);
+            colour = autocal::calibrate_colour(source, r->screen, r->projectors, r->calibration, job.colour_options);
         }
     } catch (...) {
         (void)display.value().show_outputs(dark);  // refused or failed: the wall goes dark, not a stripe pattern
