@@ -218,13 +218,12 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
         result.report.projectors[k].rms_px = ba.rms_px[k];
         result.report.projectors[k].cells = ba.inliers[k];
         if (options.fit_screen && ba.rms_sigma[k] > options.max_projector_rms) {
-            throw CalibrationRefused("projector " + std::to_string(k) + " '" + prior.projectors[k].id +
-                                     "': fit rms " + std::to_string(ba.rms_sigma[k]) +
-                                     " (in units of the decoded positions' uncertainty) above its gate " +
-                                     std::to_string(options.max_projector_rms) +
-                                     " after fitting the screen (radius " + std::to_string(ba.screen.radius_m) +
-                                     " m, arc " + std::to_string(ba.screen.arc_deg) +
-                                     " deg): the screen is not a cylinder of the prior's heights?");
+            throw CalibrationRefused(
+                "projector " + std::to_string(k) + " '" + prior.projectors[k].id + "': fit rms " +
+                std::to_string(ba.rms_sigma[k]) + " (in units of the decoded positions' uncertainty) above its gate " +
+                std::to_string(options.max_projector_rms) + " after fitting the screen (radius " +
+                std::to_string(ba.screen.radius_m) + " m, arc " + std::to_string(ba.screen.arc_deg) +
+                " deg): the screen is not a cylinder of the prior's heights?");
         }
     }
     result.calibration = calibration_from_models(result.projectors, result.screen, content, options);

@@ -16,8 +16,8 @@
 namespace mogao::autocal {
 namespace {
 
-constexpr int kCam = 6;   // camera: position offset (3), rotation vector (3)
-constexpr int kProj = 9;  // projector: fx, cx, cy, rotation vector (3), position offset (3)
+constexpr int kCam = 6;     // camera: position offset (3), rotation vector (3)
+constexpr int kProj = 9;    // projector: fx, cx, cy, rotation vector (3), position offset (3)
 constexpr int kScreen = 2;  // screen (last, when refined): radius offset (m), arc offset (rad)
 
 Eigen::Matrix3d rotation_of(const Eigen::Vector3d& w) {

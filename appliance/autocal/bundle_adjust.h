@@ -50,8 +50,8 @@ struct BundleOptions {
     // the scale): for a screen whose radius and arc are known only roughly. The 3D points follow the fitted
     // cylinder; its curvature is seen through the camera-projector baselines, its ends through the edges.
     bool refine_screen = false;
-    int rounds = 2;             // LM runs, outliers dropped between them
-    int max_iterations = 40;    // LM iterations per round
+    int rounds = 2;           // LM runs, outliers dropped between them
+    int max_iterations = 40;  // LM iterations per round
 };
 
 struct BundleResult {

@@ -210,8 +210,7 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
     mo.alpha_bit_depth = job.alpha_bits;
     mo.write_response = job.colour;
     // The fitted models first, so that whoever sees the new MPCDI (the kiosk's watcher) finds its models.
-    write_models(models_path_for(job.out / "calibration.mpcdi"),
-                 CalibrationModels{r.screen, r.camera, r.projectors});
+    write_models(models_path_for(job.out / "calibration.mpcdi"), CalibrationModels{r.screen, r.camera, r.projectors});
     write_mpcdi(job.out / "calibration.mpcdi", to_mpcdi(r.calibration, mo));
     const std::filesystem::path png = job.out / "preview.png";
     if (!cv::imwrite(png.string(), preview(rig, r.calibration, 960))) {

@@ -42,9 +42,24 @@ namespace {
 // its contrast. For the reflected Gray code that bit changes at the middle of the pixel's block of `depth` bits, so the
 // block's centre is where the pixel is (Inokuchi et al. 1984; the same property makes Gray code robust at stripe
 // edges). Pixels below `shadow` contrast stay at -1.
+// Temporal noise of one camera image (camera units) from a pattern and its inverse: their light adds up to white
+// plus black, so (on + off) - (white + black) over the lit pixels is the noise of four images (1.4826 MAD / 2).
+double pair_noise(const cv::Mat1f& on, const cv::Mat1f& off, const cv::Mat1f& white_plus_black, const cv::Mat1i& code) {
+    std::vector<float> dev;
+    for (int y = 0; y < on.rows; ++y) {
+        for (int x = 0; x < on.cols; ++x) {
+            if (code(y, x) >= 0) dev.push_back(std::abs(on(y, x) + off(y, x) - white_plus_black(y, x)));
+        }
+    }
+    if (dev.empty()) return 0.0;
+    std::nth_element(dev.begin(), dev.begin() + static_cast<long>(dev.size() / 2), dev.end());
+    return 1.4826 * dev[dev.size() / 2] / 2.0;
+}
+
+// `noise`: set from the first pattern pair (pair_noise).
 int decode_axis(PatternSource& source, int k, std::size_t projectors, ImageSize size, bool rows,
-                const cv::Mat1f& contrast, const AutocalOptions& options, cv::Mat1i& code, cv::Mat1i& depth,
-                int& captures) {
+                const cv::Mat1f& contrast, const cv::Mat1f& white_plus_black, const AutocalOptions& options,
+                cv::Mat1i& code, cv::Mat1i& depth, double& noise, int& captures) {
     const int all = gray_code_bits(rows ? size.height : size.width);
     const int n = options.max_gray_bits > 0 ? std::min(all, options.max_gray_bits) : all;
     const int frames = options.frames_per_pattern;
@@ -58,6 +73,7 @@ int decode_axis(PatternSource& source, int k, std::size_t projectors, ImageSize 
         signals[static_cast<std::size_t>(k)] = gray_code_pattern(size, rows, bit, true);
         const cv::Mat1f off = show_averaged(source, signals, frames);
         captures += 2 * frames;
+        if (bit == 0) noise = pair_noise(on, off, white_plus_black, code);
         long valid = 0;
         long resolved = 0;
         for (int y = 0; y < on.rows; ++y) {
@@ -148,8 +164,8 @@ AxisPosition gray_positions(const AxisCode& a) {
 }
 
 int refine_by_phase(PatternSource& source, int k, std::size_t projectors, ImageSize size, bool rows, const AxisCode& a,
-                    int resolved_bits, const cv::Mat1f& contrast, const AutocalOptions& o, AxisPosition& p,
-                    int& captures) {
+                    int resolved_bits, const cv::Mat1f& contrast, double image_noise, const AutocalOptions& o,
+                    AxisPosition& p, int& captures) {
     const int n = o.phase_shifts;
     // At least 4 of the finest blocks the axis resolved: pixels that stopped one bit early still unwrap (a noisy
     // or blurred camera resolves fewer bits, and a longer period is also less attenuated by its blur).
@@ -163,7 +179,9 @@ int refine_by_phase(PatternSource& source, int k, std::size_t projectors, ImageS
     }
     const PhaseImage phase = decode_phase(images, period);
     const cv::Mat1b lit(a.code >= 0);
-    const double noise = phase_image_noise(images, lit);
+    // The pattern pairs' temporal noise, or the phase images' own (for an even N, which also holds what the
+    // sinusoid model misses, such as a wrong gamma's harmonics), the larger.
+    const double noise = std::max(image_noise, phase_image_noise(images, lit));
     const double sigma_phi_b = noise * std::sqrt(2.0 / n);  // sigma_phi * b
     int refined = 0;
     for (int y = 0; y < a.code.rows; ++y) {
@@ -211,18 +229,22 @@ Correspondences decode_projector(PatternSource& source, int k, const std::vector
     }
     AxisCode row{col.code.clone(), cv::Mat1i(contrast.size(), 0), gray_code_bits(size.height)};
     out.lit_pixels = cv::countNonZero(col.code == 0);
-    out.column_bits =
-        decode_axis(source, k, projectors.size(), size, false, contrast, options, col.code, col.depth, out.captures);
-    out.row_bits =
-        decode_axis(source, k, projectors.size(), size, true, contrast, options, row.code, row.depth, out.captures);
+    cv::Mat1f white_plus_black;
+    cv::add(white, black, white_plus_black);
+    double col_noise = 0.0;
+    double row_noise = 0.0;
+    out.column_bits = decode_axis(source, k, projectors.size(), size, false, contrast, white_plus_black, options,
+                                  col.code, col.depth, col_noise, out.captures);
+    out.row_bits = decode_axis(source, k, projectors.size(), size, true, contrast, white_plus_black, options, row.code,
+                               row.depth, row_noise, out.captures);
     if (out.column_bits < options.min_bits || out.row_bits < options.min_bits) return out;
     AxisPosition px = gray_positions(col);
     AxisPosition py = gray_positions(row);
     if (options.phase_shifts > 0) {
         out.phase_refined_columns = refine_by_phase(source, k, projectors.size(), size, false, col, out.column_bits,
-                                                    contrast, options, px, out.captures);
+                                                    contrast, col_noise, options, px, out.captures);
         out.phase_refined_rows = refine_by_phase(source, k, projectors.size(), size, true, row, out.row_bits, contrast,
-                                                 options, py, out.captures);
+                                                 row_noise, options, py, out.captures);
     }
     // One correspondence per decoded camera pixel whose every axis is refined by the phase or has
     // at least all but two of the resolved Gray bits: its centre <-> the projector position, with
