@@ -106,7 +106,7 @@ struct AutocalOptions {
     // axis (0 = off, else 3..16) of `phase_period_px` projector pixels ([4, 1024]; unwrapped where the Gray block
     // is at most half of it), pre-compensated for the projectors' assumed response `phase_gamma` ((0, 10]); a
     // refined position's sigma is at least `phase_sigma_floor_px` (camera footprint and model error, > 0).
-    int phase_shifts = 4;
+    int phase_shifts = 8;  // 8, not 4: fewer harmonics of a wrong gamma and less noise (calibration-curves)
     double phase_period_px = 32.0;
     double phase_gamma = 2.2;
     double phase_sigma_floor_px = 0.29;

@@ -165,9 +165,9 @@ TEST(RigFile, ErrorsNameTheField) {
     EXPECT_NE(
         message("[camera]\nauto_exposure = 1\n[[projectors]]\n").find("camera.auto_exposure: must be true or false"),
         std::string::npos);
-    EXPECT_NE(message("[camera]\n[[projectors]]\n[prior]\nscreen_radius_error_m = 2.0\n")
-                  .find("prior.screen_radius_error_m"),
-              std::string::npos);
+    EXPECT_NE(
+        message("[camera]\n[[projectors]]\n[prior]\nscreen_radius_error_m = 2.0\n").find("prior.screen_radius_error_m"),
+        std::string::npos);
     EXPECT_THROW((void)load_rig("/nonexistent/rig.toml"), RigError);
     // toml11 recurses once per level without a limit: 20000 levels crashed the reader.
     const std::string deep = std::string(20000, '[') + std::string(20000, ']');

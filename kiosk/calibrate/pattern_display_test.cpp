@@ -102,8 +102,8 @@ TEST(PatternBudget, StandardRigImageCount) {
     const auto prior = autocal::prior_from_rig(rig::load_rig(MOGAO_SOURCE_DIR "/rigs/standard.toml"));
     const PatternBudget b = pattern_budget(prior, true, {}, {});
     EXPECT_EQ(b.identification, 5);  // black, white, 3 alone
-    // 1920x1080: 11 + 11 Gray bits, each with its inverse, + white, black, + 4 phase shifts per axis
-    EXPECT_EQ(b.geometry, 2 + 3 * (46 + 8));
+    // 1920x1080: 11 + 11 Gray bits, each with its inverse, + white, black, + 8 phase shifts per axis
+    EXPECT_EQ(b.geometry, 2 + 3 * (46 + 16));
     EXPECT_EQ(b.colour, 5 + 3 * 3 * (8 + 4) + 8);
     EXPECT_EQ(pattern_budget(prior, false, {}, {}).colour, 0);
     autocal::AutocalOptions fewer;
