@@ -166,7 +166,7 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
     // Step 2 first: all projectors white minus all black shows the screen's lit edges.
     std::vector<cv::Mat> signals(n);
     const int frames = options.frames_per_pattern;
-    const cv::Mat1f black = show_averaged(source, signals, frames);
+    const cv::Mat1f black = show_averaged(source, signals, frames).clone();  // the source may reuse its buffer
     for (std::size_t k = 0; k < n; ++k) signals[k] = cv::Mat1f(sizes[k].height, sizes[k].width, 1.0f);
     const cv::Mat1f white = show_averaged(source, signals, frames);
     result.report.captures = 2 * frames;
@@ -210,6 +210,11 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
     bo.refine_screen = options.fit_screen;
     const BundleResult ba = bundle_adjust(prior.screen, edge.camera, result.projectors, edge.edges, observations, bo);
     result.screen = ba.screen;
+    if (!(ba.screen.radius_m > 0.0 && ba.screen.arc_deg > 0.0 && ba.screen.arc_deg <= 360.0)) {
+        throw CalibrationRefused("fitted screen: radius " + std::to_string(ba.screen.radius_m) + " m, arc " +
+                                 std::to_string(ba.screen.arc_deg) +
+                                 " deg is no cylinder screen (radius > 0, arc in (0, 360]): the prior is too far off");
+    }
     result.camera = ba.camera;
     result.projectors = ba.projectors;
     result.report.camera_position_m = ba.camera.position_m;

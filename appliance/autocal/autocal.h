@@ -37,7 +37,8 @@
 //     and pose (bundle_adjust.h with the camera fixed), outliers beyond 4x the median dropped.
 //  4. Bundle adjustment (bundle_adjust.h; Sajadi & Majumder 2010): camera pose and all projector
 //     models together on every correspondence and edge point, the 3D points constrained to the
-//     cylinder.
+//     cylinder; with `fit_screen` also its radius and arc (the heights fix the scale), the projector fit
+//     gate then applied after it, and the fitted screen checked to be one.
 //  5. Warp: grid samples at texel centres (warp_sampling.h) -> fitted projector ray -> cylinder
 //     -> content (u, v), left unclamped past the screen's edges (the blend is 0 there).
 //  0. The camera's auto-exposure must be locked (refused otherwise, before any pattern is shown).

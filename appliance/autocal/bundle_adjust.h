@@ -1,11 +1,12 @@
 // SPDX-License-Identifier: Apache-2.0
 // Joint refinement of the camera pose and every projector's pinhole model on all the
-// calibration's observations, with the screen as a known cylinder (autocal.h, step 4): bundle
+// calibration's observations, with the screen as a cylinder (autocal.h, step 4): bundle
 // adjustment (Triggs, McLauchlan, Hartley, Fitzgibbon 2000, "Bundle adjustment - a modern
 // synthesis") in the form of Sajadi & Majumder 2010 ("Auto-calibration of cylindrical
 // multi-projector systems", IEEE VR): the 3D point of a correspondence is not a free unknown but
 // the camera ray's intersection with the cylinder, so the camera pose, the projectors' intrinsics
-// and their poses are the only unknowns; the screen's lit edges tie the pose to the screen's
+// and their poses are the only unknowns (with BundleOptions::refine_screen also the cylinder's radius
+// and arc); the screen's lit edges tie the pose to the screen's
 // ends and heights (the cylinder alone leaves a rotation about its axis and a shift along it).
 //
 // Minimised (Levenberg-Marquardt, Marquardt 1963, forward-difference Jacobian in double):

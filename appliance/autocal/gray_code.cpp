@@ -35,13 +35,6 @@ cv::Mat1f gray_code_pattern(ImageSize size, bool rows, int bit, bool inverted) {
 
 namespace {
 
-// Decodes one axis: captures bits from the coarsest while the camera resolves them, at most
-// options.max_gray_bits of them (0 = all), each pattern and inverse the mean of
-// options.frames_per_pattern frames. Returns the number of bits used. Per camera pixel, `gray` gets the Gray-code
-// prefix and `depth` the number of bits it resolved: a pixel stops at its first bit with |pattern - inverse| below half
-// its contrast. For the reflected Gray code that bit changes at the middle of the pixel's block of `depth` bits, so the
-// block's centre is where the pixel is (Inokuchi et al. 1984; the same property makes Gray code robust at stripe
-// edges). Pixels below `shadow` contrast stay at -1.
 // Temporal noise of one camera image (camera units) from a pattern and its inverse: their light adds up to white
 // plus black, so (on + off) - (white + black) over the lit pixels is the noise of four images (1.4826 MAD / 2).
 double pair_noise(const cv::Mat1f& on, const cv::Mat1f& off, const cv::Mat1f& white_plus_black, const cv::Mat1i& code) {
@@ -56,6 +49,13 @@ double pair_noise(const cv::Mat1f& on, const cv::Mat1f& off, const cv::Mat1f& wh
     return 1.4826 * dev[dev.size() / 2] / 2.0;
 }
 
+// Decodes one axis: captures bits from the coarsest while the camera resolves them, at most
+// options.max_gray_bits of them (0 = all), each pattern and inverse the mean of
+// options.frames_per_pattern frames. Returns the number of bits used. Per camera pixel, `gray` gets the Gray-code
+// prefix and `depth` the number of bits it resolved: a pixel stops at its first bit with |pattern - inverse| below half
+// its contrast. For the reflected Gray code that bit changes at the middle of the pixel's block of `depth` bits, so the
+// block's centre is where the pixel is (Inokuchi et al. 1984; the same property makes Gray code robust at stripe
+// edges). Pixels below `shadow` contrast stay at -1.
 // `noise`: set from the first pattern pair (pair_noise).
 int decode_axis(PatternSource& source, int k, std::size_t projectors, ImageSize size, bool rows,
                 const cv::Mat1f& contrast, const cv::Mat1f& white_plus_black, const AutocalOptions& options,
@@ -135,9 +135,7 @@ double flat_image_noise(const cv::Mat1f& img) {
     return 1.4826 * r[r.size() / 2] / 6.0;
 }
 
-// One axis of phase-shifted sinusoids (phase_shift.h) for projector k: the unwrapped positions and
-// their sigma replace the Gray-code block centres where the block is at most half a period and the
-// modulation clears the noise. Returns the number of pixels refined.
+// One axis's Gray decoding per camera pixel.
 struct AxisCode {
     cv::Mat1i code;   // Gray-decoded block index, -1 = not lit
     cv::Mat1i depth;  // bits resolved
@@ -163,12 +161,15 @@ AxisPosition gray_positions(const AxisCode& a) {
     return p;
 }
 
+// One axis of phase-shifted sinusoids (phase_shift.h) for projector k: the unwrapped positions and
+// their sigma replace the Gray-code block centres where the block is at most half a period and the
+// modulation clears the noise. Returns the number of pixels refined.
 int refine_by_phase(PatternSource& source, int k, std::size_t projectors, ImageSize size, bool rows, const AxisCode& a,
                     int resolved_bits, const cv::Mat1f& contrast, double image_noise, const AutocalOptions& o,
                     AxisPosition& p, int& captures) {
     const int n = o.phase_shifts;
-    // At least 4 of the finest blocks the axis resolved: pixels that stopped one bit early still unwrap (a noisy
-    // or blurred camera resolves fewer bits, and a longer period is also less attenuated by its blur).
+    // At least 8 of the finest blocks the axis resolved: pixels that stopped up to two bits early still unwrap (a
+    // noisy or blurred camera resolves fewer bits, and a longer period is also less attenuated by its blur).
     const double period = std::max(o.phase_period_px, 8.0 * (1 << (a.extent_bits - resolved_bits)));
     std::vector<cv::Mat1f> images;
     std::vector<cv::Mat> signals(projectors);
