@@ -44,9 +44,7 @@ double pair_noise(const cv::Mat1f& on, const cv::Mat1f& off, const cv::Mat1f& wh
             if (code(y, x) >= 0) dev.push_back(std::abs(on(y, x) + off(y, x) - white_plus_black(y, x)));
         }
     }
-    if (dev.empty()) return 0.0;
-    std::nth_element(dev.begin(), dev.begin() + static_cast<long>(dev.size() / 2), dev.end());
-    return 1.4826 * dev[dev.size() / 2] / 2.0;
+    return mad_sigma(dev) / 2.0;
 }
 
 // Decodes one axis: captures bits from the coarsest while the camera resolves them, at most
@@ -131,8 +129,7 @@ double flat_image_noise(const cv::Mat1f& img) {
             r.push_back(std::abs(v));
         }
     }
-    std::nth_element(r.begin(), r.begin() + static_cast<long>(r.size() / 2), r.end());
-    return 1.4826 * r[r.size() / 2] / 6.0;
+    return mad_sigma(r) / 6.0;
 }
 
 // One axis's Gray decoding per camera pixel.

@@ -71,6 +71,13 @@ double unwrap_position(double x_gray, double phase_position, double period_px) {
     return x_gray + d;
 }
 
+double mad_sigma(std::vector<float>& abs_devs) {
+    if (abs_devs.empty()) return 0.0;
+    const auto mid = abs_devs.begin() + static_cast<long>(abs_devs.size() / 2);
+    std::nth_element(abs_devs.begin(), mid, abs_devs.end());
+    return 1.4826 * *mid;
+}
+
 double phase_image_noise(const std::vector<cv::Mat1f>& images, const cv::Mat1b& mask) {
     const std::size_t n = images.size();
     if (n < 4 || n % 2 != 0) return 0.0;
@@ -83,9 +90,7 @@ double phase_image_noise(const std::vector<cv::Mat1f>& images, const cv::Mat1b& 
             dev.push_back(std::abs(d));
         }
     }
-    if (dev.empty()) return 0.0;
-    std::nth_element(dev.begin(), dev.begin() + static_cast<long>(dev.size() / 2), dev.end());
-    return 1.4826 * dev[dev.size() / 2] / 2.0;
+    return mad_sigma(dev) / 2.0;
 }
 
 }  // namespace mogao::autocal

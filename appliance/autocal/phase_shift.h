@@ -46,6 +46,10 @@ struct PhaseImage {
 // congruent to `phase_position` modulo the period.
 [[nodiscard]] double unwrap_position(double x_gray, double phase_position, double period_px);
 
+// The standard deviation of Gaussian noise from absolute deviations: 1.4826 x their median (the MAD's
+// consistency constant; Rousseeuw & Croux 1993). Reorders `abs_devs`; 0 when it is empty.
+[[nodiscard]] double mad_sigma(std::vector<float>& abs_devs);
+
 // Robust per-image noise of a set of N-step images (N even): the half-sum of opposite shifts,
 // (I_i + I_{i+N/2}) / 2, is a for every i, so their differences are noise alone; the median
 // absolute deviation over `mask` scaled to a Gaussian's sigma (1.4826 MAD) and to one image.
