@@ -67,7 +67,7 @@ const Calibrated& calibrated() {
         autocal::AutocalOptions options;
         options.warp_step_px = 4;
         autocal::AutocalResult r = autocal::calibrate(source, prior, kCalibrationContent, options);
-        (void)autocal::calibrate_colour(source, prior.screen, r.projectors, r.calibration);
+        (void)autocal::calibrate_colour(source, prior.screen, r.camera, r.projectors, r.calibration);
         out.calibration = r.calibration;
         const fs::path dir = fs::path(::testing::TempDir()) / "warp_blend_rig_test";
         fs::create_directories(dir);

@@ -250,4 +250,13 @@ ScreenCalibration calibration_from_models(const std::vector<DeviceModel>& projec
     return out;
 }
 
+double falloff_at(const DeviceModel& d, double x, double y) {
+    if (d.falloff.flat()) return 1.0;
+    const double half_diagonal = 0.5 * std::hypot(d.resolution.width, d.resolution.height);
+    const double u = (x - d.cx_px) / half_diagonal;
+    const double v = (y - d.cy_px) / half_diagonal;
+    const std::array<double, 6>& c = d.falloff.c;
+    return c[0] + c[1] * u + c[2] * v + c[3] * u * u + c[4] * u * v + c[5] * v * v;
+}
+
 }  // namespace mogao::autocal

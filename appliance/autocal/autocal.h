@@ -69,8 +69,20 @@ struct ScreenModel {
     double top_m = 2.3;
 };
 
+// A projector's relative light over its image: its lens's fall-off (vignetting), the part of
+// Majumder & Stevens' (TVCG 10(2) 2004) spatial luminance variation that lies within one projector,
+// measured by the colour step (colour_calibration.h). F(x, y) = c . (1, u, v, u^2, u v, v^2) with
+// u = (x - cx) / d, v = (y - cy) / d, d = half the image's diagonal in pixels and (cx, cy) the
+// device's principal point: a quadratic holds the radial leading term of vignetting and a tilt.
+// Scaled so that its mean over what the camera saw of the projector is 1. The default is flat.
+struct LensFalloff {
+    std::array<double, 6> c{1.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    [[nodiscard]] bool flat() const { return c == LensFalloff{}.c; }
+};
+
 // A pinhole device: intrinsics (image positions, pixel centre +0.5), distortion (cameras only),
-// pose in the screen frame (rotation device -> screen, position).
+// pose in the screen frame (rotation device -> screen, position); projectors also carry their
+// lens fall-off once the colour step has measured it (flat before, and always for cameras).
 struct DeviceModel {
     std::string id;
     ImageSize resolution;
@@ -81,7 +93,11 @@ struct DeviceModel {
     std::array<double, 5> distortion{};
     Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
     Eigen::Vector3d position_m = Eigen::Vector3d::Zero();
+    LensFalloff falloff;
 };
+
+// F(x, y) of `d`'s LensFalloff at image position (x, y) (formula at LensFalloff).
+[[nodiscard]] double falloff_at(const DeviceModel& d, double x, double y);
 
 // What is known before calibrating: the screen's size, the camera's intrinsics and roughly its
 // pose, each projector's resolution and data-sheet intrinsics (its pose is not used).

@@ -3,6 +3,7 @@
 //
 //   mogao-autocal calibrate --rig rigs/standard.toml --out DIR [--scale 0.5] [--content 1920x1080]
 //                 [--alpha-bits 16] [--warp-step 2] [--gray-bits N] [--frames-per-pattern 1] [--no-colour]
+//                 [--no-falloff]
 //
 // Exit codes: 0 success, 1 the job failed or the calibration was refused (the message says why;
 // nothing in DIR changes), 2 bad command line.
@@ -41,9 +42,13 @@ int main(int argc, char** argv) {
                   "Fit the screen's radius and arc too (known only roughly; the heights are taken as measured)");
     bool no_colour = false;
     cmd->add_flag("--no-colour", no_colour, "Geometry only: no response, black-level and colour matching step");
+    bool no_falloff = false;
+    cmd->add_flag("--no-falloff", no_falloff,
+                  "Colour step without the lens fall-off: one gain per projector and channel (flat projectors)");
     try {
         app.parse(argc, argv);
         job.colour = !no_colour;
+        job.colour_options.lens_falloff = !no_falloff;
         if (std::sscanf(content.c_str(), "%dx%d", &job.content.width, &job.content.height) != 2 ||
             job.content.width < 1 || job.content.height < 1 || job.content.width > 16384 ||
             job.content.height > 16384) {

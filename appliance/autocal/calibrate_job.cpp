@@ -76,10 +76,11 @@ cv::Mat1b preview(const rig::VirtualRig& rig, const ScreenCalibration& c, int wi
                 const float w = sample_blend(pc.blend, pc.output, px, py);
                 const std::array<float, 3> beta = sample_beta(pc.beta, pc.output, px, py);
                 const rig::RigProjector& rp = rig.projectors[k];
+                const double f = rig::projector_falloff(rp, p->x(), p->y());
                 for (std::size_t ch = 0; ch < 3; ++ch) {
                     const double signal =
                         apply_response(pc.response, static_cast<int>(ch), static_cast<float>(content) * w + beta[ch]);
-                    l += rp.brightness[ch] *
+                    l += f * rp.brightness[ch] *
                          (rp.black_level + (1.0 - rp.black_level) * std::pow(signal, rp.gamma[ch])) / 3.0;
                 }
             }
@@ -114,17 +115,15 @@ nlohmann::json seam_figures(const rig::VirtualRig& rig, const ScreenCalibration&
 }
 
 nlohmann::json colour_report(const ColourResult& c) {
-    nlohmann::json out = {{"captures", c.captures},
-                          {"matched_white", c.matched_white},
-                          {"black_floor", c.black_floor},
-                          {"ambient", c.ambient},
-                          {"alpha_scale", c.alpha_scale}};
+    nlohmann::json out = {{"captures", c.captures}, {"matched_white", c.matched_white}, {"black_floor", c.black_floor},
+                          {"ambient", c.ambient},   {"alpha_scale", c.alpha_scale},     {"white_floor", c.white_floor}};
     for (const ProjectorPhotometry& p : c.projectors) {
         nlohmann::json ch = nlohmann::json::array();
         for (const ChannelResponse& r : p.channels) {
             ch.push_back({{"amplitude", r.amplitude}, {"gamma", r.gamma}, {"gamma_fit_rms", r.gamma_rms}});
         }
-        out["projectors"].push_back({{"id", p.id}, {"black", p.black}, {"gain", p.gain}, {"channels", ch}});
+        out["projectors"].push_back(
+            {{"id", p.id}, {"black", p.black}, {"gain", p.gain}, {"falloff", p.falloff.c}, {"channels", ch}});
     }
     return out;
 }
@@ -143,7 +142,8 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
     if (job.colour) {
         seams_before = seam_figures(rig, r.calibration);
         const auto t1 = std::chrono::steady_clock::now();
-        colour = calibrate_colour(source, r.screen, r.projectors, r.calibration, job.colour_options);  // throws
+        colour =
+            calibrate_colour(source, r.screen, r.camera, r.projectors, r.calibration, job.colour_options);  // throws
         calibrate_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
     }
     const GeometryError g = measure_geometry(rig, r.calibration, 4);

@@ -46,7 +46,7 @@ TEST(CalibrateJob, MpcdiRoundTripGivesTheSameMaps) {
     const rig::VirtualRig rig = scaled_rig(rig::load_rig(job.rig), job.scale, job.scale);
     RigPatternSource source(rig);
     AutocalResult direct = calibrate(source, prior_from_rig(rig), job.content, job.options);
-    (void)calibrate_colour(source, prior_from_rig(rig).screen, direct.projectors, direct.calibration);
+    (void)calibrate_colour(source, prior_from_rig(rig).screen, direct.camera, direct.projectors, direct.calibration);
     const ScreenCalibration back = to_screen_calibration(read_mpcdi(job.out / "calibration.mpcdi"));
     ASSERT_EQ(back.projectors.size(), direct.calibration.projectors.size());
     EXPECT_EQ(back.content.width, job.content.width);

@@ -10,6 +10,7 @@
 #include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
 
+#include "appliance/autocal/screen_geometry.h"
 #include "appliance/warp/calibration_validation.h"
 #include "appliance/warp/response_curve.h"
 #include "appliance/warp/warp_sampling.h"
@@ -31,6 +32,7 @@ void check_options(const ColourOptions& o) {
     if (!(o.min_amplitude > 0.0 && o.min_amplitude < 1.0)) fail("min_amplitude must be in (0, 1)");
     if (!(o.max_fit_rms > 0.0)) fail("max_fit_rms must be > 0");
     if (o.mask_erode_px < 0 || o.mask_erode_px > 32) fail("mask_erode_px must be 0..32");
+    if (o.falloff_min_samples < 6) fail("falloff_min_samples must be >= 6");
 }
 
 // Projector k shows channel c at level s (the other channels and projectors black).
@@ -67,11 +69,105 @@ double fit_gamma(const ChannelResponse& r, double* rms) {
 }
 
 struct Captured {
+    cv::Mat2f screen;  // per camera pixel: the screen point (theta, h) it sees, NaN off the screen
     cv::Mat1f black;
     cv::Mat1f black_low;             // all-black at low_end_exposure, averaged
     std::vector<cv::Mat1b> inside;   // per projector: camera pixels it clearly lights
     std::vector<cv::Mat1b> outside;  // per projector: camera pixels it clearly does not light
 };
+
+// The screen point (theta, h) each camera pixel's centre sees through the camera model, NaN where
+// it sees no screen (beyond the arc's ends or the heights).
+cv::Mat2f camera_screen_points(const DeviceModel& camera, const ScreenModel& screen) {
+    const ImageSize r = camera.resolution;
+    std::vector<cv::Point2d> image;
+    image.reserve(static_cast<std::size_t>(r.pixel_count()));
+    for (int y = 0; y < r.height; ++y) {
+        for (int x = 0; x < r.width; ++x) image.emplace_back(x + 0.5, y + 0.5);
+    }
+    const std::vector<Eigen::Vector3d> rays = camera_rays(camera, image);
+    const double half_arc = screen.arc_deg * kDeg / 2.0;
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    cv::Mat2f out(r.height, r.width, cv::Vec2f(nan, nan));
+    for (int y = 0; y < r.height; ++y) {
+        for (int x = 0; x < r.width; ++x) {
+            const auto hit = cylinder_hit(screen, camera.position_m,
+                                          camera.rotation * rays[static_cast<std::size_t>(y) * r.width + x]);
+            if (!hit) continue;
+            const double theta = std::atan2(hit->x(), -hit->z());
+            if (std::abs(theta) <= half_arc && hit->y() >= screen.bottom_m && hit->y() <= screen.top_m) {
+                out(y, x) = cv::Vec2f(static_cast<float>(theta), static_cast<float>(hit->y()));
+            }
+        }
+    }
+    return out;
+}
+
+// Projector d's image position that camera pixel (x, y) sees (NaN where none).
+Eigen::Vector2d seen_pixel(const cv::Mat2f& screen_at, const DeviceModel& d, const ScreenModel& screen, int x, int y) {
+    const cv::Vec2f s = screen_at(y, x);
+    if (std::isnan(s[0])) return {std::nan(""), std::nan("")};
+    return model_pixel(d, screen, s[0], s[1]);
+}
+
+// LensFalloff's basis at image position (x, y) of d.
+std::array<double, 6> falloff_basis(const DeviceModel& d, double x, double y) {
+    const double half_diagonal = 0.5 * std::hypot(d.resolution.width, d.resolution.height);
+    const double u = (x - d.cx_px) / half_diagonal;
+    const double v = (y - d.cy_px) / half_diagonal;
+    return {1.0, u, v, u * u, u * v, v * v};
+}
+
+// Step 1b: projector k's lens fall-off, the quadratic that fits its full-white image `full` (the
+// channels summed, minus black) over the camera pixels `in` at the projector positions the
+// models give them, in least squares; scaled to a mean of 1 over those pixels, which are
+// returned in `samples` (the amplitudes A_kc are then their means, so that A_kc F(p) is the light).
+LensFalloff fit_falloff(const cv::Mat1f& full, const cv::Mat1b& in, const cv::Mat2f& screen_at, const DeviceModel& d,
+                        const ScreenModel& screen, const ColourOptions& o, std::size_t k,
+                        std::vector<cv::Point>& samples) {
+    Eigen::Matrix<double, 6, 6> ata = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> atb = Eigen::Matrix<double, 6, 1>::Zero();
+    Eigen::Matrix<double, 6, 1> basis_sum = Eigen::Matrix<double, 6, 1>::Zero();
+    samples.clear();
+    for (int y = 0; y < full.rows; ++y) {
+        for (int x = 0; x < full.cols; ++x) {
+            if (in(y, x) == 0) continue;
+            const Eigen::Vector2d p = seen_pixel(screen_at, d, screen, x, y);
+            if (!p.allFinite()) continue;
+            const std::array<double, 6> b = falloff_basis(d, p.x(), p.y());
+            const Eigen::Map<const Eigen::Matrix<double, 6, 1>> q(b.data());
+            ata += q * q.transpose();
+            atb += q * static_cast<double>(full(y, x));
+            basis_sum += q;
+            samples.emplace_back(x, y);
+        }
+    }
+    const std::string who = "projector " + std::to_string(k) + " '" + d.id + "'";
+    if (static_cast<int>(samples.size()) < o.falloff_min_samples) {
+        throw CalibrationRefused(
+            who + ": the camera sees " + std::to_string(samples.size()) +
+            " of its pixels where the models place it (need >= " + std::to_string(o.falloff_min_samples) +
+            ") to measure its lens fall-off (ColourOptions::lens_falloff = false skips it)");
+    }
+    const Eigen::Matrix<double, 6, 1> g = ata.ldlt().solve(atb);
+    const double mean = g.dot(basis_sum) / static_cast<double>(samples.size());
+    LensFalloff f;
+    for (int i = 0; i < 6; ++i) f.c[static_cast<std::size_t>(i)] = g[i] / mean;
+    DeviceModel fitted = d;
+    fitted.falloff = f;
+    for (int j = 0; j <= 2; ++j) {  // what the models file accepts (model_store.h)
+        for (int i = 0; i <= 2; ++i) {
+            const double v = falloff_at(fitted, d.resolution.width * i / 2.0, d.resolution.height * j / 2.0);
+            if (!(v >= 0.05 && v <= 5.0)) {
+                throw CalibrationRefused(who + ": its measured lens fall-off gives " + std::to_string(v) +
+                                         " at image position (" + std::to_string(d.resolution.width * i / 2.0) + ", " +
+                                         std::to_string(d.resolution.height * j / 2.0) +
+                                         "), outside [0.05, 5] of its mean: not a lens (a changing exposure?)");
+            }
+        }
+    }
+    return f;
+}
 
 // Step 1's low end for channel c of projector k: levels up to 1/4 again, and 1/32, 1/16, at
 // low_end_exposure x the locked exposure (a few camera codes at the base exposure), in base
@@ -114,8 +210,9 @@ void measure_low_end(PatternSource& source, const std::vector<DeviceModel>& proj
 }
 
 // Step 1 for projector k: ramps per channel, the coverage masks from the full-level images.
-ProjectorPhotometry measure_projector(PatternSource& source, const std::vector<DeviceModel>& projectors, std::size_t k,
-                                      const ColourOptions& o, Captured& cap, int& captures) {
+ProjectorPhotometry measure_projector(PatternSource& source, const ScreenModel& screen,
+                                      const std::vector<DeviceModel>& projectors, std::size_t k, const ColourOptions& o,
+                                      Captured& cap, int& captures) {
     ProjectorPhotometry pp;
     pp.id = projectors[k].id;
     const int n = o.ramp_steps;
@@ -150,6 +247,8 @@ ProjectorPhotometry measure_projector(PatternSource& source, const std::vector<D
                                  std::to_string(cv::countNonZero(in)) +
                                  " pixels of it (need >= 100) to measure its response");
     }
+    std::vector<cv::Point> samples;
+    if (o.lens_falloff) pp.falloff = fit_falloff(full, in, cap.screen, projectors[k], screen, o, k, samples);
     for (std::size_t c = 0; c < 3; ++c) {
         ChannelResponse& r = pp.channels[c];
         r.levels.push_back(0.0);
@@ -178,13 +277,21 @@ ProjectorPhotometry measure_projector(PatternSource& source, const std::vector<D
                                      " rms from the nearest gamma (gate " + std::to_string(o.max_fit_rms) +
                                      "): not a projector response (saturation, changing exposure?)");
         }
+        if (samples.empty()) continue;
+        // A_kc with the fall-off: the full level's mean over the pixels the fall-off was fitted on.
+        const cv::Mat1f& top_level = diffs[c].back();
+        double sum = 0.0;
+        for (const cv::Point& p : samples) sum += top_level(p);
+        r.amplitude = sum / static_cast<double>(samples.size());
     }
     return pp;
 }
 
-// Step 2: betas and ambient by least squares on the long-exposure black image.
-void measure_black(PatternSource& source, const ColourOptions& o, const Captured& cap,
-                   std::vector<ProjectorPhotometry>& pps, double& ambient, int& captures) {
+// Step 2: betas and ambient by least squares on the long-exposure black image; a projector's black
+// passes its lens, so its regressor is its fall-off at the pixel (1 where it is flat).
+void measure_black(PatternSource& source, const ColourOptions& o, const Captured& cap, const ScreenModel& screen,
+                   const std::vector<DeviceModel>& projectors, std::vector<ProjectorPhotometry>& pps, double& ambient,
+                   int& captures) {
     const std::size_t n = pps.size();
     source.set_relative_exposure(o.dark_exposure);
     cv::Mat1f dark(cap.black.size(), 0.0f);
@@ -212,7 +319,12 @@ void measure_black(PatternSource& source, const ColourOptions& o, const Captured
             for (std::size_t k = 0; k < n && clear; ++k) {
                 const bool in = cap.inside[k](y, x) != 0;
                 clear = in || cap.outside[k](y, x) != 0;
-                a[static_cast<long>(k) + 1] = in ? 1.0 : 0.0;
+                double f = 1.0;
+                if (in && !projectors[k].falloff.flat()) {
+                    const Eigen::Vector2d p = seen_pixel(cap.screen, projectors[k], screen, x, y);
+                    if (p.allFinite()) f = falloff_at(projectors[k], p.x(), p.y());
+                }
+                a[static_cast<long>(k) + 1] = in ? f : 0.0;
                 lit += in;
             }
             if (!clear || lit == 0) continue;
@@ -250,14 +362,21 @@ double invert_measured(const ChannelResponse& r, double t) {
     return (lo + hi) / 2.0;
 }
 
-// Black light per channel at screen point (theta, h): sum of the blacks of the projectors there.
+// Black light per channel at screen point (theta, h): sum of the blacks of the projectors there,
+// each through its lens's fall-off; projector `always` lights it with fall-off `always_falloff`
+// (the caller knows its pixel; models.size() = none).
 std::array<double, 3> black_at(const std::vector<DeviceModel>& models, const ScreenModel& screen,
                                const std::vector<std::array<double, 3>>& blacks, double theta, double h,
-                               std::size_t always) {
+                               std::size_t always, double always_falloff) {
     std::array<double, 3> b{};
     for (std::size_t j = 0; j < models.size(); ++j) {
-        if (j != always && !model_pixel(models[j], screen, theta, h).allFinite()) continue;
-        for (std::size_t c = 0; c < 3; ++c) b[c] += blacks[j][c];
+        double f = always_falloff;
+        if (j != always) {
+            const Eigen::Vector2d p = model_pixel(models[j], screen, theta, h);
+            if (!p.allFinite()) continue;
+            f = falloff_at(models[j], p.x(), p.y());
+        }
+        for (std::size_t c = 0; c < 3; ++c) b[c] += f * blacks[j][c];
     }
     return b;
 }
@@ -271,7 +390,7 @@ std::array<double, 3> black_floor(const std::vector<DeviceModel>& models, const 
         for (int i = 0; i <= 800; ++i) {
             const double theta = (i / 800.0 - 0.5) * arc;
             const double h = screen.bottom_m + (screen.top_m - screen.bottom_m) * j / 100.0;
-            const std::array<double, 3> b = black_at(models, screen, blacks, theta, h, models.size());
+            const std::array<double, 3> b = black_at(models, screen, blacks, theta, h, models.size(), 1.0);
             for (std::size_t c = 0; c < 3; ++c) floor[c] = std::max(floor[c], b[c]);
         }
     }
@@ -305,6 +424,52 @@ bool pixel_on_screen(const ProjectorCalibration& pc, const ScreenModel& screen, 
     return true;
 }
 
+// Projector d's image position of pc's output pixel (x, y) (pixel-index coordinates: x is the
+// centre of pixel x); the output may be a scaled copy of the projector's resolution.
+Eigen::Vector2d output_position(const DeviceModel& d, const ProjectorCalibration& pc, double x, double y) {
+    return {(x + 0.5) * d.resolution.width / pc.output.width, (y + 0.5) * d.resolution.height / pc.output.height};
+}
+
+double falloff_at_output(const DeviceModel& d, const ProjectorCalibration& pc, double x, double y) {
+    if (d.falloff.flat()) return 1.0;
+    const Eigen::Vector2d p = output_position(d, pc, x, y);
+    return falloff_at(d, p.x(), p.y());
+}
+
+// Step 4's white floor S: the least relative light F any projector gives where it shows content
+// (blend > 0); 1 when every projector is flat. The wall's white is S W_c everywhere.
+double white_floor(const std::vector<DeviceModel>& models, const ScreenCalibration& calibration) {
+    double floor = 1.0;
+    for (std::size_t k = 0; k < models.size(); ++k) {
+        if (models[k].falloff.flat()) continue;
+        const ProjectorCalibration& pc = calibration.projectors[k];
+        const ImageSize g = pc.blend.size;
+        for (int j = 0; j < g.height; ++j) {
+            const double y = grid_to_output(j, pc.output.height, g.height);
+            for (int i = 0; i < g.width; ++i) {
+                if (!(pc.blend.weight[static_cast<std::size_t>(j) * g.width + i] > 0.0F)) continue;
+                floor =
+                    std::min(floor, falloff_at_output(models[k], pc, grid_to_output(i, pc.output.width, g.width), y));
+            }
+        }
+    }
+    return floor;
+}
+
+// Step 4's blend for the fall-off: w_k(p) x s x S / F_k(p) (s the black headroom), so that the
+// projectors' light sums to S W_c c wherever they show content c.
+void scale_blend(const DeviceModel& d, double scale, double white, ProjectorCalibration& pc) {
+    const ImageSize g = pc.blend.size;
+    for (int j = 0; j < g.height; ++j) {
+        const double y = grid_to_output(j, pc.output.height, g.height);
+        for (int i = 0; i < g.width; ++i) {
+            float& w = pc.blend.weight[static_cast<std::size_t>(j) * g.width + i];
+            const double f = falloff_at_output(d, pc, grid_to_output(i, pc.output.width, g.width), y);
+            w = static_cast<float>(std::clamp(w * scale * white / f, 0.0, 1.0));
+        }
+    }
+}
+
 // Step 4's beta for projector k (blacks and floor in matched-white units, blend not yet scaled);
 // returns the largest deficit D / W it met.
 double apply_beta(std::size_t k, const std::vector<DeviceModel>& models, const ScreenModel& screen,
@@ -321,14 +486,15 @@ double apply_beta(std::size_t k, const std::vector<DeviceModel>& models, const S
             double h = 0.0;
             float alpha = 0.0F;
             if (!pixel_on_screen(pc, screen, x, y, theta, h, alpha)) continue;
-            const std::array<double, 3> b = black_at(models, screen, blacks, theta, h, k);
+            const double f = falloff_at_output(models[k], pc, x, y);
+            const std::array<double, 3> b = black_at(models, screen, blacks, theta, h, k, f);
             const std::size_t g = (static_cast<std::size_t>(y) * static_cast<std::size_t>(pc.output.width) +
                                    static_cast<std::size_t>(x)) *
                                   3;
             for (std::size_t c = 0; c < 3; ++c) {
                 const double deficit = std::max(0.0, floor[c] - b[c]);
                 worst = std::max(worst, deficit);
-                pc.beta.rgb[g + c] = static_cast<float>(std::clamp(alpha * deficit, 0.0, 1.0));
+                pc.beta.rgb[g + c] = static_cast<float>(std::clamp(alpha * deficit / f, 0.0, 1.0));
             }
         }
     }
@@ -345,7 +511,7 @@ struct BlackSystem {
 };
 
 void accumulate_blacks(const ProjectorCalibration& pc, std::size_t k, const std::vector<DeviceModel>& models,
-                       const ScreenModel& screen, double scale, BlackSystem& sys) {
+                       const ScreenModel& screen, double scale, double white, BlackSystem& sys) {
     const auto n = static_cast<long>(models.size());
     Eigen::VectorXd a(n + 1);
     for (int y = 0; y < pc.output.height; y += 2) {
@@ -354,12 +520,17 @@ void accumulate_blacks(const ProjectorCalibration& pc, std::size_t k, const std:
             double h = 0.0;
             float weight = 0.0F;
             if (!pixel_on_screen(pc, screen, x, y, theta, h, weight)) continue;
-            const double alpha = weight / scale;
+            // beta_k = alpha_k (t - sum_j b_j F_j) / F_k with w = alpha_k s S / F_k.
+            const double alpha = weight / (scale * white);
             a[0] = alpha;
             for (long j = 0; j < n; ++j) {
-                const bool lit = static_cast<std::size_t>(j) == k ||
-                                 model_pixel(models[static_cast<std::size_t>(j)], screen, theta, h).allFinite();
-                a[j + 1] = lit ? -alpha : 0.0;
+                const DeviceModel& m = models[static_cast<std::size_t>(j)];
+                if (static_cast<std::size_t>(j) == k) {
+                    a[j + 1] = -alpha * falloff_at_output(m, pc, x, y);
+                    continue;
+                }
+                const Eigen::Vector2d p = model_pixel(m, screen, theta, h);
+                a[j + 1] = p.allFinite() ? -alpha * falloff_at(m, p.x(), p.y()) : 0.0;
             }
             const std::array<float, 3> beta =
                 pc.beta.rgb.empty() ? std::array<float, 3>{} : sample_beta(pc.beta, pc.output, x, y);
@@ -413,9 +584,10 @@ double response_at(const ChannelResponse& r, double s) {
     return s <= l[i] ? a * s / l[i] : a + (b - a) * (s - l[i]) / (l[i + 1] - l[i]);
 }
 
-ColourResult calibrate_colour(PatternSource& source, const ScreenModel& screen,
-                              const std::vector<DeviceModel>& projectors, ScreenCalibration& calibration,
+ColourResult calibrate_colour(PatternSource& source, const ScreenModel& screen, const DeviceModel& camera,
+                              std::vector<DeviceModel>& models, ScreenCalibration& calibration,
                               const ColourOptions& options) {
+    std::vector<DeviceModel> projectors = models;  // `models` changes only when all has succeeded
     check_options(options);
     if (projectors.size() != calibration.projectors.size() || projectors.empty()) {
         throw std::invalid_argument("calibrate_colour: " + std::to_string(projectors.size()) + " models for " +
@@ -425,7 +597,16 @@ ColourResult calibrate_colour(PatternSource& source, const ScreenModel& screen,
     const std::size_t n = projectors.size();
     ColourResult res;
     Captured cap;
-    cap.black = source.show(std::vector<cv::Mat>(n)).clone();  // written below; the source may reuse its buffer
+    cap.black = source.show(std::vector<cv::Mat>(n)).clone();
+    if (options.lens_falloff) {
+        if (camera.resolution.width != cap.black.cols || camera.resolution.height != cap.black.rows) {
+            throw std::invalid_argument("calibrate_colour: the camera model is " +
+                                        std::to_string(camera.resolution.width) + "x" +
+                                        std::to_string(camera.resolution.height) + ", its images " +
+                                        std::to_string(cap.black.cols) + "x" + std::to_string(cap.black.rows));
+        }
+        cap.screen = camera_screen_points(camera, screen);
+    }  // written below; the source may reuse its buffer
     res.captures = 1;
     source.set_relative_exposure(options.low_end_exposure);
     cap.black_low = cv::Mat1f(cap.black.size(), 0.0f);
@@ -445,9 +626,10 @@ ColourResult calibrate_colour(PatternSource& source, const ScreenModel& screen,
         }
     }
     for (std::size_t k = 0; k < n; ++k) {
-        res.projectors.push_back(measure_projector(source, projectors, k, options, cap, res.captures));
+        res.projectors.push_back(measure_projector(source, screen, projectors, k, options, cap, res.captures));
+        projectors[k].falloff = res.projectors[k].falloff;
     }
-    measure_black(source, options, cap, res.projectors, res.ambient, res.captures);
+    measure_black(source, options, cap, screen, projectors, res.projectors, res.ambient, res.captures);
     // Step 3: matched white, blacks per channel, black floor over the screen.
     std::vector<std::array<double, 3>> blacks(n);
     for (std::size_t c = 0; c < 3; ++c) {
@@ -475,6 +657,8 @@ ColourResult calibrate_colour(PatternSource& source, const ScreenModel& screen,
     }
     res.black_floor = black_floor(projectors, screen, blacks);
     res.alpha_scale = apply_measured_colour(colour, projectors, screen, calibration);
+    res.white_floor = white_floor(projectors, calibration);
+    models = projectors;
     return res;
 }
 
@@ -500,10 +684,10 @@ double apply_measured_colour(const MeasuredColour& colour, const std::vector<Dev
             worst = std::max(worst, apply_beta(k, models, screen, colour.black, floor, calibration.projectors[k]));
         }
     }
-    const double scale = 1.0 - worst;
-    for (ProjectorCalibration& pc : calibration.projectors) {
-        for (float& w : pc.blend.weight) w = static_cast<float>(w * scale);
-    }
+    // alpha s S / F + beta <= 1 with beta <= D / F and F >= S where alpha > 0: s = 1 - max D / S.
+    const double white = white_floor(models, calibration);
+    const double scale = 1.0 - worst / white;
+    for (std::size_t k = 0; k < models.size(); ++k) scale_blend(models[k], scale, white, calibration.projectors[k]);
     validate_screen(calibration);
     return scale;
 }
@@ -515,16 +699,32 @@ MeasuredColour measured_colour(const ScreenCalibration& calibration, const std::
     MeasuredColour out;
     out.black.assign(n, std::array<double, 3>{});
     float beta_max = 0.0F;
-    float scale = 0.0F;
     for (const ProjectorCalibration& pc : calibration.projectors) {
         out.responses.push_back(pc.response);
         for (const float b : pc.beta.rgb) beta_max = std::max(beta_max, b);
-        for (const float w : pc.blend.weight) scale = std::max(scale, w);
     }
-    if (!(beta_max > 0.0F) || !(scale > 0.0F)) return out;  // no black-level compensation
+    // w = alpha s S / F: s is the largest w F / S (alpha = 1 where one projector alone shows content).
+    const double white = white_floor(models, calibration);
+    double scale = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {
+        const ProjectorCalibration& pc = calibration.projectors[k];
+        const ImageSize g = pc.blend.size;
+        for (int j = 0; j < g.height; ++j) {
+            const double y = grid_to_output(j, pc.output.height, g.height);
+            for (int i = 0; i < g.width; ++i) {
+                const float w = pc.blend.weight[static_cast<std::size_t>(j) * g.width + i];
+                if (!(w > 0.0F)) continue;
+                const double f = falloff_at_output(models[k], pc, grid_to_output(i, pc.output.width, g.width), y);
+                scale = std::max(scale, w * f / white);
+            }
+        }
+    }
+    if (!(beta_max > 0.0F) || !(scale > 0.0)) return out;  // no black-level compensation
     BlackSystem sys{Eigen::MatrixXd::Zero(static_cast<long>(n) + 1, static_cast<long>(n) + 1),
                     Eigen::MatrixXd::Zero(static_cast<long>(n) + 1, 3)};
-    for (std::size_t k = 0; k < n; ++k) accumulate_blacks(calibration.projectors[k], k, models, screen, scale, sys);
+    for (std::size_t k = 0; k < n; ++k) {
+        accumulate_blacks(calibration.projectors[k], k, models, screen, scale, white, sys);
+    }
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(sys.ata);
     const Eigen::VectorXd ev = eig.eigenvalues();
     if (sys.rows == 0 || !(ev.minCoeff() > 1e-10 * ev.maxCoeff())) {

@@ -11,9 +11,13 @@
 //
 // Method (Majumder & Stevens, "Color nonuniformity in projection-based displays: analysis and
 // solutions", IEEE TVCG 10(2) 2004: the display's range at a point is [black, white]; make it the
-// same everywhere by per-pixel attenuation of the white and offset of the black. This is its
-// simpler documented form for projectors whose light is spatially uniform, as on the virtual rig:
-// one gain per projector and channel instead of a per-pixel luminance attenuation map):
+// same everywhere by per-pixel attenuation of the white and offset of the black. Here in a
+// documented simpler form: one gain per projector and channel (its chrominance, assumed the same
+// over its image), times a per-pixel luminance attenuation from the projector's lens fall-off,
+// measured as a smooth quadratic (autocal.h's LensFalloff), towards a flat white: the limit of
+// Majumder & Stevens' perceptual smoothing, "Perceptual photometric seamlessness in projection-based
+// tiled displays", ACM TOG 24(1) 2005, at zero allowed gradient, which gives up the brightness of
+// the dimmest corner that shows content):
 //  1. Response: projector k, channel c at levels s_i = i / (ramp_steps - 1), the others black;
 //     y_kc(s) = mean over the camera pixels k lights (its coverage mask, eroded) of the image
 //     minus the all-black image; levels up to 1/4, and 1/32 and 1/16, again at low_end_exposure x
@@ -22,21 +26,29 @@
 //     normalised response R_kc(s) = y_kc(s) / A_kc (made non-decreasing) is interpolated as a
 //     power law between measured levels (linear in log s - log R, so a pure gamma is exact) and
 //     continued below s_1 with the first segment's exponent.
+//  1b. Fall-off (`lens_falloff`): F_k = the quadratic in projector k's image positions fitted by
+//     least squares to its summed full-level images over the eroded mask, each camera pixel placed
+//     in the projector by the camera and projector models through the screen; scaled to mean 1
+//     there, and A_kc taken as the mean over the same pixels, so A_kc F_k(p) is the light of pixel p.
+//     The camera's own vignetting is taken to be calibrated out (a flat-field image) or negligible;
+//     the virtual rig's camera has none.
 //  2. Black: `dark_frames` all-black images at `dark_exposure` x the base exposure (black levels are
 //     ~0.2 % of white, below one 8-bit code at the base exposure), averaged; least squares over
 //     the camera pixels inside the screen: L0(p) = a + sum_k beta_k M_k(p) with M_k the coverage
-//     masks (a = ambient, beta_k = projector k's black). Needs at least one overlap to separate
+//     masks times F_k (a = ambient, beta_k = projector k's black). Needs at least one overlap to separate
 //     a from the betas. Black's chromaticity is taken to be the projector's white's (light leaking
 //     through the same filters): black_kc = beta_k A_kc / sum_c A_kc (the mono camera sees the
 //     mean of the channels, and A_kc is one channel's light as it sees it).
 //  3. Matching: matched white W_c = min_k A_kc per channel (the largest white every projector can
 //     show, so the white point is the same everywhere; it is the per-channel minimum, not a chosen
 //     standard white). Black floor: T_c = max over screen points of B_c(p) = sum_{k lighting p}
-//     black_kc; deficit D_c(p) = T_c - B_c(p) >= 0.
+//     black_kc F_k; deficit D_c(p) = T_c - B_c(p) >= 0. White floor S = min F_k(p) over the
+//     pixels that show content (1 without fall-off).
 //  4. Per projector: LUT_kc(x) = R_kc^-1(x W_c / A_kc) (the ResponseCurve, x in matched-white
-//     units); beta_kc(p) = alpha_k(p) D_c(p) / W_c (the BlackOffset, one sample per output pixel, split between the
-//     projectors lighting p by their blend weights); alpha_k scaled by s = 1 - max_c,p D_c(p) / W_c so that x = alpha s
-//     c + beta stays <= 1. The screen then shows T_c + s W_c c everywhere for content c.
+//     units); beta_kc(p) = alpha_k(p) D_c(p) / (W_c F_k(p)) (the BlackOffset, one sample per output pixel, split
+//     between the projectors lighting p by their blend weights); alpha_k replaced by alpha_k s S / F_k with
+//     s = 1 - max_c,p D_c(p) / (W_c S) so that x = alpha s S c / F + beta stays <= 1. The screen then shows
+//     T_c + s S W_c c everywhere for content c.
 #pragma once
 
 #include <array>
@@ -56,6 +68,8 @@ struct ColourOptions {
     double min_amplitude = 0.05;    // a channel's full white must reach this much of full scale
     double max_fit_rms = 0.03;      // rms of the measured response around a pure gamma, gate
     int mask_erode_px = 2;          // coverage masks shrunk by this many camera pixels (blur, seams)
+    bool lens_falloff = true;       // step 1b: measure each projector's fall-off and attenuate per pixel
+    int falloff_min_samples = 1000;  // camera pixels a projector's fall-off fit needs, >= 6
 };
 
 struct ChannelResponse {
@@ -71,6 +85,7 @@ struct ProjectorPhotometry {
     std::array<ChannelResponse, 3> channels;
     double black = 0.0;            // beta_k, camera units (mono)
     std::array<double, 3> gain{};  // W_c / A_kc
+    LensFalloff falloff;           // F_k (flat unless ColourOptions::lens_falloff)
 };
 
 struct ColourResult {
@@ -79,23 +94,29 @@ struct ColourResult {
     std::array<double, 3> black_floor{};    // T_c, camera units
     double ambient = 0.0;                   // a, camera units (mono)
     double alpha_scale = 1.0;               // s
+    double white_floor = 1.0;               // S: the wall's white is S W_c
     int captures = 0;
 };
 
 // Measures (steps 1-2) and applies (steps 3-4) to `calibration` (from calibrate(): its warps,
-// blends and the fitted `projectors` give each output pixel's screen point and which projectors
-// light it). Throws CalibrationRefused when the camera's exposure is not locked, a channel is
-// too dark for the camera, a response is not monotone or far from any gamma (max_fit_rms), or the
-// black levels cannot be separated (no overlap seen); std::invalid_argument for bad options.
-[[nodiscard]] ColourResult calibrate_colour(PatternSource& source, const ScreenModel& screen,
-                                            const std::vector<DeviceModel>& projectors, ScreenCalibration& calibration,
+// blends, the fitted `camera` and `projectors` give each output pixel's screen point, which
+// projectors light it and which projector pixel each camera pixel sees). Sets each projector
+// model's `falloff` to the measured one (what the models file keeps for self-recalibration).
+// Throws CalibrationRefused when the camera's exposure is not locked, a channel is too dark for
+// the camera, a response is not monotone or far from any gamma (max_fit_rms), a fall-off cannot
+// be measured (too few pixels seen) or is no lens's (outside [0.05, 5] of its mean), or the black
+// levels cannot be separated (no overlap seen); std::invalid_argument for bad options or a camera
+// model whose resolution is not its images'.
+[[nodiscard]] ColourResult calibrate_colour(PatternSource& source, const ScreenModel& screen, const DeviceModel& camera,
+                                            std::vector<DeviceModel>& projectors, ScreenCalibration& calibration,
                                             const ColourOptions& options = {});
 
 // The colour a calibration measured, in the part that does not depend on where the projectors
 // point: what a bumped projector keeps (self-recalibration, appliance/selfcal, re-applies it to the
 // corrected geometry). A projector's response and its black light are properties of its lamp,
-// panel and filters, not of its pose; the black floor T_c, the beta maps and the blend scale s are
-// defined on the screen's overlaps and so follow the geometry (step 3-4 redone for it).
+// panel and filters, not of its pose, and so is its lens fall-off (kept in its DeviceModel, in its
+// own image positions); the black floor T_c, the white floor S, the beta maps and the blend scale s
+// are defined on the screen's overlaps and so follow the geometry (step 3-4 redone for it).
 struct MeasuredColour {
     std::vector<ResponseCurve> responses;      // per projector: LUT_kc of step 4 (input in matched-white units)
     std::vector<std::array<double, 3>> black;  // per projector and channel: black_kc / W_c (matched-white units, >= 0)
@@ -103,17 +124,19 @@ struct MeasuredColour {
 
 // Steps 3 (black floor) and 4 (maps) for the geometry of `models`: every projector's response
 // becomes colour.responses[k], its beta (one sample per output pixel, as calibrate_colour) the
-// compensation of the blacks at the overlaps `models` give, and the blend masks are scaled by s =
-// 1 - max D/W. `calibration` must be the unscaled one calibration_from_models(models) builds (no
+// compensation of the blacks at the overlaps `models` give (through each model's fall-off), and
+// the blend masks become w s S / F (s = 1 - max D / (W S); S and F as in step 4, 1 for flat
+// models). `calibration` must be the unscaled one calibration_from_models(models) builds (no
 // beta). All-zero blacks: no beta map (empty) and s = 1, only the responses change. Returns s.
 // Throws std::invalid_argument when the sizes do not match (projector count, response validity).
 double apply_measured_colour(const MeasuredColour& colour, const std::vector<DeviceModel>& models,
                              const ScreenModel& screen, ScreenCalibration& calibration);
 
 // The inverse, for a calibration that calibrate_colour or apply_measured_colour made with `models`
-// (e.g. read back from its MPCDI file): responses copied; s = the largest blend weight (1 before
-// scaling wherever one projector alone lights the screen); the blacks by linear least squares on
-//   beta_kc(p) = (w_k(p) / s) (t_c - sum over projectors j lighting p of b_jc)
+// (e.g. read back from its MPCDI file; the fall-offs from its models file): responses copied;
+// s = the largest w F / S (alpha = 1 wherever one projector alone lights the screen); the blacks by
+// linear least squares on
+//   beta_kc(p) = (w_k(p) / (s S)) (t_c - sum over projectors j lighting p of b_jc F_j(p))
 // over every other output pixel (x and y) with w_k > 0, for the unknowns t_c (the black floor)
 // and b_jc. A calibration without beta maps (or all-zero ones) gives zero blacks. Throws
 // std::invalid_argument naming the cause when the models do not match the calibration, or when it

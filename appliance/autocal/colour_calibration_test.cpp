@@ -45,7 +45,7 @@ TEST(ColourCalibration, NoisyCameraMeasuresTheTrueGamma) {
     RigPatternSource source(rig);
     const CalibrationPrior prior = prior_from_rig(rig);
     AutocalResult r = calibrate(source, prior, {960, 540}, fast_options());
-    const ColourResult c = calibrate_colour(source, prior.screen, r.projectors, r.calibration);
+    const ColourResult c = calibrate_colour(source, prior.screen, r.camera, r.projectors, r.calibration);
     for (const ProjectorPhotometry& p : c.projectors) {
         for (const ChannelResponse& ch : p.channels) EXPECT_NEAR(ch.gamma, 2.2, 0.03) << p.id;
     }
@@ -57,7 +57,7 @@ TEST(ColourCalibration, MatchesProjectorsOfDifferentBrightnessAndColourTemperatu
     const CalibrationPrior prior = prior_from_rig(rig);
     AutocalResult r = calibrate(source, prior, {960, 540}, fast_options());
     const ScreenCalibration before = r.calibration;
-    const ColourResult c = calibrate_colour(source, prior.screen, r.projectors, r.calibration);
+    const ColourResult c = calibrate_colour(source, prior.screen, r.camera, r.projectors, r.calibration);
     // Responses against the rig's true gammas; blacks against brightness x black level (mono).
     for (std::size_t k = 0; k < 3; ++k) {
         const rig::RigProjector& p = rig.projectors[k];
@@ -84,6 +84,69 @@ TEST(ColourCalibration, MatchesProjectorsOfDifferentBrightnessAndColourTemperatu
     }
 }
 
+// Lens fall-off that differs per projector (rigs/falloff.toml: 20, 12 and 30 % at half the
+// diagonal): one gain per projector leaves the overlaps where one projector's dim edge meets the
+// other's; the measured fall-off's per-pixel attenuation must bring them within issue 13's 1 %.
+// The measured shape is checked against the rig's own (rig_bridge's falloff_of), not the fit's.
+TEST(ColourCalibration, LensFalloffIsMeasuredAndAttenuatedPerPixel) {
+    const rig::VirtualRig rig =
+        scaled_rig(rig::load_rig(std::string(MOGAO_SOURCE_DIR) + "/rigs/falloff.toml"), 0.25, 0.25);
+    RigPatternSource source(rig);
+    const CalibrationPrior prior = prior_from_rig(rig);
+    const AutocalResult geometry = calibrate(source, prior, {960, 540}, fast_options());
+    AutocalResult flat = geometry;
+    ColourOptions one_gain;
+    one_gain.lens_falloff = false;
+    (void)calibrate_colour(source, prior.screen, flat.camera, flat.projectors, flat.calibration, one_gain);
+    AutocalResult r = geometry;
+    const ColourResult c = calibrate_colour(source, prior.screen, r.camera, r.projectors, r.calibration);
+    for (std::size_t k = 0; k < 3; ++k) {
+        // F measured / F true is the same (the normalisation) all over the image, within 1 %.
+        DeviceModel truth = r.projectors[k];
+        truth.falloff = falloff_of(rig.projectors[k]);
+        const ImageSize res = truth.resolution;
+        double lo = 1e9;
+        double hi = 0.0;
+        for (int j = 0; j <= 4; ++j) {
+            for (int i = 0; i <= 4; ++i) {
+                const double x = res.width * (0.1 + 0.2 * i);
+                const double y = res.height * (0.1 + 0.2 * j);
+                const double ratio = falloff_at(r.projectors[k], x, y) / falloff_at(truth, x, y);
+                lo = std::min(lo, ratio);
+                hi = std::max(hi, ratio);
+            }
+        }
+        EXPECT_LT(hi / lo - 1.0, 0.01) << rig.projectors[k].id;
+        EXPECT_EQ(c.projectors[k].falloff.c, r.projectors[k].falloff.c);
+        EXPECT_TRUE(flat.projectors[k].falloff.flat());
+    }
+    EXPECT_LT(c.white_floor, 0.95);  // the dimmest corner that shows content sets the wall's white
+    for (const double level : {0.0, 0.5, 1.0}) {
+        SCOPED_TRACE(level);
+        const SeamColour one = measure_seam_colour(rig, flat.calibration, level);
+        const SeamColour per_pixel = measure_seam_colour(rig, r.calibration, level);
+        std::printf("content %.2f: seam luminance p95 one gain %.2f %%, per pixel %.2f %%; max %.2f %% -> %.2f %%\n",
+                    level, 100.0 * one.seam_luminance_p95, 100.0 * per_pixel.seam_luminance_p95,
+                    100.0 * one.seam_luminance_deviation, 100.0 * per_pixel.seam_luminance_deviation);
+        EXPECT_LT(per_pixel.seam_luminance_p95, level == 0.0 ? 0.012 : 0.015);  // as the colour rig: scale 0.25
+        if (level > 0.0) {
+            EXPECT_GT(one.seam_luminance_p95, 0.05);
+            EXPECT_LT(per_pixel.seam_delta_e_p95, 0.6);
+        }
+    }
+    // What self-recalibration re-derives from the written maps and the models' fall-offs.
+    const MeasuredColour back = measured_colour(r.calibration, r.projectors, prior.screen);
+    for (std::size_t k = 0; k < 3; ++k) {
+        for (std::size_t ch = 0; ch < 3; ++ch) {
+            const double black = c.projectors[k].black * c.projectors[k].channels[ch].amplitude /
+                                 (c.projectors[k].channels[0].amplitude + c.projectors[k].channels[1].amplitude +
+                                  c.projectors[k].channels[2].amplitude) /
+                                 c.matched_white[ch];
+            EXPECT_NEAR(back.black[k][ch] / black, 1.0, 0.05) << k << " " << ch;
+        }
+    }
+}
+
 TEST(ColourCalibration, RefusesAutoExposureAndAChannelTooDarkForTheCamera) {
     rig::VirtualRig rig = colour_rig();
     RigPatternSource locked(rig);
@@ -94,7 +157,7 @@ TEST(ColourCalibration, RefusesAutoExposureAndAChannelTooDarkForTheCamera) {
     rig.camera.auto_exposure = true;
     RigPatternSource metered(rig);
     try {
-        (void)calibrate_colour(metered, prior.screen, r.projectors, r.calibration);
+        (void)calibrate_colour(metered, prior.screen, r.camera, r.projectors, r.calibration);
         FAIL() << "calibrated with auto-exposure on";
     } catch (const CalibrationRefused& e) {
         EXPECT_NE(std::string(e.what()).find("auto-exposure is not locked"), std::string::npos) << e.what();
@@ -105,7 +168,7 @@ TEST(ColourCalibration, RefusesAutoExposureAndAChannelTooDarkForTheCamera) {
     rig.projectors[1].brightness[2] = 0.05;  // a blue channel the camera barely sees
     RigPatternSource dim(rig);
     try {
-        (void)calibrate_colour(dim, prior.screen, r.projectors, r.calibration);
+        (void)calibrate_colour(dim, prior.screen, r.camera, r.projectors, r.calibration);
         FAIL() << "calibrated a channel below the camera's reach";
     } catch (const CalibrationRefused& e) {
         EXPECT_NE(std::string(e.what()).find("proj1' channel B"), std::string::npos) << e.what();

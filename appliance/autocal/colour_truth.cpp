@@ -34,12 +34,13 @@ std::vector<Point> screen_light(const rig::VirtualRig& rig, const ScreenCalibrat
             const std::array<float, 3> beta = sample_beta(pc.beta, pc.output, x, y);
             if (w > 0.0F) ++pt.lit;
             const rig::RigProjector& rp = rig.projectors[k];
+            const double f = rig::projector_falloff(rp, x + 0.5, y + 0.5);
             for (std::size_t c = 0; c < 3; ++c) {
                 const double signal =
                     shown ? apply_response(pc.response, static_cast<int>(c), static_cast<float>(level) * w + beta[c])
                           : 0.0;
                 pt.rgb[c] +=
-                    rp.brightness[c] * (rp.black_level + (1.0 - rp.black_level) * std::pow(signal, rp.gamma[c]));
+                    f * rp.brightness[c] * (rp.black_level + (1.0 - rp.black_level) * std::pow(signal, rp.gamma[c]));
             }
         }
         points.push_back(pt);

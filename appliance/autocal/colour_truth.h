@@ -2,7 +2,8 @@
 // Seams as the viewer sees them, against the virtual rig's ground truth (never the calibration's
 // own prediction): flat grey content through a ScreenCalibration (warp validity, blend, beta,
 // response, as render_output computes them) onto the rig's true light paths and responses
-// (virtual_rig.h: brightness_c (black + (1 - black) s^gamma_c) per projector, plus ambient).
+// (virtual_rig.h: F(x, y) brightness_c (black + (1 - black) s^gamma_c) per projector, F the lens fall-off,
+// plus ambient).
 //
 // Colour: the rig's linear RGB light is read as ITU-R BT.709 / sRGB primaries with D65 white
 // (IEC 61966-2-1 matrix to CIE XYZ), luminance Y = 0.2126 R + 0.7152 G + 0.0722 B; CIELAB (CIE

@@ -131,21 +131,38 @@ DeviceModel read_device(const Reader& r, bool camera) {
     d.rotation = read_rotation(r);
     const std::vector<double> p = r.numbers("position_m", 3, -1e3, 1e3, "[-1000, 1000] m");
     d.position_m = Eigen::Vector3d(p[0], p[1], p[2]);
+    if (r.json().contains("falloff")) {
+        if (camera) r.fail("falloff", " is a projector's (the camera has none)");
+        const std::vector<double> c = r.numbers("falloff", 6, -10.0, 10.0, "[-10, 10]");
+        std::copy(c.begin(), c.end(), d.falloff.c.begin());
+        // Over the image (corners, edge middles, centre) the relative light must stay a light.
+        for (int j = 0; j <= 2; ++j) {
+            for (int i = 0; i <= 2; ++i) {
+                const double f = falloff_at(d, d.resolution.width * i / 2.0, d.resolution.height * j / 2.0);
+                if (!(f >= 0.05 && f <= 5.0)) {
+                    r.fail("falloff", fmt::format(" gives {:.3g} at image position ({}, {}), outside [0.05, 5]", f,
+                                                  d.resolution.width * i / 2.0, d.resolution.height * j / 2.0));
+                }
+            }
+        }
+    }
     return d;
 }
 
 Json device_json(const DeviceModel& d) {
     Json rotation = Json::array();
     for (int i = 0; i < 3; ++i) rotation.push_back({d.rotation(i, 0), d.rotation(i, 1), d.rotation(i, 2)});
-    return {{"id", d.id},
-            {"resolution", {d.resolution.width, d.resolution.height}},
-            {"fx_px", d.fx_px},
-            {"fy_px", d.fy_px},
-            {"cx_px", d.cx_px},
-            {"cy_px", d.cy_px},
-            {"distortion", d.distortion},
-            {"rotation", rotation},
-            {"position_m", {d.position_m.x(), d.position_m.y(), d.position_m.z()}}};
+    Json out = {{"id", d.id},
+                {"resolution", {d.resolution.width, d.resolution.height}},
+                {"fx_px", d.fx_px},
+                {"fy_px", d.fy_px},
+                {"cx_px", d.cx_px},
+                {"cy_px", d.cy_px},
+                {"distortion", d.distortion},
+                {"rotation", rotation},
+                {"position_m", {d.position_m.x(), d.position_m.y(), d.position_m.z()}}};
+    if (!d.falloff.flat()) out["falloff"] = d.falloff.c;  // absent = flat (files written before it read the same)
+    return out;
 }
 
 }  // namespace

@@ -17,7 +17,10 @@
 //                                                                // (projectors: all 0)
 //             "rotation": [[r00, r01, r02], [..], [..]],         // device -> screen frame, row-major,
 //                                                                // orthonormal, det +1 (within 1e-6)
-//             "position_m": [x, y, z]}                          // device centre, screen frame, metres
+//             "position_m": [x, y, z],                          // device centre, screen frame, metres
+//             "falloff": [c0, .., c5]}                          // projectors, optional (absent = flat):
+//                                                                // autocal.h's LensFalloff, each in
+//                                                                // [-10, 10], F in [0.05, 5] over the image
 // Frames and pixel conventions are autocal.h's (the virtual rig's): screen frame in metres, +y up
 // the cylinder's axis, -z to the middle of the arc, origin on the axis at floor level; devices in
 // OpenCV's camera frame (x right, y down, z forward); image positions with pixel (x, y)'s centre at

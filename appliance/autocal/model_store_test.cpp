@@ -35,6 +35,7 @@ protected:
             DeviceModel d = prior.projectors[k];
             d.rotation = rig::device_to_screen(rig.projectors[k].pose);
             d.position_m = rig.projectors[k].pose.position_m;
+            if (k == 1) d.falloff = {{1.02, 0.01, -0.02, -0.2, 0.03, -0.25}};  // a measured lens fall-off
             models_.projectors.push_back(d);
         }
     }
@@ -78,9 +79,13 @@ TEST_F(ModelStoreTest, RoundTripKeepsEveryField) {
         EXPECT_EQ(a.distortion, b.distortion);
         EXPECT_EQ(a.rotation, b.rotation);
         EXPECT_EQ(a.position_m, b.position_m);
+        EXPECT_EQ(a.falloff.c, b.falloff.c);
     };
     same(back.camera, models_.camera);
     for (std::size_t k = 0; k < back.projectors.size(); ++k) same(back.projectors[k], models_.projectors[k]);
+    EXPECT_FALSE(back.projectors[1].falloff.flat());
+    // A flat projector writes no "falloff" (files from before it read the same); absent reads flat.
+    EXPECT_FALSE(models_json(models_)["projectors"][0].contains("falloff"));
     EXPECT_FALSE(fs::exists(file.string() + ".tmp")) << "no temporary left behind";
 }
 
@@ -130,6 +135,14 @@ TEST_F(ModelStoreTest, BadInputNamesFileFieldAndLimit) {
     EXPECT_NE(error_of([](nlohmann::json& j) {
                   j["projectors"][2]["rotation"][0][0] = 0.5;
               }).find(file + ": projectors[2].rotation is not orthonormal"),
+              std::string::npos);
+    EXPECT_EQ(error_of([](nlohmann::json& j) { j["camera"]["falloff"] = {1, 0, 0, 0, 0, 0}; }),
+              file + ": camera.falloff is a projector's (the camera has none)");
+    EXPECT_EQ(error_of([](nlohmann::json& j) { j["projectors"][1]["falloff"][5] = 11.0; }),
+              file + ": projectors[1].falloff[5] = 11 is outside [-10, 10]");
+    EXPECT_NE(error_of([](nlohmann::json& j) {
+                  j["projectors"][1]["falloff"][3] = -3.0;
+              }).find(file + ": projectors[1].falloff gives "),
               std::string::npos);
     EXPECT_EQ(error_of([](nlohmann::json& j) { j["projectors"][0]["distortion"][0] = 0.1; }),
               file + ": projectors[0].distortion[0] must be 0 (projectors are pinholes)");

@@ -52,9 +52,16 @@ CalibrationPrior prior_from_rig(const rig::VirtualRig& rig) {
     pose.pitch_deg += e.camera_angle_error_deg.y();
     pose.roll_deg += e.camera_angle_error_deg.z();
     const double cf = 1.0 + e.camera_focal_error;
-    prior.camera = {"camera",           c.resolution,       c.intrinsics.fx_px * cf, c.intrinsics.fy_px * cf,
-                    c.intrinsics.cx_px, c.intrinsics.cy_px, c.intrinsics.distortion, rig::device_to_screen(pose),
-                    pose.position_m};
+    prior.camera = {"camera",
+                    c.resolution,
+                    c.intrinsics.fx_px * cf,
+                    c.intrinsics.fy_px * cf,
+                    c.intrinsics.cx_px,
+                    c.intrinsics.cy_px,
+                    c.intrinsics.distortion,
+                    rig::device_to_screen(pose),
+                    pose.position_m,
+                    {}};
     const double pf = 1.0 + e.projector_focal_error;
     for (const rig::RigProjector& p : rig.projectors) {
         prior.projectors.push_back({p.id,
@@ -65,7 +72,8 @@ CalibrationPrior prior_from_rig(const rig::VirtualRig& rig) {
                                     p.intrinsics.cy_px,
                                     {},
                                     Eigen::Matrix3d::Identity(),
-                                    Eigen::Vector3d::Zero()});
+                                    Eigen::Vector3d::Zero(),
+                                    {}});  // fall-off unknown before the colour step measures it
     }
     return prior;
 }
@@ -129,6 +137,8 @@ std::optional<std::array<int, 2>> output_pixel(const rig::VirtualRig& rig, int k
                               std::clamp(static_cast<int>(std::floor(p->y())), 0, pc.output.height - 1)};
 }
 
+LensFalloff falloff_of(const rig::RigProjector& p) { return {{1.0, 0.0, 0.0, -p.falloff, 0.0, -p.falloff}}; }
+
 LuminanceError measure_luminance(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double inset) {
     std::vector<double> lum;
     std::vector<bool> seam;
@@ -142,9 +152,10 @@ LuminanceError measure_luminance(const rig::VirtualRig& rig, const ScreenCalibra
             const float w = sample_blend(pc.blend, pc.output, (*xy)[0], (*xy)[1]);
             if (w > 0.0f) ++lit;
             const rig::RigProjector& rp = rig.projectors[k];
+            const double f = rig::projector_falloff(rp, (*xy)[0] + 0.5, (*xy)[1] + 0.5);
             for (int c = 0; c < 3; ++c) {
                 const double signal = apply_response(pc.response, c, w);
-                l += rp.brightness[static_cast<std::size_t>(c)] *
+                l += f * rp.brightness[static_cast<std::size_t>(c)] *
                      std::pow(signal, rp.gamma[static_cast<std::size_t>(c)]) / 3.0;
             }
         }

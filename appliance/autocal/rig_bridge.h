@@ -79,9 +79,14 @@ struct LuminanceError {
     double seam_max_deviation = 0.0;  // the same over points lit by two or more projectors
 };
 
+// The rig's true lens fall-off of projector `p` as a model's LensFalloff (virtual_rig.h's
+// 1 - falloff rho^2 is the quadratic (1, 0, 0, -falloff, 0, -falloff) about the principal point;
+// exact where rho^2 <= 2, which covers the image for lens shifts up to half the image).
+[[nodiscard]] LensFalloff falloff_of(const rig::RigProjector& p);
+
 // White content through the calibration onto the rig (ground truth projections, the rig's
-// responses and brightness, black level left out: black-level compensation is a later step), on
-// a grid of content points inset by `inset` of the frame on every side.
+// responses, brightness and lens fall-off, black level left out: black-level compensation is a
+// later step), on a grid of content points inset by `inset` of the frame on every side.
 [[nodiscard]] LuminanceError measure_luminance(const rig::VirtualRig& rig, const ScreenCalibration& calibration,
                                                double inset = 0.01);
 

@@ -14,7 +14,8 @@
 
 namespace mogao::autocal {
 
-// Unit-free ray directions in the screen frame through camera image positions (undistorted).
+// Unit-free ray directions through camera image positions, undistorted, in the camera frame (z = 1;
+// camera.rotation takes them to the screen frame).
 [[nodiscard]] std::vector<Eigen::Vector3d> camera_rays(const DeviceModel& camera,
                                                        const std::vector<cv::Point2d>& image);
 

@@ -133,6 +133,7 @@ RigProjector read_projector(Table& t, int k) {
     p.gamma = t.numbers<3>("gamma", p.gamma);
     p.black_level = t.number("black_level", p.black_level);
     p.brightness = t.numbers<3>("brightness", p.brightness);
+    p.falloff = t.number("falloff", p.falloff);
     t.finish();
     return p;
 }

@@ -94,6 +94,7 @@ void validate_rig(const VirtualRig& rig) {
         for (double g : p.gamma) check_range(g, 0.1, 10.0, f + ".gamma");
         for (double b : p.brightness) check_range(b, 1e-3, 100.0, f + ".brightness");
         check_range(p.black_level, 0.0, 0.5, f + ".black_level");
+        check_range(p.falloff, 0.0, 0.45, f + ".falloff");
     }
     const RigCamera& c = rig.camera;
     validate_size(c.resolution, "camera.resolution");
@@ -119,6 +120,13 @@ Eigen::Matrix3d device_to_screen(const RigPose& pose) {
                                   .toRotationMatrix();
     // Device x right = screen +x, y down = -y, forward = -z at zero angles.
     return r * Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();
+}
+
+double projector_falloff(const RigProjector& p, double x, double y) {
+    const double half_diagonal = 0.5 * std::hypot(p.resolution.width, p.resolution.height);
+    const double rho2 =
+        (std::pow(x - p.intrinsics.cx_px, 2) + std::pow(y - p.intrinsics.cy_px, 2)) / (half_diagonal * half_diagonal);
+    return 1.0 - p.falloff * std::min(rho2, 2.0);
 }
 
 std::optional<ScreenPoint> projector_to_screen(const VirtualRig& rig, int k, double x, double y) {
@@ -214,7 +222,8 @@ cv::Mat1f CameraSimulator::capture(const std::vector<cv::Mat>& signals, std::uin
                                         "x" + std::to_string(r.height));
         }
     }
-    // Light per projector pixel value, per channel: brightness * (black + (1 - black) * s^gamma), mean of channels.
+    // Light per projector pixel value before the fall-off, per channel: brightness * (black + (1 - black) * s^gamma),
+    // mean of channels.
     const auto light = [&](std::size_t k, const float* v, int channels) {
         const RigProjector& p = rig_.projectors[k];
         double sum = 0.0;
@@ -241,9 +250,13 @@ cv::Mat1f CameraSimulator::capture(const std::vector<cv::Mat>& signals, std::uin
                             if (h < 0) continue;
                             const float zero = 0.0f;
                             const cv::Mat& s = signals[k];
-                            l += s.empty() ? light(k, &zero, 1)
-                                           : light(k, s.ptr<float>() + static_cast<std::size_t>(h) * s.channels(),
-                                                   s.channels());
+                            const RigProjector& p = rig_.projectors[k];
+                            const double f = p.falloff == 0.0 ? 1.0
+                                                              : projector_falloff(p, h % p.resolution.width + 0.5,
+                                                                                  h / p.resolution.width + 0.5);
+                            l += f * (s.empty() ? light(k, &zero, 1)
+                                                : light(k, s.ptr<float>() + static_cast<std::size_t>(h) * s.channels(),
+                                                        s.channels()));
                         }
                         acc += l;
                     }

@@ -23,9 +23,14 @@
 // Reconstruction").
 //
 // Light (linear, relative to a projector's full white = 1): projector k at signal s in [0, 1]
-// (per channel c) puts brightness_k[c] * (black + (1 - black) * s^gamma_k[c]) on the screen point
-// its pixel lands on, independent of distance and incidence (pixel-density fall-off is outside
-// the model, as in appliance/warp/composite.h); light of all projectors adds, plus `ambient`.
+// (per channel c) puts F_k(x, y) * brightness_k[c] * (black + (1 - black) * s^gamma_k[c]) on the
+// screen point its pixel (x, y) lands on, independent of distance and incidence (pixel-density
+// fall-off is outside the model, as in appliance/warp/composite.h); light of all projectors adds,
+// plus `ambient`. F_k is the lens's fall-off (vignetting), radial about the principal point:
+// F = 1 - falloff_k * min(rho^2, 2), rho = distance from (cx, cy) / half the image's diagonal (the
+// leading term of the cos^4 law's expansion, 1 - 2 tan^2 phi, with its strength a free parameter:
+// projector optics are not a plain pinhole; ANSI/INFOCOMM 3M-2011 reports the corner-to-centre
+// ratio a data sheet calls uniformity, e.g. 85 % ~ falloff 0.15). Black light passes the same lens.
 // The camera is monochrome with a flat spectral response: it sees the mean of the three channels,
 // integrated over each pixel by `supersample`^2 point samples, blurred by a Gaussian of
 // `blur_sigma_px`, scaled by exposure * gain, with Gaussian noise of standard deviation
@@ -79,6 +84,7 @@ struct RigProjector {
     std::array<double, 3> gamma{2.2, 2.2, 2.2};       // per channel, (0, 10]
     double black_level = 0.002;                       // fraction of full white at signal 0, [0, 1)
     std::array<double, 3> brightness{1.0, 1.0, 1.0};  // full white per channel, (0, 100]
+    double falloff = 0.0;                             // lens fall-off at half the diagonal, [0, 0.45]
 };
 
 struct RigCamera {
@@ -137,6 +143,10 @@ void validate_rig(const VirtualRig& rig);
 // Ground truth, the other way: the image position of projector k that lands on screen point p, or
 // nullopt when p is behind the projector or outside its image [0, W) x [0, H).
 [[nodiscard]] std::optional<Eigen::Vector2d> screen_to_projector(const VirtualRig& rig, int k, ScreenPoint p);
+
+// Ground truth: projector k's relative light at image position (x, y) (F in the header comment; 1
+// on the principal point, in (0, 1]).
+[[nodiscard]] double projector_falloff(const RigProjector& p, double x, double y);
 
 // Content (u, v) of a screen point and back (formulas in the header comment).
 [[nodiscard]] Eigen::Vector2d content_of(const RigScreen& screen, ScreenPoint p);

@@ -98,6 +98,37 @@ TEST(VirtualRig, LitBlockAppearsWhereTheCameraModelProjectsIt) {
     }
 }
 
+// The lens fall-off dims a block off the principal point by 1 - falloff rho^2 (rho over half the
+// diagonal, written out here again) and leaves one on it as it was.
+TEST(VirtualRig, LensFalloffDimsTheImageAwayFromThePrincipalPoint) {
+    VirtualRig flat = standard();
+    flat.camera.read_noise = 0.0;
+    flat.camera.shot_noise = 0.0;
+    flat.camera.bits = 16;
+    flat.ambient = 0.0;
+    VirtualRig dim = flat;
+    dim.projectors[1].falloff = 0.3;
+    const CameraSimulator sim_flat(flat);
+    const CameraSimulator sim_dim(dim);
+    const RigIntrinsics& in = flat.projectors[1].intrinsics;
+    const double half_diagonal = 0.5 * std::hypot(1920.0, 1080.0);
+    for (const cv::Point2d c :
+         {cv::Point2d(in.cx_px, in.cy_px), cv::Point2d(400.0, 300.0), cv::Point2d(1500.0, 850.0)}) {
+        std::vector<cv::Mat> signals(3);
+        signals[1] = cv::Mat1f(1080, 1920, 0.0f);
+        cv::rectangle(signals[1], cv::Rect(static_cast<int>(c.x) - 10, static_cast<int>(c.y) - 10, 20, 20), 1.0,
+                      cv::FILLED);
+        const std::vector<cv::Mat> off(3);
+        const double lit_flat = cv::sum(sim_flat.capture(signals, 0) - sim_flat.capture(off, 0))[0];
+        const double lit_dim = cv::sum(sim_dim.capture(signals, 0) - sim_dim.capture(off, 0))[0];
+        const double rho2 = (std::pow(c.x - in.cx_px, 2) + std::pow(c.y - in.cy_px, 2)) / std::pow(half_diagonal, 2);
+        EXPECT_NEAR(lit_dim / lit_flat, 1.0 - 0.3 * rho2, 0.01) << c;
+        EXPECT_NEAR(projector_falloff(dim.projectors[1], c.x, c.y), 1.0 - 0.3 * rho2, 1e-12);
+    }
+    dim.projectors[1].falloff = 0.5;
+    EXPECT_THROW(validate_rig(dim), std::invalid_argument);
+}
+
 TEST(VirtualRig, CaptureIsDeterministicAndNoisy) {
     const CameraSimulator sim(standard());
     const std::vector<cv::Mat> off(3);

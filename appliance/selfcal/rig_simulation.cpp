@@ -18,9 +18,17 @@ namespace mogao::selfcal {
 namespace {
 
 autocal::DeviceModel device_of(const std::string& id, ImageSize res, const rig::RigIntrinsics& in,
-                               const rig::RigPose& pose) {
-    return {
-        id, res, in.fx_px, in.fy_px, in.cx_px, in.cy_px, in.distortion, rig::device_to_screen(pose), pose.position_m};
+                               const rig::RigPose& pose, autocal::LensFalloff falloff = {}) {
+    return {id,
+            res,
+            in.fx_px,
+            in.fy_px,
+            in.cx_px,
+            in.cy_px,
+            in.distortion,
+            rig::device_to_screen(pose),
+            pose.position_m,
+            falloff};
 }
 
 void apply_bump(rig::VirtualRig& rig, const Bump& b) {
@@ -147,7 +155,7 @@ SystemModel models_of_rig(const rig::VirtualRig& rig) {
     m.screen = {rig.screen.radius_m, rig.screen.arc_deg, rig.screen.bottom_m, rig.screen.top_m};
     m.camera = device_of("camera", rig.camera.resolution, rig.camera.intrinsics, rig.camera.pose);
     for (const rig::RigProjector& p : rig.projectors) {
-        m.projectors.push_back(device_of(p.id, p.resolution, p.intrinsics, p.pose));
+        m.projectors.push_back(device_of(p.id, p.resolution, p.intrinsics, p.pose, autocal::falloff_of(p)));
     }
     return m;
 }

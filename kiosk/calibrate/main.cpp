@@ -53,6 +53,7 @@ struct Cli {
     std::string transfer = "srgb";
     bool grey = false;
     bool no_colour = false;
+    bool no_falloff = false;
     bool budget = false;
     double budget_fps = 30.0;
 };
@@ -205,6 +206,8 @@ int main(int argc, char** argv) {
     app.add_option("--alpha-bits", job.alpha_bits, "Alpha map bits, 8 or 16")->check(CLI::IsMember({8, 16}));
     app.add_option("--warp-step", job.options.warp_step_px, "Warp grid step, output pixels")->check(CLI::Range(1, 64));
     app.add_flag("--no-colour", cli.no_colour, "Geometry only: no response, black-level and colour matching step");
+    app.add_flag("--no-falloff", cli.no_falloff,
+                 "Colour step without the lens fall-off: one gain per projector and channel (flat projectors)");
     app.add_option("--camera-size", cli.camera_size, "Camera WIDTHxHEIGHT (default: the site file's camera)");
     app.add_option("--camera-fps", cli.camera_fps, "Camera frame rate to ask for (0: the driver's)")
         ->check(CLI::Range(0, 1000));
@@ -235,6 +238,7 @@ int main(int argc, char** argv) {
     }
     job.site = cli.site;
     job.colour = !cli.no_colour;
+    job.colour_options.lens_falloff = !cli.no_falloff;
     job.transfer =
         cli.transfer == "linear" || cli.camera.starts_with("rig:") ? CameraTransfer::linear : CameraTransfer::srgb;
     try {
@@ -244,6 +248,7 @@ int main(int argc, char** argv) {
             rig_job.content = job.content;
             rig_job.alpha_bits = job.alpha_bits;
             rig_job.options = job.options;
+            rig_job.colour_options = job.colour_options;
             return run_rig(cli, rig_job);
         }
         if (cli.budget) return run_budget(cli, job);

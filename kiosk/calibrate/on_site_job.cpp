@@ -101,17 +101,15 @@ nlohmann::json fit_json(const autocal::AutocalResult& r, std::size_t k) {
 }
 
 nlohmann::json colour_json(const autocal::ColourResult& c) {
-    nlohmann::json out = {{"captures", c.captures},
-                          {"matched_white", c.matched_white},
-                          {"black_floor", c.black_floor},
-                          {"ambient", c.ambient},
-                          {"alpha_scale", c.alpha_scale}};
+    nlohmann::json out = {{"captures", c.captures}, {"matched_white", c.matched_white}, {"black_floor", c.black_floor},
+                          {"ambient", c.ambient},   {"alpha_scale", c.alpha_scale},     {"white_floor", c.white_floor}};
     for (const autocal::ProjectorPhotometry& p : c.projectors) {
         nlohmann::json ch = nlohmann::json::array();
         for (const autocal::ChannelResponse& r : p.channels) {
             ch.push_back({{"amplitude", r.amplitude}, {"gamma", r.gamma}, {"gamma_fit_rms", r.gamma_rms}});
         }
-        out["projectors"].push_back({{"id", p.id}, {"black", p.black}, {"gain", p.gain}, {"channels", ch}});
+        out["projectors"].push_back(
+            {{"id", p.id}, {"black", p.black}, {"gain", p.gain}, {"falloff", p.falloff.c}, {"channels", ch}});
     }
     return out;
 }
@@ -227,7 +225,8 @@ nlohmann::json run_on_site(const OnSiteJob& job, OutputBackend& outputs, Calibra
         source.set_projector_output(id->projector_output);
         r = autocal::calibrate(source, prior, job.content, job.options);
         if (job.colour) {
-            colour = autocal::calibrate_colour(source, r->screen, r->projectors, r->calibration, job.colour_options);
+            colour = autocal::calibrate_colour(source, r->screen, r->camera, r->projectors, r->calibration,
+                                               job.colour_options);
         }
     } catch (...) {
         (void)display.value().show_outputs(dark);  // refused or failed: the wall goes dark, not a stripe pattern
