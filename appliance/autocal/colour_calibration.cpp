@@ -436,22 +436,29 @@ double falloff_at_output(const DeviceModel& d, const ProjectorCalibration& pc, d
     return falloff_at(d, p.x(), p.y());
 }
 
+// Calls fn(weight, F) for every blend texel of pc (weight writable when pc is), F the fall-off at
+// the texel's output position.
+template <typename Calibration, typename Fn>
+void for_each_blend_texel(const DeviceModel& d, Calibration& pc, Fn&& fn) {
+    const ImageSize g = pc.blend.size;
+    for (int j = 0; j < g.height; ++j) {
+        const double y = grid_to_output(j, pc.output.height, g.height);
+        for (int i = 0; i < g.width; ++i) {
+            fn(pc.blend.weight[static_cast<std::size_t>(j) * g.width + i],
+               falloff_at_output(d, pc, grid_to_output(i, pc.output.width, g.width), y));
+        }
+    }
+}
+
 // Step 4's white floor S: the least relative light F any projector gives where it shows content
 // (blend > 0); 1 when every projector is flat. The wall's white is S W_c everywhere.
 double white_floor(const std::vector<DeviceModel>& models, const ScreenCalibration& calibration) {
     double floor = 1.0;
     for (std::size_t k = 0; k < models.size(); ++k) {
         if (models[k].falloff.flat()) continue;
-        const ProjectorCalibration& pc = calibration.projectors[k];
-        const ImageSize g = pc.blend.size;
-        for (int j = 0; j < g.height; ++j) {
-            const double y = grid_to_output(j, pc.output.height, g.height);
-            for (int i = 0; i < g.width; ++i) {
-                if (!(pc.blend.weight[static_cast<std::size_t>(j) * g.width + i] > 0.0F)) continue;
-                floor =
-                    std::min(floor, falloff_at_output(models[k], pc, grid_to_output(i, pc.output.width, g.width), y));
-            }
-        }
+        for_each_blend_texel(models[k], calibration.projectors[k], [&](float w, double f) {
+            if (w > 0.0F) floor = std::min(floor, f);
+        });
     }
     return floor;
 }
@@ -459,15 +466,8 @@ double white_floor(const std::vector<DeviceModel>& models, const ScreenCalibrati
 // Step 4's blend for the fall-off: w_k(p) x s x S / F_k(p) (s the black headroom), so that the
 // projectors' light sums to S W_c c wherever they show content c.
 void scale_blend(const DeviceModel& d, double scale, double white, ProjectorCalibration& pc) {
-    const ImageSize g = pc.blend.size;
-    for (int j = 0; j < g.height; ++j) {
-        const double y = grid_to_output(j, pc.output.height, g.height);
-        for (int i = 0; i < g.width; ++i) {
-            float& w = pc.blend.weight[static_cast<std::size_t>(j) * g.width + i];
-            const double f = falloff_at_output(d, pc, grid_to_output(i, pc.output.width, g.width), y);
-            w = static_cast<float>(std::clamp(w * scale * white / f, 0.0, 1.0));
-        }
-    }
+    for_each_blend_texel(
+        d, pc, [&](float& w, double f) { w = static_cast<float>(std::clamp(w * scale * white / f, 0.0, 1.0)); });
 }
 
 // Step 4's beta for projector k (blacks and floor in matched-white units, blend not yet scaled);
@@ -707,17 +707,8 @@ MeasuredColour measured_colour(const ScreenCalibration& calibration, const std::
     const double white = white_floor(models, calibration);
     double scale = 0.0;
     for (std::size_t k = 0; k < n; ++k) {
-        const ProjectorCalibration& pc = calibration.projectors[k];
-        const ImageSize g = pc.blend.size;
-        for (int j = 0; j < g.height; ++j) {
-            const double y = grid_to_output(j, pc.output.height, g.height);
-            for (int i = 0; i < g.width; ++i) {
-                const float w = pc.blend.weight[static_cast<std::size_t>(j) * g.width + i];
-                if (!(w > 0.0F)) continue;
-                const double f = falloff_at_output(models[k], pc, grid_to_output(i, pc.output.width, g.width), y);
-                scale = std::max(scale, w * f / white);
-            }
-        }
+        for_each_blend_texel(models[k], calibration.projectors[k],
+                             [&](float w, double f) { scale = std::max(scale, w * f / white); });
     }
     if (!(beta_max > 0.0F) || !(scale > 0.0)) return out;  // no black-level compensation
     BlackSystem sys{Eigen::MatrixXd::Zero(static_cast<long>(n) + 1, static_cast<long>(n) + 1),
