@@ -250,13 +250,31 @@ ScreenCalibration calibration_from_models(const std::vector<DeviceModel>& projec
     return out;
 }
 
-double falloff_at(const DeviceModel& d, double x, double y) {
-    if (d.falloff.flat()) return 1.0;
+std::array<double, 6> falloff_basis(const DeviceModel& d, double x, double y) {
     const double half_diagonal = 0.5 * std::hypot(d.resolution.width, d.resolution.height);
     const double u = (x - d.cx_px) / half_diagonal;
     const double v = (y - d.cy_px) / half_diagonal;
-    const std::array<double, 6>& c = d.falloff.c;
-    return c[0] + c[1] * u + c[2] * v + c[3] * u * u + c[4] * u * v + c[5] * v * v;
+    return {1.0, u, v, u * u, u * v, v * v};
+}
+
+double falloff_at(const DeviceModel& d, double x, double y) {
+    if (d.falloff.flat()) return 1.0;
+    const std::array<double, 6> b = falloff_basis(d, x, y);
+    double f = 0.0;
+    for (std::size_t i = 0; i < b.size(); ++i) f += d.falloff.c[i] * b[i];
+    return f;
+}
+
+std::optional<Eigen::Vector3d> falloff_out_of_range(const DeviceModel& d) {
+    for (int j = 0; j <= 2; ++j) {
+        for (int i = 0; i <= 2; ++i) {
+            const double x = d.resolution.width * i / 2.0;
+            const double y = d.resolution.height * j / 2.0;
+            const double f = falloff_at(d, x, y);
+            if (!(f >= 0.05 && f <= 5.0)) return Eigen::Vector3d(x, y, f);
+        }
+    }
+    return std::nullopt;
 }
 
 }  // namespace mogao::autocal

@@ -51,6 +51,7 @@
 
 #include <array>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -96,8 +97,15 @@ struct DeviceModel {
     LensFalloff falloff;
 };
 
-// F(x, y) of `d`'s LensFalloff at image position (x, y) (formula at LensFalloff).
+// LensFalloff's basis (1, u, v, u^2, u v, v^2) at image position (x, y) of `d`, and F(x, y) =
+// its dot product with d.falloff.c (formula at LensFalloff).
+[[nodiscard]] std::array<double, 6> falloff_basis(const DeviceModel& d, double x, double y);
 [[nodiscard]] double falloff_at(const DeviceModel& d, double x, double y);
+
+// The limits a fall-off must keep to be a lens's, F in [0.05, 5] over the image (its corners,
+// edge middles and centre): the first image position (x, y) and F there that break them, or
+// nullopt. The models file and the colour step refuse such a fall-off.
+[[nodiscard]] std::optional<Eigen::Vector3d> falloff_out_of_range(const DeviceModel& d);
 
 // What is known before calibrating: the screen's size, the camera's intrinsics and roughly its
 // pose, each projector's resolution and data-sheet intrinsics (its pose is not used).

@@ -110,14 +110,6 @@ Eigen::Vector2d seen_pixel(const cv::Mat2f& screen_at, const DeviceModel& d, con
     return model_pixel(d, screen, s[0], s[1]);
 }
 
-// LensFalloff's basis at image position (x, y) of d.
-std::array<double, 6> falloff_basis(const DeviceModel& d, double x, double y) {
-    const double half_diagonal = 0.5 * std::hypot(d.resolution.width, d.resolution.height);
-    const double u = (x - d.cx_px) / half_diagonal;
-    const double v = (y - d.cy_px) / half_diagonal;
-    return {1.0, u, v, u * u, u * v, v * v};
-}
-
 // Step 1b: projector k's lens fall-off, the quadratic that fits its full-white image `full` (the
 // channels summed, minus black) over the camera pixels `in` at the projector positions the
 // models give them, in least squares; scaled to a mean of 1 over those pixels, which are
@@ -155,16 +147,10 @@ LensFalloff fit_falloff(const cv::Mat1f& full, const cv::Mat1b& in, const cv::Ma
     for (int i = 0; i < 6; ++i) f.c[static_cast<std::size_t>(i)] = g[i] / mean;
     DeviceModel fitted = d;
     fitted.falloff = f;
-    for (int j = 0; j <= 2; ++j) {  // what the models file accepts (model_store.h)
-        for (int i = 0; i <= 2; ++i) {
-            const double v = falloff_at(fitted, d.resolution.width * i / 2.0, d.resolution.height * j / 2.0);
-            if (!(v >= 0.05 && v <= 5.0)) {
-                throw CalibrationRefused(who + ": its measured lens fall-off gives " + std::to_string(v) +
-                                         " at image position (" + std::to_string(d.resolution.width * i / 2.0) + ", " +
-                                         std::to_string(d.resolution.height * j / 2.0) +
-                                         "), outside [0.05, 5] of its mean: not a lens (a changing exposure?)");
-            }
-        }
+    if (const auto bad = falloff_out_of_range(fitted)) {  // what the models file accepts (model_store.h)
+        throw CalibrationRefused(who + ": its measured lens fall-off gives " + std::to_string(bad->z()) +
+                                 " at image position (" + std::to_string(bad->x()) + ", " + std::to_string(bad->y()) +
+                                 "), outside [0.05, 5] of its mean: not a lens (a changing exposure?)");
     }
     return f;
 }

@@ -135,15 +135,9 @@ DeviceModel read_device(const Reader& r, bool camera) {
         if (camera) r.fail("falloff", " is a projector's (the camera has none)");
         const std::vector<double> c = r.numbers("falloff", 6, -10.0, 10.0, "[-10, 10]");
         std::copy(c.begin(), c.end(), d.falloff.c.begin());
-        // Over the image (corners, edge middles, centre) the relative light must stay a light.
-        for (int j = 0; j <= 2; ++j) {
-            for (int i = 0; i <= 2; ++i) {
-                const double f = falloff_at(d, d.resolution.width * i / 2.0, d.resolution.height * j / 2.0);
-                if (!(f >= 0.05 && f <= 5.0)) {
-                    r.fail("falloff", fmt::format(" gives {:.3g} at image position ({}, {}), outside [0.05, 5]", f,
-                                                  d.resolution.width * i / 2.0, d.resolution.height * j / 2.0));
-                }
-            }
+        if (const auto bad = falloff_out_of_range(d)) {  // the relative light must stay a lens's
+            r.fail("falloff", fmt::format(" gives {:.3g} at image position ({}, {}), outside [0.05, 5]", bad->z(),
+                                          bad->x(), bad->y()));
         }
     }
     return d;
