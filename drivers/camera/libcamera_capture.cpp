@@ -19,7 +19,7 @@
 #include <map>
 #include <mutex>
 
-#include "drivers/camera/mapped_buffer.h"
+#include "common/mapped_buffer.h"
 #include "drivers/camera/mjpeg_decoder.h"
 #include "drivers/camera/pixel_format.h"
 

@@ -39,11 +39,11 @@
 #include <string>
 #include <vector>
 
+#include "common/mapped_buffer.h"
 #include "common/pixel_rect.h"
 #include "common/unique_fd.h"
 #include "drivers/camera/camera_controls.h"
 #include "drivers/camera/frame_source.h"
-#include "drivers/camera/mapped_buffer.h"
 #include "drivers/camera/mjpeg_decoder.h"
 #include "drivers/camera/pixel_format.h"
 #include "drivers/camera/v4l2_controls.h"

@@ -12,6 +12,7 @@
 
 #include "drivers/egl/gl_objects.h"
 #include "drivers/kms/kms_layout.h"
+#include "drivers/kms/scanout_reader.h"
 
 namespace mogao {
 
@@ -299,6 +300,13 @@ Status KmsOutputBackend::check_index(std::size_t i) const {
                                       std::to_string(outputs_.size()) + ")");
     }
     return {};
+}
+
+Result<Rgb8Image> KmsOutputBackend::read_scanout(std::size_t i) const {
+    if (auto s = check_index(i); !s) return s.error();
+    auto image = mogao::read_scanout(drm_, outputs_[i]->plan.plane_id);
+    if (!image) return with_context(image.error(), "output " + outputs_[i]->plan.name);
+    return image;
 }
 
 bool KmsOutputBackend::ready(std::size_t i) const {

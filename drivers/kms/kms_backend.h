@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "common/image.h"
 #include "drivers/egl/egl_display.h"
 #include "drivers/egl/warp_blend_renderer.h"
 #include "drivers/kms/drm_device.h"
@@ -74,6 +75,10 @@ public:
     [[nodiscard]] Result<std::vector<std::size_t>> dispatch_events() override;
 
     [[nodiscard]] const std::filesystem::path& device_path() const { return drm_.path(); }
+
+    // What output `i`'s plane scans out now, read back from the kernel (drivers/kms/scanout_reader.h:
+    // the framebuffer after its flip, RGB8 codes as drawn). EINVAL for a bad index; its errors otherwise.
+    [[nodiscard]] Result<Rgb8Image> read_scanout(std::size_t i) const;
 
     struct Output;  // per-connector state (kms_backend.cpp)
 

@@ -6,7 +6,8 @@
 //                     --out /var/lib/mogao/calibration [--install /var/lib/mogao/etc/screen.mpcdi]
 //   On a virtual rig (tests, benchmarks; what `mogao-autocal calibrate` does, ground truth reported):
 //     mogao-calibrate --rig rigs/standard.toml --out DIR [--scale 0.5]
-//   The whole on-site path without hardware (SIMULATION: the rig's camera films the headless outputs):
+//   The whole on-site path without hardware (SIMULATION: the rig's camera films the headless outputs,
+//   or with --outputs kms the kernel's scanout buffers: the appliance image's QEMU test):
 //     mogao-calibrate --site rigs/standard.toml --outputs headless --camera rig:rigs/standard.toml --out DIR
 //   How many images and how long the capture takes:
 //     mogao-calibrate --site FILE --budget [--camera-fps 30 --settle-ms 150 --drop-frames 2]
@@ -112,13 +113,19 @@ std::unique_ptr<OutputBackend> open_outputs(const Cli& cli, const autocal::Calib
     return std::move(headless.value());
 }
 
+// The rig's projector k is lit by output k (the outputs' order; identification still finds it from
+// the images). On KMS the rig films the kernel's scanout buffers, read back after each flip.
 std::unique_ptr<CalibrationCamera> open_rig_camera(const Cli& cli, const OnSiteJob& job, OutputBackend& outputs) {
-    auto* headless = dynamic_cast<HeadlessOutputBackend*>(&outputs);
-    if (headless == nullptr) throw std::invalid_argument("--camera rig:FILE films headless outputs only");
     const rig::VirtualRig rig = autocal::scaled_rig(rig::load_rig(cli.camera.substr(4)), job.scale, job.scale);
     std::vector<std::size_t> order(rig.projectors.size());
     for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
-    return std::make_unique<RigCamera>(*headless, rig, order);
+    if (auto* headless = dynamic_cast<HeadlessOutputBackend*>(&outputs)) {
+        return std::make_unique<RigCamera>(*headless, rig, order);
+    }
+    auto* kms = dynamic_cast<KmsOutputBackend*>(&outputs);
+    if (kms == nullptr) throw std::invalid_argument("--camera rig:FILE films headless or KMS outputs only");
+    return std::make_unique<RigCamera>([kms](std::size_t i) { return kms->read_scanout(i); },
+                                       "the KMS scanout buffers of " + kms->device_path().string(), rig, order);
 }
 
 std::unique_ptr<CalibrationCamera> open_live_camera(const Cli& cli, const autocal::CalibrationPrior& prior) {

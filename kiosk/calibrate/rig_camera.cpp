@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// The virtual rig's camera filming the headless outputs (rig_camera.h).
+// The virtual rig's camera filming what the outputs show (rig_camera.h).
 #include "kiosk/calibrate/rig_camera.h"
 
 #include <cmath>
@@ -31,9 +31,10 @@ cv::Mat signal_of(const Rgb8Image& shown) {
 
 }  // namespace
 
-RigCamera::RigCamera(const HeadlessOutputBackend& outputs, const rig::VirtualRig& rig,
+RigCamera::RigCamera(ShownImage shown, std::string source, const rig::VirtualRig& rig,
                      std::vector<std::size_t> projector_output)
-    : outputs_(&outputs),
+    : shown_(std::move(shown)),
+      source_(std::move(source)),
       sim_(rig),
       projector_output_(std::move(projector_output)),
       base_exposure_(rig.camera.exposure) {
@@ -43,12 +44,21 @@ RigCamera::RigCamera(const HeadlessOutputBackend& outputs, const rig::VirtualRig
     }
 }
 
+RigCamera::RigCamera(const HeadlessOutputBackend& outputs, const rig::VirtualRig& rig,
+                     std::vector<std::size_t> projector_output)
+    : RigCamera([&outputs](std::size_t i) -> Result<Rgb8Image> { return outputs.last_frame(i); },
+                "the headless outputs", rig, std::move(projector_output)) {}
+
 Result<CameraFrame> RigCamera::next_frame() {
     std::vector<cv::Mat> signals(projector_output_.size());
     for (std::size_t k = 0; k < signals.size(); ++k) {
-        const Rgb8Image& shown = outputs_->last_frame(projector_output_[k]);
-        if (shown.pixels.empty()) continue;  // nothing presented yet: the projector shows black
-        signals[k] = signal_of(shown);
+        auto shown = shown_(projector_output_[k]);
+        if (!shown) {
+            const std::string what = "rig camera: reading back what output " + std::to_string(projector_output_[k]);
+            return with_context(shown.error(), what + " shows");
+        }
+        if (shown.value().pixels.empty()) continue;  // nothing presented yet: the projector shows black
+        signals[k] = signal_of(shown.value());
     }
     cv::Mat1f image;
     try {
@@ -88,7 +98,7 @@ Status RigCamera::set_relative_exposure(double factor) {
 
 std::string RigCamera::description() const {
     const rig::RigCamera& c = sim_.rig().camera;
-    return "rig:" + sim_.rig().name + " (SIMULATION: the virtual rig's camera filming the headless outputs, " +
+    return "rig:" + sim_.rig().name + " (SIMULATION: the virtual rig's camera filming " + source_ + ", " +
            std::to_string(c.resolution.width) + "x" + std::to_string(c.resolution.height) + ")";
 }
 

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // MappedBuffer: sole owner of one read-only shared mapping of a device buffer (a V4L2 capture
-// buffer mapped with mmap at the offset VIDIOC_QUERYBUF returned). Unmaps on destruction;
+// buffer mapped with mmap at the offset VIDIOC_QUERYBUF returned, a KMS scanout buffer at the
+// offset DRM_IOCTL_MODE_MAP_DUMB returned). Unmaps on destruction;
 // move-only (UniqueHandle, common/unique_handle.h): a moved-from buffer is empty. The fd it was
 // mapped from may be closed afterwards (the mapping keeps the buffer alive), but V4l2Capture
 // unmaps before closing anyway.
@@ -20,7 +21,8 @@ namespace mogao {
 class MappedBuffer {
 public:
     // mmap(nullptr, length, PROT_READ, MAP_SHARED, fd, offset). PROT_READ is enough for a capture
-    // queue (videobuf2 only demands VM_READ there). Errors: EINVAL for length 0, else mmap's errno.
+    // queue (videobuf2 only demands VM_READ there) and for reading a scanout buffer back.
+    // Errors: EINVAL for length 0, else mmap's errno.
     [[nodiscard]] static Result<MappedBuffer> map(int fd, std::size_t length, off_t offset);
 
     MappedBuffer() = default;

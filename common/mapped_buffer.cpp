@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "drivers/camera/mapped_buffer.h"
+#include "common/mapped_buffer.h"
 
 #include <sys/mman.h>
 
