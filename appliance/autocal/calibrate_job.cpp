@@ -11,8 +11,6 @@
 #include <optional>
 #include <stdexcept>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "appliance/autocal/colour_truth.h"
 #include "appliance/autocal/model_store.h"
 #include "appliance/autocal/rig_bridge.h"
@@ -21,6 +19,7 @@
 #include "appliance/rig/rig_file.h"
 #include "appliance/warp/response_curve.h"
 #include "appliance/warp/warp_sampling.h"
+#include "common/png_io.h"
 
 namespace mogao::autocal {
 namespace {
@@ -53,7 +52,7 @@ double predicted_seam(const AutocalResult& r, const ScreenModel& s) {
 
 // The screen as the viewer sees it: per content pixel of a size x size/aspect image, the light of
 // every projector whose (ground-truth) pixel lands there, showing white content with grid lines.
-cv::Mat1b preview(const rig::VirtualRig& rig, const ScreenCalibration& c, int width) {
+Rgb8Image preview(const rig::VirtualRig& rig, const ScreenCalibration& c, int width) {
     const int height = std::max(1, width * c.content.height / c.content.width);
     cv::Mat1f light(height, width, 0.0f);
     for (int y = 0; y < height; ++y) {
@@ -87,10 +86,12 @@ cv::Mat1b preview(const rig::VirtualRig& rig, const ScreenCalibration& c, int wi
             light(y, x) = static_cast<float>(l);
         }
     }
-    cv::Mat1b out(height, width);
+    Rgb8Image out(ImageSize{width, height});
     for (int y = 0; y < height; ++y) {
         for (int x = 0; x < width; ++x) {
-            out(y, x) = cv::saturate_cast<uchar>(255.0 * std::pow(std::clamp(light(y, x) / 1.1, 0.0, 1.0), 1.0 / 2.2));
+            std::uint8_t* px = out.at(x, y);
+            px[0] = px[1] = px[2] =
+                cv::saturate_cast<uchar>(255.0 * std::pow(std::clamp(light(y, x) / 1.1, 0.0, 1.0), 1.0 / 2.2));
         }
     }
     return out;
@@ -213,9 +214,7 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
     write_models(models_path_for(job.out / "calibration.mpcdi"), CalibrationModels{r.screen, r.camera, r.projectors});
     write_mpcdi(job.out / "calibration.mpcdi", to_mpcdi(r.calibration, mo));
     const std::filesystem::path png = job.out / "preview.png";
-    if (!cv::imwrite(png.string(), preview(rig, r.calibration, 960))) {
-        throw std::runtime_error("calibrate: cannot write '" + png.string() + "'");
-    }
+    write_png(png, preview(rig, r.calibration, 960));  // libpng: no imgcodecs in what the image ships
     const std::filesystem::path json = job.out / "report.json";
     std::ofstream f(json);
     f << report.dump(2) << "\n";

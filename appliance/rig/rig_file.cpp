@@ -171,12 +171,26 @@ VirtualRig read_root(const toml::value& root, const std::string& file) {
         rig.screen.arc_deg = t.number("arc_deg", rig.screen.arc_deg);
         rig.screen.bottom_m = t.number("bottom_m", rig.screen.bottom_m);
         rig.screen.top_m = t.number("top_m", rig.screen.top_m);
+        rig.screen.bulge_m = t.number("bulge_m", rig.screen.bulge_m);
         t.finish();
     }
+    // One camera as [camera], or several as [[cameras]] (the first is the calibration's).
     const toml::value* c = top.find("camera");
-    if (c == nullptr) top.fail("camera", "missing [camera] section");
-    Table cam(*c, "camera", file);
-    rig.camera = read_camera(cam);
+    const toml::value* cs = top.find("cameras");
+    if (c != nullptr && cs != nullptr) top.fail("cameras", "give either [camera] or [[cameras]], not both");
+    if (c == nullptr && cs == nullptr) top.fail("camera", "missing [camera] section (or [[cameras]])");
+    if (c != nullptr) {
+        Table cam(*c, "camera", file);
+        rig.camera = read_camera(cam);
+    } else {
+        if (!cs->is_array() || cs->as_array().empty() || cs->as_array().size() > 8) {
+            top.fail("cameras", "must be 1..8 [[cameras]] tables");
+        }
+        for (std::size_t i = 0; i < cs->as_array().size(); ++i) {
+            Table cam(cs->as_array()[i], "cameras[" + std::to_string(i) + "]", file);
+            (i == 0 ? rig.camera : rig.more_cameras.emplace_back()) = read_camera(cam);
+        }
+    }
     if (const toml::value* p = top.find("prior")) {
         Table t(*p, "prior", file);
         rig.prior.camera_position_error_m = t.vector3("camera_position_error_m", rig.prior.camera_position_error_m);

@@ -42,8 +42,9 @@ void validate_intrinsics(const RigIntrinsics& in, ImageSize size, const std::str
 
 void validate_pose(const RigPose& pose, const RigScreen& screen, const std::string& field) {
     for (int i = 0; i < 3; ++i) check_range(pose.position_m[i], -1e3, 1e3, field + ".position_m");
-    check(std::hypot(pose.position_m.x(), pose.position_m.z()) < screen.radius_m, field + ".position_m",
-          "inside the cylinder (distance from the axis < radius_m = " + std::to_string(screen.radius_m) + ")");
+    const double inner = screen.radius_m - std::max(0.0, -screen.bulge_m);
+    check(std::hypot(pose.position_m.x(), pose.position_m.z()) < inner, field + ".position_m",
+          "inside the cylinder (distance from the axis < radius_m - max(0, -bulge_m) = " + std::to_string(inner) + ")");
     check_range(pose.yaw_deg, -360.0, 360.0, field + ".yaw_deg");
     check_range(pose.pitch_deg, -89.0, 89.0, field + ".pitch_deg");
     check_range(pose.roll_deg, -180.0, 180.0, field + ".roll_deg");
@@ -62,6 +63,34 @@ std::optional<Eigen::Vector3d> hit_cylinder(const Eigen::Vector3d& o, const Eige
     return o + t * d;
 }
 
+// The screen's distance from the axis at (theta, h): the cylinder's radius plus the bulge's
+// half-sine bow, zero on the frame (the arc's ends, the bottom and top edges) and bulge_m in the
+// middle; the nominal radius outside the screen.
+double radius_at(const RigScreen& screen, double theta, double h) {
+    const double arc = screen.arc_deg * kDeg;
+    if (screen.bulge_m == 0.0 || std::abs(theta) > arc / 2.0 || h < screen.bottom_m || h > screen.top_m) {
+        return screen.radius_m;
+    }
+    return screen.radius_m + screen.bulge_m * std::cos(std::numbers::pi * theta / arc) *
+                                 std::sin(std::numbers::pi * (h - screen.bottom_m) / (screen.top_m - screen.bottom_m));
+}
+
+// The far intersection of o + t d (o inside) with the screen surface r = radius_at(theta, h): the
+// cylinder's intersection, then fixed-point steps through the cylinder of the radius at the last
+// hit (|bulge| <= 2 % of the radius: the steps contract by about that factor, so 1e-12 m in a few).
+std::optional<Eigen::Vector3d> hit_screen(const RigScreen& screen, const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
+    auto hit = hit_cylinder(o, d, screen.radius_m);
+    for (int i = 0; hit && screen.bulge_m != 0.0 && i < 60; ++i) {
+        const double r = radius_at(screen, std::atan2(hit->x(), -hit->z()), hit->y());
+        const auto next = hit_cylinder(o, d, r);
+        if (!next) return std::nullopt;
+        const bool converged = (*next - *hit).norm() < 1e-12;
+        hit = next;
+        if (converged) break;
+    }
+    return hit;
+}
+
 std::optional<ScreenPoint> on_screen(const RigScreen& screen, const Eigen::Vector3d& p) {
     const ScreenPoint s{std::atan2(p.x(), -p.z()), p.y()};
     const double half = screen.arc_deg * kDeg / 2.0;
@@ -70,10 +99,37 @@ std::optional<ScreenPoint> on_screen(const RigScreen& screen, const Eigen::Vecto
 }
 
 Eigen::Vector3d screen_position(const RigScreen& screen, ScreenPoint p) {
-    return {screen.radius_m * std::sin(p.theta_rad), p.h_m, -screen.radius_m * std::cos(p.theta_rad)};
+    const double r = radius_at(screen, p.theta_rad, p.h_m);
+    return {r * std::sin(p.theta_rad), p.h_m, -r * std::cos(p.theta_rad)};
+}
+
+void validate_camera(const RigCamera& c, const RigScreen& s, const std::string& f) {
+    validate_size(c.resolution, f + ".resolution");
+    validate_intrinsics(c.intrinsics, c.resolution, f);
+    validate_pose(c.pose, s, f);
+    check_range(c.exposure, 1e-3, 100.0, f + ".exposure");
+    check_range(c.gain, 1e-3, 100.0, f + ".gain");
+    check_range(c.read_noise, 0.0, 0.5, f + ".read_noise");
+    check_range(c.shot_noise, 0.0, 0.5, f + ".shot_noise");
+    check_range(c.blur_sigma_px, 0.0, 20.0, f + ".blur_sigma_px");
+    check(c.bits >= 1 && c.bits <= 16, f + ".bits", "1..16");
+    check(c.supersample >= 1 && c.supersample <= 4, f + ".supersample", "1..4");
 }
 
 }  // namespace
+
+std::size_t camera_count(const VirtualRig& rig) { return 1 + rig.more_cameras.size(); }
+
+VirtualRig seen_by(const VirtualRig& rig, std::size_t i) {
+    if (i >= camera_count(rig)) {
+        throw std::out_of_range("rig '" + rig.name + "': camera " + std::to_string(i) + " of " +
+                                std::to_string(camera_count(rig)) + " (0.." + std::to_string(camera_count(rig) - 1) +
+                                ")");
+    }
+    VirtualRig r = rig;
+    if (i > 0) r.camera = rig.more_cameras[i - 1];
+    return r;
+}
 
 void validate_rig(const VirtualRig& rig) {
     const RigScreen& s = rig.screen;
@@ -81,6 +137,7 @@ void validate_rig(const VirtualRig& rig) {
     check_range(s.arc_deg, 1.0, 360.0, "screen.arc_deg");
     check(std::isfinite(s.bottom_m) && std::isfinite(s.top_m) && s.top_m - s.bottom_m >= 0.01, "screen.top_m",
           "at least 0.01 m above screen.bottom_m");
+    check_range(s.bulge_m, -0.02 * s.radius_m, 0.02 * s.radius_m, "screen.bulge_m (2 % of radius_m)");
     check(!rig.projectors.empty() && rig.projectors.size() <= 16, "projectors", "1..16 projectors");
     check_range(rig.ambient, 0.0, 10.0, "ambient");
     for (std::size_t k = 0; k < rig.projectors.size(); ++k) {
@@ -96,17 +153,11 @@ void validate_rig(const VirtualRig& rig) {
         check_range(p.black_level, 0.0, 0.5, f + ".black_level");
         check_range(p.falloff, 0.0, 0.45, f + ".falloff");
     }
-    const RigCamera& c = rig.camera;
-    validate_size(c.resolution, "camera.resolution");
-    validate_intrinsics(c.intrinsics, c.resolution, "camera");
-    validate_pose(c.pose, s, "camera");
-    check_range(c.exposure, 1e-3, 100.0, "camera.exposure");
-    check_range(c.gain, 1e-3, 100.0, "camera.gain");
-    check_range(c.read_noise, 0.0, 0.5, "camera.read_noise");
-    check_range(c.shot_noise, 0.0, 0.5, "camera.shot_noise");
-    check_range(c.blur_sigma_px, 0.0, 20.0, "camera.blur_sigma_px");
-    check(c.bits >= 1 && c.bits <= 16, "camera.bits", "1..16");
-    check(c.supersample >= 1 && c.supersample <= 4, "camera.supersample", "1..4");
+    check(rig.more_cameras.size() <= 7, "cameras", "1..8 cameras");
+    validate_camera(rig.camera, s, "camera");
+    for (std::size_t i = 0; i < rig.more_cameras.size(); ++i) {
+        validate_camera(rig.more_cameras[i], s, "cameras[" + std::to_string(i + 1) + "]");
+    }
     // The screen as the calibration is told it must still be a screen.
     check_range(rig.prior.screen_radius_error_m, -0.5 * s.radius_m, 0.5 * s.radius_m, "prior.screen_radius_error_m");
     check_range(rig.prior.screen_arc_error_deg, -0.5 * s.arc_deg, std::min(0.5 * s.arc_deg, 360.0 - s.arc_deg),
@@ -133,7 +184,7 @@ std::optional<ScreenPoint> projector_to_screen(const VirtualRig& rig, int k, dou
     const RigProjector& p = rig.projectors.at(static_cast<std::size_t>(k));
     const RigIntrinsics& in = p.intrinsics;
     const Eigen::Vector3d d_dev((x - in.cx_px) / in.fx_px, (y - in.cy_px) / in.fy_px, 1.0);
-    const auto hit = hit_cylinder(p.pose.position_m, device_to_screen(p.pose) * d_dev, rig.screen.radius_m);
+    const auto hit = hit_screen(rig.screen, p.pose.position_m, device_to_screen(p.pose) * d_dev);
     if (!hit) return std::nullopt;
     return on_screen(rig.screen, *hit);
 }
@@ -189,7 +240,7 @@ CameraSimulator::CameraSimulator(const VirtualRig& rig) : rig_(rig) {
             for (int x = 0; x < samples_w_; ++x) {
                 const std::size_t i = static_cast<std::size_t>(y) * samples_w_ + x;
                 const Eigen::Vector3d d = r * Eigen::Vector3d(ideal[i].x, ideal[i].y, 1.0);
-                const auto hit = hit_cylinder(cam.pose.position_m, d, rig_.screen.radius_m);
+                const auto hit = hit_screen(rig_.screen, cam.pose.position_m, d);
                 const auto s = hit ? on_screen(rig_.screen, *hit) : std::nullopt;
                 if (!s) continue;
                 on_screen_[i] = 1;

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// The virtual rig: a cylindrical screen, N projectors and one camera, simulated well enough to
+// The virtual rig: a cylindrical screen (optionally bowed, RigScreen::bulge_m), N projectors and one
+// or more cameras (VirtualRig::camera and more_cameras; seen_by), simulated well enough to
 // calibrate against, with the ground truth a real rig never gives (docs/calibration.md, "The
 // virtual rig"). It is the reference the camera-based calibration (appliance/autocal) is measured
 // against, so it shares no geometry code with it: every formula here is written out again.
@@ -8,7 +9,8 @@
 // cylinder axis at floor level, +y up along the axis, -z toward the middle of the arc. A screen
 // point is (theta, h): theta in radians measured from -z toward +x (left to right for a viewer
 // inside), h in metres; its position is (r sin theta, h, -r cos theta). The screen spans
-// theta in [-arc/2, arc/2], h in [bottom_m, top_m]. Content (u, v), normalised as in
+// theta in [-arc/2, arc/2], h in [bottom_m, top_m] (a bowed screen's point (theta, h) is at its own
+// distance from the axis, RigScreen::bulge_m, in the same direction). Content (u, v), normalised as in
 // common/projector_calibration.h: u = (theta + arc/2) / arc, v = (top - h) / (top - bottom).
 //
 // Devices (projectors, camera) are pinholes at `position_m` with yaw/pitch/roll as in ViewerPose:
@@ -58,6 +60,12 @@ struct RigScreen {
     double arc_deg = 150.0;  // (0, 360]
     double bottom_m = 0.8;
     double top_m = 2.3;
+    // A screen that is only roughly a cylinder (fabric bowed between its frame, a shell's tolerance):
+    // the distance from the axis is radius_m + bulge_m cos(pi theta / arc) sin(pi (h - bottom) /
+    // (top - bottom)), so the frame (arc ends, bottom and top edges) is on the cylinder and the middle
+    // is bulge_m away from it (positive: away from the viewer). [-0.02, 0.02] x radius_m; 0 = a cylinder.
+    // The calibration is not told: it assumes the cylinder (rigs/bulge.toml).
+    double bulge_m = 0.0;
 };
 
 struct RigPose {
@@ -118,8 +126,9 @@ struct VirtualRig {
     std::string name;
     RigScreen screen;
     std::vector<RigProjector> projectors;  // 1..16
-    RigCamera camera;
-    double ambient = 0.01;  // linear light everywhere on the screen, [0, 10]
+    RigCamera camera;                      // camera 0: the one the calibration films with
+    std::vector<RigCamera> more_cameras;   // cameras 1..7 (rig file: [[cameras]] after the first)
+    double ambient = 0.01;                 // linear light everywhere on the screen, [0, 10]
     RigPrior prior;
 };
 
@@ -131,6 +140,14 @@ struct ScreenPoint {
 // Checks every field's range, that the devices are inside the cylinder and that projectors have no
 // distortion. Throws std::invalid_argument naming the field and its limit.
 void validate_rig(const VirtualRig& rig);
+
+// How many cameras the rig has (1 + more_cameras).
+[[nodiscard]] std::size_t camera_count(const VirtualRig& rig);
+
+// The same room filmed by camera `i` (0..camera_count - 1): a copy whose `camera` is that camera, so
+// that CameraSimulator(seen_by(rig, i)) forms camera i's images (each camera sees the same light on
+// the same screen). Throws std::out_of_range naming i and the count.
+[[nodiscard]] VirtualRig seen_by(const VirtualRig& rig, std::size_t i);
 
 // Rotation device -> screen frame (columns: the device's x right, y down, z forward in the screen
 // frame) for the yaw/pitch/roll convention above.

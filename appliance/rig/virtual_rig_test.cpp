@@ -44,6 +44,59 @@ TEST(VirtualRig, ProjectorScreenRoundTrip) {
     EXPECT_LT(landed, total * 9 / 10);
 }
 
+// A bowed screen (RigScreen::bulge_m): the ray of a projector pixel ends on the bowed surface, at
+// the distance from the axis the formula gives (written out here again: bulge at the middle, none on
+// the frame), and the round trip projector -> screen -> projector still holds; the pixel lands at
+// another (theta, h) than on the cylinder, by about the bulge times the ray's slope across the screen.
+TEST(VirtualRig, BowedScreenIsHitOnItsOwnSurface) {
+    VirtualRig rig = standard();
+    rig.screen.bulge_m = 0.05;
+    const VirtualRig cylinder = standard();
+    const RigScreen& sc = rig.screen;
+    const double arc = sc.arc_deg * std::numbers::pi / 180.0;
+    double largest_move_m = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        const RigProjector& p = rig.projectors[static_cast<std::size_t>(k)];
+        for (double y = 0.5; y < 1080; y += 97.0) {
+            for (double x = 0.5; x < 1920; x += 131.0) {
+                const auto s = projector_to_screen(rig, k, x, y);
+                const auto s0 = projector_to_screen(cylinder, k, x, y);
+                if (!s || !s0) continue;
+                const double r =
+                    sc.radius_m + sc.bulge_m * std::cos(std::numbers::pi * s->theta_rad / arc) *
+                                      std::sin(std::numbers::pi * (s->h_m - sc.bottom_m) / (sc.top_m - sc.bottom_m));
+                // The hit is on the projector's ray at distance r from the axis.
+                const Eigen::Vector3d hit(r * std::sin(s->theta_rad), s->h_m, -r * std::cos(s->theta_rad));
+                const Eigen::Vector3d d = device_to_screen(p.pose).transpose() * (hit - p.pose.position_m);
+                ASSERT_GT(d.z(), 0.0);
+                EXPECT_NEAR(p.intrinsics.fx_px * d.x() / d.z() + p.intrinsics.cx_px, x, 1e-6);
+                EXPECT_NEAR(p.intrinsics.fy_px * d.y() / d.z() + p.intrinsics.cy_px, y, 1e-6);
+                const auto back = screen_to_projector(rig, k, *s);
+                ASSERT_TRUE(back.has_value());
+                EXPECT_NEAR(back->x(), x, 1e-6);
+                EXPECT_NEAR(back->y(), y, 1e-6);
+                largest_move_m = std::max(largest_move_m,
+                                          std::hypot(sc.radius_m * (s->theta_rad - s0->theta_rad), s->h_m - s0->h_m));
+            }
+        }
+    }
+    // A 5 cm bow moves content by centimetres on the screen: what a calibration assuming the cylinder
+    // must cope with (rigs/bulge.toml); nothing moves by more than the bow itself.
+    EXPECT_GT(largest_move_m, 0.005);
+    EXPECT_LT(largest_move_m, 0.05);
+    rig.screen.bulge_m = 0.07;  // over 2 % of 3 m
+    EXPECT_THROW(
+        {
+            try {
+                validate_rig(rig);
+            } catch (const std::invalid_argument& e) {
+                EXPECT_NE(std::string(e.what()).find("screen.bulge_m"), std::string::npos) << e.what();
+                throw;
+            }
+        },
+        std::invalid_argument);
+}
+
 TEST(VirtualRig, StandardRigCoversTheScreenWithOverlap) {
     const VirtualRig rig = standard();
     // Content corners and the middle of each overlap: covered by one, resp. two projectors.
@@ -59,8 +112,9 @@ TEST(VirtualRig, StandardRigCoversTheScreenWithOverlap) {
     EXPECT_EQ(covering(0.7, 0.5), 2);
 }
 
-TEST(VirtualRig, LitBlockAppearsWhereTheCameraModelProjectsIt) {
-    VirtualRig rig = standard();
+// A lit 40x40 block in the middle of each projector's image appears in the camera image where OpenCV's
+// projectPoints, given the rig camera's pose and distortion, puts the screen point it lands on.
+void expect_blocks_where_the_camera_model_projects_them(VirtualRig rig) {
     rig.camera.read_noise = 0.0;
     rig.camera.shot_noise = 0.0;
     const CameraSimulator sim(rig);
@@ -96,6 +150,26 @@ TEST(VirtualRig, LitBlockAppearsWhereTheCameraModelProjectsIt) {
         EXPECT_NEAR(peak.x, image[0].x, 1.5) << "projector " << k;
         EXPECT_NEAR(peak.y, image[0].y, 1.5) << "projector " << k;
     }
+}
+
+TEST(VirtualRig, LitBlockAppearsWhereTheCameraModelProjectsIt) {
+    expect_blocks_where_the_camera_model_projects_them(standard());
+}
+
+// Several cameras film the same room: camera 1, half a metre to the left and turned 12 degrees,
+// sees each block where its own model puts it (and elsewhere than camera 0 does).
+TEST(VirtualRig, EveryCameraSeesTheRoomFromItsOwnPose) {
+    VirtualRig rig = standard();
+    RigCamera second = rig.camera;
+    second.pose.position_m.x() -= 0.5;
+    second.pose.yaw_deg += 12.0;
+    second.seed = 7;
+    rig.more_cameras.push_back(second);
+    ASSERT_EQ(camera_count(rig), 2u);
+    expect_blocks_where_the_camera_model_projects_them(seen_by(rig, 0));
+    expect_blocks_where_the_camera_model_projects_them(seen_by(rig, 1));
+    EXPECT_EQ(seen_by(rig, 1).camera.pose.yaw_deg, second.pose.yaw_deg);
+    EXPECT_THROW((void)seen_by(rig, 2), std::out_of_range);
 }
 
 // The lens fall-off dims a block off the principal point by 1 - falloff rho^2 (rho over half the
@@ -199,6 +273,14 @@ TEST(RigFile, ErrorsNameTheField) {
     EXPECT_NE(
         message("[camera]\n[[projectors]]\n[prior]\nscreen_radius_error_m = 2.0\n").find("prior.screen_radius_error_m"),
         std::string::npos);
+    // Several cameras: [[cameras]], each validated under its own name; not beside [camera].
+    EXPECT_NE(message("[camera]\n[[cameras]]\n[[projectors]]\n").find("either [camera] or [[cameras]]"),
+              std::string::npos);
+    EXPECT_NE(message("[[cameras]]\n[[cameras]]\nbits = 0\n[[projectors]]\n").find("cameras[1].bits must be 1..16"),
+              std::string::npos);
+    EXPECT_NE(message("[screen]\nbulge_m = 0.5\n[camera]\n[[projectors]]\n").find("screen.bulge_m"), std::string::npos);
+    EXPECT_EQ(
+        camera_count(parse_rig("[[cameras]]\n[[cameras]]\nposition_m = [0.5, 1.6, 1.0]\n[[projectors]]\n", "two")), 2u);
     EXPECT_THROW((void)load_rig("/nonexistent/rig.toml"), RigError);
     // toml11 recurses once per level without a limit: 20000 levels crashed the reader.
     const std::string deep = std::string(20000, '[') + std::string(20000, ']');

@@ -49,56 +49,7 @@ if grep -q "mogao.selftest.mode=service-card" /proc/cmdline; then
   # Still up after the host's screendumps, without a restart: the card feeds the watchdog.
   sleep 15
   say "service-card-steady state=$(systemctl is-active mogao-kiosk.service) restarts=$(prop mogao-kiosk.service NRestarts) answer=$answer"
-  # --- on-site calibration on the KMS outputs (mogao-calibrate, docs/on-site-calibration.md) -----------
-# The technician's procedure: the kiosk stopped (it holds the outputs), mogao-calibrate, the kiosk
-# started again. Two cameras, as far as QEMU allows:
-#  * vivid (a real V4L2 driver; it films no screen and has no exposure control): refused before any
-#    pattern is shown, exit 1, nothing written;
-#  * the virtual rig's camera filming the kernel's scanout buffers of the virtio-gpu outputs (a
-#    SIMULATION of the camera only: patterns, page flips, settling, identification, decoding, fits
-#    and files are the appliance's own), site file /mnt/site.toml (rigs/qemu.toml): calibrated, the
-#    MPCDI and its models installed atomically beside the kiosk's configuration, the accuracy against
-#    the rig's ground truth printed.
-if [ -x /usr/bin/mogao-calibrate ] && [ -f /mnt/site.toml ]; then
-  systemctl stop mogao-kiosk.service
-  say "calibrate-start kiosk=$(systemctl is-active mogao-kiosk.service) uptime=$(uptime_s)"
-  vivid=$(for d in /sys/class/video4linux/video*; do
-            grep -q vivid "$d/name" 2>/dev/null && grep -q "Capture" "$d/name" && { echo "/dev/${d##*/}"; break; }
-          done)
-  [ -n "$vivid" ] || vivid=/dev/video0
-  timeout 300 mogao-calibrate --site /mnt/site.toml --outputs kms --camera "v4l2:$vivid" --out /tmp/cal-vivid \
-    > /tmp/cal-vivid.log 2>&1
-  rc=$?
-  tail -n 3 /tmp/cal-vivid.log | sed 's/^/MOGAO-SELFTEST calibrate-log /' > "$out"
-  if [ $rc -eq 1 ] && grep -q "locked" /tmp/cal-vivid.log && [ ! -e /tmp/cal-vivid/calibration.mpcdi ]; then
-    ok "calibrate-vivid-refused camera=$vivid"
-  else
-    bad "calibrate-vivid-refused camera=$vivid rc=$rc (expected 1, a message about the locked exposure, nothing written)"
-  fi
-  t0=$(uptime_s)
-  timeout 1500 mogao-calibrate --site /mnt/site.toml --outputs kms --camera rig:/mnt/site.toml \
-    --out /var/lib/mogao/state/calibration --install /var/lib/mogao/etc/screen.mpcdi --no-colour \
-    --settle-ms 0 --drop-frames 0 > /tmp/cal-rig.log 2>&1
-  rc=$?
-  grep -v '^\[#' /tmp/cal-rig.log | tail -n 12 | sed 's/^/MOGAO-SELFTEST calibrate-log /' > "$out"
-  truth=$(grep -m1 "SIMULATION ground truth" /tmp/cal-rig.log | sed -E 's/.*geometry mean ([0-9.]+) p95 ([0-9.]+) px.*/mean=\1 p95=\2/')
-  conn=$(grep -m1 "connectors:" /tmp/cal-rig.log | sed 's/.*connectors: *//' | tr ' ' ',')
-  if [ $rc -eq 0 ] && [ -s /var/lib/mogao/etc/screen.mpcdi ] && [ -s /var/lib/mogao/etc/screen.models.json ] &&
-     [ -s /var/lib/mogao/state/calibration/report.json ] && [ -n "$truth" ]; then
-    ok "calibrate-rig $truth connectors=$conn seconds=$(echo "$(uptime_s) $t0" | awk '{print $1 - $2}')"
-  else
-    bad "calibrate-rig rc=$rc truth='$truth' files: $(ls /var/lib/mogao/etc /var/lib/mogao/state/calibration 2>&1 | tr '\n' ' ')"
-  fi
-  systemctl start mogao-kiosk.service
-  i=0
-  while [ $i -lt 300 ] && [ "$(systemctl is-active mogao-kiosk.service)" != active ]; do sleep 1; i=$((i + 1)); done
-  if [ "$(systemctl is-active mogao-kiosk.service)" = active ]; then ok "calibrate-kiosk-back after_s=$i"
-  else bad "calibrate-kiosk-back state=$(systemctl is-active mogao-kiosk.service)"; fi
-else
-  say "skip calibrate (no /usr/bin/mogao-calibrate in the image or no /mnt/site.toml)"
-fi
-
-say "done fails=$fails uptime=$(uptime_s)"
+  say "done fails=$fails uptime=$(uptime_s)"
   systemctl poweroff --no-block
   exit 0
 fi
@@ -332,6 +283,55 @@ if [ -f /mnt/vimc.ko ] && [ -x /mnt/bin/mogao_libcamera_test ]; then
   fi
 else
   say "skip libcamera-capture-test (no vimc.ko or libcamera test binary on the test disk)"
+fi
+
+# --- on-site calibration on the KMS outputs (mogao-calibrate, docs/on-site-calibration.md) -----------
+# The technician's procedure: the kiosk stopped (it holds the outputs), mogao-calibrate, the kiosk
+# started again. Two cameras, as far as QEMU allows:
+#  * vivid (a real V4L2 driver; it films no screen and has no exposure control): refused before any
+#    pattern is shown, exit 1, nothing written;
+#  * the virtual rig's camera filming the kernel's scanout buffers of the virtio-gpu outputs (a
+#    SIMULATION of the camera only: patterns, page flips, settling, identification, decoding, fits
+#    and files are the appliance's own), site file /mnt/site.toml (rigs/qemu.toml): calibrated, the
+#    MPCDI and its models installed atomically beside the kiosk's configuration, the accuracy against
+#    the rig's ground truth printed.
+if [ -x /usr/bin/mogao-calibrate ] && [ -f /mnt/site.toml ]; then
+  systemctl stop mogao-kiosk.service
+  say "calibrate-start kiosk=$(systemctl is-active mogao-kiosk.service) uptime=$(uptime_s)"
+  vivid=$(for d in /sys/class/video4linux/video*; do
+            grep -q vivid "$d/name" 2>/dev/null && grep -q "Capture" "$d/name" && { echo "/dev/${d##*/}"; break; }
+          done)
+  [ -n "$vivid" ] || vivid=/dev/video0
+  timeout 300 mogao-calibrate --site /mnt/site.toml --outputs kms --camera "v4l2:$vivid" --out /tmp/cal-vivid \
+    > /tmp/cal-vivid.log 2>&1
+  rc=$?
+  tail -n 3 /tmp/cal-vivid.log | sed 's/^/MOGAO-SELFTEST calibrate-log /' > "$out"
+  if [ $rc -eq 1 ] && grep -q "locked" /tmp/cal-vivid.log && [ ! -e /tmp/cal-vivid/calibration.mpcdi ]; then
+    ok "calibrate-vivid-refused camera=$vivid"
+  else
+    bad "calibrate-vivid-refused camera=$vivid rc=$rc (expected 1, a message about the locked exposure, nothing written)"
+  fi
+  t0=$(uptime_s)
+  timeout 1500 mogao-calibrate --site /mnt/site.toml --outputs kms --camera rig:/mnt/site.toml \
+    --out /var/lib/mogao/state/calibration --install /var/lib/mogao/etc/screen.mpcdi --no-colour \
+    --settle-ms 0 --drop-frames 0 > /tmp/cal-rig.log 2>&1
+  rc=$?
+  grep -v '^\[#' /tmp/cal-rig.log | tail -n 12 | sed 's/^/MOGAO-SELFTEST calibrate-log /' > "$out"
+  truth=$(grep -m1 "SIMULATION ground truth" /tmp/cal-rig.log | sed -E 's/.*geometry mean ([0-9.]+) p95 ([0-9.]+) px.*/mean=\1 p95=\2/')
+  conn=$(grep -m1 "connectors:" /tmp/cal-rig.log | sed 's/.*connectors: *//' | tr ' ' ',')
+  if [ $rc -eq 0 ] && [ -s /var/lib/mogao/etc/screen.mpcdi ] && [ -s /var/lib/mogao/etc/screen.models.json ] &&
+     [ -s /var/lib/mogao/state/calibration/report.json ] && [ -n "$truth" ]; then
+    ok "calibrate-rig $truth connectors=$conn seconds=$(echo "$(uptime_s) $t0" | awk '{print $1 - $2}')"
+  else
+    bad "calibrate-rig rc=$rc truth='$truth' files: $(ls /var/lib/mogao/etc /var/lib/mogao/state/calibration 2>&1 | tr '\n' ' ')"
+  fi
+  systemctl start mogao-kiosk.service
+  i=0
+  while [ $i -lt 300 ] && [ "$(systemctl is-active mogao-kiosk.service)" != active ]; do sleep 1; i=$((i + 1)); done
+  if [ "$(systemctl is-active mogao-kiosk.service)" = active ]; then ok "calibrate-kiosk-back after_s=$i"
+  else bad "calibrate-kiosk-back state=$(systemctl is-active mogao-kiosk.service)"; fi
+else
+  say "skip calibrate (no /usr/bin/mogao-calibrate in the image or no /mnt/site.toml)"
 fi
 
 say "done fails=$fails uptime=$(uptime_s)"

@@ -8,13 +8,13 @@
 #include <stdexcept>
 #include <string>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "appliance/autocal/model_store.h"
 #include "appliance/autocal/rig_bridge.h"
 #include "appliance/calibration/mpcdi_screen.h"
 #include "appliance/calibration/mpcdi_writer.h"
 #include "appliance/rig/rig_file.h"
+#include "common/png_io.h"
+#include "common/srgb.h"
 #include "kiosk/calibrate/connector_identity.h"
 #include "kiosk/calibrate/pattern_budget.h"
 
@@ -146,16 +146,17 @@ void write_calibration(const fs::path& mpcdi, const autocal::CalibrationModels& 
     write_mpcdi(mpcdi, to_mpcdi(c, mo));
 }
 
+// 8-bit sRGB PNG with libpng (common/png_io.h; OpenCV's imgcodecs would bring GDAL, HDF5, Poppler ...
+// into the appliance image, docs/image.md).
 void write_camera_png(const fs::path& png, const cv::Mat1f& linear) {
-    cv::Mat1b out(linear.size());
+    Rgb8Image out(ImageSize{linear.cols, linear.rows});
     for (int y = 0; y < linear.rows; ++y) {
         for (int x = 0; x < linear.cols; ++x) {
-            const double v = std::clamp(static_cast<double>(linear(y, x)), 0.0, 1.0);
-            const double e = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
-            out(y, x) = cv::saturate_cast<uchar>(255.0 * e);
+            std::uint8_t* px = out.at(x, y);
+            px[0] = px[1] = px[2] = srgb8_encode(linear(y, x));
         }
     }
-    if (!cv::imwrite(png.string(), out)) throw std::runtime_error("calibrate: cannot write '" + png.string() + "'");
+    write_png(png, out);
 }
 
 // Steps 4-5: the report and the files (on_site_job.h).
