@@ -221,6 +221,7 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
     result.report.edge_rms_m = ba.edge_rms_m;
     for (std::size_t k = 0; k < n; ++k) {
         result.report.projectors[k].rms_px = ba.rms_px[k];
+        result.report.projectors[k].rms_sigma = ba.rms_sigma[k];
         result.report.projectors[k].cells = ba.inliers[k];
         if (options.fit_screen && ba.rms_sigma[k] > options.max_projector_rms) {
             throw CalibrationRefused(

@@ -182,6 +182,8 @@ struct ProjectorReport {
     int row_bits = 0;
     int cells = 0;        // correspondences used
     double rms_px = 0.0;  // projector fit residual, projector pixels
+    double rms_sigma = 0.0;  // the same in units of the decoded positions' uncertainty (about 1: as good as
+                             // the decoding; the gate max_projector_rms applies to it)
     double mean_view_angle_deg = 0.0;
     int lit_pixels = 0;        // camera pixels in its shadow mask
     int phase_refined = 0;     // of them, refined by the phase (the lesser of the two axes)

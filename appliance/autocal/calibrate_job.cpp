@@ -203,6 +203,7 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
              {"noise_sigma", p.noise_sigma},
              {"correspondences", p.cells},
              {"reprojection_rms_px", p.rms_px},
+             {"reprojection_rms_sigma", p.rms_sigma},
              {"mean_view_angle_deg", p.mean_view_angle_deg},
              {"camera_coverage", source.simulator().camera_coverage(static_cast<int>(k))}});
     }

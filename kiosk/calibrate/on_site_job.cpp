@@ -97,6 +97,7 @@ nlohmann::json fit_json(const autocal::AutocalResult& r, std::size_t k) {
             {"row_bits", p.row_bits},
             {"correspondences", p.cells},
             {"reprojection_rms_px", p.rms_px},
+            {"reprojection_rms_sigma", p.rms_sigma},
             {"mean_view_angle_deg", p.mean_view_angle_deg}};
 }
 
