@@ -43,6 +43,7 @@ void check_inputs(const CalibrationPrior& prior, ImageSize content, const Autoca
     if (!(o.phase_gamma > 0.0 && o.phase_gamma <= 10.0)) fail("options.phase_gamma: (0, 10]");
     if (!(o.phase_sigma_floor_px > 0.0)) fail("options.phase_sigma_floor_px: > 0");
     if (!(o.shadow_noise_sigmas >= 0.0)) fail("options.shadow_noise_sigmas: >= 0");
+    if (!(o.bow_min_gain >= 0.0 && o.bow_min_gain < 1.0)) fail("options.bow_min_gain: [0, 1)");
     if (!(prior.screen.radius_m > 0.0 && prior.screen.arc_deg > 0.0 && prior.screen.top_m > prior.screen.bottom_m)) {
         fail("prior.screen: radius_m > 0, arc_deg > 0, top_m > bottom_m");
     }
@@ -128,6 +129,30 @@ ProjectorCalibration build_projector(const std::vector<DeviceModel>& fitted, std
     return pc;
 }
 
+double mean_of(const std::vector<double>& v) {
+    double sum = 0.0;
+    for (double x : v) sum += x;
+    return v.empty() ? 0.0 : sum / static_cast<double>(v.size());
+}
+
+// AutocalOptions::fit_bow: a second bundle adjustment from the first's result with the bow free; its
+// result replaces the first only when the projectors' mean fit rms falls by more than bow_min_gain.
+void try_bow(BundleResult& ba, const std::vector<EdgeObservation>& edges,
+             const std::vector<ProjectorObservations>& observations, BundleOptions bo, const AutocalOptions& options,
+             BowTrial& trial) {
+    bo.refine_bow = true;
+    BundleResult bowed = bundle_adjust(ba.screen, ba.camera, ba.projectors, edges, observations, bo);
+    trial.tried = true;
+    trial.cylinder_rms_sigma = mean_of(ba.rms_sigma);
+    trial.bowed_rms_sigma = mean_of(bowed.rms_sigma);
+    trial.bow_m = bowed.screen.bow_m;
+    // A bow beyond 10 % of the radius is no bow of a cylinder screen but a fit gone astray.
+    const bool plausible = std::all_of(trial.bow_m.begin(), trial.bow_m.end(),
+                                       [&](double a) { return std::abs(a) < 0.1 * bowed.screen.radius_m; });
+    trial.kept = plausible && trial.bowed_rms_sigma < (1.0 - options.bow_min_gain) * trial.cylinder_rms_sigma;
+    if (trial.kept) ba = std::move(bowed);
+}
+
 }  // namespace
 
 Eigen::Vector2d projector_content(const DeviceModel& projector, const ScreenModel& screen, double x, double y) {
@@ -208,7 +233,8 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
     // Step 4: camera pose and projector models refined together on every observation.
     BundleOptions bo;
     bo.refine_screen = options.fit_screen;
-    const BundleResult ba = bundle_adjust(prior.screen, edge.camera, result.projectors, edge.edges, observations, bo);
+    BundleResult ba = bundle_adjust(prior.screen, edge.camera, result.projectors, edge.edges, observations, bo);
+    if (options.fit_bow) try_bow(ba, edge.edges, observations, bo, options, result.report.bow);
     result.screen = ba.screen;
     if (!(ba.screen.radius_m > 0.0 && ba.screen.arc_deg > 0.0 && ba.screen.arc_deg <= 360.0)) {
         throw CalibrationRefused("fitted screen: radius " + std::to_string(ba.screen.radius_m) + " m, arc " +
@@ -223,7 +249,7 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
         result.report.projectors[k].rms_px = ba.rms_px[k];
         result.report.projectors[k].rms_sigma = ba.rms_sigma[k];
         result.report.projectors[k].cells = ba.inliers[k];
-        if (options.fit_screen && ba.rms_sigma[k] > options.max_projector_rms) {
+        if ((options.fit_screen || result.report.bow.kept) && ba.rms_sigma[k] > options.max_projector_rms) {
             throw CalibrationRefused(
                 "projector " + std::to_string(k) + " '" + prior.projectors[k].id + "': fit rms " +
                 std::to_string(ba.rms_sigma[k]) + " (in units of the decoded positions' uncertainty) above its gate " +

@@ -63,11 +63,18 @@
 
 namespace mogao::autocal {
 
+// The screen: a cylinder about the +y axis (screen frame, virtual_rig.h), optionally bowed between
+// its frame. The distance from the axis at (theta, h) is radius_m + sum over m, n in {1, 2} of
+// bow_m[2 (m - 1) + (n - 1)] sin(m pi (theta + arc/2) / arc) sin(n pi (h - bottom_m) / (top_m - bottom_m))
+// inside the screen, radius_m outside it: the bow vanishes on the frame (arc ends, bottom and top
+// edges), where the screen is held, and its first mode (m = n = 1) is a bow of the whole screen, the
+// others bows of its halves (the lowest modes of a membrane clamped at its frame). Metres.
 struct ScreenModel {
     double radius_m = 3.0;
     double arc_deg = 150.0;
     double bottom_m = 0.8;
     double top_m = 2.3;
+    std::array<double, 4> bow_m{};  // 0: a cylinder; fitted with AutocalOptions::fit_bow
 };
 
 // A projector's relative light over its image: its lens's fall-off (vignetting), the part of
@@ -144,6 +151,14 @@ struct AutocalOptions {
     // Fit the cylinder's radius and arc in the bundle adjustment (bundle_adjust.h, refine_screen) when the prior's
     // are known only roughly; the heights stay as measured. The fitted screen is AutocalResult::screen.
     bool fit_screen = false;
+    // Try the screen's bow (ScreenModel::bow_m, 4 modes that vanish on its frame) in a second bundle adjustment,
+    // from the first's result: for a screen that is not quite a cylinder (fabric bowed between its frame). The 3D
+    // points then follow the bowed surface along the camera rays; its shape is seen through the camera-projector
+    // baselines (stereo). Kept only where it pays: the projectors' mean fit rms (in units of the decoding's
+    // uncertainty) must fall by more than bow_min_gain, else the cylinder stays (a free bow on a true cylinder
+    // fits noise: 0.17 -> 0.21 px mean on the standard rig). Off: the screen is the cylinder.
+    bool fit_bow = true;
+    double bow_min_gain = 0.03;  // [0, 1)
 };
 
 // Shows one signal image per projector (CV_32FC1 grey or CV_32FC3 RGB in [0, 1], projector
@@ -190,12 +205,23 @@ struct ProjectorReport {
     double noise_sigma = 0.0;  // estimated noise of one black camera image (camera units)
 };
 
+// What the bow trial (AutocalOptions::fit_bow) found: the projectors' mean fit rms (units of the
+// decoding's uncertainty) on the cylinder and with the bow, and whether the bow was kept.
+struct BowTrial {
+    bool tried = false;
+    bool kept = false;
+    double cylinder_rms_sigma = 0.0;
+    double bowed_rms_sigma = 0.0;
+    std::array<double, 4> bow_m{};  // the fitted bow (kept or not)
+};
+
 struct AutocalReport {
     int edge_points = 0;
     double edge_rms_m = 0.0;
     Eigen::Vector3d camera_position_m = Eigen::Vector3d::Zero();
     int captures = 0;
     std::vector<ProjectorReport> projectors;
+    BowTrial bow;
 };
 
 struct AutocalResult {

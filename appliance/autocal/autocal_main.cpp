@@ -40,6 +40,9 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(4.0, 1024.0));
     cmd->add_flag("--fit-screen", job.options.fit_screen,
                   "Fit the screen's radius and arc too (known only roughly; the heights are taken as measured)");
+    bool no_bow = false;
+    cmd->add_flag("--no-bow", no_bow,
+                  "Take the screen as an exact cylinder: do not try a bow (kept by default only where it pays)");
     bool no_colour = false;
     cmd->add_flag("--no-colour", no_colour, "Geometry only: no response, black-level and colour matching step");
     bool no_falloff = false;
@@ -49,6 +52,7 @@ int main(int argc, char** argv) {
         app.parse(argc, argv);
         job.colour = !no_colour;
         job.colour_options.lens_falloff = !no_falloff;
+        job.options.fit_bow = !no_bow;
         if (std::sscanf(content.c_str(), "%dx%d", &job.content.width, &job.content.height) != 2 ||
             job.content.width < 1 || job.content.height < 1 || job.content.width > 16384 ||
             job.content.height > 16384) {

@@ -18,7 +18,10 @@ namespace {
 
 constexpr int kCam = 6;     // camera: position offset (3), rotation vector (3)
 constexpr int kProj = 9;    // projector: fx, cx, cy, rotation vector (3), position offset (3)
-constexpr int kScreen = 2;  // screen (last, when refined): radius offset (m), arc offset (rad)
+// Screen (last, when refined): radius offset (m) and arc offset (rad) with refine_screen, then the
+// four bow amplitudes (m, ScreenModel::bow_m) with refine_bow.
+constexpr int kScreenShape = 2;
+constexpr int kScreenBow = 4;
 
 Eigen::Matrix3d rotation_of(const Eigen::Vector3d& w) {
     const double a = w.norm();
@@ -44,12 +47,18 @@ DeviceModel projector_at(const DeviceModel& p0, const double* q) {
     return p;
 }
 
-// The screen the parameters describe: the prior's, with the radius and arc offsets when refined.
-ScreenModel screen_at(const ScreenModel& s0, const double* qs) {
+// The screen the parameters describe: the prior's, with the radius and arc offsets and the bow
+// when refined.
+ScreenModel screen_at(const ScreenModel& s0, const double* qs, bool shape, bool bow) {
     ScreenModel s = s0;
-    if (qs != nullptr) {
+    if (qs == nullptr) return s;
+    if (shape) {
         s.radius_m = s0.radius_m + qs[0];
         s.arc_deg = s0.arc_deg + qs[1] * 180.0 / std::numbers::pi;
+        qs += kScreenShape;
+    }
+    if (bow) {
+        for (std::size_t i = 0; i < s.bow_m.size(); ++i) s.bow_m[i] = s0.bow_m[i] + qs[i];
     }
     return s;
 }
@@ -66,14 +75,17 @@ struct Problem {
     std::vector<double> sigma_px;
     double sigma_m = 0.005;
     bool refine_screen = false;
+    bool refine_bow = false;
     Eigen::Index screen_index = 0;  // first screen parameter in q
 
+    [[nodiscard]] int screen_count() const { return (refine_screen ? kScreenShape : 0) + (refine_bow ? kScreenBow : 0); }
     [[nodiscard]] const double* screen_params(const Eigen::VectorXd& q) const {
-        return refine_screen ? q.data() + screen_index : nullptr;
+        return screen_count() > 0 ? q.data() + screen_index : nullptr;
     }
+    [[nodiscard]] ScreenModel screen(const double* qs) const { return screen_at(screen0, qs, refine_screen, refine_bow); }
 
     [[nodiscard]] Eigen::VectorXd edge_residuals(const double* qc, const double* qs) const {
-        const ScreenModel screen = screen_at(screen0, qs);
+        const ScreenModel screen = this->screen(qs);
         const DeviceModel c = camera_at(camera0, qc);
         const double half = screen.arc_deg * std::numbers::pi / 360.0;
         Eigen::VectorXd r(static_cast<Eigen::Index>(edges.size()));
@@ -102,7 +114,7 @@ struct Problem {
 
     [[nodiscard]] Eigen::VectorXd projector_residuals(std::size_t k, const double* qc, const double* qp,
                                                       const double* qs) const {
-        const ScreenModel screen = screen_at(screen0, qs);
+        const ScreenModel screen = this->screen(qs);
         const DeviceModel c = camera_at(camera0, qc);
         const DeviceModel p = projector_at(projectors0[k], qp);
         const Eigen::Matrix3d rt = p.rotation.transpose();
@@ -145,9 +157,7 @@ void accumulate(const Problem& pb, const Eigen::VectorXd& q, int block, bool ref
     if (block >= 0) {
         for (int j = 0; j < kProj; ++j) cols.push_back(kCam + kProj * block + j);
     }
-    if (pb.refine_screen) {
-        for (int j = 0; j < kScreen; ++j) cols.push_back(static_cast<int>(pb.screen_index) + j);
-    }
+    for (int j = 0; j < pb.screen_count(); ++j) cols.push_back(static_cast<int>(pb.screen_index) + j);
     Eigen::MatrixXd jac(r0.size(), static_cast<Eigen::Index>(cols.size()));
     for (std::size_t c = 0; c < cols.size(); ++c) {
         Eigen::VectorXd v = q;
@@ -221,8 +231,9 @@ BundleResult bundle_adjust(const ScreenModel& screen, const DeviceModel& camera,
     Problem pb{screen, camera, projectors, edges, observations, {}, std::vector<double>(n, 1.0), 0.005};
     // The screen needs the edges (its ends and heights) and the camera refined with it.
     pb.refine_screen = options.refine_screen && options.refine_camera && !edges.empty();
+    pb.refine_bow = options.refine_bow && options.refine_camera && !edges.empty();
     pb.screen_index = kCam + kProj * static_cast<Eigen::Index>(n);
-    Eigen::VectorXd q = Eigen::VectorXd::Zero(pb.screen_index + (pb.refine_screen ? kScreen : 0));
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(pb.screen_index + pb.screen_count());
     for (std::size_t k = 0; k < n; ++k) {
         const ProjectorObservations& o = observations[k];
         if (o.rays.size() != o.projector.size() || o.rays.size() < 10) {
@@ -281,7 +292,7 @@ BundleResult bundle_adjust(const ScreenModel& screen, const DeviceModel& camera,
         levenberg_marquardt(pb, q, refine_camera, options.max_iterations);
     }
     out.camera = camera_at(camera, q.data());
-    out.screen = screen_at(screen, pb.screen_params(q));
+    out.screen = pb.screen(pb.screen_params(q));
     for (std::size_t k = 0; k < n; ++k)
         out.projectors.push_back(projector_at(projectors[k], q.data() + kCam + kProj * k));
     return out;

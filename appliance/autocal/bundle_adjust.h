@@ -51,6 +51,9 @@ struct BundleOptions {
     // the scale): for a screen whose radius and arc are known only roughly. The 3D points follow the fitted
     // cylinder; its curvature is seen through the camera-projector baselines, its ends through the edges.
     bool refine_screen = false;
+    // The screen's bow too (ScreenModel::bow_m; with the camera, like refine_screen): the 3D points then
+    // follow the bowed surface along the camera rays, and the projectors' rays tell its depth (stereo).
+    bool refine_bow = false;
     int rounds = 2;           // LM runs, outliers dropped between them
     int max_iterations = 40;  // LM iterations per round
 };

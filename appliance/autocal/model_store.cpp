@@ -86,6 +86,12 @@ ScreenModel read_screen(const Reader& r) {
     s.bottom_m = r.number("bottom_m", -1e3, 1e3, "[-1000, 1000] m");
     s.top_m = r.number("top_m", -1e3, 1e3, "[-1000, 1000] m");
     if (!(s.top_m > s.bottom_m)) r.fail("top_m", fmt::format(" = {} must be above bottom_m = {}", s.top_m, s.bottom_m));
+    // Optional (files before the bow was fitted have none: a cylinder); each mode within 10 % of the radius.
+    if (r.json().is_object() && r.json().contains("bow_m")) {
+        const double limit = 0.1 * s.radius_m;
+        const std::vector<double> bow = r.numbers("bow_m", s.bow_m.size(), -limit, limit, "[-0.1, 0.1] x radius_m");
+        std::copy(bow.begin(), bow.end(), s.bow_m.begin());
+    }
     return s;
 }
 
@@ -176,7 +182,8 @@ Json models_json(const CalibrationModels& m, const std::string& name) {
                  {{"radius_m", m.screen.radius_m},
                   {"arc_deg", m.screen.arc_deg},
                   {"bottom_m", m.screen.bottom_m},
-                  {"top_m", m.screen.top_m}}},
+                  {"top_m", m.screen.top_m},
+                  {"bow_m", m.screen.bow_m}}},
                 {"camera", device_json(m.camera)},
                 {"projectors", projectors}};
     // nlohmann would write a non-finite number as null: validate so that what is written reads back.

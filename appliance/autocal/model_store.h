@@ -8,7 +8,7 @@
 //
 // Schema (JSON, version 1; every number finite):
 //   {"format": "mogao-calibration-models", "version": 1,
-//    "screen": {"radius_m", "arc_deg", "bottom_m", "top_m"},
+//    "screen": {"radius_m", "arc_deg", "bottom_m", "top_m", "bow_m": [4 numbers, optional: zeros]},
 //    "camera": DEVICE, "projectors": [DEVICE, ...]}           // projectors in the MPCDI's order
 //   DEVICE = {"id": "proj0", "resolution": [width, height],   // pixels, [1, 16384] per side
 //             "fx_px", "fy_px",                                 // focal lengths, pixels, > 0

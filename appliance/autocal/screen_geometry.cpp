@@ -100,17 +100,51 @@ std::vector<Eigen::Vector3d> camera_rays(const DeviceModel& camera, const std::v
     return rays;
 }
 
-std::optional<Eigen::Vector3d> cylinder_hit(const ScreenModel& screen, const Eigen::Vector3d& o,
-                                            const Eigen::Vector3d& d) {
+double screen_radius_at(const ScreenModel& screen, double theta, double h) {
+    const double arc = screen.arc_deg * std::numbers::pi / 180.0;
+    const double height = screen.top_m - screen.bottom_m;
+    if (std::abs(theta) > arc / 2.0 || h < screen.bottom_m || h > screen.top_m || !(height > 0.0)) return screen.radius_m;
+    double r = screen.radius_m;
+    for (int m = 1; m <= 2; ++m) {
+        for (int n = 1; n <= 2; ++n) {
+            const double a = screen.bow_m[static_cast<std::size_t>(2 * (m - 1) + (n - 1))];
+            if (a != 0.0) {
+                r += a * std::sin(m * std::numbers::pi * (theta + arc / 2.0) / arc) *
+                     std::sin(n * std::numbers::pi * (h - screen.bottom_m) / height);
+            }
+        }
+    }
+    return r;
+}
+
+namespace {
+
+std::optional<Eigen::Vector3d> hit_radius(double radius, const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
     const double a = d.x() * d.x() + d.z() * d.z();
     if (a < 1e-18) return std::nullopt;
     const double b = 2.0 * (o.x() * d.x() + o.z() * d.z());
-    const double c = o.x() * o.x() + o.z() * o.z() - screen.radius_m * screen.radius_m;
+    const double c = o.x() * o.x() + o.z() * o.z() - radius * radius;
     const double disc = b * b - 4.0 * a * c;
     if (disc < 0.0) return std::nullopt;
     const double t = (-b + std::sqrt(disc)) / (2.0 * a);
     if (t <= 0.0) return std::nullopt;
     return o + t * d;
+}
+
+}  // namespace
+
+std::optional<Eigen::Vector3d> cylinder_hit(const ScreenModel& screen, const Eigen::Vector3d& o,
+                                            const Eigen::Vector3d& d) {
+    auto hit = hit_radius(screen.radius_m, o, d);
+    const bool bowed = std::any_of(screen.bow_m.begin(), screen.bow_m.end(), [](double a) { return a != 0.0; });
+    for (int i = 0; hit && bowed && i < 50; ++i) {
+        const auto next = hit_radius(screen_radius_at(screen, std::atan2(hit->x(), -hit->z()), hit->y()), o, d);
+        if (!next) return std::nullopt;
+        const bool converged = (*next - *hit).squaredNorm() < 1e-24;
+        hit = next;
+        if (converged) break;
+    }
+    return hit;
 }
 
 EdgeFit fit_camera_pose(const cv::Mat1f& lit, const CalibrationPrior& prior, const AutocalOptions& options) {

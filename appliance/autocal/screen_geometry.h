@@ -19,7 +19,13 @@ namespace mogao::autocal {
 [[nodiscard]] std::vector<Eigen::Vector3d> camera_rays(const DeviceModel& camera,
                                                        const std::vector<cv::Point2d>& image);
 
-// Forward intersection of o + t d with the cylinder, o inside; nullopt when the ray is vertical.
+// The screen's distance from the axis at (theta, h) (ScreenModel: the radius plus the bow inside the
+// screen, the radius outside it).
+[[nodiscard]] double screen_radius_at(const ScreenModel& screen, double theta, double h);
+
+// Forward intersection of o + t d with the screen's surface, o inside; nullopt when the ray is
+// vertical. A cylinder in closed form; with a bow, fixed-point steps through the cylinder of the
+// radius at the previous hit (they contract by about the bow's slope times the ray's obliqueness).
 [[nodiscard]] std::optional<Eigen::Vector3d> cylinder_hit(const ScreenModel& screen, const Eigen::Vector3d& o,
                                                           const Eigen::Vector3d& d);
 

@@ -55,6 +55,7 @@ struct Cli {
     bool grey = false;
     bool no_colour = false;
     bool no_falloff = false;
+    bool no_bow = false;
     bool budget = false;
     double budget_fps = 30.0;
 };
@@ -212,6 +213,10 @@ int main(int argc, char** argv) {
     app.add_option("--content", cli.content, "Content frame WIDTHxHEIGHT (the farm's frame)");
     app.add_option("--alpha-bits", job.alpha_bits, "Alpha map bits, 8 or 16")->check(CLI::IsMember({8, 16}));
     app.add_option("--warp-step", job.options.warp_step_px, "Warp grid step, output pixels")->check(CLI::Range(1, 64));
+    app.add_flag("--fit-screen", job.options.fit_screen,
+                 "Fit the screen's radius and arc too (known only roughly; the heights are taken as measured)");
+    app.add_flag("--no-bow", cli.no_bow,
+                 "Take the screen as an exact cylinder: do not try a bow (kept by default only where it pays)");
     app.add_flag("--no-colour", cli.no_colour, "Geometry only: no response, black-level and colour matching step");
     app.add_flag("--no-falloff", cli.no_falloff,
                  "Colour step without the lens fall-off: one gain per projector and channel (flat projectors)");
@@ -246,6 +251,7 @@ int main(int argc, char** argv) {
     job.site = cli.site;
     job.colour = !cli.no_colour;
     job.colour_options.lens_falloff = !cli.no_falloff;
+    job.options.fit_bow = !cli.no_bow;
     job.transfer =
         cli.transfer == "linear" || cli.camera.starts_with("rig:") ? CameraTransfer::linear : CameraTransfer::srgb;
     try {

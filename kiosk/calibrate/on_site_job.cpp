@@ -186,6 +186,13 @@ nlohmann::json finish(const OnSiteJob& job, const Identified& id, const autocal:
     report["cabling_changes"] = cabling_changes(previous_connectors(job.out / "report.json"), report["connectors"]);
     for (std::size_t k = 0; k < r.projectors.size(); ++k) report["projectors"].push_back(fit_json(r, k));
     if (colour) report["colour"] = colour_json(*colour);
+    // The screen the calibration used: the site file's cylinder, with the bow where it paid (autocal.h).
+    report["screen"] = {{"radius_m", r.screen.radius_m},
+                        {"arc_deg", r.screen.arc_deg},
+                        {"bow_m", r.screen.bow_m},
+                        {"bow_kept", r.report.bow.kept},
+                        {"cylinder_rms_sigma", r.report.bow.cylinder_rms_sigma},
+                        {"bowed_rms_sigma", r.report.bow.bowed_rms_sigma}};
     const autocal::CalibrationModels models{r.screen, r.camera, r.projectors};
     write_calibration(job.out / "calibration.mpcdi", models, r.calibration, job);
     if (!job.install.empty()) write_calibration(job.install, models, r.calibration, job);
