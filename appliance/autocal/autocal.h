@@ -195,8 +195,8 @@ struct ProjectorReport {
     std::string id;
     int column_bits = 0;
     int row_bits = 0;
-    int cells = 0;        // correspondences used
-    double rms_px = 0.0;  // projector fit residual, projector pixels
+    int cells = 0;           // correspondences used
+    double rms_px = 0.0;     // projector fit residual, projector pixels
     double rms_sigma = 0.0;  // the same in units of the decoded positions' uncertainty (about 1: as good as
                              // the decoding; the gate max_projector_rms applies to it)
     double mean_view_angle_deg = 0.0;

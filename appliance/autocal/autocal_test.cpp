@@ -221,11 +221,12 @@ TEST(Autocal, BowedScreenIsFittedWhereTheBowPays) {
     RigPatternSource source(rig);
     const AutocalResult r = calibrate(source, prior, {1920, 1080});
     const GeometryError g = measure_geometry(rig, r.calibration, 4);
-    std::printf("bulge %.3f m: as a cylinder mean %.3f p95 %.3f px; bow trial: kept %d, fitted bow %.4f %.4f %.4f %.4f m, "
-                "rms %.3f -> %.3f sigma, mean %.3f p95 %.3f px\n",
-                rig.screen.bulge_m, gp.mean_px, gp.p95_px, r.report.bow.kept, r.screen.bow_m[0], r.screen.bow_m[1],
-                r.screen.bow_m[2], r.screen.bow_m[3], r.report.bow.cylinder_rms_sigma, r.report.bow.bowed_rms_sigma,
-                g.mean_px, g.p95_px);
+    std::printf(
+        "bulge %.3f m: as a cylinder mean %.3f p95 %.3f px; bow trial: kept %d, fitted bow %.4f %.4f %.4f %.4f m, "
+        "rms %.3f -> %.3f sigma, mean %.3f p95 %.3f px\n",
+        rig.screen.bulge_m, gp.mean_px, gp.p95_px, r.report.bow.kept, r.screen.bow_m[0], r.screen.bow_m[1],
+        r.screen.bow_m[2], r.screen.bow_m[3], r.report.bow.cylinder_rms_sigma, r.report.bow.bowed_rms_sigma, g.mean_px,
+        g.p95_px);
     EXPECT_GT(gp.mean_px, 0.5);  // the failure the trial exists for
     EXPECT_GT(gp.mean_px, 2.5 * g.mean_px);
     ASSERT_TRUE(r.report.bow.kept);
@@ -238,7 +239,8 @@ TEST(Autocal, BowedScreenIsFittedWhereTheBowPays) {
     RigPatternSource standard_source(standard);
     const AutocalResult s = calibrate(standard_source, prior_from_rig(standard), {1920, 1080});
     EXPECT_TRUE(s.report.bow.tried);
-    EXPECT_FALSE(s.report.bow.kept) << "rms " << s.report.bow.cylinder_rms_sigma << " -> " << s.report.bow.bowed_rms_sigma;
+    EXPECT_FALSE(s.report.bow.kept) << "rms " << s.report.bow.cylinder_rms_sigma << " -> "
+                                    << s.report.bow.bowed_rms_sigma;
     EXPECT_EQ(s.screen.bow_m, (std::array<double, 4>{}));
 }
 

@@ -16,8 +16,8 @@
 namespace mogao::autocal {
 namespace {
 
-constexpr int kCam = 6;     // camera: position offset (3), rotation vector (3)
-constexpr int kProj = 9;    // projector: fx, cx, cy, rotation vector (3), position offset (3)
+constexpr int kCam = 6;   // camera: position offset (3), rotation vector (3)
+constexpr int kProj = 9;  // projector: fx, cx, cy, rotation vector (3), position offset (3)
 // Screen (last, when refined): radius offset (m) and arc offset (rad) with refine_screen, then the
 // four bow amplitudes (m, ScreenModel::bow_m) with refine_bow.
 constexpr int kScreenShape = 2;
@@ -78,11 +78,15 @@ struct Problem {
     bool refine_bow = false;
     Eigen::Index screen_index = 0;  // first screen parameter in q
 
-    [[nodiscard]] int screen_count() const { return (refine_screen ? kScreenShape : 0) + (refine_bow ? kScreenBow : 0); }
+    [[nodiscard]] int screen_count() const {
+        return (refine_screen ? kScreenShape : 0) + (refine_bow ? kScreenBow : 0);
+    }
     [[nodiscard]] const double* screen_params(const Eigen::VectorXd& q) const {
         return screen_count() > 0 ? q.data() + screen_index : nullptr;
     }
-    [[nodiscard]] ScreenModel screen(const double* qs) const { return screen_at(screen0, qs, refine_screen, refine_bow); }
+    [[nodiscard]] ScreenModel screen(const double* qs) const {
+        return screen_at(screen0, qs, refine_screen, refine_bow);
+    }
 
     [[nodiscard]] Eigen::VectorXd edge_residuals(const double* qc, const double* qs) const {
         const ScreenModel screen = this->screen(qs);

@@ -44,8 +44,11 @@ CalibrationPrior prior_from_rig(const rig::VirtualRig& rig) {
     CalibrationPrior prior;
     const rig::RigPrior& e = rig.prior;
     // A bowed rig screen (bulge_m) is not told: the prior is the cylinder.
-    prior.screen = {rig.screen.radius_m + e.screen_radius_error_m, rig.screen.arc_deg + e.screen_arc_error_deg,
-                    rig.screen.bottom_m, rig.screen.top_m, {}};
+    prior.screen = {rig.screen.radius_m + e.screen_radius_error_m,
+                    rig.screen.arc_deg + e.screen_arc_error_deg,
+                    rig.screen.bottom_m,
+                    rig.screen.top_m,
+                    {}};
     const rig::RigCamera& c = rig.camera;
     rig::RigPose pose = c.pose;
     pose.position_m += e.camera_position_error_m;

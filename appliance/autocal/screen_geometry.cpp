@@ -103,7 +103,8 @@ std::vector<Eigen::Vector3d> camera_rays(const DeviceModel& camera, const std::v
 double screen_radius_at(const ScreenModel& screen, double theta, double h) {
     const double arc = screen.arc_deg * std::numbers::pi / 180.0;
     const double height = screen.top_m - screen.bottom_m;
-    if (std::abs(theta) > arc / 2.0 || h < screen.bottom_m || h > screen.top_m || !(height > 0.0)) return screen.radius_m;
+    if (std::abs(theta) > arc / 2.0 || h < screen.bottom_m || h > screen.top_m || !(height > 0.0))
+        return screen.radius_m;
     double r = screen.radius_m;
     for (int m = 1; m <= 2; ++m) {
         for (int n = 1; n <= 2; ++n) {

@@ -153,7 +153,10 @@ Bump parse_bump(const rig::VirtualRig& rig, const std::string& text) {
 SystemModel models_of_rig(const rig::VirtualRig& rig) {
     SystemModel m;
     // The rig's bow (virtual_rig.h) is ScreenModel's first bow mode exactly.
-    m.screen = {rig.screen.radius_m, rig.screen.arc_deg, rig.screen.bottom_m, rig.screen.top_m,
+    m.screen = {rig.screen.radius_m,
+                rig.screen.arc_deg,
+                rig.screen.bottom_m,
+                rig.screen.top_m,
                 {rig.screen.bulge_m, 0.0, 0.0, 0.0}};
     m.camera = device_of("camera", rig.camera.resolution, rig.camera.intrinsics, rig.camera.pose);
     for (const rig::RigProjector& p : rig.projectors) {
