@@ -13,6 +13,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "appliance/autocal/bundle_adjust.h"
+#include "appliance/autocal/screen_geometry.h"
 #include "appliance/warp/warp_sampling.h"
 
 namespace mogao::selfcal {
