@@ -24,8 +24,8 @@ namespace mogao::autocal {
 [[nodiscard]] double screen_radius_at(const ScreenModel& screen, double theta, double h);
 
 // Forward intersection of o + t d with the screen's surface, o inside; nullopt when the ray is
-// vertical. A cylinder in closed form; with a bow, fixed-point steps through the cylinder of the
-// radius at the previous hit (they contract by about the bow's slope times the ray's obliqueness).
+// vertical. A cylinder in closed form; with a bow, a step to the cylinder of the radius at the
+// cylinder's hit, then secant steps on the distance from the surface along the ray (to 1e-12 m).
 [[nodiscard]] std::optional<Eigen::Vector3d> cylinder_hit(const ScreenModel& screen, const Eigen::Vector3d& o,
                                                           const Eigen::Vector3d& d);
 
