@@ -68,8 +68,7 @@ Eigen::Vector2d device_screen(const DeviceModel& d, const ScreenModel& s, double
 // al. 1999, "Multi-projector displays using camera-based registration": the weight falls with the
 // distance to the edge of the projector's footprint on the display surface).
 double border_distance(const DeviceModel& d, const ScreenModel& s, const Eigen::Vector2d& th) {
-    const Eigen::Vector3d p(s.radius_m * std::sin(th.x()), th.y(), -s.radius_m * std::cos(th.x()));
-    const Eigen::Vector3d q = d.rotation.transpose() * (p - d.position_m);
+    const Eigen::Vector3d q = d.rotation.transpose() * (screen_position(s, th.x(), th.y()) - d.position_m);
     if (q.z() <= 0.0) return 0.0;
     const double x = d.fx_px * q.x() / q.z() + d.cx_px;
     const double y = d.fy_px * q.y() / q.z() + d.cy_px;
@@ -140,6 +139,7 @@ double mean_of(const std::vector<double>& v) {
 void try_bow(BundleResult& ba, const std::vector<EdgeObservation>& edges,
              const std::vector<ProjectorObservations>& observations, BundleOptions bo, const AutocalOptions& options,
              BowTrial& trial) {
+    if (edges.empty() || !bo.refine_camera) return;  // the bow needs the edges and the camera with it
     bo.refine_bow = true;
     BundleResult bowed = bundle_adjust(ba.screen, ba.camera, ba.projectors, edges, observations, bo);
     trial.tried = true;
@@ -149,7 +149,19 @@ void try_bow(BundleResult& ba, const std::vector<EdgeObservation>& edges,
     // A bow beyond 10 % of the radius is no bow of a cylinder screen but a fit gone astray.
     const bool plausible = std::all_of(trial.bow_m.begin(), trial.bow_m.end(),
                                        [&](double a) { return std::abs(a) < 0.1 * bowed.screen.radius_m; });
-    trial.kept = plausible && trial.bowed_rms_sigma < (1.0 - options.bow_min_gain) * trial.cylinder_rms_sigma;
+    // Each adjustment drops its own outliers: a bowed fit that only rejected more points does not count,
+    // nor one whose projector fits fail the gate the cylinder's passed.
+    int kept_cylinder = 0;
+    int kept_bowed = 0;
+    for (std::size_t k = 0; k < ba.inliers.size(); ++k) {
+        kept_cylinder += ba.inliers[k];
+        kept_bowed += bowed.inliers[k];
+    }
+    const bool same_points = kept_bowed >= 0.99 * kept_cylinder;
+    const bool within_gate = std::all_of(bowed.rms_sigma.begin(), bowed.rms_sigma.end(),
+                                         [&](double r) { return r <= options.max_projector_rms; });
+    trial.kept = plausible && same_points && within_gate &&
+                 trial.bowed_rms_sigma < (1.0 - options.bow_min_gain) * trial.cylinder_rms_sigma;
     if (trial.kept) ba = std::move(bowed);
 }
 
@@ -249,7 +261,7 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
         result.report.projectors[k].rms_px = ba.rms_px[k];
         result.report.projectors[k].rms_sigma = ba.rms_sigma[k];
         result.report.projectors[k].cells = ba.inliers[k];
-        if ((options.fit_screen || result.report.bow.kept) && ba.rms_sigma[k] > options.max_projector_rms) {
+        if (options.fit_screen && ba.rms_sigma[k] > options.max_projector_rms) {
             throw CalibrationRefused(
                 "projector " + std::to_string(k) + " '" + prior.projectors[k].id + "': fit rms " +
                 std::to_string(ba.rms_sigma[k]) + " (in units of the decoded positions' uncertainty) above its gate " +

@@ -37,6 +37,10 @@ rig::VirtualRig scaled_rig(const rig::VirtualRig& rig, double projector_scale, d
     for (rig::RigProjector& p : out.projectors) scale_device(p.resolution, p.intrinsics, projector_scale);
     scale_device(out.camera.resolution, out.camera.intrinsics, camera_scale);
     out.camera.blur_sigma_px *= camera_scale;
+    for (rig::RigCamera& c : out.more_cameras) {  // every camera of the rig, not only the calibration's
+        scale_device(c.resolution, c.intrinsics, camera_scale);
+        c.blur_sigma_px *= camera_scale;
+    }
     return out;
 }
 

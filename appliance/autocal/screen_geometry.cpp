@@ -134,34 +134,53 @@ std::optional<Eigen::Vector3d> hit_radius(double radius, const Eigen::Vector3d& 
 
 }  // namespace
 
+Eigen::Vector3d screen_position(const ScreenModel& screen, double theta, double h) {
+    const double r = screen_radius_at(screen, theta, h);
+    return {r * std::sin(theta), h, -r * std::cos(theta)};
+}
+
 std::optional<Eigen::Vector3d> cylinder_hit(const ScreenModel& screen, const Eigen::Vector3d& o,
                                             const Eigen::Vector3d& d) {
-    auto hit = hit_radius(screen.radius_m, o, d);
-    const bool bowed = std::any_of(screen.bow_m.begin(), screen.bow_m.end(), [](double a) { return a != 0.0; });
-    if (!hit || !bowed) return hit;
+    double bow = 0.0;
+    for (double a : screen.bow_m) bow += std::abs(a);
+    if (bow == 0.0) return hit_radius(screen.radius_m, o, d);
     // g(t) = distance of o + t d from the axis - the screen's radius there: zero on the surface. The
-    // first step goes to the cylinder of the radius at the cylinder's hit, then secant steps on g
-    // (superlinear: a few evaluations to 1e-12 m where fixed-point steps needed about ten).
+    // surface lies between the cylinders of radius R - sum|a| and R + sum|a|, so the root is bracketed
+    // by their hits (g <= 0 at the inner one, >= 0 at the outer; o must be inside the inner one).
+    // Regula falsi with the Illinois modification (Dowell & Jarratt 1971): superlinear, never leaves
+    // the bracket; a root not found to 1e-12 m is no hit.
+    const auto inner = hit_radius(screen.radius_m - bow, o, d);
+    const auto outer = hit_radius(screen.radius_m + bow, o, d);
+    if (!inner || !outer) return std::nullopt;
     const double nd = d.norm();
     const auto g = [&](double t) {
         const Eigen::Vector3d p = o + t * d;
         return std::hypot(p.x(), p.z()) - screen_radius_at(screen, std::atan2(p.x(), -p.z()), p.y());
     };
-    double t0 = (*hit - o).norm() / nd;
-    double g0 = g(t0);
-    const auto first = hit_radius(screen.radius_m - g0, o, d);
-    if (!first) return std::nullopt;
-    double t1 = (*first - o).norm() / nd;
-    for (int i = 0; i < 20; ++i) {
-        const double g1 = g(t1);
-        if (std::abs(g1) < 1e-12 || g1 == g0) break;
-        const double t2 = t1 - g1 * (t1 - t0) / (g1 - g0);
-        t0 = t1;
-        g0 = g1;
-        t1 = t2;
+    double a = (*inner - o).norm() / nd;
+    double b = (*outer - o).norm() / nd;
+    double ga = g(a);
+    double gb = g(b);
+    if (ga > 0.0 || gb < 0.0) return std::nullopt;  // o outside the inner cylinder
+    int side = 0;
+    for (int i = 0; i < 100; ++i) {
+        if (std::abs(ga) < 1e-12) return o + a * d;
+        if (std::abs(gb) < 1e-12) return o + b * d;
+        const double t = (a * gb - b * ga) / (gb - ga);
+        const double gt = g(t);
+        if (gt <= 0.0) {
+            a = t;
+            ga = gt;
+            if (side == -1) gb /= 2.0;
+            side = -1;
+        } else {
+            b = t;
+            gb = gt;
+            if (side == 1) ga /= 2.0;
+            side = 1;
+        }
     }
-    if (!(t1 > 0.0) || !std::isfinite(t1)) return std::nullopt;
-    return o + t1 * d;
+    return std::nullopt;
 }
 
 EdgeFit fit_camera_pose(const cv::Mat1f& lit, const CalibrationPrior& prior, const AutocalOptions& options) {

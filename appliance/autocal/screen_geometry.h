@@ -23,6 +23,9 @@ namespace mogao::autocal {
 // screen, the radius outside it).
 [[nodiscard]] double screen_radius_at(const ScreenModel& screen, double theta, double h);
 
+// The screen point at (theta, h): at screen_radius_at's distance from the axis (screen frame).
+[[nodiscard]] Eigen::Vector3d screen_position(const ScreenModel& screen, double theta, double h);
+
 // Forward intersection of o + t d with the screen's surface, o inside; nullopt when the ray is
 // vertical. A cylinder in closed form; with a bow, a step to the cylinder of the radius at the
 // cylinder's hit, then secant steps on the distance from the surface along the ray (to 1e-12 m).

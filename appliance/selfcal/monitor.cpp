@@ -252,8 +252,7 @@ Eigen::Vector3d screen_point(const autocal::ScreenModel& s, double u, double v) 
     const double arc = s.arc_deg * kDeg;
     const double theta = u * arc - arc / 2.0;
     const double h = s.top_m - v * (s.top_m - s.bottom_m);
-    const double r = autocal::screen_radius_at(s, theta, h);  // a bowed screen's own distance from the axis
-    return {r * std::sin(theta), h, -r * std::cos(theta)};
+    return autocal::screen_position(s, theta, h);  // a bowed screen's own distance from the axis
 }
 
 Monitor::Monitor(const SystemModel& model, const ScreenCalibration& calibration, const MonitorOptions& options)

@@ -5,8 +5,10 @@
 #include <drm_fourcc.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "common/mapped_buffer.h"
 #include "common/unique_handle.h"
@@ -62,7 +64,9 @@ Result<Rgb8Image> read_scanout(const DrmDevice& drm, std::uint32_t plane_id) {
     }
     if (fb->modifier != DRM_FORMAT_MOD_LINEAR && fb->modifier != DRM_FORMAT_MOD_INVALID &&
         (fb->flags & DRM_MODE_FB_MODIFIERS) != 0) {
-        return make_error(EOPNOTSUPP, fb_where + ": tiled buffer (modifier " + std::to_string(fb->modifier) + ")");
+        char modifier[32];
+        std::snprintf(modifier, sizeof modifier, "0x%016llx", static_cast<unsigned long long>(fb->modifier));
+        return make_error(EOPNOTSUPP, fb_where + ": tiled buffer (modifier " + modifier + ")");
     }
     if (fb->handles[0] == 0) {
         return make_error(EACCES, fb_where + ": no buffer handle (needs DRM master or CAP_SYS_ADMIN)");
@@ -84,8 +88,12 @@ Result<Rgb8Image> read_scanout(const DrmDevice& drm, std::uint32_t plane_id) {
     if (!mapped) return with_context(mapped.error(), fb_where);
     Rgb8Image image(ImageSize{width, height});
     const std::uint8_t* base = mapped.value().bytes().data() + fb->offsets[0];
+    // A row at a time into cached memory first: scanout buffers are often mapped write-combined, where
+    // reading a byte at a time is very slow.
+    std::vector<std::uint8_t> row(4 * static_cast<std::size_t>(width));
     for (int y = 0; y < height; ++y) {
-        xrgb8888_row_to_rgb8(base + pitch * static_cast<std::size_t>(y), image.at(0, y), width);
+        std::memcpy(row.data(), base + pitch * static_cast<std::size_t>(y), row.size());
+        xrgb8888_row_to_rgb8(row.data(), image.at(0, y), width);
     }
     return image;
 }

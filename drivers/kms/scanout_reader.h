@@ -16,7 +16,8 @@
 // Pixels: row-major, top row first, (R, G, B) per pixel -- the framebuffer's 8-bit codes unchanged
 // (sRGB-encoded as the renderer wrote them); the alpha/X byte is dropped.
 // Errors (common/result.h): ENODATA (the plane shows no framebuffer), EACCES (no buffer handle: not
-// DRM master), EOPNOTSUPP (format, or a multi-planar buffer), the kernel's errno otherwise; every
+// DRM master), EOPNOTSUPP (another format, or a tiled buffer: the modifier is named), the kernel's
+// errno otherwise; every
 // message names the plane and the framebuffer.
 #pragma once
 

@@ -301,14 +301,16 @@ if [ -x /usr/bin/mogao-calibrate ] && [ -f /mnt/site.toml ]; then
   systemctl stop mogao-kiosk.service
   say "calibrate-start kiosk=$(systemctl is-active mogao-kiosk.service) uptime=$(uptime_s)"
   vivid=$(for d in /sys/class/video4linux/video*; do
-            grep -q vivid "$d/name" 2>/dev/null && grep -q "Capture" "$d/name" && { echo "/dev/${d##*/}"; break; }
+            grep -q 'vivid-.*-vid-cap' "$d/name" 2>/dev/null && { echo "/dev/${d##*/}"; break; }
           done)
   [ -n "$vivid" ] || vivid=/dev/video0
   timeout 300 mogao-calibrate --site /mnt/site.toml --outputs kms --camera "v4l2:$vivid" --out /tmp/cal-vivid \
     > /tmp/cal-vivid.log 2>&1
   rc=$?
   tail -n 3 /tmp/cal-vivid.log | sed 's/^/MOGAO-SELFTEST calibrate-log /' > "$out"
-  if [ $rc -eq 1 ] && grep -q "locked" /tmp/cal-vivid.log && [ ! -e /tmp/cal-vivid/calibration.mpcdi ]; then
+  # The refusal must be the unlockable exposure (vivid has no V4L2_CID_EXPOSURE_ABSOLUTE), not any
+  # failure to open the camera.
+  if [ $rc -eq 1 ] && grep -q "V4L2_CID_EXPOSURE_ABSOLUTE" /tmp/cal-vivid.log && [ ! -e /tmp/cal-vivid/calibration.mpcdi ]; then
     ok "calibrate-vivid-refused camera=$vivid"
   else
     bad "calibrate-vivid-refused camera=$vivid rc=$rc (expected 1, a message about the locked exposure, nothing written)"

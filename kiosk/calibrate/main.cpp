@@ -125,7 +125,13 @@ std::unique_ptr<CalibrationCamera> open_rig_camera(const Cli& cli, const OnSiteJ
     }
     auto* kms = dynamic_cast<KmsOutputBackend*>(&outputs);
     if (kms == nullptr) throw std::invalid_argument("--camera rig:FILE films headless or KMS outputs only");
-    return std::make_unique<RigCamera>([kms](std::size_t i) { return kms->read_scanout(i); },
+    // A plane with no framebuffer yet shows black (RigCamera's empty image), not an error.
+    return std::make_unique<RigCamera>(
+        [kms](std::size_t i) -> Result<Rgb8Image> {
+            auto shown = kms->read_scanout(i);
+            if (!shown && shown.code() == ENODATA) return Rgb8Image{};
+            return shown;
+        },
                                        "the KMS scanout buffers of " + kms->device_path().string(), rig, order);
 }
 
