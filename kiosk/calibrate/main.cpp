@@ -132,7 +132,7 @@ std::unique_ptr<CalibrationCamera> open_rig_camera(const Cli& cli, const OnSiteJ
             if (!shown && shown.code() == ENODATA) return Rgb8Image{};
             return shown;
         },
-                                       "the KMS scanout buffers of " + kms->device_path().string(), rig, order);
+        "the KMS scanout buffers of " + kms->device_path().string(), rig, order);
 }
 
 std::unique_ptr<CalibrationCamera> open_live_camera(const Cli& cli, const autocal::CalibrationPrior& prior) {
