@@ -11,10 +11,12 @@ source "$(dirname "$0")/mpi_env.sh"
 rm -rf "$work" && mkdir -p "$work"
 deadline=3
 
-# The pid of the mogao-farm process that is rank $1 of the job started by mpirun $2.
+# The pid of the mogao-farm process that is rank $1 of the job started by mpirun $2 writing to $3.
+# Matched on this job's own --out directory: ctest runs other farm tests beside this one, and a
+# rank 2 of theirs must never be the one stopped or killed.
 rank_pid() {
-  local rank=$1 parent=$2 pid
-  for pid in $(pgrep -f "mogao-farm render" || true); do
+  local rank=$1 parent=$2 out=$3 pid
+  for pid in $(pgrep -f -- "mogao-farm render .*--out $out( |\$)" || true); do
     [ "$pid" = "$parent" ] && continue
     if tr '\0' '\n' < "/proc/$pid/environ" 2>/dev/null | grep -qx "OMPI_COMM_WORLD_RANK=$rank"; then
       echo "$pid"; return 0
@@ -33,7 +35,7 @@ run_case() {
   for _ in $(seq 600); do [ -e "$out/frame-0002.jpg" ] && break; sleep 0.1; done
   [ -e "$out/frame-0002.jpg" ] || { echo "FAIL($how): no frames"; cat "$log"; kill -9 $mpirun_pid; return 1; }
   local victim
-  victim=$(rank_pid 2 $mpirun_pid) || { echo "FAIL($how): rank 2 not found"; kill -9 $mpirun_pid; return 1; }
+  victim=$(rank_pid 2 $mpirun_pid "$out") || { echo "FAIL($how): rank 2 not found"; kill -9 $mpirun_pid; return 1; }
   local start=$SECONDS
   if [ "$how" = stop ]; then kill -STOP "$victim"; else kill -KILL "$victim"; fi
   # The job must end by itself; 60 s is the watchdog systemd would otherwise use.
@@ -46,7 +48,7 @@ run_case() {
     echo "FAIL($how): the job still runs $((SECONDS - start)) s after rank 2 was lost"
     kill -CONT "$victim" 2>/dev/null || true
     kill -9 $mpirun_pid 2>/dev/null || true
-    pkill -9 -f "mogao-farm render --scene $scene" || true
+    pkill -9 -f -- "mogao-farm render .*--out $out( |\$)" || true
     cat "$log"
     return 1
   fi
