@@ -291,6 +291,32 @@ cv::Mat projector_signal(const ProjectorCalibration& pc, const cv::Mat1f& conten
     return coloured_signal(pc, signal);
 }
 
+namespace {
+
+// A starting model must describe the rig it watches: the same devices at the same resolutions.
+void check_start_model(const SystemModel& m, const rig::VirtualRig& truth) {
+    const auto size_text = [](ImageSize s) { return std::to_string(s.width) + "x" + std::to_string(s.height); };
+    if (m.projectors.size() != truth.projectors.size()) {
+        throw std::invalid_argument("simulate: the starting models have " + std::to_string(m.projectors.size()) +
+                                    " projectors, the rig " + std::to_string(truth.projectors.size()));
+    }
+    if (m.camera.resolution != truth.camera.resolution) {
+        throw std::invalid_argument("simulate: the starting models' camera is " + size_text(m.camera.resolution) +
+                                    ", the scaled rig's " + size_text(truth.camera.resolution) +
+                                    " (calibrate at the same --scale/--camera-scale)");
+    }
+    for (std::size_t k = 0; k < m.projectors.size(); ++k) {
+        if (m.projectors[k].resolution != truth.projectors[k].resolution) {
+            throw std::invalid_argument("simulate: the starting models' projector " + std::to_string(k) + " is " +
+                                        size_text(m.projectors[k].resolution) + ", the scaled rig's " +
+                                        size_text(truth.projectors[k].resolution) +
+                                        " (calibrate at the same --scale)");
+        }
+    }
+}
+
+}  // namespace
+
 SimulationReport simulate(const rig::VirtualRig& input, const SimulationOptions& o) {
     if (!(o.rate_hz > 0.0) || o.frames < 1 || !(o.occlusion >= 0.0 && o.occlusion <= 0.9) ||
         !(o.exposure_jitter >= 0.0 && o.exposure_jitter < 1.0) || o.truth_every < 1) {
@@ -303,7 +329,8 @@ SimulationReport simulate(const rig::VirtualRig& input, const SimulationOptions&
             throw std::invalid_argument("simulate: bump device out of range");
         }
     }
-    const SystemModel model = models_of_rig(truth);
+    const SystemModel model = o.start_model ? *o.start_model : models_of_rig(truth);
+    check_start_model(model, truth);
     SimulationReport rep;
     ScreenCalibration wall =
         autocal::calibration_from_models(model.projectors, model.screen, {1920, 1080}, o.selfcal.build);
@@ -367,6 +394,7 @@ SimulationReport simulate(const rig::VirtualRig& input, const SimulationOptions&
                 if (e.mean_px >= g.mean_px) g = e;
             }
         }
+        if (rep.frames.empty()) rep.start_error_px = g.mean_px;
         rep.frames.push_back({t, r.status.state, r.status.waiting, g.mean_px, r.cpu_ms, r.status.text()});
         rep.waiting_frames += r.status.waiting ? 1 : 0;
         cpu += r.cpu_ms;

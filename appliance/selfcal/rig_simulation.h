@@ -4,7 +4,8 @@
 // rendered through the TRUE (possibly bumped) projector poses and seen by the TRUE (possibly
 // bumped) camera with the rig's noise, plus exposure changes and visitors occluding part of the
 // view. The monitor starts from the rig's exact models (as if the full calibration had been
-// perfect; its own residual, docs/calibration.md "Figures per rig", adds to the figures here).
+// perfect; its own residual, docs/calibration.md "Figures per rig", adds to the figures here), or
+// from given models (SimulationOptions::start_model: a full calibration's estimate).
 #pragma once
 
 #include <cstdint>
@@ -56,6 +57,12 @@ struct SimulationOptions {
     // The wall starts with the rig's true colour applied as a colour calibration would
     // (colour_of_rig, autocal::apply_measured_colour): per-channel LUTs, beta maps, scaled blends.
     bool measured_colour = false;
+    // The monitor's starting models: none = the rig's exact models (models_of_rig, a perfect full
+    // calibration); set = an estimate, e.g. autocal's on the same rig at the same scales read from
+    // its models file, so that the full calibration's own residual is in every figure. Must have
+    // the scaled rig's projectors (count, resolutions) and camera resolution; std::invalid_argument
+    // otherwise.
+    std::optional<SystemModel> start_model;
     SelfcalOptions selfcal;
 };
 
@@ -71,6 +78,7 @@ struct SimulationFrame {
 struct SimulationReport {
     std::optional<double> detected_after_s;   // first non-calibrated state after the first bump
     std::optional<double> corrected_after_s;  // first time after the bump: calibrated and error < threshold
+    double start_error_px = 0.0;              // ground truth at the first frame (the starting models' residual)
     double error_before_px = 0.0;             // ground truth right after the bump (uncorrected), worst projector
     double final_error_px = 0.0;              // ground truth, last frame: the worst projector's mean
     double final_p95_px = 0.0;                // and its p95

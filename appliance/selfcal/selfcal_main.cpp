@@ -10,6 +10,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "appliance/autocal/model_store.h"
 #include "appliance/rig/rig_file.h"
 #include "appliance/selfcal/rig_simulation.h"
 
@@ -17,13 +18,18 @@ namespace {
 
 using mogao::selfcal::ContentKind;
 
-int run_simulate(const std::string& rig_path, const std::vector<std::string>& bump_texts, double bump_at,
-                 mogao::selfcal::SimulationOptions o, bool verbose) {
+int run_simulate(const std::string& rig_path, const std::string& models_path, const std::vector<std::string>& bump_texts,
+                 double bump_at, mogao::selfcal::SimulationOptions o, bool verbose) {
     const mogao::rig::VirtualRig rig = mogao::rig::load_rig(rig_path);
     for (const std::string& b : bump_texts) {
         mogao::selfcal::Bump bump = mogao::selfcal::parse_bump(rig, b);
         bump.at_s = bump_at;
         o.bumps.push_back(bump);
+    }
+    if (!models_path.empty()) {
+        // autocal's estimate (mogao-autocal calibrate --rig ... --scale S: calibration.models.json).
+        const mogao::autocal::CalibrationModels m = mogao::autocal::read_models(models_path);
+        o.start_model = mogao::selfcal::SystemModel{m.screen, m.camera, m.projectors};
     }
     const mogao::selfcal::SimulationReport r = mogao::selfcal::simulate(rig, o);
     if (verbose) {
@@ -37,6 +43,8 @@ int run_simulate(const std::string& rig_path, const std::vector<std::string>& bu
         "rig %s, projector scale %.2f (errors in those projector pixels), camera scale %.2f, monitor %.2f Hz, "
         "%d frames (%.1f simulated s)\n",
         rig.name.c_str(), o.projector_scale, o.camera_scale, o.rate_hz, o.frames, o.frames / o.rate_hz);
+    std::printf("error at the start: %.3f px (ground truth; %s)\n", r.start_error_px,
+                models_path.empty() ? "the rig's exact models" : models_path.c_str());
     std::printf("error right after the bump: %.3f px (ground truth)\n", r.error_before_px);
     if (r.detected_after_s) std::printf("detected after: %.2f s\n", *r.detected_after_s);
     else std::printf("detected after: never\n");
@@ -114,6 +122,11 @@ int main(int argc, char** argv) {
     sim->add_option("--truth-every", o.truth_every, "ground truth every N frames (and at the last, around changes)")
         ->check(CLI::Range(1, 100000));
     sim->add_flag("--verbose", verbose, "one line per monitored frame");
+    std::string models;
+    sim->add_option("--models", models,
+                    "start from these models (a full calibration's estimate: mogao-autocal calibrate --rig RIG "
+                    "--scale S writes calibration.models.json) instead of the rig's exact ones")
+        ->check(CLI::ExistingFile);
     CLI11_PARSE(app, argc, argv);
     o.content = content == "plain"        ? ContentKind::plain
                 : content == "repetitive" ? ContentKind::repetitive
@@ -122,7 +135,7 @@ int main(int argc, char** argv) {
     o.selfcal.monitor.check_edges = !no_edge_check;
     o.selfcal.monitor.projector_fit.prior_position_sd_m = prior_mm * 1e-3;
     try {
-        return run_simulate(rig, bumps, bump_at, o, verbose);
+        return run_simulate(rig, models, bumps, bump_at, o, verbose);
     } catch (const std::invalid_argument& e) {
         std::fprintf(stderr, "mogao-selfcal simulate: %s\n", e.what());
         return 2;

@@ -63,6 +63,44 @@ TEST(SelfcalRig, ProjectorBumpedOneDegreeIsDetectedAndCorrectedBelowOnePixel) {
     EXPECT_EQ(r.final_state, SelfcalState::calibrated);
 }
 
+// A full calibration is never exact. Starting from autocal's estimate on the same rig (its own
+// residual in every ground-truth figure), the monitor must neither take that residual for a drift
+// before the bump nor fail to correct the bump below 1 px against the ground truth.
+TEST(SelfcalRig, StartingFromAFullCalibrationsEstimateABumpIsStillCorrected) {
+    SimulationOptions o = quick(16);
+    const rig::VirtualRig scaled = autocal::scaled_rig(standard(), o.projector_scale, o.camera_scale);
+    autocal::RigPatternSource source(scaled);
+    const autocal::AutocalResult est = autocal::calibrate(source, autocal::prior_from_rig(scaled), {1920, 1080});
+    o.start_model = SystemModel{est.screen, est.camera, est.projectors};
+    Bump b = parse_bump(scaled, "proj1:yaw=1deg");
+    b.at_s = 2.0;  // four monitored frames on the estimate alone first
+    o.bumps = {b};
+    const SimulationReport r = simulate(standard(), o);
+    EXPECT_GT(r.start_error_px, 0.05) << "an estimate, not the rig's exact models";
+    EXPECT_LT(r.start_error_px, 0.5);
+    for (const SimulationFrame& f : r.frames) {
+        if (f.t_s < b.at_s) {
+            EXPECT_EQ(f.state, SelfcalState::calibrated) << "t=" << f.t_s << "\n" << journal(r);
+        }
+    }
+    ASSERT_TRUE(r.detected_after_s.has_value()) << journal(r);
+    EXPECT_LE(*r.detected_after_s, 2.0);
+    ASSERT_TRUE(r.corrected_after_s.has_value()) << journal(r);
+    EXPECT_EQ(r.corrections, 1) << journal(r);
+    EXPECT_LT(r.final_error_px, 1.0);
+    EXPECT_EQ(r.final_state, SelfcalState::calibrated);
+
+    // Models of another rig's devices are refused, naming what differs.
+    SimulationOptions wrong = quick(1);
+    wrong.start_model = models_of_rig(standard());  // full resolution, the simulation's at half
+    try {
+        (void)simulate(standard(), wrong);
+        FAIL() << "models at another resolution accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("calibrate at the same"), std::string::npos) << e.what();
+    }
+}
+
 // The shift goal: a 10 mm shift (about 3 projector pixels at half resolution) is
 // detected and corrected to under 1 px against the ground truth; a shift and a rotation look
 // alike in the image, so this checks the correction's shift is not lost to the position prior.
