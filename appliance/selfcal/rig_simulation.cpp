@@ -225,6 +225,7 @@ cv::Mat1f make_content(ContentKind kind, double t_s, bool moving, std::uint64_t 
     }
     cv::max(img, 0.02f, img);
     cv::min(img, 0.98f, img);
+    if (kind == ContentKind::dark) img *= 0.04;
     return img;
 }
 

@@ -36,7 +36,7 @@ struct Bump {
 // x, y, z in mm or m). Throws std::invalid_argument naming the bad part.
 [[nodiscard]] Bump parse_bump(const rig::VirtualRig& rig, const std::string& text);
 
-enum class ContentKind { textured, plain, repetitive };
+enum class ContentKind { textured, plain, repetitive, dark };
 
 struct SimulationOptions {
     double projector_scale = 0.5;  // autocal::scaled_rig
@@ -98,7 +98,9 @@ struct SimulationReport {
 [[nodiscard]] SimulationReport simulate(const rig::VirtualRig& rig, const SimulationOptions& options);
 
 // The content frame at time t (linear grey, 960x540): textured = multi-scale blobs and strokes,
-// repetitive = a regular grid of identical dots, plain = uniform grey; moving content drifts.
+// repetitive = a regular grid of identical dots, plain = uniform grey, dark = the textured frame
+// at 4 % of its light (a dim cave: its texture near the camera's noise, few features); moving
+// content drifts.
 [[nodiscard]] cv::Mat1f make_content(ContentKind kind, double t_s, bool moving, std::uint64_t seed);
 
 // The rig's exact models (screen, camera, projectors) as the monitor's starting point.

@@ -89,8 +89,8 @@ int main(int argc, char** argv) {
         ->check(CLI::NonNegativeNumber);
     sim->add_option("--exposure-jitter", o.exposure_jitter, "camera gain varies in [1-j, 1+j]")
         ->check(CLI::Range(0.0, 0.9));
-    sim->add_option("--content", content, "textured | plain | repetitive")
-        ->check(CLI::IsMember({"textured", "plain", "repetitive"}));
+    sim->add_option("--content", content, "textured | plain | repetitive | dark")
+        ->check(CLI::IsMember({"textured", "plain", "repetitive", "dark"}));
     sim->add_option("--seed", o.seed, "noise and content seed");
     sim->add_option("--threshold", o.selfcal.drift_threshold_px, "drift threshold, projector pixels")
         ->check(CLI::PositiveNumber);
@@ -130,6 +130,7 @@ int main(int argc, char** argv) {
     CLI11_PARSE(app, argc, argv);
     o.content = content == "plain"        ? ContentKind::plain
                 : content == "repetitive" ? ContentKind::repetitive
+                : content == "dark"       ? ContentKind::dark
                                           : ContentKind::textured;
     o.selfcal.build.warp_step_px = 4;
     o.selfcal.monitor.check_edges = !no_edge_check;

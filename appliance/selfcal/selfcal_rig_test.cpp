@@ -352,15 +352,19 @@ TEST(SelfcalRig, CameraAndTwoProjectorsBumpedAtOnceAreToldApart) {
 
 TEST(SelfcalRig, TooLittleTextureWaitsAndNeverCorrects) {
     const rig::VirtualRig rig = standard();
-    SimulationOptions o = quick(6);
-    o.content = ContentKind::plain;
-    Bump b = parse_bump(rig, "proj1:yaw=1deg");
-    b.at_s = 0.5;
-    o.bumps = {b};
-    const SimulationReport r = simulate(rig, o);
-    EXPECT_EQ(r.waiting_frames, 6);
-    EXPECT_EQ(r.corrections, 0) << journal(r);
-    EXPECT_EQ(frames_in(r, SelfcalState::calibrated), 6);
+    // Plain content, and a dark scene: the textured frame at 4 % of its light, its texture near
+    // the camera's noise (as in a dim cave).
+    for (const ContentKind kind : {ContentKind::plain, ContentKind::dark}) {
+        SimulationOptions o = quick(6);
+        o.content = kind;
+        Bump b = parse_bump(rig, "proj1:yaw=1deg");
+        b.at_s = 0.5;
+        o.bumps = {b};
+        const SimulationReport r = simulate(rig, o);
+        EXPECT_EQ(r.waiting_frames, 6) << static_cast<int>(kind);
+        EXPECT_EQ(r.corrections, 0) << journal(r);
+        EXPECT_EQ(frames_in(r, SelfcalState::calibrated), 6) << static_cast<int>(kind);
+    }
 }
 
 // The content-independent fallback: plain content gives no features; with the pattern pair
