@@ -81,4 +81,52 @@ std::optional<TomlNestingExcess> toml_nesting_excess(std::string_view text, int 
     return std::nullopt;
 }
 
+namespace {
+
+// Length of the well-formed UTF-8 sequence at text[i] (table 3-7), 0 when there is none.
+std::size_t utf8_sequence_length(std::string_view text, std::size_t i) {
+    const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
+    const unsigned char b0 = byte(i);
+    if (b0 <= 0x7F) return 1;
+    // (sequence length, the second byte's range) by the first byte; later bytes are 80..BF.
+    struct Lead {
+        std::size_t n;
+        unsigned char lo;
+        unsigned char hi;
+    };
+    Lead lead{0, 0x80, 0xBF};
+    if (b0 >= 0xC2 && b0 <= 0xDF) lead = {2, 0x80, 0xBF};
+    else if (b0 == 0xE0) lead = {3, 0xA0, 0xBF};  // no overlong forms
+    else if ((b0 >= 0xE1 && b0 <= 0xEC) || b0 == 0xEE || b0 == 0xEF) lead = {3, 0x80, 0xBF};
+    else if (b0 == 0xED) lead = {3, 0x80, 0x9F};  // no surrogates
+    else if (b0 == 0xF0) lead = {4, 0x90, 0xBF};
+    else if (b0 >= 0xF1 && b0 <= 0xF3) lead = {4, 0x80, 0xBF};
+    else if (b0 == 0xF4) lead = {4, 0x80, 0x8F};  // nothing above U+10FFFF
+    else return 0;
+    const auto [n, lo, hi] = lead;
+    if (i + n > text.size()) return 0;
+    if (byte(i + 1) < lo || byte(i + 1) > hi) return 0;
+    for (std::size_t k = 2; k < n; ++k) {
+        if (byte(i + k) < 0x80 || byte(i + k) > 0xBF) return 0;
+    }
+    return n;
+}
+
+}  // namespace
+
+std::optional<TomlInvalidUtf8> toml_invalid_utf8(std::string_view text) {
+    std::size_t line = 1;
+    std::size_t line_start = 0;
+    for (std::size_t i = 0; i < text.size();) {
+        const std::size_t n = utf8_sequence_length(text, i);
+        if (n == 0) return TomlInvalidUtf8{line, i - line_start + 1};
+        if (text[i] == '\n') {
+            ++line;
+            line_start = i + 1;
+        }
+        i += n;
+    }
+    return std::nullopt;
+}
+
 }  // namespace mogao

@@ -19,6 +19,14 @@
 // "[a.b]" counts as its brackets and dots, closed on its own line. Text that is not valid TOML is
 // not judged here (toml11 does it, and stops at the first error): a single-line string ends at
 // the end of its line, an unterminated multi-line string ends the scan.
+//
+// The second guard, toml_invalid_utf8: toml11 3.7 reads out of bounds (heap-buffer-overflow under
+// ASan) when a literal string ('...' or '''...''') holds bytes that are not UTF-8: to point at the
+// bad byte it rewinds a copy of the string with an iterator into the whole file (parser.hpp,
+// parse_literal_string / parse_ml_literal_string) -- found by fuzzing the kiosk's configuration
+// (regression input tests/fuzz/corpus/kiosk_config/regression-literal-string-invalid-utf8.toml).
+// TOML 1.0 requires the whole document to be UTF-8, so every TOML reader refuses text that is
+// not, naming the line, before toml11 sees it.
 #pragma once
 
 #include <cstddef>
@@ -42,5 +50,16 @@ struct TomlNestingExcess {
 // size of the text, no recursion, no allocation.
 [[nodiscard]] std::optional<TomlNestingExcess> toml_nesting_excess(std::string_view text,
                                                                    int max_depth = kMaxTomlNesting);
+
+struct TomlInvalidUtf8 {
+    std::size_t line = 0;    // 1-based
+    std::size_t column = 0;  // 1-based, in bytes
+};
+
+// The first byte of `text` that does not start a well-formed UTF-8 sequence -- Unicode 15.0,
+// section 3.9, table 3-7 (no overlong forms, no surrogates, nothing above U+10FFFF; the same
+// table as toml11's lex_utf8_code) -- or nullopt when all of it is UTF-8. NUL is a valid code
+// point here (TOML forbids control characters; toml11 reports those). Linear, no allocation.
+[[nodiscard]] std::optional<TomlInvalidUtf8> toml_invalid_utf8(std::string_view text);
 
 }  // namespace mogao

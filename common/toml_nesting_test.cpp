@@ -75,6 +75,40 @@ TEST(TomlNesting, UnterminatedStringsAndStrayClosersEndQuietly) {
     EXPECT_TRUE(toml_nesting_excess("]]]]]] a = [[[1]]]", 2).has_value());
 }
 
+TEST(TomlUtf8, WellFormedTextPasses) {
+    EXPECT_FALSE(toml_invalid_utf8("").has_value());
+    EXPECT_FALSE(toml_invalid_utf8("a = 'plain'\n").has_value());
+    // 2, 3 and 4 bytes, the edges of table 3-7: U+0080, U+07FF, U+0800, U+D7FF, U+E000, U+FFFF,
+    // U+10000, U+10FFFF; and NUL.
+    EXPECT_FALSE(toml_invalid_utf8("a = '\xC2\x80 \xDF\xBF \xE0\xA0\x80 \xED\x9F\xBF \xEE\x80\x80 "
+                                   "\xEF\xBF\xBF \xF0\x90\x80\x80 \xF4\x8F\xBF\xBF'\n")
+                     .has_value());
+    EXPECT_FALSE(toml_invalid_utf8(std::string_view("a\0b", 3)).has_value());
+}
+
+TEST(TomlUtf8, EveryIllFormedSequenceIsFoundOnItsLineAndColumn) {
+    const char* bad[] = {
+        "\x80",              // a continuation byte alone
+        "\xC0\xAF",          // overlong '/'
+        "\xC1\xBF",          // overlong
+        "\xE0\x80\x80",      // overlong 3-byte
+        "\xED\xA0\x80",      // a surrogate, U+D800
+        "\xF0\x80\x80\x80",  // overlong 4-byte
+        "\xF4\x90\x80\x80",  // above U+10FFFF
+        "\xF5\x80\x80\x80",  // no such lead byte
+        "\xFF",
+        "\xE2\x82",          // cut short at the end of the text
+        "\xE2\x82x",         // cut short by an ASCII byte
+    };
+    for (const char* seq : bad) {
+        const std::string text = "a = 1\n# \xC3\xA9\nb = '" + std::string(seq);
+        const auto found = toml_invalid_utf8(text);
+        ASSERT_TRUE(found.has_value()) << seq;
+        EXPECT_EQ(found->line, 3U) << seq;
+        EXPECT_EQ(found->column, 6U) << seq;
+    }
+}
+
 TEST(TomlNesting, ALimitBelowOneIsRefused) {
     EXPECT_THROW((void)toml_nesting_excess("a = 1", 0), std::invalid_argument);
 }

@@ -751,6 +751,11 @@ Value parse_toml(std::string_view text, const Context& ctx) {
         throw KioskConfigError(fmt::format("{}:{}: tables or arrays nested deeper than {} levels", ctx.file,
                                            excess->line, excess->max_depth));
     }
+    // toml11 reads out of bounds on a literal string that is not UTF-8 (common/toml_nesting.h).
+    if (const auto bad = toml_invalid_utf8(text)) {
+        throw KioskConfigError(fmt::format("{}:{}: byte {} of the line is not UTF-8 (TOML files are UTF-8)",
+                                           ctx.file, bad->line, bad->column));
+    }
     try {
         std::istringstream in{std::string(text)};
         return toml::parse(in, ctx.file);

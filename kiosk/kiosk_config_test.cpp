@@ -411,6 +411,27 @@ TEST_F(KioskConfigTest, MessagesCarryTheLineOfTheOffendingValue) {
 // toml11 recurses once per nesting level without a limit: 20000 levels overflowed the stack
 // (found by fuzzing, tests/fuzz kiosk_config). The guard refuses them with the file and line; at
 // the guard's limit toml11 parses the value and the field check reports it.
+// Found by fuzzing (tests/fuzz/corpus/kiosk_config/regression-literal-string-invalid-utf8.toml):
+// toml11 3.7 read out of bounds on a literal string holding bytes that are not UTF-8.
+TEST_F(KioskConfigTest, ALiteralStringThatIsNotUtf8IsRefusedWithItsLineNotACrash) {
+    const std::string text = good();
+    const std::string field = R"(file = "out/stats.json")";
+    ASSERT_NE(text.find(field), std::string::npos);
+    const auto line = 1 + std::count(text.begin(), text.begin() + static_cast<long>(text.find(field)), '\n');
+    for (const std::string value : {"'out\xFF.json'", "'''out\xC0\xAF.json'''", "\"out\xED\xA0\x80.json\""}) {
+        const std::string e = error_of(replace(text, field, "file = " + value));
+        EXPECT_NE(e.find(name().string() + ":" + std::to_string(line) + ": byte "), std::string::npos) << e;
+        EXPECT_NE(e.find("is not UTF-8"), std::string::npos) << e;
+    }
+    EXPECT_EQ(error_of(replace(text, field, "file = 'out/\xC3\xA9t\xC3\xA9.json'")), "") << "UTF-8 is fine";
+    try {
+        (void)apply_config_overrides(text, {"stats.file='\xFF'"});
+        ADD_FAILURE() << "no error for an override that is not UTF-8";
+    } catch (const KioskConfigError& e) {
+        EXPECT_NE(std::string(e.what()).find("is not UTF-8"), std::string::npos) << e.what();
+    }
+}
+
 TEST_F(KioskConfigTest, ADeeplyNestedValueIsRefusedWithItsLineNotACrash) {
     const std::string text = good();
     const std::string field = R"(file = "out/stats.json")";

@@ -220,6 +220,11 @@ VirtualRig parse_rig(const std::string& toml_text, const std::string& name) {
         throw RigError("rig file '" + name + "' line " + std::to_string(excess->line) +
                        ": tables or arrays nested deeper than " + std::to_string(excess->max_depth) + " levels");
     }
+    // toml11 reads out of bounds on a literal string that is not UTF-8 (common/toml_nesting.h).
+    if (const auto bad = toml_invalid_utf8(toml_text)) {
+        throw RigError("rig file '" + name + "' line " + std::to_string(bad->line) + ": byte " +
+                       std::to_string(bad->column) + " of the line is not UTF-8 (TOML files are UTF-8)");
+    }
     try {
         std::istringstream in(toml_text);
         root = toml::parse(in, name);

@@ -267,6 +267,9 @@ TEST(RigFile, ErrorsNameTheField) {
         message("[camera]\n[[projectors]]\ngamma = [2.2, 2.2]\n").find("projectors[0].gamma: must be an array of 3"),
         std::string::npos);
     EXPECT_NE(message("[camera\n").find("not valid TOML"), std::string::npos);
+    // toml11 read out of bounds on a literal string that is not UTF-8 (common/toml_nesting.h).
+    EXPECT_NE(message("[camera]\nid = 'c\xFF'\n[[projectors]]\n").find("line 2: byte 8 of the line is not UTF-8"),
+              std::string::npos);
     EXPECT_NE(
         message("[camera]\nauto_exposure = 1\n[[projectors]]\n").find("camera.auto_exposure: must be true or false"),
         std::string::npos);
