@@ -97,8 +97,8 @@ TEST(TomlUtf8, EveryIllFormedSequenceIsFoundOnItsLineAndColumn) {
         "\xF4\x90\x80\x80",  // above U+10FFFF
         "\xF5\x80\x80\x80",  // no such lead byte
         "\xFF",
-        "\xE2\x82",          // cut short at the end of the text
-        "\xE2\x82x",         // cut short by an ASCII byte
+        "\xE2\x82",   // cut short at the end of the text
+        "\xE2\x82x",  // cut short by an ASCII byte
     };
     for (const char* seq : bad) {
         const std::string text = "a = 1\n# \xC3\xA9\nb = '" + std::string(seq);

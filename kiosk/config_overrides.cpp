@@ -125,8 +125,8 @@ std::string apply_config_overrides(std::string_view toml, const std::vector<std:
                                                text, excess->line, excess->max_depth));
         }
         if (const auto bad = toml_invalid_utf8(joined)) {
-            throw KioskConfigError(fmt::format("override '{}': line {} is not UTF-8 (byte {})", text, bad->line,
-                                               bad->column));
+            throw KioskConfigError(
+                fmt::format("override '{}': line {} is not UTF-8 (byte {})", text, bad->line, bad->column));
         }
         std::istringstream in(joined);
         try {

@@ -753,8 +753,8 @@ Value parse_toml(std::string_view text, const Context& ctx) {
     }
     // toml11 reads out of bounds on a literal string that is not UTF-8 (common/toml_nesting.h).
     if (const auto bad = toml_invalid_utf8(text)) {
-        throw KioskConfigError(fmt::format("{}:{}: byte {} of the line is not UTF-8 (TOML files are UTF-8)",
-                                           ctx.file, bad->line, bad->column));
+        throw KioskConfigError(fmt::format("{}:{}: byte {} of the line is not UTF-8 (TOML files are UTF-8)", ctx.file,
+                                           bad->line, bad->column));
     }
     try {
         std::istringstream in{std::string(text)};

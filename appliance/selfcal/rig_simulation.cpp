@@ -310,8 +310,7 @@ void check_start_model(const SystemModel& m, const rig::VirtualRig& truth) {
         if (m.projectors[k].resolution != truth.projectors[k].resolution) {
             throw std::invalid_argument("simulate: the starting models' projector " + std::to_string(k) + " is " +
                                         size_text(m.projectors[k].resolution) + ", the scaled rig's " +
-                                        size_text(truth.projectors[k].resolution) +
-                                        " (calibrate at the same --scale)");
+                                        size_text(truth.projectors[k].resolution) + " (calibrate at the same --scale)");
         }
     }
 }

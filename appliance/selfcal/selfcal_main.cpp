@@ -18,8 +18,9 @@ namespace {
 
 using mogao::selfcal::ContentKind;
 
-int run_simulate(const std::string& rig_path, const std::string& models_path, const std::vector<std::string>& bump_texts,
-                 double bump_at, mogao::selfcal::SimulationOptions o, bool verbose) {
+int run_simulate(const std::string& rig_path, const std::string& models_path,
+                 const std::vector<std::string>& bump_texts, double bump_at, mogao::selfcal::SimulationOptions o,
+                 bool verbose) {
     const mogao::rig::VirtualRig rig = mogao::rig::load_rig(rig_path);
     for (const std::string& b : bump_texts) {
         mogao::selfcal::Bump bump = mogao::selfcal::parse_bump(rig, b);
