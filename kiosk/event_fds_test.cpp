@@ -106,6 +106,28 @@ TEST(SignalFd, DeliversABlockedSignalAsData) {
     EXPECT_EQ(sigismember(&after, SIGUSR1), sigismember(&before, SIGUSR1));  // mask restored
 }
 
+// A program's own SignalFd: a signal that arrives after it is gone (main returning, static
+// destructors) must stay blocked and pending, never reach its default action.
+TEST(SignalFd, KeepBlockedLeavesTheSetBlockedAfterDestruction) {
+    sigset_t before;
+    ASSERT_EQ(::pthread_sigmask(SIG_SETMASK, nullptr, &before), 0);
+    ASSERT_EQ(sigismember(&before, SIGUSR1), 0);
+    {
+        auto signals = SignalFd::create({SIGUSR1}, SignalFd::OnDestroy::keep_blocked);
+        ASSERT_TRUE(signals) << signals.error().message;
+    }
+    sigset_t after;
+    ASSERT_EQ(::pthread_sigmask(SIG_SETMASK, nullptr, &after), 0);
+    EXPECT_EQ(sigismember(&after, SIGUSR1), 1);
+    ASSERT_EQ(::raise(SIGUSR1), 0);  // would kill the test if the mask had been restored
+    const timespec zero{};
+    sigset_t usr1;
+    sigemptyset(&usr1);
+    sigaddset(&usr1, SIGUSR1);
+    EXPECT_EQ(::sigtimedwait(&usr1, nullptr, &zero), SIGUSR1);  // pending, not delivered
+    ASSERT_EQ(::pthread_sigmask(SIG_SETMASK, &before, nullptr), 0);
+}
+
 TEST(SignalFd, RefusesAnEmptyOrInvalidSet) {
     EXPECT_EQ(SignalFd::create({}).code(), EINVAL);
     EXPECT_EQ(SignalFd::create({12345}).code(), EINVAL);

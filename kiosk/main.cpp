@@ -121,10 +121,12 @@ int print_config(std::vector<std::string> overrides) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    // First, before any thread exists (gRPC, llvmpipe, TBB): every thread inherits SIGINT/SIGTERM
+    // blocked and they reach the loop through the signalfd only (SIGUSR2: the status panel on the
+    // wall). They stay blocked until the process has exited (signal_fd.h: keep_blocked), so a stop
+    // that arrives while the kiosk is already on its way out still ends it with its own exit code.
+    auto signals = mogao::SignalFd::create({SIGINT, SIGTERM, SIGUSR2}, mogao::SignalFd::OnDestroy::keep_blocked);
     mogao::setup_kiosk_logging();
-    // Before any thread exists (gRPC, llvmpipe): every thread inherits SIGINT/SIGTERM blocked and
-    // they reach the loop through the signalfd only (SIGUSR2: the status panel on the wall).
-    auto signals = mogao::SignalFd::create({SIGINT, SIGTERM, SIGUSR2});  // USR2: the on-wall status panel
     if (!signals) {
         spdlog::error("signals: {}", signals.error().message);
         return 1;

@@ -12,7 +12,7 @@
 
 namespace mogao {
 
-Result<SignalFd> SignalFd::create(std::initializer_list<int> signals) {
+Result<SignalFd> SignalFd::create(std::initializer_list<int> signals, OnDestroy on_destroy) {
     if (signals.size() == 0) return make_error(EINVAL, "signalfd: empty signal set");
     sigset_t set;
     sigemptyset(&set);
@@ -29,13 +29,14 @@ Result<SignalFd> SignalFd::create(std::initializer_list<int> signals) {
         ::pthread_sigmask(SIG_SETMASK, &previous, nullptr);
         return error;
     }
-    return SignalFd(UniqueFd(fd), set, previous);
+    return SignalFd(UniqueFd(fd), set, previous, on_destroy);
 }
 
 SignalFd::~SignalFd() {
-    if (!fd_.valid()) return;  // moved from
-    // Consume what is pending for the set, then unblock: a late SIGTERM must not kill the process
-    // half-way through its clean shutdown.
+    // Moved from, or the program's own SignalFd: the set stays blocked until the process has exited
+    // (signal_fd.h), so a signal after this point cannot end it by its default action.
+    if (!fd_.valid() || on_destroy_ == OnDestroy::keep_blocked) return;
+    // Consume what is pending for the set before unblocking, so that it is not delivered then.
     const timespec zero{};
     while (::sigtimedwait(&set_, nullptr, &zero) > 0) {
     }

@@ -28,17 +28,9 @@ kiosk_prefix=()
 if [[ "$mode" == netns || "$mode" == multihost ]]; then
   ns_farm="mogao-farm-$$"
   ns_kiosk="mogao-kiosk-$$"
-  if ! ip netns add "$ns_farm" 2>"$work/netns.err"; then
-    echo "SKIP: network namespaces are not permitted here (ip netns add: $(cat "$work/netns.err")); run as root with CAP_SYS_ADMIN"
-    exit 77
-  fi
-  netns_created+=("$ns_farm")
+  netns_add_or_skip "$ns_farm"
   ip netns add "$ns_kiosk" || fail "ip netns add $ns_kiosk"
   netns_created+=("$ns_kiosk")
-  if ! ip netns exec "$ns_farm" true 2>"$work/netns.err"; then
-    echo "SKIP: cannot enter a network namespace here (ip netns exec: $(cat "$work/netns.err"))"
-    exit 77
-  fi
   veth_f="mgf$$"
   veth_k="mgk$$"
   ip link add "$veth_f" netns "$ns_farm" type veth peer name "$veth_k" netns "$ns_kiosk" || fail "veth pair"

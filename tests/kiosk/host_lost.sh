@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
 # Fault: a render host of a multi-host farm is lost while the farm serves an appliance, twice, and
-# then one comes back (issue 16, render-node failure; docs/services.md "Render-node failure"):
+# then one comes back (render-node failure: docs/services.md "Render-node failure"):
 #   cut   render host R2's link goes down (a hung or unreachable host: its rank no longer answers,
 #         nothing reports an error; the admin's frame deadline ends the job: its default, 4 x the frame's
 #         expected time and at least 2 s)
@@ -16,7 +16,7 @@
 # after R2's return with R2.
 # Checks: the launcher names the host it left out each time; the farm comes back with 1, then 0, then 1
 # render ranks; from the kiosk's own record, the appliance shows a new frame within 10 s of each
-# loss (the issue's bound) and within 10 s of the job's end for R2's return, request ids strictly
+# loss (the recovery bound) and within 10 s of the job's end for R2's return, request ids strictly
 # increasing across the restarts, the last good frame held meanwhile (no frame rejected), and it
 # ends with exit code 0.
 #
@@ -34,11 +34,7 @@ RESUME_LIMIT_S=10
 rm -rf "$work"
 mkdir -p "$work"
 A="mogao-hl-a-$$" K="mogao-hl-k-$$" R1="mogao-hl-r1-$$" R2="mogao-hl-r2-$$"
-if ! ip netns add "$A" 2>"$work/netns.err"; then
-  echo "SKIP: network namespaces are not permitted here (ip netns add: $(cat "$work/netns.err")); run as root with CAP_SYS_ADMIN"
-  exit 77
-fi
-netns_created+=("$A")
+netns_add_or_skip "$A"
 for ns in "$K" "$R1" "$R2"; do
   ip netns add "$ns" || fail "ip netns add $ns"
   netns_created+=("$ns")

@@ -54,6 +54,25 @@ stop_farm() {
   farm_sid=""
 }
 
+# netns_add_or_skip NS: creates network namespace NS (removed by `cleanup`) and checks that a process
+# can enter it with a UTS namespace of its own, as the scripts' rsh agents do. Where this environment
+# cannot (no CAP_SYS_ADMIN; a chroot or container whose / is not a mount point, where `ip netns exec`
+# fails on "mount --make-rslave /"), the test is skipped (exit 77) with the reason. In CI a skip fails
+# the run (.ci/check-skips): namespaces work there.
+netns_add_or_skip() {
+  local err
+  if ! err=$(ip netns add "$1" 2>&1); then
+    echo "SKIP: network namespaces are not permitted here (ip netns add: $err); run as root with CAP_SYS_ADMIN"
+    exit 77
+  fi
+  netns_created+=("$1")
+  if ! err=$(ip netns exec "$1" unshare --uts true 2>&1); then
+    echo "SKIP: cannot enter a network namespace here (ip netns exec $1 unshare --uts: ${err//$'\n'/; }); run as root" \
+      "on a host, VM or container whose / is a mount point"
+    exit 77
+  fi
+}
+
 cleanup() {
   [[ -n "$kiosk_pid" ]] && kill -s TERM "$kiosk_pid" 2>/dev/null
   stop_farm TERM
