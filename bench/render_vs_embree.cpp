@@ -17,12 +17,18 @@
 //       frame time ratio new/legacy, and the PSNR of each 1 spp frame (sRGB8, the scene's exposure
 //       and tone map) against a converged reference (--ref-spp, default 64, legacy estimator,
 //       rendered on all cores), so speed is never bought with error.
+//   (e) after (c), or after (d) with --scene: the same view at 0, 1, 2 and 6 bounces: the renderer
+//       against raw Embree on exactly its ray mix (camera packets + the recorded secondary rays,
+//       replayed as traced), the whole render with the former COHERENT light shadow packets over
+//       the defaults (INCOHERENT) and whether their pixels are bit-identical, and the recorded
+//       secondary rays replayed in each shape (packets with either flag, 1M streams, single rays).
 // Usage: mogao_bench_render [--width W] [--height H] [--spp N] [--reps N] [--grid N] [--json FILE]
 //                           [--scene FILE [--scans DIR] [--scene-width W] [--scene-height H] [--ref-spp N]]
 // The table goes to stdout; --json FILE also writes every figure as JSON (for bench/regenerate-docs).
 // Timings use Renderer/RenderTimings from renderfarm/trace/render_timing.h, which the farm can
 // reuse on a real scene: time_render_vs_embree(scene, request).
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -258,6 +264,112 @@ void print_path(const char* label, const PathFigures& f, const PathFigures& lega
         f.mrays() / f.embree_mrays(), f.render_s / legacy.render_s, f.psnr_db);
 }
 
+// (e): one bounce count's figures (see the header comment).
+struct BounceRow {
+    int bounces = 0;
+    std::uint64_t rays = 0;
+    double render_s = 1e300;      // defaults: every secondary ray INCOHERENT
+    double baseline_s = 1e300;    // light shadow packets COHERENT, as before the ray-flag audit
+    double camera_s = 1e300;      // raw Embree: the camera packets
+    bool identical = false;       // the two renders' pixels, bit for bit
+    std::vector<double> shape_s;  // raw Embree: the recorded secondary rays in each shape of kShapes
+    [[nodiscard]] double embree_s() const { return camera_s + shape_s[1]; }  // kAsRecorded of the defaults
+};
+
+struct Shape {
+    const char* key;
+    const char* label;
+    ReplayShape shape;
+    bool baseline_log;  // replays the baseline's log (its flags), not the defaults'
+};
+const std::array<Shape, 6> kShapes = {{
+    {"coherent_lights_as_before", "packets, light shadows COHERENT (before)", ReplayShape::kAsRecorded, true},
+    {"incoherent_packets", "packets, all INCOHERENT (defaults)", ReplayShape::kAsRecorded, false},
+    {"coherent_first_hit", "packets, COHERENT at the first hit only", ReplayShape::kCoherentFirstHit, false},
+    {"streams_coherent", "rtcOccluded1M/rtcIntersect1M, COHERENT", ReplayShape::kStreams, false},
+    {"streams_incoherent", "rtcOccluded1M/rtcIntersect1M, INCOHERENT", ReplayShape::kIncoherentStreams, false},
+    {"single_rays", "one ray at a time (rtcOccluded1/rtcIntersect1)", ReplayShape::kSingleRays, false},
+}};
+
+template <typename F>
+void keep_min(double& best, F&& f) {
+    const double t0 = thread_cpu_seconds();
+    f();
+    best = std::min(best, thread_cpu_seconds() - t0);
+}
+
+BounceRow time_bounces(Renderer& renderer, ViewRequest view, int bounces, int reps) {
+    view.quality.max_bounces = bounces;
+    RendererOptions baseline;
+    baseline.coherent_shadow_packets_baseline = true;
+    BounceRow row;
+    row.bounces = bounces;
+    row.shape_s.assign(kShapes.size(), 1e300);
+    renderer.set_path_options(RendererOptions{});
+    renderer.begin_frame(view);
+    RgbFloatImage frame(renderer.render_size());
+    RgbFloatImage old_frame(renderer.render_size());
+    const PixelRect whole = PixelRect::whole(frame.size);
+    RecordedRays log;
+    RecordedRays baseline_log;
+    row.rays = renderer.render_recording(whole, frame, log).rays;
+    renderer.set_path_options(baseline);
+    renderer.begin_frame(view);
+    (void)renderer.render_recording(whole, old_frame, baseline_log);
+    row.identical = frame.pixels == old_frame.pixels;
+    for (int r = 0; r < std::max(1, reps); ++r) {  // interleaved, so that drift affects all alike
+        renderer.set_path_options(baseline);
+        renderer.begin_frame(view);
+        keep_min(row.baseline_s, [&] { (void)renderer.render(whole, old_frame); });
+        renderer.set_path_options(RendererOptions{});
+        renderer.begin_frame(view);
+        keep_min(row.render_s, [&] { (void)renderer.render(whole, frame); });
+        keep_min(row.camera_s, [&] { (void)renderer.trace_camera_rays(whole); });
+        for (std::size_t k = 0; k < kShapes.size(); ++k) {
+            const RecordedRays& l = kShapes[k].baseline_log ? baseline_log : log;
+            keep_min(row.shape_s[k], [&] { (void)renderer.trace_recorded(l, kShapes[k].shape); });
+        }
+    }
+    return row;
+}
+
+// (e): renderer vs raw Embree on the same ray mix at 0, 1, 2 and 6 bounces, and the ray flags'
+// and shapes' cost on the recorded secondary rays, all in one run.
+nlohmann::json bounce_section(Renderer& renderer, const ViewRequest& view, int reps, const std::string& scene) {
+    renderer.set_path_options(RendererOptions{});
+    renderer.begin_frame(view);
+    const ImageSize size = renderer.render_size();
+    std::printf("(e) %s, %dx%d, %d spp, one thread, best of %d: bounces vs raw Embree on the same ray mix\n",
+                scene.c_str(), size.width, size.height, view.quality.spp, reps);
+    nlohmann::json rows = nlohmann::json::array();
+    for (const int bounces : {0, 1, 2, 6}) {
+        const BounceRow row = time_bounces(renderer, view, bounces, reps);
+        std::printf(
+            "  %d bounces: %10llu rays  renderer %8.1f ms  Embree same mix %8.1f ms  renderer/Embree throughput "
+            "%.2f (goal >= 0.60)  before/now %.2f  pixels identical %s\n",
+            bounces, static_cast<unsigned long long>(row.rays), 1e3 * row.render_s, 1e3 * row.embree_s(),
+            row.embree_s() / row.render_s, row.baseline_s / row.render_s, row.identical ? "yes" : "NO");
+        nlohmann::json shapes = nlohmann::json::object();
+        for (std::size_t k = 0; k < kShapes.size(); ++k) {
+            std::printf("      secondary rays as %-50s %8.1f ms  x%.2f vs defaults\n", kShapes[k].label,
+                        1e3 * row.shape_s[k], row.shape_s[k] / row.shape_s[1]);
+            shapes[kShapes[k].key] = 1e3 * row.shape_s[k];
+        }
+        rows.push_back({{"bounces", bounces},
+                        {"rays", row.rays},
+                        {"renderer_ms", 1e3 * row.render_s},
+                        {"coherent_baseline_ms", 1e3 * row.baseline_s},
+                        {"embree_same_mix_ms", 1e3 * row.embree_s()},
+                        {"embree_camera_ms", 1e3 * row.camera_s},
+                        {"renderer_vs_embree_throughput", row.embree_s() / row.render_s},
+                        {"speedup_over_coherent", row.baseline_s / row.render_s},
+                        {"pixels_identical", row.identical},
+                        {"secondary_ms", shapes}});
+    }
+    return {{"scene", scene}, {"width", size.width}, {"height", size.height}, {"spp", view.quality.spp},
+            {"reps", reps},   {"threads", 1},        {"rows", rows}};
+}
+
 // (d): see the header comment.
 nlohmann::json scene_section(int argc, char** argv, int reps) {
     SceneLoadOptions load;
@@ -311,7 +423,9 @@ nlohmann::json scene_section(int argc, char** argv, int reps) {
                               {"renderer_vs_embree_throughput", f.mrays() / f.embree_mrays()},
                               {"psnr_db", f.psnr_db}};
     };
+    const nlohmann::json bounce_figures = bounce_section(renderer, view, reps, arg_str(argc, argv, "--scene", ""));
     return {{"scene", arg_str(argc, argv, "--scene", "")},
+            {"e", bounce_figures},
             {"width", view.size.width},
             {"height", view.size.height},
             {"reps", reps},
@@ -379,6 +493,8 @@ int main(int argc, char** argv) {
         std::printf("    (c5)/(c1) = %.3f  (what vertex colours and a mip-mapped texture cost when used)\n",
                     colour_used.render_s / plain.render_s);
         std::printf("    BVH build (c1): %.2f s\n", plain.build_s);
+        const nlohmann::json bounce_figures =
+            bounce_section(renderer, request, reps, "in-code height field + sphere, sun");
         if (!json_file.empty()) {
             const nlohmann::json out = {
                 {"bench", "render_vs_embree"},
@@ -398,7 +514,8 @@ int main(int argc, char** argv) {
                 {"c4", timing_json("(c1) + an unplaced coloured, textured mesh", colour_unused)},
                 {"c5", timing_json("(c1) with vertex colours + a texture", colour_used)},
                 {"ratio_c4_over_c1", colour_unused.render_s / plain.render_s},
-                {"ratio_c5_over_c1", colour_used.render_s / plain.render_s}};
+                {"ratio_c5_over_c1", colour_used.render_s / plain.render_s},
+                {"e", bounce_figures}};
             std::ofstream file(json_file);
             file << out.dump(1) << '\n';
             if (!file.flush()) throw std::runtime_error("cannot write " + json_file);

@@ -75,6 +75,10 @@ struct FrameContext {
     int packet_width = 16;               // Embree packet width of the packet path (embree_packets.h)
     float cone_spread = 0.0f;            // radians: a camera sample's ray-cone spread (camera_cone_spread,
                                          // texture_lod.h); 0 filters no texture
+    // Benchmark baseline only (RendererOptions::coherent_shadow_packets_baseline): the packet path's
+    // light shadow packets traced with RTC_INTERSECT_CONTEXT_FLAG_COHERENT, as before the ray-flag
+    // audit; every secondary ray is otherwise traced INCOHERENT (packet_integrator.h).
+    bool coherent_shadow_packets = false;
 };
 
 // One shadow ray and what it adds (already multiplied by the path throughput) when unoccluded.

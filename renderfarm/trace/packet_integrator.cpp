@@ -29,11 +29,12 @@ struct Scratch {
     std::vector<unsigned char> blocked;  // per query
 };
 
-void record(RecordedRays* log, const int* valid, const RTCRay16& r, bool occlusion, bool coherent) {
+void record(RecordedRays* log, const int* valid, const RTCRay16& r, bool occlusion, bool coherent, int depth) {
     if (log == nullptr) return;
     RecordedPacket& p = log->packets.emplace_back();
     p.occlusion = occlusion;
     p.coherent = coherent;
+    p.depth = static_cast<std::uint8_t>(std::min(depth, 255));
     for (std::size_t l = 0; l < kPacketLanes; ++l) {
         p.valid[l] = valid[l];
         p.org_x[l] = r.org_x[l];
@@ -62,7 +63,11 @@ void set_lane(RTCRay16& r, std::size_t l, const Eigen::Vector3f& org, const Eige
 }
 
 // Traces every query of `s` in packets of (group, occurrence), each lane at its own position.
-void trace_queries(const FrameContext& frame, Scratch& s, std::uint64_t& rays, RecordedRays* log) {
+// Context flag: INCOHERENT. The rays leave scattered hit points, and Embree's COHERENT mode (meant
+// for camera-like rays: Embree 3 API, RTCIntersectContextFlags) traced the same shadow packets
+// about twice as slowly (docs/renderer.md, "Ray flags"); frame.coherent_shadow_packets keeps that
+// former flag for light groups as the benchmark's baseline.
+void trace_queries(const FrameContext& frame, Scratch& s, std::uint64_t& rays, RecordedRays* log, int depth) {
     const std::size_t n = s.queries.size();
     s.blocked.assign(n, 0);
     s.order.clear();
@@ -88,9 +93,10 @@ void trace_queries(const FrameContext& frame, Scratch& s, std::uint64_t& rays, R
             valid[l] = -1;
             ++end;
         }
-        const bool environment = (packet_key >> 22) == 0;
-        context.flags = environment ? RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT : RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-        record(log, valid.data(), ray, true, !environment);
+        const bool coherent = frame.coherent_shadow_packets && (packet_key >> 22) != 0;  // not the environment
+        context.flags = coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+        record(log, valid.data(), ray, true, coherent, depth);
+        if (log != nullptr && begin != 0) log->packets.back().starts_call = false;  // same vertex, same call
         occluded16_at(frame.packet_width, valid.data(), frame.scene->root(), &context, ray);
         for (std::size_t k = begin; k < end; ++k) {
             const auto q = static_cast<std::size_t>(s.order[k] & 0xFFFFFFFFu);
@@ -106,7 +112,7 @@ void trace_queries(const FrameContext& frame, Scratch& s, std::uint64_t& rays, R
 void direct_light(const FrameContext& frame, std::array<Lane, kPacketLanes>& lanes,
                   std::array<ShadingVertex, kPacketLanes>& vertices, bool bounce_follows,
                   std::array<PixelSampler, kPacketLanes>& rngs, std::array<Eigen::Vector3f, kPacketLanes>& radiance,
-                  Scratch& s, std::uint64_t& rays, RecordedRays* log) {
+                  Scratch& s, std::uint64_t& rays, RecordedRays* log, int depth) {
     s.queries.clear();
     s.lane_of.clear();
     for (std::size_t l = 0; l < kPacketLanes; ++l) {
@@ -115,7 +121,7 @@ void direct_light(const FrameContext& frame, std::array<Lane, kPacketLanes>& lan
         direct_light_queries(frame, vertices[l], lanes[l].throughput, bounce_follows, rngs[l], s.queries, radiance[l]);
         s.lane_of.resize(s.queries.size(), static_cast<int>(l));
     }
-    trace_queries(frame, s, rays, log);
+    trace_queries(frame, s, rays, log, depth);
     for (std::size_t q = 0; q < s.queries.size(); ++q) {
         if (s.blocked[q] == 0) radiance[static_cast<std::size_t>(s.lane_of[q])] += s.queries[q].contribution;
     }
@@ -124,7 +130,7 @@ void direct_light(const FrameContext& frame, std::array<Lane, kPacketLanes>& lan
 // Samples and traces the bounce of every live lane as one packet; lanes that end die.
 void bounce(const FrameContext& frame, std::array<Lane, kPacketLanes>& lanes,
             const std::array<ShadingVertex, kPacketLanes>& vertices, std::array<PixelSampler, kPacketLanes>& rngs,
-            std::array<Eigen::Vector3f, kPacketLanes>& radiance, std::uint64_t& rays, RecordedRays* log) {
+            std::array<Eigen::Vector3f, kPacketLanes>& radiance, std::uint64_t& rays, RecordedRays* log, int depth) {
     alignas(64) std::array<int, kPacketLanes> valid{};
     std::array<Bounce, kPacketLanes> bounces;
     RTCRayHit16 packet{};
@@ -145,7 +151,7 @@ void bounce(const FrameContext& frame, std::array<Lane, kPacketLanes>& lanes,
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-    record(log, valid.data(), packet.ray, false, false);
+    record(log, valid.data(), packet.ray, false, false, depth);
     intersect16_at(frame.packet_width, valid.data(), frame.scene->root(), &context, packet);
     rays += static_cast<std::uint64_t>(active);
     for (std::size_t l = 0; l < kPacketLanes; ++l) {
@@ -182,9 +188,9 @@ void radiance_packet(const FrameContext& frame, const PacketHits& hits, std::arr
     std::array<ShadingVertex, kPacketLanes> vertices;
     for (int depth = 0;; ++depth) {
         const bool bounce_follows = depth < frame.max_bounces;
-        direct_light(frame, lanes, vertices, bounce_follows, rngs, radiance, scratch, rays, log);
+        direct_light(frame, lanes, vertices, bounce_follows, rngs, radiance, scratch, rays, log, depth);
         if (!bounce_follows) break;
-        bounce(frame, lanes, vertices, rngs, radiance, rays, log);
+        bounce(frame, lanes, vertices, rngs, radiance, rays, log, depth);
         if (std::none_of(lanes.begin(), lanes.end(), [](const Lane& l) { return l.alive; })) break;
     }
 }

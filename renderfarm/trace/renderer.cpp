@@ -233,6 +233,7 @@ void Renderer::set_path_options(const RendererOptions& options) {
     impl_->options.packet_secondary_rays = options.packet_secondary_rays;
     impl_->options.camera_column_table = options.camera_column_table;
     impl_->options.native_packet_width = options.native_packet_width;
+    impl_->options.coherent_shadow_packets_baseline = options.coherent_shadow_packets_baseline;
 }
 
 void Renderer::begin_frame(const ViewRequest& request) {
@@ -254,6 +255,7 @@ void Renderer::begin_frame(const ViewRequest& request) {
                              s.options.legacy_light_sampling,
                              s.packet_width()};
     s.context.cone_spread = static_cast<float>(camera_cone_spread(*s.camera, s.spp));
+    s.context.coherent_shadow_packets = s.options.coherent_shadow_packets_baseline;
     s.columns = s.options.camera_column_table && s.spp == 1 ? make_cylinder_columns(*s.camera) : CylinderColumns{};
     s.ready = true;
 }
@@ -290,56 +292,113 @@ TileStats Renderer::render_recording(const PixelRect& rect, RgbFloatImage& frame
     return stats;
 }
 
-TileStats Renderer::trace_recorded(const RecordedRays& log) const {
+namespace {
+
+RTCRayHit single_ray(const RecordedPacket& p, std::size_t l) {
+    RTCRayHit one{};
+    one.ray.org_x = p.org_x[l];
+    one.ray.org_y = p.org_y[l];
+    one.ray.org_z = p.org_z[l];
+    one.ray.dir_x = p.dir_x[l];
+    one.ray.dir_y = p.dir_y[l];
+    one.ray.dir_z = p.dir_z[l];
+    one.ray.tfar = p.tfar[l];
+    one.ray.mask = 0xFFFFFFFFu;
+    one.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    one.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    return one;
+}
+
+void replay_packet(const RecordedPacket& p, int width, RTCScene scene, RTCIntersectContext* context) {
+    RTCRayHit16 packet{};
+    for (std::size_t l = 0; l < kLanes; ++l) {
+        packet.ray.org_x[l] = p.org_x[l];
+        packet.ray.org_y[l] = p.org_y[l];
+        packet.ray.org_z[l] = p.org_z[l];
+        packet.ray.dir_x[l] = p.dir_x[l];
+        packet.ray.dir_y[l] = p.dir_y[l];
+        packet.ray.dir_z[l] = p.dir_z[l];
+        packet.ray.tfar[l] = p.tfar[l];
+        packet.ray.mask[l] = 0xFFFFFFFFu;
+        packet.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
+        packet.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
+    }
+    if (p.occlusion) {
+        occluded16_at(width, p.valid.data(), scene, context, packet.ray);
+    } else {
+        intersect16_at(width, p.valid.data(), scene, context, packet);
+    }
+}
+
+void replay_single(const RecordedPacket& p, RTCScene scene, RTCIntersectContext* context) {
+    for (std::size_t l = 0; l < kLanes; ++l) {
+        if (p.valid[l] == 0) continue;
+        RTCRayHit one = single_ray(p, l);
+        if (p.occlusion) {
+            rtcOccluded1(scene, context, &one.ray);
+        } else {
+            rtcIntersect1(scene, context, &one);
+        }
+    }
+}
+
+// The valid rays of packets [first, last) (one call of the renderer: same kind) as one stream.
+void replay_stream(const RecordedPacket* first, const RecordedPacket* last, RTCScene scene,
+                   RTCIntersectContext* context) {
+    thread_local std::vector<RTCRayHit> stream;
+    stream.clear();
+    for (const RecordedPacket* p = first; p != last; ++p)
+        for (std::size_t l = 0; l < kLanes; ++l)
+            if (p->valid[l] != 0) stream.push_back(single_ray(*p, l));
+    const auto n = static_cast<unsigned>(stream.size());
+    if (first->occlusion) {
+        rtcOccluded1M(scene, context, &stream.data()->ray, n, sizeof(RTCRayHit));
+    } else {
+        rtcIntersect1M(scene, context, stream.data(), n, sizeof(RTCRayHit));
+    }
+}
+
+int replay_flags(const RecordedPacket& p, ReplayShape shape) {
+    switch (shape) {
+        case ReplayShape::kAsRecorded:
+            return p.coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+        case ReplayShape::kStreams:
+            return RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        case ReplayShape::kCoherentFirstHit:
+            return p.occlusion && p.depth == 0 ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT
+                                               : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+        default:
+            return RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    }
+}
+
+}  // namespace
+
+TileStats Renderer::trace_recorded(const RecordedRays& log, ReplayShape shape) const {
     const Impl& s = *impl_;
     s.check_ready();
-    TileStats stats;
+    TileStats stats{log.ray_count()};
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    for (const RecordedPacket& p : log.packets) {
-        context.flags = p.coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-        if (p.packet) {
-            RTCRayHit16 packet{};
-            for (std::size_t l = 0; l < kLanes; ++l) {
-                packet.ray.org_x[l] = p.org_x[l];
-                packet.ray.org_y[l] = p.org_y[l];
-                packet.ray.org_z[l] = p.org_z[l];
-                packet.ray.dir_x[l] = p.dir_x[l];
-                packet.ray.dir_y[l] = p.dir_y[l];
-                packet.ray.dir_z[l] = p.dir_z[l];
-                packet.ray.tfar[l] = p.tfar[l];
-                packet.ray.mask[l] = 0xFFFFFFFFu;
-                packet.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
-                packet.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
-                stats.rays += p.valid[l] != 0 ? 1u : 0u;
-            }
-            if (p.occlusion) {
-                occluded16_at(s.packet_width(), p.valid.data(), s.geometry.root(), &context, packet.ray);
-            } else {
-                intersect16_at(s.packet_width(), p.valid.data(), s.geometry.root(), &context, packet);
-            }
+    const RTCScene scene = s.geometry.root();
+    const bool streams = shape == ReplayShape::kStreams || shape == ReplayShape::kIncoherentStreams;
+    for (std::size_t i = 0; i < log.packets.size();) {
+        const RecordedPacket& p = log.packets[i];
+        context.flags = static_cast<RTCIntersectContextFlags>(replay_flags(p, shape));
+        if (streams) {
+            std::size_t j = i + 1;
+            while (j < log.packets.size() && !log.packets[j].starts_call) ++j;
+            replay_stream(&p, log.packets.data() + j, scene, &context);
+            i = j;
             continue;
         }
-        for (std::size_t l = 0; l < kLanes; ++l) {
-            if (p.valid[l] == 0) continue;
-            RTCRayHit one{};
-            one.ray.org_x = p.org_x[l];
-            one.ray.org_y = p.org_y[l];
-            one.ray.org_z = p.org_z[l];
-            one.ray.dir_x = p.dir_x[l];
-            one.ray.dir_y = p.dir_y[l];
-            one.ray.dir_z = p.dir_z[l];
-            one.ray.tfar = p.tfar[l];
-            one.ray.mask = 0xFFFFFFFFu;
-            one.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-            one.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-            if (p.occlusion) {
-                rtcOccluded1(s.geometry.root(), &context, &one.ray);
-            } else {
-                rtcIntersect1(s.geometry.root(), &context, &one);
-            }
-            ++stats.rays;
+        const bool packet = shape == ReplayShape::kAsRecorded ? p.packet : shape != ReplayShape::kSingleRays;
+        if (packet) {
+            replay_packet(p, s.packet_width(), scene, &context);
+        } else {
+            replay_single(p, scene, &context);
         }
+        ++i;
     }
     return stats;
 }

@@ -59,6 +59,25 @@ struct RendererOptions {
     // Camera and secondary packets traced at the CPU's native width (embree_packets.h: two
     // rtcIntersect8 / rtcOccluded8 halves on AVX2, where Embree would run a 16-wide call ray by ray).
     bool native_packet_width = true;
+    // Benchmark baseline only, not a setting: traces the packet path's light shadow packets with
+    // RTC_INTERSECT_CONTEXT_FLAG_COHERENT, the flag they had before the ray-flag audit (Embree
+    // reserves it for coherent rays such as camera rays; it made them about twice as slow). The
+    // same pixels either way (RendererRayFlags test); mogao_bench_render times both in one run.
+    bool coherent_shadow_packets_baseline = false;
+};
+
+// How Renderer::trace_recorded hands a recorded log to Embree (benchmarks only). "Packets" are
+// 16-lane packets at the native width (embree_packets.h); a "call" is one vertex of one 4x4 block
+// (its shadow queries, or its bounce rays: RecordedPacket::starts_call). Embree 3 traces a
+// COHERENT stream by regrouping it into packets, an INCOHERENT one ray by ray (Embree 3 API,
+// rtcIntersect1M and RTCIntersectContextFlags).
+enum class ReplayShape {
+    kAsRecorded,         // each packet in its recorded shape and context flag
+    kIncoherentPackets,  // every packet as a packet, INCOHERENT
+    kCoherentFirstHit,   // packets; COHERENT for the shadow rays of the camera ray's hit, INCOHERENT after
+    kSingleRays,         // every ray alone (rtcOccluded1 / rtcIntersect1), INCOHERENT
+    kStreams,            // each call as one rtcOccluded1M / rtcIntersect1M stream, COHERENT
+    kIncoherentStreams,  // each call as one stream, INCOHERENT
 };
 
 struct TileStats {
@@ -104,9 +123,10 @@ public:
     TileStats trace_camera_rays(const PixelRect& rect) const;
 
     // Benchmark support: render() that also keeps every secondary ray it traced, and raw Embree
-    // tracing such a log (same packets or single rays, same context flags) without any shading.
+    // tracing such a log without any shading: as traced (same packets or single rays, same context
+    // flags) or in another shape (ReplayShape), to measure which shape traces those rays fastest.
     TileStats render_recording(const PixelRect& rect, RgbFloatImage& frame, RecordedRays& log) const;
-    TileStats trace_recorded(const RecordedRays& log) const;
+    TileStats trace_recorded(const RecordedRays& log, ReplayShape shape = ReplayShape::kAsRecorded) const;
 
     // The renderer's Embree geometry, rebased by begin_frame() on the current frame's eye (or not
     // at all when rebase_on_eye is off), for passes that trace the same frame's primary hits
