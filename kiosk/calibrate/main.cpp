@@ -9,6 +9,8 @@
 //   The whole on-site path without hardware (SIMULATION: the rig's camera films the headless outputs,
 //   or with --outputs kms the kernel's scanout buffers: the appliance image's QEMU test):
 //     mogao-calibrate --site rigs/standard.toml --outputs headless --camera rig:rigs/standard.toml --out DIR
+//   Projector intrinsics on the bench from Gray-code captures of a board (docs/calibration.md):
+//     mogao-calibrate procam --images DIR [DIR...] --projector WxH --board COLSxROWS --square-mm S --out FILE.json
 //   How many images and how long the capture takes:
 //     mogao-calibrate --site FILE --budget [--camera-fps 30 --settle-ms 150 --drop-frames 2]
 //
@@ -32,6 +34,7 @@
 #include "drivers/kms/kms_backend.h"
 #include "kiosk/calibrate/on_site_job.h"
 #include "kiosk/calibrate/pattern_budget.h"
+#include "kiosk/calibrate/procam_command.h"
 #include "kiosk/calibrate/rig_camera.h"
 
 namespace {
@@ -242,8 +245,11 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(0, 30));
     app.add_flag("--budget", cli.budget, "Print the image count and capture time for --site, then exit");
     app.add_option("--budget-fps", cli.budget_fps, "Camera frame rate for --budget")->check(CLI::Range(1.0, 1000.0));
+    ProcamCommand procam;
+    add_procam_command(app, procam);
     try {
         app.parse(argc, argv);
+        if (procam.app->parsed()) return run_procam_command(procam);
         if (!parse_size(cli.content, job.content))
             throw CLI::ValidationError("--content", "must be WIDTHxHEIGHT, 1..16384");
         if (cli.rig.empty() && cli.site.empty()) throw CLI::ValidationError("--rig or --site", "one is required");

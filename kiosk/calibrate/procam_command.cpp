@@ -1,0 +1,104 @@
+// SPDX-License-Identifier: Apache-2.0
+// `mogao-calibrate procam` (procam_command.h).
+#include "kiosk/calibrate/procam_command.h"
+
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <stdexcept>
+
+#include "appliance/procam/procam_job.h"
+
+namespace mogao::calibrate {
+
+namespace {
+
+bool parse_pair(const std::string& text, int& a, int& b, int lo, int hi) {
+    char tail = 0;
+    return std::sscanf(text.c_str(), "%dx%d%c", &a, &b, &tail) == 2 && a >= lo && b >= lo && a <= hi && b <= hi;
+}
+
+void print_result(const procam::ProcamJobResult& r, const std::filesystem::path& out) {
+    const procam::ProcamCalibration& c = r.calibration;
+    for (std::size_t i = 0; i < r.views.size(); ++i) {
+        std::printf("%s: %.1f %% of the camera's pixels decoded, %zu corners; residual camera %.3f projector %.3f px\n",
+                    r.views[i].name.c_str(), 100.0 * r.views[i].decoded_fraction, r.views[i].board.size(),
+                    c.captures[i].camera_rms_px, c.captures[i].projector_rms_px);
+    }
+    const cv::Matx33d& k = c.projector.K;
+    std::printf("projector fx %.1f fy %.1f cx %.1f cy %.1f px, k1 %.4f k2 %.4f; stereo rms %.3f px\n", k(0, 0), k(1, 1),
+                k(0, 2), k(1, 2), c.projector.dist[0], c.projector.dist[1], c.rms);
+    for (const procam::HeldOutError& h : r.held_out) {
+        std::printf("held out %s: projector corners predicted within mean %.3f p95 %.3f max %.3f px\n", h.name.c_str(),
+                    h.mean_px, h.p95_px, h.max_px);
+    }
+    std::printf("written to %s\n", out.c_str());
+}
+
+}  // namespace
+
+void add_procam_command(CLI::App& parent, ProcamCommand& cmd) {
+    cmd.app = parent.add_subcommand("procam",
+                                    "Projector intrinsics on the bench from Gray-code captures of a board "
+                                    "(docs/calibration.md)");
+    cmd.app->add_option("--images", cmd.images, "Capture folders (graycode_00.png ...), one per board pose")
+        ->required()
+        ->check(CLI::ExistingDirectory);
+    cmd.app->add_option("--projector", cmd.projector, "Projector WIDTHxHEIGHT the patterns were made for")->required();
+    cmd.app->add_option("--board", cmd.board, "Inner corners COLSxROWS")->required();
+    cmd.app->add_option("--square-mm", cmd.square_mm, "Board square, mm")->required()->check(CLI::Range(0.01, 10000.0));
+    cmd.app->add_option("--out", cmd.out, "Calibration file (JSON) to write")->required();
+    cmd.app->add_option("--window", cmd.window_px, "Local homography window half-width, camera pixels")
+        ->check(CLI::Range(2, 200));
+    cmd.app->add_flag("--projector-distortion", cmd.projector_distortion,
+                      "Fit the projector's radial k1, k2 (needs many varied poses; default: a pinhole)");
+}
+
+int run_procam_command(const ProcamCommand& cmd) {
+    procam::ProcamJob job;
+    job.captures = cmd.images;
+    if (!parse_pair(cmd.projector, job.projector.width, job.projector.height, 2, 16384)) {
+        std::cerr << "mogao-calibrate procam: --projector " << cmd.projector << ": must be WIDTHxHEIGHT, 2..16384\n";
+        return 2;
+    }
+    if (!parse_pair(cmd.board, job.board.columns, job.board.rows, 2, 64)) {
+        std::cerr << "mogao-calibrate procam: --board " << cmd.board << ": must be COLSxROWS inner corners, 2..64\n";
+        return 2;
+    }
+    if (cmd.images.size() < 2) {
+        std::cerr << "mogao-calibrate procam: --images: at least 2 capture folders (board poses) are needed\n";
+        return 2;
+    }
+    job.board.square_mm = cmd.square_mm;
+    job.homography.half_window_px = cmd.window_px;
+    if (cmd.projector_distortion) job.calibration.projector_flags = procam::CalibrationOptions::kRadialProjector;
+    try {
+        const procam::ProcamJobResult r = procam::run_procam_job(job);
+        procam::write_procam_file(cmd.out, r.file);
+        print_result(r, cmd.out);
+        return 0;
+    } catch (const std::exception& e) {
+        std::cerr << "mogao-calibrate procam: " << e.what() << "\n";
+        return 1;
+    }
+}
+
+autocal::DeviceModel projector_prior_from_procam(autocal::DeviceModel device, const procam::Intrinsics& bench) {
+    const double sx = static_cast<double>(device.resolution.width) / bench.size.width;
+    const double sy = static_cast<double>(device.resolution.height) / bench.size.height;
+    if (std::abs(sx - sy) > 1e-3 * std::max(sx, sy)) {
+        throw std::invalid_argument("projector prior: the device's " + std::to_string(device.resolution.width) + "x" +
+                                    std::to_string(device.resolution.height) +
+                                    " is not a uniform scale of the bench's " + std::to_string(bench.size.width) + "x" +
+                                    std::to_string(bench.size.height));
+    }
+    // OpenCV's pixel centre is at integer coordinates, autocal's at +0.5: x_autocal = x_opencv + 0.5,
+    // then a uniform rescale of the image about its (0, 0) corner.
+    device.fx_px = bench.K(0, 0) * sx;
+    device.fy_px = bench.K(1, 1) * sy;
+    device.cx_px = (bench.K(0, 2) + 0.5) * sx;
+    device.cy_px = (bench.K(1, 2) + 0.5) * sy;
+    return device;
+}
+
+}  // namespace mogao::calibrate
