@@ -47,13 +47,17 @@ MPI_Status probe_politely(int source, int tag) {
     }
 }
 
-void broadcast_view(WireView& wire) {
-    MPI_Request request;
-    MPI_Ibcast(&wire, sizeof wire, MPI_BYTE, 0, MPI_COMM_WORLD, &request);
-    wait_politely(request);
-}
+enum Tag : int { kTagRects = 1, kTagReplyHeader, kTagReplyPixels, kTagReplyTiles, kTagProgress, kTagCut, kTagView };
 
-enum Tag : int { kTagRects = 1, kTagReplyHeader, kTagReplyPixels, kTagReplyTiles, kTagProgress, kTagCut };
+// The view goes from the admin to each render rank point to point, not through a collective: in a
+// broadcast tree a stopped rank would keep the view from the ranks below it, and they would fall
+// silent with it (the admin could no longer tell which rank was lost).
+WireView receive_view() {
+    (void)probe_politely(0, kTagView);
+    WireView wire{};
+    MPI_Recv(&wire, sizeof wire, MPI_BYTE, 0, kTagView, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    return wire;
+}
 
 struct ReplyHeader {
     std::uint64_t frame_id;
@@ -220,8 +224,7 @@ const GuidePass* begin_guides(GuidePass* guides, PackedPixels format, const View
 void serve_render_rank(Renderer* renderer, const DispatchSettings& settings, const std::string& load_error,
                        GuidePass* guides) {
     for (;;) {
-        WireView wire{};
-        broadcast_view(wire);
+        const WireView wire = receive_view();
         if (wire.stop) return;
         const std::vector<PixelRect> rects = receive_rects();
         ReplyHeader header{wire.frame_id, 0, 0, 0, 0.0, 0.0, 1, 0, 0.0};
@@ -287,7 +290,7 @@ void FrameDispatcher::stop() {
     if (mpi_.size() < 2 || broken_) return;  // broken: a rank would never take the broadcast
     WireView stop_view{};
     stop_view.stop = 1;
-    broadcast_view(stop_view);
+    for (int r = 1; r < mpi_.size(); ++r) MPI_Send(&stop_view, sizeof stop_view, MPI_BYTE, r, kTagView, MPI_COMM_WORLD);
 }
 
 CostMap& FrameDispatcher::stream_map(std::uint64_t stream, ImageSize size) {
@@ -466,13 +469,14 @@ bool FrameDispatcher::gather(const ViewRequest& view, const Assignment& assignme
     wire.sequence = ++sequence_;
     Watch watch{Clock::now(), wire.sequence, view.frame_id,
                 RankLiveness(mpi_.render_ranks(), settings_.rank_deadline_s, 0.0)};
-    MPI_Request broadcast;
-    MPI_Ibcast(&wire, sizeof wire, MPI_BYTE, 0, MPI_COMM_WORLD, &broadcast);
+    std::vector<MPI_Request> sends(static_cast<std::size_t>(mpi_.render_ranks()));
+    for (int r = 1; r <= mpi_.render_ranks(); ++r)
+        MPI_Isend(&wire, sizeof wire, MPI_BYTE, r, kTagView, MPI_COMM_WORLD, &sends[static_cast<std::size_t>(r - 1)]);
     poll_until(
         watch,
         [&] {
             int done = 0;
-            MPI_Test(&broadcast, &done, MPI_STATUS_IGNORE);
+            MPI_Testall(static_cast<int>(sends.size()), sends.data(), &done, MPI_STATUSES_IGNORE);
             return done != 0;
         },
         "(view broadcast)");

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The MPI side of one sort-first frame, both ends of it:
 //  - FrameDispatcher (admin, rank 0): assigns rects with the load balancer from the stream's
-//    predicted cost map, broadcasts the view, gathers sRGB8 pixels and per-tile times from the render
+//    predicted cost map, sends the view to every render rank, gathers sRGB8 pixels and per-tile times from the render
 //    ranks, composites the frame and updates the stream's cost map from the measured times (PBT),
 //    each rank's tile times normalised by its measured speed (schedule/rank_speed.h).
 //  - serve_render_rank (ranks 1..N-1): the loop that answers the dispatcher until it stops.
