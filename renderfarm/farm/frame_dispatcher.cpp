@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <deque>
 #include <functional>
 #include <numeric>
 
@@ -46,13 +47,17 @@ MPI_Status probe_politely(int source, int tag) {
     }
 }
 
-void broadcast_view(WireView& wire) {
-    MPI_Request request;
-    MPI_Ibcast(&wire, sizeof wire, MPI_BYTE, 0, MPI_COMM_WORLD, &request);
-    wait_politely(request);
-}
+enum Tag : int { kTagRects = 1, kTagReplyHeader, kTagReplyPixels, kTagReplyTiles, kTagProgress, kTagCut, kTagView };
 
-enum Tag : int { kTagRects = 1, kTagReplyHeader, kTagReplyPixels, kTagReplyTiles };
+// The view goes from the admin to each render rank point to point, not through a collective: in a
+// broadcast tree a stopped rank would keep the view from the ranks below it, and they would fall
+// silent with it (the admin could no longer tell which rank was lost).
+WireView receive_view() {
+    (void)probe_politely(0, kTagView);
+    WireView wire{};
+    MPI_Recv(&wire, sizeof wire, MPI_BYTE, 0, kTagView, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    return wire;
+}
 
 struct ReplyHeader {
     std::uint64_t frame_id;
@@ -62,9 +67,61 @@ struct ReplyHeader {
     double render_seconds;
     double cpu_seconds;
     std::int32_t ok;
+    std::uint64_t tiles_cut;  // tiles rendered coarse after the admin's cut
+    double full_seconds;      // the pass uncut (full_pass_seconds)
+};
+
+// A render rank's beat while it renders (kTagProgress); a cut is the frame's sequence (kTagCut).
+struct Progress {
+    std::uint64_t sequence;
+    std::uint64_t done;
+    std::uint64_t total;
 };
 
 // ---- render ranks --------------------------------------------------------------------------------
+
+// A render rank's main thread while its workers render one frame: each poll sends a progress
+// report (non-blocking) and takes the admin's cut of this frame, if any (cuts of earlier frames,
+// sent as the rank replied, are dropped).
+class RankBeat {
+public:
+    explicit RankBeat(std::uint64_t sequence) : sequence_(sequence) {}
+    RankBeat(const RankBeat&) = delete;
+    RankBeat& operator=(const RankBeat&) = delete;
+
+    bool poll(std::size_t done, std::size_t total) {
+        while (!sent_.empty()) {  // reports the admin took
+            int complete = 0;
+            MPI_Test(&sent_.front().request, &complete, MPI_STATUS_IGNORE);
+            if (!complete) break;
+            sent_.pop_front();
+        }
+        Pending& p = sent_.emplace_back(Pending{{sequence_, done, total}, MPI_REQUEST_NULL});
+        MPI_Isend(&p.progress, sizeof p.progress, MPI_BYTE, 0, kTagProgress, MPI_COMM_WORLD, &p.request);
+        for (int found = 1;;) {
+            MPI_Iprobe(0, kTagCut, MPI_COMM_WORLD, &found, MPI_STATUS_IGNORE);
+            if (!found) break;
+            std::uint64_t cut = 0;
+            MPI_Recv(&cut, 1, MPI_UINT64_T, 0, kTagCut, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+            cut_ = cut_ || cut == sequence_;
+        }
+        return cut_;
+    }
+    // Completes every report before the reply (their buffers live here).
+    void finish() {
+        for (Pending& p : sent_) wait_politely(p.request);
+        sent_.clear();
+    }
+
+private:
+    struct Pending {
+        Progress progress;
+        MPI_Request request;
+    };
+    std::uint64_t sequence_;
+    std::deque<Pending> sent_;  // stable addresses
+    bool cut_ = false;
+};
 
 std::vector<PixelRect> receive_rects() {
     MPI_Status status = probe_politely(0, kTagRects);
@@ -96,7 +153,9 @@ struct RankReply {
 // a rank stopped half-way through its reply (a rendezvous transfer waits for the sender) cannot
 // block the admin either.
 // `wait(done)` polls `done` until true, under the frame's deadline (FrameDispatcher::poll_until).
-RankReply receive_reply(int source, const std::function<void(const std::function<bool()>&)>& wait) {
+// `on_header` sees the header before the payload is received.
+RankReply receive_reply(int source, const std::function<void(const std::function<bool()>&)>& wait,
+                        const std::function<void(const ReplyHeader&)>& on_header) {
     const auto receive = [&](void* data, int count, MPI_Datatype type, int tag) {
         MPI_Request request;
         MPI_Irecv(data, count, type, source, tag, MPI_COMM_WORLD, &request);
@@ -108,6 +167,7 @@ RankReply receive_reply(int source, const std::function<void(const std::function
     };
     RankReply reply;
     receive(&reply.header, sizeof reply.header, MPI_BYTE, kTagReplyHeader);
+    on_header(reply.header);
     reply.payload.resize(reply.header.payload_bytes);
     receive(reply.payload.data(), static_cast<int>(reply.payload.size()), MPI_BYTE, kTagReplyPixels);
     MPI_Status status;
@@ -164,19 +224,22 @@ const GuidePass* begin_guides(GuidePass* guides, PackedPixels format, const View
 void serve_render_rank(Renderer* renderer, const DispatchSettings& settings, const std::string& load_error,
                        GuidePass* guides) {
     for (;;) {
-        WireView wire{};
-        broadcast_view(wire);
+        const WireView wire = receive_view();
         if (wire.stop) return;
         const std::vector<PixelRect> rects = receive_rects();
-        ReplyHeader header{wire.frame_id, 0, 0, 0, 0.0, 0.0, 1};
+        ReplyHeader header{wire.frame_id, 0, 0, 0, 0.0, 0.0, 1, 0, 0.0};
+        RankBeat beat(wire.sequence);
+        const TilePassControl control{[&beat](std::size_t done, std::size_t total) { return beat.poll(done, total); },
+                                      settings.rank_beat_s, settings.cut_block};
         try {
+            beat.poll(0, 0);  // heard before begin_frame, however long it takes
             if (!renderer) throw std::runtime_error(load_error);
             const ViewRequest view = from_wire(wire);
             renderer->begin_frame(view);
             const PackedPixels format = wire_format(wire.linear);
             const TilePassResult pass =
                 render_tile_pass(*renderer, rects, settings.cell_size, settings.threads, settings.exposure,
-                                 settings.tone_map, format, begin_guides(guides, format, view));
+                                 settings.tone_map, format, begin_guides(guides, format, view), &control);
             std::vector<double> tiles_flat;
             tiles_flat.reserve(pass.tile_times.size() * 5);
             for (const TileTime& t : pass.tile_times)
@@ -187,6 +250,10 @@ void serve_render_rank(Renderer* renderer, const DispatchSettings& settings, con
             header.tiles = pass.tile_times.size();
             header.render_seconds = pass.render_seconds;
             header.cpu_seconds = pass.cpu_seconds;
+            header.tiles_cut = pass.tiles_cut;
+            header.full_seconds = full_pass_seconds(pass.render_seconds, pass.cut_at_seconds, pass.tiles_done_at_cut,
+                                                    pass.tile_times.size());
+            beat.finish();
             send_reply(header, pass.packed_pixels.data(), pass.packed_pixels.size(), tiles_flat);
         } catch (const std::exception& e) {
             int rank = 0;
@@ -194,6 +261,7 @@ void serve_render_rank(Renderer* renderer, const DispatchSettings& settings, con
             const std::string message = fmt::format("rank {}: frame {}: {}", rank, wire.frame_id, e.what());
             header.ok = 0;
             header.payload_bytes = message.size();
+            beat.finish();
             send_reply(header, message.data(), message.size(), {});
         }
     }
@@ -206,9 +274,10 @@ FrameDispatcher::FrameDispatcher(const MpiSession& mpi, DispatchSettings setting
       local_(mpi.size() == 1 ? local : nullptr),
       local_guides_(mpi.size() == 1 ? local_guides : nullptr),
       balancer_(make_load_balancer(settings_.balancer,
-                                   settings_.balancer == "roundrobin" ? settings_.roundrobin_tile : settings_.snap)),
-      deadline_({settings_.rank_deadline_s, settings_.rank_deadline_min_s, settings_.rank_deadline_factor}) {
+                                   settings_.balancer == "roundrobin" ? settings_.roundrobin_tile : settings_.snap)) {
     if (mpi.size() == 1 && !local) throw std::invalid_argument("a one-process farm needs a local renderer");
+    if (!(settings_.rank_beat_s > 0)) throw std::invalid_argument("DispatchSettings.rank_beat_s must be > 0");
+    if (settings_.cut_block < 1) throw std::invalid_argument("DispatchSettings.cut_block must be >= 1");
 }
 
 FrameDispatcher::~FrameDispatcher() { stop(); }
@@ -221,7 +290,7 @@ void FrameDispatcher::stop() {
     if (mpi_.size() < 2 || broken_) return;  // broken: a rank would never take the broadcast
     WireView stop_view{};
     stop_view.stop = 1;
-    broadcast_view(stop_view);
+    for (int r = 1; r < mpi_.size(); ++r) MPI_Send(&stop_view, sizeof stop_view, MPI_BYTE, r, kTagView, MPI_COMM_WORLD);
 }
 
 CostMap& FrameDispatcher::stream_map(std::uint64_t stream, ImageSize size) {
@@ -261,102 +330,156 @@ DispatchedFrame FrameDispatcher::render(const ViewRequest& view, std::uint64_t s
     frame.stats.rank_predicted_seconds = assignment.predicted_cost;
     const auto start = Clock::now();
     std::vector<TileTime> normalised;
-    if (!gather(view, assignment, format, frame, normalised))
+    if (local_) {
+        gather_local(view, assignment, format, frame, normalised);
+    } else if (!gather(view, assignment, format, frame, normalised)) {
         throw FarmError(fmt::format("frame {} failed on a render rank", view.frame_id));
+    }
     frame.stats.render_phase_seconds = seconds_since(start);
+    if (frame.stats.tiles_cut == 0) frame.stats.full_seconds = frame.stats.render_phase_seconds;
     finish_stats(frame.stats);
     // Re-balance: this frame's measured tile times predict the stream's next frame.
     predicted = CostMap::from_tile_times(size, settings_.cell_size, normalised);
     return frame;
 }
 
-// Polls `done()` until it is true; past `deadline` marks the farm broken and throws RankTimeout
-// naming `who` (heartbeat about once a second meanwhile).
+void FrameDispatcher::add_tiles(int rank_index, const std::vector<TileTime>& tiles, double cpu, double wall,
+                                std::vector<TileTime>& normalised) {
+    // Tiles of the rank as the PBT should see them: at the rank's smoothed speed, or raw.
+    speeds_.observe(rank_index, cpu, wall, settings_.threads);
+    const double speed = settings_.normalise_rank_speed ? speeds_.speed(rank_index) : 1.0;
+    const std::vector<TileTime> scaled = normalise_tile_times(tiles, speed);
+    normalised.insert(normalised.end(), scaled.begin(), scaled.end());
+}
+
+// A one-process farm: the admin traces the whole frame itself, cut at the budget like the ranks.
+void FrameDispatcher::gather_local(const ViewRequest& view, const Assignment& assignment, PackedPixels format,
+                                   DispatchedFrame& frame, std::vector<TileTime>& normalised) {
+    local_->begin_frame(view);
+    const GuidePass* guides = nullptr;
+    try {
+        guides = begin_guides(local_guides_, format, view);
+    } catch (const std::runtime_error& e) {
+        throw FarmError(e.what());
+    }
+    const auto start = Clock::now();
+    auto next_beat = start + std::chrono::seconds(1);
+    const TilePassControl control{[&](std::size_t, std::size_t) {
+                                      if (heartbeat_ && Clock::now() >= next_beat) {
+                                          heartbeat_();
+                                          next_beat = Clock::now() + std::chrono::seconds(1);
+                                      }
+                                      return settings_.frame_budget_s > 0 &&
+                                             seconds_since(start) > settings_.frame_budget_s;
+                                  },
+                                  settings_.rank_beat_s, settings_.cut_block};
+    TilePassResult pass = render_tile_pass(*local_, assignment.rects[0], settings_.cell_size, settings_.threads,
+                                           settings_.exposure, settings_.tone_map, format, guides, &control);
+    unpack_reply(assignment.rects[0], pass.packed_pixels, format, frame);
+    add_tiles(0, pass.tile_times, pass.cpu_seconds, pass.render_seconds, normalised);
+    frame.stats.tiles_cut = pass.tiles_cut;
+    frame.stats.full_seconds =
+        full_pass_seconds(pass.render_seconds, pass.cut_at_seconds, pass.tiles_done_at_cut, pass.tile_times.size());
+    frame.tiles = std::move(pass.tile_times);
+    frame.stats.rays = pass.rays;
+    frame.stats.rank_render_seconds = {pass.render_seconds};
+}
+
+// One frame's watch on the ranks: who was heard when, and the frame's time budget.
+struct FrameDispatcher::Watch {
+    Clock::time_point sent;
+    std::uint64_t sequence;
+    std::uint64_t frame_id;
+    RankLiveness liveness;
+    bool cut_sent = false;
+    [[nodiscard]] double now() const { return seconds_since(sent); }
+};
+
+// Polls `done()` until it is true; meanwhile takes the ranks' progress reports, cuts the frame at
+// its budget, and throws RankTimeout (the farm broken) when a rank that owes a reply falls silent
+// (heartbeat about once a second).
 template <typename Done>
-void FrameDispatcher::poll_until(Clock::time_point deadline, const Done& done, const std::string& who,
-                                 std::uint64_t frame_id) {
+void FrameDispatcher::poll_until(Watch& watch, const Done& done, const char* phase) {
     auto next_beat = Clock::now() + std::chrono::seconds(1);
     while (!done()) {
-        const auto now = Clock::now();
-        if (now >= deadline) {
-            broken_ = true;
-            throw RankTimeout(
-                fmt::format("render rank(s) {} did not reply to frame {} within {:.1f} s (frame deadline: {} x "
-                            "its expected time, {}..{} s): host down, process stopped or link cut",
-                            who, frame_id, frame_deadline_s_, settings_.rank_deadline_factor,
-                            settings_.rank_deadline_min_s, settings_.rank_deadline_s));
-        }
-        if (heartbeat_ && now >= next_beat) {
+        drain_progress(watch);
+        if (settings_.frame_budget_s > 0 && !watch.cut_sent && watch.now() > settings_.frame_budget_s) send_cuts(watch);
+        if (const std::vector<int> silent = watch.liveness.silent(watch.now()); !silent.empty())
+            lost(watch, silent, phase);
+        if (heartbeat_ && Clock::now() >= next_beat) {
             heartbeat_();
-            next_beat = now + std::chrono::seconds(1);
+            next_beat = Clock::now() + std::chrono::seconds(1);
         }
         sleep_briefly();
     }
 }
 
+void FrameDispatcher::lost(const Watch& watch, const std::vector<int>& ranks, const char* phase) {
+    broken_ = true;
+    std::string who;
+    for (int r : ranks) who += (who.empty() ? "" : ", ") + std::to_string(r);
+    if (phase) who = phase;  // the broadcast is not any one rank's
+    throw RankTimeout(fmt::format(
+        "render rank(s) {} did not reply to frame {} and sent no progress report for {:.1f} s (liveness limit "
+        "{} s, reports every {} s while rendering): host down, process stopped or link cut",
+        who, watch.frame_id, watch.liveness.silent_for(ranks.front(), watch.now()), settings_.rank_deadline_s,
+        settings_.rank_beat_s));
+}
+
+// Takes every progress report waiting: a report of this frame counts its rank as heard.
+void FrameDispatcher::drain_progress(Watch& watch) {
+    for (;;) {
+        int found = 0;
+        MPI_Status status;
+        MPI_Iprobe(MPI_ANY_SOURCE, kTagProgress, MPI_COMM_WORLD, &found, &status);
+        if (!found) return;
+        Progress progress{};
+        MPI_Recv(&progress, sizeof progress, MPI_BYTE, status.MPI_SOURCE, kTagProgress, MPI_COMM_WORLD,
+                 MPI_STATUS_IGNORE);
+        if (progress.sequence == watch.sequence) watch.liveness.heard(status.MPI_SOURCE, watch.now());
+    }
+}
+
+// The frame's budget ran out: the ranks that still owe a reply render the rest coarse.
+void FrameDispatcher::send_cuts(Watch& watch) {
+    watch.cut_sent = true;
+    for (int r = 1; r <= mpi_.render_ranks(); ++r)
+        if (watch.liveness.owes(r)) MPI_Send(&watch.sequence, 1, MPI_UINT64_T, r, kTagCut, MPI_COMM_WORLD);
+}
+
 // The next rank whose reply header has arrived.
-int FrameDispatcher::probe_reply_until(Clock::time_point deadline, const std::vector<bool>& replied,
-                                       std::uint64_t frame_id) {
+int FrameDispatcher::probe_reply(Watch& watch) {
     MPI_Status status;
     int found = 0;
-    std::string silent;
-    for (std::size_t r = 0; r < replied.size(); ++r)
-        if (!replied[r]) silent += (silent.empty() ? "" : ", ") + std::to_string(r + 1);
     poll_until(
-        deadline,
+        watch,
         [&] {
             MPI_Iprobe(MPI_ANY_SOURCE, kTagReplyHeader, MPI_COMM_WORLD, &found, &status);
             return found != 0;
         },
-        silent, frame_id);
+        nullptr);
+    watch.liveness.heard(status.MPI_SOURCE, watch.now());
     return status.MPI_SOURCE;
 }
 
 bool FrameDispatcher::gather(const ViewRequest& view, const Assignment& assignment, PackedPixels format,
                              DispatchedFrame& frame, std::vector<TileTime>& normalised) {
-    // Tiles of rank `r` as the PBT should see them: at the rank's smoothed speed, or raw.
-    const auto add_tiles = [&](int r, const std::vector<TileTime>& tiles, double cpu, double wall) {
-        speeds_.observe(r, cpu, wall, settings_.threads);
-        const double speed = settings_.normalise_rank_speed ? speeds_.speed(r) : 1.0;
-        const std::vector<TileTime> scaled = normalise_tile_times(tiles, speed);
-        normalised.insert(normalised.end(), scaled.begin(), scaled.end());
-    };
-    if (local_) {  // a one-process farm: the admin traces the whole frame itself
-        local_->begin_frame(view);
-        const GuidePass* guides = nullptr;
-        try {
-            guides = begin_guides(local_guides_, format, view);
-        } catch (const std::runtime_error& e) {
-            throw FarmError(e.what());
-        }
-        TilePassResult pass = render_tile_pass(*local_, assignment.rects[0], settings_.cell_size, settings_.threads,
-                                               settings_.exposure, settings_.tone_map, format, guides);
-        unpack_reply(assignment.rects[0], pass.packed_pixels, format, frame);
-        add_tiles(0, pass.tile_times, pass.cpu_seconds, pass.render_seconds);
-        frame.tiles = std::move(pass.tile_times);
-        frame.stats.rays = pass.rays;
-        frame.stats.rank_render_seconds = {pass.render_seconds};
-        return true;
-    }
     WireView wire = to_wire(view);
     wire.linear = format == PackedPixels::linear_guided ? 2 : format == PackedPixels::linear ? 1 : 0;
-    const double cost = frame_cost_units(view);
-    frame_deadline_s_ = deadline_.seconds_for(cost);
-    const auto sent = Clock::now();
-    const auto deadline =
-        frame_deadline_s_ > 0
-            ? sent + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(frame_deadline_s_))
-            : Clock::time_point::max();
-    MPI_Request broadcast;
-    MPI_Ibcast(&wire, sizeof wire, MPI_BYTE, 0, MPI_COMM_WORLD, &broadcast);
+    wire.sequence = ++sequence_;
+    Watch watch{Clock::now(), wire.sequence, view.frame_id,
+                RankLiveness(mpi_.render_ranks(), settings_.rank_deadline_s, 0.0)};
+    std::vector<MPI_Request> sends(static_cast<std::size_t>(mpi_.render_ranks()));
+    for (int r = 1; r <= mpi_.render_ranks(); ++r)
+        MPI_Isend(&wire, sizeof wire, MPI_BYTE, r, kTagView, MPI_COMM_WORLD, &sends[static_cast<std::size_t>(r - 1)]);
     poll_until(
-        deadline,
+        watch,
         [&] {
             int done = 0;
-            MPI_Test(&broadcast, &done, MPI_STATUS_IGNORE);
+            MPI_Testall(static_cast<int>(sends.size()), sends.data(), &done, MPI_STATUSES_IGNORE);
             return done != 0;
         },
-        "(view broadcast)", view.frame_id);
+        "(view broadcast)");
     for (int r = 0; r < mpi_.render_ranks(); ++r) {
         std::vector<int> flat;
         for (const PixelRect& rect : assignment.rects[static_cast<std::size_t>(r)])
@@ -365,14 +488,16 @@ bool FrameDispatcher::gather(const ViewRequest& view, const Assignment& assignme
     }
     frame.stats.rank_render_seconds.assign(static_cast<std::size_t>(mpi_.render_ranks()), 0.0);
     bool ok = true;
-    std::vector<bool> replied(static_cast<std::size_t>(mpi_.render_ranks()), false);
     for (int k = 0; k < mpi_.render_ranks(); ++k) {
         // Replies in arrival order: a slow rank does not hold up compositing the others.
-        const int source = probe_reply_until(deadline, replied, view.frame_id);
-        replied[static_cast<std::size_t>(source - 1)] = true;
-        RankReply reply = receive_reply(source, [&](const std::function<bool()>& done) {
-            poll_until(deadline, done, std::to_string(source), view.frame_id);
-        });
+        const int source = probe_reply(watch);
+        // While its pixels transfer the rank sends nothing else: their time at the slowest link is allowed.
+        RankReply reply = receive_reply(
+            source, [&](const std::function<bool()>& done) { poll_until(watch, done, nullptr); },
+            [&](const ReplyHeader& h) {
+                watch.liveness.allow(source, double(h.payload_bytes) / kSlowestLinkBytesPerSecond);
+            });
+        watch.liveness.replied(source);
         if (!reply.header.ok) {
             spdlog::error("{}", std::string(reply.payload.begin(), reply.payload.end()));
             ok = false;
@@ -391,12 +516,13 @@ bool FrameDispatcher::gather(const ViewRequest& view, const Assignment& assignme
             tiles.push_back(
                 {{int(reply.tiles[i]), int(reply.tiles[i + 1]), int(reply.tiles[i + 2]), int(reply.tiles[i + 3])},
                  reply.tiles[i + 4]});
-        add_tiles(source - 1, tiles, reply.header.cpu_seconds, reply.header.render_seconds);
+        add_tiles(source - 1, tiles, reply.header.cpu_seconds, reply.header.render_seconds, normalised);
         frame.tiles.insert(frame.tiles.end(), tiles.begin(), tiles.end());
         frame.stats.rays += reply.header.rays;
         frame.stats.rank_render_seconds[static_cast<std::size_t>(source - 1)] = reply.header.render_seconds;
+        frame.stats.tiles_cut += reply.header.tiles_cut;
+        frame.stats.full_seconds = std::max(frame.stats.full_seconds, reply.header.full_seconds);
     }
-    if (ok) deadline_.observe(cost, std::chrono::duration<double>(Clock::now() - sent).count());
     return ok;
 }
 

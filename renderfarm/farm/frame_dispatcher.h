@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The MPI side of one sort-first frame, both ends of it:
 //  - FrameDispatcher (admin, rank 0): assigns rects with the load balancer from the stream's
-//    predicted cost map, broadcasts the view, gathers sRGB8 pixels and per-tile times from the render
+//    predicted cost map, sends the view to every render rank, gathers sRGB8 pixels and per-tile times from the render
 //    ranks, composites the frame and updates the stream's cost map from the measured times (PBT),
 //    each rank's tile times normalised by its measured speed (schedule/rank_speed.h).
 //  - serve_render_rank (ranks 1..N-1): the loop that answers the dispatcher until it stops.
@@ -11,12 +11,18 @@
 // Errors: a rank's failure (its message names rank, frame and reason) is thrown as FarmError by
 // render() after every rank's reply was collected, so no rank is left blocked; the caller then calls
 // stop(). Bad views are rejected on the ranks by the renderer's validation (std::invalid_argument).
-// A rank that does not reply within the frame's deadline (frame_deadline.h: a multiple of the
-// frame's expected time from recent frames, between `rank_deadline_min_s` and `rank_deadline_s`;
-// dead host, SIGSTOP, cut link; every receive of the reply is non-blocking under it) makes render()
-// throw RankTimeout naming the silent ranks; the MPI job is then unusable (a collective is half
-// done): broken() turns true, stop() no longer talks to the ranks, and the process must end the
-// job with MPI_Abort so that the service restarts (run_farm does this; docs/services.md).
+// Liveness (rank_liveness.h): while a render rank renders, its main thread reports the pass's
+// progress to the admin every `rank_beat_s` (the tiles are rendered on worker threads,
+// tile_pass.h TilePassControl), so a frame of any cost keeps its ranks heard. A rank that owes a
+// reply and has sent nothing for `rank_deadline_s` (dead host, SIGSTOP, cut link; every receive
+// of the reply is non-blocking under it) makes render() throw RankTimeout naming the silent ranks;
+// the MPI job is then unusable (a collective is half done): broken() turns true, stop() no longer
+// talks to the ranks, and the process must end the job with MPI_Abort so that the service restarts
+// (run_farm does this; docs/services.md).
+// Time budget: a frame still rendering `frame_budget_s` after it was sent is cut: the admin tells
+// the ranks that still owe a reply, and they render their remaining tiles coarse (one traced
+// pixel per `cut_block`^2 block, TilePassControl), so one dear frame holds the farm for about the
+// budget, not for its full cost; FrameStats::tiles_cut and ::full_seconds say so.
 #pragma once
 
 #include <chrono>
@@ -32,9 +38,9 @@
 #include "common/view_request.h"
 #include "renderfarm/denoise/guide_buffers.h"
 #include "renderfarm/denoise/guide_pass.h"
-#include "renderfarm/farm/frame_deadline.h"
 #include "renderfarm/farm/frame_stats.h"
 #include "renderfarm/farm/mpi_session.h"
+#include "renderfarm/farm/rank_liveness.h"
 #include "renderfarm/farm/tile_pass.h"
 #include "renderfarm/schedule/cost_map.h"
 #include "renderfarm/schedule/load_balancer.h"
@@ -63,12 +69,17 @@ struct DispatchSettings {
     // Feed the PBT with tile times x the rank's speed (its share of a core) instead of wall time.
     bool normalise_rank_speed = true;
     std::size_t max_streams = 64;  // cost maps kept; the least recently used goes beyond it
-    // Seconds from sending a frame to the ranks until the last reply (frame_deadline.h): at most
-    // rank_deadline_s (0 = wait forever), rank_deadline_factor x the frame's expected time, at least
-    // rank_deadline_min_s. Factor 0: always rank_deadline_s.
-    double rank_deadline_s = 30.0;
-    double rank_deadline_min_s = 2.0;
-    double rank_deadline_factor = 4.0;
+    // Seconds a render rank that owes a reply may stay silent (no progress report, no reply) before
+    // it is taken for lost (rank_liveness.h); 0 = never.
+    double rank_deadline_s = 2.0;
+    double rank_beat_s = 0.1;  // how often a rendering rank reports its progress, seconds (> 0)
+    // Not used: liveness no longer follows a frame's expected time. Kept so that callers that set
+    // them still build.
+    double rank_deadline_min_s = 0.0;
+    double rank_deadline_factor = 0.0;
+    // Seconds after which a frame's remaining tiles are rendered coarse (see above); 0 = never.
+    double frame_budget_s = 0.0;
+    int cut_block = 8;  // pixels per side of a coarse block after a cut (>= 1)
 };
 
 struct DispatchedFrame {
@@ -105,7 +116,7 @@ public:
     [[nodiscard]] int cell_size() const { return settings_.cell_size; }
     [[nodiscard]] const DispatchSettings& settings() const { return settings_; }
     // Called about once a second while render() waits for the ranks (serve pets systemd's
-    // watchdog from it, so a long frame within the deadline is not mistaken for a hang).
+    // watchdog from it, so a long frame whose ranks answer is not mistaken for a hang).
     void set_heartbeat(std::function<void()> heartbeat) { heartbeat_ = std::move(heartbeat); }
     // True after a RankTimeout: the MPI job must be aborted.
     [[nodiscard]] bool broken() const { return broken_; }
@@ -116,11 +127,17 @@ private:
     bool gather(const ViewRequest& view, const Assignment& assignment, PackedPixels format, DispatchedFrame& frame,
                 std::vector<TileTime>& normalised);
     CostMap& stream_map(std::uint64_t stream, ImageSize size);
+    struct Watch;  // one frame's liveness and budget (frame_dispatcher.cpp)
     template <typename Done>
-    void poll_until(std::chrono::steady_clock::time_point deadline, const Done& done, const std::string& who,
-                    std::uint64_t frame_id);
-    int probe_reply_until(std::chrono::steady_clock::time_point deadline, const std::vector<bool>& replied,
-                          std::uint64_t frame_id);
+    void poll_until(Watch& watch, const Done& done, const char* phase);
+    int probe_reply(Watch& watch);
+    void drain_progress(Watch& watch);
+    void send_cuts(Watch& watch);
+    [[noreturn]] void lost(const Watch& watch, const std::vector<int>& ranks, const char* phase);
+    void gather_local(const ViewRequest& view, const Assignment& assignment, PackedPixels format,
+                      DispatchedFrame& frame, std::vector<TileTime>& normalised);
+    void add_tiles(int rank_index, const std::vector<TileTime>& tiles, double cpu, double wall,
+                   std::vector<TileTime>& normalised);
 
     const MpiSession& mpi_;
     DispatchSettings settings_;
@@ -134,8 +151,7 @@ private:
     std::map<std::uint64_t, StreamMap> predicted_;
     std::uint64_t frames_ = 0;
     RankSpeeds speeds_;
-    FrameDeadline deadline_;
-    double frame_deadline_s_ = 0.0;  // the deadline of the frame being gathered, for messages
+    std::uint64_t sequence_ = 0;  // frames sent to the ranks (WireView::sequence)
     bool stopped_ = false;
     bool broken_ = false;
     std::function<void()> heartbeat_;

@@ -25,6 +25,11 @@ struct FrameStats {
     double rays_per_second = 0.0;             // rays / render_phase_seconds
     double encode_seconds = 0.0;              // TurboJPEG, full frame
     std::uint64_t jpeg_bytes = 0;
+    // The frame's time budget (DispatchSettings::frame_budget_s): tiles rendered coarse after it ran
+    // out, and what the render phase would have taken uncut (full_pass_seconds, rank_liveness.h;
+    // = render_phase_seconds when not cut).
+    std::uint64_t tiles_cut = 0;
+    double full_seconds = 0.0;
 };
 
 struct RunInfo {

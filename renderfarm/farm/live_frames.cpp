@@ -90,9 +90,9 @@ void LiveFrames::dispatch(Session& s, const ViewRequest& request, int spp, LiveF
     }
     frame.stats = std::move(f.stats);
     frame.samples = spp;
-    if (options_.progressive) {
+    if (options_.progressive && frame.stats.tiles_cut == 0) {
         s.accumulation.add(frame.rendered, f.radiance);
-    } else if (guided) {
+    } else if (guided || options_.progressive) {  // a cut pass is shown alone, never accumulated
         radiance = std::move(f.radiance);
     } else {
         frame.image = std::move(f.image);
@@ -129,7 +129,7 @@ LiveFrame LiveFrames::render(const ViewRequest& request) {
     } else {
         dispatch(s, request, choice.spp, frame, radiance);
     }
-    if (options_.progressive) {
+    if (options_.progressive && frame.stats.tiles_cut == 0) {
         radiance = s.accumulation.mean();
         frame.samples = s.accumulation.samples();
         frame.passes = s.accumulation.passes();

@@ -27,6 +27,8 @@
 //    any number of ranks; the accumulation keeps the raw samples (never filtered ones). The
 //    filter's time is part of LiveFrame::seconds, which the frame-time target observes, so the
 //    target still holds with it (it shrinks the frame to pay for the filter).
+// A pass cut at the farm's frame budget (FrameStats::tiles_cut, frame_dispatcher.h) is sent alone
+// and never accumulated: its coarse tiles would stay in the mean.
 // Sessions are forgotten least-recently-used beyond `max_sessions`.
 //
 // Threads: main thread only (it drives the FrameDispatcher, MPI_THREAD_FUNNELED).

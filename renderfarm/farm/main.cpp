@@ -50,17 +50,10 @@ void add_farm_flags(CLI::App& command, mogao::FarmSetup& setup, std::string& sca
     command.add_option("--threads", setup.dispatch.threads, "Render threads per rank")->check(CLI::Range(1, 256));
     command
         .add_option("--rank-deadline", setup.dispatch.rank_deadline_s,
-                    "Most seconds a frame may wait for a render rank's reply; a rank that misses its frame's "
-                    "deadline is taken as lost and the MPI job is aborted (exit 3) so that systemd restarts the farm "
-                    "over the hosts that answer (0 = wait forever)")
-        ->check(CLI::Range(0.0, 86400.0));
-    command
-        .add_option("--rank-deadline-factor", setup.dispatch.rank_deadline_factor,
-                    "A frame's deadline is this many times its expected time from recent frames, within "
-                    "--rank-deadline-min and --rank-deadline (0 = always --rank-deadline)")
-        ->check(CLI::Range(0.0, 1000.0));
-    command
-        .add_option("--rank-deadline-min", setup.dispatch.rank_deadline_min_s, "Least seconds of a frame's deadline")
+                    "Most seconds a render rank that owes a frame may stay silent (rendering ranks report their "
+                    "progress every 0.1 s, however long the frame takes); a silent rank is taken as lost and the MPI "
+                    "job is aborted (exit 3) so that systemd restarts the farm over the hosts that answer (0 = wait "
+                    "forever)")
         ->check(CLI::Range(0.0, 86400.0));
     command.add_flag("--rank-speed,!--no-rank-speed", setup.dispatch.normalise_rank_speed,
                      "Normalise each rank's tile times by its measured speed before the PBT (default; --no-rank-speed: "
@@ -316,6 +309,12 @@ int main(int argc, char** argv) {
     std::vector<double> view_screen;
     std::filesystem::path view_policy_file;
     add_view_policy_flags(*serve, serve_options.view_policy, view_screen, view_policy_file);
+    double frame_budget_s = 1.0;
+    serve
+        ->add_option("--frame-budget", frame_budget_s,
+                     "Seconds a frame may take: the rest of a frame still rendering then is rendered coarse, and a "
+                     "session's next requests are degraded from what its frames cost (0 = no budget)")
+        ->check(CLI::Range(0.0, 3600.0));
     serve->add_option("--duration", serve_options.duration_s, "Stop after this many seconds (0 = until SIGTERM)")->check(CLI::Range(0.0, 1e9));
     try {
         app.parse(argc, argv);
@@ -337,6 +336,8 @@ int main(int argc, char** argv) {
                                   {0.0, view_screen.size() > 4 ? view_screen[4] : 1.6, 0.0}};
     }
     if (serve->parsed()) {
+        setup.dispatch.frame_budget_s = frame_budget_s;
+        serve_options.budget.frame_s = frame_budget_s;
         // Only the admin talks to appliances, so only the admin host holds the link's key, its
         // revocation list and the view policies (render hosts have no /etc/mogao/pki). Every rank
         // then agrees: one that returned alone would wait in MPI_Finalize while the others wait

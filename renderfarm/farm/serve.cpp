@@ -16,6 +16,7 @@
 #include "renderfarm/farm/farm_metrics.h"
 #include "renderfarm/farm/main_thread_queue.h"
 #include "renderfarm/farm/policy_gate.h"
+#include "renderfarm/farm/session_budget.h"
 
 namespace mogao {
 namespace {
@@ -79,6 +80,49 @@ private:
     std::string last_error_;
 };
 
+// The frame budget across frames (session_budget.h): degrades a request to its appliance's measured
+// rate (logged once per session and change of decision), learns the rate from each rendered frame,
+// and logs frames cut at the budget.
+class BudgetGate {
+public:
+    BudgetGate(const Scene& scene, TimeBudget budget) : budgets_(budget, LightCounts::of(scene)) {}
+
+    // Throws RequestRefused for what the farm cannot render within the budget.
+    ViewRequest apply(const ViewRequest& view, const std::string& who) {
+        const BudgetDecision d = budgets_.apply(view, who);
+        if (!d.degraded) return d.view;
+        ++degraded_;
+        std::string& last = logged_[view.session];
+        if (last != d.changes) {
+            spdlog::warn(
+                "session {} ({}): degraded to the frame budget of {} s (estimated {:.2f} s at its measured "
+                "rate): {}",
+                view.session, who, budgets_.budget().frame_s, d.predicted_s, d.changes);
+            last = d.changes;
+        }
+        return d.view;
+    }
+    void observe(const std::string& who, const LiveFrame& frame) {
+        if (!frame.rendered_now) return;
+        if (frame.stats.tiles_cut > 0) {
+            ++cut_;
+            spdlog::warn(
+                "session {} ({}): frame {} cut at the frame budget of {} s: {} tiles rendered coarse (uncut "
+                "about {:.1f} s)",
+                frame.rendered.session, who, frame.rendered.frame_id, budgets_.budget().frame_s, frame.stats.tiles_cut,
+                frame.stats.full_seconds);
+        }
+        budgets_.observe(who, frame.rendered, frame.stats.full_seconds);
+    }
+    [[nodiscard]] std::uint64_t degraded() const { return degraded_; }
+    [[nodiscard]] std::uint64_t cut() const { return cut_; }
+
+private:
+    SessionBudgets budgets_;
+    std::map<std::uint64_t, std::string> logged_;  // by session: the last degradation logged
+    std::uint64_t degraded_ = 0, cut_ = 0;
+};
+
 }  // namespace
 
 int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& scene, RunInfo& run) {
@@ -89,6 +133,7 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& s
 
     MainThreadQueue<ServedFrame> queue;
     PolicyGate policy(scene, options.policy, ViewPolicies{options.view_policy, options.appliance_view_policies});
+    BudgetGate budget(scene, options.budget);
     LiveFrames live(farm, options.live);
     LinkServerOptions link = options.link;
     // Pipelining needs a second call in flight (another session's) while one frame is encoded; each
@@ -129,7 +174,10 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& s
         std::optional<MainThreadQueue<ServedFrame>::Job> job = queue.next(std::chrono::milliseconds(100));
         if (!job) continue;
         try {
-            LiveFrame frame = live.render(policy.apply(job->view, server.appliance_of(job->view.session)));
+            const std::string who = server.appliance_of(job->view.session);
+            const std::string key = who.empty() ? "session " + std::to_string(job->view.session) : who;
+            LiveFrame frame = live.render(budget.apply(policy.apply(job->view, who), key));
+            budget.observe(key, frame);
             metrics.observe_frame(frame.stats, frame.seconds, double(realtime_ns()) * 1e-9);
             ServedFrame out{std::move(frame.image), job->view.quality.jpeg_quality, realtime_ns(), std::nullopt};
             if (!options.pipeline) out.encoded = encode(out, encoder);
@@ -145,6 +193,7 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& s
         }
     }
     const bool lost_rank = farm.broken();
+    spdlog::info("frame budget: {} requests degraded to it, {} frames cut at it", budget.degraded(), budget.cut());
     metrics_writer.write(metrics, counters(false));
     notifier.stopping();
     spdlog::info("stopping: {}", lost_rank ? "a render rank was lost" : g_stop ? "signal" : "duration reached");

@@ -11,11 +11,16 @@
 // encodes before taking the next request (the serial loop of before).
 // Each request first passes the farm's request policy (request_policy.h): one over the farm's
 // pixel or ray bound is degraded to fit (logged once per session and decision, counted in the stats).
+// Then the frame budget (session_budget.h): a request whose appliance's frames measured too dear is
+// degraded to fit `budget.frame_s`, and one that cannot fit even degraded is refused (RequestRefused:
+// the link ends that session with the reason). The dispatcher cuts a frame still rendering at the
+// budget (DispatchSettings::frame_budget_s, set to the same value by mogao-farm serve).
 // While a frame renders, systemd's watchdog is petted about once a second (FrameDispatcher
-// heartbeat), so a long frame within the rank deadline is not taken for a hang.
+// heartbeat), so a long frame whose ranks answer is not taken for a hang.
 // Errors: a request that fails (bad view, a rank's error) fails that request only — the link logs
-// it and the session goes on; SIGINT/SIGTERM stop the service cleanly (exit 0); a render rank that
-// misses the frame deadline (RankTimeout) stops serving (exit 1, then run_farm aborts the MPI job).
+// it and the session goes on; a refused one ends its session; SIGINT/SIGTERM stop the service cleanly (exit 0); a
+// render rank that falls silent (RankTimeout, rank_liveness.h) stops serving (exit 1, then run_farm aborts the MPI
+// job).
 #pragma once
 
 #include <cstdint>
@@ -27,6 +32,7 @@
 #include "renderfarm/farm/frame_stats.h"
 #include "renderfarm/farm/live_frames.h"
 #include "renderfarm/farm/request_policy.h"
+#include "renderfarm/farm/session_budget.h"
 #include "renderfarm/farm/view_policy.h"
 #include "renderfarm/link/link_server.h"
 #include "renderfarm/scene/scene.h"
@@ -37,6 +43,7 @@ struct ServeOptions {
     LinkServerOptions link;
     LiveOptions live;
     RequestPolicy policy;    // bounds per request (request_policy.h)
+    TimeBudget budget;       // bounds per request from measured frame times (session_budget.h), after `policy`
     ViewPolicy view_policy;  // which views may be had (view_policy.h), applied before `policy`
     // Per appliance certificate (common name), replacing view_policy for it (view_policy_file.h).
     std::map<std::string, ViewPolicy> appliance_view_policies;

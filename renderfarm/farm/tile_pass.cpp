@@ -2,8 +2,10 @@
 #include "renderfarm/farm/tile_pass.h"
 #include "common/thread_clock.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstring>
 #include <exception>
 #include <mutex>
@@ -58,10 +60,37 @@ public:
     TileWriter(float exposure, ToneMap tone_map, PackedPixels format, const GuidePass* guides)
         : exposure_(exposure), tone_map_(tone_map), format_(format), guide_pass_(guides) {}
 
-    TileStats render(const Renderer& renderer, const TileJob& job, std::vector<std::uint8_t>& packed) {
+    // The tile at full quality; `coarse_block` > 0: one traced pixel per block (TilePassControl).
+    TileStats render(const Renderer& renderer, const TileJob& job, std::vector<std::uint8_t>& packed,
+                     int coarse_block = 0) {
         const ImageSize size{job.tile.width(), job.tile.height()};
         resize(radiance_, size);
-        const TileStats stats = renderer.render(job.tile, radiance_, job.tile.x0, job.tile.y0);
+        const TileStats stats = coarse_block > 0 ? render_coarse(renderer, job.tile, coarse_block)
+                                                 : renderer.render(job.tile, radiance_, job.tile.x0, job.tile.y0);
+        pack(job, size, packed);
+        return stats;
+    }
+
+private:
+    // One pixel per block x block block of the global grid inside `tile`, traced at the block's
+    // centre and copied to the block's pixels of the tile's window.
+    TileStats render_coarse(const Renderer& renderer, const PixelRect& tile, int block) {
+        TileStats stats;
+        resize(one_, ImageSize{1, 1});
+        for (int by = (tile.y0 / block) * block; by < tile.y1; by += block) {
+            for (int bx = (tile.x0 / block) * block; bx < tile.x1; bx += block) {
+                const PixelRect b = intersect(tile, PixelRect{bx, by, bx + block, by + block});
+                const int x = b.x0 + (b.width() - 1) / 2, y = b.y0 + (b.height() - 1) / 2;
+                stats.rays += renderer.render(PixelRect{x, y, x + 1, y + 1}, one_, x, y).rays;
+                for (int py = b.y0; py < b.y1; ++py)
+                    for (int px = b.x0; px < b.x1; ++px)
+                        std::copy_n(one_.at(0, 0), 3, radiance_.at(px - tile.x0, py - tile.y0));
+            }
+        }
+        return stats;
+    }
+
+    void pack(const TileJob& job, ImageSize size, std::vector<std::uint8_t>& packed) {
         if (format_ == PackedPixels::linear_guided) {
             render_guides(job, size);
             copy_guided_rows(job, packed);
@@ -72,10 +101,8 @@ public:
         } else {
             copy_rows(job, radiance_, packed);
         }
-        return stats;
     }
 
-private:
     template <typename Image>
     static void resize(Image& image, ImageSize size) {  // keeps the capacity: no allocation per tile
         image.size = size;
@@ -131,6 +158,7 @@ private:
     PackedPixels format_;
     const GuidePass* guide_pass_;
     RgbFloatImage radiance_;
+    RgbFloatImage one_;  // a coarse tile's traced pixel
     Rgb8Image display_;
     GuideBuffers guides_;
 };
@@ -159,6 +187,66 @@ void unpack(const std::vector<PixelRect>& rects, const std::vector<std::uint8_t>
     }
 }
 
+// What the workers of one pass share.
+struct PassState {
+    std::atomic<std::size_t> next{0};       // the next tile to take
+    std::atomic<std::size_t> done{0};       // tiles finished
+    std::atomic<std::size_t> tiles_cut{0};  // of which rendered coarse
+    std::atomic<std::uint64_t> rays{0};
+    std::atomic<int> coarse_block{0};  // > 0 once the pass is cut
+    std::mutex mutex;                  // guards the rest
+    std::condition_variable finished;
+    int running = 0;  // worker threads still rendering
+    std::exception_ptr failure;
+    double cpu_seconds = 0.0;
+};
+
+void run_worker(const Renderer& renderer, const std::vector<TileJob>& tiles, TileWriter writer, TilePassResult& result,
+                PassState& state) {
+    const double cpu_start = thread_cpu_seconds();
+    try {
+        for (std::size_t i = state.next++; i < tiles.size(); i = state.next++) {
+            const int block = state.coarse_block;
+            const auto t0 = Clock::now();
+            const TileStats stats = writer.render(renderer, tiles[i], result.packed_pixels, block);
+            double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+            if (block > 0) {  // its full cost, estimated from the pixels traced
+                const PixelRect& t = tiles[i].tile;
+                const int traced = ((t.x1 - 1) / block - t.x0 / block + 1) * ((t.y1 - 1) / block - t.y0 / block + 1);
+                seconds *= double(t.area()) / double(std::max(1, traced));
+                ++state.tiles_cut;
+            }
+            result.tile_times[i] = {tiles[i].tile, seconds};
+            state.rays += stats.rays;
+            ++state.done;
+        }
+    } catch (...) {
+        const std::lock_guard lock(state.mutex);
+        if (!state.failure) state.failure = std::current_exception();
+        state.next = tiles.size();
+    }
+    const std::lock_guard lock(state.mutex);
+    state.cpu_seconds += thread_cpu_seconds() - cpu_start;
+    --state.running;
+    state.finished.notify_all();
+}
+
+// The calling thread of a controlled pass: polls at once and every beat until the workers are done.
+void poll_until_done(const TilePassControl& control, std::size_t total, Clock::time_point start, PassState& state,
+                     TilePassResult& result) {
+    const auto beat = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(control.beat_s));
+    for (;;) {
+        const std::size_t done = state.done;
+        if (control.poll(done, total) && state.coarse_block == 0) {
+            result.cut_at_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+            result.tiles_done_at_cut = done;
+            state.coarse_block = control.cut_block;
+        }
+        std::unique_lock lock(state.mutex);
+        if (state.finished.wait_for(lock, beat, [&] { return state.running == 0; })) return;
+    }
+}
+
 }  // namespace
 
 std::size_t packed_size(const std::vector<PixelRect>& rects, PackedPixels format) {
@@ -169,10 +257,12 @@ std::size_t packed_size(const std::vector<PixelRect>& rects, PackedPixels format
 
 TilePassResult render_tile_pass(const Renderer& renderer, const std::vector<PixelRect>& rects, int cell_size,
                                 int threads, float exposure, ToneMap tone_map, PackedPixels format,
-                                const GuidePass* guides) {
+                                const GuidePass* guides, const TilePassControl* control) {
     if (cell_size < 1) throw std::invalid_argument("cell_size must be >= 1");
     if (format == PackedPixels::linear_guided && !guides)
         throw std::invalid_argument("PackedPixels::linear_guided needs a guide pass");
+    if (control && !(control->beat_s > 0)) throw std::invalid_argument("TilePassControl.beat_s must be > 0");
+    if (control && control->cut_block < 1) throw std::invalid_argument("TilePassControl.cut_block must be >= 1");
     const auto start = Clock::now();
     const ImageSize size = renderer.render_size();
     for (const PixelRect& r : rects)
@@ -184,38 +274,33 @@ TilePassResult render_tile_pass(const Renderer& renderer, const std::vector<Pixe
     result.tile_times.resize(tiles.size());
     result.packed_pixels.resize(packed_size(rects, format));
 
-    std::atomic<std::size_t> next{0};
-    std::atomic<std::uint64_t> rays{0};
-    std::exception_ptr failure;
-    std::mutex failure_mutex;
-    double cpu_seconds = 0.0;
+    PassState state;
     const auto worker = [&] {
-        const double cpu_start = thread_cpu_seconds();
-        try {
-            TileWriter writer(exposure, tone_map, format, guides);
-            for (std::size_t i = next++; i < tiles.size(); i = next++) {
-                const auto t0 = Clock::now();
-                const TileStats stats = writer.render(renderer, tiles[i], result.packed_pixels);
-                result.tile_times[i] = {tiles[i].tile, std::chrono::duration<double>(Clock::now() - t0).count()};
-                rays += stats.rays;
-            }
-        } catch (...) {
-            const std::lock_guard lock(failure_mutex);
-            if (!failure) failure = std::current_exception();
-            next = tiles.size();
-        }
-        const std::lock_guard lock(failure_mutex);
-        cpu_seconds += thread_cpu_seconds() - cpu_start;
+        run_worker(renderer, tiles, TileWriter(exposure, tone_map, format, guides), result, state);
     };
+    std::exception_ptr poll_failure;
     {
         std::vector<std::jthread> pool;
-        for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-        worker();
+        const int workers = std::max(1, threads);
+        state.running = control ? workers : workers - 1;
+        for (int t = control ? 0 : 1; t < workers; ++t) pool.emplace_back(worker);
+        if (!control) {
+            worker();
+        } else {
+            try {
+                poll_until_done(*control, tiles.size(), start, state, result);
+            } catch (...) {
+                poll_failure = std::current_exception();
+                state.next = tiles.size();
+            }
+        }
     }
-    if (failure) std::rethrow_exception(failure);
+    if (state.failure) std::rethrow_exception(state.failure);
+    if (poll_failure) std::rethrow_exception(poll_failure);
 
-    result.rays = rays;
-    result.cpu_seconds = cpu_seconds;
+    result.rays = state.rays;
+    result.cpu_seconds = state.cpu_seconds;
+    result.tiles_cut = state.tiles_cut;
     result.render_seconds = std::chrono::duration<double>(Clock::now() - start).count();
     return result;
 }

@@ -17,7 +17,9 @@
 // depth (metres; 0 = sky), in the same order (unpack_guided_rects()).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "common/image.h"
@@ -31,24 +33,46 @@ namespace mogao {
 
 enum class PackedPixels { srgb8, linear, linear_guided };
 
+// Progress reports and the time budget of a pass (frame_dispatcher.h: the render ranks' heartbeat
+// and the admin's cut, rank_liveness.h). With a control, every tile is rendered on `threads`
+// worker threads and the calling thread only calls `poll` (it may talk MPI there): first at once,
+// then about every `beat_s` until the workers are done, with the tiles finished so far and the
+// pass's tile count. `poll` returning true cuts the pass: tiles not begun yet are rendered coarse,
+// one traced pixel (the block's centre, the value the full pass would give it, renderer.h) per
+// `cut_block` x `cut_block` block of the global grid, copied to the whole block (guides, for
+// PackedPixels::linear_guided, are still traced per pixel: they are one primary ray each). Tiles
+// begun before the cut finish at full quality. A coarse tile's time is reported scaled by its
+// pixels over its traced pixels (an estimate of its full cost, for the PBT).
+struct TilePassControl {
+    std::function<bool(std::size_t done, std::size_t total)> poll;
+    double beat_s = 0.1;  // > 0
+    int cut_block = 8;    // >= 1
+};
+
 struct TilePassResult {
     std::vector<std::uint8_t> packed_pixels;
     std::vector<TileTime> tile_times;  // wall-clock seconds per tile
     std::uint64_t rays = 0;
     double render_seconds = 0.0;  // wall time of the whole pass on this rank
     double cpu_seconds = 0.0;     // thread CPU time of all render threads (CLOCK_THREAD_CPUTIME_ID)
+    std::size_t tiles_cut = 0;    // tiles rendered coarse after a cut (TilePassControl)
+    double cut_at_seconds = 0.0;  // when the pass was cut, from its start (0: not cut)
+    std::size_t tiles_done_at_cut = 0;  // tiles finished at full quality when it was cut
 };
 
 // Renders `rects` of the frame begun on `renderer` with `threads` worker threads (>= 1); for
 // PackedPixels::linear_guided also the guides of the same pixels with `guides` (begun on the same
 // request after the renderer; its time counts in the tile's). Throws what the renderer throws
 // (std::invalid_argument for rects outside the image), std::invalid_argument for linear_guided
-// without a guide pass, std::runtime_error naming the guide pass's error.
+// without a guide pass, std::runtime_error naming the guide pass's error; `control` (may be null:
+// no progress reports, no cut, the calling thread renders too): std::invalid_argument for a bad
+// beat_s or cut_block, and what its poll throws (after the workers stopped).
 [[nodiscard]] TilePassResult render_tile_pass(const Renderer& renderer, const std::vector<PixelRect>& rects,
                                               int cell_size, int threads, float exposure,
                                               ToneMap tone_map = ToneMap::clamp,
                                               PackedPixels format = PackedPixels::srgb8,
-                                              const GuidePass* guides = nullptr);
+                                              const GuidePass* guides = nullptr,
+                                              const TilePassControl* control = nullptr);
 
 // Copies packed pixels of `rects` into `frame`. Throws std::invalid_argument when the byte count
 // does not match the rects or a rect lies outside the frame.

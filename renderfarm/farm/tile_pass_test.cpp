@@ -73,6 +73,78 @@ TEST(TilePass, SplitRectsWithThreadsGiveTheSamePixelsAsOneRect) {
     EXPECT_THROW((void)render_tile_pass(renderer, {{0, 0, 97, 64}}, 16, 1, 1.f), std::invalid_argument);
 }
 
+// With a control the calling thread only reports: the pixels are the uncontrolled pass's, and poll
+// sees the progress, first at once (0 done) and last no further than the tile count.
+TEST(TilePass, ControlledPassReportsProgressAndKeepsThePixels) {
+    const Scene scene = small_scene();
+    Renderer renderer(scene, RendererOptions{});
+    ViewRequest view;
+    view.size = {96, 64};
+    view.pose.eye = {0, 1.5, 5};
+    view.quality.spp = 2;
+    renderer.begin_frame(view);
+    const TilePassResult plain = render_tile_pass(renderer, {{0, 0, 96, 64}}, 16, 1, 1.f);
+    std::vector<std::size_t> seen;
+    std::size_t total_seen = 0;
+    const TilePassControl control{[&](std::size_t done, std::size_t total) {
+                                      seen.push_back(done);
+                                      total_seen = total;
+                                      return false;
+                                  },
+                                  0.001, 8};
+    const TilePassResult beat = render_tile_pass(renderer, {{0, 0, 96, 64}}, 16, 2, 1.f, ToneMap::clamp,
+                                                 PackedPixels::srgb8, nullptr, &control);
+    EXPECT_EQ(beat.packed_pixels, plain.packed_pixels);
+    EXPECT_EQ(beat.tiles_cut, 0u);
+    ASSERT_FALSE(seen.empty());
+    EXPECT_EQ(total_seen, 24u);
+    for (std::size_t i = 1; i < seen.size(); ++i) EXPECT_GE(seen[i], seen[i - 1]);
+    EXPECT_LE(seen.back(), 24u);
+    const TilePassControl bad{[](std::size_t, std::size_t) { return false; }, 0.0, 8};
+    EXPECT_THROW((void)render_tile_pass(renderer, {{0, 0, 96, 64}}, 16, 1, 1.f, ToneMap::clamp, PackedPixels::srgb8,
+                                        nullptr, &bad),
+                 std::invalid_argument);
+}
+
+// A cut renders the tiles not begun yet coarse: each block of the global grid holds its centre
+// pixel's value, the one the full pass gives that pixel (the renderer's determinism), and the
+// cut tiles' times are scaled to an estimate of their full cost.
+TEST(TilePass, CutRendersTheRemainingTilesCoarseFromTheFullPassPixels) {
+    const Scene scene = small_scene();
+    Renderer renderer(scene, RendererOptions{});
+    ViewRequest view;
+    view.size = {96, 64};
+    view.pose.eye = {0, 1.5, 5};
+    view.quality.spp = 2;
+    renderer.begin_frame(view);
+    const std::vector<PixelRect> rect{{0, 0, 96, 64}};
+    const TilePassResult full = render_tile_pass(renderer, rect, 16, 1, 1.f, ToneMap::clamp, PackedPixels::linear);
+    const TilePassControl cut_now{[](std::size_t, std::size_t) { return true; }, 0.001, 8};
+    const TilePassResult cut =
+        render_tile_pass(renderer, rect, 16, 1, 1.f, ToneMap::clamp, PackedPixels::linear, nullptr, &cut_now);
+    EXPECT_GE(cut.tiles_cut, 23u);  // the one worker may have begun the first tile before the cut
+    EXPECT_LT(cut.rays, full.rays / 8);
+    EXPECT_EQ(cut.tile_times.size(), full.tile_times.size());
+    RgbFloatImage a({96, 64}), b({96, 64});
+    unpack_linear_rects(rect, full.packed_pixels, a);
+    unpack_linear_rects(rect, cut.packed_pixels, b);
+    int coarse_blocks = 0;
+    for (int by = 0; by < 64; by += 8) {
+        for (int bx = 0; bx < 96; bx += 8) {
+            const float* centre = b.at(bx + 3, by + 3);
+            bool flat = true;
+            for (int y = by; y < by + 8; ++y)
+                for (int x = bx; x < bx + 8; ++x)
+                    for (int c = 0; c < 3; ++c) flat = flat && b.at(x, y)[c] == centre[c];
+            if (!flat) continue;  // a tile begun before the cut
+            ++coarse_blocks;
+            for (int c = 0; c < 3; ++c) EXPECT_EQ(centre[c], a.at(bx + 3, by + 3)[c]) << bx << "," << by;
+        }
+    }
+    EXPECT_GE(coarse_blocks, 23 * 4);
+    EXPECT_NE(a.pixels, b.pixels);  // the comparison can fail: coarse is not the full pass
+}
+
 // The denoiser's guides travel beside the radiance: any split of the frame over ranks and threads
 // composites to the same radiance and guides, and those are the guide pass's own for the frame
 // (traced there on its own BVH).

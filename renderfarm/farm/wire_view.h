@@ -19,8 +19,9 @@ struct WireView {
     double fov_deg, radius_m, arc_deg, bottom_m, top_m, screen_eye[3];
     std::int32_t width, height, spp, max_bounces, ao_samples, area_light_samples, jpeg_quality;
     double resolution_scale;
-    std::int32_t stop;    // 1: no more frames, render ranks leave their loop
-    std::int32_t linear;  // 0: sRGB8, 1: linear radiance (PackedPixels::linear), 2: and guides (::linear_guided)
+    std::int32_t stop;       // 1: no more frames, render ranks leave their loop
+    std::int32_t linear;     // 0: sRGB8, 1: linear radiance (PackedPixels::linear), 2: and guides (::linear_guided)
+    std::uint64_t sequence;  // the dispatcher's count of frames sent: names the frame in progress reports and cuts
 };
 static_assert(std::is_trivially_copyable_v<WireView>);
 

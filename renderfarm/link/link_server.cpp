@@ -46,6 +46,7 @@ struct SessionState {
     std::deque<v1::FrameMsg> outbox;   // rendered, waiting for the handler thread to write
     bool closed = false;
     std::string close_reason;
+    std::string refused;  // the renderer refused the session (RequestRefused): the status sent
     std::uint64_t requests = 0, invalid = 0, dropped = 0, frames = 0, failures = 0, bad_acks = 0;
 
     [[nodiscard]] std::uint64_t in_flight() const { return (rendering ? 1 : 0) + (last_frame_id - acked_frame_id); }
@@ -82,7 +83,8 @@ struct LinkServer::Impl final : v1::Tour::Service {
     void close(SessionState& s, const std::string& reason);
     void render_loop();
     std::shared_ptr<SessionState> pick_ready();  // with mutex held
-    std::optional<v1::FrameMsg> render(const SessionState& s, const ViewRequest& request, std::int64_t received_ns);
+    std::optional<v1::FrameMsg> render(const SessionState& s, const ViewRequest& request, std::int64_t received_ns,
+                                       std::string& refused);
 };
 
 namespace {
@@ -247,6 +249,7 @@ grpc::Status LinkServer::Impl::Session(grpc::ServerContext* ctx, Stream* stream)
     }
     link_log().info("{}", summary);
     if (s->revoked) return grpc::Status(grpc::StatusCode::PERMISSION_DENIED, "the appliance's certificate was revoked");
+    if (!s->refused.empty()) return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, s->refused);
     return server_stopping ? grpc::Status(grpc::StatusCode::UNAVAILABLE, "farm is shutting down") : grpc::Status::OK;
 }
 
@@ -359,9 +362,16 @@ void LinkServer::Impl::render_loop() {
             s->rendering = true;
             ++totals.render_calls;
         }
-        auto frame = render(*s, request, received_ns);
+        std::string refused;
+        auto frame = render(*s, request, received_ns, refused);
         const std::lock_guard lock(mutex);
         s->rendering = false;
+        if (!refused.empty() && !s->closed) {
+            s->refused = refused;
+            s->closed = true;
+            s->close_reason = "refused by the farm: " + refused;
+            out_cv.notify_all();
+        }
         if (!frame) {
             ++s->failures;
             ++totals.render_failures;
@@ -375,11 +385,15 @@ void LinkServer::Impl::render_loop() {
 }
 
 std::optional<v1::FrameMsg> LinkServer::Impl::render(const SessionState& s, const ViewRequest& request,
-                                                     std::int64_t received_ns) {
+                                                     std::int64_t received_ns, std::string& refused) {
     const std::int64_t start_ns = realtime_ns();
     RenderedFrame rendered;
     try {
         rendered = renderer(request);
+    } catch (const RequestRefused& e) {
+        link_log().warn("{}: request {}: refused: {}", s.name(), request.frame_id, e.what());
+        refused = e.what();
+        return std::nullopt;
     } catch (const std::exception& e) {
         link_log().error("{}: request {}: renderer failed: {}", s.name(), request.frame_id, e.what());
         return std::nullopt;

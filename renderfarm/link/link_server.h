@@ -20,14 +20,16 @@
 // Errors: construction throws LinkError (bad endpoint, unusable TLS material or revocation list,
 // bad connection limits, port taken). After
 // that nothing is thrown: an invalid request is refused and logged (the session continues), a
-// renderer exception costs that request its frame, a broken session ends alone; all of it is
-// logged to stderr through spdlog (logger "mogao-link").
+// renderer exception costs that request its frame (RequestRefused: the session ends with
+// RESOURCE_EXHAUSTED and the renderer's message, which the appliance logs), a broken session ends
+// alone; all of it is logged to stderr through spdlog (logger "mogao-link").
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -39,8 +41,15 @@
 
 namespace mogao {
 
+// Thrown by a FrameRenderer that will not serve the session's requests (e.g. what it asks for costs
+// more than the farm can give it): the link ends that session with RESOURCE_EXHAUSTED and what().
+struct RequestRefused : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
 // Renders and encodes one validated request. Called from the server's render threads; may throw
-// (the request then gets no frame). ViewRequest::frame_id holds the appliance's request id.
+// (the request then gets no frame; RequestRefused ends the session, see above).
+// ViewRequest::frame_id holds the appliance's request id.
 using FrameRenderer = std::function<RenderedFrame(const ViewRequest&)>;
 
 struct LinkServerOptions {

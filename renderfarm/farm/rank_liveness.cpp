@@ -1,0 +1,54 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "renderfarm/farm/rank_liveness.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace mogao {
+
+RankLiveness::RankLiveness(int ranks, double silence_s, double now) : silence_s_(silence_s) {
+    if (ranks < 0) throw std::invalid_argument("RankLiveness: ranks must be >= 0");
+    if (!std::isfinite(silence_s)) throw std::invalid_argument("RankLiveness: silence_s must be finite");
+    ranks_.assign(static_cast<std::size_t>(ranks), Rank{now, 0.0, true});
+}
+
+std::size_t RankLiveness::index(int rank) const {
+    if (rank < 1 || rank > static_cast<int>(ranks_.size()))
+        throw std::invalid_argument("RankLiveness: rank " + std::to_string(rank) + " is not in 1.." +
+                                    std::to_string(ranks_.size()));
+    return static_cast<std::size_t>(rank - 1);
+}
+
+void RankLiveness::heard(int rank, double now) {
+    Rank& r = ranks_[index(rank)];
+    r.last_heard = std::max(r.last_heard, now);
+}
+
+void RankLiveness::allow(int rank, double extra_s) {
+    if (extra_s > 0) ranks_[index(rank)].allowance += extra_s;
+}
+
+void RankLiveness::replied(int rank) { ranks_[index(rank)].owes = false; }
+
+bool RankLiveness::owes(int rank) const { return ranks_[index(rank)].owes; }
+
+double RankLiveness::silent_for(int rank, double now) const { return now - ranks_[index(rank)].last_heard; }
+
+std::vector<int> RankLiveness::silent(double now) const {
+    std::vector<int> lost;
+    if (silence_s_ <= 0) return lost;
+    for (std::size_t i = 0; i < ranks_.size(); ++i) {
+        const Rank& r = ranks_[i];
+        if (r.owes && now - r.last_heard > silence_s_ + r.allowance) lost.push_back(static_cast<int>(i) + 1);
+    }
+    return lost;
+}
+
+double full_pass_seconds(double seconds, double cut_at_s, std::uint64_t done, std::uint64_t total) {
+    if (total == 0 || done >= total) return seconds;
+    return cut_at_s * double(total) / double(std::max<std::uint64_t>(done, 1));
+}
+
+}  // namespace mogao
