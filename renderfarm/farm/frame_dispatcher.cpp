@@ -401,7 +401,15 @@ struct FrameDispatcher::Watch {
 template <typename Done>
 void FrameDispatcher::poll_until(Watch& watch, const Done& done, const char* phase) {
     auto next_beat = Clock::now() + std::chrono::seconds(1);
+    double last_poll = watch.now();
     while (!done()) {
+        // The admin itself stalled (descheduled on a loaded host, a sanitizer, a long unpack):
+        // the ranks could not be heard meanwhile, so the stall is not their silence.
+        if (const double gap = watch.now() - last_poll; gap > kAdminStallS) {
+            for (int r = 1; r <= mpi_.render_ranks(); ++r)
+                if (watch.liveness.owes(r)) watch.liveness.allow(r, gap);
+        }
+        last_poll = watch.now();
         drain_progress(watch);
         if (settings_.frame_budget_s > 0 && !watch.cut_sent && watch.now() > settings_.frame_budget_s) send_cuts(watch);
         if (const std::vector<int> silent = watch.liveness.silent(watch.now()); !silent.empty())
@@ -479,13 +487,15 @@ bool FrameDispatcher::gather(const ViewRequest& view, const Assignment& assignme
             MPI_Testall(static_cast<int>(sends.size()), sends.data(), &done, MPI_STATUSES_IGNORE);
             return done != 0;
         },
-        "(view broadcast)");
+        "(view sent to the ranks)");
     for (int r = 0; r < mpi_.render_ranks(); ++r) {
         std::vector<int> flat;
         for (const PixelRect& rect : assignment.rects[static_cast<std::size_t>(r)])
             flat.insert(flat.end(), {rect.x0, rect.y0, rect.x1, rect.y1});
         MPI_Send(flat.data(), static_cast<int>(flat.size()), MPI_INT, r + 1, kTagRects, MPI_COMM_WORLD);
     }
+    // A rank reports progress only once it has its rects: its silence counts from here.
+    for (int r = 1; r <= mpi_.render_ranks(); ++r) watch.liveness.heard(r, watch.now());
     frame.stats.rank_render_seconds.assign(static_cast<std::size_t>(mpi_.render_ranks()), 0.0);
     bool ok = true;
     for (int k = 0; k < mpi_.render_ranks(); ++k) {
@@ -495,7 +505,11 @@ bool FrameDispatcher::gather(const ViewRequest& view, const Assignment& assignme
         RankReply reply = receive_reply(
             source, [&](const std::function<bool()>& done) { poll_until(watch, done, nullptr); },
             [&](const ReplyHeader& h) {
-                watch.liveness.allow(source, double(h.payload_bytes) / kSlowestLinkBytesPerSecond);
+                // The ranks that finished meanwhile wait in their own sends, silent, until the admin
+                // is done with this one: the transfer's time is allowed to every rank that owes.
+                const double transfer_s = double(h.payload_bytes) / kSlowestLinkBytesPerSecond;
+                for (int r = 1; r <= mpi_.render_ranks(); ++r)
+                    if (watch.liveness.owes(r)) watch.liveness.allow(r, transfer_s);
             });
         watch.liveness.replied(source);
         if (!reply.header.ok) {

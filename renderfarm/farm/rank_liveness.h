@@ -32,6 +32,9 @@ namespace mogao {
 
 // The slowest farm network the reply allowance assumes, bytes per second (100 Mbit/s Ethernet).
 inline constexpr double kSlowestLinkBytesPerSecond = 12.5e6;
+// A gap this long between two of the admin's own polls is the admin's stall (descheduled, a
+// sanitizer, a long unpack), not the ranks' silence: it is allowed to every rank that owes a reply.
+inline constexpr double kAdminStallS = 0.5;
 
 class RankLiveness {
 public:

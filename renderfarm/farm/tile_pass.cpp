@@ -232,16 +232,22 @@ void run_worker(const Renderer& renderer, const std::vector<TileJob>& tiles, Til
 }
 
 // The calling thread of a controlled pass: polls at once and every beat until the workers are done.
+// Asks the control whether to cut; on the first yes the tiles still to take are rendered coarse.
+void poll_once(const TilePassControl& control, std::size_t total, Clock::time_point start, PassState& state,
+               TilePassResult& result) {
+    const std::size_t done = state.done;
+    if (control.poll(done, total) && state.coarse_block == 0) {
+        result.cut_at_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+        result.tiles_done_at_cut = done;
+        state.coarse_block = control.cut_block;
+    }
+}
+
 void poll_until_done(const TilePassControl& control, std::size_t total, Clock::time_point start, PassState& state,
                      TilePassResult& result) {
     const auto beat = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(control.beat_s));
     for (;;) {
-        const std::size_t done = state.done;
-        if (control.poll(done, total) && state.coarse_block == 0) {
-            result.cut_at_seconds = std::chrono::duration<double>(Clock::now() - start).count();
-            result.tiles_done_at_cut = done;
-            state.coarse_block = control.cut_block;
-        }
+        poll_once(control, total, start, state, result);
         std::unique_lock lock(state.mutex);
         if (state.finished.wait_for(lock, beat, [&] { return state.running == 0; })) return;
     }
@@ -283,6 +289,9 @@ TilePassResult render_tile_pass(const Renderer& renderer, const std::vector<Pixe
         std::vector<std::jthread> pool;
         const int workers = std::max(1, threads);
         state.running = control ? workers : workers - 1;
+        // The first poll before any worker starts: a pass that is already over its budget (or
+        // told to cut) renders every tile coarse, not whatever the workers took meanwhile.
+        if (control) poll_once(*control, tiles.size(), start, state, result);
         for (int t = control ? 0 : 1; t < workers; ++t) pool.emplace_back(worker);
         if (!control) {
             worker();
