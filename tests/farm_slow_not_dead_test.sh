@@ -51,6 +51,7 @@ for _ in 1 2; do
   load_pids+=($!)
 done
 
+FARM_BUDGET_ARGS=()  # the farm's default frame budget (1 s): what this test is about
 start_farm "$work/farm.log" "$endpoint"
 log "farm up at $endpoint (3 ranks), two busy loops beside it"
 

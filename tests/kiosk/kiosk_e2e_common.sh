@@ -109,12 +109,14 @@ write_config() {
 # start_farm LOG LISTEN [PREFIX...]: 3 MPI ranks serving the test room; returns once the farm logs
 # that it serves (or fails).
 FARM_MPI_ARGS=()        # more mpirun arguments (e2e_netns.sh multihost: host file, rsh agent)
+# The farm's frame budget: off by default here, since these tests compare every shown frame with
+# the farm's full render of its pose, and on the loaded machine (or under TSan) a frame may outlast
+# the default 1 s and be cut. The slow-frame test sets its own.
+FARM_BUDGET_ARGS=(--frame-budget 0)
 start_farm() {
   local logf=$1 listen=$2; shift 2
-  # --frame-budget 0: these tests compare every shown frame with the farm's full render of its pose,
-  # and on the loaded machine (or under TSan) a frame may outlast the default 1 s budget and be cut.
   setsid "$@" "$MPIEXEC" --oversubscribe "${FARM_MPI_ARGS[@]}" -n 3 "$farm" serve --scene "$src/scenes/test-room.json" \
-    --listen "$listen" --tls-dir "$work/farm-tls" --duration 300 --frame-budget 0 >>"$logf" 2>&1 &
+    --listen "$listen" --tls-dir "$work/farm-tls" --duration 300 "${FARM_BUDGET_ARGS[@]}" >>"$logf" 2>&1 &
   farm_sid=$!
   disown "$farm_sid"  # stopped by session id in stop_farm; no job-control report when killed
   for _ in $(seq 1 300); do
