@@ -73,10 +73,6 @@ struct DispatchSettings {
     // it is taken for lost (rank_liveness.h); 0 = never.
     double rank_deadline_s = 2.0;
     double rank_beat_s = 0.1;  // how often a rendering rank reports its progress, seconds (> 0)
-    // Not used: liveness no longer follows a frame's expected time. Kept so that callers that set
-    // them still build.
-    double rank_deadline_min_s = 0.0;
-    double rank_deadline_factor = 0.0;
     // Seconds after which a frame's remaining tiles are rendered coarse (see above); 0 = never.
     double frame_budget_s = 0.0;
     int cut_block = 8;  // pixels per side of a coarse block after a cut (>= 1)

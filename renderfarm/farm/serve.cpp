@@ -92,6 +92,7 @@ public:
         const BudgetDecision d = budgets_.apply(view, who);
         if (!d.degraded) return d.view;
         ++degraded_;
+        if (logged_.size() >= kLoggedSessions) logged_.clear();  // a farm serves for months: bounded
         std::string& last = logged_[view.session];
         if (last != d.changes) {
             spdlog::warn(
@@ -118,6 +119,7 @@ public:
     [[nodiscard]] std::uint64_t cut() const { return cut_; }
 
 private:
+    static constexpr std::size_t kLoggedSessions = 1024;
     SessionBudgets budgets_;
     std::map<std::uint64_t, std::string> logged_;  // by session: the last degradation logged
     std::uint64_t degraded_ = 0, cut_ = 0;
