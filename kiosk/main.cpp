@@ -26,6 +26,7 @@
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include "common/program_cli.h"
 #include "common/service_notify.h"
 #include "kiosk/config_overrides.h"
 #include "kiosk/kiosk.h"
@@ -132,6 +133,7 @@ int main(int argc, char** argv) {
         return 1;
     }
     CLI::App app{"mogao-kiosk: the appliance's projector outputs, fed by the render farm (docs/kiosk.md)"};
+    mogao::cli::prepare(app, "mogao-kiosk");
     Flags flags;
     std::vector<std::string> overrides;
     // Not CLI::ExistingFile: a missing file (an unmounted configuration partition) is reported on the
@@ -153,12 +155,7 @@ int main(int argc, char** argv) {
                                  "Print kiosk.example.toml with overrides: section.key=VALUE (TOML value; empty: "
                                  "commented out) or @FILE of such lines, then exit")
                       ->expected(0, 1 << 20);
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
-        const int code = app.exit(e);
-        return code == 0 ? 0 : 2;
-    }
+    if (auto status = mogao::cli::parse(app, argc, argv)) return *status;
     if (print->count() > 0) return print_config(overrides);
     try {
         return run(flags, *signals);

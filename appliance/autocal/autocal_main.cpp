@@ -13,9 +13,11 @@
 #include <CLI/CLI.hpp>
 
 #include "appliance/autocal/calibrate_job.h"
+#include "common/program_cli.h"
 
 int main(int argc, char** argv) {
     CLI::App app{"Camera-based projector calibration on a virtual rig (docs/calibration.md)"};
+    mogao::cli::prepare(app, "mogao-autocal");
     app.require_subcommand(1);
     mogao::autocal::CalibrateJob job;
     std::string content = "1920x1080";
@@ -59,7 +61,7 @@ int main(int argc, char** argv) {
             throw CLI::ValidationError("--content", "must be WIDTHxHEIGHT, 1..16384 per side");
         }
     } catch (const CLI::ParseError& e) {
-        return app.exit(e) == 0 ? 0 : 2;
+        return mogao::cli::exit_status(app, e);
     }
     try {
         const nlohmann::json r = mogao::autocal::run_calibrate_job(job);

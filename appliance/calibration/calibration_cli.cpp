@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "appliance/calibration/calibration_cli.h"
+#include "common/program_cli.h"
 
 #include <CLI/CLI.hpp>
 
@@ -161,6 +162,7 @@ int run_info(const std::string& path, std::ostream& out) {
 
 int run_calibration_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
     CLI::App app{"mogao-calibration: make and inspect MPCDI projector calibrations (docs/calibration.md)"};
+    mogao::cli::prepare(app, "mogao-calibration");
     app.require_subcommand(1);
     IdealFlags ideal;
     CLI::App* ideal_cmd = app.add_subcommand("ideal", "Write the ideal calibration of N projectors side by side as a 2d-profile MPCDI file");
@@ -186,7 +188,7 @@ int run_calibration_cli(int argc, const char* const* argv, std::ostream& out, st
             }
         }
     } catch (const CLI::ParseError& e) {
-        return app.exit(e, out, err) == 0 ? 0 : 2;
+        return mogao::cli::exit_status(app, e, out, err);
     }
     try {
         if (*ideal_cmd) return run_ideal(ideal, out);

@@ -13,6 +13,7 @@
 #include "appliance/autocal/model_store.h"
 #include "appliance/rig/rig_file.h"
 #include "appliance/selfcal/rig_simulation.h"
+#include "common/program_cli.h"
 
 namespace {
 
@@ -64,6 +65,7 @@ int run_simulate(const std::string& rig_path, const std::string& models_path,
 
 int main(int argc, char** argv) {
     CLI::App app{"mogao-selfcal: continuous self-recalibration on the virtual rig"};
+    mogao::cli::prepare(app, "mogao-selfcal");
     app.require_subcommand(1);
     CLI::App* sim = app.add_subcommand("simulate", "bump devices of a virtual rig and watch the monitor correct them");
     std::string rig;
@@ -128,7 +130,7 @@ int main(int argc, char** argv) {
                     "start from these models (a full calibration's estimate: mogao-autocal calibrate --rig RIG "
                     "--scale S writes calibration.models.json) instead of the rig's exact ones")
         ->check(CLI::ExistingFile);
-    CLI11_PARSE(app, argc, argv);
+    if (auto status = mogao::cli::parse(app, argc, argv)) return *status;
     o.content = content == "plain"        ? ContentKind::plain
                 : content == "repetitive" ? ContentKind::repetitive
                 : content == "dark"       ? ContentKind::dark

@@ -6,8 +6,9 @@
 #include <cstdio>
 #include <exception>
 
-#include "appliance/tracker/tag_family.h"
 #include "appliance/tools/track_commands.h"
+#include "appliance/tracker/tag_family.h"
+#include "common/program_cli.h"
 
 namespace {
 
@@ -35,6 +36,7 @@ void add_detector_flags(CLI::App& cmd, DetectorSettings& s) {
 
 int main(int argc, char** argv) {
     CLI::App app{"mogao-track: AprilTag tracking and tag-driven navigation"};
+    mogao::cli::prepare(app, "mogao-track");
     app.require_subcommand(1);
 
     mogao::track::DetectOptions detect;
@@ -121,8 +123,7 @@ int main(int argc, char** argv) {
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        const int code = app.exit(e);
-        return code == 0 ? 0 : 2;
+        return mogao::cli::exit_status(app, e);
     }
     try {
         if (*d) return mogao::track::detect(detect);

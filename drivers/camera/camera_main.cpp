@@ -9,6 +9,7 @@
 #include <iostream>
 #include <string>
 
+#include "common/program_cli.h"
 #include "drivers/camera/camera_source.h"
 #include "drivers/camera/libcamera_capture.h"
 #include "drivers/camera/v4l2_info.h"
@@ -53,6 +54,7 @@ int run_info(const std::string& camera) {
 
 int main(int argc, char** argv) {
     CLI::App app{"mogao-camera: the cameras this machine has and what they support (formats, sizes, rates, controls)"};
+    mogao::cli::prepare(app, "mogao-camera");
     app.require_subcommand(1);
     CLI::App* list = app.add_subcommand("list", "every V4L2 capture node: device, driver, card, bus");
     CLI::App* info =
@@ -62,7 +64,7 @@ int main(int argc, char** argv) {
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e) == 0 ? 0 : 2;  // --help is 0
+        return mogao::cli::exit_status(app, e);  // --help is 0
     }
     if (list->parsed()) {
         const auto devices = mogao::list_v4l2_devices();

@@ -13,6 +13,7 @@
 #include <memory>
 #include <string>
 
+#include "common/program_cli.h"
 #include "drivers/egl/test_pattern.h"
 #include "drivers/kms/drm_device.h"
 #include "drivers/kms/kms_backend.h"
@@ -138,6 +139,7 @@ int light(const std::filesystem::path& device, double seconds) {
 
 int main(int argc, char** argv) {
     CLI::App app{"List DRM/KMS connectors, modes, CRTCs and planes; optionally light the outputs"};
+    mogao::cli::prepare(app, "mogao-kms-probe");
     std::string device;
     double seconds = 0;
     app.add_option("--device", device, "DRM card node (default: every /dev/dri/card*)")->check(CLI::ExistingFile);
@@ -146,7 +148,7 @@ int main(int argc, char** argv) {
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e) == 0 ? 0 : 2;  // prints help or the error; 2 = bad command line
+        return mogao::cli::exit_status(app, e);  // prints help or the error; 2 = bad command line
     }
 
     std::vector<std::filesystem::path> cards;

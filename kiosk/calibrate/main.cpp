@@ -30,6 +30,7 @@
 #include "appliance/calibration/mpcdi_reader.h"
 #include "appliance/calibration/mpcdi_screen.h"
 #include "appliance/rig/rig_file.h"
+#include "common/program_cli.h"
 #include "drivers/headless/headless_output.h"
 #include "drivers/kms/kms_backend.h"
 #include "kiosk/calibrate/on_site_job.h"
@@ -204,6 +205,7 @@ int run_site(const Cli& cli, OnSiteJob& job) {
 
 int main(int argc, char** argv) {
     CLI::App app{"Camera-based calibration of the projector wall (docs/on-site-calibration.md)"};
+    mogao::cli::prepare(app, "mogao-calibrate");
     Cli cli;
     OnSiteJob job;
     autocal::CalibrateJob rig_job;
@@ -258,7 +260,7 @@ int main(int argc, char** argv) {
             throw CLI::ValidationError("--site", "needs --outputs and --camera (or --budget)");
         }
     } catch (const CLI::ParseError& e) {
-        return app.exit(e) == 0 ? 0 : 2;
+        return mogao::cli::exit_status(app, e);
     }
     job.site = cli.site;
     job.colour = !cli.no_colour;

@@ -20,6 +20,7 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include "common/program_cli.h"
 #include "common/quality_preset.h"
 #include "common/request_limits.h"
 #include "renderfarm/farm/farm.h"
@@ -269,20 +270,22 @@ std::string prepare_admin_link(mogao::ServeOptions& serve_options, const std::fi
     return "";
 }
 
+bool asks_for_help_or_version(int argc, char** argv) {
+    for (int i = 1; i < argc; ++i) {
+        const std::string_view a = argv[i];
+        if (a == "-h" || a == "--help" || a == "--version") return true;
+    }
+    return false;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
     // The PKI needs no farm: handle it before MPI starts.
     if (argc >= 2 && std::string_view(argv[1]) == "pki") return mogao::run_pki_command(argc - 1, argv + 1);
     if (argc == 2 && std::string_view(argv[1]) == "health") return run_health();
-    mogao::MpiSession mpi(&argc, &argv);
-    auto logger = spdlog::stderr_color_mt("mogao-farm");
-    spdlog::set_default_logger(logger);
-    // journald-friendly: no timestamps of our own (the journal adds them), rank and level first.
-    spdlog::set_pattern(fmt::format("mogao-farm[{}] %l: %v", mpi.rank()));
-    if (!mpi.is_admin()) spdlog::set_level(spdlog::level::warn);
-
     CLI::App app{"mogao-farm: the mogao render farm (Embree ray tracing, sort-first PBT over MPI ranks, JPEG frames)"};
+    mogao::cli::prepare(app, "mogao-farm");
     app.require_subcommand(1);
     mogao::FarmSetup setup;
     mogao::PathTour job;
@@ -316,10 +319,25 @@ int main(int argc, char** argv) {
                      "session's next requests are degraded from what its frames cost (0 = no budget)")
         ->check(CLI::Range(0.0, 3600.0));
     serve->add_option("--duration", serve_options.duration_s, "Stop after this many seconds (0 = until SIGTERM)")->check(CLI::Range(0.0, 1e9));
+    // Listed in --help; handled at the top of main, before MPI starts.
+    app.add_subcommand(
+           "pki", "The link's PKI: CA, farm and appliance certificates, revocation (no MPI; mogao-farm pki --help)")
+        ->prefix_command();
+    app.add_subcommand("health",
+                       "Print ok and this host's hardware threads (no MPI; what mogao-farm-launch runs per host)");
+    // --help and --version need no farm: answered before MPI starts (a singleton MPI_Init outside
+    // mpirun takes seconds).
+    if (asks_for_help_or_version(argc, argv)) return mogao::cli::parse(app, argc, argv).value_or(0);
+    mogao::MpiSession mpi(&argc, &argv);
+    auto logger = spdlog::stderr_color_mt("mogao-farm");
+    spdlog::set_default_logger(logger);
+    // journald-friendly: no timestamps of our own (the journal adds them), rank and level first.
+    spdlog::set_pattern(fmt::format("mogao-farm[{}] %l: %v", mpi.rank()));
+    if (!mpi.is_admin()) spdlog::set_level(spdlog::level::warn);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return mpi.is_admin() ? app.exit(e) : (e.get_exit_code() == 0 ? 0 : 2);
+        return mogao::cli::exit_status(app, e, /*quiet=*/!mpi.is_admin());  // 2 on every rank
     }
     setup.scene_options.scans_dir = scans;
     if (!serve_preset.empty())
