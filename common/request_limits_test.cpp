@@ -56,7 +56,7 @@ TEST(ViewValidation, RejectsEachOutOfRangeFieldByName) {
                     "camera.top_m", "(bottom_m, inf)");
 }
 
-// Numerical stability (issue 12): NaN and +-inf in every floating-point field of a view request
+// Numerical stability: NaN and +-inf in every floating-point field of a view request
 // are refused naming the field (a NaN fails every comparison, so a check written as `v <= 0` would
 // let it through).
 TEST(ViewValidation, RejectsNanAndInfinityInEveryFloatingPointField) {

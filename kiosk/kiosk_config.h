@@ -100,8 +100,8 @@ enum class ReplayEnd {
 
 // [navigation].camera_exposure_us when absent with a live camera (a camera without a manual
 // exposure control keeps its own; see drivers/camera/camera_controls.h). 2 ms: on the rendered
-// grotto set a hand-held tag then blurs by under a pixel and its corners stay within the 0.6 px of
-// issue 15 in the room and in the dim hall, where 8 ms (the former default) blurs it by 3.4 px and
+// grotto set a hand-held tag then blurs by under a pixel and its corners stay within the 0.6 px
+// median corner-error goal in the room and in the dim hall, where 8 ms (the former default) blurs it by 3.4 px and
 // loses tags; the detector keeps finding the tag at the gain this needs, and also with the gain
 // left alone (docs/tracking.md, "Exposure of the tracking camera"; bench/tracking-grotto/exposure-study).
 inline constexpr double kDefaultExposureUs = 2000.0;

@@ -408,7 +408,7 @@ int max_abs_difference(const std::vector<Rgb8Image>& a, const std::vector<Rgb8Im
     return worst;
 }
 
-// Issue 11: a yaw-only turn is on the wall within one display round whatever the farm's latency.
+// The late rotational warp: a yaw-only turn is on the wall within one display round whatever the farm's latency.
 // No new farm frame comes after the turn, yet the outputs of the next round are those a frame
 // rendered at the new yaw gives (checked against such a frame, through the same GL outputs), and a
 // turn right after a frame was shown is on the wall one round later.

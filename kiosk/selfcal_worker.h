@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// SelfcalWorker: continuous self-recalibration beside the tour (issue 14; docs/kiosk.md,
+// SelfcalWorker: continuous self-recalibration beside the tour (docs/kiosk.md,
 // "Self-recalibration"; the maths in appliance/selfcal/self_calibrator.h). Its own thread, never
 // the display thread, at most `rate_hz` (2 Hz) monitored frames a second:
 //   1. asks the loop for the content frame on the wall (wants_content(); the loop's tick offer()s a

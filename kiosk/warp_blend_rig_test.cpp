@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// The kiosk's GL warp-and-blend output with a camera-based calibration, end to end (issue 13):
+// The kiosk's GL warp-and-blend output with a camera-based calibration, end to end:
 // the virtual rig rigs/colour.toml (projectors of different brightness, colour temperature, gamma
 // and black level) at 1/4 resolution is calibrated by appliance/autocal (geometry, then the colour
 // and black-level step: per-channel response LUTs and beta maps), the calibration goes through an
@@ -295,7 +295,7 @@ TEST(WarpBlendOnRig, GlOutputsMatchTheCpuCompositor) {
     }
 }
 
-// The issue's end-to-end check: GL outputs projected back through the rig give seams the viewer
+// The end-to-end check: GL outputs projected back through the rig give seams the viewer
 // does not see, as good as the CPU compositor's. docs/calibration.md's figures for the CPU maths
 // (float signals, scale 0.5): seam luminance p95 <= 0.55 %, Delta E p95 <= 0.21; at this test's
 // scale 0.25 the same maths give 1.13 % and 0.44 (printed as "float maths").
@@ -323,7 +323,7 @@ TEST(WarpBlendOnRig, GlOutputsThroughTheRigShowNoSeams) {
             srgb_decode(code), 100.0 * gl.luminance_p95, 100.0 * cpu.luminance_p95, 100.0 * truth.seam_luminance_p95,
             gl.delta_e_p95, cpu.delta_e_p95, truth.seam_delta_e_p95, gl.seam_samples);
         EXPECT_GT(gl.seam_samples, 1000);
-        // Issue 13: 1 %. The float maths at this scale reach 1.13 %; the 8-bit output codes add
+        // The seam goal: 1 %. The float maths at this scale reach 1.13 %; the 8-bit output codes add
         // about half a percent (one code at a seam's half-bright signal is ~1.6 % of that
         // projector's light), the same for GL and for render_output rounded to codes.
         EXPECT_LT(gl.luminance_p95, 0.02);

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
 # A render rank that stops answering mid-job ends the whole MPI job within the frame deadline,
-# naming the rank, instead of leaving the admin polling forever (issue 16, render-node failure):
+# naming the rank, instead of leaving the admin polling forever (render-node failure):
 #   stop   SIGSTOP of rank 2 (a hung process; before the deadline existed the job never ended)
 #   kill   SIGKILL of rank 2 (a dead host: Open MPI's own error handling ends the job)
 # The farm's exit code is non-zero either way, so systemd restarts the service (docs/services.md).

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// Numerical stability of the navigation filters at extreme time steps and inputs (issue 12):
+// Numerical stability of the navigation filters at extreme time steps and inputs:
 // steps of 0 (repeated timestamps), 1 us (a burst of samples) and 1 s (a stalled tracker), and
 // non-finite samples. Each guard: outputs stay finite and inside the range of the inputs seen
 // (a first-order low-pass is a convex blend, alpha in (0, 1]), and the Navigator's speeds never

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// Continuous self-recalibration (issue 14; docs/calibration.md, "Self-recalibration"): the
+// Continuous self-recalibration (docs/calibration.md, "Self-recalibration"): the
 // kiosk-facing object. Each monitored frame, step(content, camera_frame, t) measures (monitor.h),
 // filters each projector's and the camera's pose change (pose_kalman.h) and decides:
 //   calibrated -> drift detected: a projector's filtered drift is above `drift_threshold_px`

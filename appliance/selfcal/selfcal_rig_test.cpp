@@ -101,7 +101,7 @@ TEST(SelfcalRig, StartingFromAFullCalibrationsEstimateABumpIsStillCorrected) {
     }
 }
 
-// The issue's shift goal: a 10 mm shift (about 3 projector pixels at half resolution) is
+// The shift goal: a 10 mm shift (about 3 projector pixels at half resolution) is
 // detected and corrected to under 1 px against the ground truth; a shift and a rotation look
 // alike in the image, so this checks the correction's shift is not lost to the position prior.
 TEST(SelfcalRig, ProjectorShiftedTenMillimetresIsCorrectedBelowOnePixel) {
@@ -155,7 +155,7 @@ TEST(SelfcalRig, HeavyVisitorsMakeNoFalseDetectionOrCorrection) {
 }
 
 // The same visitors must not hide a real bump: proj1 yawed 1 degree among visitors hiding 10-40 %
-// is detected within 5 s (the issue asks 10 s) and corrected below 1 px (the table's row took 25 s to detect and never
+// is detected within 5 s (the goal is 10 s) and corrected below 1 px (the table's row took 25 s to detect and never
 // corrected before the occluder mask).
 TEST(SelfcalRig, BumpAmongVisitorsIsStillCorrectedBelowOnePixel) {
     const rig::VirtualRig rig = standard();
@@ -207,7 +207,7 @@ TEST(SelfcalRig, OccluderMaskFindsADarkBandAndNothingInACleanFrame) {
     EXPECT_GT(b.matches, a.matches / 3);
 }
 
-// Issue 14 with the colour calibration of issue 13: the wall carries the measured colour of
+// Self-recalibration with the colour calibration: the wall carries the measured colour of
 // rigs/colour.toml (projectors of different brightness, colour temperature, per-channel gamma and
 // black level: per-channel LUTs, beta maps, blends scaled by s). After proj1 is yawed 1 degree and
 // corrected, the wall must still show one black and one colour everywhere, judged on the bumped

@@ -7,8 +7,8 @@
 // from the hand-written manifest appliance/tracker/tags_real_manifest.json):
 //   {"images": [{"file", "family", "tags" (tags present, >= 1), "count_source", "ids" (the ids that
 //     may be present, e.g. a whole printed grid of which only "tags" are in view), "ids_source",
-//     "subset" ("issue15"
-//     for the 47 tags of the issue's report, else "extra"),
+//     "subset" ("core" for the 47 tags of the sw mapping and hallway, dt, jl and wpi images, the
+//     set the detection-rate goal is stated on; else "extra"),
 //     "reference": [{"id", "corners": [[x, y] x 4]}] (independent reference corners, tag_reference.h;
 //     pixel centres at +0.5)}]}
 //

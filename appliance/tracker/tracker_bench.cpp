@@ -200,8 +200,8 @@ struct Variant {
 };
 
 // The quad search's decimation and blur on their own (no second or third pass, as AprilTag runs
-// them), then the defaults with each extra pass turned off in turn, and the defaults of before
-// issue 15 (decimation 2, blur 0.8): the same images for every row.
+// them), then the defaults with each extra pass turned off in turn, and the former defaults
+// (decimation 2, blur 0.8; CHANGELOG.md): the same images for every row.
 std::vector<Variant> settings_variants(const DetectorSettings& defaults, bool quick) {
     std::vector<Variant> v{{"defaults", true, defaults}};
     DetectorSettings tracker = defaults;
@@ -223,8 +223,7 @@ std::vector<Variant> settings_variants(const DetectorSettings& defaults, bool qu
             s.blur_sigma = blur;
             char label[96];
             std::snprintf(label, sizeof label, "single pass, decimation %.1f, blur %.1f%s", static_cast<double>(dec),
-                          static_cast<double>(blur),
-                          dec == 2.0f && blur == 0.8f ? " (the defaults before issue 15)" : "");
+                          static_cast<double>(blur), dec == 2.0f && blur == 0.8f ? " (the former defaults)" : "");
             v.push_back({label, false, s});
         }
     }

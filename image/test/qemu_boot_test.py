@@ -69,7 +69,7 @@ PSNR_FARM_MIN_DB = 35.0  # KMS output vs the host's headless kiosk showing the s
                          # ray: both kiosks ask for SPP samples)
 SPP = 4                  # 4x the samples: the two frames' noise differs by half as much (+6 dB)
 # The on-site calibration in the guest (selftest.sh, rigs/qemu.toml): the same goals as on the virtual
-# rigs (issue 13: mean <= 0.3, p95 <= 0.8 projector pixels against the rig's ground truth).
+# rigs (geometry mean <= 0.3, p95 <= 0.8 projector pixels against the rig's ground truth).
 CALIBRATE_TIMEOUT_S = 1800
 CALIBRATE_MEAN_PX = 0.3
 CALIBRATE_P95_PX = 0.8

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: Apache-2.0
 """Boots the appliance image in QEMU with its configuration partition wiped, and checks that the box
-boots on to the kiosk's service card instead of emergency mode (issue 16, appliance liveness).
+boots on to the kiosk's service card instead of emergency mode (appliance liveness).
 
     qemu_service_card_test.py --image mogao-kiosk.img --repo SRC [--work DIR] [--accel tcg|kvm]
 

@@ -123,7 +123,7 @@ TEST_F(OnSiteJobTest, HeadlessOutputsFilmedThroughTheRigCalibrateAsWellAsTheRigI
     // The patterns reach the rig exactly through outputs, renderer and camera frames: the same result.
     EXPECT_NEAR(g.mean_px, want.mean_px, 0.01);
     EXPECT_NEAR(g.p95_px, want.p95_px, 0.02);
-    EXPECT_LE(g.mean_px, 0.3);  // issue 13's bound (full-scale pixels; at 1/4 scale it is 4x as strict)
+    EXPECT_LE(g.mean_px, 0.3);  // the geometry goal's bound (full-scale pixels; at 1/4 scale it is 4x as strict)
     EXPECT_TRUE(fs::exists(job_.out / "calibration.models.json"));
     EXPECT_FALSE(cv::imread((job_.out / "camera-white.png").string()).empty());
     // The previous run's calibration is kept, and its cabling compared.

@@ -144,7 +144,7 @@ TEST(SceneFile, RingMakesCopiesFacingTheAxis) {
     EXPECT_NEAR(scene.instances[5].object_to_world.translation().y(), 2.0, 1e-12);
 }
 
-// Numerical stability (issue 12): NaN and Infinity are not JSON; a number beyond double range
+// Numerical stability: NaN and Infinity are not JSON; a number beyond double range
 // (1e999) is refused by the JSON reader naming the file and the literal (it used to escape as a
 // bare nlohmann out_of_range without the file); the largest finite doubles are refused naming the
 // field and its limit in every kind of number the scene reads (root scalar, transform, material,

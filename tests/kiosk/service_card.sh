@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
-# Appliance liveness (issue 16): a missing or corrupt configuration partition must not leave the
+# Appliance liveness: a missing or corrupt configuration partition must not leave the
 # projectors dark in a restart loop. mogao-kiosk with neither its configuration nor a last good
 # copy shows the service card ("SERVICE NEEDED" and the reason) on every output, stays up (READY,
 # watchdog fed: kiosk/service_screen.h), and exits 1 for systemd to start the show once the
