@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Lights every connected output of the first usable /dev/dri/card* with the test pattern through
 // WarpBlendRenderer: a blocking modeset, then page flips driven by the event fd. Skipped where
-// there is no DRM device; the image issue runs it inside QEMU with virtio-gpu.
+// there is no DRM device; the image test (image_qemu_boot) runs it inside QEMU with virtio-gpu.
 #include "drivers/kms/kms_backend.h"
 
 #include <poll.h>
@@ -37,7 +37,7 @@ int max_abs_diff(const Rgb8Image& a, const Rgb8Image& b) {
 }
 
 TEST(KmsOutputBackend, LightsEveryConnectedOutput) {
-    if (list_drm_cards().empty()) GTEST_SKIP() << "no DRM device; the image issue runs this inside QEMU with virtio-gpu";
+    if (list_drm_cards().empty()) GTEST_SKIP() << "no DRM device; the image test (image_qemu_boot) runs this inside QEMU with virtio-gpu";
     auto created = KmsOutputBackend::create({});
     if (!created && (created.code() == ENODEV || created.code() == EACCES)) {
         GTEST_SKIP() << created.error().message;  // no connected output, or a compositor owns the card
@@ -108,7 +108,7 @@ TEST(KmsOutputBackend, LightsEveryConnectedOutput) {
 // round only after every output's flip event, whose timestamp becomes presented_ns.
 TEST(KmsOutputBackend, OneCommitPerRoundForEveryOutput) {
     if (list_drm_cards().empty())
-        GTEST_SKIP() << "no DRM device; the image issue runs this inside QEMU with virtio-gpu";
+        GTEST_SKIP() << "no DRM device; the image test (image_qemu_boot) runs this inside QEMU with virtio-gpu";
     auto created = KmsOutputBackend::create({});
     if (!created && (created.code() == ENODEV || created.code() == EACCES)) GTEST_SKIP() << created.error().message;
     ASSERT_TRUE(created) << created.error().message;

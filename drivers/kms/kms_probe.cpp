@@ -155,7 +155,7 @@ int main(int argc, char** argv) {
     if (!device.empty()) cards.emplace_back(device);
     else cards = list_drm_cards();
     if (cards.empty()) {
-        std::fprintf(stderr, "no DRM device; the image issue runs this inside QEMU with virtio-gpu\n");
+        std::fprintf(stderr, "no DRM device; the image test (image_qemu_boot) runs this inside QEMU with virtio-gpu\n");
         return 77;
     }
     int rc = 0;
