@@ -430,6 +430,8 @@ KioskStatus Kiosk::status(const char* state) const {
     s.latency_p95_ms = window.latency_p95_ms;
     s.last_error = last_error_;
     s.last_error_ns = last_error_ns_;
+    if (parts_.link.stats) s.certificates = parts_.link.stats().certificates;
+    s.certificate_warning_days = config_.status.certificate_warning_days;
     return s;
 }
 

@@ -630,6 +630,9 @@ void read_status(const Section& s, StatusConfig& st) {
     st.farm_lost_after_s = s.number(
         "farm_lost_after_s", st.farm_lost_after_s, [](double x) { return x >= 0 && x <= 86400; },
         "[0, 86400] s (0 = never)");
+    st.certificate_warning_days = s.number(
+        "certificate_warning_days", st.certificate_warning_days, [](double x) { return x >= 0 && x <= 3650; },
+        "[0, 3650] days (0 = never)");
 }
 
 // A screen camera's exposure or gain: "lock" (default: hold what the automatic loop reached) or a
@@ -836,7 +839,8 @@ KioskConfig parse_kiosk_config(std::string_view text, const std::filesystem::pat
     config.screen.eye_m = Eigen::Vector3d(0.0, config.navigation.eye_height_m, 0.0);
     const Section stats = section(ctx, root, "stats", {"file", "log_period_s", "status_file", "status_period_s"});
     read_stats(stats, config.stats);
-    const Section status = section(ctx, root, "status", {"on_wall", "trigger_file", "farm_lost_after_s"});
+    const Section status =
+        section(ctx, root, "status", {"on_wall", "trigger_file", "farm_lost_after_s", "certificate_warning_days"});
     read_status(status, config.status);
     const Section selfcal =
         section(ctx, root, "selfcal",

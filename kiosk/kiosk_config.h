@@ -156,6 +156,9 @@ struct StatusConfig {
     OnWall on_wall = OnWall::on_demand;
     std::filesystem::path trigger_file;  // on_demand: the panel shows while this file exists; empty = none
     double farm_lost_after_s = 10.0;     // no farm frame for this long: the indicator; 0 = never, [0, 86400]
+    // The link's certificates expiring within this many days: a warning line on the status panel
+    // and "expires_soon" in the status file; 0 = never, [0, 3650].
+    double certificate_warning_days = 30.0;
 };
 
 // [selfcal]: continuous self-recalibration (kiosk/selfcal_worker.h, docs/kiosk.md

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "kiosk/kiosk_status.h"
 
+#include <cmath>
 #include <ctime>
 #include <span>
 
@@ -56,7 +57,26 @@ nlohmann::json selfcal_json(const std::optional<selfcal::SelfcalStatus>& s) {
             {"line", s->text()}};
 }
 
+nlohmann::json certificates_json(const KioskStatus& s) {
+    const std::int64_t now_s = s.written_ns / 1'000'000'000;
+    nlohmann::json out = nlohmann::json::array();
+    for (const CertificateExpiry& c : s.certificates) {
+        out.push_back(
+            {{"role", c.role},
+             {"name", c.name},
+             {"not_after_s", c.not_after_s},
+             {"not_after_utc", utc_seconds_text(c.not_after_s)},
+             {"days_left", days_left(c.not_after_s, now_s)},
+             {"expires_soon", expires_soon(c, now_s, certificate_warning_seconds(s)) || c.not_after_s <= now_s}});
+    }
+    return out;
+}
+
 }  // namespace
+
+std::int64_t certificate_warning_seconds(const KioskStatus& status) {
+    return status.certificate_warning_days > 0 ? std::llround(status.certificate_warning_days * 86'400.0) : 0;
+}
 
 nlohmann::json kiosk_status_json(const KioskStatus& s) {
     nlohmann::json calibration = {{"source", s.calibration.source},
@@ -86,7 +106,8 @@ nlohmann::json kiosk_status_json(const KioskStatus& s) {
             {"latency_p95_ms", s.latency_p95_ms},
             {"last_error", last_error},
             {"calibration", calibration},
-            {"selfcal", selfcal_json(s.selfcal)}};
+            {"selfcal", selfcal_json(s.selfcal)},
+            {"certificates", certificates_json(s)}};
 }
 
 void write_kiosk_status(const std::filesystem::path& file, const KioskStatus& status) {

@@ -7,7 +7,9 @@
 // display loop and once at the clean stop, so a reader never sees half a file.
 //
 // Times: "*_ns" are CLOCK_REALTIME nanoseconds since the epoch, "*_utc" the same as ISO 8601 UTC
-// ("2026-11-22T12:30:05Z"); "uptime_s" is seconds since the kiosk's loop started.
+// ("2026-11-22T12:30:05Z"); "uptime_s" is seconds since the kiosk's loop started; a certificate's
+// "not_after_s" is seconds since the epoch (X.509's resolution), "days_left" counted from
+// written_ns.
 // Errors: write_kiosk_status throws std::system_error naming the file (the kiosk logs it as a
 // warning, once per kind of failure, and goes on showing).
 #pragma once
@@ -21,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "appliance/selfcal/selfcal_status.h"
+#include "renderfarm/link/cert_expiry.h"
 
 namespace mogao {
 
@@ -56,7 +59,15 @@ struct KioskStatus {
     // the kiosk could not write): what the journal said, and when. Empty: none since start.
     std::string last_error;
     std::int64_t last_error_ns = 0;
+    // The certificates the link holds (the farm CA, this appliance's own; LinkClientStats), and how
+    // long before its notAfter one is flagged (status file "expires_soon", on-wall warning line;
+    // [status].certificate_warning_days; 0: never).
+    std::vector<CertificateExpiry> certificates;
+    double certificate_warning_days = 30.0;
 };
+
+// certificate_warning_days in whole seconds (0 for none or negative).
+[[nodiscard]] std::int64_t certificate_warning_seconds(const KioskStatus& status);
 
 // "2026-11-22T12:30:05Z" (seconds, UTC) for CLOCK_REALTIME nanoseconds.
 [[nodiscard]] std::string utc_text(std::int64_t realtime_ns);

@@ -60,6 +60,30 @@ TEST(KioskStatus, JsonHoldsTheFrameRateAndTheLastError) {
     EXPECT_EQ(j["last_error"]["utc"], "1970-01-01T00:00:04Z");
 }
 
+TEST(KioskStatus, JsonHoldsTheCertificatesNotAfterInSecondsAndTheirDaysLeft) {
+    KioskStatus s;
+    s.written_ns = 1'800'000'000LL * 1'000'000'000;
+    s.certificates = {{"ca", "mogao farm CA", 1'800'000'000 + 31 * 86'400},
+                      {"appliance", "museum-1", 1'800'000'000 + 29 * 86'400 + 5}};
+    nlohmann::json j = kiosk_status_json(s);
+    ASSERT_EQ(j["certificates"].size(), 2u);
+    EXPECT_EQ(j["certificates"][0]["role"], "ca");
+    EXPECT_EQ(j["certificates"][0]["name"], "mogao farm CA");
+    EXPECT_EQ(j["certificates"][0]["not_after_s"], 1'800'000'000 + 31 * 86'400);
+    EXPECT_EQ(j["certificates"][0]["not_after_utc"], "2027-02-15T08:00:00Z");
+    EXPECT_EQ(j["certificates"][0]["days_left"], 31);
+    EXPECT_EQ(j["certificates"][0]["expires_soon"], false);
+    EXPECT_EQ(j["certificates"][1]["days_left"], 29);
+    EXPECT_EQ(j["certificates"][1]["expires_soon"], true);
+    s.certificate_warning_days = 0;  // no warning period: only an expired one is flagged
+    s.certificates[0].not_after_s = 1'800'000'000 - 1;
+    j = kiosk_status_json(s);
+    EXPECT_EQ(j["certificates"][0]["days_left"], -1);
+    EXPECT_EQ(j["certificates"][0]["expires_soon"], true);
+    EXPECT_EQ(j["certificates"][1]["expires_soon"], false);
+    EXPECT_TRUE(kiosk_status_json(KioskStatus{})["certificates"].empty());
+}
+
 TEST(KioskStatus, JsonHoldsTheSelfcalStateAndProjectors) {
     KioskStatus s;
     selfcal::SelfcalStatus sc;

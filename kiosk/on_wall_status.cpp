@@ -46,6 +46,33 @@ std::string selfcal_line(const KioskStatus& s) {
     return "SELFCAL ?";
 }
 
+std::string certificate_words(const std::string& role) {
+    if (role == "ca") return "FARM CA CERT";
+    if (role == "appliance") return "APPLIANCE CERT";
+    return wall_text(role) + " CERT";
+}
+
+// One warning line per certificate within the warning period or expired; otherwise one line with the days
+// left of the first to expire (nothing when the link reported none).
+std::vector<std::string> certificate_lines(const KioskStatus& s) {
+    std::vector<std::string> lines;
+    if (s.certificates.empty()) return lines;
+    const std::int64_t now_s = s.written_ns / 1'000'000'000;
+    const std::int64_t within_s = certificate_warning_seconds(s);
+    std::int64_t soonest = s.certificates.front().not_after_s;
+    for (const CertificateExpiry& c : s.certificates) {
+        soonest = std::min(soonest, c.not_after_s);
+        if (!expires_soon(c, now_s, within_s) && c.not_after_s > now_s) continue;  // expired: always said
+        const std::int64_t days = days_left(c.not_after_s, now_s);
+        const std::string when = c.not_after_s <= now_s ? fmt::format("EXPIRED {} DAYS AGO", -days)
+                                 : days == 0            ? std::string("EXPIRES TODAY")
+                                                        : fmt::format("EXPIRES IN {} DAYS", days);
+        lines.push_back(wall_text(certificate_words(c.role) + " " + when));
+    }
+    if (lines.empty()) lines.push_back(fmt::format("CERTIFICATES OK - {} DAYS LEFT", days_left(soonest, now_s)));
+    return lines;
+}
+
 }  // namespace
 
 std::vector<std::string> status_panel_lines(const KioskStatus& s) {
@@ -58,6 +85,7 @@ std::vector<std::string> status_panel_lines(const KioskStatus& s) {
     lines.push_back(wall_text(fmt::format("CALIBRATION {} - {} SWAPS", source, s.calibration.swaps)));
     lines.push_back(s.calibration.last_error.empty() ? std::string("LAST CALIBRATION ERROR: NONE")
                                                      : wall_text("LAST ERROR: " + s.calibration.last_error));
+    for (std::string& line : certificate_lines(s)) lines.push_back(std::move(line));
     return lines;
 }
 

@@ -9,7 +9,10 @@
 // Two uses:
 //   status panel  (on demand: SIGUSR2 or [status].trigger_file; or always): self-recalibration state
 //                 (calibrated / drift detected / correcting / cannot correct / waiting / off), the farm
-//                 link, and the calibration in use with its last refused update
+//                 link, the calibration in use with its last refused update, and the link's
+//                 certificates: a warning line for each that expires within
+//                 KioskStatus::certificate_warning_days of KioskStatus::written_ns (the clock), else
+//                 the days left of the first to expire
 //   farm lost     a single discreet line ("FARM LOST 12 S - LAST FRAME") over the held last frame once
 //                 no farm frame has arrived for [status].farm_lost_after_s; gone with the next frame.
 // Pure functions; the kiosk's loop calls them on its copy of the frame it shows.

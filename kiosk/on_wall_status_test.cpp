@@ -10,6 +10,7 @@
 #include <poll.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
 #include <fstream>
 
@@ -69,6 +70,11 @@ protected:
 
     // The kiosk with `overrides` of the example, showing its first farm frame.
     void start(const std::vector<std::string>& overrides, std::vector<StartFallback> fallbacks = {}) {
+        config_ = config_with(overrides);
+        start_with_config(std::move(fallbacks));
+    }
+    // The example with the fixture's overrides and `overrides`, parsed (throws KioskConfigError).
+    [[nodiscard]] KioskConfig config_with(const std::vector<std::string>& overrides) const {
         std::vector<std::string> all = {R"(farm.endpoint="[::1]:7443")",
                                         R"(farm.ca="pki/ca.pem")",
                                         R"(farm.cert="pki/a.pem")",
@@ -81,7 +87,9 @@ protected:
                                         "navigation.path_frames=10",
                                         "stats.file="};
         all.insert(all.end(), overrides.begin(), overrides.end());
-        config_ = parse_kiosk_config(apply_config_overrides(kiosk_example_toml(), all), dir_ / "kiosk.toml");
+        return parse_kiosk_config(apply_config_overrides(kiosk_example_toml(), all), dir_ / "kiosk.toml");
+    }
+    void start_with_config(std::vector<StartFallback> fallbacks) {
         const ScreenCalibration screen = load_calibration(config_);
         HeadlessOptions options;
         for (const auto& p : screen.projectors) options.outputs.push_back(p.output);
@@ -97,9 +105,10 @@ protected:
         inbox_ = open_inbox();
         navigation_ = std::make_unique<KioskNavigation>(make_view_script(config_));
         KioskLink link{[](ViewRequest, std::string*) { return std::uint64_t{1}; },
-                       [] {
+                       [this] {
                            LinkClientStats s;
                            s.connected = true;
+                           s.certificates = link_certificates_;
                            return s;
                        },
                        [] {}};
@@ -143,6 +152,7 @@ protected:
     std::optional<SignalFd> signals_;
     ServiceNotifier notifier_;
     std::optional<Kiosk> kiosk_;
+    std::vector<CertificateExpiry> link_certificates_;  // what the stand-in link reports holding
 };
 
 TEST_F(OnWallStatusTest, Sigusr2TogglesThePanelOnEveryOutput) {
@@ -213,6 +223,68 @@ TEST_F(OnWallStatusTest, AStartOnALastGoodFileSaysSoOnTheWallAndInTheStatus) {
     const nlohmann::json status = kiosk_status_json(kiosk_->status("showing"));
     EXPECT_EQ(status["fallbacks"][0], "screen.mpcdi: bad; running on screen.mpcdi.last-loaded");
     EXPECT_EQ(status["on_wall"][0], "CALIBRATION ERROR - LAST GOOD IN USE");
+}
+
+// The link's certificates reach the status file and the panel: the appliance's expires in 29 days
+// (now by the real clock: the margins are hours), the CA's in years.
+TEST_F(OnWallStatusTest, ACertificateNearItsEndIsOnThePanelAndInTheStatusFile) {
+    const std::int64_t now_s = realtime_ns() / 1'000'000'000;
+    link_certificates_ = {{"ca", "mogao farm CA", now_s + 3000 * 86'400},
+                          {"appliance", "museum-1", now_s + 29 * 86'400 + 3600}};
+    start({R"(status.on_wall="always")"});
+    if (!kiosk_) return;
+    const auto& wall = kiosk_->on_wall();
+    EXPECT_NE(std::find(wall.begin(), wall.end(), "APPLIANCE CERT EXPIRES IN 29 DAYS"), wall.end());
+    const nlohmann::json status = kiosk_status_json(kiosk_->status("showing"));
+    ASSERT_EQ(status["certificates"].size(), 2u);
+    EXPECT_EQ(status["certificates"][1]["name"], "museum-1");
+    EXPECT_EQ(status["certificates"][1]["not_after_s"], link_certificates_[1].not_after_s);
+    EXPECT_EQ(status["certificates"][1]["days_left"], 29);
+    EXPECT_EQ(status["certificates"][1]["expires_soon"], true);
+    EXPECT_EQ(status["certificates"][0]["expires_soon"], false);
+}
+
+// [status].certificate_warning_days sets the period; a value outside [0, 3650] is refused by name.
+TEST_F(OnWallStatusTest, TheWarningPeriodIsConfigurable) {
+    const std::int64_t now_s = realtime_ns() / 1'000'000'000;
+    link_certificates_ = {{"appliance", "museum-1", now_s + 29 * 86'400 + 3600}};
+    start({R"(status.on_wall="always")", "status.certificate_warning_days=28"});
+    if (!kiosk_) return;
+    EXPECT_EQ(kiosk_->on_wall().back(), "CERTIFICATES OK - 29 DAYS LEFT");
+    EXPECT_EQ(kiosk_status_json(kiosk_->status("showing"))["certificates"][0]["expires_soon"], false);
+    try {
+        static_cast<void>(config_with({"status.certificate_warning_days=-1"}));
+        ADD_FAILURE() << "a negative warning period was accepted";
+    } catch (const KioskConfigError& e) {
+        EXPECT_NE(std::string(e.what()).find("[status].certificate_warning_days"), std::string::npos) << e.what();
+    }
+}
+
+// The warning period on an injected clock (KioskStatus::written_ns): shown at 29 days, not at 31.
+TEST(OnWallStatusLines, WarnOfACertificateThirtyDaysBeforeItExpires) {
+    constexpr std::int64_t kNow = 1'800'000'000, kDay = 86'400;
+    KioskStatus s;
+    s.written_ns = kNow * 1'000'000'000;
+    s.certificates = {{"ca", "mogao farm CA", kNow + 3000 * kDay}, {"appliance", "museum-1", kNow + 31 * kDay}};
+    std::vector<std::string> lines = status_panel_lines(s);
+    ASSERT_EQ(lines.size(), 5u);
+    EXPECT_EQ(lines[4], "CERTIFICATES OK - 31 DAYS LEFT");
+    s.certificates[1].not_after_s = kNow + 29 * kDay + 3600;
+    lines = status_panel_lines(s);
+    ASSERT_EQ(lines.size(), 5u);
+    EXPECT_EQ(lines[4], "APPLIANCE CERT EXPIRES IN 29 DAYS");
+    s.certificates[0].not_after_s = kNow - 3 * kDay;
+    lines = status_panel_lines(s);
+    ASSERT_EQ(lines.size(), 6u);
+    EXPECT_EQ(lines[4], "FARM CA CERT EXPIRED 3 DAYS AGO");
+    s.certificate_warning_days = 0;  // [status].certificate_warning_days = 0: no warning, but expired is said
+    lines = status_panel_lines(s);
+    ASSERT_EQ(lines.size(), 5u);
+    EXPECT_EQ(lines[4], "FARM CA CERT EXPIRED 3 DAYS AGO");
+    s.certificate_warning_days = 45;  // configurable: 31 days is within 45
+    s.certificates = {{"appliance", "museum-1", kNow + 31 * kDay}};
+    EXPECT_EQ(status_panel_lines(s).back(), "APPLIANCE CERT EXPIRES IN 31 DAYS");
+    for (const auto& l : status_panel_lines(s)) EXPECT_LE(l.size(), 36u);
 }
 
 TEST(OnWallStatusLines, NameTheSelfcalStateTheFarmAndTheLastCalibrationError) {

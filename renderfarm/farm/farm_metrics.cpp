@@ -33,6 +33,29 @@ void gauge(std::string& out, const char* name, const char* help, double value) {
     family(out, name, "gauge", help, value);
 }
 
+// A label value as the exposition format escapes it: backslash, double quote, line feed.
+std::string label_value(const std::string& text) {
+    std::string out;
+    for (const char c : text) {
+        if (c == '\\' || c == '"') out += '\\';
+        out += c == '\n' ? std::string("\\n") : std::string(1, c);
+    }
+    return out;
+}
+
+// notAfter of each certificate the farm serves with, Unix seconds: an alert can fire weeks ahead.
+void certificates(std::string& out, const std::vector<CertificateExpiry>& certs) {
+    if (certs.empty()) return;
+    out +=
+        "# HELP mogao_farm_certificate_not_after_seconds notAfter of each certificate the farm holds (the CA "
+        "bundle, its serving certificate), Unix time\n"
+        "# TYPE mogao_farm_certificate_not_after_seconds gauge\n";
+    for (const auto& c : certs)
+        fmt::format_to(std::back_inserter(out),
+                       "mogao_farm_certificate_not_after_seconds{{role=\"{}\",name=\"{}\"}} {}\n", label_value(c.role),
+                       label_value(c.name), c.not_after_s);
+}
+
 }  // namespace
 
 void FarmMetrics::observe_frame(const FrameStats& stats, double frame_seconds, double unix_seconds) {
@@ -92,6 +115,11 @@ std::string FarmMetrics::text(const FarmCounters& c) const {
     counter(out, "render_failures_total", "requests whose render failed", l.render_failures);
     counter(out, "frames_sent_total", "JPEG frames sent to appliances", l.frames_sent);
     counter(out, "jpeg_bytes_sent_total", "JPEG bytes sent to appliances", l.jpeg_bytes_sent);
+    certificates(out, l.certificates);
+    if (l.crl_next_update_s != 0)
+        gauge(out, "crl_next_update_seconds",
+              "nextUpdate of the revocation list in force, Unix time (re-issue it before)",
+              static_cast<double>(l.crl_next_update_s));
     return out;
 }
 

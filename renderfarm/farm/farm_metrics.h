@@ -16,6 +16,9 @@
 //   requests_received_total, requests_invalid_total, requests_dropped_total,
 //   requests_superseded_total, requests_degraded_total (request_policy.h), render_failures_total
 //   frames_sent_total, jpeg_bytes_sent_total, last_frame_timestamp_seconds (Unix time)
+//   certificate_not_after_seconds{role="ca|farm",name="<subject CN>"} (Unix time, each certificate
+//   the farm serves with: LinkServerStats::certificates, renderfarm/link/cert_expiry.h)
+//   crl_next_update_seconds (Unix time; only with a revocation list that has a nextUpdate)
 // Errors: FarmMetrics::write throws std::runtime_error naming the file (common/file_io.h); the
 // serve loop logs it and keeps serving.
 #pragma once

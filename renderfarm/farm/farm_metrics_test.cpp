@@ -45,6 +45,9 @@ FarmCounters counters() {
     c.degraded = 3;
     c.superseded = 5;
     c.render_ranks = 2;
+    // A CA name with a space and a quote: label values are escaped, not cut.
+    c.link.crl_next_update_s = 1'780'000'000;
+    c.link.certificates = {{"ca", "mogao \"farm\" CA", 2'000'000'000}, {"farm", "farm-1", 1'790'000'000}};
     return c;
 }
 
@@ -66,7 +69,8 @@ TEST(FarmMetrics, ExpositionTextHasEveryFamilyWithItsTypeAndValue) {
     m.observe_frame(frame(0.3, {0.2, 0.3}), 0.4, 1.7e9 + 1);
     const std::string text = m.text(counters());
     // Every line is a comment or a sample as the format defines them.
-    const std::regex sample(R"(^[a-zA-Z_:][a-zA-Z0-9_:]*(\{[a-z_]+="[^"]*"\})? (NaN|[+-]Inf|-?[0-9.e+-]+)$)");
+    const std::regex sample(
+        R"(^[a-zA-Z_:][a-zA-Z0-9_:]*(\{[a-z_]+="([^"\\]|\\.)*"(,[a-z_]+="([^"\\]|\\.)*")*\})? (NaN|[+-]Inf|-?[0-9.e+-]+)$)");
     const std::regex comment(R"(^# (HELP|TYPE) mogao_farm_[a-z_]+ .+$)");
     std::istringstream in(text);
     for (std::string line; std::getline(in, line);)
@@ -84,6 +88,20 @@ TEST(FarmMetrics, ExpositionTextHasEveryFamilyWithItsTypeAndValue) {
     EXPECT_EQ(s.at("mogao_farm_connections_refused_total{cap=\"max_connections\"}"), "0");
     EXPECT_NE(text.find("# TYPE mogao_farm_frames_total counter"), std::string::npos);
     EXPECT_NE(text.find("# TYPE mogao_farm_balance_efficiency gauge"), std::string::npos);
+    // Certificate expiry: Unix seconds as integers (not 2e+09), one sample per certificate.
+    EXPECT_NE(text.find("# TYPE mogao_farm_certificate_not_after_seconds gauge"), std::string::npos);
+    EXPECT_EQ(s.at("mogao_farm_certificate_not_after_seconds{role=\"farm\",name=\"farm-1\"}"), "1790000000");
+    EXPECT_EQ(s.at("mogao_farm_crl_next_update_seconds"), "1780000000");
+    EXPECT_EQ(s.at("mogao_farm_certificate_not_after_seconds{role=\"ca\",name=\"mogao \\\"farm\\\" CA\"}"),
+              "2000000000");
+}
+
+TEST(FarmMetrics, NoCertificateOrRevocationFamilyWithoutThem) {
+    FarmCounters c = counters();
+    c.link.certificates.clear();
+    c.link.crl_next_update_s = 0;
+    EXPECT_EQ(FarmMetrics().text(c).find("certificate_not_after"), std::string::npos);
+    EXPECT_EQ(FarmMetrics().text(c).find("crl_next_update"), std::string::npos);
 }
 
 TEST(FarmMetrics, NonFiniteValuesUseTheFormatsSpelling) {
@@ -152,6 +170,9 @@ TEST(FarmMetrics, NodeExporterTextfileCollectorReadsTheFile) {
     EXPECT_NE(scraped.find("mogao_farm_rank_render_seconds{rank=\"2\"} 0.06"), std::string::npos);
     EXPECT_NE(scraped.find("mogao_farm_jpeg_bytes_sent_total 1.23456789e+08"), std::string::npos) << scraped;
     EXPECT_NE(scraped.find("node_textfile_scrape_error 0"), std::string::npos) << scraped;
+    EXPECT_NE(scraped.find("mogao_farm_certificate_not_after_seconds{name=\"farm-1\",role=\"farm\"} 1.79e+09"),
+              std::string::npos)
+        << scraped;
 }
 
 }  // namespace

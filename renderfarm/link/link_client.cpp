@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <condition_variable>
+#include <ctime>
 #include <deque>
 #include <filesystem>
 #include <mutex>
@@ -108,6 +109,7 @@ bool LinkClient::Impl::reload_tls() {
     ssl.pem_cert_chain = fresh.cert_pem;
     credentials = grpc::SslCredentials(ssl);
     options.tls = std::move(fresh);
+    stats.certificates = certificate_expiries(options.tls, "appliance");
     ++stats.tls_reloads;
     link_log().info("TLS files changed: {} taken for the next session", options.tls_files.cert.string());
     return true;
@@ -316,8 +318,12 @@ LinkClient::LinkClient(LinkClientOptions options, FrameCallback on_frame) : impl
     // Expired or foreign certificates are the farm's to refuse; say why up front, keep trying
     // (the appliance's clock may be what is wrong, and NTP may fix it).
     for (const auto& warning : tls.warnings) link_log().warn("{}", warning);
+    const auto held = certificate_expiries(options.tls, "appliance");
+    for (const auto& warning : expiry_warnings(held, std::time(nullptr), kCertificateWarningSeconds))
+        link_log().warn("appliance TLS: {}", warning);
 
     auto& impl = *impl_;
+    impl.stats.certificates = held;
     impl.options = std::move(options);
     impl.on_frame = std::move(on_frame);
     impl.endpoint = *endpoint;

@@ -24,10 +24,12 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "common/link_types.h"
-#include "renderfarm/link/tls_material.h"
 #include "common/view_request.h"
+#include "renderfarm/link/cert_expiry.h"
+#include "renderfarm/link/tls_material.h"
 
 namespace mogao {
 
@@ -78,6 +80,9 @@ struct LinkClientStats {
     double mean_frame_bytes = 0;
     double bandwidth_bytes_per_s = 0;  // JPEG payload
     std::chrono::milliseconds next_backoff{0};
+    // The certificates in use (the CA bundle and this appliance's own, rotated ones once taken),
+    // for the status file's expiry report (cert_expiry.h).
+    std::vector<CertificateExpiry> certificates;
 };
 
 using FrameCallback = std::function<void(LinkFrame&& frame)>;

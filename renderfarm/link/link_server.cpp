@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <condition_variable>
+#include <ctime>
 #include <deque>
 #include <mutex>
 #include <optional>
@@ -59,7 +60,8 @@ struct LinkServer::Impl final : v1::Tour::Service {
     LinkServerOptions options;
     FrameRenderer renderer;
     Endpoint endpoint;
-    std::unique_ptr<RevocationWatcher> revocation;  // null without LinkServerOptions::crl_path
+    std::unique_ptr<RevocationWatcher> revocation;   // null without LinkServerOptions::crl_path
+    std::unique_ptr<HeldCertificates> certificates;  // for stats()
 
     mutable std::mutex mutex;
     std::condition_variable work_cv;  // render workers: a session became ready, or stopping
@@ -463,6 +465,11 @@ LinkServer::LinkServer(LinkServerOptions options, FrameRenderer renderer) : impl
     const TlsCheck tls = check_tls_material(options.tls, "farm TLS");
     if (!tls.error.empty()) throw LinkError(tls.error);
     for (const auto& warning : tls.warnings) link_log().warn("{}", warning);
+    impl_->certificates = std::make_unique<HeldCertificates>(options.tls, options.tls_files, "farm",
+                                                             std::chrono::seconds(options.tls_refresh_s));
+    for (const auto& warning :
+         expiry_warnings(impl_->certificates->current(), std::time(nullptr), kCertificateWarningSeconds))
+        link_log().warn("farm TLS: {}", warning);
 
     impl_->options = std::move(options);
     impl_->renderer = std::move(renderer);
@@ -491,6 +498,8 @@ LinkServerStats LinkServer::stats() const {
         stats = impl_->totals;
     }
     if (impl_->guard) stats.connections = impl_->guard->stats();
+    stats.certificates = impl_->certificates->current();
+    if (impl_->revocation) stats.crl_next_update_s = impl_->revocation->next_update_s();
     return stats;
 }
 

@@ -35,6 +35,7 @@
 
 #include "common/link_types.h"
 #include "common/view_request.h"
+#include "renderfarm/link/cert_expiry.h"
 #include "renderfarm/link/connection_guard.h"
 #include "renderfarm/link/endpoint.h"
 #include "renderfarm/link/tls_material.h"
@@ -98,6 +99,11 @@ struct LinkServerStats {
     std::uint64_t frames_sent = 0;
     std::uint64_t jpeg_bytes_sent = 0;
     ConnectionGuardStats connections;  // TCP connections: accepted, refused by each cap, open now
+    // The certificates the farm serves with: the CA bundle and its own, re-read from tls_files (at
+    // most every tls_refresh_s) once rotated (cert_expiry.h, HeldCertificates).
+    std::vector<CertificateExpiry> certificates;
+    // nextUpdate of the revocation list in force (Unix seconds; 0: no list, or none in it).
+    std::int64_t crl_next_update_s = 0;
 };
 
 class LinkServer {

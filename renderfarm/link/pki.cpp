@@ -3,6 +3,7 @@
 
 #include <arpa/inet.h>
 #include <fcntl.h>
+#include <openssl/ec.h>
 #include <openssl/err.h>
 #include <sys/stat.h>
 
@@ -10,6 +11,8 @@
 #include <cerrno>
 #include <cstring>
 #include <ctime>
+
+#include <fmt/format.h>
 
 #include "common/link_types.h"
 #include "common/unique_fd.h"
@@ -73,8 +76,53 @@ void add_sans(X509* cert, const CertSpec& spec) {
     }
 }
 
-// Builds and signs one certificate. `issuer`/`issuer_key` null: self-signed with `key`.
-ossl::Cert build_cert(const CertSpec& spec, EVP_PKEY* key, X509* issuer, EVP_PKEY* issuer_key) {
+// The subject: O=mogao, CN=spec.common_name; or, renewing, the old certificate's, verbatim.
+void set_subject(X509* cert, const CertSpec& spec, X509* renewed) {
+    if (renewed) {
+        if (X509_set_subject_name(cert, X509_get_subject_name(renewed)) != 1) fail("cannot copy the subject");
+        return;
+    }
+    X509_NAME* subject = X509_get_subject_name(cert);
+    const auto* org = reinterpret_cast<const unsigned char*>("mogao");
+    const auto* cn = reinterpret_cast<const unsigned char*>(spec.common_name.c_str());
+    if (X509_NAME_add_entry_by_txt(subject, "O", MBSTRING_UTF8, org, -1, -1, 0) != 1 ||
+        X509_NAME_add_entry_by_txt(subject, "CN", MBSTRING_UTF8, cn, -1, -1, 0) != 1) {
+        fail("bad common name '" + spec.common_name + "'");
+    }
+}
+
+// basicConstraints, keyUsage, extendedKeyUsage and the SANs of the role. Renewing, the old
+// certificate's subjectAltName is copied as it is (an appliance's has none today).
+void add_role_extensions(X509* cert, X509V3_CTX& ctx, const CertSpec& spec, X509* renewed) {
+    switch (spec.role) {
+        case CertRole::ca:
+            add_ext(cert, ctx, NID_basic_constraints, "critical,CA:TRUE,pathlen:0");
+            add_ext(cert, ctx, NID_key_usage, "critical,keyCertSign,cRLSign");
+            return;
+        case CertRole::farm:
+            add_ext(cert, ctx, NID_basic_constraints, "critical,CA:FALSE");
+            add_ext(cert, ctx, NID_key_usage, "critical,digitalSignature,keyEncipherment");
+            // serverAuth only: a farm certificate cannot pose as an appliance, nor the reverse.
+            add_ext(cert, ctx, NID_ext_key_usage, "serverAuth");
+            add_sans(cert, spec);
+            return;
+        case CertRole::appliance:
+            add_ext(cert, ctx, NID_basic_constraints, "critical,CA:FALSE");
+            add_ext(cert, ctx, NID_key_usage, "critical,digitalSignature,keyEncipherment");
+            add_ext(cert, ctx, NID_ext_key_usage, "clientAuth");
+            if (!renewed) return;
+            if (const int at = X509_get_ext_by_NID(renewed, NID_subject_alt_name, -1); at >= 0) {
+                if (X509_add_ext(cert, X509_get_ext(renewed, at), -1) != 1) fail("cannot copy subjectAltName");
+            }
+            return;
+    }
+}
+
+// Builds and signs one certificate. `issuer`/`issuer_key` null: self-signed with `key` (then
+// `key` must hold the private key; otherwise its public half is enough). `renewed`: the
+// certificate being renewed, whose subject and SANs are kept.
+ossl::Cert build_cert(const CertSpec& spec, EVP_PKEY* key, X509* issuer, EVP_PKEY* issuer_key,
+                      X509* renewed = nullptr) {
     if (auto why = check_pki_name(spec.common_name); !why.empty() && spec.role != CertRole::ca) throw PkiError(why);
     if (spec.common_name.empty() || spec.common_name.size() > 64) throw PkiError("common name must be 1..64 characters");
     if (spec.lifetime_s <= 0) throw PkiError("certificate lifetime must be positive");
@@ -90,13 +138,8 @@ ossl::Cert build_cert(const CertSpec& spec, EVP_PKEY* key, X509* issuer, EVP_PKE
         !X509_gmtime_adj(X509_getm_notAfter(cert.get()), spec.not_before_offset_s + spec.lifetime_s)) {
         fail("cannot set the validity period");
     }
+    set_subject(cert.get(), spec, renewed);
     X509_NAME* subject = X509_get_subject_name(cert.get());
-    const auto* org = reinterpret_cast<const unsigned char*>("mogao");
-    const auto* cn = reinterpret_cast<const unsigned char*>(spec.common_name.c_str());
-    if (X509_NAME_add_entry_by_txt(subject, "O", MBSTRING_UTF8, org, -1, -1, 0) != 1 ||
-        X509_NAME_add_entry_by_txt(subject, "CN", MBSTRING_UTF8, cn, -1, -1, 0) != 1) {
-        fail("bad common name '" + spec.common_name + "'");
-    }
     if (X509_set_issuer_name(cert.get(), issuer ? X509_get_subject_name(issuer) : subject) != 1 ||
         X509_set_pubkey(cert.get(), key) != 1) {
         fail("cannot set issuer or public key");
@@ -104,24 +147,7 @@ ossl::Cert build_cert(const CertSpec& spec, EVP_PKEY* key, X509* issuer, EVP_PKE
     X509V3_CTX ctx;
     X509V3_set_ctx_nodb(&ctx);
     X509V3_set_ctx(&ctx, issuer ? issuer : cert.get(), cert.get(), nullptr, nullptr, 0);
-    switch (spec.role) {
-    case CertRole::ca:
-        add_ext(cert.get(), ctx, NID_basic_constraints, "critical,CA:TRUE,pathlen:0");
-        add_ext(cert.get(), ctx, NID_key_usage, "critical,keyCertSign,cRLSign");
-        break;
-    case CertRole::farm:
-        add_ext(cert.get(), ctx, NID_basic_constraints, "critical,CA:FALSE");
-        add_ext(cert.get(), ctx, NID_key_usage, "critical,digitalSignature,keyEncipherment");
-        // serverAuth only: a farm certificate cannot pose as an appliance, nor the reverse.
-        add_ext(cert.get(), ctx, NID_ext_key_usage, "serverAuth");
-        add_sans(cert.get(), spec);
-        break;
-    case CertRole::appliance:
-        add_ext(cert.get(), ctx, NID_basic_constraints, "critical,CA:FALSE");
-        add_ext(cert.get(), ctx, NID_key_usage, "critical,digitalSignature,keyEncipherment");
-        add_ext(cert.get(), ctx, NID_ext_key_usage, "clientAuth");
-        break;
-    }
+    add_role_extensions(cert.get(), ctx, spec, renewed);
     add_ext(cert.get(), ctx, NID_subject_key_identifier, "hash");
     if (issuer) add_ext(cert.get(), ctx, NID_authority_key_identifier, "keyid:always");
     if (X509_sign(cert.get(), issuer_key ? issuer_key : key, EVP_sha256()) == 0) fail("signing failed");
@@ -238,6 +264,9 @@ fs::path farm_cert_path(const fs::path& dir, const std::string& name) { return d
 fs::path farm_key_path(const fs::path& dir, const std::string& name) { return dir / ("farm-" + name + ".key"); }
 fs::path appliance_cert_path(const fs::path& dir, const std::string& name) { return dir / ("appliance-" + name + ".pem"); }
 fs::path appliance_key_path(const fs::path& dir, const std::string& name) { return dir / ("appliance-" + name + ".key"); }
+fs::path previous_appliance_cert_path(const fs::path& dir, const std::string& name) {
+    return dir / ("appliance-" + name + ".previous.pem");
+}
 fs::path crl_path(const fs::path& dir) { return dir / "crl.pem"; }
 
 std::vector<fs::path> pki_init_ca(const fs::path& dir, const std::string& name, int days, KeyAlgorithm key,
@@ -303,6 +332,87 @@ std::vector<fs::path> pki_refresh_crl(const fs::path& dir, int days) {
     const PemPair ca = load_ca_files(dir);
     write_crl(dir, ca, current_revocations(dir, ca), days);
     return {crl_path(dir)};
+}
+
+namespace {
+
+// "EC P-256 (128-bit security)", "RSA 2048 bits (112-bit security)".
+std::string key_words(EVP_PKEY* key) {
+    const int bits = EVP_PKEY_get_security_bits(key);
+    if (EVP_PKEY_is_a(key, "EC")) {
+        char curve[64] = {};
+        std::size_t length = 0;
+        if (EVP_PKEY_get_utf8_string_param(key, "group", curve, sizeof curve, &length) != 1) curve[0] = '\0';
+        const char* nist = curve[0] ? EC_curve_nid2nist(OBJ_txt2nid(curve)) : nullptr;  // "P-224" for secp224r1
+        return fmt::format("EC {} ({}-bit security)", nist ? nist : curve[0] ? curve : "?", bits);
+    }
+    return fmt::format("{} {} bits ({}-bit security)", EVP_PKEY_get0_type_name(key), EVP_PKEY_get_bits(key), bits);
+}
+
+// Why `old` may not be renewed by `ca_cert`, "" when it may (the policy in pki.h).
+std::string renewal_refusal(X509* ca_cert, X509* old, const std::vector<RevokedCert>& revoked) {
+    const std::string who = "certificate CN=" + ossl::subject_cn(old);
+    EVP_PKEY* ca_key = X509_get0_pubkey(ca_cert);
+    if (X509_check_issued(ca_cert, old) != X509_V_OK || !ca_key || X509_verify(old, ca_key) != 1) {
+        ERR_clear_error();
+        return who + " was not issued by this CA (" + ossl::subject_cn(ca_cert) + ")";
+    }
+    const std::uint32_t xku = X509_get_extended_key_usage(old);
+    if (X509_check_ca(old) != 0 || (xku & XKU_SSL_CLIENT) == 0 || (xku & XKU_SSL_SERVER) != 0) {
+        return who + " is not an appliance (clientAuth) certificate";
+    }
+    const std::string serial = ossl::integer_hex(X509_get0_serialNumber(old));
+    if (std::any_of(revoked.begin(), revoked.end(), [&](const auto& r) { return r.serial_hex == serial; })) {
+        return who + " (serial " + serial + ") is revoked: its key may be compromised";
+    }
+    EVP_PKEY* key = X509_get0_pubkey(old);
+    if (!key) return who + ": its public key cannot be read";
+    const bool kind_ok = EVP_PKEY_is_a(key, "EC") || EVP_PKEY_is_a(key, "RSA");
+    if (!kind_ok || EVP_PKEY_get_security_bits(key) < kMinRenewalSecurityBits) {
+        return who + ": its key, " + key_words(key) + ", is weaker than what issue-appliance makes (EC P-256, " +
+               std::to_string(kMinRenewalSecurityBits) + "-bit security)";
+    }
+    return {};
+}
+
+}  // namespace
+
+std::string renew_appliance_cert(const PemPair& ca, const std::string& old_cert_pem, std::int64_t lifetime_s,
+                                 const std::vector<RevokedCert>& revoked) {
+    ossl::Cert ca_cert = ossl::parse_cert(ca.cert_pem);
+    ossl::Pkey ca_key = ossl::parse_key(ca.key_pem);
+    if (!ca_cert || !ca_key) fail("cannot parse the CA certificate or key");
+    if (X509_check_private_key(ca_cert.get(), ca_key.get()) != 1) fail("the CA key does not match the CA certificate");
+    ossl::Cert old = ossl::parse_cert(old_cert_pem);
+    if (!old) fail("the certificate to renew is not a PEM certificate");
+    if (const std::string why = renewal_refusal(ca_cert.get(), old.get(), revoked); !why.empty()) {
+        throw PkiError("refusing to renew: " + why + "; issue a new key pair with issue-appliance --force instead");
+    }
+    const CertSpec spec{CertRole::appliance, ossl::subject_cn(old.get()), {}, -300, lifetime_s, KeyAlgorithm::ec_p256};
+    ossl::Cert cert = build_cert(spec, X509_get0_pubkey(old.get()), ca_cert.get(), ca_key.get(), old.get());
+    return ossl::cert_to_pem(cert.get());
+}
+
+std::vector<fs::path> pki_renew_appliance(const fs::path& dir, const std::string& name, int days) {
+    if (auto why = check_pki_name(name); !why.empty()) throw PkiError(why);
+    const std::int64_t lifetime_s = days_to_seconds(days);
+    const PemPair ca = load_ca_files(dir);
+    const fs::path path = appliance_cert_path(dir, name);
+    std::string old;
+    try {
+        old = read_pem_file(path);
+    } catch (const std::exception& e) {
+        throw PkiError(std::string(e.what()) + " (renew-appliance renews what issue-appliance made)");
+    }
+    if (const ossl::Cert parsed = ossl::parse_cert(old); parsed && ossl::subject_cn(parsed.get()) != name) {
+        throw PkiError(path.string() + " names CN=" + ossl::subject_cn(parsed.get()) + ", not '" + name + "'");
+    }
+    const std::string renewed = renew_appliance_cert(ca, old, lifetime_s, current_revocations(dir, ca));
+    // The previous certificate stays valid until its notAfter with the same key: keep it, so that
+    // `pki revoke --name` can revoke it too should the key leak.
+    write_private_file(previous_appliance_cert_path(dir, name), old, true);
+    write_private_file(path, renewed, true);
+    return {path, previous_appliance_cert_path(dir, name)};
 }
 
 std::vector<fs::path> pki_export_farm(const fs::path& dir, const std::string& name, const fs::path& to, bool force) {

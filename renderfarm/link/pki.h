@@ -9,6 +9,7 @@
 //   ca.pem, ca.key                          farm CA (10 years by default)
 //   farm-<name>.pem, farm-<name>.key        farm server certificate (825 days by default)
 //   appliance-<name>.pem, appliance-<name>.key  appliance client certificate (365 days by default)
+//   appliance-<name>.previous.pem           the certificate `pki renew-appliance` replaced
 //   crl.pem                                 revocation list signed by the CA (revocation.h)
 // That folder is the CA's workspace and holds ca.key: keep it offline. The farm serves from a
 // folder made by `pki export-farm` (ca.pem, crl.pem, farm-<name>.pem/.key, never ca.key) and
@@ -72,6 +73,8 @@ struct CertSpec {
 [[nodiscard]] std::filesystem::path farm_key_path(const std::filesystem::path& dir, const std::string& name);
 [[nodiscard]] std::filesystem::path appliance_cert_path(const std::filesystem::path& dir, const std::string& name);
 [[nodiscard]] std::filesystem::path appliance_key_path(const std::filesystem::path& dir, const std::string& name);
+[[nodiscard]] std::filesystem::path previous_appliance_cert_path(const std::filesystem::path& dir,
+                                                                 const std::string& name);
 [[nodiscard]] std::filesystem::path crl_path(const std::filesystem::path& dir);
 
 // "" when `name` is a valid certificate/file name, else why not.
@@ -84,6 +87,28 @@ std::vector<std::filesystem::path> pki_issue_farm(const std::filesystem::path& d
                                                   const std::vector<std::string>& sans, int days, bool force);
 std::vector<std::filesystem::path> pki_issue_appliance(const std::filesystem::path& dir, const std::string& name,
                                                        int days, bool force);
+
+// Renewal policy: a certificate is re-signed for the key it already has (no new key pair to carry
+// to the appliance) only when that key is as strong as what issue-appliance makes today: EC or
+// RSA with at least 128-bit security (NIST SP 800-57 Part 1 Rev. 5, Table 2: P-256 and RSA-3072
+// give 128; RSA-2048 gives 112 and is refused), as OpenSSL's EVP_PKEY_get_security_bits rates it.
+inline constexpr int kMinRenewalSecurityBits = 128;
+
+// In memory: a new appliance certificate for the public key of `old_cert_pem`, signed by `ca`,
+// with the old subject (and subjectAltName, if any), a new serial number and a new validity
+// (now - 5 min, lasting lifetime_s). Refuses with PkiError, naming the reason, a certificate that
+// `ca` did not issue (issuer and signature), that is not an appliance (clientAuth, not a CA)
+// certificate, whose serial number is in `revoked`, or whose key the policy above refuses. An
+// expired certificate may be renewed (its key did not change).
+[[nodiscard]] std::string renew_appliance_cert(const PemPair& ca, const std::string& old_cert_pem,
+                                               std::int64_t lifetime_s, const std::vector<RevokedCert>& revoked);
+
+// `pki renew-appliance`: renews dir/appliance-<name>.pem (renew_appliance_cert, checked against
+// dir/crl.pem when present) for `days`, replacing it atomically; the replaced certificate is kept
+// as appliance-<name>.previous.pem (`pki revoke --name` revokes it too). The key file is neither
+// read nor changed. Returns both paths.
+std::vector<std::filesystem::path> pki_renew_appliance(const std::filesystem::path& dir, const std::string& name,
+                                                       int days);
 
 // `pki revoke`: adds `cert`'s serial number to dir/crl.pem (created if missing), re-signed and valid
 // for `days`; revoking twice is not an error. `pki crl`: re-issues dir/crl.pem with the same
@@ -105,9 +130,9 @@ std::vector<std::filesystem::path> pki_export_farm(const std::filesystem::path& 
 // umask cannot change it), fsync'd. Refuses an existing file unless `force`.
 void write_private_file(const std::filesystem::path& path, const std::string& content, bool force);
 
-// `mogao-farm pki <init-ca|issue-farm|issue-appliance|revoke|crl|export-farm> ...`: argv[0] is the word "pki" (or any
-// program name), the subcommand follows. Returns 0 on success, 1 when the PKI operation failed
-// (logged), 2 for a bad command line (CLI11's message on stderr). Never throws.
+// `mogao-farm pki <init-ca|issue-farm|issue-appliance|renew-appliance|revoke|crl|export-farm> ...`: argv[0] is the word
+// "pki" (or any program name), the subcommand follows. Returns 0 on success, 1 when the PKI operation failed (logged),
+// 2 for a bad command line (CLI11's message on stderr). Never throws.
 int run_pki_command(int argc, char** argv);
 
 }  // namespace mogao

@@ -50,6 +50,13 @@ int run_pki_command(int argc, char** argv) {
     common(appliance);
     appliance->add_option("--name", name, "Appliance name, e.g. museum-1")->required();
     appliance->add_option("--days", days, "Validity in days")->default_val(365)->check(CLI::Range(1, 36500));
+    CLI::App* renew = app.add_subcommand(
+        "renew-appliance",
+        "Re-sign appliance-NAME.pem's public key with a new validity (no new key pair; refused for a certificate "
+        "this CA did not issue, a revoked one or a key weaker than EC P-256)");
+    renew->add_option("--dir", dir, "PKI folder (with ca.key)")->required();
+    renew->add_option("--name", name, "Appliance name: renews appliance-NAME.pem in --dir")->required();
+    renew->add_option("--days", days, "Validity in days from now")->default_val(365)->check(CLI::Range(1, 36500));
     std::string cert, to;
     CLI::App* revoke = app.add_subcommand("revoke", "Revoke an appliance certificate: add it to crl.pem (re-signed)");
     revoke->add_option("--dir", dir, "PKI folder (with ca.key)")->required();
@@ -82,10 +89,15 @@ int run_pki_command(int argc, char** argv) {
             written = pki_issue_farm(dir, name, split_sans(san), days, force);
         } else if (appliance->parsed()) {
             written = pki_issue_appliance(dir, name, days, force);
+        } else if (renew->parsed()) {
+            written = pki_renew_appliance(dir, name, days);
         } else if (revoke->parsed()) {
             if (name.empty() && cert.empty()) throw PkiError("revoke: give --name or --cert");
             written =
                 pki_revoke(dir, cert.empty() ? appliance_cert_path(dir, name) : std::filesystem::path(cert), days);
+            // By name: the certificate a renewal replaced shares the key, so it goes too.
+            if (cert.empty() && std::filesystem::exists(previous_appliance_cert_path(dir, name)))
+                written = pki_revoke(dir, previous_appliance_cert_path(dir, name), days);
         } else if (crl->parsed()) {
             written = pki_refresh_crl(dir, days);
         } else {

@@ -98,4 +98,10 @@ std::uint64_t RevocationWatcher::generation() {
     return generation_;
 }
 
+std::int64_t RevocationWatcher::next_update_s() {
+    const std::lock_guard lock(mutex_);
+    refresh_locked();
+    return list_.next_update_s;
+}
+
 }  // namespace mogao

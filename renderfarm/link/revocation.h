@@ -56,6 +56,8 @@ public:
     [[nodiscard]] bool revoked(const std::string& serial_hex);
     // Increments each time a changed file was loaded; sessions compare it to re-check themselves.
     [[nodiscard]] std::uint64_t generation();
+    // nextUpdate of the list in force (seconds since the Unix epoch; 0: it has none).
+    [[nodiscard]] std::int64_t next_update_s();
     [[nodiscard]] const std::filesystem::path& path() const { return path_; }
 
 private:

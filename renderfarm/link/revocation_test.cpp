@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <ctime>
 #include <fstream>
 #include <thread>
 
@@ -83,9 +84,13 @@ TEST(Revocation, WatcherReloadsAChangedFileAndKeepsTheLastGoodOne) {
     EXPECT_FALSE(watcher.revoked(museum2));
     const auto generation = watcher.generation();
 
-    write_text(path, make_crl(pki.ca, {{museum1, 0}, {museum2, 0}}, 86'400));
+    const std::int64_t before = std::time(nullptr);
+    write_text(path, make_crl(pki.ca, {{museum1, 0}, {museum2, 0}}, 7 * 86'400));
     EXPECT_TRUE(watcher.revoked(museum2));
     EXPECT_GT(watcher.generation(), generation);
+    // The list in force's nextUpdate (the farm's mogao_farm_crl_next_update_seconds).
+    EXPECT_GE(watcher.next_update_s(), before + 7 * 86'400);
+    EXPECT_LE(watcher.next_update_s(), std::time(nullptr) + 7 * 86'400);
 
     // A forged list (another CA) and a truncated one: the last good list stays in force.
     write_text(path, make_crl(pki.foreign_ca, {}, 86'400));
@@ -95,6 +100,7 @@ TEST(Revocation, WatcherReloadsAChangedFileAndKeepsTheLastGoodOne) {
     EXPECT_TRUE(watcher.revoked(museum2));
     fs::remove(path);
     EXPECT_TRUE(watcher.revoked(museum2));
+    EXPECT_GE(watcher.next_update_s(), before + 7 * 86'400) << "the last good list's";
 
     EXPECT_THROW(RevocationWatcher(tmp.path() / "missing.pem", pki.ca.cert_pem), LinkError);
 }
