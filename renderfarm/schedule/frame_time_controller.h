@@ -124,9 +124,9 @@ private:
     double work_ = -1.0;
     double ladder_used_work_ = -1.0;  // work of the last frame below the floor; -1 above it
     double ladder_seconds_ = 0.0;     // smoothed time of the frames at that level
-    bool timed_ = false;       // the means hold a first sample
-    double log_mean_ = 0.0;    // EWMA of log(measured): log G
-    double arithmetic_ = 0.0;  // EWMA of measured: A
+    bool timed_ = false;              // the means hold a first sample
+    double log_mean_ = 0.0;           // EWMA of log(measured): log G
+    double arithmetic_ = 0.0;         // EWMA of measured: A
 };
 
 }  // namespace mogao
