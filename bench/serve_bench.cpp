@@ -12,7 +12,9 @@
 // ranks), all (every new scheduling part), denoise (all + the à-trous denoiser on frames of at most
 // --denoise-max-spp samples, its guides traced by the ranks: live_frames.h), and all minus one part
 // (no-rate-aim: the frame-time controller aims at the target itself, without the jitter allowance,
-// the hand-off charge and the headroom of schedule/frame_time_controller.h).
+// the hand-off charge and the headroom of schedule/frame_time_controller.h), and denoise-floor-0.2
+// (the denoise configuration with the frame-time target's scale floor at 0.2 and the bounces never
+// lowered: the controller before its floor of 0.5).
 // With both all and denoise in the run, the denoiser's ratios are printed: frames/s on / off and the
 // moving frame's PSNR on - off. --quality takes a preset's request quality (spp, bounces, AO, area
 // samples, JPEG; common/quality_preset.h) for every request and the reference; without it the
@@ -64,6 +66,7 @@
 #include "common/jpeg_codec.h"
 #include "common/png_io.h"
 #include "common/quality_preset.h"
+#include "common/request_limits.h"
 #include "renderfarm/farm/farm.h"
 #include "renderfarm/farm/live_frames.h"
 #include "renderfarm/trace/film.h"
@@ -151,7 +154,13 @@ std::vector<Config> all_configs(const BenchArgs& a) {
     denoise.live.denoise = true;
     denoise.live.denoise_max_spp = a.denoise_max_spp;
     denoise.live.denoise_params.iterations = a.denoise_iterations;
-    std::vector<Config> out{today, all, denoise};
+    // The frame-time target as it was: the scale falls to 0.2 and the bounces never drop.
+    Config floor = denoise;
+    floor.key = "denoise-floor-0.2";
+    floor.name = "all + denoiser, scale floor 0.2";
+    floor.live.controller.min_scale = 0.2;
+    floor.live.controller.min_bounces = request_limits::kMaxBounces.max;
+    std::vector<Config> out{today, all, denoise, floor};
     const auto without = [&](const char* key, const char* name, auto change) {
         Config c = all;
         c.key = key;
@@ -492,10 +501,12 @@ int main(int argc, char** argv) {
     app.add_option("--reference-spp", a.reference_spp, "Reference samples per pixel (two halves)")
         ->check(CLI::Range(2, 8192));
     app.add_option("--configs", a.configs,
-                   "today, all, denoise, no-progressive, no-target, no-pipeline, no-rank-speed, no-rate-aim")
+                   "today, all, denoise, denoise-floor-0.2, no-progressive, no-target, no-pipeline, no-rank-speed, "
+                   "no-rate-aim")
         ->delimiter(',')
         ->check(CLI::IsMember(
-            {"today", "all", "denoise", "no-progressive", "no-target", "no-pipeline", "no-rank-speed", "no-rate-aim"}));
+            {"today", "all", "denoise", "denoise-floor-0.2", "no-progressive", "no-target", "no-pipeline",
+             "no-rank-speed", "no-rate-aim"}));
     app.add_option("--quality", a.quality,
                    "Preset whose request quality every request uses (" + quality_preset_names() +
                        "); default: the request's defaults")
