@@ -17,13 +17,14 @@
 // (the floor, 0.5 by default: a visitor walking through the grotto sees blocks below it).
 //
 // Below the floor the frame is made cheaper by its path depth instead: the request's bounces b_r
-// step down towards `min_bounces`, at the floor's scale and 1 spp. A frame of b bounces is modelled
-// as costing (1 + bounce_cost * b) times a direct-light-only one (docs/quality.md's bounce sweep of
-// the grotto at 1 spp: 16, 57, 90, 121 ms for 0 to 3 bounces, about 2.5 times the direct-only cost
-// per bounce), so the ladder's works are W_b = floor^2 * (1 + c b) / (1 + c b_r). Bounces are
-// discrete and change the picture's brightness, so they are not chased by the damped step (which
-// would flip between two depths every few frames when the target lies between them): once a
-// frame's damped step would take w below W_{b_r}, the controller predicts each level's time from
+// step down towards `min_bounces`, at the floor's scale and 1 spp. Its default, 1, keeps the first
+// bounce: in the closed grotto 0 bounces is the largest error of all (docs/quality.md), and the
+// serve benchmark measured a moving frame at 0 bounces 7 dB below one at 1 (docs/benchmarks.md). A frame of b bounces
+// is modelled as costing (1 + bounce_cost * b) times a direct-light-only one (docs/quality.md's bounce sweep of the
+// grotto at 1 spp: 16, 57, 90, 121 ms for 0 to 3 bounces, about 2.5 times the direct-only cost per bounce), so the
+// ladder's works are W_b = floor^2 * (1 + c b) / (1 + c b_r). Bounces are discrete and change the picture's brightness,
+// so they are not chased by the damped step (which would flip between two depths every few frames when the target lies
+// between them): once a frame's damped step would take w below W_{b_r}, the controller predicts each level's time from
 // the measured one (seconds * W_b / w_used) and takes the deepest level whose prediction meets the
 // aim, climbing back only when the prediction is within `climb_margin` of the aim (hysteresis,
 // so that a model error of up to 1 / climb_margin never oscillates). The ladder's aim is
@@ -70,7 +71,7 @@ struct FrameTimeTarget {
     double max_step = 4.0;               // >= 1: largest change of w in one frame (factor)
     double min_scale = 0.5;              // (0, 1]: the floor of the resolution scale
     int max_spp = 16;                    // in request_limits::kSpp
-    int min_bounces = 0;                 // in request_limits::kMaxBounces: fewest bounces below the floor
+    int min_bounces = 1;                 // in request_limits::kMaxBounces: fewest bounces below the floor
     double bounce_cost = 2.5;            // > 0: each bounce's cost relative to a direct-light-only frame
     double climb_margin = 0.8;           // (0, 1]: a deeper level is taken back when predicted <= margin * aim
     double jitter_weight = 0.1;          // [0, 1): weight of a frame in the means G and A (0 = off)

@@ -205,6 +205,11 @@ TEST(FrameTimeController, RejectsBadTargets) {
     EXPECT_THROW(FrameTimeController({.min_bounces = -1}), std::invalid_argument);
     EXPECT_THROW(FrameTimeController({.bounce_cost = 0.0}), std::invalid_argument);
     EXPECT_THROW(FrameTimeController({.climb_margin = 0.0}), std::invalid_argument);
+    // The default keeps the first bounce however slow the frames.
+    FrameTimeController slow(FrameTimeTarget{});
+    const ViewRequest r = request_960x540(1.0, 1, 3);
+    for (int i = 0; i < 50; ++i) slow.observe(slow.choose(r), 1e3);
+    EXPECT_EQ(slow.choose(r).bounces, 1);
 }
 
 // A synthetic farm whose bounces cost more than the controller's model says (3.5 times a
@@ -229,6 +234,7 @@ void expect_samples_before_resolution(const FrameChoice& c, const ViewRequest& r
 TEST(FrameTimeController, UnderHeavyOverloadTheScaleHoldsItsFloorAndSamplesAndBouncesGo) {
     FrameTimeTarget t;  // the default floor, 0.5
     t.target_seconds = 0.05;
+    t.min_bounces = 0;
     FrameTimeController c(t);
     const ViewRequest r = request_960x540(1.0, 4, 2);
     FrameChoice used;
@@ -245,6 +251,7 @@ TEST(FrameTimeController, UnderHeavyOverloadTheScaleHoldsItsFloorAndSamplesAndBo
 TEST(FrameTimeController, BouncesFallOnlyAsFarAsNeededHoldStillAndComeBackFirst) {
     FrameTimeTarget t;
     t.target_seconds = 0.05;
+    t.min_bounces = 0;
     FrameTimeController c(t);
     const ViewRequest r = request_960x540(1.0, 1, 2);
     // At the floor 2 bounces take 80 ms, 1 bounce 45 ms: one bounce goes, and stays gone.
