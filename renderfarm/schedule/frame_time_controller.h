@@ -19,13 +19,15 @@
 // Below the floor the frame is made cheaper by its path depth instead: the request's bounces b_r
 // step down towards `min_bounces`, at the floor's scale and 1 spp. Its default, 1, keeps the first
 // bounce: in the closed grotto 0 bounces is the largest error of all (docs/quality.md), and the
-// serve benchmark measured a moving frame at 0 bounces 7 dB below one at 1 (docs/benchmarks.md). A frame of b bounces
-// is modelled as costing (1 + bounce_cost * b) times a direct-light-only one (docs/quality.md's bounce sweep of the
-// grotto at 1 spp: 16, 57, 90, 121 ms for 0 to 3 bounces, about 2.5 times the direct-only cost per bounce), so the
-// ladder's works are W_b = floor^2 * (1 + c b) / (1 + c b_r). Bounces are discrete and change the picture's brightness,
-// so they are not chased by the damped step (which would flip between two depths every few frames when the target lies
-// between them): once a frame's damped step would take w below W_{b_r}, the controller predicts each level's time from
-// the measured one (seconds * W_b / w_used) and takes the deepest level whose prediction meets the
+// serve benchmark (mogao_bench_serve --configs denoise,denoise-floor-0.2) measured a moving frame
+// at 0 bounces about 7 dB below one at 1. A frame of b bounces is modelled as costing
+// (1 + bounce_cost * b) times a direct-light-only one (docs/quality.md's bounce sweep of the grotto
+// at 1 spp: 16, 57, 90, 121 ms for 0 to 3 bounces, about 2.5 times the direct-only cost per
+// bounce), so the ladder's works are W_b = floor^2 * (1 + c b) / (1 + c b_r). Bounces are discrete
+// and change the picture's brightness, so they are not chased by the damped step (which would flip
+// between two depths every few frames when the target lies between them): once a frame's damped
+// step would take w below W_{b_r}, the controller predicts each level's time from the measured one
+// (seconds * W_b / w_used) and takes the deepest level whose prediction meets the
 // aim, climbing back only when the prediction is within `climb_margin` of the aim (hysteresis,
 // so that a model error of up to 1 / climb_margin never oscillates). The ladder's aim is
 // target * (1 - headroom), without the jitter allowance G / A (which belongs to the damped loop
