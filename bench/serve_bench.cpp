@@ -12,7 +12,9 @@
 // ranks), all (every new scheduling part), denoise (all + the à-trous denoiser on frames of at most
 // --denoise-max-spp samples, its guides traced by the ranks: live_frames.h), and all minus one part
 // (no-rate-aim: the frame-time controller aims at the target itself, without the jitter allowance,
-// the hand-off charge and the headroom of schedule/frame_time_controller.h).
+// the hand-off charge and the headroom of schedule/frame_time_controller.h), and denoise-floor-0.2
+// (the denoise configuration with the frame-time target's scale floor at 0.2 and the bounces never
+// lowered: the controller before its floor of 0.5).
 // With both all and denoise in the run, the denoiser's ratios are printed: frames/s on / off and the
 // moving frame's PSNR on - off. --quality takes a preset's request quality (spp, bounces, AO, area
 // samples, JPEG; common/quality_preset.h) for every request and the reference; without it the
@@ -25,13 +27,20 @@
 // last moving pose is requested again and again; after every frame the served image (upsampled to
 // full size when the frame-time target had shrunk it) is compared with the reference (the same view
 // at --reference-spp, one render) by PSNR of the sRGB8 frames; comparison time is not counted.
-// The error of a moving frame is that of the last moving frame against the same reference.
+// For the moving frames counted, the table gives the scale the farm served (mean and least), the
+// spp and the bounces (means). A moving frame's error: the first frame at the reference's pose after
+// another pose, rendered as the configuration renders any moving frame, upsampled to full size,
+// against the reference by PSNR, SSIM (bench/quality/image_metrics.h) and GMSD (bench/quality/gmsd.h,
+// which counts blur and blocks: lower is better), the mean of 4 such frames. The baseline line
+// before the table: today's renderer at full resolution and 1 spp at the same pose (no scheduling,
+// no denoiser), the same metrics over 4 frames, and its time per frame.
 // The reference is the mean, in linear light, of two independent halves (reference-spp / 2 each,
 // distinct RNG keys): the PSNR between the halves is printed as its noise floor. The reference's own
 // error is about 6 dB below that floor's (each half has twice the reference's variance, their
 // difference four times), so a served frame's PSNR above floor + 6 dB cannot be measured with it.
-// --side-by-side writes one PNG: the moving frame (upsampled), the still view after
-// --still-seconds and the reference, left to right, from the "all new parts" configuration.
+// --side-by-side writes one PNG of two rows: a moving frame as rendered (at its own size) and as
+// upsampled to full size; the still view after --still-seconds and the reference; from the "all new
+// parts" configuration (the denoise one when it runs).
 // Exits 77 when the scene's scans are absent.
 #include <algorithm>
 #include <chrono>
@@ -51,10 +60,13 @@
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
+#include "bench/quality/gmsd.h"
+#include "bench/quality/image_metrics.h"
 #include "common/image_compare.h"
 #include "common/jpeg_codec.h"
 #include "common/png_io.h"
 #include "common/quality_preset.h"
+#include "common/request_limits.h"
 #include "renderfarm/farm/farm.h"
 #include "renderfarm/farm/live_frames.h"
 #include "renderfarm/trace/film.h"
@@ -82,10 +94,53 @@ struct BenchArgs {
     int denoise_max_spp = 4, denoise_iterations = AtrousParams{}.iterations;
 };
 
-// The three images of the side-by-side PNG.
+// The images of the side-by-side PNG: a moving frame as rendered and upsampled, the still view.
 struct Snapshots {
-    Rgb8Image moving, still;
+    Rgb8Image moving_rendered, moving, still;
 };
+
+// Error of a served frame (upsampled to full size) against the reference: PSNR and SSIM of the
+// sRGB8 frames, and GMSD (bench/quality/gmsd.h), which counts blur and blocks.
+struct FrameQuality {
+    double psnr_db = 0, ssim = 0, gmsd = 0;
+    FrameQuality& operator+=(const FrameQuality& o) {
+        psnr_db += o.psnr_db;
+        ssim += o.ssim;
+        gmsd += o.gmsd;
+        return *this;
+    }
+    [[nodiscard]] FrameQuality over(int n) const { return {psnr_db / n, ssim / n, gmsd / n}; }
+    [[nodiscard]] nlohmann::json json() const { return {{"psnr_db", psnr_db}, {"ssim", ssim}, {"gmsd", gmsd}}; }
+};
+
+FrameQuality frame_quality(const Rgb8Image& served, const Rgb8Image& reference) {
+    return {psnr(served, reference), quality::ssim_luminance(served, reference), quality::gmsd(served, reference)};
+}
+
+// What the farm served for each counted moving frame: its scale, spp and bounces.
+struct ServedLog {
+    nlohmann::json frames = nlohmann::json::array();
+    double scale_sum = 0, scale_min = 1, spp_sum = 0, bounces_sum = 0;
+    void add(const LiveFrame& f) {
+        const Quality& q = f.rendered.quality;
+        frames.push_back({{"scale", q.resolution_scale}, {"spp", q.spp}, {"bounces", q.max_bounces}});
+        scale_sum += q.resolution_scale;
+        scale_min = std::min(scale_min, q.resolution_scale);
+        spp_sum += q.spp;
+        bounces_sum += q.max_bounces;
+    }
+    [[nodiscard]] nlohmann::json summary() const {
+        const double n = std::max<double>(1, double(frames.size()));
+        return {{"scale_mean", scale_sum / n},
+                {"scale_min", scale_min},
+                {"spp_mean", spp_sum / n},
+                {"bounces_mean", bounces_sum / n}};
+    }
+};
+
+// Moving frames measured against the reference (each the first frame at the reference's pose
+// after another pose, so the frame-time target picks it as it picks any moving frame).
+constexpr int kMovingSamples = 4;
 
 std::vector<Config> all_configs(const BenchArgs& a) {
     Config all{"all", "all new parts", {}, true, true};
@@ -99,7 +154,13 @@ std::vector<Config> all_configs(const BenchArgs& a) {
     denoise.live.denoise = true;
     denoise.live.denoise_max_spp = a.denoise_max_spp;
     denoise.live.denoise_params.iterations = a.denoise_iterations;
-    std::vector<Config> out{today, all, denoise};
+    // The frame-time target as it was: the scale falls to 0.2 and the bounces never drop.
+    Config floor = denoise;
+    floor.key = "denoise-floor-0.2";
+    floor.name = "all + denoiser, scale floor 0.2";
+    floor.live.controller.min_scale = 0.2;
+    floor.live.controller.min_bounces = request_limits::kMaxBounces.max;
+    std::vector<Config> out{today, all, denoise, floor};
     const auto without = [&](const char* key, const char* name, auto change) {
         Config c = all;
         c.key = key;
@@ -210,22 +271,34 @@ nlohmann::json run_config(const Config& c, FrameDispatcher& farm, const Scene& s
     }
     encoder.finish();
     moved = 0;
+    ServedLog served_log;
     const auto start = Clock::now();
     while (moved < 5 || since(start) < a.move_seconds) {  // 5 frames at least, however slow
         request.frame_id = next_id++;
         request.pose.yaw_deg = base_yaw + 0.5 * (moved % 2 == 0 ? 1 : -1) * (1 + moved % 7);
         last = live.render(request);
         encoder.submit(last.image);
+        served_log.add(last);
         ++moved;
     }
     encoder.finish();
     const double move_fps = moved / since(start);
-    // The still view starts where the visitor stopped: the reference's pose.
-    request.pose.yaw_deg = base_yaw;
-    request.frame_id = next_id++;
-    last = live.render(request);  // the first frame at the new pose: a moving frame's error
-    shots.moving = upsample(last.image, reference.size);
-    const double moving_psnr = psnr(shots.moving, reference);
+    FrameQuality moving;
+    for (int k = 0; k < kMovingSamples; ++k) {
+        request.pose.yaw_deg = base_yaw + 1.5;
+        request.frame_id = next_id++;
+        (void)live.render(request);
+        // The still view starts where the visitor stopped: the reference's pose.
+        request.pose.yaw_deg = base_yaw;
+        request.frame_id = next_id++;
+        last = live.render(request);  // the first frame at the new pose: a moving frame's error
+        shots.moving_rendered = last.image;
+        shots.moving = upsample(last.image, reference.size);
+        moving += frame_quality(shots.moving, reference);
+    }
+    moving = moving.over(kMovingSamples);
+    const double moving_psnr = moving.psnr_db;
+    const nlohmann::json served_summary = served_log.summary();
     nlohmann::json curve = nlohmann::json::array();
     double served = 0.0, to38 = -1.0;
     int still_frames = 0;
@@ -242,7 +315,10 @@ nlohmann::json run_config(const Config& c, FrameDispatcher& farm, const Scene& s
     }
     encoder.finish();
     shots.still = upsample(last.image, reference.size);
-    std::printf("| %-34s | %7.2f | %6.2f | %6.2f | %s | %4d |\n", c.name.c_str(), move_fps, moving_psnr,
+    std::printf("| %-34s | %7.2f | %4.2f (%4.2f) | %4.1f | %4.2f | %6.2f | %5.3f | %5.3f | %6.2f | %s | %4d |\n",
+                c.name.c_str(), move_fps, served_summary["scale_mean"].get<double>(),
+                served_summary["scale_min"].get<double>(), served_summary["spp_mean"].get<double>(),
+                served_summary["bounces_mean"].get<double>(), moving_psnr, moving.ssim, moving.gmsd,
                 curve.back()["psnr_db"].get<double>(), to38 < 0 ? "  never" : fmt::format("{:7.2f}", to38).c_str(),
                 last.samples);
     std::fflush(stdout);
@@ -250,6 +326,9 @@ nlohmann::json run_config(const Config& c, FrameDispatcher& farm, const Scene& s
             {"key", c.key},
             {"move_frames_per_second", move_fps},
             {"moving_frame_psnr_db", moving_psnr},
+            {"moving_frame", moving.json()},
+            {"moving_served", served_summary},
+            {"moving_frames", served_log.frames},
             {"still_curve", curve},
             {"still_seconds_to_38db", to38},
             {"still_frames", still_frames}};
@@ -292,14 +371,48 @@ Reference render_reference(FrameDispatcher& farm, const Scene& scene, const Benc
     return r;
 }
 
-// Moving frame | still view after --still-seconds | reference, side by side.
+// Two rows: a moving frame as rendered (at its own size, top left, on black) | the same upsampled
+// to full size as the kiosk shows it; the still view after --still-seconds | the reference.
 void write_side_by_side(const std::string& path, const Snapshots& shots, const Rgb8Image& reference) {
     const ImageSize one = reference.size;
-    Rgb8Image out({3 * one.width, one.height});
-    const Rgb8Image* panels[3] = {&shots.moving, &shots.still, &reference};
-    for (int p = 0; p < 3; ++p)
-        for (int y = 0; y < one.height; ++y) std::copy_n(panels[p]->at(0, y), 3 * one.width, out.at(p * one.width, y));
+    Rgb8Image out({2 * one.width, 2 * one.height}, 0);
+    const Rgb8Image* panels[4] = {&shots.moving_rendered, &shots.moving, &shots.still, &reference};
+    for (int p = 0; p < 4; ++p) {
+        const Rgb8Image& im = *panels[p];
+        const int w = std::min(im.size.width, one.width), h = std::min(im.size.height, one.height);
+        for (int y = 0; y < h; ++y)
+            std::copy_n(im.at(0, y), 3 * w, out.at((p % 2) * one.width, (p / 2) * one.height + y));
+    }
     write_png(path, out);
+}
+
+// Today's renderer at full resolution and 1 spp (no scheduling, no denoiser) at the reference's
+// pose: the moving frames' quality baseline, measured in the same run, and its time per frame.
+nlohmann::json full_resolution_baseline(FrameDispatcher& farm, const Scene& scene, const BenchArgs& a,
+                                        const Rgb8Image& reference, std::uint64_t& next_id) {
+    ViewRequest v = session_view(scene, a);
+    v.quality.spp = 1;
+    v.quality.resolution_scale = 1.0;
+    FrameQuality sum;
+    const auto t0 = Clock::now();
+    double seconds = 0;
+    for (int k = 0; k < kMovingSamples; ++k) {
+        v.frame_id = next_id++;
+        const auto f0 = Clock::now();
+        const Rgb8Image image = farm.render(v, 998, PackedPixels::srgb8).image;
+        seconds += std::chrono::duration<double>(Clock::now() - f0).count();
+        sum += frame_quality(image, reference);
+    }
+    const FrameQuality q = sum.over(kMovingSamples);
+    std::printf(
+        "baseline: full resolution, 1 spp, %d bounces, no denoiser: %.1f ms/frame, PSNR %.2f dB, SSIM %.3f, "
+        "GMSD %.3f (mean of %d frames, %.1f s)\n",
+        v.quality.max_bounces, 1e3 * seconds / kMovingSamples, q.psnr_db, q.ssim, q.gmsd, kMovingSamples,
+        std::chrono::duration<double>(Clock::now() - t0).count());
+    nlohmann::json j = q.json();
+    j["seconds_per_frame"] = seconds / kMovingSamples;
+    j["bounces"] = v.quality.max_bounces;
+    return j;
 }
 
 // Ratios of configurations measured in this run.
@@ -327,10 +440,13 @@ int admin(FrameDispatcher& farm, const Scene& scene, const BenchArgs& a) {
         "measurable); %d render ranks; frame-time target %.1f ms\n\n",
         a.width, a.height, a.reference_spp, std::chrono::duration<double>(Clock::now() - t0).count(), ref.floor_psnr_db,
         ref.floor_psnr_db + 6.0, farm.render_ranks(), a.frame_time_ms);
-    std::printf("| %-34s | %7s | %6s | %6s | %7s | %4s |\n", "parts on", "move/s", "dB mov", "dB 5s", "s to 38", "spp");
-    std::printf("|%s|%s|%s|%s|%s|%s|\n", std::string(36, '-').c_str(), std::string(9, '-').c_str(),
-                std::string(8, '-').c_str(), std::string(8, '-').c_str(), std::string(9, '-').c_str(),
-                std::string(6, '-').c_str());
+    const nlohmann::json baseline = full_resolution_baseline(farm, scene, a, reference, next_id);
+    std::printf("\n| %-34s | %7s | %11s | %4s | %4s | %6s | %5s | %5s | %6s | %7s | %4s |\n", "parts on", "move/s",
+                "scale (min)", "spp", "bnc", "dB mov", "SSIM", "GMSD", "dB 5s", "s to 38", "spp");
+    std::printf("|%s|%s|%s|%s|%s|%s|%s|%s|%s|%s|%s|\n", std::string(36, '-').c_str(), std::string(9, '-').c_str(),
+                std::string(13, '-').c_str(), std::string(6, '-').c_str(), std::string(6, '-').c_str(),
+                std::string(8, '-').c_str(), std::string(7, '-').c_str(), std::string(7, '-').c_str(),
+                std::string(8, '-').c_str(), std::string(9, '-').c_str(), std::string(6, '-').c_str());
     nlohmann::json results = nlohmann::json::array();
     std::map<std::string, std::pair<double, double>> figures;  // key -> (moving frames/s, moving PSNR)
     const std::vector<Config> chosen = configs(a);
@@ -357,6 +473,7 @@ int admin(FrameDispatcher& farm, const Scene& scene, const BenchArgs& a) {
             {"quality", a.quality.empty() ? "request defaults" : a.quality},
             {"denoise_max_spp", a.denoise_max_spp},
             {"denoise_iterations", a.denoise_iterations},
+            {"baseline_full_resolution_1spp", baseline},
             {"configs", results}}.dump(2);
     }
     return 0;
@@ -384,10 +501,12 @@ int main(int argc, char** argv) {
     app.add_option("--reference-spp", a.reference_spp, "Reference samples per pixel (two halves)")
         ->check(CLI::Range(2, 8192));
     app.add_option("--configs", a.configs,
-                   "today, all, denoise, no-progressive, no-target, no-pipeline, no-rank-speed, no-rate-aim")
+                   "today, all, denoise, denoise-floor-0.2, no-progressive, no-target, no-pipeline, no-rank-speed, "
+                   "no-rate-aim")
         ->delimiter(',')
         ->check(CLI::IsMember(
-            {"today", "all", "denoise", "no-progressive", "no-target", "no-pipeline", "no-rank-speed", "no-rate-aim"}));
+            {"today", "all", "denoise", "denoise-floor-0.2", "no-progressive", "no-target", "no-pipeline",
+             "no-rank-speed", "no-rate-aim"}));
     app.add_option("--quality", a.quality,
                    "Preset whose request quality every request uses (" + quality_preset_names() +
                        "); default: the request's defaults")

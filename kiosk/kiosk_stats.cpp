@@ -114,7 +114,35 @@ std::string KioskStats::log_line() const {
         w.bytes_per_frame, w.bandwidth_bytes_per_s / 1e6, rejected_, superseded_, rounds_);
 }
 
+namespace {
+
+// The served scale of each frame (height over the content's); empty when the content's height is
+// unknown.
+std::vector<double> served_scales(const std::vector<PresentedFrame>& history, const nlohmann::json& extra) {
+    std::vector<double> out;
+    const auto content = extra.find("content");
+    if (content == extra.end() || !content->is_array() || content->size() != 2 || !(*content)[1].is_number())
+        return out;
+    const double height = (*content)[1].get<double>();
+    if (height <= 0) return out;
+    for (const auto& f : history) out.push_back(f.served.height / height);
+    return out;
+}
+
+// Their mean, least and 5th percentile; null without any.
+nlohmann::json served_scale_summary(std::vector<double> scales) {
+    if (scales.empty()) return nullptr;
+    double sum = 0;
+    for (const double v : scales) sum += v;
+    return {{"mean", round3(sum / static_cast<double>(scales.size()))},
+            {"min", round3(*std::min_element(scales.begin(), scales.end()))},
+            {"p05", round3(percentile(scales, 0.05))}};
+}
+
+}  // namespace
+
 nlohmann::json KioskStats::to_json(const nlohmann::json& extra) const {
+    const std::vector<double> scales = served_scales(history_, extra);
     nlohmann::json frames = nlohmann::json::array();
     for (const auto& f : history_) {
         frames.push_back({{"request_id", f.request_id},
@@ -125,18 +153,17 @@ nlohmann::json KioskStats::to_json(const nlohmann::json& extra) const {
                           {"presented_ns", f.presented_ns},
                           {"motion_to_photon_ms", round3(ms(f.presented_ns - f.request_ns))},
                           {"decode_ms", round3(f.decode_ms)},
-                          {"display_round", f.display_round}});
+                          {"display_round", f.display_round},
+                          {"served", {f.served.width, f.served.height}}});
+        if (!scales.empty()) frames.back()["served_scale"] = round3(scales[frames.size() - 1]);
     }
-    nlohmann::json out = {{"frames_presented", frames_},
-                          {"jpeg_bytes_presented", bytes_},
-                          {"frames_rejected", rejected_},
-                          {"frames_superseded", superseded_},
-                          {"frames_out_of_order", out_of_order_},
-                          {"display_rounds", rounds_},
-                          {"total", summary_json(total_summary())},
-                          {"window", summary_json(window_summary())},
-                          {"events", events_},
-                          {"frames", std::move(frames)}};
+    nlohmann::json total = summary_json(total_summary());
+    total["served_scale"] = served_scale_summary(scales);
+    nlohmann::json out = {
+        {"frames_presented", frames_},      {"jpeg_bytes_presented", bytes_},           {"frames_rejected", rejected_},
+        {"frames_superseded", superseded_}, {"frames_out_of_order", out_of_order_},     {"display_rounds", rounds_},
+        {"total", std::move(total)},        {"window", summary_json(window_summary())}, {"events", events_},
+        {"frames", std::move(frames)}};
     for (const auto& [key, value] : extra.items()) out[key] = value;
     return out;
 }

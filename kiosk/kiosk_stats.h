@@ -47,6 +47,7 @@ struct PresentedFrame {
     std::int64_t presented_ns = 0;
     double decode_ms = 0;
     std::uint64_t display_round = 0;  // the kiosk's display round that first showed it
+    ImageSize served;                 // the frame's pixels as the farm rendered them (its JPEG's size)
 };
 
 struct StatsSummary {
@@ -83,6 +84,9 @@ public:
     [[nodiscard]] std::string log_line() const;
 
     // Everything: summaries, counters, events, per-frame list. `extra` is merged at the top level.
+    // When `extra` holds "content": [width, height] (run_stats_json), each frame's served scale
+    // (its height over the content's: the guard band widens a request, never heightens it) is in
+    // the per-frame list and its mean, least and 5th percentile in "total.served_scale".
     [[nodiscard]] nlohmann::json to_json(const nlohmann::json& extra = nlohmann::json::object()) const;
 
     // Writes to_json(extra) atomically (common/file_io.h). Throws std::system_error

@@ -53,6 +53,28 @@ TEST(KioskStats, PercentilesOverTheRun) {
     EXPECT_NEAR(t.latency_mean_ms, 50.5, 1e-9);
 }
 
+// The served scale: each frame's height over the content's (the guard band widens the request).
+TEST(KioskStats, JsonHoldsTheServedSizeAndScaleOfEveryFrame) {
+    KioskStats stats;
+    const int heights[4] = {270, 540, 405, 540};
+    for (std::uint64_t k = 1; k <= 4; ++k) {
+        PresentedFrame f = frame(k);
+        f.served = {2 * heights[k - 1], heights[k - 1]};
+        stats.presented(f);
+    }
+    const nlohmann::json j = stats.to_json({{"content", {960, 540}}});
+    EXPECT_EQ(j["frames"][0]["served"], nlohmann::json({540, 270}));
+    EXPECT_DOUBLE_EQ(j["frames"][0]["served_scale"].get<double>(), 0.5);
+    EXPECT_DOUBLE_EQ(j["frames"][2]["served_scale"].get<double>(), 0.75);
+    EXPECT_NEAR(j["total"]["served_scale"]["mean"].get<double>(), 0.8125, 1e-3);  // rounded to 3 places
+    EXPECT_DOUBLE_EQ(j["total"]["served_scale"]["min"].get<double>(), 0.5);
+    // Without the content's size the sizes are kept and no scale is made up.
+    const nlohmann::json bare = stats.to_json();
+    EXPECT_EQ(bare["frames"][1]["served"], nlohmann::json({1080, 540}));
+    EXPECT_FALSE(bare["frames"][1].contains("served_scale"));
+    EXPECT_TRUE(bare["total"]["served_scale"].is_null());
+}
+
 TEST(KioskStats, JsonHoldsCountersEventsAndFramesInOrder) {
     KioskStats stats;
     stats.presented(frame(1));

@@ -51,13 +51,20 @@ LiveFrames::Session& LiveFrames::session(std::uint64_t id) {
 // The view to trace for `request`: still views at the request's own scale (to accumulate), moving
 // ones at the controller's choice; the pass's frame_id when it continues an accumulation.
 ViewRequest LiveFrames::plan(Session& s, const ViewRequest& request, FrameChoice& choice) const {
-    choice = {request.quality.resolution_scale, request.quality.spp};
+    choice = {};
+    choice.resolution_scale = request.quality.resolution_scale;
+    choice.spp = request.quality.spp;
     if (s.controller) choice = s.controller->choose(request);
     const bool still = options_.progressive && s.last_request && same_view(request, *s.last_request);
-    if (still) choice.resolution_scale = request.quality.resolution_scale;
+    if (still) {  // accumulated at the request's own scale and depth
+        choice.resolution_scale = request.quality.resolution_scale;
+        choice.bounces = -1;
+        choice.bounce_work = 1.0;
+    }
     ViewRequest view = request;
     view.quality.resolution_scale = choice.resolution_scale;
     view.quality.spp = choice.spp;
+    if (choice.bounces >= 0) view.quality.max_bounces = choice.bounces;
     if (options_.progressive && s.accumulation.continues(view)) {
         choice.spp = std::max(choice.spp, 2);
         view.quality.spp = choice.spp;

@@ -10,11 +10,12 @@
 //    converge to the pixel's area average. Once `converged_spp` samples are in, the mean is sent
 //    without rendering.
 //  - A frame-time target (schedule/frame_time_controller.h): while the view moves, the resolution
-//    scale and spp of each frame are chosen to take `frame_time_s`; the appliance upsamples the
-//    smaller frame (its warp takes content of any size). The controller also sees the gap since
-//    the session's previous frame was handed back, and charges it when it is a hand-off (frames
-//    back to back: the caller's encode and the next request), so that frames plus hand-offs meet
-//    the target (frame_time_controller.h).
+//    scale and spp of each frame are chosen to take `frame_time_s` (spp first, the scale down to
+//    its floor, then the bounces); the appliance upsamples the smaller frame (its warp takes
+//    content of any size). A still view is accumulated at the request's own scale and bounces. The controller also sees
+//    the gap since the session's previous frame was handed back, and charges it when it is a hand-off (frames back to
+//    back: the caller's encode and the next request), so that frames plus hand-offs meet the target
+//    (frame_time_controller.h).
 //  - Its own predicted cost map (FrameDispatcher stream = session), so sessions looking at
 //    different places do not mislead each other's PBT.
 //  - With `denoise`: every frame served with at most `denoise_max_spp` samples per pixel (moving

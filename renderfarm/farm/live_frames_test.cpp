@@ -205,17 +205,23 @@ TEST_F(LiveFramesTest, FrameTimeTargetPicksTheScaleOfMovingViewsAndFullScaleWhen
     LiveOptions options;
     options.frame_time_s = 1e-9;  // unreachable: every moving frame falls to the smallest scale
     options.controller.min_scale = 0.5;
+    options.controller.min_bounces = 0;
     LiveFrames live(source(), options, 1.f, ToneMap::clamp);
     for (std::uint64_t id = 1; id <= 8; ++id) {
         ViewRequest moving = view(static_cast<double>(id));
+        moving.quality.max_bounces = 2;
         moving.frame_id = id;
         (void)live.render(moving);
     }
+    // The scale holds its floor; below it the bounces went instead.
     EXPECT_DOUBLE_EQ(calls_.back().view.quality.resolution_scale, 0.5);
+    EXPECT_EQ(calls_.back().view.quality.max_bounces, 0);
     ViewRequest still = view(8.0);
+    still.quality.max_bounces = 2;
     still.frame_id = 9;
     const LiveFrame frame = live.render(still);
     EXPECT_DOUBLE_EQ(frame.rendered.quality.resolution_scale, 1.0);
+    EXPECT_EQ(frame.rendered.quality.max_bounces, 2);  // a still view accumulates at its own depth
     EXPECT_EQ(frame.image.size, (ImageSize{64, 48}));
 }
 

@@ -71,8 +71,10 @@ void add_live_flags(CLI::App& serve, mogao::ServeOptions& options, double& frame
         ->check(CLI::Range(0.0, 10000.0));
     serve
         .add_option("--min-scale", live.controller.min_scale,
-                    "Smallest resolution scale the frame-time target may pick")
+                    "Floor of the resolution scale the frame-time target may pick; below it, it lowers the bounces")
         ->check(CLI::Range(0.01, 1.0));
+    serve.add_option("--min-bounces", live.controller.min_bounces, "Fewest bounces the frame-time target may pick")
+        ->check(CLI::Range(L::kMaxBounces.min, L::kMaxBounces.max));
     serve.add_option("--max-spp", live.controller.max_spp, "Largest spp the frame-time target may pick")
         ->check(CLI::Range(L::kSpp.min, L::kSpp.max));
     serve.add_flag("--progressive,!--no-progressive", live.progressive,

@@ -12,7 +12,29 @@
 // measured = 0 (a frame too fast to time) counts as the largest step up. w is then clamped so that
 // the scale stays in [min_scale, the request's own scale] with each side at least
 // request_limits::kLinkImageSide.min pixels, and spp in [1, max_spp] (request_limits::kSpp).
-// The scale is spent first: spp (= round(w / scale^2)) rises above 1 only at the request's full scale.
+// Samples go first, resolution last: shrinking w, spp (= round(w / scale^2)) falls to 1 at the
+// request's full scale before the scale moves; then the scale falls, but never below `min_scale`
+// (the floor, 0.5 by default: a visitor walking through the grotto sees blocks below it).
+//
+// Below the floor the frame is made cheaper by its path depth instead: the request's bounces b_r
+// step down towards `min_bounces`, at the floor's scale and 1 spp. Its default, 1, keeps the first
+// bounce: in the closed grotto 0 bounces is the largest error of all (docs/quality.md), and the
+// serve benchmark (mogao_bench_serve --configs denoise,denoise-floor-0.2) measured a moving frame
+// at 0 bounces about 7 dB below one at 1. A frame of b bounces is modelled as costing
+// (1 + bounce_cost * b) times a direct-light-only one (docs/quality.md's bounce sweep of the grotto
+// at 1 spp: 16, 57, 90, 121 ms for 0 to 3 bounces, about 2.5 times the direct-only cost per
+// bounce), so the ladder's works are W_b = floor^2 * (1 + c b) / (1 + c b_r). Bounces are discrete
+// and change the picture's brightness, so they are not chased by the damped step (which would flip
+// between two depths every few frames when the target lies between them): once a frame's damped
+// step would take w below W_{b_r}, the controller predicts each level's time from the measured one
+// (seconds * W_b / w_used) and takes the deepest level whose prediction meets the
+// aim, climbing back only when the prediction is within `climb_margin` of the aim (hysteresis,
+// so that a model error of up to 1 / climb_margin never oscillates). The ladder's aim is
+// target * (1 - headroom), without the jitter allowance G / A (which belongs to the damped loop
+// and is inflated for a while by the descent from full scale), and the time of the frames at one
+// level is smoothed (weight kLadderWeight per frame, restarted at each change of level) so that
+// one slow frame does not drop a bounce. When even min_bounces misses the aim, the frame takes
+// longer than the target: the floor holds, the rate falls.
 //
 // The rate served is frames over the SUM of their times, so it is the arithmetic mean frame time
 // that must meet the target. The step above drives the mean of log(measured) to log(aim), i.e. the
@@ -49,8 +71,11 @@ struct FrameTimeTarget {
     double target_seconds = 1.0 / 15.0;  // > 0
     double gain = 0.5;                   // (0, 1]
     double max_step = 4.0;               // >= 1: largest change of w in one frame (factor)
-    double min_scale = 0.2;              // (0, 1]
+    double min_scale = 0.5;              // (0, 1]: the floor of the resolution scale
     int max_spp = 16;                    // in request_limits::kSpp
+    int min_bounces = 1;                 // in request_limits::kMaxBounces: fewest bounces below the floor
+    double bounce_cost = 2.5;            // > 0: each bounce's cost relative to a direct-light-only frame
+    double climb_margin = 0.8;           // (0, 1]: a deeper level is taken back when predicted <= margin * aim
     double jitter_weight = 0.1;          // [0, 1): weight of a frame in the means G and A (0 = off)
     double headroom = 0.02;              // [0, 1 - min_aim]: margin below the target (see above)
     double min_aim = 0.8;                // (0, 1]: the aim never drops below min_aim * target_seconds
@@ -60,7 +85,12 @@ struct FrameTimeTarget {
 struct FrameChoice {
     double resolution_scale = 1.0;
     int spp = 1;
-    [[nodiscard]] double work() const { return resolution_scale * resolution_scale * spp; }
+    int bounces = -1;          // path depth to trace; -1 = the request's own
+    double bounce_work = 1.0;  // (1 + c * bounces) / (1 + c * the request's bounces): 1 at its own depth
+    // The ladder below the floor (set by choose()): its scale and the request's and fewest bounces.
+    double floor_scale = 0.0;
+    int request_bounces = 0, fewest_bounces = 0;
+    [[nodiscard]] double work() const { return resolution_scale * resolution_scale * spp * bounce_work; }
 };
 
 class FrameTimeController {
@@ -84,14 +114,22 @@ public:
     [[nodiscard]] double jitter_allowance() const;
     [[nodiscard]] const FrameTimeTarget& target() const { return target_; }
 
+    // Work of the ladder's level of `bounces` for a frame shaped like `like` (see above).
+    [[nodiscard]] double level_work(const FrameChoice& like, int bounces) const;
+
 private:
     void note_time(double seconds);
+    [[nodiscard]] double ladder_work(const FrameChoice& used, double seconds) const;
+
+    static constexpr double kLadderWeight = 0.3;
 
     FrameTimeTarget target_;
     double work_ = -1.0;
-    bool timed_ = false;       // the means hold a first sample
-    double log_mean_ = 0.0;    // EWMA of log(measured): log G
-    double arithmetic_ = 0.0;  // EWMA of measured: A
+    double ladder_used_work_ = -1.0;  // work of the last frame below the floor; -1 above it
+    double ladder_seconds_ = 0.0;     // smoothed time of the frames at that level
+    bool timed_ = false;              // the means hold a first sample
+    double log_mean_ = 0.0;           // EWMA of log(measured): log G
+    double arithmetic_ = 0.0;         // EWMA of measured: A
 };
 
 }  // namespace mogao

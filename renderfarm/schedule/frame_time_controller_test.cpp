@@ -10,11 +10,12 @@
 namespace mogao {
 namespace {
 
-ViewRequest request_960x540(double scale = 1.0, int spp = 1) {
+ViewRequest request_960x540(double scale = 1.0, int spp = 1, int bounces = 0) {
     ViewRequest r;
     r.size = {960, 540};
     r.quality.resolution_scale = scale;
     r.quality.spp = spp;
+    r.quality.max_bounces = bounces;
     return r;
 }
 
@@ -33,6 +34,7 @@ TEST(FrameTimeController, FirstFrameIsTheRequestAsAsked) {
 TEST(FrameTimeController, ConvergesToTheTargetOnASyntheticCostModel) {
     FrameTimeTarget t;
     t.target_seconds = 0.05;
+    t.min_scale = 0.2;  // the settled scale, 0.49, lies below the default floor
     FrameTimeController c(t);
     const ViewRequest r = request_960x540();
     for (int i = 0; i < 40; ++i) {
@@ -124,6 +126,7 @@ double mean_settled_seconds(FrameTimeTarget t) {
 TEST(FrameTimeController, MeanFrameTimeMeetsTheTargetDespiteJitter) {
     FrameTimeTarget t;
     t.target_seconds = 0.05;
+    t.min_scale = 0.2;  // the settled scale, about 0.5, would touch the default floor
     t.headroom = 0.0;
     const double mean = mean_settled_seconds(t);
     EXPECT_LE(mean, 1.01 * t.target_seconds) << "the served rate falls short of the target's";
@@ -139,6 +142,7 @@ TEST(FrameTimeController, MeanFrameTimeMeetsTheTargetDespiteJitter) {
 TEST(FrameTimeController, AStallOrANewViewIsNotTakenForJitter) {
     FrameTimeTarget t;
     t.target_seconds = 0.05;
+    t.min_scale = 0.2;
     FrameTimeController c(t);
     const ViewRequest r = request_960x540();
     for (int i = 0; i < 200; ++i) {
@@ -176,6 +180,7 @@ double settled_frame_seconds(FrameTimeTarget t, double gap) {
 TEST(FrameTimeController, AHandOffBetweenBackToBackFramesIsChargedAndAnIdlePauseIsNot) {
     FrameTimeTarget t;
     t.target_seconds = 0.05;
+    t.min_scale = 0.2;
     t.headroom = 0.0;
     EXPECT_NEAR(settled_frame_seconds(t, 0.003) + 0.003, t.target_seconds, 1e-4);
     EXPECT_NEAR(settled_frame_seconds(t, 0.05), t.target_seconds, 1e-4);
@@ -197,6 +202,82 @@ TEST(FrameTimeController, RejectsBadTargets) {
     EXPECT_THROW(FrameTimeController({.min_aim = 0.0}), std::invalid_argument);
     EXPECT_THROW(FrameTimeController({.max_handoff = 1.0}), std::invalid_argument);
     EXPECT_THROW(FrameTimeController({.headroom = 0.5}), std::invalid_argument);  // below min_aim
+    EXPECT_THROW(FrameTimeController({.min_bounces = -1}), std::invalid_argument);
+    EXPECT_THROW(FrameTimeController({.bounce_cost = 0.0}), std::invalid_argument);
+    EXPECT_THROW(FrameTimeController({.climb_margin = 0.0}), std::invalid_argument);
+    // The default keeps the first bounce however slow the frames.
+    FrameTimeController slow(FrameTimeTarget{});
+    const ViewRequest r = request_960x540(1.0, 1, 3);
+    for (int i = 0; i < 50; ++i) slow.observe(slow.choose(r), 1e3);
+    EXPECT_EQ(slow.choose(r).bounces, 1);
+}
+
+// A synthetic farm whose bounces cost more than the controller's model says (3.5 times a
+// direct-light-only frame per bounce against its 2.5): k seconds per full 1-spp direct-only frame.
+double seconds_with_bounces(const FrameChoice& c, const ViewRequest& r, double k) {
+    const int b = c.bounces < 0 ? r.quality.max_bounces : c.bounces;
+    return k * c.resolution_scale * c.resolution_scale * c.spp * (1.0 + 3.5 * b);
+}
+
+// Samples go first, resolution last: spp is 1 whenever the scale is below the request's, and a
+// bounce is dropped only at the floor.
+void expect_samples_before_resolution(const FrameChoice& c, const ViewRequest& r, double floor) {
+    if (c.resolution_scale < r.quality.resolution_scale) {
+        EXPECT_EQ(c.spp, 1);
+    }
+    if (c.bounces < r.quality.max_bounces) {
+        EXPECT_DOUBLE_EQ(c.resolution_scale, floor);
+    }
+    EXPECT_GE(c.resolution_scale, floor - 1e-12) << "below the floor of the resolution scale";
+}
+
+TEST(FrameTimeController, UnderHeavyOverloadTheScaleHoldsItsFloorAndSamplesAndBouncesGo) {
+    FrameTimeTarget t;  // the default floor, 0.5
+    t.target_seconds = 0.05;
+    t.min_bounces = 0;
+    FrameTimeController c(t);
+    const ViewRequest r = request_960x540(1.0, 4, 2);
+    FrameChoice used;
+    for (int i = 0; i < 200; ++i) {
+        used = c.choose(r);
+        expect_samples_before_resolution(used, r, 0.5);
+        c.observe(used, seconds_with_bounces(used, r, 0.4));  // even the floor at 0 bounces is 2x too slow
+    }
+    EXPECT_DOUBLE_EQ(used.resolution_scale, 0.5);
+    EXPECT_EQ(used.spp, 1);
+    EXPECT_EQ(used.bounces, 0);
+}
+
+TEST(FrameTimeController, BouncesFallOnlyAsFarAsNeededHoldStillAndComeBackFirst) {
+    FrameTimeTarget t;
+    t.target_seconds = 0.05;
+    t.min_bounces = 0;
+    FrameTimeController c(t);
+    const ViewRequest r = request_960x540(1.0, 1, 2);
+    // At the floor 2 bounces take 80 ms, 1 bounce 45 ms: one bounce goes, and stays gone.
+    int changes = 0, last = -1;
+    FrameChoice used;
+    for (int i = 0; i < 300; ++i) {
+        used = c.choose(r);
+        expect_samples_before_resolution(used, r, 0.5);
+        if (i >= 50 && used.bounces != last) ++changes;
+        last = used.bounces;
+        c.observe(used, seconds_with_bounces(used, r, 0.04));
+    }
+    EXPECT_EQ(used.bounces, 1);
+    EXPECT_DOUBLE_EQ(used.resolution_scale, 0.5);
+    EXPECT_EQ(changes, 0) << "the depth flickers between levels";
+    // The load eases (a quarter of the cost): the bounce comes back before the scale rises.
+    bool rose_before_bounce = false;
+    for (int i = 0; i < 60; ++i) {
+        used = c.choose(r);
+        rose_before_bounce |= used.bounces < 2 && used.resolution_scale > 0.5;
+        c.observe(used, seconds_with_bounces(used, r, 0.01));
+    }
+    EXPECT_FALSE(rose_before_bounce);
+    EXPECT_EQ(used.bounces, 2);
+    // Work meeting the 49 ms aim: 0.049 / (0.01 * 8) -> scale sqrt(0.6125).
+    EXPECT_NEAR(used.resolution_scale, std::sqrt(0.6125), 0.02);
 }
 
 }  // namespace
