@@ -263,14 +263,22 @@ void direct_light_queries(const FrameContext& frame, const ShadingVertex& x, con
     if (frame.lights->has_environment) environment_queries(frame, x, throughput, sampler, sink);
 }
 
-bool sample_bounce(const ShadingVertex& x, const Eigen::Vector3f& throughput, PixelSampler& sampler, Bounce& out) {
+bool sample_bounce(const FrameContext& frame, const ShadingVertex& x, const Eigen::Vector3f& throughput, int depth,
+                   PixelSampler& sampler, Bounce& out) {
     const Eigen::Vector2f u = sampler.next2d();
     out.direction = cosine_hemisphere(Frame(x.hit->shading_normal), u.x(), u.y());
     if (x.hit->geometric_normal.dot(out.direction) <= 0.0f) return false;
     // f cosθ / pdf with pdf = cosθ/π (PBRT 4th ed. §13.1).
     out.throughput = throughput.cwiseProduct(eval_brdf(x.material, x.hit->shading_normal, x.wo, out.direction)) *
                      std::numbers::pi_v<float>;
-    return out.throughput.maxCoeff() > 0.0f;
+    const float largest = out.throughput.maxCoeff();
+    if (!(largest > 0.0f)) return false;
+    if (frame.russian_roulette && depth >= kRouletteMinDepth && largest < 1.0f) {
+        // Survive with q = the largest channel; divide by q (Arvo & Kirk 1990; integrator.h).
+        if (sampler.next2d().x() >= largest) return false;
+        out.throughput /= largest;
+    }
+    return true;
 }
 
 Eigen::Vector3f bounce_emission(const FrameContext& frame, const ShadingVertex& x, const Eigen::Vector3f& dir,
@@ -317,7 +325,7 @@ Eigen::Vector3f radiance_at(const FrameContext& frame, const SurfaceHit& first, 
         }
         if (!bounce_follows) break;
         Bounce bounce;
-        if (!sample_bounce(x, throughput, sampler, bounce)) break;
+        if (!sample_bounce(frame, x, throughput, depth, sampler, bounce)) break;
 
         RTCIntersectContext context;
         rtcInitIntersectContext(&context);

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // Light transport at a surface hit: next-event estimation of every light plus `max_bounces`
-// indirect bounces (a path tracer without Russian roulette). Every estimator below is unbiased
+// indirect bounces, ended early by Russian roulette (below). Every estimator below is unbiased
 // (consistent as samples grow); no light arrives without a visibility test.
 //
 // Per path vertex x with shading normal n, geometric normal ng (both facing the incoming ray),
@@ -23,6 +23,16 @@
 // see) is already counted by next-event estimation at every vertex, so adding it again would
 // double count it; area lights are not intersectable either (scene.h), so no emission is ever
 // found by a bounce ray.
+// Russian roulette (FrameContext::russian_roulette; Arvo & Kirk, "Particle Transport and Image
+// Synthesis", SIGGRAPH 1990, §4; as PBRT 4th ed. §14.5.1 / pbrt-v4's PathIntegrator): the bounce
+// leaving a vertex of depth >= kRouletteMinDepth (the camera ray's hit is depth 0, so the first
+// bounce is always traced) survives with probability q = min(1, max channel of the path
+// throughput after the bounce), and a surviving path's throughput is divided by q. The expected
+// value of every later term is unchanged (E[X/q · 1{u < q}] = E[X]), so the estimator stays
+// unbiased; paths whose throughput has become small end early and save their bounce and
+// next-event rays. A throughput >= 1 in every channel (albedo 1) is never rouletted. The decision
+// draws a PixelSampler pair of its own only when q < 1, so a frame without roulette (or with
+// q = 1 everywhere) draws the numbers it drew before.
 // Random numbers: one PixelSampler pair (sobol.h) per light sample set, environment and bounce,
 // so each is a stratified Owen-scrambled Sobol' net over the pixel's samples.
 //
@@ -79,7 +89,11 @@ struct FrameContext {
     // light shadow packets traced with RTC_INTERSECT_CONTEXT_FLAG_COHERENT, as before the ray-flag
     // audit; every secondary ray is otherwise traced INCOHERENT (packet_integrator.h).
     bool coherent_shadow_packets = false;
+    bool russian_roulette = false;  // end paths by Russian roulette (see above)
 };
+
+// The first path depth whose bounce may be ended by Russian roulette (depth 0 = the camera hit).
+inline constexpr int kRouletteMinDepth = 1;
 
 // One shadow ray and what it adds (already multiplied by the path throughput) when unoccluded.
 struct ShadowQuery {
@@ -106,13 +120,15 @@ void direct_light_queries(const FrameContext& frame, const ShadingVertex& x, con
                           bool bounce_follows, PixelSampler& sampler, std::vector<ShadowQuery>& queries,
                           Eigen::Vector3f& unshadowed);
 
-// The bounce of a vertex: direction and new throughput, or false when the path ends.
+// The bounce of a vertex at path depth `depth`: direction and new throughput (already divided by
+// the roulette's survival probability), or false when the path ends (below the surface, zero
+// throughput, or ended by Russian roulette).
 struct Bounce {
     Eigen::Vector3f direction;
     Eigen::Vector3f throughput;
 };
-[[nodiscard]] bool sample_bounce(const ShadingVertex& x, const Eigen::Vector3f& throughput, PixelSampler& sampler,
-                                 Bounce& out);
+[[nodiscard]] bool sample_bounce(const FrameContext& frame, const ShadingVertex& x, const Eigen::Vector3f& throughput,
+                                 int depth, PixelSampler& sampler, Bounce& out);
 
 // MIS-weighted area-light emission seen by a bounce ray from `x` along `dir` whose nearest
 // geometry hit is at `t_hit` (infinity if it escapes); 0 in legacy mode. `throughput` is the
