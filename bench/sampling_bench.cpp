@@ -6,7 +6,7 @@
 //
 //   mogao_bench_sampling [--scene scenes/grotto.json] [--scans DIR] [--width 240] [--height 135]
 //                        [--bounces 6] [--ref-spp 256] [--max-spp 16] [--passes 16] [--reps 2]
-//                        [--write-docs docs/renderer.md]
+//                        [--write-docs docs/renderer.md] [--png-dir DIR]
 //
 // View: the scene's `walk` path, pose 30 of 60, on the grotto's cylinder screen (as mogao_bench_render
 // (d)), --bounces bounces, one thread. Error: relMSE of linear radiance (bench/quality/image_metrics.h,
@@ -22,7 +22,9 @@
 //  (3) --passes one-spp frames accumulated over frame ids (what the farm does for a still view):
 //      pixel centres converge to a point-sampled image, Sobol' positions to the area average.
 // --write-docs FILE replaces the block between `<!-- generated:sampling -->` and `<!-- /generated -->`
-// in FILE with the run's line (date, commit, CPU, load average) and the tables.
+// in FILE with the run's line (date, commit, CPU, load average) and the tables. --png-dir DIR writes
+// the reference, the 1-spp frames of each setting and the accumulated passes (the scene's exposure
+// and tone map), to look at.
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -30,6 +32,7 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -39,8 +42,10 @@
 
 #include "bench/quality/image_metrics.h"
 #include "common/camera_path.h"
+#include "common/png_io.h"
 #include "common/thread_clock.h"
 #include "renderfarm/scene/scene_file.h"
+#include "renderfarm/trace/film.h"
 #include "renderfarm/trace/renderer.h"
 
 namespace {
@@ -61,14 +66,15 @@ std::string arg_str(int argc, char** argv, const char* name, const char* fallbac
 
 struct Setting {
     const char* label;
+    const char* png;  // --png-dir file of its 1-spp frame
     bool roulette;
     bool jitter;
 };
 constexpr std::array<Setting, 4> kSettings = {{
-    {"before: pixel centre at 1 spp, no roulette", false, false},
-    {"Russian roulette", true, false},
-    {"Sobol' position at 1 spp", false, true},
-    {"both (defaults)", true, true},
+    {"before: pixel centre at 1 spp, no roulette", "one-spp-before", false, false},
+    {"Russian roulette", "one-spp-roulette", true, false},
+    {"Sobol' position at 1 spp", "one-spp-sobol", false, true},
+    {"both (defaults)", "one-spp-defaults", true, true},
 }};
 
 RendererOptions options_of(const Setting& s) {
@@ -114,9 +120,17 @@ RgbFloatImage reference_frame(Renderer& renderer, ViewRequest view, int spp) {
     return frame;
 }
 
+// Writes `frame` as DIR/NAME.png with the scene's exposure and tone map; nothing when dir is empty.
+void save_png(const std::string& dir, const char* name, const RgbFloatImage& frame, const Scene& scene) {
+    if (dir.empty()) return;
+    Rgb8Image out(frame.size);
+    to_srgb8(frame, PixelRect::whole(frame.size), scene.exposure, out, scene.tone_map);
+    write_png(std::filesystem::path(dir) / (std::string(name) + ".png"), out);
+}
+
 // (1): curves[setting][k] at spp 2^k; settings 2 and 3 copy 0 and 1 above 1 spp (same renders).
 std::vector<std::vector<Point>> equal_spp(Renderer& renderer, const ViewRequest& view, const RgbFloatImage& reference,
-                                          int max_spp, int reps) {
+                                          int max_spp, int reps, const Scene& scene, const std::string& png_dir) {
     std::vector<std::vector<Point>> curves(kSettings.size());
     for (int spp = 1; spp <= max_spp; spp *= 2) {
         ViewRequest v = view;
@@ -135,6 +149,7 @@ std::vector<std::vector<Point>> equal_spp(Renderer& renderer, const ViewRequest&
                 row[s].rays_per_sample =
                     static_cast<double>(rays) / (static_cast<double>(frame.size.pixel_count()) * spp);
                 row[s].relmse = quality::relative_mse(frame, reference);
+                if (spp == 1 && r == 0) save_png(png_dir, kSettings[s].png, frame, scene);
             }
         }
         for (std::size_t s = 0; s < kSettings.size(); ++s) curves[s].push_back(row[s < measured ? s : s - 2]);
@@ -157,7 +172,7 @@ double relmse_at(const std::vector<Point>& curve, double t) {
 
 // (3): relMSE of the mean of `passes` one-spp frames (frame ids 0..passes-1), centred and jittered.
 std::array<double, 2> accumulated_passes(Renderer& renderer, const ViewRequest& view, const RgbFloatImage& reference,
-                                         int passes) {
+                                         int passes, const Scene& scene, const std::string& png_dir) {
     std::array<double, 2> out{};
     for (int jitter = 0; jitter < 2; ++jitter) {
         renderer.set_path_options(options_of(kSettings[jitter == 0 ? 1 : 3]));
@@ -172,6 +187,7 @@ std::array<double, 2> accumulated_passes(Renderer& renderer, const ViewRequest& 
                 sum.pixels[i] += frame.pixels[i] / static_cast<float>(passes);
         }
         out[static_cast<std::size_t>(jitter)] = quality::relative_mse(sum, reference);
+        save_png(png_dir, jitter == 0 ? "passes-centres" : "passes-sobol", sum, scene);
     }
     return out;
 }
@@ -267,10 +283,13 @@ int run(int argc, char** argv) {
     const int passes = arg_int(argc, argv, "--passes", 16);
     const double load_start = load_average();
     Renderer renderer(scene, RendererOptions{"threads=1"});
+    const std::string png_dir = arg_str(argc, argv, "--png-dir", "");
+    if (!png_dir.empty()) std::filesystem::create_directories(png_dir);
     const RgbFloatImage reference = reference_frame(renderer, view, ref_spp);
-    const auto curves =
-        equal_spp(renderer, view, reference, arg_int(argc, argv, "--max-spp", 16), arg_int(argc, argv, "--reps", 2));
-    const std::array<double, 2> accumulated = accumulated_passes(renderer, view, reference, passes);
+    save_png(png_dir, "reference", reference, scene);
+    const auto curves = equal_spp(renderer, view, reference, arg_int(argc, argv, "--max-spp", 16),
+                                  arg_int(argc, argv, "--reps", 2), scene, png_dir);
+    const std::array<double, 2> accumulated = accumulated_passes(renderer, view, reference, passes, scene, png_dir);
 
     std::ostringstream md;
     const std::time_t now = std::time(nullptr);
