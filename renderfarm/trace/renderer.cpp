@@ -238,6 +238,7 @@ void Renderer::set_path_options(const RendererOptions& options) {
     impl_->options.coherent_shadow_packets_baseline = options.coherent_shadow_packets_baseline;
     impl_->options.russian_roulette = options.russian_roulette;
     impl_->options.jitter_one_spp = options.jitter_one_spp;
+    impl_->options.glossy_vndf_sampling = options.glossy_vndf_sampling;
 }
 
 void Renderer::begin_frame(const ViewRequest& request) {
@@ -261,6 +262,7 @@ void Renderer::begin_frame(const ViewRequest& request) {
     s.context.cone_spread = static_cast<float>(camera_cone_spread(*s.camera, s.spp));
     s.context.coherent_shadow_packets = s.options.coherent_shadow_packets_baseline;
     s.context.russian_roulette = s.options.russian_roulette;
+    s.context.glossy_vndf = s.options.glossy_vndf_sampling;
     s.jitter_samples = s.spp > 1 || s.options.jitter_one_spp;
     // The column table holds pixel-centre angles: only for the centre-sampled baseline.
     s.columns =

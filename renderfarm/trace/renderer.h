@@ -69,6 +69,10 @@ struct RendererOptions {
     // area average: antialiased edges). Off samples the pixel centre (x + 0.5, y + 0.5), as before,
     // which never converges to the area average. spp > 1 always takes the pixel's Sobol' points.
     bool jitter_one_spp = true;
+    // Glossy materials' bounces drawn from the GGX visible normals (Heitz 2018) mixed with the
+    // cosine lobe by one-sample MIS (integrator.h); off: every bounce cosine-sampled, as before.
+    // Matte materials are unaffected either way.
+    bool glossy_vndf_sampling = true;
     // Benchmark baseline only, not a setting: traces the packet path's light shadow packets with
     // RTC_INTERSECT_CONTEXT_FLAG_COHERENT, the flag they had before the ray-flag audit (Embree
     // reserves it for coherent rays such as camera rays; it made them about twice as slow). The
@@ -106,8 +110,9 @@ public:
     Renderer& operator=(Renderer&&) noexcept;
 
     // Replaces the path switches (legacy_light_sampling, packet_secondary_rays, camera_column_table,
-    // native_packet_width, russian_roulette, jitter_one_spp) from the next begin_frame on, so a benchmark times both
-    // paths on one BVH; embree_config and rebase_on_eye keep their constructor values. Not thread-safe.
+    // native_packet_width, russian_roulette, jitter_one_spp, glossy_vndf_sampling) from the next begin_frame on, so a
+    // benchmark times both paths on one BVH; embree_config and rebase_on_eye keep their constructor values. Not
+    // thread-safe.
     void set_path_options(const RendererOptions& options);
 
     // Validates the request (std::invalid_argument naming the field and limit, see
