@@ -8,7 +8,7 @@
 //       an uninstanced mesh, a zero-specular material), vs a shadowing sun plus a used area light;
 //       (c4) an unplaced mesh with vertex colours and a texture, (c5) the field carrying them.
 // The scene is built in code: a ~1M-triangle smooth height field plus a sphere.
-//   (d) with --scene FILE (e.g. scenes/grotto.json): issue 11's speed-ups on a real scene, the
+//   (d) with --scene FILE (e.g. scenes/grotto.json): the path speed-ups on a real scene, the
 //       grotto's cylinder view at --scene-width x --scene-height (960x540), 1 spp: for today's path
 //       (every RendererOptions switch off), each part alone, the defaults and everything on, the
 //       renderer's Mrays/s, raw Embree tracing the same ray mix with

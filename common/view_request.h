@@ -50,7 +50,7 @@ using CameraModel = std::variant<PinholeCamera, CylinderScreen>;
 
 // Quality knobs: every one trades time for error (see docs/benchmarks.md).
 struct Quality {
-    int spp = 1;                  // samples per pixel (Owen-scrambled Sobol' points; 1 = pixel centre)
+    int spp = 1;                  // samples per pixel (Owen-scrambled Sobol' points in the pixel, 1 included)
     int max_bounces = 0;          // indirect bounces of the path tracer; 0 = direct light only
     int ao_samples = 0;           // cosine-weighted occlusion rays for the environment light; 0 traces 1
     int area_light_samples = 1;   // shadow rays per area light per sample

@@ -125,6 +125,22 @@ bool sample_area(const PreparedArea& l, const Eigen::Vector3f& position, const E
     return out.cos_light > 0.0f;  // one-sided emitter seen from behind
 }
 
+// Probability that the bounce at x samples the glossy lobe (0: cosine only; integrator.h).
+float glossy_probability(const FrameContext& frame, const ShadingVertex& x) {
+    if (!frame.glossy_vndf || !(x.hit->shading_normal.dot(x.wo) > 0.0f)) return 0.0f;
+    return glossy_lobe_probability(x.material);
+}
+
+// Solid-angle pdf of the bounce direction wi at x: the one-sample mixture of the cosine lobe and
+// the GGX visible-normal lobe (Veach 1997, §9.2.4's one-sample model with the balance heuristic).
+float bounce_pdf(const FrameContext& frame, const ShadingVertex& x, const Eigen::Vector3f& wi) {
+    const float cosine = x.hit->shading_normal.dot(wi) * std::numbers::inv_pi_v<float>;
+    const float pg = glossy_probability(frame, x);
+    if (pg == 0.0f) return cosine;
+    return (1.0f - pg) * std::max(0.0f, cosine) +
+           pg * ggx_reflection_pdf(x.hit->shading_normal, x.wo, wi, x.material.alpha);
+}
+
 // Power heuristic (Veach 1997, eq. 9.13 with β = 2) for n_f samples of pdf f against one of pdf g.
 float power_heuristic(float nf_pdf_f, float pdf_g) {
     const float f2 = nf_pdf_f * nf_pdf_f;
@@ -211,8 +227,7 @@ void one_light_query(const FrameContext& frame, const ShadingVertex& x, const Ei
     float mis = 1.0f;
     if (bounce_follows) {
         const float pdf_light = sel.pdf[i] * a.distance2 / (a.cos_light * l.area);  // solid angle
-        const float pdf_bounce = x.hit->shading_normal.dot(a.wi) * std::numbers::inv_pi_v<float>;
-        mis = power_heuristic(n * pdf_light, pdf_bounce);
+        mis = power_heuristic(n * pdf_light, bounce_pdf(frame, x, a.wi));
     }
     sink.add(l.cast_shadows, a.wi, kShadowEnd * a.distance,
              throughput.cwiseProduct(f.cwiseProduct(l.radiance)) * (scale * mis * a.cos_light * l.area / a.distance2),
@@ -263,14 +278,37 @@ void direct_light_queries(const FrameContext& frame, const ShadingVertex& x, con
     if (frame.lights->has_environment) environment_queries(frame, x, throughput, sampler, sink);
 }
 
-bool sample_bounce(const ShadingVertex& x, const Eigen::Vector3f& throughput, PixelSampler& sampler, Bounce& out) {
+bool sample_bounce(const FrameContext& frame, const ShadingVertex& x, const Eigen::Vector3f& throughput, int depth,
+                   PixelSampler& sampler, Bounce& out) {
     const Eigen::Vector2f u = sampler.next2d();
-    out.direction = cosine_hemisphere(Frame(x.hit->shading_normal), u.x(), u.y());
+    const Eigen::Vector3f& n = x.hit->shading_normal;
+    const Frame tangent(n);
+    const float pg = glossy_probability(frame, x);
+    if (u.x() < pg) {  // the glossy lobe: reflect wo about a visible GGX normal (Heitz 2018)
+        const Eigen::Vector3f wo_local(tangent.t.dot(x.wo), tangent.b.dot(x.wo), n.dot(x.wo));
+        const Eigen::Vector3f h = tangent.to_world(ggx_visible_normal(wo_local, x.material.alpha, u.x() / pg, u.y()));
+        out.direction = (2.0f * x.wo.dot(h) * h - x.wo).normalized();
+    } else {  // the cosine lobe; u.x() remapped to [0, 1) (PBRT 4th ed. §A.1), unchanged when pg = 0
+        out.direction = cosine_hemisphere(tangent, pg > 0.0f ? (u.x() - pg) / (1.0f - pg) : u.x(), u.y());
+    }
     if (x.hit->geometric_normal.dot(out.direction) <= 0.0f) return false;
-    // f cosθ / pdf with pdf = cosθ/π (PBRT 4th ed. §13.1).
-    out.throughput = throughput.cwiseProduct(eval_brdf(x.material, x.hit->shading_normal, x.wo, out.direction)) *
-                     std::numbers::pi_v<float>;
-    return out.throughput.maxCoeff() > 0.0f;
+    const Eigen::Vector3f f = eval_brdf(x.material, n, x.wo, out.direction);
+    if (pg > 0.0f) {  // f cosθ / pdf with the mixture's pdf (one-sample MIS, balance heuristic)
+        const float pdf = bounce_pdf(frame, x, out.direction);
+        const float cos_i = n.dot(out.direction);
+        if (!(pdf > 0.0f) || !(cos_i > 0.0f)) return false;
+        out.throughput = throughput.cwiseProduct(f) * (cos_i / pdf);
+    } else {  // f cosθ / pdf with pdf = cosθ/π (PBRT 4th ed. §13.1)
+        out.throughput = throughput.cwiseProduct(f) * std::numbers::pi_v<float>;
+    }
+    const float largest = out.throughput.maxCoeff();
+    if (!(largest > 0.0f)) return false;
+    if (frame.russian_roulette && depth >= kRouletteMinDepth && largest < 1.0f) {
+        // Survive with q = the largest channel; divide by q (Arvo & Kirk 1990; integrator.h).
+        if (sampler.next2d().x() >= largest) return false;
+        out.throughput /= largest;
+    }
+    return true;
 }
 
 Eigen::Vector3f bounce_emission(const FrameContext& frame, const ShadingVertex& x, const Eigen::Vector3f& dir,
@@ -293,9 +331,8 @@ Eigen::Vector3f bounce_emission(const FrameContext& frame, const ShadingVertex& 
         }
         const float cos_light = -l.normal.dot(dir);
         const float pdf_light = sel.pdf[first_area + static_cast<int>(k)] * t * t / (cos_light * l.area);
-        const float pdf_bounce = x.hit->shading_normal.dot(dir) * std::numbers::inv_pi_v<float>;
         const float n = static_cast<float>(frame.area_light_samples);
-        sum += throughput.cwiseProduct(l.radiance) * power_heuristic(pdf_bounce, n * pdf_light);
+        sum += throughput.cwiseProduct(l.radiance) * power_heuristic(bounce_pdf(frame, x, dir), n * pdf_light);
     }
     return sum;
 }
@@ -317,7 +354,7 @@ Eigen::Vector3f radiance_at(const FrameContext& frame, const SurfaceHit& first, 
         }
         if (!bounce_follows) break;
         Bounce bounce;
-        if (!sample_bounce(x, throughput, sampler, bounce)) break;
+        if (!sample_bounce(frame, x, throughput, depth, sampler, bounce)) break;
 
         RTCIntersectContext context;
         rtcInitIntersectContext(&context);

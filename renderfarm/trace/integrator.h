@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // Light transport at a surface hit: next-event estimation of every light plus `max_bounces`
-// indirect bounces (a path tracer without Russian roulette). Every estimator below is unbiased
+// indirect bounces, ended early by Russian roulette (below). Every estimator below is unbiased
 // (consistent as samples grow); no light arrives without a visibility test.
 //
 // Per path vertex x with shading normal n, geometric normal ng (both facing the incoming ray),
@@ -18,13 +18,27 @@
 // A light direction counts only if it is above both n and ng (no light leaks through the
 // surface at smooth-shading terminators). Shadow rays are traced only for lights with
 // cast_shadows; they end at 0.999 d for point and area lights.
-// Bounces: wi cosine-weighted around n, throughput *= π f(wo, wi) (= f cosθ / pdf). A bounce
-// ray that escapes contributes nothing: the environment (the only thing an escaping ray could
-// see) is already counted by next-event estimation at every vertex, so adding it again would
-// double count it; area lights are not intersectable either (scene.h), so no emission is ever
-// found by a bounce ray.
-// Random numbers: one PixelSampler pair (sobol.h) per light sample set, environment and bounce,
-// so each is a stratified Owen-scrambled Sobol' net over the pixel's samples.
+// Bounces: wi cosine-weighted around n, throughput *= π f(wo, wi) (= f cosθ / pdf). With
+// FrameContext::glossy_vndf, a glossy material's bounce instead picks the GGX lobe with
+// probability p_g (shading.h, glossy_lobe_probability: the lobes' luminance shares) and reflects wo
+// about a visible normal (Heitz, "Sampling the GGX Distribution of Visible Normals", JCGT 2018),
+// else the cosine lobe; either way throughput *= f cosθ / p(wi) with the mixture's pdf
+// p = (1 - p_g) cosθ/π + p_g G1(wo) D(h) / (4 cosθo): Veach's one-sample MIS with the balance
+// heuristic (Veach 1997, §9.2.4), so whichever lobe dominates a direction carries it. The same
+// p is the bounce pdf in the area-light MIS weights below. Matte materials (p_g = 0) draw and
+// compute exactly what they did without it. A bounce ray that escapes contributes nothing: the environment (the only
+// thing an escaping ray could see) is already counted by next-event estimation at every vertex, so adding it again
+// would double count it; area lights are not intersectable either (scene.h), so no emission is ever found by a bounce
+// ray. Russian roulette (FrameContext::russian_roulette; Arvo & Kirk, "Particle Transport and Image Synthesis",
+// SIGGRAPH 1990, §4; as PBRT 4th ed. §14.5.1 / pbrt-v4's PathIntegrator): the bounce leaving a vertex of depth >=
+// kRouletteMinDepth (the camera ray's hit is depth 0, so the first bounce is always traced) survives with probability q
+// = min(1, max channel of the path throughput after the bounce), and a surviving path's throughput is divided by q. The
+// expected value of every later term is unchanged (E[X/q · 1{u < q}] = E[X]), so the estimator stays unbiased; paths
+// whose throughput has become small end early and save their bounce and next-event rays. A throughput >= 1 in every
+// channel (albedo 1) is never rouletted. The decision draws a PixelSampler pair of its own only when q < 1, so a frame
+// without roulette (or with q = 1 everywhere) draws the numbers it drew before. Random numbers: one PixelSampler pair
+// (sobol.h) per light sample set, environment and bounce, so each is a stratified Owen-scrambled Sobol' net over the
+// pixel's samples.
 //
 // Light selection (FrameContext::legacy_light_sampling = false; RendererOptions keeps the legacy
 // estimator by default, renderer.h says why): the point, directional
@@ -34,7 +48,8 @@
 // light is uniform (pdf 1/A) and, where a bounce follows (depth < max_bounces), combined with the
 // bounce's cosine-sampled direction by multiple importance sampling with the power heuristic
 // (Veach 1997, §9.2.4, β = 2; PBRT 4th ed. §13.4.1): a light sample at direction ω has weight
-//   w_l = (N p_l)² / ((N p_l)² + p_b²),  p_l = p(light) d² / (cosθ_l A),  p_b = cosθ / π,
+//   w_l = (N p_l)² / ((N p_l)² + p_b²),  p_l = p(light) d² / (cosθ_l A),  p_b = the bounce pdf
+//   (cosθ / π, or the lobe mixture's above),
 // and a bounce ray that reaches the front of an area light before any geometry adds
 // throughput · L · w_b with w_b = p_b² / ((N p_l)² + p_b²) (so area lights are found by bounce
 // rays in this mode; the weights of both strategies sum to 1 for every direction). Emission of
@@ -79,7 +94,12 @@ struct FrameContext {
     // light shadow packets traced with RTC_INTERSECT_CONTEXT_FLAG_COHERENT, as before the ray-flag
     // audit; every secondary ray is otherwise traced INCOHERENT (packet_integrator.h).
     bool coherent_shadow_packets = false;
+    bool russian_roulette = false;  // end paths by Russian roulette (see above)
+    bool glossy_vndf = false;       // glossy bounces from GGX visible normals (see above)
 };
+
+// The first path depth whose bounce may be ended by Russian roulette (depth 0 = the camera hit).
+inline constexpr int kRouletteMinDepth = 1;
 
 // One shadow ray and what it adds (already multiplied by the path throughput) when unoccluded.
 struct ShadowQuery {
@@ -106,13 +126,15 @@ void direct_light_queries(const FrameContext& frame, const ShadingVertex& x, con
                           bool bounce_follows, PixelSampler& sampler, std::vector<ShadowQuery>& queries,
                           Eigen::Vector3f& unshadowed);
 
-// The bounce of a vertex: direction and new throughput, or false when the path ends.
+// The bounce of a vertex at path depth `depth`: direction and new throughput (already divided by
+// the roulette's survival probability), or false when the path ends (below the surface, zero
+// throughput, or ended by Russian roulette).
 struct Bounce {
     Eigen::Vector3f direction;
     Eigen::Vector3f throughput;
 };
-[[nodiscard]] bool sample_bounce(const ShadingVertex& x, const Eigen::Vector3f& throughput, PixelSampler& sampler,
-                                 Bounce& out);
+[[nodiscard]] bool sample_bounce(const FrameContext& frame, const ShadingVertex& x, const Eigen::Vector3f& throughput,
+                                 int depth, PixelSampler& sampler, Bounce& out);
 
 // MIS-weighted area-light emission seen by a bounce ray from `x` along `dir` whose nearest
 // geometry hit is at `t_hit` (infinity if it escapes); 0 in legacy mode. `throughput` is the

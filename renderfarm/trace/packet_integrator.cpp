@@ -137,7 +137,7 @@ void bounce(const FrameContext& frame, std::array<Lane, kPacketLanes>& lanes,
     int active = 0;
     for (std::size_t l = 0; l < kPacketLanes; ++l) {
         if (!lanes[l].alive) continue;
-        if (!sample_bounce(vertices[l], lanes[l].throughput, rngs[l], bounces[l])) {
+        if (!sample_bounce(frame, vertices[l], lanes[l].throughput, depth, rngs[l], bounces[l])) {
             lanes[l].alive = false;
             continue;
         }

@@ -78,6 +78,7 @@ struct Renderer::Impl {
     CylinderColumns columns;  // filled when options.camera_column_table and spp == 1
     std::uint64_t key = 0;
     int spp = 1;
+    bool jitter_samples = true;  // spp > 1 or options.jitter_one_spp
     FrameContext context;
 
     [[nodiscard]] int packet_width() const { return options.native_packet_width ? native_width : 16; }
@@ -98,11 +99,12 @@ struct Renderer::Impl {
             const int x = block.x0 + lane % kBlock;
             const int y = block.y0 + lane / kBlock;
             rngs[l] = PixelSampler(key, x, y, sample);
-            // spp == 1 keeps the pixel centre; otherwise the pixel's samples are one Sobol' net.
+            // The pixel's samples are one Sobol' net (a scrambled point at spp 1 too, unless the
+            // pixel-centre baseline is asked for: RendererOptions::jitter_one_spp).
             Eigen::Vector2f jitter(0.5f, 0.5f);
-            if (spp > 1) jitter = rngs[l].next2d();
+            if (jitter_samples) jitter = rngs[l].next2d();
             const Ray ray =
-                spp == 1 && !columns.sin_theta.empty()
+                !jitter_samples && !columns.sin_theta.empty()
                     ? generate_column_ray(*camera, columns, x, y + 0.5)
                     : generate_ray(*camera, x + static_cast<double>(jitter.x()), y + static_cast<double>(jitter.y()));
             const Eigen::Vector3f org = (ray.origin - origin).cast<float>();
@@ -234,6 +236,9 @@ void Renderer::set_path_options(const RendererOptions& options) {
     impl_->options.camera_column_table = options.camera_column_table;
     impl_->options.native_packet_width = options.native_packet_width;
     impl_->options.coherent_shadow_packets_baseline = options.coherent_shadow_packets_baseline;
+    impl_->options.russian_roulette = options.russian_roulette;
+    impl_->options.jitter_one_spp = options.jitter_one_spp;
+    impl_->options.glossy_vndf_sampling = options.glossy_vndf_sampling;
 }
 
 void Renderer::begin_frame(const ViewRequest& request) {
@@ -256,7 +261,12 @@ void Renderer::begin_frame(const ViewRequest& request) {
                              s.packet_width()};
     s.context.cone_spread = static_cast<float>(camera_cone_spread(*s.camera, s.spp));
     s.context.coherent_shadow_packets = s.options.coherent_shadow_packets_baseline;
-    s.columns = s.options.camera_column_table && s.spp == 1 ? make_cylinder_columns(*s.camera) : CylinderColumns{};
+    s.context.russian_roulette = s.options.russian_roulette;
+    s.context.glossy_vndf = s.options.glossy_vndf_sampling;
+    s.jitter_samples = s.spp > 1 || s.options.jitter_one_spp;
+    // The column table holds pixel-centre angles: only for the centre-sampled baseline.
+    s.columns =
+        s.options.camera_column_table && !s.jitter_samples ? make_cylinder_columns(*s.camera) : CylinderColumns{};
     s.ready = true;
 }
 

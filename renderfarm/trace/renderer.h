@@ -13,7 +13,8 @@
 // Determinism: a pixel's value depends only on (scene, request incl. seed and frame_id, x, y):
 // camera rays are traced in 4x4 packets aligned to the global image grid (x0 % 4 == 0,
 // y0 % 4 == 0), lanes outside rect or image masked off, one packet per sample index; all random
-// numbers are hashes of (seed, frame_id, x, y, sample, dimension) (rng.h). So any split of the
+// numbers are hashes of (seed, frame_id, x, y, sample, dimension) (rng.h, sobol.h), the sub-pixel
+// position at every spp included (RendererOptions::jitter_one_spp). So any split of the
 // frame into rects (e.g. across MPI ranks) reproduces the single-rect frame bit for bit.
 //
 // Lifetime: the Scene must outlive the Renderer (mesh indices and normals are shared, not copied).
@@ -40,7 +41,7 @@ struct RendererOptions {
     // Rebase the world on the eye every frame (render_scene.h). Only benchmarks and the precision
     // test turn this off, to measure what it buys.
     bool rebase_on_eye = true;
-    // Issue 11's speed-ups, each of which can be turned off so a benchmark times today's path and
+    // The path speed-ups, each of which can be turned off so a benchmark times today's path and
     // the new one in one run (docs/renderer.md, "Performance"). None changes what the renderer
     // converges to; legacy_light_sampling = false changes the noise (a different unbiased
     // estimator), the others give the same image up to Embree's packet and single-ray kernels
@@ -59,6 +60,19 @@ struct RendererOptions {
     // Camera and secondary packets traced at the CPU's native width (embree_packets.h: two
     // rtcIntersect8 / rtcOccluded8 halves on AVX2, where Embree would run a 16-wide call ray by ray).
     bool native_packet_width = true;
+    // Russian roulette ends paths whose throughput has become small (integrator.h: survival
+    // probability = the throughput's largest channel, from the second bounce on; unbiased). Off
+    // traces every path to max_bounces, as before; tests and benchmarks compare both.
+    bool russian_roulette = true;
+    // At spp = 1, the pixel's one sample at an Owen-scrambled Sobol' point (sobol.h; a fresh
+    // position per seed and frame_id, so passes accumulated over frame ids converge to the pixel's
+    // area average: antialiased edges). Off samples the pixel centre (x + 0.5, y + 0.5), as before,
+    // which never converges to the area average. spp > 1 always takes the pixel's Sobol' points.
+    bool jitter_one_spp = true;
+    // Glossy materials' bounces drawn from the GGX visible normals (Heitz 2018) mixed with the
+    // cosine lobe by one-sample MIS (integrator.h); off: every bounce cosine-sampled, as before.
+    // Matte materials are unaffected either way.
+    bool glossy_vndf_sampling = true;
     // Benchmark baseline only, not a setting: traces the packet path's light shadow packets with
     // RTC_INTERSECT_CONTEXT_FLAG_COHERENT, the flag they had before the ray-flag audit (Embree
     // reserves it for coherent rays such as camera rays; it made them about twice as slow). The
@@ -95,9 +109,10 @@ public:
     Renderer(Renderer&&) noexcept;
     Renderer& operator=(Renderer&&) noexcept;
 
-    // Replaces the speed switches (legacy_light_sampling, packet_secondary_rays,
-    // camera_column_table) from the next begin_frame on, so a benchmark times both paths on one
-    // BVH; embree_config and rebase_on_eye keep their constructor values. Not thread-safe.
+    // Replaces the path switches (legacy_light_sampling, packet_secondary_rays, camera_column_table,
+    // native_packet_width, russian_roulette, jitter_one_spp, glossy_vndf_sampling) from the next begin_frame on, so a
+    // benchmark times both paths on one BVH; embree_config and rebase_on_eye keep their constructor values. Not
+    // thread-safe.
     void set_path_options(const RendererOptions& options);
 
     // Validates the request (std::invalid_argument naming the field and limit, see

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// Issue 11's renderer speed-ups must not change what the renderer converges to:
+// The renderer's path speed-ups must not change what the renderer converges to:
 //  * light selection (one shadow ray per light sample, light chosen by estimated contribution,
 //    weighted by 1/p; MIS with the bounce for area lights) is unbiased: its mean over many seeds
 //    matches the one-ray-per-light estimator within a tolerance derived from the measured

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// Numerical stability of the renderer at the extremes (issue 12; docs/renderer.md, "Numerical
+// Numerical stability of the renderer at the extremes (docs/renderer.md, "Numerical
 // stability"). Each test names the guard it checks; all are small renders (< 0.1 MPixel).
 #include <cmath>
 #include <cstdio>

@@ -97,4 +97,29 @@ struct ShadingMaterial {
     return m.diffuse + m.specular * ggx_lobe(n, wo, wi, m.alpha);
 }
 
+// Smith G1 = 1 / (1 + Λ) for GGX at a direction with cosθ = cos_t (> 0).
+[[nodiscard]] inline float ggx_g1(float cos_t, float alpha) { return 1.0f / (1.0f + ggx_lambda(cos_t, alpha)); }
+
+// Solid-angle pdf of wi = reflect(wo, h) with h drawn from the visible normals of wo
+// (sampling.h, ggx_visible_normal): D_wo(h) / (4 wo·h) = G1(wo) D(h) / (4 cosθo) (Heitz 2018, §3;
+// PBRT 4th ed. §9.6.4). 0 when either direction is below n.
+[[nodiscard]] inline float ggx_reflection_pdf(const Eigen::Vector3f& n, const Eigen::Vector3f& wo,
+                                              const Eigen::Vector3f& wi, float alpha) {
+    const float cos_o = n.dot(wo);
+    const float cos_i = n.dot(wi);
+    if (!(cos_o > 0.0f) || !(cos_i > 0.0f)) return 0.0f;
+    const Eigen::Vector3f half = (wi + wo).normalized();
+    return ggx_g1(cos_o, alpha) * ggx_d(std::max(0.0f, n.dot(half)), alpha) / (4.0f * cos_o);
+}
+
+// Probability of sampling the glossy lobe rather than the cosine lobe: the lobes' shares of the
+// reflected light, by luminance (Rec. 709 weights) of k_s against (1 - k_s) a. 0 for matte.
+[[nodiscard]] inline float glossy_lobe_probability(const ShadingMaterial& m) {
+    if (!m.glossy) return 0.0f;
+    const Eigen::Vector3f w(0.2126f, 0.7152f, 0.0722f);
+    const float glossy = w.dot(m.specular);
+    const float diffuse = w.dot(m.diffuse) * std::numbers::pi_v<float>;
+    return glossy + diffuse > 0.0f ? glossy / (glossy + diffuse) : 0.0f;
+}
+
 }  // namespace mogao
