@@ -6,8 +6,9 @@
 //    size and quality unchanged), each request renders one more pass at the request's full scale
 //    with new random numbers (pass_frame_id) and the frame sent is the mean of all passes so far, in
 //    linear float (progressive_accumulator.h). Any change starts over. Passes after the first use
-//    at least 2 spp: at 1 spp the renderer samples the pixel centre (renderer.h), which would never
-//    converge to the pixel's area average. Once `converged_spp` samples are in, the mean is sent
+//    at least 2 spp, so each adds stratified positions over the pixel's area (with
+//    RendererOptions::jitter_one_spp off, a 1-spp pass samples the pixel centre and would never
+//    converge to the area average). Once `converged_spp` samples are in, the mean is sent
 //    without rendering.
 //  - A frame-time target (schedule/frame_time_controller.h): while the view moves, the resolution
 //    scale and spp of each frame are chosen to take `frame_time_s` (spp first, the scale down to
