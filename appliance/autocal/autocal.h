@@ -177,7 +177,7 @@ struct AutocalOptions {
     // (bundle_adjust.h), from the projectors' correspondences and the screen's known shape, each pulled to the
     // prior's by `camera_sigma`. Off: the prior's intrinsics are taken as exact.
     bool refine_camera_intrinsics = true;
-    CameraIntrinsicsSigma camera_sigma;
+    CameraIntrinsicsSigma camera_sigma{};
     // Refused unless each refined intrinsic's standard deviation is at most this fraction of the prior's (the
     // screen and the projectors must determine it, not the prior), (0, 1]; and unless each lies within 4 of the
     // prior's sigmas of the prior's value.
