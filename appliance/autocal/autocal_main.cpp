@@ -3,7 +3,7 @@
 //
 //   mogao-autocal calibrate --rig rigs/standard.toml --out DIR [--scale 0.5] [--content 1920x1080]
 //                 [--alpha-bits 16] [--warp-step 2] [--gray-bits N] [--frames-per-pattern 1] [--no-colour]
-//                 [--no-falloff] [--fit-screen] [--no-bow] [--fixed-camera-intrinsics]
+//                 [--no-falloff] [--fit-screen] [--no-bow] [--refine-camera-intrinsics]
 //
 // Exit codes: 0 success, 1 the job failed or the calibration was refused (the message says why;
 // nothing in DIR changes), 2 bad command line.
@@ -43,9 +43,8 @@ int main(int argc, char** argv) {
     bool no_bow = false;
     cmd->add_flag("--no-bow", no_bow,
                   "Take the screen as an exact cylinder: do not try a bow (kept by default only where it pays)");
-    bool fixed_camera = false;
-    cmd->add_flag("--fixed-camera-intrinsics", fixed_camera,
-                  "Take the prior's camera focal length, principal point and distortion as exact (no refinement)");
+    cmd->add_flag("--refine-camera-intrinsics", job.options.refine_camera_intrinsics,
+                  "Refine the camera's focal length, principal point and k1, k2 in the bundle adjustment");
     bool no_colour = false;
     cmd->add_flag("--no-colour", no_colour, "Geometry only: no response, black-level and colour matching step");
     bool no_falloff = false;
@@ -56,7 +55,6 @@ int main(int argc, char** argv) {
         job.colour = !no_colour;
         job.colour_options.lens_falloff = !no_falloff;
         job.options.fit_bow = !no_bow;
-        job.options.refine_camera_intrinsics = !fixed_camera;
         if (std::sscanf(content.c_str(), "%dx%d", &job.content.width, &job.content.height) != 2 ||
             job.content.width < 1 || job.content.height < 1 || job.content.width > 16384 ||
             job.content.height > 16384) {
