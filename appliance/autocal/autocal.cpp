@@ -44,6 +44,10 @@ void check_inputs(const CalibrationPrior& prior, ImageSize content, const Autoca
     if (!(o.phase_sigma_floor_px > 0.0)) fail("options.phase_sigma_floor_px: > 0");
     if (!(o.shadow_noise_sigmas >= 0.0)) fail("options.shadow_noise_sigmas: >= 0");
     if (!(o.bow_min_gain >= 0.0 && o.bow_min_gain < 1.0)) fail("options.bow_min_gain: [0, 1)");
+    if (!(o.camera_sigma.focal > 0.0 && o.camera_sigma.principal_point > 0.0 && o.camera_sigma.distortion > 0.0)) {
+        fail("options.camera_sigma: focal, principal_point and distortion > 0");
+    }
+    if (!(o.camera_sigma_gate > 0.0 && o.camera_sigma_gate <= 1.0)) fail("options.camera_sigma_gate: (0, 1]");
     if (!(prior.screen.radius_m > 0.0 && prior.screen.arc_deg > 0.0 && prior.screen.top_m > prior.screen.bottom_m)) {
         fail("prior.screen: radius_m > 0, arc_deg > 0, top_m > bottom_m");
     }
@@ -165,6 +169,42 @@ void try_bow(BundleResult& ba, const std::vector<EdgeObservation>& edges,
     if (trial.kept) ba = std::move(bowed);
 }
 
+// The refined camera intrinsics must be what the screen and the projectors determine, near a chessboard's
+// result: each within kMaxPriorSigmas of the prior's (else the prior or the screen's size is wrong), and
+// each standard deviation at most options.camera_sigma_gate of the prior's (else the data barely see it
+// and the prior decides). Throws CalibrationRefused naming the parameter.
+void check_camera_intrinsics(const BundleResult& ba, const DeviceModel& prior, const AutocalOptions& o) {
+    if (ba.camera_intrinsics_sigma.size() != 5) return;
+    constexpr double kMaxPriorSigmas = 4.0;
+    const double w = prior.resolution.width;
+    const std::array<const char*, 5> names{"focal length fx", "principal point cx", "principal point cy",
+                                           "distortion k1", "distortion k2"};
+    const std::array<double, 5> fitted{ba.camera.fx_px, ba.camera.cx_px, ba.camera.cy_px, ba.camera.distortion[0],
+                                       ba.camera.distortion[1]};
+    const std::array<double, 5> told{prior.fx_px, prior.cx_px, prior.cy_px, prior.distortion[0], prior.distortion[1]};
+    const std::array<double, 5> sigma{o.camera_sigma.focal * prior.fx_px, o.camera_sigma.principal_point * w,
+                                      o.camera_sigma.principal_point * w, o.camera_sigma.distortion,
+                                      o.camera_sigma.distortion};
+    for (std::size_t i = 0; i < 5; ++i) {
+        const double moved = std::abs(fitted[i] - told[i]) / sigma[i];
+        const double seen = ba.camera_intrinsics_sigma[i] / sigma[i];
+        if (!(moved <= kMaxPriorSigmas)) {
+            throw CalibrationRefused("camera " + std::string(names[i]) + ": refined to " + std::to_string(fitted[i]) +
+                                     " from the prior's " + std::to_string(told[i]) + ", " + std::to_string(moved) +
+                                     " of its sigmas (limit " + std::to_string(kMaxPriorSigmas) +
+                                     "): the camera's chessboard calibration or the screen's size is wrong");
+        }
+        if (!(seen <= o.camera_sigma_gate)) {
+            throw CalibrationRefused("camera " + std::string(names[i]) +
+                                     ": barely determined by the screen and the "
+                                     "projectors (standard deviation " +
+                                     std::to_string(ba.camera_intrinsics_sigma[i]) + ", " + std::to_string(seen) +
+                                     " of the prior's, gate " + std::to_string(o.camera_sigma_gate) +
+                                     "): the camera sees too little of the screen's edges or of the projectors");
+        }
+    }
+}
+
 }  // namespace
 
 Eigen::Vector2d projector_content(const DeviceModel& projector, const ScreenModel& screen, double x, double y) {
@@ -230,10 +270,11 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
                                      " row bits resolved (need >= " + std::to_string(options.min_bits) + "; " +
                                      std::to_string(c.lit_pixels) + " camera pixels lit)");
         }
-        // With the screen still to be fitted, a projector's fit on the prior's cylinder is only a start: its gate
-        // is applied after the bundle adjustment instead.
+        // With the screen or the camera's intrinsics still to be fitted, a projector's fit on the prior's is only a
+        // start: its gate is applied after the bundle adjustment instead.
         AutocalOptions start_options = options;
-        if (options.fit_screen) start_options.max_projector_rms = std::numeric_limits<double>::infinity();
+        if (options.fit_screen || options.refine_camera_intrinsics)
+            start_options.max_projector_rms = std::numeric_limits<double>::infinity();
         ProjectorFit fit =
             fit_projector(edge.camera, prior, static_cast<int>(k), c.camera, c.projector, c.sigma, start_options);
         pr.rms_px = fit.rms_px;
@@ -245,6 +286,8 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
     // Step 4: camera pose and projector models refined together on every observation.
     BundleOptions bo;
     bo.refine_screen = options.fit_screen;
+    bo.refine_camera_intrinsics = options.refine_camera_intrinsics;
+    bo.camera_sigma = options.camera_sigma;
     BundleResult ba = bundle_adjust(prior.screen, edge.camera, result.projectors, edge.edges, observations, bo);
     if (options.fit_bow) try_bow(ba, edge.edges, observations, bo, options, result.report.bow);
     result.screen = ba.screen;
@@ -253,21 +296,25 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
                                  std::to_string(ba.screen.arc_deg) +
                                  " deg is no cylinder screen (radius > 0, arc in (0, 360]): the prior is too far off");
     }
+    if (options.refine_camera_intrinsics) check_camera_intrinsics(ba, prior.camera, options);
     result.camera = ba.camera;
     result.projectors = ba.projectors;
     result.report.camera_position_m = ba.camera.position_m;
     result.report.edge_rms_m = ba.edge_rms_m;
+    result.report.camera_intrinsics_sigma = ba.camera_intrinsics_sigma;
+    result.report.condition_number = ba.condition_number;
     for (std::size_t k = 0; k < n; ++k) {
         result.report.projectors[k].rms_px = ba.rms_px[k];
         result.report.projectors[k].rms_sigma = ba.rms_sigma[k];
         result.report.projectors[k].cells = ba.inliers[k];
-        if (options.fit_screen && ba.rms_sigma[k] > options.max_projector_rms) {
+        if ((options.fit_screen || options.refine_camera_intrinsics) && ba.rms_sigma[k] > options.max_projector_rms) {
             throw CalibrationRefused(
                 "projector " + std::to_string(k) + " '" + prior.projectors[k].id + "': fit rms " +
                 std::to_string(ba.rms_sigma[k]) + " (in units of the decoded positions' uncertainty) above its gate " +
-                std::to_string(options.max_projector_rms) + " after fitting the screen (radius " +
+                std::to_string(options.max_projector_rms) + " after the bundle adjustment (screen radius " +
                 std::to_string(ba.screen.radius_m) + " m, arc " + std::to_string(ba.screen.arc_deg) +
-                " deg): the screen is not a cylinder of the prior's heights?");
+                " deg; camera focal " + std::to_string(ba.camera.fx_px) +
+                " px): decoding errors, or the screen is not a cylinder of the prior's heights?");
         }
     }
     result.calibration = calibration_from_models(result.projectors, result.screen, content, options);

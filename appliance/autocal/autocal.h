@@ -38,7 +38,11 @@
 //  4. Bundle adjustment (bundle_adjust.h; Sajadi & Majumder 2010): camera pose and all projector
 //     models together on every correspondence and edge point, the 3D points constrained to the
 //     cylinder; with `fit_screen` also its radius and arc (the heights fix the scale), the projector fit
-//     gate then applied after it, and the fitted screen checked to be one.
+//     gate then applied after it, and the fitted screen checked to be one. With
+//     `refine_camera_intrinsics` (off by default) also the camera's focal length, principal point and k1, k2
+//     (Sajadi & Majumder 2009 for an uncalibrated camera on an extruded screen), each camera ray re-derived
+//     from its image position; the projector fit gate is then applied after it, and the refined intrinsics
+//     are gated (`camera_sigma_gate`, and within 4 prior sigmas of the prior's).
 //  5. Warp: grid samples at texel centres (warp_sampling.h) -> fitted projector ray -> cylinder
 //     -> content (u, v), left unclamped past the screen's edges (the blend is 0 there).
 //  0. The camera's auto-exposure must be locked (refused otherwise, before any pattern is shown).
@@ -122,6 +126,16 @@ struct CalibrationPrior {
     std::vector<DeviceModel> projectors;
 };
 
+// What is known of the camera's intrinsics before calibrating (a chessboard calibration's
+// uncertainty), as one standard deviation each: the weak prior that keeps the refinement of
+// AutocalOptions::refine_camera_intrinsics well posed where the screen and the projectors say
+// little (a Gaussian prior, i.e. MAP; Triggs et al. 2000, section 4.4). Positive.
+struct CameraIntrinsicsSigma {
+    double focal = 0.02;            // relative, of fx (fy follows with the prior's aspect ratio)
+    double principal_point = 0.02;  // of the image's width, both axes
+    double distortion = 0.05;       // k1 and k2
+};
+
 struct AutocalOptions {
     int warp_step_px = 2;             // warp/blend grid: one sample per this many output pixels, 1..64
     double blend_ramp = 0.12;         // blend ramp width, fraction of the projector's width, (0, 0.5]
@@ -159,6 +173,17 @@ struct AutocalOptions {
     // fits noise: 0.17 -> 0.21 px mean on the standard rig). Off: the screen is the cylinder.
     bool fit_bow = true;
     double bow_min_gain = 0.03;  // [0, 1)
+    // Refine the camera's focal length, principal point and radial distortion (k1, k2) in the bundle adjustment
+    // (bundle_adjust.h), from the projectors' correspondences and the screen's known shape, each pulled to the
+    // prior's by `camera_sigma`. Off (the default): the prior's intrinsics are taken as exact. Not yet on by
+    // default: on a grazing camera and on a wrong screen radius it gave silent errors above 1 px
+    // (docs/calibration.md, "The camera's intrinsics, refined").
+    bool refine_camera_intrinsics = false;
+    CameraIntrinsicsSigma camera_sigma{};
+    // Refused unless each refined intrinsic's standard deviation is at most this fraction of the prior's (the
+    // screen and the projectors must determine it, not the prior), (0, 1]; and unless each lies within 4 of the
+    // prior's sigmas of the prior's value.
+    double camera_sigma_gate = 0.25;
 };
 
 // Shows one signal image per projector (CV_32FC1 grey or CV_32FC3 RGB in [0, 1], projector
@@ -219,6 +244,10 @@ struct AutocalReport {
     int edge_points = 0;
     double edge_rms_m = 0.0;
     Eigen::Vector3d camera_position_m = Eigen::Vector3d::Zero();
+    // The bundle adjustment's conditioning (BundleResult): standard deviations of the camera's refined fx, cx,
+    // cy (px), k1, k2 (empty when not refined) and the scaled normal matrix's condition number.
+    std::vector<double> camera_intrinsics_sigma;
+    double condition_number = 0.0;
     int captures = 0;
     std::vector<ProjectorReport> projectors;
     BowTrial bow;

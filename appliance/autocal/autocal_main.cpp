@@ -3,7 +3,7 @@
 //
 //   mogao-autocal calibrate --rig rigs/standard.toml --out DIR [--scale 0.5] [--content 1920x1080]
 //                 [--alpha-bits 16] [--warp-step 2] [--gray-bits N] [--frames-per-pattern 1] [--no-colour]
-//                 [--no-falloff]
+//                 [--no-falloff] [--fit-screen] [--no-bow] [--refine-camera-intrinsics]
 //
 // Exit codes: 0 success, 1 the job failed or the calibration was refused (the message says why;
 // nothing in DIR changes), 2 bad command line.
@@ -45,6 +45,8 @@ int main(int argc, char** argv) {
     bool no_bow = false;
     cmd->add_flag("--no-bow", no_bow,
                   "Take the screen as an exact cylinder: do not try a bow (kept by default only where it pays)");
+    cmd->add_flag("--refine-camera-intrinsics", job.options.refine_camera_intrinsics,
+                  "Refine the camera's focal length, principal point and k1, k2 in the bundle adjustment");
     bool no_colour = false;
     cmd->add_flag("--no-colour", no_colour, "Geometry only: no response, black-level and colour matching step");
     bool no_falloff = false;

@@ -3,6 +3,7 @@
 #include "appliance/autocal/bundle_adjust.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -22,17 +23,54 @@ constexpr int kProj = 9;  // projector: fx, cx, cy, rotation vector (3), positio
 // four bow amplitudes (m, ScreenModel::bow_m) with refine_bow.
 constexpr int kScreenShape = 2;
 constexpr int kScreenBow = 4;
+// Camera intrinsics (last, with refine_camera_intrinsics): fx (fy = fx * the prior's aspect), cx, cy, k1, k2.
+constexpr int kIntrinsics = 5;
 
 Eigen::Matrix3d rotation_of(const Eigen::Vector3d& w) {
     const double a = w.norm();
     return a < 1e-15 ? Eigen::Matrix3d::Identity() : Eigen::AngleAxisd(a, w / a).toRotationMatrix();
 }
 
-DeviceModel camera_at(const DeviceModel& c0, const double* q) {
+// The camera the parameters describe: pose offsets `q`, and its intrinsics `qi` (nullptr: the prior's).
+DeviceModel camera_at(const DeviceModel& c0, const double* q, const double* qi = nullptr) {
     DeviceModel c = c0;
     c.position_m = c0.position_m + Eigen::Vector3d(q[0], q[1], q[2]);
     c.rotation = rotation_of(Eigen::Vector3d(q[3], q[4], q[5])) * c0.rotation;
+    if (qi != nullptr) {
+        c.fx_px = qi[0];
+        c.fy_px = qi[0] * c0.fy_px / c0.fx_px;
+        c.cx_px = qi[1];
+        c.cy_px = qi[2];
+        c.distortion[0] = qi[3];
+        c.distortion[1] = qi[4];
+    }
     return c;
+}
+
+// Normalised undistorted camera ray (z = 1) of image position `p` (pixel centres at +0.5): the
+// Brown-Conrady model inverted by OpenCV's fixed-point iteration (undistortPoints), to 1e-14, from
+// `start` (a nearby ray, e.g. the same point's for slightly different intrinsics; nullptr: the
+// distorted position).
+Eigen::Vector3d undistorted_ray(const DeviceModel& c, const Eigen::Vector2d& p,
+                                const Eigen::Vector3d* start = nullptr) {
+    const double xd = (p.x() - c.cx_px) / c.fx_px;
+    const double yd = (p.y() - c.cy_px) / c.fy_px;
+    const auto& k = c.distortion;  // k1, k2, p1, p2, k3
+    double x = start != nullptr ? start->x() : xd;
+    double y = start != nullptr ? start->y() : yd;
+    for (int i = 0; i < 100; ++i) {
+        const double r2 = x * x + y * y;
+        const double radial = 1.0 + r2 * (k[0] + r2 * (k[1] + r2 * k[4]));
+        const double dx = 2.0 * k[2] * x * y + k[3] * (r2 + 2.0 * x * x);
+        const double dy = k[2] * (r2 + 2.0 * y * y) + 2.0 * k[3] * x * y;
+        const double nx = (xd - dx) / radial;
+        const double ny = (yd - dy) / radial;
+        const bool done = std::abs(nx - x) + std::abs(ny - y) < 1e-14;
+        x = nx;
+        y = ny;
+        if (done) break;
+    }
+    return {x, y, 1.0};
 }
 
 DeviceModel projector_at(const DeviceModel& p0, const double* q) {
@@ -63,8 +101,11 @@ ScreenModel screen_at(const ScreenModel& s0, const double* qs, bool shape, bool 
     return s;
 }
 
+using Rays = std::vector<Eigen::Vector3d>;
+
 // Residuals of one block: the edges (block -1) or projector k's inlier correspondences. `qs` is the
-// screen's parameters (nullptr: the prior's screen, fixed).
+// screen's parameters (nullptr: the prior's screen, fixed); `qi` the camera's intrinsics (nullptr: the
+// prior's, fixed). A block's camera rays are computed once per set of camera intrinsics (rays_of).
 struct Problem {
     const ScreenModel& screen0;
     const DeviceModel& camera0;
@@ -76,25 +117,62 @@ struct Problem {
     double sigma_m = 0.005;
     bool refine_screen = false;
     bool refine_bow = false;
-    Eigen::Index screen_index = 0;  // first screen parameter in q
+    bool refine_intrinsics = false;
+    CameraIntrinsicsSigma camera_sigma{};
+    Eigen::Index screen_index = 0;      // first screen parameter in q
+    Eigen::Index intrinsics_index = 0;  // first camera intrinsic in q (after the screen's)
 
     [[nodiscard]] int screen_count() const {
         return (refine_screen ? kScreenShape : 0) + (refine_bow ? kScreenBow : 0);
     }
+    [[nodiscard]] int parameter_count() const {
+        return static_cast<int>(intrinsics_index) + (refine_intrinsics ? kIntrinsics : 0);
+    }
     [[nodiscard]] const double* screen_params(const Eigen::VectorXd& q) const {
         return screen_count() > 0 ? q.data() + screen_index : nullptr;
+    }
+    [[nodiscard]] const double* intrinsic_params(const Eigen::VectorXd& q) const {
+        return refine_intrinsics ? q.data() + intrinsics_index : nullptr;
     }
     [[nodiscard]] ScreenModel screen(const double* qs) const {
         return screen_at(screen0, qs, refine_screen, refine_bow);
     }
+    // The prior's intrinsics as parameters, and their prior standard deviations.
+    [[nodiscard]] Eigen::Matrix<double, kIntrinsics, 1> intrinsics0() const {
+        return {camera0.fx_px, camera0.cx_px, camera0.cy_px, camera0.distortion[0], camera0.distortion[1]};
+    }
+    [[nodiscard]] Eigen::Matrix<double, kIntrinsics, 1> intrinsics_sigma() const {
+        const double w = camera0.resolution.width;
+        return {camera_sigma.focal * camera0.fx_px, camera_sigma.principal_point * w, camera_sigma.principal_point * w,
+                camera_sigma.distortion, camera_sigma.distortion};
+    }
 
-    [[nodiscard]] Eigen::VectorXd edge_residuals(const double* qc, const double* qs) const {
+    // The camera rays of a block (-1: edges) for camera intrinsics `qi`: from the image positions where
+    // the observations carry them (iterated from `start`'s rays when given), else the fixed rays.
+    [[nodiscard]] Rays rays_of(int block, const double* qi, const Rays* start = nullptr) const {
+        const DeviceModel c = camera_at(camera0, std::array<double, 6>{}.data(), qi);
+        const auto from = [&](std::size_t i) { return start != nullptr ? &(*start)[i] : nullptr; };
+        Rays out;
+        if (block < 0) {
+            out.reserve(edges.size());
+            for (std::size_t i = 0; i < edges.size(); ++i)
+                out.push_back(edges[i].image.allFinite() ? undistorted_ray(c, edges[i].image, from(i)) : edges[i].ray);
+            return out;
+        }
+        const ProjectorObservations& o = obs[static_cast<std::size_t>(block)];
+        if (o.camera_px.empty()) return o.rays;
+        out.reserve(o.camera_px.size());
+        for (std::size_t i = 0; i < o.camera_px.size(); ++i) out.push_back(undistorted_ray(c, o.camera_px[i], from(i)));
+        return out;
+    }
+
+    [[nodiscard]] Eigen::VectorXd edge_residuals(const double* qc, const double* qs, const Rays& rays) const {
         const ScreenModel screen = this->screen(qs);
         const DeviceModel c = camera_at(camera0, qc);
         const double half = screen.arc_deg * std::numbers::pi / 360.0;
         Eigen::VectorXd r(static_cast<Eigen::Index>(edges.size()));
         for (std::size_t i = 0; i < edges.size(); ++i) {
-            const Eigen::Vector3d x = ray_on_screen(screen, c, edges[i].ray);
+            const Eigen::Vector3d x = ray_on_screen(screen, c, rays[i]);
             const double theta = std::atan2(x.x(), -x.z());
             double e = 0.0;
             switch (edges[i].edge) {
@@ -117,7 +195,7 @@ struct Problem {
     }
 
     [[nodiscard]] Eigen::VectorXd projector_residuals(std::size_t k, const double* qc, const double* qp,
-                                                      const double* qs) const {
+                                                      const double* qs, const Rays& rays) const {
         const ScreenModel screen = this->screen(qs);
         const DeviceModel c = camera_at(camera0, qc);
         const DeviceModel p = projector_at(projectors0[k], qp);
@@ -126,7 +204,7 @@ struct Problem {
         Eigen::VectorXd r(2 * static_cast<Eigen::Index>(use.size()));
         for (std::size_t u = 0; u < use.size(); ++u) {
             const auto i = static_cast<std::size_t>(use[u]);
-            const Eigen::Vector3d x = ray_on_screen(screen, c, obs[k].rays[i]);
+            const Eigen::Vector3d x = ray_on_screen(screen, c, rays[i]);
             const Eigen::Vector3d d = rt * (x - p.position_m);
             Eigen::Vector2d e(1e3, 1e3);  // behind the projector or missed: a large, constant residual
             if (d.allFinite() && d.z() > 1e-9) {
@@ -138,21 +216,30 @@ struct Problem {
         }
         return r;
     }
+
+    // Residuals of block (-1: edges) at parameters v, with the block's rays for v's camera intrinsics.
+    [[nodiscard]] Eigen::VectorXd block_residuals(int block, const Eigen::VectorXd& v, const Rays& rays) const {
+        return block < 0 ? edge_residuals(v.data(), screen_params(v), rays)
+                         : projector_residuals(static_cast<std::size_t>(block), v.data(),
+                                               v.data() + kCam + kProj * block, screen_params(v), rays);
+    }
 };
 
-double step_of(int j) {  // forward-difference steps: pixels for intrinsics, metres and radians for poses
-    return j < 3 ? 1e-4 : 1e-8;
+// Forward-difference step of parameter `idx` of q: pixels for intrinsics (1e-4), metres and radians for
+// poses and the screen (1e-8), distortion coefficients (1e-7).
+double step_of(const Problem& pb, int idx) {
+    if (idx < kCam) return 1e-8;
+    if (idx >= pb.intrinsics_index) return idx - pb.intrinsics_index < 3 ? 1e-4 : 1e-7;
+    if (idx >= pb.screen_index) return 1e-8;
+    return (idx - kCam) % kProj < 3 ? 1e-4 : 1e-8;
 }
 
-// Adds block's J^T J and J^T r (columns: the camera's, if refined, and the block's own) to the system.
+// Adds block's J^T J and J^T r (columns: the camera's, if refined, the block's own, the screen's and
+// the camera intrinsics', if refined) to the system.
 void accumulate(const Problem& pb, const Eigen::VectorXd& q, int block, bool refine_camera, Eigen::MatrixXd& jtj,
                 Eigen::VectorXd& jtr, double& cost) {
-    const auto eval = [&](const Eigen::VectorXd& v) {
-        return block < 0 ? pb.edge_residuals(v.data(), pb.screen_params(v))
-                         : pb.projector_residuals(static_cast<std::size_t>(block), v.data(),
-                                                  v.data() + kCam + kProj * block, pb.screen_params(v));
-    };
-    const Eigen::VectorXd r0 = eval(q);
+    const Rays rays = pb.rays_of(block, pb.intrinsic_params(q));
+    const Eigen::VectorXd r0 = pb.block_residuals(block, q, rays);
     cost += r0.squaredNorm();
     std::vector<int> cols;
     if (refine_camera) {
@@ -162,13 +249,18 @@ void accumulate(const Problem& pb, const Eigen::VectorXd& q, int block, bool ref
         for (int j = 0; j < kProj; ++j) cols.push_back(kCam + kProj * block + j);
     }
     for (int j = 0; j < pb.screen_count(); ++j) cols.push_back(static_cast<int>(pb.screen_index) + j);
+    for (int j = 0; j < (pb.refine_intrinsics ? kIntrinsics : 0); ++j)
+        cols.push_back(static_cast<int>(pb.intrinsics_index) + j);
     Eigen::MatrixXd jac(r0.size(), static_cast<Eigen::Index>(cols.size()));
     for (std::size_t c = 0; c < cols.size(); ++c) {
         Eigen::VectorXd v = q;
         const int idx = cols[c];
-        const double h = idx < kCam || idx >= pb.screen_index ? 1e-8 : step_of(idx - kCam - kProj * block);
+        const double h = step_of(pb, idx);
         v[idx] += h;
-        jac.col(static_cast<Eigen::Index>(c)) = (eval(v) - r0) / h;
+        const Eigen::VectorXd r = idx >= pb.intrinsics_index
+                                      ? pb.block_residuals(block, v, pb.rays_of(block, pb.intrinsic_params(v), &rays))
+                                      : pb.block_residuals(block, v, rays);
+        jac.col(static_cast<Eigen::Index>(c)) = (r - r0) / h;
     }
     const Eigen::MatrixXd a = jac.transpose() * jac;
     const Eigen::VectorXd b = jac.transpose() * r0;
@@ -180,24 +272,51 @@ void accumulate(const Problem& pb, const Eigen::VectorXd& q, int block, bool ref
     }
 }
 
-double total_cost(const Problem& pb, const Eigen::VectorXd& q, bool refine_camera) {
-    double cost = refine_camera ? pb.edge_residuals(q.data(), pb.screen_params(q)).squaredNorm() : 0.0;
-    for (std::size_t k = 0; k < pb.obs.size(); ++k) {
-        cost += pb.projector_residuals(k, q.data(), q.data() + kCam + kProj * static_cast<int>(k), pb.screen_params(q))
-                    .squaredNorm();
+// The prior on the camera's intrinsics: residuals (q_i - prior_i) / sigma_i.
+Eigen::Matrix<double, kIntrinsics, 1> intrinsics_prior_residuals(const Problem& pb, const Eigen::VectorXd& q) {
+    if (!pb.refine_intrinsics) return Eigen::Matrix<double, kIntrinsics, 1>::Zero();
+    return (q.segment<kIntrinsics>(pb.intrinsics_index) - pb.intrinsics0()).cwiseQuotient(pb.intrinsics_sigma());
+}
+
+// The whole system's normal equations at q (every block, the intrinsics' prior); returns the cost.
+double normal_equations(const Problem& pb, const Eigen::VectorXd& q, bool refine_camera, Eigen::MatrixXd& jtj,
+                        Eigen::VectorXd& jtr) {
+    jtj = Eigen::MatrixXd::Zero(q.size(), q.size());
+    jtr = Eigen::VectorXd::Zero(q.size());
+    double cost = 0.0;
+    const int blocks = static_cast<int>(pb.obs.size());
+    for (int b = refine_camera ? -1 : 0; b < blocks; ++b) accumulate(pb, q, b, refine_camera, jtj, jtr, cost);
+    if (pb.refine_intrinsics) {
+        const Eigen::Matrix<double, kIntrinsics, 1> r = intrinsics_prior_residuals(pb, q);
+        const Eigen::Matrix<double, kIntrinsics, 1> inv = pb.intrinsics_sigma().cwiseInverse();
+        const Eigen::Index i0 = pb.intrinsics_index;
+        for (int j = 0; j < kIntrinsics; ++j) {
+            jtj(i0 + j, i0 + j) += inv[j] * inv[j];
+            jtr[i0 + j] += inv[j] * r[j];
+        }
+        cost += r.squaredNorm();
     }
+    if (!refine_camera) jtj.topLeftCorner<kCam, kCam>().setIdentity();  // fixed: zero step
     return cost;
+}
+
+double total_cost(const Problem& pb, const Eigen::VectorXd& q, bool refine_camera) {
+    const double* qi = pb.intrinsic_params(q);
+    double cost =
+        refine_camera ? pb.edge_residuals(q.data(), pb.screen_params(q), pb.rays_of(-1, qi)).squaredNorm() : 0.0;
+    for (std::size_t k = 0; k < pb.obs.size(); ++k) {
+        const int b = static_cast<int>(k);
+        cost += pb.block_residuals(b, q, pb.rays_of(b, qi)).squaredNorm();
+    }
+    return cost + intrinsics_prior_residuals(pb, q).squaredNorm();
 }
 
 void levenberg_marquardt(const Problem& pb, Eigen::VectorXd& q, bool refine_camera, int max_iterations) {
     double lambda = 1e-3;
-    const int blocks = static_cast<int>(pb.obs.size());
     for (int iter = 0; iter < max_iterations; ++iter) {
-        Eigen::MatrixXd jtj = Eigen::MatrixXd::Zero(q.size(), q.size());
-        Eigen::VectorXd jtr = Eigen::VectorXd::Zero(q.size());
-        double cost = 0.0;
-        for (int b = refine_camera ? -1 : 0; b < blocks; ++b) accumulate(pb, q, b, refine_camera, jtj, jtr, cost);
-        if (!refine_camera) jtj.topLeftCorner<kCam, kCam>().setIdentity();  // fixed: zero step
+        Eigen::MatrixXd jtj;
+        Eigen::VectorXd jtr;
+        const double cost = normal_equations(pb, q, refine_camera, jtj, jtr);
         bool improved = false;
         for (int tries = 0; tries < 8 && !improved; ++tries) {
             Eigen::MatrixXd a = jtj;
@@ -217,6 +336,56 @@ void levenberg_marquardt(const Problem& pb, Eigen::VectorXd& q, bool refine_came
     }
 }
 
+// Re-weights projector k from its current residuals (sigma = rms) and drops its outliers (> 4x the
+// median; none in the last round), recording the rms in `out`.
+void reweight(Problem& pb, const Eigen::VectorXd& q, std::size_t k, bool last, BundleResult& out) {
+    const double old_sigma = pb.sigma_px[k];
+    const int b = static_cast<int>(k);
+    const Eigen::VectorXd r = pb.block_residuals(b, q, pb.rays_of(b, pb.intrinsic_params(q))) * old_sigma;
+    std::vector<double> err(pb.inliers[k].size());
+    for (std::size_t u = 0; u < err.size(); ++u) err[u] = r.segment<2>(2 * static_cast<Eigen::Index>(u)).norm();
+    std::vector<double> sorted = err;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
+    const double limit = 4.0 * std::max(sorted[sorted.size() / 2], 0.01);
+    std::vector<int> keep;
+    double ss = 0.0;
+    double ss_px = 0.0;
+    for (std::size_t u = 0; u < err.size(); ++u) {
+        if (last || err[u] <= limit) {
+            const auto i = static_cast<std::size_t>(pb.inliers[k][u]);
+            const Eigen::Vector2d s = pb.obs[k].sigma_px.empty() ? Eigen::Vector2d(1.0, 1.0) : pb.obs[k].sigma_px[i];
+            keep.push_back(pb.inliers[k][u]);
+            ss += err[u] * err[u];
+            ss_px += r.segment<2>(2 * static_cast<Eigen::Index>(u)).cwiseProduct(s).squaredNorm();
+        }
+    }
+    const double count = std::max<double>(1.0, static_cast<double>(keep.size()));
+    out.rms_sigma[k] = std::sqrt(ss / count);
+    out.rms_px[k] = std::sqrt(ss_px / count);
+    out.inliers[k] = static_cast<int>(keep.size());
+    pb.inliers[k] = std::move(keep);
+    pb.sigma_px[k] = std::max(out.rms_sigma[k], 1e-3);
+}
+
+// BundleResult's conditioning figures from the normal matrix at the solution.
+void conditioning(const Problem& pb, const Eigen::VectorXd& q, bool refine_camera, BundleResult& out) {
+    Eigen::MatrixXd n;
+    Eigen::VectorXd g;
+    (void)normal_equations(pb, q, refine_camera, n, g);
+    const Eigen::VectorXd d = n.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
+    const Eigen::MatrixXd scaled = d.asDiagonal() * n * d.asDiagonal();
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(scaled, Eigen::EigenvaluesOnly);
+    const Eigen::VectorXd ev = eig.eigenvalues();
+    out.condition_number =
+        ev.minCoeff() > 0.0 ? ev.maxCoeff() / ev.minCoeff() : std::numeric_limits<double>::infinity();
+    if (!pb.refine_intrinsics) return;
+    const Eigen::MatrixXd cov =
+        d.asDiagonal() * scaled.ldlt().solve(Eigen::MatrixXd::Identity(n.rows(), n.cols())) * d.asDiagonal();
+    for (int j = 0; j < kIntrinsics; ++j)
+        out.camera_intrinsics_sigma.push_back(
+            std::sqrt(std::max(0.0, cov(pb.intrinsics_index + j, pb.intrinsics_index + j))));
+}
+
 }  // namespace
 
 Eigen::Vector3d ray_on_screen(const ScreenModel& screen, const DeviceModel& camera, const Eigen::Vector3d& ray) {
@@ -233,16 +402,27 @@ BundleResult bundle_adjust(const ScreenModel& screen, const DeviceModel& camera,
     }
     const std::size_t n = projectors.size();
     Problem pb{screen, camera, projectors, edges, observations, {}, std::vector<double>(n, 1.0), 0.005};
-    // The screen needs the edges (its ends and heights) and the camera refined with it.
-    pb.refine_screen = options.refine_screen && options.refine_camera && !edges.empty();
-    pb.refine_bow = options.refine_bow && options.refine_camera && !edges.empty();
+    const bool refine_camera = options.refine_camera && !edges.empty();
+    // The screen needs the edges (its ends and heights) and the camera refined with it; so do the camera's
+    // intrinsics (the edges tie its focal length to the screen's known size).
+    pb.refine_screen = options.refine_screen && refine_camera;
+    pb.refine_bow = options.refine_bow && refine_camera;
+    pb.refine_intrinsics = options.refine_camera_intrinsics && refine_camera;
+    pb.camera_sigma = options.camera_sigma;
     pb.screen_index = kCam + kProj * static_cast<Eigen::Index>(n);
-    Eigen::VectorXd q = Eigen::VectorXd::Zero(pb.screen_index + pb.screen_count());
+    pb.intrinsics_index = pb.screen_index + pb.screen_count();
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(pb.parameter_count());
     for (std::size_t k = 0; k < n; ++k) {
         const ProjectorObservations& o = observations[k];
-        if (o.rays.size() != o.projector.size() || o.rays.size() < 10) {
+        if (o.rays.size() != o.projector.size() || o.rays.size() < 10 ||
+            (!o.camera_px.empty() && o.camera_px.size() != o.rays.size())) {
             throw std::invalid_argument("bundle_adjust: projector " + std::to_string(k) +
-                                        ": needs >= 10 correspondences with as many rays as positions");
+                                        ": needs >= 10 correspondences with as many rays (and camera positions, if "
+                                        "any) as projector positions");
+        }
+        if (pb.refine_intrinsics && o.camera_px.empty()) {
+            throw std::invalid_argument("bundle_adjust: projector " + std::to_string(k) +
+                                        ": refining the camera's intrinsics needs its camera positions (camera_px)");
         }
         pb.inliers.emplace_back(o.rays.size());
         for (std::size_t i = 0; i < o.rays.size(); ++i) pb.inliers[k][i] = static_cast<int>(i);
@@ -251,51 +431,25 @@ BundleResult bundle_adjust(const ScreenModel& screen, const DeviceModel& camera,
         q[base + 1] = projectors[k].cx_px;
         q[base + 2] = projectors[k].cy_px;
     }
-    const bool refine_camera = options.refine_camera && !edges.empty();
+    if (pb.refine_intrinsics) q.segment<kIntrinsics>(pb.intrinsics_index) = pb.intrinsics0();
     BundleResult out;
     out.rms_px.assign(n, 0.0);
     out.rms_sigma.assign(n, 0.0);
     out.inliers.assign(n, 0);
     for (int round = 0; round <= options.rounds; ++round) {
-        // Re-weight from the current residuals (sigma = rms), then drop outliers (> 4x the median).
-        for (std::size_t k = 0; k < n; ++k) {
-            const double old_sigma = pb.sigma_px[k];
-            const Eigen::VectorXd r =
-                pb.projector_residuals(k, q.data(), q.data() + kCam + kProj * k, pb.screen_params(q)) * old_sigma;
-            std::vector<double> err(pb.inliers[k].size());
-            for (std::size_t u = 0; u < err.size(); ++u) err[u] = r.segment<2>(2 * static_cast<Eigen::Index>(u)).norm();
-            std::vector<double> sorted = err;
-            std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
-            const double limit = 4.0 * std::max(sorted[sorted.size() / 2], 0.01);
-            std::vector<int> keep;
-            double ss = 0.0;
-            double ss_px = 0.0;
-            for (std::size_t u = 0; u < err.size(); ++u) {
-                if (round == options.rounds || err[u] <= limit) {
-                    const auto i = static_cast<std::size_t>(pb.inliers[k][u]);
-                    const Eigen::Vector2d s =
-                        observations[k].sigma_px.empty() ? Eigen::Vector2d(1.0, 1.0) : observations[k].sigma_px[i];
-                    keep.push_back(pb.inliers[k][u]);
-                    ss += err[u] * err[u];
-                    ss_px += r.segment<2>(2 * static_cast<Eigen::Index>(u)).cwiseProduct(s).squaredNorm();
-                }
-            }
-            const double count = std::max<double>(1.0, static_cast<double>(keep.size()));
-            out.rms_sigma[k] = std::sqrt(ss / count);
-            out.rms_px[k] = std::sqrt(ss_px / count);
-            out.inliers[k] = static_cast<int>(keep.size());
-            pb.inliers[k] = std::move(keep);
-            pb.sigma_px[k] = std::max(out.rms_sigma[k], 1e-3);
-        }
+        for (std::size_t k = 0; k < n; ++k) reweight(pb, q, k, round == options.rounds, out);
         if (refine_camera) {
-            out.edge_rms_m = pb.sigma_m * pb.edge_residuals(q.data(), pb.screen_params(q)).norm() /
-                             std::sqrt(std::max<double>(1.0, static_cast<double>(edges.size())));
+            out.edge_rms_m =
+                pb.sigma_m *
+                pb.edge_residuals(q.data(), pb.screen_params(q), pb.rays_of(-1, pb.intrinsic_params(q))).norm() /
+                std::sqrt(std::max<double>(1.0, static_cast<double>(edges.size())));
             pb.sigma_m = std::max(out.edge_rms_m, 1e-5);
         }
         if (round == options.rounds) break;
         levenberg_marquardt(pb, q, refine_camera, options.max_iterations);
     }
-    out.camera = camera_at(camera, q.data());
+    conditioning(pb, q, refine_camera, out);
+    out.camera = camera_at(camera, q.data(), pb.intrinsic_params(q));
     out.screen = pb.screen(pb.screen_params(q));
     for (std::size_t k = 0; k < n; ++k)
         out.projectors.push_back(projector_at(projectors[k], q.data() + kCam + kProj * k));

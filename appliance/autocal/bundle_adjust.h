@@ -9,9 +9,25 @@
 // and arc); the screen's lit edges tie the pose to the screen's
 // ends and heights (the cylinder alone leaves a rotation about its axis and a shift along it).
 //
+// The camera's intrinsics (BundleOptions::refine_camera_intrinsics: fx with the prior's aspect, cx, cy,
+// k1, k2) are unknowns too, as in the uncalibrated-camera registration of Sajadi & Majumder 2009
+// ("Markerless view-independent registration of multiple distorted projectors on extruded surfaces
+// using an uncalibrated camera", IEEE TVCG 15(6)), where the screen's known boundary (its top and
+// bottom curves, its ends) determines the camera's focal length with its pose; here the rays are
+// re-derived from the camera's image positions at every evaluation, so the projectors' correspondences
+// (each projector a pinhole: the camera's ray errors bend its points off any pinhole, through the
+// camera-projector baseline on the curved screen) add their evidence. Gauge (Triggs et al. 2000,
+// section 9): the screen's known cylinder, heights and ends fix the frame, scale and the rotation about
+// the axis, so no parameter is left free by a symmetry; the camera's aspect ratio, skew (0), p1, p2 and
+// k3 stay the prior's; what the data barely separate (principal point against a small rotation, focal
+// length against distance) is held by a weak Gaussian prior on each intrinsic (CameraIntrinsicsSigma,
+// a chessboard's uncertainty), and reported: per-parameter standard deviations from the inverse of
+// the normal matrix and its condition number after scaling to unit diagonal (BundleResult).
+//
 // Minimised (Levenberg-Marquardt, Marquardt 1963, forward-difference Jacobian in double):
 //   sum over correspondences of |(project_k(X(camera, ray)) - measured) / sigma_i|^2 / s_k^2
 //   + sum over edge points of (distance on the screen of X(camera, ray) from its edge)^2 / sigma_e^2
+//   + sum over refined camera intrinsics of ((value - prior's) / prior sigma)^2
 // with X(camera, ray) = forward intersection of the camera ray with the cylinder; project_k the
 // pinhole x = fx X'/Z' + cx, y = fx * aspect Y'/Z' + cy (aspect fy/fx of the prior fixed, image
 // positions with pixel centres at +0.5, X' = R_k^T (X - position_k)); sigma_i per point and axis
@@ -21,6 +37,7 @@
 // correspondences beyond 4x the median residual of their projector are dropped between rounds.
 #pragma once
 
+#include <limits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -31,18 +48,24 @@ namespace mogao::autocal {
 
 enum class ScreenEdge { top, bottom, left_end, right_end };
 
-// An edge point: its undistorted camera ray (camera frame, z = 1) and the edge it lies on.
+// An edge point: its undistorted camera ray (camera frame, z = 1) and the edge it lies on; with its
+// camera image position (pixel centres at +0.5; NaN: unknown) the ray follows the camera's
+// intrinsics as they are refined (BundleOptions::refine_camera_intrinsics).
 struct EdgeObservation {
     Eigen::Vector3d ray;
     ScreenEdge edge = ScreenEdge::top;
+    Eigen::Vector2d image{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
 };
 
 // One projector's correspondences: undistorted camera rays (camera frame, z = 1) and the
-// projector image positions they were decoded to (pixel centres at +0.5).
+// projector image positions they were decoded to (pixel centres at +0.5). `camera_px`, when given
+// (as many as rays), holds the camera image positions the rays came from: the adjustment then
+// re-derives the rays from the camera's current intrinsics (undistorted as OpenCV does).
 struct ProjectorObservations {
     std::vector<Eigen::Vector3d> rays;
     std::vector<Eigen::Vector2d> projector;
-    std::vector<Eigen::Vector2d> sigma_px;  // per point and axis: its uncertainty (empty: 1 px each)
+    std::vector<Eigen::Vector2d> sigma_px;   // per point and axis: its uncertainty (empty: 1 px each)
+    std::vector<Eigen::Vector2d> camera_px;  // empty: the rays are fixed
 };
 
 struct BundleOptions {
@@ -54,6 +77,11 @@ struct BundleOptions {
     // The screen's bow too (ScreenModel::bow_m; with the camera, like refine_screen): the 3D points then
     // follow the bowed surface along the camera rays, and the projectors' rays tell its depth (stereo).
     bool refine_bow = false;
+    // The camera's focal length, principal point and radial distortion k1, k2 too (with the camera's pose;
+    // the aspect ratio, p1, p2 and k3 stay the prior's), each pulled to the prior by `camera_sigma`. Needs the
+    // observations' camera image positions (camera_px, EdgeObservation::image).
+    bool refine_camera_intrinsics = false;
+    CameraIntrinsicsSigma camera_sigma;
     int rounds = 2;           // LM runs, outliers dropped between them
     int max_iterations = 40;  // LM iterations per round
 };
@@ -66,6 +94,12 @@ struct BundleResult {
     std::vector<double> rms_sigma;  // the same in units of each point's sigma_px (about 1 for a good fit)
     std::vector<int> inliers;       // per projector
     double edge_rms_m = 0.0;
+    // Conditioning at the solution, from the normal matrix N = J^T J of the whitened residuals (prior
+    // included): standard deviations sqrt(diag(N^-1)) of the camera's fx, cx, cy (px), k1, k2 when
+    // refined (else empty), and the condition number of N after scaling it to unit diagonal (its
+    // largest over its smallest eigenvalue; large: some combination of parameters is barely seen).
+    std::vector<double> camera_intrinsics_sigma;
+    double condition_number = 0.0;
 };
 
 // `projectors` are the starting models (intrinsics and pose); observations[k] belong to

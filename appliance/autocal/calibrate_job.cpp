@@ -129,6 +129,26 @@ nlohmann::json colour_report(const ColourResult& c) {
     return out;
 }
 
+// The camera as the calibration ended with it: edges, intrinsics fitted (or the prior's) beside the
+// prior's, and the bundle adjustment's conditioning (standard deviations, condition number).
+nlohmann::json camera_report(const AutocalResult& r, const CalibrationPrior& prior, const AutocalOptions& options) {
+    const auto intrinsics = [](const DeviceModel& c) {
+        return nlohmann::json{{"fx_px", c.fx_px}, {"fy_px", c.fy_px},      {"cx_px", c.cx_px},
+                              {"cy_px", c.cy_px}, {"k1", c.distortion[0]}, {"k2", c.distortion[1]}};
+    };
+    nlohmann::json out = {{"edge_points", r.report.edge_points},
+                          {"edge_rms_mm", r.report.edge_rms_m * 1e3},
+                          {"intrinsics_refined", options.refine_camera_intrinsics},
+                          {"intrinsics", intrinsics(r.camera)},
+                          {"prior_intrinsics", intrinsics(prior.camera)},
+                          {"bundle_condition_number", r.report.condition_number}};
+    const std::vector<double>& s = r.report.camera_intrinsics_sigma;
+    if (s.size() == 5) {
+        out["intrinsics_sigma"] = {{"fx_px", s[0]}, {"cx_px", s[1]}, {"cy_px", s[2]}, {"k1", s[3]}, {"k2", s[4]}};
+    }
+    return out;
+}
+
 }  // namespace
 
 nlohmann::json run_calibrate_job(const CalibrateJob& job) {
@@ -167,7 +187,7 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
          {{"compute_s", calibrate_s - source.simulate_s()},
           {"simulate_s", source.simulate_s()},
           {"calibrate_wall_s", calibrate_s}}},
-        {"camera", {{"edge_points", r.report.edge_points}, {"edge_rms_mm", r.report.edge_rms_m * 1e3}}},
+        {"camera", camera_report(r, prior, job.options)},
         {"screen",
          {{"fitted", job.options.fit_screen},
           {"bow_m", r.screen.bow_m},

@@ -35,7 +35,13 @@ rig::VirtualRig scaled_rig(const rig::VirtualRig& rig, double projector_scale, d
     }
     rig::VirtualRig out = rig;
     for (rig::RigProjector& p : out.projectors) scale_device(p.resolution, p.intrinsics, projector_scale);
+    const ImageSize camera_before = out.camera.resolution;
     scale_device(out.camera.resolution, out.camera.intrinsics, camera_scale);
+    // The prior's principal point error is in camera pixels: it scales with them.
+    out.prior.camera_principal_point_error_px.x() *=
+        static_cast<double>(out.camera.resolution.width) / camera_before.width;
+    out.prior.camera_principal_point_error_px.y() *=
+        static_cast<double>(out.camera.resolution.height) / camera_before.height;
     out.camera.blur_sigma_px *= camera_scale;
     for (rig::RigCamera& c : out.more_cameras) {  // every camera of the rig, not only the calibration's
         scale_device(c.resolution, c.intrinsics, camera_scale);
@@ -59,14 +65,18 @@ CalibrationPrior prior_from_rig(const rig::VirtualRig& rig) {
     pose.yaw_deg += e.camera_angle_error_deg.x();
     pose.pitch_deg += e.camera_angle_error_deg.y();
     pose.roll_deg += e.camera_angle_error_deg.z();
+    // The camera's intrinsics as a chessboard calibration leaves them: focal, principal point and
+    // distortion each off by the prior's errors (the simulator films with the true lens).
     const double cf = 1.0 + e.camera_focal_error;
+    std::array<double, 5> distortion = c.intrinsics.distortion;
+    for (std::size_t i = 0; i < distortion.size(); ++i) distortion[i] += e.camera_distortion_error[i];
     prior.camera = {"camera",
                     c.resolution,
                     c.intrinsics.fx_px * cf,
                     c.intrinsics.fy_px * cf,
-                    c.intrinsics.cx_px,
-                    c.intrinsics.cy_px,
-                    c.intrinsics.distortion,
+                    c.intrinsics.cx_px + e.camera_principal_point_error_px.x(),
+                    c.intrinsics.cy_px + e.camera_principal_point_error_px.y(),
+                    distortion,
                     rig::device_to_screen(pose),
                     pose.position_m,
                     {}};

@@ -42,7 +42,8 @@ private:
 // projector pixels then scale with `projector_scale`). Scales in (0, 1].
 [[nodiscard]] rig::VirtualRig scaled_rig(const rig::VirtualRig& rig, double projector_scale, double camera_scale);
 
-// What the calibration is told about a rig: screen, camera intrinsics (focal error applied) and
+// What the calibration is told about a rig: screen, camera intrinsics (focal, principal point and
+// distortion errors applied, as a chessboard calibration leaves them; never the truth's) and
 // pose (position and angle errors applied), projector resolutions, data-sheet intrinsics (focal
 // error applied) and ids; the rig's [prior] section holds the errors.
 [[nodiscard]] CalibrationPrior prior_from_rig(const rig::VirtualRig& rig);

@@ -249,7 +249,7 @@ EdgeFit fit_camera_pose(const cv::Mat1f& lit, const CalibrationPrior& prior, con
             which = std::abs(x.y() - prior.screen.top_m) < std::abs(x.y() - prior.screen.bottom_m) ? ScreenEdge::top
                                                                                                    : ScreenEdge::bottom;
         }
-        fit.edges.push_back({rays[i], which});
+        fit.edges.push_back({rays[i], which, {image[i].x, image[i].y}});
     }
     if (fit.points < 200) {
         throw CalibrationRefused(
@@ -323,6 +323,7 @@ ProjectorFit fit_projector(const DeviceModel& camera, const CalibrationPrior& pr
         obs.rays.push_back(rays[i]);
         obs.projector.emplace_back(projector_points[i].x, projector_points[i].y);
         obs.sigma_px.emplace_back(sigmas[i].x, sigmas[i].y);
+        obs.camera_px.emplace_back(camera_points[i].x, camera_points[i].y);
     }
     BundleOptions bo;
     bo.refine_camera = false;

@@ -196,6 +196,9 @@ VirtualRig read_root(const toml::value& root, const std::string& file) {
         rig.prior.camera_position_error_m = t.vector3("camera_position_error_m", rig.prior.camera_position_error_m);
         rig.prior.camera_angle_error_deg = t.vector3("camera_angle_error_deg", rig.prior.camera_angle_error_deg);
         rig.prior.camera_focal_error = t.number("camera_focal_error", 0.0);
+        const auto pp = t.numbers<2>("camera_principal_point_error_px", {0.0, 0.0});
+        rig.prior.camera_principal_point_error_px = {pp[0], pp[1]};
+        rig.prior.camera_distortion_error = t.numbers<5>("camera_distortion_error", {});
         rig.prior.projector_focal_error = t.number("projector_focal_error", 0.0);
         rig.prior.screen_radius_error_m = t.number("screen_radius_error_m", 0.0);
         rig.prior.screen_arc_error_deg = t.number("screen_arc_error_deg", 0.0);

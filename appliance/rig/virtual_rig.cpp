@@ -133,6 +133,24 @@ VirtualRig seen_by(const VirtualRig& rig, std::size_t i) {
     return r;
 }
 
+// The errors the calibration is told the rig with (RigPrior): what it is told must still be a screen and a lens.
+void validate_prior(const VirtualRig& rig) {
+    const RigScreen& s = rig.screen;
+    const RigPrior& e = rig.prior;
+    check_range(e.screen_radius_error_m, -0.5 * s.radius_m, 0.5 * s.radius_m, "prior.screen_radius_error_m");
+    check_range(e.screen_arc_error_deg, -0.5 * s.arc_deg, std::min(0.5 * s.arc_deg, 360.0 - s.arc_deg),
+                "prior.screen_arc_error_deg");
+    check_range(e.camera_focal_error, -0.5, 0.5, "prior.camera_focal_error");
+    check_range(e.camera_principal_point_error_px.x(), -0.25 * rig.camera.resolution.width,
+                0.25 * rig.camera.resolution.width, "prior.camera_principal_point_error_px[0]");
+    check_range(e.camera_principal_point_error_px.y(), -0.25 * rig.camera.resolution.height,
+                0.25 * rig.camera.resolution.height, "prior.camera_principal_point_error_px[1]");
+    for (std::size_t i = 0; i < e.camera_distortion_error.size(); ++i) {
+        check_range(e.camera_distortion_error[i], -1.0, 1.0,
+                    "prior.camera_distortion_error[" + std::to_string(i) + "]");
+    }
+}
+
 void validate_rig(const VirtualRig& rig) {
     const RigScreen& s = rig.screen;
     check_range(s.radius_m, 0.1, 100.0, "screen.radius_m");
@@ -165,10 +183,7 @@ void validate_rig(const VirtualRig& rig) {
     for (std::size_t i = 0; i < rig.more_cameras.size(); ++i) {
         validate_camera(rig.more_cameras[i], s, "cameras[" + std::to_string(i + 1) + "]");
     }
-    // The screen as the calibration is told it must still be a screen.
-    check_range(rig.prior.screen_radius_error_m, -0.5 * s.radius_m, 0.5 * s.radius_m, "prior.screen_radius_error_m");
-    check_range(rig.prior.screen_arc_error_deg, -0.5 * s.arc_deg, std::min(0.5 * s.arc_deg, 360.0 - s.arc_deg),
-                "prior.screen_arc_error_deg");
+    validate_prior(rig);
 }
 
 Eigen::Matrix3d device_to_screen(const RigPose& pose) {

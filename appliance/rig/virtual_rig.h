@@ -117,9 +117,14 @@ struct RigPrior {
     Eigen::Vector3d camera_position_error_m{0.0, 0.0, 0.0};
     Eigen::Vector3d camera_angle_error_deg{0.0, 0.0, 0.0};  // yaw, pitch, roll
     double camera_focal_error = 0.0;                        // relative error of fx, fy
-    double projector_focal_error = 0.0;                     // relative error of the projectors' fx, fy
-    double screen_radius_error_m = 0.0;                     // the screen's radius as the installer was told it
-    double screen_arc_error_deg = 0.0;                      // and its arc (the heights are measured: no error)
+    // What a chessboard calibration leaves in the rest of the camera's intrinsics: the principal point's
+    // error in camera pixels (x, y; |each| <= a quarter of the image's side) and the distortion
+    // coefficients' errors (k1, k2, p1, p2, k3, OpenCV order, added to the truth's; |each| <= 1).
+    Eigen::Vector2d camera_principal_point_error_px{0.0, 0.0};
+    std::array<double, 5> camera_distortion_error{};
+    double projector_focal_error = 0.0;  // relative error of the projectors' fx, fy
+    double screen_radius_error_m = 0.0;  // the screen's radius as the installer was told it
+    double screen_arc_error_deg = 0.0;   // and its arc (the heights are measured: no error)
 };
 
 struct VirtualRig {

@@ -3,8 +3,10 @@
 // block seen where cv::projectPoints puts it in the camera, and rig-file errors.
 #include "appliance/rig/virtual_rig.h"
 
+#include <array>
 #include <cmath>
 #include <numbers>
+#include <string>
 
 #include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
@@ -290,6 +292,33 @@ TEST(RigFile, ErrorsNameTheField) {
     EXPECT_NE(message("[camera]\n[[projectors]]\ngamma = " + deep + "\n")
                   .find("line 3: tables or arrays nested deeper than 32 levels"),
               std::string::npos);
+}
+
+// The camera's intrinsics as a chessboard leaves them: [prior] principal point and distortion errors, read
+// and range-checked by name.
+TEST(RigFile, CameraPriorErrorsAreReadAndChecked) {
+    const VirtualRig rig = parse_rig(
+        "[camera]\n[[projectors]]\n[prior]\ncamera_focal_error = 0.01\ncamera_principal_point_error_px = [7, -9]\n"
+        "camera_distortion_error = [0.01, -0.004, 0, 0, 0.001]\n",
+        "prior.toml");
+    EXPECT_EQ(rig.prior.camera_focal_error, 0.01);
+    EXPECT_EQ(rig.prior.camera_principal_point_error_px, Eigen::Vector2d(7.0, -9.0));
+    EXPECT_EQ(rig.prior.camera_distortion_error, (std::array<double, 5>{0.01, -0.004, 0.0, 0.0, 0.001}));
+    const auto message = [](const std::string& prior) {
+        try {
+            (void)parse_rig("[camera]\n[[projectors]]\n[prior]\n" + prior + "\n", "bad.toml");
+        } catch (const RigError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    EXPECT_NE(message("camera_principal_point_error_px = [500, 0]").find("prior.camera_principal_point_error_px[0]"),
+              std::string::npos);
+    EXPECT_NE(message("camera_distortion_error = [0, 2, 0, 0, 0]").find("prior.camera_distortion_error[1]"),
+              std::string::npos);
+    EXPECT_NE(message("camera_distortion_error = [0, 0]").find("camera_distortion_error: must be an array of 5"),
+              std::string::npos);
+    EXPECT_NE(message("camera_focal_error = 0.9").find("prior.camera_focal_error"), std::string::npos);
 }
 
 }  // namespace
