@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// Camera-based geometric calibration of projectors on a cylindrical screen (issue 13; seed paper
+// Camera-based geometric calibration of projectors on a cylindrical screen (seed paper
 // II.B): Gray-code structured light per projector, the camera's pose from the screen's lit edges,
 // a pinhole model per projector fitted to the correspondences, and from it a piecewise-linear warp
 // (grid step = knob), smooth blend masks from the measured coverage and a response curve: the

@@ -37,7 +37,7 @@ TEST(Autocal, StandardRigAccuracyAgainstGroundTruth) {
     std::printf(
         "geometry: samples %d missing %d mean %.3f p95 %.3f max %.3f px (scale %.2f); luminance max %.4f seam %.4f\n",
         g.samples, g.missing, g.mean_px, g.p95_px, g.max_px, scale, l.max_deviation, l.seam_max_deviation);
-    // Issue 13's goals, in projector pixels against the rig's ground truth: mean <= 0.3 px,
+    // The calibration goals, in projector pixels against the rig's ground truth: mean <= 0.3 px,
     // p95 <= 0.8 px; seam luminance deviation <= 1 % (measured at scale 0.5: mean 0.18, p95 0.25,
     // seam 0.83 %; at scale 1: mean 0.10, p95 0.27, seam 0.54 %).
     EXPECT_LE(g.mean_px, 0.3);

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// Photometric calibration after the geometric one (issue 13; seed paper II.B "colour calibration
+// Photometric calibration after the geometric one (seed paper II.B "colour calibration
 // from channel response functions"): each projector's per-channel response measured from camera
 // images of grey ramps with the camera's exposure locked, inverse LUTs, luminance and white point
 // matched across projectors, and black-level compensation (beta maps) so that the overlaps and the

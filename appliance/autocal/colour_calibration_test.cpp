@@ -77,7 +77,7 @@ TEST(ColourCalibration, MatchesProjectorsOfDifferentBrightnessAndColourTemperatu
                     100.0 * b.seam_luminance_p95, 100.0 * a.seam_luminance_p95, b.seam_delta_e_p95, a.seam_delta_e_p95);
         EXPECT_GT(b.seam_luminance_p95, 0.15);                         // the uncalibrated rig shows its seams
         EXPECT_LT(a.seam_delta_e_p95, 0.6);                            // well under a just-noticeable difference
-        EXPECT_LT(a.seam_luminance_p95, level == 0.0 ? 0.01 : 0.015);  // issue 13: 1 %; scale 0.25 adds edge pixels
+        EXPECT_LT(a.seam_luminance_p95, level == 0.0 ? 0.01 : 0.015);  // the goal: 1 %; scale 0.25 adds edge pixels
         if (level >= 0.5) {
             EXPECT_GT(b.seam_delta_e_p95, 5.0);
         }
@@ -86,7 +86,7 @@ TEST(ColourCalibration, MatchesProjectorsOfDifferentBrightnessAndColourTemperatu
 
 // Lens fall-off that differs per projector (rigs/falloff.toml: 20, 12 and 30 % at half the
 // diagonal): one gain per projector leaves the overlaps where one projector's dim edge meets the
-// other's; the measured fall-off's per-pixel attenuation must bring them within issue 13's 1 %.
+// other's; the measured fall-off's per-pixel attenuation must bring them within the 1 % goal.
 // The measured shape is checked against the rig's own (rig_bridge's falloff_of), not the fit's.
 TEST(ColourCalibration, LensFalloffIsMeasuredAndAttenuatedPerPixel) {
     const rig::VirtualRig rig =

@@ -45,7 +45,7 @@ TEST(RequestPolicy, ARequestWithinBoundsIsUntouched) {
     EXPECT_DOUBLE_EQ(d.rendered_rays, d.requested_rays);
 }
 
-// The hostile request: valid by request_limits, minutes of work for any farm.
+// A hostile request: valid by request_limits, minutes of work for any farm.
 TEST(RequestPolicy, TheLargestValidRequestIsDegradedIntoTheBudget) {
     namespace L = request_limits;
     ViewRequest r = request(L::kImageSide.max, L::kImageSide.max, L::kSpp.max, L::kMaxBounces.max, L::kAoSamples.max);

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// One view policy per appliance certificate (issue 16: "the view policy can restrict ... the
-// resolution/field of view to the appliance's screen"). A farm serving several museums knows each
+// One view policy per appliance certificate (the view policy can restrict the
+// resolution and field of view to the appliance's screen). A farm serving several museums knows each
 // appliance's screen and content resolution; a certificate holder then gets only views its own
 // screen can show, whatever it asks.
 //

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // ConnectionGuard: the farm's own listening socket, in front of gRPC, with caps on the TCP
-// connections it hands over (issue 16, "a cap on connections and handshakes in progress").
+// connections it hands over (a cap on connections and on handshakes in progress).
 //
 // Why: gRPC 1.51 (Debian 12) accepts without limit; every connection costs a TLS handshake (CPU)
 // and buffers (memory) before anything learns who the peer is. gRPC has no cap option in 1.51
