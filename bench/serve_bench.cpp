@@ -504,9 +504,8 @@ int main(int argc, char** argv) {
                    "today, all, denoise, denoise-floor-0.2, no-progressive, no-target, no-pipeline, no-rank-speed, "
                    "no-rate-aim")
         ->delimiter(',')
-        ->check(CLI::IsMember(
-            {"today", "all", "denoise", "denoise-floor-0.2", "no-progressive", "no-target", "no-pipeline",
-             "no-rank-speed", "no-rate-aim"}));
+        ->check(CLI::IsMember({"today", "all", "denoise", "denoise-floor-0.2", "no-progressive", "no-target",
+                               "no-pipeline", "no-rank-speed", "no-rate-aim"}));
     app.add_option("--quality", a.quality,
                    "Preset whose request quality every request uses (" + quality_preset_names() +
                        "); default: the request's defaults")

@@ -37,7 +37,8 @@ int max_abs_diff(const Rgb8Image& a, const Rgb8Image& b) {
 }
 
 TEST(KmsOutputBackend, LightsEveryConnectedOutput) {
-    if (list_drm_cards().empty()) GTEST_SKIP() << "no DRM device; the image test (image_qemu_boot) runs this inside QEMU with virtio-gpu";
+    if (list_drm_cards().empty())
+        GTEST_SKIP() << "no DRM device; the image test (image_qemu_boot) runs this inside QEMU with virtio-gpu";
     auto created = KmsOutputBackend::create({});
     if (!created && (created.code() == ENODEV || created.code() == EACCES)) {
         GTEST_SKIP() << created.error().message;  // no connected output, or a compositor owns the card
