@@ -16,6 +16,13 @@
 #include "renderfarm/link/wire_convert.h"
 
 namespace mogao::testing {
+
+int run_pki(std::vector<std::string> args) {
+    args.insert(args.begin(), "pki");
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    return run_pki_command(static_cast<int>(argv.size()), argv.data());
+}
 namespace {
 
 constexpr int kBlock = 8;

@@ -25,6 +25,9 @@
 
 namespace mogao::testing {
 
+// `mogao-farm pki ARGS...` in this process (run_pki_command): its exit status.
+int run_pki(std::vector<std::string> args);
+
 // Certificates made once per test process (EC P-256, a few ms).
 struct TestPki {
     PemPair ca;                  // the farm CA

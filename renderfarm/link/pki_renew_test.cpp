@@ -21,12 +21,8 @@ namespace fs = std::filesystem;
 using testing::TempDir;
 using testing::TestPki;
 
-int run(std::vector<std::string> args) {
-    args.insert(args.begin(), "pki");
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    return run_pki_command(static_cast<int>(argv.size()), argv.data());
-}
+// `mogao-farm pki ARGS...` in this process.
+int run(std::vector<std::string> args) { return testing::run_pki(std::move(args)); }
 
 std::string slurp(const fs::path& p) { return read_pem_file(p); }
 

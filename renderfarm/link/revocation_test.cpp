@@ -21,12 +21,8 @@ namespace fs = std::filesystem;
 using testing::TempDir;
 using testing::TestPki;
 
-int run(std::vector<std::string> args) {
-    args.insert(args.begin(), "pki");
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    return run_pki_command(static_cast<int>(argv.size()), argv.data());
-}
+// `mogao-farm pki ARGS...` in this process.
+int run(std::vector<std::string> args) { return testing::run_pki(std::move(args)); }
 
 void write_text(const fs::path& path, const std::string& text) {
     const fs::path tmp = path.string() + ".new";
