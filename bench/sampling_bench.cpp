@@ -40,6 +40,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench/quality/bench_report.h"
 #include "bench/quality/image_metrics.h"
 #include "common/camera_path.h"
 #include "common/png_io.h"
@@ -51,6 +52,10 @@
 namespace {
 
 using namespace mogao;
+using bench::cpu_name;
+using bench::fmt;
+using bench::load_average;
+using bench::run_line;
 
 int arg_int(int argc, char** argv, const char* name, int fallback) {
     for (int i = 1; i + 1 < argc; ++i)
@@ -192,37 +197,6 @@ std::array<double, 2> accumulated_passes(Renderer& renderer, const ViewRequest& 
     return out;
 }
 
-std::string run_line(const std::string& command) {
-    std::string out;
-    if (FILE* pipe = popen(command.c_str(), "r")) {
-        std::array<char, 256> buffer{};
-        while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) out += buffer.data();
-        pclose(pipe);
-    }
-    while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
-    return out;
-}
-
-double load_average() {
-    std::ifstream f("/proc/loadavg");
-    double load = std::nan("");
-    f >> load;
-    return load;
-}
-
-std::string cpu_name() {
-    std::ifstream f("/proc/cpuinfo");
-    for (std::string line; std::getline(f, line);)
-        if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-    return "unknown CPU";
-}
-
-std::string fmt(const char* format, double a) {
-    std::array<char, 64> b{};
-    std::snprintf(b.data(), b.size(), format, a);
-    return b.data();
-}
-
 std::string spp_table(const std::vector<std::vector<Point>>& curves) {
     std::ostringstream md;
     md << "| spp | setting | CPU s | time / before | rays per sample | relMSE | relMSE before / setting |\n"
@@ -250,23 +224,6 @@ std::string time_table(const std::vector<std::vector<Point>>& curves) {
                << fmt("%.4g", b.relmse) << " | " << fmt("%.4g", e) << " | " << fmt("%.3f", b.relmse / e) << " |\n";
         }
     return md.str();
-}
-
-void write_docs(const std::string& file, const std::string& block) {
-    std::ifstream in(file);
-    if (!in) throw std::runtime_error("cannot read " + file);
-    std::stringstream buffer;
-    buffer << in.rdbuf();
-    std::string text = buffer.str();
-    const std::string start = "<!-- generated:sampling -->\n";
-    const std::string end = "<!-- /generated -->";
-    const std::size_t a = text.find(start);
-    const std::size_t b = a == std::string::npos ? a : text.find(end, a);
-    if (b == std::string::npos) throw std::runtime_error(file + " has no '<!-- generated:sampling -->' block");
-    text.replace(a + start.size(), b - a - start.size(), block);
-    std::ofstream out(file);
-    out << text;
-    if (!out.flush()) throw std::runtime_error("cannot write " + file);
 }
 
 int run(int argc, char** argv) {
@@ -310,7 +267,7 @@ int run(int argc, char** argv) {
        << fmt("%.2f", accumulated[0] / accumulated[1]) << ").\n";
     std::printf("%s", md.str().c_str());
     const std::string docs = arg_str(argc, argv, "--write-docs", "");
-    if (!docs.empty()) write_docs(docs, md.str());
+    if (!docs.empty()) bench::write_generated_block(docs, "sampling", md.str());
     return 0;
 }
 

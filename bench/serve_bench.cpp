@@ -14,7 +14,10 @@
 // (no-rate-aim: the frame-time controller aims at the target itself, without the jitter allowance,
 // the hand-off charge and the headroom of schedule/frame_time_controller.h), and denoise-floor-0.2
 // (the denoise configuration with the frame-time target's scale floor at 0.2 and the bounces never
-// lowered: the controller before its floor of 0.5).
+// lowered: the controller before its floor of 0.5), and cache (the denoise configuration with moving
+// frames from the ranks' radiance cache: renderfarm/trace/cached_packet.h; the cache starts empty
+// at the configuration's first frame only if it is the first configuration of the run: the ranks
+// keep their caches between configurations, as a farm keeps them between sessions).
 // With both all and denoise in the run, the denoiser's ratios are printed: frames/s on / off and the
 // moving frame's PSNR on - off. --quality takes a preset's request quality (spp, bounces, AO, area
 // samples, JPEG; common/quality_preset.h) for every request and the reference; without it the
@@ -160,7 +163,12 @@ std::vector<Config> all_configs(const BenchArgs& a) {
     floor.name = "all + denoiser, scale floor 0.2";
     floor.live.controller.min_scale = 0.2;
     floor.live.controller.min_bounces = request_limits::kMaxBounces.max;
-    std::vector<Config> out{today, all, denoise, floor};
+    // The denoise configuration with moving frames from the ranks' radiance cache.
+    Config cache = denoise;
+    cache.key = "cache";
+    cache.name = "all + denoiser + radiance cache";
+    cache.live.radiance_cache = true;
+    std::vector<Config> out{today, all, denoise, floor, cache};
     const auto without = [&](const char* key, const char* name, auto change) {
         Config c = all;
         c.key = key;
@@ -424,6 +432,12 @@ void print_ratios(const std::map<std::string, std::pair<double, double>>& figure
         std::printf("ratio frames/s denoiser on / off = %.2f; moving frame PSNR denoiser on - off = %+.2f dB\n",
                     denoise->second.first / all->second.first, denoise->second.second - all->second.second);
     }
+    const auto cache = figures.find("cache");
+    if (denoise != figures.end() && cache != figures.end() && denoise->second.first > 0) {
+        std::printf(
+            "ratio frames/s radiance cache on / off (both denoised) = %.2f; moving frame PSNR on - off = %+.2f dB\n",
+            cache->second.first / denoise->second.first, cache->second.second - denoise->second.second);
+    }
     if (today != figures.end() && denoise != figures.end() && today->second.first > 0) {
         std::printf("ratio frames/s all + denoiser / none = %.2f; moving frame PSNR all + denoiser - none = %+.2f dB\n",
                     denoise->second.first / today->second.first, denoise->second.second - today->second.second);
@@ -450,14 +464,15 @@ int admin(FrameDispatcher& farm, const Scene& scene, const BenchArgs& a) {
     nlohmann::json results = nlohmann::json::array();
     std::map<std::string, std::pair<double, double>> figures;  // key -> (moving frames/s, moving PSNR)
     const std::vector<Config> chosen = configs(a);
-    const bool has_denoise =
-        std::any_of(chosen.begin(), chosen.end(), [](const Config& c) { return c.key == "denoise"; });
+    const auto has = [&](const char* key) {
+        return std::any_of(chosen.begin(), chosen.end(), [&](const Config& c) { return c.key == key; });
+    };
+    const std::string pictured = has("cache") ? "cache" : has("denoise") ? "denoise" : "all";
     for (const Config& c : chosen) {
         Snapshots shots;
         results.push_back(run_config(c, farm, scene, a, reference, next_id, shots));
         figures[c.key] = {results.back()["move_frames_per_second"].get<double>(),
                           results.back()["moving_frame_psnr_db"].get<double>()};
-        const std::string pictured = has_denoise ? "denoise" : "all";
         if (c.key == pictured && !a.side_by_side.empty()) write_side_by_side(a.side_by_side, shots, reference);
     }
     print_ratios(figures);
@@ -501,10 +516,10 @@ int main(int argc, char** argv) {
     app.add_option("--reference-spp", a.reference_spp, "Reference samples per pixel (two halves)")
         ->check(CLI::Range(2, 8192));
     app.add_option("--configs", a.configs,
-                   "today, all, denoise, denoise-floor-0.2, no-progressive, no-target, no-pipeline, no-rank-speed, "
-                   "no-rate-aim")
+                   "today, all, denoise, denoise-floor-0.2, cache, no-progressive, no-target, no-pipeline, "
+                   "no-rank-speed, no-rate-aim")
         ->delimiter(',')
-        ->check(CLI::IsMember({"today", "all", "denoise", "denoise-floor-0.2", "no-progressive", "no-target",
+        ->check(CLI::IsMember({"today", "all", "denoise", "denoise-floor-0.2", "cache", "no-progressive", "no-target",
                                "no-pipeline", "no-rank-speed", "no-rate-aim"}));
     app.add_option("--quality", a.quality,
                    "Preset whose request quality every request uses (" + quality_preset_names() +

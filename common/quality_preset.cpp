@@ -10,9 +10,9 @@ namespace {
 // frame_time_ms, progressive, converged_spp, denoise, chroma_444. Chosen from the curves of
 // docs/quality.md ("Presets"), where bench/quality measures exactly these rows.
 constexpr std::array kPresets{
-    QualityPreset{"interactive", Quality{1, 1, 0, 1, 1.0, 80}, 1000.0 / 15.0, true, 256, true, false},
-    QualityPreset{"balanced", Quality{4, 2, 0, 1, 1.0, 85}, 150.0, true, 1024, true, false},
-    QualityPreset{"exhibit", Quality{64, 4, 0, 1, 1.0, 95}, 0.0, true, 4096, false, true},
+    QualityPreset{"interactive", Quality{1, 1, 0, 1, 1.0, 80}, 1000.0 / 15.0, true, 256, true, false, true},
+    QualityPreset{"balanced", Quality{4, 2, 0, 1, 1.0, 85}, 150.0, true, 1024, true, false, true},
+    QualityPreset{"exhibit", Quality{64, 4, 0, 1, 1.0, 95}, 0.0, true, 4096, false, true, false},
 };
 
 }  // namespace

@@ -36,6 +36,9 @@ struct QualityPreset {
     // a still view's first passes; renderfarm/farm/live_frames.h). `mogao-farm render` does not
     // apply it.
     bool denoise = false;
+    // serve: moving frames from the render ranks' radiance cache (renderfarm/trace/radiance_cache.h;
+    // biased, much cheaper; still views refine without it).
+    bool radiance_cache = false;
     // Measured in docs/quality.md but not applied by the farm yet: JPEG 4:4:4 instead of the
     // link's 4:2:0.
     bool chroma_444 = false;

@@ -69,6 +69,9 @@ struct ViewRequest {
     // Farm-internal, never on the link's wire: the link server's id of the session that sent the
     // request (0 = none), so the farm keeps per-session state (cost map, accumulation, frame time).
     std::uint64_t session = 0;
+    // Farm-internal, never on the link's wire: trace this frame with the renderer's radiance cache
+    // (renderfarm/trace/radiance_cache.h: a biased, much cheaper estimate for moving views).
+    bool radiance_cache = false;
 };
 
 // The size actually traced: size scaled by quality.resolution_scale, rounded to nearest, at least

@@ -69,8 +69,15 @@ ViewRequest LiveFrames::plan(Session& s, const ViewRequest& request, FrameChoice
         choice.spp = std::max(choice.spp, 2);
         view.quality.spp = choice.spp;
         view.frame_id = pass_frame_id(s.accumulation.first_frame_id(), s.accumulation.passes());
+    } else {
+        view.radiance_cache = options_.radiance_cache && !still;
     }
     return view;
+}
+
+// A pass joins the session's accumulation unless it was cut short or traced with the (biased) cache.
+bool LiveFrames::accumulates(const LiveFrame& frame) const {
+    return options_.progressive && frame.stats.tiles_cut == 0 && !frame.rendered.radiance_cache;
 }
 
 Rgb8Image LiveFrames::to_display(const RgbFloatImage& radiance) const {
@@ -97,7 +104,7 @@ void LiveFrames::dispatch(Session& s, const ViewRequest& request, int spp, LiveF
     }
     frame.stats = std::move(f.stats);
     frame.samples = spp;
-    if (options_.progressive && frame.stats.tiles_cut == 0) {
+    if (accumulates(frame)) {
         s.accumulation.add(frame.rendered, f.radiance);
     } else if (guided || options_.progressive) {  // a cut pass is shown alone, never accumulated
         radiance = std::move(f.radiance);
@@ -136,7 +143,7 @@ LiveFrame LiveFrames::render(const ViewRequest& request) {
     } else {
         dispatch(s, request, choice.spp, frame, radiance);
     }
-    if (options_.progressive && frame.stats.tiles_cut == 0) {
+    if (accumulates(frame)) {
         radiance = s.accumulation.mean();
         frame.samples = s.accumulation.samples();
         frame.passes = s.accumulation.passes();

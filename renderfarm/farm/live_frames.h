@@ -61,6 +61,10 @@ struct LiveOptions {
     bool denoise = false;     // filter frames of at most denoise_max_spp samples (see above)
     int denoise_max_spp = 4;  // >= 1
     AtrousParams denoise_params = default_denoise_params();  // threads 0 = every core of the admin
+    // Moving frames read and train the render ranks' radiance caches (ViewRequest::radiance_cache,
+    // renderfarm/trace/radiance_cache.h): much cheaper, biased; such a frame is shown alone, never
+    // accumulated, so a still view still converges to the unbiased image.
+    bool radiance_cache = false;
 
     // The filter's settings for served frames: AtrousParams' defaults (chosen at 1 spp) on every
     // core of the admin, which waits for the ranks meanwhile.
@@ -114,6 +118,7 @@ private:
     Session& session(std::uint64_t id);
     [[nodiscard]] ViewRequest plan(Session& s, const ViewRequest& request, FrameChoice& choice) const;
     [[nodiscard]] Rgb8Image to_display(const RgbFloatImage& radiance) const;
+    [[nodiscard]] bool accumulates(const LiveFrame& frame) const;
     void dispatch(Session& s, const ViewRequest& request, int spp, LiveFrame& frame, RgbFloatImage& radiance);
     void display(const Session& s, const RgbFloatImage& radiance, LiveFrame& frame);
 

@@ -88,6 +88,10 @@ void add_live_flags(CLI::App& serve, mogao::ServeOptions& options, double& frame
         "denoiser; the ranks trace its guides (default off; the interactive and balanced presets turn it on)");
     serve.add_option("--denoise-max-spp", live.denoise_max_spp, "Largest samples per pixel of a frame still filtered")
         ->check(CLI::Range(1, 1 << 20));
+    serve.add_flag("--radiance-cache,!--no-radiance-cache", live.radiance_cache,
+                   "Trace moving frames with the render ranks' radiance cache: the lights per pixel, the rest from "
+                   "a world-space cache that every frame trains (biased, cheaper; still views refine without it; "
+                   "default off; the interactive and balanced presets turn it on)");
     serve.add_flag("--per-session-cost-maps,!--shared-cost-map", live.per_session_maps,
                    "One PBT cost map per session (default; --shared-cost-map: one for all)");
     serve.add_flag("--pipeline,!--no-pipeline", options.pipeline,
@@ -229,6 +233,7 @@ void apply_serve_preset(const CLI::App& serve, const mogao::QualityPreset& p, mo
     if (unset("--progressive") && unset("--no-progressive")) live.progressive = p.progressive;
     if (unset("--converged-spp")) live.converged_spp = p.converged_spp;
     if (unset("--denoise") && unset("--no-denoise")) live.denoise = p.denoise;
+    if (unset("--radiance-cache") && unset("--no-radiance-cache")) live.radiance_cache = p.radiance_cache;
 }
 
 // `mogao-farm health`: what mogao-farm-launch runs on each render host (over the same rsh agent

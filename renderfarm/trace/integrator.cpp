@@ -261,10 +261,21 @@ ShadingVertex make_vertex(const FrameContext& frame, const SurfaceHit& hit, cons
             offset_ray_origin(hit.position, hit.geometric_normal)};
 }
 
+ShadingMaterial white_lambert() {
+    Material white;
+    white.albedo = Eigen::Vector3f::Ones();
+    white.specular = Eigen::Vector3f::Zero();
+    return make_shading_material(white);
+}
+
 void direct_light_queries(const FrameContext& frame, const ShadingVertex& x, const Eigen::Vector3f& throughput,
                           bool bounce_follows, PixelSampler& sampler, std::vector<ShadowQuery>& queries,
-                          Eigen::Vector3f& unshadowed) {
+                          Eigen::Vector3f& unshadowed, DirectParts parts) {
     QuerySink sink{queries, unshadowed, x};
+    if (parts == DirectParts::kEnvironmentOnly) {
+        if (frame.lights->has_environment) environment_queries(frame, x, throughput, sampler, sink);
+        return;
+    }
     const int lights = selectable_light_count(*frame.lights);
     if (frame.legacy_light_sampling || lights > kMaxSelectableLights) {
         legacy_light_queries(frame, x, throughput, sampler, sink);
@@ -275,7 +286,8 @@ void direct_light_queries(const FrameContext& frame, const ShadingVertex& x, con
             one_light_query(frame, x, throughput, sel, pair.point(s, frame.area_light_samples), bounce_follows, sink);
         }
     }
-    if (frame.lights->has_environment) environment_queries(frame, x, throughput, sampler, sink);
+    if (parts == DirectParts::kAll && frame.lights->has_environment)
+        environment_queries(frame, x, throughput, sampler, sink);
 }
 
 bool sample_bounce(const FrameContext& frame, const ShadingVertex& x, const Eigen::Vector3f& throughput, int depth,

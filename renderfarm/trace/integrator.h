@@ -96,7 +96,14 @@ struct FrameContext {
     bool coherent_shadow_packets = false;
     bool russian_roulette = false;  // end paths by Russian roulette (see above)
     bool glossy_vndf = false;       // glossy bounces from GGX visible normals (see above)
+    // The radiance cache's training paths (cached_packet.h): at the first vertex the surface is
+    // taken as white Lambertian, only the environment is sampled there and its bounce adds no area
+    // emission, so a path estimates the white radiance of the cache's part of the light.
+    bool cache_training = false;
 };
+
+// The white Lambertian material of a cache training path's first vertex (albedo 1).
+[[nodiscard]] ShadingMaterial white_lambert();
 
 // The first path depth whose bounce may be ended by Russian roulette (depth 0 = the camera hit).
 inline constexpr int kRouletteMinDepth = 1;
@@ -120,11 +127,15 @@ struct ShadingVertex {
 
 [[nodiscard]] ShadingVertex make_vertex(const FrameContext& frame, const SurfaceHit& hit, const Eigen::Vector3f& wo);
 
+// Which parts of next-event estimation direct_light_queries samples (the radiance cache splits
+// them: cached_packet.h).
+enum class DirectParts { kAll, kLightsOnly, kEnvironmentOnly };
+
 // Appends the shadow queries of next-event estimation at `x` (lights, then environment), each
 // contribution scaled by `throughput`; unshadowed light terms go straight into `unshadowed`.
 void direct_light_queries(const FrameContext& frame, const ShadingVertex& x, const Eigen::Vector3f& throughput,
                           bool bounce_follows, PixelSampler& sampler, std::vector<ShadowQuery>& queries,
-                          Eigen::Vector3f& unshadowed);
+                          Eigen::Vector3f& unshadowed, DirectParts parts = DirectParts::kAll);
 
 // The bounce of a vertex at path depth `depth`: direction and new throughput (already divided by
 // the roulette's survival probability), or false when the path ends (below the surface, zero

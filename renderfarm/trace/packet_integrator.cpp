@@ -112,13 +112,18 @@ void trace_queries(const FrameContext& frame, Scratch& s, std::uint64_t& rays, R
 void direct_light(const FrameContext& frame, std::array<Lane, kPacketLanes>& lanes,
                   std::array<ShadingVertex, kPacketLanes>& vertices, bool bounce_follows,
                   std::array<PixelSampler, kPacketLanes>& rngs, std::array<Eigen::Vector3f, kPacketLanes>& radiance,
-                  Scratch& s, std::uint64_t& rays, RecordedRays* log, int depth) {
+                  Scratch& s, std::uint64_t& rays, RecordedRays* log, int depth,
+                  DirectParts parts = DirectParts::kAll) {
     s.queries.clear();
     s.lane_of.clear();
+    const bool training_vertex = frame.cache_training && depth == 0;  // integrator.h, cache_training
+    if (training_vertex) parts = DirectParts::kEnvironmentOnly;
     for (std::size_t l = 0; l < kPacketLanes; ++l) {
         if (!lanes[l].alive) continue;
         vertices[l] = make_vertex(frame, lanes[l].hit, lanes[l].wo);
-        direct_light_queries(frame, vertices[l], lanes[l].throughput, bounce_follows, rngs[l], s.queries, radiance[l]);
+        if (training_vertex) vertices[l].material = white_lambert();
+        direct_light_queries(frame, vertices[l], lanes[l].throughput, bounce_follows, rngs[l], s.queries, radiance[l],
+                             parts);
         s.lane_of.resize(s.queries.size(), static_cast<int>(l));
     }
     trace_queries(frame, s, rays, log, depth);
@@ -158,8 +163,10 @@ void bounce(const FrameContext& frame, std::array<Lane, kPacketLanes>& lanes,
         if (valid[l] == 0) continue;
         const bool escaped = packet.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID;
         const float t = packet.ray.tfar[l];
-        radiance[l] +=
-            bounce_emission(frame, vertices[l], bounces[l].direction, escaped ? kInfinity : t, bounces[l].throughput);
+        if (!(frame.cache_training && depth == 0)) {  // a training vertex leaves the lights to the pixel
+            radiance[l] += bounce_emission(frame, vertices[l], bounces[l].direction, escaped ? kInfinity : t,
+                                           bounces[l].throughput);
+        }
         if (escaped) {
             lanes[l].alive = false;  // see integrator.h
             continue;
@@ -173,11 +180,7 @@ void bounce(const FrameContext& frame, std::array<Lane, kPacketLanes>& lanes,
     }
 }
 
-}  // namespace
-
-void radiance_packet(const FrameContext& frame, const PacketHits& hits, std::array<PixelSampler, kPacketLanes>& rngs,
-                     std::array<Eigen::Vector3f, kPacketLanes>& radiance, std::uint64_t& rays, RecordedRays* log) {
-    thread_local Scratch scratch;
+std::array<Lane, kPacketLanes> lanes_of(const PacketHits& hits) {
     std::array<Lane, kPacketLanes> lanes;
     for (std::size_t l = 0; l < kPacketLanes; ++l) {
         lanes[l].alive = hits.alive[l];
@@ -185,6 +188,23 @@ void radiance_packet(const FrameContext& frame, const PacketHits& hits, std::arr
         lanes[l].hit = hits.hit[l];
         lanes[l].wo = hits.wo[l];
     }
+    return lanes;
+}
+
+}  // namespace
+
+void light_packet(const FrameContext& frame, const PacketHits& hits, std::array<PixelSampler, kPacketLanes>& rngs,
+                  std::array<Eigen::Vector3f, kPacketLanes>& radiance, std::uint64_t& rays) {
+    thread_local Scratch scratch;
+    std::array<Lane, kPacketLanes> lanes = lanes_of(hits);
+    std::array<ShadingVertex, kPacketLanes> vertices;
+    direct_light(frame, lanes, vertices, false, rngs, radiance, scratch, rays, nullptr, 0, DirectParts::kLightsOnly);
+}
+
+void radiance_packet(const FrameContext& frame, const PacketHits& hits, std::array<PixelSampler, kPacketLanes>& rngs,
+                     std::array<Eigen::Vector3f, kPacketLanes>& radiance, std::uint64_t& rays, RecordedRays* log) {
+    thread_local Scratch scratch;
+    std::array<Lane, kPacketLanes> lanes = lanes_of(hits);
     std::array<ShadingVertex, kPacketLanes> vertices;
     for (int depth = 0;; ++depth) {
         const bool bounce_follows = depth < frame.max_bounces;

@@ -33,6 +33,11 @@ struct PacketHits {
     std::array<bool, kPacketLanes> alive{};
 };
 
+// Adds to radiance[l] (for alive lanes) next-event estimation of the lights only (no environment,
+// no bounce follows, so no MIS with one) at each lane's hit: the radiance cache's per-pixel part.
+void light_packet(const FrameContext& frame, const PacketHits& hits, std::array<PixelSampler, kPacketLanes>& rngs,
+                  std::array<Eigen::Vector3f, kPacketLanes>& radiance, std::uint64_t& rays);
+
 // Adds to radiance[l] (for alive lanes) the radiance_at value of each lane; `rays` counts every
 // ray traced; `log` (benchmarks only, may be null) receives every packet traced.
 void radiance_packet(const FrameContext& frame, const PacketHits& hits, std::array<PixelSampler, kPacketLanes>& rngs,

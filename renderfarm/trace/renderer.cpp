@@ -11,11 +11,13 @@
 #include <embree3/rtcore.h>
 
 #include "common/request_limits.h"
+#include "renderfarm/trace/cached_packet.h"
 #include "renderfarm/trace/camera.h"
 #include "renderfarm/trace/embree_packets.h"
 #include "renderfarm/trace/integrator.h"
 #include "renderfarm/trace/light_set.h"
 #include "renderfarm/trace/packet_integrator.h"
+#include "renderfarm/trace/radiance_cache.h"
 #include "renderfarm/trace/render_scene.h"
 #include "renderfarm/trace/rng.h"
 #include "renderfarm/trace/sampling.h"
@@ -60,7 +62,8 @@ struct Renderer::Impl {
         : options(opts),
           geometry(scene, opts.embree_config),
           lights(LightSet::from_scene(scene)),
-          native_width(native_packet_width(geometry.root())) {
+          native_width(native_packet_width(geometry.root())),
+          cache(std::make_unique<RadianceCache>(opts.radiance_cache)) {
         materials.reserve(scene.materials.size());
         for (const Material& m : scene.materials) materials.push_back(make_shading_material(m));
     }
@@ -70,6 +73,9 @@ struct Renderer::Impl {
     LightSet lights;
     std::vector<ShadingMaterial> materials;
     int native_width = 16;
+    // Shared by every frame; lookups are const, deposits are queued under its mutex (radiance_cache.h).
+    std::unique_ptr<RadianceCache> cache;
+    std::uint64_t frames_begun = 0;
 
     // Current frame (set by begin_frame).
     bool ready = false;
@@ -80,6 +86,8 @@ struct Renderer::Impl {
     int spp = 1;
     bool jitter_samples = true;  // spp > 1 or options.jitter_one_spp
     FrameContext context;
+    bool cached = false;  // ViewRequest::radiance_cache: cached_packet.h's light
+    CacheFrame cache_frame;
 
     [[nodiscard]] int packet_width() const { return options.native_packet_width ? native_width : 16; }
 
@@ -179,7 +187,7 @@ struct Renderer::Impl {
     // Renders every sample of one block into `frame` (render()'s body; `log` for benchmarks).
     // `frame` holds the frame's pixels from (origin_x, origin_y) on (0, 0 for a whole frame).
     void render_block(const Block& block, RgbFloatImage& frame, TileStats& stats, RecordedRays* log, int origin_x = 0,
-                      int origin_y = 0) const {
+                      int origin_y = 0, std::vector<CacheDeposit>* deposits = nullptr) const {
         std::array<Eigen::Vector3f, kLanes> sum;
         sum.fill(Eigen::Vector3f::Zero());
         PacketHits hits;
@@ -190,6 +198,19 @@ struct Renderer::Impl {
             intersect(block, packet);
             stats.rays += static_cast<std::uint64_t>(block.active);
             resolve_hits(block, packet, hits, sum);
+            if (cached && deposits != nullptr) {
+                std::array<Eigen::Vector3f, kLanes> radiance;
+                radiance.fill(Eigen::Vector3f::Zero());
+                LanePixels pixels;
+                for (int lane = 0; lane < kLanes; ++lane) {
+                    pixels.x[static_cast<std::size_t>(lane)] = block.x0 + lane % kBlock;
+                    pixels.y[static_cast<std::size_t>(lane)] = block.y0 + lane / kBlock;
+                }
+                cached_radiance_packet(context, cache_frame, hits, pixels, rngs, radiance, stats.rays, *deposits);
+                for (std::size_t l = 0; l < kLanes; ++l)
+                    if (hits.alive[l]) sum[l] += radiance[l];
+                continue;
+            }
             if (options.packet_secondary_rays) {
                 std::array<Eigen::Vector3f, kLanes> radiance;
                 radiance.fill(Eigen::Vector3f::Zero());
@@ -211,6 +232,18 @@ struct Renderer::Impl {
             out[1] = value.y();
             out[2] = value.z();
         }
+    }
+
+    // render()'s body once its arguments are checked; queues a cached frame's training estimates.
+    TileStats render_rect(const PixelRect& rect, RgbFloatImage& window, int origin_x, int origin_y) const {
+        TileStats stats;
+        thread_local std::vector<CacheDeposit> deposits;
+        deposits.clear();
+        for_each_block(rect, [&](const Block& block) {
+            render_block(block, window, stats, nullptr, origin_x, origin_y, &deposits);
+        });
+        if (!deposits.empty()) cache->deposit(deposits);
+        return stats;
     }
 
     // Visits the 4x4 blocks of the global grid that overlap rect.
@@ -264,6 +297,11 @@ void Renderer::begin_frame(const ViewRequest& request) {
     s.context.russian_roulette = s.options.russian_roulette;
     s.context.glossy_vndf = s.options.glossy_vndf_sampling;
     s.jitter_samples = s.spp > 1 || s.options.jitter_one_spp;
+    // Last frame's training estimates join the cache before this frame reads it.
+    s.cache->commit();
+    ++s.frames_begun;
+    s.cached = request.radiance_cache;
+    s.cache_frame = CacheFrame{s.cache.get(), origin, s.key, s.frames_begun << 32, size.width};
     // The column table holds pixel-centre angles: only for the centre-sampled baseline.
     s.columns =
         s.options.camera_column_table && !s.jitter_samples ? make_cylinder_columns(*s.camera) : CylinderColumns{};
@@ -278,21 +316,18 @@ ImageSize Renderer::render_size() const {
 }
 
 TileStats Renderer::render(const PixelRect& rect, RgbFloatImage& frame) const {
-    const Impl& s = *impl_;
-    s.check_target(rect, &frame);
-    TileStats stats;
-    Impl::for_each_block(rect, [&](const Block& block) { s.render_block(block, frame, stats, nullptr); });
-    return stats;
+    impl_->check_target(rect, &frame);
+    return impl_->render_rect(rect, frame, 0, 0);
 }
 
 TileStats Renderer::render(const PixelRect& rect, RgbFloatImage& window, int origin_x, int origin_y) const {
-    const Impl& s = *impl_;
-    s.check_window(rect, window, origin_x, origin_y);
-    TileStats stats;
-    Impl::for_each_block(
-        rect, [&](const Block& block) { s.render_block(block, window, stats, nullptr, origin_x, origin_y); });
-    return stats;
+    impl_->check_window(rect, window, origin_x, origin_y);
+    return impl_->render_rect(rect, window, origin_x, origin_y);
 }
+
+void Renderer::clear_radiance_cache() { impl_->cache->clear(); }
+
+RadianceCacheStats Renderer::radiance_cache_stats() const { return {impl_->cache->cells(), impl_->cache->dropped()}; }
 
 TileStats Renderer::render_recording(const PixelRect& rect, RgbFloatImage& frame, RecordedRays& log) const {
     const Impl& s = *impl_;

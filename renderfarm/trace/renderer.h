@@ -10,6 +10,12 @@
 // pixels inside `rect` and leaves every other pixel untouched. Camera rays that hit nothing see
 // the summed environment radiance (the sky); integrator.h describes what a hit receives.
 //
+// Radiance cache: a request with radiance_cache set (the farm's moving frames) reads the world-space
+// cache of earlier frames and trains it (cached_packet.h): its pixels then also depend on which
+// frames this Renderer drew before (still bit-identical for any split of one frame into rects on
+// one Renderer: a frame reads only what earlier frames committed, in a fixed order). Other frames
+// are the unbiased path tracer below and never touch the cache.
+//
 // Determinism: a pixel's value depends only on (scene, request incl. seed and frame_id, x, y):
 // camera rays are traced in 4x4 packets aligned to the global image grid (x0 % 4 == 0,
 // y0 % 4 == 0), lanes outside rect or image masked off, one packet per sample index; all random
@@ -28,6 +34,7 @@
 #include "common/pixel_rect.h"
 #include "common/view_request.h"
 #include "renderfarm/scene/scene.h"
+#include "renderfarm/trace/radiance_cache.h"
 #include "renderfarm/trace/recorded_rays.h"
 
 namespace mogao {
@@ -73,6 +80,9 @@ struct RendererOptions {
     // cosine lobe by one-sample MIS (integrator.h); off: every bounce cosine-sampled, as before.
     // Matte materials are unaffected either way.
     bool glossy_vndf_sampling = true;
+    // The radiance cache of frames whose request asks for it (ViewRequest::radiance_cache;
+    // radiance_cache.h, cached_packet.h). Frames that do not ask neither read nor train it.
+    RadianceCacheOptions radiance_cache = {};
     // Benchmark baseline only, not a setting: traces the packet path's light shadow packets with
     // RTC_INTERSECT_CONTEXT_FLAG_COHERENT, the flag they had before the ray-flag audit (Embree
     // reserves it for coherent rays such as camera rays; it made them about twice as slow). The
@@ -92,6 +102,11 @@ enum class ReplayShape {
     kSingleRays,         // every ray alone (rtcOccluded1 / rtcIntersect1), INCOHERENT
     kStreams,            // each call as one rtcOccluded1M / rtcIntersect1M stream, COHERENT
     kIncoherentStreams,  // each call as one stream, INCOHERENT
+};
+
+struct RadianceCacheStats {
+    std::size_t cells = 0;      // cells holding an estimate
+    std::uint64_t dropped = 0;  // estimates dropped: non-finite, or no free slot (radiance_cache.h)
 };
 
 struct TileStats {
@@ -132,6 +147,11 @@ public:
     // of a whole frame. The values are bit-identical to render()'s. Throws std::invalid_argument if
     // rect is not inside [0, render_size()) or not inside the window placed at the origin.
     TileStats render(const PixelRect& rect, RgbFloatImage& window, int origin_x, int origin_y) const;
+
+    // The radiance cache (radiance_cache.h): emptied (a benchmark's cold start), and its size.
+    // Neither may run concurrently with render() or begin_frame().
+    void clear_radiance_cache();
+    [[nodiscard]] RadianceCacheStats radiance_cache_stats() const;
 
     // Benchmark baseline: generates and intersects exactly the camera ray packets render() would
     // (same grid, masks and samples) with rtcIntersect16, without any shading or secondary rays.

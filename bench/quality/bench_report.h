@@ -1,0 +1,25 @@
+// SPDX-License-Identifier: Apache-2.0
+// What every benchmark that writes docs/ needs: the run's context line (commit, CPU, load) and the
+// replacement of one generated block of a Markdown file, so figures are regenerated, never pasted.
+#pragma once
+
+#include <string>
+
+namespace mogao::bench {
+
+// The first line a command prints, trailing blanks removed ("" when it cannot run).
+[[nodiscard]] std::string run_line(const std::string& command);
+// The 1-minute load average (NaN when /proc/loadavg cannot be read).
+[[nodiscard]] double load_average();
+// /proc/cpuinfo's first "model name".
+[[nodiscard]] std::string cpu_name();
+// printf of one number.
+[[nodiscard]] std::string fmt(const char* format, double value);
+// "2026-11-26 04:30 UTC, commit `abc1234`, <CPU> (N threads)".
+[[nodiscard]] std::string run_context();
+// Replaces what lies between "<!-- generated:TAG -->\n" and the next "<!-- /generated -->" in
+// `file` with `block`. Throws std::runtime_error naming the file when it cannot be read or written
+// or has no such block.
+void write_generated_block(const std::string& file, const std::string& tag, const std::string& block);
+
+}  // namespace mogao::bench

@@ -1,0 +1,148 @@
+// SPDX-License-Identifier: Apache-2.0
+// The radiance cache's hash grid (radiance_cache.h): cells, level of detail, merge order, bad input.
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "renderfarm/trace/radiance_cache.h"
+
+namespace mogao {
+namespace {
+
+const Eigen::Vector3f kUp(0.0f, 1.0f, 0.0f);
+
+TEST(RadianceCache, RefusesBadOptionsNamingThem) {
+    RadianceCacheOptions o;
+    o.base_cell_m = 0.0f;
+    EXPECT_THROW(
+        {
+            try {
+                RadianceCache c(o);
+            } catch (const std::invalid_argument& e) {
+                EXPECT_NE(std::string(e.what()).find("base_cell_m"), std::string::npos);
+                throw;
+            }
+        },
+        std::invalid_argument);
+    o = {};
+    o.slots_log2 = 40;
+    EXPECT_THROW(RadianceCache{o}, std::invalid_argument);
+    o = {};
+    o.train_one_in = 0;
+    EXPECT_THROW(RadianceCache{o}, std::invalid_argument);
+}
+
+TEST(RadianceCache, CellsGrowWithTheRayConeInPowersOfTwo) {
+    RadianceCache cache;  // base 2 mm, 4 footprints
+    EXPECT_FLOAT_EQ(cache.cell_size(0.0f), 0.002f);
+    EXPECT_FLOAT_EQ(cache.cell_size(0.0005f), 0.002f);
+    EXPECT_FLOAT_EQ(cache.cell_size(0.001f), 0.004f);   // 4 mm wanted: exactly level 1
+    EXPECT_FLOAT_EQ(cache.cell_size(0.0011f), 0.008f);  // 4.4 mm wanted: level 2
+    EXPECT_GE(cache.cell_size(0.01f), 0.04f);
+}
+
+TEST(RadianceCache, KeysSeparateCellsLevelsAndNormalOctants) {
+    RadianceCache cache;
+    const float cone = 0.001f;  // 4 mm cells
+    const Eigen::Vector3d p(1.0011, 0.0, -2.0011);
+    EXPECT_EQ(cache.key(p, kUp, cone), cache.key(p + Eigen::Vector3d(0.001, 0.0, 0.001), kUp, cone));
+    EXPECT_NE(cache.key(p, kUp, cone), cache.key(p + Eigen::Vector3d(0.004, 0.0, 0.0), kUp, cone));
+    EXPECT_NE(cache.key(p, kUp, cone), cache.key(p, -kUp, cone));
+    EXPECT_NE(cache.key(p, kUp, cone), cache.key(p, kUp, 0.01f));  // another level
+    EXPECT_NE(cache.key(p, kUp, cone), 0u);
+}
+
+TEST(RadianceCache, LookupIsTheMeanOfCommittedEstimatesOnly) {
+    RadianceCache cache;
+    const std::uint64_t k = cache.key({0.5, 0.0, 0.5}, kUp, 0.0f);
+    Eigen::Vector3f w;
+    EXPECT_FALSE(cache.lookup(k, w));
+    const std::vector<CacheDeposit> d = {{k, 0, {1.0f, 2.0f, 3.0f}}, {k, 1, {3.0f, 2.0f, 1.0f}}};
+    cache.deposit(d);
+    EXPECT_FALSE(cache.lookup(k, w)) << "deposits are not visible before commit()";
+    cache.commit();
+    ASSERT_TRUE(cache.lookup(k, w));
+    EXPECT_TRUE(w.isApprox(Eigen::Vector3f(2.0f, 2.0f, 2.0f)));
+    EXPECT_EQ(cache.cells(), 1u);
+    cache.clear();
+    EXPECT_FALSE(cache.lookup(k, w));
+    EXPECT_EQ(cache.cells(), 0u);
+}
+
+TEST(RadianceCache, NonFiniteAndNegativeEstimatesAreDroppedNotMerged) {
+    RadianceCache cache;
+    const std::uint64_t k = cache.key({0.0, 0.0, 0.0}, kUp, 0.0f);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const std::vector<CacheDeposit> d = {
+        {k, 0, {nan, 1.0f, 1.0f}}, {k, 1, {-1.0f, 1.0f, 1.0f}}, {k, 2, {0.5f, 0.5f, 0.5f}}};
+    cache.deposit(d);
+    cache.commit();
+    Eigen::Vector3f w;
+    ASSERT_TRUE(cache.lookup(k, w));
+    EXPECT_TRUE(w.isApprox(Eigen::Vector3f::Constant(0.5f)));
+    EXPECT_EQ(cache.dropped(), 2u);
+}
+
+TEST(RadianceCache, TheWindowForgetsOldEstimatesExponentially) {
+    RadianceCacheOptions o;
+    o.max_samples = 4;
+    RadianceCache cache(o);
+    const std::uint64_t k = cache.key({0.0, 0.0, 0.0}, kUp, 0.0f);
+    for (int i = 0; i < 40; ++i) {
+        const std::vector<CacheDeposit> d = {{k, 0, Eigen::Vector3f::Zero()}};
+        cache.deposit(d);
+        cache.commit();
+    }
+    for (int i = 0; i < 40; ++i) {
+        const std::vector<CacheDeposit> d = {{k, 0, Eigen::Vector3f::Ones()}};
+        cache.deposit(d);
+        cache.commit();
+    }
+    Eigen::Vector3f w;
+    ASSERT_TRUE(cache.lookup(k, w));
+    EXPECT_GT(w.x(), 0.99f) << "a 4-sample window must have forgotten the 40 zeros";
+}
+
+TEST(RadianceCache, MergedContentDoesNotDependOnTheOrderOfDeposits) {
+    RadianceCache a;
+    RadianceCache b;
+    std::vector<CacheDeposit> all;
+    for (int i = 0; i < 500; ++i) {
+        const Eigen::Vector3d p(0.001 * (i % 7), 0.0, 0.001 * (i % 5));
+        all.push_back({a.key(p, kUp, 0.0f), static_cast<std::uint64_t>(i),
+                       Eigen::Vector3f(0.1f * static_cast<float>(i % 13), 0.3f, 1.0f / static_cast<float>(i + 1))});
+    }
+    a.deposit(all);
+    std::vector<CacheDeposit> second(all.begin() + 250, all.end());
+    std::vector<CacheDeposit> first(all.begin(), all.begin() + 250);
+    b.deposit(second);  // another thread finished first
+    b.deposit(first);
+    a.commit();
+    b.commit();
+    for (const CacheDeposit& d : all) {
+        Eigen::Vector3f wa;
+        Eigen::Vector3f wb;
+        ASSERT_TRUE(a.lookup(d.key, wa));
+        ASSERT_TRUE(b.lookup(d.key, wb));
+        EXPECT_EQ(wa, wb);  // bit-identical
+    }
+}
+
+TEST(RadianceCache, AFullTableDropsCellsInsteadOfGrowing) {
+    RadianceCacheOptions o;
+    o.slots_log2 = 8;  // 256 slots
+    RadianceCache cache(o);
+    std::vector<CacheDeposit> d;
+    for (int i = 0; i < 1000; ++i)
+        d.push_back({cache.key({0.01 * i, 0.0, 0.0}, kUp, 0.0f), 0, Eigen::Vector3f::Ones()});
+    cache.deposit(d);
+    cache.commit();
+    EXPECT_LE(cache.cells(), 256u);
+    EXPECT_GE(cache.dropped(), 1000u - 256u);
+}
+
+}  // namespace
+}  // namespace mogao

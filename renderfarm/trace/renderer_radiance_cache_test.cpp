@@ -1,0 +1,135 @@
+// SPDX-License-Identifier: Apache-2.0
+// Cached frames (cached_packet.h) against the unbiased path tracer of the same scene: close to its
+// converged reference (the cache's bias is bounded), closer than a 1-spp path-traced frame, fewer
+// rays, the same bits for any split of a frame into rects, and frames that do not ask for the
+// cache untouched by it.
+#include <cmath>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "renderfarm/trace/renderer.h"
+#include "renderfarm/trace/test_scenes.h"
+
+namespace mogao {
+namespace {
+
+// A sphere on a floor before a wall, lit by two point lights and a sky: light bounces between the
+// three, so the cache's part (the sky and the bounces) is a large share of every pixel.
+Scene lit_corner() {
+    Scene scene = test::make_sphere_over_floor();
+    Eigen::Affine3d wall = Eigen::Affine3d::Identity();
+    wall.translate(Eigen::Vector3d(0.0, 2.0, -2.0));
+    wall.rotate(Eigen::AngleAxisd(M_PI / 2.0, Eigen::Vector3d::UnitX()));
+    scene.instances.push_back(Instance{"wall", 1, 0, wall});
+    scene.point_lights = {PointLight{{1.0, 2.5, 1.5}, Rgb(6.0f, 6.0f, 6.0f), true},
+                          PointLight{{-1.5, 1.5, 1.0}, Rgb(2.0f, 1.5f, 1.0f), true}};
+    scene.environment_lights = {EnvironmentLight{Rgb(0.3f, 0.3f, 0.35f)}};
+    return scene;
+}
+
+ViewRequest corner_view(std::uint64_t frame_id, int spp, bool cached) {
+    ViewRequest r = test::look_at({0.3, 1.4, 3.2}, {0.0, 0.7, 0.0}, {64, 48}, 55.0);
+    r.frame_id = frame_id;
+    r.quality.spp = spp;
+    r.quality.max_bounces = 2;
+    r.radiance_cache = cached;
+    return r;
+}
+
+RgbFloatImage draw(Renderer& renderer, const ViewRequest& request, std::uint64_t* rays = nullptr) {
+    renderer.begin_frame(request);
+    RgbFloatImage frame(renderer.render_size());
+    const TileStats stats = renderer.render(PixelRect::whole(frame.size), frame);
+    if (rays != nullptr) *rays = stats.rays;
+    return frame;
+}
+
+double mean(const RgbFloatImage& f) {
+    double sum = 0.0;
+    for (const float v : f.pixels) sum += v;
+    return sum / static_cast<double>(f.pixels.size());
+}
+
+// Mean squared error relative to the reference's mean square (an image-wide relMSE).
+double rel_mse(const RgbFloatImage& f, const RgbFloatImage& ref) {
+    double err = 0.0;
+    double norm = 0.0;
+    for (std::size_t i = 0; i < f.pixels.size(); ++i) {
+        const double d = f.pixels[i] - ref.pixels[i];
+        err += d * d;
+        norm += static_cast<double>(ref.pixels[i]) * ref.pixels[i];
+    }
+    return err / norm;
+}
+
+TEST(RendererRadianceCache, WarmCachedFramesAreCloseToTheReferenceAndBeatOneSample) {
+    const Scene scene = lit_corner();
+    Renderer reference_renderer(scene, RendererOptions{"threads=1", true});
+    const RgbFloatImage reference = draw(reference_renderer, corner_view(1000, 256, false));
+    const RgbFloatImage one_spp = draw(reference_renderer, corner_view(2000, 1, false));
+
+    Renderer renderer(scene, RendererOptions{"threads=1", true});
+    for (std::uint64_t f = 1; f <= 32; ++f) (void)draw(renderer, corner_view(f, 1, true));
+    const RgbFloatImage cached = draw(renderer, corner_view(33, 1, true));
+    EXPECT_GT(renderer.radiance_cache_stats().cells, 100u);
+
+    const double bias = mean(cached) / mean(reference) - 1.0;
+    EXPECT_LT(std::abs(bias), 0.05) << "the cached frame's mean is " << 100.0 * bias << " % off the reference's";
+    const double cached_error = rel_mse(cached, reference);
+    const double one_spp_error = rel_mse(one_spp, reference);
+    EXPECT_LT(cached_error, 0.5 * one_spp_error)
+        << "relMSE cached " << cached_error << ", path-traced 1 spp " << one_spp_error;
+}
+
+TEST(RendererRadianceCache, AWarmCacheTracesFewerRaysThanThePathTracer) {
+    const Scene scene = lit_corner();
+    Renderer renderer(scene, RendererOptions{"threads=1", true});
+    for (std::uint64_t f = 1; f <= 16; ++f) (void)draw(renderer, corner_view(f, 1, true));
+    std::uint64_t cached_rays = 0;
+    std::uint64_t traced_rays = 0;
+    (void)draw(renderer, corner_view(17, 1, true), &cached_rays);
+    (void)draw(renderer, corner_view(17, 1, false), &traced_rays);
+    // Per pixel the cache saves the environment ray and every bounce with its shadow rays; the two
+    // lights stay traced (2 of about 4.3 rays per pixel here at 2 bounces, with roulette).
+    EXPECT_LT(static_cast<double>(cached_rays), 0.7 * static_cast<double>(traced_rays))
+        << cached_rays << " rays cached, " << traced_rays << " path-traced";
+}
+
+TEST(RendererRadianceCache, AnySplitOfACachedFrameGivesTheSameBits) {
+    const Scene scene = lit_corner();
+    Renderer whole(scene, RendererOptions{"threads=1", true});
+    Renderer split(scene, RendererOptions{"threads=1", true});
+    for (std::uint64_t f = 1; f <= 4; ++f) {
+        const ViewRequest r = corner_view(f, 1, true);
+        const RgbFloatImage a = draw(whole, r);
+        split.begin_frame(r);
+        RgbFloatImage b(split.render_size());
+        const int w = b.size.width;
+        const int h = b.size.height;
+        // Rects in an order unlike the whole frame's, with edges off the 4x4 packet grid.
+        for (const PixelRect& rect :
+             {PixelRect{w / 2 + 1, h / 3, w, h}, PixelRect{0, h / 3, w / 2 + 1, h}, PixelRect{0, 0, w, h / 3}}) {
+            (void)split.render(rect, b);
+        }
+        ASSERT_EQ(a.pixels, b.pixels) << "frame " << f;
+    }
+}
+
+TEST(RendererRadianceCache, FramesThatDoNotAskNeitherReadNorTrainIt) {
+    const Scene scene = lit_corner();
+    Renderer fresh(scene, RendererOptions{"threads=1", true});
+    const RgbFloatImage expected = draw(fresh, corner_view(7, 1, false));
+    Renderer used(scene, RendererOptions{"threads=1", true});
+    for (std::uint64_t f = 1; f <= 4; ++f) (void)draw(used, corner_view(f, 1, true));
+    EXPECT_EQ(draw(used, corner_view(7, 1, false)).pixels, expected.pixels);
+    const std::size_t cells = used.radiance_cache_stats().cells;  // the last cached frame's, committed
+    EXPECT_GT(cells, 0u);
+    (void)draw(used, corner_view(8, 1, false));  // commits whatever the uncached frame queued: nothing
+    EXPECT_EQ(used.radiance_cache_stats().cells, cells);
+    used.clear_radiance_cache();
+    EXPECT_EQ(used.radiance_cache_stats().cells, 0u);
+}
+
+}  // namespace
+}  // namespace mogao
