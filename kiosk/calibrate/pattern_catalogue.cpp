@@ -30,7 +30,12 @@ void fnv_u64(std::uint64_t& h, std::uint64_t v) {
     for (int i = 0; i < 8; ++i) fnv_byte(h, static_cast<std::uint8_t>(v >> (8 * i)));
 }
 
-std::uint8_t code_of(float s) { return static_cast<std::uint8_t>(std::lround(255.0f * std::clamp(s, 0.0f, 1.0f))); }
+// pattern_display.h's quantisation; the Gray code's 0 and 1 skip the (slow) rounding call.
+std::uint8_t code_of(float s) {
+    if (!(s > 0.0f)) return 0;  // NaN too, as pattern_display
+    if (s >= 1.0f) return 255;
+    return static_cast<std::uint8_t>(std::lround(255.0f * s));
+}
 
 // One projector's codes: size, channels, then every code row by row.
 std::uint64_t projector_hash(const cv::Mat& signal, ImageSize size) {
