@@ -324,7 +324,8 @@ nlohmann::ordered_json write_patterns(const PatternCatalogue& catalogue, const f
         nlohmann::ordered_json entry = {{"id", p.id}, {"order", p.order}, {"description", p.description}};
         entry.update(spec_json(p.spec));
         for (std::size_t k = 0; k < n; ++k) {
-            const std::uint64_t h = projector_hash(signals[k], catalogue.sizes()[k]);
+            // Black (no signal) is one file per projector, without hashing it again for every pattern.
+            const std::uint64_t h = signals[k].empty() ? 0 : projector_hash(signals[k], catalogue.sizes()[k]);
             auto [it, fresh] = written[k].emplace(h, "p" + std::to_string(k) + "/" + p.id + ".png");
             if (fresh) write_png(out / it->second, pattern_content(signals[k], catalogue.sizes()[k]));
             entry["files"][catalogue.projector_ids()[k]] = it->second;
