@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <stdexcept>
 
 #include <nlohmann/json.hpp>
@@ -54,6 +55,36 @@ std::vector<fs::path> capture_files(const fs::path& file, const fs::path& folder
 
 std::string size_text(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
 
+std::uint32_t big_endian(const unsigned char* p, int bytes) {
+    std::uint32_t v = 0;
+    for (int i = 0; i < bytes; ++i) v = (v << 8) | p[i];
+    return v;
+}
+
+// The size a PNG (IHDR, ISO/IEC 15948 sec. 11.2.2) or JPEG (the first SOFn segment, ITU T.81
+// sec. B.2.2) header declares, without decoding; nullopt for other files or a header not found in
+// the first 64 KiB (the decoder then has the last word).
+std::optional<ImageSize> header_size(const fs::path& file) {
+    std::ifstream f(file, std::ios::binary);
+    std::vector<unsigned char> b(65536);
+    f.read(reinterpret_cast<char*>(b.data()), static_cast<std::streamsize>(b.size()));
+    b.resize(static_cast<std::size_t>(f.gcount()));
+    static const unsigned char png[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    if (b.size() >= 24 && std::equal(png, png + 8, b.begin()) && std::equal(b.begin() + 12, b.begin() + 16, "IHDR")) {
+        return ImageSize{static_cast<int>(big_endian(&b[16], 4)), static_cast<int>(big_endian(&b[20], 4))};
+    }
+    if (b.size() < 4 || b[0] != 0xff || b[1] != 0xd8) return std::nullopt;
+    for (std::size_t i = 2; i + 9 < b.size();) {
+        if (b[i] != 0xff) return std::nullopt;
+        const unsigned char m = b[i + 1];
+        if (m >= 0xc0 && m <= 0xcf && m != 0xc4 && m != 0xc8 && m != 0xcc) {
+            return ImageSize{static_cast<int>(big_endian(&b[i + 7], 2)), static_cast<int>(big_endian(&b[i + 5], 2))};
+        }
+        i += 2 + big_endian(&b[i + 2], 2);
+    }
+    return std::nullopt;
+}
+
 }  // namespace
 
 CapturesManifest read_captures_manifest(const fs::path& folder) {
@@ -79,7 +110,7 @@ CapturesManifest read_captures_manifest(const fs::path& folder) {
     return m;
 }
 
-void check_captures(const CapturesManifest& m, const PatternCatalogue& catalogue) {
+void check_captures(const CapturesManifest& m, const PatternCatalogue& catalogue, ImageSize camera) {
     if (m.pattern_set != catalogue.set_signature()) {
         throw std::runtime_error(m.file.string() + ": field 'pattern_set' is " + m.pattern_set +
                                  ", the patterns of this site file, --scale and phase periods are " +
@@ -95,6 +126,12 @@ void check_captures(const CapturesManifest& m, const PatternCatalogue& catalogue
         for (const fs::path& f : files) {
             if (!fs::is_regular_file(f))
                 throw std::runtime_error(f.string() + ": missing (the capture of pattern '" + id + "')");
+            const std::optional<ImageSize> size = header_size(f);
+            if (size && (size->width != camera.width || size->height != camera.height)) {
+                throw std::runtime_error(f.string() + ": " + size_text(size->width, size->height) +
+                                         ", the site file's camera is " + size_text(camera.width, camera.height) +
+                                         " (the capture of pattern '" + id + "')");
+            }
         }
     }
     for (const CataloguePattern& p : catalogue.patterns()) {

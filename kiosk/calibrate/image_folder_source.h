@@ -48,8 +48,10 @@ struct CapturesManifest {
 // Reads and checks the form of DIR/captures.json (above).
 [[nodiscard]] CapturesManifest read_captures_manifest(const std::filesystem::path& folder);
 
-// Checks `m` against the set: its signature, every id known, every pattern captured, every file present.
-void check_captures(const CapturesManifest& m, const PatternCatalogue& catalogue);
+// Checks `m` against the set: its signature, every id known, every pattern captured, every file
+// present and, where its PNG or JPEG header tells without decoding, of the camera's size (so that a
+// wrong file is named at once, not after the calibration reached it).
+void check_captures(const CapturesManifest& m, const PatternCatalogue& catalogue, ImageSize camera);
 
 // A captured image as RGB8 (the decoders' conversions, common/png_io.h). Throws std::runtime_error
 // naming the file for an unknown extension or a file that cannot be decoded.

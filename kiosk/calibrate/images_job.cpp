@@ -17,7 +17,7 @@ nlohmann::json run_from_images(const OnSiteJob& job, const fs::path& images) {
     const autocal::CalibrationPrior prior = site_prior(job);
     CapturesManifest manifest = read_captures_manifest(images);
     const PatternCatalogue catalogue(prior.projectors, job.options, manifest.phase_periods_px);
-    check_captures(manifest, catalogue);
+    check_captures(manifest, catalogue, prior.camera.resolution);
     ImageFolderSource source(catalogue, manifest, prior.camera.resolution, job.transfer);
     const autocal::AutocalResult r = autocal::calibrate(source, prior, job.content, job.options);
     OnSiteJob geometry = job;

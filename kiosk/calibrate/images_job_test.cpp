@@ -198,6 +198,29 @@ TEST_F(ImagesJobTest, CaptureOfAnotherSizeIsRefusedNamingTheFileAndBothSizes) {
     expect_last_good_untouched();
 }
 
+TEST_F(ImagesJobTest, CapturesOfAnotherSizeAreNamedBeforeAnyIsUsed) {
+    // From the files' headers, PNG and JPEG alike: not after the calibration reached the pattern.
+    const fs::path png = dir_ / "late.png";
+    const fs::path jpeg = dir_ / "late.jpg";
+    ASSERT_TRUE(cv::imwrite(png.string(), cv::Mat1b(90, 160, uchar{90})));
+    ASSERT_TRUE(cv::imwrite(jpeg.string(), cv::Mat3b(72, 128, cv::Vec3b(90, 90, 90))));
+    for (const auto& [file, size] : {std::pair{png, std::string("160x90")}, std::pair{jpeg, std::string("128x72")}}) {
+        CapturesManifest m = read_captures_manifest(
+            folder_with([&](nlohmann::json& j) { j["captures"]["p2-rows-phase-p32-s7"] = file; }));
+        try {
+            check_captures(m, *catalogue_, rig_.camera.resolution);
+            ADD_FAILURE() << file << ": a capture of another size must be refused";
+        } catch (const std::runtime_error& e) {
+            EXPECT_NE(
+                std::string(e.what()).find(file.filename().string() + ": " + size + ", the site file's camera is"),
+                std::string::npos)
+                << e.what();
+        }
+    }
+    // The right size passes (the good folder's files).
+    EXPECT_NO_THROW(check_captures(read_captures_manifest(root_ / "images"), *catalogue_, rig_.camera.resolution));
+}
+
 TEST_F(ImagesJobTest, UnreadableCaptureIsRefusedNamingTheFile) {
     const fs::path bad = dir_ / "broken.png";
     write_text(bad, "not a png");
