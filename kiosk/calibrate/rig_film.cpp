@@ -63,12 +63,16 @@ int film_patterns(const fs::path& dir, const rig::VirtualRig& rig, std::uint64_t
                                  std::to_string(rig.projectors.size()));
     }
     const rig::CameraSimulator sim(rig);
+    const std::size_t n = rig.projectors.size();
+    std::vector<std::string> last_file(n);  // per projector: its file of the previous pattern, still decoded
+    std::vector<cv::Mat> signals(n);
     int filmed = 0;
     for (const auto& p : manifest.at("patterns")) {
-        std::vector<cv::Mat> signals;
-        for (const auto& projector : manifest["projectors"]) {
-            signals.push_back(
-                signal_of(read_png(dir / p.at("files").at(projector.at("id").get<std::string>()).get<std::string>())));
+        for (std::size_t k = 0; k < n; ++k) {
+            const std::string file =
+                p.at("files").at(manifest["projectors"][k].at("id").get<std::string>()).get<std::string>();
+            if (file != last_file[k]) signals[k] = signal_of(read_png(dir / file));
+            last_file[k] = file;
         }
         const cv::Mat1f seen = sim.capture(signals, first_frame + p.at("order").get<std::uint64_t>());
         const fs::path out = dir / captures.at(p.at("id").get<std::string>()).get<std::string>();
