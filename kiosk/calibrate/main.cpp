@@ -9,6 +9,9 @@
 //   The whole on-site path without hardware (SIMULATION: the rig's camera films the headless outputs,
 //   or with --outputs kms the kernel's scanout buffers: the appliance image's QEMU test):
 //     mogao-calibrate --site rigs/standard.toml --outputs headless --camera rig:rigs/standard.toml --out DIR
+//   From images captured by any camera: write the patterns, show and film each, then calibrate:
+//     mogao-calibrate patterns --site FILE --out DIR [--scale S] [--phase-periods P[,P...]]
+//     mogao-calibrate --site FILE --images DIR --out DIR [--install FILE] [--camera-transfer srgb|linear]
 //   Projector intrinsics on the bench from Gray-code captures of a board (docs/calibration.md):
 //     mogao-calibrate procam --images DIR [DIR...] --projector WxH --board COLSxROWS --square-mm S --out FILE.json
 //   How many images and how long the capture takes:
@@ -33,8 +36,10 @@
 #include "common/program_cli.h"
 #include "drivers/headless/headless_output.h"
 #include "drivers/kms/kms_backend.h"
+#include "kiosk/calibrate/images_job.h"
 #include "kiosk/calibrate/on_site_job.h"
 #include "kiosk/calibrate/pattern_budget.h"
+#include "kiosk/calibrate/patterns_command.h"
 #include "kiosk/calibrate/procam_command.h"
 #include "kiosk/calibrate/rig_camera.h"
 
@@ -48,6 +53,7 @@ struct Cli {
     std::filesystem::path site;
     std::string outputs;
     std::string camera;
+    std::filesystem::path images;
     std::filesystem::path kms_device;
     std::string content = "1920x1080";
     std::string camera_size;
@@ -201,6 +207,19 @@ int run_site(const Cli& cli, OnSiteJob& job) {
     return 0;
 }
 
+int run_images(const Cli& cli, const OnSiteJob& job) {
+    const nlohmann::json r = run_from_images(job, cli.images);
+    std::printf("%d captured images of %d patterns (geometry only: no colour step from captures)\n",
+                r["captures"].get<int>(), r["images"]["patterns"].get<int>());
+    for (const auto& p : r["projectors"]) {
+        std::printf("  %s: %d x %d Gray bits, %d correspondences, reprojection rms %.3f px\n",
+                    p["id"].get<std::string>().c_str(), p["column_bits"].get<int>(), p["row_bits"].get<int>(),
+                    p["correspondences"].get<int>(), p["reprojection_rms_px"].get<double>());
+    }
+    std::printf("written to %s%s%s\n", job.out.c_str(), job.install.empty() ? "" : " and ", job.install.c_str());
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -217,6 +236,11 @@ int main(int argc, char** argv) {
     app.add_option("--out", job.out, "Output folder");
     app.add_option("--outputs", cli.outputs, "kms or headless")->check(CLI::IsMember({"kms", "headless"}));
     app.add_option("--camera", cli.camera, "v4l2:/dev/videoN, libcamera:[id], replay:DIR or rig:FILE (simulation)");
+    auto* images = app.add_option("--images", cli.images,
+                                  "Folder of captured images with captures.json (`patterns`): calibrate from them, "
+                                  "no outputs or camera driven")
+                       ->check(CLI::ExistingDirectory);
+    images->excludes(rig);
     app.add_option("--install", job.install, "Also write the MPCDI here (the kiosk's [calibration].source)");
     app.add_option("--kms-device", cli.kms_device, "DRM card (default: the first with a connected connector)");
     app.add_option("--scale", job.scale, "Resolution scale of projectors and camera, (0, 1]")
@@ -249,15 +273,21 @@ int main(int argc, char** argv) {
     app.add_option("--budget-fps", cli.budget_fps, "Camera frame rate for --budget")->check(CLI::Range(1.0, 1000.0));
     ProcamCommand procam;
     add_procam_command(app, procam);
+    PatternsCommand patterns;
+    add_patterns_command(app, patterns);
     try {
         app.parse(argc, argv);
         if (procam.app->parsed()) return run_procam_command(procam);
+        if (patterns.app->parsed()) return run_patterns_command(patterns);
         if (!parse_size(cli.content, job.content))
             throw CLI::ValidationError("--content", "must be WIDTHxHEIGHT, 1..16384");
         if (cli.rig.empty() && cli.site.empty()) throw CLI::ValidationError("--rig or --site", "one is required");
         if (!cli.budget && job.out.empty()) throw CLI::ValidationError("--out", "is required");
-        if (!cli.site.empty() && !cli.budget && (cli.outputs.empty() || cli.camera.empty())) {
-            throw CLI::ValidationError("--site", "needs --outputs and --camera (or --budget)");
+        if (!cli.images.empty() && (!cli.outputs.empty() || !cli.camera.empty() || cli.budget)) {
+            throw CLI::ValidationError("--images", "replaces --outputs and --camera (and is no --budget)");
+        }
+        if (!cli.site.empty() && !cli.budget && cli.images.empty() && (cli.outputs.empty() || cli.camera.empty())) {
+            throw CLI::ValidationError("--site", "needs --outputs and --camera, or --images (or --budget)");
         }
     } catch (const CLI::ParseError& e) {
         return mogao::cli::exit_status(app, e);
@@ -279,6 +309,7 @@ int main(int argc, char** argv) {
             return run_rig(cli, rig_job);
         }
         if (cli.budget) return run_budget(cli, job);
+        if (!cli.images.empty()) return run_images(cli, job);
         return run_site(cli, job);
     } catch (const std::exception& e) {
         std::cerr << "\nmogao-calibrate: " << e.what() << "\n";

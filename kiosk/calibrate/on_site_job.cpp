@@ -19,9 +19,65 @@
 #include "kiosk/calibrate/pattern_budget.h"
 
 namespace mogao::calibrate {
-namespace {
 
 namespace fs = std::filesystem;
+
+nlohmann::json fit_json(const autocal::AutocalResult& r, std::size_t k) {
+    const autocal::ProjectorReport& p = r.report.projectors[k];
+    return {{"id", p.id},
+            {"resolution", {r.projectors[k].resolution.width, r.projectors[k].resolution.height}},
+            {"column_bits", p.column_bits},
+            {"row_bits", p.row_bits},
+            {"correspondences", p.cells},
+            {"reprojection_rms_px", p.rms_px},
+            {"reprojection_rms_sigma", p.rms_sigma},
+            {"mean_view_angle_deg", p.mean_view_angle_deg}};
+}
+
+nlohmann::json screen_json(const autocal::AutocalResult& r) {
+    return {{"radius_m", r.screen.radius_m},
+            {"arc_deg", r.screen.arc_deg},
+            {"bow_m", r.screen.bow_m},
+            {"bow_kept", r.report.bow.kept},
+            {"cylinder_rms_sigma", r.report.bow.cylinder_rms_sigma},
+            {"bowed_rms_sigma", r.report.bow.bowed_rms_sigma}};
+}
+
+// Copies `file` (when present) to `<file>.last-good` atomically (temporary copy, rename).
+void keep_last_good(const fs::path& file) {
+    if (!fs::exists(file)) return;
+    const fs::path good = file.string() + ".last-good";
+    const fs::path tmp = file.string() + ".last-good.tmp";
+    fs::copy_file(file, tmp, fs::copy_options::overwrite_existing);
+    fs::rename(tmp, good);
+}
+
+void write_calibration(const fs::path& mpcdi, const autocal::CalibrationModels& models, const ScreenCalibration& c,
+                       const OnSiteJob& job) {
+    fs::create_directories(mpcdi.parent_path().empty() ? fs::path(".") : mpcdi.parent_path());
+    keep_last_good(autocal::models_path_for(mpcdi));
+    keep_last_good(mpcdi);
+    MpcdiExportOptions mo;
+    mo.alpha_bit_depth = job.alpha_bits;
+    mo.write_response = job.colour;
+    autocal::write_models(autocal::models_path_for(mpcdi), models);  // first: the watcher finds its models
+    write_mpcdi(mpcdi, to_mpcdi(c, mo));
+}
+
+// 8-bit sRGB PNG with libpng (common/png_io.h; OpenCV's imgcodecs would bring GDAL, HDF5, Poppler ...
+// into the appliance image, docs/image.md).
+void write_camera_png(const fs::path& png, const cv::Mat1f& linear) {
+    Rgb8Image out(ImageSize{linear.cols, linear.rows});
+    for (int y = 0; y < linear.rows; ++y) {
+        for (int x = 0; x < linear.cols; ++x) {
+            std::uint8_t* px = out.at(x, y);
+            px[0] = px[1] = px[2] = srgb8_encode(linear(y, x));
+        }
+    }
+    write_png(png, out);
+}
+
+namespace {
 
 struct Identified {
     std::vector<std::size_t> projector_output;
@@ -89,18 +145,6 @@ nlohmann::json connectors_json(const Identified& id, const PatternDisplay& displ
     return out;
 }
 
-nlohmann::json fit_json(const autocal::AutocalResult& r, std::size_t k) {
-    const autocal::ProjectorReport& p = r.report.projectors[k];
-    return {{"id", p.id},
-            {"resolution", {r.projectors[k].resolution.width, r.projectors[k].resolution.height}},
-            {"column_bits", p.column_bits},
-            {"row_bits", p.row_bits},
-            {"correspondences", p.cells},
-            {"reprojection_rms_px", p.rms_px},
-            {"reprojection_rms_sigma", p.rms_sigma},
-            {"mean_view_angle_deg", p.mean_view_angle_deg}};
-}
-
 nlohmann::json colour_json(const autocal::ColourResult& c) {
     nlohmann::json out = {{"captures", c.captures}, {"matched_white", c.matched_white}, {"black_floor", c.black_floor},
                           {"ambient", c.ambient},   {"alpha_scale", c.alpha_scale},     {"white_floor", c.white_floor}};
@@ -124,40 +168,6 @@ nlohmann::json previous_connectors(const fs::path& report) {
     } catch (const nlohmann::json::exception&) {
         return nullptr;  // an unreadable old report only means no comparison
     }
-}
-
-// Copies `file` (when present) to `<file>.last-good` atomically (temporary copy, rename).
-void keep_last_good(const fs::path& file) {
-    if (!fs::exists(file)) return;
-    const fs::path good = file.string() + ".last-good";
-    const fs::path tmp = file.string() + ".last-good.tmp";
-    fs::copy_file(file, tmp, fs::copy_options::overwrite_existing);
-    fs::rename(tmp, good);
-}
-
-void write_calibration(const fs::path& mpcdi, const autocal::CalibrationModels& models, const ScreenCalibration& c,
-                       const OnSiteJob& job) {
-    fs::create_directories(mpcdi.parent_path().empty() ? fs::path(".") : mpcdi.parent_path());
-    keep_last_good(autocal::models_path_for(mpcdi));
-    keep_last_good(mpcdi);
-    MpcdiExportOptions mo;
-    mo.alpha_bit_depth = job.alpha_bits;
-    mo.write_response = job.colour;
-    autocal::write_models(autocal::models_path_for(mpcdi), models);  // first: the watcher finds its models
-    write_mpcdi(mpcdi, to_mpcdi(c, mo));
-}
-
-// 8-bit sRGB PNG with libpng (common/png_io.h; OpenCV's imgcodecs would bring GDAL, HDF5, Poppler ...
-// into the appliance image, docs/image.md).
-void write_camera_png(const fs::path& png, const cv::Mat1f& linear) {
-    Rgb8Image out(ImageSize{linear.cols, linear.rows});
-    for (int y = 0; y < linear.rows; ++y) {
-        for (int x = 0; x < linear.cols; ++x) {
-            std::uint8_t* px = out.at(x, y);
-            px[0] = px[1] = px[2] = srgb8_encode(linear(y, x));
-        }
-    }
-    write_png(png, out);
 }
 
 // Steps 4-5: the report and the files (on_site_job.h).
@@ -187,12 +197,7 @@ nlohmann::json finish(const OnSiteJob& job, const Identified& id, const autocal:
     for (std::size_t k = 0; k < r.projectors.size(); ++k) report["projectors"].push_back(fit_json(r, k));
     if (colour) report["colour"] = colour_json(*colour);
     // The screen the calibration used: the site file's cylinder, with the bow where it paid (autocal.h).
-    report["screen"] = {{"radius_m", r.screen.radius_m},
-                        {"arc_deg", r.screen.arc_deg},
-                        {"bow_m", r.screen.bow_m},
-                        {"bow_kept", r.report.bow.kept},
-                        {"cylinder_rms_sigma", r.report.bow.cylinder_rms_sigma},
-                        {"bowed_rms_sigma", r.report.bow.bowed_rms_sigma}};
+    report["screen"] = screen_json(r);
     const autocal::CalibrationModels models{r.screen, r.camera, r.projectors};
     write_calibration(job.out / "calibration.mpcdi", models, r.calibration, job);
     if (!job.install.empty()) write_calibration(job.install, models, r.calibration, job);

@@ -37,6 +37,7 @@
 
 #include "appliance/autocal/autocal.h"
 #include "appliance/autocal/colour_calibration.h"
+#include "appliance/autocal/model_store.h"
 #include "drivers/output.h"
 #include "kiosk/calibrate/calibration_camera.h"
 #include "kiosk/calibrate/hardware_pattern_source.h"
@@ -67,5 +68,15 @@ struct OnSiteJob {
 // std::runtime_error naming the output, camera or file.
 nlohmann::json run_on_site(const OnSiteJob& job, OutputBackend& outputs, CalibrationCamera& camera,
                            const ProgressFn& progress);
+
+// Shared with the captured-images route (images_job.h):
+// report.json's per-projector fit and screen entries (above);
+[[nodiscard]] nlohmann::json fit_json(const autocal::AutocalResult& r, std::size_t k);
+[[nodiscard]] nlohmann::json screen_json(const autocal::AutocalResult& r);
+// the MPCDI and its models at `mpcdi`, the previous ones kept as <file>.last-good (above);
+void write_calibration(const std::filesystem::path& mpcdi, const autocal::CalibrationModels& models,
+                       const ScreenCalibration& c, const OnSiteJob& job);
+// a linear camera image as an 8-bit sRGB PNG (camera-white.png).
+void write_camera_png(const std::filesystem::path& png, const cv::Mat1f& linear);
 
 }  // namespace mogao::calibrate
