@@ -7,7 +7,6 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
-#include <numbers>
 #include <optional>
 #include <stdexcept>
 
@@ -23,32 +22,6 @@
 
 namespace mogao::autocal {
 namespace {
-
-// The calibration's own prediction of its seams: max |sum of blend weights - 1| where the fitted
-// models put two or more projectors (content grid of 401 x 101 points inset by 1 %).
-double predicted_seam(const AutocalResult& r, const ScreenModel& s) {
-    const double arc = s.arc_deg * std::numbers::pi / 180.0;
-    double worst = 0.0;
-    for (int j = 0; j <= 100; ++j) {
-        for (int i = 0; i <= 400; ++i) {
-            const double u = 0.01 + 0.98 * i / 400.0;
-            const double v = 0.01 + 0.98 * j / 100.0;
-            double sum = 0.0;
-            int lit = 0;
-            for (std::size_t k = 0; k < r.projectors.size(); ++k) {
-                const Eigen::Vector2d xy =
-                    model_pixel(r.projectors[k], s, u * arc - arc / 2.0, s.top_m - v * (s.top_m - s.bottom_m));
-                if (!xy.allFinite()) continue;
-                const ProjectorCalibration& pc = r.calibration.projectors[k];
-                const float w = sample_blend(pc.blend, pc.output, static_cast<int>(xy.x()), static_cast<int>(xy.y()));
-                sum += w;
-                lit += w > 0.0f;
-            }
-            if (lit >= 2) worst = std::max(worst, std::abs(sum - 1.0));
-        }
-    }
-    return worst;
-}
 
 // The screen as the viewer sees it: per content pixel of a size x size/aspect image, the light of
 // every projector whose (ground-truth) pixel lands there, showing white content with grid lines.
@@ -201,7 +174,7 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
           {"arc_deg", r.screen.arc_deg},
           {"prior_radius_m", prior.screen.radius_m},
           {"prior_arc_deg", prior.screen.arc_deg}}},
-        {"predicted", {{"seam_weight_sum_max_deviation", predicted_seam(r, r.screen)}}},
+        {"predicted", {{"seam_weight_sum_max_deviation", r.report.predicted_seam}}},
         {"ground_truth",
          {{"geometry_mean_px", g.mean_px},
           {"geometry_p95_px", g.p95_px},
