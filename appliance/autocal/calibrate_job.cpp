@@ -141,7 +141,8 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
         calibrate_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
     }
     const GeometryError g = measure_geometry(rig, r.calibration, 4);
-    const LuminanceError l = measure_luminance(rig, r.calibration);
+    // One grid point per projector pixel: a seam's maximum must see a line one pixel wide.
+    const LuminanceError l = measure_luminance(rig, r.calibration, 0.01, pixel_dense_seam_grid(rig));
     nlohmann::json report = {
         {"rig", rig.name},
         {"rig_file", job.rig.string()},
