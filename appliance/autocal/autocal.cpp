@@ -295,13 +295,23 @@ bool reads_off_screen(const std::vector<char>& on_screen, const ProjectorCalibra
 // The predicted seam gate (AutocalOptions::max_predicted_seam): a blend whose weights do not sum to 1
 // across the overlaps shows as a bright or dark line, which neither the projector fits nor the camera
 // pose see. Throws CalibrationRefused naming the figure, its value and its limit.
-void check_predicted_seam(double predicted, const AutocalOptions& o) {
-    if (predicted <= o.max_predicted_seam) return;
+void check_predicted_seam(const PredictedSeam& predicted, const std::vector<DeviceModel>& projectors,
+                          const AutocalOptions& o) {
+    if (predicted.deviation <= o.max_predicted_seam) return;
+    const std::string where = predicted.projector < 0
+                                  ? std::string()
+                                  : " at projector " + std::to_string(predicted.projector) + " '" +
+                                        projectors[static_cast<std::size_t>(predicted.projector)].id + "' pixel (" +
+                                        std::to_string(predicted.x) + ", " + std::to_string(predicted.y) +
+                                        "), screen theta " + std::to_string(predicted.theta_rad / kDeg) + " deg, h " +
+                                        std::to_string(predicted.h_m) + " m";
     throw CalibrationRefused(
-        "blend: predicted seam (max |sum of the blend weights - 1| over the overlaps, from the "
-        "fitted models at every projector pixel) " +
-        std::to_string(predicted) + " above its gate max_predicted_seam " + std::to_string(o.max_predicted_seam) +
-        ": a line or step of that much luminance would show where the projectors overlap");
+        "blend: predicted seam (max |sum of the blend weights - 1| over the overlaps, from the fitted models at every "
+        "projector pixel) " +
+        std::to_string(predicted.deviation) + where + " above its gate max_predicted_seam " +
+        std::to_string(o.max_predicted_seam) +
+        ": a line or spot of that much luminance would show there (a weight that jumps, or two projectors' image edges "
+        "crossing on the screen, where every overlap's weights meet at a point)");
 }
 
 }  // namespace
@@ -418,7 +428,7 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
     }
     result.calibration = calibration_from_models(result.projectors, result.screen, content, options);
     result.report.predicted_seam = predicted_seam_deviation(result.projectors, result.screen, result.calibration);
-    check_predicted_seam(result.report.predicted_seam, options);
+    check_predicted_seam(result.report.predicted_seam, result.projectors, options);
     return result;
 }
 
@@ -439,8 +449,8 @@ ScreenCalibration calibration_from_models(const std::vector<DeviceModel>& projec
     return out;
 }
 
-double predicted_seam_deviation(const std::vector<DeviceModel>& projectors, const ScreenModel& screen,
-                                const ScreenCalibration& calibration) {
+PredictedSeam predicted_seam_deviation(const std::vector<DeviceModel>& projectors, const ScreenModel& screen,
+                                       const ScreenCalibration& calibration) {
     if (projectors.size() != calibration.projectors.size()) {
         throw std::invalid_argument("predicted_seam_deviation: " + std::to_string(projectors.size()) + " models for " +
                                     std::to_string(calibration.projectors.size()) + " projectors");
@@ -451,7 +461,7 @@ double predicted_seam_deviation(const std::vector<DeviceModel>& projectors, cons
     }
     const double half_arc = 0.49 * screen.arc_deg * kDeg;  // content inset by 1 % of the frame on every side
     const double margin_m = 0.01 * (screen.top_m - screen.bottom_m);
-    double worst = 0.0;
+    PredictedSeam worst;
     for (std::size_t k = 0; k < projectors.size(); ++k) {
         const ImageSize out = calibration.projectors[k].output;
         for (int y = 0; y < out.height; ++y) {
@@ -476,7 +486,9 @@ double predicted_seam_deviation(const std::vector<DeviceModel>& projectors, cons
                     sum += w;
                     lit += w > 0.0F;
                 }
-                if (lit >= 2 && !edge) worst = std::max(worst, std::abs(sum - 1.0));
+                if (lit >= 2 && !edge && std::abs(sum - 1.0) > worst.deviation) {
+                    worst = {std::abs(sum - 1.0), static_cast<int>(k), x, y, th.x(), th.y()};
+                }
             }
         }
     }

@@ -250,6 +250,18 @@ struct BowTrial {
     std::array<double, 4> bow_m{};  // the fitted bow (kept or not)
 };
 
+// The blend's predicted seam and where it is (predicted_seam_deviation).
+struct PredictedSeam {
+    double deviation = 0.0;  // max |sum of the weights - 1|
+    // Where it is: the projector whose output pixel (x, y) was walked there, and its screen point (theta in
+    // radians, h in metres); projector -1 where no point is lit by two projectors.
+    int projector = -1;
+    int x = 0;
+    int y = 0;
+    double theta_rad = 0.0;
+    double h_m = 0.0;
+};
+
 struct AutocalReport {
     int edge_points = 0;
     double edge_rms_m = 0.0;
@@ -261,7 +273,7 @@ struct AutocalReport {
     int captures = 0;
     std::vector<ProjectorReport> projectors;
     BowTrial bow;
-    double predicted_seam = 0.0;  // predicted_seam_deviation of the result (the gate max_predicted_seam's figure)
+    PredictedSeam predicted_seam;  // predicted_seam_deviation of the result (the gate max_predicted_seam's figure)
 };
 
 struct AutocalResult {
@@ -299,8 +311,8 @@ struct AutocalResult {
 // (sample_blend); a weight that jumps shows as a line one pixel wide, which a coarser grid of screen points
 // would miss. Includes the ramps' pixel quantisation (a pixel shows one weight over its extent). Throws
 // std::invalid_argument when the models and the calibration's projectors differ in number.
-[[nodiscard]] double predicted_seam_deviation(const std::vector<DeviceModel>& projectors, const ScreenModel& screen,
-                                              const ScreenCalibration& calibration);
+[[nodiscard]] PredictedSeam predicted_seam_deviation(const std::vector<DeviceModel>& projectors,
+                                                     const ScreenModel& screen, const ScreenCalibration& calibration);
 
 // Screen point where a pinhole projector's image position (x, y) lands, as content (u, v)
 // (unclamped), or nullopt-like NaN when the ray misses the cylinder.

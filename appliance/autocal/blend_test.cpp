@@ -49,7 +49,7 @@ TEST(Blend, WeightsStayContinuousWhereImageBordersLeaveTheScreen) {
     const rig::VirtualRig rig = scaled_rig(load("wide200"), 0.5, 0.5);
     const ScreenCalibration c = calibration_from_models(true_models(rig), screen_of(rig), {1920, 1080});
     const LuminanceError dense = measure_luminance(rig, c, 0.01, pixel_dense_seam_grid(rig));
-    const double predicted = predicted_seam_deviation(true_models(rig), screen_of(rig), c);
+    const double predicted = predicted_seam_deviation(true_models(rig), screen_of(rig), c).deviation;
     std::printf("seam luminance max %.4f (%d points), predicted seam %.4f\n", dense.seam_max_deviation, dense.samples,
                 predicted);
     // A correct blend leaves the ramps' pixel quantisation: about 1.5 / 115 px at half scale.
@@ -68,7 +68,7 @@ TEST(Blend, CameraIntegratingOverItsPixelsLeavesNoLineInTheSeams) {
     const LuminanceError dense = measure_luminance(rig, r.calibration, 0.01, pixel_dense_seam_grid(rig));
     const LuminanceError coarse = measure_luminance(rig, r.calibration);
     std::printf("seam luminance max %.4f (one point per projector pixel), %.4f (401 x 101); predicted %.4f\n",
-                dense.seam_max_deviation, coarse.seam_max_deviation, r.report.predicted_seam);
+                dense.seam_max_deviation, coarse.seam_max_deviation, r.report.predicted_seam.deviation);
     EXPECT_LT(dense.seam_max_deviation, 0.05);
 }
 
@@ -78,7 +78,7 @@ TEST(Blend, PredictedSeamSeesALineOnePixelWide) {
     const rig::VirtualRig rig = scaled_rig(load("wide200"), 0.5, 0.5);
     const std::vector<DeviceModel> models = true_models(rig);
     ScreenCalibration c = calibration_from_models(models, screen_of(rig), {1920, 1080});
-    const double clean = predicted_seam_deviation(models, screen_of(rig), c);
+    const double clean = predicted_seam_deviation(models, screen_of(rig), c).deviation;
     // proj1's weight on its grid row through the image's middle, from the right: the first column whose
     // weight is between 0.2 and 0.7 (inside its ramp towards proj2) is raised by 0.3 over the whole column
     // (but not above 1).
@@ -92,7 +92,7 @@ TEST(Blend, PredictedSeamSeesALineOnePixelWide) {
         float& w = blend.weight[static_cast<std::size_t>(y * blend.size.width + column)];
         if (w > 0.0F) w = std::min(1.0F, w + 0.3F);
     }
-    const double spiked = predicted_seam_deviation(models, screen_of(rig), c);
+    const double spiked = predicted_seam_deviation(models, screen_of(rig), c).deviation;
     std::printf("predicted seam %.4f clean, %.4f with the line\n", clean, spiked);
     EXPECT_LT(clean, 0.02);
     EXPECT_GT(spiked, 0.2);  // a pixel between two grid samples shows part of the raised one

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <numbers>
 #include <optional>
 #include <stdexcept>
 
@@ -175,7 +176,13 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
           {"arc_deg", r.screen.arc_deg},
           {"prior_radius_m", prior.screen.radius_m},
           {"prior_arc_deg", prior.screen.arc_deg}}},
-        {"predicted", {{"seam_weight_sum_max_deviation", r.report.predicted_seam}}},
+        {"predicted",
+         {{"seam_weight_sum_max_deviation", r.report.predicted_seam.deviation},
+          {"seam_at",
+           {{"projector", r.report.predicted_seam.projector},
+            {"pixel", {r.report.predicted_seam.x, r.report.predicted_seam.y}},
+            {"theta_deg", r.report.predicted_seam.theta_rad * 180.0 / std::numbers::pi},
+            {"h_m", r.report.predicted_seam.h_m}}}}},
         {"ground_truth",
          {{"geometry_mean_px", g.mean_px},
           {"geometry_p95_px", g.p95_px},
