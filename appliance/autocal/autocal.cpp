@@ -3,11 +3,14 @@
 #include "appliance/autocal/autocal.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <vector>
 
 #include "appliance/autocal/bundle_adjust.h"
+#include "appliance/autocal/colour_calibration.h"
 #include "appliance/autocal/gray_code.h"
 #include "appliance/autocal/screen_geometry.h"
 #include "appliance/warp/calibration_validation.h"
@@ -20,6 +23,12 @@ namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
+// A straight piece of a device's image border, image positions (pixel centres at +0.5).
+struct BorderPiece {
+    Eigen::Vector2d a;
+    Eigen::Vector2d b;
+};
+
 void check_inputs(const CalibrationPrior& prior, ImageSize content, const AutocalOptions& o) {
     const auto fail = [](const std::string& what) { throw std::invalid_argument("calibrate: " + what); };
     if (prior.projectors.empty() || prior.projectors.size() > 16) fail("prior.projectors: 1..16 projectors");
@@ -27,6 +36,7 @@ void check_inputs(const CalibrationPrior& prior, ImageSize content, const Autoca
         fail("content: 1..16384 per side");
     if (o.warp_step_px < 1 || o.warp_step_px > 64) fail("options.warp_step_px: 1..64");
     if (!(o.blend_ramp > 0.0 && o.blend_ramp <= 0.5)) fail("options.blend_ramp: (0, 0.5]");
+    if (!(o.max_predicted_seam > 0.0 && o.max_predicted_seam <= 1.0)) fail("options.max_predicted_seam: (0, 1]");
     if (o.max_gray_bits != 0 && (o.max_gray_bits < o.min_bits || o.max_gray_bits > 16)) {
         fail("options.max_gray_bits: 0 (all) or min_bits (" + std::to_string(o.min_bits) + ")..16, got " +
              std::to_string(o.max_gray_bits));
@@ -66,34 +76,80 @@ Eigen::Vector2d device_screen(const DeviceModel& d, const ScreenModel& s, double
     return {std::atan2(hit->x(), -hit->z()), hit->y()};
 }
 
-// Distance of screen point (theta, h) from device d's image border in its pixels (0 outside),
-// counting only the parts of the border that lie on the screen: a border beyond the screen's top,
-// bottom or arc end is no overlap edge, so the blend ramps run across the overlaps only (Raskar et
-// al. 1999, "Multi-projector displays using camera-based registration": the weight falls with the
-// distance to the edge of the projector's footprint on the display surface).
-double border_distance(const DeviceModel& d, const ScreenModel& s, const Eigen::Vector2d& th) {
-    const Eigen::Vector3d q = d.rotation.transpose() * (screen_position(s, th.x(), th.y()) - d.position_m);
-    if (q.z() <= 0.0) return 0.0;
-    const double x = d.fx_px * q.x() / q.z() + d.cx_px;
-    const double y = d.fy_px * q.y() / q.z() + d.cy_px;
+bool lands_on_screen(const DeviceModel& d, const ScreenModel& s, const Eigen::Vector2d& xy) {
+    const Eigen::Vector2d th = device_screen(d, s, xy.x(), xy.y());
+    return std::isfinite(th.x()) && std::abs(th.x()) <= s.arc_deg * kDeg / 2.0 && th.y() >= s.bottom_m &&
+           th.y() <= s.top_m;
+}
+
+// The parts of d's image border whose rays land on the screen, as straight pieces in its image. Each
+// side is walked in steps of at most 4 px; each change between on and off the screen is located by
+// bisection to 1e-6 of the side. A border beyond the screen's top, bottom or arc end is no overlap
+// edge: the blend ramps run across the overlaps only.
+std::vector<BorderPiece> on_screen_border(const DeviceModel& d, const ScreenModel& s) {
     const double w = d.resolution.width;
     const double h = d.resolution.height;
-    if (!(x >= 0.0 && x <= w && y >= 0.0 && y <= h)) return 0.0;
-    const double arc = s.arc_deg * kDeg;
-    const auto on_screen = [&](double bx, double by) {
-        const Eigen::Vector2d b = device_screen(d, s, bx, by);
-        return std::isfinite(b.x()) && std::abs(b.x()) <= arc / 2.0 && b.y() >= s.bottom_m && b.y() <= s.top_m;
-    };
+    const std::array<std::array<Eigen::Vector2d, 2>, 4> sides{{{Eigen::Vector2d(0, 0), Eigen::Vector2d(w, 0)},
+                                                               {Eigen::Vector2d(w, 0), Eigen::Vector2d(w, h)},
+                                                               {Eigen::Vector2d(w, h), Eigen::Vector2d(0, h)},
+                                                               {Eigen::Vector2d(0, h), Eigen::Vector2d(0, 0)}}};
+    std::vector<BorderPiece> pieces;
+    for (const auto& [a, b] : sides) {
+        const auto at = [&](double t) -> Eigen::Vector2d { return a + t * (b - a); };
+        const auto on = [&](double t) { return lands_on_screen(d, s, at(t)); };
+        const int steps = std::max(16, static_cast<int>(std::ceil((b - a).norm() / 4.0)));
+        bool was_on = on(0.0);
+        double start = 0.0;
+        for (int i = 1; i <= steps; ++i) {
+            const double t = static_cast<double>(i) / steps;
+            if (on(t) == was_on) continue;
+            double lo = static_cast<double>(i - 1) / steps;
+            double hi = t;
+            while (hi - lo > 1e-6) {
+                const double mid = 0.5 * (lo + hi);
+                if (on(mid) == was_on) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            if (was_on) pieces.push_back({at(start), at(lo)});
+            start = hi;
+            was_on = !was_on;
+        }
+        if (was_on) pieces.push_back({at(start), b});
+    }
+    return pieces;
+}
+
+double distance_to(const BorderPiece& piece, const Eigen::Vector2d& p) {
+    const Eigen::Vector2d ab = piece.b - piece.a;
+    const double len2 = ab.squaredNorm();
+    const double t = len2 > 0.0 ? std::clamp((p - piece.a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    return (piece.a + t * ab - p).norm();
+}
+
+// Distance of screen point (theta, h) from the on-screen parts of device d's image border
+// (on_screen_border), in its pixels; 0 outside its image, infinite where no part of its border lies on
+// the screen. The Euclidean distance to a fixed closed set is 1-Lipschitz, so the weight built on it is
+// continuous everywhere on the screen: no test flips from one pixel to the next (Raskar et al. 1999,
+// "Multi-projector displays using camera-based registration", and Raskar et al. 1998, "The office of
+// the future": the weight falls with the distance to the edge of the projector's footprint on the
+// display surface).
+double border_distance(const DeviceModel& d, const std::vector<BorderPiece>& border, const ScreenModel& s,
+                       const Eigen::Vector2d& th) {
+    const Eigen::Vector3d q = d.rotation.transpose() * (screen_position(s, th.x(), th.y()) - d.position_m);
+    if (q.z() <= 0.0) return 0.0;
+    const Eigen::Vector2d p(d.fx_px * q.x() / q.z() + d.cx_px, d.fy_px * q.y() / q.z() + d.cy_px);
+    if (!(p.x() >= 0.0 && p.x() <= d.resolution.width && p.y() >= 0.0 && p.y() <= d.resolution.height)) return 0.0;
     double best = std::numeric_limits<double>::infinity();
-    if (on_screen(0.0, y)) best = std::min(best, x);
-    if (on_screen(w, y)) best = std::min(best, w - x);
-    if (on_screen(x, 0.0)) best = std::min(best, y);
-    if (on_screen(x, h)) best = std::min(best, h - y);
+    for (const BorderPiece& piece : border) best = std::min(best, distance_to(piece, p));
     return best;
 }
 
-ProjectorCalibration build_projector(const std::vector<DeviceModel>& fitted, std::size_t k, const ScreenModel& s,
-                                     const AutocalOptions& o) {
+ProjectorCalibration build_projector(const std::vector<DeviceModel>& fitted,
+                                     const std::vector<std::vector<BorderPiece>>& borders, std::size_t k,
+                                     const ScreenModel& s, const AutocalOptions& o) {
     const DeviceModel& d = fitted[k];
     ProjectorCalibration pc;
     pc.id = d.id;
@@ -121,7 +177,7 @@ ProjectorCalibration build_projector(const std::vector<DeviceModel>& fitted, std
             double own = 0.0;
             for (std::size_t j = 0; j < fitted.size() && on; ++j) {
                 const double ramp = o.blend_ramp * fitted[j].resolution.width;
-                const double f = smooth_ramp(border_distance(fitted[j], s, th) / ramp);
+                const double f = smooth_ramp(border_distance(fitted[j], borders[j], s, th) / ramp);
                 sum += f;
                 if (j == k) own = f;
             }
@@ -203,6 +259,59 @@ void check_camera_intrinsics(const BundleResult& ba, const DeviceModel& prior, c
                                      "): the camera sees too little of the screen's edges or of the projectors");
         }
     }
+}
+
+// Per blend grid sample of device d (grid of `size` samples, row-major): 1 where its output position
+// lands on the screen (the samples build_projector gives a weight), 0 where the blend is 0 for being off it.
+std::vector<char> grid_on_screen(const DeviceModel& d, const ScreenModel& s, ImageSize size) {
+    std::vector<char> on(static_cast<std::size_t>(size.pixel_count()));
+    for (int gy = 0; gy < size.height; ++gy) {
+        for (int gx = 0; gx < size.width; ++gx) {
+            const Eigen::Vector2d xy(grid_to_output(gx, d.resolution.width, size.width) + 0.5,
+                                     grid_to_output(gy, d.resolution.height, size.height) + 0.5);
+            on[static_cast<std::size_t>(gy) * size.width + gx] = lands_on_screen(d, s, xy) ? 1 : 0;
+        }
+    }
+    return on;
+}
+
+// Whether output pixel (x, y) of pc reads (bilinearly, warp_sampling.h) a blend sample that lies off the
+// screen: the band, one grid cell wide, along the screen's edge where every projector's weight falls to
+// its off-screen 0 alike. That is the screen's edge as the grid draws it, not a seam between projectors.
+bool reads_off_screen(const std::vector<char>& on_screen, const ProjectorCalibration& pc, int x, int y) {
+    const ImageSize g = pc.blend.size;
+    const double gx = std::clamp(output_to_grid(x, pc.output.width, g.width), 0.0, g.width - 1.0);
+    const double gy = std::clamp(output_to_grid(y, pc.output.height, g.height), 0.0, g.height - 1.0);
+    const int x0 = static_cast<int>(gx);
+    const int y0 = static_cast<int>(gy);
+    for (int j = y0; j <= std::min(y0 + 1, g.height - 1); ++j) {
+        for (int i = x0; i <= std::min(x0 + 1, g.width - 1); ++i) {
+            if (!on_screen[static_cast<std::size_t>(j) * g.width + i]) return true;
+        }
+    }
+    return false;
+}
+
+// The predicted seam gate (AutocalOptions::max_predicted_seam): a blend whose weights do not sum to 1
+// across the overlaps shows as a bright or dark line, which neither the projector fits nor the camera
+// pose see. Throws CalibrationRefused naming the figure, its value and its limit.
+void check_predicted_seam(const PredictedSeam& predicted, const std::vector<DeviceModel>& projectors,
+                          const AutocalOptions& o) {
+    if (predicted.deviation <= o.max_predicted_seam) return;
+    const std::string where = predicted.projector < 0
+                                  ? std::string()
+                                  : " at projector " + std::to_string(predicted.projector) + " '" +
+                                        projectors[static_cast<std::size_t>(predicted.projector)].id + "' pixel (" +
+                                        std::to_string(predicted.x) + ", " + std::to_string(predicted.y) +
+                                        "), screen theta " + std::to_string(predicted.theta_rad / kDeg) + " deg, h " +
+                                        std::to_string(predicted.h_m) + " m";
+    throw CalibrationRefused(
+        "blend: predicted seam (max |sum of the blend weights - 1| over the overlaps, from the fitted models at every "
+        "projector pixel) " +
+        std::to_string(predicted.deviation) + where + " above its gate max_predicted_seam " +
+        std::to_string(o.max_predicted_seam) +
+        ": a line or spot of that much luminance would show there (a weight that jumps, or two projectors' image edges "
+        "crossing on the screen, where every overlap's weights meet at a point)");
 }
 
 }  // namespace
@@ -318,6 +427,8 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
         }
     }
     result.calibration = calibration_from_models(result.projectors, result.screen, content, options);
+    result.report.predicted_seam = predicted_seam_deviation(result.projectors, result.screen, result.calibration);
+    check_predicted_seam(result.report.predicted_seam, result.projectors, options);
     return result;
 }
 
@@ -329,11 +440,59 @@ ScreenCalibration calibration_from_models(const std::vector<DeviceModel>& projec
     check_inputs(prior, content, options);
     ScreenCalibration out;
     out.content = content;
+    std::vector<std::vector<BorderPiece>> borders;
+    for (const DeviceModel& d : projectors) borders.push_back(on_screen_border(d, screen));
     for (std::size_t k = 0; k < projectors.size(); ++k) {
-        out.projectors.push_back(build_projector(projectors, k, screen, options));
+        out.projectors.push_back(build_projector(projectors, borders, k, screen, options));
     }
     validate_screen(out);
     return out;
+}
+
+PredictedSeam predicted_seam_deviation(const std::vector<DeviceModel>& projectors, const ScreenModel& screen,
+                                       const ScreenCalibration& calibration) {
+    if (projectors.size() != calibration.projectors.size()) {
+        throw std::invalid_argument("predicted_seam_deviation: " + std::to_string(projectors.size()) + " models for " +
+                                    std::to_string(calibration.projectors.size()) + " projectors");
+    }
+    std::vector<std::vector<char>> on_screen;
+    for (std::size_t k = 0; k < projectors.size(); ++k) {
+        on_screen.push_back(grid_on_screen(projectors[k], screen, calibration.projectors[k].blend.size));
+    }
+    const double half_arc = 0.49 * screen.arc_deg * kDeg;  // content inset by 1 % of the frame on every side
+    const double margin_m = 0.01 * (screen.top_m - screen.bottom_m);
+    PredictedSeam worst;
+    for (std::size_t k = 0; k < projectors.size(); ++k) {
+        const ImageSize out = calibration.projectors[k].output;
+        for (int y = 0; y < out.height; ++y) {
+            for (int x = 0; x < out.width; ++x) {
+                const Eigen::Vector2d th = device_screen(projectors[k], screen, x + 0.5, y + 0.5);
+                if (!(std::abs(th.x()) <= half_arc && th.y() >= screen.bottom_m + margin_m &&
+                      th.y() <= screen.top_m - margin_m)) {
+                    continue;  // NaN (no hit) fails too
+                }
+                double sum = 0.0;
+                int lit = 0;
+                bool edge = false;
+                for (std::size_t j = 0; j < projectors.size() && !edge; ++j) {
+                    const ProjectorCalibration& pc = calibration.projectors[j];
+                    const Eigen::Vector2d xy =
+                        j == k ? Eigen::Vector2d(x, y) : model_pixel(projectors[j], screen, th.x(), th.y());
+                    if (!xy.allFinite()) continue;
+                    const int px = static_cast<int>(xy.x());
+                    const int py = static_cast<int>(xy.y());
+                    edge = reads_off_screen(on_screen[j], pc, px, py);
+                    const float w = sample_blend(pc.blend, pc.output, px, py);
+                    sum += w;
+                    lit += w > 0.0F;
+                }
+                if (lit >= 2 && !edge && std::abs(sum - 1.0) > worst.deviation) {
+                    worst = {std::abs(sum - 1.0), static_cast<int>(k), x, y, th.x(), th.y()};
+                }
+            }
+        }
+    }
+    return worst;
 }
 
 std::array<double, 6> falloff_basis(const DeviceModel& d, double x, double y) {

@@ -46,11 +46,16 @@
 //  5. Warp: grid samples at texel centres (warp_sampling.h) -> fitted projector ray -> cylinder
 //     -> content (u, v), left unclamped past the screen's edges (the blend is 0 there).
 //  0. The camera's auto-exposure must be locked (refused otherwise, before any pattern is shown).
-//  6. Blend (linear light; Raskar et al. 1999): w_k = f(d_k) / sum_j f(d_j), d_j = distance in
-//     projector j's pixels of the screen point from the parts of j's image border that lie on the
-//     screen (borders beyond the screen's top, bottom or ends are no overlap edges), f =
-//     smoothstep(d / ramp); 0 off the screen. Sums to 1 wherever a projector lights the screen,
-//     C1-smooth, ramps only across the overlaps.
+//  6. Blend (linear light; Raskar et al. 1998, "The office of the future", and 1999, "Multi-projector
+//     displays using camera-based registration": weights falling with the distance to the edge of each
+//     projector's footprint, normalised to sum to 1): w_k = f(d_k) / sum_j f(d_j), d_j = Euclidean
+//     distance in projector j's pixels of the screen point from the parts of j's image border that lie
+//     on the screen (borders beyond the screen's top, bottom or ends are no overlap edges; the parts are
+//     located once per projector, each end found by bisection), 0 outside j's image, f =
+//     smoothstep(d / ramp); 0 off the screen. The distance to a fixed closed set is continuous, so the
+//     weights are continuous everywhere on the screen (no test that flips from one pixel to the next),
+//     C1 along the ramps, sum to 1 wherever a projector lights the screen, ramps only across the overlaps.
+//  7. Predicted seam gate: predicted_seam_deviation() of the result above `max_predicted_seam`: refused.
 #pragma once
 
 #include <array>
@@ -184,6 +189,11 @@ struct AutocalOptions {
     // screen and the projectors must determine it, not the prior), (0, 1]; and unless each lies within 4 of the
     // prior's sigmas of the prior's value.
     double camera_sigma_gate = 0.25;
+    // Refused when the blend's predicted seam (predicted_seam_deviation: max |sum of the weights - 1| over the
+    // overlaps, at every projector pixel) is above this, (0, 1]. A correct blend's figure is its ramps' pixel
+    // quantisation, about 1.5 / ramp width in pixels (1.3 % at 960 px wide, 0.7 % at 1920: docs/calibration.md);
+    // a weight that jumps shows as a line of the jump's height.
+    double max_predicted_seam = 0.05;
 };
 
 // Shows one signal image per projector (CV_32FC1 grey or CV_32FC3 RGB in [0, 1], projector
@@ -240,6 +250,18 @@ struct BowTrial {
     std::array<double, 4> bow_m{};  // the fitted bow (kept or not)
 };
 
+// The blend's predicted seam and where it is (predicted_seam_deviation).
+struct PredictedSeam {
+    double deviation = 0.0;  // max |sum of the weights - 1|
+    // Where it is: the projector whose output pixel (x, y) was walked there, and its screen point (theta in
+    // radians, h in metres); projector -1 where no point is lit by two projectors.
+    int projector = -1;
+    int x = 0;
+    int y = 0;
+    double theta_rad = 0.0;
+    double h_m = 0.0;
+};
+
 struct AutocalReport {
     int edge_points = 0;
     double edge_rms_m = 0.0;
@@ -251,6 +273,7 @@ struct AutocalReport {
     int captures = 0;
     std::vector<ProjectorReport> projectors;
     BowTrial bow;
+    PredictedSeam predicted_seam;  // predicted_seam_deviation of the result (the gate max_predicted_seam's figure)
 };
 
 struct AutocalResult {
@@ -280,6 +303,16 @@ struct AutocalResult {
 [[nodiscard]] ScreenCalibration calibration_from_models(const std::vector<DeviceModel>& projectors,
                                                         const ScreenModel& screen, ImageSize content,
                                                         const AutocalOptions& options = {});
+
+// The blend's own prediction of its seams, from the fitted models alone (no ground truth): max |sum of
+// the blend weights - 1| over screen points two or more projectors light, content inset by 1 % of the
+// frame on every side. Walked at every output pixel of every projector: the pixel's centre through its
+// model onto the screen, then each other projector's pixel there (model_pixel, floor) and its blend weight
+// (sample_blend); a weight that jumps shows as a line one pixel wide, which a coarser grid of screen points
+// would miss. Includes the ramps' pixel quantisation (a pixel shows one weight over its extent). Throws
+// std::invalid_argument when the models and the calibration's projectors differ in number.
+[[nodiscard]] PredictedSeam predicted_seam_deviation(const std::vector<DeviceModel>& projectors,
+                                                     const ScreenModel& screen, const ScreenCalibration& calibration);
 
 // Screen point where a pinhole projector's image position (x, y) lands, as content (u, v)
 // (unclamped), or nullopt-like NaN when the ray misses the cylinder.

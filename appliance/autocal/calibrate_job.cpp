@@ -24,32 +24,6 @@
 namespace mogao::autocal {
 namespace {
 
-// The calibration's own prediction of its seams: max |sum of blend weights - 1| where the fitted
-// models put two or more projectors (content grid of 401 x 101 points inset by 1 %).
-double predicted_seam(const AutocalResult& r, const ScreenModel& s) {
-    const double arc = s.arc_deg * std::numbers::pi / 180.0;
-    double worst = 0.0;
-    for (int j = 0; j <= 100; ++j) {
-        for (int i = 0; i <= 400; ++i) {
-            const double u = 0.01 + 0.98 * i / 400.0;
-            const double v = 0.01 + 0.98 * j / 100.0;
-            double sum = 0.0;
-            int lit = 0;
-            for (std::size_t k = 0; k < r.projectors.size(); ++k) {
-                const Eigen::Vector2d xy =
-                    model_pixel(r.projectors[k], s, u * arc - arc / 2.0, s.top_m - v * (s.top_m - s.bottom_m));
-                if (!xy.allFinite()) continue;
-                const ProjectorCalibration& pc = r.calibration.projectors[k];
-                const float w = sample_blend(pc.blend, pc.output, static_cast<int>(xy.x()), static_cast<int>(xy.y()));
-                sum += w;
-                lit += w > 0.0f;
-            }
-            if (lit >= 2) worst = std::max(worst, std::abs(sum - 1.0));
-        }
-    }
-    return worst;
-}
-
 // The screen as the viewer sees it: per content pixel of a size x size/aspect image, the light of
 // every projector whose (ground-truth) pixel lands there, showing white content with grid lines.
 Rgb8Image preview(const rig::VirtualRig& rig, const ScreenCalibration& c, int width) {
@@ -168,7 +142,8 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
         calibrate_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
     }
     const GeometryError g = measure_geometry(rig, r.calibration, 4);
-    const LuminanceError l = measure_luminance(rig, r.calibration);
+    // One grid point per projector pixel: a seam's maximum must see a line one pixel wide.
+    const LuminanceError l = measure_luminance(rig, r.calibration, 0.01, pixel_dense_seam_grid(rig));
     nlohmann::json report = {
         {"rig", rig.name},
         {"rig_file", job.rig.string()},
@@ -201,7 +176,13 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
           {"arc_deg", r.screen.arc_deg},
           {"prior_radius_m", prior.screen.radius_m},
           {"prior_arc_deg", prior.screen.arc_deg}}},
-        {"predicted", {{"seam_weight_sum_max_deviation", predicted_seam(r, r.screen)}}},
+        {"predicted",
+         {{"seam_weight_sum_max_deviation", r.report.predicted_seam.deviation},
+          {"seam_at",
+           {{"projector", r.report.predicted_seam.projector},
+            {"pixel", {r.report.predicted_seam.x, r.report.predicted_seam.y}},
+            {"theta_deg", r.report.predicted_seam.theta_rad * 180.0 / std::numbers::pi},
+            {"h_m", r.report.predicted_seam.h_m}}}}},
         {"ground_truth",
          {{"geometry_mean_px", g.mean_px},
           {"geometry_p95_px", g.p95_px},

@@ -140,5 +140,31 @@ TEST(CalibrateJob, RefusedRigLeavesThePreviousCalibration) {
     std::filesystem::remove_all(job.out);
 }
 
+// The predicted seam gate (AutocalOptions::max_predicted_seam): a blend predicted above it is refused
+// naming the figure, nothing is written, the last good calibration stays. Every blend has its ramps'
+// pixel quantisation (about 2.6 % at quarter scale), so a gate of 1e-4 refuses any.
+TEST(CalibrateJob, PredictedSeamAboveItsGateKeepsThePreviousCalibration) {
+    CalibrateJob job;
+    job.out = temp_dir("seam-gate");
+    std::filesystem::create_directories(job.out);
+    std::ofstream(job.out / "calibration.mpcdi") << "last good";
+    job.rig = std::string(MOGAO_SOURCE_DIR) + "/rigs/standard.toml";
+    job.scale = 0.25;
+    job.content = {960, 540};
+    job.colour = false;
+    job.options.phase_shifts = 0;
+    job.options.max_predicted_seam = 1e-4;
+    try {
+        (void)run_calibrate_job(job);
+        FAIL() << "calibrated with a predicted seam above its gate";
+    } catch (const CalibrationRefused& e) {
+        EXPECT_NE(std::string(e.what()).find("predicted seam"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("max_predicted_seam"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(slurp(job.out / "calibration.mpcdi"), "last good");
+    EXPECT_FALSE(std::filesystem::exists(job.out / "report.json"));
+    std::filesystem::remove_all(job.out);
+}
+
 }  // namespace
 }  // namespace mogao::autocal

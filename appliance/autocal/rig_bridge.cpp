@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <stdexcept>
 
 #include <Eigen/Geometry>
 
@@ -133,18 +134,29 @@ GeometryError measure_geometry(const rig::VirtualRig& rig, const ScreenCalibrati
     return out;
 }
 
-std::vector<rig::ScreenPoint> seam_grid(const rig::VirtualRig& rig, double inset) {
-    constexpr int kSteps = 400;
+std::vector<rig::ScreenPoint> seam_grid(const rig::VirtualRig& rig, double inset, int columns, int rows) {
+    if (columns < 2 || rows < 2) throw std::invalid_argument("seam_grid: columns and rows >= 2");
     std::vector<rig::ScreenPoint> grid;
-    grid.reserve(static_cast<std::size_t>((kSteps + 1) * (kSteps / 4 + 1)));
-    for (int j = 0; j <= kSteps / 4; ++j) {
-        for (int i = 0; i <= kSteps; ++i) {
-            const Eigen::Vector2d uv(inset + (1.0 - 2.0 * inset) * i / kSteps,
-                                     inset + (1.0 - 2.0 * inset) * j / (kSteps / 4));
+    grid.reserve(static_cast<std::size_t>(columns) * static_cast<std::size_t>(rows));
+    for (int j = 0; j < rows; ++j) {
+        for (int i = 0; i < columns; ++i) {
+            const Eigen::Vector2d uv(inset + (1.0 - 2.0 * inset) * i / (columns - 1),
+                                     inset + (1.0 - 2.0 * inset) * j / (rows - 1));
             grid.push_back(rig::screen_of(rig.screen, uv));
         }
     }
     return grid;
+}
+
+SeamGridSize pixel_dense_seam_grid(const rig::VirtualRig& rig, double per_pixel) {
+    int width = 0;
+    int height = 0;
+    for (const rig::RigProjector& p : rig.projectors) {
+        width += p.resolution.width;
+        height = std::max(height, p.resolution.height);
+    }
+    return {std::max(2, static_cast<int>(std::ceil(per_pixel * width))),
+            std::max(2, static_cast<int>(std::ceil(per_pixel * height)))};
 }
 
 std::optional<std::array<int, 2>> output_pixel(const rig::VirtualRig& rig, int k, const ProjectorCalibration& pc,
@@ -157,10 +169,11 @@ std::optional<std::array<int, 2>> output_pixel(const rig::VirtualRig& rig, int k
 
 LensFalloff falloff_of(const rig::RigProjector& p) { return {{1.0, 0.0, 0.0, -p.falloff, 0.0, -p.falloff}}; }
 
-LuminanceError measure_luminance(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double inset) {
+LuminanceError measure_luminance(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double inset,
+                                 SeamGridSize grid) {
     std::vector<double> lum;
     std::vector<bool> seam;
-    for (const rig::ScreenPoint& s : seam_grid(rig, inset)) {
+    for (const rig::ScreenPoint& s : seam_grid(rig, inset, grid.columns, grid.rows)) {
         double l = 0.0;
         int lit = 0;
         for (std::size_t k = 0; k < calibration.projectors.size(); ++k) {

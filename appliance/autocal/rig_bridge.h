@@ -65,9 +65,20 @@ struct GeometryError {
 [[nodiscard]] GeometryError measure_geometry(const rig::VirtualRig& rig, const ScreenCalibration& calibration,
                                              int step);
 
-// The content grid the seam measurements walk: 401 x 101 content points (u, v) inset by `inset`
-// of the frame on every side, row by row, each as the screen point showing it.
-[[nodiscard]] std::vector<rig::ScreenPoint> seam_grid(const rig::VirtualRig& rig, double inset);
+// The content grid the seam measurements walk: `columns` x `rows` content points (u, v) inset by `inset`
+// of the frame on every side, row by row, each as the screen point showing it (columns, rows >= 2).
+[[nodiscard]] std::vector<rig::ScreenPoint> seam_grid(const rig::VirtualRig& rig, double inset, int columns = 401,
+                                                      int rows = 101);
+
+// A seam grid fine enough that a line one projector pixel wide cannot fall between its points: as many
+// columns as the projectors have pixels side by side (their widths summed, overlaps counted twice) and
+// as many rows as the tallest has, each times `per_pixel`. A seam's maximum is only as good as its grid:
+// the default 401 x 101 points are 8 to 16 projector pixels apart on a wide rig.
+struct SeamGridSize {
+    int columns = 401;
+    int rows = 101;
+};
+[[nodiscard]] SeamGridSize pixel_dense_seam_grid(const rig::VirtualRig& rig, double per_pixel = 1.0);
 
 // Projector k's output pixel (floor of the ground-truth projection, clamped to the output) that
 // lights screen point `s`; nullopt where projector k does not reach it.
@@ -88,7 +99,8 @@ struct LuminanceError {
 // White content through the calibration onto the rig (ground truth projections, the rig's
 // responses, brightness and lens fall-off, black level left out: black-level compensation is a
 // later step), on a grid of content points inset by `inset` of the frame on every side.
+// `grid`: the seam grid's size (pixel_dense_seam_grid for a maximum that sees one-pixel lines).
 [[nodiscard]] LuminanceError measure_luminance(const rig::VirtualRig& rig, const ScreenCalibration& calibration,
-                                               double inset = 0.01);
+                                               double inset = 0.01, SeamGridSize grid = {});
 
 }  // namespace mogao::autocal
