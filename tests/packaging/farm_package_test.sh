@@ -32,16 +32,6 @@ for tool in mmdebstrap chroot unshare dpkg-deb python3; do
   command -v "$tool" > /dev/null || skip "missing tool '$tool'"
 done
 t0=$(date +%s)
-deb=${MOGAO_FARM_DEB:-}
-if [[ -z "$deb" ]]; then
-  log "bash .ci/package $deb_dir (the packages of this tree; MOGAO_FARM_DEB=FILE tests that one instead)"
-  rm -f "$deb_dir"/*.deb
-  bash "$repo/.ci/package" "$deb_dir" > "$deb_dir.log" 2>&1 || { tail -n 30 "$deb_dir.log"; fail "bash .ci/package $deb_dir failed"; }
-  deb=$(ls "$deb_dir"/mogao-farm_*.deb)
-fi
-[[ -f "$deb" ]] || fail "no package $deb"
-log "package: $deb ($(($(date +%s) - t0)) s)"
-
 source "$repo/image/lib/common.sh"
 source "$repo/image/lib/debian.sh"
 export SOURCE_DATE_EPOCH=${SOURCE_DATE_EPOCH:-$(date +%s)} LC_ALL=C.UTF-8
@@ -59,6 +49,18 @@ t1=$(date +%s)
 img_mmdebstrap "$root" "$work/mmdebstrap.log" "$cache" "apt,systemd,systemd-sysv,dbus,iproute2" \
   --skip=cleanup/apt/lists --customize-hook='cp /etc/resolv.conf "$1/etc/resolv.conf"'
 log "root: mmdebstrap bookworm in $(($(date +%s) - t1)) s"
+
+# ---- the package: this tree's, built now, or MOGAO_FARM_DEB ---------------------------------------
+deb=${MOGAO_FARM_DEB:-}
+if [[ -z "$deb" ]]; then
+  log "bash .ci/package $deb_dir (the packages of this tree; MOGAO_FARM_DEB=FILE tests that one instead)"
+  rm -f "$deb_dir"/*.deb
+  bash "$repo/.ci/package" "$deb_dir" > "$deb_dir.log" 2>&1 || { tail -n 30 "$deb_dir.log"; fail "bash .ci/package $deb_dir failed"; }
+  deb=$(ls "$deb_dir"/mogao-farm_*.deb)
+fi
+[[ -f "$deb" ]] || fail "no package $deb"
+log "package: $deb"
+
 
 # in_root CMD...: CMD in the root with /proc, /sys and /dev, in a mount namespace of its own.
 in_root() {
