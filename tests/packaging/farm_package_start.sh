@@ -1,0 +1,122 @@
+# SPDX-License-Identifier: Apache-2.0
+# Sourced by farm_package_test.sh (bash; expects root, work, log, fail, pid_nspawn): the two ways of
+# starting the installed farm. Both check that it reaches READY and listens on MOGAO_LISTEN's port.
+
+# The example farm.env listens on [::]:7443; the test moves it to a port of its own (the host's
+# network is shared with the root, and other tests may serve on 7443).
+farm_port=$((20000 + RANDOM % 20000))
+nspawn_reason=""
+
+leader=""
+
+in_container() { nsenter --target "$leader" --all /usr/bin/env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin HOME=/root "$@"; }
+
+# boot_under_systemd: boots the root with systemd-nspawn (host network) and checks that the
+# enabled farm did not start without its TLS files. Returns 1 with nspawn_reason set when the
+# container cannot boot here.
+boot_under_systemd() {
+  command -v systemd-nspawn > /dev/null || { nspawn_reason="systemd-nspawn not installed"; return 1; }
+  # --keep-unit --register=no: no host systemd or D-Bus needed (a build container has neither).
+  systemd-nspawn --quiet --directory="$root" --register=no --keep-unit --boot --console=pipe \
+    < /dev/null > "$work/nspawn.log" 2>&1 &
+  pid_nspawn=$!
+  local state="" i
+  # The container's systemd: the child of nspawn's child.
+  for ((i = 0; i < 90; i++)); do
+    kill -0 "$pid_nspawn" 2> /dev/null || break
+    local child
+    child=$(cat /proc/"$pid_nspawn"/task/*/children 2> /dev/null | awk '{ print $1 }' | head -n1)
+    [[ -n "$child" ]] && leader=$(cat /proc/"$child"/task/*/children 2> /dev/null | awk '{ print $1 }' | head -n1)
+    if [[ -n "$leader" ]]; then
+      state=$(timeout 10 nsenter --target "$leader" --all /usr/bin/env -i PATH=/usr/bin:/bin systemctl is-system-running 2> /dev/null || true)
+      [[ "$state" == running || "$state" == degraded ]] && break
+    fi
+    sleep 1
+  done
+  if [[ "$state" != running && "$state" != degraded ]]; then
+    nspawn_reason="systemd-nspawn --boot: system state '${state:-none}' after ${i} s; $(grep -v '^$' "$work/nspawn.log" | tail -n 3 | tr '\n' ' ' | cut -c1-300)"
+    kill "$pid_nspawn" 2> /dev/null; wait "$pid_nspawn" 2> /dev/null; pid_nspawn=""
+    return 1
+  fi
+  log "container booted in ${i} s (systemd: $state)"
+  in_container systemctl is-enabled mogao-farm | grep -qx enabled || fail "mogao-farm.service not enabled in the booted root"
+  local active cond
+  active=$(in_container systemctl show -P ActiveState mogao-farm)
+  cond=$(in_container systemctl show -P ConditionResult mogao-farm)
+  [[ "$active" == inactive && "$cond" == no ]] \
+    || fail "unconfigured farm at boot: ActiveState=$active ConditionResult=$cond (want inactive, condition not met)"
+  log "ok: at boot the enabled, unconfigured farm was not started (ConditionDirectoryNotEmpty=/etc/mogao/pki)"
+}
+
+# wait_state WANT...: mogao-farm's ActiveState once it is one of WANT (180 s at most).
+wait_state() {
+  local state="" i
+  for ((i = 0; i < 180; i++)); do
+    state=$(in_container systemctl show -P ActiveState mogao-farm)
+    [[ " $* " == *" $state "* ]] && break
+    sleep 1
+  done
+  echo "$state"
+}
+
+# start_under_systemd: the README's `systemctl enable --now mogao-farm`: active (Type=notify: READY=1
+# received) and listening.
+start_under_systemd() {
+  local t state
+  t=$(date +%s)
+  in_container systemctl enable --now mogao-farm || true
+  state=$(wait_state active failed)
+  in_container journalctl -u mogao-farm --no-pager > "$work/farm-journal.txt" 2>&1 || true
+  [[ "$state" == active ]] || { tail -n 30 "$work/farm-journal.txt"; fail "mogao-farm.service $state, not active (READY)"; }
+  grep -q ":$(printf '%04X' $farm_port) [0-9A-F:]* 0A " /proc/net/tcp6 /proc/net/tcp \
+    || fail "mogao-farm active but nothing listens on $farm_port"
+  local modes
+  modes=$(stat -c '%n %U:%G %a' "$root"/etc/mogao/pki "$root"/etc/mogao/pki/* | sed "s|$root||")
+  grep -qv ' root:mogao-farm \(750\|640\)$' <<<"$modes" && fail "TLS folder not root:mogao-farm 0750/0640: $modes"
+  log "ok: systemctl enable --now mogao-farm: active (READY) in $(($(date +%s) - t)) s, listening on $farm_port; TLS folder root:mogao-farm 0750/0640"
+}
+
+# configuration_error_under_systemd: a bad farm.env (MOGAO_RANKS=0) ends the start with exit 2:
+# failed, not restarted, and the journal says why and what to do.
+configuration_error_under_systemd() {
+  cp "$root/etc/mogao/farm.env" "$work/farm.env.good"
+  sed -i 's/^MOGAO_RANKS=.*/MOGAO_RANKS=0/' "$root/etc/mogao/farm.env"
+  in_container systemctl restart mogao-farm || true
+  local state restarts
+  state=$(wait_state failed)
+  sleep 2  # a restart would come 500 ms later
+  state=$(in_container systemctl show -P ActiveState mogao-farm)
+  restarts=$(in_container systemctl show -P NRestarts mogao-farm)
+  in_container journalctl -u mogao-farm --no-pager > "$work/farm-journal.txt" 2>&1 || true
+  [[ "$state" == failed && "$restarts" == 0 ]] || fail "farm with MOGAO_RANKS=0: $state after $restarts restarts (want failed, 0)"
+  grep -q "configuration error (exit 2, named above): not restarted" "$work/farm-journal.txt" \
+    || { tail -n 20 "$work/farm-journal.txt"; fail "no journal line for the configuration error"; }
+  grep -q "RANKS must be a number >= 1" "$work/farm-journal.txt" || fail "the journal does not name MOGAO_RANKS"
+  cp "$work/farm.env.good" "$root/etc/mogao/farm.env"
+  log "ok: MOGAO_RANKS=0: failed with exit 2, not restarted, the journal names the field and says so"
+}
+
+stop_container() {
+  in_container systemctl poweroff > /dev/null 2>&1 || true
+  wait "$pid_nspawn" 2> /dev/null || true
+  pid_nspawn=""
+}
+
+# start_as_the_unit_does: the installed unit's ExecStartPre and ExecStart run as systemd would run
+# them, in a chroot (tests/packaging/unit_start.py; the sandbox settings are not reproduced).
+start_as_the_unit_does() {
+  local unit=/lib/systemd/system/mogao-farm.service
+  [[ -d "$root/etc/mogao/pki" ]] && [[ -n "$(ls -A "$root/etc/mogao/pki")" ]] \
+    || fail "ConditionDirectoryNotEmpty=/etc/mogao/pki would not let the unit start"
+  unshare --mount --propagation private -- /bin/sh -c '
+    r=$1; shift
+    mount -t proc proc "$r/proc" && mount -t sysfs sys "$r/sys" && mount --rbind /dev "$r/dev" || exit 1
+    mount -t tmpfs -o mode=1777 tmp "$r/tmp" && mount -t tmpfs -o mode=0755 run "$r/run" || exit 1
+    exec python3 "$@"' sh "$root" "$(dirname "${BASH_SOURCE[0]}")/unit_start.py" "$root" "$unit" "$farm_port" 180 \
+    | tee "$work/unit-start.log" || fail "the farm did not start as its unit runs it (log above)"
+  # The ExecStartPre (tmpfiles.d/mogao-farm-pki.conf) made the TLS folder readable by the farm only.
+  local modes
+  modes=$(stat -c '%n %U:%G %a' "$root"/etc/mogao/pki "$root"/etc/mogao/pki/* | sed "s|$root||")
+  grep -qv ' root:mogao-farm \(750\|640\)$' <<<"$modes" && fail "TLS folder not root:mogao-farm 0750/0640: $modes"
+  log "ok: READY and listening on $farm_port; TLS folder root:mogao-farm 0750, files 0640"
+}
