@@ -30,7 +30,6 @@ RadianceCache::RadianceCache(const RadianceCacheOptions& options) : options_(opt
     require(options.max_samples >= 1, "max_samples must be >= 1");
     require(options.slots_log2 >= 8 && options.slots_log2 <= 26, "slots_log2 must be in [8, 26]");
     require(options.train_one_in >= 1, "train_one_in must be >= 1");
-    slots_.resize(std::size_t{1} << options.slots_log2);
 }
 
 float RadianceCache::cell_size(float cone_width) const {
@@ -53,6 +52,7 @@ std::uint64_t RadianceCache::key(const Eigen::Vector3d& world, const Eigen::Vect
 }
 
 const RadianceCache::Slot* RadianceCache::find(std::uint64_t key) const {
+    if (slots_.empty()) return nullptr;
     const std::size_t mask = slots_.size() - 1;
     for (int i = 0; i <= kProbe; ++i) {
         const Slot& s = slots_[(key + static_cast<std::size_t>(i)) & mask];
@@ -63,6 +63,7 @@ const RadianceCache::Slot* RadianceCache::find(std::uint64_t key) const {
 }
 
 RadianceCache::Slot* RadianceCache::find_or_insert(std::uint64_t key) {
+    if (slots_.empty()) slots_.resize(std::size_t{1} << options_.slots_log2);  // on first use only
     const std::size_t mask = slots_.size() - 1;
     for (int i = 0; i <= kProbe; ++i) {
         Slot& s = slots_[(key + static_cast<std::size_t>(i)) & mask];
@@ -117,7 +118,7 @@ void RadianceCache::commit() {
 }
 
 void RadianceCache::clear() {
-    std::fill(slots_.begin(), slots_.end(), Slot{});
+    slots_ = {};
     cells_ = 0;
     const std::lock_guard lock(pending_mutex_);
     pending_.clear();

@@ -44,7 +44,8 @@ struct RadianceCacheOptions {
     float base_cell_m = 0.002f;    // size of a level-0 cell, metres (> 0)
     float cell_footprints = 4.0f;  // a cell's size in ray-cone widths (pixels on screen), > 0
     int max_samples = 256;         // the exponential window's length, >= 1
-    int slots_log2 = 20;           // 2^slots_log2 cells at most (28 bytes each), in [8, 26]
+    int slots_log2 = 20;           // 2^slots_log2 cells at most (28 bytes each, allocated at the first
+                                   // estimate: a Renderer that never caches pays nothing), in [8, 26]
     int train_one_in = 16;         // pixels of a cached frame that also train the cache: 1 in N (>= 1)
 };
 
