@@ -32,6 +32,7 @@
 #include "bench/quality/bench_report.h"
 #include "bench/quality/gmsd.h"
 #include "bench/quality/image_metrics.h"
+#include "bench/trace_reference.h"
 #include "common/camera_path.h"
 #include "common/png_io.h"
 #include "common/thread_clock.h"
@@ -42,19 +43,10 @@
 namespace {
 
 using namespace mogao;
+using bench::arg_int;
+using bench::arg_str;
 using bench::fmt;
-
-int arg_int(int argc, char** argv, const char* name, int fallback) {
-    for (int i = 1; i + 1 < argc; ++i)
-        if (std::strcmp(argv[i], name) == 0) return std::atoi(argv[i + 1]);
-    return fallback;
-}
-
-std::string arg_str(int argc, char** argv, const char* name, const char* fallback) {
-    for (int i = 1; i + 1 < argc; ++i)
-        if (std::strcmp(argv[i], name) == 0) return argv[i + 1];
-    return fallback;
-}
+using bench::reference_frame;
 
 struct Setting {
     std::string label;
@@ -122,28 +114,6 @@ struct Bench {
         return sum;
     }
 };
-
-// The converged reference: roulette off, another seed, row bands on every hardware thread.
-RgbFloatImage reference_frame(Renderer& renderer, ViewRequest view, int spp) {
-    RendererOptions o;
-    o.russian_roulette = false;
-    renderer.set_path_options(o);
-    view.quality.spp = spp;
-    view.seed += 1000;
-    renderer.begin_frame(view);
-    RgbFloatImage frame(renderer.render_size());
-    std::atomic<int> next{0};
-    const auto work = [&] {
-        for (int y0 = 4 * next++; y0 < frame.size.height; y0 = 4 * next++)
-            (void)renderer.render(PixelRect{0, y0, frame.size.width, std::min(frame.size.height, y0 + 4)}, frame);
-    };
-    std::vector<std::jthread> pool;
-    for (unsigned t = 1; t < std::max(1u, std::thread::hardware_concurrency()); ++t) pool.emplace_back(work);
-    work();
-    pool.clear();
-    renderer.set_path_options(RendererOptions{});
-    return frame;
-}
 
 std::vector<Setting> settings(int warm) {
     std::vector<Setting> out;

@@ -42,6 +42,7 @@
 
 #include "bench/quality/bench_report.h"
 #include "bench/quality/image_metrics.h"
+#include "bench/trace_reference.h"
 #include "common/camera_path.h"
 #include "common/png_io.h"
 #include "common/thread_clock.h"
@@ -52,22 +53,13 @@
 namespace {
 
 using namespace mogao;
+using bench::arg_int;
+using bench::arg_str;
 using bench::cpu_name;
 using bench::fmt;
 using bench::load_average;
+using bench::reference_frame;
 using bench::run_line;
-
-int arg_int(int argc, char** argv, const char* name, int fallback) {
-    for (int i = 1; i + 1 < argc; ++i)
-        if (std::strcmp(argv[i], name) == 0) return std::atoi(argv[i + 1]);
-    return fallback;
-}
-
-std::string arg_str(int argc, char** argv, const char* name, const char* fallback) {
-    for (int i = 1; i + 1 < argc; ++i)
-        if (std::strcmp(argv[i], name) == 0) return argv[i + 1];
-    return fallback;
-}
 
 struct Setting {
     const char* label;
@@ -100,28 +92,6 @@ RgbFloatImage render_once(Renderer& renderer, const ViewRequest& view, std::uint
     renderer.begin_frame(view);
     RgbFloatImage frame(renderer.render_size());
     rays = renderer.render(PixelRect::whole(frame.size), frame).rays;
-    return frame;
-}
-
-// The converged reference: roulette off, another seed, row bands on every hardware thread.
-RgbFloatImage reference_frame(Renderer& renderer, ViewRequest view, int spp) {
-    RendererOptions o;
-    o.russian_roulette = false;
-    renderer.set_path_options(o);
-    view.quality.spp = spp;
-    view.seed += 1000;
-    renderer.begin_frame(view);
-    RgbFloatImage frame(renderer.render_size());
-    const int threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-    const int band = 4;
-    std::atomic<int> next{0};
-    const auto work = [&] {
-        for (int y0 = band * next++; y0 < frame.size.height; y0 = band * next++)
-            (void)renderer.render(PixelRect{0, y0, frame.size.width, std::min(frame.size.height, y0 + band)}, frame);
-    };
-    std::vector<std::jthread> pool;
-    for (int t = 1; t < threads; ++t) pool.emplace_back(work);
-    work();
     return frame;
 }
 

@@ -7,6 +7,10 @@
 
 namespace mogao::bench {
 
+// The value after `name` on a benchmark's command line (--name VALUE), or `fallback`.
+[[nodiscard]] int arg_int(int argc, char** argv, const char* name, int fallback);
+[[nodiscard]] std::string arg_str(int argc, char** argv, const char* name, const char* fallback);
+
 // The first line a command prints, trailing blanks removed ("" when it cannot run).
 [[nodiscard]] std::string run_line(const std::string& command);
 // The 1-minute load average (NaN when /proc/loadavg cannot be read).
