@@ -55,11 +55,9 @@ namespace {
 using namespace mogao;
 using bench::arg_int;
 using bench::arg_str;
-using bench::cpu_name;
 using bench::fmt;
 using bench::load_average;
 using bench::reference_frame;
-using bench::run_line;
 
 struct Setting {
     const char* label;
@@ -219,14 +217,10 @@ int run(int argc, char** argv) {
     const std::array<double, 2> accumulated = accumulated_passes(renderer, view, reference, passes, scene, png_dir);
 
     std::ostringstream md;
-    const std::time_t now = std::time(nullptr);
-    std::array<char, 32> when{};
-    std::strftime(when.data(), when.size(), "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
-    md << "_Run " << when.data() << ", commit `" << run_line("git rev-parse --short HEAD 2>/dev/null") << "`, "
-       << cpu_name() << " (" << std::thread::hardware_concurrency() << " threads), load average "
-       << fmt("%.2f", load_start) << " at start, " << fmt("%.2f", load_average()) << " at end. " << scene_file << ", "
-       << view.size.width << "x" << view.size.height << " cylinder `walk` view, " << view.quality.max_bounces
-       << " bounces, one thread, best of " << arg_int(argc, argv, "--reps", 2) << "; reference " << ref_spp
+    md << "_Run " << bench::run_context() << ", load average " << fmt("%.2f", load_start) << " at start, "
+       << fmt("%.2f", load_average()) << " at end. " << scene_file << ", " << view.size.width << "x" << view.size.height
+       << " cylinder `walk` view, " << view.quality.max_bounces << " bounces, one thread, best of "
+       << arg_int(argc, argv, "--reps", 2) << "; reference " << ref_spp
        << " spp. Regenerate: `build/bench/mogao_bench_sampling --write-docs docs/renderer.md`._\n\n"
        << "Equal spp:\n\n"
        << spp_table(curves) << "\nEqual time (each setting's relMSE interpolated log-log at the before-setting's "
