@@ -57,6 +57,8 @@ struct Setting {
     float cell_footprints = 4.0f;
     int train_one_in = 16;
     int frames_averaged = 1;
+    int visibility_min_samples = 8;  // RadianceCacheOptions: 0 traces every shadow ray
+    int visibility_recheck_one_in = 8;
 };
 
 struct Row {
@@ -121,13 +123,22 @@ std::vector<Setting> settings(int warm) {
         out.push_back({"path tracer, " + std::to_string(spp) + " spp", "path-" + std::to_string(spp), false, spp});
     const std::string w = std::to_string(warm) + " warm frames";
     out.push_back({"cache, cold (no frame before)", "cache-cold", true, 1, 0});
-    out.push_back({"cache, " + w + " (defaults: 4 footprints, 1 in 16 trains)", "cache", true, 1, warm});
+    out.push_back(
+        {"cache, " + w + " (defaults: 4 footprints, 1 in 16 trains, visibility 8 / 1 in 8)", "cache", true, 1, warm});
+    out.push_back(
+        {"cache, " + w + ", every shadow ray traced (no visibility)", "cache-novis", true, 1, warm, 4.0f, 16, 1, 0});
+    out.push_back(
+        {"cache, " + w + ", visibility after 12 agreeing rays", "cache-vis12", true, 1, warm, 4.0f, 16, 1, 12});
+    out.push_back(
+        {"cache, " + w + ", visibility rechecked 1 in 32", "cache-recheck32", true, 1, warm, 4.0f, 16, 1, 8, 32});
     out.push_back({"cache, " + w + ", 2 footprints", "cache-fp2", true, 1, warm, 2.0f});
     out.push_back({"cache, " + w + ", 8 footprints", "cache-fp8", true, 1, warm, 8.0f});
     out.push_back({"cache, " + w + ", 1 in 4 trains", "cache-train4", true, 1, warm, 4.0f, 4});
     out.push_back({"cache, " + w + ", 1 in 64 trains", "cache-train64", true, 1, warm, 4.0f, 64});
     out.push_back({"path tracer, 1 spp, mean of 16 frames", "path-mean16", false, 1, 0, 4.0f, 16, 16});
     out.push_back({"cache, " + w + ", mean of 16 frames (its bias)", "cache-mean16", true, 1, warm, 4.0f, 16, 16});
+    out.push_back(
+        {"cache, " + w + ", no visibility, mean of 16 frames", "cache-novis-mean16", true, 1, warm, 4.0f, 16, 16, 0});
     return out;
 }
 
@@ -161,6 +172,8 @@ int run(int argc, char** argv) {
             RendererOptions o{"threads=1"};
             o.radiance_cache.cell_footprints = all[i].cell_footprints;
             o.radiance_cache.train_one_in = all[i].train_one_in;
+            o.radiance_cache.visibility_min_samples = all[i].visibility_min_samples;
+            o.radiance_cache.visibility_recheck_one_in = all[i].visibility_recheck_one_in;
             Renderer renderer(scene, o);
             std::uint64_t rays = 0;
             double seconds = 0.0;

@@ -9,11 +9,64 @@
 namespace mogao {
 namespace {
 
-bool trains(const CacheFrame& cf, int x, int y) {
+std::uint64_t pixel_hash(const CacheFrame& cf, int x, int y, std::uint64_t salt) {
     const auto pixel =
         (static_cast<std::uint64_t>(static_cast<std::uint32_t>(x)) << 32) | static_cast<std::uint32_t>(y);
-    const auto one_in = static_cast<std::uint64_t>(cf.cache->options().train_one_in);
-    return mix64(cf.frame_key ^ mix64(pixel)) % one_in == 0;
+    return mix64(cf.frame_key ^ mix64(pixel ^ salt));
+}
+
+bool trains(const CacheFrame& cf, int x, int y) {
+    return pixel_hash(cf, x, y, 0) % static_cast<std::uint64_t>(cf.cache->options().train_one_in) == 0;
+}
+
+// A pixel of a cell that knows its lights still traces them, 1 in visibility_recheck_one_in.
+bool rechecks(const CacheFrame& cf, int x, int y) {
+    constexpr std::uint64_t kSalt = 0x9E3779B97F4A7C15ull;  // independent of the training choice
+    return pixel_hash(cf, x, y, kSalt) % static_cast<std::uint64_t>(cf.cache->options().visibility_recheck_one_in) == 0;
+}
+
+// Each alive lane's cells: its own (unjittered: training and visibility) and the jittered one its
+// cached light is read from (Binder et al.: a random point of the cell's size around the hit).
+struct LaneCells {
+    std::array<std::uint64_t, kPacketLanes> own{};
+    std::array<std::uint64_t, kPacketLanes> jittered{};
+};
+
+LaneCells cells_of(const CacheFrame& cf, const PacketHits& hits, std::array<PixelSampler, kPacketLanes>& rngs) {
+    const RadianceCache& cache = *cf.cache;
+    LaneCells cells;
+    for (std::size_t l = 0; l < kPacketLanes; ++l) {
+        if (!hits.alive[l]) continue;
+        const SurfaceHit& h = hits.hit[l];
+        const int level = cache.cell_level(h.cone_width);
+        const float size = cache.level_size(level);
+        const Eigen::Vector2f u = rngs[l].next2d();
+        const Frame tangent(h.shading_normal);
+        const Eigen::Vector3f offset = ((u.x() - 0.5f) * tangent.t + (u.y() - 0.5f) * tangent.b) * size;
+        cells.own[l] = cache.key_at_level(cf.origin + h.position.cast<double>(), h.shading_normal, level);
+        cells.jittered[l] =
+            cache.key_at_level(cf.origin + (h.position + offset).cast<double>(), h.shading_normal, level);
+        cache.prefetch(cells.own[l]);
+        cache.prefetch(cells.jittered[l]);
+    }
+    return cells;
+}
+
+// What each lane's own cell knows of its lights (nothing for a pixel that rechecks).
+ShadowGates gates_of(const CacheFrame& cf, const PacketHits& hits, const LanePixels& pixels, const LaneCells& cells) {
+    ShadowGates gates;
+    for (std::size_t l = 0; l < kPacketLanes; ++l) {
+        if (!hits.alive[l] || rechecks(cf, pixels.x[l], pixels.y[l])) continue;
+        const CellVisibility known = cf.cache->visibility(cells.own[l]);
+        gates.known_visible[l] = known.visible;
+        gates.known_blocked[l] = known.blocked;
+    }
+    return gates;
+}
+
+std::uint64_t pixel_order(const CacheFrame& cf, const LanePixels& pixels, std::size_t l) {
+    return cf.order_base + static_cast<std::uint64_t>(pixels.y[l]) * static_cast<std::uint64_t>(cf.width) +
+           static_cast<std::uint64_t>(pixels.x[l]);
 }
 
 }  // namespace
@@ -22,45 +75,38 @@ void cached_radiance_packet(const FrameContext& frame, const CacheFrame& cf, con
                             const LanePixels& pixels, std::array<PixelSampler, kPacketLanes>& rngs,
                             std::array<Eigen::Vector3f, kPacketLanes>& radiance, std::uint64_t& rays,
                             std::vector<CacheDeposit>& deposits) {
-    light_packet(frame, hits, rngs, radiance, rays);
+    const LaneCells cells = cells_of(cf, hits, rngs);
+    ShadowGates gates = gates_of(cf, hits, pixels, cells);
+    light_packet(frame, hits, rngs, radiance, rays, &gates);
 
-    const RadianceCache& cache = *cf.cache;
     PacketHits training = hits;
-    std::array<std::uint64_t, kPacketLanes> keys{};
     std::array<bool, kPacketLanes> shown{};  // the lane shows its own training estimate (empty cell)
     std::array<Eigen::Vector3f, kPacketLanes> reflectance;
     bool any = false;
     for (std::size_t l = 0; l < kPacketLanes; ++l) {
         training.alive[l] = false;
         if (!hits.alive[l]) continue;
-        const SurfaceHit& h = hits.hit[l];
-        reflectance[l] = make_vertex(frame, h, hits.wo[l]).material.diffuse * std::numbers::pi_v<float>;
-        // Jittered lookup (Binder et al.): a random point of the cell's size around the hit.
-        const float size = cache.cell_size(h.cone_width);
-        const Eigen::Vector2f u = rngs[l].next2d();
-        const Frame tangent(h.shading_normal);
-        const Eigen::Vector3f offset = ((u.x() - 0.5f) * tangent.t + (u.y() - 0.5f) * tangent.b) * size;
+        reflectance[l] = make_vertex(frame, hits.hit[l], hits.wo[l]).material.diffuse * std::numbers::pi_v<float>;
         Eigen::Vector3f white;
-        const bool found = cache.lookup(
-            cache.key(cf.origin + (h.position + offset).cast<double>(), h.shading_normal, h.cone_width), white);
+        const bool found = cf.cache->lookup(cells.jittered[l], white);
         if (found) radiance[l] += reflectance[l].cwiseProduct(white);
         shown[l] = !found;
         if (found && !trains(cf, pixels.x[l], pixels.y[l])) continue;
         training.alive[l] = true;
-        keys[l] = cache.key(cf.origin + h.position.cast<double>(), h.shading_normal, h.cone_width);
         any = true;
     }
-    if (!any) return;
-    FrameContext train_frame = frame;
-    train_frame.cache_training = true;
     std::array<Eigen::Vector3f, kPacketLanes> white;
     white.fill(Eigen::Vector3f::Zero());
-    radiance_packet(train_frame, training, rngs, white, rays, nullptr);
+    if (any) {
+        FrameContext train_frame = frame;
+        train_frame.cache_training = true;
+        radiance_packet(train_frame, training, rngs, white, rays, nullptr);
+    }
     for (std::size_t l = 0; l < kPacketLanes; ++l) {
-        if (!training.alive[l]) continue;
-        const auto pixel = static_cast<std::uint64_t>(pixels.y[l]) * static_cast<std::uint64_t>(cf.width) +
-                           static_cast<std::uint64_t>(pixels.x[l]);
-        deposits.push_back({keys[l], cf.order_base + pixel, white[l]});
+        const bool traced = gates.rays_visible[l] != 0 || gates.rays_blocked[l] != 0;
+        if (!training.alive[l] && !traced) continue;
+        deposits.push_back({cells.own[l], pixel_order(cf, pixels, l), white[l], training.alive[l],
+                            gates.rays_visible[l], gates.rays_blocked[l]});
         if (shown[l]) radiance[l] += reflectance[l].cwiseProduct(white[l]);
     }
 }

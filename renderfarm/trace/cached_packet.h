@@ -4,7 +4,10 @@
 //       RendererOptions::legacy_light_sampling; no MIS; the glossy lobe's direct light and sharp
 //       shadows stay exact. One light chosen per sample by light_selection.h was measured too: its
 //       occlusion-blind choice keeps picking the grotto's sun where the walls hide it, and the
-//       point lights' rare, heavily weighted samples speckle every frame)
+//       point lights' rare, heavily weighted samples speckle every frame). A shadow ray towards
+//       a light that the pixel's own cell knows (radiance_cache.h, visibility) is not traced: the
+//       light adds its unoccluded contribution or nothing; 1 pixel in visibility_recheck_one_in
+//       traces anyway, and every traced outcome is deposited in the pixel's cell.
 //     + π ρ_d ⊙ W(cell at a jittered position)  (ρ_d = the tinted material's diffuse part,
 //       (1 - k_s) a; W the cell's white radiance: the environment and every bounce, i.e. what a
 //       path of radiance_packet gathers beyond the first vertex's lights).

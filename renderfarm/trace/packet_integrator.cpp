@@ -8,6 +8,7 @@
 #include <embree3/rtcore.h>
 
 #include "renderfarm/trace/embree_packets.h"
+#include "renderfarm/trace/radiance_cache.h"
 
 namespace mogao {
 namespace {
@@ -108,12 +109,42 @@ void trace_queries(const FrameContext& frame, Scratch& s, std::uint64_t& rays, R
     }
 }
 
+// Drops the queries whose light group a lane knows; a known-visible one adds its contribution.
+void apply_gates(const ShadowGates& gates, Scratch& s, std::array<Eigen::Vector3f, kPacketLanes>& radiance) {
+    std::size_t kept = 0;
+    for (std::size_t q = 0; q < s.queries.size(); ++q) {
+        const auto l = static_cast<std::size_t>(s.lane_of[q]);
+        const int g = s.queries[q].group;
+        const auto bit = g >= 0 && g < kVisibilityGroups ? static_cast<std::uint8_t>(1u << g) : std::uint8_t{0};
+        if ((gates.known_visible[l] & bit) != 0) {
+            radiance[l] += s.queries[q].contribution;
+            continue;
+        }
+        if ((gates.known_blocked[l] & bit) != 0) continue;
+        s.queries[kept] = s.queries[q];
+        s.lane_of[kept] = s.lane_of[q];
+        ++kept;
+    }
+    s.queries.resize(kept);
+    s.lane_of.resize(kept);
+}
+
+void record_outcomes(const Scratch& s, ShadowGates& gates) {
+    for (std::size_t q = 0; q < s.queries.size(); ++q) {
+        const int g = s.queries[q].group;
+        if (g < 0 || g >= kVisibilityGroups) continue;
+        const auto l = static_cast<std::size_t>(s.lane_of[q]);
+        const auto bit = static_cast<std::uint8_t>(1u << g);
+        (s.blocked[q] != 0 ? gates.rays_blocked[l] : gates.rays_visible[l]) |= bit;
+    }
+}
+
 // Next-event estimation of every live lane; returns which lanes sample a bounce.
 void direct_light(const FrameContext& frame, std::array<Lane, kPacketLanes>& lanes,
                   std::array<ShadingVertex, kPacketLanes>& vertices, bool bounce_follows,
                   std::array<PixelSampler, kPacketLanes>& rngs, std::array<Eigen::Vector3f, kPacketLanes>& radiance,
-                  Scratch& s, std::uint64_t& rays, RecordedRays* log, int depth,
-                  DirectParts parts = DirectParts::kAll) {
+                  Scratch& s, std::uint64_t& rays, RecordedRays* log, int depth, DirectParts parts = DirectParts::kAll,
+                  ShadowGates* gates = nullptr) {
     s.queries.clear();
     s.lane_of.clear();
     const bool training_vertex = frame.cache_training && depth == 0;  // integrator.h, cache_training
@@ -126,7 +157,9 @@ void direct_light(const FrameContext& frame, std::array<Lane, kPacketLanes>& lan
                              parts);
         s.lane_of.resize(s.queries.size(), static_cast<int>(l));
     }
+    if (gates != nullptr) apply_gates(*gates, s, radiance);
     trace_queries(frame, s, rays, log, depth);
+    if (gates != nullptr) record_outcomes(s, *gates);
     for (std::size_t q = 0; q < s.queries.size(); ++q) {
         if (s.blocked[q] == 0) radiance[static_cast<std::size_t>(s.lane_of[q])] += s.queries[q].contribution;
     }
@@ -194,11 +227,12 @@ std::array<Lane, kPacketLanes> lanes_of(const PacketHits& hits) {
 }  // namespace
 
 void light_packet(const FrameContext& frame, const PacketHits& hits, std::array<PixelSampler, kPacketLanes>& rngs,
-                  std::array<Eigen::Vector3f, kPacketLanes>& radiance, std::uint64_t& rays) {
+                  std::array<Eigen::Vector3f, kPacketLanes>& radiance, std::uint64_t& rays, ShadowGates* gates) {
     thread_local Scratch scratch;
     std::array<Lane, kPacketLanes> lanes = lanes_of(hits);
     std::array<ShadingVertex, kPacketLanes> vertices;
-    direct_light(frame, lanes, vertices, false, rngs, radiance, scratch, rays, nullptr, 0, DirectParts::kLightsOnly);
+    direct_light(frame, lanes, vertices, false, rngs, radiance, scratch, rays, nullptr, 0, DirectParts::kLightsOnly,
+                 gates);
 }
 
 void radiance_packet(const FrameContext& frame, const PacketHits& hits, std::array<PixelSampler, kPacketLanes>& rngs,

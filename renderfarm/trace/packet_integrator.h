@@ -33,10 +33,22 @@ struct PacketHits {
     std::array<bool, kPacketLanes> alive{};
 };
 
+// What each lane already knows of its lights' visibility (bit g: light group g, the light's index
+// in the frame's light set, groups 0..7; radiance_cache.h's CellVisibility), and what it traced.
+struct ShadowGates {
+    std::array<std::uint8_t, kPacketLanes> known_visible{};  // in: add g's contribution, trace nothing
+    std::array<std::uint8_t, kPacketLanes> known_blocked{};  // in: g adds nothing, trace nothing
+    std::array<std::uint8_t, kPacketLanes> rays_visible{};   // out: g had an unoccluded ray traced
+    std::array<std::uint8_t, kPacketLanes> rays_blocked{};   // out: g had an occluded ray traced
+};
+
 // Adds to radiance[l] (for alive lanes) next-event estimation of the lights only (no environment,
 // no bounce follows, so no MIS with one) at each lane's hit: the radiance cache's per-pixel part.
+// With `gates`, shadow queries whose light a lane knows are not traced (their unoccluded
+// contribution is added, or nothing), and the outcomes of the traced ones are reported.
 void light_packet(const FrameContext& frame, const PacketHits& hits, std::array<PixelSampler, kPacketLanes>& rngs,
-                  std::array<Eigen::Vector3f, kPacketLanes>& radiance, std::uint64_t& rays);
+                  std::array<Eigen::Vector3f, kPacketLanes>& radiance, std::uint64_t& rays,
+                  ShadowGates* gates = nullptr);
 
 // Adds to radiance[l] (for alive lanes) the radiance_at value of each lane; `rays` counts every
 // ray traced; `log` (benchmarks only, may be null) receives every packet traced.

@@ -18,6 +18,16 @@ void require(bool ok, const std::string& what) {
     if (!ok) throw std::invalid_argument("RadianceCacheOptions." + what);
 }
 
+constexpr int kHistoryBits = 12;  // Slot::visibility: outcomes kept per light group
+constexpr std::uint16_t kHistoryMask = (1u << kHistoryBits) - 1u;
+
+// Appends one shadow-ray outcome (1: unoccluded) to a light group's history.
+std::uint16_t push_outcome(std::uint16_t state, bool visible) {
+    const int count = std::min(kHistoryBits, (state >> kHistoryBits) + 1);
+    const auto history = static_cast<std::uint16_t>(((state << 1) | (visible ? 1u : 0u)) & kHistoryMask);
+    return static_cast<std::uint16_t>((count << kHistoryBits) | history);
+}
+
 std::uint64_t cell_coordinate(double position, double size) {
     return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(position / size)));
 }
@@ -30,23 +40,29 @@ RadianceCache::RadianceCache(const RadianceCacheOptions& options) : options_(opt
     require(options.max_samples >= 1, "max_samples must be >= 1");
     require(options.slots_log2 >= 8 && options.slots_log2 <= 26, "slots_log2 must be in [8, 26]");
     require(options.train_one_in >= 1, "train_one_in must be >= 1");
+    require(options.visibility_min_samples >= 0 && options.visibility_min_samples <= kHistoryBits,
+            "visibility_min_samples must be in [0, 12]");
+    require(options.visibility_recheck_one_in >= 1, "visibility_recheck_one_in must be >= 1");
 }
 
-float RadianceCache::cell_size(float cone_width) const {
-    const float target = options_.cell_footprints * std::max(cone_width, 0.0f);
-    int level = 0;
-    if (target > options_.base_cell_m) {
-        level = std::min(kMaxLevel, static_cast<int>(std::ceil(std::log2(target / options_.base_cell_m))));
-    }
-    return std::ldexp(options_.base_cell_m, level);
+int RadianceCache::cell_level(float cone_width) const {
+    const float ratio = options_.cell_footprints * std::max(cone_width, 0.0f) / options_.base_cell_m;
+    if (!(ratio > 1.0f)) return 0;
+    if (!std::isfinite(ratio)) return kMaxLevel;
+    int exponent = 0;
+    const float mantissa = std::frexp(ratio, &exponent);           // ratio = mantissa 2^exponent, mantissa in [0.5, 1)
+    const int level = mantissa == 0.5f ? exponent - 1 : exponent;  // ceil(log2(ratio)) without log2
+    return std::min(kMaxLevel, level);
 }
 
-std::uint64_t RadianceCache::key(const Eigen::Vector3d& world, const Eigen::Vector3f& normal, float cone_width) const {
-    const float size = cell_size(cone_width);
-    const auto level = static_cast<std::uint64_t>(std::lround(std::log2(size / options_.base_cell_m)));
+float RadianceCache::level_size(int level) const { return std::ldexp(options_.base_cell_m, level); }
+
+std::uint64_t RadianceCache::key_at_level(const Eigen::Vector3d& world, const Eigen::Vector3f& normal,
+                                          int level) const {
+    const auto size = static_cast<double>(level_size(level));
     const std::uint64_t octant =
         (normal.x() < 0.0f ? 1u : 0u) | (normal.y() < 0.0f ? 2u : 0u) | (normal.z() < 0.0f ? 4u : 0u);
-    std::uint64_t h = mix64((level << 3) | octant);
+    std::uint64_t h = mix64((static_cast<std::uint64_t>(level) << 3) | octant);
     for (int axis = 0; axis < 3; ++axis) h = mix64(h ^ cell_coordinate(world[axis], size));
     return h == 0 ? 1 : h;
 }
@@ -84,12 +100,30 @@ bool RadianceCache::lookup(std::uint64_t key, Eigen::Vector3f& white_radiance) c
     return true;
 }
 
+CellVisibility RadianceCache::visibility(std::uint64_t key) const {
+    CellVisibility known;
+    const int need = options_.visibility_min_samples;
+    if (need == 0) return known;
+    const Slot* s = find(key);
+    if (s == nullptr) return known;
+    const auto window = static_cast<std::uint16_t>((1u << need) - 1u);
+    for (int g = 0; g < kVisibilityGroups; ++g) {
+        const std::uint16_t state = s->visibility[g];
+        if ((state >> kHistoryBits) < need) continue;
+        const auto recent = static_cast<std::uint16_t>(state & window);
+        if (recent == window) known.visible |= static_cast<std::uint8_t>(1u << g);
+        if (recent == 0) known.blocked |= static_cast<std::uint8_t>(1u << g);
+    }
+    return known;
+}
+
 void RadianceCache::deposit(std::span<const CacheDeposit> deposits) {
     const std::lock_guard lock(pending_mutex_);
-    for (const CacheDeposit& d : deposits) {
-        if (!d.white_radiance.allFinite() || d.white_radiance.minCoeff() < 0.0f) {
+    for (CacheDeposit d : deposits) {
+        if (d.has_radiance && (!d.white_radiance.allFinite() || d.white_radiance.minCoeff() < 0.0f)) {
             ++dropped_;
-            continue;
+            if (d.rays_visible == 0 && d.rays_blocked == 0) continue;
+            d.has_radiance = false;  // its shadow-ray outcomes still count
         }
         pending_.push_back(d);
     }
@@ -106,6 +140,12 @@ void RadianceCache::commit() {
             ++dropped_;
             continue;
         }
+        for (int g = 0; g < kVisibilityGroups; ++g) {  // a group with both outcomes gets both: mixed
+            const auto bit = static_cast<std::uint8_t>(1u << g);
+            if ((d.rays_visible & bit) != 0) s->visibility[g] = push_outcome(s->visibility[g], true);
+            if ((d.rays_blocked & bit) != 0) s->visibility[g] = push_outcome(s->visibility[g], false);
+        }
+        if (!d.has_radiance) continue;
         if (s->weight + 1.0f > window) {  // exponential window: older estimates weigh less
             const float keep = (window - 1.0f) / s->weight;
             for (float& c : s->sum) c *= keep;

@@ -24,6 +24,19 @@
 // removes. A cell keeps at most max_samples estimates' weight (an exponential window), so its
 // noise stops falling at about 1/sqrt(max_samples) of one estimate's.
 //
+// Shadow-ray visibility: a cell also keeps, per light group (the light's index in the frame's
+// light set, the first kVisibilityGroups lights), the outcomes of the last shadow rays traced from
+// inside it (a shift register of up to 12). A cell whose last visibility_min_samples outcomes for a
+// light all agree "knows" that light: cached_packet.h adds the light's unshadowed contribution
+// (known visible) or nothing (known blocked) without tracing the ray, and still traces one pixel
+// in visibility_recheck_one_in so the history stays fresh. A cell that a shadow edge crosses keeps
+// a mixed history and every pixel in it traces. The scheme is ours: the cache's own cells reused as
+// a visibility cache, in the spirit of estimating a point's visibility from nearby, earlier shadow
+// rays (Clarberg & Akenine-Möller, "Exploiting Visibility Correlation in Direct Illumination",
+// EGSR 2008, who use it as a control variate instead, and stay unbiased).
+// Its bias: a shadow (or a lit patch) smaller than a cell that no recent ray from that cell hit is
+// missed until a recheck ray hits it; docs/renderer.md measures it against the converged reference.
+//
 // Threading: lookup() is const and may run on many threads at once; deposit() may run
 // concurrently with lookup() and itself (a pending list under a mutex); commit() must not run
 // concurrently with either. commit() merges in a fixed order (by key, then each deposit's
@@ -41,12 +54,24 @@
 namespace mogao {
 
 struct RadianceCacheOptions {
-    float base_cell_m = 0.002f;    // size of a level-0 cell, metres (> 0)
-    float cell_footprints = 4.0f;  // a cell's size in ray-cone widths (pixels on screen), > 0
-    int max_samples = 256;         // the exponential window's length, >= 1
-    int slots_log2 = 20;           // 2^slots_log2 cells at most (28 bytes each, allocated at the first
-                                   // estimate: a Renderer that never caches pays nothing), in [8, 26]
-    int train_one_in = 16;         // pixels of a cached frame that also train the cache: 1 in N (>= 1)
+    float base_cell_m = 0.002f;         // size of a level-0 cell, metres (> 0)
+    float cell_footprints = 4.0f;       // a cell's size in ray-cone widths (pixels on screen), > 0
+    int max_samples = 256;              // the exponential window's length, >= 1
+    int slots_log2 = 20;                // 2^slots_log2 cells at most (40 bytes each, allocated at the first
+                                        // estimate: a Renderer that never caches pays nothing), in [8, 26]
+    int train_one_in = 16;              // pixels of a cached frame that also train the cache: 1 in N (>= 1)
+    int visibility_min_samples = 8;     // agreeing shadow-ray outcomes before a cell knows a light,
+                                        // in [0, 12]; 0: every shadow ray is traced
+    int visibility_recheck_one_in = 8;  // pixels of a known cell that trace anyway: 1 in N (>= 1)
+};
+
+// Lights whose visibility a cell keeps: the first 8 of the frame's light set (the rest are traced).
+inline constexpr int kVisibilityGroups = 8;
+
+// What a cell knows of its lights' visibility: bit g set for light group g.
+struct CellVisibility {
+    std::uint8_t visible = 0;  // the last visibility_min_samples rays towards g were all unoccluded
+    std::uint8_t blocked = 0;  // ... all occluded
 };
 
 // One estimate for the cell `key`; `order` fixes the merge order (renderer: frame, pixel).
@@ -54,6 +79,9 @@ struct CacheDeposit {
     std::uint64_t key = 0;
     std::uint64_t order = 0;
     Eigen::Vector3f white_radiance = Eigen::Vector3f::Zero();
+    bool has_radiance = true;       // false: the deposit carries shadow-ray outcomes only
+    std::uint8_t rays_visible = 0;  // light groups with at least one unoccluded shadow ray traced
+    std::uint8_t rays_blocked = 0;  // light groups with at least one occluded shadow ray traced
 };
 
 class RadianceCache {
@@ -63,16 +91,32 @@ public:
 
     [[nodiscard]] const RadianceCacheOptions& options() const { return options_; }
 
-    // Edge of the cells used for a hit whose ray cone is `cone_width` metres wide (0: level 0).
-    [[nodiscard]] float cell_size(float cone_width) const;
+    // Level of the cells used for a hit whose ray cone is `cone_width` metres wide (0: level 0),
+    // and their edge base_cell_m x 2^level.
+    [[nodiscard]] int cell_level(float cone_width) const;
+    [[nodiscard]] float level_size(int level) const;
+    [[nodiscard]] float cell_size(float cone_width) const { return level_size(cell_level(cone_width)); }
 
     // The cell holding absolute world position `world` (metres) on a surface with unit `normal`,
     // for cells of edge `cell_size(cone_width)`. Never 0 (0 marks an empty slot).
     [[nodiscard]] std::uint64_t key(const Eigen::Vector3d& world, const Eigen::Vector3f& normal,
-                                    float cone_width) const;
+                                    float cone_width) const {
+        return key_at_level(world, normal, cell_level(cone_width));
+    }
+    [[nodiscard]] std::uint64_t key_at_level(const Eigen::Vector3d& world, const Eigen::Vector3f& normal,
+                                             int level) const;
+
+    // Hints the cell's home slot into the CPU cache (lookups of a packet's 16 lanes miss it in turn
+    // otherwise: the table is far larger than the caches).
+    void prefetch(std::uint64_t key) const {
+        if (!slots_.empty()) __builtin_prefetch(&slots_[key & (slots_.size() - 1)]);
+    }
 
     // The cell's mean white radiance; false when the cell has no estimate yet.
     [[nodiscard]] bool lookup(std::uint64_t key, Eigen::Vector3f& white_radiance) const;
+
+    // What the cell knows of its lights' visibility (nothing for an absent cell).
+    [[nodiscard]] CellVisibility visibility(std::uint64_t key) const;
 
     // Queues estimates for the next commit(); non-finite or negative ones are dropped (counted).
     void deposit(std::span<const CacheDeposit> deposits);
@@ -91,6 +135,7 @@ private:
         std::uint64_t key = 0;
         float sum[3] = {0.0f, 0.0f, 0.0f};
         float weight = 0.0f;
+        std::uint16_t visibility[kVisibilityGroups] = {};  // per light group: outcome count << 12 | history
     };
     [[nodiscard]] const Slot* find(std::uint64_t key) const;
     Slot* find_or_insert(std::uint64_t key);

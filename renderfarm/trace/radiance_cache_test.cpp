@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // The radiance cache's hash grid (radiance_cache.h): cells, level of detail, merge order, bad input.
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -32,6 +33,12 @@ TEST(RadianceCache, RefusesBadOptionsNamingThem) {
     EXPECT_THROW(RadianceCache{o}, std::invalid_argument);
     o = {};
     o.train_one_in = 0;
+    EXPECT_THROW(RadianceCache{o}, std::invalid_argument);
+    o = {};
+    o.visibility_min_samples = 13;  // more than the 12 outcomes a cell keeps
+    EXPECT_THROW(RadianceCache{o}, std::invalid_argument);
+    o = {};
+    o.visibility_recheck_one_in = 0;
     EXPECT_THROW(RadianceCache{o}, std::invalid_argument);
 }
 
@@ -142,6 +149,85 @@ TEST(RadianceCache, AFullTableDropsCellsInsteadOfGrowing) {
     cache.commit();
     EXPECT_LE(cache.cells(), 256u);
     EXPECT_GE(cache.dropped(), 1000u - 256u);
+}
+
+// Shadow-ray outcomes of one pixel: light group g unoccluded (visible) or occluded (blocked).
+CacheDeposit outcome(std::uint64_t key, std::uint64_t order, int group, bool visible) {
+    CacheDeposit d{key, order, Eigen::Vector3f::Zero(), false};
+    (visible ? d.rays_visible : d.rays_blocked) = static_cast<std::uint8_t>(1u << group);
+    return d;
+}
+
+TEST(RadianceCache, ACellKnowsALightOnlyAfterEnoughAgreeingRays) {
+    RadianceCache cache;  // 8 agreeing outcomes
+    const std::uint64_t k = cache.key({0.2, 0.0, 0.2}, kUp, 0.0f);
+    std::vector<CacheDeposit> d;
+    for (std::uint64_t i = 0; i < 7; ++i) d.push_back(outcome(k, i, 0, true));
+    d.push_back(outcome(k, 7, 3, false));
+    cache.deposit(d);
+    cache.commit();
+    EXPECT_EQ(cache.visibility(k).visible, 0) << "7 rays are not enough";
+    EXPECT_EQ(cache.visibility(k).blocked, 0);
+    Eigen::Vector3f w;
+    EXPECT_FALSE(cache.lookup(k, w)) << "shadow-ray outcomes carry no radiance";
+
+    d = {outcome(k, 8, 0, true)};
+    cache.deposit(d);
+    cache.commit();
+    EXPECT_EQ(cache.visibility(k).visible, 1) << "the 8th agreeing ray makes light 0 known visible";
+
+    d = {outcome(k, 9, 0, false)};  // one occluded ray: a shadow edge crosses the cell
+    cache.deposit(d);
+    cache.commit();
+    EXPECT_EQ(cache.visibility(k).visible, 0);
+    EXPECT_EQ(cache.visibility(k).blocked, 0);
+    d.clear();
+    for (std::uint64_t i = 10; i < 16; ++i) d.push_back(outcome(k, i, 0, false));
+    cache.deposit(d);
+    cache.commit();
+    EXPECT_EQ(cache.visibility(k).blocked, 0) << "7 occluded after a visible one: the last 8 still disagree";
+    d = {outcome(k, 16, 0, false)};
+    cache.deposit(d);
+    cache.commit();
+    EXPECT_EQ(cache.visibility(k).blocked, 1);
+}
+
+TEST(RadianceCache, APixelWithBothOutcomesForALightLeavesItUnknown) {
+    RadianceCache cache;
+    const std::uint64_t k = cache.key({0.4, 0.0, 0.4}, kUp, 0.0f);
+    std::vector<CacheDeposit> d;
+    for (std::uint64_t i = 0; i < 12; ++i) {
+        CacheDeposit both{k, i, Eigen::Vector3f::Zero(), false, 0x04, 0x04};  // an area light half hidden
+        d.push_back(both);
+    }
+    cache.deposit(d);
+    cache.commit();
+    EXPECT_EQ(cache.visibility(k).visible, 0);
+    EXPECT_EQ(cache.visibility(k).blocked, 0);
+}
+
+TEST(RadianceCache, VisibilityOffNeverKnowsALight) {
+    RadianceCacheOptions o;
+    o.visibility_min_samples = 0;
+    RadianceCache cache(o);
+    const std::uint64_t k = cache.key({0.6, 0.0, 0.6}, kUp, 0.0f);
+    std::vector<CacheDeposit> d;
+    for (std::uint64_t i = 0; i < 20; ++i) d.push_back(outcome(k, i, 1, true));
+    cache.deposit(d);
+    cache.commit();
+    EXPECT_EQ(cache.visibility(k).visible, 0);
+}
+
+TEST(RadianceCache, CellLevelIsTheCeilingOfLog2OfTheWantedSize) {
+    RadianceCache cache;
+    for (float cone = 1e-5f; cone < 10.0f; cone *= 1.37f) {
+        const float ratio = 4.0f * cone / 0.002f;
+        const int expected = ratio > 1.0f ? static_cast<int>(std::ceil(std::log2(ratio))) : 0;
+        EXPECT_EQ(cache.cell_level(cone), expected) << "cone " << cone;
+        EXPECT_GE(cache.cell_size(cone), 4.0f * cone * 0.9999f);
+    }
+    EXPECT_EQ(cache.cell_level(std::numeric_limits<float>::infinity()), 40);
+    EXPECT_EQ(cache.cell_level(std::numeric_limits<float>::quiet_NaN()), 0);
 }
 
 }  // namespace

@@ -90,10 +90,37 @@ TEST(RendererRadianceCache, AWarmCacheTracesFewerRaysThanThePathTracer) {
     std::uint64_t traced_rays = 0;
     (void)draw(renderer, corner_view(17, 1, true), &cached_rays);
     (void)draw(renderer, corner_view(17, 1, false), &traced_rays);
-    // Per pixel the cache saves the environment ray and every bounce with its shadow rays; the two
-    // lights stay traced (2 of about 4.3 rays per pixel here at 2 bounces, with roulette).
+    // Per pixel the cache saves the environment ray and every bounce with its shadow rays, and the
+    // shadow rays towards the lights wherever the pixel's cell knows them.
     EXPECT_LT(static_cast<double>(cached_rays), 0.7 * static_cast<double>(traced_rays))
         << cached_rays << " rays cached, " << traced_rays << " path-traced";
+}
+
+// Shadow rays towards lights a cell knows are skipped: fewer rays, and the frame stays as close to
+// the reference as with every shadow ray traced (its bias: shadows smaller than a cell missed).
+TEST(RendererRadianceCache, KnownLightsAreNotTracedAndTheFrameStaysClose) {
+    const Scene scene = lit_corner();
+    Renderer reference_renderer(scene, RendererOptions{"threads=1", true});
+    const RgbFloatImage reference = draw(reference_renderer, corner_view(1000, 256, false));
+    RendererOptions all_traced{"threads=1", true};
+    all_traced.radiance_cache.visibility_min_samples = 0;
+    Renderer gated(scene, RendererOptions{"threads=1", true});
+    Renderer traced(scene, all_traced);
+    for (std::uint64_t f = 1; f <= 16; ++f) {
+        (void)draw(gated, corner_view(f, 1, true));
+        (void)draw(traced, corner_view(f, 1, true));
+    }
+    std::uint64_t gated_rays = 0;
+    std::uint64_t traced_rays = 0;
+    const RgbFloatImage a = draw(gated, corner_view(17, 1, true), &gated_rays);
+    const RgbFloatImage b = draw(traced, corner_view(17, 1, true), &traced_rays);
+    EXPECT_LT(static_cast<double>(gated_rays), 0.8 * static_cast<double>(traced_rays))
+        << gated_rays << " rays with visibility, " << traced_rays << " without";
+    const double gated_error = rel_mse(a, reference);
+    const double traced_error = rel_mse(b, reference);
+    EXPECT_LT(gated_error, 1.25 * traced_error)
+        << "relMSE " << gated_error << " with visibility, " << traced_error << " with every shadow ray traced";
+    EXPECT_LT(std::abs(mean(a) / mean(b) - 1.0), 0.02);
 }
 
 TEST(RendererRadianceCache, AnySplitOfACachedFrameGivesTheSameBits) {
