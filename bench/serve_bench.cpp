@@ -17,7 +17,9 @@
 // lowered: the controller before its floor of 0.5), and cache (the denoise configuration with moving
 // frames from the ranks' radiance cache: renderfarm/trace/cached_packet.h; the cache starts empty
 // at the configuration's first frame only if it is the first configuration of the run: the ranks
-// keep their caches between configurations, as a farm keeps them between sessions).
+// keep their caches between configurations, as a farm keeps them between sessions), and temporal
+// (the cache configuration with every filtered moving frame first blended with the session's
+// earlier frames by reprojection: renderfarm/denoise/temporal_accumulation.h).
 // With both all and denoise in the run, the denoiser's ratios are printed: frames/s on / off and the
 // moving frame's PSNR on - off. --quality takes a preset's request quality (spp, bounces, AO, area
 // samples, JPEG; common/quality_preset.h) for every request and the reference; without it the
@@ -168,7 +170,12 @@ std::vector<Config> all_configs(const BenchArgs& a) {
     cache.key = "cache";
     cache.name = "all + denoiser + radiance cache";
     cache.live.radiance_cache = true;
-    std::vector<Config> out{today, all, denoise, floor, cache};
+    // The cache configuration with each moving frame blended with earlier ones by reprojection.
+    Config temporal = cache;
+    temporal.key = "temporal";
+    temporal.name = "all + denoiser + cache + temporal";
+    temporal.live.temporal = true;
+    std::vector<Config> out{today, all, denoise, floor, cache, temporal};
     const auto without = [&](const char* key, const char* name, auto change) {
         Config c = all;
         c.key = key;
@@ -438,6 +445,11 @@ void print_ratios(const std::map<std::string, std::pair<double, double>>& figure
             "ratio frames/s radiance cache on / off (both denoised) = %.2f; moving frame PSNR on - off = %+.2f dB\n",
             cache->second.first / denoise->second.first, cache->second.second - denoise->second.second);
     }
+    const auto temporal = figures.find("temporal");
+    if (cache != figures.end() && temporal != figures.end() && cache->second.first > 0) {
+        std::printf("ratio frames/s temporal on / off (both cached) = %.2f; moving frame PSNR on - off = %+.2f dB\n",
+                    temporal->second.first / cache->second.first, temporal->second.second - cache->second.second);
+    }
     if (today != figures.end() && denoise != figures.end() && today->second.first > 0) {
         std::printf("ratio frames/s all + denoiser / none = %.2f; moving frame PSNR all + denoiser - none = %+.2f dB\n",
                     denoise->second.first / today->second.first, denoise->second.second - today->second.second);
@@ -516,11 +528,11 @@ int main(int argc, char** argv) {
     app.add_option("--reference-spp", a.reference_spp, "Reference samples per pixel (two halves)")
         ->check(CLI::Range(2, 8192));
     app.add_option("--configs", a.configs,
-                   "today, all, denoise, denoise-floor-0.2, cache, no-progressive, no-target, no-pipeline, "
+                   "today, all, denoise, denoise-floor-0.2, cache, temporal, no-progressive, no-target, no-pipeline, "
                    "no-rank-speed, no-rate-aim")
         ->delimiter(',')
-        ->check(CLI::IsMember({"today", "all", "denoise", "denoise-floor-0.2", "cache", "no-progressive", "no-target",
-                               "no-pipeline", "no-rank-speed", "no-rate-aim"}));
+        ->check(CLI::IsMember({"today", "all", "denoise", "denoise-floor-0.2", "cache", "temporal", "no-progressive",
+                               "no-target", "no-pipeline", "no-rank-speed", "no-rate-aim"}));
     app.add_option("--quality", a.quality,
                    "Preset whose request quality every request uses (" + quality_preset_names() +
                        "); default: the request's defaults")

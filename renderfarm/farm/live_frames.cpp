@@ -31,6 +31,11 @@ LiveFrames::LiveFrames(FrameSource source, LiveOptions options, float exposure, 
     const RgbFloatImage probe(ImageSize{1, 1});
     if (Status st = validate_denoise_input(probe, GuideBuffers(probe.size), options_.denoise_params); !st.ok())
         throw std::invalid_argument("LiveOptions.denoise_params: " + st.error().message);
+    try {
+        check_temporal_params(options_.temporal_params);
+    } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(std::string("LiveOptions.temporal_params: ") + e.what());
+    }
 }
 
 LiveFrames::Session& LiveFrames::session(std::uint64_t id) {
@@ -115,14 +120,21 @@ void LiveFrames::dispatch(Session& s, const ViewRequest& request, int spp, LiveF
 }
 
 // The frame served: `radiance` filtered when denoising and few samples are in it, then displayed.
-void LiveFrames::display(const Session& s, const RgbFloatImage& radiance, LiveFrame& frame) {
+void LiveFrames::display(Session& s, const RgbFloatImage& radiance, LiveFrame& frame) {
     if (!options_.denoise || frame.samples > options_.denoise_max_spp || s.guides.size != radiance.size) {
         frame.image = to_display(radiance);
         return;
     }
     const auto start = Clock::now();
+    const RgbFloatImage* noisy = &radiance;
+    RgbFloatImage blended;
+    if (options_.temporal && frame.passes <= 1) {
+        blended = s.temporal.accumulate(radiance, s.guides, make_camera_setup(frame.rendered, radiance.size),
+                                        options_.temporal_params);
+        noisy = &blended;
+    }
     RgbFloatImage filtered;
-    if (Status st = denoiser_.run(radiance, s.guides, options_.denoise_params, filtered); !st.ok())
+    if (Status st = denoiser_.run(*noisy, s.guides, options_.denoise_params, filtered); !st.ok())
         throw std::runtime_error(st.error().message);
     frame.image = to_display(filtered);
     frame.denoised = true;

@@ -28,7 +28,10 @@
 //    filters the composited frame, so the served frame is the same for any split of the frame over
 //    any number of ranks; the accumulation keeps the raw samples (never filtered ones). The
 //    filter's time is part of LiveFrame::seconds, which the frame-time target observes, so the
-//    target still holds with it (it shrinks the frame to pay for the filter).
+//    target still holds with it (it shrinks the frame to pay for the filter). With `temporal`, a
+//    filtered frame that is not a still view's accumulation is first blended with the session's
+//    earlier frames, reprojected by depth (temporal_accumulation.h; exact for a static scene, with
+//    disocclusion rejection): the temporal half of SVGF before its spatial half.
 // A pass cut at the farm's frame budget (FrameStats::tiles_cut, frame_dispatcher.h) is sent alone
 // and never accumulated: its coarse tiles would stay in the mean.
 // Sessions are forgotten least-recently-used beyond `max_sessions`.
@@ -45,6 +48,7 @@
 #include <optional>
 
 #include "renderfarm/denoise/atrous_filter.h"
+#include "renderfarm/denoise/temporal_accumulation.h"
 #include "renderfarm/farm/frame_dispatcher.h"
 #include "renderfarm/farm/progressive_accumulator.h"
 #include "renderfarm/schedule/frame_time_controller.h"
@@ -65,6 +69,11 @@ struct LiveOptions {
     // renderfarm/trace/radiance_cache.h): much cheaper, biased; such a frame is shown alone, never
     // accumulated, so a still view still converges to the unbiased image.
     bool radiance_cache = false;
+    // Frames the denoiser filters that are not a still view's accumulation (moving frames, a view's
+    // first pass) are first blended with the session's earlier frames by reprojection
+    // (renderfarm/denoise/temporal_accumulation.h): a moving view keeps most of its samples.
+    bool temporal = false;
+    TemporalParams temporal_params;
 
     // The filter's settings for served frames: AtrousParams' defaults (chosen at 1 spp) on every
     // core of the admin, which waits for the ranks meanwhile.
@@ -111,7 +120,8 @@ private:
         std::optional<ViewRequest> last_request;
         ProgressiveAccumulator accumulation;
         std::optional<FrameTimeController> controller;
-        GuideBuffers guides;  // of the accumulated view (denoise), or of the last frame
+        GuideBuffers guides;       // of the accumulated view (denoise), or of the last frame
+        TemporalHistory temporal;  // earlier moving frames (LiveOptions::temporal)
         std::uint64_t last_used = 0;
         std::optional<std::chrono::steady_clock::time_point> handed_back;  // the previous render() returned
     };
@@ -120,7 +130,7 @@ private:
     [[nodiscard]] Rgb8Image to_display(const RgbFloatImage& radiance) const;
     [[nodiscard]] bool accumulates(const LiveFrame& frame) const;
     void dispatch(Session& s, const ViewRequest& request, int spp, LiveFrame& frame, RgbFloatImage& radiance);
-    void display(const Session& s, const RgbFloatImage& radiance, LiveFrame& frame);
+    void display(Session& s, const RgbFloatImage& radiance, LiveFrame& frame);
 
     FrameSource source_;
     LiveOptions options_;

@@ -251,6 +251,42 @@ TEST_F(LiveFramesTest, DenoisedMovingFrameIsCloserToAManySppReferenceThanTheRawO
     EXPECT_GT(denoised_db, raw_db + kDenoiseGainDb);
 }
 
+// A moving view with temporal accumulation: each filtered frame is blended with the earlier frames
+// reprojected to it, so the last of a turn is closer to the reference than the filter alone makes
+// it; frames of a still view's accumulation are not blended (their mean stays unbiased).
+TEST_F(LiveFramesTest, TemporalAccumulationBringsAMovingFrameCloserToTheReference) {
+    ViewRequest request = view(0.0);
+    request.size = {96, 72};
+    request.quality.max_bounces = 1;
+    const Rgb8Image reference = single(request, 256);
+    LiveOptions filtered_options;
+    filtered_options.denoise = true;
+    LiveOptions temporal_options = filtered_options;
+    temporal_options.temporal = true;
+    LiveFrames filtered(source(), filtered_options, 1.f, ToneMap::clamp);
+    LiveFrames temporal(source(), temporal_options, 1.f, ToneMap::clamp);
+    LiveFrame a;
+    LiveFrame b;
+    for (int k = 8; k >= 0; --k) {  // turning towards the reference's pose, a degree a frame
+        ViewRequest r = request;
+        r.pose.yaw_deg += k;
+        r.frame_id = 100 + static_cast<std::uint64_t>(8 - k);
+        a = filtered.render(r);
+        b = temporal.render(r);
+    }
+    const double filtered_db = psnr(a.image, reference), temporal_db = psnr(b.image, reference);
+    std::printf("moving frame after 9 frames, 1 spp: filtered %.2f dB, temporal + filtered %.2f dB\n", filtered_db,
+                temporal_db);
+    EXPECT_GT(temporal_db, filtered_db + 1.0);
+
+    ViewRequest still = request;
+    still.frame_id = 200;
+    (void)filtered.render(still);
+    (void)temporal.render(still);  // the still view's second pass: accumulated, not blended
+    still.frame_id = 201;
+    EXPECT_EQ(filtered.render(still).image.pixels, temporal.render(still).image.pixels);
+}
+
 // A still view: the guides are traced with its first pass only, and frames are filtered while they
 // hold at most denoise_max_spp samples (1, then 1 + 2), raw after that (1 + 2 + 2 = 5).
 TEST_F(LiveFramesTest, StillViewIsDenoisedUpToDenoiseMaxSppWithTheFirstPassesGuides) {
@@ -385,6 +421,10 @@ TEST(LiveOptions, BadDenoiseOptionsAreRefusedNamingTheField) {
     LiveOptions threads;
     threads.denoise_params.threads = -1;
     EXPECT_NE(message(threads).find("threads"), std::string::npos) << message(threads);
+    LiveOptions alpha;
+    alpha.temporal_params.alpha = 0.0f;
+    EXPECT_NE(message(alpha).find("temporal_params"), std::string::npos) << message(alpha);
+    EXPECT_NE(message(alpha).find("alpha"), std::string::npos) << message(alpha);
 }
 
 TEST(LiveOptions, BadOptionsAreRefused) {

@@ -92,6 +92,9 @@ void add_live_flags(CLI::App& serve, mogao::ServeOptions& options, double& frame
                    "Trace moving frames with the render ranks' radiance cache: the lights per pixel, the rest from "
                    "a world-space cache that every frame trains (biased, cheaper; still views refine without it; "
                    "default off; the interactive and balanced presets turn it on)");
+    serve.add_flag("--temporal,!--no-temporal", live.temporal,
+                   "Blend each filtered moving frame with the session's earlier frames, reprojected by depth, before "
+                   "the denoiser (default: on whenever the denoiser is)");
     serve.add_flag("--per-session-cost-maps,!--shared-cost-map", live.per_session_maps,
                    "One PBT cost map per session (default; --shared-cost-map: one for all)");
     serve.add_flag("--pipeline,!--no-pipeline", options.pipeline,
@@ -351,6 +354,8 @@ int main(int argc, char** argv) {
         apply_serve_preset(*serve, *mogao::quality_preset(serve_preset), serve_options.live, frame_time_ms);
     if (!render_preset.empty())
         apply_render_preset(*render, *mogao::quality_preset(render_preset), job.view_template.quality);
+    if (serve->count("--temporal") == 0 && serve->count("--no-temporal") == 0)
+        serve_options.live.temporal = serve_options.live.denoise;
     serve_options.live.frame_time_s = frame_time_ms / 1e3;
     if (!view_screen.empty()) {
         serve_options.view_policy.screen =

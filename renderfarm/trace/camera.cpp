@@ -95,4 +95,28 @@ Ray generate_ray(const CameraSetup& camera, double px, double py) {
     return {camera.eye, (camera.rotation * local).normalized()};
 }
 
+bool project_to_image(const CameraSetup& camera, const Eigen::Vector3d& p, double& px, double& py) {
+    const double w = camera.size.width;
+    const double h = camera.size.height;
+    const Eigen::Vector3d q = camera.rotation.transpose() * (p - camera.eye);
+    if (const auto* screen = std::get_if<CylinderScreen>(&camera.model)) {
+        const Eigen::Vector3d& e = screen->eye_m;
+        const double a = q.x() * q.x() + q.z() * q.z();
+        const double b = 2.0 * (e.x() * q.x() + e.z() * q.z());
+        const double c = e.x() * e.x() + e.z() * e.z() - screen->radius_m * screen->radius_m;
+        if (!(a > 0.0) || !(c < 0.0)) return false;
+        const double s = (-b + std::sqrt(b * b - 4.0 * a * c)) / (2.0 * a);  // c < 0: one positive root
+        const Eigen::Vector3d on_screen = e + s * q;
+        const double arc = screen->arc_deg * kDegToRad;
+        px = (std::atan2(on_screen.x(), -on_screen.z()) + 0.5 * arc) / arc * w;
+        py = (screen->top_m - on_screen.y()) / (screen->top_m - screen->bottom_m) * h;
+        return true;
+    }
+    if (!(q.z() < 0.0)) return false;
+    const double t = camera.tan_half_fov;
+    px = 0.5 * (q.x() / -q.z() / (t * (w / h)) + 1.0) * w;
+    py = 0.5 * (1.0 - q.y() / -q.z() / t) * h;
+    return true;
+}
+
 }  // namespace mogao

@@ -49,6 +49,15 @@ struct CameraSetup {
 
 [[nodiscard]] Ray generate_ray(const CameraSetup& camera, double px, double py);
 
+// The inverse of generate_ray: the image position (px, py) (continuous, the convention above) whose
+// ray passes through world point `p` (metres). False when no ray does: `p` behind a pinhole or at
+// its eye; for the cylinder screen, `p` straight above or below the eye or the eye outside the
+// cylinder (r² <= eye_m.x² + eye_m.z²). A position outside [0, W] x [0, H] (beyond the arc, above
+// the top) is returned as it is: the caller decides what is in the image.
+// Cylinder: q = Rᵀ(p - eye) = t (S - eye_m) for the screen point S, so S = eye_m + s q with s = 1/t > 0
+// the positive root of |e + s q|² = r² over x and z; then θ = atan2(S.x, -S.z), y = S.y.
+[[nodiscard]] bool project_to_image(const CameraSetup& camera, const Eigen::Vector3d& p, double& px, double& py);
+
 // The spread angle γ (radians) of one pixel's ray cone (texture_lod.h): pinhole
 // atan(2 tan(fov/2) / H) (Ray Tracing Gems eq. 20.30); cylinder screen atan(s / d) with s the larger
 // side of a pixel on the screen (metres: (top - bottom) / H, radius arc / W) and d the distance from

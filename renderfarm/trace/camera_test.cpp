@@ -124,6 +124,49 @@ TEST(CylinderCamera, PoseYawRotatesTheScreenFrame) {
     expect_vec_near(generate_ray(cam, 360.0, 0.0).direction, {right.z(), right.y(), -right.x()});
 }
 
+// project_to_image inverts generate_ray: a point along the ray of (px, py) projects back to it.
+void expect_projection_inverts_rays(const ViewRequest& r) {
+    const CameraSetup camera = make_camera_setup(r, r.size);
+    for (const double px : {0.0, 0.5, 37.25, 100.0, 199.5}) {
+        for (const double py : {0.0, 3.5, 50.0, 99.0}) {
+            const Ray ray = generate_ray(camera, px, py);
+            for (const double t : {0.3, 2.0, 40.0}) {
+                double x = -1.0;
+                double y = -1.0;
+                ASSERT_TRUE(project_to_image(camera, ray.origin + t * ray.direction, x, y));
+                EXPECT_NEAR(x, px, 1e-7) << "t " << t;
+                EXPECT_NEAR(y, py, 1e-7) << "t " << t;
+            }
+        }
+    }
+}
+
+TEST(PinholeCamera, ProjectionInvertsRays) {
+    expect_projection_inverts_rays(pinhole_request(0.0, 0.0));
+    expect_projection_inverts_rays(pinhole_request(-35.0, 12.0));
+    const ViewRequest r = pinhole_request(0.0, 0.0);
+    double x = 0.0;
+    double y = 0.0;
+    EXPECT_FALSE(project_to_image(make_camera_setup(r, r.size), r.pose.eye + Eigen::Vector3d(0.0, 0.0, 1.0), x, y))
+        << "a point behind the camera has no ray";
+}
+
+TEST(CylinderCamera, ProjectionInvertsRays) {
+    ViewRequest r;
+    r.size = {200, 100};
+    r.camera = CylinderScreen{3.0, 150.0, 0.2, 2.8, {0.1, 1.6, -0.3}};
+    r.pose.eye = {1.0, 1.7, 5.0};
+    r.pose.yaw_deg = 20.0;
+    r.pose.pitch_deg = -5.0;
+    expect_projection_inverts_rays(r);
+    CylinderScreen outside{3.0, 150.0, 0.2, 2.8, {0.0, 1.6, 3.5}};
+    r.camera = outside;
+    double x = 0.0;
+    double y = 0.0;
+    EXPECT_FALSE(project_to_image(make_camera_setup(r, r.size), Eigen::Vector3d(0.0, 1.0, 0.0), x, y))
+        << "an eye outside the cylinder has no unique screen point";
+}
+
 TEST(PoseRotation, MatchesDocumentedAxes) {
     const Eigen::Matrix3d r = pose_rotation(90.0, 0.0);
     expect_vec_near(r * Eigen::Vector3d(0.0, 0.0, -1.0), {-1.0, 0.0, 0.0});
