@@ -45,7 +45,7 @@ Histogram::Histogram(std::vector<double> upper_bounds) : bounds_(std::move(upper
 }
 
 void Histogram::observe(double value) {
-    if (std::isnan(value)) return;
+    if (!std::isfinite(value)) return;
     // The first bucket whose upper bound is >= value (le: less than or equal).
     const auto it = std::lower_bound(bounds_.begin(), bounds_.end(), value);
     ++per_bucket_[static_cast<std::size_t>(it - bounds_.begin())];

@@ -30,8 +30,8 @@ namespace mogao::prometheus {
 
 using Labels = std::vector<std::pair<std::string, std::string>>;
 
-// A cumulative histogram with fixed upper bounds (the +Inf bucket is implicit). A NaN observation
-// is not counted (it would make _sum NaN for ever).
+// A cumulative histogram with fixed upper bounds (the +Inf bucket is implicit). A NaN or infinite
+// observation is not counted (it would make _sum NaN or infinite for ever, and every rate with it).
 class Histogram {
 public:
     explicit Histogram(std::vector<double> upper_bounds);

@@ -36,6 +36,7 @@ TEST(PrometheusText, HistogramBucketsAreCumulativeAndLeInclusive) {
     // By hand: <= 0.1: 0.05, 0.1 (le is inclusive); <= 0.5: + 0.3; <= 1: + 1.0; +Inf: + 7.
     for (const double v : {0.05, 0.1, 0.3, 1.0, 7.0}) h.observe(v);
     h.observe(std::numeric_limits<double>::quiet_NaN());  // not counted
+    h.observe(std::numeric_limits<double>::infinity());   // not counted
     EXPECT_EQ(h.cumulative_counts(), (std::vector<std::uint64_t>{2, 3, 4, 5}));
     EXPECT_EQ(h.count(), 5u);
     EXPECT_DOUBLE_EQ(h.sum(), 8.45);
