@@ -58,7 +58,8 @@ std::filesystem::path temp_path_for(const std::filesystem::path& path) {
 
 }  // namespace
 
-void write_file_atomically(const std::filesystem::path& path, std::span<const std::uint8_t> bytes) {
+void write_file_atomically(const std::filesystem::path& path, std::span<const std::uint8_t> bytes,
+                           unsigned exact_mode) {
     if (path.filename().empty()) {
         throw std::invalid_argument("write_file_atomically: '" + path.string() + "' has no file name");
     }
@@ -77,6 +78,10 @@ void write_file_atomically(const std::filesystem::path& path, std::span<const st
             fail_write(fd, tmp, err, "cannot write " + where);
         }
         done += static_cast<std::size_t>(n);
+    }
+    if (exact_mode != 0 && ::fchmod(fd.get(), static_cast<mode_t>(exact_mode)) != 0) {
+        const int err = errno;
+        fail_write(fd, tmp, err, "cannot set the mode of " + where);
     }
     if (::fsync(fd.get()) != 0) {
         const int err = errno;

@@ -110,7 +110,7 @@ protected:
                 {R"(farm.endpoint="[::1]:7443")", R"(farm.ca="pki/ca.pem")", R"(farm.cert="pki/a.pem")",
                  R"(farm.key="pki/a.key")", "display.rate_hz=240", R"(outputs.backend="headless")",
                  R"(calibration.source="screen.mpcdi")", R"(quality.content="160x90")", "navigation.path_frames=10",
-                 R"(stats.status_file="status.json")"}),
+                 R"(stats.status_file="status.json")", R"(stats.metrics_file="kiosk.prom")"}),
             dir_ / "kiosk.toml");
         const ScreenCalibration screen = load_calibration(config_);
         HeadlessOptions options;
@@ -207,6 +207,12 @@ TEST_F(CalibrationSwapTest, AReplacedMpcdiFileIsSwappedInAndMatchesTheCpuReferen
     EXPECT_EQ(status["calibration"]["swaps"], 1);
     EXPECT_EQ(status["frames_shown"], 1);
     EXPECT_EQ(status["selfcal"]["enabled"], false);
+    // The metrics file is rewritten with it (kiosk_metrics.h).
+    std::ifstream prom(dir_ / "kiosk.prom");
+    const std::string metrics((std::istreambuf_iterator<char>(prom)), std::istreambuf_iterator<char>());
+    EXPECT_NE(metrics.find("\nmogao_kiosk_calibration_swaps_total{source=\"file\"} 1\n"), std::string::npos) << metrics;
+    EXPECT_NE(metrics.find("\nmogao_kiosk_frames_shown_total 1\n"), std::string::npos) << metrics;
+    EXPECT_NE(metrics.find("\nmogao_kiosk_up 1\n"), std::string::npos) << metrics;
     const std::vector<Rgb8Image> after = outputs();
     ASSERT_EQ(after.size(), want.projectors.size());
     for (std::size_t i = 0; i < after.size(); ++i) {

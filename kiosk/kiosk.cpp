@@ -10,6 +10,8 @@
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
+#include "common/program_cli.h"
+#include "kiosk/kiosk_metrics.h"
 #include "kiosk/kiosk_setup.h"
 #include "kiosk/on_wall_status.h"
 
@@ -347,6 +349,7 @@ void Kiosk::on_calibration() {
                 std::chrono::duration_cast<std::chrono::nanoseconds>(update->loaded_at.time_since_epoch()).count();
             calibration_.last_error.clear();
             ++calibration_.swaps;
+            if (update->source == "selfcal") ++selfcal_swaps_;
             spdlog::info("calibration: now showing {} (swap {})", update->source, calibration_.swaps);
             check_frames_shown();
             write_status(running_state());
@@ -436,17 +439,41 @@ KioskStatus Kiosk::status(const char* state) const {
 }
 
 void Kiosk::write_status(const char* state) {
-    if (config_.stats.status_file.empty()) return;
+    if (config_.stats.status_file.empty() && config_.stats.metrics_file.empty()) return;
     last_status_ = std::chrono::steady_clock::now();
+    const KioskStatus now = status(state);
+    if (!config_.stats.status_file.empty()) {
+        try {
+            write_kiosk_status(config_.stats.status_file, now);
+            if (status_failing_) spdlog::info("status file: {} written again", config_.stats.status_file.string());
+            status_failing_ = false;
+        } catch (const std::exception& e) {
+            // Once, not every period: the display goes on either way.
+            if (!status_failing_) spdlog::warn("status file: {}; trying again every period", e.what());
+            note_error(std::string("status file: ") + e.what());
+            status_failing_ = true;
+        }
+    }
+    write_metrics(now);
+}
+
+void Kiosk::write_metrics(const KioskStatus& now) {
+    if (config_.stats.metrics_file.empty()) return;
+    KioskCounters counters;
+    counters.motion_to_photon = &parts_.display.stats().motion_to_photon();
+    if (parts_.link.stats) counters.link = parts_.link.stats();
+    counters.frames_dropped = parts_.inbox.rejected();
+    if (parts_.selfcal != nullptr) counters.selfcal_corrections = parts_.selfcal->corrections();
+    counters.selfcal_swaps = selfcal_swaps_;
+    counters.version = cli::version();
     try {
-        write_kiosk_status(config_.stats.status_file, status(state));
-        if (status_failing_) spdlog::info("status file: {} written again", config_.stats.status_file.string());
-        status_failing_ = false;
+        write_kiosk_metrics(config_.stats.metrics_file, now, counters);
+        if (metrics_failing_) spdlog::info("metrics file: {} written again", config_.stats.metrics_file.string());
+        metrics_failing_ = false;
     } catch (const std::exception& e) {
-        // Once, not every period: the display goes on either way.
-        if (!status_failing_) spdlog::warn("status file: {}; trying again every period", e.what());
-        note_error(std::string("status file: ") + e.what());
-        status_failing_ = true;
+        if (!metrics_failing_) spdlog::warn("metrics file: {}; trying again every period", e.what());
+        note_error(std::string("metrics file: ") + e.what());
+        metrics_failing_ = true;
     }
 }
 

@@ -137,7 +137,8 @@ private:
     void note_link_state(const LinkClientStats& link);
     void write_pose(const PoseLogEntry& entry);
     void write_statistics(const nlohmann::json& navigation, const LinkClientStats& link);
-    void write_status(const char* state);  // [stats].status_file (no-op when empty)
+    void write_status(const char* state);        // [stats].status_file and metrics_file (no-op when both empty)
+    void write_metrics(const KioskStatus& now);  // [stats].metrics_file (kiosk_metrics.h; no-op when empty)
     // The on-wall lines wanted now: the status panel when asked for ([status].on_wall, SIGUSR2,
     // trigger file) and the farm-lost indicator; empty: the picture alone.
     [[nodiscard]] std::vector<std::string> wall_lines(std::chrono::steady_clock::time_point now) const;
@@ -172,8 +173,10 @@ private:
     std::chrono::steady_clock::time_point start_;
     std::chrono::steady_clock::time_point last_log_;
     std::chrono::steady_clock::time_point last_status_;
-    bool status_failing_ = false;  // the status file's last write failed (logged once)
-    std::string last_error_;       // KioskStatus::last_error
+    bool status_failing_ = false;      // the status file's last write failed (logged once)
+    bool metrics_failing_ = false;     // the metrics file's last write failed (logged once)
+    std::uint64_t selfcal_swaps_ = 0;  // of calibration_.swaps, those from self-recalibration
+    std::string last_error_;           // KioskStatus::last_error
     std::int64_t last_error_ns_ = 0;
     bool panel_toggled_ = false;           // SIGUSR2 with [status].on_wall = "on_demand"
     std::vector<std::string> wall_lines_;  // drawn on the frame on the wall now

@@ -607,6 +607,8 @@ void read_stats(const Section& s, StatsConfig& st) {
     if (!status.empty()) st.status_file = s.context().resolve(status);
     st.status_period_s = s.number(
         "status_period_s", st.status_period_s, [](double x) { return x >= 0.1 && x <= 3600; }, "[0.1, 3600] s");
+    const std::string metrics = s.string("metrics_file", "");
+    if (!metrics.empty()) st.metrics_file = s.context().resolve(metrics);
 }
 
 void read_status(const Section& s, StatusConfig& st) {
@@ -837,7 +839,8 @@ KioskConfig parse_kiosk_config(std::string_view text, const std::filesystem::pat
     const Section navigation = section(ctx, root, "navigation", navigation_keys());
     read_navigation(navigation, config.navigation);
     config.screen.eye_m = Eigen::Vector3d(0.0, config.navigation.eye_height_m, 0.0);
-    const Section stats = section(ctx, root, "stats", {"file", "log_period_s", "status_file", "status_period_s"});
+    const Section stats =
+        section(ctx, root, "stats", {"file", "log_period_s", "status_file", "status_period_s", "metrics_file"});
     read_stats(stats, config.stats);
     const Section status =
         section(ctx, root, "status", {"on_wall", "trigger_file", "farm_lost_after_s", "certificate_warning_days"});

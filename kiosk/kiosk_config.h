@@ -144,6 +144,7 @@ struct StatsConfig {
     double log_period_s = 10.0;             // stderr summary period, [0.1, 86400]
     std::filesystem::path status_file;      // kiosk/kiosk_status.h, rewritten while running; empty = none
     double status_period_s = 1.0;           // its rewrite period, [0.1, 3600]
+    std::filesystem::path metrics_file;     // kiosk/kiosk_metrics.h, rewritten with the status; empty = none
 };
 
 // [status]: the state on the wall (kiosk/on_wall_status.h, docs/kiosk.md "On-wall status").

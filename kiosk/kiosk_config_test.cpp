@@ -228,8 +228,11 @@ TEST_F(KioskConfigTest, CalibrationWatchAndTheStatusFile) {
         good({R"(calibration.source="screen.mpcdi")",
               "calibration.projectors=", "calibration.overlap=", "calibration.output=", "calibration.gamma="});
     EXPECT_TRUE(parse(mpcdi).calibration.watch) << "an MPCDI file is swapped in when it changes by default";
-    const KioskConfig c = parse(good({R"(stats.status_file="run/kiosk-status.json")", "stats.status_period_s=0.5"}));
+    EXPECT_TRUE(plain.stats.metrics_file.empty()) << "no metrics file unless configured";
+    const KioskConfig c = parse(good({R"(stats.status_file="run/kiosk-status.json")", "stats.status_period_s=0.5",
+                                      R"(stats.metrics_file="run/kiosk.prom")"}));
     EXPECT_EQ(c.stats.status_file, dir_ / "run/kiosk-status.json");
+    EXPECT_EQ(c.stats.metrics_file, dir_ / "run/kiosk.prom");
     EXPECT_DOUBLE_EQ(c.stats.status_period_s, 0.5);
     EXPECT_NE(error_of(good({"stats.status_period_s=0.01"})).find("[stats].status_period_s"), std::string::npos);
     EXPECT_NE(error_of(good({"calibration.watch=false"})).find("[calibration].watch"), std::string::npos)

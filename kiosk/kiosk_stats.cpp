@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "common/file_io.h"
+#include "kiosk/kiosk_metrics.h"
 #include "kiosk/tracking_thread.h"
 #include "renderfarm/link/link_client.h"
 
@@ -39,13 +40,16 @@ nlohmann::json summary_json(const StatsSummary& s) {
 }  // namespace
 
 KioskStats::KioskStats(std::size_t window, std::size_t max_history)
-    : window_size_(std::max<std::size_t>(window, 2)), max_history_(max_history) {}
+    : window_size_(std::max<std::size_t>(window, 2)),
+      max_history_(max_history),
+      motion_to_photon_(motion_to_photon_buckets()) {}
 
 void KioskStats::presented(const PresentedFrame& frame) {
     if (frame.request_id <= last_request_id_) ++out_of_order_;
     last_request_id_ = frame.request_id;
     ++frames_;
     bytes_ += frame.jpeg_bytes;
+    motion_to_photon_.observe(double(frame.presented_ns - frame.request_ns) * 1e-9);
     window_.push_back(frame);
     while (window_.size() > window_size_) window_.pop_front();
     if (history_.size() < max_history_) history_.push_back(frame);

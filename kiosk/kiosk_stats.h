@@ -31,6 +31,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/pixel_rect.h"
+#include "common/prometheus_text.h"
 #include "common/view_request.h"
 
 namespace mogao {
@@ -79,6 +80,8 @@ public:
     [[nodiscard]] std::uint64_t rounds() const { return rounds_; }
     [[nodiscard]] StatsSummary window_summary() const;  // the sliding window
     [[nodiscard]] StatsSummary total_summary() const;   // the kept history
+    // Motion-to-photon of every presented frame, seconds (kiosk_metrics.h's buckets), for the metrics.
+    [[nodiscard]] const prometheus::Histogram& motion_to_photon() const { return motion_to_photon_; }
 
     // One journald-friendly line (no timestamp): frames, fps, latency, bytes, bandwidth, counters.
     [[nodiscard]] std::string log_line() const;
@@ -108,6 +111,7 @@ private:
     std::uint64_t out_of_order_ = 0;  // presented request ids not increasing (must stay 0)
     std::uint64_t last_request_id_ = 0;
     nlohmann::json events_ = nlohmann::json::array();
+    prometheus::Histogram motion_to_photon_;
 };
 
 // "link": the LinkClient's counters at exit.

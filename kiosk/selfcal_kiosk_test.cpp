@@ -201,6 +201,7 @@ TEST_F(SelfcalKioskTest, AProjectorBumpedOneDegreeIsCorrectedAndSwappedOntoTheOu
     EXPECT_EQ(worker_->status().state, selfcal::SelfcalState::calibrated) << worker_->status().text();
     EXPECT_GT(kiosk_->calibration_in_use().swaps, 0u);
     EXPECT_EQ(kiosk_->calibration_in_use().source, "selfcal");
+    EXPECT_GE(worker_->corrections(), 1u) << "a correction began (blended in over several swaps)";
     // Let the last step of the transition reach the wall, then judge it against the rig's ground truth.
     run_loop(worker_->steps() + 1, [] { return false; });
     const double after_px = projector_error_px(bumped, display_->calibration(), 1);
@@ -220,6 +221,7 @@ TEST_F(SelfcalKioskTest, WithoutABumpNothingIsCorrected) {
     EXPECT_EQ(states_, std::set<selfcal::SelfcalState>{selfcal::SelfcalState::calibrated});
     EXPECT_EQ(kiosk_->calibration_in_use().swaps, 0u);
     EXPECT_EQ(kiosk_->calibration_in_use().source, "ideal");
+    EXPECT_EQ(worker_->corrections(), 0u);
 }
 
 // [selfcal] pattern = true on a plain wall: the content gives no evidence, so the worker asks for the

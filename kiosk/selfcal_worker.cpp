@@ -100,6 +100,11 @@ selfcal::SelfcalStatus SelfcalWorker::status() const {
     return status_;
 }
 
+std::uint64_t SelfcalWorker::corrections() const {
+    const std::lock_guard lock(mutex_);
+    return corrections_;
+}
+
 std::uint64_t SelfcalWorker::steps() const {
     const std::lock_guard lock(mutex_);
     return steps_;
@@ -206,6 +211,7 @@ void SelfcalWorker::publish(selfcal::StepResult r, bool pattern_pair) {
         status_ = r.status;
         steps = ++steps_;
         if (pattern_pair) ++pattern_pairs_;
+        if (r.status.state == selfcal::SelfcalState::correcting && before != r.status.state) ++corrections_;
     }
     if (r.status.state != before || steps == 1) spdlog::info("{}", r.status.text());
     if (r.calibration) {

@@ -80,6 +80,7 @@ public:
     [[nodiscard]] selfcal::SelfcalStatus status() const;
     [[nodiscard]] std::uint64_t steps() const;
     [[nodiscard]] std::uint64_t pattern_pairs() const;  // steps that were pattern pairs
+    [[nodiscard]] std::uint64_t corrections() const;    // times the state became correcting
 
 private:
     void run();
@@ -110,6 +111,7 @@ private:
     selfcal::SelfcalStatus status_;
     std::uint64_t steps_ = 0;
     std::uint64_t pattern_pairs_ = 0;
+    std::uint64_t corrections_ = 0;
     std::thread thread_;  // last
 };
 

@@ -10,7 +10,10 @@
 #     lost ("did not reply") and never aborted the MPI job;
 #   * the ordinary appliance keeps getting frames beside the dear one: no gap between two of its
 #     frames longer than MAX_GAP_S, and at least MIN_FRAMES_BESIDE frames while both run;
-#   * the dear appliance gets frames too (cut to the frame budget, then degraded from their cost).
+#   * the dear appliance gets frames too (cut to the frame budget, then degraded from their cost);
+#   * the metrics files (docs/monitoring.md): the farm's counts frames for each appliance by its
+#     certificate name, the ordinary kiosk's counts the frames it showed, and both say up 0 after
+#     the stop.
 # Prints the ordinary appliance's frames/s alone and beside the dear one (from the kiosks' own
 # statistics), for the log; the test bounds the gap, not a speed.
 #
@@ -39,7 +42,8 @@ port=$((20000 + ($$ + 4243) % 20000))
 endpoint="[::1]:$port"
 make_pki "$work/pki" "::1"
 "$farm" pki issue-appliance --dir "$work/pki" --name museum-2 >/dev/null || fail "pki issue-appliance museum-2"
-write_config "$work/ordinary.toml" "$endpoint" "$work/pki" "$work/png" 1000000 'status.farm_lost_after_s=0'
+write_config "$work/ordinary.toml" "$endpoint" "$work/pki" "$work/png" 1000000 'status.farm_lost_after_s=0' \
+  "stats.metrics_file=\"$work/ordinary.prom\""
 write_config "$work/dear.toml" "$endpoint" "$work/pki" "$work/png-dear" 1000000 'status.farm_lost_after_s=0' \
   "farm.cert=\"$work/pki/appliance-museum-2.pem\"" "farm.key=\"$work/pki/appliance-museum-2.key\"" \
   'quality.content="320x240"' 'quality.spp=1' 'quality.bounces=8' 'quality.ao_samples=64' \
@@ -51,7 +55,8 @@ for _ in 1 2; do
   load_pids+=($!)
 done
 
-FARM_BUDGET_ARGS=()  # the farm's default frame budget (1 s): what this test is about
+# The farm's default frame budget (1 s): what this test is about.
+FARM_BUDGET_ARGS=(--metrics-file "$work/farm.prom")
 start_farm "$work/farm.log" "$endpoint"
 log "farm up at $endpoint (3 ranks), two busy loops beside it"
 
@@ -123,6 +128,20 @@ if dear_frames < 1:
 for name, s in (("ordinary", ordinary), ("dear", dear)):
     if s["frames_rejected"] != 0:
         print(f"FAIL: {name}: {s['frames_rejected']} frames rejected"); ok = False
+sys.exit(0 if ok else 1)
+PY
+python3 - "$work/farm.prom" "$work/ordinary.prom" <<'PY' || status=1
+import re, sys
+def samples(path):
+    return {m[0]: float(m[1]) for m in re.findall(r"^([a-z_]+(?:\{[^}]*\})?) (\S+)$", open(path).read(), re.M)}
+farm, kiosk = samples(sys.argv[1]), samples(sys.argv[2])
+frames = {a: farm.get(f'mogao_farm_appliance_frames_total{{appliance="{a}"}}', 0) for a in ("museum-1", "museum-2")}
+print(f"metrics: farm up {farm.get('mogao_farm_up')}, frames per appliance {frames}, "
+      f"{farm.get('mogao_farm_frame_seconds_count')} frame times; ordinary kiosk up {kiosk.get('mogao_kiosk_up')}, "
+      f"{kiosk.get('mogao_kiosk_frames_shown_total')} frames shown")
+ok = farm.get("mogao_farm_up") == 0 and kiosk.get("mogao_kiosk_up") == 0 and min(frames.values()) > 0
+ok = ok and kiosk.get("mogao_kiosk_frames_shown_total", 0) > 0 and kiosk.get("mogao_kiosk_motion_to_photon_seconds_count", 0) > 0
+print("metrics: OK" if ok else "FAIL: the metrics files do not show both appliances served and both stopped")
 sys.exit(0 if ok else 1)
 PY
 if (( status != 0 )); then

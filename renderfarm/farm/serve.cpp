@@ -12,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "common/jpeg_codec.h"
+#include "common/program_cli.h"
 #include "common/service_notify.h"
 #include "renderfarm/farm/farm_metrics.h"
 #include "renderfarm/farm/main_thread_queue.h"
@@ -24,7 +25,11 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 std::atomic<bool> g_stop{false};
-extern "C" void on_stop_signal(int) { g_stop = true; }
+extern "C" void on_stop_signal(int) {
+    g_stop = true;
+    // Up 0 now: mpirun or systemd may SIGKILL the admin before its loop sees the flag.
+    FarmMetricsFile::on_stop_signal();
+}
 
 // What the main thread hands back: the frame, encoded already unless pipelining.
 struct ServedFrame {
@@ -58,27 +63,6 @@ void log_stats(const LinkServer& server, const MainThreadQueue<ServedFrame>& que
         s.sessions_active, s.frames_sent, s.requests_received, s.requests_dropped, queue.superseded(),
         s.requests_invalid, degraded, static_cast<double>(s.jpeg_bytes_sent) / 1e6);
 }
-
-// Writes the metrics file when one is configured; a failure is logged once per kind of error and
-// never stops serving.
-class MetricsWriter {
-public:
-    explicit MetricsWriter(std::filesystem::path file) : file_(std::move(file)) {}
-    void write(const FarmMetrics& metrics, FarmCounters counters) {
-        if (file_.empty()) return;
-        try {
-            metrics.write(file_, counters);
-            last_error_.clear();
-        } catch (const std::exception& e) {
-            if (last_error_ != e.what()) spdlog::warn("metrics: {}", e.what());
-            last_error_ = e.what();
-        }
-    }
-
-private:
-    std::filesystem::path file_;
-    std::string last_error_;
-};
 
 // The frame budget across frames (session_budget.h): degrades a request to its appliance's measured
 // rate (logged once per session and change of decision), learns the rate from each rendered frame,
@@ -154,8 +138,8 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& s
     farm.set_heartbeat([&notifier] { notifier.watchdog(); });  // a long frame is not a hang
 
     JpegEncoder encoder;
-    FarmMetrics metrics;
-    MetricsWriter metrics_writer(options.metrics_file);
+    FarmMetrics metrics(cli::version());
+    FarmMetricsFile metrics_file(options.metrics_file);  // up 0 on every way out it can see
     const auto counters = [&](bool up) {
         return FarmCounters{up, server.stats(), queue.superseded(), policy.changed(), run.render_ranks};
     };
@@ -170,7 +154,7 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& s
             last_stats = Clock::now();
         }
         if (Clock::now() - last_metrics >= std::chrono::seconds(1)) {
-            metrics_writer.write(metrics, counters(true));
+            metrics_file.update(metrics, counters(true));
             last_metrics = Clock::now();
         }
         std::optional<MainThreadQueue<ServedFrame>::Job> job = queue.next(std::chrono::milliseconds(100));
@@ -180,7 +164,7 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& s
             const std::string key = who.empty() ? "session " + std::to_string(job->view.session) : who;
             LiveFrame frame = live.render(budget.apply(policy.apply(job->view, who), key));
             budget.observe(key, frame);
-            metrics.observe_frame(frame.stats, frame.seconds, double(realtime_ns()) * 1e-9);
+            metrics.observe_frame(frame.stats, frame.seconds, double(realtime_ns()) * 1e-9, who);
             ServedFrame out{std::move(frame.image), job->view.quality.jpeg_quality, realtime_ns(), std::nullopt};
             if (!options.pipeline) out.encoded = encode(out, encoder);
             job->result.set_value(std::move(out));
@@ -196,7 +180,7 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& s
     }
     const bool lost_rank = farm.broken();
     spdlog::info("frame budget: {} requests degraded to it, {} frames cut at it", budget.degraded(), budget.cut());
-    metrics_writer.write(metrics, counters(false));
+    metrics_file.update(metrics, counters(false));
     notifier.stopping();
     spdlog::info("stopping: {}", lost_rank ? "a render rank was lost" : g_stop ? "signal" : "duration reached");
     queue.close();
