@@ -154,8 +154,8 @@ Rgb8Image self_check_image(const SelfCheckResult& c) {
         }
     };
     for (const SelfCheckMark& m : c.marks) {
-        dot(m.camera_expected, 0, 4);
-        dot(m.camera_observed, 1, 2);
+        dot(m.camera_expected, 0, 8);
+        dot(m.camera_observed, 1, 3);
     }
     return out;
 }
