@@ -3,7 +3,7 @@
 //
 //   mogao-autocal calibrate --rig rigs/standard.toml --out DIR [--scale 0.5] [--content 1920x1080]
 //                 [--alpha-bits 16] [--warp-step 2] [--gray-bits N] [--frames-per-pattern 1] [--no-colour]
-//                 [--no-falloff] [--fit-screen] [--no-bow] [--refine-camera-intrinsics] [--max-self-check-px 0.8]
+//                 [--no-falloff] [--fit-screen] [--no-bow] [--refine-camera-intrinsics] [--max-self-check-px 0.65]
 //
 // Exit codes: 0 success, 1 the job failed or the calibration was refused (the message says why;
 // nothing in DIR changes), 2 bad command line.

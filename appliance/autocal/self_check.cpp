@@ -403,8 +403,8 @@ void check_self_check_gate(const SelfCheckResult& check, const SelfCheckOptions&
         "content belongs, above its gate max_self_check_px " + std::to_string(o.max_mean_px) +
         " (measured against the screen's frame; through the calibration's own camera " +
         std::to_string(check.own_camera_mean_px) +
-        " px): the camera's intrinsics, its pose or the screen's size in the site file are off (try "
-        "--refine-camera-intrinsics, --fit-screen, or a new chessboard calibration of the camera)");
+        " px): the camera's intrinsics, its pose or the screen's size in the site file are off (a new chessboard "
+        "calibration of the camera, the intrinsics' refinement where the command has it, or fitting the screen)");
 }
 
 }  // namespace mogao::autocal

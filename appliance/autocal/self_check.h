@@ -48,9 +48,10 @@ struct SelfCheckOptions {
     double max_view_angle_deg = 60.0;  // (0, 90)
     int min_marks = 8;                 // marks found, below: the check fails (refused)
     // The gate (max_self_check_px, --max-self-check-px): a calibration whose marks land further than this from
-    // where they belong (mean, the showing projector's pixels) is refused, > 0. The goals are 0.3 px; the
-    // check's own error is about 0.2 px on the rigs (docs/calibration.md, "The self-check").
-    double max_mean_px = 0.8;
+    // where they belong (mean, the showing projector's pixels) is refused, > 0. Above the check's own figure on
+    // every rig that calibrates (at most about 0.45 px: its floor is 0.1-0.2 px above the truth) and below what
+    // it reads for a wrong camera's 1 px (it reads about two thirds of that): docs/calibration.md.
+    double max_mean_px = 0.65;
 };
 
 struct SelfCheckMark {
