@@ -12,20 +12,23 @@
 // warp puts there (sample_warp), and 0 where its blend is 0; one capture per projector, minus a black one,
 // the mean of `frames` frames each. Each mark's camera position is the intensity-weighted centroid of
 // the lit pixels (above a fifth of the window's peak) in a window of 3 spot sigmas around the predicted
-// position, re-centred three times.
+// position, re-centred three times (thresholded centroid of a target image: Shortis, Clarke & Short 1994,
+// "A comparison of some techniques for the subpixel location of discrete target images", SPIE 2350).
 //
 // Where a mark belongs. A calibration agrees with its own camera by construction: the projector models
 // are fitted to what the camera saw through that camera's model, so a mark lands, in the camera image,
 // where the calibration's camera predicts it, however wrong that camera's intrinsics are (the content is
 // then off on the screen, and the camera cannot tell from the marks alone). What the camera sees that
 // the calibration does not decide is the screen's frame: its top and bottom edges at their measured
-// heights and its ends. The check therefore poses its own camera on the frame alone (a white and a black
-// capture; the screen's lit edges as in step 2 of autocal.h, then Gauss-Newton on the 6 pose parameters with
-// each edge point's distance from its edge in camera pixels; the calibration's intrinsics, which the frame
-// alone does not determine well), takes each mark's observed
-// camera position through that camera onto the screen (the calibration's screen model), and compares it
-// with the screen point its content belongs at: the distance in the showing projector's pixels through its
-// fitted model. Which errors this sees and which it cannot: docs/calibration.md, "The self-check".
+// heights and its ends (the screen's known boundary fixes the camera: Sajadi & Majumder 2009, IEEE TVCG
+// 15(6)). The check therefore poses its own camera on the frame alone (a white and a black capture; the
+// screen's lit edges as in step 2 of autocal.h, then Gauss-Newton on the 6 pose parameters with each edge
+// point's distance from its edge in camera pixels; the calibration's intrinsics, which the frame alone does
+// not determine well), takes each mark's observed camera position through that camera onto the screen (the
+// calibration's screen model), and compares it with the screen point its content belongs at: the distance
+// in the showing projector's pixels through its fitted model. Marks that camera sees more steeply than
+// `max_view_angle_deg` are left out. Which errors this sees and which it cannot: docs/calibration.md,
+// "The self-check".
 #pragma once
 
 #include <vector>
