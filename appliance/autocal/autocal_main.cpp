@@ -3,7 +3,7 @@
 //
 //   mogao-autocal calibrate --rig rigs/standard.toml --out DIR [--scale 0.5] [--content 1920x1080]
 //                 [--alpha-bits 16] [--warp-step 2] [--gray-bits N] [--frames-per-pattern 1] [--no-colour]
-//                 [--no-falloff] [--fit-screen] [--no-bow] [--refine-camera-intrinsics]
+//                 [--no-falloff] [--fit-screen] [--no-bow] [--refine-camera-intrinsics] [--max-self-check-px 0.65]
 //
 // Exit codes: 0 success, 1 the job failed or the calibration was refused (the message says why;
 // nothing in DIR changes), 2 bad command line.
@@ -47,6 +47,10 @@ int main(int argc, char** argv) {
                   "Take the screen as an exact cylinder: do not try a bow (kept by default only where it pays)");
     cmd->add_flag("--refine-camera-intrinsics", job.options.refine_camera_intrinsics,
                   "Refine the camera's focal length, principal point and k1, k2 in the bundle adjustment");
+    cmd->add_option("--max-self-check-px", job.self_check.max_mean_px,
+                    "Self-check gate: refuse when the verification marks land further than this from where they "
+                    "belong (mean, projector pixels; measured from the camera images against the screen's frame)")
+        ->check(CLI::PositiveNumber);
     bool no_colour = false;
     cmd->add_flag("--no-colour", no_colour, "Geometry only: no response, black-level and colour matching step");
     bool no_falloff = false;
@@ -68,6 +72,13 @@ int main(int argc, char** argv) {
     try {
         const nlohmann::json r = mogao::autocal::run_calibrate_job(job);
         const auto& t = r["ground_truth"];
+        const auto& c = r["self_check"];
+        std::printf(
+            "%s: self-check (no ground truth): marks landed %.3f px mean, p95 %.3f px (%.1f mm) from where they "
+            "belong, %d of %d marks measured; gate %.2f px\n",
+            r["rig"].get<std::string>().c_str(), c["mean_px"].get<double>(), c["p95_px"].get<double>(),
+            c["mean_mm"].get<double>(), c["marks_found"].get<int>(), c["marks_shown"].get<int>(),
+            c["gate_max_mean_px"].get<double>());
         std::printf("%s: geometry mean %.3f p95 %.3f px, seam luminance %.2f %% (against the rig's ground truth); %s\n",
                     r["rig"].get<std::string>().c_str(), t["geometry_mean_px"].get<double>(),
                     t["geometry_p95_px"].get<double>(), 100.0 * t["seam_luminance_max_deviation"].get<double>(),

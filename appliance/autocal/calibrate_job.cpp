@@ -123,6 +123,58 @@ nlohmann::json camera_report(const AutocalResult& r, const CalibrationPrior& pri
     return out;
 }
 
+// What the camera saw of the self-check's marks (grey, gamma 2.2), each found mark's centroid (green) and
+// where its content belongs as the check's camera sees it (red), 2x the camera's resolution.
+Rgb8Image self_check_image(const SelfCheckResult& c) {
+    constexpr int kZoom = 2;
+    const cv::Mat1f& f = c.filmed;
+    Rgb8Image out(ImageSize{f.cols * kZoom, f.rows * kZoom});
+    double peak = 1e-6;
+    for (int y = 0; y < f.rows; ++y)
+        for (int x = 0; x < f.cols; ++x) peak = std::max(peak, static_cast<double>(f(y, x)));
+    for (int y = 0; y < out.size.height; ++y) {
+        for (int x = 0; x < out.size.width; ++x) {
+            const double v = std::clamp(f(y / kZoom, x / kZoom) / peak, 0.0, 1.0);
+            std::uint8_t* px = out.at(x, y);
+            px[0] = px[1] = px[2] = cv::saturate_cast<uchar>(255.0 * std::pow(v, 1.0 / 2.2));
+        }
+    }
+    const auto dot = [&](const Eigen::Vector2d& p, int channel, int r) {
+        const int cx = static_cast<int>(p.x() * kZoom);
+        const int cy = static_cast<int>(p.y() * kZoom);
+        for (int dy = -r; dy <= r; ++dy) {
+            for (int dx = -r; dx <= r; ++dx) {
+                const int x = cx + dx;
+                const int y = cy + dy;
+                if ((dx != 0 && dy != 0) || x < 0 || y < 0 || x >= out.size.width || y >= out.size.height) continue;
+                std::uint8_t* px = out.at(x, y);
+                px[0] = px[1] = px[2] = 0;
+                px[channel] = 255;
+            }
+        }
+    };
+    for (const SelfCheckMark& m : c.marks) {
+        dot(m.camera_expected, 0, 8);
+        dot(m.camera_observed, 1, 3);
+    }
+    return out;
+}
+
+nlohmann::json self_check_report(const SelfCheckResult& c, const SelfCheckOptions& o) {
+    return {{"mean_px", c.mean_px},
+            {"p95_px", c.p95_px},
+            {"max_px", c.max_px},
+            {"mean_mm", c.mean_mm},
+            {"gate_max_mean_px", o.max_mean_px},
+            {"own_camera_mean_px", c.own_camera_mean_px},
+            {"marks_found", c.marks.size()},
+            {"marks_shown", c.shown},
+            {"marks_too_steep", c.steep},
+            {"captures", c.captures},
+            {"frame_edge_points", c.edge_points},
+            {"frame_edge_rms_camera_px", c.edge_rms_px}};
+}
+
 }  // namespace
 
 nlohmann::json run_calibrate_job(const CalibrateJob& job) {
@@ -141,6 +193,12 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
             calibrate_colour(source, r.screen, r.camera, r.projectors, r.calibration, job.colour_options);  // throws
         calibrate_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
     }
+    // The self-check sees only the camera images and the calibration (no ground truth); its gate refuses
+    // before anything is written. After the colour step, which it does not change.
+    const auto t2 = std::chrono::steady_clock::now();
+    const SelfCheckResult check = run_self_check(source, prior, r, job.self_check);
+    calibrate_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t2).count();
+    check_self_check_gate(check, job.self_check);
     const GeometryError g = measure_geometry(rig, r.calibration, 4);
     // One grid point per projector pixel: a seam's maximum must see a line one pixel wide.
     const LuminanceError l = measure_luminance(rig, r.calibration, 0.01, pixel_dense_seam_grid(rig));
@@ -149,7 +207,7 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
         {"rig_file", job.rig.string()},
         {"scale", job.scale},
         {"content", {job.content.width, job.content.height}},
-        {"captures", r.report.captures},
+        {"captures", r.report.captures + check.captures},
         {"geometry_captures", r.report.captures},
         {"knobs",
          {{"max_gray_bits", job.options.max_gray_bits},
@@ -163,6 +221,7 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
           {"simulate_s", source.simulate_s()},
           {"calibrate_wall_s", calibrate_s}}},
         {"camera", camera_report(r, prior, job.options)},
+        {"self_check", self_check_report(check, job.self_check)},
         {"screen",
          {{"fitted", job.options.fit_screen},
           {"bow_m", r.screen.bow_m},
@@ -195,7 +254,7 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
           {"camera_position_error_mm", (r.camera.position_m - rig.camera.pose.position_m).norm() * 1e3}}}};
     if (colour) {
         report["colour"] = colour_report(*colour);
-        report["captures"] = r.report.captures + colour->captures;
+        report["captures"] = r.report.captures + check.captures + colour->captures;
         report["ground_truth"]["seams_before_colour"] = seams_before;
     }
     report["ground_truth"]["seams"] = seam_figures(rig, r.calibration);
@@ -224,6 +283,7 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
     write_mpcdi(job.out / "calibration.mpcdi", to_mpcdi(r.calibration, mo));
     const std::filesystem::path png = job.out / "preview.png";
     write_png(png, preview(rig, r.calibration, 960));  // libpng: no imgcodecs in what the image ships
+    if (!check.filmed.empty()) write_png(job.out / "self-check.png", self_check_image(check));
     const std::filesystem::path json = job.out / "report.json";
     std::ofstream f(json);
     f << report.dump(2) << "\n";

@@ -15,10 +15,17 @@
 //                      apart; with the colour step, the measured responses, blacks and gains ("colour") and the seams
 //                      before and after it at black, dark, mid-grey and white content
 //                      (ground_truth.seams_before_colour, .seams),
+//                      "self_check": the on-site figure without ground truth (self_check.h: the marks' error
+//                      in projector pixels, mean / p95 / max, in mm, through the calibration's own camera, marks
+//                      found, shown and too steep, the frame fit) beside "ground_truth" (the rig's truth,
+//                      computed apart and never given to the check),
 //   preview.png        the screen as a viewer sees it (ground-truth light paths, the rig's
 //                      responses and black levels, mean of the channels): a white field with a
 //                      content grid every 1/16 of the frame, linear light -> gamma 2.2, 8 bits.
-// A refused calibration (CalibrationRefused) writes nothing: whatever the folder held stays.
+//   self-check.png     the self-check's marks as the camera saw them (grey), each found mark's centroid
+//                      (green) and where its content belongs through the check's camera (red cross), 2x.
+// A refused calibration (CalibrationRefused, the self-check's gate included) writes nothing: whatever the
+// folder held stays.
 #pragma once
 
 #include <filesystem>
@@ -29,6 +36,7 @@
 
 #include "appliance/autocal/autocal.h"
 #include "appliance/autocal/colour_calibration.h"
+#include "appliance/autocal/self_check.h"
 
 namespace mogao::autocal {
 
@@ -41,6 +49,9 @@ struct CalibrateJob {
     AutocalOptions options;
     bool colour = true;  // the photometric step (colour_calibration.h) after the geometry
     ColourOptions colour_options;
+    // The self-check after the geometry (self_check.h): marks through the new warp and blend, filmed; its
+    // gate (self_check.max_mean_px, --max-self-check-px) refuses the calibration like the others.
+    SelfCheckOptions self_check;
 };
 
 // Runs the job; returns the report (also written as report.json). Throws rig::RigError,

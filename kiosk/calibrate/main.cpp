@@ -101,12 +101,12 @@ int run_rig(const Cli& cli, autocal::CalibrateJob job) {
 
 int run_budget(const Cli& cli, const OnSiteJob& job) {
     const autocal::CalibrationPrior prior = site_prior(job);
-    const PatternBudget b = pattern_budget(prior, job.colour, job.colour_options, job.options);
+    const PatternBudget b = pattern_budget(prior, job.colour, job.colour_options, job.options, job.self_check);
     const double each = seconds_per_image(cli.budget_fps, job.timing.settle_ms, job.timing.drop_frames);
     std::printf(
-        "%zu projectors: %d images (identification %d, geometry at most %d, colour %d); at %.0f fps, settle "
-        "%d ms, %d frames dropped: %.3f s per image, %.0f s (%.1f min) of capture\n",
-        prior.projectors.size(), b.total(), b.identification, b.geometry, b.colour, cli.budget_fps,
+        "%zu projectors: %d images (identification %d, geometry at most %d, colour %d, self-check %d); at %.0f fps, "
+        "settle %d ms, %d frames dropped: %.3f s per image, %.0f s (%.1f min) of capture\n",
+        prior.projectors.size(), b.total(), b.identification, b.geometry, b.colour, b.self_check, cli.budget_fps,
         job.timing.settle_ms, job.timing.drop_frames, each, each * b.total(), each * b.total() / 60.0);
     return 0;
 }
@@ -202,6 +202,12 @@ int run_site(const Cli& cli, OnSiteJob& job) {
                     p["id"].get<std::string>().c_str(), p["column_bits"].get<int>(), p["row_bits"].get<int>(),
                     p["correspondences"].get<int>(), p["reprojection_rms_px"].get<double>());
     }
+    const auto& check = r["self_check"];
+    std::printf(
+        "self-check: marks landed %.2f px mean, p95 %.2f px (%.1f mm) from where their content belongs, "
+        "%d of %d marks measured (gate %.2f px)\n",
+        check["mean_px"].get<double>(), check["p95_px"].get<double>(), check["mean_mm"].get<double>(),
+        check["marks_found"].get<int>(), check["marks_shown"].get<int>(), check["gate_max_mean_px"].get<double>());
     std::printf("written to %s%s%s\n", job.out.c_str(), job.install.empty() ? "" : " and ", job.install.c_str());
     if (simulated) print_simulation_truth(cli, job);
     return 0;
@@ -252,6 +258,10 @@ int main(int argc, char** argv) {
                  "Fit the screen's radius and arc too (known only roughly; the heights are taken as measured)");
     app.add_flag("--no-bow", cli.no_bow,
                  "Take the screen as an exact cylinder: do not try a bow (kept by default only where it pays)");
+    app.add_option("--max-self-check-px", job.self_check.max_mean_px,
+                   "Self-check gate: refuse when the verification marks land further than this from where they "
+                   "belong (mean, projector pixels, measured against the screen's frame)")
+        ->check(CLI::PositiveNumber);
     app.add_flag("--no-colour", cli.no_colour, "Geometry only: no response, black-level and colour matching step");
     app.add_flag("--no-falloff", cli.no_falloff,
                  "Colour step without the lens fall-off: one gain per projector and channel (flat projectors)");

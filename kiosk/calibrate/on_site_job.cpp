@@ -170,11 +170,27 @@ nlohmann::json previous_connectors(const fs::path& report) {
     }
 }
 
+// report.json's "self_check": the on-site accuracy figure (appliance/autocal/self_check.h).
+nlohmann::json self_check_json(const autocal::SelfCheckResult& c, const autocal::SelfCheckOptions& o) {
+    return {{"mean_px", c.mean_px},
+            {"p95_px", c.p95_px},
+            {"max_px", c.max_px},
+            {"mean_mm", c.mean_mm},
+            {"gate_max_mean_px", o.max_mean_px},
+            {"own_camera_mean_px", c.own_camera_mean_px},
+            {"marks_found", c.marks.size()},
+            {"marks_shown", c.shown},
+            {"marks_too_steep", c.steep},
+            {"captures", c.captures},
+            {"frame_edge_points", c.edge_points},
+            {"frame_edge_rms_camera_px", c.edge_rms_px}};
+}
+
 // Steps 4-5: the report and the files (on_site_job.h).
 nlohmann::json finish(const OnSiteJob& job, const Identified& id, const autocal::AutocalResult& r,
-                      const std::optional<autocal::ColourResult>& colour, const PatternDisplay& display,
-                      const autocal::CalibrationPrior& prior, const CalibrationCamera& camera,
-                      const PatternBudget& budget, double seconds, int images) {
+                      const std::optional<autocal::ColourResult>& colour, const autocal::SelfCheckResult& check,
+                      const PatternDisplay& display, const autocal::CalibrationPrior& prior,
+                      const CalibrationCamera& camera, const PatternBudget& budget, double seconds, int images) {
     nlohmann::json report = {{"site_file", job.site.string()},
                              {"scale", job.scale},
                              {"content", {job.content.width, job.content.height}},
@@ -187,6 +203,7 @@ nlohmann::json finish(const OnSiteJob& job, const Identified& id, const autocal:
                               {{"identification", budget.identification},
                                {"geometry_at_most", budget.geometry},
                                {"colour", budget.colour},
+                               {"self_check", budget.self_check},
                                {"total", budget.total()}}},
                              {"capture_seconds", seconds},
                              {"seconds_per_image", seconds / std::max(1, images)},
@@ -196,6 +213,7 @@ nlohmann::json finish(const OnSiteJob& job, const Identified& id, const autocal:
     report["cabling_changes"] = cabling_changes(previous_connectors(job.out / "report.json"), report["connectors"]);
     for (std::size_t k = 0; k < r.projectors.size(); ++k) report["projectors"].push_back(fit_json(r, k));
     if (colour) report["colour"] = colour_json(*colour);
+    report["self_check"] = self_check_json(check, job.self_check);
     // The screen the calibration used: the site file's cylinder, with the bow where it paid (autocal.h).
     report["screen"] = screen_json(r);
     const autocal::CalibrationModels models{r.screen, r.camera, r.projectors};
@@ -224,7 +242,7 @@ nlohmann::json run_on_site(const OnSiteJob& job, OutputBackend& outputs, Calibra
     }
     auto display = PatternDisplay::create(outputs, job.flip_timeout_ms);
     if (!display) throw std::runtime_error(display.error().message);
-    const PatternBudget budget = pattern_budget(prior, job.colour, job.colour_options, job.options);
+    const PatternBudget budget = pattern_budget(prior, job.colour, job.colour_options, job.options, job.self_check);
     std::vector<std::size_t> order(prior.projectors.size());
     for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
     HardwarePatternSource source(display.value(), camera, order, prior.camera.resolution, job.transfer, job.timing,
@@ -234,6 +252,7 @@ nlohmann::json run_on_site(const OnSiteJob& job, OutputBackend& outputs, Calibra
     std::optional<Identified> id;
     std::optional<autocal::AutocalResult> r;
     std::optional<autocal::ColourResult> colour;
+    std::optional<autocal::SelfCheckResult> check;
     try {
         id = identify(source, display.value(), prior, job.options.min_contrast, job.min_lit_fraction);
         source.set_projector_output(id->projector_output);
@@ -242,6 +261,8 @@ nlohmann::json run_on_site(const OnSiteJob& job, OutputBackend& outputs, Calibra
             colour = autocal::calibrate_colour(source, r->screen, r->camera, r->projectors, r->calibration,
                                                job.colour_options);
         }
+        check = autocal::run_self_check(source, prior, *r, job.self_check);  // step 3b
+        autocal::check_self_check_gate(*check, job.self_check);
     } catch (...) {
         (void)display.value().show_outputs(dark);  // refused or failed: the wall goes dark, not a stripe pattern
         throw;
@@ -249,7 +270,7 @@ nlohmann::json run_on_site(const OnSiteJob& job, OutputBackend& outputs, Calibra
     const double seconds = source.seconds();
     const int images = source.images();
     if (auto s = display.value().show_outputs(dark); !s) throw std::runtime_error(s.error().message);
-    return finish(job, *id, *r, colour, display.value(), prior, camera, budget, seconds, images);
+    return finish(job, *id, *r, colour, *check, display.value(), prior, camera, budget, seconds, images);
 }
 
 }  // namespace mogao::calibrate

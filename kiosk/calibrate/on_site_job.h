@@ -13,7 +13,10 @@
 // output drives which projector, from the camera (connector_identity.h), with each connector's
 // EDID; (2) autocal::calibrate (Gray code, camera pose, projector fits, bundle adjustment, warp,
 // blend) and (3) autocal::calibrate_colour unless `colour` is off, both through
-// HardwarePatternSource; (4) all outputs black again; (5) the files, into `out`:
+// HardwarePatternSource; (3b) the self-check (appliance/autocal/self_check.h): marks through the new warp
+// and blend, filmed, against where their content belongs, with no ground truth; above its gate
+// (self_check.max_mean_px, --max-self-check-px) the calibration is refused; (4) all outputs black again; (5) the files,
+// into `out`:
 //   calibration.models.json, calibration.mpcdi  as mogao-autocal writes them (atomic, the models
 //                      first); a calibration.mpcdi already there is kept as calibration.mpcdi.last-good
 //                      (and its models as calibration.models.json.last-good) before it is replaced,
@@ -21,7 +24,8 @@
 //                      "connectors" (projector id, connector name, EDID, lit fraction, centroid),
 //                      "cabling_changes" against the previous report.json in `out`, the captured image
 //                      count, capture seconds and seconds per image, the budget, the camera, the colour
-//                      step's figures; no ground truth (there is none on site),
+//                      step's figures, "self_check" (the on-site accuracy figure: the marks' error in projector
+//                      pixels, mean / p95 / max, in mm, marks found); no ground truth (there is none on site),
 //   camera-white.png   what the camera saw with every projector white (8-bit, the camera's codes
 //                      re-encoded sRGB): where the screen and the projectors are, for the technician.
 // and, when `install` is set, the MPCDI and its models also to `install` (the kiosk's
@@ -38,6 +42,7 @@
 #include "appliance/autocal/autocal.h"
 #include "appliance/autocal/colour_calibration.h"
 #include "appliance/autocal/model_store.h"
+#include "appliance/autocal/self_check.h"
 #include "drivers/output.h"
 #include "kiosk/calibrate/calibration_camera.h"
 #include "kiosk/calibrate/hardware_pattern_source.h"
@@ -54,6 +59,7 @@ struct OnSiteJob {
     autocal::AutocalOptions options;
     bool colour = true;
     autocal::ColourOptions colour_options;
+    autocal::SelfCheckOptions self_check;  // step 3b and its gate (appliance/autocal/self_check.h)
     CaptureTiming timing;
     CameraTransfer transfer = CameraTransfer::srgb;
     double min_lit_fraction = 0.01;  // identification: an output must light this much of the camera image

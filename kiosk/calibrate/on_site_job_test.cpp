@@ -124,6 +124,12 @@ TEST_F(OnSiteJobTest, HeadlessOutputsFilmedThroughTheRigCalibrateAsWellAsTheRigI
     EXPECT_NEAR(g.mean_px, want.mean_px, 0.01);
     EXPECT_NEAR(g.p95_px, want.p95_px, 0.02);
     EXPECT_LE(g.mean_px, 0.3);  // the geometry goal's bound (full-scale pixels; at 1/4 scale it is 4x as strict)
+    // The on-site accuracy figure, from the camera images alone, against the ground truth measured here.
+    const nlohmann::json& check = r["self_check"];
+    std::printf("self-check (no ground truth): mean %.3f p95 %.3f px, %d of %d marks\n", check["mean_px"].get<double>(),
+                check["p95_px"].get<double>(), check["marks_found"].get<int>(), check["marks_shown"].get<int>());
+    EXPECT_NEAR(check["mean_px"].get<double>(), g.mean_px, 0.2);
+    EXPECT_GE(check["marks_found"].get<int>(), 48);
     EXPECT_TRUE(fs::exists(job_.out / "calibration.models.json"));
     EXPECT_FALSE(cv::imread((job_.out / "camera-white.png").string()).empty());
     // The previous run's calibration is kept, and its cabling compared.

@@ -7,7 +7,8 @@
 namespace mogao::calibrate {
 
 PatternBudget pattern_budget(const autocal::CalibrationPrior& prior, bool colour,
-                             const autocal::ColourOptions& colour_options, const autocal::AutocalOptions& options) {
+                             const autocal::ColourOptions& colour_options, const autocal::AutocalOptions& options,
+                             const autocal::SelfCheckOptions& self_check) {
     const int n = static_cast<int>(prior.projectors.size());
     const auto bits = [&](int extent) {
         const int all = autocal::gray_code_bits(extent);
@@ -29,6 +30,7 @@ PatternBudget pattern_budget(const autocal::CalibrationPrior& prior, bool colour
         }
         b.colour = 5 + n * 3 * ((steps - 1) + low) + colour_options.dark_frames;
     }
+    b.self_check = self_check.frames * (3 + n);
     return b;
 }
 

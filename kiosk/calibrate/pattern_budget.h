@@ -8,12 +8,15 @@
 // and white of all, per projector white and black, each Gray bit and its inverse per axis, S phase
 // shifts per axis; bits(n) = gray_code_bits, at most max_gray_bits; F frames_per_pattern); colour 5 + N * 3 *
 // ((ramp_steps - 1) + low) + dark_frames, low = 2 + the ramp levels in (0, 1/4] other than 1/32 and 1/16
-// (appliance/autocal/colour_calibration.h, step 1's low end). Time per image = settle + (drop_frames + 1) / camera fps
+// (appliance/autocal/colour_calibration.h, step 1's low end); self-check F' * (3 + N) (black and white of all for
+// the frame, black, then each projector's marks; F' its frames, appliance/autocal/self_check.h). Time per image =
+// settle + (drop_frames + 1) / camera fps
 // + exposure (the flip itself is within one refresh, part of the settle).
 #pragma once
 
 #include "appliance/autocal/autocal.h"
 #include "appliance/autocal/colour_calibration.h"
+#include "appliance/autocal/self_check.h"
 
 namespace mogao::calibrate {
 
@@ -21,12 +24,14 @@ struct PatternBudget {
     int identification = 0;
     int geometry = 0;  // at most
     int colour = 0;
-    [[nodiscard]] int total() const { return identification + geometry + colour; }
+    int self_check = 0;
+    [[nodiscard]] int total() const { return identification + geometry + colour + self_check; }
 };
 
 [[nodiscard]] PatternBudget pattern_budget(const autocal::CalibrationPrior& prior, bool colour,
                                            const autocal::ColourOptions& colour_options,
-                                           const autocal::AutocalOptions& options);
+                                           const autocal::AutocalOptions& options,
+                                           const autocal::SelfCheckOptions& self_check = {});
 
 // Seconds to capture one image: settle_ms / 1000 + (drop_frames + 1) / fps. fps > 0.
 [[nodiscard]] double seconds_per_image(double fps, int settle_ms, int drop_frames);
