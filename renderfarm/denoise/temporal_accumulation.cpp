@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 namespace mogao {
 namespace {
@@ -68,6 +69,32 @@ bool TemporalHistory::gather(const Eigen::Vector3f& position, const Eigen::Vecto
     return true;
 }
 
+// Rows [y0, y1) of accumulate(): writes their pixels of out, position and length; counts them.
+void TemporalHistory::accumulate_rows(const Pass& f, int y0, int y1, TemporalStats& counted) const {
+    for (int y = y0; y < y1; ++y) {
+        for (int x = 0; x < f.current.size.width; ++x) {
+            const std::size_t i = f.guides.pixel(x, y);
+            if (f.guides.hit[i] == 0) continue;
+            ++counted.surface_pixels;
+            const Ray ray = generate_column_ray(f.camera, f.columns, x, y + 0.5);
+            const Eigen::Vector3f p =
+                (ray.origin + static_cast<double>(f.guides.depth[i]) * ray.direction).cast<float>();
+            for (int c = 0; c < 3; ++c) f.position[3 * i + static_cast<std::size_t>(c)] = p[c];
+            Eigen::Vector3f history;
+            float frames = 0.0f;
+            if (empty() || !gather(p, at3(f.guides.normal, i), f.guides.depth[i], f.params, history, frames)) {
+                f.length[i] = 1.0f;
+                continue;
+            }
+            ++counted.reprojected;
+            const float a = std::max(f.params.alpha, 1.0f / (frames + 1.0f));
+            float* o = f.out.at(x, y);
+            for (int c = 0; c < 3; ++c) o[c] = (1.0f - a) * history[c] + a * o[c];
+            f.length[i] = frames + 1.0f;
+        }
+    }
+}
+
 RgbFloatImage TemporalHistory::accumulate(const RgbFloatImage& current, const GuideBuffers& guides,
                                           const CameraSetup& camera, const TemporalParams& params,
                                           TemporalStats* stats) {
@@ -77,28 +104,24 @@ RgbFloatImage TemporalHistory::accumulate(const RgbFloatImage& current, const Gu
     RgbFloatImage out = current;
     std::vector<float> position(3 * n, 0.0f);
     std::vector<float> length(n, 0.0f);
-    const CylinderColumns columns = make_cylinder_columns(camera);
-    TemporalStats counted;
-    for (int y = 0; y < current.size.height; ++y) {
-        for (int x = 0; x < current.size.width; ++x) {
-            const std::size_t i = guides.pixel(x, y);
-            if (guides.hit[i] == 0) continue;
-            ++counted.surface_pixels;
-            const Ray ray = generate_column_ray(camera, columns, x, y + 0.5);
-            const Eigen::Vector3f p = (ray.origin + static_cast<double>(guides.depth[i]) * ray.direction).cast<float>();
-            for (int c = 0; c < 3; ++c) position[3 * i + static_cast<std::size_t>(c)] = p[c];
-            Eigen::Vector3f history;
-            float frames = 0.0f;
-            if (empty() || !gather(p, at3(guides.normal, i), guides.depth[i], params, history, frames)) {
-                length[i] = 1.0f;
-                continue;
-            }
-            ++counted.reprojected;
-            const float a = std::max(params.alpha, 1.0f / (frames + 1.0f));
-            float* o = out.at(x, y);
-            for (int c = 0; c < 3; ++c) o[c] = (1.0f - a) * history[c] + a * o[c];
-            length[i] = frames + 1.0f;
-        }
+    const Pass f{current, guides, camera, make_cylinder_columns(camera), params, out, position, length};
+    // Rows split over the cores (each pixel reads only the history and writes only itself, so the
+    // result does not depend on the split): the admin runs this while the ranks wait.
+    const int height = current.size.height;
+    const int threads = std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, std::max(1, height / 16));
+    std::vector<TemporalStats> counted(static_cast<std::size_t>(threads));
+    std::vector<std::thread> workers;
+    for (int t = 1; t < threads; ++t) {
+        workers.emplace_back([&, t] {
+            accumulate_rows(f, height * t / threads, height * (t + 1) / threads, counted[static_cast<std::size_t>(t)]);
+        });
+    }
+    accumulate_rows(f, 0, height / threads, counted[0]);
+    for (std::thread& w : workers) w.join();
+    TemporalStats total;
+    for (const TemporalStats& c : counted) {
+        total.surface_pixels += c.surface_pixels;
+        total.reprojected += c.reprojected;
     }
     camera_ = camera;
     radiance_ = out;
@@ -106,7 +129,7 @@ RgbFloatImage TemporalHistory::accumulate(const RgbFloatImage& current, const Gu
     normal_ = guides.normal;
     hit_ = guides.hit;
     length_ = std::move(length);
-    if (stats != nullptr) *stats = counted;
+    if (stats != nullptr) *stats = total;
     return out;
 }
 

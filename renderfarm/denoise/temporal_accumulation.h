@@ -26,7 +26,7 @@
 // view-independent does not.
 //
 // Frames may change size between calls (the frame-time target scales them): the history keeps its
-// own size and camera. Pure CPU code, no GL, no Embree.
+// own size and camera. Pure CPU code, no GL, no Embree; rows run on every core.
 #pragma once
 
 #include <cstddef>
@@ -67,6 +67,18 @@ public:
     [[nodiscard]] bool empty() const { return radiance_.pixels.empty(); }
 
 private:
+    // One accumulate() call's inputs and outputs.
+    struct Pass {
+        const RgbFloatImage& current;
+        const GuideBuffers& guides;
+        const CameraSetup& camera;
+        CylinderColumns columns;
+        const TemporalParams& params;
+        RgbFloatImage& out;
+        std::vector<float>& position;
+        std::vector<float>& length;
+    };
+    void accumulate_rows(const Pass& f, int y0, int y1, TemporalStats& counted) const;
     [[nodiscard]] bool gather(const Eigen::Vector3f& position, const Eigen::Vector3f& normal, float depth,
                               const TemporalParams& params, Eigen::Vector3f& value, float& length) const;
 
