@@ -30,21 +30,6 @@ void link_families(TextWriter& w, const KioskStatus& s, const LinkClientStats& l
     w.gauge("farm_silent_seconds", "since the last farm frame (0 before the first)", s.farm_silent_s);
 }
 
-// The state's label value: an identifier (selfcal::to_string is prose for the journal).
-const char* selfcal_label(selfcal::SelfcalState state) {
-    switch (state) {
-        case selfcal::SelfcalState::calibrated:
-            return "calibrated";
-        case selfcal::SelfcalState::drift_detected:
-            return "drift_detected";
-        case selfcal::SelfcalState::correcting:
-            return "correcting";
-        case selfcal::SelfcalState::cannot_correct:
-            return "cannot_correct";
-    }
-    return "calibrated";
-}
-
 void calibration_families(TextWriter& w, const KioskStatus& s, const KioskCounters& c) {
     w.gauge("calibration_loaded_timestamp_seconds", "Unix time the calibration on the wall was loaded",
             double(s.calibration.loaded_ns) * 1e-9);
@@ -56,7 +41,7 @@ void calibration_families(TextWriter& w, const KioskStatus& s, const KioskCounte
               count(s.calibration.refused));
     if (!s.selfcal) return;
     state_set(w, "selfcal_state", "self-recalibration's state",
-              {"calibrated", "drift_detected", "correcting", "cannot_correct"}, selfcal_label(s.selfcal->state));
+              {"calibrated", "drift_detected", "correcting", "cannot_correct"}, selfcal::to_key(s.selfcal->state));
     w.counter("selfcal_corrections_total", "corrections self-recalibration began", count(c.selfcal_corrections));
     w.family("selfcal_drift_pixels", "gauge", "each projector's filtered drift on the screen, its own pixels");
     for (const selfcal::ProjectorStatus& p : s.selfcal->projectors)

@@ -21,21 +21,6 @@ std::string utc_text(std::int64_t realtime_ns) {
 
 namespace {
 
-// The state as a key a program can compare (selfcal::to_string is the journal's wording).
-const char* state_key(selfcal::SelfcalState state) {
-    switch (state) {
-        case selfcal::SelfcalState::calibrated:
-            return "calibrated";
-        case selfcal::SelfcalState::drift_detected:
-            return "drift_detected";
-        case selfcal::SelfcalState::correcting:
-            return "correcting";
-        case selfcal::SelfcalState::cannot_correct:
-            return "cannot_correct";
-    }
-    return "unknown";
-}
-
 nlohmann::json selfcal_json(const std::optional<selfcal::SelfcalStatus>& s) {
     if (!s) return {{"enabled", false}};
     nlohmann::json projectors = nlohmann::json::array();
@@ -48,7 +33,7 @@ nlohmann::json selfcal_json(const std::optional<selfcal::SelfcalStatus>& s) {
                               {"shift_mm", p.shift_mm}});
     }
     return {{"enabled", true},
-            {"state", state_key(s->state)},
+            {"state", selfcal::to_key(s->state)},
             {"t_s", s->t_s},
             {"waiting", s->waiting},
             {"reason", s->reason},

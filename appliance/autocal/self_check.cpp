@@ -407,4 +407,19 @@ void check_self_check_gate(const SelfCheckResult& check, const SelfCheckOptions&
         "calibration of the camera, the intrinsics' refinement where the command has it, or fitting the screen)");
 }
 
+nlohmann::json self_check_report(const SelfCheckResult& c, const SelfCheckOptions& o) {
+    return {{"mean_px", c.mean_px},
+            {"p95_px", c.p95_px},
+            {"max_px", c.max_px},
+            {"mean_mm", c.mean_mm},
+            {"gate_max_mean_px", o.max_mean_px},
+            {"own_camera_mean_px", c.own_camera_mean_px},
+            {"marks_found", c.marks.size()},
+            {"marks_shown", c.shown},
+            {"marks_too_steep", c.steep},
+            {"captures", c.captures},
+            {"frame_edge_points", c.edge_points},
+            {"frame_edge_rms_camera_px", c.edge_rms_px}};
+}
+
 }  // namespace mogao::autocal

@@ -34,6 +34,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
 #include "appliance/autocal/autocal.h"
@@ -89,6 +90,9 @@ struct SelfCheckResult {
 // Throws CalibrationRefused naming the figure, its gate (max_self_check_px) and the likely causes when
 // check.mean_px > o.max_mean_px.
 void check_self_check_gate(const SelfCheckResult& check, const SelfCheckOptions& o);
+
+// report.json's "self_check" block: the figures, the gate and how many marks and captures.
+[[nodiscard]] nlohmann::json self_check_report(const SelfCheckResult& check, const SelfCheckOptions& o);
 
 // Runs the check on `source` (the projectors showing `calibrated` and the camera it was made with).
 // `prior`: what the calibration was told (the check's camera starts from its intrinsics). Throws

@@ -6,6 +6,20 @@
 
 namespace mogao::selfcal {
 
+const char* to_key(SelfcalState state) {
+    switch (state) {
+        case SelfcalState::calibrated:
+            return "calibrated";
+        case SelfcalState::drift_detected:
+            return "drift_detected";
+        case SelfcalState::correcting:
+            return "correcting";
+        case SelfcalState::cannot_correct:
+            return "cannot_correct";
+    }
+    return "unknown";
+}
+
 const char* to_string(SelfcalState state) {
     switch (state) {
         case SelfcalState::calibrated:

@@ -16,6 +16,9 @@ enum class SelfcalState {
 };
 
 [[nodiscard]] const char* to_string(SelfcalState state);
+// The state as an identifier a program compares (status file, metric labels): "calibrated",
+// "drift_detected", "correcting", "cannot_correct".
+[[nodiscard]] const char* to_key(SelfcalState state);
 
 struct ProjectorStatus {
     std::string id;

@@ -170,22 +170,6 @@ nlohmann::json previous_connectors(const fs::path& report) {
     }
 }
 
-// report.json's "self_check": the on-site accuracy figure (appliance/autocal/self_check.h).
-nlohmann::json self_check_json(const autocal::SelfCheckResult& c, const autocal::SelfCheckOptions& o) {
-    return {{"mean_px", c.mean_px},
-            {"p95_px", c.p95_px},
-            {"max_px", c.max_px},
-            {"mean_mm", c.mean_mm},
-            {"gate_max_mean_px", o.max_mean_px},
-            {"own_camera_mean_px", c.own_camera_mean_px},
-            {"marks_found", c.marks.size()},
-            {"marks_shown", c.shown},
-            {"marks_too_steep", c.steep},
-            {"captures", c.captures},
-            {"frame_edge_points", c.edge_points},
-            {"frame_edge_rms_camera_px", c.edge_rms_px}};
-}
-
 // Steps 4-5: the report and the files (on_site_job.h).
 nlohmann::json finish(const OnSiteJob& job, const Identified& id, const autocal::AutocalResult& r,
                       const std::optional<autocal::ColourResult>& colour, const autocal::SelfCheckResult& check,
@@ -213,7 +197,7 @@ nlohmann::json finish(const OnSiteJob& job, const Identified& id, const autocal:
     report["cabling_changes"] = cabling_changes(previous_connectors(job.out / "report.json"), report["connectors"]);
     for (std::size_t k = 0; k < r.projectors.size(); ++k) report["projectors"].push_back(fit_json(r, k));
     if (colour) report["colour"] = colour_json(*colour);
-    report["self_check"] = self_check_json(check, job.self_check);
+    report["self_check"] = autocal::self_check_report(check, job.self_check);
     // The screen the calibration used: the site file's cylinder, with the bow where it paid (autocal.h).
     report["screen"] = screen_json(r);
     const autocal::CalibrationModels models{r.screen, r.camera, r.projectors};
