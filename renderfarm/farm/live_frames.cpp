@@ -53,6 +53,14 @@ LiveFrames::Session& LiveFrames::session(std::uint64_t id) {
     return found->second;
 }
 
+std::size_t LiveFrames::active_sessions(std::uint64_t current, std::chrono::steady_clock::time_point now) const {
+    std::size_t n = 0;
+    for (const auto& [id, s] : sessions_) {
+        if (id == current || (s.handed_back && now - *s.handed_back <= kActiveWindow)) ++n;
+    }
+    return std::max<std::size_t>(n, 1);
+}
+
 // The view to trace for `request`: still views at the request's own scale (to accumulate), moving
 // ones at the controller's choice; the pass's frame_id when it continues an accumulation.
 ViewRequest LiveFrames::plan(Session& s, const ViewRequest& request, FrameChoice& choice) const {
@@ -147,6 +155,9 @@ LiveFrame LiveFrames::render(const ViewRequest& request) {
     FrameChoice choice;
     LiveFrame frame;
     if (s.handed_back) frame.gap_seconds = std::chrono::duration<double>(start - *s.handed_back).count();
+    if (s.controller && options_.share_frame_time) {
+        s.controller->set_target_seconds(options_.frame_time_s / double(active_sessions(request.session, start)));
+    }
     frame.rendered = plan(s, request, choice);
     const bool continues = options_.progressive && s.accumulation.continues(frame.rendered);
     RgbFloatImage radiance;

@@ -56,9 +56,16 @@
 namespace mogao {
 
 struct LiveOptions {
-    bool progressive = true;       // accumulate still views
-    int converged_spp = 1024;      // stop rendering a still view once it has this many samples
-    double frame_time_s = 0.0;     // per-session frame-time target, seconds; 0 = render requests as asked
+    bool progressive = true;    // accumulate still views
+    int converged_spp = 1024;   // stop rendering a still view once it has this many samples
+    double frame_time_s = 0.0;  // per-session frame-time target, seconds; 0 = render requests as asked
+    // Share the frame-time target among the sessions served in the last kActiveWindow: each
+    // session's frames aim at frame_time_s / (active sessions), so that one round of every active
+    // session's frame takes about frame_time_s. Each appliance then keeps its frame rate and
+    // motion-to-photon latency as more appliances join, with fewer pixels (resolution first, then
+    // bounces, as the controller degrades); off, each frame aims at frame_time_s and the round,
+    // so every appliance's latency, grows with the number of appliances.
+    bool share_frame_time = false;
     FrameTimeTarget controller;    // its other settings (target_seconds is taken from frame_time_s)
     bool per_session_maps = true;  // one PBT cost map per session; false = all share one (stream 0)
     std::size_t max_sessions = 64;
@@ -126,6 +133,9 @@ private:
         std::optional<std::chrono::steady_clock::time_point> handed_back;  // the previous render() returned
     };
     Session& session(std::uint64_t id);
+    // Sessions handed a frame within kActiveWindow before `now`, `current` counted even if new.
+    [[nodiscard]] std::size_t active_sessions(std::uint64_t current, std::chrono::steady_clock::time_point now) const;
+    static constexpr std::chrono::seconds kActiveWindow{2};
     [[nodiscard]] ViewRequest plan(Session& s, const ViewRequest& request, FrameChoice& choice) const;
     [[nodiscard]] Rgb8Image to_display(const RgbFloatImage& radiance) const;
     [[nodiscard]] bool accumulates(const LiveFrame& frame) const;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -330,6 +331,40 @@ TEST_F(LiveFramesTest, FrameTimeTargetIsChargedTheFilterTime) {
         EXPECT_GE(frame.seconds, calls_.back().seconds + frame.denoise_seconds);
         replica.observe(expected, frame.seconds, frame.gap_seconds);
     }
+}
+
+// With the target shared, each of two sessions served in turn aims at half the target: a replica
+// controller given target / active sessions before each choice picks exactly the scale LiveFrames
+// renders, and one given the whole target (the unshared farm) picks another at least once.
+TEST_F(LiveFramesTest, SharedFrameTimeTargetIsDividedAmongTheActiveSessions) {
+    LiveOptions options;
+    options.frame_time_s = 2e-3;
+    options.share_frame_time = true;
+    options.controller.min_scale = 0.1;
+    LiveFrames live(source(), options, 1.f, ToneMap::clamp);
+    const double target = live.options().controller.target_seconds;
+    std::map<std::uint64_t, FrameTimeController> shared, whole;
+    int differs = 0;
+    for (std::uint64_t id = 1; id <= 6; ++id) {
+        for (const std::uint64_t session : {7u, 8u}) {
+            ViewRequest moving = view(static_cast<double>(id));
+            moving.session = session;
+            moving.frame_id = id;
+            FrameTimeController& replica = shared.try_emplace(session, live.options().controller).first->second;
+            FrameTimeController& alone = whole.try_emplace(session, live.options().controller).first->second;
+            const int active = id == 1 && session == 7 ? 1 : 2;  // session 8 is new after 7's first frame
+            replica.set_target_seconds(target / active);
+            const FrameChoice expected = replica.choose(moving);
+            const FrameChoice unshared = alone.choose(moving);
+            const LiveFrame frame = live.render(moving);
+            EXPECT_DOUBLE_EQ(frame.rendered.quality.resolution_scale, expected.resolution_scale)
+                << id << " " << session;
+            differs += unshared.resolution_scale != expected.resolution_scale ? 1 : 0;
+            replica.observe(expected, frame.seconds, frame.gap_seconds);
+            alone.observe(unshared, frame.seconds, frame.gap_seconds);
+        }
+    }
+    EXPECT_GT(differs, 0) << "the shared target never changed a choice: the test cannot tell it from the whole target";
 }
 
 // Multi-rank equals single-rank: the admin filters the composited frame, and the guided packing of

@@ -50,6 +50,11 @@ double FrameTimeController::jitter_allowance() const {
     return std::min(1.0, std::exp(log_mean_) / arithmetic_);
 }
 
+void FrameTimeController::set_target_seconds(double seconds) {
+    require(std::isfinite(seconds) && seconds > 0, "target_seconds must be > 0");
+    target_.target_seconds = seconds;
+}
+
 double FrameTimeController::aim_seconds() const {
     return target_.target_seconds * std::max(target_.min_aim, (1.0 - target_.headroom) * jitter_allowance());
 }

@@ -113,6 +113,9 @@ public:
     // G / A of the recent unclamped frames (see above): 1 without jitter, and before the first one.
     [[nodiscard]] double jitter_allowance() const;
     [[nodiscard]] const FrameTimeTarget& target() const { return target_; }
+    // Changes the target (the farm's share of it, live_frames.h); the measured means are kept.
+    // Throws std::invalid_argument unless `seconds` is finite and > 0.
+    void set_target_seconds(double seconds);
 
     // Work of the ladder's level of `bounces` for a frame shaped like `like` (see above).
     [[nodiscard]] double level_work(const FrameChoice& like, int bounces) const;

@@ -280,5 +280,19 @@ TEST(FrameTimeController, BouncesFallOnlyAsFarAsNeededHoldStillAndComeBackFirst)
     EXPECT_NEAR(used.resolution_scale, std::sqrt(0.6125), 0.02);
 }
 
+TEST(FrameTimeController, SetTargetSecondsChangesTheAimAndRefusesNonPositiveOrNaN) {
+    FrameTimeTarget t;
+    t.target_seconds = 0.1;
+    t.jitter_weight = 0;
+    t.headroom = 0;
+    FrameTimeController c(t);
+    c.set_target_seconds(0.025);
+    EXPECT_DOUBLE_EQ(c.target().target_seconds, 0.025);
+    EXPECT_DOUBLE_EQ(c.aim_seconds(), 0.025);
+    EXPECT_THROW(c.set_target_seconds(0.0), std::invalid_argument);
+    EXPECT_THROW(c.set_target_seconds(std::nan("")), std::invalid_argument);
+    EXPECT_DOUBLE_EQ(c.target().target_seconds, 0.025);  // a refused target leaves the last good one
+}
+
 }  // namespace
 }  // namespace mogao
