@@ -61,6 +61,12 @@ std::size_t LiveFrames::active_sessions(std::uint64_t current, std::chrono::stea
     return std::max<std::size_t>(n, 1);
 }
 
+double LiveFrames::frame_share_seconds(std::uint64_t current) const {
+    if (!options_.share_frame_time || options_.frame_time_s <= 0) return 0.0;
+    const std::size_t n = active_sessions(current, Clock::now());
+    return n > 1 ? options_.frame_time_s / double(n) : 0.0;
+}
+
 // The view to trace for `request`: still views at the request's own scale (to accumulate), moving
 // ones at the controller's choice; the pass's frame_id when it continues an accumulation.
 ViewRequest LiveFrames::plan(Session& s, const ViewRequest& request, FrameChoice& choice) const {

@@ -64,7 +64,9 @@ struct LiveOptions {
     // session's frame takes about frame_time_s. Each appliance then keeps its frame rate and
     // motion-to-photon latency as more appliances join, with fewer pixels (resolution first, then
     // bounces, as the controller degrades); off, each frame aims at frame_time_s and the round,
-    // so every appliance's latency, grows with the number of appliances.
+    // so every appliance's latency, grows with the number of appliances. The farm's session budget
+    // also holds each frame to that share (frame_share_seconds(), session_budget.h), so a dear
+    // request is degraded instead of holding the others' frames back.
     bool share_frame_time = false;
     FrameTimeTarget controller;    // its other settings (target_seconds is taken from frame_time_s)
     bool per_session_maps = true;  // one PBT cost map per session; false = all share one (stream 0)
@@ -121,6 +123,10 @@ public:
     LiveFrame render(const ViewRequest& request);
 
     [[nodiscard]] const LiveOptions& options() const { return options_; }
+    // The seconds of the farm a frame of session `current` may take now: frame_time_s shared by the
+    // sessions served in the last kActiveWindow (share_frame_time), or 0 when it is not shared or
+    // `current` is alone.
+    [[nodiscard]] double frame_share_seconds(std::uint64_t current) const;
 
 private:
     struct Session {

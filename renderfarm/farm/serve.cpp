@@ -72,17 +72,17 @@ public:
     BudgetGate(const Scene& scene, TimeBudget budget) : budgets_(budget, LightCounts::of(scene)) {}
 
     // Throws RequestRefused for what the farm cannot render within the budget.
-    ViewRequest apply(const ViewRequest& view, const std::string& who) {
-        const BudgetDecision d = budgets_.apply(view, who);
+    ViewRequest apply(const ViewRequest& view, const std::string& who, double share_s) {
+        const BudgetDecision d = budgets_.apply(view, who, share_s);
         if (!d.degraded) return d.view;
         ++degraded_;
         if (logged_.size() >= kLoggedSessions) logged_.clear();  // a farm serves for months: bounded
         std::string& last = logged_[view.session];
         if (last != d.changes) {
-            spdlog::warn(
-                "session {} ({}): degraded to the frame budget of {} s (estimated {:.2f} s at its measured "
-                "rate): {}",
-                view.session, who, budgets_.budget().frame_s, d.predicted_s, d.changes);
+            spdlog::warn("session {} ({}): degraded to {} of {:.3g} s (estimated {:.2f} s at its measured rate): {}",
+                         view.session, who,
+                         d.limit_s < budgets_.budget().frame_s ? "its share of the farm" : "the frame budget",
+                         d.limit_s, d.predicted_s, d.changes);
             last = d.changes;
         }
         return d.view;
@@ -162,7 +162,8 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& s
         try {
             const std::string who = server.appliance_of(job->view.session);
             const std::string key = who.empty() ? "session " + std::to_string(job->view.session) : who;
-            LiveFrame frame = live.render(budget.apply(policy.apply(job->view, who), key));
+            const double share_s = live.frame_share_seconds(job->view.session);
+            LiveFrame frame = live.render(budget.apply(policy.apply(job->view, who), key, share_s));
             budget.observe(key, frame);
             metrics.observe_frame(frame.stats, frame.seconds, double(realtime_ns()) * 1e-9, who);
             ServedFrame out{std::move(frame.image), job->view.quality.jpeg_quality, realtime_ns(), std::nullopt};

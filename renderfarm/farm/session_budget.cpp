@@ -25,15 +25,16 @@ double SessionBudgets::rate(const std::string& who) const {
     return found == appliances_.end() ? 0.0 : found->second.rays_per_s;
 }
 
-BudgetDecision SessionBudgets::apply(const ViewRequest& request, const std::string& who) {
-    BudgetDecision out{request, false, {}, 0.0};
+BudgetDecision SessionBudgets::apply(const ViewRequest& request, const std::string& who, double share_s) {
+    BudgetDecision out{request, false, {}, 0.0, budget_.frame_s};
     const double rays_per_s = rate(who);
     if (budget_.frame_s <= 0 || rays_per_s <= 0) return out;
+    if (std::isfinite(share_s) && share_s > 0) out.limit_s = std::min(budget_.frame_s, share_s);
     out.predicted_s = estimated_rays(request, lights_) / rays_per_s;
-    if (out.predicted_s <= budget_.frame_s) return out;
+    if (out.predicted_s <= out.limit_s) return out;
     RequestPolicy bound;
     bound.max_megapixels = 1e6;  // pixels are bounded by the request policy already
-    bound.max_gigarays = rays_per_s * budget_.aim * budget_.frame_s / 1e9;
+    bound.max_gigarays = rays_per_s * budget_.aim * out.limit_s / 1e9;
     PolicyDecision degraded = apply_request_policy(request, lights_, bound);
     out.view = degraded.view;
     out.degraded = degraded.degraded;

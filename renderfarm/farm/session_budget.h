@@ -46,13 +46,17 @@ struct BudgetDecision {
     bool degraded = false;
     std::string changes;     // the request policy's list of changed knobs (empty when not degraded)
     double predicted_s = 0;  // the rendered view's estimated seconds at the measured rate (0: no rate yet)
+    double limit_s = 0;      // the seconds it was held to: frame_s, or a smaller share
 };
 
 class SessionBudgets {
 public:
     SessionBudgets(TimeBudget budget, LightCounts lights);
     // `request` of appliance `who`, degraded to its measured rate; throws RequestRefused (see above).
-    [[nodiscard]] BudgetDecision apply(const ViewRequest& request, const std::string& who);
+    // `share_s` > 0: other appliances are waiting and this frame's share of the farm is share_s
+    // seconds (live_frames.h, share_frame_time): the request is degraded to fit the smaller of it
+    // and frame_s, but refused only when it cannot fit frame_s.
+    [[nodiscard]] BudgetDecision apply(const ViewRequest& request, const std::string& who, double share_s = 0.0);
     // A frame of `who` rendering `rendered` would have taken `full_seconds` uncut (> 0).
     void observe(const std::string& who, const ViewRequest& rendered, double full_seconds);
     // Estimated rays per second measured for `who`; 0 = none yet.

@@ -67,6 +67,25 @@ TEST(SessionBudgets, KeepsItsRateWithinTheBandAndReplacesItOutside) {
     EXPECT_NEAR(budgets.rate("museum-2"), rate * 10.0, 1e-6 * rate);
 }
 
+// Other appliances waiting: a frame inside the budget but over its share of the farm is degraded
+// to the share (aim x share at the measured rate); alone, the same request passes unchanged.
+TEST(SessionBudgets, AShareOfTheFarmDegradesToTheShareButOnlyTheBudgetRefuses) {
+    SessionBudgets budgets({.frame_s = 1.0, .aim = 0.5}, kRoom);
+    const ViewRequest dear = dear_view();
+    budgets.observe("museum-2", dear, 0.8);
+    EXPECT_FALSE(budgets.apply(dear, "museum-2").degraded);
+    const double rate = budgets.rate("museum-2");
+    const BudgetDecision shared = budgets.apply(dear, "museum-2", 0.1);
+    EXPECT_TRUE(shared.degraded);
+    EXPECT_DOUBLE_EQ(shared.limit_s, 0.1);
+    EXPECT_LE(estimated_rays(shared.view, kRoom) / rate, 0.5 * 0.1 + 1e-9);
+    EXPECT_FALSE(budgets.apply(dear, "museum-2", 5.0).degraded);  // a share above the budget: the budget
+    // A share no degradation reaches: degraded as far as it goes, and not refused (it fits the budget).
+    const BudgetDecision tiny = budgets.apply(dear, "museum-2", 1e-9);
+    EXPECT_TRUE(tiny.degraded);
+    EXPECT_LE(tiny.predicted_s, 1.0);
+}
+
 TEST(SessionBudgets, RefusesWhatCannotFitEvenFullyDegradedWithTheReason) {
     SessionBudgets budgets({.frame_s = 1.0}, kRoom);
     const ViewRequest dear = dear_view();
