@@ -5,6 +5,7 @@
 #include <chrono>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "renderfarm/trace/film.h"
 
@@ -63,8 +64,15 @@ std::size_t LiveFrames::active_sessions(std::uint64_t current, std::chrono::stea
 
 double LiveFrames::frame_share_seconds(std::uint64_t current) const {
     if (!options_.share_frame_time || options_.frame_time_s <= 0) return 0.0;
-    const std::size_t n = active_sessions(current, Clock::now());
-    return n > 1 ? options_.frame_time_s / double(n) : 0.0;
+    const auto now = Clock::now();
+    std::vector<double> others;
+    for (const auto& [id, s] : sessions_) {
+        if (id != current && s.handed_back && now - *s.handed_back <= kActiveWindow && s.recent_seconds > 0)
+            others.push_back(s.recent_seconds);
+    }
+    if (others.empty()) return 0.0;
+    std::nth_element(others.begin(), others.begin() + others.size() / 2, others.end());
+    return std::max(options_.frame_time_s, others[others.size() / 2]);
 }
 
 // The view to trace for `request`: still views at the request's own scale (to accumulate), moving
@@ -180,6 +188,11 @@ LiveFrame LiveFrames::render(const ViewRequest& request) {
     if (!radiance.pixels.empty()) display(s, radiance, frame);
     frame.seconds = std::chrono::duration<double>(Clock::now() - start).count();
     if (s.controller && frame.rendered_now) s.controller->observe(choice, frame.seconds, frame.gap_seconds);
+    if (frame.rendered_now) {
+        constexpr double kWeight = 0.3;  // of the newest frame: a few frames' memory
+        s.recent_seconds =
+            s.recent_seconds > 0 ? (1 - kWeight) * s.recent_seconds + kWeight * frame.seconds : frame.seconds;
+    }
     s.last_request = request;
     s.handed_back = Clock::now();
     return frame;

@@ -64,9 +64,12 @@ struct LiveOptions {
     // session's frame takes about frame_time_s. Each appliance then keeps its frame rate and
     // motion-to-photon latency as more appliances join, with fewer pixels (resolution first, then
     // bounces, as the controller degrades); off, each frame aims at frame_time_s and the round,
-    // so every appliance's latency, grows with the number of appliances. The farm's session budget
-    // also holds each frame to that share (frame_share_seconds(), session_budget.h), so a dear
-    // request is degraded instead of holding the others' frames back.
+    // so every appliance's latency, grows with the number of appliances. The controller keeps its
+    // floors (min_scale, min_bounces): past them the rate falls for everyone alike. The farm's
+    // session budget also holds each frame to an equal turn (frame_share_seconds(),
+    // session_budget.h): no longer than the target or the other active sessions' median recent
+    // frame, whichever is longer, so a dear request is degraded instead of holding the others'
+    // frames back, and an ordinary one is not shrunk below the floors when the farm is slow.
     bool share_frame_time = false;
     FrameTimeTarget controller;    // its other settings (target_seconds is taken from frame_time_s)
     bool per_session_maps = true;  // one PBT cost map per session; false = all share one (stream 0)
@@ -123,9 +126,9 @@ public:
     LiveFrame render(const ViewRequest& request);
 
     [[nodiscard]] const LiveOptions& options() const { return options_; }
-    // The seconds of the farm a frame of session `current` may take now: frame_time_s shared by the
-    // sessions served in the last kActiveWindow (share_frame_time), or 0 when it is not shared or
-    // `current` is alone.
+    // The seconds of the farm a frame of session `current` may take now (share_frame_time, with
+    // other sessions served in the last kActiveWindow): the larger of frame_time_s and the median
+    // of the other active sessions' recent frame times (an equal turn); 0 when not shared or alone.
     [[nodiscard]] double frame_share_seconds(std::uint64_t current) const;
 
 private:
@@ -137,6 +140,7 @@ private:
         TemporalHistory temporal;  // earlier moving frames (LiveOptions::temporal)
         std::uint64_t last_used = 0;
         std::optional<std::chrono::steady_clock::time_point> handed_back;  // the previous render() returned
+        double recent_seconds = 0.0;  // rendered frames' seconds, exponentially weighted (0: none yet)
     };
     Session& session(std::uint64_t id);
     // Sessions handed a frame within kActiveWindow before `now`, `current` counted even if new.

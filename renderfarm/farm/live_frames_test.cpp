@@ -367,6 +367,28 @@ TEST_F(LiveFramesTest, SharedFrameTimeTargetIsDividedAmongTheActiveSessions) {
     EXPECT_GT(differs, 0) << "the shared target never changed a choice: the test cannot tell it from the whole target";
 }
 
+// An equal turn: a session's share of the farm is the other active session's recent frame time
+// (here its one frame), never less than the target; alone, or with sharing off, there is none.
+TEST_F(LiveFramesTest, FrameShareIsTheOtherSessionsRecentFrameTimeAndNoneAlone) {
+    LiveOptions options;
+    options.frame_time_s = 1e-7;
+    options.share_frame_time = true;
+    LiveFrames live(source(), options, 1.f, ToneMap::clamp);
+    ViewRequest a = view(1.0);
+    EXPECT_EQ(live.frame_share_seconds(7), 0.0);
+    const LiveFrame first = live.render(a);
+    EXPECT_EQ(live.frame_share_seconds(7), 0.0) << "alone";
+    EXPECT_DOUBLE_EQ(live.frame_share_seconds(8), std::max(1e-7, first.seconds));
+    ViewRequest b = view(2.0);
+    b.session = 8;
+    const LiveFrame second = live.render(b);
+    EXPECT_DOUBLE_EQ(live.frame_share_seconds(7), std::max(1e-7, second.seconds));
+    options.share_frame_time = false;
+    LiveFrames unshared(source(), options, 1.f, ToneMap::clamp);
+    (void)unshared.render(a);
+    EXPECT_EQ(unshared.frame_share_seconds(8), 0.0);
+}
+
 // Multi-rank equals single-rank: the admin filters the composited frame, and the guided packing of
 // any split of the frame composites to the same radiance and guides.
 TEST_F(LiveFramesTest, DenoisedFrameIsTheSameForAnySplitOfTheFrame) {
