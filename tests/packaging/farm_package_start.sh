@@ -83,7 +83,7 @@ start_under_systemd() {
   grep -q ":$(printf '%04X' $farm_port) [0-9A-F:]* 0A " /proc/net/tcp6 /proc/net/tcp \
     || fail "mogao-farm active but nothing listens on $farm_port"
   local modes
-  modes=$(stat -c '%n %U:%G %a' "$root"/etc/mogao/pki "$root"/etc/mogao/pki/* | sed "s|$root||")
+  modes=$(root_stat "$root"/etc/mogao/pki "$root"/etc/mogao/pki/*)
   grep -qv ' root:mogao-farm \(750\|640\)$' <<<"$modes" && fail "TLS folder not root:mogao-farm 0750/0640: $modes"
   log "ok: systemctl enable --now mogao-farm: active (READY) in $(($(date +%s) - t)) s, listening on $farm_port; TLS folder root:mogao-farm 0750/0640"
 }
@@ -148,7 +148,7 @@ print(s["frames_presented"] if s["exit_code"] == 0 and s["frames_rejected"] == 0
     sleep 1
   done
   [[ -f "$prom" ]] || fail "no metrics file $prom (the farm user cannot write node_exporter's folder?)"
-  [[ "$(stat -c '%U %a' "$prom")" == "mogao-farm 644" ]] || fail "metrics file $(stat -c '%U %a' "$prom"), want mogao-farm 644"
+  [[ "$(root_stat "$prom")" == *" mogao-farm:mogao-farm 644" ]] || fail "metrics file $(root_stat "$prom"), want mogao-farm:mogao-farm 0644"
   [[ -n "$sent" ]] && ((${sent%.*} >= shown)) || fail "mogao_farm_frames_sent_total ${sent:-missing} < $shown frames the client showed"
   log "ok: served frames: the kiosk showed $shown farm frames; $(basename "$prom") in node_exporter's folder (mogao-farm, 0644): mogao_farm_frames_sent_total $sent"
 }
@@ -175,7 +175,7 @@ start_as_the_unit_does() {
     | tee "$work/unit-start.log" || fail "the farm did not start as its unit runs it (log above)"
   # The ExecStartPre (tmpfiles.d/mogao-farm-pki.conf) made the TLS folder readable by the farm only.
   local modes
-  modes=$(stat -c '%n %U:%G %a' "$root"/etc/mogao/pki "$root"/etc/mogao/pki/* | sed "s|$root||")
+  modes=$(root_stat "$root"/etc/mogao/pki "$root"/etc/mogao/pki/*)
   grep -qv ' root:mogao-farm \(750\|640\)$' <<<"$modes" && fail "TLS folder not root:mogao-farm 0750/0640: $modes"
   log "ok: READY and listening on $farm_port; TLS folder root:mogao-farm 0750, files 0640"
 }

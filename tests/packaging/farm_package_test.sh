@@ -89,9 +89,19 @@ find "$root/var/cache/apt/archives" -maxdepth 1 -name '*.deb' -exec cp -n -t "$c
 log "apt install ./$(basename "$deb"): $(($(date +%s) - t2)) s, $(grep -c '^Setting up' "$work/apt.log") packages set up"
 
 # ---- what the package installed and set up ---------------------------------------------------------
+# root_stat PATH...: "PATH USER:GROUP MODE" with the root's user and group names (the host running
+# this test has no mogao-farm user: stat's %U prints 971 there), PATH without the root's prefix.
+root_stat() {
+  local p uid gid mode
+  for p in "$@"; do
+    read -r uid gid mode < <(stat -c '%u %g %a' "$p")
+    echo "${p#"$root"} $(awk -F: -v id="$uid" '$3 == id { print $1; exit }' "$root/etc/passwd"):$(awk -F: -v id="$gid" '$3 == id { print $1; exit }' "$root/etc/group") $mode"
+  done
+}
 grep -q '^mogao-farm:x:971:971:[^:]*:/var/lib/mogao-farm:/bin/sh$' "$root/etc/passwd" \
   || fail "no mogao-farm user 971:971 with home /var/lib/mogao-farm: $(grep mogao "$root/etc/passwd" || echo none)"
-[[ "$(stat -c '%U %a' "$root/var/lib/mogao-farm/.ssh")" == "mogao-farm 700" ]] || fail "/var/lib/mogao-farm/.ssh not mogao-farm 0700"
+[[ "$(root_stat "$root/var/lib/mogao-farm/.ssh")" == *" mogao-farm:mogao-farm 700" ]] \
+  || fail "$(root_stat "$root/var/lib/mogao-farm/.ssh"), not mogao-farm:mogao-farm 0700"
 conffiles=$(in_root dpkg-query -W -f='${Conffiles}' mogao-farm)
 for f in /etc/mogao/farm.env /etc/mogao/farm-hosts; do
   grep -q " $f " <<<"$conffiles " || fail "$f is not a conffile of mogao-farm: $conffiles"
@@ -116,7 +126,7 @@ in_root systemctl disable prometheus-node-exporter > /dev/null 2>&1 || true
 textfile_dir=/var/lib/prometheus/node-exporter
 [[ -d "$root$textfile_dir" ]] || fail "prometheus-node-exporter made no $textfile_dir"
 log "apt install ./$(basename "$appliance_deb") (the client), Mesa EGL, prometheus-node-exporter: $(($(date +%s) - t3)) s;" \
-  "$textfile_dir is $(stat -c '%U:%G %a' "$root$textfile_dir")"
+  "$(root_stat "$root$textfile_dir")"
 sed -i "s|^MOGAO_FARM_ARGS=.*|MOGAO_FARM_ARGS=--metrics-file $textfile_dir/mogao-farm.prom|" "$root/etc/mogao/farm.env"
 
 # ---- the README's PKI commands, then the farm starts: under systemd where the root can boot, else
