@@ -11,6 +11,21 @@ leader=""
 
 in_container() { nsenter --target "$leader" --all /usr/bin/env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin HOME=/root "$@"; }
 
+# container_init: the container's systemd as seen from here: the descendant of systemd-nspawn whose
+# PID in its own namespace is 1 (nspawn may or may not fork between itself and it).
+container_init() {
+  local pid queue=("$pid_nspawn")
+  while ((${#queue[@]} > 0)); do
+    pid=${queue[0]}
+    queue=("${queue[@]:1}")
+    if [[ "$pid" != "$pid_nspawn" && "$(awk '/^NSpid:/ { print $NF }' /proc/"$pid"/status 2> /dev/null)" == 1 ]]; then
+      echo "$pid"
+      return 0
+    fi
+    queue+=($(cat /proc/"$pid"/task/*/children 2> /dev/null))
+  done
+}
+
 # boot_under_systemd: boots the root with systemd-nspawn (host network) and checks that the
 # enabled farm did not start without its TLS files. Returns 1 with nspawn_reason set when the
 # container cannot boot here.
@@ -21,12 +36,9 @@ boot_under_systemd() {
     < /dev/null > "$work/nspawn.log" 2>&1 &
   pid_nspawn=$!
   local state="" i
-  # The container's systemd: the child of nspawn's child.
   for ((i = 0; i < 90; i++)); do
     kill -0 "$pid_nspawn" 2> /dev/null || break
-    local child
-    child=$(cat /proc/"$pid_nspawn"/task/*/children 2> /dev/null | awk '{ print $1 }' | head -n1)
-    [[ -n "$child" ]] && leader=$(cat /proc/"$child"/task/*/children 2> /dev/null | awk '{ print $1 }' | head -n1)
+    leader=$(container_init)
     if [[ -n "$leader" ]]; then
       state=$(timeout 10 nsenter --target "$leader" --all /usr/bin/env -i PATH=/usr/bin:/bin systemctl is-system-running 2> /dev/null || true)
       [[ "$state" == running || "$state" == degraded ]] && break
@@ -71,7 +83,7 @@ start_under_systemd() {
   grep -q ":$(printf '%04X' $farm_port) [0-9A-F:]* 0A " /proc/net/tcp6 /proc/net/tcp \
     || fail "mogao-farm active but nothing listens on $farm_port"
   local modes
-  modes=$(stat -c '%n %U:%G %a' "$root"/etc/mogao/pki "$root"/etc/mogao/pki/* | sed "s|$root||")
+  modes=$(root_stat "$root"/etc/mogao/pki "$root"/etc/mogao/pki/*)
   grep -qv ' root:mogao-farm \(750\|640\)$' <<<"$modes" && fail "TLS folder not root:mogao-farm 0750/0640: $modes"
   log "ok: systemctl enable --now mogao-farm: active (READY) in $(($(date +%s) - t)) s, listening on $farm_port; TLS folder root:mogao-farm 0750/0640"
 }
@@ -96,6 +108,51 @@ configuration_error_under_systemd() {
   log "ok: MOGAO_RANKS=0: failed with exit 2, not restarted, the journal names the field and says so"
 }
 
+# write_client_script: /root/link-client.sh in the root, the link client's commands, run there while
+# the farm serves: an appliance certificate from the README's CA, a kiosk configuration
+# (kiosk.example.toml with overrides: headless outputs, the ideal 3-projector calibration at 320x240)
+# and the kiosk until 10 of the farm's frames are on its screen (statistics in /root/kiosk-stats.json).
+write_client_script() {
+  cat > "$root/root/link-client.sh" << EOF
+set -e
+mogao-farm pki issue-appliance --dir /root/mogao-ca --name museum-1
+mogao-kiosk --print-config 'farm.endpoint="[::1]:$farm_port"' 'farm.ca="/root/mogao-ca/ca.pem"' \\
+  'farm.cert="/root/mogao-ca/appliance-museum-1.pem"' 'farm.key="/root/mogao-ca/appliance-museum-1.key"' \\
+  'outputs.backend="headless"' 'calibration.source="ideal"' 'calibration.projectors=3' \\
+  'calibration.overlap=0.15' 'calibration.output="320x240"' 'quality.content="480x270"' 'quality.spp=1' \\
+  'navigation.start=[0.0, 0.0, 4.0]' 'stats.file=' > /root/kiosk.toml
+exec timeout 240 mogao-kiosk --config /root/kiosk.toml --frames 10 --duration 200 --stats /root/kiosk-stats.json
+EOF
+}
+
+# serve_frames RUNNER...: the link client through RUNNER against the farm systemd started, then the
+# checks of check_served_frames.
+serve_frames() {
+  write_client_script
+  "$@" sh /root/link-client.sh > "$work/kiosk.log" 2>&1 || { tail -n 30 "$work/kiosk.log"; fail "the link client (mogao-kiosk) failed"; }
+  check_served_frames
+}
+
+# check_served_frames: the kiosk showed 10 farm frames (none rejected, exit 0), and the farm's
+# metrics file, written by the mogao-farm user into node_exporter's folder (mode 0644, readable by
+# the exporter's user), counts at least as many frames sent (rewritten about once a second).
+check_served_frames() {
+  local stats="$root/root/kiosk-stats.json" prom="$root/var/lib/prometheus/node-exporter/mogao-farm.prom" shown sent="" i
+  [[ -f "$stats" ]] || fail "the link client wrote no statistics"
+  shown=$(python3 -c 'import json, sys; s = json.load(open(sys.argv[1]))
+print(s["frames_presented"] if s["exit_code"] == 0 and s["frames_rejected"] == 0 else -1)' "$stats")
+  ((shown >= 10)) || fail "the link client: $shown frames presented (want >= 10, none rejected, exit 0): $(head -c 400 "$stats")"
+  for ((i = 0; i < 10; i++)); do
+    sent=$(awk '$1 == "mogao_farm_frames_sent_total" { print $2 }' "$prom" 2> /dev/null || true)
+    [[ -n "$sent" ]] && ((${sent%.*} >= shown)) && break
+    sleep 1
+  done
+  [[ -f "$prom" ]] || fail "no metrics file $prom (the farm user cannot write node_exporter's folder?)"
+  [[ "$(root_stat "$prom")" == *" mogao-farm:mogao-farm 644" ]] || fail "metrics file $(root_stat "$prom"), want mogao-farm:mogao-farm 0644"
+  [[ -n "$sent" ]] && ((${sent%.*} >= shown)) || fail "mogao_farm_frames_sent_total ${sent:-missing} < $shown frames the client showed"
+  log "ok: served frames: the kiosk showed $shown farm frames; $(basename "$prom") in node_exporter's folder (mogao-farm, 0644): mogao_farm_frames_sent_total $sent"
+}
+
 stop_container() {
   in_container systemctl poweroff > /dev/null 2>&1 || true
   wait "$pid_nspawn" 2> /dev/null || true
@@ -103,20 +160,22 @@ stop_container() {
 }
 
 # start_as_the_unit_does: the installed unit's ExecStartPre and ExecStart run as systemd would run
-# them, in a chroot (tests/packaging/unit_start.py; the sandbox settings are not reproduced).
+# them, in a chroot (tests/packaging/unit_start.py; the sandbox settings are not reproduced), and
+# the link client while it serves.
 start_as_the_unit_does() {
   local unit=/lib/systemd/system/mogao-farm.service
   [[ -d "$root/etc/mogao/pki" ]] && [[ -n "$(ls -A "$root/etc/mogao/pki")" ]] \
     || fail "ConditionDirectoryNotEmpty=/etc/mogao/pki would not let the unit start"
+  write_client_script
   unshare --mount --propagation private -- /bin/sh -c '
     r=$1; shift
     mount -t proc proc "$r/proc" && mount -t sysfs sys "$r/sys" && mount --rbind /dev "$r/dev" || exit 1
     mount -t tmpfs -o mode=1777 tmp "$r/tmp" && mount -t tmpfs -o mode=0755 run "$r/run" || exit 1
-    exec python3 "$@"' sh "$root" "$(dirname "${BASH_SOURCE[0]}")/unit_start.py" "$root" "$unit" "$farm_port" 180 \
+    exec python3 "$@"' sh "$root" "$(dirname "${BASH_SOURCE[0]}")/unit_start.py" "$root" "$unit" "$farm_port" 180 sh /root/link-client.sh \
     | tee "$work/unit-start.log" || fail "the farm did not start as its unit runs it (log above)"
   # The ExecStartPre (tmpfiles.d/mogao-farm-pki.conf) made the TLS folder readable by the farm only.
   local modes
-  modes=$(stat -c '%n %U:%G %a' "$root"/etc/mogao/pki "$root"/etc/mogao/pki/* | sed "s|$root||")
+  modes=$(root_stat "$root"/etc/mogao/pki "$root"/etc/mogao/pki/*)
   grep -qv ' root:mogao-farm \(750\|640\)$' <<<"$modes" && fail "TLS folder not root:mogao-farm 0750/0640: $modes"
   log "ok: READY and listening on $farm_port; TLS folder root:mogao-farm 0750, files 0640"
 }

@@ -8,11 +8,16 @@
 #   * the mogao-farm user (971, home /var/lib/mogao-farm) and its folders exist, /etc/mogao/farm.env
 #     and farm-hosts are conffiles, the unit is enabled and the farm not started (no TLS files yet);
 #   * the README's three `mogao-farm pki` commands (init-ca, issue-farm, export-farm);
+#   * the mogao-appliance package (the link client), Mesa's EGL and Debian's prometheus-node-exporter
+#     installed beside it, the farm's --metrics-file in the exporter's textfile folder;
 #   * the farm starts: booted under systemd-nspawn where this machine allows it (`systemctl enable
 #     --now mogao-farm`, active = READY, listening on 7443); otherwise (no systemd on the host, a
 #     cgroup v1 container...) the unit's own start as systemd would run it, in the root (chroot):
 #     the ExecStartPre as root, then ExecStart as the mogao-farm user with farm.env's variables, a
-#     notification socket for READY=1, and the listening port. The log says which ran.
+#     notification socket for READY=1, and the listening port. The log says which ran;
+#   * it serves frames: the kiosk (headless outputs) with an appliance certificate of the same CA
+#     shows 10 of the farm's frames, and the farm's metrics file, written as the mogao-farm user
+#     into node_exporter's folder (the package's tmpfiles ACL), counts them.
 #
 # DEB_DIR: where .ci/package builds this tree's packages first (MOGAO_FARM_DEB=FILE: test that
 # package instead, no build).
@@ -34,6 +39,10 @@ done
 t0=$(date +%s)
 source "$repo/image/lib/common.sh"
 source "$repo/image/lib/debian.sh"
+# .ci/package runs with the caller's locale, not this script's LC_ALL: ccache hashes the locale
+# variables, and the main build compiled with the caller's.
+package_env=(env -u LC_ALL)
+[[ -n "${LC_ALL:-}" ]] && package_env=(env "LC_ALL=$LC_ALL")
 export SOURCE_DATE_EPOCH=${SOURCE_DATE_EPOCH:-$(date +%s)} LC_ALL=C.UTF-8
 work=$(mktemp -d /tmp/mogao-farm-package.XXXXXX)
 root="$work/root"
@@ -55,7 +64,7 @@ deb=${MOGAO_FARM_DEB:-}
 if [[ -z "$deb" ]]; then
   log "bash .ci/package $deb_dir (the packages of this tree; MOGAO_FARM_DEB=FILE tests that one instead)"
   rm -f "$deb_dir"/*.deb
-  bash "$repo/.ci/package" "$deb_dir" > "$deb_dir.log" 2>&1 || { tail -n 30 "$deb_dir.log"; fail "bash .ci/package $deb_dir failed"; }
+  "${package_env[@]}" bash "$repo/.ci/package" "$deb_dir" > "$deb_dir.log" 2>&1 || { tail -n 30 "$deb_dir.log"; fail "bash .ci/package $deb_dir failed"; }
   deb=$(ls "$deb_dir"/mogao-farm_*.deb)
 fi
 [[ -f "$deb" ]] || fail "no package $deb"
@@ -80,9 +89,19 @@ find "$root/var/cache/apt/archives" -maxdepth 1 -name '*.deb' -exec cp -n -t "$c
 log "apt install ./$(basename "$deb"): $(($(date +%s) - t2)) s, $(grep -c '^Setting up' "$work/apt.log") packages set up"
 
 # ---- what the package installed and set up ---------------------------------------------------------
+# root_stat PATH...: "PATH USER:GROUP MODE" with the root's user and group names (the host running
+# this test has no mogao-farm user: stat's %U prints 971 there), PATH without the root's prefix.
+root_stat() {
+  local p uid gid mode
+  for p in "$@"; do
+    read -r uid gid mode < <(stat -c '%u %g %a' "$p")
+    echo "${p#"$root"} $(awk -F: -v id="$uid" '$3 == id { print $1; exit }' "$root/etc/passwd"):$(awk -F: -v id="$gid" '$3 == id { print $1; exit }' "$root/etc/group") $mode"
+  done
+}
 grep -q '^mogao-farm:x:971:971:[^:]*:/var/lib/mogao-farm:/bin/sh$' "$root/etc/passwd" \
   || fail "no mogao-farm user 971:971 with home /var/lib/mogao-farm: $(grep mogao "$root/etc/passwd" || echo none)"
-[[ "$(stat -c '%U %a' "$root/var/lib/mogao-farm/.ssh")" == "mogao-farm 700" ]] || fail "/var/lib/mogao-farm/.ssh not mogao-farm 0700"
+[[ "$(root_stat "$root/var/lib/mogao-farm/.ssh")" == *" mogao-farm:mogao-farm 700" ]] \
+  || fail "$(root_stat "$root/var/lib/mogao-farm/.ssh"), not mogao-farm:mogao-farm 0700"
 conffiles=$(in_root dpkg-query -W -f='${Conffiles}' mogao-farm)
 for f in /etc/mogao/farm.env /etc/mogao/farm-hosts; do
   grep -q " $f " <<<"$conffiles " || fail "$f is not a conffile of mogao-farm: $conffiles"
@@ -91,6 +110,24 @@ done
 [[ ! -e "$root/etc/mogao/pki" ]] || fail "/etc/mogao/pki exists before the PKI commands"
 in_root mogao-farm --version | grep -q '^mogao-farm ' || fail "mogao-farm --version"
 log "ok: user mogao-farm, conffiles farm.env and farm-hosts, unit enabled, no TLS files yet"
+
+# ---- what a museum adds beside the farm: Debian's node exporter (the farm's Recommends; its textfile
+# folder, where the farm's metrics go) and a link client, the mogao-appliance package's kiosk with
+# Mesa's software EGL. The exporter's own service stays off (the test reads its folder) -------------
+appliance_deb=${MOGAO_APPLIANCE_DEB:-$(ls "$(dirname "$deb")"/mogao-appliance_*.deb 2> /dev/null | head -n1)}
+[[ -f "$appliance_deb" ]] || fail "no mogao-appliance package beside $deb (MOGAO_APPLIANCE_DEB=FILE)"
+t3=$(date +%s)
+cp "$appliance_deb" "$root/tmp/"
+in_root env DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends \
+  "/tmp/$(basename "$appliance_deb")" libegl-mesa0 libgl1-mesa-dri prometheus-node-exporter \
+  > "$work/apt-client.log" 2>&1 || { tail -n 40 "$work/apt-client.log"; fail "apt install of the client and node exporter failed"; }
+find "$root/var/cache/apt/archives" -maxdepth 1 -name '*.deb' -exec cp -n -t "$cache/" {} + 2> /dev/null || true
+in_root systemctl disable prometheus-node-exporter > /dev/null 2>&1 || true
+textfile_dir=/var/lib/prometheus/node-exporter
+[[ -d "$root$textfile_dir" ]] || fail "prometheus-node-exporter made no $textfile_dir"
+log "apt install ./$(basename "$appliance_deb") (the client), Mesa EGL, prometheus-node-exporter: $(($(date +%s) - t3)) s;" \
+  "$(root_stat "$root$textfile_dir")"
+sed -i "s|^MOGAO_FARM_ARGS=.*|MOGAO_FARM_ARGS=--metrics-file $textfile_dir/mogao-farm.prom|" "$root/etc/mogao/farm.env"
 
 # ---- the README's PKI commands, then the farm starts: under systemd where the root can boot, else
 # the unit's start by hand --------------------------------------------------------------------------
@@ -108,11 +145,13 @@ sed -i "s/^MOGAO_LISTEN=.*/MOGAO_LISTEN=[::]:$farm_port/" "$root/etc/mogao/farm.
 if boot_under_systemd; then
   pki_commands in_container
   start_under_systemd
+  serve_frames in_container
   configuration_error_under_systemd
   stop_container
 else
   log "systemd cannot boot here ($nspawn_reason): the unit's ExecStartPre and ExecStart as systemd runs them, in a chroot"
   pki_commands in_root
   start_as_the_unit_does
+  check_served_frames
 fi
 log "PASS in $(($(date +%s) - t0)) s"

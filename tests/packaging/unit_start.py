@@ -5,12 +5,14 @@ boot that root (farm_package_test.sh): chroot into ROOT, run each ExecStartPre (
 "-" ones may fail), then ExecStart as the unit's User= and Group= with its Environment= and
 EnvironmentFile= variables expanded as systemd expands them (${X}: one word, $X: split on blanks),
 RUNTIME_DIRECTORY and STATE_DIRECTORY made, and a NOTIFY_SOCKET. Waits for READY=1, checks that a
-TCP PORT listens, then stops the process group with SIGTERM.
+TCP PORT listens, runs CLIENT (a command in ROOT, as root) while the unit serves, then stops the
+process group with SIGTERM.
 
 Not reproduced: the unit's sandbox (ProtectSystem=, PrivateTmp=, the system call filter...), its
 watchdog and restarts; systemd-analyze verify and the QEMU render-host test cover those.
 
-  unit_start.py ROOT UNIT PORT [TIMEOUT_S]      exit 0: READY and listening; 1 otherwise
+  unit_start.py ROOT UNIT PORT [TIMEOUT_S [CLIENT...]]
+                                exit 0: READY, listening and CLIENT's exit 0; 1 otherwise
 """
 import os
 import re
@@ -71,6 +73,7 @@ def chroot_cmd(root, argv, user=None, env=None):
 def main():
     root, unit, port = sys.argv[1], sys.argv[2], int(sys.argv[3])
     timeout = float(sys.argv[4]) if len(sys.argv) > 4 else 180.0
+    client = sys.argv[5:]
     settings = unit_settings(open(os.path.join(root, unit.lstrip("/"))).read())
     env = {"PATH": "/usr/sbin:/usr/bin:/sbin:/bin", "LC_ALL": "C.UTF-8"}
     user = group = None
@@ -129,7 +132,14 @@ def main():
                 break
         listening = ready and listening_on(port)
         print(f"listening on TCP port {port}: {listening}")
-        return 0 if ready and listening else 1
+        if not (ready and listening):
+            return 1
+        if client:
+            client_env = {"PATH": env["PATH"], "LC_ALL": "C.UTF-8", "HOME": "/root"}
+            rc = subprocess.run(chroot_cmd(root, client, None, client_env)).returncode
+            print(f"client {' '.join(client)}: exit {rc}")
+            return 0 if rc == 0 else 1
+        return 0
     finally:
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGTERM)
