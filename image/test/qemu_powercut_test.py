@@ -23,12 +23,14 @@ How: the image's kernel and initramfs are booted directly with init=/powercut-in
 boot costs seconds under TCG. The first boot is saved (savevm into QEMU's -snapshot overlay);
 from it each scenario runs once up to the start of its write phase (mogao-calibrate: frozen with
 SIGSTOP as its first file in --out appears; the kiosk: before it starts) and that point is saved
-too. A reference run goes on from there without a cut and defines NEW (the files after a reboot)
-and the length of the write phase. Then, per cut: back to the saved point (loadvm), "go", a
-random delay (seeded; uniform over the reference's go-to-exit time plus 20 %), QMP system_reset:
-guest RAM, the page cache and the requests in flight are lost. The guest reboots, replays the
-journal (fsck -p, mount) and prints every file's sha256. QEMU's disk has no volatile cache: writes
-the guest's block layer completed before the cut are kept (a drive that honours flushes).
+too. A reference run goes on from there without a cut and defines NEW (its files, read as below)
+and the write window. Then, per cut: back to the saved point (loadvm), "go", a
+random delay (seeded; uniform over 1.5 x the time from "go" to the reference's last change of the
+watched folder), QMP stop: guest RAM and the page cache are lost. The disk as it is then is copied
+out (blockdev-backup) and its configuration partition read as a boot would (e2fsck -p replays the
+journal, debugfs copies the files); every --reboot-every-th cut also boots the guest on that disk,
+whose own report (fsck, mount, sha256 of every file) must agree. QEMU's disk has no volatile
+cache: writes the guest submitted before the cut are kept (a drive that honours flushes).
 
 Verdict per cut: every calibration or configuration file (*.mpcdi, *.models.json, *.last-good,
 *.last-loaded) equals its OLD or its NEW bytes (missing only where OLD was missing); the MPCDI and
@@ -64,7 +66,7 @@ VERDICT = re.compile(r"(\.mpcdi|\.models\.json|\.last-good|\.last-loaded)$")
 # The scenario's own files: what its stage is judged on.
 SUBJECT = {"calibrate": re.compile(r"^etc/screen\."), "config": re.compile(r"^last-good/")}
 FOLDERS = ("etc", "calibration", "last-good")  # on the configuration partition; as powercut_guest.sh reports
-MARGIN = 1.5           # cut delays: uniform over [0, MARGIN x the reference's go-to-exit time (host clock)]
+MARGIN = 1.5           # cut delays: uniform over [0, MARGIN x the reference's last write after "go"]
 
 
 def skip(msg):
@@ -346,17 +348,20 @@ def restore(g, name):
 
 
 def reference_run(g, scenario, work, part, timeout):
-    """From the freeze point to the end without a cut: the write phase's length and NEW. Resumed
-    by loadvm as every cut is (the first seconds after a loadvm run slower under TCG)."""
+    """From the freeze point to the end without a cut: NEW, and the write window's end, the last
+    change of the watched folder after "go" (guest clock, seconds). Resumed by loadvm as every cut
+    is (the first seconds after a loadvm run slower under TCG)."""
     restore(g, scenario)
-    t = time.monotonic()
+    start = g.cursor
     g.send("go")
     done = g.wait(r"exit ", timeout)
-    host_seconds = time.monotonic() - t  # what the cuts' delays count (host clock, as they are)
     g.wait(r"ready", 120)
-    events = [m for _, m in g.serial.marks[g.cursor - 400:g.cursor] if m.startswith("ev ")]
+    marks = [m for _, m in g.serial.marks[start:g.cursor]]
+    go = next(float(m.split()[1]) for m in marks if m.startswith("go "))
+    events = [m for m in marks if m.startswith("ev ")]
+    window = max([float(m.split()[1]) - go for m in events] + [0.0])
     new, temps, fsck = g.cut(work, part)
-    return host_seconds, done.split()[1], events, new, temps, fsck
+    return window, float(done.split()[2]) - go, done.split()[1], events, new, temps, fsck
 
 
 def one_cut(g, scenario, old, new, delay, reboot, work, part, timeout):
@@ -388,11 +393,13 @@ def run_scenario(g, scenario, a, rng, work, part):
     g.hmp(f"savevm {scenario}")
     log(f"{scenario}: frozen at the start of its write phase, saved")
     old = g.base
-    length, rc, events, new, temps, fsck = reference_run(g, scenario, work, part, a.timeout)
+    length, run_s, rc, events, new, temps, fsck = reference_run(g, scenario, work, part, a.timeout)
     changed = sorted(p for p in set(new) | set(old) if new.get(p) != old.get(p))
-    log(f"{scenario}: reference run {rc}, go to exit {length:.2f} s; changed {changed}; "
+    log(f"{scenario}: reference run {rc}, last write {length:.2f} s after go, exit {run_s:.2f} s; "
+        f"changed {changed}; "
         f"temporaries {temps}; e2fsck {fsck}")
-    res = {"reference_seconds": round(length, 3), "reference_rc": rc, "reference_events": events[-20:],
+    res = {"reference_seconds": round(length, 3), "reference_exit_seconds": round(run_s, 3), "reference_rc": rc,
+           "reference_events": events[-20:],
            "changed": changed, "cuts": []}
     if rc != "rc=0" or not changed or temps:
         res["error"] = f"the reference run did not write cleanly (exit {rc}; changed {changed}; temporaries {temps})"

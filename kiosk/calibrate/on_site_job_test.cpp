@@ -222,7 +222,7 @@ TEST(WriteCalibrationTest, KeepsThePreviousPairAndLeavesNoStagingFiles) {
     const autocal::CalibrationPrior prior = autocal::prior_from_rig(rig);
     const autocal::CalibrationModels models{prior.screen, prior.camera, prior.projectors};
     IdealCalibrationParams ideal;
-    ideal.output = {64, 48};
+    ideal.output = prior.projectors[0].resolution;  // the rig's three projectors share one size
     ideal.content = {96, 54};
     const ScreenCalibration calibration = make_ideal_calibration(ideal);
     std::ofstream(mpcdi) << "old mpcdi";
