@@ -100,6 +100,18 @@ def host_calibration(a, captures, out, extra):
     return os.path.join(out, "calibration.mpcdi"), os.path.join(out, "calibration.models.json")
 
 
+def restamped(mpcdi, out):
+    """The calibration with an earlier date stamp: other bytes, as an earlier install of the same
+    calibration has (what the kiosk's last good copy of it holds before the kiosk starts)."""
+    with zipfile.ZipFile(mpcdi) as zin, zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as zout:
+        for info in zin.infolist():
+            body = zin.read(info)
+            if info.filename == "mpcdi.xml":
+                body = re.sub(rb'date="[^"]*"', b'date="2020-01-01T00:00:00Z"', body, count=1)
+            zout.writestr(info, body)
+    return out
+
+
 def kiosk_toml(a, rate_hz):
     """The kiosk's configuration: headless outputs (the guest has no GPU), the installed MPCDI."""
     overrides = ['farm.endpoint="[fec0::2]:48615"', 'farm.ca="pki/ca.pem"', 'farm.cert="pki/appliance-museum-1.pem"',
@@ -109,7 +121,7 @@ def kiosk_toml(a, rate_hz):
     return "# written by image/test/qemu_powercut_test.py\n" + printed.stdout
 
 
-def prepare_config(a, work, img, old_cal, new_cal):
+def prepare_config(a, work, img, old_cal, earlier_mpcdi):
     """The configuration partition before the writes: OLD calibration installed; kiosk.toml and
     the MPCDI changed since the kiosk's last good copies were made (those hold older bytes)."""
     pki = os.path.join(work, "pki")
@@ -133,7 +145,7 @@ def prepare_config(a, work, img, old_cal, new_cal):
     cmds = [f"write {old_cal[0]} etc/screen.mpcdi", f"write {old_cal[1]} etc/screen.models.json",
             f"write {files}/kiosk.toml etc/kiosk.toml", "mkdir etc/pki", "mkdir last-good",
             f"write {files}/kiosk-before.toml last-good/{last}kiosk.toml.last-loaded",
-            f"write {new_cal[0]} last-good/{last}screen.mpcdi.last-loaded"]
+            f"write {earlier_mpcdi} last-good/{last}screen.mpcdi.last-loaded"]
     cmds += [f"write {pki}/{f} etc/pki/{f}" for f in ("ca.pem", "appliance-museum-1.pem", "appliance-museum-1.key")]
     debugfs_write(img, CONFIG_PART, cmds)
 
@@ -167,8 +179,7 @@ def prepare(a, work, env):
     with open(os.path.join(disk, "scale"), "w") as f:
         f.write(f"{SCALE}\n")
     old_cal = host_calibration(a, captures, os.path.join(work, "old-calibration"), ["--fit-screen"])
-    new_cal = host_calibration(a, captures, os.path.join(work, "host-calibration"), [])
-    prepare_config(a, work, img, old_cal, new_cal)
+    prepare_config(a, work, img, old_cal, restamped(old_cal[0], os.path.join(work, "earlier.mpcdi")))
     testimg = os.path.join(work, "testdisk.img")
     if os.path.exists(testimg):
         os.remove(testimg)
