@@ -26,7 +26,7 @@ SIGSTOP as its first file in --out appears; the kiosk: before it starts) and tha
 too. A reference run goes on from there without a cut and defines NEW (its files, read as below)
 and the write window. Then, per cut: back to the saved point (loadvm), "go", a
 random delay (seeded; uniform over 1.5 x the time from "go" to the reference's last change of the
-watched folder), QMP stop: guest RAM and the page cache are lost. The disk as it is then is copied
+watched folder, plus ext4's 5 s journal commit interval), QMP stop: guest RAM and the page cache are lost. The disk as it is then is copied
 out (blockdev-backup) and its configuration partition read as a boot would (e2fsck -p replays the
 journal, debugfs copies the files); every --reboot-every-th cut also boots the guest on that disk,
 whose own report (fsck, mount, sha256 of every file) must agree. QEMU's disk has no volatile
@@ -68,7 +68,9 @@ VERDICT = re.compile(r"(\.mpcdi|\.models\.json|\.last-good|\.last-loaded)$")
 # The scenario's own files: what its stage is judged on.
 SUBJECT = {"calibrate": re.compile(r"^etc/screen\."), "config": re.compile(r"^last-good/")}
 FOLDERS = ("etc", "calibration", "last-good")  # on the configuration partition; as powercut_guest.sh reports
-MARGIN = 1.5           # cut delays: uniform over [0, MARGIN x the reference's last write after "go"]
+MARGIN = 1.5           # cut delays: uniform over [0, MARGIN x the reference's last write after "go"
+COMMIT_S = 5.0         #   + ext4's journal commit interval]: a rename without a flush after it (the kiosk's
+                       #   last good copies) reaches the disk up to one commit interval later
 
 
 def skip(msg):
@@ -440,7 +442,7 @@ def run_scenario(g, scenario, a, rng, work, part):
         res["error"] = f"the reference run did not write cleanly (exit {rc}; changed {changed}; temporaries {temps})"
         return res
     for i in range(a.cuts):
-        delay = rng.uniform(0.0, MARGIN * length)
+        delay = rng.uniform(0.0, MARGIN * length + COMMIT_S)
         cut = one_cut(g, scenario, old, new, delay, a.reboot_every > 0 and i % a.reboot_every == 0, work, part,
                       a.timeout)
         res["cuts"].append(cut)
