@@ -10,7 +10,7 @@ WHAT = {"calibrate": "`mogao-calibrate --install` (MPCDI, models, last-good copi
 
 
 def table(results, command):
-    rows = ["| write | cuts | before | during | after | last write after start (s) | missing, torn or mixed | temporaries left |",
+    rows = ["| write | cuts | before | during | after | write phase (s) | missing, torn or mixed | temporaries left |",
             "|---|---:|---:|---:|---:|---:|---:|---:|"]
     total = bad = 0
     for name, res in results["scenarios"].items():
