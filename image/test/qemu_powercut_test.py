@@ -529,7 +529,7 @@ def main():
         log("serial console (last lines):\n" + Serial(os.path.join(work, "serial.log")).tail(40))
         log(f"{len(fails.items)} check(s) failed; logs in {work}")
         return 1
-    for big in (img, testimg):
+    for big in (img, testimg, os.path.join(work, "cut.img"), os.path.join(work, "cut-config.img")):
         if os.path.exists(big):
             os.remove(big)
     log("all checks passed")
