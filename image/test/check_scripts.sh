@@ -9,10 +9,28 @@ bash -n "$dir/lib/common.sh"
 bash -n "$dir/test/image_tests.sh"
 bash -n "$dir/test/build_vimc.sh"
 sh -n "$dir/test/selftest.sh"
-python3 - "$dir/test/qemu_boot_test.py" "$dir/test/qemu_service_card_test.py" "$dir/test/qemu_common.py" "$dir/test/qemu_libcamera.py" "$dir/lib/prune_modules.py" <<'PY'
+bash -n "$dir/test/powercut_guest.sh"
+python3 - "$dir/test/qemu_boot_test.py" "$dir/test/qemu_service_card_test.py" "$dir/test/qemu_common.py" "$dir/test/qemu_libcamera.py" "$dir/lib/prune_modules.py" "$dir/test/qemu_powercut_test.py" "$dir/test/powercut_report.py" <<'PY'
 import sys
 for f in sys.argv[1:]:
     compile(open(f).read(), f, "exec")
+PY
+# The power-cut verdict (qemu_powercut_test.classify) on made-up states: old, new, torn, missing, mixed.
+python3 - "$dir/test" <<'PY'
+import sys
+sys.path.insert(0, sys.argv[1])
+from qemu_powercut_test import classify
+old = {"etc/screen.mpcdi": ("a", 1), "etc/screen.models.json": ("b", 1)}
+new = {"etc/screen.mpcdi": ("c", 1), "etc/screen.models.json": ("d", 1), "etc/screen.mpcdi.last-good": ("a", 1)}
+assert classify("calibrate", old, new, dict(old), []) == ("before", [])
+assert classify("calibrate", old, new, dict(new), []) == ("after", [])
+assert classify("calibrate", old, new, dict(old), [".screen.mpcdi.tmp-x"])[0] == "during"
+torn = dict(new, **{"etc/screen.mpcdi": ("e", 1)})
+assert "torn" in classify("calibrate", old, new, torn, [])[1][0]
+gone = {k: v for k, v in new.items() if k != "etc/screen.mpcdi"}
+assert "missing" in classify("calibrate", old, new, gone, [])[1][0]
+mixed = dict(old, **{"etc/screen.models.json": ("d", 1)})
+assert any(p.startswith("mixed") for p in classify("calibrate", old, new, mixed, [])[1])
 PY
 "$dir/build" --help | grep -q "image/build"
 "$dir/provision" --help | grep -q "image/provision"

@@ -2,6 +2,9 @@
 // The on-site calibration job: outputs + camera -> calibration -> files (on_site_job.h).
 #include "kiosk/calibrate/on_site_job.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <fstream>
 #include <optional>
@@ -13,6 +16,7 @@
 #include "appliance/calibration/mpcdi_screen.h"
 #include "appliance/calibration/mpcdi_writer.h"
 #include "appliance/rig/rig_file.h"
+#include "common/file_io.h"
 #include "common/png_io.h"
 #include "common/srgb.h"
 #include "kiosk/calibrate/connector_identity.h"
@@ -43,25 +47,49 @@ nlohmann::json screen_json(const autocal::AutocalResult& r) {
             {"bowed_rms_sigma", r.report.bow.bowed_rms_sigma}};
 }
 
-// Copies `file` (when present) to `<file>.last-good` atomically (temporary copy, rename).
-void keep_last_good(const fs::path& file) {
-    if (!fs::exists(file)) return;
-    const fs::path good = file.string() + ".last-good";
-    const fs::path tmp = file.string() + ".last-good.tmp";
-    fs::copy_file(file, tmp, fs::copy_options::overwrite_existing);
-    fs::rename(tmp, good);
+namespace {
+
+// Makes the renames in the folder of `file` durable. Best effort, as write_mpcdi's: the files are
+// complete whether or not this flush succeeds.
+void sync_folder(const fs::path& file) {
+    const fs::path dir = file.has_parent_path() ? file.parent_path() : fs::path(".");
+    const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd < 0) return;
+    (void)::fsync(fd);
+    ::close(fd);
 }
 
+}  // namespace
+
+// Copies `file` (when present) to `<file>.last-good` atomically and durably (temporary, fsync,
+// rename: a power cut must not leave an empty last good copy).
+void keep_last_good(const fs::path& file) {
+    if (!fs::exists(file)) return;
+    write_file_atomically(file.string() + ".last-good", read_file_bytes(file));
+}
+
+// Both files are first written complete and flushed beside their targets (`<file>.staged`), then
+// renamed into place one right after the other: no flush between the two renames, so ext4 commits
+// them in one journal transaction and a power cut leaves the old pair or the new pair, never new
+// models beside the old MPCDI (writing each file atomically on its own left seconds between the
+// two: the MPCDI's encoding and flush). Models first: a running kiosk's calibration watcher reacts
+// to the MPCDI and then finds its models.
 void write_calibration(const fs::path& mpcdi, const autocal::CalibrationModels& models, const ScreenCalibration& c,
                        const OnSiteJob& job) {
     fs::create_directories(mpcdi.parent_path().empty() ? fs::path(".") : mpcdi.parent_path());
-    keep_last_good(autocal::models_path_for(mpcdi));
+    const fs::path models_file = autocal::models_path_for(mpcdi);
+    keep_last_good(models_file);
     keep_last_good(mpcdi);
     MpcdiExportOptions mo;
     mo.alpha_bit_depth = job.alpha_bits;
     mo.write_response = job.colour;
-    autocal::write_models(autocal::models_path_for(mpcdi), models);  // first: the watcher finds its models
-    write_mpcdi(mpcdi, to_mpcdi(c, mo));
+    const fs::path staged_models = models_file.string() + ".staged";
+    const fs::path staged_mpcdi = mpcdi.string() + ".staged";
+    autocal::write_models(staged_models, models);
+    write_mpcdi(staged_mpcdi, to_mpcdi(c, mo));
+    fs::rename(staged_models, models_file);
+    fs::rename(staged_mpcdi, mpcdi);
+    sync_folder(mpcdi);
 }
 
 // 8-bit sRGB PNG with libpng (common/png_io.h; OpenCV's imgcodecs would bring GDAL, HDF5, Poppler ...

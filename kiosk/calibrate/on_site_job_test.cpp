@@ -7,6 +7,7 @@
 // (what `mogao-calibrate --rig` gives).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 
@@ -16,6 +17,7 @@
 #include "appliance/calibration/mpcdi_reader.h"
 #include "appliance/calibration/mpcdi_screen.h"
 #include "appliance/rig/rig_file.h"
+#include "appliance/warp/ideal_calibration.h"
 #include "drivers/egl/egl_test_support.h"
 #include "kiosk/calibrate/on_site_job.h"
 #include "kiosk/calibrate/rig_camera.h"
@@ -205,6 +207,40 @@ TEST_F(OnSiteJobTest, CameraOfAnotherSizeIsAnErrorNamingBothSizes) {
             << e.what();
     }
     expect_last_good_untouched();
+}
+
+// The install's files (write_calibration): the previous pair kept as *.last-good byte for byte, the
+// new pair in place, readable and of one version, and no staging file or temporary left, also
+// when an install cut short by a power cut left its staged files behind. (That a cut never leaves
+// new models beside the old MPCDI is what image/test/qemu_powercut_test.py shows on ext4.)
+TEST(WriteCalibrationTest, KeepsThePreviousPairAndLeavesNoStagingFiles) {
+    const fs::path dir = fs::temp_directory_path() / ("mogao-write-calibration-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const fs::path mpcdi = dir / "screen.mpcdi";
+    const rig::VirtualRig rig = autocal::scaled_rig(rig::load_rig(kStandard), kScale, kScale);
+    const autocal::CalibrationPrior prior = autocal::prior_from_rig(rig);
+    const autocal::CalibrationModels models{prior.screen, prior.camera, prior.projectors};
+    IdealCalibrationParams ideal;
+    ideal.output = prior.projectors[0].resolution;  // the rig's three projectors share one size
+    ideal.content = {96, 54};
+    const ScreenCalibration calibration = make_ideal_calibration(ideal);
+    std::ofstream(mpcdi) << "old mpcdi";
+    std::ofstream(dir / "screen.models.json") << "old models";
+    std::ofstream(dir / "screen.mpcdi.staged") << "half";  // what a cut install left
+    OnSiteJob job;
+    job.colour = false;
+    write_calibration(mpcdi, models, calibration, job);
+    EXPECT_EQ(slurp(dir / "screen.mpcdi.last-good"), "old mpcdi");
+    EXPECT_EQ(slurp(dir / "screen.models.json.last-good"), "old models");
+    EXPECT_EQ(to_screen_calibration(read_mpcdi(mpcdi)).projectors.size(), 3u);
+    autocal::check_models_match(autocal::read_models(dir / "screen.models.json"), calibration, "models");
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    EXPECT_EQ(names, (std::vector<std::string>{"screen.models.json", "screen.models.json.last-good", "screen.mpcdi",
+                                               "screen.mpcdi.last-good"}));
+    fs::remove_all(dir);
 }
 
 }  // namespace
