@@ -45,6 +45,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import farmvm  # noqa: E402  (QEMU, serial and network helpers of this test)
+import host_loss  # noqa: E402  (--host-loss: a render host lost and back while serving)
 
 SKIP = 77
 PORT = 7443
@@ -225,6 +226,9 @@ def main():
     ap.add_argument("--overlay", action="store_true",
                     help="write this tree's systemd/mogao-farm.service and image/farm/rootfs/ into the copies "
                          "(try changes to them without rebuilding the image)")
+    ap.add_argument("--host-loss", action="store_true", default=os.environ.get("MOGAO_FARM_TEST_HOST_LOSS") == "1",
+                    help="also lose farm-render2 while the appliance is served (its link cut, then its VM "
+                         "killed) and measure the new frame and its return (host_loss.py; ~8 more minutes)")
     ap.add_argument("--results", default="")
     ap.add_argument("--build-seconds", type=float, default=None, help="image build time, for the results")
     ap.add_argument("--timeout", type=float, default=float(os.environ.get("MOGAO_FARM_BOOT_TIMEOUT", "900")))
@@ -369,6 +373,11 @@ def main():
         vms["farm-render2"].tell("watchdog-done")
         _, text = render.wait(r"(ok|FAIL|skip) rank-restarted", 300, alive)
         a.layout == "admin-only" or fails.check(text is not None and text.startswith("ok"), f"farm-render2: a new rank replaced the old one: {text}")
+        if a.host_loss and a.layout == "both":
+            render.wait(r"done ", 300, alive)  # farm-render2's own self-test ends before it is lost
+            _, mac, mem = HOSTS["farm-render2"]
+            host_loss.run(net, vms, ("farm-render2", "tap1", mac, mem), images["farm-render2"], work, a.kiosk,
+                          kiosk_toml, results, fails)
         vms["farm-admin"].tell("finish")
         for name, s in serials.items():
             t_done, _ = s.wait(r"done ", 300, alive)

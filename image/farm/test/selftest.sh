@@ -183,7 +183,12 @@ else
   bad "watchdog-restart (no rank 0 process among: $(ranks))"
 fi
 say "watchdog-done"
-answer=$(host_wait 600); say "host said '$answer'"
+# The farm's journal from now on, for the host (farm_qemu_test.py --host-loss times a lost render
+# host's way out of the job and back in by these lines).
+journalctl -f -n 0 -u $unit -o cat 2>/dev/null |
+  grep --line-buffered -E 'serving |did not reply|render host|left out|asking|answer' |
+  while IFS= read -r line; do say "follow $line"; done &
+answer=$(host_wait 1800); say "host said '$answer'"
 check_common
 dump_journal $unit 15
 say "done fails=$fails uptime=$(uptime_s)"
