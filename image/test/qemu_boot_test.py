@@ -46,7 +46,7 @@ import tempfile
 import time
 
 import qemu_libcamera  # noqa: E402 (this folder)
-from qemu_common import T0, Failures, Serial, log, set_name  # noqa: E402 (this folder)
+from qemu_common import T0, Failures, Serial, log, set_name, stop_qemu  # noqa: E402 (this folder)
 
 SKIP = 77
 OVMF_CODE = "/usr/share/OVMF/OVMF_CODE_4M.fd"
@@ -586,12 +586,7 @@ def main():
                 farm_proc.wait(timeout=20)
             except subprocess.TimeoutExpired:
                 os.killpg(farm_proc.pid, 9)
-        if proc.poll() is None:
-            proc.terminate()
-            try:
-                proc.wait(timeout=20)
-            except subprocess.TimeoutExpired:
-                proc.kill()
+        stop_qemu(proc)
         qemu_log.close()
     results["failures"] = fails.items
     results["image_bytes"] = os.path.getsize(a.image)

@@ -6,10 +6,22 @@ The guests' self-test scripts print `MOGAO-SELFTEST <text>` lines on the serial 
 follows the console's log file and collects them with the host time at which they were read.
 """
 import re
+import subprocess
 import time
 
 T0 = time.monotonic()
 _name = "qemu_test"
+
+
+def stop_qemu(proc, grace_s=20):
+    """Ends QEMU (SIGTERM, then SIGKILL after grace_s) unless it has ended already."""
+    if proc.poll() is None:
+        proc.terminate()
+        try:
+            proc.wait(timeout=grace_s)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
 
 
 def set_name(name):

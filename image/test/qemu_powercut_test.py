@@ -54,7 +54,7 @@ import tempfile
 import time
 import zipfile
 
-from qemu_common import T0, Failures, Serial, log, set_name  # noqa: E402 (this folder)
+from qemu_common import T0, Failures, Serial, log, set_name, stop_qemu  # noqa: E402 (this folder)
 from qemu_boot_test import Qmp, run  # noqa: E402
 import powercut_report  # noqa: E402
 
@@ -511,12 +511,7 @@ def main():
         except Exception as e:  # noqa: BLE001 - report, then fail below
             fails.check(False, f"test aborted: {type(e).__name__}: {e}")
         finally:
-            if proc.poll() is None:
-                proc.terminate()
-                try:
-                    proc.wait(timeout=20)
-                except subprocess.TimeoutExpired:
-                    proc.kill()
+            stop_qemu(proc)
     results["seconds"] = round(time.monotonic() - T0, 1)
     results["failures"] = fails.items
     log(f"test seconds: {results['seconds']}")

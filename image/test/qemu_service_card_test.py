@@ -29,7 +29,7 @@ import sys
 import tempfile
 import time
 
-from qemu_common import T0, Failures, Serial, log, set_name  # noqa: E402 (this folder)
+from qemu_common import T0, Failures, Serial, log, set_name, stop_qemu  # noqa: E402 (this folder)
 from qemu_boot_test import MODES, OUTPUTS, OVMF_CODE, OVMF_VARS, Qmp, install_selftest_entry, ppm_stats, require_qemu, run  # noqa: E402
 
 WIPE_MIB = 4  # the ext4 superblock is at 1 KiB; 4 MiB also clears the group descriptors
@@ -158,12 +158,7 @@ def main():
         except Exception as e:  # noqa: BLE001 - report, then fail below
             fails.check(False, f"test aborted: {type(e).__name__}: {e}")
         finally:
-            if proc.poll() is None:
-                proc.terminate()
-                try:
-                    proc.wait(timeout=20)
-                except subprocess.TimeoutExpired:
-                    proc.kill()
+            stop_qemu(proc)
     log(f"test seconds: {time.monotonic() - T0:.1f}")
     if fails.items:
         if serial is not None:
