@@ -332,17 +332,6 @@ def plot(result, samples, path):
     return True
 
 
-def write_docs(doc, block):
-    with open(doc) as f:
-        text = f.read()
-    marker = re.compile(r"^<!-- generated:soak -->\n.*?^<!-- /generated -->$", re.S | re.M)
-    if not marker.search(text):
-        raise SystemExit(f"soak.py: {doc} has no '<!-- generated:soak -->' ... '<!-- /generated -->' block")
-    text = marker.sub(lambda _: f"<!-- generated:soak -->\n{block}\n<!-- /generated -->", text)
-    with open(doc + ".tmp", "w") as f:
-        f.write(text)
-    os.replace(doc + ".tmp", doc)
-
 
 def report(args):
     result, samples = analyse(args.out)
@@ -359,7 +348,7 @@ def report(args):
     png = os.path.join(args.out, "soak.png")
     have_plot = plot(result, samples, png)
     if args.write_docs:
-        write_docs(args.write_docs, block)
+        summarize_module().write_block(args.write_docs, "soak", block)
         if have_plot:
             target = os.path.join(os.path.dirname(args.write_docs), "reliability", "soak.png")
             os.makedirs(os.path.dirname(target), exist_ok=True)
