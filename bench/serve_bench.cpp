@@ -5,7 +5,7 @@
 //
 //   mpirun -n 3 mogao_bench_serve --scene scenes/grotto.json [--width 960] [--height 540]
 //          [--warmup-seconds 3] [--move-seconds 4] [--still-seconds 5] [--frame-time-ms 66.7] [--reference-spp 64]
-//          [--configs today,all,denoise,...] [--quality PRESET] [--denoise-max-spp 4]
+//          [--configs today,all,denoise,...] [--quality PRESET] [--denoise-max-spp 256]
 //          [--denoise-iterations 3] [--json FILE] [--side-by-side FILE.png]
 //
 // Configurations: today (the serial loop of before: every request alone, full size, sRGB8 from the
@@ -96,7 +96,7 @@ struct BenchArgs {
     std::vector<std::string> configs;  // keys; empty = all
     std::string json, side_by_side;
     std::string quality;  // preset name; empty = Quality{}
-    int denoise_max_spp = 4, denoise_iterations = AtrousParams{}.iterations;
+    int denoise_max_spp = LiveOptions{}.denoise_max_spp, denoise_iterations = AtrousParams{}.iterations;
 };
 
 // The images of the side-by-side PNG: a moving frame as rendered and upsampled, the still view.

@@ -98,6 +98,22 @@ Status check_guides(const GuideBuffers& guides, ImageSize size) {
     return {};
 }
 
+Status check_variance(const RgbFloatImage& variance, ImageSize size) {
+    if (variance.size != size || variance.pixels.size() != static_cast<std::size_t>(size.pixel_count()) * 3) {
+        return make_error(EINVAL, "denoise: variance is " + size_text(variance.size) + " with " +
+                                      std::to_string(variance.pixels.size()) + " values, the image " + size_text(size) +
+                                      " (W*H*3 values expected)");
+    }
+    for (std::size_t i = 0; i < variance.pixels.size(); ++i) {
+        const float v = variance.pixels[i];
+        if (!(std::isfinite(v) && v >= 0.0f)) {
+            return make_error(EINVAL, "denoise: variance at pixel " + std::to_string(i / 3) + " = " +
+                                          std::to_string(v) + " must be finite and >= 0");
+        }
+    }
+    return {};
+}
+
 }  // namespace
 
 Status validate_denoise_input(const RgbFloatImage& noisy, const GuideBuffers& guides, const AtrousParams& params) {
@@ -272,6 +288,48 @@ void estimate_variance(ImageSize size, const GeometryWeight& gw, const Planes& p
     });
 }
 
+// Luminance variance of each surface pixel from a variance of its colour the caller measured (e.g.
+// across a progressive accumulation's passes, progressive_accumulator.h), per channel: demodulated
+// like the colour, the channels taken as fully correlated (an upper bound whatever their
+// correlation), Var(l) = (Σ_c w_c σ_c / max(a_c, kMinAlbedo))², then averaged over the pixel's 5x5
+// neighbourhood on the same surface (the geometry weights of estimate_variance), which steadies an
+// estimate from as few as two passes. The pong variance plane is the scratch (filter_level rewrites it).
+void given_variance(const RgbFloatImage& variance, const GuideBuffers& guides, const GeometryWeight& gw,
+                    const Planes& planes, int threads) {
+    const ImageSize size = variance.size;
+    const int w = size.width, h = size.height;
+    float* raw = planes.pong.var;
+    for (std::size_t i = 0; i < static_cast<std::size_t>(size.pixel_count()); ++i) {
+        const float* v = variance.pixels.data() + 3 * i;
+        const float* a = guides.albedo.data() + 3 * i;
+        const float sd = 0.2126f * std::sqrt(v[0]) / std::max(a[0], kMinAlbedo) +
+                         0.7152f * std::sqrt(v[1]) / std::max(a[1], kMinAlbedo) +
+                         0.0722f * std::sqrt(v[2]) / std::max(a[2], kMinAlbedo);
+        raw[i] = sd * sd;
+    }
+    for_row_bands(h, threads, [&](int y0, int y1) {
+        std::vector<float> sw(w), sv(w), wt(w);
+        for (int y = y0; y < y1; ++y) {
+            std::fill(sw.begin(), sw.end(), 0.0f), std::fill(sv.begin(), sv.end(), 0.0f);
+            const std::size_t row = static_cast<std::size_t>(y) * w;
+            for (int oy = -2; oy <= 2; ++oy) {
+                if (y + oy < 0 || y + oy >= h) continue;
+                for (int ox = -2; ox <= 2; ++ox) {
+                    const int xa = std::max(0, -ox), xb = std::min(w, w - ox);
+                    const std::ptrdiff_t offset = static_cast<std::ptrdiff_t>(oy) * w + ox;
+                    geometry_weights(planes.geometry, gw, row + xa, offset, xb - xa, float(ox), float(oy), 1.0f,
+                                     wt.data() + xa);
+                    const float* vq = raw + static_cast<std::ptrdiff_t>(row) + offset;
+                    for (int x = xa; x < xb; ++x) sw[x] += wt[x], sv[x] += wt[x] * vq[x];
+                }
+            }
+            for (int x = 0; x < w; ++x) {
+                if (planes.geometry.mask[row + x] != 0.0f) planes.ping.var[row + x] = sv[x] / sw[x];
+            }
+        }
+    });
+}
+
 // colour_scale = 1 / (σ_l sqrt(g3x3(Var)) + ε) [S eq. 5], g3x3 = (1/4, 1/2, 1/4)² over surface pixels.
 void colour_scales(ImageSize size, float sigma_colour, const Signal& s, const Planes& planes, int threads) {
     constexpr float k[3] = {0.25f, 0.5f, 0.25f};
@@ -374,8 +432,11 @@ void filter_level(ImageSize size, int step, const GeometryWeight& gw, const Sign
 }  // namespace
 
 Status AtrousDenoiser::run(const RgbFloatImage& noisy, const GuideBuffers& guides, const AtrousParams& params,
-                           RgbFloatImage& out) {
+                           RgbFloatImage& out, const RgbFloatImage* variance) {
     if (Status s = validate_denoise_input(noisy, guides, params); !s.ok()) return s;
+    if (variance) {
+        if (Status s = check_variance(*variance, noisy.size); !s.ok()) return s;
+    }
     if (params.iterations == 0) {
         out = noisy;
         return {};
@@ -387,7 +448,11 @@ Status AtrousDenoiser::run(const RgbFloatImage& noisy, const GuideBuffers& guide
     Planes planes = make_planes(planes_, n);
     const GeometryWeight gw = make_geometry_weight(params);
     prepare(noisy, guides, planes, threads);
-    estimate_variance(size, gw, planes, threads);
+    if (variance) {
+        given_variance(*variance, guides, gw, planes, threads);
+    } else {
+        estimate_variance(size, gw, planes, threads);
+    }
     for (int level = 0; level < params.iterations; ++level) {
         colour_scales(size, params.sigma_colour, planes.ping, planes, threads);
         filter_level(size, 1 << level, gw, planes.ping, planes.pong, planes, threads);

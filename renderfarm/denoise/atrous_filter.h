@@ -41,7 +41,7 @@
 
 #include "common/image.h"
 #include "common/result.h"
-#include "renderfarm/denoise/guide_buffers.h"
+#include "renderfarm/trace/guide_buffers.h"
 
 namespace mogao {
 
@@ -60,7 +60,16 @@ struct AtrousParams {
 class AtrousDenoiser {
 public:
     // Filters `noisy` into `out` (resized to noisy.size). On error, `out` is left untouched.
-    Status run(const RgbFloatImage& noisy, const GuideBuffers& guides, const AtrousParams& params, RgbFloatImage& out);
+    // `variance`, when given: the measured variance of each pixel of `noisy`, per channel (W*H*3,
+    // squared radiance units, finite and >= 0; e.g. ProgressiveAccumulator::variance_of_mean). The
+    // luminance weight w_l is then normalised by that noise instead of the spatial estimate (the
+    // luminance variance of the demodulated colour, channels taken as fully correlated, averaged
+    // over the 5x5 neighbourhood on the same surface): as samples accumulate and the noise falls,
+    // the filter lets less through and its output tends to `noisy` itself, where the spatial
+    // estimate, which also sees shading and texture, would keep blurring them.
+    // EINVAL naming the field for a variance of another size or a negative or non-finite value.
+    Status run(const RgbFloatImage& noisy, const GuideBuffers& guides, const AtrousParams& params, RgbFloatImage& out,
+               const RgbFloatImage* variance = nullptr);
 
 private:
     // Planes of W*H floats, structure of arrays so the per-tap loops over a row vectorise:

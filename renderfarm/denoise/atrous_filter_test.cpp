@@ -205,5 +205,85 @@ TEST(AtrousFilter, BadInputIsNamed) {
     expect_error(s.noisy, s.guides, threads, "params.threads");
 }
 
+// A shadow edge inside wall A (irradiance 1.0 left of x = 24, 0.3 right of it: no guide sees it)
+// under little noise of known variance, as a well-sampled still view has. The spatial estimate takes
+// the step for noise and blurs it; the measured variance keeps it and still removes noise.
+struct ShadowEdge {
+    Synthetic s;
+    RgbFloatImage variance{ImageSize{kW, kH}};
+};
+
+ShadowEdge make_shadow_edge(float noise_sigma) {
+    ShadowEdge e{make_synthetic(0.0f), RgbFloatImage(ImageSize{kW, kH})};
+    std::mt19937 rng(11);
+    std::normal_distribution<float> noise(0.0f, 1.0f);
+    for (int y = 0; y < 32; ++y) {
+        for (int x = 24; x < 48; ++x) {
+            for (int c = 0; c < 3; ++c) e.s.truth.at(x, y)[c] *= 0.3f;
+        }
+    }
+    for (int y = 0; y < kH; ++y) {
+        for (int x = 0; x < kW; ++x) {
+            if (e.s.guides.hit[e.s.guides.pixel(x, y)] == 0) continue;
+            for (int c = 0; c < 3; ++c) {
+                const float t = e.s.truth.at(x, y)[c];
+                e.s.noisy.at(x, y)[c] = t * (1.0f + noise_sigma * noise(rng));
+                e.variance.at(x, y)[c] = (noise_sigma * t) * (noise_sigma * t);
+            }
+        }
+    }
+    return e;
+}
+
+TEST(AtrousFilter, MeasuredVarianceKeepsAShadowEdgeTheSpatialEstimateBlurs) {
+    const ShadowEdge e = make_shadow_edge(0.03f);
+    AtrousDenoiser denoiser;
+    RgbFloatImage spatial, measured;
+    ASSERT_TRUE(denoiser.run(e.s.noisy, e.s.guides, AtrousParams{}, spatial).ok());
+    ASSERT_TRUE(denoiser.run(e.s.noisy, e.s.guides, AtrousParams{}, measured, &e.variance).ok());
+    const double step = 1.0 - 0.3;
+    const double spatial_bleed = 1.0 - mean_irradiance(spatial, e.s.guides, 23, 24, 0, 32);
+    const double measured_bleed = 1.0 - mean_irradiance(measured, e.s.guides, 23, 24, 0, 32);
+    const double noisy_db = linear_psnr(e.s.noisy, e.s.truth), measured_db = linear_psnr(measured, e.s.truth);
+    std::printf(
+        "shadow edge, 3 %% noise: bleed into the lit side %.4f (spatial) %.4f (measured) of a %.1f step; "
+        "PSNR noisy %.2f dB, measured %.2f dB, spatial %.2f dB\n",
+        spatial_bleed, measured_bleed, step, noisy_db, measured_db, linear_psnr(spatial, e.s.truth));
+    EXPECT_GT(spatial_bleed, 0.05 * step) << "control: the spatial estimate should blur the shadow edge";
+    EXPECT_LT(std::abs(measured_bleed), 0.01 * step);
+    EXPECT_GT(measured_db, noisy_db + 3.0) << "the measured noise must still be filtered";
+}
+
+// No noise left: only pixels whose luminance agrees within the filter's ε (1e-6) may mix, so the
+// output is the input up to the rare neighbours that agree that closely by chance.
+TEST(AtrousFilter, ZeroMeasuredVarianceReturnsTheInput) {
+    const ShadowEdge e = make_shadow_edge(0.3f);
+    const RgbFloatImage none(ImageSize{kW, kH}, 0.0f);
+    AtrousDenoiser denoiser;
+    RgbFloatImage out, spatial;
+    ASSERT_TRUE(denoiser.run(e.s.noisy, e.s.guides, AtrousParams{}, out, &none).ok());
+    ASSERT_TRUE(denoiser.run(e.s.noisy, e.s.guides, AtrousParams{}, spatial).ok());
+    EXPECT_GT(linear_psnr(out, e.s.noisy), 70.0);
+    EXPECT_LT(linear_psnr(spatial, e.s.noisy), 40.0) << "control: the spatial estimate filters this noise";
+}
+
+TEST(AtrousFilter, BadMeasuredVarianceIsNamedAndTheOutputKept) {
+    const ShadowEdge e = make_shadow_edge(0.1f);
+    RgbFloatImage smaller(ImageSize{kW, kH - 1}, 0.0f), negative = e.variance, nan = e.variance;
+    negative.at(3, 1)[2] = -1.0f;
+    nan.at(4, 0)[0] = std::numeric_limits<float>::quiet_NaN();
+    for (const auto& [variance, needle] :
+         {std::pair{&smaller, "variance is 96x63"}, std::pair{&negative, "variance at pixel 99 = -1"},
+          std::pair{&nan, "variance at pixel 4 = nan"}}) {
+        RgbFloatImage out(ImageSize{1, 1}, 42.0f);
+        AtrousDenoiser denoiser;
+        const Status st = denoiser.run(e.s.noisy, e.s.guides, AtrousParams{}, out, variance);
+        ASSERT_FALSE(st.ok()) << needle;
+        EXPECT_EQ(st.code(), EINVAL);
+        EXPECT_NE(st.error().message.find(needle), std::string::npos) << st.error().message;
+        EXPECT_EQ(out.pixels[0], 42.0f) << "output touched on error";
+    }
+}
+
 }  // namespace
 }  // namespace mogao

@@ -26,8 +26,8 @@
 #include "common/pixel_rect.h"
 #include "common/result.h"
 #include "common/view_request.h"
-#include "renderfarm/denoise/guide_buffers.h"
 #include "renderfarm/scene/scene.h"
+#include "renderfarm/trace/guide_buffers.h"
 
 namespace mogao {
 class RenderScene;

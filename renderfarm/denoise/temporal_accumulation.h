@@ -34,8 +34,8 @@
 #include <vector>
 
 #include "common/image.h"
-#include "renderfarm/denoise/guide_buffers.h"
 #include "renderfarm/trace/camera.h"
+#include "renderfarm/trace/guide_buffers.h"
 
 namespace mogao {
 

@@ -211,10 +211,10 @@ PackedPixels wire_format(std::int32_t linear) {
     return linear == 2 ? PackedPixels::linear_guided : linear == 1 ? PackedPixels::linear : PackedPixels::srgb8;
 }
 
-// Begins the guide pass's frame when `format` needs guides; throws when it cannot.
+// Begins the guide pass's frame when `format` needs guides and a guide pass is given (without one
+// the renderer's own first hits are the guides, tile_pass.h); throws when it cannot.
 const GuidePass* begin_guides(GuidePass* guides, PackedPixels format, const ViewRequest& view) {
-    if (format != PackedPixels::linear_guided) return nullptr;
-    if (!guides) throw std::runtime_error("this farm has no guide pass: it cannot send the denoiser's guides");
+    if (format != PackedPixels::linear_guided || guides == nullptr) return nullptr;
     if (Status s = guides->begin_frame(view); !s.ok()) throw std::invalid_argument(s.error().message);
     return guides;
 }

@@ -36,7 +36,6 @@
 
 #include "common/image.h"
 #include "common/view_request.h"
-#include "renderfarm/denoise/guide_buffers.h"
 #include "renderfarm/denoise/guide_pass.h"
 #include "renderfarm/farm/frame_stats.h"
 #include "renderfarm/farm/mpi_session.h"
@@ -45,6 +44,7 @@
 #include "renderfarm/schedule/cost_map.h"
 #include "renderfarm/schedule/load_balancer.h"
 #include "renderfarm/schedule/rank_speed.h"
+#include "renderfarm/trace/guide_buffers.h"
 #include "renderfarm/trace/renderer.h"
 
 namespace mogao {
@@ -89,7 +89,8 @@ struct DispatchedFrame {
 class FrameDispatcher {
 public:
     // `local` renders when the world has one process (may be null otherwise); `local_guides` (a
-    // GuidePass on local's geometry, may be null) traces its guides for PackedPixels::linear_guided.
+    // GuidePass on local's geometry, may be null: the renderer's own first hits, tile_pass.h) traces
+    // the guides of PackedPixels::linear_guided frames.
     FrameDispatcher(const MpiSession& mpi, DispatchSettings settings, Renderer* local,
                     GuidePass* local_guides = nullptr);
     ~FrameDispatcher();  // stops the render ranks if stop() was not called
@@ -155,7 +156,8 @@ private:
 
 // Render ranks: answer frames until the dispatcher stops. `renderer` is null when this rank could
 // not build one (then every frame is answered with `load_error`). `guides` (a GuidePass on the
-// renderer's geometry) answers PackedPixels::linear_guided frames; null: such frames fail.
+// renderer's geometry) traces the guides of PackedPixels::linear_guided frames; null: the
+// renderer's own first hits are the guides (tile_pass.h).
 void serve_render_rank(Renderer* renderer, const DispatchSettings& settings, const std::string& load_error,
                        GuidePass* guides = nullptr);
 

@@ -155,8 +155,14 @@ void LiveFrames::display(Session& s, const RgbFloatImage& radiance, LiveFrame& f
                                         options_.temporal_params);
         noisy = &blended;
     }
+    // A still view's accumulation of two passes or more brings its own noise, measured from the
+    // passes' spread: the filter then does less as samples come in, instead of blurring as much at
+    // 64 spp as at 1 (the spatial estimate also counts shading and texture as noise).
+    const RgbFloatImage variance = frame.passes >= 2 ? s.accumulation.variance_of_mean() : RgbFloatImage{};
     RgbFloatImage filtered;
-    if (Status st = denoiser_.run(*noisy, s.guides, options_.denoise_params, filtered); !st.ok())
+    if (Status st = denoiser_.run(*noisy, s.guides, options_.denoise_params, filtered,
+                                  variance.pixels.empty() ? nullptr : &variance);
+        !st.ok())
         throw std::runtime_error(st.error().message);
     frame.image = to_display(filtered);
     frame.denoised = true;

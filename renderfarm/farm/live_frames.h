@@ -20,11 +20,14 @@
 //  - Its own predicted cost map (FrameDispatcher stream = session), so sessions looking at
 //    different places do not mislead each other's PBT.
 //  - With `denoise`: every frame served with at most `denoise_max_spp` samples per pixel (moving
-//    frames, the first passes of a still view) is filtered by the edge-avoiding à-trous denoiser
-//    (renderfarm/denoise/atrous_filter.h) in linear light before the display transform. The first
-//    pass of each view asks the ranks for the guides too (PackedPixels::linear_guided: albedo,
-//    normal, depth of each pixel centre, traced on the ranks' own BVHs beside the tiles); later
-//    passes of the same view reuse them (the guides do not depend on the samples). The admin
+//    frames, a still view while it refines) is filtered by the edge-avoiding à-trous denoiser
+//    (renderfarm/denoise/atrous_filter.h) in linear light before the display transform. A frame
+//    of one pass is filtered by the noise the filter estimates spatially; a still view's
+//    accumulation of two passes or more by the noise its passes measure
+//    (ProgressiveAccumulator::variance_of_mean), so the filter does less as samples come in and
+//    the view keeps improving. The first pass of each view asks the ranks for the guides too
+//    (PackedPixels::linear_guided: albedo, normal, depth of each pixel's first camera hit, from the
+//    rays the ranks trace for the radiance); later passes of the same view reuse them. The admin
 //    filters the composited frame, so the served frame is the same for any split of the frame over
 //    any number of ranks; the accumulation keeps the raw samples (never filtered ones). The
 //    filter's time is part of LiveFrame::seconds, which the frame-time target observes, so the
@@ -74,8 +77,8 @@ struct LiveOptions {
     FrameTimeTarget controller;    // its other settings (target_seconds is taken from frame_time_s)
     bool per_session_maps = true;  // one PBT cost map per session; false = all share one (stream 0)
     std::size_t max_sessions = 64;
-    bool denoise = false;     // filter frames of at most denoise_max_spp samples (see above)
-    int denoise_max_spp = 4;  // >= 1
+    bool denoise = false;       // filter frames of at most denoise_max_spp samples (see above)
+    int denoise_max_spp = 256;  // >= 1; past it a still view is sent raw (its noise is below the filter's bias)
     AtrousParams denoise_params = default_denoise_params();  // threads 0 = every core of the admin
     // Moving frames read and train the render ranks' radiance caches (ViewRequest::radiance_cache,
     // renderfarm/trace/radiance_cache.h): much cheaper, biased; such a frame is shown alone, never

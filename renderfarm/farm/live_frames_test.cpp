@@ -310,6 +310,37 @@ TEST_F(LiveFramesTest, StillViewIsDenoisedUpToDenoiseMaxSppWithTheFirstPassesGui
     EXPECT_EQ(calls_.back().format, PackedPixels::linear_guided);
 }
 
+// A still view refining past its first passes: filtered with the noise its passes measure, each
+// frame is closer to the reference than the one before and than the raw mean of the same samples
+// (the raw frame is what a view past denoise_max_spp showed: noisier than its own first passes).
+TEST_F(LiveFramesTest, StillViewKeepsImprovingWithTheNoiseItsPassesMeasure) {
+    ViewRequest request = view(2.0);
+    request.size = {96, 72};
+    request.quality.max_bounces = 1;
+    const Rgb8Image reference = single(request, 512);
+    LiveOptions filtered_options;
+    filtered_options.denoise = true;
+    LiveOptions raw_options = filtered_options;
+    raw_options.denoise_max_spp = 1;  // the first pass filtered, the accumulation raw
+    LiveFrames filtered(source(), filtered_options, 1.f, ToneMap::clamp);
+    LiveFrames raw(source(), raw_options, 1.f, ToneMap::clamp);
+    double previous_db = 0.0;
+    for (std::uint64_t id = 1; id <= 7; ++id) {
+        request.frame_id = id;
+        const LiveFrame a = filtered.render(request);
+        const LiveFrame b = raw.render(request);
+        ASSERT_EQ(a.samples, b.samples);
+        const double filtered_db = psnr(a.image, reference), raw_db = psnr(b.image, reference);
+        std::printf("still view, %2d spp: filtered with the measured noise %.2f dB, raw %.2f dB\n", a.samples,
+                    filtered_db, raw_db);
+        EXPECT_TRUE(a.denoised);
+        if (id == 1) continue;
+        EXPECT_GT(filtered_db, previous_db - 0.1) << a.samples << " spp: worse than the frame before";
+        EXPECT_GT(filtered_db, raw_db + 2.0) << a.samples << " spp";
+        previous_db = filtered_db;
+    }
+}
+
 // The frame-time target sees the filter's time: a controller fed each frame's seconds (render +
 // filter) and the hand-off gap before it chooses exactly the scale LiveFrames renders next, and
 // those seconds hold the source's render and the filter one after the other.

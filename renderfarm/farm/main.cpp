@@ -86,7 +86,10 @@ void add_live_flags(CLI::App& serve, mogao::ServeOptions& options, double& frame
         "--denoise,!--no-denoise", live.denoise,
         "Filter frames of few samples (moving views, a still view's first passes) with the a-trous "
         "denoiser; the ranks trace its guides (default off; the interactive and balanced presets turn it on)");
-    serve.add_option("--denoise-max-spp", live.denoise_max_spp, "Largest samples per pixel of a frame still filtered")
+    serve
+        .add_option(
+            "--denoise-max-spp", live.denoise_max_spp,
+            "Largest samples per pixel of a frame still filtered (256; a still view by the noise its passes measure)")
         ->check(CLI::Range(1, 1 << 20));
     serve.add_flag("--radiance-cache,!--no-radiance-cache", live.radiance_cache,
                    "Trace moving frames with the render ranks' radiance cache: the lights per pixel, the rest from "

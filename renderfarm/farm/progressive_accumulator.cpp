@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "renderfarm/farm/progressive_accumulator.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace mogao {
@@ -41,10 +42,15 @@ int ProgressiveAccumulator::add(const ViewRequest& view, const RgbFloatImage& pa
     if (!continues(view)) {
         view_ = view;
         sum_ = RgbFloatImage(pass.size);
+        sum_squares_ = RgbFloatImage(pass.size);
         samples_ = 0;
         passes_ = 0;
     }
-    for (std::size_t i = 0; i < pass.pixels.size(); ++i) sum_.pixels[i] += weight * pass.pixels[i];
+    for (std::size_t i = 0; i < pass.pixels.size(); ++i) {
+        const float v = pass.pixels[i];
+        sum_.pixels[i] += weight * v;
+        sum_squares_.pixels[i] += weight * v * v;
+    }
     samples_ += view.quality.spp;
     ++passes_;
     return samples_;
@@ -58,8 +64,22 @@ RgbFloatImage ProgressiveAccumulator::mean() const {
     return out;
 }
 
+RgbFloatImage ProgressiveAccumulator::variance_of_mean() const {
+    if (passes_ < 2) return {};
+    RgbFloatImage out(sum_.size);
+    const double n = samples_;
+    const double scale = 1.0 / ((passes_ - 1) * n);
+    for (std::size_t i = 0; i < sum_.pixels.size(); ++i) {
+        const double mean = sum_.pixels[i] / n;
+        const double spread = static_cast<double>(sum_squares_.pixels[i]) - n * mean * mean;
+        out.pixels[i] = static_cast<float>(std::max(0.0, spread * scale));
+    }
+    return out;
+}
+
 void ProgressiveAccumulator::reset() {
     sum_ = {};
+    sum_squares_ = {};
     samples_ = 0;
     passes_ = 0;
 }

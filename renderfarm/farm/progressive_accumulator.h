@@ -6,7 +6,14 @@
 // its samples are new; the accumulator keeps the spp-weighted sum in linear float (never in sRGB8,
 // whose rounding and non-linearity would bias the mean) and hands out the mean:
 //     mean = sum_k (spp_k * pass_k) / sum_k spp_k
-// which is the Monte Carlo estimate with all the passes' samples together. Any change of the view
+// which is the Monte Carlo estimate with all the passes' samples together. It also keeps the
+// spp-weighted sum of squares of the passes, for the noise left in the mean (variance_of_mean()):
+// a pass of n_k samples has Var(pass_k) = σ² / n_k, so with N = Σ n_k and P passes
+//     σ² ≈ Σ_k n_k (pass_k - mean)² / (P - 1) = (Σ_k n_k pass_k² - N mean²) / (P - 1)
+//     Var(mean) = σ² / N
+// per pixel and channel (the pass-to-pass estimate of the "temporal" variance of Schied et al.,
+// "Spatiotemporal Variance-Guided Filtering", HPG 2017, §4.2, with passes in place of frames).
+// Any change of the view
 // (same_view() below: pose, camera, size, resolution scale, bounces, AO, area samples, seed)
 // starts over: the first pass of a new view replaces the sum.
 //
@@ -44,11 +51,15 @@ public:
     [[nodiscard]] std::uint64_t first_frame_id() const { return view_.frame_id; }
     // The mean radiance of every pass so far (empty image before the first add()).
     [[nodiscard]] RgbFloatImage mean() const;
+    // The variance of mean()'s pixels, per channel, in squared radiance units (formula above; >= 0,
+    // rounding clamped). Empty before the second pass: one pass says nothing of its own noise.
+    [[nodiscard]] RgbFloatImage variance_of_mean() const;
     void reset();
 
 private:
     ViewRequest view_;
-    RgbFloatImage sum_;  // spp-weighted sum of passes, linear
+    RgbFloatImage sum_;          // spp-weighted sum of passes, linear
+    RgbFloatImage sum_squares_;  // spp-weighted sum of the passes' squares
     int samples_ = 0;
     int passes_ = 0;
 };

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "renderfarm/farm/progressive_accumulator.h"
 
+#include <cmath>
+#include <cstdint>
 #include <stdexcept>
 
 #include <gtest/gtest.h>
@@ -26,6 +28,46 @@ TEST(ProgressiveAccumulator, MeanIsTheSppWeightedAverageOfPasses) {
     EXPECT_EQ(acc.add(v, filled(5.f)), 4);
     EXPECT_EQ(acc.passes(), 2);
     for (float p : acc.mean().pixels) EXPECT_FLOAT_EQ(p, (1.f + 3 * 5.f) / 4);
+}
+
+// Passes of 2 spp drawn from a known distribution (per-sample σ = 0.5): the pass-to-pass estimate
+// of the mean's variance approaches σ² / N, and one pass gives none.
+TEST(ProgressiveAccumulator, VarianceOfTheMeanIsEstimatedFromThePassesSpread) {
+    ProgressiveAccumulator acc;
+    ViewRequest v = small_view();
+    v.quality.spp = 2;
+    EXPECT_TRUE(acc.variance_of_mean().pixels.empty());
+    const double sigma = 0.5;
+    const int passes = 400;
+    std::uint64_t state = 12345;
+    const auto uniform = [&] {  // splitmix64 -> [0, 1)
+        std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
+        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+        z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+        return static_cast<double>((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
+    };
+    for (int k = 0; k < passes; ++k) {
+        RgbFloatImage pass({4, 2});
+        for (float& p : pass.pixels) {  // mean of 2 samples, each 1 ± sigma·sqrt(3)·(2u - 1): variance sigma²
+            const double a = 1.0 + sigma * std::sqrt(3.0) * (2 * uniform() - 1);
+            const double b = 1.0 + sigma * std::sqrt(3.0) * (2 * uniform() - 1);
+            p = static_cast<float>((a + b) / 2);
+        }
+        v.frame_id = pass_frame_id(1, k);
+        acc.add(v, pass);
+        if (k == 0) {
+            EXPECT_TRUE(acc.variance_of_mean().pixels.empty()) << "one pass has no spread";
+        }
+    }
+    const RgbFloatImage var = acc.variance_of_mean();
+    ASSERT_EQ(var.size, (ImageSize{4, 2}));
+    double mean_var = 0;
+    for (float p : var.pixels) mean_var += p / static_cast<double>(var.pixels.size());
+    const double expected = sigma * sigma / (2.0 * passes);
+    EXPECT_NEAR(mean_var, expected, 0.15 * expected);
+    v.pose.eye.x() += 1;  // a new view starts over: no variance until its second pass
+    acc.add(v, filled(1.f));
+    EXPECT_TRUE(acc.variance_of_mean().pixels.empty());
 }
 
 TEST(ProgressiveAccumulator, AnyChangeOfViewStartsOver) {

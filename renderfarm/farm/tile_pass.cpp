@@ -65,34 +65,63 @@ public:
                      int coarse_block = 0) {
         const ImageSize size{job.tile.width(), job.tile.height()};
         resize(radiance_, size);
-        const TileStats stats = coarse_block > 0 ? render_coarse(renderer, job.tile, coarse_block)
-                                                 : renderer.render(job.tile, radiance_, job.tile.x0, job.tile.y0);
-        pack(job, size, packed);
+        const bool own_guides = format_ == PackedPixels::linear_guided && guide_pass_ == nullptr;
+        if (format_ == PackedPixels::linear_guided) resize_guides(guides_, size);
+        TileStats stats;
+        if (coarse_block > 0) {
+            stats = render_coarse(renderer, job.tile, coarse_block, own_guides);
+        } else if (own_guides) {
+            stats = renderer.render(job.tile, radiance_, job.tile.x0, job.tile.y0, guides_);
+        } else {
+            stats = renderer.render(job.tile, radiance_, job.tile.x0, job.tile.y0);
+        }
+        pack(job, packed);
         return stats;
     }
 
 private:
     // One pixel per block x block block of the global grid inside `tile`, traced at the block's
-    // centre and copied to the block's pixels of the tile's window.
-    TileStats render_coarse(const Renderer& renderer, const PixelRect& tile, int block) {
+    // centre and copied to the block's pixels of the tile's window (its guides too, with
+    // `with_guides`: the block is one flat patch to the denoiser, as it is in the radiance).
+    TileStats render_coarse(const Renderer& renderer, const PixelRect& tile, int block, bool with_guides) {
         TileStats stats;
         resize(one_, ImageSize{1, 1});
+        if (with_guides) resize_guides(one_guides_, ImageSize{1, 1});
         for (int by = (tile.y0 / block) * block; by < tile.y1; by += block) {
             for (int bx = (tile.x0 / block) * block; bx < tile.x1; bx += block) {
                 const PixelRect b = intersect(tile, PixelRect{bx, by, bx + block, by + block});
                 const int x = b.x0 + (b.width() - 1) / 2, y = b.y0 + (b.height() - 1) / 2;
-                stats.rays += renderer.render(PixelRect{x, y, x + 1, y + 1}, one_, x, y).rays;
-                for (int py = b.y0; py < b.y1; ++py)
-                    for (int px = b.x0; px < b.x1; ++px)
+                const PixelRect centre{x, y, x + 1, y + 1};
+                stats.rays += with_guides ? renderer.render(centre, one_, x, y, one_guides_).rays
+                                          : renderer.render(centre, one_, x, y).rays;
+                for (int py = b.y0; py < b.y1; ++py) {
+                    for (int px = b.x0; px < b.x1; ++px) {
                         std::copy_n(one_.at(0, 0), 3, radiance_.at(px - tile.x0, py - tile.y0));
+                        if (with_guides) copy_guide(one_guides_, 0, guides_, guides_.pixel(px - tile.x0, py - tile.y0));
+                    }
+                }
             }
         }
         return stats;
     }
 
-    void pack(const TileJob& job, ImageSize size, std::vector<std::uint8_t>& packed) {
+    static void resize_guides(GuideBuffers& guides, ImageSize size) {  // keeps the capacity
+        const auto n = static_cast<std::size_t>(size.pixel_count());
+        guides.size = size;
+        guides.hit.resize(n), guides.depth.resize(n), guides.albedo.resize(3 * n), guides.normal.resize(3 * n);
+    }
+
+    static void copy_guide(const GuideBuffers& from, std::size_t i, GuideBuffers& to, std::size_t j) {
+        to.hit[j] = from.hit[i];
+        to.depth[j] = from.depth[i];
+        std::copy_n(from.albedo.data() + 3 * i, 3, to.albedo.data() + 3 * j);
+        std::copy_n(from.normal.data() + 3 * i, 3, to.normal.data() + 3 * j);
+    }
+
+    void pack(const TileJob& job, std::vector<std::uint8_t>& packed) {
+        const ImageSize size{job.tile.width(), job.tile.height()};
         if (format_ == PackedPixels::linear_guided) {
-            render_guides(job, size);
+            if (guide_pass_ != nullptr) render_guides(job);
             copy_guided_rows(job, packed);
         } else if (format_ == PackedPixels::srgb8) {
             resize(display_, size);
@@ -121,10 +150,8 @@ private:
         }
     }
 
-    void render_guides(const TileJob& job, ImageSize size) {
-        const auto n = static_cast<std::size_t>(size.pixel_count());
-        guides_.size = size;
-        guides_.hit.resize(n), guides_.depth.resize(n), guides_.albedo.resize(3 * n), guides_.normal.resize(3 * n);
+    // The guide pass's guides of the tile (a baseline: pixel centres, a second primary ray each).
+    void render_guides(const TileJob& job) {
         if (Status st = guide_pass_->render(job.tile, guides_, job.tile.x0, job.tile.y0); !st.ok())
             throw std::runtime_error(st.error().message);
     }
@@ -161,6 +188,7 @@ private:
     RgbFloatImage one_;  // a coarse tile's traced pixel
     Rgb8Image display_;
     GuideBuffers guides_;
+    GuideBuffers one_guides_;  // a coarse tile's traced pixel
 };
 
 void check_packed(const std::vector<PixelRect>& rects, const std::vector<std::uint8_t>& packed, PackedPixels format,
@@ -265,8 +293,6 @@ TilePassResult render_tile_pass(const Renderer& renderer, const std::vector<Pixe
                                 int threads, float exposure, ToneMap tone_map, PackedPixels format,
                                 const GuidePass* guides, const TilePassControl* control) {
     if (cell_size < 1) throw std::invalid_argument("cell_size must be >= 1");
-    if (format == PackedPixels::linear_guided && !guides)
-        throw std::invalid_argument("PackedPixels::linear_guided needs a guide pass");
     if (control && !(control->beat_s > 0)) throw std::invalid_argument("TilePassControl.beat_s must be > 0");
     if (control && control->cut_block < 1) throw std::invalid_argument("TilePassControl.cut_block must be >= 1");
     const auto start = Clock::now();

@@ -12,9 +12,11 @@
 // row, RGB8 — the order unpack_rects() expects — or, for PackedPixels::linear, three native
 // floats per pixel of linear radiance (before exposure and tone map) in the same order, for the
 // admin's progressive accumulation (unpack_linear_rects()). PackedPixels::linear_guided adds the
-// denoiser's guides of each pixel (renderfarm/denoise/guide_buffers.h) from a GuidePass sharing the
-// renderer's BVH: ten native floats per pixel, radiance R, G, B, albedo R, G, B, normal x, y, z,
-// depth (metres; 0 = sky), in the same order (unpack_guided_rects()).
+// denoiser's guides of each pixel (renderfarm/trace/guide_buffers.h), from the camera ray of each
+// pixel's first sample (Renderer::render with guides: no ray more than the radiance's), or, as a
+// baseline, from a GuidePass sharing the renderer's BVH (a second primary ray per pixel centre):
+// ten native floats per pixel, radiance R, G, B, albedo R, G, B, normal x, y, z, depth (metres;
+// 0 = sky), in the same order (unpack_guided_rects()).
 #pragma once
 
 #include <cstddef>
@@ -23,10 +25,10 @@
 #include <vector>
 
 #include "common/image.h"
-#include "renderfarm/denoise/guide_buffers.h"
 #include "renderfarm/denoise/guide_pass.h"
 #include "renderfarm/schedule/cost_map.h"
 #include "renderfarm/trace/film.h"
+#include "renderfarm/trace/guide_buffers.h"
 #include "renderfarm/trace/renderer.h"
 
 namespace mogao {
@@ -39,8 +41,8 @@ enum class PackedPixels { srgb8, linear, linear_guided };
 // then about every `beat_s` until the workers are done, with the tiles finished so far and the
 // pass's tile count. `poll` returning true cuts the pass: tiles not begun yet are rendered coarse,
 // one traced pixel (the block's centre, the value the full pass would give it, renderer.h) per
-// `cut_block` x `cut_block` block of the global grid, copied to the whole block (guides, for
-// PackedPixels::linear_guided, are still traced per pixel: they are one primary ray each). Tiles
+// `cut_block` x `cut_block` block of the global grid, copied to the whole block (for
+// PackedPixels::linear_guided its guides too, unless a guide pass traces them per pixel). Tiles
 // begun before the cut finish at full quality. A coarse tile's time is reported scaled by its
 // pixels over its traced pixels (an estimate of its full cost, for the PBT).
 struct TilePassControl {
@@ -61,10 +63,10 @@ struct TilePassResult {
 };
 
 // Renders `rects` of the frame begun on `renderer` with `threads` worker threads (>= 1); for
-// PackedPixels::linear_guided also the guides of the same pixels with `guides` (begun on the same
-// request after the renderer; its time counts in the tile's). Throws what the renderer throws
-// (std::invalid_argument for rects outside the image), std::invalid_argument for linear_guided
-// without a guide pass, std::runtime_error naming the guide pass's error; `control` (may be null:
+// PackedPixels::linear_guided also the guides of the same pixels: the renderer's own, or with
+// `guides` when given (begun on the same request after the renderer; its time counts in the
+// tile's). Throws what the renderer throws (std::invalid_argument for rects outside the image),
+// std::runtime_error naming the guide pass's error; `control` (may be null:
 // no progress reports, no cut, the calling thread renders too): std::invalid_argument for a bad
 // beat_s or cut_block, and what its poll throws (after the workers stopped).
 [[nodiscard]] TilePassResult render_tile_pass(const Renderer& renderer, const std::vector<PixelRect>& rects,

@@ -184,10 +184,40 @@ struct Renderer::Impl {
         }
     }
 
+    // The first camera hit of each valid lane into `guides` (a window from origin_x, origin_y on),
+    // resolved as the guide pass resolves its own (guide_buffers.h).
+    void store_guides(const Block& block, const RTCRayHit16& packet, const PacketHits& hits, int origin_x, int origin_y,
+                      GuideBuffers& guides) const {
+        for (std::size_t l = 0; l < kLanes; ++l) {
+            if (block.valid[l] == 0) continue;
+            const std::size_t i = guides.pixel(block.x0 + static_cast<int>(l) % kBlock - origin_x,
+                                               block.y0 + static_cast<int>(l) / kBlock - origin_y);
+            float* albedo = guides.albedo.data() + 3 * i;
+            float* normal = guides.normal.data() + 3 * i;
+            if (!hits.alive[l]) {
+                guides.hit[i] = 0;
+                guides.depth[i] = 0.0f;
+                for (int c = 0; c < 3; ++c) albedo[c] = normal[c] = 0.0f;
+                continue;
+            }
+            const SurfaceHit& hit = hits.hit[l];
+            Eigen::Vector3f a = materials[hit.material].albedo;
+            if (hit.tinted) a = a.cwiseProduct(hit.tint);
+            guides.hit[i] = 1;
+            guides.depth[i] = packet.ray.tfar[l];
+            for (int c = 0; c < 3; ++c) {
+                albedo[c] = a[c];
+                normal[c] = hit.shading_normal[c];
+            }
+        }
+    }
+
     // Renders every sample of one block into `frame` (render()'s body; `log` for benchmarks).
-    // `frame` holds the frame's pixels from (origin_x, origin_y) on (0, 0 for a whole frame).
+    // `frame` holds the frame's pixels from (origin_x, origin_y) on (0, 0 for a whole frame);
+    // `guides`, when given, the first sample's hits at the same place.
     void render_block(const Block& block, RgbFloatImage& frame, TileStats& stats, RecordedRays* log, int origin_x = 0,
-                      int origin_y = 0, std::vector<CacheDeposit>* deposits = nullptr) const {
+                      int origin_y = 0, std::vector<CacheDeposit>* deposits = nullptr,
+                      GuideBuffers* guides = nullptr) const {
         std::array<Eigen::Vector3f, kLanes> sum;
         sum.fill(Eigen::Vector3f::Zero());
         PacketHits hits;
@@ -198,6 +228,7 @@ struct Renderer::Impl {
             intersect(block, packet);
             stats.rays += static_cast<std::uint64_t>(block.active);
             resolve_hits(block, packet, hits, sum);
+            if (sample == 0 && guides != nullptr) store_guides(block, packet, hits, origin_x, origin_y, *guides);
             if (cached && deposits != nullptr) {
                 std::array<Eigen::Vector3f, kLanes> radiance;
                 radiance.fill(Eigen::Vector3f::Zero());
@@ -235,12 +266,13 @@ struct Renderer::Impl {
     }
 
     // render()'s body once its arguments are checked; queues a cached frame's training estimates.
-    TileStats render_rect(const PixelRect& rect, RgbFloatImage& window, int origin_x, int origin_y) const {
+    TileStats render_rect(const PixelRect& rect, RgbFloatImage& window, int origin_x, int origin_y,
+                          GuideBuffers* guides = nullptr) const {
         TileStats stats;
         thread_local std::vector<CacheDeposit> deposits;
         deposits.clear();
         for_each_block(rect, [&](const Block& block) {
-            render_block(block, window, stats, nullptr, origin_x, origin_y, &deposits);
+            render_block(block, window, stats, nullptr, origin_x, origin_y, &deposits, guides);
         });
         if (!deposits.empty()) cache->deposit(deposits);
         return stats;
@@ -323,6 +355,20 @@ TileStats Renderer::render(const PixelRect& rect, RgbFloatImage& frame) const {
 TileStats Renderer::render(const PixelRect& rect, RgbFloatImage& window, int origin_x, int origin_y) const {
     impl_->check_window(rect, window, origin_x, origin_y);
     return impl_->render_rect(rect, window, origin_x, origin_y);
+}
+
+TileStats Renderer::render(const PixelRect& rect, RgbFloatImage& window, int origin_x, int origin_y,
+                           GuideBuffers& guides) const {
+    impl_->check_window(rect, window, origin_x, origin_y);
+    const auto n = static_cast<std::size_t>(window.size.pixel_count());
+    if (guides.size != window.size || guides.hit.size() != n || guides.depth.size() != n ||
+        guides.albedo.size() != 3 * n || guides.normal.size() != 3 * n) {
+        throw std::invalid_argument("Renderer::render: guides are " + std::to_string(guides.size.width) + "x" +
+                                    std::to_string(guides.size.height) + " (or their buffers hold the wrong count), " +
+                                    "the window " + std::to_string(window.size.width) + "x" +
+                                    std::to_string(window.size.height));
+    }
+    return impl_->render_rect(rect, window, origin_x, origin_y, &guides);
 }
 
 void Renderer::clear_radiance_cache() { impl_->cache->clear(); }

@@ -34,6 +34,7 @@
 #include "common/pixel_rect.h"
 #include "common/view_request.h"
 #include "renderfarm/scene/scene.h"
+#include "renderfarm/trace/guide_buffers.h"
 #include "renderfarm/trace/radiance_cache.h"
 #include "renderfarm/trace/recorded_rays.h"
 
@@ -147,6 +148,17 @@ public:
     // of a whole frame. The values are bit-identical to render()'s. Throws std::invalid_argument if
     // rect is not inside [0, render_size()) or not inside the window placed at the origin.
     TileStats render(const PixelRect& rect, RgbFloatImage& window, int origin_x, int origin_y) const;
+
+    // The same pixels, and the first camera hit of each pixel's first sample into `guides`, a window
+    // of the same place and size (guide_buffers.h: hit, albedo = material albedo x the hit's tint,
+    // the shading normal facing the ray, depth = distance along the unit camera ray in metres, as
+    // the guide pass resolves them), so a frame that needs the denoiser's guides gets them from
+    // rays it traces anyway instead of a second primary ray per pixel. Radiance bit-identical to
+    // render()'s; the guides are the same for any split of the frame. Throws std::invalid_argument
+    // as above, or if guides.size != window.size or its buffers do not hold W*H (hit, depth) and
+    // W*H*3 (albedo, normal) values.
+    TileStats render(const PixelRect& rect, RgbFloatImage& window, int origin_x, int origin_y,
+                     GuideBuffers& guides) const;
 
     // The radiance cache (radiance_cache.h): emptied (a benchmark's cold start), and its size.
     // Neither may run concurrently with render() or begin_frame().

@@ -3,8 +3,10 @@
 // filter can tell a noisy pixel from an edge.
 //
 // Layout: same grid as the frame they guide (RgbFloatImage, common/image.h): row-major, top row
-// first, pixel (x, y) centred at (x + 0.5, y + 0.5) of the render size; one primary ray through each
-// pixel centre (guide_pass.h). Per pixel:
+// first, pixel (x, y) centred at (x + 0.5, y + 0.5) of the render size. Two sources fill them: the
+// renderer itself, from the camera ray of each pixel's first sample (Renderer::render with guides,
+// renderer.h: at 1 spp exactly the ray whose radiance they guide), or the denoiser's guide pass, one
+// primary ray through each pixel centre (renderfarm/denoise/guide_pass.h). Per pixel:
 //   hit     1 = the camera ray hit a surface, 0 = it hit nothing (the sky). Sky pixels are passed
 //           through by the filter and never mixed with surface pixels.
 //   albedo  linear RGB diffuse reflectance of the hit, each channel in [0, 1] (material albedo times
