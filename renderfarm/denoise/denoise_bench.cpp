@@ -10,8 +10,11 @@
 // are compared by PSNR of their sRGB8 frames (frame_error.h) against one render at --ref-spp.
 // Equal time: the raw PSNR at the denoised frame's time is interpolated linearly in log(time)
 // between the two raw frames that bracket it; the time raw rendering needs to reach the denoised
-// PSNR likewise. Times are the calling thread's CPU time (render and guides on one thread, the
+// PSNR likewise. Then what the guides cost: a 1-spp frame with the renderer's own first hits as
+// guides against the render plus the guide pass, path traced and from a warm radiance cache.
+// Times are the calling thread's CPU time (render and guides on one thread, the
 // filter on --threads), best of --reps, all measured in this run. Exits 77 without the scans.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -99,6 +102,34 @@ Timed denoise(GuidePass& pass, const ViewRequest& view, const RgbFloatImage& raw
     return best;
 }
 
+// What the denoiser's guides cost: one 1-spp frame rendered with its own first camera hits as
+// guides (Renderer::render with guides, what the farm does), against the same render followed by
+// the guide pass (a second primary ray per pixel centre), CPU seconds, best of `reps` each; with
+// `cached` the frame reads a radiance cache warmed by a few frames first (the farm's moving frames).
+void print_guide_cost(Renderer& renderer, GuidePass& pass, ViewRequest view, int reps, bool cached) {
+    view.quality.spp = 1;
+    view.radiance_cache = cached;
+    renderer.clear_radiance_cache();
+    double own = 1e300, separate = 1e300;
+    for (int r = 0; r < reps + (cached ? 4 : 0); ++r) {
+        view.frame_id = 1000 + static_cast<std::uint64_t>(r);
+        renderer.begin_frame(view);
+        RgbFloatImage frame(renderer.render_size());
+        GuideBuffers guides(frame.size);
+        double t0 = thread_cpu_seconds();
+        (void)renderer.render(PixelRect::whole(frame.size), frame, 0, 0, guides);
+        const double with_own = thread_cpu_seconds() - t0;
+        t0 = thread_cpu_seconds();
+        (void)renderer.render(PixelRect::whole(frame.size), frame);
+        if (Result<GuideBuffers> g = pass.render_frame(view); !g.ok()) throw std::runtime_error(g.error().message);
+        if (cached && r < 4) continue;  // warming the cache
+        own = std::min(own, with_own);
+        separate = std::min(separate, thread_cpu_seconds() - t0);
+    }
+    std::printf("| %s | %.1f | %.1f | %.3f |\n", cached ? "radiance cache (moving frame)" : "path traced", 1e3 * own,
+                1e3 * separate, own / separate);
+}
+
 int run(const Options& o) {
     SceneLoadReport report;
     const Scene scene = load_scene(o.scene_file, o.load, &report);
@@ -144,6 +175,10 @@ int run(const Options& o) {
         std::printf("| %d | %.2f | %+.2f | %s |\n", d.spp, equal_time_db, d.db - equal_time_db,
                     std::isnan(raw_time) ? "beyond the raw range" : std::to_string(raw_time / d.seconds).c_str());
     }
+    std::printf(
+        "\n| 1-spp frame | render with its own guides ms | render + guide pass ms | ratio |\n|---|--:|--:|--:|\n");
+    print_guide_cost(renderer, pass, view, o.reps, false);
+    print_guide_cost(renderer, pass, view, o.reps, true);
     std::printf("\nratio filter / raw 1 spp render = %.3f; filter %.1f ms per %dx%d frame (%.1f ns per pixel)\n",
                 filter_s / raw[0].seconds, 1e3 * filter_s, o.width, o.height,
                 1e9 * filter_s / (double(o.width) * o.height));
