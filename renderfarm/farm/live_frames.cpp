@@ -75,6 +75,11 @@ double LiveFrames::frame_share_seconds(std::uint64_t current) const {
     return std::max(options_.frame_time_s, others[others.size() / 2]);
 }
 
+// Whether `request` repeats the session's previous view: a still view, accumulated.
+bool LiveFrames::is_still(const Session& s, const ViewRequest& request) const {
+    return options_.progressive && s.last_request && same_view(request, *s.last_request);
+}
+
 // The view to trace for `request`: still views at the request's own scale (to accumulate), moving
 // ones at the controller's choice; the pass's frame_id when it continues an accumulation.
 ViewRequest LiveFrames::plan(Session& s, const ViewRequest& request, FrameChoice& choice) const {
@@ -82,7 +87,7 @@ ViewRequest LiveFrames::plan(Session& s, const ViewRequest& request, FrameChoice
     choice.resolution_scale = request.quality.resolution_scale;
     choice.spp = request.quality.spp;
     if (s.controller) choice = s.controller->choose(request);
-    const bool still = options_.progressive && s.last_request && same_view(request, *s.last_request);
+    const bool still = is_still(s, request);
     if (still) {  // accumulated at the request's own scale and depth
         choice.resolution_scale = request.quality.resolution_scale;
         choice.bounces = -1;
@@ -150,7 +155,7 @@ void LiveFrames::display(Session& s, const RgbFloatImage& radiance, LiveFrame& f
     const auto start = Clock::now();
     const RgbFloatImage* noisy = &radiance;
     RgbFloatImage blended;
-    if (options_.temporal && frame.passes <= 1) {
+    if (options_.temporal && !frame.still) {
         blended = s.temporal.accumulate(radiance, s.guides, make_camera_setup(frame.rendered, radiance.size),
                                         options_.temporal_params);
         noisy = &blended;
@@ -178,6 +183,7 @@ LiveFrame LiveFrames::render(const ViewRequest& request) {
     if (s.controller && options_.share_frame_time) {
         s.controller->set_target_seconds(options_.frame_time_s / double(active_sessions(request.session, start)));
     }
+    frame.still = is_still(s, request);
     frame.rendered = plan(s, request, choice);
     const bool continues = options_.progressive && s.accumulation.continues(frame.rendered);
     RgbFloatImage radiance;

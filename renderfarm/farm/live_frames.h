@@ -32,9 +32,11 @@
 //    any number of ranks; the accumulation keeps the raw samples (never filtered ones). The
 //    filter's time is part of LiveFrame::seconds, which the frame-time target observes, so the
 //    target still holds with it (it shrinks the frame to pay for the filter). With `temporal`, a
-//    filtered frame that is not a still view's accumulation is first blended with the session's
-//    earlier frames, reprojected by depth (temporal_accumulation.h; exact for a static scene, with
-//    disocclusion rejection): the temporal half of SVGF before its spatial half.
+//    filtered moving frame is first blended with the session's earlier frames, reprojected by
+//    depth (temporal_accumulation.h; exact for a static scene, with disocclusion rejection): the
+//    temporal half of SVGF before its spatial half. A still view's frames are never blended: its
+//    first pass is already at full scale and unbiased, and the moving frames' history (smaller,
+//    from the radiance cache) would outweigh it.
 // A pass cut at the farm's frame budget (FrameStats::tiles_cut, frame_dispatcher.h) is sent alone
 // and never accumulated: its coarse tiles would stay in the mean.
 // Sessions are forgotten least-recently-used beyond `max_sessions`.
@@ -104,6 +106,7 @@ struct LiveFrame {
     ViewRequest rendered;          // the view as traced: scale, spp and frame_id of the pass
     int samples = 0;               // samples per pixel in `image` (all accumulated passes)
     int passes = 1;                // passes in `image`
+    bool still = false;            // the request repeated the session's previous view (a still view)
     bool rendered_now = true;      // false: a converged still view, sent from the accumulation
     bool denoised = false;         // `image` is the filtered frame
     double seconds = 0.0;          // render + composite (+ accumulate, + denoise) on the admin, wall
@@ -149,6 +152,7 @@ private:
     // Sessions handed a frame within kActiveWindow before `now`, `current` counted even if new.
     [[nodiscard]] std::size_t active_sessions(std::uint64_t current, std::chrono::steady_clock::time_point now) const;
     static constexpr std::chrono::seconds kActiveWindow{2};
+    [[nodiscard]] bool is_still(const Session& s, const ViewRequest& request) const;
     [[nodiscard]] ViewRequest plan(Session& s, const ViewRequest& request, FrameChoice& choice) const;
     [[nodiscard]] Rgb8Image to_display(const RgbFloatImage& radiance) const;
     [[nodiscard]] bool accumulates(const LiveFrame& frame) const;

@@ -254,7 +254,7 @@ TEST_F(LiveFramesTest, DenoisedMovingFrameIsCloserToAManySppReferenceThanTheRawO
 
 // A moving view with temporal accumulation: each filtered frame is blended with the earlier frames
 // reprojected to it, so the last of a turn is closer to the reference than the filter alone makes
-// it; frames of a still view's accumulation are not blended (their mean stays unbiased).
+// it; a still view's frames, its first pass included, are not blended (unbiased at full scale).
 TEST_F(LiveFramesTest, TemporalAccumulationBringsAMovingFrameCloserToTheReference) {
     ViewRequest request = view(0.0);
     request.size = {96, 72};
@@ -286,6 +286,27 @@ TEST_F(LiveFramesTest, TemporalAccumulationBringsAMovingFrameCloserToTheReferenc
     (void)temporal.render(still);  // the still view's second pass: accumulated, not blended
     still.frame_id = 201;
     EXPECT_EQ(filtered.render(still).image.pixels, temporal.render(still).image.pixels);
+
+    // Moving frames from the radiance cache are not accumulated, so the still view's first pass
+    // follows a moving history of cached frames: it is not blended with them either.
+    filtered_options.radiance_cache = temporal_options.radiance_cache = true;
+    LiveFrames cached(source(), filtered_options, 1.f, ToneMap::clamp);
+    LiveFrames cached_temporal(source(), temporal_options, 1.f, ToneMap::clamp);
+    for (int k = 3; k >= 0; --k) {
+        ViewRequest r = request;
+        r.pose.yaw_deg += k;
+        r.frame_id = 300 + static_cast<std::uint64_t>(3 - k);
+        renderer_.clear_radiance_cache();
+        (void)cached.render(r);
+        renderer_.clear_radiance_cache();
+        (void)cached_temporal.render(r);
+    }
+    still.frame_id = 400;
+    const LiveFrame first = cached.render(still);
+    ASSERT_EQ(first.passes, 1);
+    ASSERT_TRUE(first.still);
+    EXPECT_EQ(first.image.pixels, cached_temporal.render(still).image.pixels)
+        << "a still view's first pass is not blended with the moving history";
 }
 
 // A still view: the guides are traced with its first pass only, and frames are filtered while they
