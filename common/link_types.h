@@ -26,6 +26,10 @@ struct RenderedFrame {
     std::vector<std::uint8_t> jpeg;  // baseline JFIF, sRGB
     // When tracing ended and encoding began; 0 lets the server use the time the renderer returned.
     std::int64_t render_end_ns = 0;
+    // What the frame holds as served: samples per pixel (all accumulated passes) and indirect
+    // bounces; 0 = not reported.
+    std::uint32_t spp = 0;
+    std::uint32_t bounces = 0;
 };
 
 struct FrameTimestamps {
@@ -44,6 +48,8 @@ struct LinkFrame {
     std::uint64_t request_id = 0;  // the request it answers (ViewRequest::frame_id on the farm)
     ViewerPose pose;               // the pose it was rendered for
     ImageSize size;                // JPEG pixels
+    std::uint32_t spp = 0;         // samples per pixel as served (RenderedFrame::spp); 0 = not reported
+    std::uint32_t bounces = 0;     // indirect bounces as served; 0 = none or not reported
     FrameTimestamps times;
     std::vector<std::uint8_t> jpeg;
 };

@@ -30,9 +30,9 @@ Status KioskDisplay::show_card(const Rgb8Image& card) {
 }
 
 void KioskDisplay::show(const ContentFrame& f) {
-    pending_[f.request_id] =
-        PresentedFrame{f.request_id, f.link_frame_id,     f.jpeg_bytes, f.times.request_ns, f.times.receive_ns, 0,
-                       f.decode_ms,  stats_.rounds() + 1, f.image.size};
+    pending_[f.request_id] = PresentedFrame{
+        f.request_id,        f.link_frame_id, f.jpeg_bytes, f.times.request_ns, f.times.receive_ns, 0, f.decode_ms,
+        stats_.rounds() + 1, f.image.size,    f.spp,        f.bounces};
     while (pending_.size() > kMaxPendingFrames) pending_.erase(pending_.begin());
     if (Status s = presenter_.show(f.image, f.request_id); !s) spdlog::warn("present: {}", s.error().message);
     account();

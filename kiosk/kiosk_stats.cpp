@@ -133,6 +133,24 @@ std::vector<double> served_scales(const std::vector<PresentedFrame>& history, co
     return out;
 }
 
+// The samples per pixel and bounces of the frames the farm reported them for: mean and least of
+// each; null when no frame carried them (a farm from before the fields).
+nlohmann::json served_quality_summary(const std::vector<PresentedFrame>& history) {
+    double spp_sum = 0, bounce_sum = 0;
+    std::uint32_t spp_min = 0, bounce_min = 0;
+    std::size_t n = 0;
+    for (const auto& f : history) {
+        if (f.served_spp == 0) continue;
+        spp_min = n == 0 ? f.served_spp : std::min(spp_min, f.served_spp);
+        bounce_min = n == 0 ? f.served_bounces : std::min(bounce_min, f.served_bounces);
+        spp_sum += f.served_spp, bounce_sum += f.served_bounces, ++n;
+    }
+    if (n == 0) return nullptr;
+    return {{"frames", n},
+            {"spp", {{"mean", round3(spp_sum / double(n))}, {"min", spp_min}}},
+            {"bounces", {{"mean", round3(bounce_sum / double(n))}, {"min", bounce_min}}}};
+}
+
 // Their mean, least and 5th percentile; null without any.
 nlohmann::json served_scale_summary(std::vector<double> scales) {
     if (scales.empty()) return nullptr;
@@ -160,9 +178,12 @@ nlohmann::json KioskStats::to_json(const nlohmann::json& extra) const {
                           {"display_round", f.display_round},
                           {"served", {f.served.width, f.served.height}}});
         if (!scales.empty()) frames.back()["served_scale"] = round3(scales[frames.size() - 1]);
+        if (f.served_spp > 0)
+            frames.back()["served_spp"] = f.served_spp, frames.back()["served_bounces"] = f.served_bounces;
     }
     nlohmann::json total = summary_json(total_summary());
     total["served_scale"] = served_scale_summary(scales);
+    total["served_quality"] = served_quality_summary(history_);
     nlohmann::json out = {
         {"frames_presented", frames_},      {"jpeg_bytes_presented", bytes_},           {"frames_rejected", rejected_},
         {"frames_superseded", superseded_}, {"frames_out_of_order", out_of_order_},     {"display_rounds", rounds_},

@@ -49,6 +49,8 @@ struct PresentedFrame {
     double decode_ms = 0;
     std::uint64_t display_round = 0;  // the kiosk's display round that first showed it
     ImageSize served;                 // the frame's pixels as the farm rendered them (its JPEG's size)
+    std::uint32_t served_spp = 0;     // its samples per pixel as served (0: the farm did not say)
+    std::uint32_t served_bounces = 0;  // its indirect bounces as served
 };
 
 struct StatsSummary {
@@ -89,7 +91,9 @@ public:
     // Everything: summaries, counters, events, per-frame list. `extra` is merged at the top level.
     // When `extra` holds "content": [width, height] (run_stats_json), each frame's served scale
     // (its height over the content's: the guard band widens a request, never heightens it) is in
-    // the per-frame list and its mean, least and 5th percentile in "total.served_scale".
+    // the per-frame list and its mean, least and 5th percentile in "total.served_scale". Each frame's
+    // samples per pixel and bounces as served, when the farm reported them, are in the per-frame list
+    // ("served_spp", "served_bounces") and their mean and least in "total.served_quality".
     [[nodiscard]] nlohmann::json to_json(const nlohmann::json& extra = nlohmann::json::object()) const;
 
     // Writes to_json(extra) atomically (common/file_io.h). Throws std::system_error

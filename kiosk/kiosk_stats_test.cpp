@@ -75,6 +75,32 @@ TEST(KioskStats, JsonHoldsTheServedSizeAndScaleOfEveryFrame) {
     EXPECT_TRUE(bare["total"]["served_scale"].is_null());
 }
 
+// The samples and bounces the farm served each frame with (a still view's accumulation counts every
+// pass); frames from a farm that did not report them (0) are left out of the summary.
+TEST(KioskStats, JsonHoldsTheServedSamplesAndBouncesOfEveryFrame) {
+    KioskStats stats;
+    const std::uint32_t spp[4] = {1, 0, 3, 5}, bounces[4] = {1, 0, 2, 2};
+    for (std::uint64_t k = 1; k <= 4; ++k) {
+        PresentedFrame f = frame(k);
+        f.served_spp = spp[k - 1];
+        f.served_bounces = bounces[k - 1];
+        stats.presented(f);
+    }
+    const nlohmann::json j = stats.to_json();
+    EXPECT_EQ(j["frames"][2]["served_spp"], 3);
+    EXPECT_EQ(j["frames"][2]["served_bounces"], 2);
+    EXPECT_FALSE(j["frames"][1].contains("served_spp")) << "not reported: no value made up";
+    const nlohmann::json& q = j["total"]["served_quality"];
+    EXPECT_EQ(q["frames"], 3);
+    EXPECT_NEAR(q["spp"]["mean"].get<double>(), 3.0, 1e-9);
+    EXPECT_EQ(q["spp"]["min"], 1);
+    EXPECT_NEAR(q["bounces"]["mean"].get<double>(), 5.0 / 3.0, 1e-3);
+    EXPECT_EQ(q["bounces"]["min"], 1);
+    KioskStats none;
+    none.presented(frame(1));
+    EXPECT_TRUE(none.to_json()["total"]["served_quality"].is_null());
+}
+
 TEST(KioskStats, JsonHoldsCountersEventsAndFramesInOrder) {
     KioskStats stats;
     stats.presented(frame(1));

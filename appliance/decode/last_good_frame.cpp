@@ -34,6 +34,8 @@ std::string LastGoodFrame::accept(const LinkFrame& frame) {
     next.pose = frame.pose;
     next.times = frame.times;
     next.jpeg_bytes = frame.jpeg.size();
+    next.spp = frame.spp;
+    next.bounces = frame.bounces;
     current_ = std::move(next);
     ++accepted_;
     return {};

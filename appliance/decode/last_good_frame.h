@@ -30,6 +30,8 @@ struct ContentFrame {
     FrameTimestamps times;           // request (appliance clock) ... receive (appliance clock)
     std::size_t jpeg_bytes = 0;
     double decode_ms = 0;            // TurboJPEG decode time on the kiosk
+    std::uint32_t spp = 0;           // samples per pixel as the farm served it (0: not reported)
+    std::uint32_t bounces = 0;       // indirect bounces as the farm served it
 };
 
 class LastGoodFrame {

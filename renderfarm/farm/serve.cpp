@@ -37,12 +37,15 @@ struct ServedFrame {
     int jpeg_quality = 85;
     std::int64_t render_end_ns = 0;
     std::optional<RenderedFrame> encoded;
+    std::uint32_t spp = 0, bounces = 0;  // as served (LiveFrame::samples, the traced view's bounces)
 };
 
 RenderedFrame encode(const ServedFrame& frame, JpegEncoder& encoder) {
     RenderedFrame out;
     out.size = frame.image.size;
     out.render_end_ns = frame.render_end_ns;
+    out.spp = frame.spp;
+    out.bounces = frame.bounces;
     out.jpeg = encoder.encode(frame.image, frame.jpeg_quality);
     return out;
 }
@@ -166,7 +169,12 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& s
             LiveFrame frame = live.render(budget.apply(policy.apply(job->view, who), key, share_s));
             budget.observe(key, frame);
             metrics.observe_frame(frame.stats, frame.seconds, double(realtime_ns()) * 1e-9, who);
-            ServedFrame out{std::move(frame.image), job->view.quality.jpeg_quality, realtime_ns(), std::nullopt};
+            ServedFrame out{std::move(frame.image),
+                            job->view.quality.jpeg_quality,
+                            realtime_ns(),
+                            std::nullopt,
+                            static_cast<std::uint32_t>(std::max(frame.samples, 0)),
+                            static_cast<std::uint32_t>(std::max(frame.rendered.quality.max_bounces, 0))};
             if (!options.pipeline) out.encoded = encode(out, encoder);
             job->result.set_value(std::move(out));
         } catch (const RankTimeout& e) {

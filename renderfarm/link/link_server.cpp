@@ -421,6 +421,8 @@ std::optional<v1::FrameMsg> LinkServer::Impl::render(const SessionState& s, cons
     frame.set_encode_end_ns(end_ns);
     frame.set_width(static_cast<std::uint32_t>(rendered.size.width));
     frame.set_height(static_cast<std::uint32_t>(rendered.size.height));
+    frame.set_spp(rendered.spp);
+    frame.set_bounces(rendered.bounces);
     frame.mutable_jpeg()->assign(reinterpret_cast<const char*>(rendered.jpeg.data()), rendered.jpeg.size());
     return frame;
 }

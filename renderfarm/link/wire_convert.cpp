@@ -198,6 +198,8 @@ std::string frame_from_msg(v1::FrameMsg& msg, LinkFrame& out) {
     out.frame_id = msg.frame_id();
     out.request_id = msg.request_id();
     out.size = {static_cast<int>(msg.width()), static_cast<int>(msg.height())};
+    out.spp = msg.spp();
+    out.bounces = msg.bounces();
     out.times.request_ns = msg.request_time_ns();
     out.times.received_ns = msg.received_ns();
     out.times.render_start_ns = msg.render_start_ns();

@@ -175,6 +175,8 @@ v1::FrameMsg good_frame() {
     f.set_send_ns(60);
     f.set_width(640);
     f.set_height(360);
+    f.set_spp(5);
+    f.set_bounces(2);
     f.set_jpeg(std::string("\xff\xd8 fake jpeg", 12));
     return f;
 }
@@ -187,6 +189,8 @@ TEST(WireConvert, FrameConvertsWithTimestamps) {
     EXPECT_EQ(frame.request_id, 42u);
     EXPECT_EQ(frame.pose.yaw_deg, -30.5);
     EXPECT_EQ(frame.size, (ImageSize{640, 360}));
+    EXPECT_EQ(frame.spp, 5u);
+    EXPECT_EQ(frame.bounces, 2u);
     EXPECT_EQ(frame.times.request_ns, 10);
     EXPECT_EQ(frame.times.received_ns, 20);
     EXPECT_EQ(frame.times.render_start_ns, 30);
