@@ -176,12 +176,13 @@ def plug(qmp, journal, img, n, timeout, during=None):
     """Hot-plugs stick n, waits until the guest says it can be removed, unplugs it. `during`: called
     with the journal when the guest says its calibration started (the wall's screendump)."""
     qmp.cmd("blockdev-add", driver="raw", **{"node-name": f"stick{n}"}, file={"driver": "file", "filename": img})
-    qmp.cmd("device_add", driver="usb-storage", id=f"usb{n}", drive=f"stick{n}", bus="xhci.0", removable=True)
+    qmp.cmd("device_add", driver="usb-storage", id=f"usb{n}", drive=f"stick{n}", bus="xhci.0")
     t = time.monotonic()
     if during is not None and journal.wait(r"mogao-service: calibration: mogao-calibrate ", timeout):
         during()
     done = journal.wait(r"mogao-service: done: the stick can be removed", timeout)
     seconds = time.monotonic() - t
+    journal.wait(r"mogao-service@\S+\.service: (Deactivated successfully|Failed with result)", 60)
     qmp.cmd("device_del", id=f"usb{n}")
     deadline = time.monotonic() + 30
     while not any(e.get("event") == "DEVICE_DELETED" and e.get("data", {}).get("device") == f"usb{n}" for e in qmp.events):
