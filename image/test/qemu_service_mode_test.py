@@ -24,13 +24,14 @@ One boot, in order (each printed; any failure fails the test):
   2. the same stick's request signed for "status" and then edited (action changed): refused for its
      signature;
   3. the first request again (a replay): refused for its serial;
-  4. an unsigned request: refused;
-  5. status: the status panel toggled on and off, outcome "done";
-  6. logs: the journal, the status file and the installed calibration come back on the stick; the
+  4. status: the status panel toggled on and off, outcome "done";
+  5. logs: the journal, the status file and the installed calibration come back on the stick; the
      MPCDI is byte-identical to what request 1 installed (2-4 changed nothing), its last good copy
      is OLD, and it is within the calibration's geometry goals against the rig's ground truth
      (mogao-rig-film measure: mean <= 0.3, p95 <= 0.8 projector pixels of the half-scale rig); the
      kiosk was stopped once only; every output lit by the kiosk.
+An unsigned request and the other refusals are checked on the host (service_mode_requests), not
+here: each stick costs about 15 s under TCG.
 Exit 77 (skip) with a message when QEMU, OVMF, mtools, mkfs.vfat, openssl or the image are missing.
 """
 import argparse
@@ -134,8 +135,8 @@ def provision(a, work, env):
     return img, os.path.join(work, "keys", "service-signing.key"), old_mpcdi, captures
 
 
-def make_stick(a, work, name, env, key, action, serial, captures=None, tamper=None, unsigned=False, extra=()):
-    """A FAT stick image holding a request signed by `key` (then tampered with, or unsigned)."""
+def make_stick(a, work, name, env, key, action, serial, captures=None, tamper=None, extra=()):
+    """A FAT stick image holding a request signed by `key` (then tampered with)."""
     stage = os.path.join(work, f"stick-{name}")
     shutil.rmtree(stage, ignore_errors=True)
     os.makedirs(stage)
@@ -150,8 +151,6 @@ def make_stick(a, work, name, env, key, action, serial, captures=None, tamper=No
             text = f.read()
         with open(req, "w") as f:
             f.write(text.replace(*tamper))
-    if unsigned:
-        os.remove(req + ".sig")
     img = os.path.join(work, f"stick-{name}.img")
     if os.path.exists(img):
         os.remove(img)
@@ -238,7 +237,6 @@ def check_requests(a, work, proc, fails, env, key, old_mpcdi, captures, results)
         "calibrate": make_stick(a, work, "calibrate", env, key, "calibrate", serial + 1, captures, extra=("--hold-s", "3")),
         "tampered": make_stick(a, work, "tampered", env, key, "status", serial + 2,
                                tamper=('action = "status"', 'action = "calibrate"')),
-        "unsigned": make_stick(a, work, "unsigned", env, key, "logs", serial + 3, unsigned=True),
         "status": make_stick(a, work, "status", env, key, "status", serial + 4, extra=("--show-s", "2")),
         "logs": make_stick(a, work, "logs", env, key, "logs", serial + 5),
     }
@@ -265,18 +263,17 @@ def check_requests(a, work, proc, fails, env, key, old_mpcdi, captures, results)
     fails.check("calibration" in log_text, f"calibrate: calibrate.log on the stick ({len(log_text)} bytes)")
 
     for n, (name, img, want) in enumerate((("tampered", sticks["tampered"], "bad signature"),
-                                           ("replay", replay, "used already"),
-                                           ("unsigned", sticks["unsigned"], "not signed")), start=2):
+                                           ("replay", replay, "used already")), start=2):
         ok, secs = plug(qmp, journal, img, n, a.timeout)
         rr = result_of(img, env)
         fails.check(ok and rr.get("outcome") == "refused" and want in rr.get("reason", ""),
                     f"{name}: refused ({rr.get('reason')}) in {secs:.0f} s")
 
-    ok, secs = plug(qmp, journal, sticks["status"], 5, a.timeout)
+    ok, secs = plug(qmp, journal, sticks["status"], 4, a.timeout)
     rs = result_of(sticks["status"], env)
     fails.check(ok and rs.get("outcome") == "done", f"status: panel shown ({rs.get('reason')}) in {secs:.0f} s")
 
-    ok, secs = plug(qmp, journal, sticks["logs"], 6, a.timeout)
+    ok, secs = plug(qmp, journal, sticks["logs"], 5, a.timeout)
     rl = result_of(sticks["logs"], env)
     fails.check(ok and rl.get("outcome") == "done", f"logs: {rl.get('reason')} in {secs:.0f} s")
     mpcdi = read_stick(sticks["logs"], "logs/screen.mpcdi", env) or b""
