@@ -24,7 +24,8 @@ One boot, in order (each printed; any failure fails the test):
   2. the same stick's request signed for "status" and then edited (action changed): refused for its
      signature;
   3. the first request again (a replay): refused for its serial;
-  4. status: the status panel toggled on and off, outcome "done";
+  4. status: the status panel toggled on and off, outcome "done"; output 0 differs from its
+     screendump before the request while the panel is on;
   5. logs: the journal, the status file and the installed calibration come back on the stick; the
      MPCDI is byte-identical to what request 1 installed (2-4 changed nothing), its last good copy
      is OLD, and it is within the calibration's geometry goals against the rig's ground truth
@@ -172,13 +173,13 @@ def result_of(img, env):
 
 
 def plug(qmp, journal, img, n, timeout, during=None):
-    """Hot-plugs stick n, waits until the guest says it can be removed, unplugs it. `during`: called
-    with the journal when the guest says its calibration started (the wall's screendump)."""
+    """Hot-plugs stick n, waits until the guest says it can be removed, unplugs it. `during`:
+    (pattern, function): the function is called once the guest's journal matches the pattern."""
     qmp.cmd("blockdev-add", driver="raw", **{"node-name": f"stick{n}"}, file={"driver": "file", "filename": img})
     qmp.cmd("device_add", driver="usb-storage", id=f"usb{n}", drive=f"stick{n}", bus="xhci.0")
     t = time.monotonic()
-    if during is not None and journal.wait(r"mogao-service: calibration: mogao-calibrate ", timeout):
-        during()
+    if during is not None and journal.wait(during[0], timeout):
+        during[1]()
     done = journal.wait(r"mogao-service: done: the stick can be removed", timeout)
     seconds = time.monotonic() - t
     journal.wait(r"mogao-service@\S+\.service: (Deactivated successfully|Failed with result)", 60)
@@ -208,6 +209,15 @@ def lit_fraction(path):
     return lit / max(1, len(pixels) // (3 * 7))
 
 
+def changed_fraction(a, b):
+    """Fraction of sampled pixels that differ by more than 32 codes between two P6 PPMs of one size."""
+    pa, pb = (open(p, "rb").read().split(b"\n", 3)[3] if os.path.exists(p) else b"" for p in (a, b))
+    if not pa or len(pa) != len(pb):
+        return 0.0
+    idx = range(0, len(pa) - 2, 3 * 5)
+    return sum(1 for i in idx if abs(pa[i] - pb[i]) > 32 or abs(pa[i + 1] - pb[i + 1]) > 32) / len(idx)
+
+
 def qemu_command(qemu, a, work, img):
     vars_fd = os.path.join(work, "OVMF_VARS.fd")
     shutil.copy(OVMF_VARS, vars_fd)
@@ -221,6 +231,34 @@ def qemu_command(qemu, a, work, img):
             "-netdev", "user,id=n0,ipv4=off,ipv6=on", "-device", "virtio-net-pci,netdev=n0",
             "-display", "none", "-serial", f"file:{os.path.join(work, 'serial.log')}",
             "-qmp", f"unix:{os.path.join(work, 'qmp.sock')},server=on,wait=off"]
+
+
+def check_logs(a, work, qmp, journal, fails, env, stick, installed_sha, old_mpcdi, results):
+    """The logs request, after the others: the calibration as the calibrate request left it."""
+    ok, secs = plug(qmp, journal, stick, 5, a.timeout)
+    rl = result_of(stick, env)
+    fails.check(ok and rl.get("outcome") == "done", f"logs: {rl.get('reason')} in {secs:.0f} s")
+    mpcdi = read_stick(stick, "logs/screen.mpcdi", env) or b""
+    last_good = read_stick(stick, "logs/screen.mpcdi.last-good", env) or b""
+    journal_text = (read_stick(stick, "logs/journal.txt", env) or b"").decode(errors="replace")
+    fails.check(hashlib.sha256(mpcdi).hexdigest() == installed_sha,
+                "the calibration is byte-identical to what the calibrate request installed (the refused ones changed nothing)")
+    with open(old_mpcdi, "rb") as f:
+        fails.check(last_good == f.read(), "its last good copy is the calibration installed before")
+    fetched = os.path.join(work, "fetched-screen.mpcdi")
+    with open(fetched, "wb") as f:
+        f.write(mpcdi)
+    m = re.search(r"geometry mean ([0-9.]+) p95 ([0-9.]+)", run([a.rig_film, "--rig", os.path.join(a.repo, RIG),
+                  "--scale", str(SCALE), "measure", "--mpcdi", fetched]).stdout) if mpcdi else None
+    results["geometry_px"] = [float(m.group(1)), float(m.group(2))] if m else None
+    fails.check(m is not None and float(m.group(1)) <= GOAL_MEAN_PX and float(m.group(2)) <= GOAL_P95_PX,
+                f"the new calibration against the rig's ground truth: {results['geometry_px']} (mean, p95 px)")
+    stops = len(re.findall(r"Stopping mogao-kiosk\.service", journal_text))
+    fails.check(len(journal_text) > 1000 and stops == 1,
+                f"logs: the journal on the stick ({len(journal_text)} bytes); the kiosk stopped {stops} time(s)")
+    lit = [screendump(qmp, work, "after", h) for h in range(OUTPUTS)]
+    fails.check(all(mean > 10 for _, _, mean, _ in lit),
+                f"every output lit by the kiosk after the requests (mean codes {[round(x[2], 1) for x in lit]})")
 
 
 def check_requests(a, work, proc, fails, env, key, old_mpcdi, captures, results):
@@ -237,7 +275,7 @@ def check_requests(a, work, proc, fails, env, key, old_mpcdi, captures, results)
         "calibrate": make_stick(a, work, "calibrate", env, key, "calibrate", serial + 1, captures, extra=("--hold-s", "3")),
         "tampered": make_stick(a, work, "tampered", env, key, "status", serial + 2,
                                tamper=('action = "status"', 'action = "calibrate"')),
-        "status": make_stick(a, work, "status", env, key, "status", serial + 4, extra=("--show-s", "2")),
+        "status": make_stick(a, work, "status", env, key, "status", serial + 4, extra=("--show-s", "6")),
         "logs": make_stick(a, work, "logs", env, key, "logs", serial + 5),
     }
     replay = os.path.join(work, "stick-replay.img")
@@ -249,7 +287,7 @@ def check_requests(a, work, proc, fails, env, key, old_mpcdi, captures, results)
         screendump(qmp, work, "calibrating", 0)
         wall["lit"] = lit_fraction(os.path.join(work, "calibrating-head0.ppm"))
 
-    ok, secs = plug(qmp, journal, sticks["calibrate"], 1, a.timeout, during)
+    ok, secs = plug(qmp, journal, sticks["calibrate"], 1, a.timeout, (r"mogao-service: calibration: mogao-calibrate ", during))
     r = result_of(sticks["calibrate"], env)
     results["calibrate_request_s"] = round(secs, 1)
     fails.check(ok and r.get("outcome") == "done" and r.get("calibrate_exit") == "0",
@@ -269,34 +307,19 @@ def check_requests(a, work, proc, fails, env, key, old_mpcdi, captures, results)
         fails.check(ok and rr.get("outcome") == "refused" and want in rr.get("reason", ""),
                     f"{name}: refused ({rr.get('reason')}) in {secs:.0f} s")
 
-    ok, secs = plug(qmp, journal, sticks["status"], 4, a.timeout)
+    screendump(qmp, work, "before-status", 0)
+
+    def panel():
+        time.sleep(3)  # the kiosk draws it at its next tick (2 Hz)
+        screendump(qmp, work, "status", 0)
+
+    ok, secs = plug(qmp, journal, sticks["status"], 4, a.timeout, (r"mogao-service: status panel on the wall", panel))
     rs = result_of(sticks["status"], env)
     fails.check(ok and rs.get("outcome") == "done", f"status: panel shown ({rs.get('reason')}) in {secs:.0f} s")
+    changed = changed_fraction(os.path.join(work, "before-status-head0.ppm"), os.path.join(work, "status-head0.ppm"))
+    fails.check(changed > 0.005, f"status: the panel on the wall (output 0: {changed:.3f} of its pixels changed)")
 
-    ok, secs = plug(qmp, journal, sticks["logs"], 5, a.timeout)
-    rl = result_of(sticks["logs"], env)
-    fails.check(ok and rl.get("outcome") == "done", f"logs: {rl.get('reason')} in {secs:.0f} s")
-    mpcdi = read_stick(sticks["logs"], "logs/screen.mpcdi", env) or b""
-    last_good = read_stick(sticks["logs"], "logs/screen.mpcdi.last-good", env) or b""
-    journal_text = (read_stick(sticks["logs"], "logs/journal.txt", env) or b"").decode(errors="replace")
-    fails.check(hashlib.sha256(mpcdi).hexdigest() == r.get("calibration_after"),
-                "the calibration is byte-identical to what the calibrate request installed (the refused ones changed nothing)")
-    with open(old_mpcdi, "rb") as f:
-        fails.check(last_good == f.read(), "its last good copy is the calibration installed before")
-    fetched = os.path.join(work, "fetched-screen.mpcdi")
-    with open(fetched, "wb") as f:
-        f.write(mpcdi)
-    m = re.search(r"geometry mean ([0-9.]+) p95 ([0-9.]+)", run([a.rig_film, "--rig", os.path.join(a.repo, RIG),
-                  "--scale", str(SCALE), "measure", "--mpcdi", fetched]).stdout) if mpcdi else None
-    results["geometry_px"] = [float(m.group(1)), float(m.group(2))] if m else None
-    fails.check(m is not None and float(m.group(1)) <= GOAL_MEAN_PX and float(m.group(2)) <= GOAL_P95_PX,
-                f"the new calibration against the rig's ground truth: {results['geometry_px']} (mean, p95 px)")
-    stops = len(re.findall(r"Stopping mogao-kiosk\.service", journal_text))
-    fails.check(len(journal_text) > 1000 and stops == 1,
-                f"logs: the journal on the stick ({len(journal_text)} bytes); the kiosk stopped {stops} time(s)")
-    lit = [screendump(qmp, work, "after", h) for h in range(OUTPUTS)]
-    fails.check(all(mean > 10 for _, _, mean, _ in lit),
-                f"every output lit by the kiosk after the requests (mean codes {[round(x[2], 1) for x in lit]})")
+    check_logs(a, work, qmp, journal, fails, env, sticks["logs"], r.get("calibration_after"), old_mpcdi, results)
 
 
 def main():
