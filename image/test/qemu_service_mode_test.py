@@ -32,6 +32,9 @@ One boot, in order (each printed; any failure fails the test):
      is OLD, and it is within the calibration's geometry goals against the rig's ground truth
      (mogao-rig-film measure: mean <= 0.3, p95 <= 0.8 projector pixels of the half-scale rig); the
      kiosk was stopped once only; every output lit by the kiosk.
+--live: request 1 calibrates on the guest's KMS outputs with the virtual rig's simulated camera
+(calibrate.args: --outputs kms --camera rig:/etc/mogao/site.toml, as image_qemu_boot runs it; its
+patterns on the wall) instead of captures on the stick; a manual run, minutes more under TCG.
 An unsigned request and the other refusals are checked on the host (service_mode_requests), not
 here: each stick costs about 15 s under TCG.
 Exit 77 (skip) with a message when QEMU, OVMF, mtools, mkfs.vfat, openssl or the image are missing.
@@ -114,8 +117,12 @@ def provision(a, work, env):
     shutil.copy(old_models, os.path.join(cfg, "screen.models.json"))
     shutil.copy(site, os.path.join(cfg, "site.toml"))
     with open(os.path.join(cfg, "calibrate.args"), "w") as f:  # --outputs/--camera: dropped with captures
-        f.write("# the on-site calibration's options (docs/service-mode.md)\n--outputs\nkms\n--scale\n"
-                f"{SCALE}\n--camera-transfer\nlinear\n--no-bow\n")
+        f.write("# the on-site calibration's options (docs/service-mode.md)\n")
+        if a.live:  # the KMS outputs filmed by the rig's SIMULATED camera, as image_qemu_boot runs it
+            f.write("--outputs\nkms\n--camera\nrig:/etc/mogao/site.toml\n--no-colour\n--no-bow\n--settle-ms\n0\n"
+                    "--drop-frames\n0\n")
+        else:
+            f.write(f"--outputs\nkms\n--scale\n{SCALE}\n--camera-transfer\nlinear\n--no-bow\n")
     overrides = ['farm.endpoint="[fec0::2]:48615"', 'farm.ca="pki/ca.pem"', 'farm.cert="pki/appliance-museum-1.pem"',
                  'farm.key="pki/appliance-museum-1.key"', "display.rate_hz=2", 'outputs.backend="kms"',
                  'calibration.source="screen.mpcdi"', 'quality.content="480x270"', "stats.file=",
@@ -242,7 +249,7 @@ def check_logs(a, work, qmp, journal, fails, env, stick, installed_sha, old_mpcd
     with open(fetched, "wb") as f:
         f.write(mpcdi)
     m = re.search(r"geometry mean ([0-9.]+) p95 ([0-9.]+)", run([a.rig_film, "--rig", os.path.join(a.repo, RIG),
-                  "--scale", str(SCALE), "measure", "--mpcdi", fetched]).stdout) if mpcdi else None
+                  "--scale", str(1.0 if a.live else SCALE), "measure", "--mpcdi", fetched]).stdout) if mpcdi else None
     results["geometry_px"] = [float(m.group(1)), float(m.group(2))] if m else None
     fails.check(m is not None and float(m.group(1)) <= GOAL_MEAN_PX and float(m.group(2)) <= GOAL_P95_PX,
                 f"the new calibration against the rig's ground truth: {results['geometry_px']} (mean, p95 px)")
@@ -265,7 +272,8 @@ def check_requests(a, work, proc, fails, env, key, old_mpcdi, captures, results)
         return
     serial = int(time.time())
     sticks = {
-        "calibrate": make_stick(a, work, "calibrate", env, key, "calibrate", serial + 1, captures, extra=("--hold-s", "3")),
+        "calibrate": make_stick(a, work, "calibrate", env, key, "calibrate", serial + 1, None if a.live else captures,
+                                extra=("--hold-s", "3")),
         "tampered": make_stick(a, work, "tampered", env, key, "status", serial + 2,
                                tamper=('action = "status"', 'action = "calibrate"')),
         "status": make_stick(a, work, "status", env, key, "status", serial + 4, extra=("--show-s", "1")),
@@ -328,6 +336,9 @@ def main():
     ap.add_argument("--repo", required=True)
     for t in ("kiosk", "farm", "calibrate", "rig-film"):
         ap.add_argument(f"--{t}", required=True, help=f"host mogao-{t} (prepares the files)")
+    ap.add_argument("--live", action="store_true",
+                    help="calibrate on the KMS outputs with the rig's simulated camera instead of captures on the "
+                         "stick (minutes more under TCG; not in CI)")
     ap.add_argument("--work", default="")
     ap.add_argument("--accel", default=os.environ.get("MOGAO_IMAGE_QEMU_ACCEL", "tcg"), choices=["tcg", "kvm"])
     ap.add_argument("--timeout", type=float, default=float(os.environ.get("MOGAO_IMAGE_BOOT_TIMEOUT", "900")))
