@@ -10,7 +10,10 @@ command -v systemd-analyze >/dev/null || { echo "SKIP: systemd-analyze not insta
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 mkdir -p "$work/root/usr/bin"
-for b in mpirun mogao-farm mogao-farm-launch mogao-kiosk; do printf '#!/bin/sh\n' > "$work/root/usr/bin/$b"; chmod +x "$work/root/usr/bin/$b"; done
+mkdir -p "$work/root/usr/lib/mogao"
+for b in bin/mpirun bin/mogao-farm bin/mogao-farm-launch bin/mogao-kiosk lib/mogao/mogao-service; do
+  printf '#!/bin/sh\n' > "$work/root/usr/$b"; chmod +x "$work/root/usr/$b"
+done
 fail=0
 for unit in "$dir"/*.service ${installed:+"$installed"/*.service}; do
   cp "$unit" "$work/"
@@ -18,7 +21,7 @@ for unit in "$dir"/*.service ${installed:+"$installed"/*.service}; do
   # installed copies their BINDIR's).
   from=/usr/bin/
   [[ "$unit" == "$installed"/* ]] && from=$bindir/
-  sed -i "s|$from|$work/root/usr/bin/|g" "$work/$(basename "$unit")"
+  sed -i -e "s|$from|$work/root/usr/bin/|g" -e "s|/usr/lib/mogao/|$work/root/usr/lib/mogao/|g" "$work/$(basename "$unit")"
   if out=$(systemd-analyze verify "$work/$(basename "$unit")" 2>&1) && [ -z "$out" ]; then
     echo "ok: verify $unit"
   else

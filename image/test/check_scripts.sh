@@ -10,7 +10,7 @@ bash -n "$dir/test/image_tests.sh"
 bash -n "$dir/test/build_vimc.sh"
 sh -n "$dir/test/selftest.sh"
 bash -n "$dir/test/powercut_guest.sh"
-python3 - "$dir/test/qemu_boot_test.py" "$dir/test/qemu_service_card_test.py" "$dir/test/qemu_common.py" "$dir/test/qemu_libcamera.py" "$dir/lib/prune_modules.py" "$dir/test/qemu_powercut_test.py" "$dir/test/powercut_report.py" <<'PY'
+python3 - "$dir/test/qemu_boot_test.py" "$dir/test/qemu_service_card_test.py" "$dir/test/qemu_common.py" "$dir/test/qemu_libcamera.py" "$dir/lib/prune_modules.py" "$dir/test/qemu_powercut_test.py" "$dir/test/powercut_report.py" "$dir/test/qemu_service_mode_test.py" <<'PY'
 import sys
 for f in sys.argv[1:]:
     compile(open(f).read(), f, "exec")
@@ -65,6 +65,19 @@ grep -q 'endpoint .farm.example:7443. is not "\[address\]:port"' <<< "$out" || {
 printf '[farm]\nendpoint = "[2001:db8::7]:7443"\n' > "$tmp/cfg/kiosk.toml"
 out=$("$dir/provision" --allow 10.1.0.0/16 --allow not-an-address "$tmp/none.img" "$tmp/cfg" 2>&1) && { echo "provision accepted --allow not-an-address"; exit 1; }
 grep -q "allow 'not-an-address' is not an IP address or prefix" <<< "$out" || { echo "provision: unexpected message: $out"; exit 1; }
+# provision takes the service mode's public key only (docs/service-mode.md): a private key and a
+# key of another type are refused, before it needs root or an image.
+if command -v openssl > /dev/null; then
+  openssl genpkey -algorithm ed25519 -out "$tmp/cfg/service-key.pem" 2> /dev/null
+  out=$("$dir/provision" "$tmp/none.img" "$tmp/cfg" 2>&1) && { echo "provision accepted a private service key"; exit 1; }
+  grep -q "service-key.pem: a private key" <<< "$out" || { echo "provision: unexpected message: $out"; exit 1; }
+  openssl genpkey -algorithm EC -pkeyopt ec_paramgen_curve:P-256 2> /dev/null | openssl pkey -pubout -out "$tmp/cfg/service-key.pem"
+  out=$("$dir/provision" "$tmp/none.img" "$tmp/cfg" 2>&1) && { echo "provision accepted an EC service key"; exit 1; }
+  grep -q "service-key.pem: not an Ed25519 public key" <<< "$out" || { echo "provision: unexpected message: $out"; exit 1; }
+  rm "$tmp/cfg/service-key.pem"
+fi
+bash -n "$dir/../kiosk/service_mode/mogao-service"
+bash -n "$dir/../kiosk/service_mode/mogao-service-request"
 # kiosk-ip-allow turns farm-addresses into runtime IPAddressAllow properties (systemctl stand-in),
 # and refuses a missing file, an empty list and a line that is not an address, naming the line.
 mkdir -p "$tmp/bin"

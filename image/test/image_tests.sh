@@ -7,6 +7,7 @@
 #   image_tests.sh powercut REPO OUTDIR KIOSK FARM CALIBRATE RIG_FILM   power cuts during writes
 #     (MOGAO_POWERCUT_CUTS cuts per write, default 3; MOGAO_POWERCUT_REBOOT_EVERY, default 0: no
 #     reboot on a cut disk, the full run does those; MOGAO_POWERCUT_SEED, default 1)
+#   image_tests.sh service-mode REPO OUTDIR KIOSK FARM CALIBRATE RIG_FILM   signed USB-stick requests
 # Exit 77 (skipped) with a message when not enabled (MOGAO_IMAGE_TESTS=1) or not possible here.
 set -u
 mode=$1 repo=$2 outdir=$3 kiosk=$4
@@ -51,6 +52,13 @@ case $mode in
       --farm "$farm" --calibrate "$calibrate" --rig-film "$rig_film" --binaries-into-image \
       --cuts "${MOGAO_POWERCUT_CUTS:-3}" --reboot-every "${MOGAO_POWERCUT_REBOOT_EVERY:-0}" \
       --work "$outdir/qemu-powercut" --results "$outdir/qemu-powercut-results.json"
+    ;;
+  service-mode)
+    farm=$5 calibrate=$6 rig_film=$7
+    image=${MOGAO_IMAGE:-$outdir/mogao-kiosk.img}
+    [[ -f "$image" ]] || skip "no image at $image (the image_build test builds it)"
+    exec python3 "$repo/image/test/qemu_service_mode_test.py" --image "$image" --repo "$repo" --kiosk "$kiosk" \
+      --farm "$farm" --calibrate "$calibrate" --rig-film "$rig_film" --work "$outdir/qemu-service-mode"
     ;;
   *) echo "unknown mode $mode" >&2; exit 2 ;;
 esac
