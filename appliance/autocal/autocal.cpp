@@ -302,7 +302,11 @@ void try_camera_intrinsics(BundleResult& ba, const CalibrationPrior& prior, cons
         kept_fixed += ba.inliers[k];
         kept_free += free.inliers[k];
     }
-    trial.kept = kept_free >= 0.99 * kept_fixed && trial.relative_cost < 1.0 - options.intrinsics_min_gain;
+    // A free fit that only rejected more points does not count; one that fits much better may reject more, its
+    // outlier limit (4x its median) being tighter: its cost's fall must then be ten times the points it lost.
+    const double lost = 1.0 - static_cast<double>(kept_free) / std::max(kept_fixed, 1);
+    const bool same_points = lost <= 0.01 || 1.0 - trial.relative_cost >= 10.0 * lost;
+    trial.kept = same_points && trial.relative_cost < 1.0 - options.intrinsics_min_gain;
     if (!trial.kept) return;
     check_camera_intrinsics(free, prior.camera, options);
     ba = std::move(free);
