@@ -58,6 +58,7 @@ void check_inputs(const CalibrationPrior& prior, ImageSize content, const Autoca
         fail("options.camera_sigma: focal, principal_point and distortion > 0");
     }
     if (!(o.camera_sigma_gate > 0.0 && o.camera_sigma_gate <= 1.0)) fail("options.camera_sigma_gate: (0, 1]");
+    if (!(o.intrinsics_min_gain >= 0.0 && o.intrinsics_min_gain < 1.0)) fail("options.intrinsics_min_gain: [0, 1)");
     if (!(prior.screen.radius_m > 0.0 && prior.screen.arc_deg > 0.0 && prior.screen.top_m > prior.screen.bottom_m)) {
         fail("prior.screen: radius_m > 0, arc_deg > 0, top_m > bottom_m");
     }
@@ -261,6 +262,56 @@ void check_camera_intrinsics(const BundleResult& ba, const DeviceModel& prior, c
     }
 }
 
+// The cost of fit `b` in units of fit `unit`'s: each projector's inlier correspondences and the edges at
+// unit's rms (its maximum-likelihood noise level), summed over the blocks' points and divided by their count;
+// 1 for `unit` itself.
+double relative_cost(const BundleResult& b, const BundleResult& unit, std::size_t edge_points) {
+    double cost = 0.0;
+    double points = 0.0;
+    for (std::size_t k = 0; k < b.rms_sigma.size(); ++k) {
+        const double ratio = b.rms_sigma[k] / std::max(unit.rms_sigma[k], 1e-12);
+        cost += b.inliers[k] * ratio * ratio;
+        points += unit.inliers[k];
+    }
+    const double e = static_cast<double>(edge_points);
+    const double ratio = b.edge_rms_m / std::max(unit.edge_rms_m, 1e-12);
+    cost += e * ratio * ratio;
+    points += e;
+    return points > 0.0 ? cost / points : 1.0;
+}
+
+// AutocalOptions::refine_camera_intrinsics: a second bundle adjustment from `ba`'s result (the prior's
+// intrinsics taken as exact) with the camera's intrinsics free. Its result replaces `ba` only when the cost
+// falls by more than intrinsics_min_gain on about the same correspondences (as the bow's trial); a kept
+// result must pass check_camera_intrinsics. The conditioning reported is the free adjustment's.
+void try_camera_intrinsics(BundleResult& ba, const CalibrationPrior& prior, const std::vector<EdgeObservation>& edges,
+                           const std::vector<ProjectorObservations>& observations, BundleOptions bo,
+                           const AutocalOptions& options, AutocalReport& report) {
+    report.condition_number = ba.condition_number;
+    if (!options.refine_camera_intrinsics || edges.empty()) return;
+    bo.refine_camera_intrinsics = true;
+    BundleResult free = bundle_adjust(ba.screen, ba.camera, ba.projectors, edges, observations, bo);
+    IntrinsicsTrial& trial = report.intrinsics;
+    trial.tried = true;
+    trial.relative_cost = relative_cost(free, ba, edges.size());
+    report.camera_intrinsics_sigma = free.camera_intrinsics_sigma;
+    report.condition_number = free.condition_number;
+    int kept_fixed = 0;
+    int kept_free = 0;
+    for (std::size_t k = 0; k < ba.inliers.size(); ++k) {
+        kept_fixed += ba.inliers[k];
+        kept_free += free.inliers[k];
+    }
+    // A free fit that only rejected more points does not count; one that fits much better may reject more, its
+    // outlier limit (4x its median) being tighter: its cost's fall must then be ten times the points it lost.
+    const double lost = 1.0 - static_cast<double>(kept_free) / std::max(kept_fixed, 1);
+    const bool same_points = lost <= 0.01 || 1.0 - trial.relative_cost >= 10.0 * lost;
+    trial.kept = same_points && trial.relative_cost < 1.0 - options.intrinsics_min_gain;
+    if (!trial.kept) return;
+    check_camera_intrinsics(free, prior.camera, options);
+    ba = std::move(free);
+}
+
 // Per blend grid sample of device d (grid of `size` samples, row-major): 1 where its output position
 // lands on the screen (the samples build_projector gives a weight), 0 where the blend is 0 for being off it.
 std::vector<char> grid_on_screen(const DeviceModel& d, const ScreenModel& s, ImageSize size) {
@@ -395,23 +446,23 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
     // Step 4: camera pose and projector models refined together on every observation.
     BundleOptions bo;
     bo.refine_screen = options.fit_screen;
-    bo.refine_camera_intrinsics = options.refine_camera_intrinsics;
     bo.camera_sigma = options.camera_sigma;
     BundleResult ba = bundle_adjust(prior.screen, edge.camera, result.projectors, edge.edges, observations, bo);
+    // The bow first: on a bowed screen free intrinsics take up part of the bow (k1, k2 bend the rays much as
+    // the bow bends the screen); then the intrinsics, with the bow free too where it was kept.
     if (options.fit_bow) try_bow(ba, edge.edges, observations, bo, options, result.report.bow);
+    bo.refine_bow = result.report.bow.kept;
+    try_camera_intrinsics(ba, prior, edge.edges, observations, bo, options, result.report);
     result.screen = ba.screen;
     if (!(ba.screen.radius_m > 0.0 && ba.screen.arc_deg > 0.0 && ba.screen.arc_deg <= 360.0)) {
         throw CalibrationRefused("fitted screen: radius " + std::to_string(ba.screen.radius_m) + " m, arc " +
                                  std::to_string(ba.screen.arc_deg) +
                                  " deg is no cylinder screen (radius > 0, arc in (0, 360]): the prior is too far off");
     }
-    if (options.refine_camera_intrinsics) check_camera_intrinsics(ba, prior.camera, options);
     result.camera = ba.camera;
     result.projectors = ba.projectors;
     result.report.camera_position_m = ba.camera.position_m;
     result.report.edge_rms_m = ba.edge_rms_m;
-    result.report.camera_intrinsics_sigma = ba.camera_intrinsics_sigma;
-    result.report.condition_number = ba.condition_number;
     for (std::size_t k = 0; k < n; ++k) {
         result.report.projectors[k].rms_px = ba.rms_px[k];
         result.report.projectors[k].rms_sigma = ba.rms_sigma[k];

@@ -3,7 +3,8 @@
 //
 //   mogao-autocal calibrate --rig rigs/standard.toml --out DIR [--scale 0.5] [--content 1920x1080]
 //                 [--alpha-bits 16] [--warp-step 2] [--gray-bits N] [--frames-per-pattern 1] [--no-colour]
-//                 [--no-falloff] [--fit-screen] [--no-bow] [--refine-camera-intrinsics] [--max-self-check-px 0.65]
+//                 [--no-falloff] [--fit-screen] [--no-bow] [--fixed-camera-intrinsics] [--intrinsics-min-gain 0.01]
+//                 [--max-self-check-px 0.65]
 //
 // Exit codes: 0 success, 1 the job failed or the calibration was refused (the message says why;
 // nothing in DIR changes), 2 bad command line.
@@ -45,8 +46,14 @@ int main(int argc, char** argv) {
     bool no_bow = false;
     cmd->add_flag("--no-bow", no_bow,
                   "Take the screen as an exact cylinder: do not try a bow (kept by default only where it pays)");
-    cmd->add_flag("--refine-camera-intrinsics", job.options.refine_camera_intrinsics,
-                  "Refine the camera's focal length, principal point and k1, k2 in the bundle adjustment");
+    bool fixed_intrinsics = false;
+    cmd->add_flag("--fixed-camera-intrinsics", fixed_intrinsics,
+                  "Take the camera's intrinsics as exact: do not try refining its focal length, principal point and "
+                  "k1, k2 (kept by default only where they pay)");
+    cmd->add_option("--intrinsics-min-gain", job.options.intrinsics_min_gain,
+                    "Keep the refined camera intrinsics only where the fit's cost falls by more than this fraction "
+                    "(0: whenever it falls)")
+        ->check(CLI::Range(0.0, 0.99));
     cmd->add_option("--max-self-check-px", job.self_check.max_mean_px,
                     "Self-check gate: refuse when the verification marks land further than this from where they "
                     "belong (mean, projector pixels; measured from the camera images against the screen's frame)")
@@ -61,6 +68,7 @@ int main(int argc, char** argv) {
         job.colour = !no_colour;
         job.colour_options.lens_falloff = !no_falloff;
         job.options.fit_bow = !no_bow;
+        job.options.refine_camera_intrinsics = !fixed_intrinsics;
         if (std::sscanf(content.c_str(), "%dx%d", &job.content.width, &job.content.height) != 2 ||
             job.content.width < 1 || job.content.height < 1 || job.content.width > 16384 ||
             job.content.height > 16384) {

@@ -112,7 +112,12 @@ nlohmann::json camera_report(const AutocalResult& r, const CalibrationPrior& pri
     };
     nlohmann::json out = {{"edge_points", r.report.edge_points},
                           {"edge_rms_mm", r.report.edge_rms_m * 1e3},
-                          {"intrinsics_refined", options.refine_camera_intrinsics},
+                          {"intrinsics_refined", r.report.intrinsics.kept},
+                          {"intrinsics_trial",
+                           {{"tried", r.report.intrinsics.tried},
+                            {"kept", r.report.intrinsics.kept},
+                            {"relative_cost", r.report.intrinsics.relative_cost},
+                            {"min_gain", options.intrinsics_min_gain}}},
                           {"intrinsics", intrinsics(r.camera)},
                           {"prior_intrinsics", intrinsics(prior.camera)},
                           {"bundle_condition_number", r.report.condition_number}};
