@@ -253,32 +253,44 @@ void geometry_weights(const Geometry& g, const GeometryWeight& gw, std::size_t i
     }
 }
 
+// The 5x5 neighbourhood on the same surface of row y's pixels: for each tap inside the image, the
+// geometry weights of pixels [xa, xb) into wt, then add(xa, xb, at), `at` the tap's index for x = 0.
+template <typename Add>
+void surface_taps_5x5(const Planes& planes, const GeometryWeight& gw, ImageSize size, int y, std::vector<float>& wt,
+                      Add&& add) {
+    const int w = size.width, h = size.height;
+    const std::size_t row = static_cast<std::size_t>(y) * w;
+    for (int oy = -2; oy <= 2; ++oy) {
+        if (y + oy < 0 || y + oy >= h) continue;
+        for (int ox = -2; ox <= 2; ++ox) {
+            const int xa = std::max(0, -ox), xb = std::min(w, w - ox);
+            const std::ptrdiff_t offset = static_cast<std::ptrdiff_t>(oy) * w + ox;
+            geometry_weights(planes.geometry, gw, row + xa, offset, xb - xa, float(ox), float(oy), 1.0f,
+                             wt.data() + xa);
+            add(xa, xb, static_cast<std::ptrdiff_t>(row) + offset);
+        }
+    }
+}
+
 // Spatial luminance variance of each surface pixel over its 5x5 neighbourhood on the same surface
 // (weights: the geometry terms only) — [S] §4.2's estimate for frames without history.
 void estimate_variance(ImageSize size, const GeometryWeight& gw, const Planes& planes, int threads) {
-    const int w = size.width, h = size.height;
+    const int w = size.width;
     const Signal& s = planes.ping;
-    for_row_bands(h, threads, [&](int y0, int y1) {
+    for_row_bands(size.height, threads, [&](int y0, int y1) {
         std::vector<float> sw(w), s1(w), s2(w), wt(w);
         for (int y = y0; y < y1; ++y) {
             std::fill(sw.begin(), sw.end(), 0.0f), std::fill(s1.begin(), s1.end(), 0.0f);
             std::fill(s2.begin(), s2.end(), 0.0f);
-            const std::size_t row = static_cast<std::size_t>(y) * w;
-            for (int oy = -2; oy <= 2; ++oy) {
-                if (y + oy < 0 || y + oy >= h) continue;
-                for (int ox = -2; ox <= 2; ++ox) {
-                    const int xa = std::max(0, -ox), xb = std::min(w, w - ox);
-                    const std::ptrdiff_t offset = static_cast<std::ptrdiff_t>(oy) * w + ox;
-                    geometry_weights(planes.geometry, gw, row + xa, offset, xb - xa, float(ox), float(oy), 1.0f,
-                                     wt.data() + xa);
-                    const float* lq = s.lum + static_cast<std::ptrdiff_t>(row) + offset;
-                    for (int x = xa; x < xb; ++x) {
-                        sw[x] += wt[x];
-                        s1[x] += wt[x] * lq[x];
-                        s2[x] += wt[x] * lq[x] * lq[x];
-                    }
+            surface_taps_5x5(planes, gw, size, y, wt, [&](int xa, int xb, std::ptrdiff_t at) {
+                const float* lq = s.lum + at;
+                for (int x = xa; x < xb; ++x) {
+                    sw[x] += wt[x];
+                    s1[x] += wt[x] * lq[x];
+                    s2[x] += wt[x] * lq[x] * lq[x];
                 }
-            }
+            });
+            const std::size_t row = static_cast<std::size_t>(y) * w;
             for (int x = 0; x < w; ++x) {
                 if (planes.geometry.mask[row + x] == 0.0f) continue;
                 const float mean = s1[x] / sw[x];
@@ -297,7 +309,7 @@ void estimate_variance(ImageSize size, const GeometryWeight& gw, const Planes& p
 void given_variance(const RgbFloatImage& variance, const GuideBuffers& guides, const GeometryWeight& gw,
                     const Planes& planes, int threads) {
     const ImageSize size = variance.size;
-    const int w = size.width, h = size.height;
+    const int w = size.width;
     float* raw = planes.pong.var;
     for (std::size_t i = 0; i < static_cast<std::size_t>(size.pixel_count()); ++i) {
         const float* v = variance.pixels.data() + 3 * i;
@@ -307,22 +319,15 @@ void given_variance(const RgbFloatImage& variance, const GuideBuffers& guides, c
                          0.0722f * std::sqrt(v[2]) / std::max(a[2], kMinAlbedo);
         raw[i] = sd * sd;
     }
-    for_row_bands(h, threads, [&](int y0, int y1) {
+    for_row_bands(size.height, threads, [&](int y0, int y1) {
         std::vector<float> sw(w), sv(w), wt(w);
         for (int y = y0; y < y1; ++y) {
             std::fill(sw.begin(), sw.end(), 0.0f), std::fill(sv.begin(), sv.end(), 0.0f);
+            surface_taps_5x5(planes, gw, size, y, wt, [&](int xa, int xb, std::ptrdiff_t at) {
+                const float* vq = raw + at;
+                for (int x = xa; x < xb; ++x) sw[x] += wt[x], sv[x] += wt[x] * vq[x];
+            });
             const std::size_t row = static_cast<std::size_t>(y) * w;
-            for (int oy = -2; oy <= 2; ++oy) {
-                if (y + oy < 0 || y + oy >= h) continue;
-                for (int ox = -2; ox <= 2; ++ox) {
-                    const int xa = std::max(0, -ox), xb = std::min(w, w - ox);
-                    const std::ptrdiff_t offset = static_cast<std::ptrdiff_t>(oy) * w + ox;
-                    geometry_weights(planes.geometry, gw, row + xa, offset, xb - xa, float(ox), float(oy), 1.0f,
-                                     wt.data() + xa);
-                    const float* vq = raw + static_cast<std::ptrdiff_t>(row) + offset;
-                    for (int x = xa; x < xb; ++x) sw[x] += wt[x], sv[x] += wt[x] * vq[x];
-                }
-            }
             for (int x = 0; x < w; ++x) {
                 if (planes.geometry.mask[row + x] != 0.0f) planes.ping.var[row + x] = sv[x] / sw[x];
             }

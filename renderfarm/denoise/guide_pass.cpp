@@ -67,12 +67,8 @@ struct GuidePass::Impl {
             if (valid[l] == 0) continue;
             const std::size_t i =
                 guides.pixel(x0 + static_cast<int>(l) % kBlock - ox, y0 + static_cast<int>(l) / kBlock - oy);
-            float* albedo = guides.albedo.data() + 3 * i;
-            float* normal = guides.normal.data() + 3 * i;
             if (packet.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID) {
-                guides.hit[i] = 0;
-                guides.depth[i] = 0.0f;
-                for (int c = 0; c < 3; ++c) albedo[c] = normal[c] = 0.0f;
+                guides.set_sky(i);
                 continue;
             }
             const Eigen::Vector3f org(packet.ray.org_x[l], packet.ray.org_y[l], packet.ray.org_z[l]);
@@ -83,12 +79,7 @@ struct GuidePass::Impl {
                 spread * packet.ray.tfar[l]);
             Eigen::Vector3f a = scene.materials[hit.material].albedo;
             if (hit.tinted) a = a.cwiseProduct(hit.tint);
-            guides.hit[i] = 1;
-            guides.depth[i] = packet.ray.tfar[l];
-            for (int c = 0; c < 3; ++c) {
-                albedo[c] = a[c];
-                normal[c] = hit.shading_normal[c];
-            }
+            guides.set_surface(i, a.data(), hit.shading_normal.data(), packet.ray.tfar[l]);
         }
     }
 };

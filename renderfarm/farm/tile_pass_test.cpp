@@ -145,76 +145,19 @@ TEST(TilePass, CutRendersTheRemainingTilesCoarseFromTheFullPassPixels) {
     EXPECT_NE(a.pixels, b.pixels);  // the comparison can fail: coarse is not the full pass
 }
 
-// The denoiser's guides travel beside the radiance: any split of the frame over ranks and threads
-// composites to the same radiance and guides, and those are the guide pass's own for the frame
-// (traced there on its own BVH).
-TEST(TilePass, GuidedPackingOfAnySplitEqualsTheGuidePassOfTheWholeFrame) {
-    const Scene scene = small_scene();
-    Renderer renderer(scene, RendererOptions{});
-    GuidePass shared(scene, renderer.render_scene());
-    ViewRequest view;
-    view.size = {96, 64};
-    view.pose.eye = {0, 1.5, 5};
-    view.quality.max_bounces = 1;
-    renderer.begin_frame(view);
-    ASSERT_TRUE(shared.begin_frame(view).ok());
+// Packs `view` (begun on `renderer`) with guides, whole and split over ranks and threads, and checks
+// that both composite to the same radiance and guides, that the radiance is the linear pass's, and
+// that the guides are those of a guide pass of the whole frame on its own BVH. `pass`: the guide
+// pass the tiles use (begun on the view), or null for the renderer's own first hits.
+void expect_guided_packing_agrees(const Scene& scene, const Renderer& renderer, const ViewRequest& view,
+                                  const GuidePass* pass) {
     const PixelRect all{0, 0, 96, 64};
     const std::vector<PixelRect> parts{{0, 0, 40, 64}, {40, 0, 96, 24}, {40, 24, 96, 64}};
     const TilePassResult whole =
-        render_tile_pass(renderer, {all}, 16, 1, 1.f, ToneMap::clamp, PackedPixels::linear_guided, &shared);
+        render_tile_pass(renderer, {all}, 16, 1, 1.f, ToneMap::clamp, PackedPixels::linear_guided, pass);
     const TilePassResult split =
-        render_tile_pass(renderer, parts, 16, 3, 1.f, ToneMap::clamp, PackedPixels::linear_guided, &shared);
-    EXPECT_EQ(whole.packed_pixels.size(), packed_size({all}, PackedPixels::linear_guided));
+        render_tile_pass(renderer, parts, 16, 3, 1.f, ToneMap::clamp, PackedPixels::linear_guided, pass);
     EXPECT_EQ(whole.packed_pixels.size(), 96u * 64u * 10u * sizeof(float));
-    RgbFloatImage a({96, 64}), b({96, 64});
-    GuideBuffers ga({96, 64}), gb({96, 64});
-    unpack_guided_rects({all}, whole.packed_pixels, a, ga);
-    unpack_guided_rects(parts, split.packed_pixels, b, gb);
-    EXPECT_EQ(a.pixels, b.pixels);
-    EXPECT_EQ(ga.hit, gb.hit);
-    EXPECT_EQ(ga.albedo, gb.albedo);
-    EXPECT_EQ(ga.normal, gb.normal);
-    EXPECT_EQ(ga.depth, gb.depth);
-    // The radiance is the linear pass's.
-    const TilePassResult linear = render_tile_pass(renderer, {all}, 16, 1, 1.f, ToneMap::clamp, PackedPixels::linear);
-    RgbFloatImage c({96, 64});
-    unpack_linear_rects({all}, linear.packed_pixels, c);
-    EXPECT_EQ(a.pixels, c.pixels);
-    // The guides are the guide pass's of the whole frame, on its own BVH.
-    GuidePass own(scene);
-    Result<GuideBuffers> expected = own.render_frame(view);
-    ASSERT_TRUE(expected.ok()) << expected.error().message;
-    EXPECT_EQ(ga.hit, expected->hit);
-    int hits = 0;
-    for (std::size_t i = 0; i < ga.depth.size(); ++i) {
-        hits += ga.hit[i];
-        EXPECT_NEAR(ga.depth[i], expected->depth[i], 1e-4f * (1.0f + expected->depth[i])) << i;
-        EXPECT_NEAR(ga.normal[3 * i], expected->normal[3 * i], 1e-4f) << i;
-        EXPECT_NEAR(ga.albedo[3 * i], expected->albedo[3 * i], 1e-6f) << i;
-    }
-    EXPECT_GT(hits, 0);
-    EXPECT_LT(hits, 96 * 64);  // sky too
-}
-
-// Without a guide pass the guides are the renderer's own first hits, from the rays the radiance
-// traces anyway: any split gives the same radiance and guides, the radiance is the linear pass's,
-// and with the pixel-centre sample (jitter off) the guides are the guide pass's.
-TEST(TilePass, GuidedPackingWithoutAGuidePassCarriesTheRenderersFirstHits) {
-    const Scene scene = small_scene();
-    RendererOptions centres;
-    centres.jitter_one_spp = false;
-    Renderer renderer(scene, centres);
-    ViewRequest view;
-    view.size = {96, 64};
-    view.pose.eye = {0, 1.5, 5};
-    view.quality.max_bounces = 1;
-    renderer.begin_frame(view);
-    const PixelRect all{0, 0, 96, 64};
-    const std::vector<PixelRect> parts{{0, 0, 40, 64}, {40, 0, 96, 24}, {40, 24, 96, 64}};
-    const TilePassResult whole =
-        render_tile_pass(renderer, {all}, 16, 1, 1.f, ToneMap::clamp, PackedPixels::linear_guided);
-    const TilePassResult split =
-        render_tile_pass(renderer, parts, 16, 3, 1.f, ToneMap::clamp, PackedPixels::linear_guided);
     RgbFloatImage a({96, 64}), b({96, 64}), c({96, 64});
     GuideBuffers ga({96, 64}), gb({96, 64});
     unpack_guided_rects({all}, whole.packed_pixels, a, ga);
@@ -226,7 +169,7 @@ TEST(TilePass, GuidedPackingWithoutAGuidePassCarriesTheRenderersFirstHits) {
     EXPECT_EQ(ga.depth, gb.depth);
     const TilePassResult linear = render_tile_pass(renderer, {all}, 16, 1, 1.f, ToneMap::clamp, PackedPixels::linear);
     unpack_linear_rects({all}, linear.packed_pixels, c);
-    EXPECT_EQ(a.pixels, c.pixels);
+    EXPECT_EQ(a.pixels, c.pixels) << "the radiance is the linear pass's";
     GuidePass own(scene);
     Result<GuideBuffers> expected = own.render_frame(view);
     ASSERT_TRUE(expected.ok()) << expected.error().message;
@@ -242,6 +185,38 @@ TEST(TilePass, GuidedPackingWithoutAGuidePassCarriesTheRenderersFirstHits) {
     }
     EXPECT_GT(hits, 0);
     EXPECT_LT(hits, 96 * 64);  // sky too
+}
+
+ViewRequest guided_view() {
+    ViewRequest view;
+    view.size = {96, 64};
+    view.pose.eye = {0, 1.5, 5};
+    view.quality.max_bounces = 1;
+    return view;
+}
+
+// The denoiser's guides travel beside the radiance, traced by a guide pass that shares the
+// renderer's BVH (the baseline): pixel centres, a second primary ray each.
+TEST(TilePass, GuidedPackingOfAnySplitEqualsTheGuidePassOfTheWholeFrame) {
+    const Scene scene = small_scene();
+    Renderer renderer(scene, RendererOptions{});
+    GuidePass shared(scene, renderer.render_scene());
+    const ViewRequest view = guided_view();
+    renderer.begin_frame(view);
+    ASSERT_TRUE(shared.begin_frame(view).ok());
+    expect_guided_packing_agrees(scene, renderer, view, &shared);
+}
+
+// Without a guide pass the guides are the renderer's own first hits, from the rays the radiance
+// traces anyway; with the pixel-centre sample (jitter off) they are the guide pass's.
+TEST(TilePass, GuidedPackingWithoutAGuidePassCarriesTheRenderersFirstHits) {
+    const Scene scene = small_scene();
+    RendererOptions centres;
+    centres.jitter_one_spp = false;
+    Renderer renderer(scene, centres);
+    const ViewRequest view = guided_view();
+    renderer.begin_frame(view);
+    expect_guided_packing_agrees(scene, renderer, view, nullptr);
 }
 
 TEST(TilePass, GuidedPackingReportsTheGuidePassErrorAndRefusesMismatchedBuffers) {

@@ -40,6 +40,22 @@ struct GuideBuffers {
           normal(static_cast<std::size_t>(s.pixel_count()) * 3, 0.0f),
           depth(static_cast<std::size_t>(s.pixel_count()), 0.0f) {}
 
+    // Pixel i saw a surface: albedo and normal 3 floats each (as above), depth metres.
+    void set_surface(std::size_t i, const float* albedo_rgb, const float* normal_xyz, float depth_m) {
+        hit[i] = 1;
+        depth[i] = depth_m;
+        for (std::size_t c = 0; c < 3; ++c) {
+            albedo[3 * i + c] = albedo_rgb[c];
+            normal[3 * i + c] = normal_xyz[c];
+        }
+    }
+    // Pixel i saw the sky: zero hit, depth, albedo and normal.
+    void set_sky(std::size_t i) {
+        hit[i] = 0;
+        depth[i] = 0.0f;
+        for (std::size_t c = 0; c < 3; ++c) albedo[3 * i + c] = normal[3 * i + c] = 0.0f;
+    }
+
     [[nodiscard]] std::size_t pixel(int x, int y) const {
         return static_cast<std::size_t>(y) * static_cast<std::size_t>(size.width) + static_cast<std::size_t>(x);
     }

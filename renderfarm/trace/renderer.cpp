@@ -192,23 +192,14 @@ struct Renderer::Impl {
             if (block.valid[l] == 0) continue;
             const std::size_t i = guides.pixel(block.x0 + static_cast<int>(l) % kBlock - origin_x,
                                                block.y0 + static_cast<int>(l) / kBlock - origin_y);
-            float* albedo = guides.albedo.data() + 3 * i;
-            float* normal = guides.normal.data() + 3 * i;
             if (!hits.alive[l]) {
-                guides.hit[i] = 0;
-                guides.depth[i] = 0.0f;
-                for (int c = 0; c < 3; ++c) albedo[c] = normal[c] = 0.0f;
+                guides.set_sky(i);
                 continue;
             }
             const SurfaceHit& hit = hits.hit[l];
             Eigen::Vector3f a = materials[hit.material].albedo;
             if (hit.tinted) a = a.cwiseProduct(hit.tint);
-            guides.hit[i] = 1;
-            guides.depth[i] = packet.ray.tfar[l];
-            for (int c = 0; c < 3; ++c) {
-                albedo[c] = a[c];
-                normal[c] = hit.shading_normal[c];
-            }
+            guides.set_surface(i, a.data(), hit.shading_normal.data(), packet.ray.tfar[l]);
         }
     }
 
