@@ -26,8 +26,8 @@
 //    accumulation of two passes or more by the noise its passes measure
 //    (ProgressiveAccumulator::variance_of_mean), so the filter does less as samples come in and
 //    the view keeps improving. The first pass of each view asks the ranks for the guides too
-//    (PackedPixels::linear_guided: albedo, normal, depth of each pixel's first camera hit, from the
-//    rays the ranks trace for the radiance); later passes of the same view reuse them. The admin
+//    (PackedPixels::linear_guided: albedo, normal, depth of each pixel centre's first hit, traced on
+//    the ranks' own BVHs beside the tiles); later passes of the same view reuse them. The admin
 //    filters the composited frame, so the served frame is the same for any split of the frame over
 //    any number of ranks; the accumulation keeps the raw samples (never filtered ones). The
 //    filter's time is part of LiveFrame::seconds, which the frame-time target observes, so the

@@ -12,9 +12,9 @@
 // row, RGB8 — the order unpack_rects() expects — or, for PackedPixels::linear, three native
 // floats per pixel of linear radiance (before exposure and tone map) in the same order, for the
 // admin's progressive accumulation (unpack_linear_rects()). PackedPixels::linear_guided adds the
-// denoiser's guides of each pixel (renderfarm/trace/guide_buffers.h), from the camera ray of each
-// pixel's first sample (Renderer::render with guides: no ray more than the radiance's), or, as a
-// baseline, from a GuidePass sharing the renderer's BVH (a second primary ray per pixel centre):
+// denoiser's guides of each pixel (renderfarm/trace/guide_buffers.h), from a GuidePass sharing the
+// renderer's BVH (a second primary ray per pixel centre; what the farm uses), or without one from
+// the camera ray of each pixel's first sample (Renderer::render with guides: no ray more):
 // ten native floats per pixel, radiance R, G, B, albedo R, G, B, normal x, y, z, depth (metres;
 // 0 = sky), in the same order (unpack_guided_rects()).
 #pragma once
