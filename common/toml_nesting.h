@@ -37,7 +37,7 @@ namespace mogao {
 
 // Levels a TOML reader of this project accepts: far above any real file, far below what toml11's
 // recursion survives (the worst text this limit lets through, 32 inline tables each under a
-// 31-dot key, is parsed by toml11 in kiosk/kiosk_config_test.cpp, also under ASan).
+// 31-dot key, is parsed by toml11 in kiosk/config/kiosk_config_test.cpp, also under ASan).
 inline constexpr int kMaxTomlNesting = 32;
 
 struct TomlNestingExcess {

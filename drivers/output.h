@@ -21,9 +21,9 @@
 #include <string>
 #include <vector>
 
-#include "drivers/egl/warp_blend_renderer.h"
-#include "common/result.h"
 #include "common/pixel_rect.h"
+#include "common/result.h"
+#include "drivers/projector_renderer.h"
 
 namespace mogao {
 
@@ -39,9 +39,10 @@ public:
 
     [[nodiscard]] virtual const std::vector<OutputInfo>& outputs() const = 0;
 
-    // The renderer living in this backend's GL context (valid for the backend's lifetime). Its
-    // context is current on the thread that created the backend after create/begin_frame.
-    [[nodiscard]] virtual WarpBlendRenderer& renderer() = 0;
+    // The renderer that draws this backend's outputs (valid for the backend's lifetime; for GL, it
+    // lives in the backend's context, current on the thread that created the backend after
+    // create/begin_frame).
+    [[nodiscard]] virtual ProjectorRenderer& renderer() = 0;
 
     // Makes output `i`'s target current and bound to GL_DRAW_FRAMEBUFFER, sets the viewport to the
     // whole output and clears it to black. EBUSY when !ready(i).

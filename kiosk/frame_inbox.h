@@ -16,9 +16,9 @@
 #include <optional>
 
 #include "appliance/decode/decode_worker.h"
+#include "common/event_fd.h"
 #include "common/link_types.h"
 #include "common/result.h"
-#include "kiosk/event_fd.h"
 
 namespace mogao {
 

@@ -11,9 +11,9 @@
 #include <spdlog/spdlog.h>
 
 #include "common/program_cli.h"
-#include "kiosk/kiosk_metrics.h"
+#include "kiosk/display/on_wall_status.h"
 #include "kiosk/kiosk_setup.h"
-#include "kiosk/on_wall_status.h"
+#include "kiosk/stats/kiosk_metrics.h"
 
 namespace mogao {
 
@@ -264,7 +264,7 @@ bool Kiosk::frame_waiting() const {
 }
 
 bool Kiosk::update_late_warp() {
-    WarpBlendRenderer::ContentTransform t;  // identity: no band
+    ContentTransform t;  // identity: no band
     // Every request carries the band, so every farm frame spans its arc (whatever pixel size the
     // farm rendered it at: the transform is in normalised content coordinates).
     if (guard_ && current_) {
@@ -274,7 +274,7 @@ bool Kiosk::update_late_warp() {
         t.offset_u = static_cast<float>(shift.offset);
         if (shift.clamped) ++late_warp_clamped_;
     }
-    const WarpBlendRenderer::ContentTransform before = parts_.display.content_transform();
+    const ContentTransform before = parts_.display.content_transform();
     parts_.display.set_content_transform(t);
     return t.scale_u != before.scale_u || t.offset_u != before.offset_u;
 }

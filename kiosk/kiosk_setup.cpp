@@ -6,7 +6,7 @@
 
 #include "drivers/headless/headless_output.h"
 #include "drivers/kms/kms_backend.h"
-#include "kiosk/screen_calibration_source.h"
+#include "kiosk/live_calibration/screen_calibration_source.h"
 
 namespace mogao {
 

@@ -14,16 +14,16 @@
 
 #include "common/projector_calibration.h"
 #include "drivers/output.h"
-#include "kiosk/calibration_inbox.h"
-#include "kiosk/calibration_watcher.h"
-#include "kiosk/content_dump.h"
+#include "kiosk/config/kiosk_config.h"
+#include "kiosk/config/last_loaded.h"
+#include "kiosk/display/content_dump.h"
+#include "kiosk/display/kiosk_display.h"
 #include "kiosk/frame_inbox.h"
-#include "kiosk/kiosk_config.h"
-#include "kiosk/kiosk_display.h"
-#include "kiosk/kiosk_navigation.h"
-#include "kiosk/last_loaded.h"
-#include "kiosk/pose_log.h"
-#include "kiosk/view_script.h"
+#include "kiosk/live_calibration/calibration_inbox.h"
+#include "kiosk/live_calibration/calibration_watcher.h"
+#include "kiosk/navigation/kiosk_navigation.h"
+#include "kiosk/navigation/pose_log.h"
+#include "kiosk/navigation/view_script.h"
 #include "renderfarm/link/link_client.h"
 #include "renderfarm/link/tls_material.h"
 
@@ -47,7 +47,7 @@ struct KioskSetup {
 
 // --path (non-empty: the scripted visitor on that path) and --stats (non-empty) override the file.
 // With `fall_back` (not for --check-config): a file that loads is kept as its last good copy
-// (kiosk/last_loaded.h); a bad file with such a copy runs on the copy, noted in `fallbacks`.
+// (kiosk/config/last_loaded.h); a bad file with such a copy runs on the copy, noted in `fallbacks`.
 [[nodiscard]] KioskSetup load_setup(const std::filesystem::path& file, const std::string& path,
                                     const std::filesystem::path& stats_file, bool fall_back = false);
 

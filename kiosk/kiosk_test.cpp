@@ -19,7 +19,7 @@
 #include "common/jpeg_codec.h"
 #include "drivers/egl/egl_test_support.h"
 #include "drivers/headless/headless_output.h"
-#include "kiosk/config_overrides.h"
+#include "kiosk/config/config_overrides.h"
 #include "kiosk/kiosk_setup.h"
 
 namespace mogao {
@@ -70,7 +70,7 @@ public:
     explicit FlipNeverCompletes(std::unique_ptr<OutputBackend> inner)
         : inner_(std::move(inner)), in_flight_(inner_->outputs().size(), false) {}
     const std::vector<OutputInfo>& outputs() const override { return inner_->outputs(); }
-    WarpBlendRenderer& renderer() override { return inner_->renderer(); }
+    ProjectorRenderer& renderer() override { return inner_->renderer(); }
     Status begin_frame(std::size_t i) override { return inner_->begin_frame(i); }
     Status present(std::size_t i) override {
         Status s = inner_->present(i);
@@ -368,7 +368,7 @@ TEST_F(KioskTest, GuardBandWidensTheRequestAndTheFrameIsShiftedByTheYawSinceItsR
     deliver(std::move(frame));
     k.on_frame();
     ASSERT_NE(k.current(), nullptr);
-    const WarpBlendRenderer::ContentTransform t = display_->content_transform();
+    const ContentTransform t = display_->content_transform();
     const double guarded_arc = 150.0 * 182 / 160;
     EXPECT_NEAR(t.scale_u, 150.0 / guarded_arc, 1e-6);
     EXPECT_NEAR(t.offset_u, (10.3125 - 2.0) / guarded_arc, 1e-6);

@@ -14,7 +14,7 @@
 //
 // Exit codes: 0 stopped (signal, --frames, --duration, end of a tracking replay), 1 the appliance
 // could not run (outputs, calibration, link set-up, loop failure), 2 bad command line or configuration.
-// A bad configuration or MPCDI file with a last good copy (kiosk/last_loaded.h) runs on the copy
+// A bad configuration or MPCDI file with a last good copy (kiosk/config/last_loaded.h) runs on the copy
 // and says so on the wall and in the status file instead of exiting.
 #include <csignal>
 #include <cstdio>
@@ -28,13 +28,13 @@
 
 #include "common/program_cli.h"
 #include "common/service_notify.h"
-#include "kiosk/config_overrides.h"
+#include "common/signal_fd.h"
+#include "kiosk/config/config_overrides.h"
+#include "kiosk/display/service_screen.h"
 #include "kiosk/kiosk.h"
-#include "kiosk/kiosk_log.h"
 #include "kiosk/kiosk_setup.h"
-#include "kiosk/selfcal_setup.h"
-#include "kiosk/service_screen.h"
-#include "kiosk/signal_fd.h"
+#include "kiosk/live_calibration/selfcal_setup.h"
+#include "kiosk/stats/kiosk_log.h"
 
 namespace {
 
@@ -72,7 +72,8 @@ int run(const Flags& flags, const SignalFd& signals) {
 
     const std::unique_ptr<CalibrationInbox> calibration = open_calibration_inbox();
     const std::unique_ptr<CalibrationWatcher> watcher = watch_calibration(config, *calibration);
-    const std::unique_ptr<SelfcalWorker> selfcal = start_selfcal(config, display.calibration(), *calibration);
+    const std::unique_ptr<SelfcalWorker> selfcal =
+        start_selfcal(config, display.calibration(), *calibration, built_in_simulated_camera());
     const std::unique_ptr<FrameInbox> inbox = open_inbox();
     const std::unique_ptr<LinkClient> link = open_link(config, std::move(setup.tls), *inbox, setup.script);
     std::optional<PoseLog> pose_log = open_pose_log(flags.pose_log);
@@ -89,7 +90,7 @@ int run(const Flags& flags, const SignalFd& signals) {
 }
 
 // The show cannot start (no configuration or calibration, nor a last good copy): the service card
-// says so on the wall until the configuration loads again (kiosk/service_screen.h). Other errors,
+// says so on the wall until the configuration loads again (kiosk/display/service_screen.h). Other errors,
 // and outputs that cannot show the card either, keep their exit code.
 int show_service_card(const Flags& flags, const KioskSetupError& error, const SignalFd& signals) {
     const bool config = error.exit_code == 2;
@@ -137,7 +138,7 @@ int main(int argc, char** argv) {
     Flags flags;
     std::vector<std::string> overrides;
     // Not CLI::ExistingFile: a missing file (an unmounted configuration partition) is reported on the
-    // wall by the service card, not by an exit into a restart loop (kiosk/service_screen.h).
+    // wall by the service card, not by an exit into a restart loop (kiosk/display/service_screen.h).
     app.add_option("--config", flags.config, "Configuration file (TOML)");
     app.add_option("--service-config", flags.service_config,
                    "Configuration whose [outputs] show the service card when --config and its last good copy "

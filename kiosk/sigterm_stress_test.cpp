@@ -38,7 +38,7 @@
 #include "appliance/calibration/mpcdi_writer.h"
 #include "appliance/warp/ideal_calibration.h"
 #include "common/jpeg_codec.h"
-#include "kiosk/config_overrides.h"
+#include "kiosk/config/config_overrides.h"
 #include "renderfarm/link/link_test_support.h"
 
 extern char** environ;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
-// mogao-track: tag detection, camera calibration, synthetic sequences and tag-driven navigation
-// from the command line (docs/tracking.md). Exit codes: 0 success, 1 job failed, 2 bad command line.
+// mogao-track: tag detection, camera calibration, printable tags and tag-driven navigation from
+// the command line; synthetic sequences are mogao-tag-sequence's (a laboratory program) (docs/tracking.md). Exit codes:
+// 0 success, 1 job failed, 2 bad command line.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -55,28 +56,6 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     c->add_option("--out", calib.out, "calibration file to write (.json)")->capture_default_str();
 
-    mogao::track::SequenceOptions seq;
-    auto* s = app.add_subcommand("make-sequence", "render a hand-held tag sequence (PNGs + truth) for replay");
-    s->add_option("OUT", seq.out, "output folder")->required();
-    s->add_option("--seconds", seq.seconds, "length")->check(CLI::Range(0.01, 600.0))->capture_default_str();
-    s->add_option("--fps", seq.fps, "frames per second")->check(CLI::Range(0.1, 240.0))->capture_default_str();
-    s->add_option("--family", seq.family, "tag family")
-        ->check(CLI::IsMember(mogao::TagFamily::known_names()))
-        ->capture_default_str();
-    s->add_option("--id", seq.id, "tag id")->check(CLI::NonNegativeNumber)->capture_default_str();
-    s->add_option("--tag-size-mm", seq.tag_size_mm, "tag size (black border)")
-        ->check(CLI::Range(1.0, 1000.0))
-        ->capture_default_str();
-    s->add_option("--width", seq.width, "image width")->check(CLI::Range(16, 8192))->capture_default_str();
-    s->add_option("--height", seq.height, "image height")->check(CLI::Range(16, 8192))->capture_default_str();
-    s->add_option("--focal-px", seq.focal_px, "focal length (px)")
-        ->check(CLI::Range(10.0, 100000.0))
-        ->capture_default_str();
-    s->add_option("--noise", seq.noise, "sensor noise sigma (grey levels)")
-        ->check(CLI::Range(0.0, 50.0))
-        ->capture_default_str();
-    s->add_option("--seed", seq.seed, "noise seed")->capture_default_str();
-
     mogao::track::TagImageOptions tag;
     auto* t = app.add_subcommand("make-tag", "write a printable tag image (PNG), generated from the family's codes");
     t->add_option("ID", tag.id, "tag id")->required()->check(CLI::NonNegativeNumber);
@@ -93,8 +72,8 @@ int main(int argc, char** argv) {
 
     mogao::track::NavigateOptions nav;
     auto* n = app.add_subcommand("navigate", "frames through tracker and navigation; print ViewerPoses (JSON lines)");
-    auto* replay =
-        n->add_option("REPLAY", nav.replay, "folder of frames (see make-sequence)")->check(CLI::ExistingDirectory);
+    auto* replay = n->add_option("REPLAY", nav.replay, "folder of frames (e.g. from mogao-tag-sequence)")
+                       ->check(CLI::ExistingDirectory);
     auto* device = n->add_option(
         "--device", nav.device,
         "camera instead of a folder: /dev/videoN, v4l2:/dev/videoN or libcamera:[<id>] (runs until killed)");
@@ -139,7 +118,6 @@ int main(int argc, char** argv) {
             }
             return mogao::track::calibrate_camera(calib);
         }
-        if (*s) return mogao::track::make_sequence(seq);
         if (*t) return mogao::track::make_tag(tag);
         if (*n) {
             if (nav.replay.empty() == nav.device.empty() || (!nav.device.empty() && nav.camera.empty())) {

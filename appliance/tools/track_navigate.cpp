@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // mogao-track navigate: frames from a replay folder or a V4L2 camera -> TagTracker -> Navigator ->
-// ViewerPose at the display rate, as JSON lines. With the folder's truth.json (make-sequence), also prints how
+// ViewerPose at the display rate, as JSON lines. With the folder's truth.json (mogao-tag-sequence), also prints how
 // far the tracker's yaw and distance were from the truth: the noise the One Euro filter is tuned
 // for (docs/tracking.md).
 #include <time.h>

@@ -71,7 +71,7 @@ int run_roi(const RoiOptions& options) {
     HandSequenceSpec spec;
     spec.seconds = options.seconds;
     const auto folder = std::filesystem::temp_directory_path() / ("mogao-roi-eval-" + std::to_string(::getpid()));
-    write_hand_sequence(folder, spec);  // as `mogao-track make-sequence`
+    write_hand_sequence(folder, spec);  // as `mogao-tag-sequence`
     const auto all_truth = hand_trajectory(spec);
     std::vector<HandFrame> truth;  // every `stride`-th frame, as a busy tracker that skips frames sees them
     std::vector<CameraFrame> frames;

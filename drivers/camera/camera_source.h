@@ -1,14 +1,14 @@
 // SPDX-License-Identifier: Apache-2.0
 // The camera the tracking input reads from, named by one string, and opened as a FrameSource:
 //   "replay:<folder>"     a folder of images (drivers/camera/replay_source.h), e.g. the output of
-//                         `mogao-track make-sequence`
+//                         `mogao-tag-sequence`
 //   "v4l2:/dev/videoN"    a V4L2 camera (drivers/camera/v4l2_capture.h), asked for the given size
 //                         (the calibrated one: TagTracker refuses frames of another size) and rate
 //   "libcamera:<id>"      a camera through libcamera (drivers/camera/libcamera_capture.h), <id> as
 //                         libcamera lists it (Camera::id()); "libcamera:" alone = its first camera.
 //                         Same size rule as V4L2. Without libcamera built in, opening is ENOTSUP.
 // Shared by `mogao-track navigate` (track_navigate.cpp) and the kiosk's tracking thread
-// (kiosk/tracking_thread.h), so both open a camera the same way.
+// (kiosk/navigation/tracking_thread.h), so both open a camera the same way.
 #pragma once
 
 #include <filesystem>

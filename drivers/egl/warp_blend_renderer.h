@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// WarpBlendRenderer: the GL layer of one projector output. It only uploads and draws: the content
+// WarpBlendRenderer: the GL layer of one projector output, the GLES 3 ProjectorRenderer
+// (drivers/projector_renderer.h). It only uploads and draws: the content
 // frame once per frame, each projector's calibration once, then one full-screen triangle per
 // projector per frame (the shader is linked twice: the general one and, for the common case of
 // maps as large as the target, one that fetches each map once per pixel). The maths (fragment
@@ -47,21 +48,22 @@
 #include <cstdint>
 #include <vector>
 
-#include "common/projector_calibration.h"
-#include "drivers/egl/gl_objects.h"
-#include "common/result.h"
 #include "common/image.h"
+#include "common/projector_calibration.h"
+#include "common/result.h"
+#include "drivers/egl/gl_objects.h"
+#include "drivers/projector_renderer.h"
 
 namespace mogao {
 
-class WarpBlendRenderer {
+class WarpBlendRenderer final : public ProjectorRenderer {
 public:
     // Compiles and links the program; EIO if no GLES 3 context is current or the shader fails.
     [[nodiscard]] static Result<WarpBlendRenderer> create();
 
     // Uploads the content frame: sRGB-encoded RGB8, rows top first (common/image.h).
     // Call once per frame before draw()/render(); the texture is reallocated only on a size change.
-    [[nodiscard]] Status set_content(const Rgb8Image& frame);
+    [[nodiscard]] Status set_content(const Rgb8Image& frame) override;
 
     // Validates and uploads one projector's warp map (RGB32F: u, v and, when the blend mask has
     // the warp's size, the blend weight, so that one fetch reads both), blend mask (R32F), response LUT
@@ -70,37 +72,31 @@ public:
     // draw()/render(). EINVAL when a size is empty or does not match its data (beta:
     // width*height*3 values), the LUT channels differ in length or have < 2 entries, or a blend
     // weight, LUT entry or beta offset is not finite; the message names the projector id and the map.
-    [[nodiscard]] Result<std::size_t> add_projector(const ProjectorCalibration& calibration);
+    [[nodiscard]] Result<std::size_t> add_projector(const ProjectorCalibration& calibration) override;
     // Replaces projector `index`'s calibration (a run-time calibration swap, kiosk/calibration_reload.h):
     // the same checks and uploads as add_projector; on any error the old textures stay in use.
     // EINVAL also for an index >= projector_count().
-    [[nodiscard]] Status replace_projector(std::size_t index, const ProjectorCalibration& calibration);
+    [[nodiscard]] Status replace_projector(std::size_t index, const ProjectorCalibration& calibration) override;
 
-    // The late warp's content-space affine map (appliance/warp/late_warp.h): the warp map's content
-    // coordinates uv (normalised, [0, 1] across the content the calibration was made for) are
-    // fetched at uv * scale + offset of the content frame set by set_content, per axis. Identity
-    // (scale 1, offset 0) by default; with it the draw is exactly the untransformed one. Used by
-    // draw()/render() from the next call on. Content texel indices clamp at the frame's edge.
-    struct ContentTransform {
-        float scale_u = 1.0f, scale_v = 1.0f;
-        float offset_u = 0.0f, offset_v = 0.0f;
-    };
-    void set_content_transform(const ContentTransform& transform) { transform_ = transform; }
-    [[nodiscard]] const ContentTransform& content_transform() const { return transform_; }
+    // The late warp's content-space affine map (drivers/projector_renderer.h), applied to the warp
+    // map's content coordinates before the content fetch.
+    using ContentTransform = mogao::ContentTransform;
+    void set_content_transform(const ContentTransform& transform) override { transform_ = transform; }
+    [[nodiscard]] const ContentTransform& content_transform() const override { return transform_; }
 
-    [[nodiscard]] std::size_t projector_count() const { return projectors_.size(); }
+    [[nodiscard]] std::size_t projector_count() const override { return projectors_.size(); }
     // Output size of projector `index` (< projector_count()).
-    [[nodiscard]] ImageSize output_size(std::size_t index) const { return projectors_.at(index).output; }
+    [[nodiscard]] ImageSize output_size(std::size_t index) const override { return projectors_.at(index).output; }
 
     // Draws projector `index` into the framebuffer bound to GL_DRAW_FRAMEBUFFER, viewport
     // (0, 0, output size). Leaves its program, textures (units 0-4) and viewport bound.
-    [[nodiscard]] Status draw(std::size_t index);
+    [[nodiscard]] Status draw(std::size_t index) override;
     // The same picture resampled to fill a framebuffer of `target` pixels: for an output whose mode
     // differs from the projector's calibrated output size. In the formulas above `output` becomes
     // `target`, so warp and blend are read at p * map.size / target (bilinear); the calibration's
     // geometry scales with the mode (a projector shows its whole panel at any mode). EINVAL/E2BIG
     // for an empty target or one beyond GL_MAX_TEXTURE_SIZE.
-    [[nodiscard]] Status draw(std::size_t index, ImageSize target);
+    [[nodiscard]] Status draw(std::size_t index, ImageSize target) override;
 
     // Draws projector `index` into its own FBO and reads it back as RGB8, rows top first.
     [[nodiscard]] Result<Rgb8Image> render(std::size_t index);

@@ -102,7 +102,7 @@ int light(const std::filesystem::path& device, double seconds) {
     auto created = KmsOutputBackend::create({device});
     if (!created) return std::fprintf(stderr, "%s\n", created.error().message.c_str()), 1;
     OutputBackend& backend = **created;
-    WarpBlendRenderer& renderer = backend.renderer();
+    ProjectorRenderer& renderer = backend.renderer();
     std::vector<Rgb8Image> patterns;
     for (const auto& out : backend.outputs()) {
         if (auto p = renderer.add_projector(identity_calibration(out.name, out.size)); !p) {

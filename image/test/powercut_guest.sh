@@ -16,7 +16,7 @@
 #               its write phase begins (its first file in --out), "frozen" printed; on the next line
 #               from the host ("go") it continues
 #   config      the kiosk's start-up on a changed kiosk.toml and MPCDI, which copies both to their
-#               last good copies (kiosk/last_loaded.h); "frozen" before it starts, "go" starts it
+#               last good copies (kiosk/config/last_loaded.h); "frozen" before it starts, "go" starts it
 # While the program runs, each change of the watched folder is printed with the guest's uptime
 #   MOGAO-SELFTEST ev <uptime> <file names>
 # and its end as "exit rc=<rc> <uptime>"; then everything is synced and it waits for a command again.

@@ -293,7 +293,7 @@ def main():
         json.dump(STILL_VIEW, f)
 
     def kiosk_toml(outputs, farm_endpoint=endpoint):
-        """kiosk/kiosk.example.toml with this test's overrides (mogao-kiosk --print-config; section.key=TOML
+        """kiosk/config/kiosk.example.toml with this test's overrides (mogao-kiosk --print-config; section.key=TOML
         value, empty: commented out); `outputs`: the [outputs] overrides."""
         overrides = [f'farm.endpoint="{farm_endpoint}"', 'farm.ca="pki/ca.pem"', 'farm.cert="pki/appliance-museum-1.pem"',
                      'farm.key="pki/appliance-museum-1.key"', f"display.rate_hz={RATE_HZ}", *outputs,

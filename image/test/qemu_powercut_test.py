@@ -16,7 +16,7 @@ partition (ext4 with a journal, mounted as its fstab says):
     and writes the new MPCDI and its models file, in --out and in the install path;
   * config: the kiosk's start on a changed kiosk.toml and MPCDI (mogao-kiosk with
     MOGAO_LAST_GOOD_DIR, as its unit runs it), which replaces its last good copies of both
-    (kiosk/last_loaded.h), the copies it falls back on when a file is bad at the next start.
+    (kiosk/config/last_loaded.h), the copies it falls back on when a file is bad at the next start.
 
 How: the image's kernel and initramfs are booted directly with init=/powercut-init
 (image/test/powercut_guest.sh, written onto the test copy's root) instead of systemd, so that a

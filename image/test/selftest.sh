@@ -26,7 +26,7 @@ say "start uptime=$(uptime_s) kernel=$(uname -r)"
 
 # --- mode service-card: the configuration partition is missing or corrupt ----------------------------
 # (image/test/qemu_service_card_test.py wipes it). The box must boot on, not into emergency mode, and
-# the kiosk must light every projector with its service card (kiosk/service_screen.h).
+# the kiosk must light every projector with its service card (kiosk/display/service_screen.h).
 if grep -q "mogao.selftest.mode=service-card" /proc/cmdline; then
   i=0
   state=""
@@ -195,7 +195,7 @@ opts=$(findmnt -no OPTIONS /)
 case ",$opts," in *,ro,*) ok "root-readonly options=$opts" ;; *) bad "root-readonly options=$opts" ;; esac
 if touch /.mogao-write-probe 2>/dev/null; then bad "root-write (a file could be created in /)"; rm -f /.mogao-write-probe; else ok "root-write refused"; fi
 ok "mounts $(findmnt -rno TARGET,FSTYPE,OPTIONS /var/lib/mogao | tr ' ' ':') $(findmnt -rno TARGET,OPTIONS /etc/mogao | tr ' ' ':') $(findmnt -rno TARGET,FSTYPE /tmp | tr ' ' ':')"
-# The kiosk keeps a last good copy of its configuration on the writable partition (kiosk/last_loaded.h).
+# The kiosk keeps a last good copy of its configuration on the writable partition (kiosk/config/last_loaded.h).
 lg='/var/lib/mogao/last-good/%etc%mogao%kiosk.toml.last-loaded'
 if cmp -s "$lg" /etc/mogao/kiosk.toml; then ok "last-good-copy $lg"; else bad "last-good-copy: $lg missing or not /etc/mogao/kiosk.toml"; fi
 failed=$(systemctl --failed --plain --no-legend 2>/dev/null | awk '{print $1}' | tr '\n' ' ')

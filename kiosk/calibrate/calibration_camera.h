@@ -13,7 +13,7 @@
 //
 // Camera values: CameraFrame's 8-bit codes are the camera's encoded values. camera_image() turns
 // them into the calibration's linear camera units: `srgb` decodes IEC 61966-2-1 (what webcams and
-// most V4L2 cameras deliver; an assumption, as in kiosk/selfcal_setup.h), `linear` takes code / 255
+// most V4L2 cameras deliver; an assumption, as in kiosk/live_calibration/selfcal_setup.h), `linear` takes code / 255
 // (raw sensors, the virtual rig). Colour frames (CameraFrame::colour) are averaged over R, G and B
 // after decoding (autocal's camera is monochrome with a flat spectral response,
 // appliance/autocal/colour_calibration.h); without colour the luma image is used.

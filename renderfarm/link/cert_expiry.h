@@ -2,7 +2,7 @@
 // When the certificates each side of the link holds expire, so that a lapse is seen weeks before
 // the farm refuses a gallery: the farm reports them as a Prometheus gauge
 // (mogao_farm_certificate_not_after_seconds, renderfarm/farm/farm_metrics.h), the kiosk in its
-// status file and on its on-wall status panel (kiosk/kiosk_status.h, kiosk/on_wall_status.h), and
+// status file and on its on-wall status panel (kiosk/stats/kiosk_status.h, kiosk/display/on_wall_status.h), and
 // both log a warning at start for any that expires within kCertificateWarningSeconds.
 //
 // Held: every certificate of the CA bundle (role "ca") and the side's own certificate (role

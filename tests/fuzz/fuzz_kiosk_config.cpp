@@ -4,7 +4,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "kiosk/kiosk_config.h"
+#include "kiosk/config/kiosk_config.h"
 #include "tests/fuzz/fuzz_input.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

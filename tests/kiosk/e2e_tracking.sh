@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
 # End to end, tracking as the kiosk's navigation input: a hand-held tag sequence with known motion
-# (`mogao-track make-sequence`: rest, turn the tag left 25 deg, back, push it 12 cm toward the
+# (`mogao-tag-sequence`: rest, turn the tag left 25 deg, back, push it 12 cm toward the
 # camera, back, fast turn right 30 deg, back, tag out of view 11.0-11.6 s, rest; 12 s, 800x600)
 # replayed as the camera of a headless kiosk ([navigation] source = "tracking",
 # replay_end = "stop"), which streams from a 3-rank farm over [::1] with mutual TLS.
@@ -20,16 +20,16 @@
 #     behind a newer one (as a busy camera reader would), at least 60 tracked, the tag
 #     seen in most, no sample dropped; farm frames were shown.
 #
-# usage: e2e_tracking.sh FARM KIOSK TRACK MPIEXEC SOURCE_DIR WORK_DIR
-farm=$1 kiosk=$2 track=$3 MPIEXEC=$4 src=$5 work=$6
+# usage: e2e_tracking.sh FARM KIOSK TAG_SEQUENCE MPIEXEC SOURCE_DIR WORK_DIR
+farm=$1 kiosk=$2 tag_sequence=$3 MPIEXEC=$4 src=$5 work=$6
 tool=true  # kiosk_e2e_common.sh's PNG checks are not used here
 source "$src/tests/kiosk/kiosk_e2e_common.sh"
 
 rm -rf "$work"
 mkdir -p "$work"
-"$track" make-sequence "$work/hand-sequence" >"$work/make-sequence.log" 2>&1 \
-  || { cat "$work/make-sequence.log"; fail "mogao-track make-sequence"; }
-[[ -f "$work/hand-sequence/camera.json" ]] || fail "make-sequence wrote no camera.json"
+"$tag_sequence" "$work/hand-sequence" >"$work/tag-sequence.log" 2>&1 \
+  || { cat "$work/tag-sequence.log"; fail "mogao-tag-sequence"; }
+[[ -f "$work/hand-sequence/camera.json" ]] || fail "mogao-tag-sequence wrote no camera.json"
 
 port=$((20000 + ($$ + 4099) % 20000))
 endpoint="[::1]:$port"
@@ -39,7 +39,7 @@ make_pki "$work/pki" "::1"
 # A slow machine ticks and tracks less often (it has to pass on one core): max_dt_s = 0.5 lets the
 # Navigator integrate display steps of up to 0.5 s instead of clamping them at 0.1 s (which loses
 # motion), hold_s = 0.3 keeps the command across camera frames skipped behind newer ones (the tag
-# is out of view for 0.6 s, longer than that), as kiosk/tour-tracking.overrides does.
+# is out of view for 0.6 s, longer than that), as kiosk/config/tour-tracking.overrides does.
 # The scripted visitor's keys out, the tracking source in (the replay's camera.json is the intrinsics).
 write_config "$work/kiosk.toml" "$endpoint" "$work/pki" "$work/png" 30 \
   'display.rate_hz=15' 'navigation.path=' 'navigation.path_frames=' 'navigation.source="tracking"' \

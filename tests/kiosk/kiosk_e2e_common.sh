@@ -90,7 +90,7 @@ make_pki() {
   "$farm" pki export-farm --dir "$1" --name farm --to "$(dirname "$1")/farm-tls" >/dev/null || fail "pki export-farm"
 }
 
-# write_config FILE ENDPOINT PKI PNG_DIR PNG_EVERY [OVERRIDE...]: kiosk/kiosk.example.toml with the
+# write_config FILE ENDPOINT PKI PNG_DIR PNG_EVERY [OVERRIDE...]: kiosk/config/kiosk.example.toml with the
 # test's overrides (mogao-kiosk --print-config; section.key=TOML value, empty value: commented out):
 # headless, the ideal 3-projector calibration at 320x240, the walk; later OVERRIDEs win.
 write_config() {

@@ -3,7 +3,7 @@
 # Appliance liveness: a missing or corrupt configuration partition must not leave the
 # projectors dark in a restart loop. mogao-kiosk with neither its configuration nor a last good
 # copy shows the service card ("SERVICE NEEDED" and the reason) on every output, stays up (READY,
-# watchdog fed: kiosk/service_screen.h), and exits 1 for systemd to start the show once the
+# watchdog fed: kiosk/display/service_screen.h), and exits 1 for systemd to start the show once the
 # configuration loads again.
 #   missing   --config names a file that does not exist (an unmounted partition): card on both
 #             outputs (headless, two sizes), exit 0 at --duration

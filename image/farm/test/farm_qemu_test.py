@@ -167,7 +167,7 @@ def host_dirs(work, farm, overlay, layout):
 
 
 def kiosk_config(kiosk, work, pki):
-    """kiosk/kiosk.example.toml with this test's overrides (mogao-kiosk --print-config; section.key=TOML value,
+    """kiosk/config/kiosk.example.toml with this test's overrides (mogao-kiosk --print-config; section.key=TOML value,
     empty: commented out): headless, one 320x180 output, the walk."""
     out = os.path.join(work, "kiosk")
     shutil.rmtree(out, ignore_errors=True)

@@ -1,0 +1,46 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "kiosk/navigation/view_script.h"
+
+#include <stdexcept>
+
+#include "common/camera_path.h"
+
+namespace mogao {
+
+ViewRequest make_view_template(const KioskConfig& config) {
+    ViewRequest r;
+    r.camera = config.screen;
+    r.size = config.quality.content;
+    r.quality.spp = config.quality.spp;
+    r.quality.jpeg_quality = config.quality.jpeg_quality;
+    r.quality.max_bounces = config.quality.max_bounces;
+    r.quality.ao_samples = config.quality.ao_samples;
+    r.quality.area_light_samples = config.quality.area_light_samples;
+    r.quality.resolution_scale = 1.0;
+    r.request_time_ns = 0;
+    return r;
+}
+
+ViewScript::ViewScript(std::vector<ViewerPose> poses, ViewRequest request_template)
+    : poses_(std::move(poses)), template_(std::move(request_template)) {
+    if (poses_.empty()) throw std::invalid_argument("ViewScript: no poses");
+}
+
+ViewRequest ViewScript::next() {
+    ViewRequest r = template_;
+    r.pose = poses_[next_];
+    next_ = (next_ + 1) % poses_.size();
+    r.request_time_ns = 0;
+    return r;
+}
+
+ViewScript make_view_script(const KioskConfig& config) {
+    Viewer viewer;
+    viewer.eye_height_m = config.navigation.eye_height_m;
+    viewer.start = config.navigation.start;
+    viewer.start_yaw_deg = config.navigation.start_yaw_deg;
+    return ViewScript(make_camera_path(config.navigation.path, viewer, config.navigation.path_frames),
+                      make_view_template(config));
+}
+
+}  // namespace mogao
