@@ -8,8 +8,8 @@
 #include <random>
 
 #include "appliance/navigation/tag_control.h"
+#include "appliance/tracker/lab/synthetic_view.h"
 #include "appliance/tracker/pose_disambiguator.h"
-#include "appliance/tracker/synthetic_view.h"
 
 namespace mogao {
 namespace {

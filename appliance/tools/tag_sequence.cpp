@@ -3,7 +3,7 @@
 #include <cstdio>
 
 #include "appliance/tools/track_commands.h"
-#include "appliance/tracker/hand_sequence.h"
+#include "appliance/tracker/lab/hand_sequence.h"
 
 namespace mogao::track {
 

@@ -15,11 +15,11 @@
 #include <CLI/CLI.hpp>
 
 #include "appliance/navigation/navigator.h"
-#include "appliance/tracker/hand_sequence.h"
-#include "appliance/tracker/synthetic_view.h"
+#include "appliance/navigation/tag_sample_of.h"
+#include "appliance/tracker/lab/hand_sequence.h"
+#include "appliance/tracker/lab/synthetic_view.h"
 #include "appliance/tracker/tag_bitmap.h"
 #include "appliance/tracker/tag_family.h"
-#include "appliance/navigation/tag_sample_of.h"
 #include "appliance/tracker/tag_tracker.h"
 
 namespace mogao {

@@ -9,7 +9,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "appliance/tracker/synthetic_view.h"
+#include "appliance/tracker/lab/synthetic_view.h"
 #include "tests/support/scratch_dir.h"
 
 namespace mogao {

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <random>
 
-#include "appliance/tracker/synthetic_view.h"
+#include "appliance/tracker/lab/synthetic_view.h"
 
 namespace mogao {
 namespace {

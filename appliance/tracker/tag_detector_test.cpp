@@ -8,7 +8,7 @@
 #include <type_traits>
 #include <utility>
 
-#include "appliance/tracker/synthetic_view.h"
+#include "appliance/tracker/lab/synthetic_view.h"
 
 namespace mogao {
 namespace {

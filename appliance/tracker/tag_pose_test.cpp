@@ -5,7 +5,7 @@
 
 #include <random>
 
-#include "appliance/tracker/synthetic_view.h"
+#include "appliance/tracker/lab/synthetic_view.h"
 
 namespace mogao {
 namespace {

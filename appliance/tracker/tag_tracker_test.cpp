@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "appliance/tracker/synthetic_view.h"
+#include "appliance/tracker/lab/synthetic_view.h"
 #include "appliance/tracker/tag_bitmap.h"
 
 namespace mogao {

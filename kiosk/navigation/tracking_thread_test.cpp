@@ -11,7 +11,7 @@
 #include <thread>
 #include <vector>
 
-#include "appliance/tracker/hand_sequence.h"
+#include "appliance/tracker/lab/hand_sequence.h"
 
 namespace mogao {
 namespace {

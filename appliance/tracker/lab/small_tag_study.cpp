@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "appliance/tracker/synthetic_view.h"
+#include "appliance/tracker/lab/synthetic_view.h"
 #include "appliance/tracker/tag_bitmap.h"
 #include "appliance/tracker/tag_detector.h"
 #include "appliance/tracker/tag_pose.h"

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "appliance/tracker/code_ranking.h"
+#include "appliance/tracker/lab/code_ranking.h"
 
 #include <opencv2/imgproc.hpp>
 

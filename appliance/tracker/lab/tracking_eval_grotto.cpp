@@ -11,11 +11,11 @@
 #include <string>
 #include <vector>
 
+#include "appliance/tracker/lab/tag_reference.h"
+#include "appliance/tracker/lab/tracking_eval.h"
+#include "appliance/tracker/lab/tracking_eval_grotto.h"
 #include "appliance/tracker/tag_detector.h"
-#include "appliance/tracker/tag_reference.h"
 #include "appliance/tracker/tag_tracker.h"
-#include "appliance/tracker/tracking_eval.h"
-#include "appliance/tracker/tracking_eval_grotto.h"
 #include "drivers/camera/image_file.h"
 
 namespace mogao::eval {

@@ -3,13 +3,13 @@
 // corner error against tags_real_truth.json (counts from PROVENANCE.md and its ground-truth
 // files; corners from the independent ArUco + edge-line reference, tag_reference.h). Skipped (exit
 // 77) with a message when the photographs are absent.
-#include "appliance/tracker/tags_real.h"
+#include "appliance/tracker/lab/tags_real.h"
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
 
-#include "appliance/tracker/code_ranking.h"
+#include "appliance/tracker/lab/code_ranking.h"
 #include "appliance/tracker/tag_detector.h"
 #include "drivers/camera/image_file.h"
 
@@ -31,7 +31,7 @@ TEST(TagsReal, DefaultsFindTheTagsWithAccurateCorners) {
     if (!std::filesystem::exists(data))
         GTEST_SKIP() << "real tag photographs not found at " << data << " (../shared/data/tags-real)";
     const auto truth =
-        read_real_truth(std::filesystem::path(MOGAO_SOURCE_DIR) / "appliance/tracker/tags_real_truth.json");
+        read_real_truth(std::filesystem::path(MOGAO_SOURCE_DIR) / "appliance/tracker/lab/tags_real_truth.json");
     SetScore all, core;
     for (const auto& t : truth) {
         auto image = read_gray_image(data / t.file);
@@ -62,7 +62,7 @@ TEST(TagsReal, CorrelationRanksArucosIdsFirst) {
     if (!std::filesystem::exists(data))
         GTEST_SKIP() << "real tag photographs not found at " << data << " (../shared/data/tags-real)";
     const auto truth =
-        read_real_truth(std::filesystem::path(MOGAO_SOURCE_DIR) / "appliance/tracker/tags_real_truth.json");
+        read_real_truth(std::filesystem::path(MOGAO_SOURCE_DIR) / "appliance/tracker/lab/tags_real_truth.json");
     int checked = 0;
     for (const auto& t : truth) {
         const auto image = read_gray_image(data / t.file);

@@ -10,8 +10,8 @@
 #include <random>
 #include <stdexcept>
 
-#include "appliance/tracker/tracking_eval.h"
-#include "appliance/tracker/tracking_eval_grotto.h"
+#include "appliance/tracker/lab/tracking_eval.h"
+#include "appliance/tracker/lab/tracking_eval_grotto.h"
 #include "common/file_io.h"
 #include "common/image.h"
 #include "common/jpeg_codec.h"

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "appliance/tracker/tracking_eval_grotto.h"
+#include "appliance/tracker/lab/tracking_eval_grotto.h"
 
 #include <cmath>
 #include <cstdio>

@@ -11,11 +11,11 @@
 
 #include <unistd.h>
 
-#include "appliance/tracker/hand_sequence.h"
-#include "appliance/tracker/synthetic_view.h"
-#include "appliance/tracker/tag_reference.h"
+#include "appliance/tracker/lab/hand_sequence.h"
+#include "appliance/tracker/lab/synthetic_view.h"
+#include "appliance/tracker/lab/tag_reference.h"
+#include "appliance/tracker/lab/tracking_eval.h"
 #include "appliance/tracker/tag_tracker.h"
-#include "appliance/tracker/tracking_eval.h"
 #include "drivers/camera/image_file.h"
 
 namespace mogao::eval {

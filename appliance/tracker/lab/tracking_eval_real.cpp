@@ -10,11 +10,11 @@
 #include <string>
 #include <utility>
 
-#include "appliance/tracker/code_ranking.h"
+#include "appliance/tracker/lab/code_ranking.h"
+#include "appliance/tracker/lab/tag_reference.h"
+#include "appliance/tracker/lab/tags_real.h"
+#include "appliance/tracker/lab/tracking_eval.h"
 #include "appliance/tracker/tag_detector.h"
-#include "appliance/tracker/tag_reference.h"
-#include "appliance/tracker/tags_real.h"
-#include "appliance/tracker/tracking_eval.h"
 #include "drivers/camera/image_file.h"
 
 namespace mogao::eval {

@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <exception>
 
-#include "appliance/tracker/tags_real.h"
-#include "appliance/tracker/tracking_eval.h"
+#include "appliance/tracker/lab/tags_real.h"
+#include "appliance/tracker/lab/tracking_eval.h"
 
 int main(int argc, char** argv) {
     CLI::App app{"mogao_tracking_eval: tag detection and tracking against ground truth"};
@@ -15,15 +15,15 @@ int main(int argc, char** argv) {
     const std::filesystem::path source = MOGAO_SOURCE_DIR;
     const std::filesystem::path data_default = mogao::tags_real_dir(MOGAO_TAGS_REAL_DIR);
 
-    mogao::eval::RealOptions real{source / "appliance/tracker/tags_real_truth.json", data_default};
+    mogao::eval::RealOptions real{source / "appliance/tracker/lab/tags_real_truth.json", data_default};
     auto* r = app.add_subcommand("real", "detection rate and corner error on the real photographs, per setting");
     r->add_option("--truth", real.truth, "truth file")->capture_default_str();
     r->add_option("--data", real.data, "tags-real folder")->capture_default_str();
     r->add_option("--repeat", real.repeat, "timing runs per image")->check(CLI::Range(1, 100))->capture_default_str();
     r->add_flag("--per-image", real.per_image, "per-image lines on stderr");
 
-    mogao::eval::ReferenceOptions ref{source / "appliance/tracker/tags_real_manifest.json", data_default,
-                                      source / "appliance/tracker/tags_real_truth.json"};
+    mogao::eval::ReferenceOptions ref{source / "appliance/tracker/lab/tags_real_manifest.json", data_default,
+                                      source / "appliance/tracker/lab/tags_real_truth.json"};
     auto* f = app.add_subcommand("reference", "independent reference corners (ArUco + edge-line fits) -> truth file");
     f->add_option("--manifest", ref.manifest, "hand-written manifest")->capture_default_str();
     f->add_option("--data", ref.data, "tags-real folder")->capture_default_str();

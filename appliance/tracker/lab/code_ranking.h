@@ -21,8 +21,8 @@
 
 #include <vector>
 
+#include "appliance/tracker/lab/tag_reference.h"
 #include "appliance/tracker/tag_family.h"
-#include "appliance/tracker/tag_reference.h"
 #include "drivers/camera/camera_frame.h"
 
 namespace mogao {

@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "appliance/tracker/camera_intrinsics.h"
-#include "appliance/tracker/synthetic_view.h"
+#include "appliance/tracker/lab/synthetic_view.h"
 #include "appliance/tracker/tag_pose.h"
 
 namespace mogao {

@@ -3,8 +3,8 @@
 // each image and how a detector's output is scored against it. Used by tracking_eval and
 // tags_real_test only; the images are never copied into the repository.
 //
-// Truth file (appliance/tracker/tags_real_truth.json, written by `mogao_tracking_eval reference`
-// from the hand-written manifest appliance/tracker/tags_real_manifest.json):
+// Truth file (appliance/tracker/lab/tags_real_truth.json, written by `mogao_tracking_eval reference`
+// from the hand-written manifest appliance/tracker/lab/tags_real_manifest.json):
 //   {"images": [{"file", "family", "tags" (tags present, >= 1), "count_source", "ids" (the ids that
 //     may be present, e.g. a whole printed grid of which only "tags" are in view), "ids_source",
 //     "subset" ("core" for the 47 tags of the sw mapping and hallway, dt, jl and wpi images, the
@@ -23,8 +23,8 @@
 #include <string>
 #include <vector>
 
+#include "appliance/tracker/lab/tag_reference.h"
 #include "appliance/tracker/tag_detector.h"
-#include "appliance/tracker/tag_reference.h"
 
 namespace mogao {
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "appliance/tracker/hand_sequence.h"
+#include "appliance/tracker/lab/hand_sequence.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "appliance/tracker/tags_real.h"
+#include "appliance/tracker/lab/tags_real.h"
 
 #include <algorithm>
 #include <cmath>

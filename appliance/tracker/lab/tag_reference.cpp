@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "appliance/tracker/tag_reference.h"
+#include "appliance/tracker/lab/tag_reference.h"
 
 #include <algorithm>
 #include <cmath>
