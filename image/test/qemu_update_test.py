@@ -243,7 +243,7 @@ def check_updates(a, work, proc, fails, env, key, img, sticks, cal_sha, results)
     fails.check(re.search(r"Started mogao-kiosk\.service", journal.text()) is not None, "slot a: the kiosk started")
 
     t0 = time.monotonic()
-    ok, secs = plug(qmp, journal, sticks["good"], 2, a.timeout)
+    ok, secs = plug(qmp, journal, sticks["good"], 2, a.install_timeout)
     r = result_of(sticks["good"], env)
     results["install_good_s"] = round(secs, 1)
     fails.check(ok and r.get("outcome") == "done" and "into slot b" in r.get("reason", ""),
@@ -259,7 +259,7 @@ def check_updates(a, work, proc, fails, env, key, img, sticks, cal_sha, results)
     fails.check(sha == cal_sha, f"after the good update the calibration is byte-identical (sha256 {sha})")
 
     t0 = time.monotonic()
-    ok, secs = plug(qmp, journal, sticks["bad"], 3, a.timeout)
+    ok, secs = plug(qmp, journal, sticks["bad"], 3, a.install_timeout)
     r = result_of(sticks["bad"], env)
     results["install_bad_s"] = round(secs, 1)
     fails.check(ok and r.get("outcome") == "done" and "into slot a" in r.get("reason", ""),
@@ -285,6 +285,7 @@ def main():
     ap.add_argument("--results", default="")
     ap.add_argument("--accel", default=os.environ.get("MOGAO_IMAGE_QEMU_ACCEL", "tcg"), choices=["tcg", "kvm"])
     ap.add_argument("--timeout", type=float, default=float(os.environ.get("MOGAO_UPDATE_TEST_TIMEOUT", "150")))
+    ap.add_argument("--install-timeout", type=float, default=float(os.environ.get("MOGAO_UPDATE_INSTALL_TIMEOUT", "300")))
     a = ap.parse_args()
     qemu = require_qemu(a.image)
     for t in ("mkfs.vfat", "mcopy", "mtype", "mdir", "openssl", "zstd", "debugfs"):
@@ -300,11 +301,13 @@ def main():
     env = dict(os.environ, MTOOLS_SKIP_CHECK="1")
     fails, results = Failures(), {}
     img, provision_cmd, key, cal_sha = provision(a, work, env)
+    log("provisioned")
     again = subprocess.run(provision_cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     fails.check(again.returncode != 0 and "holds a configuration already" in again.stdout and "--wipe" in again.stdout,
                 f"re-provisioning without --wipe is refused ({again.stdout.strip().splitlines()[-1][:160] if again.stdout else ''})")
     console_entry(img, env, work)
     good, bad, wrong = bundles(a, work)
+    log("bundles made")
     results["bundle_mib"] = round(os.path.getsize(good) / (1 << 20), 1)
     serial = int(time.time())
     sticks = {"wrong": make_stick(a, work, "wrong", env, key, serial + 1, wrong),
