@@ -119,7 +119,7 @@ if command -v openssl > /dev/null && command -v zstd > /dev/null; then
   make_bundle() { # make_bundle OUT KEY [compatible]: signs b/manifest.toml with KEY
     { echo 'format = "mogao-update-bundle"'; echo 'version = 1'; echo 'image_version = "mogao-kiosk test"'
       echo "compatible = \"${3:-mogao-kiosk-amd64}\""; echo 'built = "2026-11-26T00:00:00Z"'; echo 'tries = 3'
-      echo 'options = "ro quiet panic=10"'; echo "root_size = 100000"; echo "root_sha256 = \"$(sha "$u/root.img")\""
+      echo 'options = "ro quiet panic=10"'; echo "root_size = 100000"
       echo "root_zst_sha256 = \"$(sha "$u/b/root.img.zst")\""; echo "vmlinuz_sha256 = \"$(sha "$u/b/vmlinuz")\""
       echo "initrd_sha256 = \"$(sha "$u/b/initrd.img")\""; } > "$u/b/manifest.toml"
     openssl pkeyutl -sign -inkey "$2" -rawin -in "$u/b/manifest.toml" -out "$u/b/manifest.toml.sig"
