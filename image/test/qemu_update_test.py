@@ -28,7 +28,8 @@ In order (each printed; any failure fails the test):
   2. the WRONG stick: refused for its signature (result.toml), nothing written;
   3. the GOOD stick: installed into slot b; the appliance reboots, systemd-boot tries slot b, the
      kiosk reports READY there, the boot assessment passes and systemd-bless-boot marks it good;
-     the calibration's sha256 on the configuration partition is unchanged;
+     the calibration's sha256 on the configuration partition is unchanged (read from the running
+     guest's disk with debugfs -c);
   4. the BAD stick (on slot b): installed into slot a; the reboot tries it, the kiosk fails, the
      boot assessment fails and reboots, systemd-boot falls back to slot b (GOOD), whose kiosk
      starts and whose status line names the rolled-back update;
@@ -252,8 +253,8 @@ def check_updates(a, work, proc, fails, env, key, img, sticks, cal_sha, results)
     fails.check(line is not None and "update-test good" in line, f"the reboot runs slot b: {line}")
     m = journal.wait(r"boot assessment: mogao-kiosk is READY on slot b[^\r\n]*", 120)
     fails.check(m is not None, f"slot b: {m.group(0) if m else 'no boot assessment'}")
-    m = journal.wait(r"Successfully renamed '[^']*mogao-2-b\+\d+-\d+\.conf' to '[^']*mogao-2-b\.conf'", 60)
-    fails.check(m is not None, f"systemd-bless-boot marked slot b good: {m.group(0) if m else 'no rename'}")
+    m = journal.wait(r"systemd-bless-boot\[\d+\]: Marked boot as 'good'[^\r\n]*", 60)
+    fails.check(m is not None, f"systemd-bless-boot marked slot b good: {m.group(0) if m else 'not seen'}")
     results["good_update_to_blessed_s"] = round(time.monotonic() - t0, 1)
     sha = config_file_sha(img, "etc/screen.mpcdi")
     fails.check(sha == cal_sha, f"after the good update the calibration is byte-identical (sha256 {sha})")
@@ -284,7 +285,7 @@ def main():
     ap.add_argument("--work", default="")
     ap.add_argument("--results", default="")
     ap.add_argument("--accel", default=os.environ.get("MOGAO_IMAGE_QEMU_ACCEL", "tcg"), choices=["tcg", "kvm"])
-    ap.add_argument("--timeout", type=float, default=float(os.environ.get("MOGAO_UPDATE_TEST_TIMEOUT", "150")))
+    ap.add_argument("--timeout", type=float, default=float(os.environ.get("MOGAO_UPDATE_TEST_TIMEOUT", "240")))
     ap.add_argument("--install-timeout", type=float, default=float(os.environ.get("MOGAO_UPDATE_INSTALL_TIMEOUT", "300")))
     a = ap.parse_args()
     qemu = require_qemu(a.image)
