@@ -2,14 +2,20 @@
 # Shared by image/build, image/provision and the QEMU test (sourced, bash).
 #
 # Disk layout of mogao-kiosk.img (GPT, 512-byte sectors, partitions aligned to 1 MiB):
-#   1  ESP           FAT32, label ESP           systemd-boot, kernel, initramfs, loader entry
-#   2  mogao-root    ext4 (no journal), label mogao-root, mounted read-only at /
+#   1  ESP           FAT32, label ESP           systemd-boot, per slot a kernel and initramfs
+#                                               (/mogao/a, /mogao/b), one loader entry per slot
+#   2  mogao-root-a  ext4 (no journal), label mogao-root: root of slot a, read-only at / when it runs
 #   3  mogao-config  ext4, label mogao-config, mounted read-write at /var/lib/mogao;
 #                    its etc/ folder is bind-mounted read-only at /etc/mogao
-# Partition names (GPT) equal the file system labels.
+#   4  mogao-root-b  root of slot b (empty until the first update; docs/updates.md)
+# The root file systems of both slots carry the label mogao-root (the same file system image goes
+# into either slot); the loader entries name their root by PARTUUID.
 
 MOGAO_ROOT_LABEL=mogao-root
 MOGAO_CONFIG_LABEL=mogao-config
+MOGAO_ROOT_A_PART=2
+MOGAO_CONFIG_PART=3
+MOGAO_ROOT_B_PART=4
 MOGAO_KIOSK_UID=970   # usr/lib/sysusers.d/mogao.conf in image/rootfs
 MOGAO_KIOSK_GID=970
 

@@ -10,7 +10,7 @@ bash -n "$dir/test/image_tests.sh"
 bash -n "$dir/test/build_vimc.sh"
 sh -n "$dir/test/selftest.sh"
 bash -n "$dir/test/powercut_guest.sh"
-python3 - "$dir/test/qemu_boot_test.py" "$dir/test/qemu_service_card_test.py" "$dir/test/qemu_common.py" "$dir/test/qemu_libcamera.py" "$dir/lib/prune_modules.py" "$dir/test/qemu_powercut_test.py" "$dir/test/powercut_report.py" "$dir/test/qemu_service_mode_test.py" <<'PY'
+python3 - "$dir/test/qemu_boot_test.py" "$dir/test/qemu_service_card_test.py" "$dir/test/qemu_common.py" "$dir/test/qemu_libcamera.py" "$dir/lib/prune_modules.py" "$dir/test/qemu_powercut_test.py" "$dir/test/powercut_report.py" "$dir/test/qemu_service_mode_test.py" "$dir/test/qemu_update_test.py" <<'PY'
 import sys
 for f in sys.argv[1:]:
     compile(open(f).read(), f, "exec")
@@ -36,7 +36,9 @@ PY
 "$dir/provision" --help | grep -q "image/provision"
 # The fstab labels are the ones image/build and image/provision write.
 source "$dir/lib/common.sh"
-grep -q "^LABEL=$MOGAO_ROOT_LABEL " "$dir/rootfs/etc/fstab"
+# The root is not in fstab: both slots' file systems carry its label (docs/updates.md).
+! grep -q "^LABEL=$MOGAO_ROOT_LABEL " "$dir/rootfs/etc/fstab"
+grep -q "^PARTLABEL=ESP  *\/efi  *vfat .*x-systemd.automount" "$dir/rootfs/etc/fstab"
 grep -q "^LABEL=$MOGAO_CONFIG_LABEL " "$dir/rootfs/etc/fstab"
 grep -q "^u mogao-kiosk $MOGAO_KIOSK_UID:$MOGAO_KIOSK_GID " "$dir/rootfs/usr/lib/sysusers.d/mogao.conf"
 # provision refuses a configuration folder holding a CA's private key, by name and by content,
@@ -96,4 +98,61 @@ printf '# nothing\n' > "$tmp/addrs"
 PATH="$tmp/bin:$PATH" "$allow" "$tmp/addrs" 2> /dev/null && { echo "kiosk-ip-allow accepted an empty list"; exit 1; }
 PATH="$tmp/bin:$PATH" "$allow" "$tmp/missing" 2> /dev/null && { echo "kiosk-ip-allow accepted a missing file"; exit 1; }
 [[ ! -e "$tmp/systemctl.args" ]] || { echo "kiosk-ip-allow called systemctl on bad input"; exit 1; }
+# mogao-update verify (docs/updates.md) on small hand-made bundles: a good one is accepted; an
+# unsigned one, one signed by another key, a changed manifest, a changed payload and one for
+# another appliance are refused with their reason, before anything is written.
+bash -n "$dir/bundle"
+bash -n "$dir/rootfs/usr/lib/mogao/mogao-update"
+"$dir/bundle" --help | grep -q "image/bundle"
+if command -v openssl > /dev/null && command -v zstd > /dev/null; then
+  u=$tmp/update
+  mkdir -p "$u/keys" "$u/b"
+  "$dir/bundle" keygen --out "$u/k1" 2> /dev/null
+  "$dir/bundle" keygen --out "$u/k2" 2> /dev/null
+  cp "$u/k1/update-key.pem" "$u/keys/"
+  echo mogao-kiosk-amd64 > "$u/compatible"
+  head -c 100000 /dev/urandom > "$u/root.img"
+  head -c 1000 /dev/urandom > "$u/b/vmlinuz"
+  head -c 2000 /dev/urandom > "$u/b/initrd.img"
+  zstd -q "$u/root.img" -o "$u/b/root.img.zst"
+  sha() { sha256sum < "$1" | cut -c1-64; }
+  make_bundle() { # make_bundle OUT KEY [compatible]: signs b/manifest.toml with KEY
+    { echo 'format = "mogao-update-bundle"'; echo 'version = 1'; echo 'image_version = "mogao-kiosk test"'
+      echo "compatible = \"${3:-mogao-kiosk-amd64}\""; echo 'built = "2026-11-26T00:00:00Z"'; echo 'tries = 3'
+      echo 'options = "ro quiet panic=10"'; echo "root_size = 100000"
+      echo "root_zst_sha256 = \"$(sha "$u/b/root.img.zst")\""; echo "vmlinuz_sha256 = \"$(sha "$u/b/vmlinuz")\""
+      echo "initrd_sha256 = \"$(sha "$u/b/initrd.img")\""; } > "$u/b/manifest.toml"
+    openssl pkeyutl -sign -inkey "$2" -rawin -in "$u/b/manifest.toml" -out "$u/b/manifest.toml.sig"
+    tar -cf "$1" -C "$u/b" manifest.toml manifest.toml.sig vmlinuz initrd.img root.img.zst
+  }
+  verify() { MOGAO_UPDATE_KEYS=$u/keys MOGAO_UPDATE_COMPATIBLE_FILE=$u/compatible RUNTIME_DIRECTORY=$u/run \
+    "$dir/rootfs/usr/lib/mogao/mogao-update" verify "$@" 2>&1; }
+  expect_refused() { # expect_refused WHAT PATTERN BUNDLE...
+    local what=$1 pattern=$2 out; shift 2
+    out=$(verify "$@") && { echo "mogao-update accepted $what"; exit 1; }
+    grep -q "REFUSED: .*$pattern" <<< "$out" || { echo "mogao-update, $what: unexpected message: $out"; exit 1; }
+  }
+  make_bundle "$u/good.bundle" "$u/k1/update-signing.key"
+  out=$(verify "$u/good.bundle") || { echo "mogao-update refused a good bundle: $out"; exit 1; }
+  grep -q "payloads match the signed manifest" <<< "$out" || { echo "mogao-update verify: $out"; exit 1; }
+  manifest_sha=$(sha "$u/b/manifest.toml")
+  verify "$u/good.bundle" --manifest-sha256 "$manifest_sha" > /dev/null || { echo "mogao-update refused the named bundle"; exit 1; }
+  expect_refused "another bundle than the request names" "not the one the service request names" "$u/good.bundle" --manifest-sha256 "${manifest_sha//?/0}"
+  tar -cf "$u/unsigned.bundle" -C "$u/b" manifest.toml vmlinuz initrd.img root.img.zst
+  expect_refused "an unsigned bundle" "not signed" "$u/unsigned.bundle"
+  make_bundle "$u/other.bundle" "$u/k2/update-signing.key"
+  expect_refused "a bundle signed by another key" "bad signature" "$u/other.bundle"
+  make_bundle "$u/good.bundle" "$u/k1/update-signing.key"
+  echo "# changed after signing" >> "$u/b/manifest.toml"
+  tar -cf "$u/changed.bundle" -C "$u/b" manifest.toml manifest.toml.sig vmlinuz initrd.img root.img.zst
+  expect_refused "a manifest changed after signing" "bad signature" "$u/changed.bundle"
+  make_bundle "$u/good.bundle" "$u/k1/update-signing.key"
+  head -c 1000 /dev/urandom > "$u/b/vmlinuz"
+  tar -cf "$u/payload.bundle" -C "$u/b" manifest.toml manifest.toml.sig vmlinuz initrd.img root.img.zst
+  expect_refused "a changed payload" "vmlinuz does not match the signed manifest" "$u/payload.bundle"
+  make_bundle "$u/foreign.bundle" "$u/k1/update-signing.key" mogao-farm-amd64
+  expect_refused "a bundle for another appliance" "is for 'mogao-farm-amd64'" "$u/foreign.bundle"
+  rm -f "$u/keys/"*
+  expect_refused "a bundle on an image without update keys" "trusts no update key" "$u/foreign.bundle"
+fi
 echo "image scripts: ok"

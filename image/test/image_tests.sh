@@ -8,6 +8,10 @@
 #     (MOGAO_POWERCUT_CUTS cuts per write, default 3; MOGAO_POWERCUT_REBOOT_EVERY, default 0: no
 #     reboot on a cut disk, the full run does those; MOGAO_POWERCUT_SEED, default 1)
 #   image_tests.sh service-mode REPO OUTDIR KIOSK FARM CALIBRATE RIG_FILM   signed USB-stick requests
+#   image_tests.sh update REPO OUTDIR KIOSK FARM   A/B updates through the service mode, a rollback
+# The image the build mode makes trusts a test update key made next to it (OUTDIR/update-test-key/,
+# image/bundle keygen): the update test signs its bundles with it. With MOGAO_IMAGE, the update
+# test needs MOGAO_UPDATE_SIGNING_KEY (the private key whose public key that image trusts).
 # Exit 77 (skipped) with a message when not enabled (MOGAO_IMAGE_TESTS=1) or not possible here.
 set -u
 mode=$1 repo=$2 outdir=$3 kiosk=$4
@@ -24,7 +28,9 @@ case $mode in
     why=$(img_build_preconditions mmdebstrap mke2fs mkfs.vfat mcopy sfdisk xz python3) || skip "$why"
     mkdir -p "$outdir"
     start=$(date +%s)
-    "$repo/image/build" --kiosk "$kiosk" --out "$outdir" --cache "$outdir/apt-cache" || exit 1
+    [[ -f "$outdir/update-test-key/update-key.pem" ]] || "$repo/image/bundle" keygen --out "$outdir/update-test-key" || exit 1
+    "$repo/image/build" --kiosk "$kiosk" --out "$outdir" --cache "$outdir/apt-cache" \
+      --update-key "$outdir/update-test-key/update-key.pem" || exit 1
     echo "image_build: $(( $(date +%s) - start )) s"
     ;;
   boot)
@@ -59,6 +65,15 @@ case $mode in
     [[ -f "$image" ]] || skip "no image at $image (the image_build test builds it)"
     exec python3 "$repo/image/test/qemu_service_mode_test.py" --image "$image" --repo "$repo" --kiosk "$kiosk" \
       --farm "$farm" --calibrate "$calibrate" --rig-film "$rig_film" --work "$outdir/qemu-service-mode"
+    ;;
+  update)
+    farm=$5
+    image=${MOGAO_IMAGE:-$outdir/mogao-kiosk.img}
+    [[ -f "$image" ]] || skip "no image at $image (the image_build test builds it)"
+    key=${MOGAO_UPDATE_SIGNING_KEY:-$outdir/update-test-key/update-signing.key}
+    [[ -f "$key" ]] || skip "no update signing key $key (image_build makes one; with MOGAO_IMAGE set MOGAO_UPDATE_SIGNING_KEY)"
+    exec python3 "$repo/image/test/qemu_update_test.py" --image "$image" --repo "$repo" --kiosk "$kiosk" \
+      --farm "$farm" --update-key "$key" --work "$outdir/qemu-update" --results "$outdir/qemu-update-results.json"
     ;;
   *) echo "unknown mode $mode" >&2; exit 2 ;;
 esac

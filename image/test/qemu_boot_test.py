@@ -46,7 +46,7 @@ import tempfile
 import time
 
 import qemu_libcamera  # noqa: E402 (this folder)
-from qemu_common import T0, Failures, Serial, log, set_name, stop_qemu  # noqa: E402 (this folder)
+from qemu_common import IMAGE_ENTRY, IMAGE_INITRD, IMAGE_KERNEL, T0, Failures, Serial, log, set_name, stop_qemu  # noqa: E402,E501
 
 SKIP = 77
 OVMF_CODE = "/usr/share/OVMF/OVMF_CODE_4M.fd"
@@ -221,7 +221,7 @@ def install_selftest_entry(work, esp, title, options, extra, env):
     """Makes a systemd-boot entry `title` with the image's kernel options plus `extra` the default of
     the test copy's ESP (`esp`: an mtools image@@offset)."""
     with open(os.path.join(work, "selftest.conf"), "w") as f:
-        f.write(f"title {title}\nlinux /mogao/vmlinuz\ninitrd /mogao/initrd.img\n"
+        f.write(f"title {title}\nlinux {IMAGE_KERNEL}\ninitrd {IMAGE_INITRD}\n"
                 f"options {' '.join(options.split())} {' '.join(extra)}\n")
     with open(os.path.join(work, "loader.conf"), "w") as f:
         f.write("default selftest.conf\ntimeout 0\neditor no\n")
@@ -341,7 +341,7 @@ def main():
     run(["cp", "--sparse=always", a.image, img])
     run([os.path.join(a.repo, "image", "provision"), "--kiosk", a.kiosk, img, cfg])
     esp = f"{img}@@1M"
-    entry = run(["mtype", "-i", esp, "::/loader/entries/mogao.conf"], env=env).stdout
+    entry = run(["mtype", "-i", esp, IMAGE_ENTRY], env=env).stdout
     options = re.search(r"^options (.*)$", entry, re.M).group(1)
     options = re.sub(r"\b(quiet|loglevel=\d|systemd.show_status=\S+)\b", "", options)
     boot = ("udevadm settle; mount -o ro /dev/disk/by-label/mogao-test /mnt && exec /bin/sh /mnt/selftest.sh")
@@ -377,7 +377,7 @@ def main():
         log(f"camera test on the test disk: {a.camera_test}")
     else:
         log("no drivers/camera test binary given: the V4L2 capture test is skipped")
-    run(["mcopy", "-o", "-i", esp, "::/mogao/vmlinuz", os.path.join(work, "vmlinuz")], env=env)
+    run(["mcopy", "-o", "-i", esp, f"::{IMAGE_KERNEL}", os.path.join(work, "vmlinuz")], env=env)
     libcamera_staged, what = qemu_libcamera.stage(a.repo, work, disk, os.path.join(work, "vmlinuz"), a.libcamera_test)
     log(f"libcamera test on the test disk: {what}" if libcamera_staged else f"libcamera test not staged: {what}")
     if not libcamera_staged and os.environ.get("CI") == "true":

@@ -10,6 +10,11 @@ import subprocess
 import time
 
 T0 = time.monotonic()
+# image/build's ESP: slot a's loader entry, kernel and initramfs (docs/updates.md; slot b's appear
+# with the first update).
+IMAGE_ENTRY = "::/loader/entries/mogao-1-a.conf"
+IMAGE_KERNEL = "/mogao/a/vmlinuz"
+IMAGE_INITRD = "/mogao/a/initrd.img"
 _name = "qemu_test"
 
 

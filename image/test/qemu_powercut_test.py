@@ -54,7 +54,7 @@ import tempfile
 import time
 import zipfile
 
-from qemu_common import T0, Failures, Serial, log, set_name, stop_qemu  # noqa: E402 (this folder)
+from qemu_common import IMAGE_ENTRY, IMAGE_KERNEL, T0, Failures, Serial, log, set_name, stop_qemu  # noqa: E402,E501
 from qemu_boot_test import Qmp, run  # noqa: E402
 import powercut_report  # noqa: E402
 
@@ -144,8 +144,8 @@ def prepare(a, work, env):
     img = os.path.join(work, "powercut.img")
     run(["cp", "--sparse=always", a.image, img])
     for f in ("vmlinuz", "initrd.img"):
-        run(["mcopy", "-o", "-i", f"{img}@@1M", f"::/mogao/{f}", os.path.join(work, f)], env=env)
-    entry = run(["mtype", "-i", f"{img}@@1M", "::/loader/entries/mogao.conf"], env=env).stdout
+        run(["mcopy", "-o", "-i", f"{img}@@1M", f"::{os.path.dirname(IMAGE_KERNEL)}/{f}", os.path.join(work, f)], env=env)
+    entry = run(["mtype", "-i", f"{img}@@1M", IMAGE_ENTRY], env=env).stdout
     options = re.search(r"^options (.*)$", entry, re.M).group(1)
     keep = [o for o in options.split() if o.split("=")[0] in ("root", "ro", "rootfstype")]
     cmdline = " ".join(keep + ["init=/powercut-init", "console=ttyS0,115200", "loglevel=3", "panic=0"])

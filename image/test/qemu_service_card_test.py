@@ -29,7 +29,7 @@ import sys
 import tempfile
 import time
 
-from qemu_common import T0, Failures, Serial, log, set_name, stop_qemu  # noqa: E402 (this folder)
+from qemu_common import IMAGE_ENTRY, T0, Failures, Serial, log, set_name, stop_qemu  # noqa: E402 (this folder)
 from qemu_boot_test import MODES, OUTPUTS, OVMF_CODE, OVMF_VARS, Qmp, install_selftest_entry, ppm_stats, require_qemu, run  # noqa: E402
 
 WIPE_MIB = 4  # the ext4 superblock is at 1 KiB; 4 MiB also clears the group descriptors
@@ -58,7 +58,7 @@ def prepare(a, work, env):
          "conv=notrunc", "status=none"])
     log(f"configuration partition (sector {start}, {size} sectors): first {WIPE_MIB} MiB zeroed")
     esp = f"{img}@@1M"
-    entry = run(["mtype", "-i", esp, "::/loader/entries/mogao.conf"], env=env).stdout
+    entry = run(["mtype", "-i", esp, IMAGE_ENTRY], env=env).stdout
     options = re.search(r"^options (.*)$", entry, re.M).group(1)
     options = re.sub(r"\b(quiet|loglevel=\d|systemd.show_status=\S+)\b", "", options)
     boot = "udevadm settle; mount -o ro /dev/disk/by-label/mogao-test /mnt && exec /bin/sh /mnt/selftest.sh"

@@ -50,7 +50,7 @@ import sys
 import tempfile
 import time
 
-from qemu_common import T0, Failures, log, set_name, stop_qemu  # noqa: E402 (this folder)
+from qemu_common import IMAGE_ENTRY, T0, Failures, log, set_name, stop_qemu  # noqa: E402 (this folder)
 from qemu_boot_test import (MODES, OUTPUTS, OVMF_CODE, OVMF_VARS, Qmp, install_selftest_entry,  # noqa: E402
                             ppm_stats, require_qemu, run)
 from qemu_powercut_test import RIG, SCALE, host_calibration  # noqa: E402
@@ -136,7 +136,7 @@ def provision(a, work, env):
     run(["cp", "--sparse=always", a.image, img])
     run([os.path.join(a.repo, "image", "provision"), "--kiosk", a.kiosk, img, cfg])
     esp = f"{img}@@1M"
-    entry = run(["mtype", "-i", esp, "::/loader/entries/mogao.conf"], env=env).stdout
+    entry = run(["mtype", "-i", esp, IMAGE_ENTRY], env=env).stdout
     # loglevel=3 stays: the wall's text console shows the service mode's lines, not the kernel's.
     options = re.sub(r"\b(quiet|systemd.show_status=\S+)\b", "", re.search(r"^options (.*)$", entry, re.M).group(1))
     extra = ["console=tty0", "console=ttyS0,115200", "systemd.show_status=true", "systemd.journald.forward_to_console=1",
