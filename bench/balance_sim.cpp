@@ -37,8 +37,12 @@ int main(int argc, char** argv) {
     app.add_option("--balancers", options.balancers, "balancers to compare (pbt, equal, roundrobin)")
         ->delimiter(',')
         ->capture_default_str();
-    app.add_option("--snap", options.snap, "PBT/equal cut snap in pixels")->check(CLI::PositiveNumber)->capture_default_str();
-    app.add_option("--tile", options.tile, "round-robin tile size in pixels")->check(CLI::PositiveNumber)->capture_default_str();
+    app.add_option("--snap", options.snap, "PBT/equal cut snap in pixels")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+    app.add_option("--tile", options.tile, "round-robin tile size in pixels")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
     app.add_option("--json", json_file, "also write the results as JSON to this file");
     CLI11_PARSE(app, argc, argv);
     if (input.empty() && synthetic_frames == 0) {

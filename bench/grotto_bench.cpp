@@ -218,7 +218,10 @@ int main(int argc, char** argv) {
         else if (flag == "--height") height = std::stoi(argv[i + 1]);
         else if (flag == "--reps") reps = std::stoi(argv[i + 1]);
         else if (flag == "--json") json_file = argv[i + 1];
-        else { std::fprintf(stderr, "unknown flag %s\n", flag.c_str()); return 2; }
+        else {
+            std::fprintf(stderr, "unknown flag %s\n", flag.c_str());
+            return 2;
+        }
     }
     if (scene_uses_scans(scene_file) && !std::filesystem::exists(resolve_scans_dir(scene_file, options))) {
         std::printf("SKIP: real scans not found at %s\n", resolve_scans_dir(scene_file, options).c_str());
@@ -227,8 +230,9 @@ int main(int argc, char** argv) {
     try {
         SceneLoadReport report;
         const Scene scene = load_scene(scene_file, options, &report);
-        std::printf("# grotto benchmark: %s, %zu instanced triangles, %dx%d cylinder frames, one thread, best of %d\n\n",
-                    scene_file.filename().c_str(), scene.triangle_count(), width, height, reps);
+        std::printf(
+            "# grotto benchmark: %s, %zu instanced triangles, %dx%d cylinder frames, one thread, best of %d\n\n",
+            scene_file.filename().c_str(), scene.triangle_count(), width, height, reps);
         nlohmann::json out = {{"bench", "grotto"},
                               {"scene", scene_file.filename().string()},
                               {"instanced_triangles", scene.triangle_count()},
@@ -249,8 +253,10 @@ int main(int argc, char** argv) {
         std::printf("## Renderer vs raw Embree (same camera rays)\n\n| | CPU ms | rays | ratio |\n|---|--:|--:|--:|\n");
         std::printf("| (a) rtcIntersect16 camera packets | %.1f | %llu | 1.00 |\n", 1e3 * t.camera_rays_s,
                     static_cast<unsigned long long>(t.camera_rays));
-        std::printf("| (b) full renderer, default knobs (direct light, shadows from sun, 2 point, 1 area light) | %.1f | %llu | %.2f |\n\n",
-                    1e3 * t.render_s, static_cast<unsigned long long>(t.render_rays), t.ratio());
+        std::printf(
+            "| (b) full renderer, default knobs (direct light, shadows from sun, 2 point, 1 area light) | %.1f | %llu "
+            "| %.2f |\n\n",
+            1e3 * t.render_s, static_cast<unsigned long long>(t.render_rays), t.ratio());
         out["renderer_vs_embree"] = {{"embree_camera_ms", 1e3 * t.camera_rays_s},
                                      {"embree_camera_rays", t.camera_rays},
                                      {"renderer_ms", 1e3 * t.render_s},

@@ -63,7 +63,9 @@ using namespace mogao;
 Mesh height_field(int n) {
     Mesh mesh;
     mesh.source = "height_field";
-    const auto height = [](double x, double z) { return 0.4 * std::sin(1.3 * x) * std::cos(0.9 * z) + 0.1 * std::sin(4.0 * x + 3.0 * z); };
+    const auto height = [](double x, double z) {
+        return 0.4 * std::sin(1.3 * x) * std::cos(0.9 * z) + 0.1 * std::sin(4.0 * x + 3.0 * z);
+    };
     const double half = 10.0;
     const double step = 2.0 * half / n;
     for (int j = 0; j <= n; ++j) {
@@ -486,8 +488,10 @@ int main(int argc, char** argv) {
         print("(c3) sun + shadows + used area light", used, used.camera_rays_s);
         print("(c4) (c1) + unplaced coloured mesh", colour_unused, colour_unused.camera_rays_s);
         print("(c5) (c1), field coloured + textured", colour_used, colour_used.camera_rays_s);
-        std::printf("    (c2)/(c1) = %.3f  (unused features should cost nothing: ~1.0)\n", unused.render_s / plain.render_s);
-        std::printf("    (c3)/(c1) = %.3f  (what shadows and an area light cost when used)\n", used.render_s / plain.render_s);
+        std::printf("    (c2)/(c1) = %.3f  (unused features should cost nothing: ~1.0)\n",
+                    unused.render_s / plain.render_s);
+        std::printf("    (c3)/(c1) = %.3f  (what shadows and an area light cost when used)\n",
+                    used.render_s / plain.render_s);
         std::printf("    (c4)/(c1) = %.3f  (a scene without colour or texture pays nothing: ~1.0)\n",
                     colour_unused.render_s / plain.render_s);
         std::printf("    (c5)/(c1) = %.3f  (what vertex colours and a mip-mapped texture cost when used)\n",

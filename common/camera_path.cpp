@@ -97,7 +97,9 @@ std::vector<ViewerPose> make_camera_path(const std::string& name_or_file, const 
 std::vector<ViewerPose> read_path_file(const std::filesystem::path& file, const Viewer& viewer, int frames) {
     if (frames < 1 || frames > 1'000'000) throw PathError(fmt::format("frames = {} is outside [1, 1000000]", frames));
     std::ifstream in(file);
-    if (!in) throw PathError(fmt::format("{}: cannot open path file (expected walk, orbit or a JSON path file)", file.string()));
+    if (!in)
+        throw PathError(
+            fmt::format("{}: cannot open path file (expected walk, orbit or a JSON path file)", file.string()));
     nlohmann::json root;
     try {
         root = nlohmann::json::parse(in);

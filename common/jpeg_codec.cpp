@@ -25,9 +25,12 @@ std::string tj_reason(tjhandle handle) {
 
 int tj_subsampling(Subsampling s) {
     switch (s) {
-        case Subsampling::yuv444: return TJSAMP_444;
-        case Subsampling::yuv422: return TJSAMP_422;
-        case Subsampling::yuv420: return TJSAMP_420;
+        case Subsampling::yuv444:
+            return TJSAMP_444;
+        case Subsampling::yuv422:
+            return TJSAMP_422;
+        case Subsampling::yuv420:
+            return TJSAMP_420;
     }
     throw std::invalid_argument("JpegEncoder::encode: unknown subsampling");
 }
@@ -80,8 +83,8 @@ std::vector<std::uint8_t> JpegEncoder::encode(const Rgb8Image& image, int qualit
     if (rc != 0) {
         const std::string reason = tj_reason(handle_.get());
         replace_handle(handle_, tjInitCompress);
-        throw EncodeError("JpegEncoder::encode: tjCompress2 failed for " + std::to_string(w) + "x" +
-                          std::to_string(h) + " at quality " + std::to_string(quality) + ": " + reason);
+        throw EncodeError("JpegEncoder::encode: tjCompress2 failed for " + std::to_string(w) + "x" + std::to_string(h) +
+                          " at quality " + std::to_string(quality) + ": " + reason);
     }
     out.resize(size);
     return out;

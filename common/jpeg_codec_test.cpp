@@ -224,9 +224,8 @@ TEST(JpegDecode, DamagedStreamsGiveAnImageOrDecodeErrorAndNeverPoisonTheDecoder)
     };
     for (std::size_t keep = 0; keep < jpeg.size(); ++keep) {  // no truncation is acceptable
         const std::string what = "truncation to " + std::to_string(keep);
-        expect_decode_error(decoder,
-                            std::vector<std::uint8_t>(jpeg.begin(), jpeg.begin() + static_cast<std::ptrdiff_t>(keep)),
-                            what);
+        expect_decode_error(
+            decoder, std::vector<std::uint8_t>(jpeg.begin(), jpeg.begin() + static_cast<std::ptrdiff_t>(keep)), what);
         still_usable(what);
     }
     int refused = 0;

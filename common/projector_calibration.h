@@ -31,15 +31,15 @@ namespace mogao {
 // Per output pixel: where in the content frame it samples. NaN (both u and v) = no content there
 // (outside the screen): the output shows black.
 struct WarpMap {
-    ImageSize size;                 // grid samples: the output size, or coarser (see sample_warp)
-    std::vector<float> uv;          // size.width * size.height * 2, row-major, (u, v) interleaved
+    ImageSize size;         // grid samples: the output size, or coarser (see sample_warp)
+    std::vector<float> uv;  // size.width * size.height * 2, row-major, (u, v) interleaved
 };
 
 // Per output pixel: attenuation in linear light in [0, 1] (1 = full brightness) applied before the
 // response curve, so overlaps sum to 1 on the screen.
 struct BlendMask {
-    ImageSize size;                 // grid samples: the output size, or coarser (see sample_blend)
-    std::vector<float> weight;      // size.width * size.height
+    ImageSize size;             // grid samples: the output size, or coarser (see sample_blend)
+    std::vector<float> weight;  // size.width * size.height
 };
 
 // The projector's response: display value = lut(linear value). Stored as a per-channel table of
@@ -63,8 +63,8 @@ struct BlackOffset {
 // Per channel c of one output pixel (appliance/warp/composite.h, render_output):
 //   linear_c = clamp(content_c * blend + beta_c, 0, 1); signal_c = response.lut[c](linear_c).
 struct ProjectorCalibration {
-    std::string id;                 // region id (MPCDI) e.g. "proj0"
-    ImageSize output;               // projector resolution in pixels
+    std::string id;    // region id (MPCDI) e.g. "proj0"
+    ImageSize output;  // projector resolution in pixels
     WarpMap warp;
     BlendMask blend;
     ResponseCurve response;
@@ -72,7 +72,7 @@ struct ProjectorCalibration {
 };
 
 struct ScreenCalibration {
-    ImageSize content;              // content frame size the warps were made for
+    ImageSize content;  // content frame size the warps were made for
     std::vector<ProjectorCalibration> projectors;
 };
 

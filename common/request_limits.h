@@ -33,11 +33,11 @@ namespace request_limits {
 inline constexpr IntRange kImageSide{1, 16384};
 // Pixels per side of a frame sent over the link: below 16 px a JPEG is all block edges.
 inline constexpr IntRange kLinkImageSide{16, 16384};
-inline constexpr IntRange kSpp{1, 4096};              // samples per pixel
-inline constexpr IntRange kMaxBounces{0, 64};         // path-tracing bounces
-inline constexpr IntRange kAoSamples{0, 1024};        // occlusion rays for the environment light
-inline constexpr IntRange kAreaLightSamples{1, 1024}; // shadow rays per area light per sample
-inline constexpr IntRange kJpegQuality{1, 100};       // TurboJPEG quality
+inline constexpr IntRange kSpp{1, 4096};               // samples per pixel
+inline constexpr IntRange kMaxBounces{0, 64};          // path-tracing bounces
+inline constexpr IntRange kAoSamples{0, 1024};         // occlusion rays for the environment light
+inline constexpr IntRange kAreaLightSamples{1, 1024};  // shadow rays per area light per sample
+inline constexpr IntRange kJpegQuality{1, 100};        // TurboJPEG quality
 }  // namespace request_limits
 
 void validate_view_request(const ViewRequest& request);

@@ -13,7 +13,8 @@ namespace mogao {
 namespace {
 
 // Expects begin_frame to throw std::invalid_argument whose message contains every `needle`.
-void expect_rejected(const std::function<void(ViewRequest&)>& edit, const std::string& field, const std::string& limit) {
+void expect_rejected(const std::function<void(ViewRequest&)>& edit, const std::string& field,
+                     const std::string& limit) {
     ViewRequest request;
     request.size = {64, 32};
     edit(request);
@@ -36,7 +37,8 @@ TEST(ViewValidation, RejectsEachOutOfRangeFieldByName) {
     expect_rejected([](ViewRequest& r) { r.quality.max_bounces = 65; }, "quality.max_bounces", "[0, 64]");
     expect_rejected([](ViewRequest& r) { r.quality.ao_samples = -1; }, "quality.ao_samples", "[0, 1024]");
     expect_rejected([](ViewRequest& r) { r.quality.ao_samples = 1025; }, "quality.ao_samples", "[0, 1024]");
-    expect_rejected([](ViewRequest& r) { r.quality.area_light_samples = 0; }, "quality.area_light_samples", "[1, 1024]");
+    expect_rejected([](ViewRequest& r) { r.quality.area_light_samples = 0; }, "quality.area_light_samples",
+                    "[1, 1024]");
     expect_rejected([](ViewRequest& r) { r.quality.resolution_scale = 0.0; }, "quality.resolution_scale", "(0, 1]");
     expect_rejected([](ViewRequest& r) { r.quality.resolution_scale = 1.5; }, "quality.resolution_scale", "(0, 1]");
     expect_rejected([nan](ViewRequest& r) { r.quality.resolution_scale = nan; }, "quality.resolution_scale", "(0, 1]");
@@ -46,14 +48,26 @@ TEST(ViewValidation, RejectsEachOutOfRangeFieldByName) {
     expect_rejected([inf](ViewRequest& r) { r.pose.yaw_deg = inf; }, "pose.yaw_deg", "finite");
     expect_rejected([nan](ViewRequest& r) { r.pose.pitch_deg = nan; }, "pose.pitch_deg", "finite");
     expect_rejected([](ViewRequest& r) { r.camera = PinholeCamera{180.0}; }, "camera.vertical_fov_deg", "(0, 180)");
-    expect_rejected([](ViewRequest& r) { r.camera = CylinderScreen{0.0, 180.0, 0.0, 2.5, {0.0, 1.6, 0.0}}; },
-                    "camera.radius_m", "(0, inf)");
-    expect_rejected([](ViewRequest& r) { r.camera = CylinderScreen{3.0, 0.0, 0.0, 2.5, {0.0, 1.6, 0.0}}; },
-                    "camera.arc_deg", "(0, 360]");
-    expect_rejected([](ViewRequest& r) { r.camera = CylinderScreen{3.0, 361.0, 0.0, 2.5, {0.0, 1.6, 0.0}}; },
-                    "camera.arc_deg", "(0, 360]");
-    expect_rejected([](ViewRequest& r) { r.camera = CylinderScreen{3.0, 180.0, 2.5, 2.5, {0.0, 1.6, 0.0}}; },
-                    "camera.top_m", "(bottom_m, inf)");
+    expect_rejected(
+        [](ViewRequest& r) {
+            r.camera = CylinderScreen{0.0, 180.0, 0.0, 2.5, {0.0, 1.6, 0.0}};
+        },
+        "camera.radius_m", "(0, inf)");
+    expect_rejected(
+        [](ViewRequest& r) {
+            r.camera = CylinderScreen{3.0, 0.0, 0.0, 2.5, {0.0, 1.6, 0.0}};
+        },
+        "camera.arc_deg", "(0, 360]");
+    expect_rejected(
+        [](ViewRequest& r) {
+            r.camera = CylinderScreen{3.0, 361.0, 0.0, 2.5, {0.0, 1.6, 0.0}};
+        },
+        "camera.arc_deg", "(0, 360]");
+    expect_rejected(
+        [](ViewRequest& r) {
+            r.camera = CylinderScreen{3.0, 180.0, 2.5, 2.5, {0.0, 1.6, 0.0}};
+        },
+        "camera.top_m", "(bottom_m, inf)");
 }
 
 // Numerical stability: NaN and +-inf in every floating-point field of a view request

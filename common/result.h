@@ -54,7 +54,7 @@ namespace result_detail {
 
 class [[nodiscard]] Status {
 public:
-    Status() = default;                                                // success
+    Status() = default;                                               // success
     Status(Error error) : error_(std::move(error)), failed_(true) {}  // NOLINT: implicit on purpose
 
     [[nodiscard]] bool ok() const { return !failed_; }
@@ -76,16 +76,25 @@ class [[nodiscard]] Result {
     static_assert(!std::is_reference_v<T>, "Result<T&> is not supported");
 
 public:
-    Result(T value) : v_(std::in_place_index<0>, std::move(value)) {}     // NOLINT: implicit on purpose
+    Result(T value) : v_(std::in_place_index<0>, std::move(value)) {}      // NOLINT: implicit on purpose
     Result(Error error) : v_(std::in_place_index<1>, std::move(error)) {}  // NOLINT: implicit on purpose
 
     [[nodiscard]] bool ok() const { return v_.index() == 0; }
     explicit operator bool() const { return ok(); }
     [[nodiscard]] int code() const { return ok() ? 0 : std::get<1>(v_).code; }
 
-    [[nodiscard]] T& value() & { check(); return std::get<0>(v_); }
-    [[nodiscard]] const T& value() const& { check(); return std::get<0>(v_); }
-    [[nodiscard]] T&& value() && { check(); return std::get<0>(std::move(v_)); }
+    [[nodiscard]] T& value() & {
+        check();
+        return std::get<0>(v_);
+    }
+    [[nodiscard]] const T& value() const& {
+        check();
+        return std::get<0>(v_);
+    }
+    [[nodiscard]] T&& value() && {
+        check();
+        return std::get<0>(std::move(v_));
+    }
     T* operator->() { return &value(); }
     const T* operator->() const { return &value(); }
     T& operator*() & { return value(); }

@@ -55,9 +55,7 @@ TEST(Status, ErrnoErrorNamesCallAndReason) {
     EXPECT_EQ(e.message, "open(/nope): No such file or directory");
 }
 
-TEST(ResultDeathTest, ValueOfErrorAborts) {
-    EXPECT_DEATH((void)parse_positive(0).value(), "x must be > 0");
-}
+TEST(ResultDeathTest, ValueOfErrorAborts) { EXPECT_DEATH((void)parse_positive(0).value(), "x must be > 0"); }
 
 }  // namespace
 }  // namespace mogao

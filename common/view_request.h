@@ -40,22 +40,22 @@ struct PinholeCamera {
 // ViewerPose (its eye is the physical eye, its yaw/pitch rotate the screen frame).
 struct CylinderScreen {
     double radius_m = 3.0;
-    double arc_deg = 180.0;                     // (0, 360]
+    double arc_deg = 180.0;  // (0, 360]
     double bottom_m = 0.0;
     double top_m = 2.5;
-    Eigen::Vector3d eye_m{0.0, 1.6, 0.0};       // viewer's eye in the screen frame
+    Eigen::Vector3d eye_m{0.0, 1.6, 0.0};  // viewer's eye in the screen frame
 };
 
 using CameraModel = std::variant<PinholeCamera, CylinderScreen>;
 
 // Quality knobs: every one trades time for error (see docs/benchmarks.md).
 struct Quality {
-    int spp = 1;                  // samples per pixel (Owen-scrambled Sobol' points in the pixel, 1 included)
-    int max_bounces = 0;          // indirect bounces of the path tracer; 0 = direct light only
-    int ao_samples = 0;           // cosine-weighted occlusion rays for the environment light; 0 traces 1
-    int area_light_samples = 1;   // shadow rays per area light per sample
+    int spp = 1;                    // samples per pixel (Owen-scrambled Sobol' points in the pixel, 1 included)
+    int max_bounces = 0;            // indirect bounces of the path tracer; 0 = direct light only
+    int ao_samples = 0;             // cosine-weighted occlusion rays for the environment light; 0 traces 1
+    int area_light_samples = 1;     // shadow rays per area light per sample
     double resolution_scale = 1.0;  // render at width*scale x height*scale, (0, 1]
-    int jpeg_quality = 85;        // 1..100, TurboJPEG
+    int jpeg_quality = 85;          // 1..100, TurboJPEG
 };
 
 struct ViewRequest {
@@ -64,8 +64,8 @@ struct ViewRequest {
     CameraModel camera = PinholeCamera{};
     ImageSize size{1920, 1080};
     Quality quality;
-    std::uint64_t seed = 1;             // same seed + same request = same pixels
-    std::int64_t request_time_ns = 0;   // CLOCK_REALTIME of the sender, for latency accounting
+    std::uint64_t seed = 1;            // same seed + same request = same pixels
+    std::int64_t request_time_ns = 0;  // CLOCK_REALTIME of the sender, for latency accounting
     // Farm-internal, never on the link's wire: the link server's id of the session that sent the
     // request (0 = none), so the farm keeps per-session state (cost map, accumulation, frame time).
     std::uint64_t session = 0;

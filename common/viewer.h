@@ -27,7 +27,7 @@ struct VisitableArea {
 
 struct Viewer {
     double eye_height_m = 1.6;
-    Eigen::Vector3d start{0.0, 0.0, 5.0};     // floor position of the viewer at start, world metres
+    Eigen::Vector3d start{0.0, 0.0, 5.0};  // floor position of the viewer at start, world metres
     double start_yaw_deg = 0.0;
     std::optional<VisitableArea> visitable;  // none: anywhere
 };

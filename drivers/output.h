@@ -28,9 +28,9 @@
 namespace mogao {
 
 struct OutputInfo {
-    std::string name;        // "HDMI-A-1" (KMS connector), "headless-0"
-    ImageSize size;          // pixels (the KMS mode's active area)
-    double refresh_hz = 0;   // vertical refresh of the mode; 0 for headless
+    std::string name;       // "HDMI-A-1" (KMS connector), "headless-0"
+    ImageSize size;         // pixels (the KMS mode's active area)
+    double refresh_hz = 0;  // vertical refresh of the mode; 0 for headless
 };
 
 class OutputBackend {

@@ -42,13 +42,13 @@ using namespace mogao;
 
 struct Flags {
     std::filesystem::path config = "/etc/mogao/kiosk.toml";
-    std::string path;                 // overrides [navigation].path
-    std::uint64_t frames = 0;         // stop after this many farm frames are on screen (0 = never)
-    double duration_s = 0;            // stop after this long (0 = never)
-    std::filesystem::path dump_dir;   // --dump-content
+    std::string path;                // overrides [navigation].path
+    std::uint64_t frames = 0;        // stop after this many farm frames are on screen (0 = never)
+    double duration_s = 0;           // stop after this long (0 = never)
+    std::filesystem::path dump_dir;  // --dump-content
     int dump_every = 1;
-    std::filesystem::path stats_file; // overrides [stats].file
-    std::filesystem::path pose_log;   // every submitted pose, JSON lines
+    std::filesystem::path stats_file;  // overrides [stats].file
+    std::filesystem::path pose_log;    // every submitted pose, JSON lines
     bool check_only = false;
     std::filesystem::path service_config;  // [outputs] of the service card (empty: built-in defaults)
 };
@@ -145,10 +145,12 @@ int main(int argc, char** argv) {
                    "cannot be loaded (default: built-in, KMS)");
     app.add_option("--path", flags.path,
                    "Scripted visitor: walk | orbit | a JSON path file (overrides [navigation].path and .source)");
-    app.add_option("--frames", flags.frames, "Stop after this many farm frames are on screen")->check(CLI::Range(1, 100000000));
+    app.add_option("--frames", flags.frames, "Stop after this many farm frames are on screen")
+        ->check(CLI::Range(1, 100000000));
     app.add_option("--duration", flags.duration_s, "Stop after this many seconds")->check(CLI::Range(0.001, 1e9));
     app.add_option("--dump-content", flags.dump_dir, "Write decoded content frames (PPM + pose JSON) here");
-    app.add_option("--dump-every", flags.dump_every, "With --dump-content: every k-th frame")->check(CLI::Range(1, 1000000));
+    app.add_option("--dump-every", flags.dump_every, "With --dump-content: every k-th frame")
+        ->check(CLI::Range(1, 1000000));
     app.add_option("--stats", flags.stats_file, "Statistics JSON written at exit (overrides [stats].file)");
     app.add_option("--pose-log", flags.pose_log, "Write every submitted pose here (JSON lines, one per display tick)");
     app.add_flag("--check-config", flags.check_only, "Validate the configuration (and TLS files, path) and exit");

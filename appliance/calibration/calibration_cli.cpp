@@ -49,7 +49,8 @@ RgbFloatImage check_pattern(ImageSize size) {
     RgbFloatImage img(size);
     for (int y = 0; y < size.height; ++y) {
         for (int x = 0; x < size.width; ++x) {
-            const double c = std::sin(2 * std::numbers::pi * (x + 0.5) / 96.0) * std::sin(2 * std::numbers::pi * (y + 0.5) / 96.0);
+            const double c =
+                std::sin(2 * std::numbers::pi * (x + 0.5) / 96.0) * std::sin(2 * std::numbers::pi * (y + 0.5) / 96.0);
             float* p = img.at(x, y);
             p[0] = static_cast<float>(0.2 + 0.6 * (x + 0.5) / size.width + 0.15 * c);
             p[1] = static_cast<float>(0.2 + 0.6 * (y + 0.5) / size.height + 0.15 * c);
@@ -77,12 +78,11 @@ int run_ideal(const IdealFlags& f, std::ostream& out) {
     std::vector<RgbFloatImage> outputs;
     for (const auto& p : back.projectors) outputs.push_back(render_output(p, content));
     const RgbFloatImage lit = composite_on_screen(back, outputs);
-    const ImageDifference d =
-        compare_images(lit, content, {2, 2, back.content.width - 2, back.content.height - 2});
+    const ImageDifference d = compare_images(lit, content, {2, 2, back.content.width - 2, back.content.height - 2});
     const double tolerance = 1.0 / 255.0 + alpha_quantisation_bound(f.alpha_bits, f.params.gamma);
     out << "check: composite vs content (frame minus 2 px): max |error| " << d.max_abs << " at (" << d.max_x << ", "
-        << d.max_y << "), mean " << d.mean_abs << ", tolerance " << tolerance << (d.max_abs < tolerance ? " OK" : " FAILED")
-        << "\n";
+        << d.max_y << "), mean " << d.mean_abs << ", tolerance " << tolerance
+        << (d.max_abs < tolerance ? " OK" : " FAILED") << "\n";
     return d.max_abs < tolerance ? 0 : 1;
 }
 
@@ -119,8 +119,8 @@ int run_info(const std::string& path, std::ostream& out) {
             if (r.frustum) {
                 const MpcdiFrustum& fr = *r.frustum;
                 out << "    frustum yaw " << fr.yaw << " pitch " << fr.pitch << " roll " << fr.roll << ", left "
-                    << fr.left_angle << " right " << fr.right_angle << " up " << fr.up_angle << " down " << fr.down_angle
-                    << " (degrees)\n";
+                    << fr.left_angle << " right " << fr.right_angle << " up " << fr.up_angle << " down "
+                    << fr.down_angle << " (degrees)\n";
             }
             if (r.coordinate_frame) {
                 const auto& c = *r.coordinate_frame;
@@ -130,9 +130,9 @@ int run_info(const std::string& path, std::ostream& out) {
                 << r.warp.map.channels << ", unit " << to_string(r.warp.geometric_unit) << ", interpolation "
                 << to_string(r.warp.interpolation) << ", origin " << to_string(r.warp.origin_of_3d_data) << ", ranges";
             print_range(out, r.warp.map.values, r.warp.map.channels);
-            out << "\n    alpha " << r.alpha.path << ": " << r.alpha.map.size.width << "x" << r.alpha.map.size.height << " x"
-                << r.alpha.map.channels << " " << r.alpha.map.bit_depth << "-bit, gammaEmbedded " << r.alpha.gamma_embedded
-                << ", ranges";
+            out << "\n    alpha " << r.alpha.path << ": " << r.alpha.map.size.width << "x" << r.alpha.map.size.height
+                << " x" << r.alpha.map.channels << " " << r.alpha.map.bit_depth << "-bit, gammaEmbedded "
+                << r.alpha.gamma_embedded << ", ranges";
             print_range(out, r.alpha.map.values, r.alpha.map.channels);
             out << "\n";
             if (r.beta) {
@@ -165,7 +165,8 @@ int run_calibration_cli(int argc, const char* const* argv, std::ostream& out, st
     mogao::cli::prepare(app, "mogao-calibration");
     app.require_subcommand(1);
     IdealFlags ideal;
-    CLI::App* ideal_cmd = app.add_subcommand("ideal", "Write the ideal calibration of N projectors side by side as a 2d-profile MPCDI file");
+    CLI::App* ideal_cmd = app.add_subcommand(
+        "ideal", "Write the ideal calibration of N projectors side by side as a 2d-profile MPCDI file");
     ideal_cmd->add_option("--projectors", ideal.params.projectors, "Number of projectors")->check(CLI::Range(1, 64));
     ideal_cmd->add_option("--overlap", ideal.params.overlap, "Overlap, fraction of one projector's width, [0, 0.5)")
         ->check(CLI::Range(0.0, 0.4999999));
@@ -182,7 +183,8 @@ int run_calibration_cli(int argc, const char* const* argv, std::ostream& out, st
     info_cmd->add_option("file", info_path, "MPCDI file")->required()->check(CLI::ExistingFile);
     try {
         app.parse(argc, argv);
-        for (const auto& [text, size] : {std::pair{&ideal.output, &ideal.params.output}, std::pair{&ideal.content, &ideal.params.content}}) {
+        for (const auto& [text, size] :
+             {std::pair{&ideal.output, &ideal.params.output}, std::pair{&ideal.content, &ideal.params.content}}) {
             if (const std::string why = parse_size(*text, *size); !why.empty()) {
                 throw CLI::ValidationError(text == &ideal.output ? "--output" : "--content", why);
             }

@@ -33,8 +33,8 @@ CliRun run(std::vector<std::string> args) {
 TEST(CalibrationCli, IdealWritesAFileThatPassesTheCheck) {
     test::ScratchDir dir;
     const std::string file = (dir / "ideal.mpcdi").string();
-    const CliRun r = run({"ideal", "--projectors", "3", "--overlap", "0.15", "--output", "256x192", "--content", "480x270",
-                       "--out", file, "--check"});
+    const CliRun r = run({"ideal", "--projectors", "3", "--overlap", "0.15", "--output", "256x192", "--content",
+                          "480x270", "--out", file, "--check"});
     EXPECT_EQ(r.code, 0) << r.out << r.err;
     EXPECT_NE(r.out.find("OK"), std::string::npos) << r.out;
     const MpcdiFile f = read_mpcdi(file);

@@ -47,7 +47,8 @@ protected:
 TEST_F(MpcdiErrors, TheUncorruptedFileReads) { EXPECT_EQ(read_error(), ""); }
 
 TEST_F(MpcdiErrors, NotAFileNotAZipNoDescriptor) {
-    EXPECT_EQ(error_at(dir / "missing.mpcdi"), "read_mpcdi '" + (dir / "missing.mpcdi").string() + "': not a regular file or does not exist");
+    EXPECT_EQ(error_at(dir / "missing.mpcdi"),
+              "read_mpcdi '" + (dir / "missing.mpcdi").string() + "': not a regular file or does not exist");
     test::write_bytes(dir / "f.mpcdi", {'<', 'x', 'm', 'l', '>'});
     EXPECT_EQ(error_at(dir / "f.mpcdi"), prefix() + "not a ZIP archive (no readable central directory)");
     entries.pop_back();  // mpcdi.xml
@@ -57,8 +58,9 @@ TEST_F(MpcdiErrors, NotAFileNotAZipNoDescriptor) {
 TEST_F(MpcdiErrors, TruncatedOrMismatchedPfm) {
     std::vector<std::uint8_t>& pfm = test::entry(entries, "GeometryWarpFile-p0.pfm");
     pfm.resize(pfm.size() - 5);
-    EXPECT_EQ(read_error(), prefix() + "entry 'GeometryWarpFile-p0.pfm': PFM size mismatch: 91 data bytes after the header, "
-                                       "4x2 x 3 channels x 4 = 96 expected (truncated)");
+    EXPECT_EQ(read_error(), prefix() +
+                                "entry 'GeometryWarpFile-p0.pfm': PFM size mismatch: 91 data bytes after the header, "
+                                "4x2 x 3 channels x 4 = 96 expected (truncated)");
     pfm = test::small_file_entries()[0].second;
     pfm[3] = '9';  // "PF\n4 2" -> "PF\n9 2": header larger than the data
     EXPECT_NE(read_error().find("4 = 216 expected (truncated)"), std::string::npos);
@@ -72,8 +74,9 @@ TEST_F(MpcdiErrors, NanIsKeptInfinityIsNamed) {
     EXPECT_EQ(read_error(), "");
     const float inf = INFINITY;
     std::memcpy(pfm.data() + header, &inf, 4);  // first stored value = bottom-left (0, 1), channel 0
-    EXPECT_EQ(read_error(), prefix() + "entry 'GeometryWarpFile-p0.pfm': PFM sample at (0, 1) channel 0 is infinite "
-                                       "(only finite values or NaN are accepted)");
+    EXPECT_EQ(read_error(), prefix() +
+                                "entry 'GeometryWarpFile-p0.pfm': PFM sample at (0, 1) channel 0 is infinite "
+                                "(only finite values or NaN are accepted)");
 }
 
 TEST_F(MpcdiErrors, MissingAttributeOrEntry) {
@@ -85,10 +88,12 @@ TEST_F(MpcdiErrors, MissingAttributeOrEntry) {
 }
 
 TEST_F(MpcdiErrors, PngMustMatchItsDeclaration) {
-    replace_in_xml("<componentDepth>1</componentDepth>\n                <bitDepth>8</bitDepth>\n                <gamma",
-                   "<componentDepth>3</componentDepth>\n                <bitDepth>8</bitDepth>\n                <gamma");
-    EXPECT_EQ(read_error(), prefix() + "entry 'AlphaMap-p0.png': PNG has 1 channel(s) of 8 bits but mpcdi.xml declares "
-                                       "componentDepth 3, bitDepth 8");
+    replace_in_xml(
+        "<componentDepth>1</componentDepth>\n                <bitDepth>8</bitDepth>\n                <gamma",
+        "<componentDepth>3</componentDepth>\n                <bitDepth>8</bitDepth>\n                <gamma");
+    EXPECT_EQ(read_error(), prefix() +
+                                "entry 'AlphaMap-p0.png': PNG has 1 channel(s) of 8 bits but mpcdi.xml declares "
+                                "componentDepth 3, bitDepth 8");
 }
 
 TEST_F(MpcdiErrors, PathTraversalInZipNamesOrXmlPaths) {

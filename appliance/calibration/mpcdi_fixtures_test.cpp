@@ -46,7 +46,9 @@ TEST(MpcdiFixtures, CustomMedia2dCoarseWarpAndAlphaRamps) {
     EXPECT_FALSE(a.beta);
     EXPECT_EQ(a.warp.interpolation, WarpInterpolation::linear);
     EXPECT_EQ(a.warp.origin_of_3d_data, OriginOf3DData::unknown);  // file says "linear": writer bug
-    EXPECT_EQ(std::count_if(notes.begin(), notes.end(), [](const std::string& n) { return n.find("writer bug") != std::string::npos; }), 2);
+    EXPECT_EQ(std::count_if(notes.begin(), notes.end(),
+                            [](const std::string& n) { return n.find("writer bug") != std::string::npos; }),
+              2);
 
     for (const MpcdiRegion* r : {&a, &b}) {
         const float sign = r == &a ? 1.0F : -1.0F;
@@ -166,7 +168,7 @@ TEST(MpcdiFixtures, CustomAdvanced3dPointsLieOnTheCylinderWithYUp) {
                                   std::abs(p[2] + 3.0 * std::cos(ang))});
             }
         }
-        EXPECT_LE(worst, 2.4e-7) << r.id;  // computed in double, stored as float32
+        EXPECT_LE(worst, 2.4e-7) << r.id;                  // computed in double, stored as float32
         EXPECT_NEAR(r.warp.map.at(50, 0)[1], 2.5, 1e-7);   // top row: 2.5 m (Y up)
         EXPECT_NEAR(r.warp.map.at(50, 75)[1], 0.5, 1e-7);  // bottom row: 0.5 m
         const float* c = r.warp.map.at(33, 40);
@@ -212,7 +214,8 @@ void check_example_common(const MpcdiFile& f, ImageSize res, const std::string& 
     for (int j = 0; j < H; ++j) {
         for (int i = 0; i < W; ++i) {
             for (int c = 0; c < 3; ++c) {
-                const bool inside = std::abs(i - W / 2) <= (W / 4 + W / 4 * c) / 2 && std::abs(j - H / 2) <= (H / 4 + H / 4 * c) / 2;
+                const bool inside =
+                    std::abs(i - W / 2) <= (W / 4 + W / 4 * c) / 2 && std::abs(j - H / 2) <= (H / 4 + H / 4 * c) / 2;
                 bad += r.alpha.map.at(i, j, c) != (inside ? 255 : 0);
             }
         }
@@ -252,7 +255,8 @@ TEST(MpcdiFixtures, ExamplesHoldTheGradientWithAZeroBlock) {
     EXPECT_EQ(*r.coordinate_frame, (MpcdiCoordinateFrame{{0, 0, 1}, {0, 0, 1}, {0, 1, 0}, {1, 0, 0}}));
     ASSERT_TRUE(r.distortion);
     EXPECT_EQ(r.distortion->map.size, (ImageSize{400, 200}));
-    EXPECT_TRUE(std::all_of(r.distortion->map.values.begin(), r.distortion->map.values.end(), [](float v) { return v == 0.0F; }));
+    EXPECT_TRUE(std::all_of(r.distortion->map.values.begin(), r.distortion->map.values.end(),
+                            [](float v) { return v == 0.0F; }));
 }
 
 TEST(MpcdiFixtures, SampleMpcdiThreeRegions) {
@@ -290,7 +294,9 @@ TEST(MpcdiFixtures, SampleMpcdiThreeRegions) {
         EXPECT_EQ(r.warp.map.at(21, 20)[0], 21.0F / 200.0F);
         EXPECT_EQ(r.warp.map.at(5, 199)[1], 199.0F / 200.0F);
     }
-    EXPECT_EQ(std::count_if(notes.begin(), notes.end(), [](const std::string& n) { return n.find("gammaEmbedded") != std::string::npos; }), 3);
+    EXPECT_EQ(std::count_if(notes.begin(), notes.end(),
+                            [](const std::string& n) { return n.find("gammaEmbedded") != std::string::npos; }),
+              3);
 }
 
 }  // namespace

@@ -45,7 +45,8 @@ MpcdiFile read_mpcdi(const std::filesystem::path& path, std::vector<std::string>
         if (notes != nullptr) notes->push_back("descriptor entry is 'mpacs.xml' (pre-standard name)");
     }
     const std::vector<std::uint8_t> xml = zip.read(xml_name);
-    MpcdiFile file = parse_mpcdi_xml(std::string_view(reinterpret_cast<const char*>(xml.data()), xml.size()), who, notes);
+    MpcdiFile file =
+        parse_mpcdi_xml(std::string_view(reinterpret_cast<const char*>(xml.data()), xml.size()), who, notes);
 
     std::set<std::string> used{xml_name};
     for (MpcdiBuffer& buffer : file.buffers) {
@@ -72,7 +73,8 @@ MpcdiFile read_mpcdi(const std::filesystem::path& path, std::vector<std::string>
     }
     if (notes != nullptr) {
         for (const std::string& name : zip.names()) {
-            if (used.count(name) == 0) notes->push_back("entry '" + name + "' is not referenced by mpcdi.xml (ignored)");
+            if (used.count(name) == 0)
+                notes->push_back("entry '" + name + "' is not referenced by mpcdi.xml (ignored)");
         }
     }
     return file;

@@ -92,8 +92,8 @@ TEST(MpcdiRoundTrip, IdealCalibrationSurvivesMpcdi) {
             for (std::size_t i = 0; i < a.blend.weight.size(); ++i) {
                 blend_err = std::max(blend_err, std::abs(static_cast<double>(a.blend.weight[i]) - b.blend.weight[i]));
             }
-            std::printf("%d-bit alpha, %s: max |warp error| %.3g, max |blend error| %.3g (bound %.3g)\n", bits, a.id.c_str(),
-                        warp_err, blend_err, blend_bound);
+            std::printf("%d-bit alpha, %s: max |warp error| %.3g, max |blend error| %.3g (bound %.3g)\n", bits,
+                        a.id.c_str(), warp_err, blend_err, blend_bound);
             EXPECT_LE(warp_err, 1.2e-7);  // float32 rounding of the region-relative warp
             EXPECT_LE(blend_err, blend_bound);
         }

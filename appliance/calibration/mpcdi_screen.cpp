@@ -17,7 +17,8 @@ std::string size_text(ImageSize s) { return std::to_string(s.width) + "x" + std:
 WarpMap convert_warp(const MpcdiRegion& r, WarpSpace space, const std::string& who) {
     const PfmMap& m = r.warp.map;
     if (m.channels < 2) {
-        throw MpcdiError(who + ": geometry warp has " + std::to_string(m.channels) + " channel(s); a 2D warp needs r and g (PF)");
+        throw MpcdiError(who + ": geometry warp has " + std::to_string(m.channels) +
+                         " channel(s); a 2D warp needs r and g (PF)");
     }
     if (m.size.width > r.resolution.width || m.size.height > r.resolution.height) {
         throw MpcdiError(who + ": geometry warp grid " + size_text(m.size) + " is larger than the region resolution " +
@@ -42,7 +43,8 @@ WarpMap convert_warp(const MpcdiRegion& r, WarpSpace space, const std::string& w
     return w;
 }
 
-BlendMask convert_alpha(const MpcdiRegion& r, double assumed_gamma, const std::string& who, std::vector<std::string>* notes) {
+BlendMask convert_alpha(const MpcdiRegion& r, double assumed_gamma, const std::string& who,
+                        std::vector<std::string>* notes) {
     const PngMap& a = r.alpha.map;
     if (a.size.width > r.resolution.width || a.size.height > r.resolution.height) {
         throw MpcdiError(who + ": alpha map " + size_text(a.size) + " is larger than the region resolution " +
@@ -68,7 +70,8 @@ BlendMask convert_alpha(const MpcdiRegion& r, double assumed_gamma, const std::s
         b.weight[i] = static_cast<float>(std::min(1.0, sum / static_cast<double>(ch)));
     }
     if (notes != nullptr && channels_differ) {
-        notes->push_back("region \"" + r.id + "\": RGB alpha map with different channels: blend weight = mean of the channels");
+        notes->push_back("region \"" + r.id +
+                         "\": RGB alpha map with different channels: blend weight = mean of the channels");
     }
     return b;
 }
@@ -144,8 +147,8 @@ ScreenCalibration to_screen_calibration(const MpcdiFile& file, const ScreenConve
                          "\" is not supported (only 2d: its warps map projector pixels to content positions)");
     }
     if (options.buffer >= file.buffers.size()) {
-        throw MpcdiError("to_screen_calibration: buffer index " + std::to_string(options.buffer) + " but the file has " +
-                         std::to_string(file.buffers.size()) + " buffer(s)");
+        throw MpcdiError("to_screen_calibration: buffer index " + std::to_string(options.buffer) +
+                         " but the file has " + std::to_string(file.buffers.size()) + " buffer(s)");
     }
     if (!(options.assumed_gamma > 0.0 && options.assumed_gamma <= 10.0)) {
         throw MpcdiError("to_screen_calibration: assumed_gamma must be in (0, 10]");
@@ -192,7 +195,8 @@ double alpha_quantisation_bound(int bit_depth, double gamma) {
 MpcdiFile to_mpcdi(const ScreenCalibration& screen, const MpcdiExportOptions& options) {
     validate_screen(screen);
     if (options.alpha_bit_depth != 8 && options.alpha_bit_depth != 16) {
-        throw std::invalid_argument("to_mpcdi: alpha_bit_depth " + std::to_string(options.alpha_bit_depth) + " must be 8 or 16");
+        throw std::invalid_argument("to_mpcdi: alpha_bit_depth " + std::to_string(options.alpha_bit_depth) +
+                                    " must be 8 or 16");
     }
     if (!(options.alpha_gamma > 0.0 && options.alpha_gamma <= 10.0)) {
         throw std::invalid_argument("to_mpcdi: alpha_gamma must be in (0, 10]");
@@ -244,7 +248,8 @@ MpcdiFile to_mpcdi(const ScreenCalibration& screen, const MpcdiExportOptions& op
             r.warp.map.values[3 * i + 1] = std::isnan(v) ? NAN : static_cast<float>((v - r.y) / r.ysize);
             r.warp.map.values[3 * i + 2] = 0.0F;
         }
-        all_per_pixel = all_per_pixel && (p.warp.size.width > p.output.width / 10 || p.warp.size.height > p.output.height / 10);
+        all_per_pixel =
+            all_per_pixel && (p.warp.size.width > p.output.width / 10 || p.warp.size.height > p.output.height / 10);
 
         r.alpha.gamma_embedded = options.alpha_gamma;
         r.alpha.map.size = p.blend.size;
@@ -252,7 +257,8 @@ MpcdiFile to_mpcdi(const ScreenCalibration& screen, const MpcdiExportOptions& op
         r.alpha.map.bit_depth = options.alpha_bit_depth;
         r.alpha.map.values.resize(p.blend.weight.size());
         for (std::size_t i = 0; i < p.blend.weight.size(); ++i) {
-            const double code = std::round(max * std::pow(static_cast<double>(p.blend.weight[i]), 1.0 / options.alpha_gamma));
+            const double code =
+                std::round(max * std::pow(static_cast<double>(p.blend.weight[i]), 1.0 / options.alpha_gamma));
             r.alpha.map.values[i] = static_cast<std::uint16_t>(std::clamp(code, 0.0, max));
         }
         if (!p.beta.rgb.empty()) r.beta = beta_map(p.beta);

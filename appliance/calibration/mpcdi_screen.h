@@ -36,30 +36,31 @@
 #include <vector>
 
 #include "appliance/calibration/mpcdi_types.h"
-#include "common/projector_calibration.h"
 #include "appliance/warp/response_curve.h"
+#include "common/projector_calibration.h"
 
 namespace mogao {
 
 enum class WarpSpace { region, buffer };
 
 struct ScreenConversionOptions {
-    std::size_t buffer = 0;                            // which <buffer> is the content frame
+    std::size_t buffer = 0;  // which <buffer> is the content frame
     WarpSpace warp_space = WarpSpace::region;
-    double assumed_gamma = 2.2;                        // for gammaEmbedded 0, (0, 10]
-    ResponseCurve response = make_gamma_response();    // every projector's response
+    double assumed_gamma = 2.2;                      // for gammaEmbedded 0, (0, 10]
+    ResponseCurve response = make_gamma_response();  // every projector's response
 };
 
 // Throws MpcdiError (profile not 2d, buffer index, warp with fewer than 2 channels, grids larger
 // than the region resolution, invalid result) naming the region and field.
-[[nodiscard]] ScreenCalibration to_screen_calibration(const MpcdiFile& file, const ScreenConversionOptions& options = {},
+[[nodiscard]] ScreenCalibration to_screen_calibration(const MpcdiFile& file,
+                                                      const ScreenConversionOptions& options = {},
                                                       std::vector<std::string>* notes = nullptr);
 
 struct MpcdiExportOptions {
-    int alpha_bit_depth = 8;    // 8 (what the reference library reads) or 16 (finer blends)
-    double alpha_gamma = 2.2;   // gammaEmbedded written and applied, (0, 10]
+    int alpha_bit_depth = 8;   // 8 (what the reference library reads) or 16 (finer blends)
+    double alpha_gamma = 2.2;  // gammaEmbedded written and applied, (0, 10]
     std::string buffer_id = "buffer1";
-    std::string date;           // empty = the time of writing
+    std::string date;             // empty = the time of writing
     bool write_response = false;  // write each projector's response LUT (mogao extension entry)
 };
 

@@ -23,8 +23,8 @@ TEST(MpcdiScreen, WarpIsRegionRelativeByDefault) {
     EXPECT_EQ(p.id, "p0");
     EXPECT_EQ(p.output, (ImageSize{16, 8}));
     EXPECT_EQ(p.warp.size, (ImageSize{4, 2}));
-    EXPECT_FLOAT_EQ(p.warp.uv[0], 0.25F);       // x + xsize * 0
-    EXPECT_FLOAT_EQ(p.warp.uv[2 * 3], 0.75F);   // x + xsize * 1
+    EXPECT_FLOAT_EQ(p.warp.uv[0], 0.25F);      // x + xsize * 0
+    EXPECT_FLOAT_EQ(p.warp.uv[2 * 3], 0.75F);  // x + xsize * 1
     EXPECT_FLOAT_EQ(p.warp.uv[2 * 7 + 1], 1.0F);
     ScreenConversionOptions buffer_space;
     buffer_space.warp_space = WarpSpace::buffer;
@@ -71,7 +71,9 @@ TEST(MpcdiScreen, UnsupportedInputsAreNamed) {
         (void)to_screen_calibration(f);
         FAIL();
     } catch (const MpcdiError& e) {
-        EXPECT_STREQ(e.what(), "to_screen_calibration: region \"p0\": geometry warp grid 32x2 is larger than the region resolution 16x8");
+        EXPECT_STREQ(
+            e.what(),
+            "to_screen_calibration: region \"p0\": geometry warp grid 32x2 is larger than the region resolution 16x8");
     }
     f = test::small_file();
     f.buffers[0].regions[0].warp.map = PfmMap{{1, 1}, 1, {0.5F}};
@@ -128,7 +130,8 @@ TEST(MpcdiScreen, CustomMedia2dFixtureConverts) {
     EXPECT_NEAR(b.warp.uv[0], 0.444444 + 0.555556 * 0.05, 1e-6);
     EXPECT_EQ(b.blend.weight[5 * 1920 + 500], 0.0F);  // orientation rows
     EXPECT_FLOAT_EQ(b.blend.weight[100 * 1920 + 500], 1.0F);
-    EXPECT_FLOAT_EQ(b.blend.weight[100 * 1920 + 191], static_cast<float>(std::pow(std::floor(255.0 * 191 / 383 + 0.5) / 255.0, 2.2)));
+    EXPECT_FLOAT_EQ(b.blend.weight[100 * 1920 + 191],
+                    static_cast<float>(std::pow(std::floor(255.0 * 191 / 383 + 0.5) / 255.0, 2.2)));
 }
 
 }  // namespace

@@ -27,18 +27,22 @@ inline std::filesystem::path fixture(const std::string& relative) {
 }
 
 // GTEST_SKIP()s the calling test when the fixture folder is absent (it is never in the repo).
-#define MOGAO_REQUIRE_FIXTURES()                                                                            \
-    do {                                                                                                    \
-        if (!std::filesystem::is_directory(std::filesystem::path(MOGAO_MPCDI_DIR) / "custom")) {            \
-            GTEST_SKIP() << "MPCDI fixtures not found in " MOGAO_MPCDI_DIR " (../shared/data/mpcdi)";       \
-        }                                                                                                   \
+#define MOGAO_REQUIRE_FIXTURES()                                                                      \
+    do {                                                                                              \
+        if (!std::filesystem::is_directory(std::filesystem::path(MOGAO_MPCDI_DIR) / "custom")) {      \
+            GTEST_SKIP() << "MPCDI fixtures not found in " MOGAO_MPCDI_DIR " (../shared/data/mpcdi)"; \
+        }                                                                                             \
     } while (0)
 
 inline const std::vector<std::string>& all_fixtures() {
-    static const std::vector<std::string> names = {
-        "custom/Media2D_2x1920x1080_L1.mpcdi", "custom/Sim3D_1024x768_L4.mpcdi",
-        "custom/Advanced3D_3x1024x768_cylinder_L1.mpcdi", "examples/Media2D.mpcdi", "examples/Sim3D.mpcdi",
-        "examples/ShaderLamp.mpcdi", "examples/Advanced3D.mpcdi", "examples/SampleMPCDI.mpcdi"};
+    static const std::vector<std::string> names = {"custom/Media2D_2x1920x1080_L1.mpcdi",
+                                                   "custom/Sim3D_1024x768_L4.mpcdi",
+                                                   "custom/Advanced3D_3x1024x768_cylinder_L1.mpcdi",
+                                                   "examples/Media2D.mpcdi",
+                                                   "examples/Sim3D.mpcdi",
+                                                   "examples/ShaderLamp.mpcdi",
+                                                   "examples/Advanced3D.mpcdi",
+                                                   "examples/SampleMPCDI.mpcdi"};
     return names;
 }
 

@@ -9,44 +9,64 @@ namespace mogao {
 
 std::string_view to_string(MpcdiProfile value) {
     switch (value) {
-        case MpcdiProfile::two_d: return "2d";
-        case MpcdiProfile::three_d: return "3d";
-        case MpcdiProfile::advanced_3d: return "a3";
-        case MpcdiProfile::shader_lamp: return "sl";
+        case MpcdiProfile::two_d:
+            return "2d";
+        case MpcdiProfile::three_d:
+            return "3d";
+        case MpcdiProfile::advanced_3d:
+            return "a3";
+        case MpcdiProfile::shader_lamp:
+            return "sl";
     }
     return "?";
 }
 
 std::string_view to_string(GeometricUnit value) {
     switch (value) {
-        case GeometricUnit::mm: return "mm";
-        case GeometricUnit::cm: return "cm";
-        case GeometricUnit::dm: return "dm";
-        case GeometricUnit::m: return "m";
-        case GeometricUnit::in: return "in";
-        case GeometricUnit::ft: return "ft";
-        case GeometricUnit::yd: return "yd";
-        case GeometricUnit::unknown: return "unknown";
+        case GeometricUnit::mm:
+            return "mm";
+        case GeometricUnit::cm:
+            return "cm";
+        case GeometricUnit::dm:
+            return "dm";
+        case GeometricUnit::m:
+            return "m";
+        case GeometricUnit::in:
+            return "in";
+        case GeometricUnit::ft:
+            return "ft";
+        case GeometricUnit::yd:
+            return "yd";
+        case GeometricUnit::unknown:
+            return "unknown";
     }
     return "?";
 }
 
 std::string_view to_string(WarpInterpolation value) {
     switch (value) {
-        case WarpInterpolation::linear: return "linear";
-        case WarpInterpolation::keystone: return "keystone";
-        case WarpInterpolation::smooth: return "smooth";
-        case WarpInterpolation::unknown: return "unknown";
+        case WarpInterpolation::linear:
+            return "linear";
+        case WarpInterpolation::keystone:
+            return "keystone";
+        case WarpInterpolation::smooth:
+            return "smooth";
+        case WarpInterpolation::unknown:
+            return "unknown";
     }
     return "?";
 }
 
 std::string_view to_string(OriginOf3DData value) {
     switch (value) {
-        case OriginOf3DData::center_of_mass: return "centerOfMass";
-        case OriginOf3DData::ideal_eye_point: return "idealEyePoint";
-        case OriginOf3DData::floor_center: return "floorCenter";
-        case OriginOf3DData::unknown: return "unknown";
+        case OriginOf3DData::center_of_mass:
+            return "centerOfMass";
+        case OriginOf3DData::ideal_eye_point:
+            return "idealEyePoint";
+        case OriginOf3DData::floor_center:
+            return "floorCenter";
+        case OriginOf3DData::unknown:
+            return "unknown";
     }
     return "?";
 }

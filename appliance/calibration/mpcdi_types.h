@@ -44,8 +44,9 @@ struct PfmMap {
     int channels = 3;
     std::vector<float> values;  // width * height * channels, top row first
     [[nodiscard]] const float* at(int x, int y) const {
-        return values.data() + (static_cast<std::size_t>(y) * static_cast<std::size_t>(size.width) +
-                                static_cast<std::size_t>(x)) * static_cast<std::size_t>(channels);
+        return values.data() +
+               (static_cast<std::size_t>(y) * static_cast<std::size_t>(size.width) + static_cast<std::size_t>(x)) *
+                   static_cast<std::size_t>(channels);
     }
     // Bit-wise equality of the values: NaN equals the same NaN, 0 differs from -0 ("identical data").
     friend bool operator==(const PfmMap& a, const PfmMap& b);
@@ -58,8 +59,10 @@ struct PngMap {
     int bit_depth = 8;
     std::vector<std::uint16_t> values;  // width * height * channels, top row first, 0..2^bit_depth-1
     [[nodiscard]] std::uint16_t at(int x, int y, int c = 0) const {
-        return values[(static_cast<std::size_t>(y) * static_cast<std::size_t>(size.width) + static_cast<std::size_t>(x)) *
-                          static_cast<std::size_t>(channels) + static_cast<std::size_t>(c)];
+        return values[(static_cast<std::size_t>(y) * static_cast<std::size_t>(size.width) +
+                       static_cast<std::size_t>(x)) *
+                          static_cast<std::size_t>(channels) +
+                      static_cast<std::size_t>(c)];
     }
     friend bool operator==(const PngMap&, const PngMap&) = default;
 };
@@ -85,9 +88,9 @@ struct MpcdiGeometryWarp {
 };
 
 struct MpcdiAlphaMap {
-    std::string path;            // "AlphaMap-<regionId>.png"
-    double gamma_embedded = 2.2; // linear weight = (value / max)^gamma; 0 = not recorded (SampleMPCDI)
-    PngMap map;                  // componentDepth = map.channels, bitDepth = map.bit_depth
+    std::string path;             // "AlphaMap-<regionId>.png"
+    double gamma_embedded = 2.2;  // linear weight = (value / max)^gamma; 0 = not recorded (SampleMPCDI)
+    PngMap map;                   // componentDepth = map.channels, bitDepth = map.bit_depth
     friend bool operator==(const MpcdiAlphaMap&, const MpcdiAlphaMap&) = default;
 };
 
@@ -122,9 +125,9 @@ void check_response_lut(const PfmMap& map, const std::string& who);
 
 struct MpcdiRegion {
     std::string id;
-    ImageSize resolution;            // Xresolution, Yresolution: the projector's pixels
-    double x = 0.0, y = 0.0;         // normalised position in the buffer
-    double xsize = 1.0, ysize = 1.0; // normalised size in the buffer
+    ImageSize resolution;             // Xresolution, Yresolution: the projector's pixels
+    double x = 0.0, y = 0.0;          // normalised position in the buffer
+    double xsize = 1.0, ysize = 1.0;  // normalised size in the buffer
     std::optional<MpcdiFrustum> frustum;
     std::optional<MpcdiCoordinateFrame> coordinate_frame;
     MpcdiGeometryWarp warp;
@@ -137,16 +140,16 @@ struct MpcdiRegion {
 
 struct MpcdiBuffer {
     std::string id;
-    ImageSize resolution;            // Xresolution, Yresolution
+    ImageSize resolution;  // Xresolution, Yresolution
     std::vector<MpcdiRegion> regions;
     friend bool operator==(const MpcdiBuffer&, const MpcdiBuffer&) = default;
 };
 
 struct MpcdiFile {
     MpcdiProfile profile = MpcdiProfile::two_d;
-    int level = 1;                   // 1..4
+    int level = 1;  // 1..4
     std::string version = "1.0";
-    std::string date;                // as written, "YYYY-MM-DDThh:mm:ssZ"; empty = write the current UTC time
+    std::string date;  // as written, "YYYY-MM-DDThh:mm:ssZ"; empty = write the current UTC time
     std::vector<MpcdiBuffer> buffers;
     friend bool operator==(const MpcdiFile&, const MpcdiFile&) = default;
 };

@@ -65,7 +65,8 @@ void validate_numbers(const MpcdiRegion& r, const std::string& rw) {
 }
 
 void validate(const MpcdiFile& file, const std::string& who) {
-    if (file.level < 1 || file.level > 4) throw MpcdiError(who + ": level " + std::to_string(file.level) + " is outside 1..4");
+    if (file.level < 1 || file.level > 4)
+        throw MpcdiError(who + ": level " + std::to_string(file.level) + " is outside 1..4");
     if (file.version.rfind("1.", 0) != 0) throw MpcdiError(who + ": version \"" + file.version + "\" is not 1.x");
     if (file.buffers.empty()) throw MpcdiError(who + ": no buffer");
     std::set<std::string> ids;
@@ -74,7 +75,8 @@ void validate(const MpcdiFile& file, const std::string& who) {
         if (b.id.empty()) throw MpcdiError(who + ": buffer with an empty id");
         if (b.regions.empty()) throw MpcdiError(who + ": buffer '" + b.id + "' has no region");
         if (!valid_resolution(b.resolution)) {
-            throw MpcdiError(who + ": buffer '" + b.id + "': resolution is outside 1.." + std::to_string(kMaxMapDimension));
+            throw MpcdiError(who + ": buffer '" + b.id + "': resolution is outside 1.." +
+                             std::to_string(kMaxMapDimension));
         }
         for (const MpcdiRegion& r : b.regions) {
             const std::string rw = who + ": region '" + r.id + "'";
@@ -150,12 +152,14 @@ void write_mpcdi(const std::filesystem::path& path, const MpcdiFile& input) {
     const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
     std::string temp = (dir / ("." + path.filename().string() + ".tmp-XXXXXX")).string();
     const int fd = ::mkstemp(temp.data());
-    if (fd < 0) throw MpcdiError(who + ": cannot create a temporary file in '" + dir.string() + "': " + std::strerror(errno));
+    if (fd < 0)
+        throw MpcdiError(who + ": cannot create a temporary file in '" + dir.string() + "': " + std::strerror(errno));
     // mkstemp creates 0600; a calibration is not secret and other users (the kiosk) must read it.
     const int chmod_rc = ::fchmod(fd, 0644);
     ::close(fd);
     try {
-        if (chmod_rc != 0) throw MpcdiError(who + ": cannot set permissions of the temporary file: " + std::strerror(errno));
+        if (chmod_rc != 0)
+            throw MpcdiError(who + ": cannot set permissions of the temporary file: " + std::strerror(errno));
         write_zip(temp, entries, who);
         fsync_path(temp, O_RDONLY, who);
         std::error_code ec;
@@ -169,8 +173,7 @@ void write_mpcdi(const std::filesystem::path& path, const MpcdiFile& input) {
     // Make the rename itself durable; failure here does not undo a complete write, so it is ignored.
     try {
         fsync_path(dir, O_RDONLY | O_DIRECTORY, who);
-    } catch (const MpcdiError&) {
-    }
+    } catch (const MpcdiError&) {}
 }
 
 }  // namespace mogao

@@ -31,7 +31,8 @@ public:
     Parser(std::string who, std::vector<std::string>* notes) : who_(std::move(who) + ": mpcdi.xml"), notes_(notes) {}
 
     [[noreturn]] void fail(const XMLElement* e, const std::string& why) const {
-        throw MpcdiError(who_ + ": " + (e != nullptr ? tag(e) + " (line " + std::to_string(e->GetLineNum()) + "): " : "") + why);
+        throw MpcdiError(who_ + ": " +
+                         (e != nullptr ? tag(e) + " (line " + std::to_string(e->GetLineNum()) + "): " : "") + why);
     }
     void note(const std::string& text) const {
         if (notes_ != nullptr) notes_->push_back(text);
@@ -149,7 +150,8 @@ public:
     MpcdiBuffer parse_buffer(const XMLElement* b) {
         MpcdiBuffer buffer;
         buffer.id = attr(b, "id");
-        buffer.resolution = {int_attr(b, "Xresolution", 1, kMaxMapDimension), int_attr(b, "Yresolution", 1, kMaxMapDimension)};
+        buffer.resolution = {int_attr(b, "Xresolution", 1, kMaxMapDimension),
+                             int_attr(b, "Yresolution", 1, kMaxMapDimension)};
         for (const XMLElement* r = b->FirstChildElement(); r != nullptr; r = r->NextSiblingElement()) {
             if (std::string_view(r->Name()) != "region") fail(r, "unexpected element in <buffer> (only <region>)");
             buffer.regions.push_back(parse_region(r));
@@ -162,7 +164,8 @@ public:
         MpcdiRegion region;
         region.id = attr(r, "id");
         if (!region_ids_.insert(region.id).second) fail(r, "region id is used twice");
-        region.resolution = {int_attr(r, "Xresolution", 1, kMaxMapDimension), int_attr(r, "Yresolution", 1, kMaxMapDimension)};
+        region.resolution = {int_attr(r, "Xresolution", 1, kMaxMapDimension),
+                             int_attr(r, "Yresolution", 1, kMaxMapDimension)};
         region.x = number_attr(r, "x", 0.0, 1.0);
         region.y = number_attr(r, "y", 0.0, 1.0);
         // Sizes up to 1; x + xsize may pass 1 by the 6-digit rounding of "%g" (0.666667 + 0.333334).
@@ -172,8 +175,9 @@ public:
             fail(r, "region extends past the buffer (x + xsize or y + ysize > 1)");
         }
         if (const XMLElement* f = r->FirstChildElement("frustum")) {
-            region.frustum = MpcdiFrustum{number(f, "yaw"), number(f, "pitch"), number(f, "roll"), number(f, "rightAngle"),
-                                          number(f, "leftAngle"), number(f, "upAngle"), number(f, "downAngle")};
+            region.frustum = MpcdiFrustum{number(f, "yaw"),        number(f, "pitch"),     number(f, "roll"),
+                                          number(f, "rightAngle"), number(f, "leftAngle"), number(f, "upAngle"),
+                                          number(f, "downAngle")};
         }
         if (const XMLElement* c = r->FirstChildElement("coordinateFrame")) {
             MpcdiCoordinateFrame frame;
@@ -214,13 +218,14 @@ public:
     void parse_fileset(const XMLElement* fs, MpcdiRegion& region) {
         const XMLElement* w = child(fs, "geometryWarpFile");
         region.warp.path = nonempty_text(w, "path");
-        region.warp.geometric_unit = enum_text(w, "geometricUnit",
-            std::array{GeometricUnit::mm, GeometricUnit::cm, GeometricUnit::dm, GeometricUnit::m, GeometricUnit::in,
-                       GeometricUnit::ft, GeometricUnit::yd, GeometricUnit::unknown});
+        region.warp.geometric_unit =
+            enum_text(w, "geometricUnit",
+                      std::array{GeometricUnit::mm, GeometricUnit::cm, GeometricUnit::dm, GeometricUnit::m,
+                                 GeometricUnit::in, GeometricUnit::ft, GeometricUnit::yd, GeometricUnit::unknown});
         const std::string interpolation = text(w, "interpolation");
         region.warp.interpolation = enum_text(w, "interpolation",
-            std::array{WarpInterpolation::linear, WarpInterpolation::keystone, WarpInterpolation::smooth,
-                       WarpInterpolation::unknown});
+                                              std::array{WarpInterpolation::linear, WarpInterpolation::keystone,
+                                                         WarpInterpolation::smooth, WarpInterpolation::unknown});
         region.warp.origin_of_3d_data = parse_origin(w, region.id, interpolation);
 
         const XMLElement* a = child(fs, "alphaMap");
@@ -246,7 +251,8 @@ public:
         }
     }
 
-    OriginOf3DData parse_origin(const XMLElement* w, const std::string& region_id, const std::string& interpolation) const {
+    OriginOf3DData parse_origin(const XMLElement* w, const std::string& region_id,
+                                const std::string& interpolation) const {
         const XMLElement* o = w->FirstChildElement("originOf3DData");
         if (o == nullptr) o = w->FirstChildElement("originof3DData");
         if (o == nullptr) fail(w, "missing child element <originof3DData> (or <originOf3DData>)");
@@ -272,12 +278,23 @@ std::string escape(std::string_view s) {
     std::string out;
     for (const char c : s) {
         switch (c) {
-            case '&': out += "&amp;"; break;
-            case '<': out += "&lt;"; break;
-            case '>': out += "&gt;"; break;
-            case '"': out += "&quot;"; break;
-            case '\'': out += "&apos;"; break;
-            default: out += c;
+            case '&':
+                out += "&amp;";
+                break;
+            case '<':
+                out += "&lt;";
+                break;
+            case '>':
+                out += "&gt;";
+                break;
+            case '"':
+                out += "&quot;";
+                break;
+            case '\'':
+                out += "&apos;";
+                break;
+            default:
+                out += c;
         }
     }
     return out;
@@ -294,7 +311,9 @@ std::string utc_now() {
 
 class Printer {
 public:
-    void line(int depth, const std::string& text) { out_ += std::string(static_cast<std::size_t>(depth) * 4, ' ') + text + "\n"; }
+    void line(int depth, const std::string& text) {
+        out_ += std::string(static_cast<std::size_t>(depth) * 4, ' ') + text + "\n";
+    }
     void value(int depth, const char* name, const std::string& text) {
         line(depth, "<" + std::string(name) + ">" + escape(text) + "</" + name + ">");
     }
@@ -322,9 +341,10 @@ std::string print_mpcdi_xml(const MpcdiFile& file) {
         p.line(2, "<buffer id=\"" + escape(b.id) + "\" Xresolution=\"" + std::to_string(b.resolution.width) +
                       "\" Yresolution=\"" + std::to_string(b.resolution.height) + "\">");
         for (const MpcdiRegion& r : b.regions) {
-            const std::string open = "<region id=\"" + escape(r.id) + "\" Xresolution=\"" + std::to_string(r.resolution.width) +
-                                     "\" Yresolution=\"" + std::to_string(r.resolution.height) + "\" x=\"" + format_number(r.x) +
-                                     "\" y=\"" + format_number(r.y) + "\" xsize=\"" + format_number(r.xsize) + "\" ysize=\"" +
+            const std::string open = "<region id=\"" + escape(r.id) + "\" Xresolution=\"" +
+                                     std::to_string(r.resolution.width) + "\" Yresolution=\"" +
+                                     std::to_string(r.resolution.height) + "\" x=\"" + format_number(r.x) + "\" y=\"" +
+                                     format_number(r.y) + "\" xsize=\"" + format_number(r.xsize) + "\" ysize=\"" +
                                      format_number(r.ysize) + "\"";
             if (!r.frustum && !r.coordinate_frame) {
                 p.line(3, open + "/>");

@@ -97,10 +97,12 @@ TEST(MpcdiXml, ErrorsNameTheElementAndField) {
     const std::string base = kSmallXml;
     EXPECT_EQ(error_of(with(base, R"( Xresolution="16")", "")),
               "read_mpcdi 'f.mpcdi': mpcdi.xml: <region id=\"p0\"> (line 5): missing attribute 'Xresolution'");
-    EXPECT_NE(error_of(with(base, R"(level="2")", R"(level="5")")).find("attribute level=\"5\" is not an integer in [1, 4]"),
-              std::string::npos);
-    EXPECT_NE(error_of(with(base, R"(profile="2d")", R"(profile="4d")")).find("profile=\"4d\" is not one of 2d, 3d, a3, sl"),
-              std::string::npos);
+    EXPECT_NE(
+        error_of(with(base, R"(level="2")", R"(level="5")")).find("attribute level=\"5\" is not an integer in [1, 4]"),
+        std::string::npos);
+    EXPECT_NE(
+        error_of(with(base, R"(profile="2d")", R"(profile="4d")")).find("profile=\"4d\" is not one of 2d, 3d, a3, sl"),
+        std::string::npos);
     EXPECT_NE(error_of(with(base, R"(version="1.0">)", R"(version="2.0">)")).find("version \"2.0\" is not supported"),
               std::string::npos)
         << error_of(with(base, R"(version="1.0">)", R"(version="2.0">)"));
@@ -108,21 +110,28 @@ TEST(MpcdiXml, ErrorsNameTheElementAndField) {
               std::string::npos);
     EXPECT_NE(error_of(with(base, R"(x="0.25")", R"(x="abc")")).find("attribute x=\"abc\" is not a number in [0, 1]"),
               std::string::npos);
-    EXPECT_NE(error_of(with(base, R"(<fileset region="p0">)", R"(<fileset region="p1">)")).find("no <region> has id \"p1\""),
-              std::string::npos);
-    EXPECT_NE(error_of(with(base, "<gammaEmbedded>2.2<", "<gammaEmbedded>-1<")).find("<gammaEmbedded> -1 is outside [0, 10]"),
-              std::string::npos);
-    EXPECT_NE(error_of(with(base, "<componentDepth>1</componentDepth>\n                <bitDepth>8</bitDepth>\n                <gamma",
-                            "<componentDepth>2</componentDepth>\n                <bitDepth>8</bitDepth>\n                <gamma"))
-                  .find("<componentDepth>2</componentDepth> is not one of 1, 3"),
-              std::string::npos);
+    EXPECT_NE(
+        error_of(with(base, R"(<fileset region="p0">)", R"(<fileset region="p1">)")).find("no <region> has id \"p1\""),
+        std::string::npos);
+    EXPECT_NE(
+        error_of(with(base, "<gammaEmbedded>2.2<", "<gammaEmbedded>-1<")).find("<gammaEmbedded> -1 is outside [0, 10]"),
+        std::string::npos);
+    EXPECT_NE(
+        error_of(
+            with(base,
+                 "<componentDepth>1</componentDepth>\n                <bitDepth>8</bitDepth>\n                <gamma",
+                 "<componentDepth>2</componentDepth>\n                <bitDepth>8</bitDepth>\n                <gamma"))
+            .find("<componentDepth>2</componentDepth> is not one of 1, 3"),
+        std::string::npos);
     EXPECT_NE(error_of(with(base, "<path>AlphaMap-p0.png</path>", "")).find("<alphaMap"), std::string::npos);
     EXPECT_NE(error_of(with(base, "<geometricUnit>unknown<", "<geometricUnit>furlong<")).find("is not one of mm, cm"),
               std::string::npos);
     EXPECT_NE(error_of(with(base, "</MPCDI>", "")).find("not well-formed XML"), std::string::npos);
-    const std::string fileset = base.substr(base.find("        <fileset"), base.find("    </files>") - base.find("        <fileset"));
-    EXPECT_NE(error_of(with(base, "    </files>", fileset + "    </files>")).find("second <fileset> for the same region"),
-              std::string::npos);
+    const std::string fileset =
+        base.substr(base.find("        <fileset"), base.find("    </files>") - base.find("        <fileset"));
+    EXPECT_NE(
+        error_of(with(base, "    </files>", fileset + "    </files>")).find("second <fileset> for the same region"),
+        std::string::npos);
     std::string no_files = base.substr(0, base.find("    <files>")) + "</MPCDI>\n";
     EXPECT_NE(error_of(no_files).find("missing child element <files>"), std::string::npos) << error_of(no_files);
 }
@@ -131,9 +140,9 @@ TEST(MpcdiXml, OriginSpellingsAndTheReferenceWriterBug) {
     const std::string base = kSmallXml;
     std::vector<std::string> notes;
     // The standard's spelling is accepted as well as the reference library's.
-    MpcdiFile f = parse_mpcdi_xml(with(base, "<originof3DData>unknown</originof3DData>",
-                                       "<originOf3DData>idealEyePoint</originOf3DData>"),
-                                  "t", &notes);
+    MpcdiFile f = parse_mpcdi_xml(
+        with(base, "<originof3DData>unknown</originof3DData>", "<originOf3DData>idealEyePoint</originOf3DData>"), "t",
+        &notes);
     EXPECT_EQ(f.buffers[0].regions[0].warp.origin_of_3d_data, OriginOf3DData::ideal_eye_point);
     // The reference writer copies <interpolation> into the origin: read as unknown, with a note.
     f = parse_mpcdi_xml(with(base, "<originof3DData>unknown<", "<originof3DData>linear<"), "t", &notes);
@@ -141,8 +150,9 @@ TEST(MpcdiXml, OriginSpellingsAndTheReferenceWriterBug) {
     ASSERT_EQ(notes.size(), 1U);
     EXPECT_NE(notes[0].find("reference writer bug"), std::string::npos);
     // Any other non-origin value is an error.
-    EXPECT_NE(error_of(with(base, "<originof3DData>unknown<", "<originof3DData>smooth<")).find("is not one of centerOfMass"),
-              std::string::npos);
+    EXPECT_NE(
+        error_of(with(base, "<originof3DData>unknown<", "<originof3DData>smooth<")).find("is not one of centerOfMass"),
+        std::string::npos);
     // The pre-fix reference spelling "unkown" reads as unknown.
     f = parse_mpcdi_xml(with(base, "<geometricUnit>unknown<", "<geometricUnit>unkown<"), "t", nullptr);
     EXPECT_EQ(f.buffers[0].regions[0].warp.geometric_unit, GeometricUnit::unknown);

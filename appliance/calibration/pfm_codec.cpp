@@ -68,7 +68,8 @@ PfmMap decode_pfm(std::span<const std::uint8_t> bytes, const std::string& who) {
         throw fail("header: scale '" + std::string(scale_text) +
                    "' is not a non-zero number (its sign gives the byte order)");
     }
-    if (pos >= bytes.size() || !is_space(bytes[pos])) throw fail("header: scale is not followed by one whitespace byte");
+    if (pos >= bytes.size() || !is_space(bytes[pos]))
+        throw fail("header: scale is not followed by one whitespace byte");
     ++pos;
     map.size = {*width, *height};
     const std::size_t count = static_cast<std::size_t>(map.size.pixel_count()) * static_cast<std::size_t>(map.channels);
@@ -89,7 +90,8 @@ PfmMap decode_pfm(std::span<const std::uint8_t> bytes, const std::string& who) {
             const float value = load_float(src + 4 * i, little);
             if (std::isinf(value)) {
                 throw fail("sample at (" + std::to_string(i / static_cast<std::size_t>(map.channels)) + ", " +
-                           std::to_string(y) + ") channel " + std::to_string(i % static_cast<std::size_t>(map.channels)) +
+                           std::to_string(y) + ") channel " +
+                           std::to_string(i % static_cast<std::size_t>(map.channels)) +
                            " is infinite (only finite values or NaN are accepted)");
             }
             dst[i] = value;
@@ -104,7 +106,8 @@ std::vector<std::uint8_t> encode_pfm(const PfmMap& map, const std::string& who) 
     }
     if (map.size.width < 1 || map.size.height < 1 || map.size.width > kMaxMapDimension ||
         map.size.height > kMaxMapDimension) {
-        throw MpcdiError(who + ": PFM size " + size_text(map.size) + " is outside 1.." + std::to_string(kMaxMapDimension));
+        throw MpcdiError(who + ": PFM size " + size_text(map.size) + " is outside 1.." +
+                         std::to_string(kMaxMapDimension));
     }
     const std::size_t row_values = static_cast<std::size_t>(map.size.width) * static_cast<std::size_t>(map.channels);
     if (map.values.size() != row_values * static_cast<std::size_t>(map.size.height)) {

@@ -54,8 +54,8 @@ struct RawHeader {
 
 // Phase 1 reads the header; if it is acceptable, `pixels` is sized by the caller-side callback and
 // phase 2 fills it. Returns false with state.message set on any libpng error.
-bool png_decode_raw(PngState& state, RawHeader& header, std::vector<std::uint8_t>& pixels,
-                    std::vector<png_bytep>& rows, bool (*accept)(const RawHeader&, PngState&)) {
+bool png_decode_raw(PngState& state, RawHeader& header, std::vector<std::uint8_t>& pixels, std::vector<png_bytep>& rows,
+                    bool (*accept)(const RawHeader&, PngState&)) {
     png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &state, on_error, on_warning);
     if (png == nullptr) {
         std::snprintf(state.message, sizeof state.message, "out of memory");
@@ -165,22 +165,24 @@ std::vector<std::uint8_t> encode_png_map(const PngMap& map, const std::string& w
     }
     const std::size_t count = static_cast<std::size_t>(map.size.pixel_count()) * static_cast<std::size_t>(map.channels);
     if (map.values.size() != count) {
-        throw MpcdiError(who + ": PNG holds " + std::to_string(map.values.size()) + " values, " + std::to_string(count) +
-                         " expected");
+        throw MpcdiError(who + ": PNG holds " + std::to_string(map.values.size()) + " values, " +
+                         std::to_string(count) + " expected");
     }
     const std::size_t bytes_per = map.bit_depth == 8 ? 1 : 2;
     std::vector<std::uint8_t> pixels(count * bytes_per);
     for (std::size_t i = 0; i < count; ++i) {
         const std::uint16_t v = map.values[i];
         if (map.bit_depth == 8) {
-            if (v > 255) throw MpcdiError(who + ": PNG value " + std::to_string(i) + " = " + std::to_string(v) + " exceeds 255");
+            if (v > 255)
+                throw MpcdiError(who + ": PNG value " + std::to_string(i) + " = " + std::to_string(v) + " exceeds 255");
             pixels[i] = static_cast<std::uint8_t>(v);
         } else {
             pixels[2 * i] = static_cast<std::uint8_t>(v >> 8);
             pixels[2 * i + 1] = static_cast<std::uint8_t>(v & 0xFF);
         }
     }
-    const std::size_t stride = static_cast<std::size_t>(map.size.width) * static_cast<std::size_t>(map.channels) * bytes_per;
+    const std::size_t stride =
+        static_cast<std::size_t>(map.size.width) * static_cast<std::size_t>(map.channels) * bytes_per;
     std::vector<png_bytep> rows(static_cast<std::size_t>(map.size.height));
     for (std::size_t y = 0; y < rows.size(); ++y) rows[y] = pixels.data() + y * stride;
     std::vector<std::uint8_t> out;

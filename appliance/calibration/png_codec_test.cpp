@@ -58,10 +58,12 @@ TEST(PngCodec, RejectsOtherColourTypesAndGarbage) {
     std::vector<std::uint8_t> rgba(size);
     ASSERT_NE(png_image_write_to_memory(&image, rgba.data(), &size, 0, pixels, 0, nullptr), 0);
     rgba.resize(size);
-    EXPECT_NE(error_of(rgba).find("entry 'A.png': PNG: colour type 6 is not supported"), std::string::npos) << error_of(rgba);
+    EXPECT_NE(error_of(rgba).find("entry 'A.png': PNG: colour type 6 is not supported"), std::string::npos)
+        << error_of(rgba);
 
     EXPECT_NE(error_of({1, 2, 3}).find("not a PNG (bad signature)"), std::string::npos);
-    std::vector<std::uint8_t> truncated = encode_png_map(PngMap{{64, 64}, 1, 8, std::vector<std::uint16_t>(4096, 7)}, "t");
+    std::vector<std::uint8_t> truncated =
+        encode_png_map(PngMap{{64, 64}, 1, 8, std::vector<std::uint16_t>(4096, 7)}, "t");
     truncated.resize(truncated.size() / 2);
     EXPECT_NE(error_of(truncated).find("PNG:"), std::string::npos) << error_of(truncated);
 }

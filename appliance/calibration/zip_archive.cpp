@@ -47,7 +47,8 @@ ZipReader::ZipReader(const std::filesystem::path& path, std::string who) : who_(
     std::set<std::string> seen;
     try {
         for (int rc = unzGoToFirstFile(zip_); rc != UNZ_END_OF_LIST_OF_FILE; rc = unzGoToNextFile(zip_)) {
-            if (rc != UNZ_OK) throw MpcdiError(who_ + ": corrupt ZIP central directory (minizip error " + std::to_string(rc) + ")");
+            if (rc != UNZ_OK)
+                throw MpcdiError(who_ + ": corrupt ZIP central directory (minizip error " + std::to_string(rc) + ")");
             unz_file_info64 info{};
             char name[1024];
             if (unzGetCurrentFileInfo64(zip_, &info, name, sizeof name, nullptr, 0, nullptr, 0) != UNZ_OK ||
@@ -56,7 +57,8 @@ ZipReader::ZipReader(const std::filesystem::path& path, std::string who) : who_(
             }
             const std::string entry(name, info.size_filename);
             require_safe_entry_name(entry, who_);
-            if (!seen.insert(entry).second) throw MpcdiError(who_ + ": " + entry_text(entry) + ": duplicate entry name");
+            if (!seen.insert(entry).second)
+                throw MpcdiError(who_ + ": " + entry_text(entry) + ": duplicate entry name");
             names_.push_back(entry);
         }
     } catch (...) {

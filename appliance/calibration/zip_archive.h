@@ -47,7 +47,8 @@ void require_safe_entry_name(const std::string& name, const std::string& who);
 
 // Writes a new archive at `path` (replacing any file there) with the entries in order: deflate at
 // zlib's default level, no extra fields, no data descriptors, DOS time 0 and date 0x0020
-// ("1980-01-00", day 0) and version-made-by 0, as the reference writer does. Throws MpcdiError (prefixed `who`) on failure.
+// ("1980-01-00", day 0) and version-made-by 0, as the reference writer does. Throws MpcdiError (prefixed `who`) on
+// failure.
 void write_zip(const std::filesystem::path& path,
                const std::vector<std::pair<std::string, std::vector<std::uint8_t>>>& entries, const std::string& who);
 

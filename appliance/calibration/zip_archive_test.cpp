@@ -33,15 +33,16 @@ TEST(ZipArchive, WritesTheReferenceLayoutAndReadsItBack) {
     const std::vector<std::uint8_t> bytes = test::read_bytes(dir / "a.zip");
     ASSERT_GT(bytes.size(), 30U);
     EXPECT_EQ(u16(bytes, 0), 0x4b50);
-    EXPECT_EQ(u16(bytes, 6), 0);   // general-purpose flags
-    EXPECT_EQ(u16(bytes, 8), 8);   // deflate
-    EXPECT_EQ(u16(bytes, 10), 0);  // DOS time
+    EXPECT_EQ(u16(bytes, 6), 0);        // general-purpose flags
+    EXPECT_EQ(u16(bytes, 8), 8);        // deflate
+    EXPECT_EQ(u16(bytes, 10), 0);       // DOS time
     EXPECT_EQ(u16(bytes, 12), 0x0020);  // DOS date: 1980, month 1, day 0 ("1980-01-00", like the fixtures)
-    EXPECT_EQ(u16(bytes, 28), 0);  // no extra field
+    EXPECT_EQ(u16(bytes, 28), 0);       // no extra field
 }
 
 TEST(ZipArchive, EntryNamesMustBeSafe) {
-    for (const std::string& bad : std::vector<std::string>{"", "/etc/passwd", "../up", "a/../../b", "a\\b", "a//b", "./a", "a\x01"}) {
+    for (const std::string& bad :
+         std::vector<std::string>{"", "/etc/passwd", "../up", "a/../../b", "a\\b", "a//b", "./a", "a\x01"}) {
         EXPECT_THROW(require_safe_entry_name(bad, "t"), MpcdiError) << bad;
     }
     for (const std::string& good : std::vector<std::string>{"mpcdi.xml", "dir/file.pfm", "dir/", "a..b"}) {

@@ -15,23 +15,23 @@
 #include <optional>
 #include <string>
 
+#include "common/image.h"
 #include "common/jpeg_codec.h"
 #include "common/link_types.h"
-#include "common/image.h"
 
 namespace mogao {
 
 // A decoded frame and what the kiosk reports about it.
 struct ContentFrame {
-    Rgb8Image image;                 // sRGB RGB8, rows top first
-    std::uint64_t request_id = 0;    // the view request it answers (increasing)
-    std::uint64_t link_frame_id = 0; // per link session
-    ViewerPose pose;                 // the pose it was rendered for
-    FrameTimestamps times;           // request (appliance clock) ... receive (appliance clock)
+    Rgb8Image image;                  // sRGB RGB8, rows top first
+    std::uint64_t request_id = 0;     // the view request it answers (increasing)
+    std::uint64_t link_frame_id = 0;  // per link session
+    ViewerPose pose;                  // the pose it was rendered for
+    FrameTimestamps times;            // request (appliance clock) ... receive (appliance clock)
     std::size_t jpeg_bytes = 0;
-    double decode_ms = 0;            // TurboJPEG decode time on the kiosk
-    std::uint32_t spp = 0;           // samples per pixel as the farm served it (0: not reported)
-    std::uint32_t bounces = 0;       // indirect bounces as the farm served it
+    double decode_ms = 0;       // TurboJPEG decode time on the kiosk
+    std::uint32_t spp = 0;      // samples per pixel as the farm served it (0: not reported)
+    std::uint32_t bounces = 0;  // indirect bounces as the farm served it
 };
 
 class LastGoodFrame {

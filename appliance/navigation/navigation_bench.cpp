@@ -16,10 +16,10 @@
 // Usage: mogao_navigation_bench [noise_sigma_deg [min_cutoff_hz beta]]
 //   noise default 1.0 deg: the tracker's yaw noise on a near-frontal tag at 0.5 m (the worst
 //   case, `mogao-track navigate` on the hand-held sequence; docs/tracking.md).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <algorithm>
 #include <functional>
 #include <memory>
 #include <random>

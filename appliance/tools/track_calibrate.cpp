@@ -2,8 +2,8 @@
 // mogao-track calibrate-camera: OpenCV chessboard calibration of a folder of photos.
 #include <cstdio>
 
-#include "appliance/tracker/chessboard_calibration.h"
 #include "appliance/tools/track_commands.h"
+#include "appliance/tracker/chessboard_calibration.h"
 
 namespace mogao::track {
 

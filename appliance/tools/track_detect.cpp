@@ -4,8 +4,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "appliance/tracker/tag_detector.h"
 #include "appliance/tools/track_commands.h"
+#include "appliance/tracker/tag_detector.h"
 #include "drivers/camera/image_file.h"
 
 namespace mogao::track {

@@ -14,10 +14,10 @@
 #include <nlohmann/json.hpp>
 
 #include "appliance/navigation/navigator.h"
-#include "drivers/camera/camera_source.h"
 #include "appliance/navigation/tag_sample_of.h"
-#include "appliance/tracker/tag_tracker.h"
 #include "appliance/tools/track_commands.h"
+#include "appliance/tracker/tag_tracker.h"
+#include "drivers/camera/camera_source.h"
 
 namespace mogao::track {
 namespace {

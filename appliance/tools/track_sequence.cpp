@@ -5,8 +5,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "appliance/tracker/tag_bitmap.h"
 #include "appliance/tools/track_commands.h"
+#include "appliance/tracker/tag_bitmap.h"
 
 namespace mogao::track {
 

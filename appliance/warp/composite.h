@@ -19,8 +19,8 @@
 #include <array>
 #include <vector>
 
-#include "common/projector_calibration.h"
 #include "common/image.h"
+#include "common/projector_calibration.h"
 
 namespace mogao {
 

@@ -18,9 +18,9 @@ namespace {
 
 constexpr double kTolerance = 1.0 / 255.0;  // linear light, see docs/calibration.md
 
-// Gradient + a smooth (sinusoidal) checker, values in [0.05, 0.95] (inside the response's [0, 1]). Smooth because the round trip
-// resamples twice (content -> projector pixels -> content pixels); a hard-edged checker is blurred
-// by one pixel there by design, which is interpolation, not calibration error.
+// Gradient + a smooth (sinusoidal) checker, values in [0.05, 0.95] (inside the response's [0, 1]). Smooth because the
+// round trip resamples twice (content -> projector pixels -> content pixels); a hard-edged checker is blurred by one
+// pixel there by design, which is interpolation, not calibration error.
 RgbFloatImage test_content(ImageSize size) {
     RgbFloatImage img(size);
     const double period = 96.0;  // content pixels per checker cell pair
@@ -64,8 +64,8 @@ PixelRect inner(ImageSize s) { return {2, 2, s.width - 2, s.height - 2}; }
 TEST(Composite, SampleContentUsesPixelCentresAndClamps) {
     RgbFloatImage img({2, 1});
     img.pixels = {0.0F, 0.2F, 1.0F, 1.0F, 0.4F, 0.0F};
-    EXPECT_EQ(sample_content(img, 0.25, 0.5)[1], 0.2F);   // pixel 0's centre
-    EXPECT_EQ(sample_content(img, 0.75, 0.5)[0], 1.0F);   // pixel 1's centre
+    EXPECT_EQ(sample_content(img, 0.25, 0.5)[1], 0.2F);  // pixel 0's centre
+    EXPECT_EQ(sample_content(img, 0.75, 0.5)[0], 1.0F);  // pixel 1's centre
     EXPECT_FLOAT_EQ(sample_content(img, 0.5, 0.5)[1], 0.3F);
     EXPECT_FLOAT_EQ(sample_content(img, 0.375, 0.1)[2], 0.75F);
     EXPECT_EQ(sample_content(img, -5.0, 9.0)[2], 1.0F);  // clamp to pixel 0

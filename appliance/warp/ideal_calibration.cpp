@@ -11,13 +11,12 @@ namespace mogao {
 
 std::vector<ContentBand> ideal_bands(int projectors, double overlap) {
     if (projectors < 1 || projectors > kMaxProjectors) {
-        throw std::invalid_argument("ideal calibration: projectors " + std::to_string(projectors) +
-                                    " is outside [1, " + std::to_string(kMaxProjectors) + "]");
+        throw std::invalid_argument("ideal calibration: projectors " + std::to_string(projectors) + " is outside [1, " +
+                                    std::to_string(kMaxProjectors) + "]");
     }
     // Below 0.5 only neighbours overlap, and a projector's left and right ramps never meet.
     if (!(overlap >= 0.0 && overlap < 0.5)) {
-        throw std::invalid_argument("ideal calibration: overlap " + std::to_string(overlap) +
-                                    " is outside [0, 0.5)");
+        throw std::invalid_argument("ideal calibration: overlap " + std::to_string(overlap) + " is outside [0, 0.5)");
     }
     const double band = 1.0 / (projectors - (projectors - 1) * overlap);
     const double shared = band * overlap;
@@ -85,8 +84,8 @@ ScreenCalibration make_ideal_calibration(const IdealCalibrationParams& params) {
         for (int y = 0; y < out.height; ++y) {
             const auto v = static_cast<float>((y + 0.5) / out.height);
             for (int x = 0; x < out.width; ++x) {
-                const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(out.width) +
-                                      static_cast<std::size_t>(x);
+                const std::size_t i =
+                    static_cast<std::size_t>(y) * static_cast<std::size_t>(out.width) + static_cast<std::size_t>(x);
                 p.warp.uv[2 * i] = row_u[static_cast<std::size_t>(x)];
                 p.warp.uv[2 * i + 1] = v;
                 p.blend.weight[i] = row_w[static_cast<std::size_t>(x)];

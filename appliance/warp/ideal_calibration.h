@@ -26,8 +26,8 @@
 
 #include <vector>
 
-#include "common/projector_calibration.h"
 #include "appliance/warp/response_curve.h"
+#include "common/projector_calibration.h"
 
 namespace mogao {
 

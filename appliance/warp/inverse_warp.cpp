@@ -70,7 +70,8 @@ InverseWarp build_inverse_warp(const WarpMap& warp, ImageSize output, ImageSize 
     const double cw = content.width;
     const double ch = content.height;
     const auto node = [&](int i, int j) -> Vec2 {
-        const std::size_t idx = (static_cast<std::size_t>(j) * static_cast<std::size_t>(gw) + static_cast<std::size_t>(i)) * 2;
+        const std::size_t idx =
+            (static_cast<std::size_t>(j) * static_cast<std::size_t>(gw) + static_cast<std::size_t>(i)) * 2;
         // Content pixel-index coordinates: content pixel i's centre is at i.
         return {warp.uv[idx] * cw - 0.5, warp.uv[idx + 1] * ch - 0.5};
     };
@@ -96,15 +97,17 @@ InverseWarp build_inverse_warp(const WarpMap& warp, ImageSize output, ImageSize 
             const Patch patch(p);
             for (int py = py0; py <= py1; ++py) {
                 for (int px = px0; px <= px1; ++px) {
-                    const std::size_t out =
-                        (static_cast<std::size_t>(py) * static_cast<std::size_t>(content.width) + static_cast<std::size_t>(px)) * 2;
+                    const std::size_t out = (static_cast<std::size_t>(py) * static_cast<std::size_t>(content.width) +
+                                             static_cast<std::size_t>(px)) *
+                                            2;
                     if (!std::isnan(inv.xy[out])) continue;  // claimed by an earlier cell
                     double s = 0.0;
                     double t = 0.0;
                     if (!patch.solve({static_cast<double>(px), static_cast<double>(py)}, s, t)) continue;
                     if (s < -kSlack || s > 1.0 + kSlack || t < -kSlack || t > 1.0 + kSlack) continue;
                     inv.xy[out] = static_cast<float>(grid_to_output(i + std::clamp(s, 0.0, 1.0), output.width, gw));
-                    inv.xy[out + 1] = static_cast<float>(grid_to_output(j + std::clamp(t, 0.0, 1.0), output.height, gh));
+                    inv.xy[out + 1] =
+                        static_cast<float>(grid_to_output(j + std::clamp(t, 0.0, 1.0), output.height, gh));
                 }
             }
         }

@@ -25,7 +25,7 @@
 namespace mogao {
 
 struct InverseWarp {
-    ImageSize content;       // content frame size
+    ImageSize content;  // content frame size
     // Per content pixel (row-major, top row first): (x, y) output position in pixel-index
     // coordinates (pixel x's centre is x; add 0.5 for image coordinates), or NaN, NaN when no
     // output pixel of this projector lands there.

@@ -16,8 +16,8 @@ struct Taps {
 };
 
 Taps taps_at(double pixel, int output_extent, int grid_extent) {
-    const double g = std::clamp(output_to_grid(pixel, output_extent, grid_extent), 0.0,
-                                static_cast<double>(grid_extent - 1));
+    const double g =
+        std::clamp(output_to_grid(pixel, output_extent, grid_extent), 0.0, static_cast<double>(grid_extent - 1));
     Taps t;
     t.i0 = static_cast<int>(std::floor(g));
     t.i1 = std::min(t.i0 + 1, grid_extent - 1);
@@ -52,9 +52,9 @@ ContentUv sample_warp_at(const WarpMap& warp, ImageSize output, double x, double
         for (int a = 0; a < 2; ++a) {
             const double w = wx[a] * wy[b];
             if (w == 0.0) continue;  // a NaN neighbour with zero weight must not poison the result
-            const std::size_t idx =
-                (static_cast<std::size_t>(ys[b]) * static_cast<std::size_t>(warp.size.width) +
-                 static_cast<std::size_t>(xs[a])) * 2;
+            const std::size_t idx = (static_cast<std::size_t>(ys[b]) * static_cast<std::size_t>(warp.size.width) +
+                                     static_cast<std::size_t>(xs[a])) *
+                                    2;
             const float su = warp.uv[idx];
             const float sv = warp.uv[idx + 1];
             if (std::isnan(su) || std::isnan(sv)) return {NAN, NAN};

@@ -32,10 +32,10 @@ struct CameraSourceSpec {
     std::string camera_id;         // libcamera: Camera::id(); empty = the first camera
     int width = 800;               // v4l2, libcamera: requested size (the driver may choose another: checked)
     int height = 600;
-    int fps = 0;                   // v4l2: requested rate, 0 = the driver's default
-    int timeout_ms = 2000;         // v4l2, libcamera: next_frame() gives ETIMEDOUT after this long
-    bool colour = false;           // v4l2, libcamera: also deliver CameraFrame::colour (camera_frame.h)
-    CameraControls controls;       // v4l2, libcamera: exposure, gain, white balance (camera_controls.h)
+    int fps = 0;              // v4l2: requested rate, 0 = the driver's default
+    int timeout_ms = 2000;    // v4l2, libcamera: next_frame() gives ETIMEDOUT after this long
+    bool colour = false;      // v4l2, libcamera: also deliver CameraFrame::colour (camera_frame.h)
+    CameraControls controls;  // v4l2, libcamera: exposure, gain, white balance (camera_controls.h)
 };
 
 // "replay:<folder>", "v4l2:<device>" or "libcamera:[<id>]" -> true and `out.kind` + folder/device/

@@ -14,8 +14,8 @@
 
 #include <string>
 
-#include "drivers/camera/camera_frame.h"
 #include "common/result.h"
+#include "drivers/camera/camera_frame.h"
 
 namespace mogao {
 

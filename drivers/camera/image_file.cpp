@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
+#include "common/unique_fd.h"
 #include "drivers/camera/mjpeg_decoder.h"
 #include "drivers/camera/pixel_format.h"
-#include "common/unique_fd.h"
 
 namespace mogao {
 namespace {
@@ -76,7 +76,8 @@ Result<GrayImage> decode_png(const std::filesystem::path& path, std::span<const 
     // luma601. Alpha is composited on black.
     const bool wide = (png.format & PNG_FORMAT_FLAG_LINEAR) != 0;
     const bool colour = (png.format & PNG_FORMAT_FLAG_COLOR) != 0;
-    png.format = colour ? (wide ? PNG_FORMAT_LINEAR_RGB : PNG_FORMAT_RGB) : (wide ? PNG_FORMAT_LINEAR_Y : PNG_FORMAT_GRAY);
+    png.format =
+        colour ? (wide ? PNG_FORMAT_LINEAR_RGB : PNG_FORMAT_RGB) : (wide ? PNG_FORMAT_LINEAR_Y : PNG_FORMAT_GRAY);
     const std::size_t count = static_cast<std::size_t>(png.width) * png.height;
     std::vector<std::uint8_t> buffer(PNG_IMAGE_SIZE(png));
     png_color black{0, 0, 0};
@@ -113,7 +114,8 @@ Result<GrayImage> decode_pgm(const std::filesystem::path& path, std::span<const 
         }
         std::uint64_t value = 0;
         const std::size_t start = pos;
-        while (pos < bytes.size() && std::isdigit(bytes[pos]) && pos - start < 10) value = value * 10 + (bytes[pos++] - '0');
+        while (pos < bytes.size() && std::isdigit(bytes[pos]) && pos - start < 10)
+            value = value * 10 + (bytes[pos++] - '0');
         if (pos == start || value == 0 || value > limit) {
             return make_error(EBADMSG, path.string() + ": bad PGM header: " + field + " missing or outside 1.." +
                                            std::to_string(limit));
@@ -134,8 +136,8 @@ Result<GrayImage> decode_pgm(const std::filesystem::path& path, std::span<const 
     const std::size_t count = static_cast<std::size_t>(*w) * static_cast<std::size_t>(*h);
     if (bytes.size() - pos < count * sample_bytes) {
         return make_error(EBADMSG, path.string() + ": truncated PGM: " + std::to_string(bytes.size() - pos) +
-                                       " raster bytes for " + std::to_string(*w) + "x" + std::to_string(*h) + " (need " +
-                                       std::to_string(count * sample_bytes) + ")");
+                                       " raster bytes for " + std::to_string(*w) + "x" + std::to_string(*h) +
+                                       " (need " + std::to_string(count * sample_bytes) + ")");
     }
     GrayImage image(static_cast<int>(*w), static_cast<int>(*h));
     const double scale = 255.0 / static_cast<double>(*maxval);
@@ -169,8 +171,8 @@ Result<GrayImage> read_gray_image(const std::filesystem::path& path) {
         }
         return image;
     }
-    return make_error(EBADMSG, path.string() + ": not a PNG, binary PGM (P5) or JPEG file (" +
-                                   std::to_string(b.size()) + " bytes)");
+    return make_error(
+        EBADMSG, path.string() + ": not a PNG, binary PGM (P5) or JPEG file (" + std::to_string(b.size()) + " bytes)");
 }
 
 }  // namespace mogao

@@ -20,8 +20,8 @@
 #include <cstdint>
 #include <filesystem>
 
-#include "drivers/camera/camera_frame.h"
 #include "common/result.h"
+#include "drivers/camera/camera_frame.h"
 
 namespace mogao {
 

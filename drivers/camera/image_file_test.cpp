@@ -79,7 +79,8 @@ TEST_F(ImageFile, SixteenBitPngAndPgmScaleTo8Bit) {
 
 TEST_F(ImageFile, PgmHeaderWithCommentsAndSmallMaxval) {
     // maxval 3: samples 0..3 map to 0, 85, 170, 255.
-    auto img = read_gray_image(write_bytes("c.pgm", std::string("P5\n# a comment\n4 1 # w h\n3\n") + '\0' + '\1' + '\2' + '\3'));
+    auto img = read_gray_image(
+        write_bytes("c.pgm", std::string("P5\n# a comment\n4 1 # w h\n3\n") + '\0' + '\1' + '\2' + '\3'));
     ASSERT_TRUE(img.ok()) << img.error().message;
     ASSERT_EQ(img->width, 4);
     EXPECT_EQ(img->at(0, 0), 0);

@@ -308,8 +308,9 @@ Result<std::unique_ptr<LibcameraCapture>> LibcameraCapture::open(const Libcamera
     const std::vector<std::shared_ptr<libcamera::Camera>> cameras = d.manager->cameras();
     if (config.camera_id.empty()) {
         if (cameras.empty()) {
-            return make_error(ENODEV, "libcamera: no camera found (CameraManager lists none: no supported camera "
-                                      "attached, or its pipeline handler or IPA module is missing)");
+            return make_error(ENODEV,
+                              "libcamera: no camera found (CameraManager lists none: no supported camera "
+                              "attached, or its pipeline handler or IPA module is missing)");
         }
         d.camera = cameras.front();
     } else {
@@ -365,8 +366,8 @@ Status LibcameraCapture::Impl::configure(const LibcameraConfig& config) {
                                       std::to_string(config.width) + "x" + std::to_string(config.height));
     }
     if (sc.pixelFormat != wanted) {
-        return make_error(ENOTSUP, name + ": asked " + wanted.toString() + ", the pipeline adjusted to " +
-                                       sc.pixelFormat.toString());
+        return make_error(
+            ENOTSUP, name + ": asked " + wanted.toString() + ", the pipeline adjusted to " + sc.pixelFormat.toString());
     }
     if (sc.size.width < 1 || sc.size.height < 1 || sc.size.width > kMaxCaptureDimension ||
         sc.size.height > kMaxCaptureDimension) {
@@ -460,8 +461,8 @@ Result<CameraFrame> LibcameraCapture::next_frame() {
         {
             std::unique_lock<std::mutex> lock(d.mutex);
             if (!d.ready.wait_until(lock, deadline, [&] { return !d.completed.empty() || d.disconnected; })) {
-                return make_error(ETIMEDOUT,
-                                  "libcamera camera " + d.id + ": no frame for " + std::to_string(d.timeout_ms) + " ms");
+                return make_error(
+                    ETIMEDOUT, "libcamera camera " + d.id + ": no frame for " + std::to_string(d.timeout_ms) + " ms");
             }
             if (d.disconnected) return make_error(ENODEV, "libcamera camera " + d.id + ": disconnected");
             d.taken.assign(d.completed.begin(), d.completed.end());  // within capacity: no allocation

@@ -59,8 +59,8 @@ struct LibcameraConfig {
                                        CaptureFormat::rgb24, CaptureFormat::bgr24,  CaptureFormat::mjpeg};
     bool colour = false;      // also deliver CameraFrame::colour (R'G'B'); GREY (R8) is then not used
     CameraControls controls;  // applied when the camera starts (camera_controls.h)
-    int buffer_count = 3;   // [2, 4]
-    int timeout_ms = 2000;  // [1, 60000]: next_frame() gives ETIMEDOUT after this long without a frame
+    int buffer_count = 3;     // [2, 4]
+    int timeout_ms = 2000;    // [1, 60000]: next_frame() gives ETIMEDOUT after this long without a frame
 };
 
 // True when this build of mogao_camera has the libcamera backend (MOGAO_HAVE_LIBCAMERA).

@@ -84,8 +84,7 @@ TEST(LibcameraHelpers, ChoosesFirstPreferredOfferedFormat) {
     const std::vector<CaptureFormat> all{CaptureFormat::grey, CaptureFormat::yuyv, CaptureFormat::mjpeg};
     EXPECT_EQ(choose_libcamera_format(all, {mjpg, yuyv, nv12}), CaptureFormat::yuyv);  // preference, not offer order
     EXPECT_EQ(choose_libcamera_format(all, {mjpg, r8}), CaptureFormat::grey);
-    EXPECT_EQ(choose_libcamera_format({CaptureFormat::mjpeg, CaptureFormat::yuyv}, {yuyv, mjpg}),
-              CaptureFormat::mjpeg);
+    EXPECT_EQ(choose_libcamera_format({CaptureFormat::mjpeg, CaptureFormat::yuyv}, {yuyv, mjpg}), CaptureFormat::mjpeg);
     EXPECT_EQ(choose_libcamera_format(all, {nv12}), std::nullopt);
     EXPECT_EQ(choose_libcamera_format(all, {}), std::nullopt);
     EXPECT_EQ(choose_libcamera_format({CaptureFormat::image_file}, {0u}), std::nullopt);  // 0 is no format

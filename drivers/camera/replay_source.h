@@ -62,5 +62,4 @@ private:
     std::uint64_t pass_ = 0;
 };
 
-
 }  // namespace mogao

@@ -101,7 +101,7 @@ private:
     UniqueFd fd_;
     std::vector<std::vector<MappedBuffer>> buffers_;  // [buffer][plane]
     std::vector<int> plane_bytes_per_line_;           // per memory plane
-    std::unique_ptr<MjpegDecoder> mjpeg_;  // only for MJPEG
+    std::unique_ptr<MjpegDecoder> mjpeg_;             // only for MJPEG
     std::string device_;
     std::string driver_;
     CaptureFormat format_ = CaptureFormat::grey;

@@ -39,21 +39,36 @@ bool has_token(const char* list, std::string_view name) {
 
 std::string egl_error_name(EGLint error) {
     switch (error) {
-        case EGL_SUCCESS: return "EGL_SUCCESS";
-        case EGL_NOT_INITIALIZED: return "EGL_NOT_INITIALIZED";
-        case EGL_BAD_ACCESS: return "EGL_BAD_ACCESS";
-        case EGL_BAD_ALLOC: return "EGL_BAD_ALLOC";
-        case EGL_BAD_ATTRIBUTE: return "EGL_BAD_ATTRIBUTE";
-        case EGL_BAD_CONFIG: return "EGL_BAD_CONFIG";
-        case EGL_BAD_CONTEXT: return "EGL_BAD_CONTEXT";
-        case EGL_BAD_CURRENT_SURFACE: return "EGL_BAD_CURRENT_SURFACE";
-        case EGL_BAD_DISPLAY: return "EGL_BAD_DISPLAY";
-        case EGL_BAD_MATCH: return "EGL_BAD_MATCH";
-        case EGL_BAD_NATIVE_PIXMAP: return "EGL_BAD_NATIVE_PIXMAP";
-        case EGL_BAD_NATIVE_WINDOW: return "EGL_BAD_NATIVE_WINDOW";
-        case EGL_BAD_PARAMETER: return "EGL_BAD_PARAMETER";
-        case EGL_BAD_SURFACE: return "EGL_BAD_SURFACE";
-        case EGL_CONTEXT_LOST: return "EGL_CONTEXT_LOST";
+        case EGL_SUCCESS:
+            return "EGL_SUCCESS";
+        case EGL_NOT_INITIALIZED:
+            return "EGL_NOT_INITIALIZED";
+        case EGL_BAD_ACCESS:
+            return "EGL_BAD_ACCESS";
+        case EGL_BAD_ALLOC:
+            return "EGL_BAD_ALLOC";
+        case EGL_BAD_ATTRIBUTE:
+            return "EGL_BAD_ATTRIBUTE";
+        case EGL_BAD_CONFIG:
+            return "EGL_BAD_CONFIG";
+        case EGL_BAD_CONTEXT:
+            return "EGL_BAD_CONTEXT";
+        case EGL_BAD_CURRENT_SURFACE:
+            return "EGL_BAD_CURRENT_SURFACE";
+        case EGL_BAD_DISPLAY:
+            return "EGL_BAD_DISPLAY";
+        case EGL_BAD_MATCH:
+            return "EGL_BAD_MATCH";
+        case EGL_BAD_NATIVE_PIXMAP:
+            return "EGL_BAD_NATIVE_PIXMAP";
+        case EGL_BAD_NATIVE_WINDOW:
+            return "EGL_BAD_NATIVE_WINDOW";
+        case EGL_BAD_PARAMETER:
+            return "EGL_BAD_PARAMETER";
+        case EGL_BAD_SURFACE:
+            return "EGL_BAD_SURFACE";
+        case EGL_CONTEXT_LOST:
+            return "EGL_CONTEXT_LOST";
         default: {
             char buf[16];
             std::snprintf(buf, sizeof buf, "0x%04x", static_cast<unsigned>(error));
@@ -66,8 +81,9 @@ std::string egl_error_name(EGLint error) {
 
 Result<EglDisplay> EglDisplay::open_surfaceless() {
     if (!has_token(eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS), "EGL_MESA_platform_surfaceless")) {
-        return make_error(ENODEV, "EGL has no surfaceless platform (EGL_MESA_platform_surfaceless; "
-                                  "install libegl-mesa0 and libgl1-mesa-dri)");
+        return make_error(ENODEV,
+                          "EGL has no surfaceless platform (EGL_MESA_platform_surfaceless; "
+                          "install libegl-mesa0 and libgl1-mesa-dri)");
     }
     return open_platform(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY);
 }
@@ -99,8 +115,18 @@ bool EglDisplay::has_extension(std::string_view name) const {
 }
 
 Result<EGLConfig> choose_window_config(const EglDisplay& display, EGLint native_visual_id) {
-    const EGLint attribs[] = {EGL_SURFACE_TYPE, EGL_WINDOW_BIT, EGL_RED_SIZE, 8, EGL_GREEN_SIZE, 8,
-                              EGL_BLUE_SIZE, 8, EGL_ALPHA_SIZE, 0, EGL_RENDERABLE_TYPE, EGL_OPENGL_ES3_BIT,
+    const EGLint attribs[] = {EGL_SURFACE_TYPE,
+                              EGL_WINDOW_BIT,
+                              EGL_RED_SIZE,
+                              8,
+                              EGL_GREEN_SIZE,
+                              8,
+                              EGL_BLUE_SIZE,
+                              8,
+                              EGL_ALPHA_SIZE,
+                              0,
+                              EGL_RENDERABLE_TYPE,
+                              EGL_OPENGL_ES3_BIT,
                               EGL_NONE};
     EGLint count = 0;
     if (eglChooseConfig(display.get(), attribs, nullptr, 0, &count) != EGL_TRUE) {
@@ -119,7 +145,8 @@ Result<EGLConfig> choose_window_config(const EglDisplay& display, EGLint native_
         }
     }
     char buf[64];
-    std::snprintf(buf, sizeof buf, "no EGL window config with native visual 0x%08x", static_cast<unsigned>(native_visual_id));
+    std::snprintf(buf, sizeof buf, "no EGL window config with native visual 0x%08x",
+                  static_cast<unsigned>(native_visual_id));
     return make_error(ENODEV, buf);
 }
 
@@ -133,7 +160,8 @@ Result<EglContext> EglContext::create(const EglDisplay& display, EGLConfig confi
     if (eglBindAPI(EGL_OPENGL_ES_API) != EGL_TRUE) return egl_failure("eglBindAPI(EGL_OPENGL_ES_API)", ENODEV);
     const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION, major, EGL_CONTEXT_MINOR_VERSION, minor, EGL_NONE};
     EGLContext context = eglCreateContext(display.get(), config, EGL_NO_CONTEXT, attribs);
-    if (context == EGL_NO_CONTEXT) return egl_failure("eglCreateContext(GLES " + std::to_string(major) + "." + std::to_string(minor) + ")");
+    if (context == EGL_NO_CONTEXT)
+        return egl_failure("eglCreateContext(GLES " + std::to_string(major) + "." + std::to_string(minor) + ")");
     return EglContext(display.get(), context);
 }
 

@@ -120,8 +120,7 @@ TEST(EglContext, UnsupportedVersionIsAnError) {
     if (!display) return skip_or_fail_without_egl(display.error().message);
     auto context = EglContext::create(display.value(), EGL_NO_CONFIG_KHR, 9, 0);
     ASSERT_FALSE(context);
-    EXPECT_NE(context.error().message.find("eglCreateContext(GLES 9.0)"), std::string::npos)
-        << context.error().message;
+    EXPECT_NE(context.error().message.find("eglCreateContext(GLES 9.0)"), std::string::npos) << context.error().message;
 }
 
 TEST(EglConfig, SurfacelessDisplayHasNoWindowConfig) {

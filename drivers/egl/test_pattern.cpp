@@ -48,7 +48,9 @@ ProjectorCalibration identity_calibration(std::string id, ImageSize output) {
     c.warp.uv.resize(static_cast<std::size_t>(output.pixel_count()) * 2);
     for (int y = 0; y < output.height; ++y) {
         for (int x = 0; x < output.width; ++x) {
-            const std::size_t i = (static_cast<std::size_t>(y) * static_cast<std::size_t>(output.width) + static_cast<std::size_t>(x)) * 2;
+            const std::size_t i =
+                (static_cast<std::size_t>(y) * static_cast<std::size_t>(output.width) + static_cast<std::size_t>(x)) *
+                2;
             c.warp.uv[i] = static_cast<float>((x + 0.5) / output.width);
             c.warp.uv[i + 1] = static_cast<float>((y + 0.5) / output.height);
         }

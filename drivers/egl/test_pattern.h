@@ -7,8 +7,8 @@
 #include <cstddef>
 #include <string>
 
-#include "common/projector_calibration.h"
 #include "common/image.h"
+#include "common/projector_calibration.h"
 
 namespace mogao {
 

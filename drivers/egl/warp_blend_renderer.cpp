@@ -196,8 +196,7 @@ Result<GlTexture> upload(std::string_view what, GLenum internal_format, ImageSiz
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glTexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(internal_format), size.width, size.height, 0, format, type,
-                 data);
+    glTexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(internal_format), size.width, size.height, 0, format, type, data);
     if (auto s = gl_check("upload " + std::string(what)); !s) return s.error();
     return texture;
 }

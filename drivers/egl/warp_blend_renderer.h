@@ -144,7 +144,7 @@ private:
     GlTexture no_beta_;  // 1x1 zero RGB32F, bound on unit 4 for projectors without beta
     ImageSize content_size_;
     std::vector<Projector> projectors_;
-    std::vector<std::uint8_t> readback_;  // RGBA scratch for render()
+    std::vector<std::uint8_t> readback_;         // RGBA scratch for render()
     std::vector<std::uint16_t> content_linear_;  // set_content's frame in linear light (half floats)
 };
 

@@ -16,9 +16,9 @@
 #include <string>
 #include <thread>
 
+#include "common/png_io.h"
 #include "drivers/egl/egl_test_support.h"
 #include "drivers/egl/test_pattern.h"
-#include "common/png_io.h"
 
 namespace mogao {
 namespace {
@@ -52,8 +52,12 @@ Taps taps_at(double qx, double qy, ImageSize size) {
     const double by = std::floor(qy);
     const auto ix = static_cast<int>(bx);
     const auto iy = static_cast<int>(by);
-    return {std::clamp(ix, 0, size.width - 1), std::clamp(iy, 0, size.height - 1),
-            std::clamp(ix + 1, 0, size.width - 1), std::clamp(iy + 1, 0, size.height - 1), qx - bx, qy - by};
+    return {std::clamp(ix, 0, size.width - 1),
+            std::clamp(iy, 0, size.height - 1),
+            std::clamp(ix + 1, 0, size.width - 1),
+            std::clamp(iy + 1, 0, size.height - 1),
+            qx - bx,
+            qy - by};
 }
 
 std::size_t at(ImageSize s, int x, int y) {

@@ -32,8 +32,8 @@ Result<std::unique_ptr<HeadlessOutputBackend>> HeadlessOutputBackend::create(Hea
     auto renderer = WarpBlendRenderer::create();
     if (!renderer) return with_context(renderer.error(), "headless backend");
 
-    std::unique_ptr<HeadlessOutputBackend> backend(new HeadlessOutputBackend(
-        std::move(display.value()), std::move(context.value()), std::move(renderer.value())));
+    std::unique_ptr<HeadlessOutputBackend> backend(
+        new HeadlessOutputBackend(std::move(display.value()), std::move(context.value()), std::move(renderer.value())));
     GLint max_size = 0;
     glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_size);
     for (std::size_t i = 0; i < options.outputs.size(); ++i) {
@@ -62,8 +62,8 @@ HeadlessOutputBackend::~HeadlessOutputBackend() {
 
 Status HeadlessOutputBackend::check_index(std::size_t i) const {
     if (i >= targets_.size()) {
-        return make_error(EINVAL, "output " + std::to_string(i) + " out of range (have " +
-                                      std::to_string(targets_.size()) + ")");
+        return make_error(
+            EINVAL, "output " + std::to_string(i) + " out of range (have " + std::to_string(targets_.size()) + ")");
     }
     return {};
 }

@@ -10,9 +10,9 @@
 #include <string>
 #include <unistd.h>
 
+#include "common/png_io.h"
 #include "drivers/egl/egl_test_support.h"
 #include "drivers/egl/test_pattern.h"
-#include "common/png_io.h"
 
 namespace mogao {
 namespace {

@@ -120,7 +120,8 @@ TEST(DrmDevice, NonKmsNodeIsENODEV) {
 TEST(ListDrmCards, SortsCardsByNumberAndIgnoresOtherNodes) {
     const auto dir = std::filesystem::temp_directory_path() / ("mogao-dri-" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
-    for (const char* name : {"card10", "card2", "renderD128", "card0", "cardX", "card"}) std::ofstream(dir / name) << "";
+    for (const char* name : {"card10", "card2", "renderD128", "card0", "cardX", "card"})
+        std::ofstream(dir / name) << "";
     const auto cards = list_drm_cards(dir);
     ASSERT_EQ(cards.size(), 3u);
     EXPECT_EQ(cards[0].filename(), "card0");

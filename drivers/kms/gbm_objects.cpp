@@ -22,7 +22,8 @@ Result<GbmSurface> GbmSurface::create(const GbmDevice& device, ImageSize size, s
     gbm_surface* surface = gbm_surface_create(device.get(), static_cast<std::uint32_t>(size.width),
                                               static_cast<std::uint32_t>(size.height), format, flags);
     if (surface == nullptr) {
-        return errno_error("gbm_surface_create(" + std::to_string(size.width) + "x" + std::to_string(size.height) + ")");
+        return errno_error("gbm_surface_create(" + std::to_string(size.width) + "x" + std::to_string(size.height) +
+                           ")");
     }
     return GbmSurface(surface);
 }

@@ -24,7 +24,10 @@ struct KmsProps {
 
 struct KmsOutputBackend::Output {
     Output(OutputPlan p, KmsProps k, PropertyBlob blob, GbmSurface gbm, EglSurface egl)
-        : plan(std::move(p)), props(k), mode_blob(std::move(blob)), gbm_surface(std::move(gbm)),
+        : plan(std::move(p)),
+          props(k),
+          mode_blob(std::move(blob)),
+          gbm_surface(std::move(gbm)),
           egl_surface(std::move(egl)) {}
 
     OutputPlan plan;
@@ -257,8 +260,8 @@ Result<std::unique_ptr<KmsOutputBackend>> KmsOutputBackend::create(const KmsOpti
     auto context = EglContext::create(*egl, *config);
     if (!context) return context.error();
 
-    std::unique_ptr<KmsOutputBackend> backend(new KmsOutputBackend(
-        std::move(*drm), std::move(gbm.value()), std::move(egl.value()), std::move(context.value())));
+    std::unique_ptr<KmsOutputBackend> backend(new KmsOutputBackend(std::move(*drm), std::move(gbm.value()),
+                                                                   std::move(egl.value()), std::move(context.value())));
     const int fd = backend->drm_.fd();
     for (auto& plan : plans) {
         const ImageSize size{plan.mode.hdisplay, plan.mode.vdisplay};
@@ -266,8 +269,7 @@ Result<std::unique_ptr<KmsOutputBackend>> KmsOutputBackend::create(const KmsOpti
         if (!props) return with_context(props.error(), plan.name);
         auto blob = PropertyBlob::create(fd, &plan.mode, sizeof plan.mode);
         if (!blob) return with_context(blob.error(), plan.name);
-        auto gbm_surface =
-            GbmSurface::create(backend->gbm_, size, kFormat, GBM_BO_USE_SCANOUT | GBM_BO_USE_RENDERING);
+        auto gbm_surface = GbmSurface::create(backend->gbm_, size, kFormat, GBM_BO_USE_SCANOUT | GBM_BO_USE_RENDERING);
         if (!gbm_surface) return with_context(gbm_surface.error(), plan.name);
         auto egl_surface = EglSurface::create_window(backend->egl_, *config, gbm_surface->get());
         if (!egl_surface) return with_context(egl_surface.error(), plan.name);
@@ -296,8 +298,8 @@ KmsOutputBackend::~KmsOutputBackend() {
 
 Status KmsOutputBackend::check_index(std::size_t i) const {
     if (i >= outputs_.size()) {
-        return make_error(EINVAL, "output " + std::to_string(i) + " out of range (have " +
-                                      std::to_string(outputs_.size()) + ")");
+        return make_error(
+            EINVAL, "output " + std::to_string(i) + " out of range (have " + std::to_string(outputs_.size()) + ")");
     }
     return {};
 }
@@ -383,7 +385,7 @@ Status KmsOutputBackend::commit_round() {
 
 Result<std::vector<std::size_t>> KmsOutputBackend::dispatch_events() {
     drmEventContext ev{};
-    ev.version = 3;  // page_flip_handler2
+    ev.version = 3;                         // page_flip_handler2
     ev.page_flip_handler2 = &on_page_flip;  // user data: &outputs_ (commit_outputs)
     // The fd is non-blocking: read until the kernel has nothing more (EAGAIN). Bounded, as a
     // 60 Hz flip per output cannot outrun a few reads.

@@ -41,8 +41,8 @@ namespace mogao {
 // What create() will light: one entry per connected connector that got a CRTC and a plane.
 struct OutputPlan {
     std::uint32_t connector_id = 0;
-    std::string name;            // "HDMI-A-1"
-    drmModeModeInfo mode{};      // pick_mode(): preferred, else largest
+    std::string name;        // "HDMI-A-1"
+    drmModeModeInfo mode{};  // pick_mode(): preferred, else largest
     std::uint32_t crtc_id = 0;
     std::uint32_t plane_id = 0;
 };

@@ -26,24 +26,30 @@ using DrmVersionPtr = UniquePtr<drmVersion, &drmFreeVersion>;
 
 const char* connection_text(drmModeConnection c) {
     switch (c) {
-        case DRM_MODE_CONNECTED: return "connected";
-        case DRM_MODE_DISCONNECTED: return "disconnected";
-        default: return "unknown";
+        case DRM_MODE_CONNECTED:
+            return "connected";
+        case DRM_MODE_DISCONNECTED:
+            return "disconnected";
+        default:
+            return "unknown";
     }
 }
 
 const char* plane_type_text(std::uint64_t type) {
     switch (type) {
-        case DRM_PLANE_TYPE_PRIMARY: return "primary";
-        case DRM_PLANE_TYPE_CURSOR: return "cursor";
-        default: return "overlay";
+        case DRM_PLANE_TYPE_PRIMARY:
+            return "primary";
+        case DRM_PLANE_TYPE_CURSOR:
+            return "cursor";
+        default:
+            return "overlay";
     }
 }
 
 int list(const DrmDevice& drm) {
     if (DrmVersionPtr v{drmGetVersion(drm.fd())}) {
-        std::printf("%s: driver %s %d.%d.%d (%s)\n", drm.path().c_str(), v->name, v->version_major,
-                    v->version_minor, v->version_patchlevel, v->desc);
+        std::printf("%s: driver %s %d.%d.%d (%s)\n", drm.path().c_str(), v->name, v->version_major, v->version_minor,
+                    v->version_patchlevel, v->desc);
     }
     auto res = drm.resources();
     if (!res) return std::fprintf(stderr, "%s\n", res.error().message.c_str()), 1;

@@ -83,8 +83,8 @@ TEST(KioskMetrics, EveryFamilyWithItsValueFromTheStatusAndTheCounters) {
     c.version = "1.2.3";
     const std::string text = kiosk_metrics_text(showing_status(), c);
     leave_sample(text);
-    const std::regex line(
-        R"(^(# (HELP|TYPE) mogao_kiosk_[a-z_]+ .+|mogao_kiosk_[a-z_]+(\{[a-z_]+="[^"]*"(,[a-z_]+="[^"]*")*\})? -?[0-9.e+]+)$)");
+    const std::regex line(R"(^(# (HELP|TYPE) mogao_kiosk_[a-z_]+ .+|)"
+                          R"(mogao_kiosk_[a-z_]+(\{[a-z_]+="[^"]*"(,[a-z_]+="[^"]*")*\})? -?[0-9.e+]+)$)");
     std::istringstream in(text);
     for (std::string l; std::getline(in, l);) EXPECT_TRUE(std::regex_match(l, line)) << l;
     const auto s = samples(text);

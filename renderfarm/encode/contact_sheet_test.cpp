@@ -67,7 +67,7 @@ TEST(ContactSheet, UniformFrameFillsItsCellWithItsColour) {
     }
     const int border = 3;
     const Rgb8Image sheet = make_contact_sheet(frames, 3, 10, border);  // thumbnails 10x5
-    const int x0 = border + (10 + border);  // second cell
+    const int x0 = border + (10 + border);                              // second cell
     for (int y = border; y < border + 5; ++y) {
         for (int x = x0; x < x0 + 10; ++x) {
             const std::uint8_t* p = sheet.at(x, y);

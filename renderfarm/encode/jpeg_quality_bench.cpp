@@ -140,7 +140,7 @@ int run(int argc, char** argv) {
     }
 
     const std::string ext = std::filesystem::path(input).extension().string();
-    const Rgb8Image image = input.empty()                     ? synthetic_frame({1920, 1080})
+    const Rgb8Image image = input.empty()                      ? synthetic_frame({1920, 1080})
                             : (ext == ".ppm" || ext == ".pnm") ? mogao::read_ppm(input)
                                                                : mogao::read_png(input);
     std::printf("# input: %s, %dx%d, subsampling %s, median of %d encodes per quality\n",
@@ -184,8 +184,8 @@ int run(int argc, char** argv) {
     std::printf("|--------:|------:|-----------:|----------:|-------------------:|----------:|--------:|\n");
     for (const Row& r : rows) {
         std::printf("| %d | %zu | %.2f | %.2f | %.2fx | %.2f | %.2f |\n", r.quality, r.bytes,
-                    8.0 * static_cast<double>(r.bytes) / pixels, r.encode_ms, r.encode_ms / q85->encode_ms,
-                    r.decode_ms, r.psnr_db);
+                    8.0 * static_cast<double>(r.bytes) / pixels, r.encode_ms, r.encode_ms / q85->encode_ms, r.decode_ms,
+                    r.psnr_db);
     }
     if (!json_file.empty()) {
         std::ofstream out(json_file);

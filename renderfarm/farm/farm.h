@@ -23,7 +23,7 @@ namespace mogao {
 struct FarmSetup {
     std::filesystem::path scene_file;
     SceneLoadOptions scene_options;
-    DispatchSettings dispatch;       // exposure is taken from the scene
+    DispatchSettings dispatch;  // exposure is taken from the scene
 };
 
 // What the admin does once the farm stands: returns the process exit code.

@@ -70,8 +70,8 @@ constexpr double kNow = 1.7e9 + 5;
 
 // Every line is a comment or a sample as the format defines them.
 void expect_every_line_well_formed(const std::string& text) {
-    const std::regex sample(
-        R"(^[a-zA-Z_:][a-zA-Z0-9_:]*(\{[a-z_]+="([^"\\]|\\.)*"(,[a-z_]+="([^"\\]|\\.)*")*\})? (NaN|[+-]Inf|-?[0-9.e+-]+)$)");
+    const std::regex sample(R"(^[a-zA-Z_:][a-zA-Z0-9_:]*(\{[a-z_]+="([^"\\]|\\.)*"(,[a-z_]+="([^"\\]|\\.)*")*\})?)"
+                            R"( (NaN|[+-]Inf|-?[0-9.e+-]+)$)");
     const std::regex comment(R"(^# (HELP|TYPE) mogao_farm_[a-z_]+ .+$)");
     std::istringstream in(text);
     for (std::string line; std::getline(in, line);)

@@ -130,7 +130,8 @@ std::vector<PixelRect> receive_rects() {
     std::vector<int> flat(static_cast<std::size_t>(count));
     MPI_Recv(flat.data(), count, MPI_INT, 0, kTagRects, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
     std::vector<PixelRect> rects;
-    for (std::size_t i = 0; i + 3 < flat.size(); i += 4) rects.push_back({flat[i], flat[i + 1], flat[i + 2], flat[i + 3]});
+    for (std::size_t i = 0; i + 3 < flat.size(); i += 4)
+        rects.push_back({flat[i], flat[i + 1], flat[i + 2], flat[i + 3]});
     return rects;
 }
 

@@ -59,12 +59,12 @@ struct RankTimeout : FarmError {
 };
 
 struct DispatchSettings {
-    std::string balancer = "pbt";  // pbt | equal | roundrobin
-    int snap = 16;                 // PBT/equal split snap, pixels
-    int roundrobin_tile = 32;      // round-robin tile, pixels
-    int cell_size = 16;            // tile timing / cost-map cell, pixels
-    int threads = 1;               // render threads per rank
-    float exposure = 1.f;          // the scene's exposure (sRGB8 conversion happens on the ranks)
+    std::string balancer = "pbt";       // pbt | equal | roundrobin
+    int snap = 16;                      // PBT/equal split snap, pixels
+    int roundrobin_tile = 32;           // round-robin tile, pixels
+    int cell_size = 16;                 // tile timing / cost-map cell, pixels
+    int threads = 1;                    // render threads per rank
+    float exposure = 1.f;               // the scene's exposure (sRGB8 conversion happens on the ranks)
     ToneMap tone_map = ToneMap::clamp;  // the scene's tone map (film.h)
     // Feed the PBT with tile times x the rank's speed (its share of a core) instead of wall time.
     bool normalise_rank_speed = true;
@@ -79,11 +79,11 @@ struct DispatchSettings {
 };
 
 struct DispatchedFrame {
-    Rgb8Image image;               // render_size(view), sRGB8 (PackedPixels::srgb8 frames)
-    RgbFloatImage radiance;        // render_size(view), linear (PackedPixels::linear, ::linear_guided frames)
-    GuideBuffers guides;           // render_size(view), the denoiser's guides (PackedPixels::linear_guided)
-    std::vector<TileTime> tiles;   // measured per-tile times of every rank
-    FrameStats stats;              // all but encode figures
+    Rgb8Image image;              // render_size(view), sRGB8 (PackedPixels::srgb8 frames)
+    RgbFloatImage radiance;       // render_size(view), linear (PackedPixels::linear, ::linear_guided frames)
+    GuideBuffers guides;          // render_size(view), the denoiser's guides (PackedPixels::linear_guided)
+    std::vector<TileTime> tiles;  // measured per-tile times of every rank
+    FrameStats stats;             // all but encode figures
 };
 
 class FrameDispatcher {

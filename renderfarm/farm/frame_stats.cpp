@@ -45,8 +45,11 @@ void write_stats_json(const std::filesystem::path& file, const RunInfo& run, con
                 {"bvh_build_seconds", run.bvh_build_seconds},
                 {"instanced_triangles", run.scene_load.instanced_triangles}};
     for (const MeshLoadFigures& m : run.scene_load.meshes)
-        j["run"]["meshes"].push_back({{"name", m.name}, {"source", m.source}, {"triangles", m.triangles},
-                                      {"vertices", m.vertices}, {"load_seconds", m.seconds}});
+        j["run"]["meshes"].push_back({{"name", m.name},
+                                      {"source", m.source},
+                                      {"triangles", m.triangles},
+                                      {"vertices", m.vertices},
+                                      {"load_seconds", m.seconds}});
     std::vector<double> frame_times, efficiencies, rays_per_second, encode, bytes;
     for (const FrameStats& f : frames) {
         j["frames"].push_back({{"frame", f.frame},
@@ -65,15 +68,17 @@ void write_stats_json(const std::filesystem::path& file, const RunInfo& run, con
         encode.push_back(f.encode_seconds);
         bytes.push_back(static_cast<double>(f.jpeg_bytes));
     }
-    j["summary"] = {{"frames", frames.size()},
-                    {"mean_frame_seconds", mean(frame_times)},
-                    {"max_frame_seconds", frame_times.empty() ? 0.0 : *std::max_element(frame_times.begin(), frame_times.end())},
-                    {"mean_balance_efficiency", mean(efficiencies)},
-                    {"mean_balance_efficiency_after_first", frames.size() > 1
-                         ? mean(std::vector<double>(efficiencies.begin() + 1, efficiencies.end())) : mean(efficiencies)},
-                    {"mean_rays_per_second", mean(rays_per_second)},
-                    {"mean_encode_seconds", mean(encode)},
-                    {"mean_jpeg_bytes", mean(bytes)}};
+    j["summary"] = {
+        {"frames", frames.size()},
+        {"mean_frame_seconds", mean(frame_times)},
+        {"max_frame_seconds", frame_times.empty() ? 0.0 : *std::max_element(frame_times.begin(), frame_times.end())},
+        {"mean_balance_efficiency", mean(efficiencies)},
+        {"mean_balance_efficiency_after_first",
+         frames.size() > 1 ? mean(std::vector<double>(efficiencies.begin() + 1, efficiencies.end()))
+                           : mean(efficiencies)},
+        {"mean_rays_per_second", mean(rays_per_second)},
+        {"mean_encode_seconds", mean(encode)},
+        {"mean_jpeg_bytes", mean(bytes)}};
     write_json(file, j);
 }
 

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "renderfarm/schedule/cost_map.h"
-#include "renderfarm/scene/scene_file.h"
 #include "common/pixel_rect.h"
+#include "renderfarm/scene/scene_file.h"
+#include "renderfarm/schedule/cost_map.h"
 
 namespace mogao {
 
@@ -20,10 +20,10 @@ struct FrameStats {
     double render_phase_seconds = 0.0;        // admin wall time from assignment sent to last rank's pixels in
     std::vector<double> rank_render_seconds;  // per render rank (index 0 = MPI rank 1)
     std::vector<double> rank_predicted_seconds;
-    double balance_efficiency = 1.0;          // mean(rank_render_seconds) / max(rank_render_seconds)
-    std::uint64_t rays = 0;                   // every ray traced: camera, shadow, AO, bounce
-    double rays_per_second = 0.0;             // rays / render_phase_seconds
-    double encode_seconds = 0.0;              // TurboJPEG, full frame
+    double balance_efficiency = 1.0;  // mean(rank_render_seconds) / max(rank_render_seconds)
+    std::uint64_t rays = 0;           // every ray traced: camera, shadow, AO, bounce
+    double rays_per_second = 0.0;     // rays / render_phase_seconds
+    double encode_seconds = 0.0;      // TurboJPEG, full frame
     std::uint64_t jpeg_bytes = 0;
     // The frame's time budget (DispatchSettings::frame_budget_s): tiles rendered coarse after it ran
     // out, and what the render phase would have taken uncut (full_pass_seconds, rank_liveness.h;
@@ -35,8 +35,8 @@ struct FrameStats {
 struct RunInfo {
     std::string scene;
     std::string balancer;
-    int ranks = 1;           // MPI world size
-    int render_ranks = 1;    // ranks that trace (world size - 1, or 1 when the admin renders alone)
+    int ranks = 1;         // MPI world size
+    int render_ranks = 1;  // ranks that trace (world size - 1, or 1 when the admin renders alone)
     int threads_per_rank = 1;
     ImageSize size;
     std::string camera;

@@ -43,11 +43,17 @@ struct CameraFlags {
 
 // Flags every farm command shares: the scene and how frames are split over the ranks.
 void add_farm_flags(CLI::App& command, mogao::FarmSetup& setup, std::string& scans) {
-    command.add_option("--scene", setup.scene_file, "Scene file (JSON, docs/scene-format.md)")->required()->check(CLI::ExistingFile);
-    command.add_option("--scans", scans, "Folder of the real scans (default: $MOGAO_SCANS_DIR or ../shared/data/scans)");
-    command.add_option("--balance", setup.dispatch.balancer, "pbt | equal | roundrobin")->check(CLI::IsMember({"pbt", "equal", "roundrobin"}));
-    command.add_option("--snap", setup.dispatch.snap, "PBT/equal split snap in pixels")->check(CLI::IsMember({4, 8, 16, 32}));
-    command.add_option("--rr-tile", setup.dispatch.roundrobin_tile, "Round-robin tile size in pixels")->check(CLI::Range(8, 1024));
+    command.add_option("--scene", setup.scene_file, "Scene file (JSON, docs/scene-format.md)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    command.add_option("--scans", scans,
+                       "Folder of the real scans (default: $MOGAO_SCANS_DIR or ../shared/data/scans)");
+    command.add_option("--balance", setup.dispatch.balancer, "pbt | equal | roundrobin")
+        ->check(CLI::IsMember({"pbt", "equal", "roundrobin"}));
+    command.add_option("--snap", setup.dispatch.snap, "PBT/equal split snap in pixels")
+        ->check(CLI::IsMember({4, 8, 16, 32}));
+    command.add_option("--rr-tile", setup.dispatch.roundrobin_tile, "Round-robin tile size in pixels")
+        ->check(CLI::Range(8, 1024));
     command.add_option("--threads", setup.dispatch.threads, "Render threads per rank")->check(CLI::Range(1, 256));
     command
         .add_option("--rank-deadline", setup.dispatch.rank_deadline_s,
@@ -112,28 +118,40 @@ void add_render_flags(CLI::App& render, mogao::PathTour& job, CameraFlags& camer
     auto& q = job.view_template.quality;
     render.add_option("--frames", job.frames, "Number of frames of the camera path")->check(CLI::Range(1, 1000000));
     render.add_option("--path", job.path, "walk | orbit | a JSON path file");
-    render.add_option("--out", job.out_dir, "Output folder for frame-NNNN.jpg, stats.json, tile-costs.json, contact-sheet.png")->required();
-    render.add_option("--width", job.view_template.size.width, "Frame width in pixels")->check(CLI::Range(16, L::kImageSide.max));
-    render.add_option("--height", job.view_template.size.height, "Frame height in pixels")->check(CLI::Range(16, L::kImageSide.max));
+    render
+        .add_option("--out", job.out_dir,
+                    "Output folder for frame-NNNN.jpg, stats.json, tile-costs.json, contact-sheet.png")
+        ->required();
+    render.add_option("--width", job.view_template.size.width, "Frame width in pixels")
+        ->check(CLI::Range(16, L::kImageSide.max));
+    render.add_option("--height", job.view_template.size.height, "Frame height in pixels")
+        ->check(CLI::Range(16, L::kImageSide.max));
     render.add_option("--camera", camera.kind, "cylinder (the projection screen's content) | pinhole")
         ->check(CLI::IsMember({"cylinder", "pinhole"}));
-    render.add_option("--fov", camera.fov_deg, "Pinhole vertical field of view, degrees")->check(CLI::Range(1.0, 179.0));
-    render.add_option("--screen-radius", camera.radius, "Cylinder screen radius, metres")->check(CLI::Range(0.1, 1000.0));
+    render.add_option("--fov", camera.fov_deg, "Pinhole vertical field of view, degrees")
+        ->check(CLI::Range(1.0, 179.0));
+    render.add_option("--screen-radius", camera.radius, "Cylinder screen radius, metres")
+        ->check(CLI::Range(0.1, 1000.0));
     render.add_option("--screen-arc", camera.arc, "Cylinder screen arc, degrees")->check(CLI::Range(1.0, 360.0));
     render.add_option("--screen-bottom", camera.bottom, "Cylinder screen bottom edge, metres above the floor");
     render.add_option("--screen-top", camera.top, "Cylinder screen top edge, metres above the floor");
     render.add_option("--spp", q.spp, "Samples per pixel")->check(CLI::Range(L::kSpp.min, L::kSpp.max));
-    render.add_option("--bounces", q.max_bounces, "Path-tracing bounces (0 = direct light only)")->check(CLI::Range(L::kMaxBounces.min, L::kMaxBounces.max));
-    render.add_option("--ao", q.ao_samples, "Ambient-occlusion rays for the environment light (0 = unoccluded)")->check(CLI::Range(L::kAoSamples.min, L::kAoSamples.max));
-    render.add_option("--area-samples", q.area_light_samples, "Shadow rays per area light per sample")->check(CLI::Range(L::kAreaLightSamples.min, L::kAreaLightSamples.max));
+    render.add_option("--bounces", q.max_bounces, "Path-tracing bounces (0 = direct light only)")
+        ->check(CLI::Range(L::kMaxBounces.min, L::kMaxBounces.max));
+    render.add_option("--ao", q.ao_samples, "Ambient-occlusion rays for the environment light (0 = unoccluded)")
+        ->check(CLI::Range(L::kAoSamples.min, L::kAoSamples.max));
+    render.add_option("--area-samples", q.area_light_samples, "Shadow rays per area light per sample")
+        ->check(CLI::Range(L::kAreaLightSamples.min, L::kAreaLightSamples.max));
     render.add_option("--scale", q.resolution_scale, "Resolution scale (0, 1]")->check(CLI::Range(0.01, 1.0));
-    render.add_option("--jpeg-quality", q.jpeg_quality, "TurboJPEG quality 1..100")->check(CLI::Range(L::kJpegQuality.min, L::kJpegQuality.max));
+    render.add_option("--jpeg-quality", q.jpeg_quality, "TurboJPEG quality 1..100")
+        ->check(CLI::Range(L::kJpegQuality.min, L::kJpegQuality.max));
     render.add_option("--seed", job.view_template.seed, "Sampling seed (same seed, same pixels)");
     render.add_option(
         "--first-frame-id", job.first_frame_id,
         "frame_id of the first frame (sampling depends on seed and frame_id; a live frame's is its request id)");
     render.add_flag("--save-raw", job.save_raw, "Also write lossless frame-NNNN.ppm");
-    render.add_option("--contact-sheet", job.contact_sheet_frames, "Frames on the contact sheet (0 = none)")->check(CLI::Range(0, 64));
+    render.add_option("--contact-sheet", job.contact_sheet_frames, "Frames on the contact sheet (0 = none)")
+        ->check(CLI::Range(0, 64));
 }
 
 // Which views appliances may have (view_policy.h).
@@ -317,7 +335,8 @@ int main(int argc, char** argv) {
     mogao::ServeOptions serve_options;
     std::filesystem::path tls_dir;
     std::string farm_name = "farm";
-    CLI::App* serve = app.add_subcommand("serve", "Serve live tours to authenticated appliances over IPv6 (gRPC, mutual TLS)");
+    CLI::App* serve =
+        app.add_subcommand("serve", "Serve live tours to authenticated appliances over IPv6 (gRPC, mutual TLS)");
     add_farm_flags(*serve, setup, scans);
     add_link_flags(*serve, serve_options, tls_dir, farm_name);
     double frame_time_ms = 0.0;
@@ -335,7 +354,8 @@ int main(int argc, char** argv) {
                      "Seconds a frame may take: the rest of a frame still rendering then is rendered coarse, and a "
                      "session's next requests are degraded from what its frames cost (0 = no budget)")
         ->check(CLI::Range(0.0, 3600.0));
-    serve->add_option("--duration", serve_options.duration_s, "Stop after this many seconds (0 = until SIGTERM)")->check(CLI::Range(0.0, 1e9));
+    serve->add_option("--duration", serve_options.duration_s, "Stop after this many seconds (0 = until SIGTERM)")
+        ->check(CLI::Range(0.0, 1e9));
     // Listed in --help; handled at the top of main, before MPI starts.
     app.add_subcommand(
            "pki", "The link's PKI: CA, farm and appliance certificates, revocation (no MPI; mogao-farm pki --help)")
@@ -383,21 +403,24 @@ int main(int argc, char** argv) {
             mpi.is_admin() ? prepare_admin_link(serve_options, tls_dir, farm_name, view_policy_file) : std::string();
         if (!error.empty()) spdlog::error("{}", error);
         if (!mpi.all(error.empty())) return 2;
-        return mogao::run_farm(mpi, setup, [&](mogao::FrameDispatcher& farm, const mogao::Scene& scene, mogao::RunInfo& run) {
-            return mogao::run_serve(serve_options, farm, scene, run);
-        });
+        return mogao::run_farm(mpi, setup,
+                               [&](mogao::FrameDispatcher& farm, const mogao::Scene& scene, mogao::RunInfo& run) {
+                                   return mogao::run_serve(serve_options, farm, scene, run);
+                               });
     }
     if (camera.kind == "pinhole") {
         job.view_template.camera = mogao::PinholeCamera{camera.fov_deg};
     } else {
         if (!(camera.top > camera.bottom)) {
-            if (mpi.is_admin()) spdlog::error("--screen-top ({}) must be above --screen-bottom ({})", camera.top, camera.bottom);
+            if (mpi.is_admin())
+                spdlog::error("--screen-top ({}) must be above --screen-bottom ({})", camera.top, camera.bottom);
             return 2;
         }
         job.view_template.camera =
             mogao::CylinderScreen{camera.radius, camera.arc, camera.bottom, camera.top, {0.0, camera.eye_height, 0.0}};
     }
-    return mogao::run_farm(mpi, setup, [&](mogao::FrameDispatcher& farm, const mogao::Scene& scene, mogao::RunInfo& run) {
-        return mogao::run_path_tour(job, farm, scene, run);
-    });
+    return mogao::run_farm(mpi, setup,
+                           [&](mogao::FrameDispatcher& farm, const mogao::Scene& scene, mogao::RunInfo& run) {
+                               return mogao::run_path_tour(job, farm, scene, run);
+                           });
 }

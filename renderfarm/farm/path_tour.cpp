@@ -7,11 +7,11 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include "renderfarm/encode/contact_sheet.h"
+#include "common/camera_path.h"
 #include "common/file_io.h"
 #include "common/jpeg_codec.h"
 #include "common/png_io.h"
-#include "common/camera_path.h"
+#include "renderfarm/encode/contact_sheet.h"
 
 namespace mogao {
 namespace {
@@ -36,8 +36,8 @@ int run_path_tour(const PathTour& tour, FrameDispatcher& farm, const Scene& scen
     run.seed = tour.view_template.seed;
 
     std::filesystem::create_directories(tour.out_dir);
-    const int sheet_every = tour.contact_sheet_frames > 0
-                                ? std::max(1, static_cast<int>(poses.size()) / tour.contact_sheet_frames) : 0;
+    const int sheet_every =
+        tour.contact_sheet_frames > 0 ? std::max(1, static_cast<int>(poses.size()) / tour.contact_sheet_frames) : 0;
     JpegEncoder encoder;
     std::vector<FrameStats> stats;
     std::vector<std::vector<TileTime>> tile_log;
@@ -47,8 +47,9 @@ int run_path_tour(const PathTour& tour, FrameDispatcher& farm, const Scene& scen
         ViewRequest view = tour.view_template;
         view.frame_id = tour.first_frame_id + f;
         view.pose = poses[f];
-        view.request_time_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                   std::chrono::system_clock::now().time_since_epoch()).count();
+        view.request_time_ns =
+            std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+                .count();
         DispatchedFrame frame = farm.render(view);
 
         const auto encode_start = Clock::now();

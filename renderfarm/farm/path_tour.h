@@ -9,20 +9,20 @@
 #include <filesystem>
 #include <string>
 
+#include "common/view_request.h"
 #include "renderfarm/farm/frame_dispatcher.h"
 #include "renderfarm/farm/frame_stats.h"
 #include "renderfarm/scene/scene.h"
-#include "common/view_request.h"
 
 namespace mogao {
 
 struct PathTour {
-    std::string path = "walk";        // walk | orbit | path file
+    std::string path = "walk";  // walk | orbit | path file
     int frames = 60;
-    ViewRequest view_template;        // camera, size, quality, seed; the pose comes from the path
+    ViewRequest view_template;  // camera, size, quality, seed; the pose comes from the path
     std::filesystem::path out_dir;
-    bool save_raw = false;            // also write lossless frame-NNNN.ppm
-    int contact_sheet_frames = 12;    // 0: no contact sheet
+    bool save_raw = false;          // also write lossless frame-NNNN.ppm
+    int contact_sheet_frames = 12;  // 0: no contact sheet
     // ViewRequest::frame_id of the first frame (then +1 per frame). Sampling depends on (seed,
     // frame_id) (renderer.h): a live frame is reproduced with frame_id = its request id.
     std::uint64_t first_frame_id = 0;

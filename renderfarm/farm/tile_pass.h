@@ -55,10 +55,10 @@ struct TilePassResult {
     std::vector<std::uint8_t> packed_pixels;
     std::vector<TileTime> tile_times;  // wall-clock seconds per tile
     std::uint64_t rays = 0;
-    double render_seconds = 0.0;  // wall time of the whole pass on this rank
-    double cpu_seconds = 0.0;     // thread CPU time of all render threads (CLOCK_THREAD_CPUTIME_ID)
-    std::size_t tiles_cut = 0;    // tiles rendered coarse after a cut (TilePassControl)
-    double cut_at_seconds = 0.0;  // when the pass was cut, from its start (0: not cut)
+    double render_seconds = 0.0;        // wall time of the whole pass on this rank
+    double cpu_seconds = 0.0;           // thread CPU time of all render threads (CLOCK_THREAD_CPUTIME_ID)
+    std::size_t tiles_cut = 0;          // tiles rendered coarse after a cut (TilePassControl)
+    double cut_at_seconds = 0.0;        // when the pass was cut, from its start (0: not cut)
     std::size_t tiles_done_at_cut = 0;  // tiles finished at full quality when it was cut
 };
 

@@ -17,7 +17,8 @@ std::optional<Endpoint> parse_endpoint(std::string_view text, std::string* error
         return fail("expected [IPv6-address]:port, e.g. [::1]:7443");
     }
     const std::string address(text.substr(1, close - 1));
-    if (address.find('%') != std::string::npos) return fail("zone ids (%iface) are not supported; use a global or ULA address");
+    if (address.find('%') != std::string::npos)
+        return fail("zone ids (%iface) are not supported; use a global or ULA address");
     in6_addr binary{};
     if (inet_pton(AF_INET6, address.c_str(), &binary) != 1) return fail("'" + address + "' is not an IPv6 address");
     const std::string_view rest = text.substr(close + 1);

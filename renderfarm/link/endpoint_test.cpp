@@ -31,7 +31,8 @@ TEST(Endpoint, RefusesWhatIsNotBracketedIpv6WithAPort) {
                             "[127.0.0.1]:7443", "[farm-1]:7443", "[fe80::1%eth0]:7443", "[::1]:7443x", "[]:7443"}) {
         std::string error;
         EXPECT_FALSE(parse_endpoint(bad, &error)) << bad;
-        EXPECT_NE(error.find(std::string("'") + bad + "'"), std::string::npos) << "error should quote the text: " << error;
+        EXPECT_NE(error.find(std::string("'") + bad + "'"), std::string::npos)
+            << "error should quote the text: " << error;
     }
 }
 

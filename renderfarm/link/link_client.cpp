@@ -43,12 +43,12 @@ struct LinkClient::Impl {
     mutable std::mutex mutex;
     std::condition_variable cv;
     bool stopping = false;
-    bool session_over = false;              // the current stream ended: the writer leaves
+    bool session_over = false;               // the current stream ended: the writer leaves
     grpc::ClientContext* current = nullptr;  // the call stop() cancels
     std::uint64_t next_request_id = 1;
-    std::optional<ViewRequest> latest;  // newest submitted; re-sent after a reconnect if unanswered
-    std::optional<ViewRequest> unsent;  // newest not yet written on the current stream
-    std::uint64_t ack_due = 0;          // frame id to acknowledge on the current stream (0: none)
+    std::optional<ViewRequest> latest;   // newest submitted; re-sent after a reconnect if unanswered
+    std::optional<ViewRequest> unsent;   // newest not yet written on the current stream
+    std::uint64_t ack_due = 0;           // frame id to acknowledge on the current stream (0: none)
     std::uint64_t newest_delivered = 0;  // request id of the newest frame handed to the callback
     LinkClientStats stats;
     std::deque<Sample> window;
@@ -127,8 +127,8 @@ void LinkClient::Impl::run() {
             continue;
         }
         std::uniform_real_distribution<double> jitter(1.0 - options.backoff_jitter, 1.0 + options.backoff_jitter);
-        const auto wait = std::chrono::milliseconds(
-            static_cast<std::int64_t>(static_cast<double>(backoff.count()) * jitter(rng)));
+        const auto wait =
+            std::chrono::milliseconds(static_cast<std::int64_t>(static_cast<double>(backoff.count()) * jitter(rng)));
         backoff = std::min(backoff * 2, options.max_backoff);
         stats.next_backoff = backoff;
         link_log().info("reconnecting to the farm at {} in {} ms", endpoint.to_string(), wait.count());
@@ -250,8 +250,9 @@ void LinkClient::Impl::on_frame_msg(v1::FrameMsg& msg) {
         }
     }
     if (deliver) {
-        const Sample sample{receive_ns, frame.jpeg.size(),
-                            frame.times.request_ns > 0 ? static_cast<double>(receive_ns - frame.times.request_ns) / 1e6 : 0.0};
+        const Sample sample{
+            receive_ns, frame.jpeg.size(),
+            frame.times.request_ns > 0 ? static_cast<double>(receive_ns - frame.times.request_ns) / 1e6 : 0.0};
         const std::uint64_t request_id = frame.request_id;
         try {
             on_frame(std::move(frame));
@@ -302,7 +303,8 @@ LinkClient::LinkClient(LinkClientOptions options, FrameCallback on_frame) : impl
     const auto endpoint = parse_endpoint(options.endpoint, &error);
     if (!endpoint) throw LinkError("LinkClientOptions.endpoint: " + error);
     if (endpoint->port == 0 || endpoint->is_wildcard()) {
-        throw LinkError("LinkClientOptions.endpoint: '" + options.endpoint + "' is not a farm address (port 0 or [::])");
+        throw LinkError("LinkClientOptions.endpoint: '" + options.endpoint +
+                        "' is not a farm address (port 0 or [::])");
     }
     if (options.initial_backoff.count() < 1 || options.max_backoff < options.initial_backoff) {
         throw LinkError("LinkClientOptions: backoff must satisfy 1 ms <= initial_backoff <= max_backoff");

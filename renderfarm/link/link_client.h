@@ -55,15 +55,15 @@ struct LinkClientOptions {
     // second is nothing for a farm to answer.
     std::chrono::milliseconds initial_backoff{250};
     std::chrono::milliseconds max_backoff{1000};
-    double backoff_jitter = 0.2;  // [0, 1)
+    double backoff_jitter = 0.2;     // [0, 1)
     std::size_t stats_window = 120;  // frames over which fps, bandwidth and latency are averaged, >= 2
 };
 
 struct LinkClientStats {
     bool connected = false;
-    std::uint64_t sessions_opened = 0;   // successful connects (reconnects = sessions_opened - 1)
-    std::uint64_t attempts_failed = 0;   // connects refused or broken before the session was established
-    std::uint64_t tls_reloads = 0;       // rotated TLS material taken from tls_files
+    std::uint64_t sessions_opened = 0;      // successful connects (reconnects = sessions_opened - 1)
+    std::uint64_t attempts_failed = 0;      // connects refused or broken before the session was established
+    std::uint64_t tls_reloads = 0;          // rotated TLS material taken from tls_files
     std::uint64_t tls_reloads_refused = 0;  // changed files that did not load or check (last good kept)
     std::uint64_t requests_submitted = 0;
     std::uint64_t requests_sent = 0;

@@ -30,7 +30,8 @@ TEST(LinkFault, ClientReconnectsToARestartedFarmAndIdsKeepIncreasing) {
     LinkClient client(test_client_options(port, TestPki::get().museum1), [&](LinkFrame&& f) {
         const auto mark = read_mark(f.jpeg);
         const std::lock_guard lock(mutex);
-        if (!mark || mark->request_id != f.request_id) problems.push_back("wrong pixels for " + std::to_string(f.request_id));
+        if (!mark || mark->request_id != f.request_id)
+            problems.push_back("wrong pixels for " + std::to_string(f.request_id));
         ids.push_back(f.request_id);
     });
     // The tracker keeps sending poses whatever the link's state.

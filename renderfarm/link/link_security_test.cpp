@@ -38,7 +38,8 @@ protected:
     [[nodiscard]] std::string target() const { return server_->endpoint().grpc_target(); }
     // A good appliance still gets a frame: the positive control of every refusal below.
     void expect_good_client_served() {
-        const RawOutcome good = raw_session_once(tls_channel(target(), TestPki::get().appliance_tls(TestPki::get().museum1)));
+        const RawOutcome good =
+            raw_session_once(tls_channel(target(), TestPki::get().appliance_tls(TestPki::get().museum1)));
         EXPECT_TRUE(good.got_frame) << good.status.error_message();
     }
     void expect_refused(const TlsMaterial& tls, const char* what) {
@@ -46,7 +47,8 @@ protected:
         const RawOutcome outcome = raw_session_once(tls_channel(target(), tls));
         EXPECT_FALSE(outcome.got_frame) << what;
         EXPECT_FALSE(outcome.status.ok()) << what;
-        EXPECT_EQ(outcome.status.error_code(), grpc::StatusCode::UNAVAILABLE) << what << ": " << outcome.status.error_message();
+        EXPECT_EQ(outcome.status.error_code(), grpc::StatusCode::UNAVAILABLE)
+            << what << ": " << outcome.status.error_message();
         EXPECT_EQ(server_->stats().sessions_opened, before.sessions_opened) << what << " reached the session handler";
         EXPECT_EQ(server_->stats().render_calls, before.render_calls) << what;
     }
@@ -98,14 +100,15 @@ TEST_F(LinkSecurity, PlaintextClientIsRefused) {
 
 TEST_F(LinkSecurity, LinkClientWithExpiredCertificateKeepsBackingOffAndGetsNothing) {
     int frames = 0;
-    LinkClient client(test_client_options(server_->endpoint().port, TestPki::get().expired), [&](LinkFrame&&) { ++frames; });
+    LinkClient client(test_client_options(server_->endpoint().port, TestPki::get().expired),
+                      [&](LinkFrame&&) { ++frames; });
     client.submit(test_request());
     ASSERT_TRUE(wait_until([&] { return client.stats().attempts_failed >= 3; }));
     const auto stats = client.stats();
     EXPECT_EQ(stats.sessions_opened, 0u);
     EXPECT_EQ(stats.frames_received, 0u);
     EXPECT_FALSE(stats.connected);
-    EXPECT_GT(stats.next_backoff, std::chrono::milliseconds(20));  // it doubled
+    EXPECT_GT(stats.next_backoff, std::chrono::milliseconds(20));   // it doubled
     EXPECT_LE(stats.next_backoff, std::chrono::milliseconds(200));  // up to the cap
     EXPECT_EQ(server_->stats().sessions_opened, 0u);
     client.stop();
@@ -190,10 +193,12 @@ TEST_F(LinkSecurity, ApplianceOutsideTheAllowedListIsRefused) {
     auto options = test_server_options();
     options.allowed_appliances = {"museum-2"};
     server_ = std::make_unique<LinkServer>(options, renderer_.function());
-    const RawOutcome refused = raw_session_once(tls_channel(target(), TestPki::get().appliance_tls(TestPki::get().museum1)));
+    const RawOutcome refused =
+        raw_session_once(tls_channel(target(), TestPki::get().appliance_tls(TestPki::get().museum1)));
     EXPECT_FALSE(refused.got_frame);
     EXPECT_EQ(refused.status.error_code(), grpc::StatusCode::PERMISSION_DENIED) << refused.status.error_message();
-    const RawOutcome allowed = raw_session_once(tls_channel(target(), TestPki::get().appliance_tls(TestPki::get().museum2)));
+    const RawOutcome allowed =
+        raw_session_once(tls_channel(target(), TestPki::get().appliance_tls(TestPki::get().museum2)));
     EXPECT_TRUE(allowed.got_frame) << allowed.status.error_message();
     EXPECT_EQ(server_->stats().sessions_refused, 1u);
 }

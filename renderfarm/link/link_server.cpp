@@ -33,25 +33,27 @@ bool worth_logging(std::uint64_t count) { return count <= 4 || (count & (count -
 
 struct SessionState {
     std::uint64_t id = 0;
-    std::string peer;      // "ipv6:[addr]:port"
-    std::string identity;  // certificate CN
-    std::string serial;    // certificate serial number (hex), checked against the revocation list
+    std::string peer;                         // "ipv6:[addr]:port"
+    std::string identity;                     // certificate CN
+    std::string serial;                       // certificate serial number (hex), checked against the revocation list
     std::uint64_t revocation_generation = 0;  // of the list last checked against (reader thread only)
     bool revoked = false;
     std::optional<ViewRequest> pending;
     std::int64_t pending_received_ns = 0;
     std::uint64_t newest_request_id = 0;
-    std::uint64_t last_frame_id = 0;   // frames queued or sent
+    std::uint64_t last_frame_id = 0;  // frames queued or sent
     std::uint64_t acked_frame_id = 0;
     bool rendering = false;
-    std::deque<v1::FrameMsg> outbox;   // rendered, waiting for the handler thread to write
+    std::deque<v1::FrameMsg> outbox;  // rendered, waiting for the handler thread to write
     bool closed = false;
     std::string close_reason;
     std::string refused;  // the renderer refused the session (RequestRefused): the status sent
     std::uint64_t requests = 0, invalid = 0, dropped = 0, frames = 0, failures = 0, bad_acks = 0;
 
     [[nodiscard]] std::uint64_t in_flight() const { return (rendering ? 1 : 0) + (last_frame_id - acked_frame_id); }
-    [[nodiscard]] std::string name() const { return "session " + std::to_string(id) + " (" + identity + " " + peer + ")"; }
+    [[nodiscard]] std::string name() const {
+        return "session " + std::to_string(id) + " (" + identity + " " + peer + ")";
+    }
 };
 
 }  // namespace
@@ -168,7 +170,8 @@ grpc::Status LinkServer::Impl::admit(grpc::ServerContext* ctx, std::shared_ptr<S
     }
     const auto& allowed = options.allowed_appliances;
     if (!allowed.empty() && std::find(allowed.begin(), allowed.end(), s->identity) == allowed.end()) {
-        return refuse(grpc::StatusCode::PERMISSION_DENIED, "appliance '" + s->identity + "' is not in the allowed list");
+        return refuse(grpc::StatusCode::PERMISSION_DENIED,
+                      "appliance '" + s->identity + "' is not in the allowed list");
     }
     if (revocation) {
         s->serial = peer_serial(*ctx);

@@ -95,7 +95,7 @@ struct LinkServerStats {
     std::uint64_t requests_invalid = 0;   // refused by validation (logged)
     std::uint64_t requests_dropped = 0;   // stale: replaced before rendering, or not newer than one seen
     std::uint64_t render_calls = 0;
-    std::uint64_t render_failures = 0;    // renderer threw or returned an unusable frame
+    std::uint64_t render_failures = 0;  // renderer threw or returned an unusable frame
     std::uint64_t frames_sent = 0;
     std::uint64_t jpeg_bytes_sent = 0;
     ConnectionGuardStats connections;  // TCP connections: accepted, refused by each cap, open now

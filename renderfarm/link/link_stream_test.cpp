@@ -127,11 +127,11 @@ TEST(LinkStream, StreamsAt720pFromAFastTracker) {
     const auto ss = server.stats();
     EXPECT_EQ(cs.frames_discarded, 0u);
     EXPECT_GT(ss.requests_dropped + cs.requests_coalesced, 0u);
-    std::printf("loopback streaming 1280x720 (tracker 500 Hz): %.1f fps, latency mean %.2f ms max %.2f ms, "
-                "%.0f bytes/frame, %.2f MB/s; %llu requests dropped on the farm, %llu coalesced in the client\n",
-                cs.fps, cs.mean_latency_ms, cs.max_latency_ms, cs.mean_frame_bytes, cs.bandwidth_bytes_per_s / 1e6,
-                static_cast<unsigned long long>(ss.requests_dropped),
-                static_cast<unsigned long long>(cs.requests_coalesced));
+    std::printf(
+        "loopback streaming 1280x720 (tracker 500 Hz): %.1f fps, latency mean %.2f ms max %.2f ms, "
+        "%.0f bytes/frame, %.2f MB/s; %llu requests dropped on the farm, %llu coalesced in the client\n",
+        cs.fps, cs.mean_latency_ms, cs.max_latency_ms, cs.mean_frame_bytes, cs.bandwidth_bytes_per_s / 1e6,
+        static_cast<unsigned long long>(ss.requests_dropped), static_cast<unsigned long long>(cs.requests_coalesced));
 }
 
 TEST(LinkStream, NewestRequestWinsWhileTheRendererIsBusy) {
@@ -188,7 +188,8 @@ TEST(LinkStream, AtMostTwoFramesInFlightUntilAcknowledged) {
     SyntheticRenderer renderer;
     LinkServer server(test_server_options(), renderer.function());
     // A raw stream that acknowledges only when told to.
-    auto stub = v1::Tour::NewStub(tls_channel(server.endpoint().grpc_target(), TestPki::get().appliance_tls(TestPki::get().museum1)));
+    auto stub = v1::Tour::NewStub(
+        tls_channel(server.endpoint().grpc_target(), TestPki::get().appliance_tls(TestPki::get().museum1)));
     grpc::ClientContext ctx;
     ctx.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
     auto stream = stub->Session(&ctx);
@@ -270,7 +271,8 @@ TEST(LinkStream, InvalidRequestIsRefusedAndTheSessionContinues) {
     REQUIRE_IPV6_LOOPBACK();
     SyntheticRenderer renderer;
     LinkServer server(test_server_options(), renderer.function());
-    auto stub = v1::Tour::NewStub(tls_channel(server.endpoint().grpc_target(), TestPki::get().appliance_tls(TestPki::get().museum1)));
+    auto stub = v1::Tour::NewStub(
+        tls_channel(server.endpoint().grpc_target(), TestPki::get().appliance_tls(TestPki::get().museum1)));
     grpc::ClientContext ctx;
     ctx.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
     auto stream = stub->Session(&ctx);

@@ -28,7 +28,7 @@ namespace {
 constexpr int kBlock = 8;
 constexpr int kBlocksPerRow = 16;
 constexpr int kMarkBits = 96;
-constexpr int kMarkWidth = kBlock * kBlocksPerRow;                                   // 128
+constexpr int kMarkWidth = kBlock * kBlocksPerRow;                                       // 128
 constexpr int kMarkHeight = kBlock * ((kMarkBits + kBlocksPerRow - 1) / kBlocksPerRow);  // 48
 
 bool mark_bit(std::uint64_t id, std::uint32_t yaw, int bit) {
@@ -41,16 +41,19 @@ const TestPki& TestPki::get() {
     static const TestPki pki = [] {
         TestPki p;
         p.ca = make_ca({CertRole::ca, "mogao test CA", {}, -300, 10 * kSecondsPerDay, KeyAlgorithm::ec_p256});
-        p.farm = issue_cert(p.ca, {CertRole::farm, "farm-test", {"::1", "127.0.0.1"}, -300, kSecondsPerDay,
-                                   KeyAlgorithm::ec_p256});
-        p.museum1 = issue_cert(p.ca, {CertRole::appliance, "museum-1", {}, -300, kSecondsPerDay, KeyAlgorithm::ec_p256});
-        p.museum2 = issue_cert(p.ca, {CertRole::appliance, "museum-2", {}, -300, kSecondsPerDay, KeyAlgorithm::ec_p256});
+        p.farm = issue_cert(
+            p.ca, {CertRole::farm, "farm-test", {"::1", "127.0.0.1"}, -300, kSecondsPerDay, KeyAlgorithm::ec_p256});
+        p.museum1 =
+            issue_cert(p.ca, {CertRole::appliance, "museum-1", {}, -300, kSecondsPerDay, KeyAlgorithm::ec_p256});
+        p.museum2 =
+            issue_cert(p.ca, {CertRole::appliance, "museum-2", {}, -300, kSecondsPerDay, KeyAlgorithm::ec_p256});
         // Valid from two days ago until yesterday.
-        p.expired = issue_cert(p.ca, {CertRole::appliance, "museum-old", {}, -2 * kSecondsPerDay, kSecondsPerDay,
-                                      KeyAlgorithm::ec_p256});
-        p.foreign_ca = make_ca({CertRole::ca, "someone else's CA", {}, -300, 10 * kSecondsPerDay, KeyAlgorithm::ec_p256});
-        p.foreign_museum1 = issue_cert(p.foreign_ca, {CertRole::appliance, "museum-1", {}, -300, kSecondsPerDay,
-                                                      KeyAlgorithm::ec_p256});
+        p.expired = issue_cert(
+            p.ca, {CertRole::appliance, "museum-old", {}, -2 * kSecondsPerDay, kSecondsPerDay, KeyAlgorithm::ec_p256});
+        p.foreign_ca =
+            make_ca({CertRole::ca, "someone else's CA", {}, -300, 10 * kSecondsPerDay, KeyAlgorithm::ec_p256});
+        p.foreign_museum1 = issue_cert(
+            p.foreign_ca, {CertRole::appliance, "museum-1", {}, -300, kSecondsPerDay, KeyAlgorithm::ec_p256});
         return p;
     }();
     return pki;

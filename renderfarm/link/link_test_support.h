@@ -30,16 +30,18 @@ int run_pki(std::vector<std::string> args);
 
 // Certificates made once per test process (EC P-256, a few ms).
 struct TestPki {
-    PemPair ca;                  // the farm CA
-    PemPair farm;                // CN farm-test, SANs ::1 and 127.0.0.1
-    PemPair museum1, museum2;    // appliances
-    PemPair expired;             // appliance "museum-old", expired yesterday
-    PemPair foreign_ca;          // another CA
-    PemPair foreign_museum1;     // "museum-1" issued by the other CA
+    PemPair ca;                // the farm CA
+    PemPair farm;              // CN farm-test, SANs ::1 and 127.0.0.1
+    PemPair museum1, museum2;  // appliances
+    PemPair expired;           // appliance "museum-old", expired yesterday
+    PemPair foreign_ca;        // another CA
+    PemPair foreign_museum1;   // "museum-1" issued by the other CA
 
     [[nodiscard]] static const TestPki& get();
     [[nodiscard]] TlsMaterial farm_tls() const { return {ca.cert_pem, farm.cert_pem, farm.key_pem}; }
-    [[nodiscard]] TlsMaterial appliance_tls(const PemPair& who) const { return {ca.cert_pem, who.cert_pem, who.key_pem}; }
+    [[nodiscard]] TlsMaterial appliance_tls(const PemPair& who) const {
+        return {ca.cert_pem, who.cert_pem, who.key_pem};
+    }
 };
 
 // A request the synthetic renderer accepts: pinhole, width x height, resolution scale 1.
@@ -54,7 +56,9 @@ inline constexpr std::uint64_t kPoisonSeed = 0xDEAD;
 class SyntheticRenderer {
 public:
     RenderedFrame operator()(const ViewRequest& request);  // thread-safe
-    [[nodiscard]] FrameRenderer function() { return [this](const ViewRequest& r) { return (*this)(r); }; }
+    [[nodiscard]] FrameRenderer function() {
+        return [this](const ViewRequest& r) { return (*this)(r); };
+    }
 
     // Releases at scope exit. Declare it after the LinkServer so that a failed assertion releases
     // the renderer before ~LinkServer waits for the renderer call in progress.
@@ -68,8 +72,8 @@ public:
     private:
         SyntheticRenderer& renderer_;
     };
-    Hold hold();     // later calls block until release() or the Hold ends
-    void release();  // lets every blocked and later call through
+    Hold hold();                                      // later calls block until release() or the Hold ends
+    void release();                                   // lets every blocked and later call through
     void set_delay(std::chrono::microseconds delay);  // each call sleeps this long (a slow farm)
     [[nodiscard]] int blocked() const;                // calls waiting in hold()
     [[nodiscard]] std::vector<std::uint64_t> rendered_ids() const;  // request ids, call order

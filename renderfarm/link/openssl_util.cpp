@@ -9,9 +9,7 @@
 namespace mogao::ossl {
 namespace {
 
-Bio read_bio(std::string_view text) {
-    return Bio(BIO_new_mem_buf(text.data(), static_cast<int>(text.size())));
-}
+Bio read_bio(std::string_view text) { return Bio(BIO_new_mem_buf(text.data(), static_cast<int>(text.size()))); }
 
 std::string drain(BIO* bio) {
     char* data = nullptr;

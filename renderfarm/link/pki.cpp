@@ -124,7 +124,8 @@ void add_role_extensions(X509* cert, X509V3_CTX& ctx, const CertSpec& spec, X509
 ossl::Cert build_cert(const CertSpec& spec, EVP_PKEY* key, X509* issuer, EVP_PKEY* issuer_key,
                       X509* renewed = nullptr) {
     if (auto why = check_pki_name(spec.common_name); !why.empty() && spec.role != CertRole::ca) throw PkiError(why);
-    if (spec.common_name.empty() || spec.common_name.size() > 64) throw PkiError("common name must be 1..64 characters");
+    if (spec.common_name.empty() || spec.common_name.size() > 64)
+        throw PkiError("common name must be 1..64 characters");
     if (spec.lifetime_s <= 0) throw PkiError("certificate lifetime must be positive");
     ossl::Cert cert(X509_new());
     if (!cert || X509_set_version(cert.get(), X509_VERSION_3) != 1) fail("out of memory");
@@ -169,7 +170,8 @@ void ensure_dir(const fs::path& dir) {
     if (fs::is_directory(dir, ec)) return;
     fs::create_directories(dir, ec);
     if (ec) throw PkiError("cannot create " + dir.string() + ": " + ec.message());
-    if (::chmod(dir.c_str(), 0700) != 0) throw PkiError("cannot chmod 0700 " + dir.string() + ": " + std::strerror(errno));
+    if (::chmod(dir.c_str(), 0700) != 0)
+        throw PkiError("cannot chmod 0700 " + dir.string() + ": " + std::strerror(errno));
 }
 
 PemPair load_ca_files(const fs::path& dir) {
@@ -180,8 +182,7 @@ PemPair load_ca_files(const fs::path& dir) {
     }
 }
 
-std::vector<fs::path> write_pair(const fs::path& cert_path, const fs::path& key_path, const PemPair& pair,
-                                 bool force) {
+std::vector<fs::path> write_pair(const fs::path& cert_path, const fs::path& key_path, const PemPair& pair, bool force) {
     require_absent({cert_path, key_path}, force);
     write_private_file(key_path, pair.key_pem, force);
     write_private_file(cert_path, pair.cert_pem, force);
@@ -262,8 +263,12 @@ fs::path ca_cert_path(const fs::path& dir) { return dir / "ca.pem"; }
 fs::path ca_key_path(const fs::path& dir) { return dir / "ca.key"; }
 fs::path farm_cert_path(const fs::path& dir, const std::string& name) { return dir / ("farm-" + name + ".pem"); }
 fs::path farm_key_path(const fs::path& dir, const std::string& name) { return dir / ("farm-" + name + ".key"); }
-fs::path appliance_cert_path(const fs::path& dir, const std::string& name) { return dir / ("appliance-" + name + ".pem"); }
-fs::path appliance_key_path(const fs::path& dir, const std::string& name) { return dir / ("appliance-" + name + ".key"); }
+fs::path appliance_cert_path(const fs::path& dir, const std::string& name) {
+    return dir / ("appliance-" + name + ".pem");
+}
+fs::path appliance_key_path(const fs::path& dir, const std::string& name) {
+    return dir / ("appliance-" + name + ".key");
+}
 fs::path previous_appliance_cert_path(const fs::path& dir, const std::string& name) {
     return dir / ("appliance-" + name + ".previous.pem");
 }

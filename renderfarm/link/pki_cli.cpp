@@ -46,7 +46,8 @@ int run_pki_command(int argc, char** argv) {
     farm->add_option("--san", san, "Comma-separated IPv6 addresses (IP SANs) or DNS names, e.g. ::1,2001:db8::5")
         ->required();
     farm->add_option("--days", days, "Validity in days")->default_val(825)->check(CLI::Range(1, 36500));
-    CLI::App* appliance = app.add_subcommand("issue-appliance", "Issue an appliance client certificate: appliance-NAME.pem + .key");
+    CLI::App* appliance =
+        app.add_subcommand("issue-appliance", "Issue an appliance client certificate: appliance-NAME.pem + .key");
     common(appliance);
     appliance->add_option("--name", name, "Appliance name, e.g. museum-1")->required();
     appliance->add_option("--days", days, "Validity in days")->default_val(365)->check(CLI::Range(1, 36500));
@@ -84,7 +85,8 @@ int run_pki_command(int argc, char** argv) {
     try {
         std::vector<std::filesystem::path> written;
         if (init->parsed()) {
-            written = pki_init_ca(dir, name, days, key == "rsa" ? KeyAlgorithm::rsa_3072 : KeyAlgorithm::ec_p256, force);
+            written =
+                pki_init_ca(dir, name, days, key == "rsa" ? KeyAlgorithm::rsa_3072 : KeyAlgorithm::ec_p256, force);
         } else if (farm->parsed()) {
             written = pki_issue_farm(dir, name, split_sans(san), days, force);
         } else if (appliance->parsed()) {

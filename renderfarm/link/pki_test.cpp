@@ -19,7 +19,7 @@ using testing::TempDir;
 using testing::TestPki;
 
 unsigned mode_of(const fs::path& p) {
-    struct stat st{};
+    struct stat st {};
     EXPECT_EQ(::stat(p.c_str(), &st), 0) << p;
     return st.st_mode & 07777;
 }
@@ -64,7 +64,8 @@ TEST(Pki, CommandsWriteEveryFileWithMode0600) {
 TEST(Pki, FarmCertificateCarriesIpv6SansAndServerAuthOnly) {
     const TempDir tmp;
     ASSERT_EQ(run({"init-ca", "--dir", tmp.path().string()}), 0);
-    ASSERT_EQ(run({"issue-farm", "--dir", tmp.path().string(), "--name", "farm-1", "--san", "::1,2001:DB8::5,farm.lan"}), 0);
+    ASSERT_EQ(
+        run({"issue-farm", "--dir", tmp.path().string(), "--name", "farm-1", "--san", "::1,2001:DB8::5,farm.lan"}), 0);
     const auto cert = ossl::parse_cert(read_pem_file(farm_cert_path(tmp.path(), "farm-1")));
     ASSERT_TRUE(cert);
     EXPECT_EQ(X509_check_ip_asc(cert.get(), "::1", 0), 1);
@@ -111,7 +112,7 @@ TEST(Pki, BadCommandLinesAndMissingCaFailClearly) {
     const std::string dir = tmp.path().string();
     EXPECT_EQ(run({}), 2);
     EXPECT_EQ(run({"frobnicate"}), 2);
-    EXPECT_EQ(run({"issue-appliance", "--dir", dir}), 2);                        // --name missing
+    EXPECT_EQ(run({"issue-appliance", "--dir", dir}), 2);  // --name missing
     EXPECT_EQ(run({"issue-appliance", "--dir", dir, "--name", "m", "--days", "0"}), 2);
     EXPECT_EQ(run({"issue-appliance", "--dir", dir, "--name", "museum-1"}), 1);  // no CA yet
     try {
@@ -129,7 +130,8 @@ TEST(Pki, BadCommandLinesAndMissingCaFailClearly) {
 
 TEST(Pki, RsaCaWorks) {
     const PemPair ca = make_ca({CertRole::ca, "rsa CA", {}, -300, kSecondsPerDay, KeyAlgorithm::rsa_3072});
-    const PemPair leaf = issue_cert(ca, {CertRole::appliance, "museum-9", {}, -300, kSecondsPerDay, KeyAlgorithm::ec_p256});
+    const PemPair leaf =
+        issue_cert(ca, {CertRole::appliance, "museum-9", {}, -300, kSecondsPerDay, KeyAlgorithm::ec_p256});
     const TlsCheck check = check_tls_material({ca.cert_pem, leaf.cert_pem, leaf.key_pem}, "appliance");
     EXPECT_EQ(check.error, "");
     EXPECT_TRUE(check.warnings.empty());
@@ -150,7 +152,8 @@ TEST(TlsCheck, NamesExpiredForeignAndMismatchedMaterial) {
     ASSERT_EQ(foreign.warnings.size(), 1u);
     EXPECT_NE(foreign.warnings[0].find("does not chain"), std::string::npos) << foreign.warnings[0];
 
-    const TlsCheck mismatched = check_tls_material({pki.ca.cert_pem, pki.museum1.cert_pem, pki.museum2.key_pem}, "appliance");
+    const TlsCheck mismatched =
+        check_tls_material({pki.ca.cert_pem, pki.museum1.cert_pem, pki.museum2.key_pem}, "appliance");
     EXPECT_NE(mismatched.error.find("does not belong"), std::string::npos) << mismatched.error;
 
     const TlsCheck garbage = check_tls_material({"garbage", pki.museum1.cert_pem, pki.museum1.key_pem}, "appliance");

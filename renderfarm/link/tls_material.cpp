@@ -10,8 +10,8 @@
 #include <openssl/err.h>
 
 #include "common/link_types.h"
-#include "renderfarm/link/openssl_util.h"
 #include "common/unique_fd.h"
+#include "renderfarm/link/openssl_util.h"
 
 namespace mogao {
 
@@ -68,7 +68,8 @@ TlsCheck check_tls_material(const TlsMaterial& m, const std::string& who) {
     if (!store || !ctx) return fail("out of memory");
     for (const auto& ca : cas) X509_STORE_add_cert(store.get(), ca.get());
     X509_STORE_set_flags(store.get(), X509_V_FLAG_NO_CHECK_TIME);
-    if (X509_STORE_CTX_init(ctx.get(), store.get(), cert.get(), nullptr) != 1) return fail("cannot set up verification");
+    if (X509_STORE_CTX_init(ctx.get(), store.get(), cert.get(), nullptr) != 1)
+        return fail("cannot set up verification");
     if (X509_verify_cert(ctx.get()) != 1) {
         check.warnings.push_back(who + ": " + name + " does not chain to the CA: " +
                                  X509_verify_cert_error_string(X509_STORE_CTX_get_error(ctx.get())));

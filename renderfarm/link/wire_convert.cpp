@@ -76,7 +76,8 @@ std::string validate_link_request(const ViewRequest& r) {
         }
     } else {
         const auto& c = std::get<CylinderScreen>(r.camera);
-        if (!(c.radius_m > 0.0) || !std::isfinite(c.radius_m)) return outside("cylinder.radius_m", c.radius_m, "(0, inf)");
+        if (!(c.radius_m > 0.0) || !std::isfinite(c.radius_m))
+            return outside("cylinder.radius_m", c.radius_m, "(0, inf)");
         if (!(c.arc_deg > 0.0 && c.arc_deg <= 360.0)) return outside("cylinder.arc_deg", c.arc_deg, "(0, 360]");
         if (auto e = check_finite("cylinder.bottom_m", c.bottom_m); !e.empty()) return e;
         if (auto e = check_finite("cylinder.top_m", c.top_m); !e.empty()) return e;
@@ -87,9 +88,14 @@ std::string validate_link_request(const ViewRequest& r) {
     if (auto e = check_range("height", r.size.height, kMinLinkImageSide, kMaxLinkImageSide); !e.empty()) return e;
     const Quality& q = r.quality;
     if (auto e = check_range("quality.spp", q.spp, L::kSpp.min, L::kSpp.max); !e.empty()) return e;
-    if (auto e = check_range("quality.max_bounces", q.max_bounces, L::kMaxBounces.min, L::kMaxBounces.max); !e.empty()) return e;
-    if (auto e = check_range("quality.ao_samples", q.ao_samples, L::kAoSamples.min, L::kAoSamples.max); !e.empty()) return e;
-    if (auto e = check_range("quality.area_light_samples", q.area_light_samples, L::kAreaLightSamples.min, L::kAreaLightSamples.max); !e.empty()) return e;
+    if (auto e = check_range("quality.max_bounces", q.max_bounces, L::kMaxBounces.min, L::kMaxBounces.max); !e.empty())
+        return e;
+    if (auto e = check_range("quality.ao_samples", q.ao_samples, L::kAoSamples.min, L::kAoSamples.max); !e.empty())
+        return e;
+    if (auto e = check_range("quality.area_light_samples", q.area_light_samples, L::kAreaLightSamples.min,
+                             L::kAreaLightSamples.max);
+        !e.empty())
+        return e;
     if (!(q.resolution_scale > 0.0 && q.resolution_scale <= 1.0)) {
         return outside("quality.resolution_scale", q.resolution_scale, "(0, 1]");
     }
@@ -143,13 +149,14 @@ std::string view_from_msg(const v1::ViewRequestMsg& msg, ViewRequest& out) {
         std::uint32_t value;
         int lo, hi;
     };
-    const Field fields[] = {{"width", msg.width(), kMinLinkImageSide, kMaxLinkImageSide},
-                            {"height", msg.height(), kMinLinkImageSide, kMaxLinkImageSide},
-                            {"quality.spp", q.spp(), L::kSpp.min, L::kSpp.max},
-                            {"quality.max_bounces", q.max_bounces(), L::kMaxBounces.min, L::kMaxBounces.max},
-                            {"quality.ao_samples", q.ao_samples(), L::kAoSamples.min, L::kAoSamples.max},
-                            {"quality.area_light_samples", q.area_light_samples(), L::kAreaLightSamples.min, L::kAreaLightSamples.max},
-                            {"quality.jpeg_quality", q.jpeg_quality(), L::kJpegQuality.min, L::kJpegQuality.max}};
+    const Field fields[] = {
+        {"width", msg.width(), kMinLinkImageSide, kMaxLinkImageSide},
+        {"height", msg.height(), kMinLinkImageSide, kMaxLinkImageSide},
+        {"quality.spp", q.spp(), L::kSpp.min, L::kSpp.max},
+        {"quality.max_bounces", q.max_bounces(), L::kMaxBounces.min, L::kMaxBounces.max},
+        {"quality.ao_samples", q.ao_samples(), L::kAoSamples.min, L::kAoSamples.max},
+        {"quality.area_light_samples", q.area_light_samples(), L::kAreaLightSamples.min, L::kAreaLightSamples.max},
+        {"quality.jpeg_quality", q.jpeg_quality(), L::kJpegQuality.min, L::kJpegQuality.max}};
     for (const auto& f : fields) {
         if (auto e = check_range(f.name, f.value, f.lo, f.hi); !e.empty()) return e;
     }
@@ -158,18 +165,18 @@ std::string view_from_msg(const v1::ViewRequestMsg& msg, ViewRequest& out) {
     out.frame_id = msg.request_id();
     out.pose = pose_from(msg.pose());
     switch (msg.camera_case()) {
-    case v1::ViewRequestMsg::kPinhole:
-        out.camera.emplace<PinholeCamera>(PinholeCamera{msg.pinhole().vertical_fov_deg()});
-        break;
-    case v1::ViewRequestMsg::kCylinder: {
-        const auto& c = msg.cylinder();
-        if (!c.has_eye_m()) return "cylinder.eye_m is missing";
-        out.camera.emplace<CylinderScreen>(
-            CylinderScreen{c.radius_m(), c.arc_deg(), c.bottom_m(), c.top_m(), vec_from(c.eye_m())});
-        break;
-    }
-    default:
-        return "camera is missing (set pinhole or cylinder)";
+        case v1::ViewRequestMsg::kPinhole:
+            out.camera.emplace<PinholeCamera>(PinholeCamera{msg.pinhole().vertical_fov_deg()});
+            break;
+        case v1::ViewRequestMsg::kCylinder: {
+            const auto& c = msg.cylinder();
+            if (!c.has_eye_m()) return "cylinder.eye_m is missing";
+            out.camera.emplace<CylinderScreen>(
+                CylinderScreen{c.radius_m(), c.arc_deg(), c.bottom_m(), c.top_m(), vec_from(c.eye_m())});
+            break;
+        }
+        default:
+            return "camera is missing (set pinhole or cylinder)";
     }
     out.size = {static_cast<int>(msg.width()), static_cast<int>(msg.height())};
     out.quality.spp = static_cast<int>(q.spp());

@@ -15,8 +15,8 @@
 
 #include "common/link_types.h"
 #include "common/request_limits.h"
-#include "renderfarm/link/mogao_link.pb.h"
 #include "common/view_request.h"
+#include "renderfarm/link/mogao_link.pb.h"
 
 namespace mogao {
 

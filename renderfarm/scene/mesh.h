@@ -23,15 +23,15 @@
 namespace mogao {
 
 struct Mesh {
-    std::string source;                       // file path or procedural name, for messages
+    std::string source;                                // file path or procedural name, for messages
     Eigen::Vector3d origin = Eigen::Vector3d::Zero();  // file units; positions are relative to it
     std::vector<Eigen::Vector3f> positions;            // file units, relative to origin
-    std::vector<Eigen::Vector3f> normals;     // unit per-vertex normals, or empty
-    std::vector<Eigen::Vector3f> colors;      // linear RGB in [0, 1] per vertex (from sRGB), or empty
-    std::vector<Eigen::Vector2f> uvs;         // texture coordinates per vertex (glTF/OpenGL-image
-                                              // convention as assimp gives them: (0,0) = first
-                                              // texel row's left edge after its v flip), or empty
-    std::shared_ptr<const Texture> texture;   // base colour, with uvs; null when none
+    std::vector<Eigen::Vector3f> normals;              // unit per-vertex normals, or empty
+    std::vector<Eigen::Vector3f> colors;               // linear RGB in [0, 1] per vertex (from sRGB), or empty
+    std::vector<Eigen::Vector2f> uvs;                  // texture coordinates per vertex (glTF/OpenGL-image
+                                                       // convention as assimp gives them: (0,0) = first
+                                                       // texel row's left edge after its v flip), or empty
+    std::shared_ptr<const Texture> texture;            // base colour, with uvs; null when none
     std::vector<std::array<std::uint32_t, 3>> triangles;
 
     [[nodiscard]] std::size_t triangle_count() const { return triangles.size(); }

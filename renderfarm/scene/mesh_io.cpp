@@ -38,7 +38,8 @@ namespace {
 
 std::string lower_extension(const std::filesystem::path& path) {
     std::string ext = path.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
     return ext;
 }
 
@@ -72,7 +73,8 @@ void append_mesh(Mesh& out, const aiMesh& in, const Eigen::Matrix4d& to_file, co
     const Eigen::Matrix3d linear = to_file.topLeftCorner<3, 3>();
     // Normals transform by the inverse transpose; a singular transform keeps the linear part
     // (the normals get renormalised later anyway).
-    const Eigen::Matrix3d normal_matrix = std::abs(linear.determinant()) > 0.0 ? Eigen::Matrix3d(linear.inverse().transpose()) : linear;
+    const Eigen::Matrix3d normal_matrix =
+        std::abs(linear.determinant()) > 0.0 ? Eigen::Matrix3d(linear.inverse().transpose()) : linear;
     for (unsigned v = 0; v < in.mNumVertices; ++v) {
         const aiVector3D& p = in.mVertices[v];
         const Eigen::Vector4d q = to_file * Eigen::Vector4d(p.x, p.y, p.z, 1.0);
@@ -91,7 +93,8 @@ void append_mesh(Mesh& out, const aiMesh& in, const Eigen::Matrix4d& to_file, co
     for (unsigned f = 0; f < in.mNumFaces; ++f) {
         const aiFace& face = in.mFaces[f];
         if (face.mNumIndices != 3) continue;  // points and lines left after triangulation
-        out.triangles.push_back({static_cast<std::uint32_t>(base + face.mIndices[0]), static_cast<std::uint32_t>(base + face.mIndices[1]),
+        out.triangles.push_back({static_cast<std::uint32_t>(base + face.mIndices[0]),
+                                 static_cast<std::uint32_t>(base + face.mIndices[1]),
                                  static_cast<std::uint32_t>(base + face.mIndices[2])});
     }
     has.normals = has.normals && in.HasNormals();
@@ -107,7 +110,8 @@ void check_finite(const aiScene& scene, const std::string& file) {
         for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
             const aiVector3D& p = mesh.mVertices[v];
             if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-                throw MeshLoadError(file, fmt::format("mesh {} vertex {}: coordinate is not finite ({}, {}, {})", m, v, p.x, p.y, p.z));
+                throw MeshLoadError(
+                    file, fmt::format("mesh {} vertex {}: coordinate is not finite ({}, {}, {})", m, v, p.x, p.y, p.z));
             }
             if (mesh.HasNormals()) {
                 const aiVector3D& n = mesh.mNormals[v];
@@ -240,7 +244,8 @@ Mesh read_with_assimp(const std::filesystem::path& path) {
         stack.pop_back();
         const Eigen::Matrix4d to_file = parent * to_eigen(node->mTransformation);
         for (unsigned k = 0; k < node->mNumMeshes; ++k) {
-            if (node->mMeshes[k] >= scene->mNumMeshes) throw MeshLoadError(file, "assimp: node refers to a missing mesh");
+            if (node->mMeshes[k] >= scene->mNumMeshes)
+                throw MeshLoadError(file, "assimp: node refers to a missing mesh");
             const aiMesh& part = *scene->mMeshes[node->mMeshes[k]];
             append_mesh(mesh, part, to_file, file, linear_colors, has);
             materials.push_back(part.mMaterialIndex);

@@ -33,8 +33,8 @@ private:
 struct MeshLoadReport {
     std::size_t triangles = 0;
     std::size_t vertices = 0;
-    double seconds = 0.0;     // wall time of read + parse + validate
-    std::string loader;       // "ply" (ours) or "assimp"
+    double seconds = 0.0;  // wall time of read + parse + validate
+    std::string loader;    // "ply" (ours) or "assimp"
 };
 
 // Loads a triangle mesh in the file's own units and frame. Extension ".ply" (any case) uses our

@@ -11,8 +11,8 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
-#include <set>
 #include <ostream>
+#include <set>
 #include <sstream>
 #include <string>
 #include <tuple>
@@ -73,7 +73,14 @@ std::string sample_ply(const std::string& format) {
     PlyWriter w(format);
     const float xy[5][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}, {2, 0}};
     for (int i = 0; i < 5; ++i) {
-        w.v(xy[i][0]).v(xy[i][1]).v(0.5f).v(static_cast<float>(i) * 0.25f).v(std::uint8_t{2}).v(std::int32_t{7}).v(std::int32_t{-8}).end();
+        w.v(xy[i][0])
+            .v(xy[i][1])
+            .v(0.5f)
+            .v(static_cast<float>(i) * 0.25f)
+            .v(std::uint8_t{2})
+            .v(std::int32_t{7})
+            .v(std::int32_t{-8})
+            .end();
     }
     w.v(std::uint8_t{255}).v(std::uint8_t{1}).v(0.5).end();
     w.v(std::uint8_t{0}).v(std::uint8_t{0}).end();
@@ -89,14 +96,16 @@ std::string plain_ply(const std::string& format, float nan_or_inf_z = 0.f, int b
     for (const auto& q : p) w.v(q[0]).v(q[1]).v(q[2]).end();
     w.v(std::uint8_t{3}).v(0).v(1).v(2).end();
     w.v(std::uint8_t{3}).v(0).v(2).v(bad_index).end();
-    return w.bytes("element vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 2\nproperty list uchar int vertex_indices\n");
+    return w.bytes(
+        "element vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 2\nproperty list uchar "
+        "int vertex_indices\n");
 }
 
 class MeshIo : public ::testing::Test {
 protected:
     void SetUp() override {
-        dir_ = fs::path(::testing::TempDir()) /
-               ("mogao_mesh_io_" + std::to_string(::getpid()) + "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        dir_ = fs::path(::testing::TempDir()) / ("mogao_mesh_io_" + std::to_string(::getpid()) + "_" +
+                                                 ::testing::UnitTest::GetInstance()->current_test_info()->name());
         fs::create_directories(dir_);
     }
     void TearDown() override {
@@ -153,9 +162,10 @@ TEST_F(MeshIo, PlyNormalsReadAndNormalised) {
     const double p[3][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
     for (const auto& q : p) w.v(q[0]).v(q[1]).v(q[2]).v(0.0).v(0.0).v(2.0).end();
     w.v(std::int16_t{5}).v(0).v(1).v(2).v(0).v(1).end();  // a "pentagon" with vertex_index alias
-    const Mesh m = load_mesh(write("n.ply", w.bytes("element vertex 3\nproperty double x\nproperty double y\nproperty double z\n"
-                                                    "property double nx\nproperty double ny\nproperty double nz\n"
-                                                    "element face 1\nproperty list short uint vertex_index\n")));
+    const Mesh m =
+        load_mesh(write("n.ply", w.bytes("element vertex 3\nproperty double x\nproperty double y\nproperty double z\n"
+                                         "property double nx\nproperty double ny\nproperty double nz\n"
+                                         "element face 1\nproperty list short uint vertex_index\n")));
     ASSERT_EQ(m.normals.size(), 3u);
     EXPECT_EQ(m.normals[1], Eigen::Vector3f(0.f, 0.f, 1.f));
     EXPECT_EQ(m.triangles.size(), 3u);
@@ -170,8 +180,9 @@ TEST_F(MeshIo, TristripWindingAlternates) {
     const std::int32_t strips[] = {0, 1, 2, 3, 4, -1, 5, 6, 6, 7, -1};
     w.v(static_cast<std::int32_t>(std::size(strips)));
     for (const std::int32_t s : strips) w.v(s);
-    const Mesh m = load_mesh(write("strip.ply", w.bytes("element vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
-                                                        "element tristrips 1\nproperty list int int vertex_indices\n")));
+    const Mesh m =
+        load_mesh(write("strip.ply", w.bytes("element vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
+                                             "element tristrips 1\nproperty list int int vertex_indices\n")));
     using Tri = std::array<std::uint32_t, 3>;
     EXPECT_EQ(m.triangles, (std::vector<Tri>{{0, 1, 2}, {2, 1, 3}, {2, 3, 4}}));
     for (const Tri& t : m.triangles) {
@@ -185,7 +196,7 @@ TEST_F(MeshIo, TristripIndexOutOfRange) {
     for (int i = 0; i < 3; ++i) w.v(i).v(0).v(i % 2).end();
     w.v(5).v(0).v(1).v(2).v(-1).v(-2).end();
     expect_error(write("badstrip.ply", w.bytes("element vertex 3\nproperty int x\nproperty int y\nproperty int z\n"
-                                              "element tristrips 1\nproperty list int int vertex_indices\n")),
+                                               "element tristrips 1\nproperty list int int vertex_indices\n")),
                  "tristrips 0: item 4: vertex index -2 out of range (3 vertices)");
 }
 
@@ -211,13 +222,17 @@ TEST_F(MeshIo, HugeCountsFailWithoutAllocating) {
     const std::string xyz = "property float x\nproperty float y\nproperty float z\n";
     PlyWriter small("binary_little_endian");
     for (int i = 0; i < 9; ++i) small.v(1.f);
-    expect_error(write("huge_bin.ply", small.bytes("element vertex 4000000000\n" + xyz)), "vertex 3: unexpected end of file");
+    expect_error(write("huge_bin.ply", small.bytes("element vertex 4000000000\n" + xyz)),
+                 "vertex 3: unexpected end of file");
     PlyWriter small_ascii("ascii");
     for (int i = 0; i < 9; ++i) small_ascii.v(1.f);
-    expect_error(write("huge_ascii.ply", small_ascii.bytes("element vertex 4000000000\n" + xyz)), "vertex 3: unexpected end of file");
+    expect_error(write("huge_ascii.ply", small_ascii.bytes("element vertex 4000000000\n" + xyz)),
+                 "vertex 3: unexpected end of file");
     expect_error(write("too_many.ply", small_ascii.bytes("element vertex 5000000000\n" + xyz)), "32-bit index limit");
     // An element without properties takes no bytes whatever its count: skipped, not looped over.
-    expect_error(write("empty_elem.ply", small.bytes("element vertex 3\n" + xyz + "element nothing 18446744073709551615\n")), "no triangles");
+    expect_error(
+        write("empty_elem.ply", small.bytes("element vertex 3\n" + xyz + "element nothing 18446744073709551615\n")),
+        "no triangles");
 
     PlyWriter list("binary_little_endian");
     for (int i = 0; i < 9; ++i) list.v(1.f);
@@ -227,7 +242,8 @@ TEST_F(MeshIo, HugeCountsFailWithoutAllocating) {
     PlyWriter list2("binary_little_endian");
     for (int i = 0; i < 9; ++i) list2.v(1.f);
     list2.v(std::uint32_t{1000000}).v(0).v(1).v(2);
-    expect_error(write("long_list.ply", list2.bytes("element vertex 3\n" + xyz + face)), "face 0: unexpected end of file");
+    expect_error(write("long_list.ply", list2.bytes("element vertex 3\n" + xyz + face)),
+                 "face 0: unexpected end of file");
     EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
 }
 
@@ -237,7 +253,8 @@ TEST_F(MeshIo, UnsupportedPlyHeaders) {
     expect_error(write("middle.ply", "ply\nformat binary_middle_endian 1.0\nend_header\n"), "unsupported format");
     expect_error(write("noend.ply", "ply\nformat ascii 1.0\nelement vertex 1\n"), "no end_header");
     expect_error(write("text.ply", "hello\n"), "not a PLY file");
-    expect_error(write("novertex.ply", "ply\nformat ascii 1.0\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n"),
+    expect_error(write("novertex.ply",
+                       "ply\nformat ascii 1.0\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n"),
                  "no 'vertex' element");
 }
 
@@ -263,7 +280,7 @@ TEST_F(MeshIo, EmptyMeshesRejected) {
     PlyWriter w("ascii");
     w.v(0).v(0).v(0).end();
     expect_error(write("nofaces.ply", w.bytes("element vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
-                                             "element face 0\nproperty list uchar int vertex_indices\n")),
+                                              "element face 0\nproperty list uchar int vertex_indices\n")),
                  "no triangles");
     expect_error(write("nofaces.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n"), "no triangles");
     expect_error(write("empty.obj", ""), "assimp");
@@ -290,7 +307,8 @@ TEST_F(MeshIo, GltfNodeTransformsApplied) {
     const std::string gltf = R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],
       "nodes":[{"children":[1],"translation":[10,20,30]},{"mesh":0,"scale":[2,2,2]}],
       "meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],
-      "buffers":[{"byteLength":44,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAAA="}],
+      "buffers":[{"byteLength":44,"uri":"data:application/octet-stream;base64,)"
+                             R"(AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAAA="}],
       "bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":36},{"buffer":0,"byteOffset":36,"byteLength":6}],
       "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]},
                    {"bufferView":1,"componentType":5123,"count":3,"type":"SCALAR"}]})";
@@ -375,8 +393,8 @@ TEST_P(RealScans, CountsMatchProvenance) {
     EXPECT_EQ(m.positions.size(), s.vertices);
     EXPECT_EQ(report.loader, s.loader);
     RecordProperty("load_seconds", std::to_string(report.seconds));
-    std::printf("[ load     ] %-26s %7zu triangles %7zu vertices %8.3f s (%s)\n", s.file, report.triangles, report.vertices,
-                report.seconds, report.loader.c_str());
+    std::printf("[ load     ] %-26s %7zu triangles %7zu vertices %8.3f s (%s)\n", s.file, report.triangles,
+                report.vertices, report.seconds, report.loader.c_str());
     // Consistent orientation: in a consistently wound mesh no directed edge is used twice. For
     // igea this checks the alternating strip winding on real data (a wrong parity flips half of
     // the triangles); happy-buddha's decimation left 102 such edges, a property of the file.
@@ -391,7 +409,8 @@ TEST_P(RealScans, CountsMatchProvenance) {
 // Vertex counts: the OBJ files have as many vertices as PROVENANCE.md except the bunny, whose
 // file holds 1,113 vertices no face uses (35,947 in the file); assimp keeps only used ones.
 INSTANTIATE_TEST_SUITE_P(Scans, RealScans,
-                         ::testing::Values(Scan{"igea.ply", 268686, 134345, "ply", 0}, Scan{"happy-buddha-100k.obj", 100000, 49950, "assimp", 102},
+                         ::testing::Values(Scan{"igea.ply", 268686, 134345, "ply", 0},
+                                           Scan{"happy-buddha-100k.obj", 100000, 49950, "assimp", 102},
                                            Scan{"stanford-dragon-100k.obj", 100000, 50000, "assimp", 0},
                                            Scan{"nefertiti-100k.obj", 99938, 49971, "assimp", 0},
                                            Scan{"stanford-bunny.obj", 69451, 34834, "assimp", 0}),

@@ -23,15 +23,20 @@ void validate_mesh(const Mesh& mesh) {
     if (mesh.triangles.empty()) throw MeshLoadError(file, fmt::format("empty mesh: no triangles ({} vertices)", n));
     for (std::size_t i = 0; i < n; ++i) {
         const Eigen::Vector3f& p = mesh.positions[i];
-        if (!p.allFinite()) throw MeshLoadError(file, fmt::format("vertex {}: coordinate is not finite ({}, {}, {})", i, p.x(), p.y(), p.z()));
+        if (!p.allFinite())
+            throw MeshLoadError(
+                file, fmt::format("vertex {}: coordinate is not finite ({}, {}, {})", i, p.x(), p.y(), p.z()));
     }
     for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
         for (const std::uint32_t v : mesh.triangles[t]) {
-            if (v >= n) throw MeshLoadError(file, fmt::format("triangle {}: vertex index {} out of range ({} vertices)", t, v, n));
+            if (v >= n)
+                throw MeshLoadError(file,
+                                    fmt::format("triangle {}: vertex index {} out of range ({} vertices)", t, v, n));
         }
     }
     if (!mesh.normals.empty() && mesh.normals.size() != n) {
-        throw MeshLoadError(file, fmt::format("normals count mismatch: {} normals for {} vertices", mesh.normals.size(), n));
+        throw MeshLoadError(file,
+                            fmt::format("normals count mismatch: {} normals for {} vertices", mesh.normals.size(), n));
     }
     for (std::size_t i = 0; i < mesh.normals.size(); ++i) {
         if (!mesh.normals[i].allFinite()) throw MeshLoadError(file, fmt::format("normal {}: not finite", i));
@@ -70,7 +75,8 @@ void compute_vertex_normals(Mesh& mesh) {
     mesh.normals.resize(mesh.positions.size());
     for (std::size_t i = 0; i < sum.size(); ++i) {
         const double len = sum[i].norm();
-        mesh.normals[i] = (len > 0.0 && std::isfinite(len)) ? Eigen::Vector3f((sum[i] / len).cast<float>()) : Eigen::Vector3f(0.f, 1.f, 0.f);
+        mesh.normals[i] = (len > 0.0 && std::isfinite(len)) ? Eigen::Vector3f((sum[i] / len).cast<float>())
+                                                            : Eigen::Vector3f(0.f, 1.f, 0.f);
     }
 }
 

@@ -29,10 +29,10 @@ struct TypeName {
     Type type;
 };
 constexpr TypeName kTypeNames[] = {
-    {"char", Type::i8},    {"int8", Type::i8},     {"uchar", Type::u8},    {"uint8", Type::u8},
-    {"short", Type::i16},  {"int16", Type::i16},   {"ushort", Type::u16},  {"uint16", Type::u16},
-    {"int", Type::i32},    {"int32", Type::i32},   {"uint", Type::u32},    {"uint32", Type::u32},
-    {"float", Type::f32},  {"float32", Type::f32}, {"double", Type::f64},  {"float64", Type::f64},
+    {"char", Type::i8},   {"int8", Type::i8},     {"uchar", Type::u8},   {"uint8", Type::u8},
+    {"short", Type::i16}, {"int16", Type::i16},   {"ushort", Type::u16}, {"uint16", Type::u16},
+    {"int", Type::i32},   {"int32", Type::i32},   {"uint", Type::u32},   {"uint32", Type::u32},
+    {"float", Type::f32}, {"float32", Type::f32}, {"double", Type::f64}, {"float64", Type::f64},
 };
 
 std::optional<Type> parse_type(std::string_view s) {
@@ -44,10 +44,18 @@ std::optional<Type> parse_type(std::string_view s) {
 
 std::size_t size_of(Type t) {
     switch (t) {
-        case Type::i8: case Type::u8: return 1;
-        case Type::i16: case Type::u16: return 2;
-        case Type::i32: case Type::u32: case Type::f32: return 4;
-        case Type::f64: return 8;
+        case Type::i8:
+        case Type::u8:
+            return 1;
+        case Type::i16:
+        case Type::u16:
+            return 2;
+        case Type::i32:
+        case Type::u32:
+        case Type::f32:
+            return 4;
+        case Type::f64:
+            return 8;
     }
     return 0;
 }
@@ -56,9 +64,9 @@ bool is_integer(Type t) { return t != Type::f32 && t != Type::f64; }
 
 struct Property {
     std::string name;
-    Type type = Type::f32;        // item type for lists
+    Type type = Type::f32;  // item type for lists
     bool is_list = false;
-    Type count_type = Type::u8;   // lists only
+    Type count_type = Type::u8;  // lists only
 };
 
 struct Element {
@@ -109,7 +117,9 @@ Header parse_header(std::string_view bytes, const std::string& file) {
         ++line_no;
         return true;
     };
-    auto fail = [&](const std::string& why) { return MeshLoadError(file, fmt::format("header line {}: {}", line_no, why)); };
+    auto fail = [&](const std::string& why) {
+        return MeshLoadError(file, fmt::format("header line {}: {}", line_no, why));
+    };
 
     std::string_view line;
     if (!next_line(line) || line != "ply") throw MeshLoadError(file, "not a PLY file (first line is not 'ply')");
@@ -143,11 +153,14 @@ Header parse_header(std::string_view bytes, const std::string& file) {
             p.name = std::string(w.back());
             p.is_list = list;
             const auto type = parse_type(list ? w[3] : w[1]);
-            if (!type) throw fail(fmt::format("unknown property type '{}' for property '{}'", list ? w[3] : w[1], p.name));
+            if (!type)
+                throw fail(fmt::format("unknown property type '{}' for property '{}'", list ? w[3] : w[1], p.name));
             p.type = *type;
             if (list) {
                 const auto ct = parse_type(w[2]);
-                if (!ct || !is_integer(*ct)) throw fail(fmt::format("unknown or non-integer list count type '{}' for property '{}'", w[2], p.name));
+                if (!ct || !is_integer(*ct))
+                    throw fail(
+                        fmt::format("unknown or non-integer list count type '{}' for property '{}'", w[2], p.name));
                 p.count_type = *ct;
             }
             h.elements.back().props.push_back(std::move(p));
@@ -171,27 +184,43 @@ public:
 
     double real(Type t) {
         switch (t) {
-            case Type::i8: return get<std::int8_t>();
-            case Type::u8: return get<std::uint8_t>();
-            case Type::i16: return get<std::int16_t>();
-            case Type::u16: return get<std::uint16_t>();
-            case Type::i32: return get<std::int32_t>();
-            case Type::u32: return get<std::uint32_t>();
-            case Type::f32: return get<float>();
-            case Type::f64: return get<double>();
+            case Type::i8:
+                return get<std::int8_t>();
+            case Type::u8:
+                return get<std::uint8_t>();
+            case Type::i16:
+                return get<std::int16_t>();
+            case Type::u16:
+                return get<std::uint16_t>();
+            case Type::i32:
+                return get<std::int32_t>();
+            case Type::u32:
+                return get<std::uint32_t>();
+            case Type::f32:
+                return get<float>();
+            case Type::f64:
+                return get<double>();
         }
         throw ParseFailure("bad type");
     }
 
     std::int64_t integer(Type t) {
         switch (t) {
-            case Type::i8: return get<std::int8_t>();
-            case Type::u8: return get<std::uint8_t>();
-            case Type::i16: return get<std::int16_t>();
-            case Type::u16: return get<std::uint16_t>();
-            case Type::i32: return get<std::int32_t>();
-            case Type::u32: return get<std::uint32_t>();
-            case Type::f32: case Type::f64: break;
+            case Type::i8:
+                return get<std::int8_t>();
+            case Type::u8:
+                return get<std::uint8_t>();
+            case Type::i16:
+                return get<std::int16_t>();
+            case Type::u16:
+                return get<std::uint16_t>();
+            case Type::i32:
+                return get<std::int32_t>();
+            case Type::u32:
+                return get<std::uint32_t>();
+            case Type::f32:
+            case Type::f64:
+                break;
         }
         throw ParseFailure("integer expected where the header declares a floating-point type");
     }
@@ -199,7 +228,8 @@ public:
     // Throws unless `n` items of type `t` can still follow (so callers may reserve n).
     void check_list(std::uint64_t n, Type t) const {
         if (n > remaining() / size_of(t)) {
-            throw ParseFailure(fmt::format("unexpected end of file: list of {} items needs {} bytes, {} remain", n, n * size_of(t), remaining()));
+            throw ParseFailure(fmt::format("unexpected end of file: list of {} items needs {} bytes, {} remain", n,
+                                           n * size_of(t), remaining()));
         }
     }
 
@@ -263,7 +293,8 @@ public:
     // Every ascii value takes at least one byte, so more items than bytes left cannot follow.
     void check_list(std::uint64_t n, Type) const {
         if (n > remaining()) {
-            throw ParseFailure(fmt::format("unexpected end of file: list of {} items, only {} bytes remain", n, remaining()));
+            throw ParseFailure(
+                fmt::format("unexpected end of file: list of {} items, only {} bytes remain", n, remaining()));
         }
     }
 
@@ -297,7 +328,8 @@ std::uint64_t list_length(Source& src, const Property& p) {
     if (n < 0) throw ParseFailure(fmt::format("negative list length {} for '{}'", n, p.name));
     const auto un = static_cast<std::uint64_t>(n);
     if (un > kMaxPlyListLength) {
-        throw ParseFailure(fmt::format("list '{}' has {} items, more than the limit of {}", p.name, un, kMaxPlyListLength));
+        throw ParseFailure(
+            fmt::format("list '{}' has {} items, more than the limit of {}", p.name, un, kMaxPlyListLength));
     }
     src.check_list(un, p.type);
     return un;
@@ -400,7 +432,8 @@ std::size_t index_list(const Element& e) {
     for (std::size_t k = 0; k < e.props.size(); ++k) {
         const Property& p = e.props[k];
         if (p.name == "vertex_indices" || p.name == "vertex_index") {
-            if (!p.is_list || !is_integer(p.type)) throw ParseFailure(fmt::format("'{}' must be a list of integers", p.name));
+            if (!p.is_list || !is_integer(p.type))
+                throw ParseFailure(fmt::format("'{}' must be a list of integers", p.name));
             return k;
         }
     }
@@ -417,7 +450,8 @@ std::uint32_t checked_index(std::int64_t v, std::uint64_t vertex_count) {
 template <class Source>
 void read_faces(const Element& e, Source& src, Mesh& mesh, std::uint64_t vertex_count, std::uint64_t& i) {
     const std::size_t list = index_list(e);
-    mesh.triangles.reserve(mesh.triangles.size() + static_cast<std::size_t>(std::min<std::uint64_t>(e.count, src.remaining() / 4 + 1)));
+    mesh.triangles.reserve(mesh.triangles.size() +
+                           static_cast<std::size_t>(std::min<std::uint64_t>(e.count, src.remaining() / 4 + 1)));
     std::vector<std::uint32_t> poly;
     for (; i < e.count; ++i) {
         for (std::size_t k = 0; k < e.props.size(); ++k) {
@@ -478,8 +512,8 @@ void read_tristrips(const Element& e, Source& src, Mesh& mesh, std::uint64_t ver
 // A corrupt count (e.g. 4e9 vertices) fails here, before anything is reserved: each element of
 // fixed size must fit in the bytes after the header. Lists count with their length field only.
 void check_binary_sizes(const Header& h, std::size_t body_bytes, const std::string& file) {
-    std::uint64_t before = 0;   // minimum bytes of the elements before this one
-    bool exact = true;          // `before` is exact (no lists so far)
+    std::uint64_t before = 0;  // minimum bytes of the elements before this one
+    bool exact = true;         // `before` is exact (no lists so far)
     for (const Element& e : h.elements) {
         std::uint64_t min_size = 0;
         bool fixed = true;
@@ -491,10 +525,12 @@ void check_binary_sizes(const Header& h, std::size_t body_bytes, const std::stri
         const std::uint64_t avail = body_bytes - before;
         if (e.count > avail / min_size) {
             if (exact && fixed) {
-                throw MeshLoadError(file, fmt::format("{} {}: unexpected end of file (header declares {} '{}' elements of {} bytes; {} bytes follow the header)",
+                throw MeshLoadError(file, fmt::format("{} {}: unexpected end of file (header declares {} '{}' elements "
+                                                      "of {} bytes; {} bytes follow the header)",
                                                       e.name, avail / min_size, e.count, e.name, min_size, body_bytes));
             }
-            throw MeshLoadError(file, fmt::format("element '{}': unexpected end of file (header declares {} elements of at least {} bytes; {} bytes follow the header)",
+            throw MeshLoadError(file, fmt::format("element '{}': unexpected end of file (header declares {} elements "
+                                                  "of at least {} bytes; {} bytes follow the header)",
                                                   e.name, e.count, min_size, body_bytes));
         }
         before += e.count * min_size;

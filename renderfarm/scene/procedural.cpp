@@ -128,7 +128,8 @@ Mesh make_grotto_room(const GrottoRoomParams& p) {
         for (int i = 0; i < seg; ++i) {
             const double theta = theta_of(i);
             const double r = wall_radius(theta, 0) * k / floor_rings;
-            floor_grid[static_cast<std::size_t>(k - 1) * seg + i] = add_vertex(mesh, r * std::sin(theta), 0, r * std::cos(theta));
+            floor_grid[static_cast<std::size_t>(k - 1) * seg + i] =
+                add_vertex(mesh, r * std::sin(theta), 0, r * std::cos(theta));
         }
     }
     const Eigen::Vector3f up(0, 1, 0);

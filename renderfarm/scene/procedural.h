@@ -16,13 +16,13 @@ namespace mogao {
 // height (deterministic value noise, amplitude `roughness` * radius), a domed ceiling, and an
 // entrance gap of `entrance_deg` centred on +z (where the sun comes in). Faces point inward.
 struct GrottoRoomParams {
-    double radius = 7.0;          // metres, (0.5, 1000]
-    double height = 5.0;          // wall height before the dome, (0.5, 1000]
-    double dome_height = 2.0;     // [0, 1000]
-    double entrance_deg = 40.0;   // [0, 180)
-    int segments = 512;           // around the axis, [8, 65536]
-    int rings = 128;              // up the wall, [1, 65536]
-    double roughness = 0.03;      // [0, 0.2]
+    double radius = 7.0;         // metres, (0.5, 1000]
+    double height = 5.0;         // wall height before the dome, (0.5, 1000]
+    double dome_height = 2.0;    // [0, 1000]
+    double entrance_deg = 40.0;  // [0, 180)
+    int segments = 512;          // around the axis, [8, 65536]
+    int rings = 128;             // up the wall, [1, 65536]
+    double roughness = 0.03;     // [0, 0.2]
     std::uint32_t seed = 7;
 };
 [[nodiscard]] Mesh make_grotto_room(const GrottoRoomParams& params);

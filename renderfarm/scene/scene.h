@@ -24,15 +24,15 @@ using Rgb = Eigen::Vector3f;  // linear RGB
 
 struct Material {
     std::string name;
-    Rgb albedo{0.7f, 0.7f, 0.7f};   // diffuse reflectance, each channel in [0, 1]
-    Rgb specular{0.f, 0.f, 0.f};    // Blinn-Phong specular reflectance; zero = no glossy term
-    float shininess = 32.f;         // Blinn-Phong exponent
+    Rgb albedo{0.7f, 0.7f, 0.7f};  // diffuse reflectance, each channel in [0, 1]
+    Rgb specular{0.f, 0.f, 0.f};   // Blinn-Phong specular reflectance; zero = no glossy term
+    float shininess = 32.f;        // Blinn-Phong exponent
 };
 
 struct Instance {
     std::string name;
-    std::size_t mesh = 0;                 // index into Scene::meshes
-    std::size_t material = 0;             // index into Scene::materials
+    std::size_t mesh = 0;      // index into Scene::meshes
+    std::size_t material = 0;  // index into Scene::materials
     Eigen::Affine3d object_to_world = Eigen::Affine3d::Identity();
 };
 
@@ -57,7 +57,7 @@ struct AreaLight {
     Eigen::Vector3d corner{0.0, 3.0, 0.0};
     Eigen::Vector3d edge_u{1.0, 0.0, 0.0};
     Eigen::Vector3d edge_v{0.0, 0.0, 1.0};
-    Rgb radiance{5.f, 5.f, 5.f};              // W/(sr·m²) per channel
+    Rgb radiance{5.f, 5.f, 5.f};  // W/(sr·m²) per channel
     bool cast_shadows = true;
 };
 
@@ -71,17 +71,17 @@ struct EnvironmentLight {
 enum class ToneMap { clamp, reinhard, aces };
 
 struct Scene {
-    std::string source;                        // scene file path, for messages
+    std::string source;  // scene file path, for messages
     std::vector<Mesh> meshes;
-    std::vector<Material> materials;           // at least one
+    std::vector<Material> materials;  // at least one
     std::vector<Instance> instances;
     std::vector<DirectionalLight> directional_lights;
     std::vector<PointLight> point_lights;
     std::vector<AreaLight> area_lights;
     std::vector<EnvironmentLight> environment_lights;
     Viewer viewer;
-    float exposure = 1.f;                      // multiplies radiance before the sRGB transfer
-    ToneMap tone_map = ToneMap::clamp;         // scene file "tone_map": "clamp" | "reinhard" | "aces"
+    float exposure = 1.f;               // multiplies radiance before the sRGB transfer
+    ToneMap tone_map = ToneMap::clamp;  // scene file "tone_map": "clamp" | "reinhard" | "aces"
     // Scene file "robust_intersection": build every mesh BVH with Embree's RTC_SCENE_FLAG_ROBUST,
     // whose triangle test is watertight along shared edges and vertices. Off by default (14-22 %
     // slower): without it about 4 % of rays aimed exactly at the edges/vertices of a closed
@@ -89,7 +89,7 @@ struct Scene {
     // from inside where a speck of sky through an edge would show.
     bool robust_intersection = false;
 
-    [[nodiscard]] std::size_t triangle_count() const;   // summed over instances
+    [[nodiscard]] std::size_t triangle_count() const;  // summed over instances
 };
 
 }  // namespace mogao

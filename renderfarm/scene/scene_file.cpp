@@ -24,9 +24,7 @@ using Clock = std::chrono::steady_clock;
 constexpr double kMaxCoordinate = 1e9;  // metres; beyond this float BLAS + double rebasing lose meaning
 constexpr std::size_t kMaxInstances = 1'000'000;
 
-double seconds_since(Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-}
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 // Reads typed fields and turns every problem into a SceneError naming file and field.
 class FieldReader {
@@ -154,7 +152,8 @@ private:
     }
 
     void parse_meshes(const json& meshes) {
-        if (!meshes.is_object() || meshes.empty()) fields_.fail("meshes", "expected a non-empty object of named meshes");
+        if (!meshes.is_object() || meshes.empty())
+            fields_.fail("meshes", "expected a non-empty object of named meshes");
         for (auto it = meshes.begin(); it != meshes.end(); ++it) {
             const std::string field = "meshes." + it.key();
             const auto start = Clock::now();
@@ -163,8 +162,8 @@ private:
             // Keep float coordinates small: the bounding-box centre moves into the transforms.
             const Eigen::Vector3d centre = recentre_mesh(mesh);
             if (report_)
-                report_->meshes.push_back({it.key(), mesh.source, mesh.triangle_count(), mesh.positions.size(),
-                                           seconds_since(start)});
+                report_->meshes.push_back(
+                    {it.key(), mesh.source, mesh.triangle_count(), mesh.positions.size(), seconds_since(start)});
             mesh_index_[it.key()] = scene_.meshes.size();
             mesh_centre_.push_back(centre);
             scene_.meshes.push_back(std::move(mesh));
@@ -178,10 +177,11 @@ private:
             std::filesystem::path path = expand_scans(fields_.string(spec["file"], field + ".file"), scans_);
             if (path.is_relative()) path = origin_.parent_path() / path;
             if (!std::filesystem::exists(path))
-                fields_.fail(field + ".file", fmt::format("{} does not exist{}", path.string(),
-                                                          spec["file"].get<std::string>().find("{scans}") != std::string::npos
-                                                              ? " (set MOGAO_SCANS_DIR or --scans to the scans folder)"
-                                                              : ""));
+                fields_.fail(field + ".file",
+                             fmt::format("{} does not exist{}", path.string(),
+                                         spec["file"].get<std::string>().find("{scans}") != std::string::npos
+                                             ? " (set MOGAO_SCANS_DIR or --scans to the scans folder)"
+                                             : ""));
             try {
                 return load_mesh(path);
             } catch (const std::exception& e) {
@@ -191,8 +191,9 @@ private:
         const std::string kind = fields_.string(fields_.member(spec, field, "procedural"), field + ".procedural");
         try {
             if (kind == "grotto_room") {
-                fields_.only_keys(spec, field, {"procedural", "radius", "height", "dome_height", "entrance_deg",
-                                                "segments", "rings", "roughness", "seed"});
+                fields_.only_keys(spec, field,
+                                  {"procedural", "radius", "height", "dome_height", "entrance_deg", "segments", "rings",
+                                   "roughness", "seed"});
                 GrottoRoomParams p;
                 p.radius = fields_.number_or(spec, field, "radius", p.radius, -1e300, 1e300);
                 p.height = fields_.number_or(spec, field, "height", p.height, -1e300, 1e300);
@@ -201,12 +202,14 @@ private:
                 p.segments = fields_.integer_or(spec, field, "segments", p.segments, 0, 1 << 30);
                 p.rings = fields_.integer_or(spec, field, "rings", p.rings, 0, 1 << 30);
                 p.roughness = fields_.number_or(spec, field, "roughness", p.roughness, -1e300, 1e300);
-                p.seed = static_cast<std::uint32_t>(fields_.integer_or(spec, field, "seed", static_cast<int>(p.seed), 0, 1 << 30));
+                p.seed = static_cast<std::uint32_t>(
+                    fields_.integer_or(spec, field, "seed", static_cast<int>(p.seed), 0, 1 << 30));
                 return make_grotto_room(p);
             }
             if (kind == "box") {
                 fields_.only_keys(spec, field, {"procedural", "size"});
-                const Eigen::Vector3d s = fields_.vec3(fields_.member(spec, field, "size"), field + ".size", -1e300, 1e300);
+                const Eigen::Vector3d s =
+                    fields_.vec3(fields_.member(spec, field, "size"), field + ".size", -1e300, 1e300);
                 return make_box(s.x(), s.y(), s.z());
             }
             if (kind == "uv_sphere") {
@@ -239,7 +242,8 @@ private:
             Material material{it.key()};
             material.albedo = fields_.colour_or(m, field, "albedo", material.albedo, 1.0);
             material.specular = fields_.colour_or(m, field, "specular", material.specular, 1.0);
-            material.shininess = static_cast<float>(fields_.number_or(m, field, "shininess", material.shininess, 1, 1e5));
+            material.shininess =
+                static_cast<float>(fields_.number_or(m, field, "shininess", material.shininess, 1, 1e5));
             material_index_[it.key()] = scene_.materials.size();
             if (it.key() == "default") scene_.materials[0] = material;
             else scene_.materials.push_back(material);
@@ -259,7 +263,8 @@ private:
         const Eigen::Matrix3d linear =
             rotation_xyz_deg(fields_.vec3_or(t, field, "rotate_deg", Eigen::Vector3d::Zero(), -1e6, 1e6)) *
             scale.asDiagonal();
-        Eigen::Vector3d translate = fields_.vec3_or(t, field, "translate", Eigen::Vector3d::Zero(), -kMaxCoordinate, kMaxCoordinate);
+        Eigen::Vector3d translate =
+            fields_.vec3_or(t, field, "translate", Eigen::Vector3d::Zero(), -kMaxCoordinate, kMaxCoordinate);
         const std::string anchor = t.contains("anchor") ? fields_.string(t["anchor"], field + ".anchor") : "origin";
         if (anchor == "base") {
             Eigen::AlignedBox3d box;
@@ -286,9 +291,11 @@ private:
             instance.name = o.contains("name") ? fields_.string(o["name"], field + ".name") : field;
             const std::string mesh_name = fields_.string(fields_.member(o, field, "mesh"), field + ".mesh");
             auto mesh = mesh_index_.find(mesh_name);
-            if (mesh == mesh_index_.end()) fields_.fail(field + ".mesh", "no mesh named \"" + mesh_name + "\" in meshes");
+            if (mesh == mesh_index_.end())
+                fields_.fail(field + ".mesh", "no mesh named \"" + mesh_name + "\" in meshes");
             instance.mesh = mesh->second;
-            const std::string material_name = o.contains("material") ? fields_.string(o["material"], field + ".material") : "default";
+            const std::string material_name =
+                o.contains("material") ? fields_.string(o["material"], field + ".material") : "default";
             auto material = material_index_.find(material_name);
             if (material == material_index_.end())
                 fields_.fail(field + ".material", "no material named \"" + material_name + "\" in materials");
@@ -317,7 +324,8 @@ private:
         if (!ring.is_object()) fields_.fail(field, "expected an object");
         fields_.only_keys(ring, field, {"count", "radius", "start_deg", "end_deg", "heights"});
         const int count = fields_.integer_or(ring, field, "count", 8, 1, 100000);
-        const double radius = fields_.number(fields_.member(ring, field, "radius"), field + ".radius", 0, kMaxCoordinate);
+        const double radius =
+            fields_.number(fields_.member(ring, field, "radius"), field + ".radius", 0, kMaxCoordinate);
         const double start = fields_.number_or(ring, field, "start_deg", 0, -720, 720);
         const double end = fields_.number_or(ring, field, "end_deg", 360.0 * (count - 1) / count, -720, 720);
         std::vector<double> heights{0.0};
@@ -326,7 +334,8 @@ private:
             if (!h.is_array() || h.empty()) fields_.fail(field + ".heights", "expected a non-empty array of numbers");
             heights.clear();
             for (std::size_t k = 0; k < h.size(); ++k)
-                heights.push_back(fields_.number(h[k], fmt::format("{}.heights[{}]", field, k), -kMaxCoordinate, kMaxCoordinate));
+                heights.push_back(
+                    fields_.number(h[k], fmt::format("{}.heights[{}]", field, k), -kMaxCoordinate, kMaxCoordinate));
         }
         const double k = std::numbers::pi / 180;
         for (std::size_t tier = 0; tier < heights.size(); ++tier) {
@@ -334,9 +343,11 @@ private:
                 const double deg = count == 1 ? start : start + (end - start) * i / (count - 1);
                 const double theta = deg * k;
                 Eigen::Affine3d place = Eigen::Affine3d::Identity();
-                place.translation() = Eigen::Vector3d(radius * std::sin(theta), heights[tier], radius * std::cos(theta));
+                place.translation() =
+                    Eigen::Vector3d(radius * std::sin(theta), heights[tier], radius * std::cos(theta));
                 // Objects face +z in their own frame; turn them to face the axis.
-                place.linear() = Eigen::AngleAxisd(theta + std::numbers::pi, Eigen::Vector3d::UnitY()).toRotationMatrix();
+                place.linear() =
+                    Eigen::AngleAxisd(theta + std::numbers::pi, Eigen::Vector3d::UnitY()).toRotationMatrix();
                 Instance copy = prototype;
                 copy.name = fmt::format("{}#{}.{}", prototype.name, tier, i);
                 add_instance(std::move(copy), place * local, field);
@@ -363,14 +374,16 @@ private:
             } else if (type == "point") {
                 fields_.only_keys(l, field, {"type", "position", "intensity", "cast_shadows"});
                 PointLight point;
-                point.position = fields_.vec3(fields_.member(l, field, "position"), field + ".position", -kMaxCoordinate, kMaxCoordinate);
+                point.position = fields_.vec3(fields_.member(l, field, "position"), field + ".position",
+                                              -kMaxCoordinate, kMaxCoordinate);
                 point.intensity = fields_.colour_or(l, field, "intensity", point.intensity, 1e9);
                 point.cast_shadows = fields_.boolean_or(l, field, "cast_shadows", true);
                 scene_.point_lights.push_back(point);
             } else if (type == "area") {
                 fields_.only_keys(l, field, {"type", "corner", "edge_u", "edge_v", "radiance", "cast_shadows"});
                 AreaLight area;
-                area.corner = fields_.vec3(fields_.member(l, field, "corner"), field + ".corner", -kMaxCoordinate, kMaxCoordinate);
+                area.corner = fields_.vec3(fields_.member(l, field, "corner"), field + ".corner", -kMaxCoordinate,
+                                           kMaxCoordinate);
                 area.edge_u = fields_.vec3(fields_.member(l, field, "edge_u"), field + ".edge_u", -1e6, 1e6);
                 area.edge_v = fields_.vec3(fields_.member(l, field, "edge_v"), field + ".edge_v", -1e6, 1e6);
                 if (area.edge_u.cross(area.edge_v).norm() < 1e-12)
@@ -384,7 +397,8 @@ private:
                 env.radiance = fields_.colour_or(l, field, "radiance", env.radiance, 1e6);
                 scene_.environment_lights.push_back(env);
             } else {
-                fields_.fail(field + ".type", "unknown light type \"" + type + "\" (expected sun, point, area or environment)");
+                fields_.fail(field + ".type",
+                             "unknown light type \"" + type + "\" (expected sun, point, area or environment)");
             }
         }
     }
@@ -392,8 +406,10 @@ private:
     void parse_viewer(const json& v) {
         if (!v.is_object()) fields_.fail("viewer", "expected an object");
         fields_.only_keys(v, "viewer", {"eye_height", "start", "start_yaw_deg", "visitable"});
-        scene_.viewer.eye_height_m = fields_.number_or(v, "viewer", "eye_height", scene_.viewer.eye_height_m, 0.01, 100);
-        scene_.viewer.start = fields_.vec3_or(v, "viewer", "start", scene_.viewer.start, -kMaxCoordinate, kMaxCoordinate);
+        scene_.viewer.eye_height_m =
+            fields_.number_or(v, "viewer", "eye_height", scene_.viewer.eye_height_m, 0.01, 100);
+        scene_.viewer.start =
+            fields_.vec3_or(v, "viewer", "start", scene_.viewer.start, -kMaxCoordinate, kMaxCoordinate);
         scene_.viewer.start_yaw_deg = fields_.number_or(v, "viewer", "start_yaw_deg", 0, -3600, 3600);
         if (v.contains("visitable")) scene_.viewer.visitable = parse_visitable(v["visitable"]);
     }
@@ -449,7 +465,8 @@ std::filesystem::path resolve_scans_dir(const std::filesystem::path& scene_file,
     // Absolute, so that "{scans}/x.obj" is not joined to the scene's folder a second time.
     if (!options.scans_dir.empty()) return std::filesystem::absolute(options.scans_dir);
     if (const char* env = std::getenv("MOGAO_SCANS_DIR"); env && *env) return std::filesystem::absolute(env);
-    return std::filesystem::absolute(scene_file.parent_path() / ".." / ".." / "shared" / "data" / "scans").lexically_normal();
+    return std::filesystem::absolute(scene_file.parent_path() / ".." / ".." / "shared" / "data" / "scans")
+        .lexically_normal();
 }
 
 Scene parse_scene(const std::string& json_text, const std::filesystem::path& origin, const SceneLoadOptions& options,

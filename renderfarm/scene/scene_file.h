@@ -37,8 +37,8 @@ struct MeshLoadFigures {
 
 struct SceneLoadReport {
     std::vector<MeshLoadFigures> meshes;
-    std::size_t instanced_triangles = 0;   // Scene::triangle_count()
-    double seconds = 0.0;                  // whole load, parsing included
+    std::size_t instanced_triangles = 0;  // Scene::triangle_count()
+    double seconds = 0.0;                 // whole load, parsing included
 };
 
 [[nodiscard]] Scene load_scene(const std::filesystem::path& file, const SceneLoadOptions& options = {},

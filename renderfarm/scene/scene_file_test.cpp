@@ -129,10 +129,10 @@ TEST(SceneFile, FarFromOriginMeshesAreRecentredWithoutLosingPlacement) {
 }
 
 TEST(SceneFile, RingMakesCopiesFacingTheAxis) {
-    const Scene scene = parse_scene(
-        minimal(
-            R"([ { "mesh": "ball", "ring": { "count": 5, "radius": 4, "start_deg": -90, "end_deg": 90, "heights": [0, 2] } } ])"),
-        kOrigin);
+    const Scene scene =
+        parse_scene(minimal(R"([ { "mesh": "ball", "ring": { "count": 5, "radius": 4, "start_deg": -90, "end_deg": 90,)"
+                            R"( "heights": [0, 2] } } ])"),
+                    kOrigin);
     ASSERT_EQ(scene.instances.size(), 10u);
     for (const Instance& instance : scene.instances) {
         const Eigen::Vector3d c = instance.object_to_world.translation();

@@ -17,9 +17,7 @@ CostMap three_cells() {
     return map;
 }
 
-Assignment one_cell_per_rank() {
-    return {{{{0, 0, 16, 16}}, {{16, 0, 32, 16}}, {{32, 0, 48, 16}}}, {0.0, 0.0, 0.0}};
-}
+Assignment one_cell_per_rank() { return {{{{0, 0, 16, 16}}, {{16, 0, 32, 16}}, {{32, 0, 48, 16}}}, {0.0, 0.0, 0.0}}; }
 
 TEST(BalanceEfficiency, MeanOverMax) {
     EXPECT_DOUBLE_EQ(balance_efficiency(one_cell_per_rank(), three_cells()), 2.0 / 3.0);

@@ -84,18 +84,20 @@ std::string ratio_text(std::optional<double> num, std::optional<double> den) {
 }  // namespace
 
 std::string balance_table_markdown(std::span<const BalanceSimResult> results) {
-    std::string out = "| ranks | balancer | frames | mean efficiency | min efficiency | rects per rank |\n"
-                      "|------:|----------|-------:|----------------:|---------------:|---------------:|\n";
+    std::string out =
+        "| ranks | balancer | frames | mean efficiency | min efficiency | rects per rank |\n"
+        "|------:|----------|-------:|----------------:|---------------:|---------------:|\n";
     std::vector<int> rank_counts;
     for (const auto& r : results) {
-        out += fmt::format("| {} | {} | {} | {:.3f} | {:.3f} | {:.1f} |\n", r.ranks, r.balancer,
-                           r.efficiency.size(), r.mean_efficiency, r.min_efficiency, r.mean_rects_per_rank);
+        out += fmt::format("| {} | {} | {} | {:.3f} | {:.3f} | {:.1f} |\n", r.ranks, r.balancer, r.efficiency.size(),
+                           r.mean_efficiency, r.min_efficiency, r.mean_rects_per_rank);
         if (std::find(rank_counts.begin(), rank_counts.end(), r.ranks) == rank_counts.end()) {
             rank_counts.push_back(r.ranks);
         }
     }
-    out += "\n| ranks | pbt/equal (mean) | pbt/roundrobin (mean) |\n"
-           "|------:|-----------------:|----------------------:|\n";
+    out +=
+        "\n| ranks | pbt/equal (mean) | pbt/roundrobin (mean) |\n"
+        "|------:|-----------------:|----------------------:|\n";
     for (const int n : rank_counts) {
         const auto pbt = mean_of(results, n, "pbt");
         out += fmt::format("| {} | {} | {} |\n", n, ratio_text(pbt, mean_of(results, n, "equal")),
@@ -109,7 +111,8 @@ std::vector<CostMap> moving_hotspot_frames(const MovingHotspot& spec) {
         throw std::invalid_argument(fmt::format("MovingHotspot.frames must be >= 0 (got {})", spec.frames));
     }
     if (!(spec.sigma_px > 0.0) || !std::isfinite(spec.sigma_px)) {
-        throw std::invalid_argument(fmt::format("MovingHotspot.sigma_px must be finite and > 0 (got {})", spec.sigma_px));
+        throw std::invalid_argument(
+            fmt::format("MovingHotspot.sigma_px must be finite and > 0 (got {})", spec.sigma_px));
     }
     if (!(spec.peak_ratio >= 0.0) || !std::isfinite(spec.peak_ratio) || !std::isfinite(spec.speed_px_per_frame)) {
         throw std::invalid_argument("MovingHotspot.peak_ratio must be finite and >= 0, speed_px_per_frame finite");
@@ -129,7 +132,8 @@ std::vector<CostMap> moving_hotspot_frames(const MovingHotspot& spec) {
                 const PixelRect r = map.cell_rect(i, j);
                 const double dx = (r.x0 + r.x1) / 2.0 - hx;
                 const double dy = (r.y0 + r.y1) / 2.0 - hy;
-                const double hot = spec.peak_ratio * std::exp(-(dx * dx + dy * dy) / (2.0 * spec.sigma_px * spec.sigma_px));
+                const double hot =
+                    spec.peak_ratio * std::exp(-(dx * dx + dy * dy) / (2.0 * spec.sigma_px * spec.sigma_px));
                 map.set_cell(i, j, spec.background_seconds_per_pixel * (1.0 + hot) * static_cast<double>(r.area()));
             }
         }

@@ -18,10 +18,10 @@
 namespace mogao {
 
 struct BalanceSimOptions {
-    std::vector<int> rank_counts{4, 8, 16};                    // each in [1, LoadBalancer::kMaxRanks]
+    std::vector<int> rank_counts{4, 8, 16};                            // each in [1, LoadBalancer::kMaxRanks]
     std::vector<std::string> balancers{"pbt", "equal", "roundrobin"};  // make_load_balancer names
-    int snap = 16;  // pixels, for "pbt" and "equal"
-    int tile = 32;  // pixels, for "roundrobin"
+    int snap = 16;                                                     // pixels, for "pbt" and "equal"
+    int tile = 32;                                                     // pixels, for "roundrobin"
 };
 
 // One balancer at one rank count over the whole sequence.
@@ -50,12 +50,12 @@ struct BalanceSimResult {
 // background plus a Gaussian hot spot circling the image centre at radius 0.3*min(width, height).
 struct MovingHotspot {
     ImageSize image{1920, 1080};
-    int cell_size = 16;                        // pixels
+    int cell_size = 16;  // pixels
     int frames = 30;
     double background_seconds_per_pixel = 1e-7;
-    double peak_ratio = 20.0;                  // hot spot centre cost per pixel / background, >= 0
-    double sigma_px = 100.0;                   // Gaussian radius, pixels, > 0
-    double speed_px_per_frame = 8.0;           // along the circle; small = slowly moving costs
+    double peak_ratio = 20.0;         // hot spot centre cost per pixel / background, >= 0
+    double sigma_px = 100.0;          // Gaussian radius, pixels, > 0
+    double speed_px_per_frame = 8.0;  // along the circle; small = slowly moving costs
 };
 [[nodiscard]] std::vector<CostMap> moving_hotspot_frames(const MovingHotspot& spec);
 

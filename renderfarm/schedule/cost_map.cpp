@@ -19,9 +19,7 @@ void check_seconds(double seconds, const char* field) {
     }
 }
 
-bool inside(const PixelRect& r, ImageSize s) {
-    return r.x0 >= 0 && r.y0 >= 0 && r.x1 <= s.width && r.y1 <= s.height;
-}
+bool inside(const PixelRect& r, ImageSize s) { return r.x0 >= 0 && r.y0 >= 0 && r.x1 <= s.width && r.y1 <= s.height; }
 
 std::string rect_text(const PixelRect& r) { return fmt::format("[{},{})x[{},{})", r.x0, r.x1, r.y0, r.y1); }
 
@@ -79,9 +77,9 @@ CostMap CostMap::from_tile_times(ImageSize image, int cell_size, std::span<const
         check_seconds(tile.seconds, "TileTime.seconds");
         if (tile.rect.empty()) {
             if (tile.seconds > 0.0) {
-                throw std::invalid_argument(fmt::format(
-                    "TileTime.rect of tile {} is empty {} but has {} s: its time cannot be placed", t,
-                    rect_text(tile.rect), tile.seconds));
+                throw std::invalid_argument(
+                    fmt::format("TileTime.rect of tile {} is empty {} but has {} s: its time cannot be placed", t,
+                                rect_text(tile.rect), tile.seconds));
             }
             continue;
         }
@@ -166,7 +164,9 @@ double CostMap::prefix(int x, int y) const {
     const double fx = locate(x, size_.width, cells_x_, i0);
     const double fy = locate(y, size_.height, cells_y_, j0);
     const auto stride = static_cast<std::size_t>(cells_x_) + 1;
-    const auto at = [&](int i, int j) { return sat_[static_cast<std::size_t>(j) * stride + static_cast<std::size_t>(i)]; };
+    const auto at = [&](int i, int j) {
+        return sat_[static_cast<std::size_t>(j) * stride + static_cast<std::size_t>(i)];
+    };
     double value = at(i0, j0);
     if (fx > 0.0) {
         value += fx * (at(i0 + 1, j0) - at(i0, j0));
@@ -189,8 +189,8 @@ double CostMap::sum(const PixelRect& rect) const {
                                                 rect_text(rect), size_.width, size_.height));
     }
     finalize();
-    const double s = prefix(rect.x1, rect.y1) - prefix(rect.x0, rect.y1) - prefix(rect.x1, rect.y0) +
-                     prefix(rect.x0, rect.y0);
+    const double s =
+        prefix(rect.x1, rect.y1) - prefix(rect.x0, rect.y1) - prefix(rect.x1, rect.y0) + prefix(rect.x0, rect.y0);
     // Costs are >= 0; a tiny negative value is rounding in the table differences.
     return std::max(0.0, s);
 }

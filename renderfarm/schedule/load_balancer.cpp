@@ -16,8 +16,7 @@ std::vector<std::string_view> load_balancer_names() { return {"pbt", "equal", "r
 
 void check_rank_count(int ranks) {
     if (ranks < 1 || ranks > LoadBalancer::kMaxRanks) {
-        throw std::invalid_argument(
-            fmt::format("ranks must be in [1, {}] (got {})", LoadBalancer::kMaxRanks, ranks));
+        throw std::invalid_argument(fmt::format("ranks must be in [1, {}] (got {})", LoadBalancer::kMaxRanks, ranks));
     }
 }
 
@@ -31,8 +30,8 @@ std::unique_ptr<LoadBalancer> make_load_balancer(std::string_view name, int snap
     if (name == "roundrobin") {
         return std::make_unique<RoundRobinBalancer>(snap_or_tile);
     }
-    throw std::invalid_argument(fmt::format("load balancer name must be one of {} (got \"{}\")",
-                                            fmt::join(load_balancer_names(), ", "), name));
+    throw std::invalid_argument(
+        fmt::format("load balancer name must be one of {} (got \"{}\")", fmt::join(load_balancer_names(), ", "), name));
 }
 
 }  // namespace mogao

@@ -11,8 +11,8 @@
 #include <string_view>
 #include <vector>
 
-#include "renderfarm/schedule/cost_map.h"
 #include "common/pixel_rect.h"
+#include "renderfarm/schedule/cost_map.h"
 
 namespace mogao {
 

@@ -110,8 +110,7 @@ int PredictionBinaryTree::build(const CostMap& map, const PixelRect& rect, int l
     const Cut cut = choose_cut(map, rect, leaves, node.predicted_cost, zero_cost, snap_);
     const int n_low = leaves / 2;
     const int low = build(map, low_part(rect, cut.axis, cut.position), n_low, first_rank, zero_cost);
-    const int high =
-        build(map, high_part(rect, cut.axis, cut.position), leaves - n_low, first_rank + n_low, zero_cost);
+    const int high = build(map, high_part(rect, cut.axis, cut.position), leaves - n_low, first_rank + n_low, zero_cost);
     PbtNode& stored = nodes_[static_cast<std::size_t>(index)];  // re-fetched: recursion grew the vector
     stored.axis = cut.axis;
     stored.split = cut.position;

@@ -37,9 +37,9 @@
 #include <string_view>
 #include <vector>
 
+#include "common/pixel_rect.h"
 #include "renderfarm/schedule/cost_map.h"
 #include "renderfarm/schedule/load_balancer.h"
-#include "common/pixel_rect.h"
 
 namespace mogao {
 
@@ -50,13 +50,13 @@ enum class SplitAxis {
 };
 
 struct PbtNode {
-    PixelRect rect;                   // pixels covered by this node
-    int leaves = 1;                   // ranks under this node
-    int first_rank = 0;               // its leaves are ranks first_rank .. first_rank + leaves - 1
+    PixelRect rect;      // pixels covered by this node
+    int leaves = 1;      // ranks under this node
+    int first_rank = 0;  // its leaves are ranks first_rank .. first_rank + leaves - 1
     SplitAxis axis = SplitAxis::none;
-    int split = 0;                    // absolute pixel coordinate of the cut; 0 for leaves
-    double predicted_cost = 0.0;      // seconds, CostMap::sum(rect) of the map the tree was built from
-    bool area_fallback = false;       // cut by pixel area because the node predicted zero cost
+    int split = 0;                        // absolute pixel coordinate of the cut; 0 for leaves
+    double predicted_cost = 0.0;          // seconds, CostMap::sum(rect) of the map the tree was built from
+    bool area_fallback = false;           // cut by pixel area because the node predicted zero cost
     std::array<int, 2> children{-1, -1};  // indices into nodes(): low side, high side; -1 for leaves
 };
 
@@ -70,7 +70,7 @@ public:
     [[nodiscard]] const std::vector<PbtNode>& nodes() const { return nodes_; }  // [0] is the root, pre-order
     [[nodiscard]] int ranks() const { return static_cast<int>(leaf_of_rank_.size()); }
     [[nodiscard]] int snap() const { return snap_; }
-    [[nodiscard]] const PbtNode& leaf(int rank) const;  // throws std::invalid_argument if rank is out of range
+    [[nodiscard]] const PbtNode& leaf(int rank) const;        // throws std::invalid_argument if rank is out of range
     [[nodiscard]] std::vector<PixelRect> leaf_rects() const;  // index = rank
 
 private:

@@ -38,8 +38,8 @@ int integer(const json& value, const std::string& field, int min) {
 
 TileTime parse_tile(const json& value, const std::string& where) {
     if (!value.is_array() || value.size() != 5) {
-        throw std::invalid_argument(
-            fmt::format("tile-costs.json: {} must be an array [x0, y0, x1, y1, seconds] (got {})", where, value.dump()));
+        throw std::invalid_argument(fmt::format(
+            "tile-costs.json: {} must be an array [x0, y0, x1, y1, seconds] (got {})", where, value.dump()));
     }
     TileTime tile;
     tile.rect = {integer(value[0], where + "[0] (x0)", 0), integer(value[1], where + "[1] (y0)", 0),

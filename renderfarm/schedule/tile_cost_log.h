@@ -20,8 +20,8 @@ namespace mogao {
 
 struct TileCostLog {
     ImageSize image;
-    int cell_size = CostMap::kDefaultCellSize;      // pixels, >= 1
-    std::vector<std::vector<TileTime>> frames;      // per frame, its tiles
+    int cell_size = CostMap::kDefaultCellSize;  // pixels, >= 1
+    std::vector<std::vector<TileTime>> frames;  // per frame, its tiles
 };
 
 // Parses and validates the JSON text. Throws std::invalid_argument naming the JSON field and the

@@ -69,8 +69,8 @@ TEST(TileCostLog, BadContentNamesTheField) {
     const std::string neg = message_of(
         R"({"image": {"width": 4, "height": 4}, "cell_size": 16, "frames": [{"tiles": [[0, 0, 4, 4, -1]]}]})");
     EXPECT_NE(neg.find("frames[0].tiles[0][4] (seconds)"), std::string::npos) << neg;
-    const std::string arity = message_of(
-        R"({"image": {"width": 4, "height": 4}, "cell_size": 16, "frames": [{}, {"tiles": [[0, 0, 4]]}]})");
+    const std::string arity =
+        message_of(R"({"image": {"width": 4, "height": 4}, "cell_size": 16, "frames": [{}, {"tiles": [[0, 0, 4]]}]})");
     EXPECT_NE(arity.find("frames[0]"), std::string::npos) << arity;  // frame 0 lacks "tiles"
     const std::string outside = message_of(
         R"({"image": {"width": 4, "height": 4}, "cell_size": 16, "frames": [{"tiles": [[0, 0, 8, 4, 1]]}]})");

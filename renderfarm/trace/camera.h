@@ -35,10 +35,10 @@ struct Ray {
 // Everything generate_ray needs, precomputed once per frame.
 struct CameraSetup {
     CameraModel model;
-    ImageSize size;                 // render size (after resolution_scale)
-    Eigen::Vector3d eye;            // pose.eye, world metres
-    Eigen::Matrix3d rotation;       // R = Ry(yaw) Rx(pitch): camera/screen frame -> world
-    double tan_half_fov = 0.0;      // pinhole only
+    ImageSize size;             // render size (after resolution_scale)
+    Eigen::Vector3d eye;        // pose.eye, world metres
+    Eigen::Matrix3d rotation;   // R = Ry(yaw) Rx(pitch): camera/screen frame -> world
+    double tan_half_fov = 0.0;  // pinhole only
 };
 
 // Rotation of a pose (see above). Angles in degrees.

@@ -88,11 +88,11 @@ TEST(CylinderCamera, CornersAndCentreHitTheScreenFromThePhysicalEye) {
         double px, py;
         Eigen::Vector3d screen;
     } cases[] = {
-        {0.0, 0.0, {-3.0, 2.5, 0.0}},    // top-left
-        {360.0, 0.0, {3.0, 2.5, 0.0}},   // top-right
-        {0.0, 120.0, {-3.0, 0.0, 0.0}},  // bottom-left
-        {360.0, 120.0, {3.0, 0.0, 0.0}}, // bottom-right
-        {180.0, 60.0, {0.0, 1.25, -3.0}}, // centre: middle of the arc, mid height
+        {0.0, 0.0, {-3.0, 2.5, 0.0}},      // top-left
+        {360.0, 0.0, {3.0, 2.5, 0.0}},     // top-right
+        {0.0, 120.0, {-3.0, 0.0, 0.0}},    // bottom-left
+        {360.0, 120.0, {3.0, 0.0, 0.0}},   // bottom-right
+        {180.0, 60.0, {0.0, 1.25, -3.0}},  // centre: middle of the arc, mid height
     };
     for (const auto& c : cases) {
         const Ray ray = generate_ray(cam, c.px, c.py);

@@ -16,13 +16,20 @@ void record_error(void* /*user*/, RTCError /*code*/, const char* message) {
 
 const char* error_name(RTCError code) {
     switch (code) {
-        case RTC_ERROR_NONE: return "RTC_ERROR_NONE";
-        case RTC_ERROR_UNKNOWN: return "RTC_ERROR_UNKNOWN";
-        case RTC_ERROR_INVALID_ARGUMENT: return "RTC_ERROR_INVALID_ARGUMENT";
-        case RTC_ERROR_INVALID_OPERATION: return "RTC_ERROR_INVALID_OPERATION";
-        case RTC_ERROR_OUT_OF_MEMORY: return "RTC_ERROR_OUT_OF_MEMORY";
-        case RTC_ERROR_UNSUPPORTED_CPU: return "RTC_ERROR_UNSUPPORTED_CPU";
-        case RTC_ERROR_CANCELLED: return "RTC_ERROR_CANCELLED";
+        case RTC_ERROR_NONE:
+            return "RTC_ERROR_NONE";
+        case RTC_ERROR_UNKNOWN:
+            return "RTC_ERROR_UNKNOWN";
+        case RTC_ERROR_INVALID_ARGUMENT:
+            return "RTC_ERROR_INVALID_ARGUMENT";
+        case RTC_ERROR_INVALID_OPERATION:
+            return "RTC_ERROR_INVALID_OPERATION";
+        case RTC_ERROR_OUT_OF_MEMORY:
+            return "RTC_ERROR_OUT_OF_MEMORY";
+        case RTC_ERROR_UNSUPPORTED_CPU:
+            return "RTC_ERROR_UNSUPPORTED_CPU";
+        case RTC_ERROR_CANCELLED:
+            return "RTC_ERROR_CANCELLED";
     }
     return "RTC_ERROR_?";
 }

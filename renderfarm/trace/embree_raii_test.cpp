@@ -155,9 +155,7 @@ TEST(EmbreeRaii, EmbreeErrorsBecomeExceptions) {
     EXPECT_NO_THROW(device.check("nothing failed since"));
 }
 
-TEST(EmbreeRaii, BadDeviceConfigThrows) {
-    EXPECT_THROW(EmbreeDevice("threads=abc"), std::runtime_error);
-}
+TEST(EmbreeRaii, BadDeviceConfigThrows) { EXPECT_THROW(EmbreeDevice("threads=abc"), std::runtime_error); }
 
 }  // namespace
 }  // namespace mogao

@@ -20,8 +20,8 @@ int reference_code(double v) {
 TEST(Film, KnownSrgbCodes) {
     EXPECT_EQ(encode_srgb8(0.0f), 0);
     EXPECT_EQ(encode_srgb8(1.0f), 255);
-    EXPECT_EQ(encode_srgb8(0.5f), 188);   // 1.055 * 0.5^(1/2.4) - 0.055 = 0.7354 -> 187.5 -> 188
-    EXPECT_EQ(encode_srgb8(0.18f), 118);  // middle grey
+    EXPECT_EQ(encode_srgb8(0.5f), 188);       // 1.055 * 0.5^(1/2.4) - 0.055 = 0.7354 -> 187.5 -> 188
+    EXPECT_EQ(encode_srgb8(0.18f), 118);      // middle grey
     EXPECT_EQ(encode_srgb8(0.0031308f), 10);  // 12.92 * 0.0031308 * 255 = 10.3
     EXPECT_EQ(encode_srgb8(-3.0f), 0);
     EXPECT_EQ(encode_srgb8(7.0f), 255);

@@ -22,9 +22,9 @@
 namespace mogao {
 
 namespace ray_offset_constants {
-inline constexpr float kOrigin = 1.0f / 32.0f;       // below this |coordinate|, use the float offset
-inline constexpr float kFloatScale = 1.0f / 65536.0f; // metres per unit normal near zero
-inline constexpr float kIntScale = 256.0f;           // ULPs per unit normal elsewhere
+inline constexpr float kOrigin = 1.0f / 32.0f;         // below this |coordinate|, use the float offset
+inline constexpr float kFloatScale = 1.0f / 65536.0f;  // metres per unit normal near zero
+inline constexpr float kIntScale = 256.0f;             // ULPs per unit normal elsewhere
 }  // namespace ray_offset_constants
 
 [[nodiscard]] inline float offset_component(float p, float n) {

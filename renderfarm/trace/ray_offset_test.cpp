@@ -10,12 +10,13 @@ namespace mogao {
 namespace {
 
 TEST(RayOffset, MovesToThePositiveSideAtAllMagnitudes) {
-    const Eigen::Vector3f normals[] = {
-        Eigen::Vector3f(0.0f, 1.0f, 0.0f), Eigen::Vector3f(0.0f, -1.0f, 0.0f),
-        Eigen::Vector3f(1.0f, 2.0f, -3.0f).normalized(), Eigen::Vector3f(-0.6f, -0.48f, 0.64f).normalized(),
-        Eigen::Vector3f(0.001f, 1.0f, 0.0f).normalized()};
+    const Eigen::Vector3f normals[] = {Eigen::Vector3f(0.0f, 1.0f, 0.0f), Eigen::Vector3f(0.0f, -1.0f, 0.0f),
+                                       Eigen::Vector3f(1.0f, 2.0f, -3.0f).normalized(),
+                                       Eigen::Vector3f(-0.6f, -0.48f, 0.64f).normalized(),
+                                       Eigen::Vector3f(0.001f, 1.0f, 0.0f).normalized()};
     for (const float magnitude : {1e-6f, 1.0f, 1e5f}) {
-        for (const Eigen::Vector3f& sign : {Eigen::Vector3f(1, 1, 1), Eigen::Vector3f(-1, 1, -1), Eigen::Vector3f(-1, -1, 1)}) {
+        for (const Eigen::Vector3f& sign :
+             {Eigen::Vector3f(1, 1, 1), Eigen::Vector3f(-1, 1, -1), Eigen::Vector3f(-1, -1, 1)}) {
             const Eigen::Vector3f p = magnitude * sign.cwiseProduct(Eigen::Vector3f(1.0f, 0.7f, 1.3f));
             for (const Eigen::Vector3f& n : normals) {
                 const Eigen::Vector3f q = offset_ray_origin(p, n);

@@ -34,8 +34,8 @@ void validate_mesh_indices(const Scene& scene, std::size_t index, const Mesh& me
     }
     for (const auto& tri : mesh.triangles) {
         if (tri[0] >= vertex_count || tri[1] >= vertex_count || tri[2] >= vertex_count) {
-            invalid(scene, "mesh " + std::to_string(index) + " has a triangle index >= " +
-                               std::to_string(vertex_count) + " vertices");
+            invalid(scene, "mesh " + std::to_string(index) +
+                               " has a triangle index >= " + std::to_string(vertex_count) + " vertices");
         }
     }
 }
@@ -136,7 +136,8 @@ void RenderScene::commit_transforms() {
         const Eigen::Vector3d translation = xf.translation() - origin_;
         std::array<float, 12> column_major{};
         for (int c = 0; c < 3; ++c) {
-            for (int r = 0; r < 3; ++r) column_major[static_cast<std::size_t>(c * 3 + r)] = static_cast<float>(xf.linear()(r, c));
+            for (int r = 0; r < 3; ++r)
+                column_major[static_cast<std::size_t>(c * 3 + r)] = static_cast<float>(xf.linear()(r, c));
         }
         for (int r = 0; r < 3; ++r) column_major[static_cast<std::size_t>(9 + r)] = static_cast<float>(translation[r]);
         const RTCGeometry g = instance_geometry_[i].get();

@@ -31,12 +31,12 @@ namespace mogao {
 
 // A ray hit resolved for shading, in the rebased float frame.
 struct SurfaceHit {
-    Eigen::Vector3f position;          // rebased world metres (org + t dir)
-    Eigen::Vector3f geometric_normal;  // unit, facing the incoming ray
-    Eigen::Vector3f shading_normal;    // unit; interpolated vertex normal or = geometric_normal,
-                                       // flipped to the geometric normal's side
-    std::uint32_t material = 0;        // index into Scene::materials
-    bool tinted = false;               // the mesh has vertex colours or a texture
+    Eigen::Vector3f position;                        // rebased world metres (org + t dir)
+    Eigen::Vector3f geometric_normal;                // unit, facing the incoming ray
+    Eigen::Vector3f shading_normal;                  // unit; interpolated vertex normal or = geometric_normal,
+                                                     // flipped to the geometric normal's side
+    std::uint32_t material = 0;                      // index into Scene::materials
+    bool tinted = false;                             // the mesh has vertex colours or a texture
     Eigen::Vector3f tint = Eigen::Vector3f::Ones();  // linear RGB multiplying the albedo: the
                                                      // interpolated vertex colour times the texture
                                                      // filtered at the interpolated uv for the ray
@@ -72,11 +72,11 @@ private:
     struct InstanceData {
         const Mesh* mesh = nullptr;
         std::uint32_t material = 0;
-        bool smooth = false;                  // mesh has vertex normals
-        bool tinted = false;                  // mesh has vertex colours or a texture
-        Eigen::Affine3d object_to_world;      // double, world metres
-        Eigen::Matrix3f normal_matrix;        // inverse transpose of the linear part
-        Eigen::Matrix3f linear;               // the linear part (world triangle areas for texture_lod.h)
+        bool smooth = false;              // mesh has vertex normals
+        bool tinted = false;              // mesh has vertex colours or a texture
+        Eigen::Affine3d object_to_world;  // double, world metres
+        Eigen::Matrix3f normal_matrix;    // inverse transpose of the linear part
+        Eigen::Matrix3f linear;           // the linear part (world triangle areas for texture_lod.h)
     };
 
     void commit_transforms();
@@ -84,7 +84,7 @@ private:
                                                  float cone_width, float cos_incidence);
 
     EmbreeDevice device_;
-    std::vector<EmbreeScene> blas_;           // per mesh; empty owner for unused meshes
+    std::vector<EmbreeScene> blas_;  // per mesh; empty owner for unused meshes
     EmbreeScene tlas_;
     std::vector<EmbreeGeometry> instance_geometry_;  // per instance (id = instance index)
     std::vector<InstanceData> instances_;

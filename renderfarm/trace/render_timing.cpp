@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <chrono>
 #include <ctime>
-#include <memory>
 #include <limits>
+#include <memory>
 
 namespace mogao {
 namespace {
@@ -39,7 +39,8 @@ RenderTimings time_frame(Renderer& renderer, const ViewRequest& request, int rep
     t.render_s = std::numeric_limits<double>::infinity();
     // Interleave (a) and (b) so that clock or load drift affects both alike.
     for (int i = 0; i < std::max(1, repetitions); ++i) {
-        t.camera_rays_s = std::min(t.camera_rays_s, cpu_seconds([&] { t.camera_rays = renderer.trace_camera_rays(whole).rays; }));
+        t.camera_rays_s =
+            std::min(t.camera_rays_s, cpu_seconds([&] { t.camera_rays = renderer.trace_camera_rays(whole).rays; }));
         t.render_s = std::min(t.render_s, cpu_seconds([&] { t.render_rays = renderer.render(whole, frame).rays; }));
     }
     return t;

@@ -8,18 +8,18 @@
 
 #include <cstdint>
 
+#include "common/view_request.h"
 #include "renderfarm/scene/scene.h"
 #include "renderfarm/trace/renderer.h"
-#include "common/view_request.h"
 
 namespace mogao {
 
 struct RenderTimings {
-    double build_s = 0.0;              // Renderer construction (BVH builds), wall seconds; 0 if not measured
-    double camera_rays_s = 0.0;        // (a) raw Embree camera packets, CPU seconds per frame
-    double render_s = 0.0;             // (b) full render, CPU seconds per frame
-    std::uint64_t camera_rays = 0;     // rays per frame in (a)
-    std::uint64_t render_rays = 0;     // rays per frame in (b): camera + shadow + AO + bounce
+    double build_s = 0.0;           // Renderer construction (BVH builds), wall seconds; 0 if not measured
+    double camera_rays_s = 0.0;     // (a) raw Embree camera packets, CPU seconds per frame
+    double render_s = 0.0;          // (b) full render, CPU seconds per frame
+    std::uint64_t camera_rays = 0;  // rays per frame in (a)
+    std::uint64_t render_rays = 0;  // rays per frame in (b): camera + shadow + AO + bounce
     [[nodiscard]] double ratio() const { return camera_rays_s > 0.0 ? render_s / camera_rays_s : 0.0; }
 };
 

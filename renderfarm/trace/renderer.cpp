@@ -145,7 +145,8 @@ struct Renderer::Impl {
             throw std::invalid_argument("Renderer::render: rect " + describe(rect) + " is outside the render size " +
                                         std::to_string(size.width) + "x" + std::to_string(size.height));
         }
-        if (frame != nullptr && (frame->size != size || frame->pixels.size() != static_cast<std::size_t>(size.pixel_count()) * 3)) {
+        if (frame != nullptr &&
+            (frame->size != size || frame->pixels.size() != static_cast<std::size_t>(size.pixel_count()) * 3)) {
             throw std::invalid_argument("Renderer::render: frame is " + std::to_string(frame->size.width) + "x" +
                                         std::to_string(frame->size.height) + ", render size is " +
                                         std::to_string(size.width) + "x" + std::to_string(size.height));

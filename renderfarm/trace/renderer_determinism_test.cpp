@@ -89,7 +89,8 @@ TEST_P(RendererDeterminism, RectSplitsAndThreadsGiveBitIdenticalFrames) {
     std::vector<std::thread> threads;
     for (std::size_t t = 0; t < 2; ++t) {
         threads.emplace_back([&, t] {
-            for (std::size_t i = t; i < rects.size(); i += 2) rays_per_thread[t] += renderer.render(rects[i], pieces).rays;
+            for (std::size_t i = t; i < rects.size(); i += 2)
+                rays_per_thread[t] += renderer.render(rects[i], pieces).rays;
         });
     }
     for (auto& thread : threads) thread.join();

@@ -19,8 +19,8 @@ Scene lit_scene_at(const Eigen::Vector3d& offset) {
     sun.direction_to_light = Eigen::Vector3d(-0.4, 1.0, 0.3).normalized();
     scene.directional_lights = {sun};
     scene.point_lights = {PointLight{offset + Eigen::Vector3d(1.0, 2.0, 1.0), Rgb(4.0f, 4.0f, 4.0f), true}};
-    scene.area_lights = {AreaLight{offset + Eigen::Vector3d(-0.5, 2.5, -0.5), {1.0, 0.0, 0.0}, {0.0, 0.0, 1.0},
-                                   Rgb(3.0f, 3.0f, 3.0f), true}};
+    scene.area_lights = {AreaLight{
+        offset + Eigen::Vector3d(-0.5, 2.5, -0.5), {1.0, 0.0, 0.0}, {0.0, 0.0, 1.0}, Rgb(3.0f, 3.0f, 3.0f), true}};
     scene.environment_lights = {EnvironmentLight{Rgb(0.2f, 0.2f, 0.25f)}};
     return scene;
 }
@@ -28,8 +28,8 @@ Scene lit_scene_at(const Eigen::Vector3d& offset) {
 RgbFloatImage render_at(const Eigen::Vector3d& offset, bool rebase) {
     const Scene scene = lit_scene_at(offset);
     Renderer renderer(scene, RendererOptions{"threads=1", rebase});
-    ViewRequest request = test::look_at(offset + Eigen::Vector3d(0.3, 2.0, 3.5), offset + Eigen::Vector3d(0.0, 0.6, 0.0),
-                                        {64, 48}, 50.0);
+    ViewRequest request =
+        test::look_at(offset + Eigen::Vector3d(0.3, 2.0, 3.5), offset + Eigen::Vector3d(0.0, 0.6, 0.0), {64, 48}, 50.0);
     request.quality.spp = 2;
     request.quality.ao_samples = 2;
     request.quality.max_bounces = 1;

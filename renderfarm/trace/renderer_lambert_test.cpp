@@ -4,14 +4,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <string>
 #include <numbers>
+#include <string>
 
 #include <gtest/gtest.h>
 
+#include "renderfarm/scene/procedural.h"
 #include "renderfarm/trace/camera.h"
 #include "renderfarm/trace/renderer.h"
-#include "renderfarm/scene/procedural.h"
 #include "renderfarm/trace/test_scenes.h"
 
 namespace mogao {
@@ -78,8 +78,10 @@ TEST(RendererLambert, TessellatedSphereMatchesAnalyticRadiance) {
                 const double full = 0.5 / std::numbers::pi * sun.irradiance[c];
                 const double expected = full * cos_l;
                 const double absolute = cos_l < 0.035 ? 0.035 : 0.01;
-                EXPECT_NEAR(got[c], expected, 0.02 * expected + absolute * full) << "pixel " << x << "," << y << " c" << c;
-                (cos_l < 0.035 ? worst_terminator : worst) = std::max(cos_l < 0.035 ? worst_terminator : worst, std::abs(got[c] - expected) / full);
+                EXPECT_NEAR(got[c], expected, 0.02 * expected + absolute * full)
+                    << "pixel " << x << "," << y << " c" << c;
+                (cos_l < 0.035 ? worst_terminator : worst) =
+                    std::max(cos_l < 0.035 ? worst_terminator : worst, std::abs(got[c] - expected) / full);
             }
             ++checked;
         }

@@ -69,15 +69,16 @@ TEST(RendererLights, PointLightFollowsInverseSquareLaw) {
     scene.point_lights = {PointLight{{0.3, 2.0, -0.2}, Rgb(8.0f, 4.0f, 2.0f), true}};
     const ViewRequest request = floor_view();
     const RgbFloatImage frame = render(scene, request);
-    const int n = for_floor_pixels(frame, request, [&](int x, int y, const Eigen::Vector3d& q, const Ray&, const float* v) {
-        const Eigen::Vector3d to_light = scene.point_lights[0].position - q;
-        const double d2 = to_light.squaredNorm();
-        const double cos = to_light.y() / std::sqrt(d2);
-        for (int c = 0; c < 3; ++c) {
-            const double expected = 0.5 / kPi * scene.point_lights[0].intensity[c] * cos / d2;
-            EXPECT_NEAR(v[c], expected, 1e-4 * expected + 1e-7) << x << "," << y;
-        }
-    });
+    const int n =
+        for_floor_pixels(frame, request, [&](int x, int y, const Eigen::Vector3d& q, const Ray&, const float* v) {
+            const Eigen::Vector3d to_light = scene.point_lights[0].position - q;
+            const double d2 = to_light.squaredNorm();
+            const double cos = to_light.y() / std::sqrt(d2);
+            for (int c = 0; c < 3; ++c) {
+                const double expected = 0.5 / kPi * scene.point_lights[0].intensity[c] * cos / d2;
+                EXPECT_NEAR(v[c], expected, 1e-4 * expected + 1e-7) << x << "," << y;
+            }
+        });
     EXPECT_GT(n, 1000);
 }
 
@@ -86,8 +87,11 @@ TEST(RendererLights, SmallAreaLightMatchesSolidAngleFormulaAndIsOneSided) {
     // 0.1 x 0.1 m at 2 m, emitting downward (edge_u x edge_v = x x z = -y). Using the light's
     // own cosθ_l = direction.y (its normal is -y) and the floor's cosθ = direction.y as well.
     const Eigen::Vector3d centre(0.0, 2.0, -0.3);
-    scene.area_lights = {AreaLight{centre - Eigen::Vector3d(0.05, 0.0, 0.05), {0.1, 0.0, 0.0}, {0.0, 0.0, 0.1},
-                                   Rgb(200.0f, 200.0f, 200.0f), true}};
+    scene.area_lights = {AreaLight{centre - Eigen::Vector3d(0.05, 0.0, 0.05),
+                                   {0.1, 0.0, 0.0},
+                                   {0.0, 0.0, 0.1},
+                                   Rgb(200.0f, 200.0f, 200.0f),
+                                   true}};
     ViewRequest request = floor_view();
     request.quality.area_light_samples = 256;
     const RgbFloatImage frame = render(scene, request);
@@ -95,20 +99,22 @@ TEST(RendererLights, SmallAreaLightMatchesSolidAngleFormulaAndIsOneSided) {
     // within 1% (Monte Carlo noise of 256 samples), the mean relative error within 0.2% (bias).
     const AreaLight& light = scene.area_lights[0];
     double error_sum = 0.0;
-    const int n = for_floor_pixels(frame, request, [&](int x, int y, const Eigen::Vector3d& q, const Ray&, const float* v) {
-        double irradiance = 0.0;
-        for (int i = 0; i < 32; ++i) {
-            for (int j = 0; j < 32; ++j) {
-                const Eigen::Vector3d p = light.corner + (i + 0.5) / 32.0 * light.edge_u + (j + 0.5) / 32.0 * light.edge_v;
-                const Eigen::Vector3d w = p - q;
-                const double d2 = w.squaredNorm();
-                irradiance += 200.0 * (w.y() / std::sqrt(d2)) * (w.y() / std::sqrt(d2)) / d2 * (0.01 / 1024.0);
+    const int n =
+        for_floor_pixels(frame, request, [&](int x, int y, const Eigen::Vector3d& q, const Ray&, const float* v) {
+            double irradiance = 0.0;
+            for (int i = 0; i < 32; ++i) {
+                for (int j = 0; j < 32; ++j) {
+                    const Eigen::Vector3d p =
+                        light.corner + (i + 0.5) / 32.0 * light.edge_u + (j + 0.5) / 32.0 * light.edge_v;
+                    const Eigen::Vector3d w = p - q;
+                    const double d2 = w.squaredNorm();
+                    irradiance += 200.0 * (w.y() / std::sqrt(d2)) * (w.y() / std::sqrt(d2)) / d2 * (0.01 / 1024.0);
+                }
             }
-        }
-        const double expected = 0.5 / kPi * irradiance;
-        EXPECT_NEAR(v[0], expected, 0.01 * expected) << x << "," << y;
-        error_sum += (v[0] - expected) / expected;
-    });
+            const double expected = 0.5 / kPi * irradiance;
+            EXPECT_NEAR(v[0], expected, 0.01 * expected) << x << "," << y;
+            error_sum += (v[0] - expected) / expected;
+        });
     EXPECT_GT(n, 1000);
     EXPECT_NEAR(error_sum / n, 0.0, 0.002);
 
@@ -176,13 +182,14 @@ TEST(RendererLights, GlossyLobeMatchesGgx) {
     const ViewRequest request = floor_view();
     const RgbFloatImage frame = render(scene, request);
     double brightest = 0.0;
-    const int n = for_floor_pixels(frame, request, [&](int x, int y, const Eigen::Vector3d&, const Ray& ray, const float* v) {
-        const Eigen::Vector3d l = sun.direction_to_light;
-        const double f = ggx_reference(-ray.direction, l, 0.4, 0.5, 20.0);
-        const double expected = f * 2.0 * l.y();
-        EXPECT_NEAR(v[0], expected, 2e-4 * expected) << x << "," << y;
-        brightest = std::max(brightest, static_cast<double>(v[0]));
-    });
+    const int n =
+        for_floor_pixels(frame, request, [&](int x, int y, const Eigen::Vector3d&, const Ray& ray, const float* v) {
+            const Eigen::Vector3d l = sun.direction_to_light;
+            const double f = ggx_reference(-ray.direction, l, 0.4, 0.5, 20.0);
+            const double expected = f * 2.0 * l.y();
+            EXPECT_NEAR(v[0], expected, 2e-4 * expected) << x << "," << y;
+            brightest = std::max(brightest, static_cast<double>(v[0]));
+        });
     EXPECT_GT(n, 1000);
     EXPECT_GT(brightest, 2.0 * 0.2 / kPi * 2.0 * sun.direction_to_light.y());  // a highlight is in view
 }

@@ -79,7 +79,8 @@ TEST(RendererShadow, GrazingSunDoesNotSelfShadowAFlatPlane) {
 
     Renderer renderer(scene, RendererOptions{"threads=1", true});
     const Eigen::Vector3d target = xf.translation();
-    const ViewRequest request = test::look_at(target + 2.5 * normal + Eigen::Vector3d(0.3, 0.0, 0.2), target, {80, 80}, 60.0);
+    const ViewRequest request =
+        test::look_at(target + 2.5 * normal + Eigen::Vector3d(0.3, 0.0, 0.2), target, {80, 80}, 60.0);
     renderer.begin_frame(request);
     RgbFloatImage frame(renderer.render_size());
     renderer.render(PixelRect::whole(frame.size), frame);

@@ -28,9 +28,10 @@ class PixelRng {
 public:
     constexpr PixelRng() = default;  // key 0; only meant to be assigned over
     constexpr PixelRng(std::uint64_t frame, int x, int y, int sample)
-        : key_(mix64(frame ^ mix64((static_cast<std::uint64_t>(static_cast<std::uint32_t>(x)) << 32) |
-                                   static_cast<std::uint32_t>(y)) ^
-                     (static_cast<std::uint64_t>(static_cast<std::uint32_t>(sample)) * 0xaef17502108ef2d9ULL))) {}
+        : key_(mix64(
+              frame ^
+              mix64((static_cast<std::uint64_t>(static_cast<std::uint32_t>(x)) << 32) | static_cast<std::uint32_t>(y)) ^
+              (static_cast<std::uint64_t>(static_cast<std::uint32_t>(sample)) * 0xaef17502108ef2d9ULL))) {}
 
     // Uniform in [0, 1).
     [[nodiscard]] constexpr float next() {

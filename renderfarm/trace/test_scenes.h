@@ -4,9 +4,9 @@
 
 #include <Eigen/Core>
 
+#include "common/view_request.h"
 #include "renderfarm/scene/mesh.h"
 #include "renderfarm/scene/scene.h"
-#include "common/view_request.h"
 
 namespace mogao::test {
 
