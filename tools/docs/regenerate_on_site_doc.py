@@ -10,7 +10,7 @@ standard rig at full resolution (count, files, size), and one run of the capture
 1/4 scale (patterns written, filmed by the rig with mogao-rig-film, calibrated with --images, measured
 against the rig's ground truth). Figures there are never pasted.
 
-  kiosk/calibrate/regenerate-on-site-doc [--build build-calhw]
+  tools/docs/regenerate_on_site_doc.py [--build build-calhw]
 Python 3 standard library only.
 """
 import argparse, json, os, re, subprocess, tempfile, time

@@ -9,7 +9,7 @@ changes and visitors) and writes what it printed: detection time, time to under 
 of geometric error against the rig's ground truth, final error, CPU per monitored frame.
 Figures there are never pasted.
 
-  appliance/selfcal/regenerate-selfcal-doc [--build build-calib] [--static-frames 240] [--long-static-frames 1200]
+  tools/docs/regenerate_selfcal_doc.py [--build build-calib] [--static-frames 240] [--long-static-frames 1200]
                                            [--only scenarios|autocal]
 
 A second table (<!-- generated:selfcal-from-autocal -->) starts the monitor from a full
@@ -158,7 +158,7 @@ def from_autocal_table(args, tool):
     rig = os.path.join(ROOT, "rigs", "standard.toml")
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout.strip()
     lines = [f"Run {datetime.date.today()} at commit {commit} on {platform.node()} by "
-             f"`appliance/selfcal/regenerate-selfcal-doc --only autocal --static-frames {args.static_frames}`: "
+             f"`tools/docs/regenerate_selfcal_doc.py --only autocal --static-frames {args.static_frames}`: "
              "rigs/standard.toml calibrated by `mogao-autocal calibrate --rig rigs/standard.toml --scale S` (S = 0.5: "
              "projectors and camera at half resolution; S = 1: three 1920x1080 projectors and the 1280x720 camera), "
              "the monitor started from its calibration.models.json (`mogao-selfcal simulate --models`), errors against "
@@ -194,7 +194,7 @@ def scenarios_table(args, tool):
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout.strip()
     hour = f" --long-static-frames {args.long_frames}"
     lines = [f"Run {datetime.date.today()} at commit {commit} on {platform.node()} by "
-             f"`appliance/selfcal/regenerate-selfcal-doc --static-frames {args.static_frames}{hour}`: rigs/standard.toml, "
+             f"`tools/docs/regenerate_selfcal_doc.py --static-frames {args.static_frames}{hour}`: rigs/standard.toml, "
              "projectors and camera at half resolution (errors in those projector pixels, the worst projector's mean, "
              "against the rig's ground truth), monitor at 2 Hz, bumps at t = 2 s, hold 2 s, transition 3 s, "
              "camera gain ±10 % per frame unless stated.", "",
