@@ -319,7 +319,7 @@ table.list td{font-weight:normal;font-size:14px}.unknown{color:#8a939c;font-styl
 .b-stopped{background:#5d6670}.b-unknown{background:#8a939c}.ok{color:#23864a}.bad{color:#c0392b}
 .warn{background:#fdecea;border-left:4px solid #c0392b;padding:5px 8px;margin:6px 0}.warnrow td{color:#c0392b}
 .info{color:#55606c;font-size:13px;margin:4px 0}.small{font-size:12px;font-weight:normal;color:#55606c}
-figure{margin:8px 0 0 0}figure img{max-width:100%;border:1px solid #cfd5dc;background:#000;image-rendering:auto}
+figure{margin:8px 0 0 0}figure img{max-width:100%;height:auto;border:1px solid #cfd5dc;background:#000;image-rendering:auto}
 figcaption{font-size:12px;color:#55606c}footer{font-size:12px;color:#55606c}ul{margin:4px 0;padding-left:20px}
 )";
 
@@ -345,7 +345,7 @@ std::string kiosk_status_page_html(const StatusPageInput& in) {
     fmt::format_to(std::back_inserter(out),
                    "<footer>From the status file <span id=\"status-file\">{}</span>{}. mogao-kiosk-status-page; "
                    "docs/monitoring.md, \"Status page\".</footer>\n</body></html>\n",
-                   html_escape(in.status_file.string()),
+                   html_escape(in.status_file.filename().string()),
                    in.calibration.dir.empty()
                        ? std::string()
                        : " and the calibration folder " + html_escape(in.calibration.dir.string()));

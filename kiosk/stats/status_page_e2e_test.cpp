@@ -350,8 +350,8 @@ TEST(StatusPageProgram, AMissingOrGarbledStatusFileIsNamed) {
     refuses(dir / "kiosk-status.json", "No such file");
     std::ofstream(dir / "garbled.json") << "{\"state\": \"showing\", \"frames_";
     refuses(dir / "garbled.json", "is not JSON");
-    EXPECT_EQ(run({MOGAO_STATUS_PAGE_BINARY, "--out", page.string()}, dir / "out", dir / "err"), 2)
-        << "--status is required";
+    EXPECT_EQ(run({MOGAO_STATUS_PAGE_BINARY, "--status", (dir / "garbled.json").string()}, dir / "out", dir / "err"), 2)
+        << "--out is required";
 }
 
 }  // namespace

@@ -2,8 +2,8 @@
 // mogao-kiosk-status-page: the technician's one-page status view (docs/monitoring.md, "Status page")
 // from the kiosk's status file and, optionally, the calibration's output folder:
 //
-//   mogao-kiosk-status-page --status /run/mogao/kiosk-status.json --calibration /var/lib/mogao/calibration \
-//       --out status.html
+//   mogao-kiosk-status-page --status /run/mogao/kiosk-status.json
+//       --calibration /var/lib/mogao/calibration --out status.html
 //
 // One self-contained HTML file (inline CSS, the calibration's preview as a data: URI, no script, no
 // network), written atomically. The service mode's `status` action puts it on the USB stick next to
@@ -30,10 +30,10 @@ int main(int argc, char** argv) {
         "The kiosk's status as one self-contained HTML page for the museum technician "
         "(docs/monitoring.md, \"Status page\")"};
     cli::prepare(app, "mogao-kiosk-status-page");
-    std::filesystem::path status_file;
+    std::filesystem::path status_file = "/run/mogao/kiosk-status.json";  // the appliance's ([stats] status_file)
     std::filesystem::path calibration_dir;
     std::filesystem::path out;
-    app.add_option("--status", status_file, "the kiosk's status file ([stats] status_file)")->required();
+    app.add_option("--status", status_file, "the kiosk's status file ([stats] status_file)");
     app.add_option("--calibration", calibration_dir,
                    "the calibration's output folder (report.json, preview.png or camera-white.png); "
                    "default: the folder of the status's calibration.source when it holds a report.json");
