@@ -430,6 +430,7 @@ KioskStatus Kiosk::status(const char* state) const {
         s.farm_silent_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_frame_at_).count();
     const StatsSummary window = parts_.display.stats().window_summary();
     s.fps = window.fps;
+    s.latency_mean_ms = window.latency_mean_ms;
     s.latency_p95_ms = window.latency_p95_ms;
     s.last_error = last_error_;
     s.last_error_ns = last_error_ns_;

@@ -88,6 +88,7 @@ nlohmann::json kiosk_status_json(const KioskStatus& s) {
             {"frames_shown", s.frames_shown},
             {"showing_request", s.showing_request},
             {"fps", s.fps},
+            {"latency_mean_ms", s.latency_mean_ms},
             {"latency_p95_ms", s.latency_p95_ms},
             {"last_error", last_error},
             {"calibration", calibration},

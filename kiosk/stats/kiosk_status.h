@@ -53,8 +53,9 @@ struct KioskStatus {
     double farm_silent_s = 0.0;                     // since the last farm frame (0 before the first)
     std::vector<std::string> fallbacks;             // bad start-up files replaced by last good copies
     // Over the display statistics' sliding window (kiosk_stats.h; 0 before two frames):
-    double fps = 0.0;             // farm frames presented per second
-    double latency_p95_ms = 0.0;  // motion-to-photon, request to presented
+    double fps = 0.0;              // farm frames presented per second
+    double latency_mean_ms = 0.0;  // motion-to-photon, request to presented: mean
+    double latency_p95_ms = 0.0;   // and 95th percentile
     // The latest error outside the calibration's (a dropped frame, a refused view request, a file
     // the kiosk could not write): what the journal said, and when. Empty: none since start.
     std::string last_error;

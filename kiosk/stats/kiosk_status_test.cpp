@@ -49,11 +49,13 @@ TEST(KioskStatus, JsonHoldsConnectionFramesCalibrationAndSelfcalOff) {
 TEST(KioskStatus, JsonHoldsTheFrameRateAndTheLastError) {
     KioskStatus s;
     s.fps = 14.5;
+    s.latency_mean_ms = 96.5;
     s.latency_p95_ms = 180.25;
     s.last_error = "frame dropped (3 so far): corrupt JPEG";
     s.last_error_ns = 4'000'000'000;
     const nlohmann::json j = kiosk_status_json(s);
     EXPECT_DOUBLE_EQ(j["fps"].get<double>(), 14.5);
+    EXPECT_DOUBLE_EQ(j["latency_mean_ms"].get<double>(), 96.5);
     EXPECT_DOUBLE_EQ(j["latency_p95_ms"].get<double>(), 180.25);
     EXPECT_EQ(j["last_error"]["what"], s.last_error);
     EXPECT_EQ(j["last_error"]["ns"], 4'000'000'000);
