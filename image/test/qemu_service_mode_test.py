@@ -26,7 +26,8 @@ One boot, in order (each printed; any failure fails the test):
   3. the first request again (a replay): refused for its serial;
   4. status: the status panel toggled on and off (the kiosk's journal says so; it draws the panel
      over the show, not over its connecting card, and no farm runs here), outcome "done"; the
-     kiosk's status file on the stick names the installed calibration, loaded after request 1;
+     kiosk's status file on the stick names the installed calibration, loaded after request 1, and
+     so does the status page (status.html) the appliance made from it;
   5. logs: the journal, the status file and the installed calibration come back on the stick; the
      MPCDI is byte-identical to what request 1 installed (2-4 changed nothing), its last good copy
      is OLD, and it is within the calibration's geometry goals against the rig's ground truth
@@ -325,6 +326,11 @@ def check_requests(a, work, proc, fails, env, key, old_mpcdi, captures, results)
                 and cal.get("loaded_utc", "") > plugged_utc,
                 f"status: the kiosk's status file on the stick: running on the installed calibration, loaded "
                 f"{cal.get('loaded_utc')} (the calibrate stick went in at {plugged_utc}), no error")
+    # The technician's status page, made on the appliance from the same status file (docs/monitoring.md).
+    page = (read_stick(sticks["status"], "status.html", env) or b"").decode("utf-8", "replace")
+    fails.check(rs.get("status_page") == "status.html" and "/etc/mogao/screen.mpcdi" in page and "<html" in page.lower(),
+                f"status: status.html on the stick names the installed calibration (result: {rs.get('status_page')}, "
+                f"{len(page)} characters)")
 
     check_logs(a, work, qmp, journal, fails, env, sticks["logs"], r.get("calibration_after"), old_mpcdi, results)
 
