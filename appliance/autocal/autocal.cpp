@@ -315,8 +315,9 @@ void try_camera_intrinsics(BundleResult& ba, const CalibrationPrior& prior, cons
 
 // AutocalOptions::fit_projector_distortion: a bundle adjustment from `ba`'s result (with what the earlier trials
 // kept free: `bo`) with every projector's distortion free; a projector keeps it where its own cost, in units of
-// `ba`'s, falls by more than distortion_min_gain on about the same correspondences. Where only some keep it, the
-// adjustment is run again with only theirs free. Kept intrinsics are checked again (check_camera_intrinsics).
+// `ba`'s, falls by more than distortion_min_gain on about the same correspondences, and so does the whole fit's. Where
+// only some keep it, the adjustment is run again with only theirs free. Kept intrinsics are checked again
+// (check_camera_intrinsics).
 void try_projector_distortion(BundleResult& ba, const CalibrationPrior& prior,
                               const std::vector<EdgeObservation>& edges,
                               const std::vector<ProjectorObservations>& observations, BundleOptions bo,
@@ -339,6 +340,11 @@ void try_projector_distortion(BundleResult& ba, const CalibrationPrior& prior,
         const bool same_points = lost <= 0.01 || 1.0 - t.relative_cost >= 10.0 * lost;
         keep[k] = same_points && t.relative_cost < 1.0 - options.distortion_min_gain;
     }
+    // And the whole fit's cost (every projector and the edges, as the intrinsics' trial counts it) must fall by
+    // more than the gain too: one projector's fall of a percent or two on a noisy rig is its noise taken up.
+    const double whole = relative_cost(free, ba, edges.size());
+    for (DistortionTrial& t : report.distortion) t.fit_relative_cost = whole;
+    if (!(whole < 1.0 - options.distortion_min_gain)) keep.assign(n, false);
     const auto kept = static_cast<std::size_t>(std::count(keep.begin(), keep.end(), true));
     if (kept == 0) return;
     if (kept < n) {

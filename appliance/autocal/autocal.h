@@ -200,8 +200,9 @@ struct AutocalOptions {
     // kept free: a projection lens is not a pinhole, and a pinhole fitted to a distorting lens puts content off by
     // pixels at its image's edges. Kept per projector only where that projector's cost (its inlier
     // correspondences at the previous fit's rms) falls by more than distortion_min_gain, on about the same
-    // correspondences (as the intrinsics' trial); where only some projectors keep it, the adjustment is run again
-    // with only theirs free. A pinhole lens lowers the cost by about 0.1 % (fitting noise): nothing changes.
+    // correspondences, and the whole fit's cost (as the intrinsics' trial counts it) too; where only some
+    // projectors keep it, the adjustment is run again with only theirs free. A pinhole lens lowers the cost by
+    // about 0.1 % (fitting noise): nothing changes.
     // Off: the projectors are pinholes (docs/calibration.md, "Projector lens distortion").
     bool fit_projector_distortion = true;
     double distortion_min_gain = 0.01;  // [0, 1)
@@ -278,6 +279,7 @@ struct DistortionTrial {
     bool tried = false;
     bool kept = false;
     double relative_cost = 1.0;
+    double fit_relative_cost = 1.0;  // the whole fit's (every projector and the edges), the same for every projector
     std::array<double, 4> distortion{};
 };
 

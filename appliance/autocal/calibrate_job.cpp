@@ -128,6 +128,7 @@ nlohmann::json projector_json(const AutocalResult& r, std::size_t k, const rig::
          {{"tried", t.tried},
           {"kept", t.kept},
           {"relative_cost", t.relative_cost},
+          {"fit_relative_cost", t.fit_relative_cost},
           {"min_gain", options.distortion_min_gain},
           {"fitted",
            {{"k1", t.distortion[0]}, {"k2", t.distortion[1]}, {"p1", t.distortion[2]}, {"p2", t.distortion[3]}}}}},
