@@ -59,6 +59,7 @@ void check_inputs(const CalibrationPrior& prior, ImageSize content, const Autoca
     }
     if (!(o.camera_sigma_gate > 0.0 && o.camera_sigma_gate <= 1.0)) fail("options.camera_sigma_gate: (0, 1]");
     if (!(o.intrinsics_min_gain >= 0.0 && o.intrinsics_min_gain < 1.0)) fail("options.intrinsics_min_gain: [0, 1)");
+    if (!(o.distortion_min_gain >= 0.0 && o.distortion_min_gain < 1.0)) fail("options.distortion_min_gain: [0, 1)");
     if (!(prior.screen.radius_m > 0.0 && prior.screen.arc_deg > 0.0 && prior.screen.top_m > prior.screen.bottom_m)) {
         fail("prior.screen: radius_m > 0, arc_deg > 0, top_m > bottom_m");
     }
@@ -71,7 +72,7 @@ void check_inputs(const CalibrationPrior& prior, ImageSize content, const Autoca
 
 // Screen point of a pinhole device's image position as (theta, h), or NaN.
 Eigen::Vector2d device_screen(const DeviceModel& d, const ScreenModel& s, double x, double y) {
-    const Eigen::Vector3d dir = d.rotation * Eigen::Vector3d((x - d.cx_px) / d.fx_px, (y - d.cy_px) / d.fy_px, 1.0);
+    const Eigen::Vector3d dir = d.rotation * device_ray(d, x, y);
     const auto hit = cylinder_hit(s, d.position_m, dir);
     if (!hit) return {std::nan(""), std::nan("")};
     return {std::atan2(hit->x(), -hit->z()), hit->y()};
@@ -141,7 +142,7 @@ double border_distance(const DeviceModel& d, const std::vector<BorderPiece>& bor
                        const Eigen::Vector2d& th) {
     const Eigen::Vector3d q = d.rotation.transpose() * (screen_position(s, th.x(), th.y()) - d.position_m);
     if (q.z() <= 0.0) return 0.0;
-    const Eigen::Vector2d p(d.fx_px * q.x() / q.z() + d.cx_px, d.fy_px * q.y() / q.z() + d.cy_px);
+    const Eigen::Vector2d p = device_image(d, q);
     if (!(p.x() >= 0.0 && p.x() <= d.resolution.width && p.y() >= 0.0 && p.y() <= d.resolution.height)) return 0.0;
     double best = std::numeric_limits<double>::infinity();
     for (const BorderPiece& piece : border) best = std::min(best, distance_to(piece, p));
@@ -312,6 +313,58 @@ void try_camera_intrinsics(BundleResult& ba, const CalibrationPrior& prior, cons
     ba = std::move(free);
 }
 
+// AutocalOptions::fit_projector_distortion: a bundle adjustment from `ba`'s result (with what the earlier trials
+// kept free: `bo`) with every projector's distortion free; a projector keeps it where its own cost, in units of
+// `ba`'s, falls by more than distortion_min_gain on about the same correspondences, and so does the whole fit's. Where
+// only some keep it, the adjustment is run again with only theirs free. Kept intrinsics are checked again
+// (check_camera_intrinsics).
+void try_projector_distortion(BundleResult& ba, const CalibrationPrior& prior,
+                              const std::vector<EdgeObservation>& edges,
+                              const std::vector<ProjectorObservations>& observations, BundleOptions bo,
+                              const AutocalOptions& options, AutocalReport& report) {
+    const std::size_t n = ba.projectors.size();
+    if (!options.fit_projector_distortion || n == 0) return;
+    bo.refine_projector_distortion.assign(n, true);
+    BundleResult free = bundle_adjust(ba.screen, ba.camera, ba.projectors, edges, observations, bo);
+    report.distortion.assign(n, DistortionTrial{});
+    std::vector<bool> keep(n, false);
+    for (std::size_t k = 0; k < n; ++k) {
+        DistortionTrial& t = report.distortion[k];
+        t.tried = true;
+        const double ratio = free.rms_sigma[k] / std::max(ba.rms_sigma[k], 1e-12);
+        t.relative_cost = free.inliers[k] * ratio * ratio / std::max(ba.inliers[k], 1);
+        for (std::size_t i = 0; i < t.distortion.size(); ++i) t.distortion[i] = free.projectors[k].distortion[i];
+        // As the intrinsics' trial: a fit that only rejected more points does not count; a much better one may
+        // reject more (its outlier limit is tighter), its fall then ten times the points it lost.
+        const double lost = 1.0 - static_cast<double>(free.inliers[k]) / std::max(ba.inliers[k], 1);
+        const bool same_points = lost <= 0.01 || 1.0 - t.relative_cost >= 10.0 * lost;
+        keep[k] = same_points && t.relative_cost < 1.0 - options.distortion_min_gain;
+    }
+    // And the whole fit's cost (every projector and the edges, as the intrinsics' trial counts it) must fall by
+    // more than the gain too: one projector's fall of a percent or two on a noisy rig is its noise taken up.
+    const double whole = relative_cost(free, ba, edges.size());
+    for (DistortionTrial& t : report.distortion) t.fit_relative_cost = whole;
+    if (!(whole < 1.0 - options.distortion_min_gain)) keep.assign(n, false);
+    const auto kept = static_cast<std::size_t>(std::count(keep.begin(), keep.end(), true));
+    if (kept == 0) return;
+    if (kept < n) {
+        bo.refine_projector_distortion = keep;
+        free = bundle_adjust(ba.screen, ba.camera, ba.projectors, edges, observations, bo);
+    }
+    for (std::size_t k = 0; k < n; ++k) {
+        report.distortion[k].kept = keep[k];
+        if (keep[k]) {
+            for (std::size_t i = 0; i < 4; ++i) report.distortion[k].distortion[i] = free.projectors[k].distortion[i];
+        }
+    }
+    if (bo.refine_camera_intrinsics) {
+        check_camera_intrinsics(free, prior.camera, options);
+        report.camera_intrinsics_sigma = free.camera_intrinsics_sigma;
+    }
+    report.condition_number = free.condition_number;
+    ba = std::move(free);
+}
+
 // Per blend grid sample of device d (grid of `size` samples, row-major): 1 where its output position
 // lands on the screen (the samples build_projector gives a weight), 0 where the blend is 0 for being off it.
 std::vector<char> grid_on_screen(const DeviceModel& d, const ScreenModel& s, ImageSize size) {
@@ -453,6 +506,9 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
     if (options.fit_bow) try_bow(ba, edge.edges, observations, bo, options, result.report.bow);
     bo.refine_bow = result.report.bow.kept;
     try_camera_intrinsics(ba, prior, edge.edges, observations, bo, options, result.report);
+    // Last, with what the other trials kept free: each projector's lens distortion.
+    bo.refine_camera_intrinsics = result.report.intrinsics.kept;
+    try_projector_distortion(ba, prior, edge.edges, observations, bo, options, result.report);
     result.screen = ba.screen;
     if (!(ba.screen.radius_m > 0.0 && ba.screen.arc_deg > 0.0 && ba.screen.arc_deg <= 360.0)) {
         throw CalibrationRefused("fitted screen: radius " + std::to_string(ba.screen.radius_m) + " m, arc " +

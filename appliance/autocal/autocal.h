@@ -43,7 +43,10 @@
 //     k2 (Sajadi & Majumder 2009 for an uncalibrated camera on an extruded screen), each camera ray re-derived from its
 //     image position; the projector fit gate is then applied after it, and the refined intrinsics are gated
 //     (`camera_sigma_gate`, and within 4 prior sigmas of the prior's).
-//  5. Warp: grid samples at texel centres (warp_sampling.h) -> fitted projector ray -> cylinder
+//     With `fit_projector_distortion` (a trial kept per projector where it pays) also each projector's lens
+//     distortion k1, k2, p1, p2 (OpenCV's model about its principal point, Brown 1966), after the other trials.
+//  5. Warp: grid samples at texel centres (warp_sampling.h) -> fitted projector ray (through its distortion) ->
+//  cylinder
 //     -> content (u, v), left unclamped past the screen's edges (the blend is 0 there).
 //  0. The camera's auto-exposure must be locked (refused otherwise, before any pattern is shown).
 //  6. Blend (linear light; Raskar et al. 1998, "The office of the future", and 1999, "Multi-projector
@@ -97,7 +100,9 @@ struct LensFalloff {
     [[nodiscard]] bool flat() const { return c == LensFalloff{}.c; }
 };
 
-// A pinhole device: intrinsics (image positions, pixel centre +0.5), distortion (cameras only),
+// A device: intrinsics (image positions, pixel centre +0.5), lens distortion (OpenCV's Brown-Conrady model
+// about the principal point, bundle_adjust.h's device_image / device_ray; a projector's is fitted by the
+// distortion trial, zero otherwise),
 // pose in the screen frame (rotation device -> screen, position); projectors also carry their
 // lens fall-off once the colour step has measured it (flat before, and always for cameras).
 struct DeviceModel {
@@ -190,6 +195,17 @@ struct AutocalOptions {
     // intrinsics are taken as exact.
     bool refine_camera_intrinsics = true;
     double intrinsics_min_gain = 0.01;  // [0, 1); 0 keeps the refined intrinsics whenever the cost falls
+    // Try each projector's lens distortion (k1, k2, p1, p2 of OpenCV's model about its principal point; k3 stays
+    // 0) free in a further bundle adjustment, after the bow's and the camera intrinsics' trials and with what they
+    // kept free: a projection lens is not a pinhole, and a pinhole fitted to a distorting lens puts content off by
+    // pixels at its image's edges. Kept per projector only where that projector's cost (its inlier
+    // correspondences at the previous fit's rms) falls by more than distortion_min_gain, on about the same
+    // correspondences, and the whole fit's cost (as the intrinsics' trial counts it) too; where only some
+    // projectors keep it, the adjustment is run again with only theirs free. A pinhole lens lowers the cost by
+    // about 0.1 % (fitting noise): nothing changes.
+    // Off: the projectors are pinholes (docs/calibration.md, "Projector lens distortion").
+    bool fit_projector_distortion = true;
+    double distortion_min_gain = 0.01;  // [0, 1)
     CameraIntrinsicsSigma camera_sigma{};
     // Refused unless each refined intrinsic's standard deviation is at most this fraction of the prior's (the
     // screen and the projectors must determine it, not the prior), (0, 1]; and unless each lies within 4 of the
@@ -256,6 +272,17 @@ struct IntrinsicsTrial {
     double relative_cost = 1.0;  // sum over blocks of points x (rms free / rms fixed)^2, over the points
 };
 
+// The projector distortion trial (AutocalOptions::fit_projector_distortion), per projector: its cost with the
+// distortion free in units of its cost before (1 = no better), whether it was kept, and the fitted k1, k2, p1, p2
+// (kept or not; the kept ones are in the projector's model).
+struct DistortionTrial {
+    bool tried = false;
+    bool kept = false;
+    double relative_cost = 1.0;
+    double fit_relative_cost = 1.0;  // the whole fit's (every projector and the edges), the same for every projector
+    std::array<double, 4> distortion{};
+};
+
 struct BowTrial {
     bool tried = false;
     bool kept = false;
@@ -289,6 +316,7 @@ struct AutocalReport {
     std::vector<ProjectorReport> projectors;
     IntrinsicsTrial intrinsics;
     BowTrial bow;
+    std::vector<DistortionTrial> distortion;  // per projector (empty when not tried)
     PredictedSeam predicted_seam;  // predicted_seam_deviation of the result (the gate max_predicted_seam's figure)
 };
 
@@ -330,7 +358,7 @@ struct AutocalResult {
 [[nodiscard]] PredictedSeam predicted_seam_deviation(const std::vector<DeviceModel>& projectors,
                                                      const ScreenModel& screen, const ScreenCalibration& calibration);
 
-// Screen point where a pinhole projector's image position (x, y) lands, as content (u, v)
+// Screen point where a projector's image position (x, y) lands (through its distortion), as content (u, v)
 // (unclamped), or nullopt-like NaN when the ray misses the cylinder.
 [[nodiscard]] Eigen::Vector2d projector_content(const DeviceModel& projector, const ScreenModel& screen, double x,
                                                 double y);

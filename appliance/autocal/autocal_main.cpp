@@ -4,7 +4,7 @@
 //   mogao-autocal calibrate --rig rigs/standard.toml --out DIR [--scale 0.5] [--content 1920x1080]
 //                 [--alpha-bits 16] [--warp-step 2] [--gray-bits N] [--frames-per-pattern 1] [--no-colour]
 //                 [--no-falloff] [--fit-screen] [--no-bow] [--fixed-camera-intrinsics] [--intrinsics-min-gain 0.01]
-//                 [--max-self-check-px 0.65]
+//                 [--pinhole-projectors] [--distortion-min-gain 0.01] [--max-self-check-px 0.65]
 //
 // Exit codes: 0 success, 1 the job failed or the calibration was refused (the message says why;
 // nothing in DIR changes), 2 bad command line.
@@ -54,6 +54,14 @@ int main(int argc, char** argv) {
                     "Keep the refined camera intrinsics only where the fit's cost falls by more than this fraction "
                     "(0: whenever it falls)")
         ->check(CLI::Range(0.0, 0.99));
+    bool pinhole = false;
+    cmd->add_flag("--pinhole-projectors", pinhole,
+                  "Take the projectors as pinholes: do not try fitting their lens distortion (kept by default, per "
+                  "projector, only where it pays)");
+    cmd->add_option("--distortion-min-gain", job.options.distortion_min_gain,
+                    "Keep a projector's fitted lens distortion only where its fit's cost falls by more than this "
+                    "fraction (0: whenever it falls)")
+        ->check(CLI::Range(0.0, 0.99));
     cmd->add_option("--max-self-check-px", job.self_check.max_mean_px,
                     "Self-check gate: refuse when the verification marks land further than this from where they "
                     "belong (mean, projector pixels; measured from the camera images against the screen's frame)")
@@ -69,6 +77,7 @@ int main(int argc, char** argv) {
         job.colour_options.lens_falloff = !no_falloff;
         job.options.fit_bow = !no_bow;
         job.options.refine_camera_intrinsics = !fixed_intrinsics;
+        job.options.fit_projector_distortion = !pinhole;
         if (std::sscanf(content.c_str(), "%dx%d", &job.content.width, &job.content.height) != 2 ||
             job.content.width < 1 || job.content.height < 1 || job.content.width > 16384 ||
             job.content.height > 16384) {

@@ -19,6 +19,9 @@ namespace {
 
 constexpr int kCam = 6;   // camera: position offset (3), rotation vector (3)
 constexpr int kProj = 9;  // projector: fx, cx, cy, rotation vector (3), position offset (3)
+// then, when any projector's distortion is refined, its k1, k2, p1, p2 (every projector's block has them; a
+// projector whose distortion stays has those columns held fixed).
+constexpr int kProjDistortion = 4;
 // Screen (last, when refined): radius offset (m) and arc offset (rad) with refine_screen, then the
 // four bow amplitudes (m, ScreenModel::bow_m) with refine_bow.
 constexpr int kScreenShape = 2;
@@ -73,8 +76,12 @@ Eigen::Vector3d undistorted_ray(const DeviceModel& c, const Eigen::Vector2d& p,
     return {x, y, 1.0};
 }
 
-DeviceModel projector_at(const DeviceModel& p0, const double* q) {
+// The projector the parameters describe (`distortion`: q carries its k1, k2, p1, p2 after the pose).
+DeviceModel projector_at(const DeviceModel& p0, const double* q, bool distortion = false) {
     DeviceModel p = p0;
+    if (distortion) {
+        for (int i = 0; i < kProjDistortion; ++i) p.distortion[static_cast<std::size_t>(i)] = q[kProj + i];
+    }
     const double aspect = p0.fy_px / p0.fx_px;
     p.fx_px = q[0];
     p.fy_px = q[0] * aspect;
@@ -118,6 +125,8 @@ struct Problem {
     bool refine_screen = false;
     bool refine_bow = false;
     bool refine_intrinsics = false;
+    std::vector<bool> refine_distortion{};  // per projector (empty: none)
+    int kp = kProj;                         // parameters per projector block (kProj, + kProjDistortion)
     CameraIntrinsicsSigma camera_sigma{};
     Eigen::Index screen_index = 0;      // first screen parameter in q
     Eigen::Index intrinsics_index = 0;  // first camera intrinsic in q (after the screen's)
@@ -198,7 +207,7 @@ struct Problem {
                                                       const double* qs, const Rays& rays) const {
         const ScreenModel screen = this->screen(qs);
         const DeviceModel c = camera_at(camera0, qc);
-        const DeviceModel p = projector_at(projectors0[k], qp);
+        const DeviceModel p = projector_at(projectors0[k], qp, kp > kProj);
         const Eigen::Matrix3d rt = p.rotation.transpose();
         const std::vector<int>& use = inliers[k];
         Eigen::VectorXd r(2 * static_cast<Eigen::Index>(use.size()));
@@ -208,8 +217,8 @@ struct Problem {
             const Eigen::Vector3d d = rt * (x - p.position_m);
             Eigen::Vector2d e(1e3, 1e3);  // behind the projector or missed: a large, constant residual
             if (d.allFinite() && d.z() > 1e-9) {
-                e = Eigen::Vector2d(p.fx_px * d.x() / d.z() + p.cx_px, p.fy_px * d.y() / d.z() + p.cy_px) -
-                    obs[k].projector[i];
+                const Eigen::Vector2d image = device_image(p, d);
+                if (image.allFinite()) e = image - obs[k].projector[i];
             }
             if (!obs[k].sigma_px.empty()) e = e.cwiseQuotient(obs[k].sigma_px[i]);
             r.segment<2>(2 * static_cast<Eigen::Index>(u)) = e / sigma_px[k];
@@ -220,8 +229,8 @@ struct Problem {
     // Residuals of block (-1: edges) at parameters v, with the block's rays for v's camera intrinsics.
     [[nodiscard]] Eigen::VectorXd block_residuals(int block, const Eigen::VectorXd& v, const Rays& rays) const {
         return block < 0 ? edge_residuals(v.data(), screen_params(v), rays)
-                         : projector_residuals(static_cast<std::size_t>(block), v.data(),
-                                               v.data() + kCam + kProj * block, screen_params(v), rays);
+                         : projector_residuals(static_cast<std::size_t>(block), v.data(), v.data() + kCam + kp * block,
+                                               screen_params(v), rays);
     }
 };
 
@@ -231,7 +240,8 @@ double step_of(const Problem& pb, int idx) {
     if (idx < kCam) return 1e-8;
     if (idx >= pb.intrinsics_index) return idx - pb.intrinsics_index < 3 ? 1e-4 : 1e-7;
     if (idx >= pb.screen_index) return 1e-8;
-    return (idx - kCam) % kProj < 3 ? 1e-4 : 1e-8;
+    const int j = (idx - kCam) % pb.kp;
+    return j < 3 ? 1e-4 : (j < kProj ? 1e-8 : 1e-7);
 }
 
 // Adds block's J^T J and J^T r (columns: the camera's, if refined, the block's own, the screen's and
@@ -246,7 +256,8 @@ void accumulate(const Problem& pb, const Eigen::VectorXd& q, int block, bool ref
         for (int j = 0; j < kCam; ++j) cols.push_back(j);
     }
     if (block >= 0) {
-        for (int j = 0; j < kProj; ++j) cols.push_back(kCam + kProj * block + j);
+        const bool free = pb.kp > kProj && pb.refine_distortion[static_cast<std::size_t>(block)];
+        for (int j = 0; j < (free ? pb.kp : kProj); ++j) cols.push_back(kCam + pb.kp * block + j);
     }
     for (int j = 0; j < pb.screen_count(); ++j) cols.push_back(static_cast<int>(pb.screen_index) + j);
     for (int j = 0; j < (pb.refine_intrinsics ? kIntrinsics : 0); ++j)
@@ -297,6 +308,14 @@ double normal_equations(const Problem& pb, const Eigen::VectorXd& q, bool refine
         cost += r.squaredNorm();
     }
     if (!refine_camera) jtj.topLeftCorner<kCam, kCam>().setIdentity();  // fixed: zero step
+    for (std::size_t k = 0; pb.kp > kProj && k < pb.refine_distortion.size(); ++k) {
+        if (pb.refine_distortion[k]) continue;
+        for (int j = kProj; j < pb.kp; ++j) {  // a projector whose distortion stays: zero step
+            const Eigen::Index i = kCam + pb.kp * static_cast<Eigen::Index>(k) + j;
+            jtj(i, i) = 1.0;
+            jtr[i] = 0.0;
+        }
+    }
     return cost;
 }
 
@@ -388,6 +407,30 @@ void conditioning(const Problem& pb, const Eigen::VectorXd& q, bool refine_camer
 
 }  // namespace
 
+Eigen::Vector2d device_image(const DeviceModel& d, const Eigen::Vector3d& q) {
+    const auto& k = d.distortion;
+    if (k == std::array<double, 5>{}) return {d.fx_px * q.x() / q.z() + d.cx_px, d.fy_px * q.y() / q.z() + d.cy_px};
+    const double x = q.x() / q.z();
+    const double y = q.y() / q.z();
+    double corner2 = 0.0;
+    for (const double cx : {0.0, static_cast<double>(d.resolution.width)}) {
+        for (const double cy : {0.0, static_cast<double>(d.resolution.height)}) {
+            corner2 = std::max(corner2, std::pow((cx - d.cx_px) / d.fx_px, 2) + std::pow((cy - d.cy_px) / d.fy_px, 2));
+        }
+    }
+    const double r2 = x * x + y * y;
+    if (!(r2 <= 4.0 * corner2)) return {std::nan(""), std::nan("")};
+    const double radial = 1.0 + r2 * (k[0] + r2 * (k[1] + r2 * k[4]));
+    const double xd = x * radial + 2.0 * k[2] * x * y + k[3] * (r2 + 2.0 * x * x);
+    const double yd = y * radial + k[2] * (r2 + 2.0 * y * y) + 2.0 * k[3] * x * y;
+    return {d.fx_px * xd + d.cx_px, d.fy_px * yd + d.cy_px};
+}
+
+Eigen::Vector3d device_ray(const DeviceModel& d, double x, double y) {
+    if (d.distortion == std::array<double, 5>{}) return {(x - d.cx_px) / d.fx_px, (y - d.cy_px) / d.fy_px, 1.0};
+    return undistorted_ray(d, Eigen::Vector2d(x, y));
+}
+
 Eigen::Vector3d ray_on_screen(const ScreenModel& screen, const DeviceModel& camera, const Eigen::Vector3d& ray) {
     const auto hit = cylinder_hit(screen, camera.position_m, camera.rotation * ray);
     return hit ? *hit : Eigen::Vector3d::Constant(std::nan(""));
@@ -409,7 +452,11 @@ BundleResult bundle_adjust(const ScreenModel& screen, const DeviceModel& camera,
     pb.refine_bow = options.refine_bow && refine_camera;
     pb.refine_intrinsics = options.refine_camera_intrinsics && refine_camera;
     pb.camera_sigma = options.camera_sigma;
-    pb.screen_index = kCam + kProj * static_cast<Eigen::Index>(n);
+    pb.refine_distortion = options.refine_projector_distortion;
+    pb.refine_distortion.resize(n, false);
+    if (std::find(pb.refine_distortion.begin(), pb.refine_distortion.end(), true) != pb.refine_distortion.end())
+        pb.kp = kProj + kProjDistortion;
+    pb.screen_index = kCam + pb.kp * static_cast<Eigen::Index>(n);
     pb.intrinsics_index = pb.screen_index + pb.screen_count();
     Eigen::VectorXd q = Eigen::VectorXd::Zero(pb.parameter_count());
     for (std::size_t k = 0; k < n; ++k) {
@@ -426,10 +473,11 @@ BundleResult bundle_adjust(const ScreenModel& screen, const DeviceModel& camera,
         }
         pb.inliers.emplace_back(o.rays.size());
         for (std::size_t i = 0; i < o.rays.size(); ++i) pb.inliers[k][i] = static_cast<int>(i);
-        const auto base = static_cast<Eigen::Index>(kCam + kProj * k);
+        const auto base = static_cast<Eigen::Index>(kCam + pb.kp * static_cast<int>(k));
         q[base] = projectors[k].fx_px;
         q[base + 1] = projectors[k].cx_px;
         q[base + 2] = projectors[k].cy_px;
+        for (int j = kProj; j < pb.kp; ++j) q[base + j] = projectors[k].distortion[static_cast<std::size_t>(j - kProj)];
     }
     if (pb.refine_intrinsics) q.segment<kIntrinsics>(pb.intrinsics_index) = pb.intrinsics0();
     BundleResult out;
@@ -452,7 +500,8 @@ BundleResult bundle_adjust(const ScreenModel& screen, const DeviceModel& camera,
     out.camera = camera_at(camera, q.data(), pb.intrinsic_params(q));
     out.screen = pb.screen(pb.screen_params(q));
     for (std::size_t k = 0; k < n; ++k)
-        out.projectors.push_back(projector_at(projectors[k], q.data() + kCam + kProj * k));
+        out.projectors.push_back(
+            projector_at(projectors[k], q.data() + kCam + pb.kp * static_cast<int>(k), pb.kp > kProj));
     return out;
 }
 

@@ -29,7 +29,9 @@
 //   + sum over edge points of (distance on the screen of X(camera, ray) from its edge)^2 / sigma_e^2
 //   + sum over refined camera intrinsics of ((value - prior's) / prior sigma)^2
 // with X(camera, ray) = forward intersection of the camera ray with the cylinder; project_k the
-// pinhole x = fx X'/Z' + cx, y = fx * aspect Y'/Z' + cy (aspect fy/fx of the prior fixed, image
+// pinhole x = fx X'/Z' + cx, y = fx * aspect Y'/Z' + cy, or with the projector's lens distortion
+// (BundleOptions::refine_projector_distortion, device_image) x = fx xd + cx, y = fx * aspect yd + cy with
+// (xd, yd) OpenCV's distorted (X'/Z', Y'/Z') (aspect fy/fx of the prior fixed, image
 // positions with pixel centres at +0.5, X' = R_k^T (X - position_k)); sigma_i per point and axis
 // (a decoded block of b pixels: b / sqrt(12), the uniform distribution's; a phase-refined position: its own,
 // phase_shift.h); s_k and sigma_e are the
@@ -82,6 +84,9 @@ struct BundleOptions {
     // observations' camera image positions (camera_px, EdgeObservation::image).
     bool refine_camera_intrinsics = false;
     CameraIntrinsicsSigma camera_sigma;
+    // Per projector (empty: none): its lens distortion k1, k2, p1, p2 free too (OpenCV's model about its principal
+    // point, autocal.h; k3 stays the starting model's). Four more columns per projector; no prior pulls them.
+    std::vector<bool> refine_projector_distortion;
     int rounds = 2;           // LM runs, outliers dropped between them
     int max_iterations = 40;  // LM iterations per round
 };
@@ -110,6 +115,17 @@ struct BundleResult {
                                          const std::vector<EdgeObservation>& edges,
                                          const std::vector<ProjectorObservations>& observations,
                                          const BundleOptions& options = {});
+
+// A device's image position (pixel centres at +0.5) of point q in its own frame (OpenCV's camera frame,
+// q.z() > 0; the caller checks), through its lens distortion (OpenCV's Brown-Conrady model about the
+// principal point, autocal.h): (fx xd + cx, fy yd + cy). Without distortion the pinhole, computed as
+// before it had any. NaN with distortion where the ray is beyond twice the normalised radius of the image's
+// farthest corner (there the polynomial may fold back into the image).
+[[nodiscard]] Eigen::Vector2d device_image(const DeviceModel& d, const Eigen::Vector3d& q);
+
+// The ray (device frame, z = 1) of image position (x, y): the distortion inverted by OpenCV's fixed-point
+// iteration (undistortPoints) to 1e-14; the pinhole's ray without distortion.
+[[nodiscard]] Eigen::Vector3d device_ray(const DeviceModel& d, double x, double y);
 
 // The screen point (x, y, z) of an edge or correspondence: camera ray (camera frame) -> cylinder.
 // NaN when the ray misses.

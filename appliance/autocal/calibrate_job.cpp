@@ -103,6 +103,38 @@ nlohmann::json colour_report(const ColourResult& c) {
     return out;
 }
 
+// Projector k's part of report.json: decoding, fit, coverage, its lens distortion and the distortion trial's outcome
+// (with the rig's true distortion beside it).
+nlohmann::json projector_json(const AutocalResult& r, std::size_t k, const rig::VirtualRig& rig,
+                              const AutocalOptions& options, double coverage) {
+    const ProjectorReport& p = r.report.projectors[k];
+    const DistortionTrial t = k < r.report.distortion.size() ? r.report.distortion[k] : DistortionTrial{};
+    const std::array<double, 5>& d = r.projectors[k].distortion;
+    return nlohmann::json{
+        {"id", p.id},
+        {"resolution", {r.projectors[k].resolution.width, r.projectors[k].resolution.height}},
+        {"column_bits", p.column_bits},
+        {"row_bits", p.row_bits},
+        {"lit_pixels", p.lit_pixels},
+        {"phase_refined", p.phase_refined},
+        {"noise_sigma", p.noise_sigma},
+        {"correspondences", p.cells},
+        {"reprojection_rms_px", p.rms_px},
+        {"reprojection_rms_sigma", p.rms_sigma},
+        {"mean_view_angle_deg", p.mean_view_angle_deg},
+        {"camera_coverage", coverage},
+        {"distortion", {{"k1", d[0]}, {"k2", d[1]}, {"p1", d[2]}, {"p2", d[3]}, {"k3", d[4]}}},
+        {"distortion_trial",
+         {{"tried", t.tried},
+          {"kept", t.kept},
+          {"relative_cost", t.relative_cost},
+          {"fit_relative_cost", t.fit_relative_cost},
+          {"min_gain", options.distortion_min_gain},
+          {"fitted",
+           {{"k1", t.distortion[0]}, {"k2", t.distortion[1]}, {"p1", t.distortion[2]}, {"p2", t.distortion[3]}}}}},
+        {"true_distortion", rig.projectors[k].intrinsics.distortion}};
+}
+
 // The camera as the calibration ended with it: edges, intrinsics fitted (or the prior's) beside the
 // prior's, and the bundle adjustment's conditioning (standard deviations, condition number).
 nlohmann::json camera_report(const AutocalResult& r, const CalibrationPrior& prior, const AutocalOptions& options) {
@@ -248,22 +280,9 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
         report["ground_truth"]["seams_before_colour"] = seams_before;
     }
     report["ground_truth"]["seams"] = seam_figures(rig, r.calibration);
-    for (std::size_t k = 0; k < r.report.projectors.size(); ++k) {
-        const ProjectorReport& p = r.report.projectors[k];
+    for (std::size_t k = 0; k < r.report.projectors.size(); ++k)
         report["projectors"].push_back(
-            {{"id", p.id},
-             {"resolution", {r.projectors[k].resolution.width, r.projectors[k].resolution.height}},
-             {"column_bits", p.column_bits},
-             {"row_bits", p.row_bits},
-             {"lit_pixels", p.lit_pixels},
-             {"phase_refined", p.phase_refined},
-             {"noise_sigma", p.noise_sigma},
-             {"correspondences", p.cells},
-             {"reprojection_rms_px", p.rms_px},
-             {"reprojection_rms_sigma", p.rms_sigma},
-             {"mean_view_angle_deg", p.mean_view_angle_deg},
-             {"camera_coverage", source.simulator().camera_coverage(static_cast<int>(k))}});
-    }
+            projector_json(r, k, rig, job.options, source.simulator().camera_coverage(static_cast<int>(k))));
     std::filesystem::create_directories(job.out);
     MpcdiExportOptions mo;
     mo.alpha_bit_depth = job.alpha_bits;

@@ -543,7 +543,7 @@ void check_colour_layout(const std::vector<DeviceModel>& models, const ScreenCal
 
 Eigen::Vector2d model_pixel(const DeviceModel& d, const ScreenModel& s, double theta, double h) {
     const Eigen::Vector3d q = d.rotation.transpose() * (screen_position(s, theta, h) - d.position_m);
-    const Eigen::Vector2d xy(d.fx_px * q.x() / q.z() + d.cx_px, d.fy_px * q.y() / q.z() + d.cy_px);
+    const Eigen::Vector2d xy = device_image(d, q);  // through its distortion (NaN fails the test below)
     if (q.z() <= 0.0 ||
         !(xy.x() >= 0.0 && xy.x() < d.resolution.width && xy.y() >= 0.0 && xy.y() < d.resolution.height)) {
         return {std::nan(""), std::nan("")};

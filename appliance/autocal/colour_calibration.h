@@ -148,8 +148,8 @@ double apply_measured_colour(const MeasuredColour& colour, const std::vector<Dev
 // Step 1's interpolation: normalised light R(s) of a measured channel, s in [0, 1].
 [[nodiscard]] double response_at(const ChannelResponse& r, double s);
 
-// Image position of screen point (theta, h) in a fitted pinhole model, or NaN when it is behind the
-// projector or outside its image.
+// Image position of screen point (theta, h) in a fitted model (through its lens distortion), or NaN when it is behind
+// the projector or outside its image.
 [[nodiscard]] Eigen::Vector2d model_pixel(const DeviceModel& d, const ScreenModel& s, double theta, double h);
 
 }  // namespace mogao::autocal

@@ -115,7 +115,7 @@ Eigen::Matrix3d read_rotation(const Reader& r) {
     return m;
 }
 
-DeviceModel read_device(const Reader& r, bool camera) {
+DeviceModel read_device(const Reader& r, bool camera, bool distortion_allowed) {
     DeviceModel d;
     const Json& id = r.at("id");
     if (!id.is_string() || id.get<std::string>().empty() || id.get<std::string>().size() > 256) {
@@ -131,7 +131,11 @@ DeviceModel read_device(const Reader& r, bool camera) {
     d.cy_px = r.number("cy_px", -kBig, kBig, "[-1e6, 1e6] px");
     const std::vector<double> k = r.numbers("distortion", 5, -kBig, kBig, "[-1e6, 1e6]");
     for (std::size_t i = 0; i < 5; ++i) {
-        if (!camera && k[i] != 0.0) r.fail(fmt::format("distortion[{}]", i), " must be 0 (projectors are pinholes)");
+        if (!camera && !distortion_allowed && k[i] != 0.0) {
+            r.fail(fmt::format("distortion[{}]", i),
+                   " must be 0 (projectors are pinholes here: self-recalibration does not model a projector's lens "
+                   "distortion, which this calibration's distortion trial kept)");
+        }
         d.distortion[i] = k[i];
     }
     d.rotation = read_rotation(r);
@@ -187,11 +191,11 @@ Json models_json(const CalibrationModels& m, const std::string& name) {
                 {"camera", device_json(m.camera)},
                 {"projectors", projectors}};
     // nlohmann would write a non-finite number as null: validate so that what is written reads back.
-    (void)models_from_json(out, name);
+    (void)models_from_json(out, name, true);
     return out;
 }
 
-CalibrationModels models_from_json(const Json& json, const std::string& name) {
+CalibrationModels models_from_json(const Json& json, const std::string& name, bool projector_distortion) {
     const Reader root(name, json, "");
     const Json& format = root.at("format");
     if (format != kFormat) root.fail("format", fmt::format(" = {} is not \"{}\"", format.dump(), kFormat));
@@ -200,13 +204,14 @@ CalibrationModels models_from_json(const Json& json, const std::string& name) {
         root.fail("version", fmt::format(" = {} is not {} (the one this reader knows)", version.dump(), kVersion));
     CalibrationModels m;
     m.screen = read_screen(root.child("screen"));
-    m.camera = read_device(root.child("camera"), true);
+    m.camera = read_device(root.child("camera"), true, true);
     const Json& projectors = root.at("projectors");
     if (!projectors.is_array() || projectors.empty() || projectors.size() > kMaxProjectors) {
         root.fail("projectors", fmt::format(" must be an array of 1 to {} projectors", kMaxProjectors));
     }
     for (std::size_t k = 0; k < projectors.size(); ++k) {
-        m.projectors.push_back(read_device(Reader(name, projectors[k], fmt::format("projectors[{}]", k)), false));
+        m.projectors.push_back(
+            read_device(Reader(name, projectors[k], fmt::format("projectors[{}]", k)), false, projector_distortion));
     }
     return m;
 }

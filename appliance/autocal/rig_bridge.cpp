@@ -35,7 +35,10 @@ rig::VirtualRig scaled_rig(const rig::VirtualRig& rig, double projector_scale, d
         throw std::invalid_argument("scaled_rig: scales must be in (0, 1]");
     }
     rig::VirtualRig out = rig;
-    for (rig::RigProjector& p : out.projectors) scale_device(p.resolution, p.intrinsics, projector_scale);
+    for (rig::RigProjector& p : out.projectors) {
+        scale_device(p.resolution, p.intrinsics, projector_scale);
+        p.blur_px *= projector_scale;  // the same defocus on the screen, in the scaled projector's pixels
+    }
     const ImageSize camera_before = out.camera.resolution;
     scale_device(out.camera.resolution, out.camera.intrinsics, camera_scale);
     // The prior's principal point error is in camera pixels: it scales with them.

@@ -38,7 +38,8 @@ private:
     double simulate_s_ = 0.0;
 };
 
-// The rig at reduced resolution: projector and camera sizes and intrinsics scaled (errors in
+// The rig at reduced resolution: projector and camera sizes and intrinsics scaled, the projectors'
+// defocus (blur_px) with them (errors in
 // projector pixels then scale with `projector_scale`). Scales in (0, 1].
 [[nodiscard]] rig::VirtualRig scaled_rig(const rig::VirtualRig& rig, double projector_scale, double camera_scale);
 

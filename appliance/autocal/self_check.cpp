@@ -39,11 +39,12 @@ Eigen::Vector2d content_screen(const ScreenModel& s, const Eigen::Vector2d& uv) 
     return {(uv.x() - 0.5) * s.arc_deg * kDeg, s.top_m - uv.y() * (s.top_m - s.bottom_m)};
 }
 
-// A pinhole's image position of screen point th, unclipped (NaN behind the device).
+// A projector's image position of screen point th (through its distortion, device_image), unclipped (NaN
+// behind the device).
 Eigen::Vector2d pinhole_pixel(const DeviceModel& d, const ScreenModel& s, const Eigen::Vector2d& th) {
     const Eigen::Vector3d q = d.rotation.transpose() * (screen_position(s, th.x(), th.y()) - d.position_m);
     if (q.z() <= 0.0) return {std::nan(""), std::nan("")};
-    return {d.fx_px * q.x() / q.z() + d.cx_px, d.fy_px * q.y() / q.z() + d.cy_px};
+    return device_image(d, q);
 }
 
 // The camera's image position of screen point th, through its distortion (OpenCV's Brown-Conrady model).

@@ -134,6 +134,9 @@ RigProjector read_projector(Table& t, int k) {
     p.black_level = t.number("black_level", p.black_level);
     p.brightness = t.numbers<3>("brightness", p.brightness);
     p.falloff = t.number("falloff", p.falloff);
+    // Lens distortion (OpenCV's k1, k2, p1, p2, k3 about the lens-shifted principal point) and defocus.
+    p.intrinsics.distortion = t.numbers<5>("distortion", p.intrinsics.distortion);
+    p.blur_px = t.number("blur_px", p.blur_px);
     t.finish();
     return p;
 }
@@ -153,6 +156,7 @@ RigCamera read_camera(Table& t) {
     c.blur_sigma_px = t.number("blur_sigma_px", c.blur_sigma_px);
     c.bits = t.integer("bits", c.bits);
     c.supersample = t.integer("supersample", c.supersample);
+    c.vignetting = t.number("vignetting", c.vignetting);
     const int seed = t.integer("seed", 1);
     if (seed < 0) t.fail("seed", "must be >= 0");
     c.seed = static_cast<std::uint64_t>(seed);

@@ -105,6 +105,40 @@ Eigen::Vector3d screen_position(const RigScreen& screen, ScreenPoint p) {
     return {r * std::sin(p.theta_rad), p.h_m, -r * std::cos(p.theta_rad)};
 }
 
+// The normalised radius of a projector's image corner farthest from its principal point.
+double corner_radius(const RigProjector& p) {
+    const RigIntrinsics& in = p.intrinsics;
+    double corner = 0.0;
+    for (const double x : {0.0, static_cast<double>(p.resolution.width)}) {
+        for (const double y : {0.0, static_cast<double>(p.resolution.height)}) {
+            corner = std::max(corner, std::hypot((x - in.cx_px) / in.fx_px, (y - in.cy_px) / in.fy_px));
+        }
+    }
+    return corner;
+}
+
+// A projector's distortion (RigProjector::intrinsics.distortion): coefficients within the ranges a
+// projection lens has, and the radial map r -> r (1 + k1 r^2 + k2 r^4 + k3 r^6) increasing out to 1.2
+// times the normalised radius of the image's farthest corner (one ray per image position).
+void validate_projector_distortion(const RigProjector& p, const std::string& f) {
+    const auto& k = p.intrinsics.distortion;
+    const std::array<double, 5> limit{1.0, 1.0, 0.1, 0.1, 1.0};
+    for (std::size_t i = 0; i < k.size(); ++i) {
+        check_range(k[i], -limit[i], limit[i], f + ".distortion[" + std::to_string(i) + "]");
+    }
+    const double corner = corner_radius(p);
+    for (int i = 0; i <= 100; ++i) {
+        const double r2 = std::pow(1.2 * corner * i / 100.0, 2);
+        const double slope = 1.0 + r2 * (3.0 * k[0] + r2 * (5.0 * k[1] + r2 * 7.0 * k[4]));
+        check(
+            slope > 0.0 && (i < 100 || std::sqrt(r2) * (1.0 + r2 * (k[0] + r2 * (k[1] + r2 * k[4]))) > corner),
+            f + ".distortion",
+            "one-to-one out to 1.2 times the image's corners (d/dr of r (1 + k1 r^2 + k2 r^4 + k3 r^6) > 0 for r <= " +
+                std::to_string(1.2 * corner) + ", and that radius mapped beyond the corners' " +
+                std::to_string(corner) + ")");
+    }
+}
+
 void validate_camera(const RigCamera& c, const RigScreen& s, const std::string& f) {
     validate_size(c.resolution, f + ".resolution");
     validate_intrinsics(c.intrinsics, c.resolution, f);
@@ -116,6 +150,34 @@ void validate_camera(const RigCamera& c, const RigScreen& s, const std::string& 
     check_range(c.blur_sigma_px, 0.0, 20.0, f + ".blur_sigma_px");
     check(c.bits >= 1 && c.bits <= 16, f + ".bits", "1..16");
     check(c.supersample >= 1 && c.supersample <= 4, f + ".supersample", "1..4");
+    check_range(c.vignetting, 0.0, 0.45, f + ".vignetting");
+}
+
+// Light per projector pixel value before the fall-off, per channel: brightness * (black + (1 - black) * s^gamma),
+// mean of channels.
+double projector_light(const RigProjector& p, const float* v, int channels) {
+    double sum = 0.0;
+    for (int c = 0; c < 3; ++c) {
+        const double s = std::clamp(static_cast<double>(v[channels == 3 ? c : 0]), 0.0, 1.0);
+        const double lin = s <= 0.0 ? 0.0 : (s >= 1.0 ? 1.0 : std::pow(s, p.gamma[static_cast<std::size_t>(c)]));
+        sum += p.brightness[static_cast<std::size_t>(c)] * (p.black_level + (1.0 - p.black_level) * lin);
+    }
+    return sum / 3.0;
+}
+
+// The light of projector p's image for `signal`, defocused (RigProjector::blur_px): Gaussian, +-4 sigma,
+// zero beyond the image's border.
+cv::Mat1f defocused_light(const RigProjector& p, const cv::Mat& signal) {
+    cv::Mat1f out(signal.rows, signal.cols);
+    for (int y = 0; y < signal.rows; ++y) {
+        for (int x = 0; x < signal.cols; ++x) {
+            out(y, x) =
+                static_cast<float>(projector_light(p, signal.ptr<float>(y) + x * signal.channels(), signal.channels()));
+        }
+    }
+    const int half = static_cast<int>(std::ceil(4.0 * p.blur_px));
+    cv::GaussianBlur(out, out, cv::Size(2 * half + 1, 2 * half + 1), p.blur_px, p.blur_px, cv::BORDER_CONSTANT);
+    return out;
 }
 
 }  // namespace
@@ -171,12 +233,13 @@ void validate_rig(const VirtualRig& rig) {
         check(!p.id.empty(), f + ".id", "non-empty");
         validate_size(p.resolution, f + ".resolution");
         validate_intrinsics(p.intrinsics, p.resolution, f);
-        for (double d : p.intrinsics.distortion) check(d == 0.0, f + ".distortion", "zero (projectors are pinholes)");
+        validate_projector_distortion(p, f);
         validate_pose(p.pose, s, f);
         for (double g : p.gamma) check_range(g, 0.1, 10.0, f + ".gamma");
         for (double b : p.brightness) check_range(b, 1e-3, 100.0, f + ".brightness");
         check_range(p.black_level, 0.0, 0.5, f + ".black_level");
         check_range(p.falloff, 0.0, 0.45, f + ".falloff");
+        check_range(p.blur_px, 0.0, 10.0, f + ".blur_px");
     }
     check(rig.more_cameras.size() <= 7, "cameras", "1..8 cameras");
     validate_camera(rig.camera, s, "camera");
@@ -202,10 +265,47 @@ double projector_falloff(const RigProjector& p, double x, double y) {
     return 1.0 - p.falloff * std::min(rho2, 2.0);
 }
 
+Eigen::Vector2d distort(const std::array<double, 5>& k, double x, double y) {
+    const double r2 = x * x + y * y;
+    const double radial = 1.0 + r2 * (k[0] + r2 * (k[1] + r2 * k[4]));
+    return {x * radial + 2.0 * k[2] * x * y + k[3] * (r2 + 2.0 * x * x),
+            y * radial + k[2] * (r2 + 2.0 * y * y) + 2.0 * k[3] * x * y};
+}
+
+Eigen::Vector2d undistort(const std::array<double, 5>& k, double xd, double yd) {
+    double x = xd;
+    double y = yd;
+    for (int i = 0; i < 200; ++i) {
+        const double r2 = x * x + y * y;
+        const double radial = 1.0 + r2 * (k[0] + r2 * (k[1] + r2 * k[4]));
+        const double nx = (xd - 2.0 * k[2] * x * y - k[3] * (r2 + 2.0 * x * x)) / radial;
+        const double ny = (yd - k[2] * (r2 + 2.0 * y * y) - 2.0 * k[3] * x * y) / radial;
+        const bool done = std::abs(nx - x) + std::abs(ny - y) < 1e-14;
+        x = nx;
+        y = ny;
+        if (done) break;
+    }
+    return {x, y};
+}
+
+double camera_vignetting(const RigCamera& c, double x, double y) {
+    if (c.vignetting == 0.0) return 1.0;
+    const double half_diagonal = 0.5 * std::hypot(c.resolution.width, c.resolution.height);
+    const double rho2 =
+        (std::pow(x - c.intrinsics.cx_px, 2) + std::pow(y - c.intrinsics.cy_px, 2)) / (half_diagonal * half_diagonal);
+    return 1.0 - c.vignetting * std::min(rho2, 2.0);
+}
+
 std::optional<ScreenPoint> projector_to_screen(const VirtualRig& rig, int k, double x, double y) {
     const RigProjector& p = rig.projectors.at(static_cast<std::size_t>(k));
     const RigIntrinsics& in = p.intrinsics;
-    const Eigen::Vector3d d_dev((x - in.cx_px) / in.fx_px, (y - in.cy_px) / in.fy_px, 1.0);
+    Eigen::Vector3d d_dev((x - in.cx_px) / in.fx_px, (y - in.cy_px) / in.fy_px, 1.0);
+    if (in.distortion != std::array<double, 5>{}) {
+        const Eigen::Vector2d u = undistort(in.distortion, d_dev.x(), d_dev.y());
+        const Eigen::Vector2d back = distort(in.distortion, u.x(), u.y());
+        if (!((back - d_dev.head<2>()).norm() < 1e-10)) return std::nullopt;  // not converged: no ground truth
+        d_dev.head<2>() = u;
+    }
     const auto hit = hit_screen(rig.screen, p.pose.position_m, device_to_screen(p.pose) * d_dev);
     if (!hit) return std::nullopt;
     return on_screen(rig.screen, *hit);
@@ -216,8 +316,14 @@ std::optional<Eigen::Vector2d> screen_to_projector(const VirtualRig& rig, int k,
     const Eigen::Vector3d d =
         device_to_screen(p.pose).transpose() * (screen_position(rig.screen, s) - p.pose.position_m);
     if (d.z() <= 1e-9) return std::nullopt;
-    const Eigen::Vector2d xy(p.intrinsics.fx_px * d.x() / d.z() + p.intrinsics.cx_px,
-                             p.intrinsics.fy_px * d.y() / d.z() + p.intrinsics.cy_px);
+    const RigIntrinsics& in = p.intrinsics;
+    Eigen::Vector2d n(d.x() / d.z(), d.y() / d.z());
+    if (in.distortion != std::array<double, 5>{}) {
+        // Far outside the image the polynomial folds back: only rays within the validated radius count.
+        if (n.norm() > 1.2 * corner_radius(p)) return std::nullopt;
+        n = distort(in.distortion, n.x(), n.y());
+    }
+    const Eigen::Vector2d xy(in.fx_px * n.x() + in.cx_px, in.fy_px * n.y() + in.cy_px);
     if (!(xy.x() >= 0.0 && xy.x() < p.resolution.width && xy.y() >= 0.0 && xy.y() < p.resolution.height)) {
         return std::nullopt;
     }
@@ -295,18 +401,15 @@ cv::Mat1f CameraSimulator::capture(const std::vector<cv::Mat>& signals, std::uin
                                         "x" + std::to_string(r.height));
         }
     }
-    // Light per projector pixel value before the fall-off, per channel: brightness * (black + (1 - black) * s^gamma),
-    // mean of channels.
     const auto light = [&](std::size_t k, const float* v, int channels) {
-        const RigProjector& p = rig_.projectors[k];
-        double sum = 0.0;
-        for (int c = 0; c < 3; ++c) {
-            const double s = std::clamp(static_cast<double>(v[channels == 3 ? c : 0]), 0.0, 1.0);
-            const double lin = s <= 0.0 ? 0.0 : (s >= 1.0 ? 1.0 : std::pow(s, p.gamma[static_cast<std::size_t>(c)]));
-            sum += p.brightness[static_cast<std::size_t>(c)] * (p.black_level + (1.0 - p.black_level) * lin);
-        }
-        return sum / 3.0;
+        return projector_light(rig_.projectors[k], v, channels);
     };
+    // Defocus (RigProjector::blur_px): each lit projector's light image, blurred; looked up in place of `light`.
+    std::vector<cv::Mat1f> blurred(np);
+    for (std::size_t k = 0; k < np; ++k) {
+        if (rig_.projectors[k].blur_px > 0.0 && !signals[k].empty())
+            blurred[k] = defocused_light(rig_.projectors[k], signals[k]);
+    }
     const int ss = rig_.camera.supersample;
     const ImageSize res = rig_.camera.resolution;
     cv::Mat1f img(res.height, res.width, 0.0f);
@@ -327,6 +430,10 @@ cv::Mat1f CameraSimulator::capture(const std::vector<cv::Mat>& signals, std::uin
                             const double f = p.falloff == 0.0 ? 1.0
                                                               : projector_falloff(p, h % p.resolution.width + 0.5,
                                                                                   h / p.resolution.width + 0.5);
+                            if (!blurred[k].empty()) {
+                                l += f * blurred[k](h / p.resolution.width, h % p.resolution.width);
+                                continue;
+                            }
                             l += f * (s.empty() ? light(k, &zero, 1)
                                                 : light(k, s.ptr<float>() + static_cast<std::size_t>(h) * s.channels(),
                                                         s.channels()));
@@ -334,7 +441,8 @@ cv::Mat1f CameraSimulator::capture(const std::vector<cv::Mat>& signals, std::uin
                         acc += l;
                     }
                 }
-                img(y, x) = static_cast<float>(acc / (ss * ss));
+                const double v = camera_vignetting(rig_.camera, x + 0.5, y + 0.5);
+                img(y, x) = static_cast<float>(v == 1.0 ? acc / (ss * ss) : v * acc / (ss * ss));
             }
         }
     });

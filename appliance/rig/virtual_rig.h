@@ -20,9 +20,15 @@
 // Image positions are continuous with pixel (x, y) covering [x, x + 1) x [y, y + 1), so its centre
 // is at (x + 0.5, y + 0.5) (projector_calibration.h); principal points use the same convention
 // (OpenCV's matrices put the centre at integers: cx_opencv = cx - 0.5).
-// Lens distortion (camera only): OpenCV's Brown-Conrady model, coefficients (k1, k2, p1, p2, k3)
-// on normalised coordinates (Brown 1966; OpenCV calib3d "Camera Calibration and 3D
-// Reconstruction").
+// Lens distortion (cameras and projectors): OpenCV's Brown-Conrady model, coefficients (k1, k2, p1, p2, k3)
+// on normalised coordinates about the principal point (for a projector the lens-shifted one): a ray
+// (x, y, 1) in the device frame reaches image position (fx xd + cx, fy yd + cy) with
+// xd = x (1 + k1 r^2 + k2 r^4 + k3 r^6) + 2 p1 x y + p2 (r^2 + 2 x^2),
+// yd = y (1 + k1 r^2 + k2 r^4 + k3 r^6) + p1 (r^2 + 2 y^2) + 2 p2 x y, r^2 = x^2 + y^2 (Brown 1966;
+// OpenCV calib3d "Camera Calibration and 3D Reconstruction", cv::projectPoints). An image position's
+// ray is the model inverted by fixed-point iteration (as cv::undistortPoints) to 1e-14.
+// A projector's distortion must keep its image one-to-one out to 1.2 times its corners' radius
+// (validate_rig), so that every image position has one ray.
 //
 // Light (linear, relative to a projector's full white = 1): projector k at signal s in [0, 1]
 // (per channel c) puts F_k(x, y) * brightness_k[c] * (black + (1 - black) * s^gamma_k[c]) on the
@@ -33,9 +39,17 @@
 // leading term of the cos^4 law's expansion, 1 - 2 tan^2 phi, with its strength a free parameter:
 // projector optics are not a plain pinhole; ANSI/INFOCOMM 3M-2011 reports the corner-to-centre
 // ratio a data sheet calls uniformity, e.g. 85 % ~ falloff 0.15). Black light passes the same lens.
+// Defocus (RigProjector::blur_px): the light of projector k's image (after its response, before the
+// fall-off) is convolved with a Gaussian of standard deviation blur_px projector pixels (OpenCV's
+// GaussianBlur, kernel +-4 sigma); light that would spread beyond the image's border is lost (zero
+// outside the image), so the image's outermost pixel rows are dimmed by up to half.
+// Camera vignetting (RigCamera::vignetting = v): the light reaching camera pixel (x, y) (its centre) is
+// multiplied by V = 1 - v min(rho^2, 2), rho = distance from the principal point / half the camera
+// image's diagonal: the same radial law as the projectors' fall-off (the leading term of cos^4), so v is
+// the light lost at a corner when the principal point is at the image's centre (v = 0.2: 20 %).
 // The camera is monochrome with a flat spectral response: it sees the mean of the three channels,
 // integrated over each pixel by `supersample`^2 point samples, blurred by a Gaussian of
-// `blur_sigma_px`, scaled by exposure * gain, with Gaussian noise of standard deviation
+// `blur_sigma_px` (after the vignetting), scaled by exposure * gain, with Gaussian noise of standard deviation
 // sqrt(read_noise^2 + shot_noise^2 * value), clipped to [0, 1] and quantised to `bits`.
 // Auto-exposure (camera.auto_exposure, what a webcam does unless told otherwise): before the noise,
 // each image is rescaled so that its mean is kAutoExposureTarget of full scale, whatever the
@@ -87,12 +101,13 @@ struct RigIntrinsics {
 struct RigProjector {
     std::string id;
     ImageSize resolution{1920, 1080};
-    RigIntrinsics intrinsics;  // no distortion for projectors (checked)
+    RigIntrinsics intrinsics;  // distortion: |k1|, |k2|, |k3| <= 1, |p1|, |p2| <= 0.1, one-to-one (checked)
     RigPose pose;
     std::array<double, 3> gamma{2.2, 2.2, 2.2};       // per channel, (0, 10]
     double black_level = 0.002;                       // fraction of full white at signal 0, [0, 1)
     std::array<double, 3> brightness{1.0, 1.0, 1.0};  // full white per channel, (0, 100]
     double falloff = 0.0;                             // lens fall-off at half the diagonal, [0, 0.45]
+    double blur_px = 0.0;  // defocus: Gaussian sigma in projector pixels, [0, 10] (header comment)
 };
 
 struct RigCamera {
@@ -107,6 +122,7 @@ struct RigCamera {
     double blur_sigma_px = 0.7;  // Gaussian blur, camera pixels, [0, 20]
     int bits = 8;                // quantisation, 1..16
     int supersample = 1;         // point samples per pixel side, 1..4
+    double vignetting = 0.0;     // light lost at rho = 1 (header comment), [0, 0.45]
     std::uint64_t seed = 1;
 };
 
@@ -142,8 +158,8 @@ struct ScreenPoint {
     double h_m = 0.0;
 };
 
-// Checks every field's range, that the devices are inside the cylinder and that projectors have no
-// distortion. Throws std::invalid_argument naming the field and its limit.
+// Checks every field's range, that the devices are inside the cylinder and that projectors' distortion
+// keeps their image one-to-one. Throws std::invalid_argument naming the field and its limit.
 void validate_rig(const VirtualRig& rig);
 
 // How many cameras the rig has (1 + more_cameras).
@@ -165,6 +181,14 @@ void validate_rig(const VirtualRig& rig);
 // Ground truth, the other way: the image position of projector k that lands on screen point p, or
 // nullopt when p is behind the projector or outside its image [0, W) x [0, H).
 [[nodiscard]] std::optional<Eigen::Vector2d> screen_to_projector(const VirtualRig& rig, int k, ScreenPoint p);
+
+// The Brown-Conrady model (header comment): distorted normalised coordinates of ray (x, y, 1), and the
+// ray (z = 1) of distorted normalised coordinates (fixed-point inverse, to 1e-14 or 200 steps).
+[[nodiscard]] Eigen::Vector2d distort(const std::array<double, 5>& k, double x, double y);
+[[nodiscard]] Eigen::Vector2d undistort(const std::array<double, 5>& k, double xd, double yd);
+
+// Camera vignetting V at camera image position (x, y) (header comment; 1 on the principal point).
+[[nodiscard]] double camera_vignetting(const RigCamera& c, double x, double y);
 
 // Ground truth: projector k's relative light at image position (x, y) (F in the header comment; 1
 // on the principal point, in (0, 1]).

@@ -3,10 +3,12 @@
 // block seen where cv::projectPoints puts it in the camera, and rig-file errors.
 #include "appliance/rig/virtual_rig.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
@@ -205,6 +207,112 @@ TEST(VirtualRig, LensFalloffDimsTheImageAwayFromThePrincipalPoint) {
     EXPECT_THROW(validate_rig(dim), std::invalid_argument);
 }
 
+// A projector's lens distortion (OpenCV's model about its lens-shifted principal point): its image position of
+// a screen point is where cv::projectPoints puts it (OpenCV's matrix has the pixel centre at integers), the
+// round trip through projector_to_screen holds, and the distortion moves the image by tens of pixels.
+TEST(VirtualRig, ProjectorDistortionIsOpenCvsModel) {
+    const VirtualRig pinhole = standard();
+    VirtualRig rig = pinhole;
+    rig.projectors[0].intrinsics.distortion = {-0.04, 0.01, 0.002, -0.001, 0.003};
+    rig.projectors[2].intrinsics.distortion = {0.03, -0.01, -0.0015, 0.001, 0.0};
+    validate_rig(rig);
+    double largest_shift = 0.0;
+    int compared = 0;
+    for (const int k : {0, 2}) {
+        const RigProjector& p = rig.projectors[static_cast<std::size_t>(k)];
+        const Eigen::Matrix3d world_to_device = device_to_screen(p.pose).transpose();
+        cv::Mat rvec;
+        cv::Rodrigues(cv::Matx33d(world_to_device.data()).t(), rvec);  // Eigen is column-major
+        const Eigen::Vector3d t = -world_to_device * p.pose.position_m;
+        const cv::Matx33d kmat(p.intrinsics.fx_px, 0.0, p.intrinsics.cx_px - 0.5, 0.0, p.intrinsics.fy_px,
+                               p.intrinsics.cy_px - 0.5, 0.0, 0.0, 1.0);
+        for (double th = -70.0; th <= 70.0; th += 5.0) {
+            for (double h = 0.85; h < 2.3; h += 0.1) {
+                const ScreenPoint s{th * std::numbers::pi / 180.0, h};
+                const auto xy = screen_to_projector(rig, k, s);
+                if (!xy) continue;
+                const double r = rig.screen.radius_m;
+                const std::vector<cv::Point3d> world{{r * std::sin(s.theta_rad), h, -r * std::cos(s.theta_rad)}};
+                std::vector<cv::Point2d> image;
+                cv::projectPoints(world, rvec, cv::Vec3d(t.x(), t.y(), t.z()), kmat, p.intrinsics.distortion, image);
+                EXPECT_NEAR(xy->x(), image[0].x + 0.5, 1e-6);
+                EXPECT_NEAR(xy->y(), image[0].y + 0.5, 1e-6);
+                const auto back = projector_to_screen(rig, k, xy->x(), xy->y());
+                ASSERT_TRUE(back.has_value());
+                EXPECT_NEAR(back->theta_rad, s.theta_rad, 1e-9);
+                EXPECT_NEAR(back->h_m, s.h_m, 1e-9);
+                if (const auto flat = screen_to_projector(pinhole, k, s))
+                    largest_shift = std::max(largest_shift, (*flat - *xy).norm());
+                ++compared;
+            }
+        }
+    }
+    EXPECT_GT(compared, 200);
+    EXPECT_GT(largest_shift, 5.0);  // 9.4 px at these points
+}
+
+// Defocus (blur_px) is a Gaussian of the projector's light: with a linear response and no black level the
+// rig shows a block defocused as the sharp rig shows the block blurred beforehand, and it keeps the light.
+TEST(VirtualRig, DefocusIsAGaussianOfTheProjectorsLight) {
+    VirtualRig sharp = standard();
+    sharp.camera.read_noise = 0.0;
+    sharp.camera.shot_noise = 0.0;
+    sharp.camera.bits = 16;
+    sharp.camera.blur_sigma_px = 0.0;
+    sharp.camera.exposure = 0.5;  // unclipped
+    sharp.ambient = 0.0;
+    for (RigProjector& p : sharp.projectors) {
+        p.gamma = {1.0, 1.0, 1.0};
+        p.black_level = 0.0;
+    }
+    sharp.camera.supersample = 2;  // the camera integrates: its sum is about the light's integral
+    VirtualRig blurred = sharp;
+    blurred.projectors[1].blur_px = 2.5;
+    std::vector<cv::Mat> signals(3);
+    cv::Mat1f block(1080, 1920, 0.0f);
+    cv::rectangle(block, cv::Rect(900, 500, 48, 48), 1.0, cv::FILLED);
+    signals[1] = block;
+    const cv::Mat1f defocused = CameraSimulator(blurred).capture(signals, 0);
+    const cv::Mat1f in_focus = CameraSimulator(sharp).capture(signals, 0);
+    cv::Mat1f pre_blurred;
+    cv::GaussianBlur(block, pre_blurred, cv::Size(21, 21), 2.5, 2.5, cv::BORDER_CONSTANT);
+    signals[1] = pre_blurred;
+    const cv::Mat1f expected = CameraSimulator(sharp).capture(signals, 0);
+    EXPECT_LT(cv::norm(defocused, expected, cv::NORM_INF), 1e-4);
+    EXPECT_NEAR(cv::sum(defocused)[0] / cv::sum(in_focus)[0], 1.0, 0.02);
+    EXPECT_GT(cv::norm(defocused, in_focus, cv::NORM_INF), 0.02);  // the block's edges spread
+}
+
+// Camera vignetting dims every camera pixel by 1 - v min(rho^2, 2) (rho over half the diagonal from the
+// principal point, written out here again): 20 % at a corner of a centred lens.
+TEST(VirtualRig, CameraVignettingFollowsItsRadialLaw) {
+    VirtualRig flat = standard();
+    flat.camera.read_noise = 0.0;
+    flat.camera.shot_noise = 0.0;
+    flat.camera.bits = 16;
+    flat.camera.blur_sigma_px = 0.0;
+    flat.ambient = 0.5;
+    VirtualRig dim = flat;
+    dim.camera.vignetting = 0.2;
+    const std::vector<cv::Mat> off(3);
+    const cv::Mat1f a = CameraSimulator(flat).capture(off, 0);
+    const cv::Mat1f b = CameraSimulator(dim).capture(off, 0);
+    const RigIntrinsics& in = flat.camera.intrinsics;
+    const double half_diagonal = 0.5 * std::hypot(1280.0, 720.0);
+    int checked = 0;
+    for (int y = 0; y < 720; y += 37) {
+        for (int x = 0; x < 1280; x += 41) {
+            if (a(y, x) < 0.1f) continue;
+            const double rho2 =
+                (std::pow(x + 0.5 - in.cx_px, 2) + std::pow(y + 0.5 - in.cy_px, 2)) / (half_diagonal * half_diagonal);
+            EXPECT_NEAR(b(y, x) / a(y, x), 1.0 - 0.2 * rho2, 2e-4) << x << ", " << y;
+            ++checked;
+        }
+    }
+    EXPECT_GT(checked, 300);
+    EXPECT_NEAR(camera_vignetting(dim.camera, 0.0, 0.0), 0.8, 0.01);  // the principal point is near the centre
+}
+
 TEST(VirtualRig, CaptureIsDeterministicAndNoisy) {
     const CameraSimulator sim(standard());
     const std::vector<cv::Mat> off(3);
@@ -284,6 +392,29 @@ TEST(RigFile, ErrorsNameTheField) {
     EXPECT_NE(message("[[cameras]]\n[[cameras]]\nbits = 0\n[[projectors]]\n").find("cameras[1].bits must be 1..16"),
               std::string::npos);
     EXPECT_NE(message("[screen]\nbulge_m = 0.5\n[camera]\n[[projectors]]\n").find("screen.bulge_m"), std::string::npos);
+    // Projector lens distortion and defocus, camera vignetting: each key and its range named.
+    EXPECT_NE(message("[camera]\n[[projectors]]\ndistortion = [0, 0, 0.5, 0, 0]\n")
+                  .find("projectors[0] 'proj0'.distortion[2] must be in [-0.100000, 0.100000]"),
+              std::string::npos);
+    EXPECT_NE(message("[camera]\n[[projectors]]\ndistortion = [-1, 0, 0, 0, 0]\n")
+                  .find("projectors[0] 'proj0'.distortion must be one-to-one"),
+              std::string::npos);
+    EXPECT_NE(message("[camera]\n[[projectors]]\ndistortion = [0, 0]\n").find("distortion: must be an array of 5"),
+              std::string::npos);
+    EXPECT_NE(message("[camera]\n[[projectors]]\nblur_px = 20\n").find("projectors[0] 'proj0'.blur_px must be in [0"),
+              std::string::npos);
+    EXPECT_NE(message("[camera]\nvignetting = 0.6\n[[projectors]]\n").find("camera.vignetting must be in [0"),
+              std::string::npos);
+    const VirtualRig lens = parse_rig(
+        "[camera]\nvignetting = 0.2\n[[projectors]]\ndistortion = [-0.04, 0.01, 0.001, -0.002, 0]\nblur_px = 0.7\n",
+        "lens.toml");
+    EXPECT_EQ(lens.projectors[0].intrinsics.distortion, (std::array<double, 5>{-0.04, 0.01, 0.001, -0.002, 0.0}));
+    EXPECT_EQ(lens.projectors[0].blur_px, 0.7);
+    EXPECT_EQ(lens.camera.vignetting, 0.2);
+    const VirtualRig old = standard();  // old rigs: none of them
+    EXPECT_EQ(old.projectors[0].intrinsics.distortion, (std::array<double, 5>{}));
+    EXPECT_EQ(old.projectors[0].blur_px, 0.0);
+    EXPECT_EQ(old.camera.vignetting, 0.0);
     EXPECT_EQ(
         camera_count(parse_rig("[[cameras]]\n[[cameras]]\nposition_m = [0.5, 1.6, 1.0]\n[[projectors]]\n", "two")), 2u);
     EXPECT_THROW((void)load_rig("/nonexistent/rig.toml"), RigError);
