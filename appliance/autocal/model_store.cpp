@@ -134,7 +134,8 @@ DeviceModel read_device(const Reader& r, bool camera, bool distortion_allowed) {
         if (!camera && !distortion_allowed && k[i] != 0.0) {
             r.fail(fmt::format("distortion[{}]", i),
                    " must be 0 (projectors are pinholes here: self-recalibration does not model a projector's lens "
-                   "distortion, which this calibration's distortion trial kept)");
+                   "distortion, which this calibration's distortion trial kept: calibrate again with "
+                   "--pinhole-projectors, or run without self-recalibration)");
         }
         d.distortion[i] = k[i];
     }

@@ -66,6 +66,7 @@ struct Cli {
     bool no_colour = false;
     bool no_falloff = false;
     bool no_bow = false;
+    bool pinhole_projectors = false;
     bool budget = false;
     double budget_fps = 30.0;
 };
@@ -258,6 +259,9 @@ int main(int argc, char** argv) {
                  "Fit the screen's radius and arc too (known only roughly; the heights are taken as measured)");
     app.add_flag("--no-bow", cli.no_bow,
                  "Take the screen as an exact cylinder: do not try a bow (kept by default only where it pays)");
+    app.add_flag("--pinhole-projectors", cli.pinhole_projectors,
+                 "Take the projectors as pinholes: do not try fitting their lens distortion (kept by default, per "
+                 "projector, only where it pays; self-recalibration needs pinholes)");
     app.add_option("--max-self-check-px", job.self_check.max_mean_px,
                    "Self-check gate: refuse when the verification marks land further than this from where they "
                    "belong (mean, projector pixels, measured against the screen's frame)")
@@ -306,6 +310,7 @@ int main(int argc, char** argv) {
     job.colour = !cli.no_colour;
     job.colour_options.lens_falloff = !cli.no_falloff;
     job.options.fit_bow = !cli.no_bow;
+    job.options.fit_projector_distortion = !cli.pinhole_projectors;
     job.transfer =
         cli.transfer == "linear" || cli.camera.starts_with("rig:") ? CameraTransfer::linear : CameraTransfer::srgb;
     try {

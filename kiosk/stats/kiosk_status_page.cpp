@@ -307,7 +307,8 @@ void calibration_section(std::string& out, const StatusPageInput& in) {
 }
 
 const char* const kStyle = R"(
-body{font-family:"DejaVu Sans",Arial,Helvetica,sans-serif;font-size:15px;color:#1d232b;background:#eef0f3;margin:0;padding:18px 22px}
+body{font-family:"DejaVu Sans",Arial,Helvetica,sans-serif;font-size:15px;color:#1d232b;background:#eef0f3;
+margin:0;padding:18px 22px}
 header{margin-bottom:12px}h1{font-size:24px;margin:0 0 4px 0}h2{font-size:17px;margin:0 0 8px 0;color:#2b4a6f}
 .when{margin:2px 0;color:#3a4450}.grid{display:grid;grid-template-columns:1fr 1.15fr;gap:14px;align-items:start}
 section{background:#fff;border:1px solid #cfd5dc;border-radius:6px;padding:10px 14px;margin-bottom:14px}
@@ -319,7 +320,8 @@ table.list td{font-weight:normal;font-size:14px}.unknown{color:#8a939c;font-styl
 .b-stopped{background:#5d6670}.b-unknown{background:#8a939c}.ok{color:#23864a}.bad{color:#c0392b}
 .warn{background:#fdecea;border-left:4px solid #c0392b;padding:5px 8px;margin:6px 0}.warnrow td{color:#c0392b}
 .info{color:#55606c;font-size:13px;margin:4px 0}.small{font-size:12px;font-weight:normal;color:#55606c}
-figure{margin:8px 0 0 0}figure img{max-width:100%;height:auto;border:1px solid #cfd5dc;background:#000;image-rendering:auto}
+figure{margin:8px 0 0 0}
+figure img{max-width:100%;height:auto;border:1px solid #cfd5dc;background:#000;image-rendering:auto}
 figcaption{font-size:12px;color:#55606c}footer{font-size:12px;color:#55606c}ul{margin:4px 0;padding-left:20px}
 )";
 

@@ -8,7 +8,7 @@ black-level step) beside the self-check's figure (from the camera images alone),
 a run the self-check refuses is run again with its gate off (--max-self-check-px 1e9) to show the ground
 truth of what it refused. Figures there are never pasted.
 
-  appliance/autocal/regenerate-calibration-doc [--build build-calib] [--scale 0.5]
+  tools/docs/regenerate_calibration_doc.py [--build build-calib] [--scale 0.5]
 Python 3 standard library only.
 """
 import argparse, datetime, glob, json, os, platform, re, subprocess, sys, tempfile
@@ -59,7 +59,7 @@ def main():
     tool = os.path.join(ROOT, args.build, "appliance", "autocal", "mogao-autocal")
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout.strip()
     lines = [f"Run {datetime.date.today()} at commit {commit} on {platform.node()} by "
-             f"`appliance/autocal/regenerate-calibration-doc --scale {args.scale}` (projector and camera resolution x{args.scale}, "
+             f"`tools/docs/regenerate_calibration_doc.py --scale {args.scale}` (projector and camera resolution x{args.scale}, "
              "but x1 for rigs marked so; errors in that rig's projector pixels, against the rig's ground truth; compute = "
              "the calibration's wall time without the rig's camera simulation, colour step included, 2 cores).", "",
              "| rig | result | geometry mean / p95 / max (px) | self-check mean / p95 (px) | camera intrinsics (trial's "
