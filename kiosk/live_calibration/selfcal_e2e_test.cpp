@@ -44,6 +44,7 @@
 #include "common/jpeg_codec.h"
 #include "kiosk/config/config_overrides.h"
 #include "renderfarm/link/link_test_support.h"
+#include "tests/support/child_process.h"
 
 extern char** environ;
 
@@ -83,42 +84,7 @@ double projector_error_px(const rig::VirtualRig& truth, const ScreenCalibration&
     return autocal::measure_geometry(one, c, 8).mean_px;
 }
 
-// The kiosk as a child process; SIGTERM and reaped at scope exit.
-class Child {
-public:
-    explicit Child(const std::vector<std::string>& args) {
-        std::vector<char*> argv;
-        for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-        argv.push_back(nullptr);
-        if (::posix_spawn(&pid_, argv[0], nullptr, nullptr, argv.data(), environ) != 0) pid_ = -1;
-    }
-    ~Child() { (void)stop(); }
-    [[nodiscard]] bool running() const { return pid_ > 0; }
-    [[nodiscard]] bool exited() {
-        if (pid_ <= 0) return true;
-        int status = 0;
-        if (::waitpid(pid_, &status, WNOHANG) == pid_) {
-            status_ = status;
-            pid_ = -1;
-            return true;
-        }
-        return false;
-    }
-    int stop() {
-        if (pid_ > 0) {
-            ::kill(pid_, SIGTERM);
-            int status = 0;
-            ::waitpid(pid_, &status, 0);
-            status_ = status;
-            pid_ = -1;
-        }
-        return WIFEXITED(status_) ? WEXITSTATUS(status_) : 128 + WTERMSIG(status_);
-    }
-
-private:
-    pid_t pid_ = -1;
-    int status_ = 0;
-};
+using mogao::testing::ChildProcess;
 
 TEST(SelfcalKioskEndToEnd, ABumpedProjectorIsCorrectedAndWrittenBackByMogaoKiosk) {
     if (!testing::ipv6_loopback_available()) GTEST_SKIP() << "no IPv6 loopback ([::1]) for the link";
@@ -168,7 +134,7 @@ TEST(SelfcalKioskEndToEnd, ABumpedProjectorIsCorrectedAndWrittenBackByMogaoKiosk
          "stats.file=", R"(stats.status_file="status.json")", "stats.status_period_s=0.2", "selfcal.enabled=true",
          R"(selfcal.camera="rig:bumped.toml")", "selfcal.hold_s=1", "selfcal.transition_s=1"});
     std::ofstream(dir / "kiosk.toml") << toml;
-    Child kiosk({MOGAO_KIOSK_BINARY, "--config", (dir / "kiosk.toml").string(), "--duration", "100"});
+    ChildProcess kiosk({MOGAO_KIOSK_BINARY, "--config", (dir / "kiosk.toml").string(), "--duration", "100"});
     ASSERT_TRUE(kiosk.running());
 
     // Poll the status file (written atomically) until calibrated again after a correction.

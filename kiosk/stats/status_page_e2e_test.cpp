@@ -38,6 +38,7 @@
 #include "kiosk/config/config_overrides.h"
 #include "kiosk/stats/status_page_test_util.h"
 #include "renderfarm/link/link_test_support.h"
+#include "tests/support/child_process.h"
 
 extern char** environ;
 
@@ -90,39 +91,7 @@ int run(const std::vector<std::string>& args, const fs::path& out, const fs::pat
     return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
-// The kiosk as a child process; SIGTERM and reaped at scope exit.
-class Child {
-public:
-    explicit Child(const std::vector<std::string>& args) {
-        std::vector<char*> argv;
-        for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-        argv.push_back(nullptr);
-        if (::posix_spawn(&pid_, argv[0], nullptr, nullptr, argv.data(), environ) != 0) pid_ = -1;
-    }
-    ~Child() { (void)stop(); }
-    Child(const Child&) = delete;
-    Child& operator=(const Child&) = delete;
-    [[nodiscard]] bool alive() {
-        if (pid_ <= 0) return false;
-        int status = 0;
-        if (::waitpid(pid_, &status, WNOHANG) != pid_) return true;
-        status_ = status;
-        pid_ = -1;
-        return false;
-    }
-    int stop() {
-        if (pid_ > 0) {
-            ::kill(pid_, SIGTERM);
-            ::waitpid(pid_, &status_, 0);
-            pid_ = -1;
-        }
-        return WIFEXITED(status_) ? WEXITSTATUS(status_) : 128 + WTERMSIG(status_);
-    }
-
-private:
-    pid_t pid_ = -1;
-    int status_ = 0;
-};
+using mogao::testing::ChildProcess;
 
 // The calibration folder as `mogao-autocal calibrate --rig rigs/standard.toml --scale 0.25` leaves it.
 nlohmann::json calibrate(const fs::path& out) {
@@ -150,9 +119,10 @@ Rgb8Image textured_content() {
 }
 
 // Polls the status file until `done` holds for a complete (parsed) file; returns that file's text.
-std::string wait_status(const fs::path& file, Child& kiosk, const std::function<bool(const nlohmann::json&)>& done) {
+std::string wait_status(const fs::path& file, ChildProcess& kiosk,
+                        const std::function<bool(const nlohmann::json&)>& done) {
     const auto guard = Clock::now() + std::chrono::seconds(60);
-    while (kiosk.alive() && Clock::now() < guard) {
+    while (!kiosk.exited() && Clock::now() < guard) {
         const std::string text = slurp(file);
         const auto status = nlohmann::json::parse(text, nullptr, false);
         if (!status.is_discarded() && status.is_object() && done(status)) return text;
@@ -222,7 +192,7 @@ std::string run_kiosk(const fs::path& dir, const fs::path& calibration) {
          "navigation.path_frames=10", "stats.file=", R"(stats.status_file="status.json")",
          "stats.status_period_s=0.2"});
     std::ofstream(dir / "kiosk.toml") << toml;
-    Child kiosk({MOGAO_KIOSK_BINARY, "--config", (dir / "kiosk.toml").string(), "--duration", "120"});
+    ChildProcess kiosk({MOGAO_KIOSK_BINARY, "--config", (dir / "kiosk.toml").string(), "--duration", "120"});
     const fs::path status = dir / "status.json";
     if (wait_status(status, kiosk, [](const nlohmann::json& j) {
             return j.value("frames_shown", 0) >= 20 && j.value("fps", 0.0) > 0.0;
