@@ -282,7 +282,8 @@ def check_requests(a, work, proc, fails, env, key, old_mpcdi, captures, results)
     broken = os.path.join(work, "captures-broken")
     shutil.rmtree(broken, ignore_errors=True)
     shutil.copytree(captures, broken)
-    os.remove(os.path.join(broken, "p0", "p0-columns-bit00.png"))
+    with open(os.path.join(broken, "captures.json")) as f:
+        os.remove(os.path.join(broken, json.load(f)["captures"]["p0-columns-bit00"]))
     sticks = {
         "calibrate": make_stick(a, work, "calibrate", env, key, "calibrate", serial + 1, None if a.live else captures,
                                 extra=("--hold-s", "3")),
