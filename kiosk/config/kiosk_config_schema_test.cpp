@@ -17,9 +17,12 @@
 #include <toml.hpp>
 
 #include "kiosk/config/config_overrides.h"
+#include "kiosk/config/kiosk_config_test_support.h"
 
 namespace mogao {
 namespace {
+
+using kiosk_config_test::KioskConfigTest;
 
 struct ExampleKey {
     std::string value;  // as written after "key = "
@@ -133,6 +136,28 @@ TEST(KioskConfigSchema, TheReferenceHasALinePerRow) {
     EXPECT_NE(reference.find("| `[display] rate_hz` | number | `30` | [0.5, 240] Hz |"), std::string::npos)
         << reference;
     EXPECT_NE(reference.find("| `[quality] spp` | integer | `1` | [1, 4096] |"), std::string::npos) << reference;
+}
+
+// The parser checks each plain number against its row: one just above the limit is refused, and the
+// message writes the row's range (the rows that apply to kGood's modes: headless, ideal, path).
+TEST_F(KioskConfigTest, EveryPlainNumberIsRefusedJustAboveItsLimitWithTheSchemasRange) {
+    int checked = 0;
+    for (const ConfigKey& row : kiosk_config_schema()) {
+        const bool plain = row.type == KeyType::integer || row.type == KeyType::number;
+        const bool applies = row.when == When::always || row.when == When::headless || row.when == When::ideal ||
+                             row.when == When::path_source;
+        if (!plain || !applies || row.table.find('.') != std::string_view::npos) continue;
+        const double above = row.limit.hi_open ? row.limit.hi : row.limit.hi + 1;
+        const std::string value = fmt::format("{}", above);
+        const std::string range =
+            row.type == KeyType::integer ? fmt::format("[{}, {}]", row.limit.lo, row.limit.hi) : std::string(row.range);
+        const std::string message = error_of(good({fmt::format("{}.{}={}", row.table, row.key, value)}));
+        EXPECT_NE(message.find(fmt::format("[{}].{} = {} is outside {}", row.table, row.key, value, range)),
+                  std::string::npos)
+            << message;
+        ++checked;
+    }
+    EXPECT_GE(checked, 20);
 }
 
 }  // namespace
