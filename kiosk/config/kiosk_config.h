@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 // The kiosk's configuration file (TOML, read with toml11): where the farm is and how to trust it,
 // which outputs to drive, the projector calibration, what to ask the farm to render, how the
-// scripted visitor moves, and where statistics go. Schema and an example: docs/kiosk.md and
-// kiosk/kiosk.example.toml.
+// scripted visitor moves, and where statistics go. The schema, one row per key with its member, type,
+// limit, default and description: kiosk/config/kiosk_config_schema.h (its reference: docs/kiosk.md);
+// the example: kiosk/config/kiosk.example.toml.
 //
 // Units: metres, degrees, hertz, seconds; sizes are "WIDTHxHEIGHT" strings in pixels.
 // Relative paths in the file are resolved against the folder of the configuration file, so a

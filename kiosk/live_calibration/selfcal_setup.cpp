@@ -19,18 +19,18 @@ namespace {
 [[noreturn]] void refuse(const std::string& message) { throw KioskSetupError(1, "selfcal: " + message); }
 
 // A real V4L2 camera with its exposure and gain locked (or manual), at the models' camera size.
-SelfcalWorker::Camera v4l2_camera(const KioskConfig& config, const selfcal::SystemModel& model) {
-    CameraSourceSpec spec = config.selfcal.source;
+SelfcalWorker::Camera v4l2_camera(const SelfcalConfig& sc, const selfcal::SystemModel& model) {
+    CameraSourceSpec spec = sc.source;
     const ImageSize want = model.camera.resolution;
     if (spec.width == 0) {
         spec.width = want.width;
         spec.height = want.height;
     } else if (spec.width != want.width || spec.height != want.height) {
         refuse(fmt::format("[selfcal].camera_size = {}x{} differs from the models' camera ({}x{}, {})", spec.width,
-                           spec.height, want.width, want.height, config.selfcal.models.string()));
+                           spec.height, want.width, want.height, sc.models.string()));
     }
     auto opened = open_camera_source(spec);
-    if (!opened) refuse(fmt::format("[selfcal].camera '{}': {}", config.selfcal.camera, opened.error().message));
+    if (!opened) refuse(fmt::format("[selfcal].camera '{}': {}", sc.camera, opened.error().message));
     std::shared_ptr<FrameSource> source = std::move(opened).value();
     spdlog::info("selfcal: screen camera {} (exposure {}, gain {})", source->description(),
                  describe(spec.controls.exposure), describe(spec.controls.gain));
@@ -51,11 +51,11 @@ SelfcalWorker::Camera v4l2_camera(const KioskConfig& config, const selfcal::Syst
     };
 }
 
-selfcal::SystemModel read_system_model(const KioskConfig& config, const ScreenCalibration& wall) {
+selfcal::SystemModel read_system_model(const SelfcalConfig& sc, const ScreenCalibration& wall) {
     autocal::CalibrationModels m;
     try {
-        m = autocal::read_models(config.selfcal.models);
-        autocal::check_models_match(m, wall, config.selfcal.models.string());
+        m = autocal::read_models(sc.models);
+        autocal::check_models_match(m, wall, sc.models.string());
     } catch (const autocal::ModelStoreError& e) {
         refuse(fmt::format("[selfcal].models: {}", e.what()));
     }
@@ -82,7 +82,7 @@ std::unique_ptr<SelfcalWorker> start_selfcal(const KioskConfig& config, const Sc
                                              CalibrationInbox& inbox, const SimulatedScreenCamera& simulated) {
     const SelfcalConfig& sc = config.selfcal;
     if (!sc.enabled) return nullptr;
-    const selfcal::SystemModel model = read_system_model(config, wall);
+    const selfcal::SystemModel model = read_system_model(sc, wall);
     selfcal::SelfcalOptions options;
     options.hold_s = sc.hold_s;
     options.transition_s = sc.transition_s;
@@ -107,7 +107,7 @@ std::unique_ptr<SelfcalWorker> start_selfcal(const KioskConfig& config, const Sc
                         sc.camera));
     }
     SelfcalWorker::Camera camera =
-        sc.kind == SelfcalConfig::CameraKind::rig ? simulated(config, model) : v4l2_camera(config, model);
+        sc.kind == SelfcalConfig::CameraKind::rig ? simulated(config, model) : v4l2_camera(sc, model);
     try {
         auto worker = std::make_unique<SelfcalWorker>(selfcal::SelfCalibrator(model, wall, options), std::move(camera),
                                                       inbox, sc.rate_hz);
