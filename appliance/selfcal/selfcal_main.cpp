@@ -74,33 +74,33 @@ int main(int argc, char** argv) {
     bool verbose = false;
     std::string content = "textured";
     mogao::selfcal::SimulationOptions o;
-    sim->add_option("--rig", rig, "rig file (rigs/*.toml)")->required()->check(CLI::ExistingFile);
+    sim->add_option("--rig", rig, "Virtual rig (rigs/*.toml)")->required()->check(CLI::ExistingFile);
     sim->add_option("--bump", bumps,
                     "device:yaw=1deg,pitch=..,roll=..,x=5mm,y=..,z=.. (device: a projector id or camera)");
-    sim->add_option("--bump-at", bump_at, "simulated second of the bumps")->check(CLI::NonNegativeNumber);
-    sim->add_option("--rate", o.rate_hz, "monitored frames per simulated second")->check(CLI::Range(0.01, 60.0));
+    sim->add_option("--bump-at-s", bump_at, "simulated second of the bumps")->check(CLI::NonNegativeNumber);
+    sim->add_option("--rate-hz", o.rate_hz, "monitored frames per simulated second")->check(CLI::Range(0.01, 60.0));
     sim->add_option("--frames", o.frames, "monitored frames")->check(CLI::Range(1, 100000));
-    sim->add_option("--scale", o.projector_scale, "projector resolution scale")->check(CLI::Range(0.05, 1.0));
+    sim->add_option("--projector-scale", o.projector_scale, "projector resolution scale")->check(CLI::Range(0.05, 1.0));
     sim->add_option("--camera-scale", o.camera_scale, "camera resolution scale")->check(CLI::Range(0.05, 1.0));
     sim->add_option("--occlusion", o.occlusion, "fraction of the camera view hidden by visitors")
         ->check(CLI::Range(0.0, 0.9));
     sim->add_option("--occlusion-max", o.occlusion_max, "each frame's occlusion uniform in [occlusion, this]")
         ->check(CLI::Range(0.0, 0.9));
-    sim->add_option("--hold", o.selfcal.hold_s, "seconds a drift must last before correcting")
+    sim->add_option("--hold-s", o.selfcal.hold_s, "seconds a drift must last before correcting")
         ->check(CLI::NonNegativeNumber);
-    sim->add_option("--transition", o.selfcal.transition_s, "seconds a correction is blended in over")
+    sim->add_option("--transition-s", o.selfcal.transition_s, "seconds a correction is blended in over")
         ->check(CLI::NonNegativeNumber);
     sim->add_option("--exposure-jitter", o.exposure_jitter, "camera gain varies in [1-j, 1+j]")
         ->check(CLI::Range(0.0, 0.9));
-    sim->add_option("--content", content, "textured | plain | repetitive | dark")
+    sim->add_option("--content-kind", content, "textured | plain | repetitive | dark")
         ->check(CLI::IsMember({"textured", "plain", "repetitive", "dark"}));
     sim->add_option("--seed", o.seed, "noise and content seed");
-    sim->add_option("--threshold", o.selfcal.drift_threshold_px, "drift threshold, projector pixels")
+    sim->add_option("--threshold-px", o.selfcal.drift_threshold_px, "drift threshold, projector pixels")
         ->check(CLI::PositiveNumber);
     sim->add_option("--owner-min-blend", o.selfcal.monitor.owner_min_blend,
                     "a match belongs to a projector from this blend weight")
         ->check(CLI::Range(0.5, 1.0));
-    sim->add_option("--unmix-max-shift", o.selfcal.monitor.unmix_max_shift_px,
+    sim->add_option("--unmix-max-shift-px", o.selfcal.monitor.unmix_max_shift_px,
                     "overlap matches shifted less than this (camera px) are un-mixed; 0 off")
         ->check(CLI::NonNegativeNumber);
     bool no_edge_check = false;
@@ -109,7 +109,7 @@ int main(int argc, char** argv) {
     sim->add_option("--occluder-ratio", o.selfcal.monitor.occluder_ratio,
                     "visitor mask: cells darker or brighter than predicted by this factor; 0 off")
         ->check(CLI::Range(0.0, 0.99));
-    sim->add_option("--occluder-cell", o.selfcal.monitor.occluder_cell_px, "visitor mask: cell size, camera pixels")
+    sim->add_option("--occluder-cell-px", o.selfcal.monitor.occluder_cell_px, "visitor mask: cell size, camera pixels")
         ->check(CLI::Range(2, 256));
     sim->add_option("--min-matches", o.selfcal.min_matches, "matches a projector needs for a measurement")
         ->check(CLI::Range(6, 100000));

@@ -20,6 +20,14 @@ std::vector<std::string> split_sans(const std::string& text) {
     return out;
 }
 
+// --days: one name, one meaning (docs/cli.md): the validity of what the command signs, from now.
+void add_days(CLI::App& sub, int& days, int default_days) {
+    sub.add_option("--days", days,
+                   "Validity from now in days of what it signs (a certificate, or crl.pem's nextUpdate)")
+        ->default_val(default_days)
+        ->check(CLI::Range(1, 36500));
+}
+
 }  // namespace
 
 int run_pki_command(int argc, char** argv) {
@@ -38,39 +46,35 @@ int run_pki_command(int argc, char** argv) {
     CLI::App* init = app.add_subcommand("init-ca", "Create the farm CA: ca.pem + ca.key");
     common(init);
     init->add_option("--name", name, "CA common name")->default_val("mogao farm CA");
-    init->add_option("--days", days, "Validity in days")->default_val(3650)->check(CLI::Range(1, 36500));
+    add_days(*init, days, 3650);
     init->add_option("--key", key, "Key type: ec (P-256) | rsa (3072 bits)")->check(CLI::IsMember({"ec", "rsa"}));
     CLI::App* farm = app.add_subcommand("issue-farm", "Issue the farm's server certificate: farm-NAME.pem + .key");
     common(farm);
     farm->add_option("--name", name, "Farm host name (also a DNS SAN)")->required();
     farm->add_option("--san", san, "Comma-separated IPv6 addresses (IP SANs) or DNS names, e.g. ::1,2001:db8::5")
         ->required();
-    farm->add_option("--days", days, "Validity in days")->default_val(825)->check(CLI::Range(1, 36500));
+    add_days(*farm, days, 825);
     CLI::App* appliance =
         app.add_subcommand("issue-appliance", "Issue an appliance client certificate: appliance-NAME.pem + .key");
     common(appliance);
     appliance->add_option("--name", name, "Appliance name, e.g. museum-1")->required();
-    appliance->add_option("--days", days, "Validity in days")->default_val(365)->check(CLI::Range(1, 36500));
+    add_days(*appliance, days, 365);
     CLI::App* renew = app.add_subcommand(
         "renew-appliance",
         "Re-sign appliance-NAME.pem's public key with a new validity (no new key pair; refused for a certificate "
         "this CA did not issue, a revoked one or a key weaker than EC P-256)");
     renew->add_option("--dir", dir, "PKI folder (with ca.key)")->required();
     renew->add_option("--name", name, "Appliance name: renews appliance-NAME.pem in --dir")->required();
-    renew->add_option("--days", days, "Validity in days from now")->default_val(365)->check(CLI::Range(1, 36500));
+    add_days(*renew, days, 365);
     std::string cert, to;
     CLI::App* revoke = app.add_subcommand("revoke", "Revoke an appliance certificate: add it to crl.pem (re-signed)");
     revoke->add_option("--dir", dir, "PKI folder (with ca.key)")->required();
     auto* by_name = revoke->add_option("--name", name, "Appliance name: revokes appliance-NAME.pem in --dir");
     revoke->add_option("--cert", cert, "Or the certificate file to revoke")->excludes(by_name);
-    revoke->add_option("--days", days, "The list's validity (nextUpdate) in days")
-        ->default_val(30)
-        ->check(CLI::Range(1, 36500));
+    add_days(*revoke, days, 30);
     CLI::App* crl = app.add_subcommand("crl", "Re-issue crl.pem with the same entries and a fresh nextUpdate");
     crl->add_option("--dir", dir, "PKI folder (with ca.key)")->required();
-    crl->add_option("--days", days, "The list's validity (nextUpdate) in days")
-        ->default_val(30)
-        ->check(CLI::Range(1, 36500));
+    add_days(*crl, days, 30);
     CLI::App* export_farm = app.add_subcommand(
         "export-farm", "Copy what the farm serves with (ca.pem, crl.pem, farm-NAME.pem/.key; never ca.key) to --to");
     common(export_farm);

@@ -44,7 +44,9 @@ int main(int argc, char** argv) {
 
     mogao::eval::RoiOptions roi;
     auto* o = app.add_subcommand("roi", "ROI tracking against full-frame detection on the hand-held sequence");
-    o->add_option("--seconds", roi.seconds, "sequence length")->check(CLI::Range(0.5, 60.0))->capture_default_str();
+    o->add_option("--length-s", roi.seconds, "Length of the sequence, seconds")
+        ->check(CLI::Range(0.5, 60.0))
+        ->capture_default_str();
     o->add_option("--repeat", roi.repeat, "timing passes")->check(CLI::Range(1, 100))->capture_default_str();
     o->add_option("--stride", roi.stride, "track every N-th frame only")
         ->check(CLI::Range(1, 30))
