@@ -314,6 +314,103 @@ bool asks_for_help_or_version(int argc, char** argv) {
     return false;
 }
 
+// `render`: a camera path into numbered frames.
+struct RenderCommand {
+    CLI::App* app = nullptr;
+    mogao::PathTour job;
+    CameraFlags camera;
+    std::string preset;
+};
+
+// `serve`: live tours for authenticated appliances.
+struct ServeCommand {
+    CLI::App* app = nullptr;
+    mogao::ServeOptions options;
+    std::filesystem::path tls_dir;
+    std::string farm_name = "farm";
+    std::string preset;
+    double frame_time_ms = 0.0;
+    double frame_budget_s = 1.0;
+    std::vector<double> view_screen;
+    std::filesystem::path view_policy_file;
+};
+
+void add_render_command(CLI::App& app, mogao::FarmSetup& setup, std::string& scans, RenderCommand& r) {
+    r.app = app.add_subcommand("render", "Render a camera path headless into numbered JPEG frames");
+    add_farm_flags(*r.app, setup, scans);
+    add_render_flags(*r.app, r.job, r.camera);
+    add_quality_flag(*r.app, r.preset);
+}
+
+void add_serve_command(CLI::App& app, mogao::FarmSetup& setup, std::string& scans, ServeCommand& s) {
+    s.app = app.add_subcommand("serve", "Serve live tours to authenticated appliances over IPv6 (gRPC, mutual TLS)");
+    add_farm_flags(*s.app, setup, scans);
+    add_link_flags(*s.app, s.options, s.tls_dir, s.farm_name);
+    // Off unless asked: a refined frame is not the lone render of its request that the kiosk's
+    // end-to-end tests compare against.
+    s.options.live.progressive = false;
+    add_live_flags(*s.app, s.options, s.frame_time_ms);
+    add_quality_flag(*s.app, s.preset);
+    add_view_policy_flags(*s.app, s.options.view_policy, s.view_screen, s.view_policy_file);
+    s.app
+        ->add_option("--frame-budget-s", s.frame_budget_s,
+                     "Seconds a frame may take: the rest of a frame still rendering then is rendered coarse, and a "
+                     "session's next requests are degraded from what its frames cost (0 = no budget)")
+        ->check(CLI::Range(0.0, 3600.0));
+    mogao::cli::add_duration_flag(*s.app, s.options.duration_s);
+}
+
+// After the parse: the presets and what the flags imply.
+void apply_flags(RenderCommand& r, ServeCommand& s) {
+    if (!s.preset.empty())
+        apply_serve_preset(*s.app, *mogao::quality_preset(s.preset), s.options.live, s.frame_time_ms);
+    if (!r.preset.empty()) apply_render_preset(*r.app, *mogao::quality_preset(r.preset), r.job.view_template.quality);
+    if (s.app->count("--temporal") == 0 && s.app->count("--no-temporal") == 0)
+        s.options.live.temporal = s.options.live.denoise;
+    s.options.live.frame_time_s = s.frame_time_ms / 1e3;
+    const std::vector<double>& v = s.view_screen;
+    if (!v.empty()) {
+        s.options.view_policy.screen =
+            mogao::CylinderScreen{v[0], v[1], v[2], v[3], {0.0, v.size() > 4 ? v[4] : 1.6, 0.0}};
+    }
+}
+
+int run_serve_command(mogao::MpiSession& mpi, mogao::FarmSetup& setup, ServeCommand& s) {
+    setup.dispatch.frame_budget_s = s.frame_budget_s;
+    s.options.budget.frame_s = s.frame_budget_s;
+    // Only the admin talks to appliances, so only the admin host holds the link's key, its
+    // revocation list and the view policies (render hosts have no /etc/mogao/pki). Every rank
+    // then agrees: one that returned alone would wait in MPI_Finalize while the others wait
+    // for it in their first collective (the two-host farm hung so).
+    const std::string error =
+        mpi.is_admin() ? prepare_admin_link(s.options, s.tls_dir, s.farm_name, s.view_policy_file) : std::string();
+    if (!error.empty()) spdlog::error("{}", error);
+    if (!mpi.all(error.empty())) return 2;
+    return mogao::run_farm(mpi, setup,
+                           [&](mogao::FrameDispatcher& farm, const mogao::Scene& scene, mogao::RunInfo& run) {
+                               return mogao::run_serve(s.options, farm, scene, run);
+                           });
+}
+
+int run_render_command(mogao::MpiSession& mpi, mogao::FarmSetup& setup, RenderCommand& r) {
+    const CameraFlags& camera = r.camera;
+    if (camera.kind == "pinhole") {
+        r.job.view_template.camera = mogao::PinholeCamera{camera.fov_deg};
+    } else {
+        if (!(camera.top > camera.bottom)) {
+            if (mpi.is_admin())
+                spdlog::error("--screen-top-m ({}) must be above --screen-bottom-m ({})", camera.top, camera.bottom);
+            return 2;
+        }
+        r.job.view_template.camera =
+            mogao::CylinderScreen{camera.radius, camera.arc, camera.bottom, camera.top, {0.0, camera.eye_height, 0.0}};
+    }
+    return mogao::run_farm(mpi, setup,
+                           [&](mogao::FrameDispatcher& farm, const mogao::Scene& scene, mogao::RunInfo& run) {
+                               return mogao::run_path_tour(r.job, farm, scene, run);
+                           });
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -324,38 +421,11 @@ int main(int argc, char** argv) {
     mogao::cli::prepare(app, "mogao-farm");
     app.require_subcommand(1);
     mogao::FarmSetup setup;
-    mogao::PathTour job;
-    CameraFlags camera;
     std::string scans;
-    CLI::App* render = app.add_subcommand("render", "Render a camera path headless into numbered JPEG frames");
-    add_farm_flags(*render, setup, scans);
-    add_render_flags(*render, job, camera);
-    std::string render_preset, serve_preset;
-    add_quality_flag(*render, render_preset);
-
-    mogao::ServeOptions serve_options;
-    std::filesystem::path tls_dir;
-    std::string farm_name = "farm";
-    CLI::App* serve =
-        app.add_subcommand("serve", "Serve live tours to authenticated appliances over IPv6 (gRPC, mutual TLS)");
-    add_farm_flags(*serve, setup, scans);
-    add_link_flags(*serve, serve_options, tls_dir, farm_name);
-    double frame_time_ms = 0.0;
-    // Off unless asked: a refined frame is not the lone render of its request that the kiosk's
-    // end-to-end tests compare against.
-    serve_options.live.progressive = false;
-    add_live_flags(*serve, serve_options, frame_time_ms);
-    add_quality_flag(*serve, serve_preset);
-    std::vector<double> view_screen;
-    std::filesystem::path view_policy_file;
-    add_view_policy_flags(*serve, serve_options.view_policy, view_screen, view_policy_file);
-    double frame_budget_s = 1.0;
-    serve
-        ->add_option("--frame-budget-s", frame_budget_s,
-                     "Seconds a frame may take: the rest of a frame still rendering then is rendered coarse, and a "
-                     "session's next requests are degraded from what its frames cost (0 = no budget)")
-        ->check(CLI::Range(0.0, 3600.0));
-    mogao::cli::add_duration_flag(*serve, serve_options.duration_s);
+    RenderCommand render;
+    add_render_command(app, setup, scans, render);
+    ServeCommand serve;
+    add_serve_command(app, setup, scans, serve);
     // Listed in --help; handled at the top of main, before MPI starts.
     app.add_subcommand(
            "pki", "The link's PKI: CA, farm and appliance certificates, revocation (no MPI; mogao-farm pki --help)")
@@ -377,50 +447,7 @@ int main(int argc, char** argv) {
         return mogao::cli::exit_status(app, e, /*quiet=*/!mpi.is_admin());  // 2 on every rank
     }
     setup.scene_options.scans_dir = scans;
-    if (!serve_preset.empty())
-        apply_serve_preset(*serve, *mogao::quality_preset(serve_preset), serve_options.live, frame_time_ms);
-    if (!render_preset.empty())
-        apply_render_preset(*render, *mogao::quality_preset(render_preset), job.view_template.quality);
-    if (serve->count("--temporal") == 0 && serve->count("--no-temporal") == 0)
-        serve_options.live.temporal = serve_options.live.denoise;
-    serve_options.live.frame_time_s = frame_time_ms / 1e3;
-    if (!view_screen.empty()) {
-        serve_options.view_policy.screen =
-            mogao::CylinderScreen{view_screen[0],
-                                  view_screen[1],
-                                  view_screen[2],
-                                  view_screen[3],
-                                  {0.0, view_screen.size() > 4 ? view_screen[4] : 1.6, 0.0}};
-    }
-    if (serve->parsed()) {
-        setup.dispatch.frame_budget_s = frame_budget_s;
-        serve_options.budget.frame_s = frame_budget_s;
-        // Only the admin talks to appliances, so only the admin host holds the link's key, its
-        // revocation list and the view policies (render hosts have no /etc/mogao/pki). Every rank
-        // then agrees: one that returned alone would wait in MPI_Finalize while the others wait
-        // for it in their first collective (the two-host farm hung so).
-        const std::string error =
-            mpi.is_admin() ? prepare_admin_link(serve_options, tls_dir, farm_name, view_policy_file) : std::string();
-        if (!error.empty()) spdlog::error("{}", error);
-        if (!mpi.all(error.empty())) return 2;
-        return mogao::run_farm(mpi, setup,
-                               [&](mogao::FrameDispatcher& farm, const mogao::Scene& scene, mogao::RunInfo& run) {
-                                   return mogao::run_serve(serve_options, farm, scene, run);
-                               });
-    }
-    if (camera.kind == "pinhole") {
-        job.view_template.camera = mogao::PinholeCamera{camera.fov_deg};
-    } else {
-        if (!(camera.top > camera.bottom)) {
-            if (mpi.is_admin())
-                spdlog::error("--screen-top-m ({}) must be above --screen-bottom-m ({})", camera.top, camera.bottom);
-            return 2;
-        }
-        job.view_template.camera =
-            mogao::CylinderScreen{camera.radius, camera.arc, camera.bottom, camera.top, {0.0, camera.eye_height, 0.0}};
-    }
-    return mogao::run_farm(mpi, setup,
-                           [&](mogao::FrameDispatcher& farm, const mogao::Scene& scene, mogao::RunInfo& run) {
-                               return mogao::run_path_tour(job, farm, scene, run);
-                           });
+    apply_flags(render, serve);
+    if (serve.app->parsed()) return run_serve_command(mpi, setup, serve);
+    return run_render_command(mpi, setup, render);
 }
