@@ -440,6 +440,69 @@ nlohmann::json scene_section(int argc, char** argv, int reps) {
             {"frame_time_new_over_legacy", current.render_s / legacy.render_s}};
 }
 
+void write_json(const std::string& path, const nlohmann::json& j) {
+    std::ofstream file(path);
+    file << j.dump(1) << '\n';
+    if (!file.flush()) throw std::runtime_error("cannot write " + path);
+}
+
+// The synthetic scene's sections (a)-(c) and (e), printed; their figures as the JSON file's body.
+nlohmann::json synthetic_section(const ViewRequest& request, const RendererOptions& options, int grid, int reps) {
+    const Scene shadowed = base_scene(grid, true);
+    std::printf("scene: %zu + %zu triangles, %dx%d, spp %d, best of %d, one thread\n",
+                shadowed.meshes[0].triangle_count(), shadowed.meshes[1].triangle_count(), request.size.width,
+                request.size.height, request.quality.spp, reps);
+    Renderer renderer(shadowed, options);
+    const RenderTimings direct = time_frame(renderer, request, reps);
+    std::printf("(a) Embree rtcIntersect16, camera rays only    %9.2f ms  %11llu rays  %6.2f Mrays/s\n",
+                1e3 * direct.camera_rays_s, static_cast<unsigned long long>(direct.camera_rays),
+                1e-6 * static_cast<double>(direct.camera_rays) / direct.camera_rays_s);
+    print("(b) renderer, sun + shadows", direct, direct.camera_rays_s);
+    std::printf("    ratio (b)/(a) = %.2f\n", direct.ratio());
+
+    // (c) Each variant gets its own (a) baseline from its own renderer, so ratios compare alike.
+    const auto run = [&](const Scene& scene) { return time_render_vs_embree(scene, request, options, reps); };
+    const RenderTimings plain = run(base_scene(grid, false));
+    const RenderTimings unused = run(with_unused_features(base_scene(grid, false)));
+    const RenderTimings used = run(with_used_area_light(base_scene(grid, true)));
+    const RenderTimings colour_unused = run(with_unused_colour(base_scene(grid, false)));
+    const RenderTimings colour_used = run(with_used_colour(base_scene(grid, false)));
+    print("(c1) sun, no shadows, nothing else", plain, plain.camera_rays_s);
+    print("(c2) (c1) + unused lights/mesh/material", unused, unused.camera_rays_s);
+    print("(c3) sun + shadows + used area light", used, used.camera_rays_s);
+    print("(c4) (c1) + unplaced coloured mesh", colour_unused, colour_unused.camera_rays_s);
+    print("(c5) (c1), field coloured + textured", colour_used, colour_used.camera_rays_s);
+    std::printf("    (c2)/(c1) = %.3f  (unused features should cost nothing: ~1.0)\n",
+                unused.render_s / plain.render_s);
+    std::printf("    (c3)/(c1) = %.3f  (what shadows and an area light cost when used)\n",
+                used.render_s / plain.render_s);
+    std::printf("    (c4)/(c1) = %.3f  (a scene without colour or texture pays nothing: ~1.0)\n",
+                colour_unused.render_s / plain.render_s);
+    std::printf("    (c5)/(c1) = %.3f  (what vertex colours and a mip-mapped texture cost when used)\n",
+                colour_used.render_s / plain.render_s);
+    std::printf("    BVH build (c1): %.2f s\n", plain.build_s);
+    const nlohmann::json bounce_figures = bounce_section(renderer, request, reps, "in-code height field + sphere, sun");
+    return {{"bench", "render_vs_embree"},
+            {"triangles", shadowed.meshes[0].triangle_count() + shadowed.meshes[1].triangle_count()},
+            {"width", request.size.width},
+            {"height", request.size.height},
+            {"spp", request.quality.spp},
+            {"reps", reps},
+            {"threads", 1},
+            {"b", timing_json("renderer, sun + shadows", direct)},
+            {"c1", timing_json("sun, no shadows, nothing else", plain)},
+            {"c2", timing_json("(c1) + unused lights/mesh/material", unused)},
+            {"c3", timing_json("sun + shadows + used area light", used)},
+            {"ratio_b_over_a", direct.ratio()},
+            {"ratio_c2_over_c1", unused.render_s / plain.render_s},
+            {"ratio_c3_over_c1", used.render_s / plain.render_s},
+            {"c4", timing_json("(c1) + an unplaced coloured, textured mesh", colour_unused)},
+            {"c5", timing_json("(c1) with vertex colours + a texture", colour_used)},
+            {"ratio_c4_over_c1", colour_unused.render_s / plain.render_s},
+            {"ratio_c5_over_c1", colour_used.render_s / plain.render_s},
+            {"e", bounce_figures}};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -457,73 +520,11 @@ int main(int argc, char** argv) {
     try {
         if (std::strlen(arg_str(argc, argv, "--scene", "")) > 0) {
             const nlohmann::json d = scene_section(argc, argv, reps);
-            if (!json_file.empty()) {
-                std::ofstream file(json_file);
-                file << nlohmann::json{{"bench", "render_vs_embree_scene"}, {"d", d}}.dump(1) << '\n';
-                if (!file.flush()) throw std::runtime_error("cannot write " + json_file);
-            }
+            if (!json_file.empty()) write_json(json_file, {{"bench", "render_vs_embree_scene"}, {"d", d}});
             return 0;
         }
-        const Scene shadowed = base_scene(grid, true);
-        std::printf("scene: %zu + %zu triangles, %dx%d, spp %d, best of %d, one thread\n",
-                    shadowed.meshes[0].triangle_count(), shadowed.meshes[1].triangle_count(), request.size.width,
-                    request.size.height, request.quality.spp, reps);
-        Renderer renderer(shadowed, options);
-        const RenderTimings direct = time_frame(renderer, request, reps);
-        std::printf("(a) Embree rtcIntersect16, camera rays only    %9.2f ms  %11llu rays  %6.2f Mrays/s\n",
-                    1e3 * direct.camera_rays_s, static_cast<unsigned long long>(direct.camera_rays),
-                    1e-6 * static_cast<double>(direct.camera_rays) / direct.camera_rays_s);
-        print("(b) renderer, sun + shadows", direct, direct.camera_rays_s);
-        std::printf("    ratio (b)/(a) = %.2f\n", direct.ratio());
-
-        // (c) Each variant gets its own (a) baseline from its own renderer, so ratios compare alike.
-        const auto run = [&](const Scene& scene) { return time_render_vs_embree(scene, request, options, reps); };
-        const RenderTimings plain = run(base_scene(grid, false));
-        const RenderTimings unused = run(with_unused_features(base_scene(grid, false)));
-        const RenderTimings used = run(with_used_area_light(base_scene(grid, true)));
-        const RenderTimings colour_unused = run(with_unused_colour(base_scene(grid, false)));
-        const RenderTimings colour_used = run(with_used_colour(base_scene(grid, false)));
-        print("(c1) sun, no shadows, nothing else", plain, plain.camera_rays_s);
-        print("(c2) (c1) + unused lights/mesh/material", unused, unused.camera_rays_s);
-        print("(c3) sun + shadows + used area light", used, used.camera_rays_s);
-        print("(c4) (c1) + unplaced coloured mesh", colour_unused, colour_unused.camera_rays_s);
-        print("(c5) (c1), field coloured + textured", colour_used, colour_used.camera_rays_s);
-        std::printf("    (c2)/(c1) = %.3f  (unused features should cost nothing: ~1.0)\n",
-                    unused.render_s / plain.render_s);
-        std::printf("    (c3)/(c1) = %.3f  (what shadows and an area light cost when used)\n",
-                    used.render_s / plain.render_s);
-        std::printf("    (c4)/(c1) = %.3f  (a scene without colour or texture pays nothing: ~1.0)\n",
-                    colour_unused.render_s / plain.render_s);
-        std::printf("    (c5)/(c1) = %.3f  (what vertex colours and a mip-mapped texture cost when used)\n",
-                    colour_used.render_s / plain.render_s);
-        std::printf("    BVH build (c1): %.2f s\n", plain.build_s);
-        const nlohmann::json bounce_figures =
-            bounce_section(renderer, request, reps, "in-code height field + sphere, sun");
-        if (!json_file.empty()) {
-            const nlohmann::json out = {
-                {"bench", "render_vs_embree"},
-                {"triangles", shadowed.meshes[0].triangle_count() + shadowed.meshes[1].triangle_count()},
-                {"width", request.size.width},
-                {"height", request.size.height},
-                {"spp", request.quality.spp},
-                {"reps", reps},
-                {"threads", 1},
-                {"b", timing_json("renderer, sun + shadows", direct)},
-                {"c1", timing_json("sun, no shadows, nothing else", plain)},
-                {"c2", timing_json("(c1) + unused lights/mesh/material", unused)},
-                {"c3", timing_json("sun + shadows + used area light", used)},
-                {"ratio_b_over_a", direct.ratio()},
-                {"ratio_c2_over_c1", unused.render_s / plain.render_s},
-                {"ratio_c3_over_c1", used.render_s / plain.render_s},
-                {"c4", timing_json("(c1) + an unplaced coloured, textured mesh", colour_unused)},
-                {"c5", timing_json("(c1) with vertex colours + a texture", colour_used)},
-                {"ratio_c4_over_c1", colour_unused.render_s / plain.render_s},
-                {"ratio_c5_over_c1", colour_used.render_s / plain.render_s},
-                {"e", bounce_figures}};
-            std::ofstream file(json_file);
-            file << out.dump(1) << '\n';
-            if (!file.flush()) throw std::runtime_error("cannot write " + json_file);
-        }
+        const nlohmann::json out = synthetic_section(request, options, grid, reps);
+        if (!json_file.empty()) write_json(json_file, out);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "mogao_bench_render: %s\n", e.what());
         return 1;

@@ -265,6 +265,27 @@ ViewRequest session_view(const Scene& scene, const BenchArgs& a) {
     return v;
 }
 
+// A moving frame's error against the reference: kMovingSamples times, a frame 1.5 degrees off and then the first
+// frame back at the reference's pose, upsampled to the reference's size (shots keep the last).
+FrameQuality moving_frame_quality(LiveFrames& live, ViewRequest& request, double base_yaw, const Rgb8Image& reference,
+                                  std::uint64_t& next_id, Snapshots& shots) {
+    LiveFrame last;
+    FrameQuality moving;
+    for (int k = 0; k < kMovingSamples; ++k) {
+        request.pose.yaw_deg = base_yaw + 1.5;
+        request.frame_id = next_id++;
+        (void)live.render(request);
+        // The still view starts where the visitor stopped: the reference's pose.
+        request.pose.yaw_deg = base_yaw;
+        request.frame_id = next_id++;
+        last = live.render(request);  // the first frame at the new pose: a moving frame's error
+        shots.moving_rendered = last.image;
+        shots.moving = upsample(last.image, reference.size);
+        moving += frame_quality(shots.moving, reference);
+    }
+    return moving.over(kMovingSamples);
+}
+
 nlohmann::json run_config(const Config& c, FrameDispatcher& farm, const Scene& scene, const BenchArgs& a,
                           const Rgb8Image& reference, std::uint64_t& next_id, Snapshots& shots) {
     farm.set_normalise_rank_speed(c.rank_speed);
@@ -298,20 +319,7 @@ nlohmann::json run_config(const Config& c, FrameDispatcher& farm, const Scene& s
     }
     encoder.finish();
     const double move_fps = moved / since(start);
-    FrameQuality moving;
-    for (int k = 0; k < kMovingSamples; ++k) {
-        request.pose.yaw_deg = base_yaw + 1.5;
-        request.frame_id = next_id++;
-        (void)live.render(request);
-        // The still view starts where the visitor stopped: the reference's pose.
-        request.pose.yaw_deg = base_yaw;
-        request.frame_id = next_id++;
-        last = live.render(request);  // the first frame at the new pose: a moving frame's error
-        shots.moving_rendered = last.image;
-        shots.moving = upsample(last.image, reference.size);
-        moving += frame_quality(shots.moving, reference);
-    }
-    moving = moving.over(kMovingSamples);
+    const FrameQuality moving = moving_frame_quality(live, request, base_yaw, reference, next_id, shots);
     const double moving_psnr = moving.psnr_db;
     const nlohmann::json served_summary = served_log.summary();
     nlohmann::json curve = nlohmann::json::array();

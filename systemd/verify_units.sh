@@ -19,9 +19,9 @@ for unit in "$dir"/*.service ${installed:+"$installed"/*.service}; do
   cp "$unit" "$work/"
   # Point ExecStart at the stand-ins (the units name /usr/bin paths of the installed system; the
   # installed copies their BINDIR's).
-  from=/usr/bin/
-  [[ "$unit" == "$installed"/* ]] && from=$bindir/
-  sed -i -e "s|$from|$work/root/usr/bin/|g" -e "s|/usr/lib/mogao/|$work/root/usr/lib/mogao/|g" "$work/$(basename "$unit")"
+  from=/usr/bin/ libexec=/usr/lib/mogao/
+  [[ "$unit" == "$installed"/* ]] && from=$bindir/ libexec=${bindir%/bin}/lib/mogao/
+  sed -i -e "s|$from|$work/root/usr/bin/|g" -e "s|$libexec|$work/root/usr/lib/mogao/|g" "$work/$(basename "$unit")"
   if out=$(systemd-analyze verify "$work/$(basename "$unit")" 2>&1) && [ -z "$out" ]; then
     echo "ok: verify $unit"
   else

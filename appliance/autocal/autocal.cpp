@@ -12,6 +12,7 @@
 #include "appliance/autocal/bundle_adjust.h"
 #include "appliance/autocal/colour_calibration.h"
 #include "appliance/autocal/gray_code.h"
+#include "appliance/autocal/model_trials.h"
 #include "appliance/autocal/screen_geometry.h"
 #include "appliance/warp/calibration_validation.h"
 #include "appliance/warp/ideal_calibration.h"
@@ -190,181 +191,6 @@ ProjectorCalibration build_projector(const std::vector<DeviceModel>& fitted,
     return pc;
 }
 
-double mean_of(const std::vector<double>& v) {
-    double sum = 0.0;
-    for (double x : v) sum += x;
-    return v.empty() ? 0.0 : sum / static_cast<double>(v.size());
-}
-
-// AutocalOptions::fit_bow: a second bundle adjustment from the first's result with the bow free; its
-// result replaces the first only when the projectors' mean fit rms falls by more than bow_min_gain.
-void try_bow(BundleResult& ba, const std::vector<EdgeObservation>& edges,
-             const std::vector<ProjectorObservations>& observations, BundleOptions bo, const AutocalOptions& options,
-             BowTrial& trial) {
-    if (edges.empty() || !bo.refine_camera) return;  // the bow needs the edges and the camera with it
-    bo.refine_bow = true;
-    BundleResult bowed = bundle_adjust(ba.screen, ba.camera, ba.projectors, edges, observations, bo);
-    trial.tried = true;
-    trial.cylinder_rms_sigma = mean_of(ba.rms_sigma);
-    trial.bowed_rms_sigma = mean_of(bowed.rms_sigma);
-    trial.bow_m = bowed.screen.bow_m;
-    // A bow beyond 10 % of the radius is no bow of a cylinder screen but a fit gone astray.
-    const bool plausible = std::all_of(trial.bow_m.begin(), trial.bow_m.end(),
-                                       [&](double a) { return std::abs(a) < 0.1 * bowed.screen.radius_m; });
-    // Each adjustment drops its own outliers: a bowed fit that only rejected more points does not count,
-    // nor one whose projector fits fail the gate the cylinder's passed.
-    int kept_cylinder = 0;
-    int kept_bowed = 0;
-    for (std::size_t k = 0; k < ba.inliers.size(); ++k) {
-        kept_cylinder += ba.inliers[k];
-        kept_bowed += bowed.inliers[k];
-    }
-    const bool same_points = kept_bowed >= 0.99 * kept_cylinder;
-    const bool within_gate = std::all_of(bowed.rms_sigma.begin(), bowed.rms_sigma.end(),
-                                         [&](double r) { return r <= options.max_projector_rms; });
-    trial.kept = plausible && same_points && within_gate &&
-                 trial.bowed_rms_sigma < (1.0 - options.bow_min_gain) * trial.cylinder_rms_sigma;
-    if (trial.kept) ba = std::move(bowed);
-}
-
-// The refined camera intrinsics must be what the screen and the projectors determine, near a chessboard's
-// result: each within kMaxPriorSigmas of the prior's (else the prior or the screen's size is wrong), and
-// each standard deviation at most options.camera_sigma_gate of the prior's (else the data barely see it
-// and the prior decides). Throws CalibrationRefused naming the parameter.
-void check_camera_intrinsics(const BundleResult& ba, const DeviceModel& prior, const AutocalOptions& o) {
-    if (ba.camera_intrinsics_sigma.size() != 5) return;
-    constexpr double kMaxPriorSigmas = 4.0;
-    const double w = prior.resolution.width;
-    const std::array<const char*, 5> names{"focal length fx", "principal point cx", "principal point cy",
-                                           "distortion k1", "distortion k2"};
-    const std::array<double, 5> fitted{ba.camera.fx_px, ba.camera.cx_px, ba.camera.cy_px, ba.camera.distortion[0],
-                                       ba.camera.distortion[1]};
-    const std::array<double, 5> told{prior.fx_px, prior.cx_px, prior.cy_px, prior.distortion[0], prior.distortion[1]};
-    const std::array<double, 5> sigma{o.camera_sigma.focal * prior.fx_px, o.camera_sigma.principal_point * w,
-                                      o.camera_sigma.principal_point * w, o.camera_sigma.distortion,
-                                      o.camera_sigma.distortion};
-    for (std::size_t i = 0; i < 5; ++i) {
-        const double moved = std::abs(fitted[i] - told[i]) / sigma[i];
-        const double seen = ba.camera_intrinsics_sigma[i] / sigma[i];
-        if (!(moved <= kMaxPriorSigmas)) {
-            throw CalibrationRefused("camera " + std::string(names[i]) + ": refined to " + std::to_string(fitted[i]) +
-                                     " from the prior's " + std::to_string(told[i]) + ", " + std::to_string(moved) +
-                                     " of its sigmas (limit " + std::to_string(kMaxPriorSigmas) +
-                                     "): the camera's chessboard calibration or the screen's size is wrong");
-        }
-        if (!(seen <= o.camera_sigma_gate)) {
-            throw CalibrationRefused("camera " + std::string(names[i]) +
-                                     ": barely determined by the screen and the "
-                                     "projectors (standard deviation " +
-                                     std::to_string(ba.camera_intrinsics_sigma[i]) + ", " + std::to_string(seen) +
-                                     " of the prior's, gate " + std::to_string(o.camera_sigma_gate) +
-                                     "): the camera sees too little of the screen's edges or of the projectors");
-        }
-    }
-}
-
-// The cost of fit `b` in units of fit `unit`'s: each projector's inlier correspondences and the edges at
-// unit's rms (its maximum-likelihood noise level), summed over the blocks' points and divided by their count;
-// 1 for `unit` itself.
-double relative_cost(const BundleResult& b, const BundleResult& unit, std::size_t edge_points) {
-    double cost = 0.0;
-    double points = 0.0;
-    for (std::size_t k = 0; k < b.rms_sigma.size(); ++k) {
-        const double ratio = b.rms_sigma[k] / std::max(unit.rms_sigma[k], 1e-12);
-        cost += b.inliers[k] * ratio * ratio;
-        points += unit.inliers[k];
-    }
-    const double e = static_cast<double>(edge_points);
-    const double ratio = b.edge_rms_m / std::max(unit.edge_rms_m, 1e-12);
-    cost += e * ratio * ratio;
-    points += e;
-    return points > 0.0 ? cost / points : 1.0;
-}
-
-// AutocalOptions::refine_camera_intrinsics: a second bundle adjustment from `ba`'s result (the prior's
-// intrinsics taken as exact) with the camera's intrinsics free. Its result replaces `ba` only when the cost
-// falls by more than intrinsics_min_gain on about the same correspondences (as the bow's trial); a kept
-// result must pass check_camera_intrinsics. The conditioning reported is the free adjustment's.
-void try_camera_intrinsics(BundleResult& ba, const CalibrationPrior& prior, const std::vector<EdgeObservation>& edges,
-                           const std::vector<ProjectorObservations>& observations, BundleOptions bo,
-                           const AutocalOptions& options, AutocalReport& report) {
-    report.condition_number = ba.condition_number;
-    if (!options.refine_camera_intrinsics || edges.empty()) return;
-    bo.refine_camera_intrinsics = true;
-    BundleResult free = bundle_adjust(ba.screen, ba.camera, ba.projectors, edges, observations, bo);
-    IntrinsicsTrial& trial = report.intrinsics;
-    trial.tried = true;
-    trial.relative_cost = relative_cost(free, ba, edges.size());
-    report.camera_intrinsics_sigma = free.camera_intrinsics_sigma;
-    report.condition_number = free.condition_number;
-    int kept_fixed = 0;
-    int kept_free = 0;
-    for (std::size_t k = 0; k < ba.inliers.size(); ++k) {
-        kept_fixed += ba.inliers[k];
-        kept_free += free.inliers[k];
-    }
-    // A free fit that only rejected more points does not count; one that fits much better may reject more, its
-    // outlier limit (4x its median) being tighter: its cost's fall must then be ten times the points it lost.
-    const double lost = 1.0 - static_cast<double>(kept_free) / std::max(kept_fixed, 1);
-    const bool same_points = lost <= 0.01 || 1.0 - trial.relative_cost >= 10.0 * lost;
-    trial.kept = same_points && trial.relative_cost < 1.0 - options.intrinsics_min_gain;
-    if (!trial.kept) return;
-    check_camera_intrinsics(free, prior.camera, options);
-    ba = std::move(free);
-}
-
-// AutocalOptions::fit_projector_distortion: a bundle adjustment from `ba`'s result (with what the earlier trials
-// kept free: `bo`) with every projector's distortion free; a projector keeps it where its own cost, in units of
-// `ba`'s, falls by more than distortion_min_gain on about the same correspondences, and so does the whole fit's. Where
-// only some keep it, the adjustment is run again with only theirs free. Kept intrinsics are checked again
-// (check_camera_intrinsics).
-void try_projector_distortion(BundleResult& ba, const CalibrationPrior& prior,
-                              const std::vector<EdgeObservation>& edges,
-                              const std::vector<ProjectorObservations>& observations, BundleOptions bo,
-                              const AutocalOptions& options, AutocalReport& report) {
-    const std::size_t n = ba.projectors.size();
-    if (!options.fit_projector_distortion || n == 0) return;
-    bo.refine_projector_distortion.assign(n, true);
-    BundleResult free = bundle_adjust(ba.screen, ba.camera, ba.projectors, edges, observations, bo);
-    report.distortion.assign(n, DistortionTrial{});
-    std::vector<bool> keep(n, false);
-    for (std::size_t k = 0; k < n; ++k) {
-        DistortionTrial& t = report.distortion[k];
-        t.tried = true;
-        const double ratio = free.rms_sigma[k] / std::max(ba.rms_sigma[k], 1e-12);
-        t.relative_cost = free.inliers[k] * ratio * ratio / std::max(ba.inliers[k], 1);
-        for (std::size_t i = 0; i < t.distortion.size(); ++i) t.distortion[i] = free.projectors[k].distortion[i];
-        // As the intrinsics' trial: a fit that only rejected more points does not count; a much better one may
-        // reject more (its outlier limit is tighter), its fall then ten times the points it lost.
-        const double lost = 1.0 - static_cast<double>(free.inliers[k]) / std::max(ba.inliers[k], 1);
-        const bool same_points = lost <= 0.01 || 1.0 - t.relative_cost >= 10.0 * lost;
-        keep[k] = same_points && t.relative_cost < 1.0 - options.distortion_min_gain;
-    }
-    // And the whole fit's cost (every projector and the edges, as the intrinsics' trial counts it) must fall by
-    // more than the gain too: one projector's fall of a percent or two on a noisy rig is its noise taken up.
-    const double whole = relative_cost(free, ba, edges.size());
-    for (DistortionTrial& t : report.distortion) t.fit_relative_cost = whole;
-    if (!(whole < 1.0 - options.distortion_min_gain)) keep.assign(n, false);
-    const auto kept = static_cast<std::size_t>(std::count(keep.begin(), keep.end(), true));
-    if (kept == 0) return;
-    if (kept < n) {
-        bo.refine_projector_distortion = keep;
-        free = bundle_adjust(ba.screen, ba.camera, ba.projectors, edges, observations, bo);
-    }
-    for (std::size_t k = 0; k < n; ++k) {
-        report.distortion[k].kept = keep[k];
-        if (keep[k]) {
-            for (std::size_t i = 0; i < 4; ++i) report.distortion[k].distortion[i] = free.projectors[k].distortion[i];
-        }
-    }
-    if (bo.refine_camera_intrinsics) {
-        check_camera_intrinsics(free, prior.camera, options);
-        report.camera_intrinsics_sigma = free.camera_intrinsics_sigma;
-    }
-    report.condition_number = free.condition_number;
-    ba = std::move(free);
-}
-
 // Per blend grid sample of device d (grid of `size` samples, row-major): 1 where its output position
 // lands on the screen (the samples build_projector gives a weight), 0 where the blend is 0 for being off it.
 std::vector<char> grid_on_screen(const DeviceModel& d, const ScreenModel& s, ImageSize size) {
@@ -445,81 +271,71 @@ cv::Mat1f show_averaged(PatternSource& source, const std::vector<cv::Mat>& signa
     return sum;
 }
 
-AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, ImageSize content,
-                        const AutocalOptions& options) {
-    check_inputs(prior, content, options);
-    require_locked_exposure(source);
-    const std::size_t n = prior.projectors.size();
-    std::vector<ImageSize> sizes;
-    for (const DeviceModel& p : prior.projectors) sizes.push_back(p.resolution);
-    AutocalResult result;
-    // Step 2 first: all projectors white minus all black shows the screen's lit edges.
-    std::vector<cv::Mat> signals(n);
+namespace {
+
+// Step 2: all projectors white minus all black shows the screen's lit edges, and the camera's pose from them.
+EdgeFit fit_camera_to_lit_screen(PatternSource& source, const CalibrationPrior& prior,
+                                 const std::vector<ImageSize>& sizes, const AutocalOptions& options,
+                                 AutocalReport& report) {
+    std::vector<cv::Mat> signals(sizes.size());
     const int frames = options.frames_per_pattern;
     const cv::Mat1f black = show_averaged(source, signals, frames).clone();  // the source may reuse its buffer
-    for (std::size_t k = 0; k < n; ++k) signals[k] = cv::Mat1f(sizes[k].height, sizes[k].width, 1.0f);
+    for (std::size_t k = 0; k < sizes.size(); ++k) signals[k] = cv::Mat1f(sizes[k].height, sizes[k].width, 1.0f);
     const cv::Mat1f white = show_averaged(source, signals, frames);
-    result.report.captures = 2 * frames;
+    report.captures = 2 * frames;
     cv::Mat1f lit;
     cv::subtract(white, black, lit);
-    const EdgeFit edge = fit_camera_pose(lit, prior, options);
-    result.camera = edge.camera;
-    result.report.edge_points = edge.points;
-    result.report.edge_rms_m = edge.rms_m;
-    result.report.camera_position_m = edge.camera.position_m;
-    std::vector<ProjectorObservations> observations;
-    for (std::size_t k = 0; k < n; ++k) {
-        const Correspondences c = decode_projector(source, static_cast<int>(k), sizes, options);
-        result.report.captures += c.captures;
-        ProjectorReport pr{
-            prior.projectors[k].id, c.column_bits, c.row_bits, static_cast<int>(c.camera.size()), 0.0, 0.0};
-        pr.lit_pixels = c.lit_pixels;
-        pr.phase_refined = std::min(c.phase_refined_columns, c.phase_refined_rows);
-        pr.noise_sigma = c.noise_sigma;
-        if (c.column_bits < options.min_bits || c.row_bits < options.min_bits) {
-            throw CalibrationRefused("projector " + std::to_string(k) + " '" + pr.id +
-                                     "': Gray-code decoding failed: " + std::to_string(c.column_bits) + " column and " +
-                                     std::to_string(c.row_bits) +
-                                     " row bits resolved (need >= " + std::to_string(options.min_bits) + "; " +
-                                     std::to_string(c.lit_pixels) + " camera pixels lit)");
-        }
-        // With the screen or the camera's intrinsics still to be fitted, a projector's fit on the prior's is only a
-        // start: its gate is applied after the bundle adjustment instead.
-        AutocalOptions start_options = options;
-        if (options.fit_screen || options.refine_camera_intrinsics)
-            start_options.max_projector_rms = std::numeric_limits<double>::infinity();
-        ProjectorFit fit =
-            fit_projector(edge.camera, prior, static_cast<int>(k), c.camera, c.projector, c.sigma, start_options);
-        pr.rms_px = fit.rms_px;
-        pr.mean_view_angle_deg = fit.mean_view_angle_deg;
-        result.projectors.push_back(fit.model);
-        result.report.projectors.push_back(pr);
-        observations.push_back(std::move(fit.observations));
+    EdgeFit edge = fit_camera_pose(lit, prior, options);
+    report.edge_points = edge.points;
+    report.edge_rms_m = edge.rms_m;
+    report.camera_position_m = edge.camera.position_m;
+    return edge;
+}
+
+// Step 3 for projector k: its patterns decoded into correspondences and its model fitted from the camera's pose.
+// Throws CalibrationRefused when too few Gray-code bits resolve.
+ProjectorFit observe_projector(PatternSource& source, const CalibrationPrior& prior,
+                               const std::vector<ImageSize>& sizes, std::size_t k, const EdgeFit& edge,
+                               const AutocalOptions& options, AutocalReport& report) {
+    const Correspondences c = decode_projector(source, static_cast<int>(k), sizes, options);
+    report.captures += c.captures;
+    ProjectorReport pr{prior.projectors[k].id, c.column_bits, c.row_bits, static_cast<int>(c.camera.size()), 0.0, 0.0};
+    pr.lit_pixels = c.lit_pixels;
+    pr.phase_refined = std::min(c.phase_refined_columns, c.phase_refined_rows);
+    pr.noise_sigma = c.noise_sigma;
+    if (c.column_bits < options.min_bits || c.row_bits < options.min_bits) {
+        throw CalibrationRefused("projector " + std::to_string(k) + " '" + pr.id + "': Gray-code decoding failed: " +
+                                 std::to_string(c.column_bits) + " column and " + std::to_string(c.row_bits) +
+                                 " row bits resolved (need >= " + std::to_string(options.min_bits) + "; " +
+                                 std::to_string(c.lit_pixels) + " camera pixels lit)");
     }
-    // Step 4: camera pose and projector models refined together on every observation.
-    BundleOptions bo;
-    bo.refine_screen = options.fit_screen;
-    bo.camera_sigma = options.camera_sigma;
-    BundleResult ba = bundle_adjust(prior.screen, edge.camera, result.projectors, edge.edges, observations, bo);
-    // The bow first: on a bowed screen free intrinsics take up part of the bow (k1, k2 bend the rays much as
-    // the bow bends the screen); then the intrinsics, with the bow free too where it was kept.
-    if (options.fit_bow) try_bow(ba, edge.edges, observations, bo, options, result.report.bow);
-    bo.refine_bow = result.report.bow.kept;
-    try_camera_intrinsics(ba, prior, edge.edges, observations, bo, options, result.report);
-    // Last, with what the other trials kept free: each projector's lens distortion.
-    bo.refine_camera_intrinsics = result.report.intrinsics.kept;
-    try_projector_distortion(ba, prior, edge.edges, observations, bo, options, result.report);
-    result.screen = ba.screen;
+    // With the screen or the camera's intrinsics still to be fitted, a projector's fit on the prior's is only a
+    // start: its gate is applied after the bundle adjustment instead.
+    AutocalOptions start_options = options;
+    if (options.fit_screen || options.refine_camera_intrinsics)
+        start_options.max_projector_rms = std::numeric_limits<double>::infinity();
+    ProjectorFit fit =
+        fit_projector(edge.camera, prior, static_cast<int>(k), c.camera, c.projector, c.sigma, start_options);
+    pr.rms_px = fit.rms_px;
+    pr.mean_view_angle_deg = fit.mean_view_angle_deg;
+    report.projectors.push_back(pr);
+    return fit;
+}
+
+// Step 4's result taken into `result`, through the gates a fitted screen and fitted projectors must pass.
+void adopt_bundle(const BundleResult& ba, const CalibrationPrior& prior, const AutocalOptions& options,
+                  AutocalResult& result) {
     if (!(ba.screen.radius_m > 0.0 && ba.screen.arc_deg > 0.0 && ba.screen.arc_deg <= 360.0)) {
         throw CalibrationRefused("fitted screen: radius " + std::to_string(ba.screen.radius_m) + " m, arc " +
                                  std::to_string(ba.screen.arc_deg) +
                                  " deg is no cylinder screen (radius > 0, arc in (0, 360]): the prior is too far off");
     }
+    result.screen = ba.screen;
     result.camera = ba.camera;
     result.projectors = ba.projectors;
     result.report.camera_position_m = ba.camera.position_m;
     result.report.edge_rms_m = ba.edge_rms_m;
-    for (std::size_t k = 0; k < n; ++k) {
+    for (std::size_t k = 0; k < ba.projectors.size(); ++k) {
         result.report.projectors[k].rms_px = ba.rms_px[k];
         result.report.projectors[k].rms_sigma = ba.rms_sigma[k];
         result.report.projectors[k].cells = ba.inliers[k];
@@ -533,6 +349,39 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
                 " px): decoding errors, or the screen is not a cylinder of the prior's heights?");
         }
     }
+}
+
+}  // namespace
+
+AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, ImageSize content,
+                        const AutocalOptions& options) {
+    check_inputs(prior, content, options);
+    require_locked_exposure(source);
+    std::vector<ImageSize> sizes;
+    for (const DeviceModel& p : prior.projectors) sizes.push_back(p.resolution);
+    AutocalResult result;
+    const EdgeFit edge = fit_camera_to_lit_screen(source, prior, sizes, options, result.report);
+    result.camera = edge.camera;
+    std::vector<ProjectorObservations> observations;
+    for (std::size_t k = 0; k < sizes.size(); ++k) {
+        ProjectorFit fit = observe_projector(source, prior, sizes, k, edge, options, result.report);
+        result.projectors.push_back(fit.model);
+        observations.push_back(std::move(fit.observations));
+    }
+    // Step 4: camera pose and projector models refined together on every observation.
+    BundleOptions bo;
+    bo.refine_screen = options.fit_screen;
+    bo.camera_sigma = options.camera_sigma;
+    BundleResult ba = bundle_adjust(prior.screen, edge.camera, result.projectors, edge.edges, observations, bo);
+    // The bow first: on a bowed screen free intrinsics take up part of the bow (k1, k2 bend the rays much as
+    // the bow bends the screen); then the intrinsics, with the bow free too where it was kept.
+    if (options.fit_bow) trials::try_bow(ba, edge.edges, observations, bo, options, result.report.bow);
+    bo.refine_bow = result.report.bow.kept;
+    trials::try_camera_intrinsics(ba, prior, edge.edges, observations, bo, options, result.report);
+    // Last, with what the other trials kept free: each projector's lens distortion.
+    bo.refine_camera_intrinsics = result.report.intrinsics.kept;
+    trials::try_projector_distortion(ba, prior, edge.edges, observations, bo, options, result.report);
+    adopt_bundle(ba, prior, options, result);
     result.calibration = calibration_from_models(result.projectors, result.screen, content, options);
     result.report.predicted_seam = predicted_seam_deviation(result.projectors, result.screen, result.calibration);
     check_predicted_seam(result.report.predicted_seam, result.projectors, options);

@@ -197,6 +197,65 @@ Rgb8Image self_check_image(const SelfCheckResult& c) {
     return out;
 }
 
+// report.json's "screen": the fitted cylinder, the bow's trial and the prior's size.
+nlohmann::json screen_report(const AutocalResult& r, const CalibrationPrior& prior, const CalibrateJob& job) {
+    return {{"fitted", job.options.fit_screen},
+            {"bow_m", r.screen.bow_m},
+            {"bow_trial",
+             {{"tried", r.report.bow.tried},
+              {"kept", r.report.bow.kept},
+              {"fitted_bow_m", r.report.bow.bow_m},
+              {"cylinder_rms_sigma", r.report.bow.cylinder_rms_sigma},
+              {"bowed_rms_sigma", r.report.bow.bowed_rms_sigma}}},
+            {"radius_m", r.screen.radius_m},
+            {"arc_deg", r.screen.arc_deg},
+            {"prior_radius_m", prior.screen.radius_m},
+            {"prior_arc_deg", prior.screen.arc_deg}};
+}
+
+// report.json's "predicted": the blend's worst weight-sum deviation as the fitted models predict it.
+nlohmann::json predicted_report(const AutocalResult& r) {
+    const PredictedSeam& p = r.report.predicted_seam;
+    return {{"seam_weight_sum_max_deviation", p.deviation},
+            {"seam_at",
+             {{"projector", p.projector},
+              {"pixel", {p.x, p.y}},
+              {"theta_deg", p.theta_rad * 180.0 / std::numbers::pi},
+              {"h_m", p.h_m}}}};
+}
+
+// report.json's "ground_truth": the calibration measured against the rig's truth (none of it is the fit's own).
+nlohmann::json ground_truth_report(const GeometryError& g, const LuminanceError& l, const AutocalResult& r,
+                                   const rig::VirtualRig& rig) {
+    return {{"geometry_mean_px", g.mean_px},
+            {"geometry_p95_px", g.p95_px},
+            {"geometry_max_px", g.max_px},
+            {"geometry_samples", g.samples},
+            {"missing", g.missing},
+            {"outside", g.outside},
+            {"luminance_max_deviation", l.max_deviation},
+            {"seam_luminance_max_deviation", l.seam_max_deviation},
+            {"camera_position_error_mm", (r.camera.position_m - rig.camera.pose.position_m).norm() * 1e3}};
+}
+
+// The job's files: the models first, so that whoever sees the new MPCDI (the kiosk's watcher) finds its models;
+// then the MPCDI, the previews and report.json.
+void write_job_outputs(const CalibrateJob& job, const AutocalResult& r, const rig::VirtualRig& rig,
+                       const SelfCheckResult& check, const nlohmann::json& report) {
+    std::filesystem::create_directories(job.out);
+    MpcdiExportOptions mo;
+    mo.alpha_bit_depth = job.alpha_bits;
+    mo.write_response = job.colour;
+    write_models(models_path_for(job.out / "calibration.mpcdi"), CalibrationModels{r.screen, r.camera, r.projectors});
+    write_mpcdi(job.out / "calibration.mpcdi", to_mpcdi(r.calibration, mo));
+    write_png(job.out / "preview.png", preview(rig, r.calibration, 960));  // libpng: no imgcodecs in the image
+    if (!check.filmed.empty()) write_png(job.out / "self-check.png", self_check_image(check));
+    const std::filesystem::path json = job.out / "report.json";
+    std::ofstream f(json);
+    f << report.dump(2) << "\n";
+    if (!f) throw std::runtime_error("calibrate: cannot write '" + json.string() + "'");
+}
+
 }  // namespace
 
 nlohmann::json run_calibrate_job(const CalibrateJob& job) {
@@ -224,56 +283,28 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
     const GeometryError g = measure_geometry(rig, r.calibration, 4);
     // One grid point per projector pixel: a seam's maximum must see a line one pixel wide.
     const LuminanceError l = measure_luminance(rig, r.calibration, 0.01, pixel_dense_seam_grid(rig));
-    nlohmann::json report = {
-        {"rig", rig.name},
-        {"rig_file", job.rig.string()},
-        {"scale", job.scale},
-        {"content", {job.content.width, job.content.height}},
-        {"captures", r.report.captures + check.captures},
-        {"geometry_captures", r.report.captures},
-        {"knobs",
-         {{"max_gray_bits", job.options.max_gray_bits},
-          {"frames_per_pattern", job.options.frames_per_pattern},
-          {"phase_shifts", job.options.phase_shifts},
-          {"warp_step_px", job.options.warp_step_px}}},
-        // Wall seconds: the calibration's own compute (calibrate and the colour step, without the
-        // rig's camera simulation, which a real camera replaces) and the simulation apart.
-        {"timing",
-         {{"compute_s", calibrate_s - source.simulate_s()},
-          {"simulate_s", source.simulate_s()},
-          {"calibrate_wall_s", calibrate_s}}},
-        {"camera", camera_report(r, prior, job.options)},
-        {"self_check", self_check_report(check, job.self_check)},
-        {"screen",
-         {{"fitted", job.options.fit_screen},
-          {"bow_m", r.screen.bow_m},
-          {"bow_trial",
-           {{"tried", r.report.bow.tried},
-            {"kept", r.report.bow.kept},
-            {"fitted_bow_m", r.report.bow.bow_m},
-            {"cylinder_rms_sigma", r.report.bow.cylinder_rms_sigma},
-            {"bowed_rms_sigma", r.report.bow.bowed_rms_sigma}}},
-          {"radius_m", r.screen.radius_m},
-          {"arc_deg", r.screen.arc_deg},
-          {"prior_radius_m", prior.screen.radius_m},
-          {"prior_arc_deg", prior.screen.arc_deg}}},
-        {"predicted",
-         {{"seam_weight_sum_max_deviation", r.report.predicted_seam.deviation},
-          {"seam_at",
-           {{"projector", r.report.predicted_seam.projector},
-            {"pixel", {r.report.predicted_seam.x, r.report.predicted_seam.y}},
-            {"theta_deg", r.report.predicted_seam.theta_rad * 180.0 / std::numbers::pi},
-            {"h_m", r.report.predicted_seam.h_m}}}}},
-        {"ground_truth",
-         {{"geometry_mean_px", g.mean_px},
-          {"geometry_p95_px", g.p95_px},
-          {"geometry_max_px", g.max_px},
-          {"geometry_samples", g.samples},
-          {"missing", g.missing},
-          {"outside", g.outside},
-          {"luminance_max_deviation", l.max_deviation},
-          {"seam_luminance_max_deviation", l.seam_max_deviation},
-          {"camera_position_error_mm", (r.camera.position_m - rig.camera.pose.position_m).norm() * 1e3}}}};
+    nlohmann::json report = {{"rig", rig.name},
+                             {"rig_file", job.rig.string()},
+                             {"scale", job.scale},
+                             {"content", {job.content.width, job.content.height}},
+                             {"captures", r.report.captures + check.captures},
+                             {"geometry_captures", r.report.captures},
+                             {"knobs",
+                              {{"max_gray_bits", job.options.max_gray_bits},
+                               {"frames_per_pattern", job.options.frames_per_pattern},
+                               {"phase_shifts", job.options.phase_shifts},
+                               {"warp_step_px", job.options.warp_step_px}}},
+                             // Wall seconds: the calibration's own compute (calibrate and the colour step, without the
+                             // rig's camera simulation, which a real camera replaces) and the simulation apart.
+                             {"timing",
+                              {{"compute_s", calibrate_s - source.simulate_s()},
+                               {"simulate_s", source.simulate_s()},
+                               {"calibrate_wall_s", calibrate_s}}},
+                             {"camera", camera_report(r, prior, job.options)},
+                             {"self_check", self_check_report(check, job.self_check)},
+                             {"screen", screen_report(r, prior, job)},
+                             {"predicted", predicted_report(r)},
+                             {"ground_truth", ground_truth_report(g, l, r, rig)}};
     if (colour) {
         report["colour"] = colour_report(*colour);
         report["captures"] = r.report.captures + check.captures + colour->captures;
@@ -283,20 +314,7 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
     for (std::size_t k = 0; k < r.report.projectors.size(); ++k)
         report["projectors"].push_back(
             projector_json(r, k, rig, job.options, source.simulator().camera_coverage(static_cast<int>(k))));
-    std::filesystem::create_directories(job.out);
-    MpcdiExportOptions mo;
-    mo.alpha_bit_depth = job.alpha_bits;
-    mo.write_response = job.colour;
-    // The fitted models first, so that whoever sees the new MPCDI (the kiosk's watcher) finds its models.
-    write_models(models_path_for(job.out / "calibration.mpcdi"), CalibrationModels{r.screen, r.camera, r.projectors});
-    write_mpcdi(job.out / "calibration.mpcdi", to_mpcdi(r.calibration, mo));
-    const std::filesystem::path png = job.out / "preview.png";
-    write_png(png, preview(rig, r.calibration, 960));  // libpng: no imgcodecs in what the image ships
-    if (!check.filmed.empty()) write_png(job.out / "self-check.png", self_check_image(check));
-    const std::filesystem::path json = job.out / "report.json";
-    std::ofstream f(json);
-    f << report.dump(2) << "\n";
-    if (!f) throw std::runtime_error("calibrate: cannot write '" + json.string() + "'");
+    write_job_outputs(job, r, rig, check, report);
     return report;
 }
 

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The virtual rig as the calibration's input, and the calibration measured against the rig's
-// ground truth (never against the calibration's own prediction): docs/calibration.md.
+// ground truth (never against the calibration's own prediction): docs/calibration.md. LABORATORY code
+// (.ci/check-shipped-links); the prior a rig file gives (site_prior.h) is not.
 #pragma once
 
 #include <array>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "appliance/autocal/autocal.h"
+#include "appliance/autocal/site_prior.h"
 #include "appliance/rig/virtual_rig.h"
 
 namespace mogao::autocal {
@@ -37,17 +39,6 @@ private:
     std::uint64_t frame_ = 0;
     double simulate_s_ = 0.0;
 };
-
-// The rig at reduced resolution: projector and camera sizes and intrinsics scaled, the projectors'
-// defocus (blur_px) with them (errors in
-// projector pixels then scale with `projector_scale`). Scales in (0, 1].
-[[nodiscard]] rig::VirtualRig scaled_rig(const rig::VirtualRig& rig, double projector_scale, double camera_scale);
-
-// What the calibration is told about a rig: screen, camera intrinsics (focal, principal point and
-// distortion errors applied, as a chessboard calibration leaves them; never the truth's) and
-// pose (position and angle errors applied), projector resolutions, data-sheet intrinsics (focal
-// error applied) and ids; the rig's [prior] section holds the errors.
-[[nodiscard]] CalibrationPrior prior_from_rig(const rig::VirtualRig& rig);
 
 struct GeometryError {
     int samples = 0;       // projector pixels that land on the screen and were measured

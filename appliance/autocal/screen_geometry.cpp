@@ -183,6 +183,30 @@ std::optional<Eigen::Vector3d> cylinder_hit(const ScreenModel& screen, const Eig
     return std::nullopt;
 }
 
+namespace {
+
+// The gates a camera pose from the screen's lit edges must pass; throws CalibrationRefused naming the shortfall.
+void check_edge_fit(const EdgeFit& fit, const AutocalOptions& options) {
+    if (fit.points < 200) {
+        throw CalibrationRefused(
+            "camera pose: only " + std::to_string(fit.points) +
+            " points on the screen's lit edges (need >= 200): the camera does not see the screen's top and "
+            "bottom edges lit (projectors must overfill them)");
+    }
+    if (fit.side_points < 20) {
+        throw CalibrationRefused(
+            "camera pose: only " + std::to_string(fit.side_points) +
+            " points on the arc's ends (need >= 20): the ends of the screen are not lit or not seen");
+    }
+    if (fit.rms_m > options.max_edge_rms_m) {
+        throw CalibrationRefused("camera pose: edge fit rms " + fmt(fit.rms_m * 1000.0) + " mm above its gate " +
+                                 fmt(options.max_edge_rms_m * 1000.0) +
+                                 " mm (wrong screen size or camera intrinsics?)");
+    }
+}
+
+}  // namespace
+
 EdgeFit fit_camera_pose(const cv::Mat1f& lit, const CalibrationPrior& prior, const AutocalOptions& options) {
     const std::vector<EdgePoint> edges = find_edges(lit);
     std::vector<cv::Point2d> image;
@@ -251,22 +275,7 @@ EdgeFit fit_camera_pose(const cv::Mat1f& lit, const CalibrationPrior& prior, con
         }
         fit.edges.push_back({rays[i], which, {image[i].x, image[i].y}});
     }
-    if (fit.points < 200) {
-        throw CalibrationRefused(
-            "camera pose: only " + std::to_string(fit.points) +
-            " points on the screen's lit edges (need >= 200): the camera does not see the screen's top and "
-            "bottom edges lit (projectors must overfill them)");
-    }
-    if (fit.side_points < 20) {
-        throw CalibrationRefused(
-            "camera pose: only " + std::to_string(fit.side_points) +
-            " points on the arc's ends (need >= 20): the ends of the screen are not lit or not seen");
-    }
-    if (fit.rms_m > options.max_edge_rms_m) {
-        throw CalibrationRefused("camera pose: edge fit rms " + fmt(fit.rms_m * 1000.0) + " mm above its gate " +
-                                 fmt(options.max_edge_rms_m * 1000.0) +
-                                 " mm (wrong screen size or camera intrinsics?)");
-    }
+    check_edge_fit(fit, options);
     return fit;
 }
 

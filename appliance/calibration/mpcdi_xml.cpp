@@ -330,6 +330,69 @@ MpcdiFile parse_mpcdi_xml(std::string_view text, const std::string& who, std::ve
     return Parser(who, notes).parse(text);
 }
 
+namespace {
+
+// A region's <frustum> and <coordinateFrame> (whichever it has), inside its <region> element.
+void print_region_placement(Printer& p, const MpcdiRegion& r) {
+    if (r.frustum) {
+        const MpcdiFrustum& f = *r.frustum;
+        p.line(4, "<frustum>");
+        p.number(5, "yaw", f.yaw);
+        p.number(5, "pitch", f.pitch);
+        p.number(5, "roll", f.roll);
+        p.number(5, "rightAngle", f.right_angle);
+        p.number(5, "leftAngle", f.left_angle);
+        p.number(5, "upAngle", f.up_angle);
+        p.number(5, "downAngle", f.down_angle);
+        p.line(4, "</frustum>");
+    }
+    if (r.coordinate_frame) {
+        const MpcdiCoordinateFrame& c = *r.coordinate_frame;
+        p.line(4, "<coordinateFrame>");
+        const auto vec = [&](const char* stem, const std::array<double, 3>& v) {
+            const char* axes[3] = {"x", "y", "z"};
+            for (std::size_t i = 0; i < 3; ++i) p.number(5, (std::string(stem) + axes[i]).c_str(), v[i]);
+        };
+        vec("pos", c.pos);
+        vec("yaw", c.yaw);
+        vec("pitch", c.pitch);
+        vec("roll", c.roll);
+        p.line(4, "</coordinateFrame>");
+    }
+}
+
+// A region's <fileset>: its warp, alpha and optional beta and distortion maps' files.
+void print_fileset(Printer& p, const MpcdiRegion& r) {
+    p.line(2, "<fileset region=\"" + escape(r.id) + "\">");
+    p.line(3, "<geometryWarpFile>");
+    p.value(4, "path", r.warp.path);
+    p.value(4, "geometricUnit", std::string(to_string(r.warp.geometric_unit)));
+    p.value(4, "interpolation", std::string(to_string(r.warp.interpolation)));
+    p.value(4, "originof3DData", std::string(to_string(r.warp.origin_of_3d_data)));
+    p.line(3, "</geometryWarpFile>");
+    p.line(3, "<alphaMap>");
+    p.value(4, "path", r.alpha.path);
+    p.value(4, "componentDepth", std::to_string(r.alpha.map.channels));
+    p.value(4, "bitDepth", std::to_string(r.alpha.map.bit_depth));
+    p.number(4, "gammaEmbedded", r.alpha.gamma_embedded);
+    p.line(3, "</alphaMap>");
+    if (r.beta) {
+        p.line(3, "<betaMap>");
+        p.value(4, "path", r.beta->path);
+        p.value(4, "bitDepth", std::to_string(r.beta->map.bit_depth));  // reference order: bitDepth first
+        p.value(4, "componentDepth", std::to_string(r.beta->map.channels));
+        p.line(3, "</betaMap>");
+    }
+    if (r.distortion) {
+        p.line(3, "<distortionMap>");
+        p.value(4, "path", r.distortion->path);
+        p.line(3, "</distortionMap>");
+    }
+    p.line(2, "</fileset>");
+}
+
+}  // namespace
+
 std::string print_mpcdi_xml(const MpcdiFile& file) {
     Printer p;
     p.line(0, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>");
@@ -351,31 +414,7 @@ std::string print_mpcdi_xml(const MpcdiFile& file) {
                 continue;
             }
             p.line(3, open + ">");
-            if (r.frustum) {
-                const MpcdiFrustum& f = *r.frustum;
-                p.line(4, "<frustum>");
-                p.number(5, "yaw", f.yaw);
-                p.number(5, "pitch", f.pitch);
-                p.number(5, "roll", f.roll);
-                p.number(5, "rightAngle", f.right_angle);
-                p.number(5, "leftAngle", f.left_angle);
-                p.number(5, "upAngle", f.up_angle);
-                p.number(5, "downAngle", f.down_angle);
-                p.line(4, "</frustum>");
-            }
-            if (r.coordinate_frame) {
-                const MpcdiCoordinateFrame& c = *r.coordinate_frame;
-                p.line(4, "<coordinateFrame>");
-                const auto vec = [&](const char* stem, const std::array<double, 3>& v) {
-                    const char* axes[3] = {"x", "y", "z"};
-                    for (std::size_t i = 0; i < 3; ++i) p.number(5, (std::string(stem) + axes[i]).c_str(), v[i]);
-                };
-                vec("pos", c.pos);
-                vec("yaw", c.yaw);
-                vec("pitch", c.pitch);
-                vec("roll", c.roll);
-                p.line(4, "</coordinateFrame>");
-            }
+            print_region_placement(p, r);
             p.line(3, "</region>");
         }
         p.line(2, "</buffer>");
@@ -384,32 +423,7 @@ std::string print_mpcdi_xml(const MpcdiFile& file) {
     p.line(1, "<files>");
     for (const MpcdiBuffer& b : file.buffers) {
         for (const MpcdiRegion& r : b.regions) {
-            p.line(2, "<fileset region=\"" + escape(r.id) + "\">");
-            p.line(3, "<geometryWarpFile>");
-            p.value(4, "path", r.warp.path);
-            p.value(4, "geometricUnit", std::string(to_string(r.warp.geometric_unit)));
-            p.value(4, "interpolation", std::string(to_string(r.warp.interpolation)));
-            p.value(4, "originof3DData", std::string(to_string(r.warp.origin_of_3d_data)));
-            p.line(3, "</geometryWarpFile>");
-            p.line(3, "<alphaMap>");
-            p.value(4, "path", r.alpha.path);
-            p.value(4, "componentDepth", std::to_string(r.alpha.map.channels));
-            p.value(4, "bitDepth", std::to_string(r.alpha.map.bit_depth));
-            p.number(4, "gammaEmbedded", r.alpha.gamma_embedded);
-            p.line(3, "</alphaMap>");
-            if (r.beta) {
-                p.line(3, "<betaMap>");
-                p.value(4, "path", r.beta->path);
-                p.value(4, "bitDepth", std::to_string(r.beta->map.bit_depth));  // reference order: bitDepth first
-                p.value(4, "componentDepth", std::to_string(r.beta->map.channels));
-                p.line(3, "</betaMap>");
-            }
-            if (r.distortion) {
-                p.line(3, "<distortionMap>");
-                p.value(4, "path", r.distortion->path);
-                p.line(3, "</distortionMap>");
-            }
-            p.line(2, "</fileset>");
+            print_fileset(p, r);
         }
     }
     p.line(1, "</files>");

@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "appliance/rig/virtual_rig.h"
+#include "appliance/rig/rig_model.h"
 
 namespace mogao::rig {
 

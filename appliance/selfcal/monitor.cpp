@@ -415,15 +415,8 @@ cv::Mat1f Monitor::predict(const cv::Mat1f& content) const {
     return out;
 }
 
-FrameMeasurement Monitor::measure(const cv::Mat1f& content, const cv::Mat1f& camera_frame,
-                                  const std::vector<bool>& suspects, bool pattern_pair) const {
-    const autocal::DeviceModel& cam = model_.camera;
-    if (camera_frame.cols != cam.resolution.width || camera_frame.rows != cam.resolution.height) {
-        throw std::invalid_argument("Monitor::measure: camera frame must be " + std::to_string(cam.resolution.width) +
-                                    "x" + std::to_string(cam.resolution.height));
-    }
-    FrameMeasurement m;
-    m.projectors.resize(model_.projectors.size());
+Monitor::ScreenMatches Monitor::match_on_screen(const cv::Mat1f& content, const cv::Mat1f& camera_frame,
+                                                bool pattern_pair, FrameMeasurement& m) const {
     std::vector<Match> matches;
     if (pattern_pair) {
         // A difference of two frames: the dots on a zero background with the noise of two frames.
@@ -443,36 +436,38 @@ FrameMeasurement Monitor::measure(const cv::Mat1f& content, const cv::Mat1f& cam
             m.matches = static_cast<int>(matches.size());
         }
     }
-    std::vector<Eigen::Vector3d> s_pred;
+    ScreenMatches sm;
     std::vector<cv::Point2d> observed;
-    std::vector<int> owner;
-    std::vector<double> unmix;  // per match: 1 / the owner's blend weight where un-mixed, else 1
     for (const Match& mt : matches) {
         const double u = bilinear(map_u_, mt.predicted.x - 0.5, mt.predicted.y - 0.5);
         const double v = bilinear(map_v_, mt.predicted.x - 0.5, mt.predicted.y - 0.5);
         if (!std::isfinite(u) || !std::isfinite(v)) continue;
-        s_pred.push_back(screen_point(model_.screen, u, v));
+        sm.s_pred.push_back(screen_point(model_.screen, u, v));
         observed.push_back(mt.observed);
         const int px = static_cast<int>(mt.predicted.x);
         const int py = static_cast<int>(mt.predicted.y);
-        owner.push_back(owner_(py, px));
+        sm.owner.push_back(owner_(py, px));
         const double w = owner_weight_(py, px);
         const bool small = cv::norm(mt.observed - mt.predicted) < options_.unmix_max_shift_px;
-        unmix.push_back(small && w > 0.0 && w < 1.0 ? 1.0 / w : 1.0);
+        sm.unmix.push_back(small && w > 0.0 && w < 1.0 ? 1.0 / w : 1.0);
     }
-    const std::vector<cv::Point2d> n = undistort(cam, observed);
-    std::vector<Eigen::Vector2d> obs_n;
-    for (const cv::Point2d& p : n) obs_n.emplace_back(p.x, p.y);
+    for (const cv::Point2d& p : undistort(model_.camera, observed)) sm.obs_n.emplace_back(p.x, p.y);
+    return sm;
+}
+
+void Monitor::fit_camera(const ScreenMatches& sm, const cv::Mat1f& camera_frame, const std::vector<bool>& suspects,
+                         bool pattern_pair, FrameMeasurement& m) const {
+    const autocal::DeviceModel& cam = model_.camera;
     const bool any_suspect = std::find(suspects.begin(), suspects.end(), true) != suspects.end();
     std::vector<Eigen::Vector3d> cam_points;
     std::vector<Eigen::Vector2d> cam_image;
-    for (std::size_t i = 0; i < s_pred.size(); ++i) {
-        const bool suspect = owner[i] == 255 ? any_suspect
-                                             : (static_cast<std::size_t>(owner[i]) < suspects.size() &&
-                                                suspects[static_cast<std::size_t>(owner[i])]);
+    for (std::size_t i = 0; i < sm.s_pred.size(); ++i) {
+        const bool suspect = sm.owner[i] == 255 ? any_suspect
+                                                : (static_cast<std::size_t>(sm.owner[i]) < suspects.size() &&
+                                                   suspects[static_cast<std::size_t>(sm.owner[i])]);
         if (suspect) continue;
-        cam_points.push_back(s_pred[i]);
-        cam_image.push_back(obs_n[i]);
+        cam_points.push_back(sm.s_pred[i]);
+        cam_image.push_back(sm.obs_n[i]);
     }
     m.camera = fit_pose_robust(cam, cam_points, cam_image, options_.camera_fit);
     // The screen does not move: a camera fit whose screen edges the frame shows where they were is
@@ -494,7 +489,7 @@ FrameMeasurement Monitor::measure(const cv::Mat1f& content, const cv::Mat1f& cam
     const bool contested = any_suspect || !m.camera.ok ||
                            static_cast<double>(m.camera.inliers) < 0.9 * static_cast<double>(cam_points.size());
     if (!pattern_pair && options_.check_edges && contested) {
-        auto edge_camera = camera_from_one_projector(cam, s_pred, obs_n, owner, camera_frame);
+        auto edge_camera = camera_from_one_projector(cam, sm.s_pred, sm.obs_n, sm.owner, camera_frame);
         // A consensus fit that moved the edges too stays unless the frame prefers the other's edges.
         if (edge_camera && moved == true && edges_prefer(edge_camera->model, m.camera.model, camera_frame) != true)
             edge_camera.reset();
@@ -504,19 +499,23 @@ FrameMeasurement Monitor::measure(const cv::Mat1f& content, const cv::Mat1f& cam
             m.camera_from_edges = true;
         }
     }
-    const autocal::DeviceModel camera = m.camera.ok ? m.camera.model : cam;
     if (m.camera.ok) m.camera_delta = pose_delta(cam, m.camera.model);
+}
+
+void Monitor::fit_projectors(const ScreenMatches& sm, FrameMeasurement& m) const {
+    const autocal::DeviceModel& cam = model_.camera;
+    const autocal::DeviceModel camera = m.camera.ok ? m.camera.model : cam;
     for (std::size_t k = 0; k < model_.projectors.size(); ++k) {
         const autocal::DeviceModel& d = model_.projectors[k];
         std::vector<Eigen::Vector3d> s_obs;
         std::vector<Eigen::Vector2d> x_k;
-        for (std::size_t i = 0; i < s_pred.size(); ++i) {
-            if (owner[i] != static_cast<int>(k)) continue;
-            Eigen::Vector3d so = autocal::ray_on_screen(model_.screen, camera, {obs_n[i].x(), obs_n[i].y(), 1.0});
+        for (std::size_t i = 0; i < sm.s_pred.size(); ++i) {
+            if (sm.owner[i] != static_cast<int>(k)) continue;
+            Eigen::Vector3d so = autocal::ray_on_screen(model_.screen, camera, {sm.obs_n[i].x(), sm.obs_n[i].y(), 1.0});
             // Un-mixing (MonitorOptions::unmix_max_shift_px); the cylinder's curvature over a
             // sub-pixel step is negligible, so the scaled point stays on the screen to ~1e-7 m.
-            so = s_pred[i] + unmix[i] * (so - s_pred[i]);
-            const Eigen::Vector2d xn = project_normalised(d.rotation, d.position_m, s_pred[i]);
+            so = sm.s_pred[i] + sm.unmix[i] * (so - sm.s_pred[i]);
+            const Eigen::Vector2d xn = project_normalised(d.rotation, d.position_m, sm.s_pred[i]);
             if (!so.allFinite() || !xn.allFinite()) continue;
             s_obs.push_back(so);
             x_k.push_back(xn);
@@ -526,6 +525,20 @@ FrameMeasurement Monitor::measure(const cv::Mat1f& content, const cv::Mat1f& cam
         pm.fit = fit_pose_robust(d, s_obs, x_k, options_.projector_fit);
         if (pm.fit.ok) pm.delta = pose_delta(d, pm.fit.model);
     }
+}
+
+FrameMeasurement Monitor::measure(const cv::Mat1f& content, const cv::Mat1f& camera_frame,
+                                  const std::vector<bool>& suspects, bool pattern_pair) const {
+    const autocal::DeviceModel& cam = model_.camera;
+    if (camera_frame.cols != cam.resolution.width || camera_frame.rows != cam.resolution.height) {
+        throw std::invalid_argument("Monitor::measure: camera frame must be " + std::to_string(cam.resolution.width) +
+                                    "x" + std::to_string(cam.resolution.height));
+    }
+    FrameMeasurement m;
+    m.projectors.resize(model_.projectors.size());
+    const ScreenMatches sm = match_on_screen(content, camera_frame, pattern_pair, m);
+    fit_camera(sm, camera_frame, suspects, pattern_pair, m);
+    fit_projectors(sm, m);
     return m;
 }
 

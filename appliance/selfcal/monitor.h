@@ -130,6 +130,23 @@ public:
     static constexpr double kEdgeContrast = 0.002;  // linear camera units (about half an 8-bit code)
 
 private:
+    // measure()'s matches as screen points: each match's screen point under the reference (from its predicted
+    // position), its observed position (normalised, undistorted), its owner (projector index, 255 none) and its
+    // un-mixing factor (1 / the owner's blend weight where un-mixed, else 1; MonitorOptions::unmix_max_shift_px).
+    struct ScreenMatches {
+        std::vector<Eigen::Vector3d> s_pred;
+        std::vector<Eigen::Vector2d> obs_n;
+        std::vector<int> owner;
+        std::vector<double> unmix;
+    };
+    [[nodiscard]] ScreenMatches match_on_screen(const cv::Mat1f& content, const cv::Mat1f& camera_frame,
+                                                bool pattern_pair, FrameMeasurement& m) const;
+    // The camera's fit on the matches of projectors not suspected (m.camera, camera_delta and the edges' verdicts).
+    void fit_camera(const ScreenMatches& sm, const cv::Mat1f& camera_frame, const std::vector<bool>& suspects,
+                    bool pattern_pair, FrameMeasurement& m) const;
+    // Each projector's fit on its own matches, seen through the camera m.camera holds (or the reference's).
+    void fit_projectors(const ScreenMatches& sm, FrameMeasurement& m) const;
+
     // A camera fitted to each projector's matches alone (k's own, `owner`): among those whose edges
     // moved (edges_moved == true), the one whose edges the frame prefers to the others'; or none.
     [[nodiscard]] std::optional<PoseFit> camera_from_one_projector(const autocal::DeviceModel& camera,

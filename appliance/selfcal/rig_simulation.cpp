@@ -316,6 +316,45 @@ void check_start_model(const SystemModel& m, const rig::VirtualRig& truth) {
     }
 }
 
+// One monitored frame: the content as the camera films it (with the options' exposure jitter and occluding
+// visitors), or the fallback pattern pair (two refreshes 1/60 s apart, same exposure, the visitors where they were),
+// handed to the self-calibrator.
+StepResult step_on_frame(SelfCalibrator& sc, const rig::CameraSimulator& sim, const ScreenCalibration& wall,
+                         const cv::Mat1f& content, const SimulationOptions& o, cv::RNG& rng, int i, double t) {
+    const double gain = 1.0 + rng.uniform(-o.exposure_jitter, o.exposure_jitter + 1e-12);
+    const double hidden =
+        o.occlusion_max > o.occlusion ? rng.uniform(o.occlusion, std::min(0.9, o.occlusion_max)) : o.occlusion;
+    const std::uint64_t frame_seed = static_cast<std::uint64_t>(i) + o.seed * 100000;
+    const std::optional<cv::Mat1f> plus = sc.pattern_for_refresh(0, content.size());
+    if (plus) {
+        // The pattern pair: two refreshes 1/60 s apart, same exposure, the visitors where they were.
+        const std::uint64_t visitors = rng.next();
+        cv::Mat1f shown_plus;
+        cv::Mat1f shown_minus;
+        cv::add(content, *plus, shown_plus);
+        cv::add(content, *sc.pattern_for_refresh(1, content.size()), shown_minus);
+        const cv::Mat1f cam_plus = capture(sim, wall, shown_plus, gain, hidden, visitors, frame_seed);
+        const cv::Mat1f cam_minus = capture(sim, wall, shown_minus, gain, hidden, visitors, frame_seed + (1ULL << 40));
+        return sc.step_pattern(content, cam_plus, cam_minus, t);
+    }
+    return sc.step(content, capture(sim, wall, content, gain, hidden, rng.next(), frame_seed), t);
+}
+
+// The report's timings after the first bump (`since_bump` seconds): the error when it struck, when the drift
+// was detected and when a correction brought the error under the threshold.
+void record_after_bump(SimulationReport& rep, const StepResult& r, const autocal::GeometryError& g, double since_bump,
+                       const SimulationOptions& o, bool& measured_before) {
+    if (!measured_before) {
+        rep.error_before_px = g.mean_px;
+        measured_before = true;
+    }
+    if (!rep.detected_after_s && r.status.state != SelfcalState::calibrated) rep.detected_after_s = since_bump;
+    if (!rep.corrected_after_s && rep.corrections > 0 && r.status.state == SelfcalState::calibrated &&
+        g.mean_px < o.error_threshold_px) {
+        rep.corrected_after_s = since_bump;
+    }
+}
+
 }  // namespace
 
 SimulationReport simulate(const rig::VirtualRig& input, const SimulationOptions& o) {
@@ -359,26 +398,7 @@ SimulationReport simulate(const rig::VirtualRig& input, const SimulationOptions&
         }
         if (changed) sim = std::make_unique<rig::CameraSimulator>(truth);
         const cv::Mat1f content = make_content(o.content, t, o.moving_content, o.seed);
-        const double gain = 1.0 + rng.uniform(-o.exposure_jitter, o.exposure_jitter + 1e-12);
-        const double hidden =
-            o.occlusion_max > o.occlusion ? rng.uniform(o.occlusion, std::min(0.9, o.occlusion_max)) : o.occlusion;
-        const std::uint64_t frame_seed = static_cast<std::uint64_t>(i) + o.seed * 100000;
-        const std::optional<cv::Mat1f> plus = sc.pattern_for_refresh(0, content.size());
-        StepResult r;
-        if (plus) {
-            // The pattern pair: two refreshes 1/60 s apart, same exposure, the visitors where they were.
-            const std::uint64_t visitors = rng.next();
-            cv::Mat1f shown_plus;
-            cv::Mat1f shown_minus;
-            cv::add(content, *plus, shown_plus);
-            cv::add(content, *sc.pattern_for_refresh(1, content.size()), shown_minus);
-            const cv::Mat1f cam_plus = capture(*sim, wall, shown_plus, gain, hidden, visitors, frame_seed);
-            const cv::Mat1f cam_minus =
-                capture(*sim, wall, shown_minus, gain, hidden, visitors, frame_seed + (1ULL << 40));
-            r = sc.step_pattern(content, cam_plus, cam_minus, t);
-        } else {
-            r = sc.step(content, capture(*sim, wall, content, gain, hidden, rng.next(), frame_seed), t);
-        }
+        const StepResult r = step_on_frame(sc, *sim, wall, content, o, rng, i, t);
         if (r.calibration) wall = *r.calibration;
         for (const std::string& line : r.journal) rep.journal.push_back(line);
         if (r.status.state == SelfcalState::correcting &&
@@ -402,18 +422,8 @@ SimulationReport simulate(const rig::VirtualRig& input, const SimulationOptions&
         rep.final_error_px = g.mean_px;
         rep.final_p95_px = g.p95_px;
         rep.final_state = r.status.state;
-        if (std::isfinite(first_bump) && t >= first_bump) {
-            if (!measured_before) {
-                rep.error_before_px = g.mean_px;
-                measured_before = true;
-            }
-            if (!rep.detected_after_s && r.status.state != SelfcalState::calibrated)
-                rep.detected_after_s = t - first_bump;
-            if (!rep.corrected_after_s && rep.corrections > 0 && r.status.state == SelfcalState::calibrated &&
-                g.mean_px < o.error_threshold_px) {
-                rep.corrected_after_s = t - first_bump;
-            }
-        }
+        if (std::isfinite(first_bump) && t >= first_bump)
+            record_after_bump(rep, r, g, t - first_bump, o, measured_before);
     }
     rep.mean_cpu_ms = cpu / o.frames;
     rep.final_calibration = std::move(wall);

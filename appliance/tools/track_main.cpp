@@ -41,7 +41,7 @@ constexpr const char* kBoardHelp = "Chessboard inner corners, COLUMNSxROWS";
 constexpr const char* kSquareHelp = "Chessboard square side, mm";
 constexpr const char* kCameraHelp =
     "Capture device: v4l2:/dev/videoN (or /dev/videoN) or libcamera:[id]; mogao-calibrate also replay:DIR and "
-    "rig:FILE (simulation)";
+    "rig:FILE (simulation: mogao-calibrate-sim)";
 
 CLI::App* add_detect(CLI::App& app, mogao::track::DetectOptions& detect) {
     auto* d = app.add_subcommand("detect", "print every tag's id and corners in images (JPEG, PNG, PGM)");

@@ -148,27 +148,36 @@ std::optional<Choice> choose_format(const V4l2Config& config, const std::vector<
     return std::nullopt;
 }
 
-}  // namespace
-
-Status V4l2Capture::negotiate_format(const V4l2Config& config) {
+// The pixel formats (fourccs) the device offers for buffer type `type`, in its order (VIDIOC_ENUM_FMT).
+std::vector<std::uint32_t> offered_formats(int fd, std::uint32_t type) {
     std::vector<std::uint32_t> offered;
     for (std::uint32_t i = 0;; ++i) {
         v4l2_fmtdesc desc{};
         desc.index = i;
-        desc.type = buf_type_;
-        if (xioctl(fd_.get(), VIDIOC_ENUM_FMT, &desc) == -1) break;  // EINVAL ends the list
+        desc.type = type;
+        if (xioctl(fd, VIDIOC_ENUM_FMT, &desc) == -1) break;  // EINVAL ends the list
         offered.push_back(desc.pixelformat);
     }
+    return offered;
+}
+
+// The error when none of the configuration's formats is offered: what was wanted and what the device has.
+std::string no_wanted_format(const std::string& device, const V4l2Config& config,
+                             const std::vector<std::uint32_t>& offered) {
+    std::string list;
+    for (std::uint32_t f : offered) list += (list.empty() ? "" : ", ") + fourcc_name(f);
+    std::string names;
+    for (CaptureFormat f : config.formats) names += (names.empty() ? "" : "/") + pixel_format_name(f);
+    return device + ": none of the wanted formats (" + names + (config.colour ? ", in colour" : "") +
+           ") is offered; device has: " + (list.empty() ? std::string("none") : list);
+}
+
+}  // namespace
+
+Status V4l2Capture::negotiate_format(const V4l2Config& config) {
+    const std::vector<std::uint32_t> offered = offered_formats(fd_.get(), buf_type_);
     const std::optional<Choice> wanted = choose_format(config, offered, multiplanar_);
-    if (!wanted) {
-        std::string list;
-        for (std::uint32_t f : offered) list += (list.empty() ? "" : ", ") + fourcc_name(f);
-        std::string names;
-        for (CaptureFormat f : config.formats) names += (names.empty() ? "" : "/") + pixel_format_name(f);
-        return make_error(ENOTSUP, device_ + ": none of the wanted formats (" + names +
-                                       (config.colour ? ", in colour" : "") +
-                                       ") is offered; device has: " + (list.empty() ? std::string("none") : list));
-    }
+    if (!wanted) return make_error(ENOTSUP, no_wanted_format(device_, config, offered));
     v4l2_format fmt{};
     fmt.type = buf_type_;
     std::uint32_t got = 0;

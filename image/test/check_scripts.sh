@@ -10,10 +10,16 @@ bash -n "$dir/test/image_tests.sh"
 bash -n "$dir/test/build_vimc.sh"
 sh -n "$dir/test/selftest.sh"
 bash -n "$dir/test/powercut_guest.sh"
-python3 - "$dir/test/qemu_boot_test.py" "$dir/test/qemu_service_card_test.py" "$dir/test/qemu_common.py" "$dir/test/qemu_libcamera.py" "$dir/lib/prune_modules.py" "$dir/test/qemu_powercut_test.py" "$dir/test/powercut_report.py" "$dir/test/qemu_service_mode_test.py" "$dir/test/qemu_update_test.py" <<'PY'
+python3 - "$dir/test/qemu_boot_test.py" "$dir/test/qemu_service_card_test.py" "$dir/test/qemu_common.py" "$dir/test/qemu_qmp.py" "$dir/test/qemu_libcamera.py" "$dir/lib/prune_modules.py" "$dir/test/qemu_powercut_test.py" "$dir/test/powercut_report.py" "$dir/test/qemu_service_mode_test.py" "$dir/test/qemu_update_test.py" <<'PY'
 import sys
 for f in sys.argv[1:]:
     compile(open(f).read(), f, "exec")
+PY
+# The QEMU tests import what they share (qemu_common, qemu_qmp, qemu_boot_test) without error.
+python3 - "$dir/test" <<'PY'
+import sys
+sys.path.insert(0, sys.argv[1])
+import qemu_boot_test, qemu_service_card_test, qemu_service_mode_test, qemu_update_test  # noqa: F401,E401
 PY
 # The power-cut verdict (qemu_powercut_test.classify) on made-up states: old, new, torn, missing, mixed.
 python3 - "$dir/test" <<'PY'

@@ -34,7 +34,7 @@ case $mode in
     echo "image_build: $(( $(date +%s) - start )) s"
     ;;
   boot)
-    farm=$5 tool=$6 mpiexec=$7 camera=${8:-} libcamera=${9:-}
+    farm=$5 tool=$6 mpiexec=$7 camera=${8:-} libcamera=${9:-} calibrate_sim=${10:-}
     image=${MOGAO_IMAGE:-$outdir/mogao-kiosk.img}
     [[ -f "$image" ]] || skip "no image at $image (the image_build test builds it)"
     args=(--image "$image" --repo "$repo" --kiosk "$kiosk" --farm "$farm" --image-tool "$tool"
@@ -42,6 +42,7 @@ case $mode in
     [[ -n "$mpiexec" ]] && args+=(--mpiexec "$mpiexec")
     [[ -n "$camera" ]] && args+=(--camera-test "$camera")
     [[ -n "$libcamera" ]] && args+=(--libcamera-test "$libcamera")
+    [[ -n "$calibrate_sim" ]] && args+=(--calibrate-sim "$calibrate_sim")
     exec python3 "$repo/image/test/qemu_boot_test.py" "${args[@]}"
     ;;
   service-card)

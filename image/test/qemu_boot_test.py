@@ -3,7 +3,8 @@
 """Boots the appliance image in QEMU (real kernel, real drivers) and checks it end to end.
 
     qemu_boot_test.py --image mogao-kiosk.img --repo SRC --kiosk BIN --farm BIN --image-tool BIN
-                      [--mpiexec MPIEXEC] [--camera-test BIN] [--libcamera-test BIN] [--work DIR]
+                      [--mpiexec MPIEXEC] [--camera-test BIN] [--libcamera-test BIN] [--calibrate-sim BIN]
+                      [--work DIR]
                       [--accel tcg|kvm]
                       [--no-farm] [--no-tco] [--results FILE]
 
@@ -46,6 +47,7 @@ import tempfile
 import time
 
 import qemu_libcamera  # noqa: E402 (this folder)
+from qemu_qmp import Qmp, ppm_stats  # noqa: E402,F401 (also imported from here by the other QEMU tests)
 from qemu_common import IMAGE_ENTRY, IMAGE_INITRD, IMAGE_KERNEL, T0, Failures, Serial, log, set_name, stop_qemu  # noqa: E402,E501
 
 SKIP = 77
@@ -80,101 +82,6 @@ STILL_VIEW = {"keyframes": [{"position": [0.0, 1.6, 4.0], "yaw_deg": 0.0, "pitch
 def skip(msg):
     print(f"SKIP: {msg}", flush=True)
     sys.exit(SKIP)
-
-
-# --- images -----------------------------------------------------------------------------------------
-def read_ppm(path):
-    with open(path, "rb") as f:
-        data = f.read()
-    fields = []
-    pos = 0
-    while len(fields) < 4:
-        while data[pos:pos + 1].isspace():
-            pos += 1
-        if data[pos:pos + 1] == b"#":
-            pos = data.index(b"\n", pos) + 1
-            continue
-        start = pos
-        while not data[pos:pos + 1].isspace():
-            pos += 1
-        fields.append(data[start:pos])
-    if fields[0] != b"P6" or int(fields[3]) != 255:
-        raise ValueError(f"{path}: not an 8-bit P6 PPM")
-    w, h = int(fields[1]), int(fields[2])
-    return w, h, data[pos + 1:pos + 1 + w * h * 3]
-
-
-def ppm_stats(path, x_from=0):
-    """(width, height, mean code, fraction of pixels with max channel < 16) of the columns >= x_from."""
-    w, h, px = read_ppm(path)
-    step = 7  # sample every 7th pixel of a row: plenty for "is it lit"
-    total = dark = count = 0
-    for y in range(h):
-        for x in range(x_from, w, step):
-            i = y * w + x
-            r, g, b = px[3 * i], px[3 * i + 1], px[3 * i + 2]
-            total += r + g + b
-            dark += max(r, g, b) < 16
-            count += 1
-    if count == 0:
-        return w, h, 0.0, 1.0
-    return w, h, total / (3 * count), dark / count
-
-
-# --- QMP ----------------------------------------------------------------------------------------------
-class Qmp:
-    def __init__(self, path, timeout=60):
-        deadline = time.monotonic() + timeout
-        while True:
-            try:
-                self.sock = socket.socket(socket.AF_UNIX)
-                self.sock.connect(path)
-                break
-            except OSError:
-                if time.monotonic() > deadline:
-                    raise
-                time.sleep(0.2)
-        self.buf = b""
-        self.events = []
-        self._read()  # greeting
-        self.cmd("qmp_capabilities")
-
-    def _read(self, timeout=120):
-        self.sock.settimeout(timeout)
-        while b"\n" not in self.buf:
-            chunk = self.sock.recv(65536)
-            if not chunk:
-                raise EOFError("QMP closed")
-            self.buf += chunk
-        line, self.buf = self.buf.split(b"\n", 1)
-        return json.loads(line)
-
-    def cmd(self, name, **arguments):
-        msg = {"execute": name}
-        if arguments:
-            msg["arguments"] = arguments
-        self.sock.sendall(json.dumps(msg).encode() + b"\n")
-        while True:
-            reply = self._read()
-            if "event" in reply:
-                self.events.append(reply)
-                continue
-            if "error" in reply:
-                raise RuntimeError(f"QMP {name}: {reply['error']}")
-            return reply.get("return")
-
-    def poll_events(self, timeout):
-        """Collects events for up to `timeout` seconds; returns all seen so far (False on EOF)."""
-        deadline = time.monotonic() + timeout
-        try:
-            while time.monotonic() < deadline:
-                try:
-                    self.events.append(self._read(timeout=max(0.1, deadline - time.monotonic())))
-                except socket.timeout:
-                    break
-        except (EOFError, OSError):
-            return False
-        return True
 
 
 # --- serial console -----------------------------------------------------------------------------------
@@ -229,6 +136,17 @@ def install_selftest_entry(work, esp, title, options, extra, env):
     run(["mcopy", "-o", "-i", esp, os.path.join(work, "loader.conf"), "::/loader/loader.conf"], env=env)
 
 
+def stage_binary(path, name, disk):
+    """A host binary on the test disk as bin/NAME, with the shared libraries it needs (but glibc's) in lib/:
+    the guest runs it with LD_LIBRARY_PATH=/mnt/lib (host and image are both Debian 12)."""
+    shutil.copy(path, os.path.join(disk, "bin", name))
+    glibc = re.compile(r"^(libc|libm|libpthread|libdl|librt|ld-linux.*)\.so")
+    for line in run(["ldd", path]).stdout.splitlines():
+        m = re.search(r"=> (/\S+)", line)
+        if m and not glibc.match(os.path.basename(m.group(1))):
+            shutil.copy(m.group(1), os.path.join(disk, "lib", os.path.basename(m.group(1))))
+
+
 def run(cmd, **kw):
     return subprocess.run(cmd, check=True, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, **kw)
 
@@ -243,6 +161,8 @@ def main():
     ap.add_argument("--image-tool", required=True, help="mogao_kiosk_image_tool (PSNR of PNG/PPM)")
     ap.add_argument("--mpiexec", default=shutil.which("mpirun") or "mpirun")
     ap.add_argument("--camera-test", default="", help="drivers/camera test binary (mogao_camera_test), optional")
+    ap.add_argument("--calibrate-sim", default="",
+                    help="mogao-calibrate-sim (host): the in-guest calibration with the rig's camera on the outputs")
     ap.add_argument("--libcamera-test", default="",
                     help="drivers/camera libcamera test binary (mogao_libcamera_test), optional")
     ap.add_argument("--work", default="")
@@ -368,15 +288,17 @@ def main():
     # The on-site calibration's site file, also the rig its simulated camera films (selftest.sh).
     shutil.copy(os.path.join(a.repo, "rigs", "qemu.toml"), os.path.join(disk, "site.toml"))
     if a.camera_test and os.access(a.camera_test, os.X_OK):
-        shutil.copy(a.camera_test, os.path.join(disk, "bin", "mogao_camera_test"))
-        glibc = re.compile(r"^(libc|libm|libpthread|libdl|librt|ld-linux.*)\.so")
-        for line in run(["ldd", a.camera_test]).stdout.splitlines():
-            m = re.search(r"=> (/\S+)", line)
-            if m and not glibc.match(os.path.basename(m.group(1))):
-                shutil.copy(m.group(1), os.path.join(disk, "lib", os.path.basename(m.group(1))))
+        stage_binary(a.camera_test, "mogao_camera_test", disk)
         log(f"camera test on the test disk: {a.camera_test}")
     else:
         log("no drivers/camera test binary given: the V4L2 capture test is skipped")
+    # The on-site calibration's simulated camera: mogao-calibrate-sim (the shipped mogao-calibrate has no rig).
+    if a.calibrate_sim and os.access(a.calibrate_sim, os.X_OK):
+        stage_binary(a.calibrate_sim, "mogao-calibrate-sim", disk)
+        log(f"mogao-calibrate-sim on the test disk: {a.calibrate_sim}")
+    else:
+        fails.check(False, f"mogao-calibrate-sim given and executable (--calibrate-sim '{a.calibrate_sim}'): the "
+                           "in-guest calibration films the outputs with the rig's camera")
     run(["mcopy", "-o", "-i", esp, f"::{IMAGE_KERNEL}", os.path.join(work, "vmlinuz")], env=env)
     libcamera_staged, what = qemu_libcamera.stage(a.repo, work, disk, os.path.join(work, "vmlinuz"), a.libcamera_test)
     log(f"libcamera test on the test disk: {what}" if libcamera_staged else f"libcamera test not staged: {what}")

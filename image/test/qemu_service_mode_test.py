@@ -21,21 +21,26 @@ One boot, in order (each printed; any failure fails the test):
   1. calibrate (captures on the stick): result.toml outcome "done", mogao-calibrate exit 0, the
      installed calibration changed, the kiosk active again; the text console shows the run on the
      wall while the kiosk is stopped (screendump of output 0 not black);
-  2. the same stick's request signed for "status" and then edited (action changed): refused for its
+  2. calibrate from captures with one pattern's image missing (signed as they are): outcome
+     "failed", the reason names the missing capture and says the last good calibration is kept, the
+     installed calibration unchanged, the kiosk active again;
+  3. the same stick's request signed for "status" and then edited (action changed): refused for its
      signature;
-  3. the first request again (a replay): refused for its serial;
-  4. status: the status panel toggled on and off (the kiosk's journal says so; it draws the panel
+  4. the first request again (a replay): refused for its serial;
+  5. status: the status panel toggled on and off (the kiosk's journal says so; it draws the panel
      over the show, not over its connecting card, and no farm runs here), outcome "done"; the
      kiosk's status file on the stick names the installed calibration, loaded after request 1, and
      so does the status page (status.html) the appliance made from it;
-  5. logs: the journal, the status file and the installed calibration come back on the stick; the
-     MPCDI is byte-identical to what request 1 installed (2-4 changed nothing), its last good copy
+  6. logs: the journal, the status file and the installed calibration come back on the stick; the
+     MPCDI is byte-identical to what request 1 installed (2-5 changed nothing), its last good copy
      is OLD, and it is within the calibration's geometry goals against the rig's ground truth
      (mogao-rig-film measure: mean <= 0.3, p95 <= 0.8 projector pixels of the half-scale rig); the
-     kiosk was stopped once only; every output lit by the kiosk.
+     kiosk was stopped once per calibrate request only; every output lit by the kiosk.
 --live: request 1 calibrates on the guest's KMS outputs with the virtual rig's simulated camera
 (calibrate.args: --outputs kms --camera rig:/etc/mogao/site.toml, as image_qemu_boot runs it; its
-patterns on the wall) instead of captures on the stick; a manual run, minutes more under TCG.
+patterns on the wall) instead of captures on the stick; a manual run, minutes more under TCG, on an image
+built with `image/build --calibrate build/kiosk/calibrate/mogao-calibrate-sim` (the shipped
+mogao-calibrate has no rig camera).
 An unsigned request and the other refusals are checked on the host (service_mode_requests), not
 here: each stick costs about 15 s under TCG.
 Exit 77 (skip) with a message when QEMU, OVMF, mtools, mkfs.vfat, openssl or the image are missing.
@@ -236,7 +241,7 @@ def qemu_command(qemu, a, work, img):
 
 def check_logs(a, work, qmp, journal, fails, env, stick, installed_sha, old_mpcdi, results):
     """The logs request, after the others: the calibration as the calibrate request left it."""
-    ok, secs = plug(qmp, journal, stick, 5, a.timeout)
+    ok, secs = plug(qmp, journal, stick, 6, a.timeout)
     rl = result_of(stick, env)
     fails.check(ok and rl.get("outcome") == "done", f"logs: {rl.get('reason')} in {secs:.0f} s")
     mpcdi = read_stick(stick, "logs/screen.mpcdi", env) or b""
@@ -255,8 +260,9 @@ def check_logs(a, work, qmp, journal, fails, env, stick, installed_sha, old_mpcd
     fails.check(m is not None and float(m.group(1)) <= GOAL_MEAN_PX and float(m.group(2)) <= GOAL_P95_PX,
                 f"the new calibration against the rig's ground truth: {results['geometry_px']} (mean, p95 px)")
     stops = len(re.findall(r"Stopping mogao-kiosk\.service", journal_text))
-    fails.check(len(journal_text) > 1000 and stops == 1,
-                f"logs: the journal on the stick ({len(journal_text)} bytes); the kiosk stopped {stops} time(s)")
+    fails.check(len(journal_text) > 1000 and stops == 2,
+                f"logs: the journal on the stick ({len(journal_text)} bytes); the kiosk stopped {stops} time(s) "
+                "(once per calibrate request)")
     lit = [screendump(qmp, work, "after", h) for h in range(OUTPUTS)]
     fails.check(all(mean > 10 for _, _, mean, _ in lit),
                 f"every output lit by the kiosk after the requests (mean codes {[round(x[2], 1) for x in lit]})")
@@ -272,10 +278,16 @@ def check_requests(a, work, proc, fails, env, key, old_mpcdi, captures, results)
     if not fails.check(ready is not None, f"the kiosk started ({results['boot_to_kiosk_s']} s after QEMU)"):
         return
     serial = int(time.time())
+    # A calibration that must fail: the captures with one pattern's image missing (signed as they are).
+    broken = os.path.join(work, "captures-broken")
+    shutil.rmtree(broken, ignore_errors=True)
+    shutil.copytree(captures, broken)
+    os.remove(os.path.join(broken, "p0", "p0-columns-bit00.png"))
     sticks = {
         "calibrate": make_stick(a, work, "calibrate", env, key, "calibrate", serial + 1, None if a.live else captures,
                                 extra=("--hold-s", "3")),
-        "tampered": make_stick(a, work, "tampered", env, key, "status", serial + 2,
+        "broken": make_stick(a, work, "broken", env, key, "calibrate", serial + 2, broken, extra=("--hold-s", "1")),
+        "tampered": make_stick(a, work, "tampered", env, key, "status", serial + 3,
                                tamper=('action = "status"', 'action = "calibrate"')),
         "status": make_stick(a, work, "status", env, key, "status", serial + 4, extra=("--show-s", "1")),
         "logs": make_stick(a, work, "logs", env, key, "logs", serial + 5),
@@ -303,14 +315,25 @@ def check_requests(a, work, proc, fails, env, key, old_mpcdi, captures, results)
     log_text = (read_stick(sticks["calibrate"], "calibrate.log", env) or b"").decode(errors="replace")
     fails.check("calibration" in log_text, f"calibrate: calibrate.log on the stick ({len(log_text)} bytes)")
 
+    # A failed calibration keeps the installed one (byte-identical) and brings the show back on it.
+    ok, secs = plug(qmp, journal, sticks["broken"], 2, a.timeout)
+    rb = result_of(sticks["broken"], env)
+    results["failed_calibrate_request_s"] = round(secs, 1)
+    fails.check(ok and rb.get("outcome") == "failed" and "missing" in rb.get("reason", "")
+                and "last good calibration is kept" in rb.get("reason", ""),
+                f"failing calibrate: failed, naming the missing capture, in {secs:.0f} s ({rb.get('reason')})")
+    fails.check(rb.get("calibration_before") == rb.get("calibration_after") == r.get("calibration_after"),
+                "failing calibrate: the installed calibration unchanged (the first calibrate's)")
+    fails.check(rb.get("kiosk") == "active", f"failing calibrate: the kiosk active again ({rb.get('kiosk')})")
+
     for n, (name, img, want) in enumerate((("tampered", sticks["tampered"], "bad signature"),
-                                           ("replay", replay, "used already")), start=2):
+                                           ("replay", replay, "used already")), start=3):
         ok, secs = plug(qmp, journal, img, n, a.timeout)
         rr = result_of(img, env)
         fails.check(ok and rr.get("outcome") == "refused" and want in rr.get("reason", ""),
                     f"{name}: refused ({rr.get('reason')}) in {secs:.0f} s")
 
-    ok, secs = plug(qmp, journal, sticks["status"], 4, a.timeout)
+    ok, secs = plug(qmp, journal, sticks["status"], 5, a.timeout)
     rs = result_of(sticks["status"], env)
     fails.check(ok and rs.get("outcome") == "done", f"status: {rs.get('reason')} in {secs:.0f} s")
     # The kiosk draws the panel over the show, not over its connecting card (no farm here): the

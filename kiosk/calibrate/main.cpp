@@ -5,10 +5,12 @@
 //     mogao-calibrate --site /etc/mogao/site.toml --outputs kms --camera v4l2:/dev/video0
 //                     --out /var/lib/mogao/calibration [--install /var/lib/mogao/etc/screen.mpcdi]
 //   On a virtual rig (tests, benchmarks; what `mogao-autocal calibrate` does, ground truth reported):
-//     mogao-calibrate --rig rigs/standard.toml --out DIR [--scale 0.5]
+//     mogao-calibrate-sim --rig rigs/standard.toml --out DIR [--scale 0.5]
 //   The whole on-site path without hardware (SIMULATION: the rig's camera films the headless outputs,
 //   or with --outputs kms the kernel's scanout buffers: the appliance image's QEMU test):
-//     mogao-calibrate --site rigs/standard.toml --outputs headless --camera rig:rigs/standard.toml --out DIR
+//     mogao-calibrate-sim --site rigs/standard.toml --outputs headless --camera rig:rigs/standard.toml --out DIR
+//   (mogao-calibrate-sim: this program with the routes of simulation_routes.h; the shipped mogao-calibrate
+//   refuses them, exit 2.)
 //   From images captured by any camera: write the patterns, show and film each, then calibrate:
 //     mogao-calibrate patterns --site FILE --out DIR [--scale S] [--phase-periods-px P[,P...]]
 //     mogao-calibrate --site FILE --images DIR --out DIR [--install FILE] [--camera-transfer srgb|linear]
@@ -31,10 +33,6 @@
 
 #include "appliance/autocal/calibrate_job.h"
 #include "appliance/autocal/calibration_flags.h"
-#include "appliance/autocal/rig_bridge.h"
-#include "appliance/calibration/mpcdi_reader.h"
-#include "appliance/calibration/mpcdi_screen.h"
-#include "appliance/rig/rig_file.h"
 #include "common/program_cli.h"
 #include "drivers/headless/headless_output.h"
 #include "drivers/kms/kms_backend.h"
@@ -43,7 +41,7 @@
 #include "kiosk/calibrate/pattern_budget.h"
 #include "kiosk/calibrate/patterns_command.h"
 #include "kiosk/calibrate/procam_command.h"
-#include "kiosk/calibrate/rig_camera.h"
+#include "kiosk/calibrate/simulation_routes.h"
 
 namespace {
 
@@ -74,7 +72,7 @@ struct Cli {
 // DRM card as mogao-kms-probe does.
 constexpr const char* kCameraHelp =
     "Capture device: v4l2:/dev/videoN (or /dev/videoN) or libcamera:[id]; mogao-calibrate also replay:DIR and "
-    "rig:FILE (simulation)";
+    "rig:FILE (simulation: mogao-calibrate-sim)";
 constexpr const char* kKmsDeviceHelp =
     "DRM card node /dev/dri/cardN (default: mogao-calibrate the first with a connected connector, mogao-kms-probe "
     "every card)";
@@ -106,14 +104,7 @@ int run_rig(const Cli& cli, const OnSiteJob& site_job) {
     job.colour = site_job.colour;
     job.colour_options = site_job.colour_options;
     job.self_check = site_job.self_check;
-    const nlohmann::json r = autocal::run_calibrate_job(job);
-    const auto& t = r["ground_truth"];
-    std::printf(
-        "%s: %d images; geometry mean %.3f p95 %.3f px, seam luminance %.2f %% (against the rig's ground "
-        "truth); %s\n",
-        r["rig"].get<std::string>().c_str(), r["captures"].get<int>(), t["geometry_mean_px"].get<double>(),
-        t["geometry_p95_px"].get<double>(), 100.0 * t["seam_luminance_max_deviation"].get<double>(), job.out.c_str());
-    return 0;
+    return run_rig_calibration(job);
 }
 
 int run_budget(const Cli& cli, const OnSiteJob& job) {
@@ -141,27 +132,6 @@ std::unique_ptr<OutputBackend> open_outputs(const Cli& cli, const autocal::Calib
     return std::move(headless.value());
 }
 
-// The rig's projector k is lit by output k (the outputs' order; identification still finds it from
-// the images). On KMS the rig films the kernel's scanout buffers, read back after each flip.
-std::unique_ptr<CalibrationCamera> open_rig_camera(const Cli& cli, const OnSiteJob& job, OutputBackend& outputs) {
-    const rig::VirtualRig rig = autocal::scaled_rig(rig::load_rig(cli.camera.substr(4)), job.scale, job.scale);
-    std::vector<std::size_t> order(rig.projectors.size());
-    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
-    if (auto* headless = dynamic_cast<HeadlessOutputBackend*>(&outputs)) {
-        return std::make_unique<RigCamera>(*headless, rig, order);
-    }
-    auto* kms = dynamic_cast<KmsOutputBackend*>(&outputs);
-    if (kms == nullptr) throw std::invalid_argument("--camera rig:FILE films headless or KMS outputs only");
-    // A plane with no framebuffer yet shows black (RigCamera's empty image), not an error.
-    return std::make_unique<RigCamera>(
-        [kms](std::size_t i) -> Result<Rgb8Image> {
-            auto shown = kms->read_scanout(i);
-            if (!shown && shown.code() == ENODATA) return Rgb8Image{};
-            return shown;
-        },
-        "the KMS scanout buffers of " + kms->device_path().string(), rig, order);
-}
-
 std::unique_ptr<CalibrationCamera> open_live_camera(const Cli& cli, const autocal::CalibrationPrior& prior) {
     CameraSourceSpec spec;
     std::string why;
@@ -187,16 +157,6 @@ std::unique_ptr<CalibrationCamera> open_live_camera(const Cli& cli, const autoca
     return std::move(camera.value());
 }
 
-// A simulation knows the truth: the written MPCDI (as the kiosk reads it) against the rig's ground
-// truth, in projector pixels of the (scaled) rig (autocal::measure_geometry).
-void print_simulation_truth(const Cli& cli, const OnSiteJob& job) {
-    const rig::VirtualRig rig = autocal::scaled_rig(rig::load_rig(cli.camera.substr(4)), job.scale, job.scale);
-    const ScreenCalibration c = to_screen_calibration(read_mpcdi(job.out / "calibration.mpcdi"));
-    const autocal::GeometryError g = autocal::measure_geometry(rig, c, 4);
-    std::printf("SIMULATION ground truth (rig %s): geometry mean %.3f p95 %.3f px\n", rig.name.c_str(), g.mean_px,
-                g.p95_px);
-}
-
 int run_site(const Cli& cli, OnSiteJob& job) {
     const autocal::CalibrationPrior prior = site_prior(job);
     // A live camera first: one whose exposure cannot be locked is refused before the outputs light.
@@ -204,7 +164,7 @@ int run_site(const Cli& cli, OnSiteJob& job) {
     std::unique_ptr<CalibrationCamera> camera;
     if (!simulated) camera = open_live_camera(cli, prior);
     std::unique_ptr<OutputBackend> outputs = open_outputs(cli, prior);
-    if (simulated) camera = open_rig_camera(cli, job, *outputs);
+    if (simulated) camera = open_rig_camera(cli.camera.substr(4), job.scale, *outputs);
     std::fprintf(stderr, "mogao-calibrate: camera %s; %zu outputs\n", camera->description().c_str(),
                  outputs->outputs().size());
     const nlohmann::json r = run_on_site(job, *outputs, *camera, print_progress);
@@ -228,7 +188,7 @@ int run_site(const Cli& cli, OnSiteJob& job) {
         check["mean_px"].get<double>(), check["p95_px"].get<double>(), check["mean_mm"].get<double>(),
         check["marks_found"].get<int>(), check["marks_shown"].get<int>(), check["gate_max_mean_px"].get<double>());
     std::printf("written to %s%s%s\n", job.out.c_str(), job.install.empty() ? "" : " and ", job.install.c_str());
-    if (simulated) print_simulation_truth(cli, job);
+    if (simulated) print_simulation_truth(cli.camera.substr(4), job.scale, job.out / "calibration.mpcdi");
     return 0;
 }
 
@@ -284,6 +244,11 @@ void add_calibrate_flags(CLI::App& app, Cli& cli, OnSiteJob& job) {
 void apply_calibrate_flags(const Cli& cli, OnSiteJob& job) {
     autocal::apply_calibration_flags(cli.shared, job);
     if (cli.rig.empty() && cli.site.empty()) throw CLI::ValidationError("--rig or --site", "one is required");
+    if (!has_simulation_routes() && (!cli.rig.empty() || cli.camera.starts_with("rig:"))) {
+        throw CLI::ValidationError(
+            "--rig and --camera rig:FILE",
+            "are simulation: mogao-calibrate-sim has them (built with the tests, not installed)");
+    }
     if (!cli.budget && job.out.empty()) throw CLI::ValidationError("--out", "is required");
     if (!cli.images.empty() && (!cli.outputs.empty() || !cli.camera.empty() || cli.budget)) {
         throw CLI::ValidationError("--images", "replaces --outputs and --camera (and is no --budget)");

@@ -71,6 +71,45 @@ bool TrackingThread::wait_until(std::int64_t deadline_ns) {
     return !stop_;
 }
 
+bool TrackingThread::reopen_source() {
+    // Once a second, until it opens or the thread is stopped.
+    if (!wait_until(monotonic_ns() + 1'000'000'000)) return false;
+    auto opened = open_camera_source(spec_);
+    if (!opened) {
+        spdlog::warn("tracking: camera {} still unavailable: {}", description_, opened.error().message);
+        return true;
+    }
+    source_ = std::move(opened).value();
+    count(&TrackingCounters::reopens);
+    spdlog::info("tracking: camera re-opened: {}", source_->description());
+    return true;
+}
+
+bool TrackingThread::on_frame_error(int code, const std::string& message) {
+    if (code == ENODATA) {
+        spdlog::info("tracking: the replay ended ({} frames)", counters().frames);
+        {
+            const std::lock_guard lock(mutex_);
+            counters_.ended = true;
+        }
+        queue_.close();
+        return false;
+    }
+    if (code == ETIMEDOUT) {
+        count(&TrackingCounters::timeouts);
+        if (worth_logging(counters().timeouts)) spdlog::warn("tracking: {}", message);
+        return true;
+    }
+    if (code == EBADMSG) {
+        count(&TrackingCounters::frame_errors);
+        if (worth_logging(counters().frame_errors)) spdlog::warn("tracking: frame skipped: {}", message);
+        return true;
+    }
+    spdlog::error("tracking: camera failed, re-opening it every second: {}", message);
+    source_.reset();
+    return true;
+}
+
 void TrackingThread::run() {
     bool rebased = false;
     std::int64_t offset_ns = 0;  // replay timestamp -> CLOCK_MONOTONIC
@@ -80,16 +119,7 @@ void TrackingThread::run() {
             if (stop_) return;
         }
         if (!source_) {
-            // Re-open after an error, once a second.
-            if (!wait_until(monotonic_ns() + 1'000'000'000)) return;
-            auto opened = open_camera_source(spec_);
-            if (!opened) {
-                spdlog::warn("tracking: camera {} still unavailable: {}", description_, opened.error().message);
-                continue;
-            }
-            source_ = std::move(opened).value();
-            count(&TrackingCounters::reopens);
-            spdlog::info("tracking: camera re-opened: {}", source_->description());
+            if (!reopen_source()) return;
             continue;
         }
         if (rebased) {
@@ -102,29 +132,7 @@ void TrackingThread::run() {
         }
         auto frame = source_->next_frame();
         if (!frame) {
-            const int code = frame.code();
-            if (code == ENODATA) {
-                spdlog::info("tracking: the replay ended ({} frames)", counters().frames);
-                {
-                    const std::lock_guard lock(mutex_);
-                    counters_.ended = true;
-                }
-                queue_.close();
-                return;
-            }
-            if (code == ETIMEDOUT) {
-                count(&TrackingCounters::timeouts);
-                if (worth_logging(counters().timeouts)) spdlog::warn("tracking: {}", frame.error().message);
-                continue;
-            }
-            if (code == EBADMSG) {
-                count(&TrackingCounters::frame_errors);
-                if (worth_logging(counters().frame_errors))
-                    spdlog::warn("tracking: frame skipped: {}", frame.error().message);
-                continue;
-            }
-            spdlog::error("tracking: camera failed, re-opening it every second: {}", frame.error().message);
-            source_.reset();
+            if (!on_frame_error(frame.code(), frame.error().message)) return;
             continue;
         }
         std::int64_t time_ns = frame->timestamp_ns;

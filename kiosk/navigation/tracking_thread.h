@@ -70,6 +70,11 @@ public:
 
 private:
     void run();
+    // After a camera error: waits a second and tries to open the camera again. False when the thread was stopped.
+    bool reopen_source();
+    // A failed next_frame(): counts and logs it (the end of a replay closes the queue, a failed camera is closed to be
+    // re-opened). False when the thread must end (the replay ended).
+    bool on_frame_error(int code, const std::string& message);
     // Waits until `deadline_ns` (CLOCK_MONOTONIC) or stop(); false when stopped.
     bool wait_until(std::int64_t deadline_ns);
     void count(std::uint64_t TrackingCounters::*field);

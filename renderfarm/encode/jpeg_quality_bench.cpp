@@ -111,6 +111,65 @@ struct Row {
     double psnr_db = 0;
 };
 
+// Median encode and decode times and the PSNR at each quality; rounds over all qualities rather than all reps of one
+// quality: a burst of load from other processes then hits every quality alike and the relative times stay meaningful.
+std::vector<Row> measure(const Rgb8Image& image, mogao::Subsampling subsampling, int reps) {
+    mogao::JpegEncoder encoder;
+    mogao::JpegDecoder decoder;
+    using Clock = std::chrono::steady_clock;
+    auto ms_since = [](Clock::time_point t0) {
+        return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    };
+    const std::vector<int> qualities = {50, 60, 70, 75, 80, 85, 90, 95, 100};
+    std::vector<std::vector<double>> enc(qualities.size());
+    std::vector<std::vector<double>> dec(qualities.size());
+    std::vector<std::vector<std::uint8_t>> jpegs(qualities.size());
+    std::vector<Rgb8Image> decoded(qualities.size());
+    for (int round = -1; round < reps; ++round) {  // round -1 warms caches, clocks and allocations
+        for (std::size_t i = 0; i < qualities.size(); ++i) {
+            const auto t0 = Clock::now();
+            jpegs[i] = encoder.encode(image, qualities[i], subsampling);
+            const double e = ms_since(t0);
+            const auto t1 = Clock::now();
+            decoded[i] = decoder.decode(jpegs[i]);
+            const double d = ms_since(t1);
+            if (round >= 0) {
+                enc[i].push_back(e);
+                dec[i].push_back(d);
+            }
+        }
+    }
+    std::vector<Row> rows;
+    for (std::size_t i = 0; i < qualities.size(); ++i) {
+        rows.push_back({qualities[i], jpegs[i].size(), median(enc[i]), median(dec[i]), mogao::psnr(image, decoded[i])});
+    }
+    return rows;
+}
+
+void write_json(const std::string& json_file, const std::string& input, const Rgb8Image& image,
+                const std::string& subsampling_name, int reps, const std::vector<Row>& rows) {
+    const double pixels = static_cast<double>(image.size.pixel_count());
+    const auto q85 = std::find_if(rows.begin(), rows.end(), [](const Row& r) { return r.quality == 85; });
+    const double q85_ms = q85->encode_ms;
+    std::ofstream out(json_file);
+    out << "{\n \"bench\": \"jpeg_quality\",\n \"input\": "
+        << json_string(input.empty() ? "synthetic render-like frame" : input) << ",\n \"width\": " << image.size.width
+        << ",\n \"height\": " << image.size.height << ",\n \"subsampling\": " << json_string(subsampling_name)
+        << ",\n \"reps\": " << reps << ",\n \"rows\": [";
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+        const Row& r = rows[i];
+        char line[320];
+        std::snprintf(line, sizeof line,
+                      "%s\n  {\"quality\": %d, \"bytes\": %zu, \"bits_per_pixel\": %.6g, \"encode_ms\": %.6g, "
+                      "\"encode_vs_q85\": %.6g, \"decode_ms\": %.6g, \"psnr_db\": %.6g}",
+                      i == 0 ? "" : ",", r.quality, r.bytes, 8.0 * static_cast<double>(r.bytes) / pixels, r.encode_ms,
+                      r.encode_ms / q85_ms, r.decode_ms, r.psnr_db);
+        out << line;
+    }
+    out << "\n ]\n}\n";
+    if (!out.flush()) throw std::runtime_error("cannot write " + json_file);
+}
+
 int run(int argc, char** argv) {
     std::string input;
     std::string json_file;
@@ -147,37 +206,7 @@ int run(int argc, char** argv) {
                 input.empty() ? "synthetic render-like frame" : input.c_str(), image.size.width, image.size.height,
                 subsampling_name.c_str(), reps);
 
-    mogao::JpegEncoder encoder;
-    mogao::JpegDecoder decoder;
-    using Clock = std::chrono::steady_clock;
-    auto ms_since = [](Clock::time_point t0) {
-        return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-    };
-    // Rounds over all qualities rather than all reps of one quality: a burst of load from other
-    // processes then hits every quality alike and the relative times stay meaningful.
-    const std::vector<int> qualities = {50, 60, 70, 75, 80, 85, 90, 95, 100};
-    std::vector<Row> rows;
-    std::vector<std::vector<double>> enc(qualities.size());
-    std::vector<std::vector<double>> dec(qualities.size());
-    std::vector<std::vector<std::uint8_t>> jpegs(qualities.size());
-    std::vector<Rgb8Image> decoded(qualities.size());
-    for (int round = -1; round < reps; ++round) {  // round -1 warms caches, clocks and allocations
-        for (std::size_t i = 0; i < qualities.size(); ++i) {
-            const auto t0 = Clock::now();
-            jpegs[i] = encoder.encode(image, qualities[i], subsampling);
-            const double e = ms_since(t0);
-            const auto t1 = Clock::now();
-            decoded[i] = decoder.decode(jpegs[i]);
-            const double d = ms_since(t1);
-            if (round >= 0) {
-                enc[i].push_back(e);
-                dec[i].push_back(d);
-            }
-        }
-    }
-    for (std::size_t i = 0; i < qualities.size(); ++i) {
-        rows.push_back({qualities[i], jpegs[i].size(), median(enc[i]), median(dec[i]), mogao::psnr(image, decoded[i])});
-    }
+    const std::vector<Row> rows = measure(image, subsampling, reps);
     const auto q85 = std::find_if(rows.begin(), rows.end(), [](const Row& r) { return r.quality == 85; });
     const double pixels = static_cast<double>(image.size.pixel_count());
     std::printf("| quality | bytes | bits/pixel | encode ms | encode time vs q85 | decode ms | PSNR dB |\n");
@@ -187,26 +216,7 @@ int run(int argc, char** argv) {
                     8.0 * static_cast<double>(r.bytes) / pixels, r.encode_ms, r.encode_ms / q85->encode_ms, r.decode_ms,
                     r.psnr_db);
     }
-    if (!json_file.empty()) {
-        std::ofstream out(json_file);
-        out << "{\n \"bench\": \"jpeg_quality\",\n \"input\": "
-            << json_string(input.empty() ? "synthetic render-like frame" : input)
-            << ",\n \"width\": " << image.size.width << ",\n \"height\": " << image.size.height
-            << ",\n \"subsampling\": " << json_string(subsampling_name) << ",\n \"reps\": " << reps
-            << ",\n \"rows\": [";
-        for (std::size_t i = 0; i < rows.size(); ++i) {
-            const Row& r = rows[i];
-            char line[320];
-            std::snprintf(line, sizeof line,
-                          "%s\n  {\"quality\": %d, \"bytes\": %zu, \"bits_per_pixel\": %.6g, \"encode_ms\": %.6g, "
-                          "\"encode_vs_q85\": %.6g, \"decode_ms\": %.6g, \"psnr_db\": %.6g}",
-                          i == 0 ? "" : ",", r.quality, r.bytes, 8.0 * static_cast<double>(r.bytes) / pixels,
-                          r.encode_ms, r.encode_ms / q85->encode_ms, r.decode_ms, r.psnr_db);
-            out << line;
-        }
-        out << "\n ]\n}\n";
-        if (!out.flush()) throw std::runtime_error("cannot write " + json_file);
-    }
+    if (!json_file.empty()) write_json(json_file, input, image, subsampling_name, reps, rows);
     return 0;
 }
 

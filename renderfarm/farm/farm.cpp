@@ -74,6 +74,26 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
+// What the admin job is told of the run (RunInfo), logged once: the scene's load and its BVH's build.
+RunInfo describe_run(const MpiSession& mpi, const FarmSetup& setup, const DispatchSettings& dispatch,
+                     const SceneLoadReport& report, double load_seconds, double max_bvh) {
+    RunInfo run;
+    run.scene = setup.scene_file.string();
+    run.balancer = dispatch.balancer;
+    run.ranks = mpi.size();
+    run.render_ranks = std::max(1, mpi.render_ranks());
+    run.threads_per_rank = dispatch.threads;
+    run.scene_load = report;
+    run.scene_load_seconds = load_seconds;
+    run.bvh_build_seconds = max_bvh;
+    spdlog::info("scene {}: {} triangles instanced from {} meshes, loaded in {:.2f} s; BVH {:.2f} s", run.scene,
+                 report.instanced_triangles, report.meshes.size(), load_seconds, max_bvh);
+    for (const MeshLoadFigures& m : report.meshes)
+        spdlog::info("  mesh {:<12} {:>9} triangles {:>8} vertices {:6.3f} s  {}", m.name, m.triangles, m.vertices,
+                     m.seconds, m.source);
+    return run;
+}
+
 }  // namespace
 
 int run_farm(const MpiSession& mpi, const FarmSetup& setup, const AdminJob& admin_job) {
@@ -125,20 +145,7 @@ int run_farm(const MpiSession& mpi, const FarmSetup& setup, const AdminJob& admi
         return 0;
     }
 
-    RunInfo run;
-    run.scene = setup.scene_file.string();
-    run.balancer = dispatch.balancer;
-    run.ranks = mpi.size();
-    run.render_ranks = std::max(1, mpi.render_ranks());
-    run.threads_per_rank = dispatch.threads;
-    run.scene_load = report;
-    run.scene_load_seconds = load_seconds;
-    run.bvh_build_seconds = max_bvh;
-    spdlog::info("scene {}: {} triangles instanced from {} meshes, loaded in {:.2f} s; BVH {:.2f} s", run.scene,
-                 report.instanced_triangles, report.meshes.size(), load_seconds, max_bvh);
-    for (const MeshLoadFigures& m : report.meshes)
-        spdlog::info("  mesh {:<12} {:>9} triangles {:>8} vertices {:6.3f} s  {}", m.name, m.triangles, m.vertices,
-                     m.seconds, m.source);
+    RunInfo run = describe_run(mpi, setup, dispatch, report, load_seconds, max_bvh);
 
     // 3. The admin job. One boundary catches what it throws; the dispatcher's destructor releases
     //    the render ranks on every path out.

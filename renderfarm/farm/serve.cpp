@@ -112,14 +112,27 @@ private:
     std::uint64_t degraded_ = 0, cut_ = 0;
 };
 
-}  // namespace
-
-int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& scene, RunInfo& run) {
+// SIGINT and SIGTERM end the serving loop (g_stop) instead of the process: the link is closed and the ranks freed.
+void install_stop_handlers() {
     struct sigaction action {};
     action.sa_handler = on_stop_signal;
     sigaction(SIGINT, &action, nullptr);
     sigaction(SIGTERM, &action, nullptr);
+}
 
+void log_serving(const ServeOptions& options, const RunInfo& run, const std::string& endpoint) {
+    spdlog::info(
+        "serving {} ({} render ranks, {}) on {}; progressive {}, frame-time target {}, {} cost maps, "
+        "pipeline {}",
+        run.scene, run.render_ranks, run.balancer, endpoint, options.live.progressive ? "on" : "off",
+        options.live.frame_time_s > 0 ? std::to_string(options.live.frame_time_s * 1e3) + " ms" : "off",
+        options.live.per_session_maps ? "per-session" : "shared", options.pipeline ? "on" : "off");
+}
+
+}  // namespace
+
+int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& scene, RunInfo& run) {
+    install_stop_handlers();
     MainThreadQueue<ServedFrame> queue;
     PolicyGate policy(scene, options.policy, ViewPolicies{options.view_policy, options.appliance_view_policies});
     BudgetGate budget(scene, options.budget);
@@ -129,13 +142,7 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& s
     // session still has at most one, and the queue serialises them onto the main thread.
     if (options.pipeline) link.render_threads = std::clamp(link.max_sessions, std::max(2, link.render_threads), 64);
     LinkServer server(link, [&queue](const ViewRequest& view) { return serve_request(queue, view); });
-    spdlog::info(
-        "serving {} ({} render ranks, {}) on {}; progressive {}, frame-time target {}, {} cost maps, "
-        "pipeline {}",
-        run.scene, run.render_ranks, run.balancer, server.endpoint().to_string(),
-        options.live.progressive ? "on" : "off",
-        options.live.frame_time_s > 0 ? std::to_string(options.live.frame_time_s * 1e3) + " ms" : "off",
-        options.live.per_session_maps ? "per-session" : "shared", options.pipeline ? "on" : "off");
+    log_serving(options, run, server.endpoint().to_string());
     ServiceNotifier notifier;
     notifier.ready();
     farm.set_heartbeat([&notifier] { notifier.watchdog(); });  // a long frame is not a hang

@@ -5,7 +5,7 @@
 docs/on-site-calibration.md: the image count and capture time `mogao-calibrate --budget` prints for
 rigs/standard.toml at several camera frame rates and settle times, one run of the whole on-site
 path without hardware (headless outputs filmed by the standard rig's camera, 1/4 scale) next to
-`mogao-calibrate --rig` at the same scale, the pattern set `mogao-calibrate patterns` writes for the
+`mogao-calibrate-sim --rig` at the same scale, the pattern set `mogao-calibrate patterns` writes for the
 standard rig at full resolution (count, files, size), and one run of the captured-images route at
 1/4 scale (patterns written, filmed by the rig with mogao-rig-film, calibrated with --images, measured
 against the rig's ground truth). Figures there are never pasted.
@@ -126,7 +126,8 @@ def main():
     os.chdir(ROOT)
     text = open(DOC).read()
     text = replace(text, "on-site-budget", budget_rows(tool, site))
-    text = replace(text, "on-site-path", path_rows(tool, site))
+    sim = os.path.join(ROOT, args.build, "kiosk", "calibrate", "mogao-calibrate-sim")  # the rig camera and --rig
+    text = replace(text, "on-site-path", path_rows(sim, site))
     text = replace(text, "on-site-pattern-set", pattern_set_rows(tool, site))
     film = os.path.join(ROOT, args.build, "kiosk", "calibrate", "mogao-rig-film")
     text = replace(text, "on-site-images", images_rows(tool, film, site))

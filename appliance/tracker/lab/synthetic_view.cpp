@@ -144,28 +144,12 @@ PlanarTarget chessboard_target(int inner_columns, int inner_rows, double square_
     return t;
 }
 
-GrayImage render_target(const PlanarTarget& target, const TagPose& pose, const CameraIntrinsics& camera,
-                        const RenderEffects& e) {
-    validate(camera);
-    check_effects(e);
-    if (target.columns < 1 || target.rows < 1 ||
-        target.cells.size() != static_cast<std::size_t>(target.columns * target.rows)) {
-        throw std::invalid_argument("render_target: target cells do not match columns x rows");
-    }
-    const cv::Matx33d h = cells_to_image(target, pose, camera);
-    // All four card corners must be in front of the camera, else the homography folds.
-    std::vector<cv::Point2d> outline;
-    for (const auto& [u, v] : {std::pair{-0.5, -0.5},
-                               {target.columns - 0.5, -0.5},
-                               {target.columns - 0.5, target.rows - 0.5},
-                               {-0.5, target.rows - 0.5}}) {
-        const cv::Vec3d q = h * cv::Vec3d(u, v, 1.0);
-        if (q[2] <= 1e-9) throw std::invalid_argument("render_target: the target is (partly) behind the camera");
-        outline.emplace_back(q[0] / q[2], q[1] / q[2]);
-    }
-    cv::Mat image = e.clutter_seed != 0 ? clutter(camera.width, camera.height, e.background, e.clutter_seed)
-                                        : cv::Mat(camera.height, camera.width, CV_32F, cv::Scalar(e.background));
+namespace {
 
+// The target drawn into `image` over the region its outline covers: each output pixel blends the target's cells
+// (supersampled e.supersample times per axis) over what was behind by the pixel's exact coverage.
+void composite_target(cv::Mat& image, const PlanarTarget& target, const cv::Matx33d& h,
+                      const std::vector<cv::Point2d>& outline, const CameraIntrinsics& camera, const RenderEffects& e) {
     // Region of the output the target covers, with a pixel of margin, clipped to the image.
     double x0 = outline[0].x, x1 = x0, y0 = outline[0].y, y1 = y0;
     for (const auto& p : outline) {
@@ -209,6 +193,10 @@ GrayImage render_target(const PlanarTarget& target, const TagPose& pose, const C
         const cv::Mat blended = coarse + behind.mul(1.0 - coverage);
         blended.copyTo(image(roi));
     }
+}
+
+// The effects after the target: illumination gradient, occluders, motion blur and sensor noise (RenderEffects).
+void apply_effects(cv::Mat& image, const CameraIntrinsics& camera, const RenderEffects& e) {
     if (e.gradient > 0.0) {
         for (int x = 0; x < camera.width; ++x) {
             const double g = 1.0 + e.gradient * ((x + 0.5) / camera.width - 0.5);
@@ -231,6 +219,34 @@ GrayImage render_target(const PlanarTarget& target, const TagPose& pose, const C
         rng.fill(noise, cv::RNG::NORMAL, 0.0, e.noise_sigma);
         image += noise;
     }
+}
+
+}  // namespace
+
+GrayImage render_target(const PlanarTarget& target, const TagPose& pose, const CameraIntrinsics& camera,
+                        const RenderEffects& e) {
+    validate(camera);
+    check_effects(e);
+    if (target.columns < 1 || target.rows < 1 ||
+        target.cells.size() != static_cast<std::size_t>(target.columns * target.rows)) {
+        throw std::invalid_argument("render_target: target cells do not match columns x rows");
+    }
+    const cv::Matx33d h = cells_to_image(target, pose, camera);
+    // All four card corners must be in front of the camera, else the homography folds.
+    std::vector<cv::Point2d> outline;
+    for (const auto& [u, v] : {std::pair{-0.5, -0.5},
+                               {target.columns - 0.5, -0.5},
+                               {target.columns - 0.5, target.rows - 0.5},
+                               {-0.5, target.rows - 0.5}}) {
+        const cv::Vec3d q = h * cv::Vec3d(u, v, 1.0);
+        if (q[2] <= 1e-9) throw std::invalid_argument("render_target: the target is (partly) behind the camera");
+        outline.emplace_back(q[0] / q[2], q[1] / q[2]);
+    }
+    cv::Mat image = e.clutter_seed != 0 ? clutter(camera.width, camera.height, e.background, e.clutter_seed)
+                                        : cv::Mat(camera.height, camera.width, CV_32F, cv::Scalar(e.background));
+
+    composite_target(image, target, h, outline, camera, e);
+    apply_effects(image, camera, e);
     cv::Mat out8;
     image.convertTo(out8, CV_8U);  // rounds and saturates
     GrayImage out(camera.width, camera.height);
