@@ -37,7 +37,7 @@ int main(int argc, char** argv) {
     app.add_option("--balancers", options.balancers, "balancers to compare (pbt, equal, roundrobin)")
         ->delimiter(',')
         ->capture_default_str();
-    app.add_option("--snap", options.snap, "PBT/equal cut snap in pixels")
+    app.add_option("--snap-px", options.snap, "PBT/equal cut snap in pixels")
         ->check(CLI::PositiveNumber)
         ->capture_default_str();
     app.add_option("--tile", options.tile, "round-robin tile size in pixels")

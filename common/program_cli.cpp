@@ -38,4 +38,9 @@ std::optional<int> parse(CLI::App& app, int argc, const char* const* argv, bool 
     return std::nullopt;
 }
 
+CLI::Option* add_duration_flag(CLI::App& app, double& seconds) {
+    return app.add_option("--duration-s", seconds, "Stop after this many seconds (0 = until SIGTERM or SIGINT)")
+        ->check(CLI::Range(0.0, 1e9));
+}
+
 }  // namespace mogao::cli

@@ -39,4 +39,12 @@ void prepare(CLI::App& app, const std::string& program);
 // The same, printing to the given streams (programs whose entry point takes them, for tests).
 [[nodiscard]] int exit_status(const CLI::App& app, const CLI::ParseError& error, std::ostream& out, std::ostream& err);
 
+// Flags that more than one program declares, declared here once so that a name keeps one meaning
+// and one help text everywhere (docs/cli.md, "Flag names"; the test cli_flag_names):
+//   --duration-s SECONDS  stop after this long (0, the default: until SIGTERM/SIGINT): mogao-kiosk, mogao-farm serve;
+CLI::Option* add_duration_flag(CLI::App& app, double& seconds);
+//   --path  the scripted camera path's help text (mogao-kiosk, mogao-farm render).
+inline constexpr const char* kPathHelp =
+    "Scripted camera path: walk | orbit | a JSON path file (mogao-kiosk: instead of [navigation].path and .source)";
+
 }  // namespace mogao::cli

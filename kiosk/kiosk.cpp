@@ -214,7 +214,7 @@ void Kiosk::on_tick() {
     if (*expirations == 0) return;
     const auto now = std::chrono::steady_clock::now();
     if (options_.duration_s > 0 && std::chrono::duration<double>(now - start_).count() >= options_.duration_s) {
-        spdlog::info("stopping: {} s elapsed (--duration)", options_.duration_s);
+        spdlog::info("stopping: {} s elapsed (--duration-s)", options_.duration_s);
         loop_.stop();
         return;
     }

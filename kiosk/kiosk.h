@@ -5,7 +5,7 @@
 //   on_frame   the FrameInbox's eventfd: take the newest farm frame its worker thread decoded (a
 //              frame that failed was dropped there; the last good one stays) and show it on every
 //              output
-//   on_tick    timerfd ([display].rate_hz): --duration; next pose from the navigation; submit the view
+//   on_tick    timerfd ([display].rate_hz): --duration-s; next pose from the navigation; submit the view
 //              request; link state changes; idle repaint (also when the late warp's shift changed:
 //              [screen].guard_deg > 0, appliance/warp/late_warp.h); periodic stats line; WATCHDOG=1
 //   on_flip    the backend's event fd (KMS page flips): pending content onto outputs ready again
@@ -14,7 +14,7 @@
 //              off this thread (a changed MPCDI file, self-recalibration) is swapped onto the outputs;
 //              an unusable one is logged (file and field) and the last good one stays on the wall
 // The handlers are public so that tests can drive them one at a time (kiosk/kiosk_test.cpp).
-// run() loops until a stop (signal, --frames N on screen, --duration, end of a tracking replay), then
+// run() loops until a stop (signal, --frames N on screen, --duration-s, end of a tracking replay), then
 // makes the clean stop: STOPPING=1, navigation, link, pose log, final stats line, composite, JSON.
 //
 // The parts are made by kiosk/main.cpp (kiosk/kiosk_setup.h) and outlive the Kiosk. Loop thread only
@@ -75,7 +75,7 @@ struct KioskParts {
 // What the command line adds: stop conditions and records of the run.
 struct KioskRunOptions {
     std::uint64_t frames = 0;         // --frames: stop once this many farm frames are on screen (0: never)
-    double duration_s = 0;            // --duration (0: never)
+    double duration_s = 0;            // --duration-s (0: never)
     std::optional<ContentDump> dump;  // --dump-content
     std::optional<PoseLog> pose_log;  // --pose-log
     // When positive: an output whose page flip has not completed for this long fails the kiosk

@@ -12,7 +12,7 @@
 //   mogao-kiosk --config kiosk.toml --path orbit --frames 100 --dump-content out/content
 //   mogao-kiosk --print-config 'farm.endpoint="[::1]:7443"' > kiosk.toml   # the example, overridden
 //
-// Exit codes: 0 stopped (signal, --frames, --duration, end of a tracking replay), 1 the appliance
+// Exit codes: 0 stopped (signal, --frames, --duration-s, end of a tracking replay), 1 the appliance
 // could not run (outputs, calibration, link set-up, loop failure), 2 bad command line or configuration.
 // A bad configuration or MPCDI file with a last good copy (kiosk/config/last_loaded.h) runs on the copy
 // and says so on the wall and in the status file instead of exiting.
@@ -143,11 +143,10 @@ int main(int argc, char** argv) {
     app.add_option("--service-config", flags.service_config,
                    "Configuration whose [outputs] show the service card when --config and its last good copy "
                    "cannot be loaded (default: built-in, KMS)");
-    app.add_option("--path", flags.path,
-                   "Scripted visitor: walk | orbit | a JSON path file (overrides [navigation].path and .source)");
+    app.add_option("--path", flags.path, mogao::cli::kPathHelp);
     app.add_option("--frames", flags.frames, "Stop after this many farm frames are on screen")
         ->check(CLI::Range(1, 100000000));
-    app.add_option("--duration", flags.duration_s, "Stop after this many seconds")->check(CLI::Range(0.001, 1e9));
+    mogao::cli::add_duration_flag(app, flags.duration_s);
     app.add_option("--dump-content", flags.dump_dir, "Write decoded content frames (PPM + pose JSON) here");
     app.add_option("--dump-every", flags.dump_every, "With --dump-content: every k-th frame")
         ->check(CLI::Range(1, 1000000));

@@ -8,7 +8,7 @@
 //                mutual TLS, answering every request with one frame) and shown on headless outputs;
 //   swap         the watched MPCDI file just replaced by another calibration (loaded and swapped in
 //                by the watcher thread while the signal arrives);
-//   shutdown     the kiosk stopping on its own (--duration) as the signal arrives.
+//   shutdown     the kiosk stopping on its own (--duration-s) as the signal arrives.
 // Before its main() blocks the signals (the dynamic loader and library constructors) a process
 // cannot handle SIGTERM at all; that moment is left out here (systemd counts a death by SIGTERM as a
 // clean stop). MOGAO_SIGTERM_STRESS_RUNS (default 200) sets the number of runs over the phases.
@@ -246,7 +246,7 @@ protected:
         const char* binary = std::getenv("MOGAO_KIOSK_UNDER_TEST");
         auto kiosk = std::make_unique<KioskProcess>(
             std::vector<std::string>{binary != nullptr ? binary : MOGAO_KIOSK_BINARY, "--config",
-                                     (w.dir / "kiosk.toml").string(), "--duration", std::to_string(duration_s)});
+                                     (w.dir / "kiosk.toml").string(), "--duration-s", std::to_string(duration_s)});
         const auto guard = Clock::now() + std::chrono::seconds(20);
         while (kiosk->alive() && !has_signalfd(kiosk->pid()) && Clock::now() < guard) {
             std::this_thread::sleep_for(std::chrono::microseconds(200));
@@ -287,7 +287,7 @@ protected:
                 write_ideal(w.dir / "screen.mpcdi", run % 2 == 0 ? 0.3 : 0.15, run % 2 == 0 ? 1.8 : 2.2);
                 at = Clock::now() + uniform_ms(0, 150);
                 break;
-            case Phase::shutdown: {  // the kiosk stopping on its own (--duration): from its log line to its exit
+            case Phase::shutdown: {  // the kiosk stopping on its own (--duration-s): from its log line to its exit
                 const auto stopping = kiosk->wait_line("stopping:", std::chrono::seconds(30));
                 if (!stopping) return "never logged its stop:\n" + kiosk->log();
                 at = *stopping + uniform_ms(0, static_cast<int>(1.1 * shutdown_ms) + 1);

@@ -45,7 +45,7 @@ fi
 # MPMD form gives rank 0 one --tls-dir and ranks 1-2 another, as two hosts' file systems would.
 "$farm" pki init-ca --dir "$work/pki" > /dev/null && "$farm" pki issue-farm --dir "$work/pki" --name farm --san ::1 > /dev/null \
   && "$farm" pki export-farm --dir "$work/pki" --name farm --to "$work/farm-tls" > /dev/null || { echo "FAIL: pki"; fail=1; }
-serve_args=(serve --scene "$work/ok.json" --listen "[::1]:0" --name farm --duration 2)
+serve_args=(serve --scene "$work/ok.json" --listen "[::1]:0" --name farm --duration-s 2)
 expect_failure admin-without-tls "$work/absent" "${serve_args[@]}" --tls-dir "$work/absent"
 timeout 120 "$MPIEXEC" --oversubscribe -n 1 "$farm" "${serve_args[@]}" --tls-dir "$work/farm-tls" \
   : -n 2 "$farm" "${serve_args[@]}" --tls-dir "$work/absent" > "$work/render-without-tls.log" 2>&1

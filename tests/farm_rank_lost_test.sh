@@ -29,7 +29,7 @@ run_case() {
   local how=$1 out="$work/$1" log="$work/$1.log"
   mkdir -p "$out"
   mpirun_n 4 "$farm" render --scene "$scene" --frames 100000 --path orbit --width 64 --height 48 --spp 1 \
-    --contact-sheet 0 --rank-deadline "$deadline" --out "$out" 2> "$log" &
+    --contact-sheet 0 --rank-deadline-s "$deadline" --out "$out" 2> "$log" &
   local mpirun_pid=$!
   # Wait until frames flow, then take rank 2 away.
   for _ in $(seq 600); do [ -e "$out/frame-0002.jpg" ] && break; sleep 0.1; done

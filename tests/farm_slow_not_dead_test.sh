@@ -60,7 +60,7 @@ FARM_BUDGET_ARGS=(--metrics-file "$work/farm.prom")
 start_farm "$work/farm.log" "$endpoint"
 log "farm up at $endpoint (3 ranks), two busy loops beside it"
 
-timeout 200 "$kiosk" --config "$work/ordinary.toml" --frames 1000000 --duration 150 --stats "$work/ordinary.json" \
+timeout 200 "$kiosk" --config "$work/ordinary.toml" --frames 1000000 --duration-s 150 --stats "$work/ordinary.json" \
   >"$work/ordinary.log" 2>&1 &
 kiosk_pid=$!
 frames_of() { grep -o "stats: frames=[0-9]*" "$1" | tail -1 | cut -d= -f2; }
@@ -75,7 +75,7 @@ t_alone=$(date +%s%N)
 sleep "$ALONE_S"
 t_dear=$(date +%s%N)
 log "the dear appliance (museum-2) connects"
-timeout 200 "$kiosk" --config "$work/dear.toml" --frames 1000000 --duration 150 --stats "$work/dear.json" \
+timeout 200 "$kiosk" --config "$work/dear.toml" --frames 1000000 --duration-s 150 --stats "$work/dear.json" \
   >"$work/dear.log" 2>&1 &
 dear_pid=$!
 sleep "$BESIDE_S"

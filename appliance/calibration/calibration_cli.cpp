@@ -37,7 +37,7 @@ std::string parse_size(const std::string& text, ImageSize& size) {
 
 struct IdealFlags {
     IdealCalibrationParams params;
-    std::string output = "1024x768";
+    std::string projector_size = "1024x768";
     std::string content = "1920x1080";
     std::string out;
     int alpha_bits = 8;
@@ -170,8 +170,8 @@ int run_calibration_cli(int argc, const char* const* argv, std::ostream& out, st
     ideal_cmd->add_option("--projectors", ideal.params.projectors, "Number of projectors")->check(CLI::Range(1, 64));
     ideal_cmd->add_option("--overlap", ideal.params.overlap, "Overlap, fraction of one projector's width, [0, 0.5)")
         ->check(CLI::Range(0.0, 0.4999999));
-    ideal_cmd->add_option("--output", ideal.output, "Projector resolution WIDTHxHEIGHT");
-    ideal_cmd->add_option("--content", ideal.content, "Content frame WIDTHxHEIGHT (the farm's cylinder frame)");
+    ideal_cmd->add_option("--projector-size", ideal.projector_size, "Projector resolution WIDTHxHEIGHT");
+    ideal_cmd->add_option("--content", ideal.content, "Content frame WIDTHxHEIGHT (the farm's frame)");
     ideal_cmd->add_option("--gamma", ideal.params.gamma, "Projector gamma, also the alpha maps' gammaEmbedded")
         ->check(CLI::Range(0.1, 10.0));
     ideal_cmd->add_option("--alpha-bits", ideal.alpha_bits, "Alpha map bits: 8 (reference-library compatible) or 16")
@@ -183,10 +183,10 @@ int run_calibration_cli(int argc, const char* const* argv, std::ostream& out, st
     info_cmd->add_option("file", info_path, "MPCDI file")->required()->check(CLI::ExistingFile);
     try {
         app.parse(argc, argv);
-        for (const auto& [text, size] :
-             {std::pair{&ideal.output, &ideal.params.output}, std::pair{&ideal.content, &ideal.params.content}}) {
+        for (const auto& [text, size] : {std::pair{&ideal.projector_size, &ideal.params.output},
+                                         std::pair{&ideal.content, &ideal.params.content}}) {
             if (const std::string why = parse_size(*text, *size); !why.empty()) {
-                throw CLI::ValidationError(text == &ideal.output ? "--output" : "--content", why);
+                throw CLI::ValidationError(text == &ideal.projector_size ? "--projector-size" : "--content", why);
             }
         }
     } catch (const CLI::ParseError& e) {

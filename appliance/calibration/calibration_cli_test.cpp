@@ -33,7 +33,7 @@ CliRun run(std::vector<std::string> args) {
 TEST(CalibrationCli, IdealWritesAFileThatPassesTheCheck) {
     test::ScratchDir dir;
     const std::string file = (dir / "ideal.mpcdi").string();
-    const CliRun r = run({"ideal", "--projectors", "3", "--overlap", "0.15", "--output", "256x192", "--content",
+    const CliRun r = run({"ideal", "--projectors", "3", "--overlap", "0.15", "--projector-size", "256x192", "--content",
                           "480x270", "--out", file, "--check"});
     EXPECT_EQ(r.code, 0) << r.out << r.err;
     EXPECT_NE(r.out.find("OK"), std::string::npos) << r.out;
@@ -53,7 +53,7 @@ TEST(CalibrationCli, BadCommandLinesExitTwo) {
     const std::string out = (dir / "x.mpcdi").string();
     EXPECT_EQ(run({"ideal", "--overlap", "0.5", "--out", out}).code, 2);
     EXPECT_EQ(run({"ideal", "--projectors", "0", "--out", out}).code, 2);
-    EXPECT_EQ(run({"ideal", "--output", "1024x", "--out", out}).code, 2);
+    EXPECT_EQ(run({"ideal", "--projector-size", "1024x", "--out", out}).code, 2);
     EXPECT_EQ(run({"ideal", "--content", "0x5", "--out", out}).code, 2);
     EXPECT_EQ(run({"ideal", "--alpha-bits", "12", "--out", out}).code, 2);
     EXPECT_EQ(run({"ideal"}).code, 2);  // --out is required

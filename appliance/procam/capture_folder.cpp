@@ -45,7 +45,7 @@ std::vector<cv::Mat> load_capture_folder(const std::filesystem::path& folder, co
         throw ProcamError(extra.string() + ": unexpected; a " + std::to_string(layout.projector.width) + "x" +
                           std::to_string(layout.projector.height) + " projector has " +
                           std::to_string(layout.image_count()) + " images (graycode_00.png .. " +
-                          capture_file_name(layout.image_count() - 1) + "): is --projector the patterns' size?");
+                          capture_file_name(layout.image_count() - 1) + "): is --projector-size the patterns' size?");
     }
     std::vector<cv::Mat> images;
     for (int i = 0; i < layout.image_count(); ++i) {

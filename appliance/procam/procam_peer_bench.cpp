@@ -161,7 +161,7 @@ int main(int argc, char** argv) {
     app.add_option("--shadow", job.decode.shadow_threshold, "Shadow threshold, white - black grey levels");
     app.add_option("--bit-contrast", job.decode.min_bit_contrast, "Least |pattern - inverse|, grey levels");
     app.add_option("--bit-fraction", job.decode.bit_contrast_fraction, "... or this fraction of white - black");
-    app.add_option("--window", job.homography.half_window_px, "Homography window half-width, camera px");
+    app.add_option("--half-window-px", job.homography.half_window_px, "Homography window half-width, camera px");
     app.add_option("--ransac", job.homography.ransac_px, "RANSAC distance, projector px (0: least squares)");
     app.add_option("--projector-flags", job.calibration.projector_flags, "cv::calibrateCamera flags, projector");
     app.add_option("--camera-flags", job.calibration.camera_flags, "cv::calibrateCamera flags, camera");

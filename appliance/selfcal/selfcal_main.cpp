@@ -61,6 +61,76 @@ int run_simulate(const std::string& rig_path, const std::string& models_path,
     return 0;
 }
 
+// What `simulate` takes beyond SimulationOptions' own fields.
+struct SimulateFlags {
+    std::string rig;
+    std::vector<std::string> bumps;
+    double bump_at_s = 2.0;
+    bool verbose = false;
+    std::string content = "textured";
+    bool no_edge_check = false;
+    double prior_mm = 0.0;
+    std::string models;
+    mogao::selfcal::SimulationOptions o;
+};
+
+void add_simulate_flags(CLI::App& cmd, SimulateFlags& f) {
+    f.prior_mm = f.o.selfcal.monitor.projector_fit.prior_position_sd_m * 1e3;
+    cmd.add_option("--rig", f.rig, "Virtual rig (rigs/*.toml)")->required()->check(CLI::ExistingFile);
+    cmd.add_option("--bump", f.bumps,
+                   "device:yaw=1deg,pitch=..,roll=..,x=5mm,y=..,z=.. (device: a projector id or camera)");
+    cmd.add_option("--bump-at-s", f.bump_at_s, "simulated second of the bumps")->check(CLI::NonNegativeNumber);
+    cmd.add_option("--rate-hz", f.o.rate_hz, "monitored frames per simulated second")->check(CLI::Range(0.01, 60.0));
+    cmd.add_option("--frames", f.o.frames, "monitored frames")->check(CLI::Range(1, 100000));
+    cmd.add_option("--projector-scale", f.o.projector_scale, "projector resolution scale")
+        ->check(CLI::Range(0.05, 1.0));
+    cmd.add_option("--camera-scale", f.o.camera_scale, "camera resolution scale")->check(CLI::Range(0.05, 1.0));
+    cmd.add_option("--occlusion", f.o.occlusion, "fraction of the camera view hidden by visitors")
+        ->check(CLI::Range(0.0, 0.9));
+    cmd.add_option("--occlusion-max", f.o.occlusion_max, "each frame's occlusion uniform in [occlusion, this]")
+        ->check(CLI::Range(0.0, 0.9));
+    cmd.add_option("--hold-s", f.o.selfcal.hold_s, "seconds a drift must last before correcting")
+        ->check(CLI::NonNegativeNumber);
+    cmd.add_option("--transition-s", f.o.selfcal.transition_s, "seconds a correction is blended in over")
+        ->check(CLI::NonNegativeNumber);
+    cmd.add_option("--exposure-jitter", f.o.exposure_jitter, "camera gain varies in [1-j, 1+j]")
+        ->check(CLI::Range(0.0, 0.9));
+    cmd.add_option("--content-kind", f.content, "textured | plain | repetitive | dark")
+        ->check(CLI::IsMember({"textured", "plain", "repetitive", "dark"}));
+    cmd.add_option("--seed", f.o.seed, "noise and content seed");
+    cmd.add_option("--threshold-px", f.o.selfcal.drift_threshold_px, "drift threshold, projector pixels")
+        ->check(CLI::PositiveNumber);
+    cmd.add_option("--owner-min-blend", f.o.selfcal.monitor.owner_min_blend,
+                   "a match belongs to a projector from this blend weight")
+        ->check(CLI::Range(0.5, 1.0));
+    cmd.add_option("--unmix-max-shift-px", f.o.selfcal.monitor.unmix_max_shift_px,
+                   "overlap matches shifted less than this (camera px) are un-mixed; 0 off")
+        ->check(CLI::NonNegativeNumber);
+    cmd.add_flag("--no-edge-check", f.no_edge_check,
+                 "do not check the camera fit against the screen's edges (Monitor::edges_moved)");
+    cmd.add_option("--occluder-ratio", f.o.selfcal.monitor.occluder_ratio,
+                   "visitor mask: cells darker or brighter than predicted by this factor; 0 off")
+        ->check(CLI::Range(0.0, 0.99));
+    cmd.add_option("--occluder-cell-px", f.o.selfcal.monitor.occluder_cell_px, "visitor mask: cell size, camera pixels")
+        ->check(CLI::Range(2, 256));
+    cmd.add_option("--min-matches", f.o.selfcal.min_matches, "matches a projector needs for a measurement")
+        ->check(CLI::Range(6, 100000));
+    cmd.add_option("--position-prior-mm", f.prior_mm,
+                   "projector fit's position prior, mm per pixel of residual (0 none)")
+        ->check(CLI::NonNegativeNumber);
+    cmd.add_flag("--pattern", f.o.selfcal.pattern.enabled,
+                 "content-independent fallback: an imperceptible pattern pair when the content has too little texture");
+    cmd.add_option("--pattern-amplitude", f.o.selfcal.pattern.amplitude, "the pattern's amplitude, linear content")
+        ->check(CLI::Range(0.001, 0.2));
+    cmd.add_option("--truth-every", f.o.truth_every, "ground truth every N frames (and at the last, around changes)")
+        ->check(CLI::Range(1, 100000));
+    cmd.add_flag("--verbose", f.verbose, "one line per monitored frame");
+    cmd.add_option("--models", f.models,
+                   "start from these models (a full calibration's estimate: mogao-autocal calibrate --rig RIG "
+                   "--scale S writes calibration.models.json) instead of the rig's exact ones")
+        ->check(CLI::ExistingFile);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -68,78 +138,19 @@ int main(int argc, char** argv) {
     mogao::cli::prepare(app, "mogao-selfcal");
     app.require_subcommand(1);
     CLI::App* sim = app.add_subcommand("simulate", "bump devices of a virtual rig and watch the monitor correct them");
-    std::string rig;
-    std::vector<std::string> bumps;
-    double bump_at = 2.0;
-    bool verbose = false;
-    std::string content = "textured";
-    mogao::selfcal::SimulationOptions o;
-    sim->add_option("--rig", rig, "rig file (rigs/*.toml)")->required()->check(CLI::ExistingFile);
-    sim->add_option("--bump", bumps,
-                    "device:yaw=1deg,pitch=..,roll=..,x=5mm,y=..,z=.. (device: a projector id or camera)");
-    sim->add_option("--bump-at", bump_at, "simulated second of the bumps")->check(CLI::NonNegativeNumber);
-    sim->add_option("--rate", o.rate_hz, "monitored frames per simulated second")->check(CLI::Range(0.01, 60.0));
-    sim->add_option("--frames", o.frames, "monitored frames")->check(CLI::Range(1, 100000));
-    sim->add_option("--scale", o.projector_scale, "projector resolution scale")->check(CLI::Range(0.05, 1.0));
-    sim->add_option("--camera-scale", o.camera_scale, "camera resolution scale")->check(CLI::Range(0.05, 1.0));
-    sim->add_option("--occlusion", o.occlusion, "fraction of the camera view hidden by visitors")
-        ->check(CLI::Range(0.0, 0.9));
-    sim->add_option("--occlusion-max", o.occlusion_max, "each frame's occlusion uniform in [occlusion, this]")
-        ->check(CLI::Range(0.0, 0.9));
-    sim->add_option("--hold", o.selfcal.hold_s, "seconds a drift must last before correcting")
-        ->check(CLI::NonNegativeNumber);
-    sim->add_option("--transition", o.selfcal.transition_s, "seconds a correction is blended in over")
-        ->check(CLI::NonNegativeNumber);
-    sim->add_option("--exposure-jitter", o.exposure_jitter, "camera gain varies in [1-j, 1+j]")
-        ->check(CLI::Range(0.0, 0.9));
-    sim->add_option("--content", content, "textured | plain | repetitive | dark")
-        ->check(CLI::IsMember({"textured", "plain", "repetitive", "dark"}));
-    sim->add_option("--seed", o.seed, "noise and content seed");
-    sim->add_option("--threshold", o.selfcal.drift_threshold_px, "drift threshold, projector pixels")
-        ->check(CLI::PositiveNumber);
-    sim->add_option("--owner-min-blend", o.selfcal.monitor.owner_min_blend,
-                    "a match belongs to a projector from this blend weight")
-        ->check(CLI::Range(0.5, 1.0));
-    sim->add_option("--unmix-max-shift", o.selfcal.monitor.unmix_max_shift_px,
-                    "overlap matches shifted less than this (camera px) are un-mixed; 0 off")
-        ->check(CLI::NonNegativeNumber);
-    bool no_edge_check = false;
-    sim->add_flag("--no-edge-check", no_edge_check,
-                  "do not check the camera fit against the screen's edges (Monitor::edges_moved)");
-    sim->add_option("--occluder-ratio", o.selfcal.monitor.occluder_ratio,
-                    "visitor mask: cells darker or brighter than predicted by this factor; 0 off")
-        ->check(CLI::Range(0.0, 0.99));
-    sim->add_option("--occluder-cell", o.selfcal.monitor.occluder_cell_px, "visitor mask: cell size, camera pixels")
-        ->check(CLI::Range(2, 256));
-    sim->add_option("--min-matches", o.selfcal.min_matches, "matches a projector needs for a measurement")
-        ->check(CLI::Range(6, 100000));
-    double prior_mm = o.selfcal.monitor.projector_fit.prior_position_sd_m * 1e3;
-    sim->add_option("--position-prior-mm", prior_mm,
-                    "projector fit's position prior, mm per pixel of residual (0 none)")
-        ->check(CLI::NonNegativeNumber);
-    sim->add_flag(
-        "--pattern", o.selfcal.pattern.enabled,
-        "content-independent fallback: an imperceptible pattern pair when the content has too little texture");
-    sim->add_option("--pattern-amplitude", o.selfcal.pattern.amplitude, "the pattern's amplitude, linear content")
-        ->check(CLI::Range(0.001, 0.2));
-    sim->add_option("--truth-every", o.truth_every, "ground truth every N frames (and at the last, around changes)")
-        ->check(CLI::Range(1, 100000));
-    sim->add_flag("--verbose", verbose, "one line per monitored frame");
-    std::string models;
-    sim->add_option("--models", models,
-                    "start from these models (a full calibration's estimate: mogao-autocal calibrate --rig RIG "
-                    "--scale S writes calibration.models.json) instead of the rig's exact ones")
-        ->check(CLI::ExistingFile);
+    SimulateFlags f;
+    add_simulate_flags(*sim, f);
     if (auto status = mogao::cli::parse(app, argc, argv)) return *status;
-    o.content = content == "plain"        ? ContentKind::plain
-                : content == "repetitive" ? ContentKind::repetitive
-                : content == "dark"       ? ContentKind::dark
-                                          : ContentKind::textured;
+    mogao::selfcal::SimulationOptions& o = f.o;
+    o.content = f.content == "plain"        ? ContentKind::plain
+                : f.content == "repetitive" ? ContentKind::repetitive
+                : f.content == "dark"       ? ContentKind::dark
+                                            : ContentKind::textured;
     o.selfcal.build.warp_step_px = 4;
-    o.selfcal.monitor.check_edges = !no_edge_check;
-    o.selfcal.monitor.projector_fit.prior_position_sd_m = prior_mm * 1e-3;
+    o.selfcal.monitor.check_edges = !f.no_edge_check;
+    o.selfcal.monitor.projector_fit.prior_position_sd_m = f.prior_mm * 1e-3;
     try {
-        return run_simulate(rig, models, bumps, bump_at, o, verbose);
+        return run_simulate(f.rig, f.models, f.bumps, f.bump_at_s, o, f.verbose);
     } catch (const std::invalid_argument& e) {
         std::fprintf(stderr, "mogao-selfcal simulate: %s\n", e.what());
         return 2;

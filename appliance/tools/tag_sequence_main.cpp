@@ -19,17 +19,22 @@ int main(int argc, char** argv) {
     mogao::track::SequenceOptions seq;
     CLI::App* s = &app;
     s->add_option("OUT", seq.out, "output folder")->required();
-    s->add_option("--seconds", seq.seconds, "length")->check(CLI::Range(0.01, 600.0))->capture_default_str();
+    s->add_option("--length-s", seq.seconds, "Length of the sequence, seconds")
+        ->check(CLI::Range(0.01, 600.0))
+        ->capture_default_str();
     s->add_option("--fps", seq.fps, "frames per second")->check(CLI::Range(0.1, 240.0))->capture_default_str();
     s->add_option("--family", seq.family, "tag family")
         ->check(CLI::IsMember(mogao::TagFamily::known_names()))
         ->capture_default_str();
-    s->add_option("--id", seq.id, "tag id")->check(CLI::NonNegativeNumber)->capture_default_str();
+    // The same text as mogao-track navigate's --id (one text per name, docs/cli.md).
+    s->add_option("--id", seq.id, "Tag id (navigate: the one to follow, -1 the largest)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
     s->add_option("--tag-size-mm", seq.tag_size_mm, "tag size (black border)")
         ->check(CLI::Range(1.0, 1000.0))
         ->capture_default_str();
-    s->add_option("--width", seq.width, "image width")->check(CLI::Range(16, 8192))->capture_default_str();
-    s->add_option("--height", seq.height, "image height")->check(CLI::Range(16, 8192))->capture_default_str();
+    s->add_option("--width", seq.width, "Image width in pixels")->check(CLI::Range(16, 8192))->capture_default_str();
+    s->add_option("--height", seq.height, "Image height in pixels")->check(CLI::Range(16, 8192))->capture_default_str();
     s->add_option("--focal-px", seq.focal_px, "focal length (px)")
         ->check(CLI::Range(10.0, 100000.0))
         ->capture_default_str();

@@ -57,8 +57,9 @@ int make_tag(const TagImageOptions& options);
 
 struct NavigateOptions {
     std::filesystem::path replay;  // a replay folder, or
-    std::string device;  // /dev/videoN, v4l2:..., libcamera:[<id>] (then `camera` is required; runs until killed)
-    std::filesystem::path camera;  // default: <replay>/camera.json
+    std::string
+        device;  // --camera: /dev/videoN, v4l2:..., libcamera:[<id>] (then `camera` is required; runs until killed)
+    std::filesystem::path camera;  // --camera-calibration; default: <replay>/camera.json
     double tag_size_mm = 100.0;
     int id = -1;
     double display_hz = 60.0;

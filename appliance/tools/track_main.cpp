@@ -6,6 +6,7 @@
 
 #include <cstdio>
 #include <exception>
+#include <string>
 
 #include "appliance/tools/track_commands.h"
 #include "appliance/tracker/tag_family.h"
@@ -23,7 +24,7 @@ void add_detector_flags(CLI::App& cmd, DetectorSettings& s) {
     cmd.add_option("--decimate", s.decimation, "quad decimation factor")
         ->check(CLI::Range(1.0f, 8.0f))
         ->capture_default_str();
-    cmd.add_option("--blur", s.blur_sigma, "Gaussian blur sigma before the quad search (px)")
+    cmd.add_option("--blur-px", s.blur_sigma, "Gaussian blur sigma before the quad search, pixels")
         ->check(CLI::Range(-5.0f, 5.0f))
         ->capture_default_str();
     cmd.add_flag("!--no-refine", s.refine_edges, "do not refine the quad edges");
@@ -33,30 +34,33 @@ void add_detector_flags(CLI::App& cmd, DetectorSettings& s) {
     cmd.add_option("--threads", s.threads, "detector threads")->check(CLI::Range(1, 64))->capture_default_str();
 }
 
-}  // namespace
+// The help texts of flags mogao-tag-sequence and mogao-calibrate declare too, word for word (one
+// text per name, docs/cli.md; the test cli_flag_names compares them).
+constexpr const char* kTagIdHelp = "Tag id (navigate: the one to follow, -1 the largest)";
+constexpr const char* kBoardHelp = "Chessboard inner corners, COLUMNSxROWS";
+constexpr const char* kSquareHelp = "Chessboard square side, mm";
+constexpr const char* kCameraHelp =
+    "Capture device: v4l2:/dev/videoN (or /dev/videoN) or libcamera:[id]; mogao-calibrate also replay:DIR and "
+    "rig:FILE (simulation: mogao-calibrate-sim)";
 
-int main(int argc, char** argv) {
-    CLI::App app{"mogao-track: AprilTag tracking and tag-driven navigation"};
-    mogao::cli::prepare(app, "mogao-track");
-    app.require_subcommand(1);
-
-    mogao::track::DetectOptions detect;
+CLI::App* add_detect(CLI::App& app, mogao::track::DetectOptions& detect) {
     auto* d = app.add_subcommand("detect", "print every tag's id and corners in images (JPEG, PNG, PGM)");
     d->add_option("IMAGE", detect.images, "images")->required();
     d->add_flag("--json", detect.json, "one JSON array instead of text");
     add_detector_flags(*d, detect.detector);
+    return d;
+}
 
-    mogao::track::CalibrateOptions calib;
-    std::string board = "9x6";
+CLI::App* add_calibrate_camera(CLI::App& app, mogao::track::CalibrateOptions& calib, std::string& board) {
     auto* c = app.add_subcommand("calibrate-camera", "camera intrinsics from chessboard photos in a folder");
     c->add_option("FOLDER", calib.folder, "folder of chessboard images")->required()->check(CLI::ExistingDirectory);
-    c->add_option("--board", board, "inner corners, COLUMNSxROWS")->capture_default_str();
-    c->add_option("--square-mm", calib.square_mm, "side of one square (mm)")
-        ->check(CLI::Range(0.1, 1000.0))
-        ->capture_default_str();
+    c->add_option("--board", board, kBoardHelp)->capture_default_str();
+    c->add_option("--square-mm", calib.square_mm, kSquareHelp)->check(CLI::Range(0.1, 1000.0))->capture_default_str();
     c->add_option("--out", calib.out, "calibration file to write (.json)")->capture_default_str();
+    return c;
+}
 
-    mogao::track::TagImageOptions tag;
+CLI::App* add_make_tag(CLI::App& app, mogao::track::TagImageOptions& tag) {
     auto* t = app.add_subcommand("make-tag", "write a printable tag image (PNG), generated from the family's codes");
     t->add_option("ID", tag.id, "tag id")->required()->check(CLI::NonNegativeNumber);
     t->add_option("--family", tag.family, "tag family")
@@ -69,26 +73,24 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(0, 100))
         ->capture_default_str();
     t->add_option("--out", tag.out, "PNG to write")->required();
+    return t;
+}
 
-    mogao::track::NavigateOptions nav;
+CLI::App* add_navigate(CLI::App& app, mogao::track::NavigateOptions& nav) {
     auto* n = app.add_subcommand("navigate", "frames through tracker and navigation; print ViewerPoses (JSON lines)");
     auto* replay = n->add_option("REPLAY", nav.replay, "folder of frames (e.g. from mogao-tag-sequence)")
                        ->check(CLI::ExistingDirectory);
-    auto* device = n->add_option(
-        "--device", nav.device,
-        "camera instead of a folder: /dev/videoN, v4l2:/dev/videoN or libcamera:[<id>] (runs until killed)");
-    replay->excludes(device);
-    n->add_option("--camera", nav.camera, "calibration file (default REPLAY/camera.json; required with --device)");
+    n->add_option("--camera", nav.device, kCameraHelp)->excludes(replay);
+    n->add_option("--camera-calibration", nav.camera,
+                  "camera calibration file (default REPLAY/camera.json; required with --camera)");
     n->add_option("--tag-size-mm", nav.tag_size_mm, "tag size (black border)")
         ->check(CLI::Range(1.0, 1000.0))
         ->capture_default_str();
-    n->add_option("--id", nav.id, "tag id to follow (-1: the largest)")
-        ->check(CLI::Range(-1, 100000))
-        ->capture_default_str();
+    n->add_option("--id", nav.id, kTagIdHelp)->check(CLI::Range(-1, 100000))->capture_default_str();
     n->add_option("--display-hz", nav.display_hz, "rate of the output poses")
         ->check(CLI::Range(1.0, 1000.0))
         ->capture_default_str();
-    n->add_option("--fps", nav.fps, "replay rate without timestamps.txt")
+    n->add_option("--replay-fps", nav.fps, "frame rate of a REPLAY folder without timestamps.txt")
         ->check(CLI::Range(0.1, 1000.0))
         ->capture_default_str();
     n->add_option("--out", nav.out, "JSON lines file (default stdout)");
@@ -98,7 +100,37 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(0.0, 1000.0))  // (0, 4) is refused by TagTracker, naming the field
         ->capture_default_str();
     add_detector_flags(*n, nav.detector);
+    return n;
+}
 
+// "9x6" -> columns and rows; false when it is not COLUMNSxROWS.
+bool parse_board(const std::string& board, mogao::track::CalibrateOptions& calib) {
+    const auto x = board.find('x');
+    try {
+        if (x == std::string::npos) return false;
+        calib.inner_columns = std::stoi(board.substr(0, x));
+        calib.inner_rows = std::stoi(board.substr(x + 1));
+        return true;
+    } catch (const std::exception&) {
+        return false;
+    }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"mogao-track: AprilTag tracking and tag-driven navigation"};
+    mogao::cli::prepare(app, "mogao-track");
+    app.require_subcommand(1);
+    mogao::track::DetectOptions detect;
+    mogao::track::CalibrateOptions calib;
+    std::string board = "9x6";
+    mogao::track::TagImageOptions tag;
+    mogao::track::NavigateOptions nav;
+    auto* d = add_detect(app, detect);
+    auto* c = add_calibrate_camera(app, calib, board);
+    auto* t = add_make_tag(app, tag);
+    auto* n = add_navigate(app, nav);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -107,12 +139,7 @@ int main(int argc, char** argv) {
     try {
         if (*d) return mogao::track::detect(detect);
         if (*c) {
-            const auto x = board.find('x');
-            try {
-                if (x == std::string::npos) throw std::invalid_argument("");
-                calib.inner_columns = std::stoi(board.substr(0, x));
-                calib.inner_rows = std::stoi(board.substr(x + 1));
-            } catch (const std::exception&) {
+            if (!parse_board(board, calib)) {
                 std::fprintf(stderr, "mogao-track: --board '%s' is not COLUMNSxROWS (e.g. 9x6)\n", board.c_str());
                 return 2;
             }
@@ -121,7 +148,7 @@ int main(int argc, char** argv) {
         if (*t) return mogao::track::make_tag(tag);
         if (*n) {
             if (nav.replay.empty() == nav.device.empty() || (!nav.device.empty() && nav.camera.empty())) {
-                std::fprintf(stderr, "mogao-track navigate: give REPLAY, or --device with --camera\n");
+                std::fprintf(stderr, "mogao-track navigate: give REPLAY, or --camera with --camera-calibration\n");
                 return 2;
             }
             return mogao::track::navigate(nav);

@@ -61,7 +61,7 @@ int navigate(const NavigateOptions& o) {
         const std::string named = o.device.starts_with("/") ? "v4l2:" + o.device : o.device;
         std::string why;
         if (!parse_camera_source(named, spec, &why) || spec.kind == CameraSourceSpec::Kind::replay) {
-            std::fprintf(stderr, "mogao-track navigate: --device '%s': %s\n", o.device.c_str(),
+            std::fprintf(stderr, "mogao-track navigate: --camera '%s': %s\n", o.device.c_str(),
                          why.empty() ? "give /dev/videoN, v4l2:/dev/videoN or libcamera:[<id>]" : why.c_str());
             return 2;
         }

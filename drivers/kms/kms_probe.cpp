@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // mogao-kms-probe: what a technician needs to know about the card before the kiosk runs: the
 // driver, each connector (state, modes, possible CRTCs), CRTCs, planes, and which outputs the
-// kiosk would light. With --test-pattern SECONDS it lights them with the test pattern through
+// kiosk would light. With --test-pattern-s SECONDS it lights them with the test pattern through
 // the same KMS backend and warp/blend renderer as the kiosk.
 // Exit codes: 0 ok, 1 failure, 2 bad command line, 77 no DRM device.
 #include <poll.h>
@@ -148,8 +148,12 @@ int main(int argc, char** argv) {
     mogao::cli::prepare(app, "mogao-kms-probe");
     std::string device;
     double seconds = 0;
-    app.add_option("--device", device, "DRM card node (default: every /dev/dri/card*)")->check(CLI::ExistingFile);
-    app.add_option("--test-pattern", seconds, "light the outputs with the test pattern for SECONDS")
+    // The same text as mogao-calibrate's --kms-device (one text per name, docs/cli.md).
+    app.add_option("--kms-device", device,
+                   "DRM card node /dev/dri/cardN (default: mogao-calibrate the first with a connected connector, "
+                   "mogao-kms-probe every card)")
+        ->check(CLI::ExistingFile);
+    app.add_option("--test-pattern-s", seconds, "light the outputs with the test pattern for this many seconds")
         ->check(CLI::Range(0.0, 86400.0));
     try {
         app.parse(argc, argv);

@@ -100,7 +100,7 @@ run_config() {
   say "frozen $(uptime_s)"
   read -r _ <&3
   say "go $(uptime_s)"
-  MOGAO_LAST_GOOD_DIR=$cfg/last-good mogao-kiosk --config /etc/mogao/kiosk.toml --duration 2 > /tmp/run.log 2>&1 &
+  MOGAO_LAST_GOOD_DIR=$cfg/last-good mogao-kiosk --config /etc/mogao/kiosk.toml --duration-s 2 > /tmp/run.log 2>&1 &
   local pid=$!
   watch_folder "$pid" "$cfg/last-good"
   finish "$pid"

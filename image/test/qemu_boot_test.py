@@ -237,7 +237,7 @@ def main():
         with open(os.path.join(cfg, "reference.toml"), "w") as f:
             f.write(kiosk_toml(['outputs.backend="headless"', f"outputs.sizes=[{sizes}]", f'outputs.png_dir="{ref}"',
                                 'outputs.composite=false'], farm_endpoint))
-        subprocess.run([a.kiosk, "--config", os.path.join(cfg, "reference.toml"), "--duration", str(seconds)],
+        subprocess.run([a.kiosk, "--config", os.path.join(cfg, "reference.toml"), "--duration-s", str(seconds)],
                        stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT, env=env, timeout=120)
         os.remove(os.path.join(cfg, "reference.toml"))
         found = []
@@ -398,10 +398,10 @@ def main():
             farm_proc = subprocess.Popen(
                 [a.mpiexec, "--oversubscribe", "-n", "1", a.farm, "serve", "--scene",
                  os.path.join(a.repo, "scenes", "test-room.json"), "--listen", f"[::1]:{port}",
-                 "--tls-dir", farm_tls, "--name", "farm", "--threads", "1", "--duration", "1200",
+                 "--tls-dir", farm_tls, "--name", "farm", "--threads", "1", "--duration-s", "1200",
                  # The wall is compared with a full render of the same view: no frame cut by the
                  # time budget while QEMU loads the host.
-                 "--frame-budget", "0"],
+                 "--frame-budget-s", "0"],
                 stdout=farm_log, stderr=subprocess.STDOUT, env=env, start_new_session=True)
             deadline = time.monotonic() + 120
             while time.monotonic() < deadline and farm_proc.poll() is None:

@@ -43,7 +43,7 @@ def copy_with_libraries(binary, disk, name):
 def stage_tools(test_binary, disk):
     """The commands a technician points at a libcamera camera, from the build the test binary is in
     (BUILD/drivers/camera/mogao_libcamera_test): mogao-camera (info libcamera:) and mogao-track
-    (navigate --device libcamera:). selftest.sh runs each one it finds. Returns their names."""
+    (navigate --camera libcamera:). selftest.sh runs each one it finds. Returns their names."""
     build = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(test_binary))))
     staged = []
     for rel in (os.path.join("drivers", "camera", "mogao-camera"), os.path.join("appliance", "tools", "mogao-track")):

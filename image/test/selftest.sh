@@ -269,7 +269,7 @@ if [ -f /mnt/vimc.ko ] && [ -x /mnt/bin/mogao_libcamera_test ]; then
   if [ -x /mnt/bin/mogao-track ]; then
     # vimc's pipeline in libcamera 0.0.3 keeps widths that are multiples of 6: 960x540 is kept.
     printf '{"fx": 700, "fy": 700, "cx": 479.5, "cy": 269.5, "distortion": [], "image_width": 960, "image_height": 540}\n' > /tmp/lc-camera.json
-    env $lc_env timeout -s INT 20 /mnt/bin/mogao-track navigate --device libcamera: --camera /tmp/lc-camera.json \
+    env $lc_env timeout -s INT 20 /mnt/bin/mogao-track navigate --camera libcamera: --camera-calibration /tmp/lc-camera.json \
       --display-hz 10 --out /tmp/lc-poses.jsonl 2> /tmp/lc-track.err
     rc=$?
     tail -n 5 /tmp/lc-track.err | sed 's/^/MOGAO-SELFTEST libcamera-track-log /' > "$out"

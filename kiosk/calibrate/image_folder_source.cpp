@@ -176,7 +176,7 @@ cv::Mat1f ImageFolderSource::show(const std::vector<cv::Mat>& signals) {
             (phase ? "it shows " + *phase +
                          ", a phase period the pattern set lacks (the camera resolved fewer Gray bits than the "
                          "projector has, so the period grew): write the patterns again with that period in "
-                         "--phase-periods, and capture them"
+                         "--phase-periods-px, and capture them"
                    : std::string("it shows a pattern that is not in the pattern set (other calibration options?)")));
     }
     const std::vector<fs::path>& files = manifest_.captures.at(p->id);

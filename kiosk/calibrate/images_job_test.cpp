@@ -283,7 +283,7 @@ TEST_F(ImagesJobTest, PhasePeriodTheSetLacksIsNamedWithTheOptionThatAddsIt) {
     } catch (const std::runtime_error& e) {
         EXPECT_NE(std::string(e.what()).find("period 128 px, a phase period the pattern set lacks"), std::string::npos)
             << e.what();
-        EXPECT_NE(std::string(e.what()).find("--phase-periods"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("--phase-periods-px"), std::string::npos) << e.what();
     }
 }
 

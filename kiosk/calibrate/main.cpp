@@ -12,10 +12,11 @@
 //   (mogao-calibrate-sim: this program with the routes of simulation_routes.h; the shipped mogao-calibrate
 //   refuses them, exit 2.)
 //   From images captured by any camera: write the patterns, show and film each, then calibrate:
-//     mogao-calibrate patterns --site FILE --out DIR [--scale S] [--phase-periods P[,P...]]
+//     mogao-calibrate patterns --site FILE --out DIR [--scale S] [--phase-periods-px P[,P...]]
 //     mogao-calibrate --site FILE --images DIR --out DIR [--install FILE] [--camera-transfer srgb|linear]
 //   Projector intrinsics on the bench from Gray-code captures of a board (docs/calibration.md):
-//     mogao-calibrate procam --images DIR [DIR...] --projector WxH --board COLSxROWS --square-mm S --out FILE.json
+//     mogao-calibrate procam --pose-images DIR [DIR...] --projector-size WxH --board COLSxROWS --square-mm S --out
+//     FILE.json
 //   How many images and how long the capture takes:
 //     mogao-calibrate --site FILE --budget [--camera-fps 30 --settle-ms 150 --drop-frames 2]
 //
@@ -31,6 +32,7 @@
 #include <CLI/CLI.hpp>
 
 #include "appliance/autocal/calibrate_job.h"
+#include "appliance/autocal/calibration_flags.h"
 #include "common/program_cli.h"
 #include "drivers/headless/headless_output.h"
 #include "drivers/kms/kms_backend.h"
@@ -53,7 +55,7 @@ struct Cli {
     std::string camera;
     std::filesystem::path images;
     std::filesystem::path kms_device;
-    std::string content = "1920x1080";
+    autocal::CalibrationFlags shared;  // calibration_flags.h
     std::string camera_size;
     int camera_fps = 0;
     double exposure_us = 0.0;
@@ -61,13 +63,19 @@ struct Cli {
     double white_balance_k = 0.0;
     std::string transfer = "srgb";
     bool grey = false;
-    bool no_colour = false;
-    bool no_falloff = false;
-    bool no_bow = false;
-    bool pinhole_projectors = false;
     bool budget = false;
     double budget_fps = 30.0;
 };
+
+// Help texts of flags other programs declare too, word for word (one text per name, docs/cli.md;
+// the test cli_flag_names compares them): the capture device as mogao-track navigate takes it, the
+// DRM card as mogao-kms-probe does.
+constexpr const char* kCameraHelp =
+    "Capture device: v4l2:/dev/videoN (or /dev/videoN) or libcamera:[id]; mogao-calibrate also replay:DIR and "
+    "rig:FILE (simulation: mogao-calibrate-sim)";
+constexpr const char* kKmsDeviceHelp =
+    "DRM card node /dev/dri/cardN (default: mogao-calibrate the first with a connected connector, mogao-kms-probe "
+    "every card)";
 
 bool parse_size(const std::string& text, ImageSize& out) {
     return std::sscanf(text.c_str(), "%dx%d", &out.width, &out.height) == 2 && out.width >= 1 && out.height >= 1 &&
@@ -85,9 +93,17 @@ void print_progress(const CaptureProgress& p) {
                  p.seconds_left, tty ? "" : "\n");
 }
 
-int run_rig(const Cli& cli, autocal::CalibrateJob job) {
+int run_rig(const Cli& cli, const OnSiteJob& site_job) {
+    autocal::CalibrateJob job;
     job.rig = cli.rig;
-    job.colour = !cli.no_colour;
+    job.out = site_job.out;
+    job.scale = site_job.scale;
+    job.content = site_job.content;
+    job.alpha_bits = site_job.alpha_bits;
+    job.options = site_job.options;
+    job.colour = site_job.colour;
+    job.colour_options = site_job.colour_options;
+    job.self_check = site_job.self_check;
     return run_rig_calibration(job);
 }
 
@@ -119,7 +135,9 @@ std::unique_ptr<OutputBackend> open_outputs(const Cli& cli, const autocal::Calib
 std::unique_ptr<CalibrationCamera> open_live_camera(const Cli& cli, const autocal::CalibrationPrior& prior) {
     CameraSourceSpec spec;
     std::string why;
-    if (!parse_camera_source(cli.camera, spec, &why)) throw std::invalid_argument("--camera: " + why);
+    // "/dev/videoN" alone is V4L2, as mogao-track navigate takes it.
+    const std::string named = cli.camera.starts_with("/") ? "v4l2:" + cli.camera : cli.camera;
+    if (!parse_camera_source(named, spec, &why)) throw std::invalid_argument("--camera: " + why);
     ImageSize size = prior.camera.resolution;
     if (!cli.camera_size.empty() && !parse_size(cli.camera_size, size)) {
         throw std::invalid_argument("--camera-size must be WIDTHxHEIGHT");
@@ -187,51 +205,23 @@ int run_images(const Cli& cli, const OnSiteJob& job) {
     return 0;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-    CLI::App app{"Camera-based calibration of the projector wall (docs/on-site-calibration.md)"};
-    mogao::cli::prepare(app, "mogao-calibrate");
-    Cli cli;
-    OnSiteJob job;
-    autocal::CalibrateJob rig_job;
-    auto* rig =
-        app.add_option("--rig", cli.rig,
-                       "Virtual rig (rigs/*.toml): calibrate it, accuracy vs ground truth (mogao-calibrate-sim)")
-            ->check(CLI::ExistingFile);
+// The flags of the calibration itself (on site, from images, on a rig); `procam` and `patterns` add their own.
+void add_calibrate_flags(CLI::App& app, Cli& cli, OnSiteJob& job) {
+    auto* rig = app.add_option("--rig", cli.rig, "Virtual rig (rigs/*.toml)")->check(CLI::ExistingFile);
     auto* site = app.add_option("--site", cli.site, "Site file (rig format): the installation as measured")
                      ->check(CLI::ExistingFile);
     rig->excludes(site);
     app.add_option("--out", job.out, "Output folder");
     app.add_option("--outputs", cli.outputs, "kms or headless")->check(CLI::IsMember({"kms", "headless"}));
-    app.add_option("--camera", cli.camera,
-                   "v4l2:/dev/videoN, libcamera:[id], replay:DIR or rig:FILE (simulation: mogao-calibrate-sim)");
-    auto* images = app.add_option("--images", cli.images,
-                                  "Folder of captured images with captures.json (`patterns`): calibrate from them, "
-                                  "no outputs or camera driven")
-                       ->check(CLI::ExistingDirectory);
-    images->excludes(rig);
+    app.add_option("--camera", cli.camera, kCameraHelp);
+    app.add_option("--images", cli.images,
+                   "Folder of captured images with captures.json (`patterns`): calibrate from them, no outputs or "
+                   "camera driven")
+        ->check(CLI::ExistingDirectory)
+        ->excludes(rig);
     app.add_option("--install", job.install, "Also write the MPCDI here (the kiosk's [calibration].source)");
-    app.add_option("--kms-device", cli.kms_device, "DRM card (default: the first with a connected connector)");
-    app.add_option("--scale", job.scale, "Resolution scale of projectors and camera, (0, 1]")
-        ->check(CLI::Range(0.05, 1.0));
-    app.add_option("--content", cli.content, "Content frame WIDTHxHEIGHT (the farm's frame)");
-    app.add_option("--alpha-bits", job.alpha_bits, "Alpha map bits, 8 or 16")->check(CLI::IsMember({8, 16}));
-    app.add_option("--warp-step", job.options.warp_step_px, "Warp grid step, output pixels")->check(CLI::Range(1, 64));
-    app.add_flag("--fit-screen", job.options.fit_screen,
-                 "Fit the screen's radius and arc too (known only roughly; the heights are taken as measured)");
-    app.add_flag("--no-bow", cli.no_bow,
-                 "Take the screen as an exact cylinder: do not try a bow (kept by default only where it pays)");
-    app.add_flag("--pinhole-projectors", cli.pinhole_projectors,
-                 "Take the projectors as pinholes: do not try fitting their lens distortion (kept by default, per "
-                 "projector, only where it pays; self-recalibration needs pinholes)");
-    app.add_option("--max-self-check-px", job.self_check.max_mean_px,
-                   "Self-check gate: refuse when the verification marks land further than this from where they "
-                   "belong (mean, projector pixels, measured against the screen's frame)")
-        ->check(CLI::PositiveNumber);
-    app.add_flag("--no-colour", cli.no_colour, "Geometry only: no response, black-level and colour matching step");
-    app.add_flag("--no-falloff", cli.no_falloff,
-                 "Colour step without the lens fall-off: one gain per projector and channel (flat projectors)");
+    app.add_option("--kms-device", cli.kms_device, kKmsDeviceHelp);
+    autocal::add_calibration_flags(app, cli.shared, job);
     app.add_option("--camera-size", cli.camera_size, "Camera WIDTHxHEIGHT (default: the site file's camera)");
     app.add_option("--camera-fps", cli.camera_fps, "Camera frame rate to ask for (0: the driver's)")
         ->check(CLI::Range(0, 1000));
@@ -248,6 +238,37 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(0, 30));
     app.add_flag("--budget", cli.budget, "Print the image count and capture time for --site, then exit");
     app.add_option("--budget-fps", cli.budget_fps, "Camera frame rate for --budget")->check(CLI::Range(1.0, 1000.0));
+}
+
+// After the parse: what CLI11 cannot check, and the flags into the job. Throws CLI::ValidationError.
+void apply_calibrate_flags(const Cli& cli, OnSiteJob& job) {
+    autocal::apply_calibration_flags(cli.shared, job);
+    if (cli.rig.empty() && cli.site.empty()) throw CLI::ValidationError("--rig or --site", "one is required");
+    if (!has_simulation_routes() && (!cli.rig.empty() || cli.camera.starts_with("rig:"))) {
+        throw CLI::ValidationError(
+            "--rig and --camera rig:FILE",
+            "are simulation: mogao-calibrate-sim has them (built with the tests, not installed)");
+    }
+    if (!cli.budget && job.out.empty()) throw CLI::ValidationError("--out", "is required");
+    if (!cli.images.empty() && (!cli.outputs.empty() || !cli.camera.empty() || cli.budget)) {
+        throw CLI::ValidationError("--images", "replaces --outputs and --camera (and is no --budget)");
+    }
+    if (!cli.site.empty() && !cli.budget && cli.images.empty() && (cli.outputs.empty() || cli.camera.empty())) {
+        throw CLI::ValidationError("--site", "needs --outputs and --camera, or --images (or --budget)");
+    }
+    job.site = cli.site;
+    job.transfer =
+        cli.transfer == "linear" || cli.camera.starts_with("rig:") ? CameraTransfer::linear : CameraTransfer::srgb;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"Camera-based calibration of the projector wall (docs/on-site-calibration.md)"};
+    mogao::cli::prepare(app, "mogao-calibrate");
+    Cli cli;
+    OnSiteJob job;
+    add_calibrate_flags(app, cli, job);
     ProcamCommand procam;
     add_procam_command(app, procam);
     PatternsCommand patterns;
@@ -256,41 +277,12 @@ int main(int argc, char** argv) {
         app.parse(argc, argv);
         if (procam.app->parsed()) return run_procam_command(procam);
         if (patterns.app->parsed()) return run_patterns_command(patterns);
-        if (!parse_size(cli.content, job.content))
-            throw CLI::ValidationError("--content", "must be WIDTHxHEIGHT, 1..16384");
-        if (cli.rig.empty() && cli.site.empty()) throw CLI::ValidationError("--rig or --site", "one is required");
-        if (!has_simulation_routes() && (!cli.rig.empty() || cli.camera.starts_with("rig:"))) {
-            throw CLI::ValidationError("--rig and --camera rig:FILE",
-                                       "are simulation: mogao-calibrate-sim has them (built with the tests, not "
-                                       "installed)");
-        }
-        if (!cli.budget && job.out.empty()) throw CLI::ValidationError("--out", "is required");
-        if (!cli.images.empty() && (!cli.outputs.empty() || !cli.camera.empty() || cli.budget)) {
-            throw CLI::ValidationError("--images", "replaces --outputs and --camera (and is no --budget)");
-        }
-        if (!cli.site.empty() && !cli.budget && cli.images.empty() && (cli.outputs.empty() || cli.camera.empty())) {
-            throw CLI::ValidationError("--site", "needs --outputs and --camera, or --images (or --budget)");
-        }
+        apply_calibrate_flags(cli, job);
     } catch (const CLI::ParseError& e) {
         return mogao::cli::exit_status(app, e);
     }
-    job.site = cli.site;
-    job.colour = !cli.no_colour;
-    job.colour_options.lens_falloff = !cli.no_falloff;
-    job.options.fit_bow = !cli.no_bow;
-    job.options.fit_projector_distortion = !cli.pinhole_projectors;
-    job.transfer =
-        cli.transfer == "linear" || cli.camera.starts_with("rig:") ? CameraTransfer::linear : CameraTransfer::srgb;
     try {
-        if (!cli.rig.empty()) {
-            rig_job.out = job.out;
-            rig_job.scale = job.scale;
-            rig_job.content = job.content;
-            rig_job.alpha_bits = job.alpha_bits;
-            rig_job.options = job.options;
-            rig_job.colour_options = job.colour_options;
-            return run_rig(cli, rig_job);
-        }
+        if (!cli.rig.empty()) return run_rig(cli, job);
         if (cli.budget) return run_budget(cli, job);
         if (!cli.images.empty()) return run_images(cli, job);
         return run_site(cli, job);

@@ -6,6 +6,7 @@
 #include <iostream>
 #include <stdexcept>
 
+#include "appliance/autocal/calibration_flags.h"
 #include "kiosk/calibrate/on_site_job.h"
 #include "kiosk/calibrate/pattern_catalogue.h"
 
@@ -19,10 +20,9 @@ void add_patterns_command(CLI::App& parent, PatternsCommand& cmd) {
         ->required()
         ->check(CLI::ExistingFile);
     cmd.app->add_option("--out", cmd.out, "Folder to write the patterns into")->required();
-    cmd.app->add_option("--scale", cmd.scale, "Resolution scale of projectors and camera, (0, 1]")
-        ->check(CLI::Range(0.05, 1.0));
+    autocal::add_scale_flag(*cmd.app, cmd.scale);
     cmd.app
-        ->add_option("--phase-periods", cmd.phase_periods_px,
+        ->add_option("--phase-periods-px", cmd.phase_periods_px,
                      "Phase-shift periods, projector pixels (default: the calibration's; add longer ones when the "
                      "camera resolves fewer Gray bits)")
         ->delimiter(',')

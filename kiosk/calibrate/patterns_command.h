@@ -2,7 +2,7 @@
 // `mogao-calibrate patterns`: the calibration's patterns written as files, so that any camera can
 // capture them (pattern_catalogue.h; docs/on-site-calibration.md, "Calibration from captured images").
 //
-//   mogao-calibrate patterns --site FILE --out DIR [--scale S] [--phase-periods P[,P...]]
+//   mogao-calibrate patterns --site FILE --out DIR [--scale S] [--phase-periods-px P[,P...]]
 //
 // Writes DIR/p<k>/*.png (one image per pattern per projector, the site file's projectors left to
 // right), DIR/patterns.json (the manifest) and DIR/captures.json (the captures manifest to fill in).

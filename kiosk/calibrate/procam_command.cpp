@@ -41,14 +41,17 @@ void add_procam_command(CLI::App& parent, ProcamCommand& cmd) {
     cmd.app = parent.add_subcommand("procam",
                                     "Projector intrinsics on the bench from Gray-code captures of a board "
                                     "(docs/calibration.md)");
-    cmd.app->add_option("--images", cmd.images, "Capture folders (graycode_00.png ...), one per board pose")
+    cmd.app->add_option("--pose-images", cmd.images, "Capture folders (graycode_00.png ...), one per board pose")
         ->required()
         ->check(CLI::ExistingDirectory);
-    cmd.app->add_option("--projector", cmd.projector, "Projector WIDTHxHEIGHT the patterns were made for")->required();
-    cmd.app->add_option("--board", cmd.board, "Inner corners COLSxROWS")->required();
-    cmd.app->add_option("--square-mm", cmd.square_mm, "Board square, mm")->required()->check(CLI::Range(0.01, 10000.0));
+    cmd.app->add_option("--projector-size", cmd.projector, "Projector resolution WIDTHxHEIGHT")->required();
+    // The same texts as mogao-track calibrate-camera's (one text per name, docs/cli.md).
+    cmd.app->add_option("--board", cmd.board, "Chessboard inner corners, COLUMNSxROWS")->required();
+    cmd.app->add_option("--square-mm", cmd.square_mm, "Chessboard square side, mm")
+        ->required()
+        ->check(CLI::Range(0.01, 10000.0));
     cmd.app->add_option("--out", cmd.out, "Calibration file (JSON) to write")->required();
-    cmd.app->add_option("--window", cmd.window_px, "Local homography window half-width, camera pixels")
+    cmd.app->add_option("--half-window-px", cmd.window_px, "Local homography window half-width, camera pixels")
         ->check(CLI::Range(2, 200));
     cmd.app->add_flag("--projector-distortion", cmd.projector_distortion,
                       "Fit the projector's radial k1, k2 (needs many varied poses; default: a pinhole)");
@@ -58,7 +61,8 @@ int run_procam_command(const ProcamCommand& cmd) {
     procam::ProcamJob job;
     job.captures = cmd.images;
     if (!parse_pair(cmd.projector, job.projector.width, job.projector.height, 2, 16384)) {
-        std::cerr << "mogao-calibrate procam: --projector " << cmd.projector << ": must be WIDTHxHEIGHT, 2..16384\n";
+        std::cerr << "mogao-calibrate procam: --projector-size " << cmd.projector
+                  << ": must be WIDTHxHEIGHT, 2..16384\n";
         return 2;
     }
     if (!parse_pair(cmd.board, job.board.columns, job.board.rows, 2, 64)) {
@@ -66,7 +70,7 @@ int run_procam_command(const ProcamCommand& cmd) {
         return 2;
     }
     if (cmd.images.size() < 2) {
-        std::cerr << "mogao-calibrate procam: --images: at least 2 capture folders (board poses) are needed\n";
+        std::cerr << "mogao-calibrate procam: --pose-images: at least 2 capture folders (board poses) are needed\n";
         return 2;
     }
     job.board.square_mm = cmd.square_mm;

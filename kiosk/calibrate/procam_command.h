@@ -4,8 +4,8 @@
 // bench"), and the bridge that hands its projector intrinsics to the on-site calibration as the
 // projector's prior.
 //
-//   mogao-calibrate procam --images DIR [DIR...] --projector WxH --board COLSxROWS --square-mm S
-//                          --out FILE.json [--window PX] [--projector-distortion]
+//   mogao-calibrate procam --pose-images DIR [DIR...] --projector-size WxH --board COLSxROWS --square-mm S
+//                          --out FILE.json [--half-window-px PX] [--projector-distortion]
 #pragma once
 
 #include <filesystem>
@@ -34,7 +34,7 @@ struct ProcamCommand {
 void add_procam_command(CLI::App& parent, ProcamCommand& cmd);
 
 // Runs a parsed subcommand: 0 written, 1 the job failed (the message names the folder or file and
-// the reason), 2 a malformed --projector or --board.
+// the reason), 2 a malformed --projector-size or --board.
 [[nodiscard]] int run_procam_command(const ProcamCommand& cmd);
 
 // The on-site calibration's projector prior (appliance/autocal: CalibrationPrior::projectors, the

@@ -11,6 +11,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "appliance/autocal/calibration_flags.h"
 #include "appliance/autocal/rig_bridge.h"
 #include "appliance/calibration/mpcdi_reader.h"
 #include "appliance/calibration/mpcdi_screen.h"
@@ -29,7 +30,7 @@ int main(int argc, char** argv) {
     std::filesystem::path mpcdi;
     double scale = 1.0;
     app.add_option("--rig", rig_file, "Virtual rig (rigs/*.toml)")->required()->check(CLI::ExistingFile);
-    app.add_option("--scale", scale, "Resolution scale of projectors and camera, (0, 1]")->check(CLI::Range(0.05, 1.0));
+    autocal::add_scale_flag(app, scale);
     auto* film = app.add_subcommand("film", "Film every pattern of DIR/patterns.json into DIR/captures.json's files");
     film->add_option("--patterns", patterns, "Folder `mogao-calibrate patterns` wrote")
         ->required()

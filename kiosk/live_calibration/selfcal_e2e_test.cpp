@@ -134,7 +134,7 @@ TEST(SelfcalKioskEndToEnd, ABumpedProjectorIsCorrectedAndWrittenBackByMogaoKiosk
          "stats.file=", R"(stats.status_file="status.json")", "stats.status_period_s=0.2", "selfcal.enabled=true",
          R"(selfcal.camera="rig:bumped.toml")", "selfcal.hold_s=1", "selfcal.transition_s=1"});
     std::ofstream(dir / "kiosk.toml") << toml;
-    ChildProcess kiosk({MOGAO_KIOSK_BINARY, "--config", (dir / "kiosk.toml").string(), "--duration", "100"});
+    ChildProcess kiosk({MOGAO_KIOSK_BINARY, "--config", (dir / "kiosk.toml").string(), "--duration-s", "100"});
     ASSERT_TRUE(kiosk.running());
 
     // Poll the status file (written atomically) until calibrated again after a correction.

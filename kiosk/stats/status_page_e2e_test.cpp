@@ -192,7 +192,7 @@ std::string run_kiosk(const fs::path& dir, const fs::path& calibration) {
          "navigation.path_frames=10", "stats.file=", R"(stats.status_file="status.json")",
          "stats.status_period_s=0.2"});
     std::ofstream(dir / "kiosk.toml") << toml;
-    ChildProcess kiosk({MOGAO_KIOSK_BINARY, "--config", (dir / "kiosk.toml").string(), "--duration", "120"});
+    ChildProcess kiosk({MOGAO_KIOSK_BINARY, "--config", (dir / "kiosk.toml").string(), "--duration-s", "120"});
     const fs::path status = dir / "status.json";
     if (wait_status(status, kiosk, [](const nlohmann::json& j) {
             return j.value("frames_shown", 0) >= 20 && j.value("fps", 0.0) > 0.0;

@@ -50,13 +50,13 @@ void add_farm_flags(CLI::App& command, mogao::FarmSetup& setup, std::string& sca
                        "Folder of the real scans (default: $MOGAO_SCANS_DIR or ../shared/data/scans)");
     command.add_option("--balance", setup.dispatch.balancer, "pbt | equal | roundrobin")
         ->check(CLI::IsMember({"pbt", "equal", "roundrobin"}));
-    command.add_option("--snap", setup.dispatch.snap, "PBT/equal split snap in pixels")
+    command.add_option("--snap-px", setup.dispatch.snap, "PBT/equal split snap in pixels")
         ->check(CLI::IsMember({4, 8, 16, 32}));
-    command.add_option("--rr-tile", setup.dispatch.roundrobin_tile, "Round-robin tile size in pixels")
+    command.add_option("--rr-tile-px", setup.dispatch.roundrobin_tile, "Round-robin tile size in pixels")
         ->check(CLI::Range(8, 1024));
     command.add_option("--threads", setup.dispatch.threads, "Render threads per rank")->check(CLI::Range(1, 256));
     command
-        .add_option("--rank-deadline", setup.dispatch.rank_deadline_s,
+        .add_option("--rank-deadline-s", setup.dispatch.rank_deadline_s,
                     "Most seconds a render rank that owes a frame may stay silent (rendering ranks report their "
                     "progress every 0.1 s, however long the frame takes); a silent rank is taken as lost and the MPI "
                     "job is aborted (exit 3) so that systemd restarts the farm over the hosts that answer (0 = wait "
@@ -117,24 +117,24 @@ void add_live_flags(CLI::App& serve, mogao::ServeOptions& options, double& frame
 void add_render_flags(CLI::App& render, mogao::PathTour& job, CameraFlags& camera) {
     auto& q = job.view_template.quality;
     render.add_option("--frames", job.frames, "Number of frames of the camera path")->check(CLI::Range(1, 1000000));
-    render.add_option("--path", job.path, "walk | orbit | a JSON path file");
+    render.add_option("--path", job.path, mogao::cli::kPathHelp);
     render
         .add_option("--out", job.out_dir,
                     "Output folder for frame-NNNN.jpg, stats.json, tile-costs.json, contact-sheet.png")
         ->required();
-    render.add_option("--width", job.view_template.size.width, "Frame width in pixels")
+    render.add_option("--width", job.view_template.size.width, "Image width in pixels")
         ->check(CLI::Range(16, L::kImageSide.max));
-    render.add_option("--height", job.view_template.size.height, "Frame height in pixels")
+    render.add_option("--height", job.view_template.size.height, "Image height in pixels")
         ->check(CLI::Range(16, L::kImageSide.max));
-    render.add_option("--camera", camera.kind, "cylinder (the projection screen's content) | pinhole")
+    render.add_option("--projection", camera.kind, "cylinder (the projection screen's content) | pinhole")
         ->check(CLI::IsMember({"cylinder", "pinhole"}));
-    render.add_option("--fov", camera.fov_deg, "Pinhole vertical field of view, degrees")
+    render.add_option("--fov-deg", camera.fov_deg, "Pinhole vertical field of view, degrees")
         ->check(CLI::Range(1.0, 179.0));
-    render.add_option("--screen-radius", camera.radius, "Cylinder screen radius, metres")
+    render.add_option("--screen-radius-m", camera.radius, "Cylinder screen radius, metres")
         ->check(CLI::Range(0.1, 1000.0));
-    render.add_option("--screen-arc", camera.arc, "Cylinder screen arc, degrees")->check(CLI::Range(1.0, 360.0));
-    render.add_option("--screen-bottom", camera.bottom, "Cylinder screen bottom edge, metres above the floor");
-    render.add_option("--screen-top", camera.top, "Cylinder screen top edge, metres above the floor");
+    render.add_option("--screen-arc-deg", camera.arc, "Cylinder screen arc, degrees")->check(CLI::Range(1.0, 360.0));
+    render.add_option("--screen-bottom-m", camera.bottom, "Cylinder screen bottom edge, metres above the floor");
+    render.add_option("--screen-top-m", camera.top, "Cylinder screen top edge, metres above the floor");
     render.add_option("--spp", q.spp, "Samples per pixel")->check(CLI::Range(L::kSpp.min, L::kSpp.max));
     render.add_option("--bounces", q.max_bounces, "Path-tracing bounces (0 = direct light only)")
         ->check(CLI::Range(L::kMaxBounces.min, L::kMaxBounces.max));
@@ -142,10 +142,11 @@ void add_render_flags(CLI::App& render, mogao::PathTour& job, CameraFlags& camer
         ->check(CLI::Range(L::kAoSamples.min, L::kAoSamples.max));
     render.add_option("--area-samples", q.area_light_samples, "Shadow rays per area light per sample")
         ->check(CLI::Range(L::kAreaLightSamples.min, L::kAreaLightSamples.max));
-    render.add_option("--scale", q.resolution_scale, "Resolution scale (0, 1]")->check(CLI::Range(0.01, 1.0));
+    render.add_option("--resolution-scale", q.resolution_scale, "Resolution scale of the frames, (0, 1]")
+        ->check(CLI::Range(0.01, 1.0));
     render.add_option("--jpeg-quality", q.jpeg_quality, "TurboJPEG quality 1..100")
         ->check(CLI::Range(L::kJpegQuality.min, L::kJpegQuality.max));
-    render.add_option("--seed", job.view_template.seed, "Sampling seed (same seed, same pixels)");
+    render.add_option("--seed", job.view_template.seed, "Sampling seed (same seed, same image)");
     render.add_option(
         "--first-frame-id", job.first_frame_id,
         "frame_id of the first frame (sampling depends on seed and frame_id; a live frame's is its request id)");
@@ -161,7 +162,7 @@ void add_view_policy_flags(CLI::App& serve, mogao::ViewPolicy& policy, std::vect
                    "Move each requested eye into the scene's viewer.visitable area (default, when the scene has one)");
     serve
         .add_option("--view-screen", screen,
-                    "The appliances' screen RADIUS,ARC,BOTTOM,TOP[,EYE_HEIGHT] (metres, degrees): cylinder requests "
+                    "The appliances' screen RADIUS_M,ARC_DEG,BOTTOM_M,TOP_M[,EYE_HEIGHT_M]: cylinder requests "
                     "get its shape and at most its arc plus the guard band, pinhole requests its camera")
         ->delimiter(',')
         ->expected(4, 5);
@@ -218,7 +219,7 @@ void add_link_flags(CLI::App& serve, mogao::ServeOptions& serve_options, std::fi
         ->check(CLI::Range(1.0, 3600.0));
     serve
         .add_option("--max-request-megapixels", serve_options.policy.max_megapixels,
-                    "Rendered pixels per request, millions; a larger request is rendered at a lower resolution scale")
+                    "Megapixels rendered per request; a larger request is rendered at a lower resolution scale")
         ->check(CLI::Range(0.001, 268.5));
     serve
         .add_option("--max-request-gigarays", serve_options.policy.max_gigarays,
@@ -249,7 +250,7 @@ void apply_render_preset(const CLI::App& render, const mogao::QualityPreset& p, 
     if (unset("--bounces")) q.max_bounces = p.request.max_bounces;
     if (unset("--ao")) q.ao_samples = p.request.ao_samples;
     if (unset("--area-samples")) q.area_light_samples = p.request.area_light_samples;
-    if (unset("--scale")) q.resolution_scale = p.request.resolution_scale;
+    if (unset("--resolution-scale")) q.resolution_scale = p.request.resolution_scale;
     if (unset("--jpeg-quality")) q.jpeg_quality = p.request.jpeg_quality;
 }
 
@@ -313,6 +314,103 @@ bool asks_for_help_or_version(int argc, char** argv) {
     return false;
 }
 
+// `render`: a camera path into numbered frames.
+struct RenderCommand {
+    CLI::App* app = nullptr;
+    mogao::PathTour job;
+    CameraFlags camera;
+    std::string preset;
+};
+
+// `serve`: live tours for authenticated appliances.
+struct ServeCommand {
+    CLI::App* app = nullptr;
+    mogao::ServeOptions options;
+    std::filesystem::path tls_dir;
+    std::string farm_name = "farm";
+    std::string preset;
+    double frame_time_ms = 0.0;
+    double frame_budget_s = 1.0;
+    std::vector<double> view_screen;
+    std::filesystem::path view_policy_file;
+};
+
+void add_render_command(CLI::App& app, mogao::FarmSetup& setup, std::string& scans, RenderCommand& r) {
+    r.app = app.add_subcommand("render", "Render a camera path headless into numbered JPEG frames");
+    add_farm_flags(*r.app, setup, scans);
+    add_render_flags(*r.app, r.job, r.camera);
+    add_quality_flag(*r.app, r.preset);
+}
+
+void add_serve_command(CLI::App& app, mogao::FarmSetup& setup, std::string& scans, ServeCommand& s) {
+    s.app = app.add_subcommand("serve", "Serve live tours to authenticated appliances over IPv6 (gRPC, mutual TLS)");
+    add_farm_flags(*s.app, setup, scans);
+    add_link_flags(*s.app, s.options, s.tls_dir, s.farm_name);
+    // Off unless asked: a refined frame is not the lone render of its request that the kiosk's
+    // end-to-end tests compare against.
+    s.options.live.progressive = false;
+    add_live_flags(*s.app, s.options, s.frame_time_ms);
+    add_quality_flag(*s.app, s.preset);
+    add_view_policy_flags(*s.app, s.options.view_policy, s.view_screen, s.view_policy_file);
+    s.app
+        ->add_option("--frame-budget-s", s.frame_budget_s,
+                     "Seconds a frame may take: the rest of a frame still rendering then is rendered coarse, and a "
+                     "session's next requests are degraded from what its frames cost (0 = no budget)")
+        ->check(CLI::Range(0.0, 3600.0));
+    mogao::cli::add_duration_flag(*s.app, s.options.duration_s);
+}
+
+// After the parse: the presets and what the flags imply.
+void apply_flags(RenderCommand& r, ServeCommand& s) {
+    if (!s.preset.empty())
+        apply_serve_preset(*s.app, *mogao::quality_preset(s.preset), s.options.live, s.frame_time_ms);
+    if (!r.preset.empty()) apply_render_preset(*r.app, *mogao::quality_preset(r.preset), r.job.view_template.quality);
+    if (s.app->count("--temporal") == 0 && s.app->count("--no-temporal") == 0)
+        s.options.live.temporal = s.options.live.denoise;
+    s.options.live.frame_time_s = s.frame_time_ms / 1e3;
+    const std::vector<double>& v = s.view_screen;
+    if (!v.empty()) {
+        s.options.view_policy.screen =
+            mogao::CylinderScreen{v[0], v[1], v[2], v[3], {0.0, v.size() > 4 ? v[4] : 1.6, 0.0}};
+    }
+}
+
+int run_serve_command(mogao::MpiSession& mpi, mogao::FarmSetup& setup, ServeCommand& s) {
+    setup.dispatch.frame_budget_s = s.frame_budget_s;
+    s.options.budget.frame_s = s.frame_budget_s;
+    // Only the admin talks to appliances, so only the admin host holds the link's key, its
+    // revocation list and the view policies (render hosts have no /etc/mogao/pki). Every rank
+    // then agrees: one that returned alone would wait in MPI_Finalize while the others wait
+    // for it in their first collective (the two-host farm hung so).
+    const std::string error =
+        mpi.is_admin() ? prepare_admin_link(s.options, s.tls_dir, s.farm_name, s.view_policy_file) : std::string();
+    if (!error.empty()) spdlog::error("{}", error);
+    if (!mpi.all(error.empty())) return 2;
+    return mogao::run_farm(mpi, setup,
+                           [&](mogao::FrameDispatcher& farm, const mogao::Scene& scene, mogao::RunInfo& run) {
+                               return mogao::run_serve(s.options, farm, scene, run);
+                           });
+}
+
+int run_render_command(mogao::MpiSession& mpi, mogao::FarmSetup& setup, RenderCommand& r) {
+    const CameraFlags& camera = r.camera;
+    if (camera.kind == "pinhole") {
+        r.job.view_template.camera = mogao::PinholeCamera{camera.fov_deg};
+    } else {
+        if (!(camera.top > camera.bottom)) {
+            if (mpi.is_admin())
+                spdlog::error("--screen-top-m ({}) must be above --screen-bottom-m ({})", camera.top, camera.bottom);
+            return 2;
+        }
+        r.job.view_template.camera =
+            mogao::CylinderScreen{camera.radius, camera.arc, camera.bottom, camera.top, {0.0, camera.eye_height, 0.0}};
+    }
+    return mogao::run_farm(mpi, setup,
+                           [&](mogao::FrameDispatcher& farm, const mogao::Scene& scene, mogao::RunInfo& run) {
+                               return mogao::run_path_tour(r.job, farm, scene, run);
+                           });
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -323,39 +421,11 @@ int main(int argc, char** argv) {
     mogao::cli::prepare(app, "mogao-farm");
     app.require_subcommand(1);
     mogao::FarmSetup setup;
-    mogao::PathTour job;
-    CameraFlags camera;
     std::string scans;
-    CLI::App* render = app.add_subcommand("render", "Render a camera path headless into numbered JPEG frames");
-    add_farm_flags(*render, setup, scans);
-    add_render_flags(*render, job, camera);
-    std::string render_preset, serve_preset;
-    add_quality_flag(*render, render_preset);
-
-    mogao::ServeOptions serve_options;
-    std::filesystem::path tls_dir;
-    std::string farm_name = "farm";
-    CLI::App* serve =
-        app.add_subcommand("serve", "Serve live tours to authenticated appliances over IPv6 (gRPC, mutual TLS)");
-    add_farm_flags(*serve, setup, scans);
-    add_link_flags(*serve, serve_options, tls_dir, farm_name);
-    double frame_time_ms = 0.0;
-    // Off unless asked: a refined frame is not the lone render of its request that the kiosk's
-    // end-to-end tests compare against.
-    serve_options.live.progressive = false;
-    add_live_flags(*serve, serve_options, frame_time_ms);
-    add_quality_flag(*serve, serve_preset);
-    std::vector<double> view_screen;
-    std::filesystem::path view_policy_file;
-    add_view_policy_flags(*serve, serve_options.view_policy, view_screen, view_policy_file);
-    double frame_budget_s = 1.0;
-    serve
-        ->add_option("--frame-budget", frame_budget_s,
-                     "Seconds a frame may take: the rest of a frame still rendering then is rendered coarse, and a "
-                     "session's next requests are degraded from what its frames cost (0 = no budget)")
-        ->check(CLI::Range(0.0, 3600.0));
-    serve->add_option("--duration", serve_options.duration_s, "Stop after this many seconds (0 = until SIGTERM)")
-        ->check(CLI::Range(0.0, 1e9));
+    RenderCommand render;
+    add_render_command(app, setup, scans, render);
+    ServeCommand serve;
+    add_serve_command(app, setup, scans, serve);
     // Listed in --help; handled at the top of main, before MPI starts.
     app.add_subcommand(
            "pki", "The link's PKI: CA, farm and appliance certificates, revocation (no MPI; mogao-farm pki --help)")
@@ -377,50 +447,7 @@ int main(int argc, char** argv) {
         return mogao::cli::exit_status(app, e, /*quiet=*/!mpi.is_admin());  // 2 on every rank
     }
     setup.scene_options.scans_dir = scans;
-    if (!serve_preset.empty())
-        apply_serve_preset(*serve, *mogao::quality_preset(serve_preset), serve_options.live, frame_time_ms);
-    if (!render_preset.empty())
-        apply_render_preset(*render, *mogao::quality_preset(render_preset), job.view_template.quality);
-    if (serve->count("--temporal") == 0 && serve->count("--no-temporal") == 0)
-        serve_options.live.temporal = serve_options.live.denoise;
-    serve_options.live.frame_time_s = frame_time_ms / 1e3;
-    if (!view_screen.empty()) {
-        serve_options.view_policy.screen =
-            mogao::CylinderScreen{view_screen[0],
-                                  view_screen[1],
-                                  view_screen[2],
-                                  view_screen[3],
-                                  {0.0, view_screen.size() > 4 ? view_screen[4] : 1.6, 0.0}};
-    }
-    if (serve->parsed()) {
-        setup.dispatch.frame_budget_s = frame_budget_s;
-        serve_options.budget.frame_s = frame_budget_s;
-        // Only the admin talks to appliances, so only the admin host holds the link's key, its
-        // revocation list and the view policies (render hosts have no /etc/mogao/pki). Every rank
-        // then agrees: one that returned alone would wait in MPI_Finalize while the others wait
-        // for it in their first collective (the two-host farm hung so).
-        const std::string error =
-            mpi.is_admin() ? prepare_admin_link(serve_options, tls_dir, farm_name, view_policy_file) : std::string();
-        if (!error.empty()) spdlog::error("{}", error);
-        if (!mpi.all(error.empty())) return 2;
-        return mogao::run_farm(mpi, setup,
-                               [&](mogao::FrameDispatcher& farm, const mogao::Scene& scene, mogao::RunInfo& run) {
-                                   return mogao::run_serve(serve_options, farm, scene, run);
-                               });
-    }
-    if (camera.kind == "pinhole") {
-        job.view_template.camera = mogao::PinholeCamera{camera.fov_deg};
-    } else {
-        if (!(camera.top > camera.bottom)) {
-            if (mpi.is_admin())
-                spdlog::error("--screen-top ({}) must be above --screen-bottom ({})", camera.top, camera.bottom);
-            return 2;
-        }
-        job.view_template.camera =
-            mogao::CylinderScreen{camera.radius, camera.arc, camera.bottom, camera.top, {0.0, camera.eye_height, 0.0}};
-    }
-    return mogao::run_farm(mpi, setup,
-                           [&](mogao::FrameDispatcher& farm, const mogao::Scene& scene, mogao::RunInfo& run) {
-                               return mogao::run_path_tour(job, farm, scene, run);
-                           });
+    apply_flags(render, serve);
+    if (serve.app->parsed()) return run_serve_command(mpi, setup, serve);
+    return run_render_command(mpi, setup, render);
 }

@@ -98,7 +98,7 @@ if [[ "$mode" == multihost ]]; then
   log "rank 2 runs on the render host (namespace $ns_render); ranks 0-1 on the admin"
 fi
 
-"${kiosk_prefix[@]}" timeout 300 "$kiosk" --config "$work/kiosk.toml" --frames 100 --duration 240 \
+"${kiosk_prefix[@]}" timeout 300 "$kiosk" --config "$work/kiosk.toml" --frames 100 --duration-s 240 \
   --dump-content "$work/content" --dump-every 25 --stats "$work/stats.json" >"$work/kiosk.log" 2>&1
 rc=$?
 stop_farm TERM

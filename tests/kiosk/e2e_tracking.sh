@@ -49,7 +49,7 @@ grep -q '^source = "tracking"' "$work/kiosk.toml" || fail "the tracking source i
 start_farm "$work/farm.log" "$endpoint"
 log "farm up at $endpoint"
 
-timeout 120 "$kiosk" --config "$work/kiosk.toml" --duration 90 --pose-log "$work/poses.jsonl" \
+timeout 120 "$kiosk" --config "$work/kiosk.toml" --duration-s 90 --pose-log "$work/poses.jsonl" \
   --stats "$work/stats.json" >"$work/kiosk.log" 2>&1
 rc=$?
 stop_farm TERM

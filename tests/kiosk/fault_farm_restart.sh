@@ -27,7 +27,7 @@ write_config "$work/kiosk.toml" "$endpoint" "$work/pki" "$work/png" 3 'status.fa
 start_farm "$work/farm-1.log" "$endpoint"
 log "farm 1 up at $endpoint"
 
-timeout 300 "$kiosk" --config "$work/kiosk.toml" --frames 150 --duration 200 --stats "$work/stats.json" \
+timeout 300 "$kiosk" --config "$work/kiosk.toml" --frames 150 --duration-s 200 --stats "$work/stats.json" \
   >"$work/kiosk.log" 2>&1 &
 kiosk_pid=$!
 

@@ -97,7 +97,7 @@ source "$src/tests/mpi_env.sh"
 for start in 1 2 3 4 5 6; do
   echo "supervise: start \$start at \$(date +%s%N)"
   "$launcher" "$work/farm-hosts" 3 "$farm" serve --scene "$src/scenes/test-room.json" --listen "[::]:7443" \
-    --tls-dir "$work/farm-tls" --duration 300
+    --tls-dir "$work/farm-tls" --duration-s 300
   rc=\$?
   echo "supervise: exit \$rc at \$(date +%s%N)"
   [ \$rc -eq 0 ] && exit 0
@@ -124,7 +124,7 @@ wait_serving() {
 wait_serving 1 2
 log "farm up over 3 hosts (2 render ranks)"
 
-ip netns exec "$K" timeout 300 "$kiosk" --config "$work/kiosk.toml" --frames 1000000 --duration 200 \
+ip netns exec "$K" timeout 300 "$kiosk" --config "$work/kiosk.toml" --frames 1000000 --duration-s 200 \
   --stats "$work/stats.json" >"$work/kiosk.log" 2>&1 &
 kiosk_pid=$!
 # wait_frames N SECONDS: until the kiosk's periodic stats line reports at least N frames more than now.

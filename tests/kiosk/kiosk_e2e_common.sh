@@ -12,7 +12,7 @@ CONTENT_W=480
 CONTENT_H=270
 JPEG_QUALITY=90
 PSNR_MIN_DB=35          # decoded frame vs the farm's lossless render of the same pose, JPEG q90
-SCREEN_ARGS=(--camera cylinder --screen-radius 3 --screen-arc 150 --screen-bottom 0.2 --screen-top 2.8)
+SCREEN_ARGS=(--projection cylinder --screen-radius-m 3 --screen-arc-deg 150 --screen-bottom-m 0.2 --screen-top-m 2.8)
 
 farm_sid=""             # session id of the running farm (mpirun is its leader)
 kiosk_pid=""
@@ -112,11 +112,11 @@ FARM_MPI_ARGS=()        # more mpirun arguments (e2e_netns.sh multihost: host fi
 # The farm's frame budget: off by default here, since these tests compare every shown frame with
 # the farm's full render of its pose, and on the loaded machine (or under TSan) a frame may outlast
 # the default 1 s and be cut. The slow-frame test sets its own.
-FARM_BUDGET_ARGS=(--frame-budget 0)
+FARM_BUDGET_ARGS=(--frame-budget-s 0)
 start_farm() {
   local logf=$1 listen=$2; shift 2
   setsid "$@" "$MPIEXEC" --oversubscribe "${FARM_MPI_ARGS[@]}" -n 3 "$farm" serve --scene "$src/scenes/test-room.json" \
-    --listen "$listen" --tls-dir "$work/farm-tls" --duration 300 "${FARM_BUDGET_ARGS[@]}" >>"$logf" 2>&1 &
+    --listen "$listen" --tls-dir "$work/farm-tls" --duration-s 300 "${FARM_BUDGET_ARGS[@]}" >>"$logf" 2>&1 &
   farm_sid=$!
   disown "$farm_sid"  # stopped by session id in stop_farm; no job-control report when killed
   for _ in $(seq 1 300); do

@@ -6,7 +6,7 @@
 # watchdog fed: kiosk/display/service_screen.h), and exits 1 for systemd to start the show once the
 # configuration loads again.
 #   missing   --config names a file that does not exist (an unmounted partition): card on both
-#             outputs (headless, two sizes), exit 0 at --duration
+#             outputs (headless, two sizes), exit 0 at --duration-s
 #   corrupt   not TOML: card; then a good configuration is written: exit 1 within the retry
 # The outputs come from --service-config (headless here; the appliance uses the built-in KMS).
 #
@@ -19,12 +19,12 @@ export MOGAO_LAST_GOOD_DIR="$work/last-good"   # empty: no last good copy to fal
 
 printf '[outputs]\nbackend = "headless"\nsizes = ["800x600", "640x480"]\npng_dir = "%s"\n' "$work/png" > "$work/service.toml"
 
-# missing: the card on both outputs, the process up until --duration.
-timeout 60 "$kiosk" --config "$work/absent/kiosk.toml" --service-config "$work/service.toml" --duration 2 \
+# missing: the card on both outputs, the process up until --duration-s.
+timeout 60 "$kiosk" --config "$work/absent/kiosk.toml" --service-config "$work/service.toml" --duration-s 2 \
   > "$work/missing.log" 2>&1
 rc=$?
 cat "$work/missing.log"
-(( rc == 0 )) || fail "missing: exit $rc, expected 0 (the card until --duration)"
+(( rc == 0 )) || fail "missing: exit $rc, expected 0 (the card until --duration-s)"
 grep -q "service card on every output: .*absent/kiosk.toml: no such file" "$work/missing.log" ||
   fail "missing: the log does not name the file and the reason"
 cards=("$work"/png/headless-0-*.png "$work"/png/headless-1-*.png)
@@ -44,7 +44,7 @@ PY
 # corrupt, then repaired: exit 1 so that systemd starts the show.
 make_pki "$work/pki" "::1"
 printf 'this is [not TOML\n' > "$work/kiosk.toml"
-timeout 60 "$kiosk" --config "$work/kiosk.toml" --service-config "$work/service.toml" --duration 40 \
+timeout 60 "$kiosk" --config "$work/kiosk.toml" --service-config "$work/service.toml" --duration-s 40 \
   > "$work/corrupt.log" 2>&1 &
 kiosk_pid=$!
 for _ in $(seq 100); do grep -q "service card on every output" "$work/corrupt.log" && break; sleep 0.1; done

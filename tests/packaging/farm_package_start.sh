@@ -121,7 +121,7 @@ mogao-kiosk --print-config 'farm.endpoint="[::1]:$farm_port"' 'farm.ca="/root/mo
   'outputs.backend="headless"' 'calibration.source="ideal"' 'calibration.projectors=3' \\
   'calibration.overlap=0.15' 'calibration.output="320x240"' 'quality.content="480x270"' 'quality.spp=1' \\
   'navigation.start=[0.0, 0.0, 4.0]' 'stats.file=' > /root/kiosk.toml
-exec timeout 240 mogao-kiosk --config /root/kiosk.toml --frames 10 --duration 200 --stats /root/kiosk-stats.json
+exec timeout 240 mogao-kiosk --config /root/kiosk.toml --frames 10 --duration-s 200 --stats /root/kiosk-stats.json
 EOF
 }
 

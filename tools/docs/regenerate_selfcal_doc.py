@@ -30,7 +30,7 @@ import argparse, datetime, os, platform, re, subprocess, sys, tempfile
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BLOCK = re.compile(r"^<!-- generated:selfcal-scenarios -->\n.*?^<!-- /generated -->$", re.S | re.M)
 AUTOCAL_BLOCK = re.compile(r"^<!-- generated:selfcal-from-autocal -->\n.*?^<!-- /generated -->$", re.S | re.M)
-COMMON = ["--rate", "2", "--bump-at", "2", "--scale", "0.5", "--camera-scale", "0.5"]
+COMMON = ["--rate-hz", "2", "--bump-at-s", "2", "--projector-scale", "0.5", "--camera-scale", "0.5"]
 
 
 def long_static_scenario(frames):
@@ -42,7 +42,7 @@ def long_static_scenario(frames):
     span = f"{minutes / 60:.2g} h" if minutes >= 60 else f"{minutes:.3g} min"
     return (f"static, {span} (projectors at quarter resolution), visitors 10–40 %, exposure ±30 %",
             ["--frames", str(frames), "--occlusion", "0.1", "--occlusion-max", "0.4", "--exposure-jitter", "0.3",
-             "--scale", "0.25", "--truth-every", "600"])
+             "--projector-scale", "0.25", "--truth-every", "600"])
 
 
 def scenarios(static_frames):
@@ -65,16 +65,16 @@ def scenarios(static_frames):
     out.append(("proj1 yaw 1°, visitors 10–40 %", ["--bump", "proj1:yaw=1deg", "--frames", "60",
                                                     "--occlusion", "0.1", "--occlusion-max", "0.4"]))
     out.append(("proj1 yaw 1°, repetitive content", ["--bump", "proj1:yaw=1deg", "--frames", "60",
-                                                      "--content", "repetitive"]))
+                                                      "--content-kind", "repetitive"]))
     out.append(("proj1 yaw 1°, plain (textureless) content", ["--bump", "proj1:yaw=1deg", "--frames", "20",
-                                                               "--content", "plain"]))
+                                                               "--content-kind", "plain"]))
     # A pattern pair takes a monitored frame of its own: these rows run as long as the textured ones.
     out.append(("proj1 yaw 1°, plain content, pattern fallback on", ["--bump", "proj1:yaw=1deg", "--frames", "60",
-                                                                      "--content", "plain", "--pattern"]))
+                                                                      "--content-kind", "plain", "--pattern"]))
     out.append(("proj1 yaw 1°, dark scene (4 % of the light)", ["--bump", "proj1:yaw=1deg", "--frames", "20",
-                                                                "--content", "dark"]))
+                                                                "--content-kind", "dark"]))
     out.append(("proj1 yaw 1°, dark scene, pattern fallback on", ["--bump", "proj1:yaw=1deg", "--frames", "60",
-                                                                  "--content", "dark", "--pattern"]))
+                                                                  "--content-kind", "dark", "--pattern"]))
     out.append(("proj2 yaw −20° (image off the screen)", ["--bump", "proj2:yaw=-20deg", "--frames", "20"]))
     out.append((f"static, {static_frames / 2 / 60:.0f} min, visitors 10–40 %, exposure ±30 %",
                 ["--frames", str(static_frames), "--occlusion", "0.1", "--occlusion-max", "0.4",
@@ -179,7 +179,7 @@ def from_autocal_table(args, tool):
             models[scale] = os.path.join(out, "calibration.models.json")
         for name, scale, extra in autocal_scenarios(args.static_frames):
             jitter = [] if "--exposure-jitter" in extra else ["--exposure-jitter", "0.1"]
-            cmd = [tool, "simulate", "--rig", rig, "--rate", "2", "--bump-at", "2", "--scale", scale,
+            cmd = [tool, "simulate", "--rig", rig, "--rate-hz", "2", "--bump-at-s", "2", "--projector-scale", scale,
                    "--camera-scale", scale, "--models", models[scale]] + jitter + extra
             p = subprocess.run(cmd, capture_output=True, text=True)
             if p.returncode != 0:

@@ -343,7 +343,7 @@ def main():
         if ok:
             t_kiosk = time.time()
             stats_file = os.path.join(kiosk_dir, "stats.json")
-            r = net.run([a.kiosk, "--config", kiosk_toml, "--frames", str(KIOSK_FRAMES), "--duration", str(KIOSK_TIMEOUT_S),
+            r = net.run([a.kiosk, "--config", kiosk_toml, "--frames", str(KIOSK_FRAMES), "--duration-s", str(KIOSK_TIMEOUT_S),
                          "--stats", stats_file, "--dump-content", os.path.join(kiosk_dir, "content")],
                         os.path.join(kiosk_dir, "kiosk.log"), timeout=KIOSK_TIMEOUT_S + 60)
             log(f"host kiosk exited {r} after {time.time() - t_kiosk:.1f} s")

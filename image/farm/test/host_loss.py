@@ -49,7 +49,7 @@ def start_kiosk(net, kiosk, toml, kdir):
     os.makedirs(kdir, exist_ok=True)
     stats = os.path.join(kdir, "stats.json")
     logf = open(os.path.join(kdir, "kiosk.log"), "w")
-    p = subprocess.Popen(net.prefix() + [kiosk, "--config", toml, "--duration", "3000", "--stats", stats],
+    p = subprocess.Popen(net.prefix() + [kiosk, "--config", toml, "--duration-s", "3000", "--stats", stats],
                          stdout=logf, stderr=subprocess.STDOUT, start_new_session=True)
     return p, stats
 

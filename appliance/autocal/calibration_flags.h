@@ -1,0 +1,77 @@
+// SPDX-License-Identifier: Apache-2.0
+// The calibration flags that `mogao-autocal calibrate` and `mogao-calibrate` (on site, from images,
+// on a rig) share, declared once so that a name means one thing with one help text in both
+// (docs/cli.md, "Flag names"; the test cli_flag_names holds it).
+//
+//   --scale              resolution scale of projectors and camera, (0, 1] (also `mogao-calibrate patterns`
+//                        and mogao-rig-film: add_scale_flag)
+//   --content            the content frame WIDTHxHEIGHT, pixels (the farm's frame)
+//   --alpha-bits         alpha map bits, 8 or 16
+//   --warp-step-px       warp grid step, output pixels
+//   --fit-screen, --no-bow, --pinhole-projectors, --no-colour, --no-falloff   switches of the fit
+//   --max-self-check-px  the self-check gate, projector pixels (self_check.h)
+//
+// Job is autocal::CalibrateJob or calibrate::OnSiteJob: both have scale, content, alpha_bits,
+// options (AutocalOptions), colour, colour_options and self_check.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <string>
+
+namespace mogao::autocal {
+
+// What the flags hold that is no job field as it stands: the negated switches and the size's text.
+struct CalibrationFlags {
+    std::string content = "1920x1080";
+    bool no_bow = false;
+    bool pinhole_projectors = false;
+    bool no_colour = false;
+    bool no_falloff = false;
+};
+
+inline CLI::Option* add_scale_flag(CLI::App& cmd, double& scale) {
+    return cmd.add_option("--scale", scale, "Resolution scale of projectors and camera, (0, 1]")
+        ->check(CLI::Range(0.05, 1.0));
+}
+
+template <typename Job>
+void add_calibration_flags(CLI::App& cmd, CalibrationFlags& flags, Job& job) {
+    add_scale_flag(cmd, job.scale);
+    cmd.add_option("--content", flags.content, "Content frame WIDTHxHEIGHT (the farm's frame)");
+    cmd.add_option("--alpha-bits", job.alpha_bits, "Alpha map bits: 8 (reference-library compatible) or 16")
+        ->check(CLI::IsMember({8, 16}));
+    cmd.add_option("--warp-step-px", job.options.warp_step_px, "Warp grid step, output pixels")
+        ->check(CLI::Range(1, 64));
+    cmd.add_flag("--fit-screen", job.options.fit_screen,
+                 "Fit the screen's radius and arc too (known only roughly; the heights are taken as measured)");
+    cmd.add_flag("--no-bow", flags.no_bow,
+                 "Take the screen as an exact cylinder: do not try a bow (kept by default only where it pays)");
+    cmd.add_flag("--pinhole-projectors", flags.pinhole_projectors,
+                 "Take the projectors as pinholes: do not try fitting their lens distortion (kept by default, per "
+                 "projector, only where it pays; self-recalibration needs pinholes)");
+    cmd.add_option("--max-self-check-px", job.self_check.max_mean_px,
+                   "Self-check gate: refuse when the verification marks land further than this from where they "
+                   "belong (mean, projector pixels; measured from the camera images against the screen's frame)")
+        ->check(CLI::PositiveNumber);
+    cmd.add_flag("--no-colour", flags.no_colour, "Geometry only: no response, black-level and colour matching step");
+    cmd.add_flag("--no-falloff", flags.no_falloff,
+                 "Colour step without the lens fall-off: one gain per projector and channel (flat projectors)");
+}
+
+// After the parse: the flags into the job. Throws CLI::ValidationError naming --content (exit 2).
+template <typename Job>
+void apply_calibration_flags(const CalibrationFlags& flags, Job& job) {
+    char tail = 0;
+    if (std::sscanf(flags.content.c_str(), "%dx%d%c", &job.content.width, &job.content.height, &tail) != 2 ||
+        job.content.width < 1 || job.content.height < 1 || job.content.width > 16384 || job.content.height > 16384) {
+        throw CLI::ValidationError("--content", "must be WIDTHxHEIGHT, 1..16384 per side");
+    }
+    job.colour = !flags.no_colour;
+    job.colour_options.lens_falloff = !flags.no_falloff;
+    job.options.fit_bow = !flags.no_bow;
+    job.options.fit_projector_distortion = !flags.pinhole_projectors;
+}
+
+}  // namespace mogao::autocal
