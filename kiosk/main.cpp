@@ -5,7 +5,7 @@
 //   config (TOML) -> calibration (MPCDI | ideal) -> outputs (KMS | headless, connecting screen)
 //   -> calibration swap (watcher of the MPCDI; self-recalibration worker when [selfcal] is on)
 //   -> link (gRPC + mutual TLS over IPv6; frames into the FrameInbox) -> navigation (scripted
-//   visitor | tracking thread -> Navigator) -> the Kiosk's poll loop (kiosk/kiosk.h: signals, frames,
+//   visitor | tracking thread -> Navigator) -> the Kiosk's poll loop (kiosk/loop/kiosk.h: signals, frames,
 //   display tick, page flips) -> clean stop and statistics
 //
 //   mogao-kiosk --config /etc/mogao/kiosk.toml
@@ -31,8 +31,8 @@
 #include "common/signal_fd.h"
 #include "kiosk/config/config_overrides.h"
 #include "kiosk/display/service_screen.h"
-#include "kiosk/kiosk.h"
-#include "kiosk/kiosk_setup.h"
+#include "kiosk/loop/kiosk.h"
+#include "kiosk/loop/kiosk_setup.h"
 #include "kiosk/live_calibration/selfcal_setup.h"
 #include "kiosk/stats/kiosk_log.h"
 

@@ -43,15 +43,9 @@ double thread_cpu_ms() {
     return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
 }
 
-}  // namespace
-
-int navigate(const NavigateOptions& o) {
-    TrackerConfig config;
-    config.detector = o.detector;
-    config.roi.enabled = o.roi;
-    config.roi.window_tag_px = o.window_tag_px;
-    config.camera = read_intrinsics(o.camera.empty() ? o.replay / "camera.json" : o.camera);
-    CameraSourceSpec spec;
+// The frame source: the replay folder, or the camera --camera names at the calibration's size. Returns 0, or the
+// exit status (2: a camera that is no capture device) after the message.
+int source_spec(const NavigateOptions& o, const CameraIntrinsics& camera, CameraSourceSpec& spec) {
     if (o.device.empty()) {
         spec.kind = CameraSourceSpec::Kind::replay;
         spec.folder = o.replay;
@@ -65,9 +59,47 @@ int navigate(const NavigateOptions& o) {
                          why.empty() ? "give /dev/videoN, v4l2:/dev/videoN or libcamera:[<id>]" : why.c_str());
             return 2;
         }
-        spec.width = config.camera.width;  // the calibrated size; the tracker refuses any other
-        spec.height = config.camera.height;
+        spec.width = camera.width;  // the calibrated size; the tracker refuses any other
+        spec.height = camera.height;
     }
+    return 0;
+}
+
+// One display tick's pose as a JSON line.
+void write_pose(std::ostream& out, std::int64_t t_ns, const ViewerPose& p, const Navigator& navigator) {
+    out << nlohmann::json{{"t_ns", t_ns},
+                          {"eye", {p.eye.x(), p.eye.y(), p.eye.z()}},
+                          {"yaw_deg", p.yaw_deg},
+                          {"pitch_deg", p.pitch_deg},
+                          {"tracking", navigator.tracking()},
+                          {"turn_deg_s", navigator.velocity().turn_deg_s},
+                          {"forward_m_s", navigator.velocity().forward_m_s}}
+               .dump()
+        << '\n';
+}
+
+// The tracked tag's yaw and distance against truth.json's frame `f` (mogao-tag-sequence's rotation and translation).
+void add_truth_errors(const nlohmann::json& f, const TrackedTag& tag, Stats& yaw_error, Stats& distance_error_mm) {
+    const ControlSignals measured = control_signals(tag.pose.rotation, tag.pose.translation_m);
+    Eigen::Matrix3d r;
+    for (int i = 0; i < 9; ++i) r(i / 3, i % 3) = f["rotation"][static_cast<std::size_t>(i)].get<double>();
+    const Eigen::Vector3d t(f["translation_m"][0].get<double>(), f["translation_m"][1].get<double>(),
+                            f["translation_m"][2].get<double>());
+    const ControlSignals expected = control_signals(r, t);
+    yaw_error.add(measured.yaw_deg - expected.yaw_deg);
+    distance_error_mm.add((measured.distance_m - expected.distance_m) * 1000.0);
+}
+
+}  // namespace
+
+int navigate(const NavigateOptions& o) {
+    TrackerConfig config;
+    config.detector = o.detector;
+    config.roi.enabled = o.roi;
+    config.roi.window_tag_px = o.window_tag_px;
+    config.camera = read_intrinsics(o.camera.empty() ? o.replay / "camera.json" : o.camera);
+    CameraSourceSpec spec;
+    if (const int status = source_spec(o, config.camera, spec); status != 0) return status;
     auto opened = open_camera_source(spec);
     if (!opened) {
         std::fprintf(stderr, "mogao-track navigate: %s\n", opened.error().message.c_str());
@@ -113,16 +145,7 @@ int navigate(const NavigateOptions& o) {
             started = true;
         }
         for (; next_display < frame->timestamp_ns; next_display += period, ++poses) {
-            const ViewerPose p = navigator.advance(next_display);
-            out << nlohmann::json{{"t_ns", next_display},
-                                  {"eye", {p.eye.x(), p.eye.y(), p.eye.z()}},
-                                  {"yaw_deg", p.yaw_deg},
-                                  {"pitch_deg", p.pitch_deg},
-                                  {"tracking", navigator.tracking()},
-                                  {"turn_deg_s", navigator.velocity().turn_deg_s},
-                                  {"forward_m_s", navigator.velocity().forward_m_s}}
-                       .dump()
-                << '\n';
+            write_pose(out, next_display, navigator.advance(next_display), navigator);
         }
         const double cpu_before = thread_cpu_ms();
         const TrackedTag tag = tracker.track(*frame);
@@ -131,17 +154,8 @@ int navigate(const NavigateOptions& o) {
         const std::size_t index = static_cast<std::size_t>(frames++);
         visible += tag.visible ? 1 : 0;
         ambiguous += tag.ambiguous ? 1 : 0;
-        if (tag.visible && truth.is_object() && index < truth["frames"].size()) {
-            const auto& f = truth["frames"][index];
-            const ControlSignals measured = control_signals(tag.pose.rotation, tag.pose.translation_m);
-            Eigen::Matrix3d r;
-            for (int i = 0; i < 9; ++i) r(i / 3, i % 3) = f["rotation"][static_cast<std::size_t>(i)].get<double>();
-            const Eigen::Vector3d t(f["translation_m"][0].get<double>(), f["translation_m"][1].get<double>(),
-                                    f["translation_m"][2].get<double>());
-            const ControlSignals expected = control_signals(r, t);
-            yaw_error.add(measured.yaw_deg - expected.yaw_deg);
-            distance_error_mm.add((measured.distance_m - expected.distance_m) * 1000.0);
-        }
+        if (tag.visible && truth.is_object() && index < truth["frames"].size())
+            add_truth_errors(truth["frames"][index], tag, yaw_error, distance_error_mm);
     }
     std::fprintf(
         stderr,

@@ -14,7 +14,7 @@
 #include "appliance/calibration/mpcdi_writer.h"
 #include "appliance/warp/ideal_calibration.h"
 #include "kiosk/config/config_overrides.h"
-#include "kiosk/kiosk_setup.h"
+#include "kiosk/loop/kiosk_setup.h"
 #include "kiosk/stats/kiosk_status.h"
 
 namespace mogao {

@@ -13,7 +13,7 @@
 #include "drivers/headless/headless_output.h"
 #include "kiosk/config/config_overrides.h"
 #include "kiosk/display/connecting_screen.h"
-#include "kiosk/kiosk_setup.h"
+#include "kiosk/loop/kiosk_setup.h"
 
 namespace mogao {
 namespace {

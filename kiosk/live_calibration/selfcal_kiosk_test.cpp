@@ -29,8 +29,8 @@
 #include "drivers/egl/egl_test_support.h"
 #include "drivers/headless/headless_output.h"
 #include "kiosk/config/config_overrides.h"
-#include "kiosk/kiosk.h"
-#include "kiosk/kiosk_setup.h"
+#include "kiosk/loop/kiosk.h"
+#include "kiosk/loop/kiosk_setup.h"
 #include "kiosk/live_calibration/selfcal_worker.h"
 
 #if defined(__SANITIZE_THREAD__)

@@ -11,7 +11,7 @@
 #include "appliance/autocal/model_store.h"
 #include "common/srgb.h"
 #include "drivers/camera/camera_source.h"
-#include "kiosk/kiosk_setup.h"
+#include "kiosk/loop/kiosk_setup.h"
 
 namespace mogao {
 namespace {

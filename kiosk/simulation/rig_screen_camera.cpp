@@ -19,7 +19,7 @@
 #include "appliance/autocal/rig_bridge.h"
 #include "appliance/rig/rig_file.h"
 #include "appliance/selfcal/rig_simulation.h"
-#include "kiosk/kiosk_setup.h"
+#include "kiosk/loop/kiosk_setup.h"
 
 namespace mogao {
 namespace {

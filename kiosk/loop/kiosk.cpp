@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "kiosk/kiosk.h"
+#include "kiosk/loop/kiosk.h"
 
 #include <poll.h>
 
@@ -12,7 +12,7 @@
 
 #include "common/program_cli.h"
 #include "kiosk/display/on_wall_status.h"
-#include "kiosk/kiosk_setup.h"
+#include "kiosk/loop/kiosk_setup.h"
 #include "kiosk/stats/kiosk_metrics.h"
 
 namespace mogao {

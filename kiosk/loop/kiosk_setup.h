@@ -18,7 +18,7 @@
 #include "kiosk/config/last_loaded.h"
 #include "kiosk/display/content_dump.h"
 #include "kiosk/display/kiosk_display.h"
-#include "kiosk/frame_inbox.h"
+#include "kiosk/loop/frame_inbox.h"
 #include "kiosk/live_calibration/calibration_inbox.h"
 #include "kiosk/live_calibration/calibration_watcher.h"
 #include "kiosk/navigation/kiosk_navigation.h"

@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
-// The Kiosk's loop handlers (kiosk/kiosk.h), one at a time, on real parts: headless outputs on
+// The Kiosk's loop handlers (kiosk/loop/kiosk.h), one at a time, on real parts: headless outputs on
 // surfaceless EGL (Mesa llvmpipe), the ideal 3-projector calibration, a real FrameInbox (slot +
 // eventfd), timerfd and signalfd, the scripted visitor, KioskStats, PoseLog and the configuration
 // made from kiosk.example.toml with overrides. The one stand-in is the link: the real LinkClient
 // needs a farm over gRPC + mutual TLS (the end-to-end tests in tests/kiosk/ run it), so here a
 // recording KioskLink keeps the view requests the loop submits and plays the link's counters.
-#include "kiosk/kiosk.h"
+#include "kiosk/loop/kiosk.h"
 
 #include <gtest/gtest.h>
 #include <poll.h>
@@ -20,7 +20,7 @@
 #include "drivers/egl/egl_test_support.h"
 #include "drivers/headless/headless_output.h"
 #include "kiosk/config/config_overrides.h"
-#include "kiosk/kiosk_setup.h"
+#include "kiosk/loop/kiosk_setup.h"
 
 namespace mogao {
 namespace {

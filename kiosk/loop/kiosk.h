@@ -13,11 +13,11 @@
 //   on_calibration  the CalibrationInbox's eventfd (when given): a calibration loaded and validated
 //              off this thread (a changed MPCDI file, self-recalibration) is swapped onto the outputs;
 //              an unusable one is logged (file and field) and the last good one stays on the wall
-// The handlers are public so that tests can drive them one at a time (kiosk/kiosk_test.cpp).
+// The handlers are public so that tests can drive them one at a time (kiosk/loop/kiosk_test.cpp).
 // run() loops until a stop (signal, --frames N on screen, --duration-s, end of a tracking replay), then
 // makes the clean stop: STOPPING=1, navigation, link, pose log, final stats line, composite, JSON.
 //
-// The parts are made by kiosk/main.cpp (kiosk/kiosk_setup.h) and outlive the Kiosk. Loop thread only
+// The parts are made by kiosk/main.cpp (kiosk/loop/kiosk_setup.h) and outlive the Kiosk. Loop thread only
 // (the link's thread only touches the FrameInbox). Errors per docs/architecture.md: a bad frame is
 // dropped and logged; a broken fd stops the loop with exit code 1; run() returns the exit code.
 #pragma once
@@ -40,7 +40,7 @@
 #include "kiosk/config/last_loaded.h"
 #include "kiosk/display/content_dump.h"
 #include "kiosk/display/kiosk_display.h"
-#include "kiosk/frame_inbox.h"
+#include "kiosk/loop/frame_inbox.h"
 #include "kiosk/live_calibration/calibration_inbox.h"
 #include "kiosk/live_calibration/selfcal_worker.h"
 #include "kiosk/navigation/kiosk_navigation.h"

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "kiosk/frame_inbox.h"
+#include "kiosk/loop/frame_inbox.h"
 
 #include <spdlog/spdlog.h>
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "kiosk/kiosk_setup.h"
+#include "kiosk/loop/kiosk_setup.h"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
