@@ -31,9 +31,9 @@
 #include "common/signal_fd.h"
 #include "kiosk/config/config_overrides.h"
 #include "kiosk/display/service_screen.h"
+#include "kiosk/live_calibration/selfcal_setup.h"
 #include "kiosk/loop/kiosk.h"
 #include "kiosk/loop/kiosk_setup.h"
-#include "kiosk/live_calibration/selfcal_setup.h"
 #include "kiosk/stats/kiosk_log.h"
 
 namespace {

@@ -25,9 +25,9 @@
 #include "drivers/egl/egl_test_support.h"
 #include "drivers/headless/headless_output.h"
 #include "kiosk/config/config_overrides.h"
+#include "kiosk/live_calibration/screen_calibration_source.h"
 #include "kiosk/loop/kiosk.h"
 #include "kiosk/loop/kiosk_setup.h"
-#include "kiosk/live_calibration/screen_calibration_source.h"
 
 namespace mogao {
 namespace {

@@ -29,9 +29,9 @@
 #include "drivers/egl/egl_test_support.h"
 #include "drivers/headless/headless_output.h"
 #include "kiosk/config/config_overrides.h"
+#include "kiosk/live_calibration/selfcal_worker.h"
 #include "kiosk/loop/kiosk.h"
 #include "kiosk/loop/kiosk_setup.h"
-#include "kiosk/live_calibration/selfcal_worker.h"
 
 #if defined(__SANITIZE_THREAD__)
 // ThreadSanitizer cannot see the joins of OpenCV's parallel_for_ (TBB's workers, not instrumented):
