@@ -304,14 +304,15 @@ void check_start_model(const SystemModel& m, const rig::VirtualRig& truth) {
     if (m.camera.resolution != truth.camera.resolution) {
         throw std::invalid_argument("simulate: the starting models' camera is " + size_text(m.camera.resolution) +
                                     ", the scaled rig's " + size_text(truth.camera.resolution) +
-                                    " (calibrate with mogao-autocal --scale equal to --camera-scale)");
+                                    " (calibrate at the same scale: mogao-autocal --scale equal to --camera-scale)");
     }
     for (std::size_t k = 0; k < m.projectors.size(); ++k) {
         if (m.projectors[k].resolution != truth.projectors[k].resolution) {
-            throw std::invalid_argument("simulate: the starting models' projector " + std::to_string(k) + " is " +
-                                        size_text(m.projectors[k].resolution) + ", the scaled rig's " +
-                                        size_text(truth.projectors[k].resolution) +
-                                        " (calibrate with mogao-autocal --scale equal to --projector-scale)");
+            throw std::invalid_argument(
+                "simulate: the starting models' projector " + std::to_string(k) + " is " +
+                size_text(m.projectors[k].resolution) + ", the scaled rig's " +
+                size_text(truth.projectors[k].resolution) +
+                " (calibrate at the same scale: mogao-autocal --scale equal to --projector-scale)");
         }
     }
 }
