@@ -10,6 +10,7 @@ bash -n "$dir/test/image_tests.sh"
 bash -n "$dir/test/build_vimc.sh"
 sh -n "$dir/test/selftest.sh"
 bash -n "$dir/test/powercut_guest.sh"
+bash -n "$dir/rootfs/usr/lib/mogao/journal-persistent"
 python3 - "$dir/test/qemu_boot_test.py" "$dir/test/qemu_service_card_test.py" "$dir/test/qemu_common.py" "$dir/test/qemu_qmp.py" "$dir/test/qemu_libcamera.py" "$dir/lib/prune_modules.py" "$dir/test/qemu_powercut_test.py" "$dir/test/powercut_report.py" "$dir/test/qemu_service_mode_test.py" "$dir/test/qemu_update_test.py" <<'PY'
 import sys
 for f in sys.argv[1:]:

@@ -33,8 +33,15 @@ In order (each printed; any failure fails the test):
   4. the BAD stick (on slot b): installed into slot a; the reboot tries it, the kiosk fails, the
      boot assessment fails and reboots, systemd-boot falls back to slot b (GOOD), whose kiosk
      starts and whose status line names the rolled-back update;
-  5. on the disk after QEMU: slot b's entry blessed, slot a's with no tries left, the calibration
-     byte-identical (sha256) to the provisioned one.
+  5. a logs stick on the rolled-back appliance: the journal of the boot before (the bad root's, kept
+     on the configuration partition, docs/image.md "Journal") comes back as
+     logs/journal-previous-boot.txt (journalctl --boot=-1 in the guest) with that boot's lines
+     ("running slot a: ... update-test bad", "boot assessment FAILED") and none of this boot's
+     (the rollback line), which logs/journal.txt has;
+  6. on the disk after QEMU: slot b's entry blessed, slot a's with no tries left, the calibration
+     byte-identical (sha256) to the provisioned one; the configuration partition's journal/ (copied
+     out after e2fsck -p) holds all 4 boots (the host's journalctl --list-boots) in no more than
+     the image's SystemMaxUse.
 Exit 77 (skip) with a message when QEMU, OVMF, mtools, mkfs.vfat, zstd or openssl are missing.
 """
 import argparse
@@ -50,11 +57,13 @@ import time
 
 from qemu_common import IMAGE_ENTRY, T0, Failures, log, set_name, stop_qemu  # noqa: E402 (this folder)
 from qemu_boot_test import MODES, OVMF_CODE, OVMF_VARS, Qmp, require_qemu, run  # noqa: E402
-from qemu_service_mode_test import LABEL, Journal, result_of, skip, tool  # noqa: E402
+from qemu_service_mode_test import LABEL, Journal, read_stick, result_of, skip, tool  # noqa: E402
+from qemu_service_mode_test import make_stick as make_request_stick  # noqa: E402
 
 OUTPUTS = 2            # the calibration's projectors
 CONFIG_PART = 3        # image/lib/common.sh
 CALIBRATION = "tests/fuzz/corpus/mpcdi/ideal-2.mpcdi"
+JOURNAL_CONF = "image/rootfs/etc/systemd/journald.conf.d/50-mogao.conf"
 BROKEN_KIOSK = "#!/bin/sh\necho 'mogao-kiosk: a broken build (image/test/qemu_update_test.py)' >&2\nexit 1\n"
 
 
@@ -227,8 +236,54 @@ def booted(journal, slot, timeout, kiosk=True):
     return m.group(1) if started else None
 
 
+def check_previous_boot_log(a, qmp, journal, fails, env, stick, results):
+    """Step 5: the logs request after the rollback; the previous boot is the bad root's."""
+    ok, secs = plug(qmp, journal, stick, 4, a.timeout)
+    r = result_of(stick, env)
+    results["logs_s"] = round(secs, 1)
+    fails.check(ok and r.get("outcome") == "done", f"logs after the rollback: {r.get('reason')} in {secs:.0f} s")
+    prev = (read_stick(stick, "logs/journal-previous-boot.txt", env) or b"").decode(errors="replace")
+    this = (read_stick(stick, "logs/journal.txt", env) or b"").decode(errors="replace")
+    ran = r"running slot a: [^\n]*update-test bad"
+    failed = r"boot assessment FAILED: mogao-kiosk not READY on slot a"
+    rolled = r"slot a: the update '[^']*update-test bad[^']*' failed its boot assessment"
+    results["previous_boot_log_lines"] = prev.count("\n")
+    fails.check(re.search(ran, prev) is not None and re.search(failed, prev) is not None and re.search(rolled, prev) is None,
+                f"logs/journal-previous-boot.txt is the bad root's boot ({prev.count(chr(10))} lines; its slot line and "
+                f"failed assessment, not this boot's rollback line): {prev.strip().splitlines()[:1]}")
+    fails.check(re.search(rolled, this) is not None and re.search(failed, this) is None,
+                "logs/journal.txt is this boot's (the rollback line, not the failed assessment)")
+    kept = re.search(r"mogao-journal: the journal is kept in [^\n]*", this)
+    fails.check(kept is not None, f"this boot's journal is on the configuration partition: {kept.group(0) if kept else 'no such line'}")
+
+
+def journal_on_disk(a, img, work, fails, results):
+    """Step 6, the journal part: the configuration partition copied out, e2fsck -p (as the
+    appliance's systemd-fsck), journal/ copied out with debugfs and read by the host's journalctl."""
+    part, dump = os.path.join(work, "config.ext4"), os.path.join(work, "journal-dump")
+    run(["dd", f"if={img}", f"of={part}", "bs=512", f"skip={partition_offset(img, CONFIG_PART) // 512}",
+         f"count={partition_sectors(img, CONFIG_PART)}", "conv=sparse", "status=none"])
+    subprocess.run(["e2fsck", "-p", part], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    shutil.rmtree(dump, ignore_errors=True)
+    os.makedirs(dump)
+    run(["debugfs", "-R", f"rdump /journal {dump}", part])
+    files = [os.path.join(dump, "journal", n) for n in os.listdir(os.path.join(dump, "journal"))] \
+        if os.path.isdir(os.path.join(dump, "journal")) else []
+    used = sum(os.path.getsize(f) for f in files)
+    with open(os.path.join(a.repo, JOURNAL_CONF)) as f:
+        m = re.search(r"^SystemMaxUse=(\d+)M$", f.read(), re.M)
+    bound = int(m.group(1)) << 20
+    boots = subprocess.run(["journalctl", "-D", os.path.join(dump, "journal"), "--list-boots", "--no-pager", "-q"],
+                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True).stdout.strip().splitlines()
+    results.update(journal_files=len(files), journal_mib=round(used / (1 << 20), 1), journal_boots=len(boots))
+    fails.check(len(boots) >= 4 and 0 < used <= bound,
+                f"the configuration partition's journal/: {len(boots)} boots (4 expected), {len(files)} files, "
+                f"{used / (1 << 20):.1f} MiB <= SystemMaxUse {bound >> 20} MiB")
+    os.remove(part)
+
+
 def check_updates(a, work, proc, fails, env, key, img, sticks, cal_sha, results):
-    """Steps 1-4 of the module's docstring, in one QEMU run."""
+    """Steps 1-5 of the module's docstring, in one QEMU run."""
     journal = Journal(os.path.join(work, "serial.log"), proc)
     qmp = Qmp(os.path.join(work, "qmp.sock"))
     t0 = time.monotonic()
@@ -272,6 +327,7 @@ def check_updates(a, work, proc, fails, env, key, img, sticks, cal_sha, results)
     m = journal.wait(r"slot a: the update '[^']*update-test bad[^']*' failed its boot assessment[^\r\n]*", 60)
     fails.check(m is not None, f"the journal names the rolled-back update: {m.group(0) if m else 'not seen'}")
     results["bad_update_to_rollback_s"] = round(time.monotonic() - t0, 1)
+    check_previous_boot_log(a, qmp, journal, fails, env, sticks["logs"], results)
 
 
 def main():
@@ -289,7 +345,7 @@ def main():
     ap.add_argument("--install-timeout", type=float, default=float(os.environ.get("MOGAO_UPDATE_INSTALL_TIMEOUT", "300")))
     a = ap.parse_args()
     qemu = require_qemu(a.image)
-    for t in ("mkfs.vfat", "mcopy", "mtype", "mdir", "openssl", "zstd", "debugfs"):
+    for t in ("mkfs.vfat", "mcopy", "mtype", "mdir", "openssl", "zstd", "debugfs", "e2fsck", "journalctl"):
         if shutil.which(t) is None:
             skip(f"{t} not found (apt-get install dosfstools mtools openssl zstd e2fsprogs)")
     if os.geteuid() != 0:
@@ -313,7 +369,8 @@ def main():
     serial = int(time.time())
     sticks = {"wrong": make_stick(a, work, "wrong", env, key, serial + 1, wrong),
               "good": make_stick(a, work, "good", env, key, serial + 2, good),
-              "bad": make_stick(a, work, "bad", env, key, serial + 3, bad)}
+              "bad": make_stick(a, work, "bad", env, key, serial + 3, bad),
+              "logs": make_request_stick(a, work, "logs", env, key, "logs", serial + 4)}
     results["prepare_s"] = round(time.monotonic() - T0, 1)
     cmd = qemu_command(qemu, a, work, img)
     log("starting QEMU: " + " ".join(cmd))
@@ -330,6 +387,7 @@ def main():
                 f"on the ESP: slot b blessed, slot a with no tries left ({entries})")
     sha = config_file_sha(img, "etc/screen.mpcdi")
     fails.check(sha == cal_sha, f"after both updates the calibration is byte-identical (sha256 {sha}, provisioned {cal_sha})")
+    journal_on_disk(a, img, work, fails, results)
     results["test_s"] = round(time.monotonic() - T0, 1)
     results["failures"] = fails.items
     log(f"figures: {results}")
