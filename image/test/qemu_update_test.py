@@ -267,8 +267,7 @@ def journal_on_disk(a, img, work, fails, results):
     shutil.rmtree(dump, ignore_errors=True)
     os.makedirs(dump)
     run(["debugfs", "-R", f"rdump /journal {dump}", part])
-    files = [os.path.join(dump, "journal", n) for n in os.listdir(os.path.join(dump, "journal"))] \
-        if os.path.isdir(os.path.join(dump, "journal")) else []
+    files = [os.path.join(d, n) for d, _, names in os.walk(os.path.join(dump, "journal")) for n in names]
     used = sum(os.path.getsize(f) for f in files)
     with open(os.path.join(a.repo, JOURNAL_CONF)) as f:
         m = re.search(r"^SystemMaxUse=(\d+)M$", f.read(), re.M)
