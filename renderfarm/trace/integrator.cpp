@@ -383,7 +383,7 @@ Eigen::Vector3f radiance_at(const FrameContext& frame, const SurfaceHit& first, 
             bounce_emission(frame, x, bounce.direction, escaped ? kInfinity : ray_hit.ray.tfar, bounce.throughput);
         if (escaped) break;  // see header
         hit = frame.scene->surface(x.origin, bounce.direction, ray_hit.ray.tfar, ray_hit.hit.instID[0],
-                                   ray_hit.hit.primID, ray_hit.hit.u, ray_hit.hit.v,
+                                   ray_hit.hit.geomID, ray_hit.hit.primID, ray_hit.hit.u, ray_hit.hit.v,
                                    Eigen::Vector3f(ray_hit.hit.Ng_x, ray_hit.hit.Ng_y, ray_hit.hit.Ng_z),
                                    x.hit->cone_width + frame.cone_spread * ray_hit.ray.tfar);
         throughput = bounce.throughput;
