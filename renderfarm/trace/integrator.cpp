@@ -316,9 +316,10 @@ bool sample_bounce(const FrameContext& frame, const ShadingVertex& x, const Eige
     const float largest = out.throughput.maxCoeff();
     if (!(largest > 0.0f)) return false;
     if (frame.russian_roulette && depth >= kRouletteMinDepth && largest < 1.0f) {
-        // Survive with q = the largest channel; divide by q (Arvo & Kirk 1990; integrator.h).
-        if (sampler.next2d().x() >= largest) return false;
-        out.throughput /= largest;
+        // Survive with q = sqrt of the largest channel; divide by q (Arvo & Kirk 1990; integrator.h).
+        const float q = std::sqrt(largest);
+        if (sampler.next2d().x() >= q) return false;
+        out.throughput /= q;
     }
     return true;
 }

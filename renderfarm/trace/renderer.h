@@ -70,7 +70,7 @@ struct RendererOptions {
     // rtcIntersect8 / rtcOccluded8 halves on AVX2, where Embree would run a 16-wide call ray by ray).
     bool native_packet_width = true;
     // Russian roulette ends paths whose throughput has become small (integrator.h: survival
-    // probability = the throughput's largest channel, from the second bounce on; unbiased). Off
+    // probability = the square root of the throughput's largest channel, from the second bounce on; unbiased). Off
     // traces every path to max_bounces, as before; tests and benchmarks compare both.
     bool russian_roulette = true;
     // At spp = 1, the pixel's one sample at an Owen-scrambled Sobol' point (sobol.h; a fresh
