@@ -187,7 +187,6 @@ void add_site_command(CLI::App& parent, SiteCommand& cmd) {
 void check_site_command(SiteCommand& cli) {
     OnSiteJob& job = cli.job;
     autocal::apply_calibration_flags(cli.shared, job);
-
     if (cli.site.empty()) throw CLI::ValidationError("--site", "is required (or a subcommand)");
     if (!has_simulation_routes() && cli.camera.starts_with("rig:")) {
         throw CLI::ValidationError("--camera rig:FILE",
