@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// `mogao-autocal calibrate`: the camera-based calibration of a virtual rig (rigs/*.toml) from
+// `mogao-calibrate-sim rig`: the camera-based calibration of a virtual rig (rigs/*.toml) from
 // patterns to files (docs/calibration.md, "The calibrate command"): writes into the output folder
 //   calibration.mpcdi  the ScreenCalibration as a 2d-profile MPCDI file (appliance/calibration's
 //                      writer, atomic; 16-bit alpha by default; with the colour step, 16-bit RGB
@@ -34,24 +34,14 @@
 
 #include <nlohmann/json.hpp>
 
-#include "appliance/autocal/autocal.h"
-#include "appliance/autocal/colour_calibration.h"
-#include "appliance/autocal/self_check.h"
+#include "appliance/autocal/calibration_settings.h"
 
 namespace mogao::autocal {
 
-struct CalibrateJob {
+// The settings (calibration_settings.h: scale, content, alpha bits, options, colour, self-check) and where.
+struct CalibrateJob : CalibrationSettings {
     std::filesystem::path rig;  // rigs/*.toml
     std::filesystem::path out;  // folder, created if missing
-    double scale = 1.0;         // projector and camera resolution scale, (0, 1] (scaled_rig)
-    ImageSize content{1920, 1080};
-    int alpha_bits = 16;  // 8 or 16
-    AutocalOptions options;
-    bool colour = true;  // the photometric step (colour_calibration.h) after the geometry
-    ColourOptions colour_options;
-    // The self-check after the geometry (self_check.h): marks through the new warp and blend, filmed; its
-    // gate (self_check.max_mean_px, --max-self-check-px) refuses the calibration like the others.
-    SelfCheckOptions self_check;
 };
 
 // Runs the job; returns the report (also written as report.json). Throws rig::RigError,

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// The calibration flags that `mogao-autocal calibrate` and `mogao-calibrate` (on site, from images,
-// on a rig) share, declared once so that a name means one thing with one help text in both
+// The calibration flags of `mogao-calibrate` (on site, from images) and `mogao-calibrate-sim rig` (on a virtual
+// rig), declared once so that a name means one thing with one help text in both
 // (docs/cli.md, "Flag names"; the test cli_flag_names holds it).
 //
 //   --scale              resolution scale of projectors and camera, (0, 1] (also `mogao-calibrate patterns`
@@ -11,14 +11,15 @@
 //   --fit-screen, --no-bow, --pinhole-projectors, --no-colour, --no-falloff   switches of the fit
 //   --max-self-check-px  the self-check gate, projector pixels (self_check.h)
 //
-// Job is autocal::CalibrateJob or calibrate::OnSiteJob: both have scale, content, alpha_bits,
-// options (AutocalOptions), colour, colour_options and self_check.
+// They fill CalibrationSettings (calibration_settings.h), which autocal::CalibrateJob and calibrate::OnSiteJob hold.
 #pragma once
 
 #include <CLI/CLI.hpp>
 
-#include <cstdio>
 #include <string>
+
+#include "appliance/autocal/calibration_settings.h"
+#include "common/size_text.h"
 
 namespace mogao::autocal {
 
@@ -36,8 +37,7 @@ inline CLI::Option* add_scale_flag(CLI::App& cmd, double& scale) {
         ->check(CLI::Range(0.05, 1.0));
 }
 
-template <typename Job>
-void add_calibration_flags(CLI::App& cmd, CalibrationFlags& flags, Job& job) {
+inline void add_calibration_flags(CLI::App& cmd, CalibrationFlags& flags, CalibrationSettings& job) {
     add_scale_flag(cmd, job.scale);
     cmd.add_option("--content", flags.content, "Content frame WIDTHxHEIGHT (the farm's frame)");
     cmd.add_option("--alpha-bits", job.alpha_bits, "Alpha map bits: 8 (reference-library compatible) or 16")
@@ -61,11 +61,8 @@ void add_calibration_flags(CLI::App& cmd, CalibrationFlags& flags, Job& job) {
 }
 
 // After the parse: the flags into the job. Throws CLI::ValidationError naming --content (exit 2).
-template <typename Job>
-void apply_calibration_flags(const CalibrationFlags& flags, Job& job) {
-    char tail = 0;
-    if (std::sscanf(flags.content.c_str(), "%dx%d%c", &job.content.width, &job.content.height, &tail) != 2 ||
-        job.content.width < 1 || job.content.height < 1 || job.content.width > 16384 || job.content.height > 16384) {
+inline void apply_calibration_flags(const CalibrationFlags& flags, CalibrationSettings& job) {
+    if (!parse_size(flags.content, job.content, 1, 16384)) {
         throw CLI::ValidationError("--content", "must be WIDTHxHEIGHT, 1..16384 per side");
     }
     job.colour = !flags.no_colour;

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The fitted models of a calibration, stored beside its MPCDI file (docs/kiosk.md, "The models
 // file"): the screen cylinder, the camera (intrinsics, distortion, pose) and every
-// projector (intrinsics, pose) that `mogao-autocal calibrate` fitted. The MPCDI holds only what the
+// projector (intrinsics, pose) that `mogao-calibrate-sim rig` fitted. The MPCDI holds only what the
 // compositor needs (warp maps, blend masks, responses); self-recalibration (appliance/selfcal,
 // the kiosk's [selfcal]) needs the models to predict what the screen camera sees and to rebuild
 // the warps from re-estimated poses, so they travel with the MPCDI as `<name>.models.json`.

@@ -1,14 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "appliance/calibration/calibration_cli.h"
-#include "common/program_cli.h"
-
-#include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <ostream>
-#include <sstream>
+#include <tuple>
 
 #include "appliance/calibration/mpcdi_error.h"
 #include "appliance/calibration/mpcdi_reader.h"
@@ -17,32 +14,10 @@
 #include "appliance/warp/composite.h"
 #include "appliance/warp/composite_check.h"
 #include "appliance/warp/ideal_calibration.h"
+#include "common/size_text.h"
 
 namespace mogao {
 namespace {
-
-// "1024x768" -> ImageSize; CLI11 reports the message on failure.
-std::string parse_size(const std::string& text, ImageSize& size) {
-    int w = 0;
-    int h = 0;
-    char x = 0;
-    char extra = 0;
-    std::istringstream in(text);
-    if (!(in >> w >> x >> h) || (x != 'x' && x != 'X') || (in >> extra) || w < 1 || h < 1 || w > 16384 || h > 16384) {
-        return "'" + text + "' is not WIDTHxHEIGHT with each side in 1..16384";
-    }
-    size = {w, h};
-    return {};
-}
-
-struct IdealFlags {
-    IdealCalibrationParams params;
-    std::string projector_size = "1024x768";
-    std::string content = "1920x1080";
-    std::string out;
-    int alpha_bits = 8;
-    bool check = false;
-};
 
 // Smooth test content for --check (gradient + sinusoidal checker, docs/calibration.md).
 RgbFloatImage check_pattern(ImageSize size) {
@@ -60,7 +35,7 @@ RgbFloatImage check_pattern(ImageSize size) {
     return img;
 }
 
-int run_ideal(const IdealFlags& f, std::ostream& out) {
+int run_ideal(const MpcdiCommands& f, std::ostream& out) {
     const ScreenCalibration screen = make_ideal_calibration(f.params);
     MpcdiExportOptions options;
     options.alpha_bit_depth = f.alpha_bits;
@@ -160,43 +135,41 @@ int run_info(const std::string& path, std::ostream& out) {
 
 }  // namespace
 
-int run_calibration_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
-    CLI::App app{"mogao-calibration: make and inspect MPCDI projector calibrations (docs/calibration.md)"};
-    mogao::cli::prepare(app, "mogao-calibration");
-    app.require_subcommand(1);
-    IdealFlags ideal;
-    CLI::App* ideal_cmd = app.add_subcommand(
+void add_mpcdi_commands(CLI::App& parent, MpcdiCommands& cmds) {
+    CLI::App* ideal = parent.add_subcommand(
         "ideal", "Write the ideal calibration of N projectors side by side as a 2d-profile MPCDI file");
-    ideal_cmd->add_option("--projectors", ideal.params.projectors, "Number of projectors")->check(CLI::Range(1, 64));
-    ideal_cmd->add_option("--overlap", ideal.params.overlap, "Overlap, fraction of one projector's width, [0, 0.5)")
+    ideal->add_option("--projectors", cmds.params.projectors, "Number of projectors")->check(CLI::Range(1, 64));
+    ideal->add_option("--overlap", cmds.params.overlap, "Overlap, fraction of one projector's width, [0, 0.5)")
         ->check(CLI::Range(0.0, 0.4999999));
-    ideal_cmd->add_option("--projector-size", ideal.projector_size, "Projector resolution WIDTHxHEIGHT");
-    ideal_cmd->add_option("--content", ideal.content, "Content frame WIDTHxHEIGHT (the farm's frame)");
-    ideal_cmd->add_option("--gamma", ideal.params.gamma, "Projector gamma, also the alpha maps' gammaEmbedded")
+    ideal->add_option("--projector-size", cmds.projector_size, "Projector resolution WIDTHxHEIGHT");
+    ideal->add_option("--content", cmds.content, "Content frame WIDTHxHEIGHT (the farm's frame)");
+    ideal->add_option("--gamma", cmds.params.gamma, "Projector gamma, also the alpha maps' gammaEmbedded")
         ->check(CLI::Range(0.1, 10.0));
-    ideal_cmd->add_option("--alpha-bits", ideal.alpha_bits, "Alpha map bits: 8 (reference-library compatible) or 16")
+    ideal->add_option("--alpha-bits", cmds.alpha_bits, "Alpha map bits: 8 (reference-library compatible) or 16")
         ->check(CLI::IsMember({8, 16}));
-    ideal_cmd->add_flag("--check", ideal.check, "Read the file back and run the composite check");
-    ideal_cmd->add_option("--out", ideal.out, "Output .mpcdi file (written atomically)")->required();
-    std::string info_path;
-    CLI::App* info_cmd = app.add_subcommand("info", "Print what an MPCDI file holds");
-    info_cmd->add_option("file", info_path, "MPCDI file")->required()->check(CLI::ExistingFile);
-    try {
-        app.parse(argc, argv);
-        for (const auto& [text, size] : {std::pair{&ideal.projector_size, &ideal.params.output},
-                                         std::pair{&ideal.content, &ideal.params.content}}) {
-            if (const std::string why = parse_size(*text, *size); !why.empty()) {
-                throw CLI::ValidationError(text == &ideal.projector_size ? "--projector-size" : "--content", why);
+    ideal->add_flag("--check", cmds.check, "Read the file back and run the composite check");
+    ideal->add_option("--out", cmds.out, "Output .mpcdi file (written atomically)")->required();
+    ideal->parse_complete_callback([&cmds] {
+        for (const auto& [text, size, flag] :
+             {std::tuple{&cmds.projector_size, &cmds.params.output, "--projector-size"},
+              std::tuple{&cmds.content, &cmds.params.content, "--content"}}) {
+            if (!parse_size(*text, *size, 1, 16384)) {
+                throw CLI::ValidationError(flag, "'" + *text + "' is not WIDTHxHEIGHT with each side in 1..16384");
             }
         }
-    } catch (const CLI::ParseError& e) {
-        return mogao::cli::exit_status(app, e, out, err);
-    }
+    });
+    cmds.ideal = ideal;
+    cmds.info = parent.add_subcommand("mpcdi-info", "Print what an MPCDI file holds");
+    cmds.info->add_option("file", cmds.info_path, "MPCDI file")->required()->check(CLI::ExistingFile);
+}
+
+std::optional<int> run_mpcdi_commands(const MpcdiCommands& cmds, std::ostream& out, std::ostream& err) {
+    const bool ideal = cmds.ideal->parsed();
+    if (!ideal && !cmds.info->parsed()) return std::nullopt;
     try {
-        if (*ideal_cmd) return run_ideal(ideal, out);
-        return run_info(info_path, out);
+        return ideal ? run_ideal(cmds, out) : run_info(cmds.info_path, out);
     } catch (const std::exception& e) {  // MpcdiError, std::invalid_argument, std::bad_alloc
-        err << "mogao-calibration: " << e.what() << "\n";
+        err << "mogao-calibrate " << (ideal ? "ideal" : "mpcdi-info") << ": " << e.what() << "\n";
         return 1;
     }
 }

@@ -302,9 +302,10 @@ void check_start_model(const SystemModel& m, const rig::VirtualRig& truth) {
                                     " projectors, the rig " + std::to_string(truth.projectors.size()));
     }
     if (m.camera.resolution != truth.camera.resolution) {
-        throw std::invalid_argument("simulate: the starting models' camera is " + size_text(m.camera.resolution) +
-                                    ", the scaled rig's " + size_text(truth.camera.resolution) +
-                                    " (calibrate at the same scale: mogao-autocal --scale equal to --camera-scale)");
+        throw std::invalid_argument(
+            "simulate: the starting models' camera is " + size_text(m.camera.resolution) + ", the scaled rig's " +
+            size_text(truth.camera.resolution) +
+            " (calibrate at the same scale: mogao-calibrate-sim rig --scale equal to --camera-scale)");
     }
     for (std::size_t k = 0; k < m.projectors.size(); ++k) {
         if (m.projectors[k].resolution != truth.projectors[k].resolution) {
@@ -312,7 +313,7 @@ void check_start_model(const SystemModel& m, const rig::VirtualRig& truth) {
                 "simulate: the starting models' projector " + std::to_string(k) + " is " +
                 size_text(m.projectors[k].resolution) + ", the scaled rig's " +
                 size_text(truth.projectors[k].resolution) +
-                " (calibrate at the same scale: mogao-autocal --scale equal to --projector-scale)");
+                " (calibrate at the same scale: mogao-calibrate-sim rig --scale equal to --projector-scale)");
         }
     }
 }

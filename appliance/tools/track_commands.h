@@ -22,15 +22,6 @@ struct DetectOptions {
 // +0.5; docs/tracking.md), as text or as one JSON array.
 int detect(const DetectOptions& options);
 
-struct CalibrateOptions {
-    std::filesystem::path folder;
-    int inner_columns = 9;
-    int inner_rows = 6;
-    double square_mm = 25.0;
-    std::filesystem::path out = "camera.json";
-};
-int calibrate_camera(const CalibrateOptions& options);
-
 struct SequenceOptions {
     std::filesystem::path out;
     double seconds = 12.0;

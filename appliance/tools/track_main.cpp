@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
-// mogao-track: tag detection, camera calibration, printable tags and tag-driven navigation from
-// the command line; synthetic sequences are mogao-tag-sequence's (a laboratory program) (docs/tracking.md). Exit codes:
-// 0 success, 1 job failed, 2 bad command line.
+// mogao-track: tag detection, printable tags and tag-driven navigation from the command line (a camera's
+// intrinsics: mogao-calibrate camera-intrinsics); synthetic sequences are mogao-tag-sequence's (a laboratory
+// program) (docs/tracking.md). Exit codes: 0 success, 1 job failed, 2 bad command line.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -37,8 +37,6 @@ void add_detector_flags(CLI::App& cmd, DetectorSettings& s) {
 // The help texts of flags mogao-tag-sequence and mogao-calibrate declare too, word for word (one
 // text per name, docs/cli.md; the test cli_flag_names compares them).
 constexpr const char* kTagIdHelp = "Tag id (navigate: the one to follow, -1 the largest)";
-constexpr const char* kBoardHelp = "Chessboard inner corners, COLUMNSxROWS";
-constexpr const char* kSquareHelp = "Chessboard square side, mm";
 constexpr const char* kCameraHelp =
     "Capture device: v4l2:/dev/videoN (or /dev/videoN) or libcamera:[id]; mogao-calibrate also replay:DIR and "
     "rig:FILE (simulation: mogao-calibrate-sim)";
@@ -49,15 +47,6 @@ CLI::App* add_detect(CLI::App& app, mogao::track::DetectOptions& detect) {
     d->add_flag("--json", detect.json, "one JSON array instead of text");
     add_detector_flags(*d, detect.detector);
     return d;
-}
-
-CLI::App* add_calibrate_camera(CLI::App& app, mogao::track::CalibrateOptions& calib, std::string& board) {
-    auto* c = app.add_subcommand("calibrate-camera", "camera intrinsics from chessboard photos in a folder");
-    c->add_option("FOLDER", calib.folder, "folder of chessboard images")->required()->check(CLI::ExistingDirectory);
-    c->add_option("--board", board, kBoardHelp)->capture_default_str();
-    c->add_option("--square-mm", calib.square_mm, kSquareHelp)->check(CLI::Range(0.1, 1000.0))->capture_default_str();
-    c->add_option("--out", calib.out, "calibration file to write (.json)")->capture_default_str();
-    return c;
 }
 
 CLI::App* add_make_tag(CLI::App& app, mogao::track::TagImageOptions& tag) {
@@ -103,19 +92,6 @@ CLI::App* add_navigate(CLI::App& app, mogao::track::NavigateOptions& nav) {
     return n;
 }
 
-// "9x6" -> columns and rows; false when it is not COLUMNSxROWS.
-bool parse_board(const std::string& board, mogao::track::CalibrateOptions& calib) {
-    const auto x = board.find('x');
-    try {
-        if (x == std::string::npos) return false;
-        calib.inner_columns = std::stoi(board.substr(0, x));
-        calib.inner_rows = std::stoi(board.substr(x + 1));
-        return true;
-    } catch (const std::exception&) {
-        return false;
-    }
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -123,12 +99,9 @@ int main(int argc, char** argv) {
     mogao::cli::prepare(app, "mogao-track");
     app.require_subcommand(1);
     mogao::track::DetectOptions detect;
-    mogao::track::CalibrateOptions calib;
-    std::string board = "9x6";
     mogao::track::TagImageOptions tag;
     mogao::track::NavigateOptions nav;
     auto* d = add_detect(app, detect);
-    auto* c = add_calibrate_camera(app, calib, board);
     auto* t = add_make_tag(app, tag);
     auto* n = add_navigate(app, nav);
     try {
@@ -138,13 +111,6 @@ int main(int argc, char** argv) {
     }
     try {
         if (*d) return mogao::track::detect(detect);
-        if (*c) {
-            if (!parse_board(board, calib)) {
-                std::fprintf(stderr, "mogao-track: --board '%s' is not COLUMNSxROWS (e.g. 9x6)\n", board.c_str());
-                return 2;
-            }
-            return mogao::track::calibrate_camera(calib);
-        }
         if (*t) return mogao::track::make_tag(tag);
         if (*n) {
             if (nav.replay.empty() == nav.device.empty() || (!nav.device.empty() && nav.camera.empty())) {

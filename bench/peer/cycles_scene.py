@@ -3,7 +3,7 @@
 "A peer: Blender Cycles"). Run by bench/peer/run inside Blender:
 
   blender -b --factory-startup --python-exit-code 1 -P bench/peer/cycles_scene.py -- \
-      --dir DIR --spp 1,4,16,64 [--ref-spp 1024] [--threads 1] [--ref-threads 2]
+      --dir DIR --spp 1,4,16,64 [--ref-spp 1024] [--threads 1] [--ref-threads 2] [--window FILE]
 
 Reads DIR/scene.obj, DIR/peer.json (mogao_peer_bench export). Writes DIR/cycles-<spp>.pfm (seed 1, one
 thread) and DIR/cycles-ref-a.pfm, cycles-ref-b.pfm (two halves of ref-spp/2 samples, seeds 1000/1001),
@@ -46,6 +46,8 @@ def parse():
     p.add_argument("--threads", type=int, default=1)
     p.add_argument("--ref-threads", type=int, default=2)
     p.add_argument("--reps", type=int, default=1)
+    p.add_argument("--window", default="", help="write 'START END': CLOCK_MONOTONIC s around the spp renders "
+                   "(bench/profile/run profiles them alone)")
     return p.parse_args(argv)
 
 
@@ -312,6 +314,7 @@ def main():
     print("import and warm-up %.1f s (first render %.2f s CPU), sampling pattern %s"
           % (time.perf_counter() - t0, warm_cpu, s.cycles.sampling_pattern), flush=True)
     times = ["spp,cpu_s,wall_s"]
+    window_start = time.monotonic()  # CLOCK_MONOTONIC, as perf record -k mono
     for spp in [int(x) for x in a.spp.split(",")]:
         s.cycles.samples, s.cycles.seed = spp, 1
         best = None
@@ -321,6 +324,9 @@ def main():
         write_pfm(os.path.join(a.dir, "cycles-%d.pfm" % spp), px)
         times.append("%d,%.6f,%.6f" % (spp, *best))
         print(times[-1], flush=True)
+    if a.window:
+        with open(a.window, "w") as f:
+            f.write("%.6f %.6f\n" % (window_start, time.monotonic()))
     s.render.threads = a.ref_threads
     for half, seed in (("a", 1000), ("b", 1001)):
         s.cycles.samples, s.cycles.seed = a.ref_spp // 2, seed

@@ -6,7 +6,8 @@
 //   mogao_peer_bench ours      --out DIR --spp 1,4,16,64 [--reps 1] [common flags]
 //        renders the view at each spp on one thread (reference knobs: 6 bounces), writes
 //        DIR/ours-<spp>.pfm and prints "spp,cpu_s" rows (CPU time of the rendering thread, best of reps;
-//        the BVH is built once before, not timed)
+//        the BVH is built once before, not timed); --window FILE writes "START END", the CLOCK_MONOTONIC
+//        seconds around the renders, for a profile of them alone (bench/profile/run)
 //   mogao_peer_bench reference --out DIR [--ref-spp 512] [--budget-s 600] [--cache-dir D] [--renderer-version V]
 //        our converged reference of the view (bench/quality's cache and its two halves), DIR/ours-ref.pfm,
 //        and prints its noise floor (relMSE of the reference against the truth, from its halves)
@@ -15,6 +16,7 @@
 // Common flags: [--scene scenes/grotto.json] [--scans DIR] [--view still|mask] [--width 120] (4:3 frame).
 // Exits 77 when the scene needs the real scans and they are absent.
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -45,6 +47,7 @@ struct Options {
     int width = 120;
     std::vector<int> spp{1, 4, 16, 64};
     int reps = 1;
+    std::filesystem::path window;
     ReferencePlan plan;
     std::filesystem::path out_dir;
     std::vector<std::string> positional;
@@ -83,6 +86,7 @@ Options parse(int argc, char** argv) {
         else if (flag == "--cache-dir") o.plan.cache_dir = v;
         else if (flag == "--renderer-version") o.plan.renderer_version = v;
         else if (flag == "--out") o.out_dir = v;
+        else if (flag == "--window") o.window = v;
         else throw std::invalid_argument("unknown flag " + flag);
     }
     if (o.width < 16) throw std::invalid_argument("--width must be >= 16 (SSIM window)");
@@ -120,6 +124,10 @@ void run_ours(const Options& o, const Scene& scene, const QualityView& view) {
     options.embree_config = "threads=1";  // the BVH build on one thread too: the same CPU as Cycles' one thread
     Renderer renderer(scene, options);
     std::printf("spp,cpu_s\n");
+    const auto monotonic = [] {  // steady_clock is CLOCK_MONOTONIC on Linux, perf record -k mono's clock
+        return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+    };
+    const double start = monotonic();
     for (const int spp : o.spp) {
         ViewRequest r = reference_request(view);
         r.quality.spp = spp;
@@ -128,6 +136,9 @@ void run_ours(const Options& o, const Scene& scene, const QualityView& view) {
         must(peer::write_pfm(o.out_dir / ("ours-" + std::to_string(spp) + ".pfm"), f.image));
         std::printf("%d,%.6f\n", spp, f.seconds);
         std::fflush(stdout);
+    }
+    if (!o.window.empty()) {
+        std::ofstream(o.window) << std::fixed << start << ' ' << monotonic() << '\n';
     }
 }
 

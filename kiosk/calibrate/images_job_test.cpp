@@ -3,7 +3,7 @@
 // each written PNG (SIMULATION standing in for the technician's camera, rig_film.h: appliance/rig's
 // CameraSimulator renders what the rig's camera sees of those files through the rig's true projectors), and the
 // calibration runs from that folder. Accuracy against the rig's ground truth, next to the live run
-// on the same rig (autocal's rig source, what `mogao-calibrate --rig` gives). Bad folders and
+// on the same rig (autocal's rig source, what `mogao-calibrate-sim rig` gives). Bad folders and
 // manifests are refused naming the file or field, and the last good calibration stays. At 1/4
 // resolution to stay fast.
 #include <gtest/gtest.h>

@@ -4,7 +4,7 @@
 // appliance's outputs and a camera, from the site file to the files the kiosk loads.
 //
 // Site file: a rig file (rigs/*.toml, appliance/rig/rig_file.h) describing the installation as
-// measured: [screen], the camera's intrinsics (chessboard, `mogao-track calibrate-camera`) and
+// measured: [screen], the camera's intrinsics (chessboard, `mogao-calibrate camera-intrinsics`) and
 // roughly measured pose, and per projector (listed left to right as the viewer sees them) its id,
 // resolution (= its output's mode), throw ratio and lens shift from the data sheet; [prior] errors
 // 0. Responses, gamma, noise and the projectors' poses are not used (they are what is measured).
@@ -17,7 +17,7 @@
 // and blend, filmed, against where their content belongs, with no ground truth; above its gate
 // (self_check.max_mean_px, --max-self-check-px) the calibration is refused; (4) all outputs black again; (5) the files,
 // into `out`:
-//   calibration.models.json, calibration.mpcdi  as mogao-autocal writes them (atomic, the models
+//   calibration.models.json, calibration.mpcdi  as mogao-calibrate-sim rig writes them (atomic, the models
 //                      first); a calibration.mpcdi already there is kept as calibration.mpcdi.last-good
 //                      (and its models as calibration.models.json.last-good) before it is replaced,
 //   report.json        per projector the fit (bits, correspondences, reprojection rms, view angle),
@@ -40,6 +40,7 @@
 #include <nlohmann/json.hpp>
 
 #include "appliance/autocal/autocal.h"
+#include "appliance/autocal/calibration_settings.h"
 #include "appliance/autocal/colour_calibration.h"
 #include "appliance/autocal/model_store.h"
 #include "appliance/autocal/self_check.h"
@@ -49,17 +50,12 @@
 
 namespace mogao::calibrate {
 
-struct OnSiteJob {
+// The settings (appliance/autocal/calibration_settings.h: scale, content, alpha bits, options, colour, self-check,
+// step 3b and its gate) and the site's own.
+struct OnSiteJob : autocal::CalibrationSettings {
     std::filesystem::path site;     // rig-format site file (above)
-    double scale = 1.0;             // projector and camera resolutions scaled (tests, demos), (0, 1]
     std::filesystem::path out;      // folder, created if missing
     std::filesystem::path install;  // empty: none
-    ImageSize content{1920, 1080};
-    int alpha_bits = 16;
-    autocal::AutocalOptions options;
-    bool colour = true;
-    autocal::ColourOptions colour_options;
-    autocal::SelfCheckOptions self_check;  // step 3b and its gate (appliance/autocal/self_check.h)
     CaptureTiming timing;
     CameraTransfer transfer = CameraTransfer::srgb;
     double min_lit_fraction = 0.01;  // identification: an output must light this much of the camera image

@@ -4,7 +4,7 @@
 // the virtual rig's filming the headless outputs (rig_camera.h): the one part this cannot test is a
 // real camera looking at a real screen. At 1/4 resolution to stay fast; accuracy against the rig's
 // ground truth, compared with the calibration of the same rig through autocal's own rig source
-// (what `mogao-calibrate --rig` gives).
+// (what `mogao-calibrate-sim rig` gives).
 #include <gtest/gtest.h>
 
 #include <algorithm>

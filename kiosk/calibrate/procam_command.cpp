@@ -8,14 +8,18 @@
 #include <stdexcept>
 
 #include "appliance/procam/procam_job.h"
+#include "common/size_text.h"
 
 namespace mogao::calibrate {
 
 namespace {
 
 bool parse_pair(const std::string& text, int& a, int& b, int lo, int hi) {
-    char tail = 0;
-    return std::sscanf(text.c_str(), "%dx%d%c", &a, &b, &tail) == 2 && a >= lo && b >= lo && a <= hi && b <= hi;
+    ImageSize pair;
+    if (!parse_size(text, pair, lo, hi)) return false;
+    a = pair.width;
+    b = pair.height;
+    return true;
 }
 
 void print_result(const procam::ProcamJobResult& r, const std::filesystem::path& out) {
@@ -45,7 +49,7 @@ void add_procam_command(CLI::App& parent, ProcamCommand& cmd) {
         ->required()
         ->check(CLI::ExistingDirectory);
     cmd.app->add_option("--projector-size", cmd.projector, "Projector resolution WIDTHxHEIGHT")->required();
-    // The same texts as mogao-track calibrate-camera's (one text per name, docs/cli.md).
+    // The same texts as `camera-intrinsics`' (one text per name, docs/cli.md).
     cmd.app->add_option("--board", cmd.board, "Chessboard inner corners, COLUMNSxROWS")->required();
     cmd.app->add_option("--square-mm", cmd.square_mm, "Chessboard square side, mm")
         ->required()

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// mogao-calibrate-sim's simulation routes (simulation_routes.h): the virtual rig's calibration job and camera.
+// mogao-calibrate-sim's simulation routes (simulation_routes.h): the virtual rig's calibration job, its
+// self-recalibration scenarios and its camera.
 #include "kiosk/calibrate/simulation_routes.h"
 
 #include <cerrno>
@@ -15,20 +16,31 @@
 #include "drivers/headless/headless_output.h"
 #include "drivers/kms/kms_backend.h"
 #include "kiosk/calibrate/rig_camera.h"
+#include "kiosk/calibrate/rig_command.h"
+#include "kiosk/calibrate/selfcal_command.h"
 
 namespace mogao::calibrate {
 
 bool has_simulation_routes() { return true; }
 
-int run_rig_calibration(const autocal::CalibrateJob& job) {
-    const nlohmann::json r = autocal::run_calibrate_job(job);
-    const auto& t = r["ground_truth"];
-    std::printf(
-        "%s: %d images; geometry mean %.3f p95 %.3f px, seam luminance %.2f %% (against the rig's ground "
-        "truth); %s\n",
-        r["rig"].get<std::string>().c_str(), r["captures"].get<int>(), t["geometry_mean_px"].get<double>(),
-        t["geometry_p95_px"].get<double>(), 100.0 * t["seam_luminance_max_deviation"].get<double>(), job.out.c_str());
-    return 0;
+const char* program_name() { return "mogao-calibrate-sim"; }
+
+struct SimulationCommands {
+    RigCommand rig;
+    SelfcalCommand selfcal;
+};
+
+std::shared_ptr<SimulationCommands> add_simulation_commands(CLI::App& app) {
+    auto cmds = std::make_shared<SimulationCommands>();
+    add_rig_command(app, cmds->rig);
+    add_selfcal_command(app, cmds->selfcal);
+    return cmds;
+}
+
+std::optional<int> run_simulation_commands(const SimulationCommands& cmds) {
+    if (cmds.rig.app->parsed()) return run_rig_command(cmds.rig);
+    if (cmds.selfcal.app->parsed()) return run_selfcal_command(cmds.selfcal);
+    return std::nullopt;
 }
 
 // The rig's projector k is lit by output k (the outputs' order; identification still finds it from

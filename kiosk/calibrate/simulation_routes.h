@@ -1,16 +1,19 @@
 // SPDX-License-Identifier: Apache-2.0
-// The routes of mogao-calibrate that need the virtual rig (SIMULATION, tests and benchmarks): the calibration of a
-// rig file against its ground truth (--rig FILE) and the rig's camera filming the outputs (--camera rig:FILE).
+// The routes of mogao-calibrate that need the virtual rig (SIMULATION, tests and benchmarks): the subcommands `rig`
+// (the calibration of a rig file against its ground truth, rig_command.h) and `selfcal-simulate` (self-recalibration
+// on a rig, selfcal_command.h), and the rig's camera filming the outputs (--camera rig:FILE).
 // mogao-calibrate-sim links them (simulation_routes.cpp); the shipped mogao-calibrate links no_simulation.cpp,
 // which has none, so that the appliance carries no simulation code (.ci/check-shipped-links). One main for both
-// (main.cpp): the command line is the same, and the shipped program refuses the two routes as a usage error
+// (main.cpp): the command line is the same, and the shipped program refuses the routes as a usage error (exit 2)
 // naming mogao-calibrate-sim.
 #pragma once
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 
-#include "appliance/autocal/calibrate_job.h"
+#include <CLI/CLI.hpp>
+
 #include "drivers/output.h"
 #include "kiosk/calibrate/calibration_camera.h"
 
@@ -19,9 +22,18 @@ namespace mogao::calibrate {
 // Whether this program has the routes below (mogao-calibrate-sim); the others throw std::logic_error without them.
 [[nodiscard]] bool has_simulation_routes();
 
-// --rig FILE: calibrates the rig file's virtual rig (autocal::run_calibrate_job, job.rig set) and prints the
-// result against the rig's ground truth. Returns the exit status (0); throws what run_calibrate_job throws.
-int run_rig_calibration(const autocal::CalibrateJob& job);
+// The program's name: mogao-calibrate-sim or mogao-calibrate.
+[[nodiscard]] const char* program_name();
+
+// The simulation subcommands' state (defined where they are: simulation_routes.cpp or no_simulation.cpp).
+struct SimulationCommands;
+
+// Adds `rig` and `selfcal-simulate` to `app`: mogao-calibrate-sim's, or in the shipped program hidden ones that
+// refuse during the parse (CLI::ValidationError naming mogao-calibrate-sim).
+[[nodiscard]] std::shared_ptr<SimulationCommands> add_simulation_commands(CLI::App& app);
+
+// After the parse: the exit status of the simulation subcommand that ran, or nullopt when none was given.
+[[nodiscard]] std::optional<int> run_simulation_commands(const SimulationCommands& cmds);
 
 // --camera rig:FILE: the rig file's camera (at `scale`) filming `outputs` (headless: their last presents; KMS:
 // the kernel's scanout buffers), rig projector k lit by output k. Throws rig::RigError naming the file, or

@@ -6,7 +6,6 @@
 #include "kiosk/config/kiosk_config.h"
 
 #include <algorithm>
-#include <charconv>
 #include <span>
 #include <utility>
 #include <vector>
@@ -224,7 +223,7 @@ void read_models(const Section& s, const ConfigKey& row, const Value* v, KioskCo
     std::error_code ec;
     if (!fs::is_regular_file(sc.models, ec)) {
         s.fail(nullptr, row.key,
-               fmt::format(" is required: '{}' (beside the MPCDI, written by mogao-autocal calibrate) does not exist",
+               fmt::format(" is required: '{}' (beside the MPCDI, written by mogao-calibrate) does not exist",
                            sc.models.string()));
     }
 }
@@ -524,23 +523,6 @@ ViewerPose start_pose(const NavigationConfig& navigation) {
     pose.yaw_deg = navigation.start_yaw_deg;
     pose.pitch_deg = 0.0;
     return pose;
-}
-
-bool parse_size(std::string_view text, ImageSize& out) {
-    const auto x = text.find('x');
-    if (x == std::string_view::npos || x == 0 || x + 1 >= text.size()) return false;
-    const auto parse = [](std::string_view digits, int& value) {
-        if (digits.empty() || digits.size() > 6) return false;
-        for (const char c : digits) {
-            if (c < '0' || c > '9') return false;
-        }
-        const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
-        return ec == std::errc() && end == digits.data() + digits.size();
-    };
-    ImageSize s;
-    if (!parse(text.substr(0, x), s.width) || !parse(text.substr(x + 1), s.height)) return false;
-    out = s;
-    return true;
 }
 
 OutputsConfig parse_outputs_config(std::string_view text, const std::filesystem::path& name) {

@@ -33,6 +33,7 @@
 #include "appliance/tracker/detector_settings.h"
 #include "appliance/tracker/tag_tracker.h"
 #include "common/pixel_rect.h"
+#include "common/size_text.h"
 #include "common/view_request.h"
 #include "drivers/camera/camera_source.h"
 
@@ -213,8 +214,6 @@ struct KioskConfig {
 // Validates TOML `text` as if read from `name` (messages and relative paths use it).
 [[nodiscard]] KioskConfig parse_kiosk_config(std::string_view text, const std::filesystem::path& name);
 
-// "WIDTHxHEIGHT" (decimal digits only, at most 6 per side) -> true and `out` set; false and `out`
-// untouched otherwise.
-[[nodiscard]] bool parse_size(std::string_view text, ImageSize& out);
+// "WIDTHxHEIGHT": parse_size (common/size_text.h).
 
 }  // namespace mogao

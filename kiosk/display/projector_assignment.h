@@ -2,7 +2,7 @@
 // Which projector calibration each output shows.
 //
 // Rules, in order: output i shows projector i when their sizes are equal (the normal case: outputs
-// in connector order = projectors left to right, as mogao-calibration writes them); an output left
+// in connector order = projectors left to right, as mogao-calibrate writes them); an output left
 // over takes the first unused projector of its size; then the first unused projector of any size
 // (its warp is in normalised coordinates, so it still lands on the right part of the screen, at
 // the output's resolution; a note says so). Outputs beyond the projectors show nothing (black),

@@ -73,7 +73,7 @@ const Calibrated& calibrated() {
         fs::create_directories(dir);
         MpcdiExportOptions export_options;
         export_options.alpha_bit_depth = 16;
-        export_options.write_response = true;  // as mogao-autocal calibrate writes it (calibrate_job.cpp)
+        export_options.write_response = true;  // as mogao-calibrate-sim rig writes it (calibrate_job.cpp)
         write_mpcdi(dir / "calibration.mpcdi", to_mpcdi(r.calibration, export_options));
         CalibrationConfig config;
         config.mpcdi = dir / "calibration.mpcdi";

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // [selfcal] end to end through the real `mogao-kiosk` binary: headless outputs (Mesa surfaceless
-// EGL), an MPCDI calibration and its models file as `mogao-autocal calibrate` writes them (here
+// EGL), an MPCDI calibration and its models file as `mogao-calibrate-sim rig` writes them (here
 // built from the standard virtual rig's exact models at half resolution, as the existing
 // selfcal_kiosk_test does), the real link (gRPC + mutual TLS over [::1]) to a TEST DOUBLE of the
 // farm -- a LinkServer whose renderer answers every view request with the same textured content
@@ -9,7 +9,7 @@
 // The rig is rigs/colour.toml (the standard geometry with projectors of different brightness,
 // colour temperature, gamma and black level) and the calibration carries its measured colour
 // (per-channel response LUTs, black-level beta maps, scaled blends: selfcal::colour_of_rig, what
-// `mogao-autocal calibrate` measures, written with 16-bit alpha and the LUT entries as it writes).
+// `mogao-calibrate-sim rig` measures, written with 16-bit alpha and the LUT entries as it writes).
 // Checks, from outside the process: the status file goes through drift detected / correcting to
 // calibrated, the drift it reports falls, the corrected calibration is written back to the MPCDI
 // (the previous one kept as .last-good) with the corrected poses in the models file beside it, its
@@ -90,7 +90,7 @@ TEST(SelfcalKioskEndToEnd, ABumpedProjectorIsCorrectedAndWrittenBackByMogaoKiosk
     if (!testing::ipv6_loopback_available()) GTEST_SKIP() << "no IPv6 loopback ([::1]) for the link";
     const testing::TempDir tmp;
     const fs::path dir = tmp.path();
-    // The calibration as mogao-autocal calibrate leaves it: MPCDI + models beside it.
+    // The calibration as mogao-calibrate-sim rig leaves it: MPCDI + models beside it.
     const rig::VirtualRig truth =
         autocal::scaled_rig(rig::load_rig(std::string(MOGAO_SOURCE_DIR) + "/rigs/colour.toml"), 0.5, 0.5);
     const selfcal::SystemModel model = selfcal::models_of_rig(truth);

@@ -94,7 +94,7 @@ std::unique_ptr<SelfcalWorker> start_selfcal(const KioskConfig& config, const Sc
     const std::optional<int> step = warp_step_of(wall);
     if (!step) {
         refuse(
-            fmt::format("{}: its warp grids are not ones mogao-autocal builds (a grid step of 1..64 pixels): "
+            fmt::format("{}: its warp grids are not ones mogao-calibrate builds (a grid step of 1..64 pixels): "
                         "self-recalibration cannot blend a correction into them",
                         config.calibration.mpcdi.string()));
     }

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The technician's status page (docs/monitoring.md, "Status page"): one self-contained HTML file
 // made from the kiosk's status file (kiosk_status.h; schema in docs/kiosk.md, "Status file") and,
-// optionally, the calibration's output folder (`mogao-calibrate --out`, `mogao-autocal calibrate
+// optionally, the calibration's output folder (`mogao-calibrate --out`, `mogao-calibrate-sim rig
 // --out`: report.json, preview.png or camera-white.png). It shows the kiosk's state and the time
 // of the status, the link, the frames shown, the frame rate, motion-to-photon latency (mean, p95),
 // the calibration on the wall with its preview image, the self-check figure (on-site accuracy in

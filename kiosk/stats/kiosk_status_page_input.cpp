@@ -55,7 +55,7 @@ void read_report(CalibrationFolder& c) {
     }
 }
 
-// preview.png (mogao-autocal calibrate: the screen as a viewer sees it), else camera-white.png
+// preview.png (mogao-calibrate-sim rig: the screen as a viewer sees it), else camera-white.png
 // (mogao-calibrate: what the camera saw with every projector white).
 void read_preview(CalibrationFolder& c) {
     for (const char* name : {"preview.png", "camera-white.png"}) {

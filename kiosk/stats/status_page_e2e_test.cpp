@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // The technician's status page end to end, in a real browser: the real `mogao-kiosk` binary runs
-// on headless outputs (Mesa surfaceless EGL) with a calibration made by `mogao-autocal calibrate`'s
+// on headless outputs (Mesa surfaceless EGL) with a calibration made by `mogao-calibrate-sim rig`'s
 // job on the standard virtual rig at quarter resolution (its folder: calibration.mpcdi, report.json
 // with the self-check, preview.png), fed over the real link (gRPC + mutual TLS over [::1]) by a
 // TEST DOUBLE of the farm (a LinkServer answering every view request with one textured frame).
@@ -93,7 +93,7 @@ int run(const std::vector<std::string>& args, const fs::path& out, const fs::pat
 
 using mogao::testing::ChildProcess;
 
-// The calibration folder as `mogao-autocal calibrate --rig rigs/standard.toml --scale 0.25` leaves it.
+// The calibration folder as `mogao-calibrate-sim rig --rig rigs/standard.toml --scale 0.25` leaves it.
 nlohmann::json calibrate(const fs::path& out) {
     autocal::CalibrateJob job;
     job.rig = std::string(MOGAO_SOURCE_DIR) + "/rigs/standard.toml";

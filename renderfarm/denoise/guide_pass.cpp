@@ -73,10 +73,11 @@ struct GuidePass::Impl {
             }
             const Eigen::Vector3f org(packet.ray.org_x[l], packet.ray.org_y[l], packet.ray.org_z[l]);
             const Eigen::Vector3f dir(packet.ray.dir_x[l], packet.ray.dir_y[l], packet.ray.dir_z[l]);
-            const SurfaceHit hit = geometry.surface(
-                org, dir, packet.ray.tfar[l], packet.hit.instID[0][l], packet.hit.primID[l], packet.hit.u[l],
-                packet.hit.v[l], Eigen::Vector3f(packet.hit.Ng_x[l], packet.hit.Ng_y[l], packet.hit.Ng_z[l]),
-                spread * packet.ray.tfar[l]);
+            const SurfaceHit hit =
+                geometry.surface(org, dir, packet.ray.tfar[l], packet.hit.instID[0][l], packet.hit.geomID[l],
+                                 packet.hit.primID[l], packet.hit.u[l], packet.hit.v[l],
+                                 Eigen::Vector3f(packet.hit.Ng_x[l], packet.hit.Ng_y[l], packet.hit.Ng_z[l]),
+                                 spread * packet.ray.tfar[l]);
             Eigen::Vector3f a = scene.materials[hit.material].albedo;
             if (hit.tinted) a = a.cwiseProduct(hit.tint);
             guides.set_surface(i, a.data(), hit.shading_normal.data(), packet.ray.tfar[l]);

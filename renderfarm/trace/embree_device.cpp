@@ -41,6 +41,12 @@ const char* error_name(RTCError code) {
     throw std::runtime_error(message);
 }
 
+// Embree reports every allocation (bytes > 0) and release (bytes < 0); true lets it proceed.
+bool count_memory(void* user, ssize_t bytes, bool /*post*/) {
+    static_cast<std::atomic<std::int64_t>*>(user)->fetch_add(bytes, std::memory_order_relaxed);
+    return true;
+}
+
 }  // namespace
 
 std::string EmbreeDevice::effective_config(const std::string& config) {
@@ -54,6 +60,7 @@ EmbreeDevice::EmbreeDevice(const std::string& config) : device_(rtcNewDevice(eff
         throw_error("rtcNewDevice(\"" + effective_config(config) + "\")", rtcGetDeviceError(nullptr));
     }
     rtcSetDeviceErrorFunction(device_.get(), record_error, nullptr);
+    rtcSetDeviceMemoryMonitorFunction(device_.get(), count_memory, allocated_.get());
 }
 
 void EmbreeDevice::check(std::string_view what) const {

@@ -16,6 +16,9 @@
 // device configuration keys isa / max_isa (https://www.embree.org/api.html).
 #pragma once
 
+#include <atomic>
+#include <cstdint>
+#include <memory>
 #include <string>
 #include <string_view>
 
@@ -38,6 +41,10 @@ public:
     // last check(); no-op otherwise.
     void check(std::string_view what) const;
 
+    // Bytes Embree holds on this device now (BVHs, buffers it allocated), from its memory monitor
+    // (rtcSetDeviceMemoryMonitorFunction); what benchmarks compare across BVH choices.
+    [[nodiscard]] std::int64_t allocated_bytes() const noexcept { return allocated_ ? allocated_->load() : 0; }
+
     // The configuration rtcNewDevice gets for `config` (the ISA cap added where it names none).
     [[nodiscard]] static std::string effective_config(const std::string& config);
 
@@ -47,6 +54,9 @@ private:
         static constexpr RTCDevice null() noexcept { return nullptr; }
         static void close(RTCDevice device) noexcept { rtcReleaseDevice(device); }
     };
+    // Heap-held so the monitor's user pointer survives a move of the device; declared before
+    // device_ so it outlives the device's last callback.
+    std::unique_ptr<std::atomic<std::int64_t>> allocated_ = std::make_unique<std::atomic<std::int64_t>>(0);
     UniqueHandle<Traits> device_;  // move-only; a moved-from device holds nullptr
 };
 

@@ -316,9 +316,10 @@ bool sample_bounce(const FrameContext& frame, const ShadingVertex& x, const Eige
     const float largest = out.throughput.maxCoeff();
     if (!(largest > 0.0f)) return false;
     if (frame.russian_roulette && depth >= kRouletteMinDepth && largest < 1.0f) {
-        // Survive with q = the largest channel; divide by q (Arvo & Kirk 1990; integrator.h).
-        if (sampler.next2d().x() >= largest) return false;
-        out.throughput /= largest;
+        // Survive with q = sqrt of the largest channel; divide by q (Arvo & Kirk 1990; integrator.h).
+        const float q = std::sqrt(largest);
+        if (sampler.next2d().x() >= q) return false;
+        out.throughput /= q;
     }
     return true;
 }
@@ -383,7 +384,7 @@ Eigen::Vector3f radiance_at(const FrameContext& frame, const SurfaceHit& first, 
             bounce_emission(frame, x, bounce.direction, escaped ? kInfinity : ray_hit.ray.tfar, bounce.throughput);
         if (escaped) break;  // see header
         hit = frame.scene->surface(x.origin, bounce.direction, ray_hit.ray.tfar, ray_hit.hit.instID[0],
-                                   ray_hit.hit.primID, ray_hit.hit.u, ray_hit.hit.v,
+                                   ray_hit.hit.geomID, ray_hit.hit.primID, ray_hit.hit.u, ray_hit.hit.v,
                                    Eigen::Vector3f(ray_hit.hit.Ng_x, ray_hit.hit.Ng_y, ray_hit.hit.Ng_z),
                                    x.hit->cone_width + frame.cone_spread * ray_hit.ray.tfar);
         throughput = bounce.throughput;

@@ -32,13 +32,15 @@
 // ray. Russian roulette (FrameContext::russian_roulette; Arvo & Kirk, "Particle Transport and Image Synthesis",
 // SIGGRAPH 1990, §4; as PBRT 4th ed. §14.5.1 / pbrt-v4's PathIntegrator): the bounce leaving a vertex of depth >=
 // kRouletteMinDepth (the camera ray's hit is depth 0, so the first bounce is always traced) survives with probability q
-// = min(1, max channel of the path throughput after the bounce), and a surviving path's throughput is divided by q. The
-// expected value of every later term is unchanged (E[X/q · 1{u < q}] = E[X]), so the estimator stays unbiased; paths
-// whose throughput has become small end early and save their bounce and next-event rays. A throughput >= 1 in every
-// channel (albedo 1) is never rouletted. The decision draws a PixelSampler pair of its own only when q < 1, so a frame
-// without roulette (or with q = 1 everywhere) draws the numbers it drew before. Random numbers: one PixelSampler pair
-// (sobol.h) per light sample set, environment and bounce, so each is a stratified Owen-scrambled Sobol' net over the
-// pixel's samples.
+// = min(1, sqrt(max channel of the path throughput after the bounce)) (the square root as Cycles takes it: a
+// gentler cut than q = max channel, which in a room lit mostly by interreflection raised the error per sample by more
+// than it saved; docs/renderer.md, "Cheaper and better samples"), and a surviving path's throughput is divided by q.
+// The expected value of every later term is unchanged (E[X/q · 1{u < q}] = E[X]), so the estimator stays unbiased;
+// paths whose throughput has become small end early and save their bounce and next-event rays. A throughput >= 1 in
+// every channel (albedo 1) is never rouletted. The decision draws a PixelSampler pair of its own only when q < 1, so a
+// frame without roulette (or with q = 1 everywhere) draws the numbers it drew before. Random numbers: one PixelSampler
+// pair (sobol.h) per light sample set, environment and bounce, so each is a stratified Owen-scrambled Sobol' net over
+// the pixel's samples.
 //
 // Light selection (FrameContext::legacy_light_sampling = false; RendererOptions keeps the legacy
 // estimator by default, renderer.h says why): the point, directional

@@ -204,10 +204,11 @@ void bounce(const FrameContext& frame, std::array<Lane, kPacketLanes>& lanes,
             lanes[l].alive = false;  // see integrator.h
             continue;
         }
-        lanes[l].hit = frame.scene->surface(vertices[l].origin, bounces[l].direction, t, packet.hit.instID[0][l],
-                                            packet.hit.primID[l], packet.hit.u[l], packet.hit.v[l],
-                                            Eigen::Vector3f(packet.hit.Ng_x[l], packet.hit.Ng_y[l], packet.hit.Ng_z[l]),
-                                            vertices[l].hit->cone_width + frame.cone_spread * t);
+        lanes[l].hit =
+            frame.scene->surface(vertices[l].origin, bounces[l].direction, t, packet.hit.instID[0][l],
+                                 packet.hit.geomID[l], packet.hit.primID[l], packet.hit.u[l], packet.hit.v[l],
+                                 Eigen::Vector3f(packet.hit.Ng_x[l], packet.hit.Ng_y[l], packet.hit.Ng_z[l]),
+                                 vertices[l].hit->cone_width + frame.cone_spread * t);
         lanes[l].throughput = bounces[l].throughput;
         lanes[l].wo = -bounces[l].direction;
     }

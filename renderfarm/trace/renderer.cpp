@@ -60,7 +60,7 @@ std::string describe(const PixelRect& r) {
 struct Renderer::Impl {
     Impl(const Scene& scene, const RendererOptions& opts)
         : options(opts),
-          geometry(scene, opts.embree_config),
+          geometry(scene, opts.embree_config, opts.bvh),
           lights(LightSet::from_scene(scene)),
           native_width(native_packet_width(geometry.root())),
           cache(std::make_unique<RadianceCache>(opts.radiance_cache)) {
@@ -176,8 +176,8 @@ struct Renderer::Impl {
             }
             const Eigen::Vector3f org(packet.ray.org_x[l], packet.ray.org_y[l], packet.ray.org_z[l]);
             const Eigen::Vector3f dir(packet.ray.dir_x[l], packet.ray.dir_y[l], packet.ray.dir_z[l]);
-            hits.hit[l] = geometry.surface(org, dir, packet.ray.tfar[l], packet.hit.instID[0][l], packet.hit.primID[l],
-                                           packet.hit.u[l], packet.hit.v[l],
+            hits.hit[l] = geometry.surface(org, dir, packet.ray.tfar[l], packet.hit.instID[0][l], packet.hit.geomID[l],
+                                           packet.hit.primID[l], packet.hit.u[l], packet.hit.v[l],
                                            Eigen::Vector3f(packet.hit.Ng_x[l], packet.hit.Ng_y[l], packet.hit.Ng_z[l]),
                                            context.cone_spread * packet.ray.tfar[l]);
             hits.wo[l] = -dir;

@@ -37,10 +37,9 @@
 #include "renderfarm/trace/guide_buffers.h"
 #include "renderfarm/trace/radiance_cache.h"
 #include "renderfarm/trace/recorded_rays.h"
+#include "renderfarm/trace/render_scene.h"
 
 namespace mogao {
-
-class RenderScene;
 
 struct RendererOptions {
     // rtcNewDevice configuration, e.g. "threads=1" to build BVHs on one thread; "" = Embree default
@@ -49,6 +48,8 @@ struct RendererOptions {
     // Rebase the world on the eye every frame (render_scene.h). Only benchmarks and the precision
     // test turn this off, to measure what it buys.
     bool rebase_on_eye = true;
+    // How the BVHs are built (render_scene.h; fixed at construction like embree_config).
+    BvhOptions bvh = {};
     // The path speed-ups, each of which can be turned off so a benchmark times today's path and
     // the new one in one run (docs/renderer.md, "Performance"). None changes what the renderer
     // converges to; legacy_light_sampling = false changes the noise (a different unbiased
@@ -69,7 +70,7 @@ struct RendererOptions {
     // rtcIntersect8 / rtcOccluded8 halves on AVX2, where Embree would run a 16-wide call ray by ray).
     bool native_packet_width = true;
     // Russian roulette ends paths whose throughput has become small (integrator.h: survival
-    // probability = the throughput's largest channel, from the second bounce on; unbiased). Off
+    // probability = the square root of the throughput's largest channel, from the second bounce on; unbiased). Off
     // traces every path to max_bounces, as before; tests and benchmarks compare both.
     bool russian_roulette = true;
     // At spp = 1, the pixel's one sample at an Owen-scrambled Sobol' point (sobol.h; a fresh

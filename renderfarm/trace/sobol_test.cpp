@@ -27,6 +27,21 @@ TEST(Sobol, UnscrambledDimensionsMatchTheSequence) {
     EXPECT_EQ(reverse_bits32(0x80000001u), 0x80000001u);
 }
 
+// The byte-table generator is the bitwise one, and owen_sobol_2d's x is the nested scramble of the
+// reversed shuffled index (its two inner reversals cancelled), over indices of every magnitude.
+TEST(Sobol, TableAndCancelledReversalsGiveTheBitwiseValues) {
+    std::uint64_t state = 12345;
+    for (int i = 0; i < 200000; ++i) {
+        state = mix64(state + 0x9e3779b97f4a7c15ULL);
+        const auto index = static_cast<std::uint32_t>(i < 1000 ? i : state);
+        ASSERT_EQ(sobol_dimension1(index), sobol_dimension1_bitwise(index)) << index;
+        const auto seed = static_cast<std::uint32_t>(state >> 32);
+        ASSERT_EQ(reverse_bits32(laine_karras_permutation(index, seed)),
+                  nested_uniform_scramble(reverse_bits32(index), seed))
+            << index;
+    }
+}
+
 // Every elementary interval of area 2^-m holds exactly one of the first 2^m points of a pixel's
 // pair, for every shape 2^-i x 2^-(m-i), in any pixel and pair, also when the pair is drawn
 // `count` times per sample (points sample * count + k).

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: Apache-2.0
 """Fills the <!-- generated:calibration-rigs --> and <!-- generated:calibration-colour --> tables of
-docs/calibration.md: runs `mogao-autocal calibrate` on every rigs/*.toml and writes, per rig, the
+docs/calibration.md: runs `mogao-calibrate-sim rig` on every rigs/*.toml and writes, per rig, the
 accuracy against the rig's ground truth from its report.json (geometry; the seam luminance's maximum
 at white; the blend's predicted seam, which its gate holds; seams before and after the colour and
 black-level step) beside the self-check's figure (from the camera images alone), or the refusal message;
@@ -56,7 +56,7 @@ def main():
     ap.add_argument("--build", default="build-calib")
     ap.add_argument("--scale", default="0.5")
     args = ap.parse_args()
-    tool = os.path.join(ROOT, args.build, "appliance", "autocal", "mogao-autocal")
+    tool = os.path.join(ROOT, args.build, "kiosk", "calibrate", "mogao-calibrate-sim")
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout.strip()
     lines = [f"Run {datetime.date.today()} at commit {commit} on {platform.node()} by "
              f"`tools/docs/regenerate_calibration_doc.py --scale {args.scale}` (projector and camera resolution x{args.scale}, "
@@ -86,11 +86,11 @@ def main():
     for name, rig, extra in runs:
         with tempfile.TemporaryDirectory() as out:
             scale = "1" if name.split()[0] in OWN_SCALE or name.endswith("(x1)") else args.scale
-            command = [tool, "calibrate", "--rig", rig, "--out", out, "--scale", scale] + extra
+            command = [tool, "rig", "--rig", rig, "--out", out, "--scale", scale] + extra
             p = subprocess.run(command, capture_output=True, text=True)
             result = "calibrated"
             if p.returncode != 0:
-                why = p.stderr.strip().replace("mogao-autocal calibrate: ", "").replace("|", "/")
+                why = p.stderr.strip().replace("mogao-calibrate-sim rig: ", "").replace("|", "/")
                 if not why.startswith("self-check:"):
                     lines.append(f"| {name} | refused: {why} | — | — | — | — | — | — | — | — | — |")
                     continue

@@ -5,7 +5,7 @@
 docs/on-site-calibration.md: the image count and capture time `mogao-calibrate --budget` prints for
 rigs/standard.toml at several camera frame rates and settle times, one run of the whole on-site
 path without hardware (headless outputs filmed by the standard rig's camera, 1/4 scale) next to
-`mogao-calibrate-sim --rig` at the same scale, the pattern set `mogao-calibrate patterns` writes for the
+`mogao-calibrate-sim rig` at the same scale, the pattern set `mogao-calibrate patterns` writes for the
 standard rig at full resolution (count, files, size), and one run of the captured-images route at
 1/4 scale (patterns written, filmed by the rig with mogao-rig-film, calibrated with --images, measured
 against the rig's ground truth). Figures there are never pasted.
@@ -51,7 +51,7 @@ def path_rows(tool, site):
         t_site = time.time() - t0
         site_report = json.load(open(os.path.join(d, "site", "report.json")))
         t0 = time.time()
-        subprocess.run([tool, "--rig", site, "--scale", "0.25", "--content", "480x270", "--no-colour",
+        subprocess.run([tool, "rig", "--rig", site, "--scale", "0.25", "--content", "480x270", "--no-colour",
                         "--out", os.path.join(d, "rig")], capture_output=True, text=True, check=True)
         t_rig = time.time() - t0
         rig_report = json.load(open(os.path.join(d, "rig", "report.json")))
@@ -66,7 +66,7 @@ def path_rows(tool, site):
         f"| `--outputs headless --camera rig:` ({conn}) | {site_report['captures']} | {rms} | "
         f"mean {site_report['self_check']['mean_px']:.3f}, p95 {site_report['self_check']['p95_px']:.3f} px | "
         f"mean {truth.group(1)}, p95 {truth.group(2)} px | {t_site:.1f} s |",
-        f"| `--rig` | {rig_report['captures']} | "
+        f"| `rig` | {rig_report['captures']} | "
         f"{rig_rms} | "
         f"mean {rig_report['self_check']['mean_px']:.3f}, p95 {rig_report['self_check']['p95_px']:.3f} px | "
         f"mean {g['geometry_mean_px']:.3f}, p95 {g['geometry_p95_px']:.3f} px | {t_rig:.1f} s |"])
@@ -126,7 +126,7 @@ def main():
     os.chdir(ROOT)
     text = open(DOC).read()
     text = replace(text, "on-site-budget", budget_rows(tool, site))
-    sim = os.path.join(ROOT, args.build, "kiosk", "calibrate", "mogao-calibrate-sim")  # the rig camera and --rig
+    sim = os.path.join(ROOT, args.build, "kiosk", "calibrate", "mogao-calibrate-sim")  # the rig camera and `rig`
     text = replace(text, "on-site-path", path_rows(sim, site))
     text = replace(text, "on-site-pattern-set", pattern_set_rows(tool, site))
     film = os.path.join(ROOT, args.build, "kiosk", "calibrate", "mogao-rig-film")

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: Apache-2.0
 """Fills the <!-- generated:selfcal-scenarios --> table of docs/calibration.md: runs
-`mogao-selfcal simulate` on rigs/standard.toml for each scenario (bumps of 0.2, 1 and 3 degrees in
+`mogao-calibrate-sim selfcal-simulate` on rigs/standard.toml for each scenario (bumps of 0.2, 1 and 3 degrees in
 yaw, pitch and roll and of 2, 5 and 10 mm along x, y and z, two projectors at once (also alike), the camera bumped
 (also with two projectors), plain and
 repetitive content, a projector pushed off the screen, a long static run with noise, exposure
@@ -13,9 +13,9 @@ Figures there are never pasted.
                                            [--only scenarios|autocal]
 
 A second table (<!-- generated:selfcal-from-autocal -->) starts the monitor from a full
-calibration's estimate instead of the rig's exact models: `mogao-autocal calibrate --rig
+calibration's estimate instead of the rig's exact models: `mogao-calibrate-sim rig --rig
 rigs/standard.toml --scale S` on the same rig, its calibration.models.json passed to
-`mogao-selfcal simulate --models`, at half resolution and at full resolution (three 1920x1080
+`mogao-calibrate-sim selfcal-simulate --models`, at half resolution and at full resolution (three 1920x1080
 projectors, the 1280x720 camera: the appliance's own cost per monitored frame). --only regenerates
 one of the two tables.
 
@@ -118,7 +118,7 @@ def main():
     ap.add_argument("--only", choices=["scenarios", "autocal"], default=None,
                     help="regenerate one table only (default: both)")
     args = ap.parse_args()
-    tool = os.path.join(ROOT, args.build, "appliance", "selfcal", "mogao-selfcal")
+    tool = os.path.join(ROOT, args.build, "kiosk", "calibrate", "mogao-calibrate-sim")
     if args.only != "scenarios":
         from_autocal_table(args, tool)
     if args.only != "autocal":
@@ -126,7 +126,7 @@ def main():
 
 
 def row(name, t, start=False):
-    """One table row from mogao-selfcal simulate's output."""
+    """One table row from mogao-calibrate-sim selfcal-simulate's output."""
     cells = [name] + ([field(t, r"^error at the start: ([0-9.]+) px")] if start else []) + [
         field(t, r"^error right after the bump: ([0-9.]+) px"),
         field(t, r"^detected after: ([0-9.]+) s", "never"),
@@ -154,14 +154,15 @@ def write_block(pattern, tag, lines):
 
 def from_autocal_table(args, tool):
     """The monitor started from autocal's estimate (the full calibration's residual included)."""
-    autocal = os.path.join(ROOT, args.build, "appliance", "autocal", "mogao-autocal")
+    autocal = os.path.join(ROOT, args.build, "kiosk", "calibrate", "mogao-calibrate-sim")
     rig = os.path.join(ROOT, "rigs", "standard.toml")
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout.strip()
     lines = [f"Run {datetime.date.today()} at commit {commit} on {platform.node()} by "
              f"`tools/docs/regenerate_selfcal_doc.py --only autocal --static-frames {args.static_frames}`: "
-             "rigs/standard.toml calibrated by `mogao-autocal calibrate --rig rigs/standard.toml --scale S` (S = 0.5: "
+             "rigs/standard.toml calibrated by `mogao-calibrate-sim rig --rig rigs/standard.toml --scale S` (S = 0.5: "
              "projectors and camera at half resolution; S = 1: three 1920x1080 projectors and the 1280x720 camera), "
-             "the monitor started from its calibration.models.json (`mogao-selfcal simulate --models`), errors against "
+             "the monitor started from its calibration.models.json "
+             "(`mogao-calibrate-sim selfcal-simulate --models`), errors against "
              "the rig's ground truth in the projectors' pixels at that scale; otherwise as the table above.", "",
              "| scenario | error at the start (px) | error after the bump (px) | detected after (s) | < 1 px after (s) | "
              "detections | corrections | camera re-basings | final state | final error mean / p95 (px) | waiting frames | "
@@ -172,18 +173,18 @@ def from_autocal_table(args, tool):
         for scale in ("0.5", "1"):
             out = os.path.join(work, scale)
             os.makedirs(out)
-            p = subprocess.run([autocal, "calibrate", "--rig", rig, "--out", out, "--scale", scale],
+            p = subprocess.run([autocal, "rig", "--rig", rig, "--out", out, "--scale", scale],
                                capture_output=True, text=True)
             if p.returncode != 0:
-                sys.exit(f"mogao-autocal calibrate --scale {scale} failed: {p.stderr.strip()}")
+                sys.exit(f"mogao-calibrate-sim rig --scale {scale} failed: {p.stderr.strip()}")
             models[scale] = os.path.join(out, "calibration.models.json")
         for name, scale, extra in autocal_scenarios(args.static_frames):
             jitter = [] if "--exposure-jitter" in extra else ["--exposure-jitter", "0.1"]
-            cmd = [tool, "simulate", "--rig", rig, "--rate-hz", "2", "--bump-at-s", "2", "--projector-scale", scale,
+            cmd = [tool, "selfcal-simulate", "--rig", rig, "--rate-hz", "2", "--bump-at-s", "2", "--projector-scale", scale,
                    "--camera-scale", scale, "--models", models[scale]] + jitter + extra
             p = subprocess.run(cmd, capture_output=True, text=True)
             if p.returncode != 0:
-                sys.exit(f"{name}: mogao-selfcal failed: {p.stderr.strip()}")
+                sys.exit(f"{name}: mogao-calibrate-sim selfcal-simulate failed: {p.stderr.strip()}")
             lines.append(row(f"{name} (x{scale})" if scale != "1" else name, p.stdout, start=True))
             print(lines[-1], flush=True)
     write_block(AUTOCAL_BLOCK, "selfcal-from-autocal", lines)
@@ -207,7 +208,7 @@ def scenarios_table(args, tool):
         for i in range(0, len(COMMON), 2):
             if COMMON[i] not in extra:
                 common += COMMON[i:i + 2]
-        return [tool, "simulate", "--rig", rig] + common + jitter + extra
+        return [tool, "selfcal-simulate", "--rig", rig] + common + jitter + extra
 
     # The long run goes on beside the short ones (its own process, a second core).
     long_run = None
@@ -223,7 +224,7 @@ def scenarios_table(args, tool):
         outputs.append((long_name, long_run.returncode, out, err))
     for name, rc, t, err in outputs:
         if rc != 0:
-            sys.exit(f"{name}: mogao-selfcal failed: {err.strip()}")
+            sys.exit(f"{name}: mogao-calibrate-sim selfcal-simulate failed: {err.strip()}")
         lines.append(row(name, t))
         print(lines[-1], flush=True)
     write_block(BLOCK, "selfcal-scenarios", lines)

@@ -1,36 +1,19 @@
 // SPDX-License-Identifier: Apache-2.0
-// mogao-autocal: camera-based calibration of a virtual rig (calibrate_job.h, docs/calibration.md).
-//
-//   mogao-autocal calibrate --rig rigs/standard.toml --out DIR [--scale 0.5] [--content 1920x1080]
-//                 [--alpha-bits 16] [--warp-step-px 2] [--gray-bits N] [--frames-per-pattern 1] [--no-colour]
-//                 [--no-falloff] [--fit-screen] [--no-bow] [--fixed-camera-intrinsics] [--intrinsics-min-gain 0.01]
-//                 [--pinhole-projectors] [--distortion-min-gain 0.01] [--max-self-check-px 0.65]
-//
-// Exit codes: 0 success, 1 the job failed or the calibration was refused (the message says why;
-// nothing in DIR changes), 2 bad command line.
+// `mogao-calibrate-sim rig` (rig_command.h).
+#include "kiosk/calibrate/rig_command.h"
+
 #include <cstdio>
 #include <iostream>
 
-#include <CLI/CLI.hpp>
-
-#include "appliance/autocal/calibrate_job.h"
-#include "appliance/autocal/calibration_flags.h"
-#include "common/program_cli.h"
-
+namespace mogao::calibrate {
 namespace {
 
-using mogao::autocal::CalibrateJob;
+using autocal::CalibrateJob;
 
-// The flags of `calibrate` beyond those mogao-calibrate shares (calibration_flags.h).
-struct AutocalFlags {
-    mogao::autocal::CalibrationFlags shared;
-    bool fixed_intrinsics = false;
-};
-
-void add_autocal_flags(CLI::App& cmd, AutocalFlags& flags, CalibrateJob& job) {
+void add_rig_flags(CLI::App& cmd, RigCommand& flags, CalibrateJob& job) {
     cmd.add_option("--rig", job.rig, "Virtual rig (rigs/*.toml)")->required()->check(CLI::ExistingFile);
     cmd.add_option("--out", job.out, "Output folder")->required();
-    mogao::autocal::add_calibration_flags(cmd, flags.shared, job);
+    autocal::add_calibration_flags(cmd, flags.shared, job);
     cmd.add_option("--gray-bits", job.options.max_gray_bits,
                    "Gray-code bits shown per axis, 0 = all (down to the finest stripe); else 4..16")
         ->check(CLI::Range(0, 16));
@@ -78,26 +61,26 @@ void print_report(const nlohmann::json& r, const CalibrateJob& job) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-    CLI::App app{"Camera-based projector calibration on a virtual rig (docs/calibration.md)"};
-    mogao::cli::prepare(app, "mogao-autocal");
-    app.require_subcommand(1);
-    CalibrateJob job;
-    AutocalFlags flags;
-    CLI::App* cmd = app.add_subcommand("calibrate", "Calibrate a rig: MPCDI, report.json and preview.png into --out");
-    add_autocal_flags(*cmd, flags, job);
+void add_rig_command(CLI::App& parent, RigCommand& cmd) {
+    cmd.app = parent.add_subcommand(
+        "rig",
+        "Calibrate a virtual rig (simulation): MPCDI, report.json and preview.png into --out, against its ground "
+        "truth");
+    add_rig_flags(*cmd.app, cmd, cmd.job);
+    cmd.app->parse_complete_callback([&cmd] {
+        autocal::apply_calibration_flags(cmd.shared, cmd.job);
+        cmd.job.options.refine_camera_intrinsics = !cmd.fixed_intrinsics;
+    });
+}
+
+int run_rig_command(const RigCommand& cmd) {
     try {
-        app.parse(argc, argv);
-        mogao::autocal::apply_calibration_flags(flags.shared, job);
-        job.options.refine_camera_intrinsics = !flags.fixed_intrinsics;
-    } catch (const CLI::ParseError& e) {
-        return mogao::cli::exit_status(app, e);
-    }
-    try {
-        print_report(mogao::autocal::run_calibrate_job(job), job);
+        print_report(autocal::run_calibrate_job(cmd.job), cmd.job);
         return 0;
     } catch (const std::exception& e) {
-        std::cerr << "mogao-autocal calibrate: " << e.what() << "\n";
+        std::cerr << "mogao-calibrate-sim rig: " << e.what() << "\n";
         return 1;
     }
 }
+
+}  // namespace mogao::calibrate

@@ -1,39 +1,34 @@
 // SPDX-License-Identifier: Apache-2.0
-// mogao-selfcal simulate: a self-recalibration scenario on a virtual rig (docs/calibration.md,
-// "Self-recalibration"): bumps, noise, exposure changes, visitors; prints the detection time in
-// simulated seconds at the stated monitor rate, the geometric error against the rig's ground
-// truth before and after, and the CPU time per monitored frame. Exit 0 done, 1 failed, 2 bad flags.
+// `mogao-calibrate-sim selfcal-simulate` (selfcal_command.h).
+#include "kiosk/calibrate/selfcal_command.h"
+
 #include <cstdio>
 #include <exception>
-#include <string>
-#include <vector>
-
-#include <CLI/CLI.hpp>
+#include <stdexcept>
 
 #include "appliance/autocal/model_store.h"
 #include "appliance/rig/rig_file.h"
-#include "appliance/selfcal/rig_simulation.h"
-#include "common/program_cli.h"
 
+namespace mogao::calibrate {
 namespace {
 
-using mogao::selfcal::ContentKind;
+using selfcal::ContentKind;
 
 int run_simulate(const std::string& rig_path, const std::string& models_path,
-                 const std::vector<std::string>& bump_texts, double bump_at, mogao::selfcal::SimulationOptions o,
+                 const std::vector<std::string>& bump_texts, double bump_at, selfcal::SimulationOptions o,
                  bool verbose) {
-    const mogao::rig::VirtualRig rig = mogao::rig::load_rig(rig_path);
+    const rig::VirtualRig rig = rig::load_rig(rig_path);
     for (const std::string& b : bump_texts) {
-        mogao::selfcal::Bump bump = mogao::selfcal::parse_bump(rig, b);
+        selfcal::Bump bump = selfcal::parse_bump(rig, b);
         bump.at_s = bump_at;
         o.bumps.push_back(bump);
     }
     if (!models_path.empty()) {
-        // autocal's estimate (mogao-autocal calibrate --rig ... --scale S: calibration.models.json).
-        const mogao::autocal::CalibrationModels m = mogao::autocal::read_models(models_path);
-        o.start_model = mogao::selfcal::SystemModel{m.screen, m.camera, m.projectors};
+        // autocal's estimate (mogao-calibrate-sim rig --rig ... --scale S: calibration.models.json).
+        const autocal::CalibrationModels m = autocal::read_models(models_path);
+        o.start_model = selfcal::SystemModel{m.screen, m.camera, m.projectors};
     }
-    const mogao::selfcal::SimulationReport r = mogao::selfcal::simulate(rig, o);
+    const selfcal::SimulationReport r = selfcal::simulate(rig, o);
     if (verbose) {
         for (const auto& f : r.frames) {
             std::printf("t=%6.2f s  ground-truth error %.3f px  cpu %.1f ms  %s\n", f.t_s, f.geometry_mean_px, f.cpu_ms,
@@ -54,27 +49,14 @@ int run_simulate(const std::string& rig_path, const std::string& models_path,
         std::printf("corrected (< %.2f px) after: %.2f s\n", o.error_threshold_px, *r.corrected_after_s);
     else std::printf("corrected after: never\n");
     std::printf("final state: %s; corrections: %d; detections: %d; waiting frames: %d\n",
-                mogao::selfcal::to_string(r.final_state), r.corrections, r.detections, r.waiting_frames);
+                selfcal::to_string(r.final_state), r.corrections, r.detections, r.waiting_frames);
     std::printf("final geometric error vs ground truth: mean %.3f px, p95 %.3f px\n", r.final_error_px, r.final_p95_px);
     std::printf("CPU per monitored frame: %.1f ms (%.1f %% of one core at %.2f Hz)\n", r.mean_cpu_ms,
                 r.mean_cpu_ms * o.rate_hz / 10.0, o.rate_hz);
     return 0;
 }
 
-// What `simulate` takes beyond SimulationOptions' own fields.
-struct SimulateFlags {
-    std::string rig;
-    std::vector<std::string> bumps;
-    double bump_at_s = 2.0;
-    bool verbose = false;
-    std::string content = "textured";
-    bool no_edge_check = false;
-    double prior_mm = 0.0;
-    std::string models;
-    mogao::selfcal::SimulationOptions o;
-};
-
-void add_simulate_flags(CLI::App& cmd, SimulateFlags& f) {
+void add_simulate_flags(CLI::App& cmd, SelfcalCommand& f) {
     f.prior_mm = f.o.selfcal.monitor.projector_fit.prior_position_sd_m * 1e3;
     cmd.add_option("--rig", f.rig, "Virtual rig (rigs/*.toml)")->required()->check(CLI::ExistingFile);
     cmd.add_option("--bump", f.bumps,
@@ -126,22 +108,22 @@ void add_simulate_flags(CLI::App& cmd, SimulateFlags& f) {
         ->check(CLI::Range(1, 100000));
     cmd.add_flag("--verbose", f.verbose, "one line per monitored frame");
     cmd.add_option("--models", f.models,
-                   "start from these models (a full calibration's estimate: mogao-autocal calibrate --rig RIG "
+                   "start from these models (a full calibration's estimate: mogao-calibrate-sim rig --rig RIG "
                    "--scale S writes calibration.models.json) instead of the rig's exact ones")
         ->check(CLI::ExistingFile);
 }
 
 }  // namespace
 
-int main(int argc, char** argv) {
-    CLI::App app{"mogao-selfcal: continuous self-recalibration on the virtual rig"};
-    mogao::cli::prepare(app, "mogao-selfcal");
-    app.require_subcommand(1);
-    CLI::App* sim = app.add_subcommand("simulate", "bump devices of a virtual rig and watch the monitor correct them");
-    SimulateFlags f;
-    add_simulate_flags(*sim, f);
-    if (auto status = mogao::cli::parse(app, argc, argv)) return *status;
-    mogao::selfcal::SimulationOptions& o = f.o;
+void add_selfcal_command(CLI::App& parent, SelfcalCommand& cmd) {
+    cmd.app = parent.add_subcommand(
+        "selfcal-simulate",
+        "Self-recalibration on a virtual rig (simulation): bump devices and watch the monitor correct them");
+    add_simulate_flags(*cmd.app, cmd);
+}
+
+int run_selfcal_command(SelfcalCommand f) {
+    selfcal::SimulationOptions& o = f.o;
     o.content = f.content == "plain"        ? ContentKind::plain
                 : f.content == "repetitive" ? ContentKind::repetitive
                 : f.content == "dark"       ? ContentKind::dark
@@ -152,10 +134,12 @@ int main(int argc, char** argv) {
     try {
         return run_simulate(f.rig, f.models, f.bumps, f.bump_at_s, o, f.verbose);
     } catch (const std::invalid_argument& e) {
-        std::fprintf(stderr, "mogao-selfcal simulate: %s\n", e.what());
+        std::fprintf(stderr, "mogao-calibrate-sim selfcal-simulate: %s\n", e.what());
         return 2;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "mogao-selfcal simulate: %s\n", e.what());
+        std::fprintf(stderr, "mogao-calibrate-sim selfcal-simulate: %s\n", e.what());
         return 1;
     }
 }
+
+}  // namespace mogao::calibrate
