@@ -85,7 +85,8 @@ EmbreeScene build_blas(const EmbreeDevice& device, const Scene& scene, const Mes
     return blas;  // the scene holds its own reference to the geometry
 }
 
-// Which instances go into the shared BLAS: those of meshes placed once, and of small meshes.
+// Which instances go into the shared BLAS: those of meshes placed once, and of meshes whose copies
+// together stay small (so a scan placed many times is never multiplied in memory).
 std::vector<bool> choose_flattened(const Scene& scene, const BvhOptions& bvh) {
     std::vector<std::size_t> placements(scene.meshes.size(), 0);
     for (const Instance& inst : scene.instances) ++placements[inst.mesh];
@@ -96,7 +97,7 @@ std::vector<bool> choose_flattened(const Scene& scene, const BvhOptions& bvh) {
     if (!bvh.flatten || scene.robust_intersection) return flat;
     for (std::size_t i = 0; i < scene.instances.size(); ++i) {
         const std::size_t m = scene.instances[i].mesh;
-        flat[i] = placements[m] == 1 || scene.meshes[m].triangle_count() <= bvh.flatten_max_triangles;
+        flat[i] = placements[m] == 1 || scene.meshes[m].triangle_count() * placements[m] <= bvh.flatten_max_triangles;
     }
     return flat;
 }

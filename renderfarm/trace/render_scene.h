@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // Embree geometry of a Scene: a top-level scene (TLAS) of Embree instances over bottom-level BVHs
 // (BLAS). By default (BvhOptions::flatten) the instances are flattened: every instance of a mesh
-// placed once, or of a small mesh, is copied in world space into ONE shared BLAS (one geometry per
-// instance, geometry id = instance index), which the TLAS holds as a single instance. A large mesh
+// placed once, or of a mesh whose copies stay small, is copied in world space into ONE shared BLAS (one geometry per
+// instance, geometry id = instance index), which the TLAS holds as a single instance. Any other mesh
 // placed several times keeps its own BLAS, built and stored once, and one TLAS instance per
 // placement. Why: in a two-level BVH whose instance boxes overlap (a room whose box encloses every
 // exhibit) each ray descends several BVHs; one BVH over all the static triangles separates them
@@ -57,12 +57,13 @@ struct SurfaceHit {
 // How the BVHs are built. Every choice renders the same image up to float rounding of the hit points;
 // they differ in build time, memory and traversal speed (mogao_bench_bvh, docs/renderer.md).
 struct BvhOptions {
-    // One shared BLAS for the instances of meshes placed once and of meshes of at most
-    // flatten_max_triangles triangles (see the file comment); false: one BLAS per mesh and one TLAS
+    // One shared BLAS for the instances of meshes placed once and of meshes whose copies total at
+    // most flatten_max_triangles triangles (see the file comment); false: one BLAS per mesh and one TLAS
     // instance per placement, every mesh stored once. A scene with robust_intersection is never
     // flattened (its meshes stay watertight in their own object space).
     bool flatten = true;
-    // A mesh placed more than once is copied per placement only up to this size (triangles).
+    // A mesh placed more than once is copied per placement only while its copies total at most this
+    // many triangles (its triangles times its placements).
     std::size_t flatten_max_triangles = 65536;
     // Embree's build quality of the static BLASes (RTC_BUILD_QUALITY_LOW/MEDIUM/HIGH).
     RTCBuildQuality quality = RTC_BUILD_QUALITY_HIGH;
