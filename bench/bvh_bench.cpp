@@ -157,19 +157,10 @@ int run(int argc, char** argv) {
        << poses << " poses of the `walk` path, 1 spp, one thread, best of " << reps
        << ". Regenerate: `build/bench/mogao_bench_bvh --write-docs docs/renderer.md`._\n\n"
        << table(ms);
-    std::printf("%s", md.str().c_str());
-    const std::string docs = arg_str(argc, argv, "--write-docs", "");
-    if (!docs.empty()) bench::write_generated_block(docs, "bvh", md.str());
+    bench::print_and_write_block(argc, argv, "bvh", md.str());
     return 0;
 }
 
 }  // namespace
 
-int main(int argc, char** argv) {
-    try {
-        return run(argc, argv);
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "mogao_bench_bvh: %s\n", e.what());
-        return 1;
-    }
-}
+int main(int argc, char** argv) { return mogao::bench::run_main("mogao_bench_bvh", run, argc, argv); }

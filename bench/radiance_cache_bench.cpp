@@ -202,19 +202,10 @@ int run(int argc, char** argv) {
            << fmt("%.4g", p.relmse) << " | " << fmt("%.2f", rows[0].relmse / p.relmse) << " | " << fmt("%.4f", p.gmsd)
            << " |\n";
     }
-    std::printf("%s", md.str().c_str());
-    const std::string docs = arg_str(argc, argv, "--write-docs", "");
-    if (!docs.empty()) bench::write_generated_block(docs, "radiance-cache", md.str());
+    bench::print_and_write_block(argc, argv, "radiance-cache", md.str());
     return 0;
 }
 
 }  // namespace
 
-int main(int argc, char** argv) {
-    try {
-        return run(argc, argv);
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "mogao_bench_radiance_cache: %s\n", e.what());
-        return 1;
-    }
-}
+int main(int argc, char** argv) { return mogao::bench::run_main("mogao_bench_radiance_cache", run, argc, argv); }

@@ -229,19 +229,10 @@ int run(int argc, char** argv) {
        << passes << " one-spp passes accumulated over frame ids: relMSE pixel centres " << fmt("%.4g", accumulated[0])
        << ", Sobol' positions " << fmt("%.4g", accumulated[1]) << " (centres / Sobol' "
        << fmt("%.2f", accumulated[0] / accumulated[1]) << ").\n";
-    std::printf("%s", md.str().c_str());
-    const std::string docs = arg_str(argc, argv, "--write-docs", "");
-    if (!docs.empty()) bench::write_generated_block(docs, "sampling", md.str());
+    bench::print_and_write_block(argc, argv, "sampling", md.str());
     return 0;
 }
 
 }  // namespace
 
-int main(int argc, char** argv) {
-    try {
-        return run(argc, argv);
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "mogao_bench_sampling: %s\n", e.what());
-        return 1;
-    }
-}
+int main(int argc, char** argv) { return mogao::bench::run_main("mogao_bench_sampling", run, argc, argv); }

@@ -9,6 +9,7 @@
 #include <ctime>
 #include <fstream>
 #include <sstream>
+#include <exception>
 #include <stdexcept>
 #include <thread>
 
@@ -80,6 +81,21 @@ void write_generated_block(const std::string& file, const std::string& tag, cons
     std::ofstream out(file);
     out << text;
     if (!out.flush()) throw std::runtime_error("cannot write " + file);
+}
+
+void print_and_write_block(int argc, char** argv, const std::string& tag, const std::string& block) {
+    std::printf("%s", block.c_str());
+    const std::string docs = arg_str(argc, argv, "--write-docs", "");
+    if (!docs.empty()) write_generated_block(docs, tag, block);
+}
+
+int run_main(const char* name, int (*run)(int, char**), int argc, char** argv) {
+    try {
+        return run(argc, argv);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "%s: %s\n", name, e.what());
+        return 1;
+    }
 }
 
 }  // namespace mogao::bench

@@ -25,5 +25,10 @@ namespace mogao::bench {
 // `file` with `block`. Throws std::runtime_error naming the file when it cannot be read or written
 // or has no such block.
 void write_generated_block(const std::string& file, const std::string& tag, const std::string& block);
+// Prints `block` to stdout and, when the command line has --write-docs FILE, writes it as FILE's
+// generated block `tag` (write_generated_block).
+void print_and_write_block(int argc, char** argv, const std::string& tag, const std::string& block);
+// A benchmark's main: run(argc, argv), or on an exception "NAME: what" on stderr and exit status 1.
+[[nodiscard]] int run_main(const char* name, int (*run)(int, char**), int argc, char** argv);
 
 }  // namespace mogao::bench
