@@ -1,12 +1,18 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: Apache-2.0
-"""Boots two render hosts from mogao-farm.img in QEMU and checks mogao-farm.service end to end.
+"""Installs the mogao-farm package on two stock Debian 12 render hosts in QEMU and checks
+mogao-farm.service end to end.
 
-    farm_qemu_test.py --image mogao-farm.img --repo SRC --farm BIN --kiosk BIN [--image-tool BIN]
-                      [--work DIR] [--results FILE] [--timeout S]
+    farm_qemu_test.py --image mogao-farm.img --deb mogao-farm_VERSION_amd64.deb --repo SRC --farm BIN
+                      --kiosk BIN [--image-tool BIN] [--work DIR] [--results FILE] [--timeout S]
 
-Two provisioned copies of the image (image/farm/provision) boot under TCG with OVMF on a bridge in
-a private network namespace (taps; the host side is fd00:6d6f::1 and 10.77.0.1):
+Two provisioned copies of the render-host image (image/farm/build: Debian 12 with the package's
+dependencies, no mogao program; image/farm/provision: names, network, host keys, the package
+file) boot under TCG with OVMF on a bridge in a private network namespace (taps; the host side is
+fd00:6d6f::1 and 10.77.0.1). On each, the test's unit does what docs/packaging.md tells a
+technician: `apt install ./mogao-farm_*.deb` (offline: the dependencies are in the image), then
+the site's files (farm.env, farm-hosts, the TLS folder, the farm user's ssh files), the packet
+filter reloaded, and on the admin `systemctl enable --now mogao-farm` once farm-render2 answers:
   farm-admin    fd00:6d6f::10, 10.77.0.10: mogao-farm.service, farm-hosts = farm-admin (2 slots)
                 + farm-render2 (1 slot), MOGAO_RANKS=3, the farm's PKI (SAN fd00:6d6f::10)
   farm-render2  fd00:6d6f::11, 10.77.0.11: sshd for the mogao-farm user (key only)
@@ -15,6 +21,8 @@ serial console; the shipped image is not changed. The host is the appliance: mog
 headless in the namespace against [fd00:6d6f::10]:7443.
 
 Assertions (each printed as PASS/FAIL; any failure fails the test):
+  * on both hosts the package installs with apt: the mogao-farm user (971), the unit enabled and
+    not started before its TLS files exist;
   * mogao-farm.service on farm-admin reaches active (Type=notify READY) as user mogao-farm;
   * ranks run on both hosts (rank 2 on farm-render2, started over ssh by mpirun) and the admin
     serves with 2 render ranks (--layout both, the default; admin-only runs every rank on
@@ -84,8 +92,14 @@ def write(path, text, mode=0o644):
     os.chmod(path, mode)
 
 
-def host_dirs(work, farm, overlay, layout):
-    """PKI, ssh keys and the two hosts' provisioning folders (image/farm/provision's HOST_DIR)."""
+# Inside each host: the package and the site's files that the test's unit installs after it
+# (selftest.sh), as a technician would after `apt install` (docs/packaging.md).
+STAGE = "var/lib/mogao-test"
+
+
+def host_dirs(work, farm, deb, overlay, layout):
+    """PKI, ssh keys and the two hosts' provisioning folders (image/farm/provision's HOST_DIR): the
+    host's own files in place, the package and the farm's configuration under STAGE."""
     pki = os.path.join(work, "pki")
     keys = os.path.join(work, "ssh")
     for d in (pki, keys):
@@ -105,10 +119,8 @@ def host_dirs(work, farm, overlay, layout):
         d = os.path.join(work, "hosts", name)
         shutil.rmtree(d, ignore_errors=True)
         if overlay:
-            # This tree's image files and unit, without rebuilding the image (host files follow).
+            # This tree's image files, without rebuilding the image (host files follow).
             shutil.copytree(os.path.join(overlay, "image", "farm", "rootfs"), d, symlinks=True)
-            write(f"{d}/usr/lib/systemd/system/mogao-farm.service",
-                  open(os.path.join(overlay, "systemd", "mogao-farm.service")).read())
         write(f"{d}/etc/hostname", name + "\n")
         write(f"{d}/etc/hosts", hosts_file)
         write(f"{d}/etc/systemd/network/10-farm.network",
@@ -117,6 +129,8 @@ def host_dirs(work, farm, overlay, layout):
               "IPv6AcceptRA=no\nLinkLocalAddressing=ipv6\nLLMNR=no\nMulticastDNS=no\n")
         # The packet filter's farm network (mogao-farm-firewall.service): Open MPI's ports from it only.
         write(f"{d}/etc/mogao/farm-network", f"# the farm's network (written by farm_qemu_test.py)\n{FARM_NETWORK}")
+        os.makedirs(f"{d}/{STAGE}/site", exist_ok=True)
+        shutil.copy(deb, f"{d}/{STAGE}/")
         os.makedirs(f"{d}/etc/ssh", exist_ok=True)
         shutil.copy(os.path.join(keys, name), f"{d}/etc/ssh/ssh_host_ed25519_key")
         shutil.copy(os.path.join(keys, name + ".pub"), f"{d}/etc/ssh/ssh_host_ed25519_key.pub")
@@ -133,7 +147,7 @@ def host_dirs(work, farm, overlay, layout):
         write(f"{d}/etc/systemd/journald.conf.d/90-test-console.conf",
               "[Journal]\nForwardToConsole=yes\nTTYPath=/dev/ttyS0\nMaxLevelConsole=info\n")
         dirs[name] = d
-    admin, render = dirs["farm-admin"], dirs["farm-render2"]
+    admin, render = (f"{dirs[n]}/{STAGE}/site" for n in ("farm-admin", "farm-render2"))
     if layout == "admin-only":
         # Diagnosis: every rank on farm-admin (the unit, READY, the watchdog, the link without
         # Open MPI between the hosts).
@@ -214,7 +228,8 @@ def check_packet_filter(net, serials, fails, results):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--image", required=True)
+    ap.add_argument("--image", required=True, help="the render-host image (image/farm/build)")
+    ap.add_argument("--deb", required=True, help="the mogao-farm package the hosts install")
     ap.add_argument("--repo", required=True)
     ap.add_argument("--farm", required=True, help="mogao-farm (host): the PKI")
     ap.add_argument("--kiosk", required=True, help="mogao-kiosk (host): the appliance, headless")
@@ -224,8 +239,8 @@ def main():
                     help="both: ranks on farm-admin and farm-render2 (the test); admin-only: every rank on "
                          "farm-admin (diagnosis: the unit and the link without MPI between the hosts)")
     ap.add_argument("--overlay", action="store_true",
-                    help="write this tree's systemd/mogao-farm.service and image/farm/rootfs/ into the copies "
-                         "(try changes to them without rebuilding the image)")
+                    help="write this tree's image/farm/rootfs/ into the copies (try changes to it without "
+                         "rebuilding the image)")
     ap.add_argument("--host-loss", action="store_true", default=os.environ.get("MOGAO_FARM_TEST_HOST_LOSS") == "1",
                     help="also lose farm-render2 while the appliance is served (its link cut, then its VM "
                          "killed) and measure the new frame and its return (host_loss.py; ~8 more minutes)")
@@ -244,6 +259,8 @@ def main():
         skip(missing)
     if not os.path.isfile(a.image):
         skip(f"no image at {a.image} (image/farm/build, or the farm_image_build test, makes it)")
+    if not os.path.isfile(a.deb):
+        skip(f"no package at {a.deb} (bash .ci/package, or the farm_packages_build test, makes it)")
     for b in (a.farm, a.kiosk):
         if not os.access(b, os.X_OK):
             skip(f"{b} not built")
@@ -260,7 +277,7 @@ def main():
     if a.build_seconds is not None:
         results["image_build_s"] = a.build_seconds
 
-    pki, dirs = host_dirs(work, a.farm, a.repo if a.overlay else "", a.layout)
+    pki, dirs = host_dirs(work, a.farm, a.deb, a.repo if a.overlay else "", a.layout)
     results["layout"] = a.layout
     images = {}
     for name, d in dirs.items():
@@ -294,6 +311,23 @@ def main():
             if not fails.check(t is not None, f"{name}: the self-test started (serial marker)"):
                 raise RuntimeError(f"{name} did not boot")
             results[f"{name}_qemu_start_to_selftest_s"] = round(t - t_start, 1)
+        # The technician's install on each host (selftest.sh install_package), then the admin's
+        # start once farm-render2 answers its ssh login with the package there.
+        for name, s in serials.items():
+            _, text = s.wait(r"(ok|FAIL) package-installed", 600, alive)
+            fails.check(text is not None and text.startswith("ok"),
+                        f"{name}: apt install ./mogao-farm_*.deb (offline, stock Debian 12): {text}")
+            if text and text.startswith("ok"):
+                results[f"{name}_package_install_s"] = float(farmvm.fields(text)["seconds"])
+            _, text = s.wait(r"(ok|FAIL) package-state", 60, alive)
+            fails.check(text is not None and text.startswith("ok"),
+                        f"{name}: the package made user mogao-farm (971, home /var/lib/mogao-farm) and enabled, "
+                        f"did not start, the unit: {text}")
+            _, text = s.wait(r"(ok|FAIL) site-configured", 120, alive)
+            fails.check(text is not None and text.startswith("ok"), f"{name}: the site's files written after it: {text}")
+        _, text = admin.wait(r"(ok|FAIL) render-host-answers", 700, alive)
+        fails.check(text is not None and text.startswith("ok"),
+                    f"farm-admin: farm-render2 answers the farm user's ssh login with mogao-farm installed: {text}")
         t_ready, text = admin.wait(r"(ok|FAIL) farm-ready", a.timeout, alive)
         ok = fails.check(text is not None and text.startswith("ok"), f"farm-admin: mogao-farm.service active (READY): {text}")
         if ok:

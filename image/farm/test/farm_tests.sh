@@ -1,12 +1,16 @@
 #!/bin/bash
 # SPDX-License-Identifier: Apache-2.0
 # CTest entry of the render-host image tests (labels "image;qemu;farm"); see image/CMakeLists.txt.
-#   farm_tests.sh check REPO                                  syntax and --help (always runs)
-#   farm_tests.sh build REPO OUTDIR FARM                      image/farm/build into OUTDIR
-#   farm_tests.sh qemu  REPO OUTDIR FARM KIOSK [IMAGE_TOOL]   two hosts in QEMU (farm_qemu_test.py)
-# build and qemu are opt-in like the appliance's image tests (MOGAO_IMAGE_TESTS=1) and exit 77
-# (skipped) with a message when not enabled or not possible here. MOGAO_FARM_IMAGE=/path/to/img
-# makes "qemu" test that image instead of the one "build" made.
+#   farm_tests.sh check    REPO                       syntax and --help (always runs)
+#   farm_tests.sh packages REPO PKGDIR                .ci/package: the Debian packages into PKGDIR
+#   farm_tests.sh build    REPO OUTDIR PKGDIR         image/farm/build into OUTDIR (the base for
+#                                                     PKGDIR's mogao-farm package)
+#   farm_tests.sh qemu     REPO OUTDIR PKGDIR FARM KIOSK [IMAGE_TOOL]
+#                                                     two hosts in QEMU that install PKGDIR's
+#                                                     mogao-farm package (farm_qemu_test.py)
+# packages, build and qemu are opt-in like the appliance's image tests (MOGAO_IMAGE_TESTS=1) and
+# exit 77 (skipped) with a message when not enabled or not possible here.
+# MOGAO_FARM_IMAGE=/path/to/img makes "qemu" test that image instead of the one "build" made.
 set -euo pipefail
 mode=$1 repo=$2
 skip() { echo "SKIP: $*"; exit 77; }
@@ -64,33 +68,47 @@ PY
   "$repo/image/farm/provision" --help | grep -q "image/farm/provision"
   source "$repo/image/farm/lib/farm.sh"
   grep -q "^LABEL=$MOGAO_FARM_ROOT_LABEL " "$repo/image/farm/rootfs/etc/fstab"
-  grep -q "^u mogao-farm $MOGAO_FARM_UID:$MOGAO_FARM_GID " "$repo/image/farm/rootfs/usr/lib/sysusers.d/mogao-farm.conf"
+  grep -q "^u mogao-farm $MOGAO_FARM_UID:$MOGAO_FARM_GID " "$repo/systemd/mogao-farm.sysusers"
   echo "farm image scripts: ok"
   exit 0
 fi
 
-outdir=$3 farm=$4
 [[ "${MOGAO_IMAGE_TESTS:-0}" == 1 ]] \
   || skip "the image tests are opt-in (root, Debian mirrors, ~10 min on 2 cores; docs/services.md): set MOGAO_IMAGE_TESTS=1"
 [[ $(id -u) == 0 ]] || skip "the render-host image tests need root (chroot, file ownership, network namespaces)"
-image=${MOGAO_FARM_IMAGE:-$outdir/mogao-farm.img}
 
 case $mode in
+  packages)
+    pkgdir=$3
+    mkdir -p "$pkgdir"
+    rm -f "$pkgdir"/*.deb
+    start=$(date +%s)
+    bash "$repo/.ci/package" "$pkgdir" > "$pkgdir/package.log" 2>&1 \
+      || { tail -n 40 "$pkgdir/package.log"; echo "bash .ci/package $pkgdir failed (log: $pkgdir/package.log)"; exit 1; }
+    grep -E '^(ccache|lintian|package build)' "$pkgdir/package.log" || true
+    echo "farm_packages_build: $(( $(date +%s) - start )) s"
+    ;;
   build)
+    outdir=$3
     [[ -z "${MOGAO_FARM_IMAGE:-}" ]] || skip "MOGAO_FARM_IMAGE=$MOGAO_FARM_IMAGE given: not building an image"
+    deb=${MOGAO_FARM_DEB:-$(ls "$4"/mogao-farm_*.deb 2>/dev/null | head -n1)}
+    [[ -f "$deb" ]] || { echo "no mogao-farm package in $4 (farm_packages_build makes it; or MOGAO_FARM_DEB=FILE)"; exit 1; }
     source "$repo/image/lib/common.sh"
     why=$(img_build_preconditions mmdebstrap mke2fs debugfs mkfs.vfat mcopy sfdisk xz python3) || skip "$why"
     mkdir -p "$outdir"
     start=$(date +%s)
     # The appliance image's .deb cache: most packages are the same.
-    "$repo/image/farm/build" --farm "$farm" --out "$outdir" --cache "$outdir/apt-cache"
+    "$repo/image/farm/build" --deb "$deb" --out "$outdir" --cache "$outdir/apt-cache"
     echo "$(( $(date +%s) - start ))" > "$outdir/mogao-farm.img.build-seconds"
     echo "farm_image_build: $(cat "$outdir/mogao-farm.img.build-seconds") s"
     ;;
   qemu)
-    kiosk=$5 tool=${6:-}
+    outdir=$3 farm=$5 kiosk=$6 tool=${7:-}
+    deb=${MOGAO_FARM_DEB:-$(ls "$4"/mogao-farm_*.deb 2>/dev/null | head -n1)}
+    [[ -n "$deb" ]] || skip "no mogao-farm package in $4 (farm_packages_build makes it; or MOGAO_FARM_DEB=FILE)"
+    image=${MOGAO_FARM_IMAGE:-$outdir/mogao-farm.img}
     [[ -f "$image" ]] || skip "no image at $image (the farm_image_build test builds it)"
-    args=(--image "$image" --repo "$repo" --farm "$farm" --kiosk "$kiosk" --work "$outdir/farm-qemu-test"
+    args=(--image "$image" --deb "$deb" --repo "$repo" --farm "$farm" --kiosk "$kiosk" --work "$outdir/farm-qemu-test"
           --results "$outdir/farm-qemu-test-results.json")
     [[ -n "$tool" ]] && args+=(--image-tool "$tool")
     if [[ -z "${MOGAO_FARM_IMAGE:-}" && -f "$outdir/mogao-farm.img.build-seconds" ]]; then

@@ -24,6 +24,7 @@ SAMPLE = {"layout": "both", "date": "2026-01-01", "commit": "abc1234", "host_cpu
           "guest_boot_to_farm_ready_s": 67.4, "guest_exec_to_farm_ready_s": 18.5, "restarts_before_ready": 0,
           "admin_ranks": [{"rank": "0"}, {"rank": "1"}], "render2_ranks": [{"rank": "2"}],
           "kiosk_connected_s": 0.7, "kiosk_first_frame_s": 11.8, "kiosk_frames": 4,
+          "farm-admin_package_install_s": 21.0, "farm-render2_package_install_s": 20.5,
           "watchdog_stop_to_kill_s": 43.7, "watchdog_stop_to_active_again_s": 69.5, "security_online_exposure": 1.6,
           "test_seconds": 247.7, "failures": []}
 
@@ -47,6 +48,9 @@ def table(r):
                  f"{r['image_allocated_bytes'] / 1e6:.0f} MB allocated |")
     lines.append(f"| ranks | farm-admin: {ranks(r.get('admin_ranks', []))}; "
                  f"farm-render2: {ranks(r.get('render2_ranks', []))} |")
+    lines.append(f"| `apt install ./mogao-farm_*.deb` (offline) | farm-admin "
+                 f"{seconds(r, 'farm-admin_package_install_s')}, farm-render2 "
+                 f"{seconds(r, 'farm-render2_package_install_s')} |")
     lines.append(f"| QEMU start to self-test | farm-admin {seconds(r, 'farm-admin_qemu_start_to_selftest_s')}, "
                  f"farm-render2 {seconds(r, 'farm-render2_qemu_start_to_selftest_s')} |")
     lines.append(f"| READY | {seconds(r, 'guest_boot_to_farm_ready_s')} after boot (guest clock), "

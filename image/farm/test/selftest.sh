@@ -61,6 +61,41 @@ check_common() {
 stty -F "$ctl" -echo icanon 2>/dev/null
 say "start role=$role uptime=$(uptime_s) host=$(hostname) addrs=$(ip -br addr show scope global | awk '{ $1 = $2 = ""; print }' | tr -s ' ' ',')"
 
+# --- what docs/packaging.md tells a technician: the package with apt (offline here: the image holds
+# its dependencies), then the site's files; the test provisioned both under $stage ------------------
+stage=/var/lib/mogao-test
+since() { awk -v a="$1" -v b="$(uptime_s)" 'BEGIN { printf "%.1f", b - a }'; }
+install_package() {
+  deb=$(ls "$stage"/mogao-farm_*.deb 2> /dev/null | head -n1) t0=$(uptime_s)
+  if [ -n "$deb" ] && DEBIAN_FRONTEND=noninteractive apt install -y "$deb" > "$stage/apt.log" 2>&1; then
+    ok "package-installed seconds=$(since "$t0") version=$(dpkg-query -W -f '${Version}' mogao-farm)"
+  else
+    bad "package-installed deb='$deb'"
+    tail -n 30 "$stage/apt.log" | sed 's/^/MOGAO-SELFTEST log /' > "$out"
+  fi
+  # What the package made: its user (fixed ids, the home sshd reads), the unit enabled but not
+  # started (no TLS files yet).
+  user=$(getent passwd mogao-farm | cut -d: -f3,4,6)
+  st="user=$user enabled=$(systemctl is-enabled $unit 2> /dev/null) active=$(systemctl is-active $unit 2> /dev/null)"
+  if [ "$user" = 971:971:/var/lib/mogao-farm ] && [ "$(systemctl is-enabled $unit 2> /dev/null)" = enabled ] &&
+     [ "$(systemctl is-active $unit 2> /dev/null)" = inactive ]; then ok "package-state $st"; else bad "package-state $st"; fi
+  # The site's files: the farm's readable by its group only, the farm user's ssh files its own.
+  cp -a "$stage/site/." /
+  chown -R root:mogao-farm /etc/mogao
+  find /etc/mogao -type d -exec chmod 0750 {} +
+  find /etc/mogao -type f -exec chmod 0640 {} +
+  if [ -d /var/lib/mogao-farm/.ssh ]; then
+    chown -R mogao-farm:mogao-farm /var/lib/mogao-farm/.ssh
+    chmod 0700 /var/lib/mogao-farm/.ssh
+    find /var/lib/mogao-farm/.ssh -type f -exec chmod 0600 {} +
+    find /var/lib/mogao-farm/.ssh -type f -name '*.pub' -exec chmod 0644 {} +
+  fi
+  # The packet filter reads the link port from farm.env, which is new.
+  systemctl reload mogao-farm-firewall.service || bad "firewall-reload"
+  ok "site-configured uptime=$(uptime_s)"
+}
+install_package
+
 if [ "$role" = render ]; then
   i=0
   while [ "$(systemctl is-active ssh.service)" != active ] && [ $i -lt 120 ]; do sleep 1; i=$((i + 1)); done
@@ -103,6 +138,16 @@ if [ "$role" = render ]; then
   say "done fails=$fails uptime=$(uptime_s)"
   exit 0
 fi
+
+# --- admin: once farm-render2 answers the farm's ssh login with its package installed (else the
+# launcher's health check would leave it out), `systemctl enable --now mogao-farm` ----------------------
+t0=$(uptime_s) i=0
+until runuser -u mogao-farm -- ssh -o BatchMode=yes -o ConnectTimeout=10 farm-render2 mogao-farm --version > /dev/null 2>&1; do
+  i=$((i + 1)); [ $i -ge 120 ] && break
+  sleep 5
+done
+[ $i -lt 120 ] && ok "render-host-answers seconds=$(since "$t0")" || bad "render-host-answers (farm-render2: no ssh login or no mogao-farm there)"
+systemctl enable --now --no-block $unit
 
 # --- admin: mogao-farm.service reaches READY (Type=notify: active == READY=1 received) ------------
 # READY comes ~10 s after ExecStart under TCG; each round here takes 1-2 s of the guest.
