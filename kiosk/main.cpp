@@ -72,8 +72,8 @@ int run(const Flags& flags, const SignalFd& signals) {
 
     const std::unique_ptr<CalibrationInbox> calibration = open_calibration_inbox();
     const std::unique_ptr<CalibrationWatcher> watcher = watch_calibration(config, *calibration);
-    const std::unique_ptr<SelfcalWorker> selfcal =
-        start_selfcal(config, display.calibration(), *calibration, built_in_simulated_camera());
+    const std::unique_ptr<SelfcalWorker> selfcal = start_selfcal(
+        config.selfcal, config.calibration.mpcdi, display.calibration(), *calibration, built_in_simulated_camera());
     const std::unique_ptr<FrameInbox> inbox = open_inbox();
     const std::unique_ptr<LinkClient> link = open_link(config, std::move(setup.tls), *inbox, setup.script);
     std::optional<PoseLog> pose_log = open_pose_log(flags.pose_log);

@@ -103,7 +103,7 @@ protected:
         ASSERT_TRUE(display) << display.error().message;
         display_.emplace(std::move(display).value());
         inbox_ = open_inbox();
-        navigation_ = std::make_unique<KioskNavigation>(make_view_script(config_));
+        navigation_ = std::make_unique<KioskNavigation>(scripted_visitor(config_));
         KioskLink link{[](ViewRequest, std::string*) { return std::uint64_t{1}; },
                        [this] {
                            LinkClientStats s;

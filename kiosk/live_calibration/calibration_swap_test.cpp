@@ -128,7 +128,7 @@ protected:
         calibration_ = open_calibration_inbox();
         watcher_ = watch_calibration(config_, *calibration_);
         ASSERT_NE(watcher_, nullptr);
-        navigation_ = std::make_unique<KioskNavigation>(make_view_script(config_));
+        navigation_ = std::make_unique<KioskNavigation>(scripted_visitor(config_));
         auto signals = SignalFd::create({SIGUSR1});
         ASSERT_TRUE(signals) << signals.error().message;
         signals_.emplace(std::move(signals).value());

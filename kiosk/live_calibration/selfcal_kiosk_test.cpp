@@ -113,7 +113,7 @@ protected:
         display_.emplace(std::move(display).value());
         inbox_ = open_inbox();
         calibration_ = open_calibration_inbox();
-        navigation_ = std::make_unique<KioskNavigation>(make_view_script(config_));
+        navigation_ = std::make_unique<KioskNavigation>(scripted_visitor(config_));
         auto signals = SignalFd::create({SIGUSR1});
         ASSERT_TRUE(signals) << signals.error().message;
         signals_.emplace(std::move(signals).value());

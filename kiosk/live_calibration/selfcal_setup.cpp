@@ -78,9 +78,9 @@ std::optional<int> warp_step_of(const ScreenCalibration& calibration) {
     return std::nullopt;
 }
 
-std::unique_ptr<SelfcalWorker> start_selfcal(const KioskConfig& config, const ScreenCalibration& wall,
-                                             CalibrationInbox& inbox, const SimulatedScreenCamera& simulated) {
-    const SelfcalConfig& sc = config.selfcal;
+std::unique_ptr<SelfcalWorker> start_selfcal(const SelfcalConfig& sc, const std::filesystem::path& mpcdi,
+                                             const ScreenCalibration& wall, CalibrationInbox& inbox,
+                                             const SimulatedScreenCamera& simulated) {
     if (!sc.enabled) return nullptr;
     const selfcal::SystemModel model = read_system_model(sc, wall);
     selfcal::SelfcalOptions options;
@@ -89,14 +89,14 @@ std::unique_ptr<SelfcalWorker> start_selfcal(const KioskConfig& config, const Sc
     options.drift_threshold_px = sc.drift_threshold_px;
     options.pattern.enabled = sc.pattern;
     options.pattern.amplitude = sc.pattern_amplitude;
-    options.store = config.calibration.mpcdi;  // corrections written back; the watcher sees the same file
-    options.models_store = sc.models;          // and the corrected poses beside it, for the next start
+    options.store = mpcdi;             // corrections written back; the watcher sees the same file
+    options.models_store = sc.models;  // and the corrected poses beside it, for the next start
     const std::optional<int> step = warp_step_of(wall);
     if (!step) {
         refuse(
             fmt::format("{}: its warp grids are not ones mogao-calibrate builds (a grid step of 1..64 pixels): "
                         "self-recalibration cannot blend a correction into them",
-                        config.calibration.mpcdi.string()));
+                        mpcdi.string()));
     }
     options.build.warp_step_px = *step;
     if (sc.kind == SelfcalConfig::CameraKind::rig && !simulated) {
@@ -107,7 +107,7 @@ std::unique_ptr<SelfcalWorker> start_selfcal(const KioskConfig& config, const Sc
                         sc.camera));
     }
     SelfcalWorker::Camera camera =
-        sc.kind == SelfcalConfig::CameraKind::rig ? simulated(config, model) : v4l2_camera(sc, model);
+        sc.kind == SelfcalConfig::CameraKind::rig ? simulated(sc, model) : v4l2_camera(sc, model);
     try {
         auto worker = std::make_unique<SelfcalWorker>(selfcal::SelfCalibrator(model, wall, options), std::move(camera),
                                                       inbox, sc.rate_hz);

@@ -34,7 +34,7 @@ namespace mogao {
 
 // Opens a simulated screen camera ("rig:") for the models. Errors: KioskSetupError as above.
 using SimulatedScreenCamera =
-    std::function<SelfcalWorker::Camera(const KioskConfig& config, const selfcal::SystemModel& model)>;
+    std::function<SelfcalWorker::Camera(const SelfcalConfig& config, const selfcal::SystemModel& model)>;
 
 // The simulated screen camera this program was built with, defined once per executable (not in
 // the mogao_kiosk library): empty in the appliance's mogao-kiosk
@@ -42,10 +42,12 @@ using SimulatedScreenCamera =
 // (kiosk/simulation/rig_screen_camera.cpp).
 [[nodiscard]] SimulatedScreenCamera built_in_simulated_camera();
 
-// nullptr when [selfcal].enabled is false. `wall`: the calibration the outputs show (the MPCDI).
-// `inbox` must outlive the worker. `simulated` empty: a "rig:" camera is refused.
-[[nodiscard]] std::unique_ptr<SelfcalWorker> start_selfcal(const KioskConfig& config, const ScreenCalibration& wall,
-                                                           CalibrationInbox& inbox,
+// nullptr when [selfcal].enabled is false. `wall`: the calibration the outputs show, read from
+// `mpcdi` ([calibration] source), where corrections are written back. `inbox` must outlive the
+// worker. `simulated` empty: a "rig:" camera is refused.
+[[nodiscard]] std::unique_ptr<SelfcalWorker> start_selfcal(const SelfcalConfig& config,
+                                                           const std::filesystem::path& mpcdi,
+                                                           const ScreenCalibration& wall, CalibrationInbox& inbox,
                                                            const SimulatedScreenCamera& simulated = {});
 
 // The warp grid step (1..64) that autocal::calibration_from_models uses to build grids of the sizes

@@ -58,7 +58,7 @@ KioskSetup load_setup(const std::filesystem::path& file, const std::string& path
     }
     if (!stats_file.empty()) config.stats.file = stats_file;
     try {
-        if (config.navigation.source != NavigationSource::tracking) setup.script.emplace(make_view_script(config));
+        if (config.navigation.source != NavigationSource::tracking) setup.script.emplace(scripted_visitor(config));
         setup.tls = load_tls_files(config.farm.ca, config.farm.cert, config.farm.key);
     } catch (const std::exception& e) {
         throw KioskSetupError(2, fmt::format("{}: {}", config.source.string(), e.what()));
@@ -184,11 +184,17 @@ std::optional<PoseLog> open_pose_log(const std::filesystem::path& file) {
     }
 }
 
+ViewRequest view_template(const KioskConfig& config) { return make_view_template(config.screen, config.quality); }
+
+ViewScript scripted_visitor(const KioskConfig& config) {
+    return make_view_script(config.navigation, view_template(config));
+}
+
 std::unique_ptr<KioskNavigation> start_navigation(const KioskConfig& config, std::optional<ViewScript> script) {
     if (config.navigation.source != NavigationSource::tracking)
         return std::make_unique<KioskNavigation>(std::move(*script));
     try {
-        return std::make_unique<KioskNavigation>(config);
+        return std::make_unique<KioskNavigation>(config.navigation, view_template(config));
     } catch (const std::exception& e) {
         throw KioskSetupError(1, fmt::format("tracking: {}", e.what()));
     }

@@ -86,6 +86,12 @@ struct KioskSetup {
 // --pose-log FILE (empty: none).
 [[nodiscard]] std::optional<PoseLog> open_pose_log(const std::filesystem::path& file);
 
+// The request every view is filled into: [screen] and [quality] (make_view_template).
+[[nodiscard]] ViewRequest view_template(const KioskConfig& config);
+
+// The scripted visitor of [navigation] (make_view_script with view_template). Throws PathError.
+[[nodiscard]] ViewScript scripted_visitor(const KioskConfig& config);
+
 // The scripted visitor (`script`) or, with tracking, the Navigator and tracking thread.
 [[nodiscard]] std::unique_ptr<KioskNavigation> start_navigation(const KioskConfig& config,
                                                                 std::optional<ViewScript> script);

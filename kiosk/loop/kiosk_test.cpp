@@ -117,7 +117,7 @@ protected:
         display_.emplace(std::move(display).value());
         ASSERT_TRUE(display_->show_connecting_screen(config_.quality.content, config_.farm.endpoint));
         inbox_ = open_inbox();
-        navigation_ = std::make_unique<KioskNavigation>(make_view_script(config_));
+        navigation_ = std::make_unique<KioskNavigation>(scripted_visitor(config_));
         auto signals = SignalFd::create({SIGUSR1});
         ASSERT_TRUE(signals) << signals.error().message;
         signals_.emplace(std::move(signals).value());
@@ -223,7 +223,7 @@ TEST_F(KioskTest, OnTickSubmitsTheNavigationsPoseAndLogsIt) {
     KioskRunOptions options;
     options.pose_log.emplace(dir_ / "poses.jsonl");
     Kiosk& k = kiosk(std::move(options));
-    ViewScript expected = make_view_script(config_);  // the same scripted visitor, stepped alongside
+    ViewScript expected = scripted_visitor(config_);  // the same scripted visitor, stepped alongside
     for (int tick = 1; tick <= 3; ++tick) {
         wait_readable(k.tick_fd());
         k.on_tick();
@@ -419,8 +419,8 @@ TEST_F(KioskTest, AYawOnlyTurnReachesTheWallWithinOneDisplayRoundWithoutANewFram
     ViewerPose turned = ahead;
     turned.yaw_deg += kTurnColumns * 150.0 / 160.0;
     // The visitor's pose at ticks 1..5: still, still, turned left, back, back.
-    navigation_ = std::make_unique<KioskNavigation>(
-        ViewScript({ahead, ahead, turned, ahead, ahead}, make_view_template(config_)));
+    navigation_ =
+        std::make_unique<KioskNavigation>(ViewScript({ahead, ahead, turned, ahead, ahead}, view_template(config_)));
     Kiosk& k = kiosk();
     const ImageSize guarded{182, 90};
 

@@ -18,12 +18,12 @@ const char* replay_end_name(ReplayEnd end) {
 
 KioskNavigation::KioskNavigation(ViewScript script) : script_(std::move(script)) {}
 
-KioskNavigation::KioskNavigation(const KioskConfig& config)
-    : template_(make_view_template(config)),
-      navigator_(std::in_place, config.navigation.tracking.params, start_pose(config.navigation)),
-      replay_end_(config.navigation.tracking.replay_end),
+KioskNavigation::KioskNavigation(const NavigationConfig& navigation, ViewRequest request_template)
+    : template_(std::move(request_template)),
+      navigator_(std::in_place, navigation.tracking.params, start_pose(navigation)),
+      replay_end_(navigation.tracking.replay_end),
       samples_(std::make_unique<TagSampleQueue>()) {
-    const TrackingConfig& t = config.navigation.tracking;
+    const TrackingConfig& t = navigation.tracking;
     tracker_ = std::make_unique<TrackingThread>(t, *samples_);
     spdlog::info("tracking: {} -> tag {} of {} mm ({}), intrinsics {}; replay end: {}", tracker_->description(),
                  t.tag_id < 0 ? std::string("largest") : std::to_string(t.tag_id), t.tag_size_m * 1000.0,

@@ -31,8 +31,9 @@ public:
     // The scripted visitor.
     explicit KioskNavigation(ViewScript script);
     // Tracking ([navigation] source = "tracking"): a Navigator at the viewer start and the tracking
-    // thread on the configured camera, started here.
-    explicit KioskNavigation(const KioskConfig& config);
+    // thread on the configured camera, started here; each view filled into `request_template`
+    // (make_view_template).
+    KioskNavigation(const NavigationConfig& navigation, ViewRequest request_template);
     ~KioskNavigation();
     KioskNavigation(const KioskNavigation&) = delete;
     KioskNavigation& operator=(const KioskNavigation&) = delete;

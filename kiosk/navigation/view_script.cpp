@@ -7,15 +7,15 @@
 
 namespace mogao {
 
-ViewRequest make_view_template(const KioskConfig& config) {
+ViewRequest make_view_template(const CylinderScreen& screen, const QualityConfig& quality) {
     ViewRequest r;
-    r.camera = config.screen;
-    r.size = config.quality.content;
-    r.quality.spp = config.quality.spp;
-    r.quality.jpeg_quality = config.quality.jpeg_quality;
-    r.quality.max_bounces = config.quality.max_bounces;
-    r.quality.ao_samples = config.quality.ao_samples;
-    r.quality.area_light_samples = config.quality.area_light_samples;
+    r.camera = screen;
+    r.size = quality.content;
+    r.quality.spp = quality.spp;
+    r.quality.jpeg_quality = quality.jpeg_quality;
+    r.quality.max_bounces = quality.max_bounces;
+    r.quality.ao_samples = quality.ao_samples;
+    r.quality.area_light_samples = quality.area_light_samples;
     r.quality.resolution_scale = 1.0;
     r.request_time_ns = 0;
     return r;
@@ -34,13 +34,12 @@ ViewRequest ViewScript::next() {
     return r;
 }
 
-ViewScript make_view_script(const KioskConfig& config) {
+ViewScript make_view_script(const NavigationConfig& navigation, ViewRequest request_template) {
     Viewer viewer;
-    viewer.eye_height_m = config.navigation.eye_height_m;
-    viewer.start = config.navigation.start;
-    viewer.start_yaw_deg = config.navigation.start_yaw_deg;
-    return ViewScript(make_camera_path(config.navigation.path, viewer, config.navigation.path_frames),
-                      make_view_template(config));
+    viewer.eye_height_m = navigation.eye_height_m;
+    viewer.start = navigation.start;
+    viewer.start_yaw_deg = navigation.start_yaw_deg;
+    return ViewScript(make_camera_path(navigation.path, viewer, navigation.path_frames), std::move(request_template));
 }
 
 }  // namespace mogao

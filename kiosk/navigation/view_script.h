@@ -14,9 +14,10 @@
 
 namespace mogao {
 
-// The request every scripted pose is filled into: CylinderScreen camera (eye at the configured
-// eye height), content size, quality. Pose, frame_id and request_time_ns are left for later.
-[[nodiscard]] ViewRequest make_view_template(const KioskConfig& config);
+// The request every pose is filled into: the [screen] camera (CylinderScreen: its eye at the
+// configured eye height), [quality]'s content size and knobs. Pose, frame_id and request_time_ns are
+// left for later.
+[[nodiscard]] ViewRequest make_view_template(const CylinderScreen& screen, const QualityConfig& quality);
 
 class ViewScript {
 public:
@@ -34,8 +35,8 @@ private:
     std::size_t next_ = 0;
 };
 
-// make_camera_path(config.navigation.path, viewer from [navigation], path_frames). Throws PathError
-// naming the path file and field.
-[[nodiscard]] ViewScript make_view_script(const KioskConfig& config);
+// make_camera_path(navigation.path, viewer from [navigation], path_frames), each pose filled into
+// `request_template` (make_view_template). Throws PathError naming the path file and field.
+[[nodiscard]] ViewScript make_view_script(const NavigationConfig& navigation, ViewRequest request_template);
 
 }  // namespace mogao

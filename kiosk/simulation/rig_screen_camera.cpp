@@ -28,15 +28,15 @@ namespace {
 
 // A SIMULATED screen camera: the rig file's camera seeing what the wall's calibration makes the rig
 // file's (true, possibly bumped) projectors show, at the models' resolutions.
-SelfcalWorker::Camera rig_camera(const KioskConfig& config, const selfcal::SystemModel& model) {
+SelfcalWorker::Camera rig_camera(const SelfcalConfig& sc, const selfcal::SystemModel& model) {
     rig::VirtualRig rig;
     try {
-        rig = rig::load_rig(config.selfcal.rig);
+        rig = rig::load_rig(sc.rig);
     } catch (const std::exception& e) {
         refuse(fmt::format("[selfcal].camera: {}", e.what()));
     }
     if (rig.projectors.size() != model.projectors.size()) {
-        refuse(fmt::format("[selfcal].camera: rig '{}' has {} projectors, the models {}", config.selfcal.rig.string(),
+        refuse(fmt::format("[selfcal].camera: rig '{}' has {} projectors, the models {}", sc.rig.string(),
                            rig.projectors.size(), model.projectors.size()));
     }
     const double projector_scale =
@@ -46,11 +46,11 @@ SelfcalWorker::Camera rig_camera(const KioskConfig& config, const selfcal::Syste
     if (rig.camera.resolution.width != model.camera.resolution.width ||
         rig.camera.resolution.height != model.camera.resolution.height) {
         refuse(fmt::format("[selfcal].camera: rig '{}' camera {}x{} does not scale to the models' {}x{}",
-                           config.selfcal.rig.string(), rig.camera.resolution.width, rig.camera.resolution.height,
+                           sc.rig.string(), rig.camera.resolution.width, rig.camera.resolution.height,
                            model.camera.resolution.width, model.camera.resolution.height));
     }
     spdlog::warn("selfcal: the screen camera is SIMULATED from the virtual rig {} (tests and demos only)",
-                 config.selfcal.rig.string());
+                 sc.rig.string());
     auto sim = std::make_shared<rig::CameraSimulator>(rig);
     return [sim](const cv::Mat1f& content, const ScreenCalibration& wall, std::uint64_t frame) {
         std::vector<cv::Mat> signals;
