@@ -28,7 +28,7 @@ std::string size_text(ImageSize s) { return std::to_string(s.width) + "x" + std:
 // part t = trunc(y) (the float's exponent field) and f = y - t in (-1, 0] (degree-5 Taylor series of
 // 2^f, relative error < 2e-4 — ample for filter weights, which are renormalised). Branch-free, so
 // the row loops below vectorise.
-inline float fast_exp_neg(float x) {
+MOGAO_ALWAYS_INLINE inline float fast_exp_neg(float x) {
     const float y = -x * 1.44269504f;
     const int whole = static_cast<int>(y);
     const float f = y - static_cast<float>(whole);
@@ -232,17 +232,18 @@ void prepare(const RgbFloatImage& noisy, const GuideBuffers& guides, const Plane
 
 // The geometry exponent of tap q for pixel p, offset (ox, oy) pixels (GeometryWeight's formula);
 // NaN for a sky p (0/0), which callers clamp to kMaxExponent.
-inline float geometry_exponent(const Geometry& g, const GeometryWeight& gw, std::size_t p, std::size_t q, float ox,
-                               float oy) {
+MOGAO_ALWAYS_INLINE inline float geometry_exponent(const Geometry& g, const GeometryWeight& gw, std::size_t p,
+                                                   std::size_t q, float ox, float oy) {
     const float ex = g.nx[p] - g.nx[q], ey = g.ny[p] - g.ny[q], ez = g.nz[p] - g.nz[q];
     const float allowed = gw.sigma_depth * std::abs(g.dzdx[p] * ox + g.dzdy[p] * oy) + gw.depth_eps * g.z[p];
     return (ex * ex + ey * ey + ez * ez) * gw.inv_sigma_normal2 + std::abs(g.z[p] - g.z[q]) / allowed;
 }
 
 // exp(-(geometry exponent)) of taps q = p + offset for p in [i, i + count), times hw and q's
-// surface mask, into `out`. The loop vectorises.
-void geometry_weights(const Geometry& g, const GeometryWeight& gw, std::size_t i, std::ptrdiff_t offset, int count,
-                      float ox, float oy, float hw, float* out) {
+// surface mask, into `out`. The loop vectorises (built twice: common/cpu_level.h).
+MOGAO_ALWAYS_INLINE inline void geometry_weights_body(const Geometry& g, const GeometryWeight& gw, std::size_t i,
+                                                      std::ptrdiff_t offset, int count, float ox, float oy, float hw,
+                                                      float* out) {
 #pragma GCC ivdep  // out never aliases the geometry planes
     for (int k = 0; k < count; ++k) {
         const std::size_t p = i + static_cast<std::size_t>(k);
@@ -252,12 +253,23 @@ void geometry_weights(const Geometry& g, const GeometryWeight& gw, std::size_t i
         out[k] = hw * g.mask[q] * fast_exp_neg(e);
     }
 }
+MOGAO_TARGET_X86_64_V3 void geometry_weights_v3(const Geometry& g, const GeometryWeight& gw, std::size_t i,
+                                                std::ptrdiff_t offset, int count, float ox, float oy, float hw,
+                                                float* out) {
+    geometry_weights_body(g, gw, i, offset, count, ox, oy, hw, out);
+}
+void geometry_weights_base(const Geometry& g, const GeometryWeight& gw, std::size_t i, std::ptrdiff_t offset, int count,
+                           float ox, float oy, float hw, float* out) {
+    geometry_weights_body(g, gw, i, offset, count, ox, oy, hw, out);
+}
 
 // The 5x5 neighbourhood on the same surface of row y's pixels: for each tap inside the image, the
 // geometry weights of pixels [xa, xb) into wt, then add(xa, xb, at), `at` the tap's index for x = 0.
+using GeometryWeightsFn = decltype(&geometry_weights_base);
+
 template <typename Add>
-void surface_taps_5x5(const Planes& planes, const GeometryWeight& gw, ImageSize size, int y, std::vector<float>& wt,
-                      Add&& add) {
+void surface_taps_5x5(GeometryWeightsFn geometry_weights, const Planes& planes, const GeometryWeight& gw,
+                      ImageSize size, int y, std::vector<float>& wt, Add&& add) {
     const int w = size.width, h = size.height;
     const std::size_t row = static_cast<std::size_t>(y) * w;
     for (int oy = -2; oy <= 2; ++oy) {
@@ -274,7 +286,8 @@ void surface_taps_5x5(const Planes& planes, const GeometryWeight& gw, ImageSize 
 
 // Spatial luminance variance of each surface pixel over its 5x5 neighbourhood on the same surface
 // (weights: the geometry terms only) — [S] §4.2's estimate for frames without history.
-void estimate_variance(ImageSize size, const GeometryWeight& gw, const Planes& planes, int threads) {
+void estimate_variance(GeometryWeightsFn geometry_weights, ImageSize size, const GeometryWeight& gw,
+                       const Planes& planes, int threads) {
     const int w = size.width;
     const Signal& s = planes.ping;
     for_row_bands(size.height, threads, [&](int y0, int y1) {
@@ -282,7 +295,7 @@ void estimate_variance(ImageSize size, const GeometryWeight& gw, const Planes& p
         for (int y = y0; y < y1; ++y) {
             std::fill(sw.begin(), sw.end(), 0.0f), std::fill(s1.begin(), s1.end(), 0.0f);
             std::fill(s2.begin(), s2.end(), 0.0f);
-            surface_taps_5x5(planes, gw, size, y, wt, [&](int xa, int xb, std::ptrdiff_t at) {
+            surface_taps_5x5(geometry_weights, planes, gw, size, y, wt, [&](int xa, int xb, std::ptrdiff_t at) {
                 const float* lq = s.lum + at;
                 for (int x = xa; x < xb; ++x) {
                     sw[x] += wt[x];
@@ -306,8 +319,8 @@ void estimate_variance(ImageSize size, const GeometryWeight& gw, const Planes& p
 // correlation), Var(l) = (Σ_c w_c σ_c / max(a_c, kMinAlbedo))², then averaged over the pixel's 5x5
 // neighbourhood on the same surface (the geometry weights of estimate_variance), which steadies an
 // estimate from as few as two passes. The pong variance plane is the scratch (filter_level rewrites it).
-void given_variance(const RgbFloatImage& variance, const GuideBuffers& guides, const GeometryWeight& gw,
-                    const Planes& planes, int threads) {
+void given_variance(GeometryWeightsFn geometry_weights, const RgbFloatImage& variance, const GuideBuffers& guides,
+                    const GeometryWeight& gw, const Planes& planes, int threads) {
     const ImageSize size = variance.size;
     const int w = size.width;
     float* raw = planes.pong.var;
@@ -323,7 +336,7 @@ void given_variance(const RgbFloatImage& variance, const GuideBuffers& guides, c
         std::vector<float> sw(w), sv(w), wt(w);
         for (int y = y0; y < y1; ++y) {
             std::fill(sw.begin(), sw.end(), 0.0f), std::fill(sv.begin(), sv.end(), 0.0f);
-            surface_taps_5x5(planes, gw, size, y, wt, [&](int xa, int xb, std::ptrdiff_t at) {
+            surface_taps_5x5(geometry_weights, planes, gw, size, y, wt, [&](int xa, int xb, std::ptrdiff_t at) {
                 const float* vq = raw + at;
                 for (int x = xa; x < xb; ++x) sw[x] += wt[x], sv[x] += wt[x] * vq[x];
             });
@@ -369,9 +382,11 @@ struct RowSums {
     }
 };
 
-// Adds one tap (offset ox, oy in pixels, kernel weight hw) of row `row` [xa, xb) to the sums.
-void add_tap(const Signal& src, const Planes& planes, const GeometryWeight& gw, std::size_t row, int xa, int xb, int ox,
-             int oy, int width, float hw, RowSums& sums) {
+// Adds one tap (offset ox, oy in pixels, kernel weight hw) of row `row` [xa, xb) to the sums (built
+// twice: common/cpu_level.h).
+MOGAO_ALWAYS_INLINE inline void add_tap_body(const Signal& src, const Planes& planes, const GeometryWeight& gw,
+                                             std::size_t row, int xa, int xb, int ox, int oy, int width, float hw,
+                                             RowSums& sums) {
     const std::ptrdiff_t offset = static_cast<std::ptrdiff_t>(oy) * width + ox;
     const std::size_t p0 = row + static_cast<std::size_t>(xa);
     const Geometry& g = planes.geometry;
@@ -399,10 +414,30 @@ void add_tap(const Signal& src, const Planes& planes, const GeometryWeight& gw, 
         sv[k] += wt * wt * src.var[q];
     }
 }
+MOGAO_TARGET_X86_64_V3 void add_tap_v3(const Signal& src, const Planes& planes, const GeometryWeight& gw,
+                                       std::size_t row, int xa, int xb, int ox, int oy, int width, float hw,
+                                       RowSums& sums) {
+    add_tap_body(src, planes, gw, row, xa, xb, ox, oy, width, hw, sums);
+}
+void add_tap_base(const Signal& src, const Planes& planes, const GeometryWeight& gw, std::size_t row, int xa, int xb,
+                  int ox, int oy, int width, float hw, RowSums& sums) {
+    add_tap_body(src, planes, gw, row, xa, xb, ox, oy, width, hw, sums);
+}
+
+// The build of the tap loops this run uses.
+struct Kernels {
+    decltype(&geometry_weights_base) geometry_weights;
+    decltype(&add_tap_base) add_tap;
+};
+
+Kernels kernels_for(CpuLevel level) {
+    if (use_x86_64_v3(level)) return {geometry_weights_v3, add_tap_v3};
+    return {geometry_weights_base, add_tap_base};
+}
 
 // One à-trous level [D]: every surface pixel becomes the weighted mean of its 5x5 taps at `step`.
-void filter_level(ImageSize size, int step, const GeometryWeight& gw, const Signal& src, const Signal& dst,
-                  const Planes& planes, int threads) {
+void filter_level(const Kernels& kernels, ImageSize size, int step, const GeometryWeight& gw, const Signal& src,
+                  const Signal& dst, const Planes& planes, int threads) {
     const int w = size.width, h = size.height;
     for_row_bands(h, threads, [&](int y0, int y1) {
         RowSums sums(w);
@@ -415,7 +450,8 @@ void filter_level(ImageSize size, int step, const GeometryWeight& gw, const Sign
                 for (int kx = -2; kx <= 2; ++kx) {
                     const int ox = kx * step;
                     const int xa = std::max(0, -ox), xb = std::min(w, w - ox);
-                    if (xa < xb) add_tap(src, planes, gw, row, xa, xb, ox, oy, w, kB3[kx + 2] * kB3[ky + 2], sums);
+                    if (xa < xb)
+                        kernels.add_tap(src, planes, gw, row, xa, xb, ox, oy, w, kB3[kx + 2] * kB3[ky + 2], sums);
                 }
             }
             for (int x = 0; x < w; ++x) {
@@ -452,15 +488,16 @@ Status AtrousDenoiser::run(const RgbFloatImage& noisy, const GuideBuffers& guide
         params.threads > 0 ? params.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
     Planes planes = make_planes(planes_, n);
     const GeometryWeight gw = make_geometry_weight(params);
+    const Kernels kernels = kernels_for(params.cpu);
     prepare(noisy, guides, planes, threads);
     if (variance) {
-        given_variance(*variance, guides, gw, planes, threads);
+        given_variance(kernels.geometry_weights, *variance, guides, gw, planes, threads);
     } else {
-        estimate_variance(size, gw, planes, threads);
+        estimate_variance(kernels.geometry_weights, size, gw, planes, threads);
     }
     for (int level = 0; level < params.iterations; ++level) {
         colour_scales(size, params.sigma_colour, planes.ping, planes, threads);
-        filter_level(size, 1 << level, gw, planes.ping, planes.pong, planes, threads);
+        filter_level(kernels, size, 1 << level, gw, planes.ping, planes.pong, planes, threads);
         std::swap(planes.ping, planes.pong);
     }
     out.size = size;

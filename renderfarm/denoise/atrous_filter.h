@@ -34,11 +34,13 @@
 // length is not W·H·3, guides of another size or with buffers of the wrong length, iterations
 // outside [0, kMaxIterations], a σ that is negative or not finite, threads < 0, a hit pixel whose
 // depth is not finite and > 0. The message names the field and the limit; `out` is not touched.
-// Cost: (25 + 25 · iterations) taps per surface pixel, each one exp; threads split rows.
+// Cost: (25 + 25 · iterations) taps per surface pixel, each one exp; threads split rows. The tap loops
+// run eight pixels at a time where the CPU has x86-64-v3 (AVX2, FMA), else four.
 #pragma once
 
 #include <vector>
 
+#include "common/cpu_level.h"
 #include "common/image.h"
 #include "common/result.h"
 #include "renderfarm/trace/guide_buffers.h"
@@ -53,6 +55,9 @@ struct AtrousParams {
     float sigma_normal = 0.5f;  // σ_n [D]: on |n_p - n_q| (unit normals: 0.5 ≈ weight 1/e at 29°)
     float sigma_depth = 1.0f;   // σ_z [S]: in multiples of the depth change the local slope predicts
     int threads = 1;            // row bands run on this many threads; 0 = std::thread::hardware_concurrency
+    // The kernels' build (common/cpu_level.h): x86-64-v3 where the CPU has it, or the baseline build
+    // (tests and benchmarks compare the two; results agree to float rounding, not bit for bit).
+    CpuLevel cpu = CpuLevel::automatic;
 };
 
 // Reusable scratch buffers: keep one AtrousDenoiser per stream of frames so that per-frame calls
