@@ -175,7 +175,12 @@ std::vector<Config> all_configs(const BenchArgs& a) {
     temporal.key = "temporal";
     temporal.name = "all + denoiser + cache + temporal";
     temporal.live.temporal = true;
-    std::vector<Config> out{today, all, denoise, floor, cache, temporal};
+    // The cache configuration with a still view's later passes of 1 spp (2 by default).
+    Config still1 = cache;
+    still1.key = "cache-still-1spp";
+    still1.name = "all + denoiser + cache, still passes of 1 spp";
+    still1.live.still_pass_min_spp = 1;
+    std::vector<Config> out{today, all, denoise, floor, cache, temporal, still1};
     const auto without = [&](const char* key, const char* name, auto change) {
         Config c = all;
         c.key = key;
@@ -536,11 +541,12 @@ int main(int argc, char** argv) {
     app.add_option("--reference-spp", a.reference_spp, "Reference samples per pixel (two halves)")
         ->check(CLI::Range(2, 8192));
     app.add_option("--configs", a.configs,
-                   "today, all, denoise, denoise-floor-0.2, cache, temporal, no-progressive, no-target, no-pipeline, "
+                   "today, all, denoise, denoise-floor-0.2, cache, temporal, cache-still-1spp, no-progressive, "
+                   "no-target, no-pipeline, "
                    "no-rank-speed, no-rate-aim")
         ->delimiter(',')
-        ->check(CLI::IsMember({"today", "all", "denoise", "denoise-floor-0.2", "cache", "temporal", "no-progressive",
-                               "no-target", "no-pipeline", "no-rank-speed", "no-rate-aim"}));
+        ->check(CLI::IsMember({"today", "all", "denoise", "denoise-floor-0.2", "cache", "temporal", "cache-still-1spp",
+                               "no-progressive", "no-target", "no-pipeline", "no-rank-speed", "no-rate-aim"}));
     app.add_option("--quality", a.quality,
                    "Preset whose request quality every request uses (" + quality_preset_names() +
                        "); default: the request's defaults")

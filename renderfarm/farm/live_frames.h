@@ -61,9 +61,10 @@
 namespace mogao {
 
 struct LiveOptions {
-    bool progressive = true;    // accumulate still views
-    int converged_spp = 1024;   // stop rendering a still view once it has this many samples
-    double frame_time_s = 0.0;  // per-session frame-time target, seconds; 0 = render requests as asked
+    bool progressive = true;     // accumulate still views
+    int converged_spp = 1024;    // stop rendering a still view once it has this many samples
+    int still_pass_min_spp = 2;  // a still view's passes after its first take at least this many spp, >= 1
+    double frame_time_s = 0.0;   // per-session frame-time target, seconds; 0 = render requests as asked
     // Share the frame-time target among the sessions served in the last kActiveWindow: each
     // session's frames aim at frame_time_s / (active sessions), so that one round of every active
     // session's frame takes about frame_time_s. Each appliance then keeps its frame rate and
