@@ -34,8 +34,8 @@ farm_check_host_dir() {
   # The farm's own configuration comes with the mogao-farm package, after it is installed
   # (docs/packaging.md): dpkg would find farm.env and farm-hosts in the way of its conffiles.
   for f in etc/mogao/farm.env etc/mogao/farm-hosts etc/mogao/pki; do
-    [[ ! -e "$dir/$f" ]] \
-      || img_die "$dir/$f: the farm's configuration is written after \`apt install ./mogao-farm_*.deb\` on the host (docs/packaging.md), not provisioned into the image"
+    [[ ! -e "$dir/$f" ]] || img_die "$dir/$f: the farm's configuration is written after" \
+      "\`apt install ./mogao-farm_*.deb\` on the host (docs/packaging.md), not provisioned into the image"
   done
 }
 

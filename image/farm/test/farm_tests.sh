@@ -66,7 +66,20 @@ for f in sys.argv[1:]:
 PY
   "$repo/image/farm/build" --help | grep -q "image/farm/build"
   "$repo/image/farm/provision" --help | grep -q "image/farm/provision"
+  source "$repo/image/lib/common.sh"
   source "$repo/image/farm/lib/farm.sh"
+  # Provisioning takes a host's own files and refuses the farm's configuration, which the package's
+  # conffiles own (written on the host after apt install), naming the file.
+  mkdir -p "$tmp/host/etc/mogao"
+  printf '10.77.0.0/24\n' > "$tmp/host/etc/mogao/farm-network"
+  (farm_check_host_dir "$tmp/host") || { echo "provisioning refused a host's own files"; exit 1; }
+  for f in farm.env farm-hosts pki; do
+    if [[ $f == pki ]]; then mkdir "$tmp/host/etc/mogao/pki"; else : > "$tmp/host/etc/mogao/$f"; fi
+    if (farm_check_host_dir "$tmp/host") 2> "$tmp/provision.err"; then echo "provisioning took etc/mogao/$f"; exit 1; fi
+    grep -q "etc/mogao/$f: the farm's configuration is written after" "$tmp/provision.err" \
+      || { echo "provisioning refused etc/mogao/$f without saying why:"; cat "$tmp/provision.err"; exit 1; }
+    rm -rf "$tmp/host/etc/mogao/$f"
+  done
   grep -q "^LABEL=$MOGAO_FARM_ROOT_LABEL " "$repo/image/farm/rootfs/etc/fstab"
   grep -q "^u mogao-farm $MOGAO_FARM_UID:$MOGAO_FARM_GID " "$repo/systemd/mogao-farm.sysusers"
   echo "farm image scripts: ok"
