@@ -48,7 +48,7 @@ def prose_figures(text):
     """Measured figures outside generated blocks and outside what the rule above allows:
     a list of 'line N: 'FIGURE' in: LINE' (N counted in `text`)."""
     found = []
-    generated = fenced = reference = False
+    generated = fenced = reference = in_span = False
     previous = ""
     for number, line in enumerate(text.splitlines(), 1):
         stripped_line = line.strip()
@@ -63,9 +63,14 @@ def prose_figures(text):
         else:
             reference = False
         previous = stripped_line
+        if not stripped_line:
+            in_span = False  # a code span never crosses a blank line
         if generated or fenced or reference or stripped_line.startswith(("<!--", "```", "~~~")):
             continue
-        stripped = re.sub(r"`[^`]*`", "", line)  # commands, code, configuration values
+        spanned = ("`" if in_span else "") + line  # a code span that began on the line before
+        in_span = spanned.count("`") % 2 == 1
+        stripped = re.sub(r"`[^`]*`", "", spanned)  # commands, code, configuration values
+        stripped = re.sub(r"`.*$", "", stripped)  # a code span that goes on to the next line
         stripped = re.sub(r"\]\([^)]*\)", "]", stripped)  # link targets
         for m in FIGURE.finditer(stripped):
             found.append(f"line {number}: '{m.group(0)}' in: {stripped_line}")
