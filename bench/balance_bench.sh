@@ -26,7 +26,8 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 for b in pbt equal roundrobin; do
   mpirun_n "$ranks" "$build/renderfarm/farm/mogao-farm" render --scene "$scene" --scans "$scans" \
-    --frames "$frames" --width "$width" --height "$height" --balance "$b" --contact-sheet 0 --out "$work/$b" 2> "$work/$b.log" \
+    --frames "$frames" --width "$width" --height "$height" --balance "$b" --contact-sheet 0 --out "$work/$b" \
+    2> "$work/$b.log" \
     || { cat "$work/$b.log" >&2; exit 1; }
 done
 "$build/bench/mogao_balance_sim" "$work/pbt/tile-costs.json" --ranks 4 8 16 --json "$work/sim.json" > /dev/null
@@ -42,14 +43,16 @@ for b in ("pbt", "equal", "roundrobin"):
                  "mean_frame_seconds": sum(x["frame_seconds"] for x in f) / len(f),
                  "mean_render_phase_seconds": sum(x["render_phase_seconds"] for x in f) / len(f)})
 by = {r["balancer"]: r for r in real}
+render_phase = {b: by[b]["mean_render_phase_seconds"] for b in ("pbt", "equal", "roundrobin")}
 ratios = {"efficiency_pbt_over_equal": by["pbt"]["mean_efficiency"] / by["equal"]["mean_efficiency"],
           "efficiency_pbt_over_roundrobin": by["pbt"]["mean_efficiency"] / by["roundrobin"]["mean_efficiency"],
-          "render_phase_equal_over_pbt": by["equal"]["mean_render_phase_seconds"] / by["pbt"]["mean_render_phase_seconds"],
-          "render_phase_roundrobin_over_pbt": by["roundrobin"]["mean_render_phase_seconds"] / by["pbt"]["mean_render_phase_seconds"]}
+          "render_phase_equal_over_pbt": render_phase["equal"] / render_phase["pbt"],
+          "render_phase_roundrobin_over_pbt": render_phase["roundrobin"] / render_phase["pbt"]}
 sim = json.load(open(f"{w}/sim.json"))
 sim["input"]["file"] = "tile-costs.json of the pbt run"
-result = {"bench": "balance", "scene": os.path.basename(scene), "frames": frames, "width": width, "height": height, "mpi_ranks": ranks,
-          "render_ranks": ranks - 1, "threads_per_rank": 1, "real": real, "ratios": ratios, "simulated": sim}
+result = {"bench": "balance", "scene": os.path.basename(scene), "frames": frames, "width": width, "height": height,
+          "mpi_ranks": ranks, "render_ranks": ranks - 1, "threads_per_rank": 1, "real": real, "ratios": ratios,
+          "simulated": sim}
 if out:
     with open(out, "w") as fh:
         json.dump(result, fh, indent=1)

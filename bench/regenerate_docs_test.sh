@@ -27,7 +27,8 @@ sed 's/^<!-- generated:jpeg-quality -->$/<!-- generated:jpeg-qualty -->/' "$doc"
 expect_fail "an unknown table" "unknown table generated:jpeg-qualty" "$work/unknown.md"
 sed '/^<!-- generated:jpeg-quality -->$/,/^<!-- \/generated -->$/d' "$doc" > "$work/missing.md"
 expect_fail "a table without markers" "tables without markers in the doc: jpeg-quality" "$work/missing.md" --only jpeg
-sed 's/^## JPEG quality$/## JPEG quality\n\nThe main job renders at 2.22 s\/frame and 8.1 Mrays\/s./' "$doc" > "$work/figure.md"
+sed 's/^## JPEG quality$/## JPEG quality\n\nThe main job renders at 2.22 s\/frame and 8.1 Mrays\/s./' "$doc" \
+    > "$work/figure.md"
 expect_fail "a figure in the prose" "measured figure in prose" "$work/figure.md" --only jpeg
 out=$(python3 "$src/bench/regenerate-docs" --check --build "$work/no-build" --only jpeg 2>&1); rc=$?
 if [[ $rc -ne 1 || $out != *"cannot run"* ]]; then

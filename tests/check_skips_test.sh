@@ -12,13 +12,15 @@ report() {  # report FILE SKIPPED_NAME...
     echo '<testsuite name="t" tests="3" failures="0" skipped="1">'
     echo '<testcase name="Unit.Runs" classname="Unit.Runs" time="0.1" status="run"/>'
     for name in "$@"; do
-      echo "<testcase name=\"$name\" classname=\"$name\" time=\"0.1\" status=\"notrun\"><skipped message=\"SKIP_RETURN_CODE=77\"/></testcase>"
+      echo "<testcase name=\"$name\" classname=\"$name\" time=\"0.1\" status=\"notrun\">"\
+"<skipped message=\"SKIP_RETURN_CODE=77\"/></testcase>"
     done
     echo '</testsuite>'; } > "$file"
 }
 failures=0
 report "$work/ok.xml" V4l2CaptureVivid.StreamsGrey mogao_kms_probe_lists
-out=$(python3 "$src/.ci/check-skips" "$work/ok.xml") || { echo "FAIL: allowlisted skips refused: $out"; failures=$((failures + 1)); }
+out=$(python3 "$src/.ci/check-skips" "$work/ok.xml") || { echo "FAIL: allowlisted skips refused: $out";
+    failures=$((failures + 1)); }
 [[ $out == *"1 passed, 0 failed, 2 skipped"* ]] || { echo "FAIL: closing line: $out"; failures=$((failures + 1)); }
 report "$work/bad.xml" V4l2CaptureVivid.StreamsGrey kiosk_e2e_netns
 if out=$(python3 "$src/.ci/check-skips" "$work/bad.xml"); then

@@ -24,7 +24,8 @@ check() {  # check NAME EXPECTED_STATUS ARGS... (runs "${run[@]}" ARGS)
 for entry in "$@"; do
   name=${entry%%=*} exe=${entry#*=}
   run=("$exe")
-  check "$name" 0 --version && { grep -qx "$name $version" "$out" || fail "$name --version printed '$(head -c 200 "$out")', not '$name $version'"; }
+  check "$name" 0 --version && { grep -qx "$name $version" "$out" ||
+      fail "$name --version printed '$(head -c 200 "$out")', not '$name $version'"; }
   check "$name" 0 --help && { grep -q "$name" "$out" || fail "$name --help does not name the program"; }
   # A program whose top level has only subcommands: its first subcommand's help shows the defaults
   # and takes the unknown flag (a missing subcommand would be reported first).
@@ -37,7 +38,8 @@ for entry in "$@"; do
   fi
   check "$name" 2 ${sub:+"$sub"} --no-such-flag-xyz
   # The message names the unknown flag, or the required one CLI11 checks first.
-  grep -qE -- "--no-such-flag-xyz|is required" "$err" || fail "$name: the usage error names no flag (stderr: $(head -c 300 "$err"))"
+  grep -qE -- "--no-such-flag-xyz|is required" "$err" || fail \
+      "$name: the usage error names no flag (stderr: $(head -c 300 "$err"))"
   if [ "$name" = mogao-farm ]; then
     # Under MPI: rank 0 reports, the others exit 2 quietly; mpirun passes the status on.
     run=("$mpiexec" -n 2 "$exe")

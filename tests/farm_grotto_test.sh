@@ -6,7 +6,8 @@ farm=$1 MPIEXEC=$2 scene=$3 scans=$4 work=$5
 if [ ! -d "$scans" ]; then echo "SKIP: real scans not found at $scans (../shared/data/scans)"; exit 77; fi
 source "$(dirname "$0")/mpi_env.sh"
 rm -rf "$work" && mkdir -p "$work"
-mpirun_n 3 "$farm" render --scene "$scene" --scans "$scans" --frames 4 --width 320 --height 180 --out "$work" 2> "$work/log"
+mpirun_n 3 "$farm" render --scene "$scene" --scans "$scans" --frames 4 --width 320 --height 180 --out \
+    "$work" 2> "$work/log"
 cat "$work/log"
 python3 - "$work/stats.json" <<'PY'
 import json, sys

@@ -120,7 +120,8 @@ print(f"ordinary appliance: {rate(t_alone, t_dear):.2f} frames/s alone, {rate(t_
       f"the dear one ({len(beside)} frames, longest wait {gap:.1f} s); dear appliance: {dear_frames} frames")
 ok = True
 if len(beside) < min_frames:
-    print(f"FAIL: the ordinary appliance got {len(beside)} frames beside the dear one, {min_frames} expected"); ok = False
+    print(f"FAIL: the ordinary appliance got {len(beside)} frames beside the dear one, {min_frames} expected")
+    ok = False
 if gap > max_gap:
     print(f"FAIL: the ordinary appliance waited {gap:.1f} s for a frame (bound {max_gap:.0f} s)"); ok = False
 if dear_frames < 1:
@@ -140,7 +141,8 @@ print(f"metrics: farm up {farm.get('mogao_farm_up')}, frames per appliance {fram
       f"{farm.get('mogao_farm_frame_seconds_count')} frame times; ordinary kiosk up {kiosk.get('mogao_kiosk_up')}, "
       f"{kiosk.get('mogao_kiosk_frames_shown_total')} frames shown")
 ok = farm.get("mogao_farm_up") == 0 and kiosk.get("mogao_kiosk_up") == 0 and min(frames.values()) > 0
-ok = ok and kiosk.get("mogao_kiosk_frames_shown_total", 0) > 0 and kiosk.get("mogao_kiosk_motion_to_photon_seconds_count", 0) > 0
+ok = ok and kiosk.get("mogao_kiosk_frames_shown_total", 0) > 0 \
+    and kiosk.get("mogao_kiosk_motion_to_photon_seconds_count", 0) > 0
 print("metrics: OK" if ok else "FAIL: the metrics files do not show both appliances served and both stopped")
 sys.exit(0 if ok else 1)
 PY

@@ -17,8 +17,10 @@ if ! command -v promtool >/dev/null; then
 fi
 rm -rf "$work"
 mkdir -p "$work"
-MOGAO_METRICS_SAMPLE_DIR=$work "$farm_test" --gtest_filter='FarmMetrics.ExpositionTextHasEveryFamilyWithItsTypeAndValue' >"$work/farm-test.log"
-MOGAO_METRICS_SAMPLE_DIR=$work "$kiosk_test" --gtest_filter='KioskMetrics.EveryFamilyWithItsValueFromTheStatusAndTheCounters' >"$work/kiosk-test.log"
+MOGAO_METRICS_SAMPLE_DIR=$work "$farm_test" \
+    --gtest_filter='FarmMetrics.ExpositionTextHasEveryFamilyWithItsTypeAndValue' >"$work/farm-test.log"
+MOGAO_METRICS_SAMPLE_DIR=$work "$kiosk_test" \
+    --gtest_filter='KioskMetrics.EveryFamilyWithItsValueFromTheStatusAndTheCounters' >"$work/kiosk-test.log"
 for side in farm kiosk; do
   file=$work/mogao-$side.prom
   [ -s "$file" ] || { echo "FAIL: the $side metrics test left no $file"; exit 1; }

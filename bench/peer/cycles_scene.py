@@ -17,9 +17,10 @@ Mapping (each one checked or stated in docs/quality.md):
     height-correlated G2 (differs at grazing angles only). Principled BSDF is not used: its Fresnel
     term and specular tint have no counterpart in our model.
   * lights: strength chosen so that a white Lambert plane receives our irradiance. The factor per light
-    type is MEASURED here on every run (calibrate()): a white plane under each light alone, compared with the analytic irradiance; so no assumption about Blender's watts
-    conventions enters. Point: radius 0; sun: angle 0; area: rectangle, one-sided, invisible to the
-    camera (ours is invisible to camera rays); environment: world background colour.
+    type is MEASURED here on every run (calibrate()): a white plane under each light alone, compared
+    with the analytic irradiance; so no assumption about Blender's watts conventions enters. Point:
+    radius 0; sun: angle 0; area: rectangle, one-sided, invisible to the camera (ours is invisible to
+    camera rays); environment: world background colour.
   * camera: pinhole, vertical fov (sensor fit vertical), camera-to-world = [R | eye] from peer.json
     (both look along local -z with +y up); pixel filter box 1 px (ours: uniform jitter in the pixel).
   * integrator: max 6 bounces of every kind (our reference knobs), no clamping, no filter glossy,

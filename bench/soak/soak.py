@@ -253,7 +253,8 @@ def analyse(out):
         "frames_rejected": stats.get("frames_rejected"),
         "loadavg_1min": {"min": min(loads), "mean": sum(loads) / len(loads), "max": max(loads)},
         "log_bytes_per_h": {
-            k: 60.0 * (samples[-1][k] - samples[0][k]) / max(minutes, 1e-9) for k in ("farm_log_bytes", "kiosk_log_bytes")},
+            k: 60.0 * (samples[-1][k] - samples[0][k]) / max(minutes, 1e-9) for k in ("farm_log_bytes",
+                                                                                      "kiosk_log_bytes")},
         "per_minute": latency_minutes(stats, start),
     }, samples
 
@@ -270,14 +271,16 @@ def markdown(result, meta, command):
              "–".join(str(x) for x in sorted(set(p["threads"]))), "yes" if p["ok"] else "**no**"]
             for p in result["processes"]]
     lines.append(s.table(["process", "RSS at 10 min (MiB)", "RSS at end (MiB)", "RSS growth after 10 min (MiB/h)",
-                          "open fds after 10 min (min–max)", "threads after 10 min (min–max)", "within the goal"], rows))
+                          "open fds after 10 min (min–max)", "threads after 10 min (min–max)", "within the goal"],
+                         rows))
     lines.append("")
     f, l = result["first_10_min"], result["last_10_min"]
     rows = [[name, w["frames"], fmt(w["fps"], ".2f"), fmt(w["p50_ms"], ".0f"), fmt(w["p95_ms"], ".0f"),
              fmt(w["farm_frame_ms"], ".0f"), fmt(w["loadavg_1min"], ".1f")]
             for name, w in (("first 10 min", f), ("last 10 min", l))]
     lines.append(s.table(["window", "frames shown", "frames/s", "motion-to-photon p50 (ms)",
-                          "motion-to-photon p95 (ms)", "farm frame time mean (ms)", "load average (1 min, mean)"], rows))
+                          "motion-to-photon p95 (ms)", "farm frame time mean (ms)", "load average (1 min, mean)"],
+                         rows))
     lines.append("")
     ch = result["p95_change"]
     load = result["loadavg_1min"]
@@ -318,7 +321,8 @@ def plot(result, samples, path):
     axes[2].plot(t, [s["loadavg_1min"] for s in samples], label="load average (1 min)")
     ft = [(b["t_s"] / 60.0, 1000.0 * (b["farm_frame_seconds_sum"] - a["farm_frame_seconds_sum"])
            / (b["farm_frame_seconds_count"] - a["farm_frame_seconds_count"]))
-          for a, b in zip(samples, samples[1:]) if a.get("farm_frame_seconds_count") and b.get("farm_frame_seconds_count")
+          for a, b in zip(samples, samples[1:]) if a.get("farm_frame_seconds_count")
+          and b.get("farm_frame_seconds_count")
           and b["farm_frame_seconds_count"] > a["farm_frame_seconds_count"]]
     ax2 = axes[2].twinx()
     ax2.plot([x for x, _ in ft], [y for _, y in ft], color="tab:red", label="farm frame time (ms)")

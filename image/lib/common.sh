@@ -92,9 +92,11 @@ img_stage_config() {
 # so the used ones are 2 and 11..N; the caller checks the result with e2fsck.
 img_clamp_times() {
   local file=$1 epoch=$2 used
-  used=$(dumpe2fs -h "$file" 2>/dev/null | awk -F: '/^Inode count/ { c = $2 } /^Free inodes/ { f = $2 } END { print c - f }')
+  used=$(dumpe2fs -h "$file" 2>/dev/null | awk -F: \
+      '/^Inode count/ { c = $2 } /^Free inodes/ { f = $2 } END { print c - f }')
   [[ "$used" =~ ^[0-9]+$ ]] || img_die "cannot read the inode count of $file"
-  { for n in 2 $(seq 11 "$used"); do printf 'sif <%d> ctime @%d\nsif <%d> atime @%d\n' "$n" "$epoch" "$n" "$epoch"; done; } |
+  { for n in 2 $(seq 11 "$used"); do printf 'sif <%d> ctime @%d\nsif <%d> atime @%d\n' "$n" "$epoch" "$n" "$epoch";
+      done; } |
     E2FSPROGS_FAKE_TIME=$epoch debugfs -w -f - "$file" > /dev/null 2>&1 || img_die "debugfs on $file failed"
 }
 
@@ -119,8 +121,9 @@ img_build_preconditions() {
   done
   [[ -f /usr/lib/systemd/boot/efi/systemd-bootx64.efi ]] \
     || { echo "systemd-boot not found (apt-get install systemd-boot-efi)"; return 1; }
-  python3 - "$mirror/dists/bookworm/Release" 2>/dev/null <<'PY' || { echo "the Debian mirror $mirror is not reachable"; return 1; }
+  python3 - "$mirror/dists/bookworm/Release" 2>/dev/null <<'PY' ||
 import sys, urllib.request
 urllib.request.urlopen(urllib.request.Request(sys.argv[1], method="HEAD"), timeout=20)
 PY
+    { echo "the Debian mirror $mirror is not reachable"; return 1; }
 }

@@ -24,7 +24,8 @@ img_binary_packages() {
   libs=$(ldd "$bin" | awk '/=> \// { print $3 } /^\t\/.*ld-linux/ { print $1 }' | sort -u)
   # merged /usr: dpkg knows a library under the path its package ships, /lib or /usr/lib. One
   # dpkg-query for every candidate path (one per library is slow).
-  owners=$(while read -r lib; do printf '%s\n' "$lib" "$(readlink -f "$lib")" "/usr$lib" "${lib#/usr}"; done <<<"$libs" |
+  owners=$(while read -r lib; do printf '%s\n' "$lib" "$(readlink -f "$lib")" "/usr$lib" "${lib#/usr}"; done \
+      <<<"$libs" |
            sort -u | { xargs dpkg-query -S 2>/dev/null || true; } | sed -E 's/^([^:]+)(:[a-z0-9]+)?: /\1 /')
   while read -r lib; do
     local pkg="" cand
@@ -55,8 +56,10 @@ img_mmdebstrap() {
     mkdir -p "$cache"
     cache=$(cd "$cache" && pwd)
     args+=(--skip=essential/unlink
-           --setup-hook="mkdir -p \"\$1/var/cache/apt/archives\"; find '$cache' -maxdepth 1 -name '*.deb' -exec cp -t \"\$1/var/cache/apt/archives/\" {} +"
-           --customize-hook="find \"\$1/var/cache/apt/archives\" -maxdepth 1 -name '*.deb' -exec cp -n -t '$cache/' {} +")
+           --setup-hook="mkdir -p \"\$1/var/cache/apt/archives\";
+                         find '$cache' -maxdepth 1 -name '*.deb' -exec cp -t \"\$1/var/cache/apt/archives/\" {} +"
+           --customize-hook="find \"\$1/var/cache/apt/archives\" -maxdepth 1 -name '*.deb' \
+                             -exec cp -n -t '$cache/' {} +")
   fi
   mmdebstrap "${args[@]}" "$suite" "$root" \
     "deb $mirror $suite main" "deb $mirror $suite-updates main" "deb $security $suite-security main" \
@@ -77,9 +80,11 @@ img_kernel() {
   kver=$(ls "$root/usr/lib/modules" | sort -V | tail -n1)
   [[ -n "$kver" ]] || img_die "no kernel in $root/usr/lib/modules"
   python3 "$(dirname "${BASH_SOURCE[0]}")/prune_modules.py" "$root/usr/lib/modules/$kver" "$allow" >&2
-  find "$root/usr/lib/modules/$kver/kernel" -name '*.ko' -print0 | xargs -0 -r -n 64 -P "$(nproc)" xz -q --check=crc32 -T1
+  find "$root/usr/lib/modules/$kver/kernel" -name '*.ko' -print0 |
+      xargs -0 -r -n 64 -P "$(nproc)" xz -q --check=crc32 -T1
   img_in_root "$root" depmod -a "$kver"
-  img_in_root "$root" update-initramfs -u -k "$kver" > "$log" 2>&1 || { cat "$log" >&2; img_die "update-initramfs failed"; }
+  img_in_root "$root" update-initramfs -u -k "$kver" > "$log" 2>&1 ||
+      { cat "$log" >&2; img_die "update-initramfs failed"; }
   echo "$kver"
 }
 
@@ -88,7 +93,8 @@ img_kernel() {
 # what tmpfiles.d declares (mmdebstrap without mounts misses some folders).
 img_trim() {
   local root=$1
-  find "$root/usr/share/doc" -mindepth 1 -not -name copyright -not -path "$root/usr/share/doc/mogao*" \( -type f -o -type l \) -delete
+  find "$root/usr/share/doc" -mindepth 1 -not -name copyright -not -path "$root/usr/share/doc/mogao*" \( \
+      -type f -o -type l \) -delete
   find "$root/usr/share/doc" -mindepth 1 -type d -empty -delete
   rm -rf "$root/usr/share/man" "$root/usr/share/info" "$root/usr/share/lintian" "$root/usr/share/locale" \
     "$root/var/cache/apt" "$root/var/lib/apt/lists" "$root/var/cache/debconf/"*-old "$root/var/lib/dpkg/"*-old
@@ -107,7 +113,8 @@ img_esp() {
   rm -f "$file"; truncate -s "${mib}M" "$file"
   mkfs.vfat -F 32 -n ESP --invariant -i "$(printf '%08X' $((SOURCE_DATE_EPOCH & 0xffffffff)))" "$file" >/dev/null \
     || img_die "mkfs.vfat $file failed"
-  printf 'default mogao.conf\ntimeout 0\neditor no\nauto-entries no\nauto-firmware no\nconsole-mode keep\n' > "$stage/loader.conf"
+  printf 'default mogao.conf\ntimeout 0\neditor no\nauto-entries no\nauto-firmware no\nconsole-mode keep\n' \
+      > "$stage/loader.conf"
   printf 'title %s\nversion %s\nlinux /mogao/vmlinuz\ninitrd /mogao/initrd.img\noptions %s\n' \
     "$title" "$kver" "$cmdline" > "$stage/mogao.conf"
   cp "$sdboot" "$stage/BOOTX64.EFI"
@@ -184,7 +191,8 @@ img_ext4_put() {
   # debugfs's mkdir of a folder that exists leaves an orphaned inode: find the existing ones first.
   ( cd "$staging" && find . -mindepth 1 -type d -printf 'stat "/%P"\n' ) > "$script"
   DEBUGFS_PAGER=__none__ debugfs -f "$script" "$file" 2>&1 |
-    awk '/^debugfs: stat "/ { p = substr($0, 16); sub(/"$/, "", p) } /^Inode: .*Type: directory/ { print p }' > "$existing"
+    awk '/^debugfs: stat "/ { p = substr($0, 16); sub(/"$/, "", p) } /^Inode: .*Type: directory/ { print p }' > \
+        "$existing"
   ( cd "$staging" && find . -mindepth 1 -printf '%y %m %U %G %P\n' ) | while read -r type mode uid gid rel; do
     local path=/$rel kind=10
     case $type in
@@ -193,12 +201,14 @@ img_ext4_put() {
       l) printf 'rm "%s"\nsymlink "%s" "%s"\n' "$path" "$path" "$(readlink "$staging/$rel")"; continue ;;
       *) img_die "$staging/$rel: only files, folders and symbolic links can be provisioned" ;;
     esac
-    printf 'sif "%s" mode 0%s%04o\nsif "%s" uid %s\nsif "%s" gid %s\n' "$path" "$kind" "$((8#$mode))" "$path" "$uid" "$path" "$gid"
+    printf 'sif "%s" mode 0%s%04o\nsif "%s" uid %s\nsif "%s" gid %s\n' "$path" "$kind" "$((8#$mode))" \
+        "$path" "$uid" "$path" "$gid"
   done > "$script"
   out=$(debugfs -w -f "$script" "$file" 2>&1) || img_die "debugfs on $file failed: $out"
   rm -f "$script" "$existing"
   # Expected noise: the echoed commands, "rm" of a file that is not there yet, inode numbers.
-  out=$(grep -vE '^debugfs [0-9.]+ |^debugfs: |^Allocated inode: [0-9]+$|File not found by ext2_lookup|^$' <<<"$out" || true)
+  out=$(grep -vE '^debugfs [0-9.]+ |^debugfs: |^Allocated inode: [0-9]+$|File not found by ext2_lookup|^$' \
+      <<<"$out" || true)
   [[ -z "$out" ]] || img_die "debugfs could not write into $file: $out"
   e2fsck -fn "$file" > /dev/null 2>&1 || img_die "e2fsck of $file failed after provisioning"
 }

@@ -28,7 +28,8 @@ if [[ -s $ko ]]; then echo "$ko"; exit 0; fi
 mkdir -p "$out"
 src=$(mktemp -d "$out/vimc-src.XXXXXX")
 trap 'rm -rf "$src"' EXIT
-tar -xJf "$source_tar" -C "$src" --strip-components=1 --wildcards "linux-source-$series/drivers/media/test-drivers/vimc/*" \
+tar -xJf "$source_tar" -C "$src" --strip-components=1 --wildcards \
+    "linux-source-$series/drivers/media/test-drivers/vimc/*" \
   || { echo "extracting vimc from $source_tar failed" >&2; exit 1; }
 dir=$src/drivers/media/test-drivers/vimc
 make -s -C "$headers" M="$dir" CONFIG_VIDEO_VIMC=m modules -j"$(nproc)" > "$src/build.log" 2>&1 \

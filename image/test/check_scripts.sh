@@ -11,7 +11,11 @@ bash -n "$dir/test/build_vimc.sh"
 sh -n "$dir/test/selftest.sh"
 bash -n "$dir/test/powercut_guest.sh"
 bash -n "$dir/rootfs/usr/lib/mogao/journal-persistent"
-python3 - "$dir/test/qemu_boot_test.py" "$dir/test/qemu_service_card_test.py" "$dir/test/qemu_common.py" "$dir/test/qemu_qmp.py" "$dir/test/qemu_libcamera.py" "$dir/lib/prune_modules.py" "$dir/test/qemu_powercut_test.py" "$dir/test/powercut_report.py" "$dir/test/qemu_service_mode_test.py" "$dir/test/qemu_update_test.py" <<'PY'
+py_files=("$dir/test/qemu_boot_test.py" "$dir/test/qemu_service_card_test.py" "$dir/test/qemu_common.py"
+          "$dir/test/qemu_qmp.py" "$dir/test/qemu_libcamera.py" "$dir/lib/prune_modules.py"
+          "$dir/test/qemu_powercut_test.py" "$dir/test/powercut_report.py" "$dir/test/qemu_service_mode_test.py"
+          "$dir/test/qemu_update_test.py")
+python3 - "${py_files[@]}" <<'PY'
 import sys
 for f in sys.argv[1:]:
     compile(open(f).read(), f, "exec")
@@ -63,26 +67,33 @@ if [[ -n "$farm" && -x "$farm" ]]; then
   cp "$tmp/ca/ca.pem" "$tmp/cfg/pki/ca.pem"
   cp "$tmp/ca/ca.key" "$tmp/cfg/pki/appliance-museum-1.key"   # the CA key under an innocent name
   out=$("$dir/provision" "$tmp/none.img" "$tmp/cfg" 2>&1) && { echo "provision accepted a renamed CA key"; exit 1; }
-  grep -q "appliance-museum-1.key: this is a CA's private key" <<< "$out" || { echo "provision: unexpected message: $out"; exit 1; }
+  grep -q "appliance-museum-1.key: this is a CA's private key" <<< "$out" ||
+      { echo "provision: unexpected message: $out"; exit 1; }
 fi
 # provision derives the kiosk's network allow-list from kiosk.toml's farm endpoint and refuses a
 # name or a bad --allow, before it needs root or an image.
 rm -f "$tmp/cfg/pki/"*.key
 printf '[farm]\nendpoint = "farm.example:7443"\n' > "$tmp/cfg/kiosk.toml"
 out=$("$dir/provision" "$tmp/none.img" "$tmp/cfg" 2>&1) && { echo "provision accepted a farm name"; exit 1; }
-grep -q 'endpoint .farm.example:7443. is not "\[address\]:port"' <<< "$out" || { echo "provision: unexpected message: $out"; exit 1; }
+grep -q 'endpoint .farm.example:7443. is not "\[address\]:port"' <<< "$out" ||
+    { echo "provision: unexpected message: $out"; exit 1; }
 printf '[farm]\nendpoint = "[2001:db8::7]:7443"\n' > "$tmp/cfg/kiosk.toml"
-out=$("$dir/provision" --allow 10.1.0.0/16 --allow not-an-address "$tmp/none.img" "$tmp/cfg" 2>&1) && { echo "provision accepted --allow not-an-address"; exit 1; }
-grep -q "allow 'not-an-address' is not an IP address or prefix" <<< "$out" || { echo "provision: unexpected message: $out"; exit 1; }
+out=$("$dir/provision" --allow 10.1.0.0/16 --allow not-an-address "$tmp/none.img" "$tmp/cfg" 2>&1) &&
+    { echo "provision accepted --allow not-an-address"; exit 1; }
+grep -q "allow 'not-an-address' is not an IP address or prefix" <<< "$out" ||
+    { echo "provision: unexpected message: $out"; exit 1; }
 # provision takes the service mode's public key only (docs/service-mode.md): a private key and a
 # key of another type are refused, before it needs root or an image.
 if command -v openssl > /dev/null; then
   openssl genpkey -algorithm ed25519 -out "$tmp/cfg/service-key.pem" 2> /dev/null
-  out=$("$dir/provision" "$tmp/none.img" "$tmp/cfg" 2>&1) && { echo "provision accepted a private service key"; exit 1; }
+  out=$("$dir/provision" "$tmp/none.img" "$tmp/cfg" 2>&1) &&
+      { echo "provision accepted a private service key"; exit 1; }
   grep -q "service-key.pem: a private key" <<< "$out" || { echo "provision: unexpected message: $out"; exit 1; }
-  openssl genpkey -algorithm EC -pkeyopt ec_paramgen_curve:P-256 2> /dev/null | openssl pkey -pubout -out "$tmp/cfg/service-key.pem"
+  openssl genpkey -algorithm EC -pkeyopt ec_paramgen_curve:P-256 2> /dev/null |
+      openssl pkey -pubout -out "$tmp/cfg/service-key.pem"
   out=$("$dir/provision" "$tmp/none.img" "$tmp/cfg" 2>&1) && { echo "provision accepted an EC service key"; exit 1; }
-  grep -q "service-key.pem: not an Ed25519 public key" <<< "$out" || { echo "provision: unexpected message: $out"; exit 1; }
+  grep -q "service-key.pem: not an Ed25519 public key" <<< "$out" ||
+      { echo "provision: unexpected message: $out"; exit 1; }
   rm "$tmp/cfg/service-key.pem"
 fi
 bash -n "$dir/../kiosk/service_mode/mogao-service"
@@ -95,12 +106,14 @@ chmod +x "$tmp/bin/systemctl"
 allow=$dir/rootfs/usr/lib/mogao/kiosk-ip-allow
 printf '# comment\n2001:db8::7\n\n10.1.0.0/16  # lab\n' > "$tmp/addrs"
 PATH="$tmp/bin:$PATH" "$allow" "$tmp/addrs" > /dev/null
-[[ $(cat "$tmp/systemctl.args") == "set-property --runtime mogao-kiosk.service IPAddressAllow=2001:db8::7 IPAddressAllow=10.1.0.0/16" ]] \
+[[ $(cat "$tmp/systemctl.args") == \
+    "set-property --runtime mogao-kiosk.service IPAddressAllow=2001:db8::7 IPAddressAllow=10.1.0.0/16" ]] \
   || { echo "kiosk-ip-allow: unexpected systemctl call: $(cat "$tmp/systemctl.args")"; exit 1; }
 rm -f "$tmp/systemctl.args"
 printf '2001:db8::7\nfarm.example\n' > "$tmp/addrs"
 out=$(PATH="$tmp/bin:$PATH" "$allow" "$tmp/addrs" 2>&1) && { echo "kiosk-ip-allow accepted a name"; exit 1; }
-grep -q "addrs:2: 'farm.example' is not an IP address" <<< "$out" || { echo "kiosk-ip-allow: unexpected message: $out"; exit 1; }
+grep -q "addrs:2: 'farm.example' is not an IP address" <<< "$out" ||
+    { echo "kiosk-ip-allow: unexpected message: $out"; exit 1; }
 printf '# nothing\n' > "$tmp/addrs"
 PATH="$tmp/bin:$PATH" "$allow" "$tmp/addrs" 2> /dev/null && { echo "kiosk-ip-allow accepted an empty list"; exit 1; }
 PATH="$tmp/bin:$PATH" "$allow" "$tmp/missing" 2> /dev/null && { echo "kiosk-ip-allow accepted a missing file"; exit 1; }
@@ -143,8 +156,10 @@ if command -v openssl > /dev/null && command -v zstd > /dev/null; then
   out=$(verify "$u/good.bundle") || { echo "mogao-update refused a good bundle: $out"; exit 1; }
   grep -q "payloads match the signed manifest" <<< "$out" || { echo "mogao-update verify: $out"; exit 1; }
   manifest_sha=$(sha "$u/b/manifest.toml")
-  verify "$u/good.bundle" --manifest-sha256 "$manifest_sha" > /dev/null || { echo "mogao-update refused the named bundle"; exit 1; }
-  expect_refused "another bundle than the request names" "not the one the service request names" "$u/good.bundle" --manifest-sha256 "${manifest_sha//?/0}"
+  verify "$u/good.bundle" --manifest-sha256 "$manifest_sha" > /dev/null ||
+      { echo "mogao-update refused the named bundle"; exit 1; }
+  expect_refused "another bundle than the request names" "not the one the service request names" \
+      "$u/good.bundle" --manifest-sha256 "${manifest_sha//?/0}"
   tar -cf "$u/unsigned.bundle" -C "$u/b" manifest.toml vmlinuz initrd.img root.img.zst
   expect_refused "an unsigned bundle" "not signed" "$u/unsigned.bundle"
   make_bundle "$u/other.bundle" "$u/k2/update-signing.key"

@@ -18,7 +18,8 @@ mode=$1 repo=$2 outdir=$3 kiosk=$4
 skip() { echo "SKIP: $*"; exit 77; }
 
 [[ "${MOGAO_IMAGE_TESTS:-0}" == 1 ]] \
-  || skip "the image tests are opt-in (5-10 min on 2 cores, root, Debian mirrors; docs/image.md): set MOGAO_IMAGE_TESTS=1"
+  || skip "the image tests are opt-in (5-10 min on 2 cores, root, Debian mirrors; docs/image.md):"\
+" set MOGAO_IMAGE_TESTS=1"
 [[ $(id -u) == 0 ]] || skip "the image tests need root (chroot, file ownership)"
 
 case $mode in
@@ -28,7 +29,8 @@ case $mode in
     why=$(img_build_preconditions mmdebstrap mke2fs mkfs.vfat mcopy sfdisk xz python3) || skip "$why"
     mkdir -p "$outdir"
     start=$(date +%s)
-    [[ -f "$outdir/update-test-key/update-key.pem" ]] || "$repo/image/bundle" keygen --out "$outdir/update-test-key" || exit 1
+    [[ -f "$outdir/update-test-key/update-key.pem" ]] || "$repo/image/bundle" keygen --out \
+        "$outdir/update-test-key" || exit 1
     "$repo/image/build" --kiosk "$kiosk" --out "$outdir" --cache "$outdir/apt-cache" \
       --update-key "$outdir/update-test-key/update-key.pem" || exit 1
     echo "image_build: $(( $(date +%s) - start )) s"
@@ -72,7 +74,8 @@ case $mode in
     image=${MOGAO_IMAGE:-$outdir/mogao-kiosk.img}
     [[ -f "$image" ]] || skip "no image at $image (the image_build test builds it)"
     key=${MOGAO_UPDATE_SIGNING_KEY:-$outdir/update-test-key/update-signing.key}
-    [[ -f "$key" ]] || skip "no update signing key $key (image_build makes one; with MOGAO_IMAGE set MOGAO_UPDATE_SIGNING_KEY)"
+    [[ -f "$key" ]] || skip \
+        "no update signing key $key (image_build makes one; with MOGAO_IMAGE set MOGAO_UPDATE_SIGNING_KEY)"
     exec python3 "$repo/image/test/qemu_update_test.py" --image "$image" --repo "$repo" --kiosk "$kiosk" \
       --farm "$farm" --update-key "$key" --work "$outdir/qemu-update" --results "$outdir/qemu-update-results.json"
     ;;

@@ -48,7 +48,8 @@ import time
 
 import qemu_libcamera  # noqa: E402 (this folder)
 from qemu_qmp import Qmp, ppm_stats  # noqa: E402,F401 (also imported from here by the other QEMU tests)
-from qemu_common import IMAGE_ENTRY, IMAGE_INITRD, IMAGE_KERNEL, T0, Failures, Serial, log, set_name, stop_qemu  # noqa: E402,E501
+from qemu_common import (IMAGE_ENTRY, IMAGE_INITRD, IMAGE_KERNEL, T0, Failures, Serial, log, set_name,  # noqa: E402
+                         stop_qemu)
 
 SKIP = 77
 OVMF_CODE = "/usr/share/OVMF/OVMF_CODE_4M.fd"
@@ -215,10 +216,12 @@ def main():
     def kiosk_toml(outputs, farm_endpoint=endpoint):
         """kiosk/config/kiosk.example.toml with this test's overrides (mogao-kiosk --print-config; section.key=TOML
         value, empty: commented out); `outputs`: the [outputs] overrides."""
-        overrides = [f'farm.endpoint="{farm_endpoint}"', 'farm.ca="pki/ca.pem"', 'farm.cert="pki/appliance-museum-1.pem"',
+        overrides = [f'farm.endpoint="{farm_endpoint}"', 'farm.ca="pki/ca.pem"',
+                     'farm.cert="pki/appliance-museum-1.pem"',
                      'farm.key="pki/appliance-museum-1.key"', f"display.rate_hz={RATE_HZ}", *outputs,
                      'calibration.source="ideal"', f"calibration.projectors={OUTPUTS}", "calibration.overlap=0.15",
-                     f'calibration.output="{CALIBRATION[0]}x{CALIBRATION[1]}"', 'quality.content="480x270"', f"quality.spp={SPP}",
+                     f'calibration.output="{CALIBRATION[0]}x{CALIBRATION[1]}"', 'quality.content="480x270"',
+                     f"quality.spp={SPP}",
                      'navigation.path="still.json"', "navigation.path_frames=240", "navigation.start=[0.0, 0.0, 4.0]",
                      "stats.file=", "stats.log_period_s=10"]
         printed = subprocess.run([a.kiosk, "--print-config", *overrides], check=True, stdout=subprocess.PIPE, text=True)
@@ -326,7 +329,8 @@ def main():
            "-drive", f"if=pflash,format=raw,file={vars_fd}",
            "-drive", f"if=virtio,format=raw,file={img}",
            "-drive", f"if=virtio,format=raw,readonly=on,file={testimg}",
-           "-device", f"virtio-gpu-pci,id=gpu0,max_outputs={OUTPUTS},xres={CALIBRATION[0]},yres={CALIBRATION[1]},edid=off",
+           "-device", f"virtio-gpu-pci,id=gpu0,max_outputs={OUTPUTS},xres={CALIBRATION[0]},"
+                      f"yres={CALIBRATION[1]},edid=off",
            "-global", "ICH9-LPC.noreboot=off", "-action", "reboot=shutdown",
            "-netdev", "user,id=n0,ipv4=off,ipv6=on", "-device", "virtio-net-pci,netdev=n0",
            "-display", "none", "-serial", f"file:{serial_log}",
@@ -387,7 +391,8 @@ def main():
                     db = psnr(a.image_tool, path, refs[head])
                     results[f"connecting_psnr_head{head}"] = db_json(db)
                     fails.check(db is not None and db >= PSNR_MIN_DB,
-                                f"output {head} shows the connecting screen: PSNR {db} dB vs headless (>= {PSNR_MIN_DB})")
+                                f"output {head} shows the connecting screen: PSNR {db} dB vs headless (>= "
+                                f"{PSNR_MIN_DB})")
                 else:
                     fails.check(False, f"no headless reference for output {head}")
         # Farm on the host, reached from the guest as [fec0::2]:PORT (QEMU user network, IPv6).
@@ -457,7 +462,8 @@ def main():
             results["calibrate_rig"] = kv
             ok_truth = all(k in kv for k in ("mean", "p95")) and float(kv["mean"]) <= CALIBRATE_MEAN_PX and \
                 float(kv["p95"]) <= CALIBRATE_P95_PX
-            fails.check(ok_truth, f"the on-site calibration's MPCDI against the rig's ground truth: mean {kv.get('mean')} "
+            fails.check(ok_truth,
+                        f"the on-site calibration's MPCDI against the rig's ground truth: mean {kv.get('mean')} "
                                   f"<= {CALIBRATE_MEAN_PX} px, p95 {kv.get('p95')} <= {CALIBRATE_P95_PX} px")
         # After it: the kiosk restarted on the new calibration (up to 300 s in the guest), then "done".
         t_done, text = serial.wait(r"done ", 540 if libcamera_staged else 420, alive)

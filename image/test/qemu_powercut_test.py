@@ -144,7 +144,8 @@ def prepare(a, work, env):
     img = os.path.join(work, "powercut.img")
     run(["cp", "--sparse=always", a.image, img])
     for f in ("vmlinuz", "initrd.img"):
-        run(["mcopy", "-o", "-i", f"{img}@@1M", f"::{os.path.dirname(IMAGE_KERNEL)}/{f}", os.path.join(work, f)], env=env)
+        run(["mcopy", "-o", "-i", f"{img}@@1M", f"::{os.path.dirname(IMAGE_KERNEL)}/{f}", os.path.join(work, f)],
+            env=env)
     entry = run(["mtype", "-i", f"{img}@@1M", IMAGE_ENTRY], env=env).stdout
     options = re.search(r"^options (.*)$", entry, re.M).group(1)
     keep = [o for o in options.split() if o.split("=")[0] in ("root", "ro", "rootfstype")]

@@ -30,7 +30,8 @@ import tempfile
 import time
 
 from qemu_common import IMAGE_ENTRY, T0, Failures, Serial, log, set_name, stop_qemu  # noqa: E402 (this folder)
-from qemu_boot_test import MODES, OUTPUTS, OVMF_CODE, OVMF_VARS, Qmp, install_selftest_entry, ppm_stats, require_qemu, run  # noqa: E402
+from qemu_boot_test import (MODES, OUTPUTS, OVMF_CODE, OVMF_VARS, Qmp, install_selftest_entry,  # noqa: E402
+                            ppm_stats, require_qemu, run)
 
 WIPE_MIB = 4  # the ext4 superblock is at 1 KiB; 4 MiB also clears the group descriptors
 

@@ -145,7 +145,8 @@ def provision(a, work, env):
     entry = run(["mtype", "-i", esp, IMAGE_ENTRY], env=env).stdout
     # loglevel=3 stays: the wall's text console shows the service mode's lines, not the kernel's.
     options = re.sub(r"\b(quiet|systemd.show_status=\S+)\b", "", re.search(r"^options (.*)$", entry, re.M).group(1))
-    extra = ["console=tty0", "console=ttyS0,115200", "systemd.show_status=true", "systemd.journald.forward_to_console=1",
+    extra = ["console=tty0", "console=ttyS0,115200", "systemd.show_status=true",
+             "systemd.journald.forward_to_console=1",
              *[f"video=Virtual-{i + 1}:{MODES[i][0]}x{MODES[i][1]}e" for i in range(1, OUTPUTS)]]
     install_selftest_entry(work, esp, "mogao (QEMU service-mode test: console on the serial port)", options, extra, env)
     return img, os.path.join(work, "keys", "service-signing.key"), old_mpcdi, captures
@@ -200,7 +201,8 @@ def plug(qmp, journal, img, n, timeout, during=None):
     journal.wait(r"mogao-service@\S+\.service: (Deactivated successfully|Failed with result)", 60)
     qmp.cmd("device_del", id=f"usb{n}")
     deadline = time.monotonic() + 30
-    while not any(e.get("event") == "DEVICE_DELETED" and e.get("data", {}).get("device") == f"usb{n}" for e in qmp.events):
+    while not any(e.get("event") == "DEVICE_DELETED" and e.get("data", {}).get("device")
+                  == f"usb{n}" for e in qmp.events):
         if time.monotonic() > deadline:
             break
         qmp.poll_events(0.5)
@@ -248,7 +250,8 @@ def check_logs(a, work, qmp, journal, fails, env, stick, installed_sha, old_mpcd
     last_good = read_stick(stick, "logs/screen.mpcdi.last-good", env) or b""
     journal_text = (read_stick(stick, "logs/journal.txt", env) or b"").decode(errors="replace")
     fails.check(hashlib.sha256(mpcdi).hexdigest() == installed_sha,
-                "the calibration is byte-identical to what the calibrate request installed (the refused ones changed nothing)")
+                "the calibration is byte-identical to what the calibrate request installed (the refused ones "
+                "changed nothing)")
     with open(old_mpcdi, "rb") as f:
         fails.check(last_good == f.read(), "its last good copy is the calibration installed before")
     fetched = os.path.join(work, "fetched-screen.mpcdi")
@@ -303,12 +306,14 @@ def check_requests(a, work, proc, fails, env, key, old_mpcdi, captures, results)
         wall["lit"] = lit_fraction(os.path.join(work, "calibrating-head0.ppm"))
 
     plugged_utc = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
-    ok, secs = plug(qmp, journal, sticks["calibrate"], 1, a.timeout, (r"mogao-service: calibration: mogao-calibrate ", during))
+    ok, secs = plug(qmp, journal, sticks["calibrate"], 1, a.timeout,
+                    (r"mogao-service: calibration: mogao-calibrate ", during))
     r = result_of(sticks["calibrate"], env)
     results["calibrate_request_s"] = round(secs, 1)
     fails.check(ok and r.get("outcome") == "done" and r.get("calibrate_exit") == "0",
                 f"calibrate: done in {secs:.0f} s ({r})")
-    fails.check(r.get("calibration_before") != r.get("calibration_after") and r.get("calibration_after", "none") != "none",
+    fails.check(r.get("calibration_before") != r.get("calibration_after") and r.get("calibration_after", "none")
+                != "none",
                 "calibrate: the installed calibration changed")
     fails.check(r.get("kiosk") == "active", f"calibrate: the kiosk active again ({r.get('kiosk')})")
     fails.check(wall.get("lit", 0) > 0.002, f"calibrate: its output on the wall while the kiosk is stopped "
@@ -346,13 +351,15 @@ def check_requests(a, work, proc, fails, env, key, old_mpcdi, captures, results)
     except ValueError:
         st = {}
     cal = st.get("calibration", {})
-    fails.check(cal.get("source") == "/etc/mogao/screen.mpcdi" and cal.get("last_error") == "" and cal.get("refused") == 0
+    fails.check(cal.get("source") == "/etc/mogao/screen.mpcdi" and cal.get("last_error") == "" and cal.get("refused")
+                == 0
                 and cal.get("loaded_utc", "") > plugged_utc,
                 f"status: the kiosk's status file on the stick: running on the installed calibration, loaded "
                 f"{cal.get('loaded_utc')} (the calibrate stick went in at {plugged_utc}), no error")
     # The technician's status page, made on the appliance from the same status file (docs/monitoring.md).
     page = (read_stick(sticks["status"], "status.html", env) or b"").decode("utf-8", "replace")
-    fails.check(rs.get("status_page") == "status.html" and "/etc/mogao/screen.mpcdi" in page and "<html" in page.lower(),
+    fails.check(rs.get("status_page") == "status.html" and "/etc/mogao/screen.mpcdi" in page
+                and "<html" in page.lower(),
                 f"status: status.html on the stick names the installed calibration (result: {rs.get('status_page')}, "
                 f"{len(page)} characters)")
 

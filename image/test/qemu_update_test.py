@@ -120,7 +120,8 @@ def console_entry(img, env, work):
     entry = run(["mtype", "-i", esp, IMAGE_ENTRY], env=env).stdout
     options = re.search(r"^options (.*)$", entry, re.M).group(1)
     options = re.sub(r"\b(quiet|systemd.show_status=\S+)\b", "", options)
-    extra = ["console=tty0", "console=ttyS0,115200", "systemd.show_status=true", "systemd.journald.forward_to_console=1",
+    extra = ["console=tty0", "console=ttyS0,115200", "systemd.show_status=true",
+             "systemd.journald.forward_to_console=1",
              f"video=Virtual-2:{MODES[1][0]}x{MODES[1][1]}e"]
     entry = re.sub(r"^options .*$", "options " + " ".join(options.split() + extra), entry, flags=re.M)
     path = os.path.join(work, "mogao-1-a.conf")
@@ -141,8 +142,10 @@ def bundles(a, work):
     script = os.path.join(work, "broken-kiosk")
     with open(script, "w") as f:
         f.write(BROKEN_KIOSK)
-    r = subprocess.run(["debugfs", "-w", "-f", "-", root], input=f"rm /usr/bin/mogao-kiosk\nwrite {script} /usr/bin/mogao-kiosk\n"
-                       "sif /usr/bin/mogao-kiosk mode 0100755\nsif /usr/bin/mogao-kiosk uid 0\nsif /usr/bin/mogao-kiosk gid 0\n",
+    r = subprocess.run(["debugfs", "-w", "-f", "-", root],
+                       input=f"rm /usr/bin/mogao-kiosk\nwrite {script} /usr/bin/mogao-kiosk\n"
+                       "sif /usr/bin/mogao-kiosk mode 0100755\nsif /usr/bin/mogao-kiosk uid 0\nsif "
+                       "/usr/bin/mogao-kiosk gid 0\n",
                        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, check=True)
     if re.search(r"(error|not found|cannot)", r.stdout, re.I):
         raise RuntimeError("debugfs: " + r.stdout)
@@ -176,7 +179,8 @@ def make_stick(a, work, name, env, key, serial, bundle):
     shutil.rmtree(stage, ignore_errors=True)
     os.makedirs(stage)
     os.link(bundle, os.path.join(stage, "update.bundle"))
-    tool(a, "sign", "--key", key, "--action", "update", "--stick", stage, "--serial", str(serial), "--bundle", "update.bundle")
+    tool(a, "sign", "--key", key, "--action", "update", "--stick", stage, "--serial", str(serial), "--bundle",
+         "update.bundle")
     img = os.path.join(work, f"stick-{name}.img")
     if os.path.exists(img):
         os.remove(img)
@@ -197,7 +201,8 @@ def plug(qmp, journal, img, n, timeout):
     journal.wait(r"mogao-service@\S+\.service: (Deactivated successfully|Failed with result)", 15)
     qmp.cmd("device_del", id=f"usb{n}")
     deadline = time.monotonic() + 20
-    while not any(e.get("event") == "DEVICE_DELETED" and e.get("data", {}).get("device") == f"usb{n}" for e in qmp.events):
+    while not any(e.get("event") == "DEVICE_DELETED" and e.get("data", {}).get("device")
+                  == f"usb{n}" for e in qmp.events):
         if time.monotonic() > deadline:
             break
         qmp.poll_events(0.5)
@@ -248,13 +253,16 @@ def check_previous_boot_log(a, qmp, journal, fails, env, stick, results):
     failed = r"boot assessment FAILED: mogao-kiosk not READY on slot a"
     rolled = r"slot a: the update '[^']*update-test bad[^']*' failed its boot assessment"
     results["previous_boot_log_lines"] = prev.count("\n")
-    fails.check(re.search(ran, prev) is not None and re.search(failed, prev) is not None and re.search(rolled, prev) is None,
-                f"logs/journal-previous-boot.txt is the bad root's boot ({prev.count(chr(10))} lines; its slot line and "
+    fails.check(re.search(ran, prev) is not None and re.search(failed, prev) is not None
+                and re.search(rolled, prev) is None,
+                f"logs/journal-previous-boot.txt is the bad root's boot ({prev.count(chr(10))} lines; its "
+                f"slot line and "
                 f"failed assessment, not this boot's rollback line): {prev.strip().splitlines()[:1]}")
     fails.check(re.search(rolled, this) is not None and re.search(failed, this) is None,
                 "logs/journal.txt is this boot's (the rollback line, not the failed assessment)")
     kept = re.search(r"mogao-journal: the journal is kept in [^\n]*", this)
-    fails.check(kept is not None, f"this boot's journal is on the configuration partition: {kept.group(0) if kept else 'no such line'}")
+    fails.check(kept is not None,
+                f"this boot's journal is on the configuration partition: {kept.group(0) if kept else 'no such line'}")
 
 
 def journal_on_disk(a, img, work, fails, results):
@@ -341,7 +349,8 @@ def main():
     ap.add_argument("--results", default="")
     ap.add_argument("--accel", default=os.environ.get("MOGAO_IMAGE_QEMU_ACCEL", "tcg"), choices=["tcg", "kvm"])
     ap.add_argument("--timeout", type=float, default=float(os.environ.get("MOGAO_UPDATE_TEST_TIMEOUT", "240")))
-    ap.add_argument("--install-timeout", type=float, default=float(os.environ.get("MOGAO_UPDATE_INSTALL_TIMEOUT", "300")))
+    ap.add_argument("--install-timeout", type=float, default=float(os.environ.get("MOGAO_UPDATE_INSTALL_TIMEOUT",
+                                                                                  "300")))
     a = ap.parse_args()
     qemu = require_qemu(a.image)
     for t in ("mkfs.vfat", "mcopy", "mtype", "mdir", "openssl", "zstd", "debugfs", "e2fsck", "journalctl"):
@@ -360,7 +369,8 @@ def main():
     log("provisioned")
     again = subprocess.run(provision_cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     fails.check(again.returncode != 0 and "holds a configuration already" in again.stdout and "--wipe" in again.stdout,
-                f"re-provisioning without --wipe is refused ({again.stdout.strip().splitlines()[-1][:160] if again.stdout else ''})")
+                f"re-provisioning without --wipe is refused "
+                f"({again.stdout.strip().splitlines()[-1][:160] if again.stdout else ''})")
     console_entry(img, env, work)
     good, bad, wrong = bundles(a, work)
     log("bundles made")
@@ -385,7 +395,8 @@ def main():
     fails.check("mogao-2-b.conf" in entries and any(re.match(r"mogao-3-a\+0-\d+\.conf$", e) for e in entries),
                 f"on the ESP: slot b blessed, slot a with no tries left ({entries})")
     sha = config_file_sha(img, "etc/screen.mpcdi")
-    fails.check(sha == cal_sha, f"after both updates the calibration is byte-identical (sha256 {sha}, provisioned {cal_sha})")
+    fails.check(sha == cal_sha,
+                f"after both updates the calibration is byte-identical (sha256 {sha}, provisioned {cal_sha})")
     journal_on_disk(a, img, work, fails, results)
     results["test_s"] = round(time.monotonic() - T0, 1)
     results["failures"] = fails.items

@@ -36,19 +36,23 @@ if grep -q "mogao.selftest.mode=service-card" /proc/cmdline; then
     [ $((i % 30)) -eq 0 ] && say "waiting kiosk state=$state uptime=$(uptime_s)"
     sleep 1; i=$((i + 1))
   done
-  if [ "$state" = active ]; then ok "service-kiosk-active uptime=$(uptime_s)"; else bad "service-kiosk-active state=$state"; fi
+  if [ "$state" = active ]; then ok "service-kiosk-active uptime=$(uptime_s)";
+      else bad "service-kiosk-active state=$state"; fi
   for t in emergency.target rescue.target; do
     if [ "$(systemctl is-active $t)" = active ]; then bad "no-$t (active)"; else ok "no-$t"; fi
   done
   say "system-state $(systemctl is-system-running 2>/dev/null)"
-  if findmnt -n /etc/mogao > /dev/null 2>&1; then bad "config-missing (/etc/mogao is mounted)"; else ok "config-missing"; fi
+  if findmnt -n /etc/mogao > /dev/null 2>&1; then bad "config-missing (/etc/mogao is mounted)";
+      else ok "config-missing"; fi
   line=$(journalctl -b -u mogao-kiosk.service --no-pager -o cat 2>/dev/null | grep -m1 "service card on every output")
-  if [ -n "$line" ]; then ok "service-card-journal $line"; else bad "service-card-journal (no 'service card on every output' line)"; fi
+  if [ -n "$line" ]; then ok "service-card-journal $line"; else bad \
+      "service-card-journal (no 'service card on every output' line)"; fi
   say "service-card-shown restarts=$(prop mogao-kiosk.service NRestarts)"
   answer=$(host_wait 300)
   # Still up after the host's screendumps, without a restart: the card feeds the watchdog.
   sleep 15
-  say "service-card-steady state=$(systemctl is-active mogao-kiosk.service) restarts=$(prop mogao-kiosk.service NRestarts) answer=$answer"
+  say "service-card-steady state=$(systemctl is-active mogao-kiosk.service)" \
+      "restarts=$(prop mogao-kiosk.service NRestarts) answer=$answer"
   say "done fails=$fails uptime=$(uptime_s)"
   systemctl poweroff --no-block
   exit 0
@@ -69,27 +73,34 @@ i=0
 while [ $i -lt 900 ]; do
   state=$(systemctl is-active mogao-kiosk.service)
   [ "$state" = active ] && break
-  [ $((i % 30)) -eq 0 ] && say "waiting kiosk state=$state restarts=$(prop mogao-kiosk.service NRestarts) uptime=$(uptime_s)"
+  [ $((i % 30)) -eq 0 ] && say "waiting kiosk state=$state restarts=$(prop mogao-kiosk.service NRestarts)" \
+      "uptime=$(uptime_s)"
   sleep 1; i=$((i + 1))
 done
 if [ "$state" = active ]; then
   ok "kiosk-ready uptime=$(uptime_s) ready_us=$(prop mogao-kiosk.service ActiveEnterTimestampMonotonic)" \
-     "exec_us=$(prop mogao-kiosk.service ExecMainStartTimestampMonotonic) restarts=$(prop mogao-kiosk.service NRestarts)" \
+     "exec_us=$(prop mogao-kiosk.service ExecMainStartTimestampMonotonic) restarts=$(prop \
+     mogao-kiosk.service NRestarts)" \
      "pid=$(prop mogao-kiosk.service MainPID)"
 else
   bad "kiosk-ready state=$state"
   journalctl -b -u mogao-kiosk.service --no-pager -n 40 > "$out" 2>&1
 fi
 # Boot phases as systemd saw them (µs): firmware and loader from systemd-boot's EFI variables.
-say "boot firmware_us=$(systemctl show -P FirmwareTimestampMonotonic) loader_us=$(systemctl show -P LoaderTimestampMonotonic)" \
-    "initrd_us=$(systemctl show -P InitRDTimestampMonotonic) userspace_us=$(systemctl show -P UserspaceTimestampMonotonic)" \
+say "boot firmware_us=$(systemctl show -P FirmwareTimestampMonotonic)" \
+    "loader_us=$(systemctl show -P LoaderTimestampMonotonic)" \
+    "initrd_us=$(systemctl show -P InitRDTimestampMonotonic) userspace_us=$(systemctl show -P \
+    UserspaceTimestampMonotonic)" \
     "network_online_us=$(prop network-online.target ActiveEnterTimestampMonotonic)" \
-    "localfs_us=$(prop local-fs.target ActiveEnterTimestampMonotonic) card0_us=$(prop dev-dri-card0.device ActiveEnterTimestampMonotonic)"
-journalctl -b -u mogao-kiosk.service --no-pager -o cat 2>/dev/null | grep -E "output |outputs|KMS|calibration" | head -n 12 |
+    "localfs_us=$(prop local-fs.target ActiveEnterTimestampMonotonic) card0_us=$(prop dev-dri-card0.device \
+    ActiveEnterTimestampMonotonic)"
+journalctl -b -u mogao-kiosk.service --no-pager -o cat 2>/dev/null |
+    grep -E "output |outputs|KMS|calibration" | head -n 12 |
   while read -r line; do say "kiosk-log $line"; done
 
 # --- unit limits and the kiosk's network allow-list (docs/services.md) -----------------------------
-kl="MemoryMax=$(prop mogao-kiosk.service MemoryMax) TasksMax=$(prop mogao-kiosk.service TasksMax) LimitNOFILE=$(prop mogao-kiosk.service LimitNOFILE)"
+kl="MemoryMax=$(prop mogao-kiosk.service MemoryMax) TasksMax=$(prop mogao-kiosk.service \
+    TasksMax) LimitNOFILE=$(prop mogao-kiosk.service LimitNOFILE)"
 case $kl in
   "MemoryMax=1610612736 TasksMax=256 LimitNOFILE=1024") ok "kiosk-limits $kl" ;;
   *) bad "kiosk-limits $kl (expected MemoryMax=1536M TasksMax=256 LimitNOFILE=1024)" ;;
@@ -101,7 +112,8 @@ if [ -n "$farm_addr" ] && [ "$(systemctl is-active mogao-kiosk-ip-allow.service)
    echo " $allow " | grep -q " $farm_addr/" && echo " $deny " | grep -q " ::/0 "; then
   ok "kiosk-ip-allow farm=$farm_addr allow='$allow' deny='$deny'"
 else
-  bad "kiosk-ip-allow farm='$farm_addr' allow='$allow' deny='$deny' unit=$(systemctl is-active mogao-kiosk-ip-allow.service)"
+  bad "kiosk-ip-allow farm='$farm_addr' allow='$allow' deny='$deny'" \
+      "unit=$(systemctl is-active mogao-kiosk-ip-allow.service)"
 fi
 # Enforced, not only configured. The guest's own global address answers at once (nothing listens on
 # port 9: "Connection refused") from outside the kiosk's cgroup; from inside, the cgroup's filter
@@ -121,7 +133,8 @@ farm_in=$(probe "$farm_addr" kiosk)
 if echo "$own_out" | grep -q refused && ! echo "$own_in" | grep -q refused && echo "$farm_in" | grep -q refused; then
   ok "kiosk-ip-enforced own=$own outside='$own_out' inside='$own_in' farm='$farm_in'"
 else
-  bad "kiosk-ip-enforced own=$own outside='$own_out' inside='$own_in' farm='$farm_in' (expected: refused | no answer or not permitted | refused)"
+  bad "kiosk-ip-enforced own=$own outside='$own_out' inside='$own_in' farm='$farm_in' (expected: refused |" \
+      "no answer or not permitted | refused)"
 fi
 
 # --- the host takes screendumps of every output, then (maybe) starts the farm ---------------------
@@ -146,7 +159,8 @@ case $answer in
       done
       journalctl -b -u mogao-kiosk.service --no-pager -o cat 2>/dev/null | grep -E "stats:" | tail -n 2 |
         while read -r line; do say "kiosk-log $line"; done
-      [ "${frames:-0}" -gt 0 ] && ok "farm-frames-presented frames=$frames" || bad "farm-frames-presented (none in 120 s)"
+      [ "${frames:-0}" -gt 0 ] && ok "farm-frames-presented frames=$frames" ||
+          bad "farm-frames-presented (none in 120 s)"
     else
       bad "farm-connected (no 'connected' in the kiosk's journal after 300 s)"
       journalctl -b -u mogao-kiosk.service --no-pager -o cat -n 20 > "$out" 2>&1
@@ -173,7 +187,8 @@ if [ "${pid:-0}" -gt 0 ]; then
   t1=$(date +%s.%N)
   why=$(journalctl -b -u mogao-kiosk.service --no-pager -o cat 2>/dev/null | grep -m1 -i "watchdog timeout")
   if [ "$n" -gt "$n0" ] && [ "$p" != "$pid" ]; then
-    ok "watchdog-restart seconds=$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.1f", b - a }') new_pid=$p restarts=$n reason='$why'"
+    ok "watchdog-restart seconds=$(awk -v a="$t0" -v b="$t1" \
+        'BEGIN { printf "%.1f", b - a }') new_pid=$p restarts=$n reason='$why'"
   else
     bad "watchdog-restart (pid $pid still there or not restarted: restarts=$n pid=$p)"
   fi
@@ -184,7 +199,8 @@ fi
 # --- hardware watchdog ------------------------------------------------------------------------------
 if [ -e /sys/class/watchdog/watchdog0 ]; then
   w=/sys/class/watchdog/watchdog0
-  ok "hw-watchdog identity='$(cat $w/identity 2>/dev/null)' state=$(cat $w/state 2>/dev/null) timeout=$(cat $w/timeout 2>/dev/null)" \
+  ok "hw-watchdog identity='$(cat $w/identity 2>/dev/null)' state=$(cat $w/state 2>/dev/null)" \
+      "timeout=$(cat $w/timeout 2>/dev/null)" \
      "pid1='$(journalctl -b -o cat --no-pager 2>/dev/null | grep -m1 'Using hardware watchdog')'"
 else
   bad "hw-watchdog (no /sys/class/watchdog/watchdog0)"
@@ -193,31 +209,39 @@ fi
 # --- lock-down --------------------------------------------------------------------------------------
 opts=$(findmnt -no OPTIONS /)
 case ",$opts," in *,ro,*) ok "root-readonly options=$opts" ;; *) bad "root-readonly options=$opts" ;; esac
-if touch /.mogao-write-probe 2>/dev/null; then bad "root-write (a file could be created in /)"; rm -f /.mogao-write-probe; else ok "root-write refused"; fi
-ok "mounts $(findmnt -rno TARGET,FSTYPE,OPTIONS /var/lib/mogao | tr ' ' ':') $(findmnt -rno TARGET,OPTIONS /etc/mogao | tr ' ' ':') $(findmnt -rno TARGET,FSTYPE /tmp | tr ' ' ':')"
+if touch /.mogao-write-probe 2>/dev/null; then bad "root-write (a file could be created in /)";
+    rm -f /.mogao-write-probe; else ok "root-write refused"; fi
+ok "mounts $(findmnt -rno TARGET,FSTYPE,OPTIONS /var/lib/mogao | tr ' ' ':')" \
+    "$(findmnt -rno TARGET,OPTIONS /etc/mogao | tr ' ' ':') $(findmnt -rno TARGET,FSTYPE /tmp | tr ' ' ':')"
 # The kiosk keeps a last good copy of its configuration on the writable partition (kiosk/config/last_loaded.h).
 lg='/var/lib/mogao/last-good/%etc%mogao%kiosk.toml.last-loaded'
-if cmp -s "$lg" /etc/mogao/kiosk.toml; then ok "last-good-copy $lg"; else bad "last-good-copy: $lg missing or not /etc/mogao/kiosk.toml"; fi
+if cmp -s "$lg" /etc/mogao/kiosk.toml; then ok "last-good-copy $lg";
+    else bad "last-good-copy: $lg missing or not /etc/mogao/kiosk.toml"; fi
 failed=$(systemctl --failed --plain --no-legend 2>/dev/null | awk '{print $1}' | tr '\n' ' ')
 [ -z "$failed" ] && ok "no-failed-units" || bad "failed-units $failed"
-gettys=$(systemctl list-units --plain --no-legend --state=active 'getty@*' 'serial-getty@*' 'autovt@*' 'console-getty*' 2>/dev/null | awk '{print $1}' | tr '\n' ' ')
+gettys=$(systemctl list-units --plain --no-legend --state=active 'getty@*' 'serial-getty@*' 'autovt@*' \
+    'console-getty*' 2>/dev/null | awk '{print $1}' | tr '\n' ' ')
 logins=$(for p in /proc/[0-9]*; do readlink "$p/exe"; done 2>/dev/null | grep -cE '/(agetty|login|sulogin|sshd)$')
 [ -z "$gettys" ] && [ "$logins" -eq 0 ] && ok "no-login-prompt" || bad "login-prompt units='$gettys' processes=$logins"
 pw=$(awk -F: '$2 !~ /^[*!]/ { print $1 }' /etc/shadow | tr '\n' ' ')
 [ -z "$pw" ] && ok "no-passwords" || bad "accounts-with-password $pw"
 # Listening sockets: TCP in state LISTEN (0A), any bound UDP/raw socket with a local port.
 listen=$(awk 'FNR > 1 && $4 == "0A" { print FILENAME ":" $2 }' /proc/net/tcp /proc/net/tcp6 2>/dev/null | tr '\n' ' ')
-udp=$(awk 'FNR > 1 { split($2, a, ":"); if (a[2] != "0000") print FILENAME ":" $2 }' /proc/net/udp /proc/net/udp6 2>/dev/null | tr '\n' ' ')
+udp=$(awk 'FNR > 1 { split($2, a, ":"); if (a[2] != "0000") print FILENAME ":" $2 }' /proc/net/udp \
+    /proc/net/udp6 2>/dev/null | tr '\n' ' ')
 [ -z "$listen" ] && [ -z "$udp" ] && ok "no-listening-sockets" || bad "listening tcp='$listen' udp='$udp'"
 kuid=$(awk '/^Uid:/ { print $2 }' /proc/"$(prop mogao-kiosk.service MainPID)"/status 2>/dev/null)
-ok "kiosk-user uid=$kuid seccomp=$(awk '/^Seccomp:/ { print $2 }' /proc/"$(prop mogao-kiosk.service MainPID)"/status 2>/dev/null)"
-ok "units running=$(systemctl list-units --type=service --state=running --plain --no-legend | awk '{print $1}' | tr '\n' ',')"
+ok "kiosk-user uid=$kuid seccomp=$(awk '/^Seccomp:/ { print $2 }' /proc/"$(prop mogao-kiosk.service \
+    MainPID)"/status 2>/dev/null)"
+ok "units running=$(systemctl list-units --type=service --state=running --plain --no-legend | awk \
+    '{print $1}' | tr '\n' ',')"
 
 # --- V4L2 capture test of drivers/camera, when the host put it on the test disk ---------------------
 if [ -x /mnt/bin/mogao_camera_test ]; then
   LD_LIBRARY_PATH=/mnt/lib /mnt/bin/mogao_camera_test --gtest_filter='V4l2Capture*' > /tmp/camera.log 2>&1
   rc=$?
-  sed 's/^/MOGAO-SELFTEST camera-log /' /tmp/camera.log | grep -E "OK|FAILED|SKIPPED|PASSED|Skipped|error" | head -n 20 > "$out"
+  sed 's/^/MOGAO-SELFTEST camera-log /' /tmp/camera.log | grep -E "OK|FAILED|SKIPPED|PASSED|Skipped|error" |
+      head -n 20 > "$out"
   passed=$(grep -c '^\[       OK \] V4l2CaptureVivid' /tmp/camera.log)
   skipped=$(grep -c '^\[  SKIPPED \] V4l2CaptureVivid' /tmp/camera.log)
   if [ $rc -eq 0 ] && [ "$passed" -gt 0 ]; then ok "v4l2-capture-test vivid_passed=$passed vivid_skipped=$skipped"
@@ -245,31 +269,40 @@ if [ -f /mnt/vimc.ko ] && [ -x /mnt/bin/mogao_libcamera_test ]; then
     LIBCAMERA_IPA_CONFIG_PATH=/mnt/libcamera/conf LIBCAMERA_LOG_LEVELS='*:ERROR' MOGAO_REQUIRE_LIBCAMERA_CAMERA=1 \
     timeout 400 /mnt/bin/mogao_libcamera_test --gtest_filter='LibcameraCamera*' > /tmp/libcamera.log 2>&1
   rc=$?
-  grep -v '^\[ RUN' /tmp/libcamera.log | grep -E "OK|FAILED|SKIPPED|PASSED|Skipped|error|Failure|: libcamera|bar|frames|not offered|exposure|ERROR|WARN|Expected|Which|  " |
+  keep="OK|FAILED|SKIPPED|PASSED|Skipped|error|Failure|: libcamera|bar|frames|not offered|exposure|ERROR|WARN"
+  keep="$keep|Expected|Which|  "
+  grep -v '^\[ RUN' /tmp/libcamera.log | grep -E "$keep" |
     head -n 80 | sed 's/^/MOGAO-SELFTEST libcamera-log /' > "$out"
   passed=$(grep -c '^\[       OK \] LibcameraCamera' /tmp/libcamera.log)
   skipped=$(grep -c '^\[  SKIPPED \] LibcameraCamera' /tmp/libcamera.log)
   if [ $rc -eq 0 ] && [ "$passed" -ge 5 ] && [ "$skipped" -eq 0 ]; then
-    ok "libcamera-capture-test vimc passed=$passed skipped=$skipped seconds=$(echo "$(uptime_s) $t0" | awk '{print $1 - $2}')"
+    ok "libcamera-capture-test vimc passed=$passed skipped=$skipped" \
+        "seconds=$(echo "$(uptime_s) $t0" | awk '{print $1 - $2}')"
   else
     bad "libcamera-capture-test rc=$rc passed=$passed skipped=$skipped"
   fi
   # The technician's commands against the same camera: what it supports, then tracking from it.
-  lc_env="LD_LIBRARY_PATH=/mnt/lib LIBCAMERA_IPA_MODULE_PATH=/mnt/libcamera/ipa LIBCAMERA_IPA_PROXY_PATH=/mnt/libcamera/ipa LIBCAMERA_IPA_CONFIG_PATH=/mnt/libcamera/conf LIBCAMERA_LOG_LEVELS=*:ERROR"
+  lc_env="LD_LIBRARY_PATH=/mnt/lib LIBCAMERA_IPA_MODULE_PATH=/mnt/libcamera/ipa"
+  lc_env="$lc_env LIBCAMERA_IPA_PROXY_PATH=/mnt/libcamera/ipa LIBCAMERA_IPA_CONFIG_PATH=/mnt/libcamera/conf"
+  lc_env="$lc_env LIBCAMERA_LOG_LEVELS=*:ERROR"
   if [ -x /mnt/bin/mogao-camera ]; then
     env $lc_env timeout 120 /mnt/bin/mogao-camera info libcamera: > /tmp/lcinfo.log 2>&1
     rc=$?
     head -n 40 /tmp/lcinfo.log | sed 's/^/MOGAO-SELFTEST libcamera-info-log /' > "$out"
-    if [ $rc -eq 0 ] && grep -q '^libcamera:' /tmp/lcinfo.log && grep -q 'Viewfinder stream formats' /tmp/lcinfo.log; then
-      ok "libcamera-info cameras=$(grep -c '^libcamera:' /tmp/lcinfo.log) controls=$(sed -n '/controls:/,$p' /tmp/lcinfo.log | grep -c ': ')"
+    if [ $rc -eq 0 ] && grep -q '^libcamera:' /tmp/lcinfo.log &&
+        grep -q 'Viewfinder stream formats' /tmp/lcinfo.log; then
+      ok "libcamera-info cameras=$(grep -c '^libcamera:' /tmp/lcinfo.log)" \
+          "controls=$(sed -n '/controls:/,$p' /tmp/lcinfo.log | grep -c ': ')"
     else
       bad "libcamera-info rc=$rc"
     fi
   fi
   if [ -x /mnt/bin/mogao-track ]; then
     # vimc's pipeline in libcamera 0.0.3 keeps widths that are multiples of 6: 960x540 is kept.
-    printf '{"fx": 700, "fy": 700, "cx": 479.5, "cy": 269.5, "distortion": [], "image_width": 960, "image_height": 540}\n' > /tmp/lc-camera.json
-    env $lc_env timeout -s INT 20 /mnt/bin/mogao-track navigate --camera libcamera: --camera-calibration /tmp/lc-camera.json \
+    printf '{"fx": 700, "fy": 700, "cx": 479.5, "cy": 269.5, "distortion": [], %s}\n' \
+      '"image_width": 960, "image_height": 540' > /tmp/lc-camera.json
+    env $lc_env timeout -s INT 20 /mnt/bin/mogao-track navigate --camera libcamera: --camera-calibration \
+        /tmp/lc-camera.json \
       --display-hz 10 --out /tmp/lc-poses.jsonl 2> /tmp/lc-track.err
     rc=$?
     tail -n 5 /tmp/lc-track.err | sed 's/^/MOGAO-SELFTEST libcamera-track-log /' > "$out"
@@ -310,10 +343,12 @@ if [ -x /usr/bin/mogao-calibrate ] && [ -f /mnt/site.toml ]; then
   tail -n 3 /tmp/cal-vivid.log | sed 's/^/MOGAO-SELFTEST calibrate-log /' > "$out"
   # The refusal must be the unlockable exposure (vivid has no V4L2_CID_EXPOSURE_ABSOLUTE), not any
   # failure to open the camera.
-  if [ $rc -eq 1 ] && grep -q "V4L2_CID_EXPOSURE_ABSOLUTE" /tmp/cal-vivid.log && [ ! -e /tmp/cal-vivid/calibration.mpcdi ]; then
+  if [ $rc -eq 1 ] && grep -q "V4L2_CID_EXPOSURE_ABSOLUTE" /tmp/cal-vivid.log &&
+      [ ! -e /tmp/cal-vivid/calibration.mpcdi ]; then
     ok "calibrate-vivid-refused camera=$vivid"
   else
-    bad "calibrate-vivid-refused camera=$vivid rc=$rc (expected 1, a message about the locked exposure, nothing written)"
+    bad "calibrate-vivid-refused camera=$vivid rc=$rc (expected 1, a message about the locked exposure," \
+        "nothing written)"
   fi
   t0=$(uptime_s)
   # The rig's camera is simulation: mogao-calibrate-sim from the test disk (the image's program refuses it).
@@ -327,13 +362,15 @@ if [ -x /usr/bin/mogao-calibrate ] && [ -f /mnt/site.toml ]; then
     rc=127
   fi
   grep -v '^\[#' /tmp/cal-rig.log | tail -n 12 | sed 's/^/MOGAO-SELFTEST calibrate-log /' > "$out"
-  truth=$(grep -m1 "SIMULATION ground truth" /tmp/cal-rig.log | sed -E 's/.*geometry mean ([0-9.]+) p95 ([0-9.]+) px.*/mean=\1 p95=\2/')
+  truth=$(grep -m1 "SIMULATION ground truth" /tmp/cal-rig.log | sed -E \
+      's/.*geometry mean ([0-9.]+) p95 ([0-9.]+) px.*/mean=\1 p95=\2/')
   conn=$(grep -m1 "connectors:" /tmp/cal-rig.log | sed 's/.*connectors: *//' | tr ' ' ',')
   if [ $rc -eq 0 ] && [ -s /var/lib/mogao/etc/screen.mpcdi ] && [ -s /var/lib/mogao/etc/screen.models.json ] &&
      [ -s /var/lib/mogao/state/calibration/report.json ] && [ -n "$truth" ]; then
     ok "calibrate-rig $truth connectors=$conn seconds=$(echo "$(uptime_s) $t0" | awk '{print $1 - $2}')"
   else
-    bad "calibrate-rig rc=$rc truth='$truth' files: $(ls /var/lib/mogao/etc /var/lib/mogao/state/calibration 2>&1 | tr '\n' ' ')"
+    bad "calibrate-rig rc=$rc truth='$truth' files: $(ls /var/lib/mogao/etc /var/lib/mogao/state/calibration \
+        2>&1 | tr '\n' ' ')"
   fi
   # The kiosk back on the new calibration: [calibration] source = the installed MPCDI instead of the
   # ideal one (its ideal-only keys go). Each output then has its own calibration at its own mode, so
@@ -348,7 +385,8 @@ if [ -x /usr/bin/mogao-calibrate ] && [ -f /mnt/site.toml ]; then
   while [ $i -lt 300 ] && [ "$(systemctl is-active mogao-kiosk.service)" != active ]; do sleep 1; i=$((i + 1)); done
   log=$(journalctl -b -u mogao-kiosk.service --since "@$since" --no-pager -o cat 2>/dev/null)
   echo "$log" | grep -E "output |calibration" | head -n 8 | sed 's/^/MOGAO-SELFTEST calibrate-kiosk-log /' > "$out"
-  if [ "$(systemctl is-active mogao-kiosk.service)" = active ] && grep -q '^source = "/etc/mogao/screen.mpcdi"' /etc/mogao/kiosk.toml &&
+  if [ "$(systemctl is-active mogao-kiosk.service)" = active ] &&
+      grep -q '^source = "/etc/mogao/screen.mpcdi"' /etc/mogao/kiosk.toml &&
      ! echo "$log" | grep -q "resampled to the output size"; then
     ok "calibrate-kiosk-back after_s=$i calibration=/etc/mogao/screen.mpcdi"
   else

@@ -58,10 +58,12 @@ refuses unsigned "not signed" "a request without signature"
 # Expired / too long / unknown field / bad line: re-signed after the edit, so only the content is judged.
 resign() { openssl pkeyutl -sign -inkey "$key" -rawin -in "$work/$1/request.toml" -out "$work/$1/request.toml.sig"; }
 sign expired 104
-sed -i "s/^not_after = .*/not_after = \"$(date -u -d '-1 hour' +%Y-%m-%dT%H:%M:%SZ)\"/" "$work/expired/request.toml"; resign expired
+sed -i "s/^not_after = .*/not_after = \"$(date -u -d '-1 hour' +%Y-%m-%dT%H:%M:%SZ)\"/" "$work/expired/request.toml";
+    resign expired
 refuses expired "expired" "an expired request"
 sign long 105
-sed -i "s/^not_after = .*/not_after = \"$(date -u -d '+40 days' +%Y-%m-%dT%H:%M:%SZ)\"/" "$work/long/request.toml"; resign long
+sed -i "s/^not_after = .*/not_after = \"$(date -u -d '+40 days' +%Y-%m-%dT%H:%M:%SZ)\"/" "$work/long/request.toml";
+    resign long
 refuses long "more than 31 days" "a request valid for 40 days"
 sign unknown 106
 echo 'command = "rm"' >> "$work/unknown/request.toml"; resign unknown

@@ -54,7 +54,8 @@ if [[ "$mode" == netns || "$mode" == multihost ]]; then
     ns_render="mogao-render-$$"
     ip netns add "$ns_render" || fail "ip netns add $ns_render"
     netns_created+=("$ns_render")
-    ip link add "mga$$" netns "$ns_farm" type veth peer name "mgr$$" netns "$ns_render" || fail "veth pair to the render host"
+    ip link add "mga$$" netns "$ns_farm" type veth peer name "mgr$$" netns "$ns_render" ||
+        fail "veth pair to the render host"
     ip -n "$ns_render" link set lo up
     ip -n "$ns_farm" addr add 10.77.1.1/24 dev "mga$$" || fail "address in $ns_farm"
     ip -n "$ns_render" addr add 10.77.1.2/24 dev "mgr$$" || fail "address in $ns_render"
@@ -92,9 +93,12 @@ make_pki "$work/pki" "$farm_addr"
 write_config "$work/kiosk.toml" "$endpoint" "$work/pki" "$work/png" 10
 start_farm "$work/farm.log" "$endpoint" "${farm_prefix[@]}"
 if [[ "$mode" == multihost ]]; then
-  grep -q "(2 render ranks" "$work/farm.log" || { cat "$work/farm.log"; fail "the farm does not serve with 2 render ranks"; }
-  remote=$(for pid in $(ip netns pids "$ns_render"); do cat "/proc/$pid/comm" 2>/dev/null; done | grep -c '^mogao-farm$')
-  (( remote == 1 )) || fail "$remote mogao-farm processes on the render host (namespace $ns_render), expected 1 (rank 2)"
+  grep -q "(2 render ranks" "$work/farm.log" || { cat "$work/farm.log";
+      fail "the farm does not serve with 2 render ranks"; }
+  remote=$(for pid in $(ip netns pids "$ns_render"); do cat "/proc/$pid/comm" 2>/dev/null; done | grep -c \
+      '^mogao-farm$')
+  (( remote == 1 )) || fail \
+      "$remote mogao-farm processes on the render host (namespace $ns_render), expected 1 (rank 2)"
   log "rank 2 runs on the render host (namespace $ns_render); ranks 0-1 on the admin"
 fi
 

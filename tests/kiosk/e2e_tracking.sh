@@ -55,7 +55,8 @@ rc=$?
 stop_farm TERM
 cat "$work/kiosk.log"
 (( rc == 0 )) || fail "mogao-kiosk exited with $rc"
-grep -q "stopping: the tracking replay ended" "$work/kiosk.log" || fail "the kiosk did not stop at the end of the replay"
+grep -q "stopping: the tracking replay ended" "$work/kiosk.log" ||
+    fail "the kiosk did not stop at the end of the replay"
 [[ -f "$work/poses.jsonl" ]] || fail "no pose log written"
 [[ -f "$work/stats.json" ]] || fail "no statistics written"
 

@@ -169,7 +169,8 @@ rc=$?
 kiosk_pid=""
 stop_farm TERM
 grep -E "mogao-farm-launch|supervise|did not reply|serving" "$work/farm.log"
-grep -q "render host(s) 10.77.2.3 answer again" "$work/farm.log" || fail "the launcher's watcher did not name R2 (10.77.2.3) back"
+grep -q "render host(s) 10.77.2.3 answer again" "$work/farm.log" ||
+    fail "the launcher's watcher did not name R2 (10.77.2.3) back"
 (( rc == 0 )) || { cat "$work/kiosk.log"; fail "mogao-kiosk exited with $rc"; }
 grep -q "render host 10.77.2.3 left out" "$work/farm.log" || fail "the launcher did not name R2 (10.77.2.3) as left out"
 grep -q "render host 10.77.2.2 left out" "$work/farm.log" || fail "the launcher did not name R1 (10.77.2.2) as left out"

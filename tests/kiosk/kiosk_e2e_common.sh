@@ -137,12 +137,14 @@ s = json.load(open(sys.argv[1]))
 need = int(sys.argv[2])
 t = s["total"]
 m = t["motion_to_photon_ms"]
-print(f"frames presented {s['frames_presented']}, rejected {s['frames_rejected']}, superseded {s['frames_superseded']}, "
+print(f"frames presented {s['frames_presented']}, rejected {s['frames_rejected']}, "
+      f"superseded {s['frames_superseded']}, "
       f"link sessions {s['link']['sessions_opened']}")
 print(f"motion-to-photon ms: mean {m['mean']:.1f} p50 {m['p50']:.1f} p95 {m['p95']:.1f} max {m['max']:.1f}; "
       f"link (request->receive) {t['link_mean_ms']:.1f} ms, kiosk (receive->presented) {t['kiosk_mean_ms']:.1f} ms, "
       f"decode {t['decode_mean_ms']:.2f} ms")
-print(f"fps {t['fps']:.1f}, bytes/frame {t['bytes_per_frame']:.0f}, bandwidth {t['bandwidth_bytes_per_s'] / 1e6:.3f} MB/s "
+print(f"fps {t['fps']:.1f}, bytes/frame {t['bytes_per_frame']:.0f}, "
+      f"bandwidth {t['bandwidth_bytes_per_s'] / 1e6:.3f} MB/s "
       f"({t['bandwidth_bytes_per_s'] * 8 / 1e6:.2f} Mbit/s)")
 ok = True
 if s["frames_presented"] < need:
@@ -176,9 +178,9 @@ sys.exit(1 if bad or n == 0 else 0)
 PY
 }
 
-# check_psnr CONTENT_DIR REF_DIR: every dumped content frame against the farm's lossless render of
-# its pose with the same samples (seed, and frame_id = the request id; PSNR >= PSNR_MIN_DB), and one frame against another pose's render (must be below: the
-# comparison can fail).
+# check_psnr CONTENT_DIR REF_DIR: every dumped content frame against the farm's lossless render of its pose
+# with the same samples (seed, and frame_id = the request id; PSNR >= PSNR_MIN_DB), and one frame against
+# another pose's render (must be below: the comparison can fail).
 check_psnr() {
   local dumps=$1 refs=$2 n=0 worst=inf first_ppm="" last_ref=""
   mkdir -p "$refs"
@@ -196,7 +198,8 @@ json.dump({"keyframes": [{"position": [e[0], e[1] - 1.6, e[2]], "yaw_deg": m["ya
           open(sys.argv[2], "w"))
 PY
     "$MPIEXEC" --oversubscribe -n 1 "$farm" render --scene "$src/scenes/test-room.json" --frames 1 \
-      --path "$refs/pose-$id.json" --width "$CONTENT_W" --height "$CONTENT_H" --spp 1 --jpeg-quality "$JPEG_QUALITY" --first-frame-id "$id" \
+      --path "$refs/pose-$id.json" --width "$CONTENT_W" --height "$CONTENT_H" --spp 1 --jpeg-quality \
+      "$JPEG_QUALITY" --first-frame-id "$id" \
       "${SCREEN_ARGS[@]}" --save-raw --contact-sheet 0 --out "$refs/req$id" >"$refs/render-$id.log" 2>&1 \
       || { cat "$refs/render-$id.log"; fail "reference render of request $id"; }
     local db

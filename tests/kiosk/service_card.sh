@@ -17,7 +17,8 @@ rm -rf "$work"
 mkdir -p "$work"
 export MOGAO_LAST_GOOD_DIR="$work/last-good"   # empty: no last good copy to fall back on
 
-printf '[outputs]\nbackend = "headless"\nsizes = ["800x600", "640x480"]\npng_dir = "%s"\n' "$work/png" > "$work/service.toml"
+printf '[outputs]\nbackend = "headless"\nsizes = ["800x600", "640x480"]\npng_dir = "%s"\n' "$work/png" > \
+    "$work/service.toml"
 
 # missing: the card on both outputs, the process up until --duration-s.
 timeout 60 "$kiosk" --config "$work/absent/kiosk.toml" --service-config "$work/service.toml" --duration-s 2 \

@@ -57,12 +57,16 @@ def main():
     ap.add_argument("--scale", default="0.5")
     args = ap.parse_args()
     tool = os.path.join(ROOT, args.build, "kiosk", "calibrate", "mogao-calibrate-sim")
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout.strip()
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
+                            text=True).stdout.strip()
     lines = [f"Run {datetime.date.today()} at commit {commit} on {platform.node()} by "
-             f"`tools/docs/regenerate_calibration_doc.py --scale {args.scale}` (projector and camera resolution x{args.scale}, "
-             "but x1 for rigs marked so; errors in that rig's projector pixels, against the rig's ground truth; compute = "
+             f"`tools/docs/regenerate_calibration_doc.py --scale {args.scale}` (projector and camera "
+             f"resolution x{args.scale}, "
+             "but x1 for rigs marked so; errors in that rig's projector pixels, against the rig's ground "
+             "truth; compute = "
              "the calibration's wall time without the rig's camera simulation, colour step included, 2 cores).", "",
-             "| rig | result | geometry mean / p95 / max (px) | self-check mean / p95 (px) | camera intrinsics (trial's "
+             "| rig | result | geometry mean / p95 / max (px) | self-check mean / p95 (px) | camera "
+             "intrinsics (trial's "
              "relative cost) | projector distortion (trial's relative cost per projector) | seam luminance max | "
              "predicted seam | camera position error | reprojection rms (px) | compute s |",
              "|---|---|---|---|---|---|---|---|---|---|--:|"]
@@ -116,7 +120,8 @@ def main():
     text = open(doc).read()
     if not BLOCK.search(text):
         sys.exit("docs/calibration.md: no <!-- generated:calibration-rigs --> block")
-    text = BLOCK.sub(lambda m: "<!-- generated:calibration-rigs -->\n" + "\n".join(lines) + "\n<!-- /generated -->", text)
+    text = BLOCK.sub(lambda m: "<!-- generated:calibration-rigs -->\n" + "\n".join(lines) + "\n<!-- /generated -->",
+                     text)
     if not COLOUR.search(text):
         sys.exit("docs/calibration.md: no <!-- generated:calibration-colour --> block")
     text = COLOUR.sub(lambda m: "<!-- generated:calibration-colour -->\n" + "\n".join(colour) + "\n<!-- /generated -->",

@@ -34,10 +34,11 @@ COMMON = ["--rate-hz", "2", "--bump-at-s", "2", "--projector-scale", "0.5", "--c
 
 
 def long_static_scenario(frames):
-    """The long static run (the simulated hour at 7200 frames is a benchmark, not a CI test): `frames` monitored frames at 2 Hz with camera
-    noise, exposure ±30 %, moving content and visitors hiding 10–40 %, the camera at half resolution
-    as in the other rows but the projectors at a quarter (their images are only rendered for the
-    simulated camera) and ground truth every 600 frames, to keep it to minutes."""
+    """The long static run (the simulated hour at 7200 frames is a benchmark, not a CI test): `frames`
+    monitored frames at 2 Hz with camera noise, exposure ±30 %, moving content and visitors hiding
+    10–40 %, the camera at half resolution as in the other rows but the projectors at a quarter (their
+    images are only rendered for the simulated camera) and ground truth every 600 frames, to keep it to
+    minutes."""
     minutes = frames / 2 / 60
     span = f"{minutes / 60:.2g} h" if minutes >= 60 else f"{minutes:.3g} min"
     return (f"static, {span} (projectors at quarter resolution), visitors 10–40 %, exposure ±30 %",
@@ -61,7 +62,8 @@ def scenarios(static_frames):
     out.append(("camera yaw 1° with proj0 yaw 1° and proj2 pitch 1°",
                 ["--bump", "camera:yaw=1deg", "--bump", "proj0:yaw=1deg", "--bump", "proj2:pitch=1deg",
                  "--frames", "60"]))
-    out.append(("camera yaw 1°, pitch 0.5°, 10 mm", ["--bump", "camera:yaw=1deg,pitch=0.5deg,x=10mm", "--frames", "30"]))
+    out.append(("camera yaw 1°, pitch 0.5°, 10 mm", ["--bump", "camera:yaw=1deg,pitch=0.5deg,x=10mm", "--frames",
+                                                     "30"]))
     out.append(("proj1 yaw 1°, visitors 10–40 %", ["--bump", "proj1:yaw=1deg", "--frames", "60",
                                                     "--occlusion", "0.1", "--occlusion-max", "0.4"]))
     out.append(("proj1 yaw 1°, repetitive content", ["--bump", "proj1:yaw=1deg", "--frames", "60",
@@ -91,7 +93,8 @@ def autocal_scenarios(static_frames):
                                                   "--frames", "60"]),
              ("camera yaw 1°, pitch 0.5°, 10 mm", ["--bump", "camera:yaw=1deg,pitch=0.5deg,x=10mm", "--frames", "30"]),
              (f"static, {static_frames / 2 / 60:.0f} min, visitors 10–40 %, exposure ±30 %",
-              ["--frames", str(static_frames), "--occlusion", "0.1", "--occlusion-max", "0.4", "--exposure-jitter", "0.3"])]
+              ["--frames", str(static_frames), "--occlusion", "0.1", "--occlusion-max", "0.4", "--exposure-jitter",
+               "0.3"])]
     # The shifts the half-resolution table never detects (under 1 of its pixels), where a pixel is
     # half as large.
     full = [("proj1 yaw 1°, full resolution", ["--bump", "proj1:yaw=1deg", "--frames", "40"])]
@@ -156,7 +159,8 @@ def from_autocal_table(args, tool):
     """The monitor started from autocal's estimate (the full calibration's residual included)."""
     autocal = os.path.join(ROOT, args.build, "kiosk", "calibrate", "mogao-calibrate-sim")
     rig = os.path.join(ROOT, "rigs", "standard.toml")
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout.strip()
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
+                            text=True).stdout.strip()
     lines = [f"Run {datetime.date.today()} at commit {commit} on {platform.node()} by "
              f"`tools/docs/regenerate_selfcal_doc.py --only autocal --static-frames {args.static_frames}`: "
              "rigs/standard.toml calibrated by `mogao-calibrate-sim rig --rig rigs/standard.toml --scale S` (S = 0.5: "
@@ -164,8 +168,10 @@ def from_autocal_table(args, tool):
              "the monitor started from its calibration.models.json "
              "(`mogao-calibrate-sim selfcal-simulate --models`), errors against "
              "the rig's ground truth in the projectors' pixels at that scale; otherwise as the table above.", "",
-             "| scenario | error at the start (px) | error after the bump (px) | detected after (s) | < 1 px after (s) | "
-             "detections | corrections | camera re-basings | final state | final error mean / p95 (px) | waiting frames | "
+             "| scenario | error at the start (px) | error after the bump (px) | detected after (s) | < 1 px "
+             "after (s) | "
+             "detections | corrections | camera re-basings | final state | final error mean / p95 (px) | "
+             "waiting frames | "
              "CPU per frame (ms) | share of one core |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     with tempfile.TemporaryDirectory() as work:
@@ -180,7 +186,8 @@ def from_autocal_table(args, tool):
             models[scale] = os.path.join(out, "calibration.models.json")
         for name, scale, extra in autocal_scenarios(args.static_frames):
             jitter = [] if "--exposure-jitter" in extra else ["--exposure-jitter", "0.1"]
-            cmd = [tool, "selfcal-simulate", "--rig", rig, "--rate-hz", "2", "--bump-at-s", "2", "--projector-scale", scale,
+            cmd = [tool, "selfcal-simulate", "--rig", rig, "--rate-hz", "2", "--bump-at-s", "2", "--projector-scale",
+                   scale,
                    "--camera-scale", scale, "--models", models[scale]] + jitter + extra
             p = subprocess.run(cmd, capture_output=True, text=True)
             if p.returncode != 0:
@@ -192,15 +199,18 @@ def from_autocal_table(args, tool):
 
 def scenarios_table(args, tool):
     rig = os.path.join(ROOT, "rigs", "standard.toml")
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout.strip()
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
+                            text=True).stdout.strip()
     hour = f" --long-static-frames {args.long_frames}"
     lines = [f"Run {datetime.date.today()} at commit {commit} on {platform.node()} by "
              f"`tools/docs/regenerate_selfcal_doc.py --static-frames {args.static_frames}{hour}`: rigs/standard.toml, "
              "projectors and camera at half resolution (errors in those projector pixels, the worst projector's mean, "
              "against the rig's ground truth), monitor at 2 Hz, bumps at t = 2 s, hold 2 s, transition 3 s, "
              "camera gain ±10 % per frame unless stated.", "",
-             "| scenario | error after the bump (px) | detected after (s) | < 1 px after (s) | detections | corrections | "
-             "camera re-basings | final state | final error mean / p95 (px) | waiting frames | CPU per frame (ms) | share of one core |",
+             "| scenario | error after the bump (px) | detected after (s) | < 1 px after (s) | detections | "
+             "corrections | "
+             "camera re-basings | final state | final error mean / p95 (px) | waiting frames | CPU per frame "
+             "(ms) | share of one core |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     def command(extra):
         jitter = [] if "--exposure-jitter" in extra else ["--exposure-jitter", "0.1"]
