@@ -26,7 +26,8 @@ LiveFrames::LiveFrames(FrameSource source, LiveOptions options, float exposure, 
     if (!source_) throw std::invalid_argument("LiveFrames: no frame source");
     if (options_.frame_time_s < 0) throw std::invalid_argument("LiveOptions.frame_time_s must be >= 0");
     if (options_.converged_spp < 1) throw std::invalid_argument("LiveOptions.converged_spp must be >= 1");
-    if (options_.still_pass_min_spp < 1) throw std::invalid_argument("LiveOptions.still_pass_min_spp must be >= 1");
+    if (options_.still_second_pass_spp < 1 || options_.still_pass_spp < 1)
+        throw std::invalid_argument("LiveOptions.still_second_pass_spp and still_pass_spp must be >= 1");
     options_.controller.target_seconds = options_.frame_time_s > 0 ? options_.frame_time_s : 1.0;
     (void)FrameTimeController(options_.controller);  // validates the controller's settings now
     if (options_.denoise_max_spp < 1) throw std::invalid_argument("LiveOptions.denoise_max_spp must be >= 1");
@@ -99,7 +100,8 @@ ViewRequest LiveFrames::plan(Session& s, const ViewRequest& request, FrameChoice
     view.quality.spp = choice.spp;
     if (choice.bounces >= 0) view.quality.max_bounces = choice.bounces;
     if (options_.progressive && s.accumulation.continues(view)) {
-        choice.spp = std::max(choice.spp, options_.still_pass_min_spp);
+        const int pass_spp = s.accumulation.passes() == 1 ? options_.still_second_pass_spp : options_.still_pass_spp;
+        choice.spp = std::max(choice.spp, pass_spp);
         view.quality.spp = choice.spp;
         view.frame_id = pass_frame_id(s.accumulation.first_frame_id(), s.accumulation.passes());
     } else {

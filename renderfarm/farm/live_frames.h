@@ -5,11 +5,11 @@
 //  - Progressive refinement: while the session asks for the same view (same_view(): pose, camera,
 //    size and quality unchanged), each request renders one more pass at the request's full scale
 //    with new random numbers (pass_frame_id) and the frame sent is the mean of all passes so far, in
-//    linear float (progressive_accumulator.h). Any change starts over. Passes after the first use
-//    at least 2 spp, so each adds stratified positions over the pixel's area (with
-//    RendererOptions::jitter_one_spp off, a 1-spp pass samples the pixel centre and would never
-//    converge to the area average). Once `converged_spp` samples are in, the mean is sent
-//    without rendering.
+//    linear float (progressive_accumulator.h). Any change starts over. The second pass takes
+//    LiveOptions::still_second_pass_spp samples per pixel, later ones still_pass_spp (each pass's
+//    samples at fresh sub-pixel positions, RendererOptions::jitter_one_spp, so the mean converges
+//    to the pixel's area average). Once `converged_spp` samples are in, the mean is sent without
+//    rendering.
 //  - A frame-time target (schedule/frame_time_controller.h): while the view moves, the resolution
 //    scale and spp of each frame are chosen to take `frame_time_s` (spp first, the scale down to
 //    its floor, then the bounces); the appliance upsamples the smaller frame (its warp takes
@@ -61,10 +61,16 @@
 namespace mogao {
 
 struct LiveOptions {
-    bool progressive = true;     // accumulate still views
-    int converged_spp = 1024;    // stop rendering a still view once it has this many samples
-    int still_pass_min_spp = 2;  // a still view's passes after its first take at least this many spp, >= 1
-    double frame_time_s = 0.0;   // per-session frame-time target, seconds; 0 = render requests as asked
+    bool progressive = true;   // accumulate still views
+    int converged_spp = 1024;  // stop rendering a still view once it has this many samples
+    // A still view's passes after its first: the second takes still_second_pass_spp samples per pixel
+    // (one: the view sharpens soonest, two samples being the first denoised view past 38 dB on the
+    // grotto), later ones still_pass_spp (fewer passes: less filtering, encoding and hand-off per
+    // sample, while a pass stays short enough for a visitor who moves on); never fewer than the
+    // frame-time controller's choice. Each >= 1.
+    int still_second_pass_spp = 1;
+    int still_pass_spp = 2;
+    double frame_time_s = 0.0;  // per-session frame-time target, seconds; 0 = render requests as asked
     // Share the frame-time target among the sessions served in the last kActiveWindow: each
     // session's frames aim at frame_time_s / (active sessions), so that one round of every active
     // session's frame takes about frame_time_s. Each appliance then keeps its frame rate and
