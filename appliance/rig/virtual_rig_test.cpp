@@ -490,6 +490,11 @@ TEST(RigFile, ScreenHeightErrorsAreToldNotFilmed) {
     EXPECT_EQ(
         cv::norm(CameraSimulator(truth).capture(signals, 3), CameraSimulator(told).capture(signals, 3), cv::NORM_INF),
         0.0);
+    // The installation rig carries both errors.
+    const VirtualRig install = load_rig(std::string(MOGAO_SOURCE_DIR) + "/rigs/realistic-install.toml");
+    EXPECT_NE(install.prior.screen_bottom_error_m, 0.0);
+    EXPECT_NE(install.prior.screen_top_error_m, install.prior.screen_bottom_error_m);
+    EXPECT_GT(install.camera.mjpeg_quality, 0);
 }
 
 // Motion-JPEG frames (camera.mjpeg_quality): the rig's frame is its raw 8-bit frame as a JPEG codec of quality q
