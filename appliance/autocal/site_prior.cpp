@@ -54,11 +54,11 @@ rig::VirtualRig scaled_rig(const rig::VirtualRig& rig, double projector_scale, d
 CalibrationPrior prior_from_rig(const rig::VirtualRig& rig) {
     CalibrationPrior prior;
     const rig::RigPrior& e = rig.prior;
-    // A bowed rig screen (bulge_m) is not told: the prior is the cylinder.
+    // A bowed rig screen (bulge_m) is not told: the prior is the cylinder, its heights as the tape measured them.
     prior.screen = {rig.screen.radius_m + e.screen_radius_error_m,
                     rig.screen.arc_deg + e.screen_arc_error_deg,
-                    rig.screen.bottom_m,
-                    rig.screen.top_m,
+                    rig.screen.bottom_m + e.screen_bottom_error_m,
+                    rig.screen.top_m + e.screen_top_error_m,
                     {}};
     const rig::RigCamera& c = rig.camera;
     rig::RigPose pose = c.pose;

@@ -157,6 +157,7 @@ RigCamera read_camera(Table& t) {
     c.bits = t.integer("bits", c.bits);
     c.supersample = t.integer("supersample", c.supersample);
     c.vignetting = t.number("vignetting", c.vignetting);
+    c.mjpeg_quality = t.integer("mjpeg_quality", c.mjpeg_quality);
     const int seed = t.integer("seed", 1);
     if (seed < 0) t.fail("seed", "must be >= 0");
     c.seed = static_cast<std::uint64_t>(seed);
@@ -206,6 +207,8 @@ VirtualRig read_root(const toml::value& root, const std::string& file) {
         rig.prior.projector_focal_error = t.number("projector_focal_error", 0.0);
         rig.prior.screen_radius_error_m = t.number("screen_radius_error_m", 0.0);
         rig.prior.screen_arc_error_deg = t.number("screen_arc_error_deg", 0.0);
+        rig.prior.screen_bottom_error_m = t.number("screen_bottom_error_m", 0.0);
+        rig.prior.screen_top_error_m = t.number("screen_top_error_m", 0.0);
         t.finish();
     }
     const toml::value* ps = top.find("projectors");

@@ -101,6 +101,10 @@ void validate_camera(const RigCamera& c, const RigScreen& s, const std::string& 
     check(c.bits >= 1 && c.bits <= 16, f + ".bits", "1..16");
     check(c.supersample >= 1 && c.supersample <= 4, f + ".supersample", "1..4");
     check_range(c.vignetting, 0.0, 0.45, f + ".vignetting");
+    check(c.mjpeg_quality >= 0 && c.mjpeg_quality <= 100, f + ".mjpeg_quality",
+          "0..100 (0 = raw frames; got " + std::to_string(c.mjpeg_quality) + ")");
+    check(c.mjpeg_quality == 0 || c.bits == 8, f + ".mjpeg_quality",
+          "0 unless bits = 8 (JPEG frames carry 8-bit samples; bits = " + std::to_string(c.bits) + ")");
 }
 
 // The errors the calibration is told the rig with (RigPrior): what it is told must still be a screen and a lens.
@@ -110,6 +114,12 @@ void validate_prior(const VirtualRig& rig) {
     check_range(e.screen_radius_error_m, -0.5 * s.radius_m, 0.5 * s.radius_m, "prior.screen_radius_error_m");
     check_range(e.screen_arc_error_deg, -0.5 * s.arc_deg, std::min(0.5 * s.arc_deg, 360.0 - s.arc_deg),
                 "prior.screen_arc_error_deg");
+    // Heights measured with a tape: each within a tenth of the screen's height (the told screen stays a screen).
+    const double height = s.top_m - s.bottom_m;
+    check_range(e.screen_bottom_error_m, -0.1 * height, 0.1 * height,
+                "prior.screen_bottom_error_m (0.1 x the screen's height)");
+    check_range(e.screen_top_error_m, -0.1 * height, 0.1 * height,
+                "prior.screen_top_error_m (0.1 x the screen's height)");
     check_range(e.camera_focal_error, -0.5, 0.5, "prior.camera_focal_error");
     check_range(e.camera_principal_point_error_px.x(), -0.25 * rig.camera.resolution.width,
                 0.25 * rig.camera.resolution.width, "prior.camera_principal_point_error_px[0]");

@@ -76,6 +76,10 @@ struct RigCamera {
     int bits = 8;                // quantisation, 1..16
     int supersample = 1;         // point samples per pixel side, 1..4
     double vignetting = 0.0;     // light lost at rho = 1 (header comment), [0, 0.45]
+    // Motion-JPEG frames (a webcam's MJPEG mode): each quantised image is JPEG-compressed at this quality
+    // (libjpeg-turbo, 4:2:0) and decoded back, as a USB camera's frames reach the host; 1..100, 0 = raw
+    // frames. Needs bits = 8 (JPEG's baseline samples).
+    int mjpeg_quality = 0;
     std::uint64_t seed = 1;
 };
 
@@ -93,7 +97,12 @@ struct RigPrior {
     std::array<double, 5> camera_distortion_error{};
     double projector_focal_error = 0.0;  // relative error of the projectors' fx, fy
     double screen_radius_error_m = 0.0;  // the screen's radius as the installer was told it
-    double screen_arc_error_deg = 0.0;   // and its arc (the heights are measured: no error)
+    double screen_arc_error_deg = 0.0;   // and its arc
+    // The heights of the screen's bottom and top edges as measured with a tape (metres, added to the truth's;
+    // |each| <= 0.1 x the screen's height): a common error shifts the screen along its axis, a different one
+    // changes its height and so the scale the calibration takes from it (docs/calibration.md, "Rig files").
+    double screen_bottom_error_m = 0.0;
+    double screen_top_error_m = 0.0;
 };
 
 struct VirtualRig {

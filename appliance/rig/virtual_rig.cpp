@@ -13,6 +13,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "common/jpeg_codec.h"
+
 namespace mogao::rig {
 namespace {
 
@@ -251,6 +253,27 @@ void expose(const RigCamera& cam, cv::Mat1f& img, std::uint64_t frame) {
     }
 }
 
+// A Motion-JPEG camera's frame (RigCamera::mjpeg_quality): the quantised 8-bit image, grey on R, G and B,
+// compressed by libjpeg-turbo at `quality` (4:2:0, as a webcam's MJPEG) and decoded back; grey in, grey out
+// (the colour conversion of R = G = B is exact in libjpeg-turbo's fixed point, so the decoded channels agree).
+void mjpeg_round_trip(cv::Mat1f& img, int quality) {
+    Rgb8Image rgb(ImageSize{img.cols, img.rows});
+    for (int y = 0; y < img.rows; ++y) {
+        for (int x = 0; x < img.cols; ++x) {
+            const auto v = static_cast<std::uint8_t>(std::lround(std::clamp(img(y, x), 0.0f, 1.0f) * 255.0f));
+            std::uint8_t* p = rgb.at(x, y);
+            p[0] = p[1] = p[2] = v;
+        }
+    }
+    JpegEncoder encoder;
+    const std::vector<std::uint8_t> jpeg = encoder.encode(rgb, quality, Subsampling::yuv420);
+    JpegDecoder decoder;
+    const Rgb8Image back = decoder.decode(jpeg);
+    for (int y = 0; y < img.rows; ++y) {
+        for (int x = 0; x < img.cols; ++x) img(y, x) = static_cast<float>(back.at(x, y)[1] / 255.0);
+    }
+}
+
 }  // namespace
 
 cv::Mat1f CameraSimulator::capture(const std::vector<cv::Mat>& signals, std::uint64_t frame) const {
@@ -306,6 +329,7 @@ cv::Mat1f CameraSimulator::capture(const std::vector<cv::Mat>& signals, std::uin
         }
     });
     expose(rig_.camera, img, frame);
+    if (rig_.camera.mjpeg_quality > 0) mjpeg_round_trip(img, rig_.camera.mjpeg_quality);
     return img;
 }
 

@@ -51,6 +51,10 @@
 // integrated over each pixel by `supersample`^2 point samples, blurred by a Gaussian of
 // `blur_sigma_px` (after the vignetting), scaled by exposure * gain, with Gaussian noise of standard deviation
 // sqrt(read_noise^2 + shot_noise^2 * value), clipped to [0, 1] and quantised to `bits`.
+// Motion-JPEG (RigCamera::mjpeg_quality = q > 0, bits = 8): the quantised frame, grey on R, G and B, is
+// compressed by libjpeg-turbo (common/jpeg_codec.h: TurboJPEG's tjCompress2 with its defaults, 4:2:0, the
+// ITU-T T.81 Annex K tables scaled to quality q, the fast integer DCT) and decoded back, as a USB camera's MJPEG
+// frames reach the host: 8 x 8 blocks, ringing at sharp edges, fine detail quantised away.
 // Auto-exposure (camera.auto_exposure, what a webcam does unless told otherwise): before the noise,
 // each image is rescaled so that its mean is kAutoExposureTarget of full scale, whatever the
 // exposure, so images of different patterns are not comparable (a calibration must refuse it).

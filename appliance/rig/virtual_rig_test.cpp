@@ -6,12 +6,14 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "appliance/rig/rig_file.h"
@@ -450,6 +452,101 @@ TEST(RigFile, CameraPriorErrorsAreReadAndChecked) {
     EXPECT_NE(message("camera_distortion_error = [0, 0]").find("camera_distortion_error: must be an array of 5"),
               std::string::npos);
     EXPECT_NE(message("camera_focal_error = 0.9").find("prior.camera_focal_error"), std::string::npos);
+}
+
+// The screen's heights as a tape measured them ([prior] screen_bottom_error_m, screen_top_error_m): read, checked
+// by name against a tenth of the screen's height, and told only to the calibration: the simulator films the true
+// screen, so a rig with the errors gives the very same images as one without.
+TEST(RigFile, ScreenHeightErrorsAreToldNotFilmed) {
+    const VirtualRig rig = parse_rig(
+        "[camera]\nposition_m = [0, 1.6, 1.2]\n[[projectors]]\n[prior]\nscreen_bottom_error_m = 0.02\n"
+        "screen_top_error_m = -0.015\n",
+        "heights.toml");
+    EXPECT_EQ(rig.prior.screen_bottom_error_m, 0.02);
+    EXPECT_EQ(rig.prior.screen_top_error_m, -0.015);
+    EXPECT_EQ(rig.screen.bottom_m, 0.8);  // the truth stays
+    EXPECT_EQ(rig.screen.top_m, 2.3);
+    const auto message = [](const std::string& prior) {
+        try {
+            (void)parse_rig("[camera]\n[[projectors]]\n[prior]\n" + prior + "\n", "bad.toml");
+        } catch (const RigError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    // The standard screen is 1.5 m high: +-0.15 m.
+    EXPECT_NE(message("screen_bottom_error_m = 0.2")
+                  .find("bad.toml': rig: prior.screen_bottom_error_m (0.1 x the screen's height) must be in "
+                        "[-0.150000, 0.150000] (got 0.200000)"),
+              std::string::npos);
+    EXPECT_NE(message("screen_top_error_m = -0.151").find("prior.screen_top_error_m"), std::string::npos);
+    EXPECT_EQ(message("screen_top_error_m = -0.149"), "no error");
+    VirtualRig truth = standard();
+    VirtualRig told = truth;
+    told.prior.screen_bottom_error_m = 0.02;
+    told.prior.screen_top_error_m = -0.02;
+    std::vector<cv::Mat> signals(3);
+    signals[1] = cv::Mat1f(1080, 1920, 1.0f);
+    EXPECT_EQ(
+        cv::norm(CameraSimulator(truth).capture(signals, 3), CameraSimulator(told).capture(signals, 3), cv::NORM_INF),
+        0.0);
+    // The installation rig carries both errors.
+    const VirtualRig install = load_rig(std::string(MOGAO_SOURCE_DIR) + "/rigs/realistic-install.toml");
+    EXPECT_NE(install.prior.screen_bottom_error_m, 0.0);
+    EXPECT_NE(install.prior.screen_top_error_m, install.prior.screen_bottom_error_m);
+    EXPECT_GT(install.camera.mjpeg_quality, 0);
+}
+
+// Motion-JPEG frames (camera.mjpeg_quality): the rig's frame is its raw 8-bit frame as a JPEG codec of quality q
+// leaves it. Checked against OpenCV's own JPEG codec (cv::imencode / cv::imdecode of the raw frame, R = G = B, at
+// the same quality and 4:2:0): the same quantisation tables, so most pixels decode alike and the compression
+// error has the same size; TurboJPEG's encoder uses the fast integer DCT where OpenCV's uses the accurate one, so
+// a coefficient rounded the other way changes a block here and there.
+TEST(VirtualRig, MjpegFramesAreTheRawFramesThroughAJpegCodec) {
+    VirtualRig raw = standard();
+    VirtualRig mjpeg = raw;
+    mjpeg.camera.mjpeg_quality = 60;
+    std::vector<cv::Mat> signals(3);
+    cv::Mat1f checker(1080, 1920, 0.0f);
+    for (int y = 0; y < 1080; y += 64) {
+        for (int x = (y / 64) % 2 * 64; x < 1920; x += 128) cv::rectangle(checker, cv::Rect(x, y, 64, 64), 1.0, -1);
+    }
+    signals[1] = checker;
+    const cv::Mat1f a = CameraSimulator(raw).capture(signals, 5);
+    const cv::Mat1f b = CameraSimulator(mjpeg).capture(signals, 5);
+    cv::Mat a8;
+    a.convertTo(a8, CV_8U, 255.0);
+    cv::Mat bgr;
+    cv::cvtColor(a8, bgr, cv::COLOR_GRAY2BGR);
+    std::vector<std::uint8_t> jpeg;
+    ASSERT_TRUE(cv::imencode(".jpg", bgr, jpeg, {cv::IMWRITE_JPEG_QUALITY, 60}));  // libjpeg's default: 4:2:0
+    std::vector<cv::Mat> channels;
+    cv::split(cv::imdecode(jpeg, cv::IMREAD_COLOR), channels);
+    cv::Mat1f expected;
+    channels[1].convertTo(expected, CV_32F, 1.0 / 255.0);
+    const double n = static_cast<double>(b.total());
+    const int differing = cv::countNonZero(cv::abs(b - expected) > 0.5 / 255.0);
+    const double ours = cv::norm(a, b, cv::NORM_L2) / std::sqrt(n);
+    const double opencv = cv::norm(a, expected, cv::NORM_L2) / std::sqrt(n);
+    std::printf("MJPEG q60: %d of %.0f pixels differ from OpenCV's codec; rms error %.3f (OpenCV's %.3f) levels\n",
+                differing, n, ours * 255.0, opencv * 255.0);
+    EXPECT_LT(differing, n / 20);
+    EXPECT_GT(ours, 0.3 / 255.0);  // the compression is there
+    EXPECT_NEAR(ours / opencv, 1.0, 0.1);
+    EXPECT_GT(cv::norm(a, b, cv::NORM_INF), 8.0 / 255.0);                                   // ringing at the edges
+    EXPECT_EQ(cv::norm(CameraSimulator(mjpeg).capture(signals, 5), b, cv::NORM_INF), 0.0);  // deterministic
+    const auto message = [](const std::string& camera) {
+        try {
+            (void)parse_rig("[camera]\n" + camera + "\n[[projectors]]\n", "bad.toml");
+        } catch (const RigError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    EXPECT_EQ(parse_rig("[camera]\nmjpeg_quality = 80\n[[projectors]]\n", "q.toml").camera.mjpeg_quality, 80);
+    EXPECT_NE(message("mjpeg_quality = 101").find("camera.mjpeg_quality must be 0..100"), std::string::npos);
+    EXPECT_NE(message("mjpeg_quality = 80\nbits = 10").find("camera.mjpeg_quality must be 0 unless bits = 8"),
+              std::string::npos);
 }
 
 }  // namespace

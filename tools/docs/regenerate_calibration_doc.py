@@ -19,7 +19,7 @@ BLOCK = re.compile(r"^<!-- generated:calibration-rigs -->\n.*?^<!-- /generated -
 EXTRA_RUNS = {"roughscreen": ["--fit-screen"], "falloff": ["--no-falloff"], "bulge": ["--no-bow"],
               "realistic": ["--fixed-camera-intrinsics"], "focal": ["--fixed-camera-intrinsics"],
               "grazing": ["--intrinsics-min-gain", "0"], "standard": ["--intrinsics-min-gain", "0"],
-              "realistic-lens": ["--pinhole-projectors"]}
+              "realistic-lens": ["--pinhole-projectors"], "realistic-install": ["--fit-screen"]}
 # Rigs already at small resolutions, run at their own (x1): the QEMU test's rig (rigs/qemu.toml).
 OWN_SCALE = {"qemu"}
 COLOUR = re.compile(r"^<!-- generated:calibration-colour -->\n.*?^<!-- /generated -->$", re.S | re.M)

@@ -1,0 +1,109 @@
+// SPDX-License-Identifier: Apache-2.0
+// A real installation's measuring and camera errors on the virtual rig, each alone on the standard rig at half
+// scale (rig keys [prior] screen_bottom_error_m / screen_top_error_m, [camera] mjpeg_quality; docs/calibration.md,
+// "Rig files"): the calibration must meet its goals or refuse naming the cause, never put content silently off.
+// Measured against the virtual rig's ground truth (rig_bridge.h), never against the calibration's own prediction.
+#include <cstdio>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "appliance/autocal/autocal.h"
+#include "appliance/autocal/rig_bridge.h"
+#include "appliance/autocal/self_check.h"
+#include "appliance/rig/rig_file.h"
+
+namespace mogao::autocal {
+namespace {
+
+rig::VirtualRig standard_half() {
+    return scaled_rig(rig::load_rig(std::string(MOGAO_SOURCE_DIR) + "/rigs/standard.toml"), 0.5, 0.5);
+}
+
+struct Outcome {
+    std::string refused;     // the refusal's reason, empty when calibrated
+    GeometryError geometry;  // against the rig's truth, also where the self-check's gate refused it
+    SelfCheckResult check;
+    AutocalResult result;
+};
+
+// Calibrates the rig as the calibrate command does (calibrate, then the self-check and its gate), measuring the
+// result against the rig's ground truth apart (also where the gate refuses it: `gate_refused` has the reason).
+Outcome calibrate_rig(const rig::VirtualRig& rig, const AutocalOptions& options, const char* what) {
+    RigPatternSource source(rig);
+    const CalibrationPrior prior = prior_from_rig(rig);
+    Outcome out;
+    try {
+        out.result = calibrate(source, prior, {1920, 1080}, options);
+    } catch (const CalibrationRefused& e) {
+        out.refused = e.what();
+        std::printf("%s: refused: %s\n", what, e.what());
+        return out;
+    }
+    out.check = run_self_check(source, prior, out.result);
+    out.geometry = measure_geometry(rig, out.result.calibration, 4);
+    try {
+        check_self_check_gate(out.check, SelfCheckOptions{});
+    } catch (const CalibrationRefused& e) {
+        out.refused = e.what();
+    }
+    std::printf(
+        "%s: geometry mean %.3f p95 %.3f max %.3f px; self-check mean %.3f px; screen radius %.4f m arc "
+        "%.3f deg%s%s\n",
+        what, out.geometry.mean_px, out.geometry.p95_px, out.geometry.max_px, out.check.mean_px,
+        out.result.screen.radius_m, out.result.screen.arc_deg,
+        out.refused.empty() ? "" : "; refused: ", out.refused.c_str());
+    return out;
+}
+
+bool meets_goals(const Outcome& o) {
+    // The calibration's goals against the rig's ground truth: mean <= 0.3 px, p95 <= 0.8 px.
+    return o.refused.empty() && o.geometry.mean_px <= 0.3 && o.geometry.p95_px <= 0.8 &&
+           o.geometry.missing + o.geometry.outside < o.geometry.samples / 100;
+}
+
+// The screen's heights as a tape measures them: the bottom edge told 2 cm high, the top edge 2 cm low, so the
+// screen is told 4 cm (2.7 %) short of its 1.5 m. With the radius and arc taken as told the screen's shape is
+// wrong, and content lands pixels off: the self-check must refuse it, naming the screen's size. Fitting the
+// screen (AutocalOptions::fit_screen) takes the told heights as the scale and finds the rest: the whole room
+// scaled is the same to the camera, so content lands where it belongs.
+TEST(InstallErrors, TapeMeasuredHeightsAreRefusedOrFitted) {
+    rig::VirtualRig rig = standard_half();
+    rig.prior.screen_bottom_error_m = 0.02;
+    rig.prior.screen_top_error_m = -0.02;
+    const CalibrationPrior prior = prior_from_rig(rig);
+    ASSERT_NEAR(prior.screen.bottom_m, rig.screen.bottom_m + 0.02, 1e-12);
+    ASSERT_NEAR(prior.screen.top_m, rig.screen.top_m - 0.02, 1e-12);
+    const Outcome told = calibrate_rig(rig, {}, "heights taken as told");
+    EXPECT_GT(told.geometry.mean_px, 1.0);  // the failure the refusal exists for (measured 3.7 px)
+    EXPECT_NE(told.refused.find("self-check"), std::string::npos) << told.refused;
+    EXPECT_NE(told.refused.find("the screen's size in the site file"), std::string::npos) << told.refused;
+    AutocalOptions fit;
+    fit.fit_screen = true;
+    const Outcome fitted = calibrate_rig(rig, fit, "screen fitted");
+    EXPECT_TRUE(meets_goals(fitted)) << fitted.geometry.mean_px << " / " << fitted.geometry.p95_px;
+    // The scale is the told heights': the fitted radius is the true one times told / true height (1.46 / 1.5).
+    EXPECT_NEAR(fitted.result.screen.radius_m, rig.screen.radius_m * 1.46 / 1.5, 0.01);
+}
+
+// Both heights 2 cm high: the screen told where it is not along its axis, its size right. The edges fix the
+// camera's pose to the screen, so the whole room is told 2 cm higher, and content lands where it belongs.
+TEST(InstallErrors, ACommonHeightErrorMovesNothing) {
+    rig::VirtualRig rig = standard_half();
+    rig.prior.screen_bottom_error_m = 0.02;
+    rig.prior.screen_top_error_m = 0.02;
+    const Outcome o = calibrate_rig(rig, {}, "both heights 2 cm high");
+    EXPECT_TRUE(meets_goals(o)) << o.refused << " " << o.geometry.mean_px << " / " << o.geometry.p95_px;
+}
+
+// Motion-JPEG frames at quality 80 (8 x 8 blocks, ringing at the patterns' edges): the Gray code compares each
+// pattern with its inverse and the phase sinusoids are smooth, so the decoding holds and the goals are met.
+TEST(InstallErrors, MjpegFramesMeetTheGoals) {
+    rig::VirtualRig rig = standard_half();
+    rig.camera.mjpeg_quality = 80;
+    const Outcome o = calibrate_rig(rig, {}, "MJPEG quality 80");
+    EXPECT_TRUE(meets_goals(o)) << o.refused << " " << o.geometry.mean_px << " / " << o.geometry.p95_px;
+}
+
+}  // namespace
+}  // namespace mogao::autocal
