@@ -11,7 +11,8 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 mkdir -p "$work/root/usr/bin"
 mkdir -p "$work/root/usr/lib/mogao"
-for b in bin/mpirun bin/mogao-farm bin/mogao-farm-launch bin/mogao-kiosk lib/mogao/mogao-service lib/mogao/mogao-update; do
+for b in bin/mpirun bin/mogao-farm bin/mogao-farm-launch bin/mogao-kiosk lib/mogao/mogao-service \
+    lib/mogao/mogao-update; do
   printf '#!/bin/sh\n' > "$work/root/usr/$b"; chmod +x "$work/root/usr/$b"
 done
 fail=0

@@ -40,18 +40,21 @@ boot_under_systemd() {
     kill -0 "$pid_nspawn" 2> /dev/null || break
     leader=$(container_init)
     if [[ -n "$leader" ]]; then
-      state=$(timeout 10 nsenter --target "$leader" --all /usr/bin/env -i PATH=/usr/bin:/bin systemctl is-system-running 2> /dev/null || true)
+      state=$(timeout 10 nsenter --target "$leader" --all /usr/bin/env -i PATH=/usr/bin:/bin \
+        systemctl is-system-running 2> /dev/null || true)
       [[ "$state" == running || "$state" == degraded ]] && break
     fi
     sleep 1
   done
   if [[ "$state" != running && "$state" != degraded ]]; then
-    nspawn_reason="systemd-nspawn --boot: system state '${state:-none}' after ${i} s; $(grep -v '^$' "$work/nspawn.log" | tail -n 3 | tr '\n' ' ' | cut -c1-300)"
+    nspawn_reason="systemd-nspawn --boot: system state '${state:-none}' after ${i} s;"
+    nspawn_reason+=" $(grep -v '^$' "$work/nspawn.log" | tail -n 3 | tr '\n' ' ' | cut -c1-300)"
     kill "$pid_nspawn" 2> /dev/null; wait "$pid_nspawn" 2> /dev/null; pid_nspawn=""
     return 1
   fi
   log "container booted in ${i} s (systemd: $state)"
-  in_container systemctl is-enabled mogao-farm | grep -qx enabled || fail "mogao-farm.service not enabled in the booted root"
+  in_container systemctl is-enabled mogao-farm | grep -qx enabled \
+    || fail "mogao-farm.service not enabled in the booted root"
   local active cond
   active=$(in_container systemctl show -P ActiveState mogao-farm)
   cond=$(in_container systemctl show -P ConditionResult mogao-farm)
@@ -79,13 +82,15 @@ start_under_systemd() {
   in_container systemctl enable --now mogao-farm || true
   state=$(wait_state active failed)
   in_container journalctl -u mogao-farm --no-pager > "$work/farm-journal.txt" 2>&1 || true
-  [[ "$state" == active ]] || { tail -n 30 "$work/farm-journal.txt"; fail "mogao-farm.service $state, not active (READY)"; }
+  [[ "$state" == active ]] \
+    || { tail -n 30 "$work/farm-journal.txt"; fail "mogao-farm.service $state, not active (READY)"; }
   grep -q ":$(printf '%04X' $farm_port) [0-9A-F:]* 0A " /proc/net/tcp6 /proc/net/tcp \
     || fail "mogao-farm active but nothing listens on $farm_port"
   local modes
   modes=$(root_stat "$root"/etc/mogao/pki "$root"/etc/mogao/pki/*)
   grep -qv ' root:mogao-farm \(750\|640\)$' <<<"$modes" && fail "TLS folder not root:mogao-farm 0750/0640: $modes"
-  log "ok: systemctl enable --now mogao-farm: active (READY) in $(($(date +%s) - t)) s, listening on $farm_port; TLS folder root:mogao-farm 0750/0640"
+  log "ok: systemctl enable --now mogao-farm: active (READY) in $(($(date +%s) - t)) s, listening on $farm_port;" \
+    "TLS folder root:mogao-farm 0750/0640"
 }
 
 # configuration_error_under_systemd: a bad farm.env (MOGAO_RANKS=0) ends the start with exit 2:
@@ -100,7 +105,8 @@ configuration_error_under_systemd() {
   state=$(in_container systemctl show -P ActiveState mogao-farm)
   restarts=$(in_container systemctl show -P NRestarts mogao-farm)
   in_container journalctl -u mogao-farm --no-pager > "$work/farm-journal.txt" 2>&1 || true
-  [[ "$state" == failed && "$restarts" == 0 ]] || fail "farm with MOGAO_RANKS=0: $state after $restarts restarts (want failed, 0)"
+  [[ "$state" == failed && "$restarts" == 0 ]] \
+    || fail "farm with MOGAO_RANKS=0: $state after $restarts restarts (want failed, 0)"
   grep -q "configuration error (exit 2, named above): not restarted" "$work/farm-journal.txt" \
     || { tail -n 20 "$work/farm-journal.txt"; fail "no journal line for the configuration error"; }
   grep -q "RANKS must be a number >= 1" "$work/farm-journal.txt" || fail "the journal does not name MOGAO_RANKS"
@@ -129,7 +135,8 @@ EOF
 # checks of check_served_frames.
 serve_frames() {
   write_client_script
-  "$@" sh /root/link-client.sh > "$work/kiosk.log" 2>&1 || { tail -n 30 "$work/kiosk.log"; fail "the link client (mogao-kiosk) failed"; }
+  "$@" sh /root/link-client.sh > "$work/kiosk.log" 2>&1 \
+    || { tail -n 30 "$work/kiosk.log"; fail "the link client (mogao-kiosk) failed"; }
   check_served_frames
 }
 
@@ -137,20 +144,25 @@ serve_frames() {
 # metrics file, written by the mogao-farm user into node_exporter's folder (mode 0644, readable by
 # the exporter's user), counts at least as many frames sent (rewritten about once a second).
 check_served_frames() {
-  local stats="$root/root/kiosk-stats.json" prom="$root/var/lib/prometheus/node-exporter/mogao-farm.prom" shown sent="" i
+  local stats="$root/root/kiosk-stats.json" prom="$root/var/lib/prometheus/node-exporter/mogao-farm.prom"
+  local shown sent="" i
   [[ -f "$stats" ]] || fail "the link client wrote no statistics"
   shown=$(python3 -c 'import json, sys; s = json.load(open(sys.argv[1]))
 print(s["frames_presented"] if s["exit_code"] == 0 and s["frames_rejected"] == 0 else -1)' "$stats")
-  ((shown >= 10)) || fail "the link client: $shown frames presented (want >= 10, none rejected, exit 0): $(head -c 400 "$stats")"
+  ((shown >= 10)) \
+    || fail "the link client: $shown frames presented (want >= 10, none rejected, exit 0): $(head -c 400 "$stats")"
   for ((i = 0; i < 10; i++)); do
     sent=$(awk '$1 == "mogao_farm_frames_sent_total" { print $2 }' "$prom" 2> /dev/null || true)
     [[ -n "$sent" ]] && ((${sent%.*} >= shown)) && break
     sleep 1
   done
   [[ -f "$prom" ]] || fail "no metrics file $prom (the farm user cannot write node_exporter's folder?)"
-  [[ "$(root_stat "$prom")" == *" mogao-farm:mogao-farm 644" ]] || fail "metrics file $(root_stat "$prom"), want mogao-farm:mogao-farm 0644"
-  [[ -n "$sent" ]] && ((${sent%.*} >= shown)) || fail "mogao_farm_frames_sent_total ${sent:-missing} < $shown frames the client showed"
-  log "ok: served frames: the kiosk showed $shown farm frames; $(basename "$prom") in node_exporter's folder (mogao-farm, 0644): mogao_farm_frames_sent_total $sent"
+  [[ "$(root_stat "$prom")" == *" mogao-farm:mogao-farm 644" ]] \
+    || fail "metrics file $(root_stat "$prom"), want mogao-farm:mogao-farm 0644"
+  [[ -n "$sent" ]] && ((${sent%.*} >= shown)) \
+    || fail "mogao_farm_frames_sent_total ${sent:-missing} < $shown frames the client showed"
+  log "ok: served frames: the kiosk showed $shown farm frames; $(basename "$prom") in node_exporter's folder" \
+    "(mogao-farm, 0644): mogao_farm_frames_sent_total $sent"
 }
 
 stop_container() {
@@ -171,7 +183,8 @@ start_as_the_unit_does() {
     r=$1; shift
     mount -t proc proc "$r/proc" && mount -t sysfs sys "$r/sys" && mount --rbind /dev "$r/dev" || exit 1
     mount -t tmpfs -o mode=1777 tmp "$r/tmp" && mount -t tmpfs -o mode=0755 run "$r/run" || exit 1
-    exec python3 "$@"' sh "$root" "$(dirname "${BASH_SOURCE[0]}")/unit_start.py" "$root" "$unit" "$farm_port" 180 sh /root/link-client.sh \
+    exec python3 "$@"' sh "$root" "$(dirname "${BASH_SOURCE[0]}")/unit_start.py" "$root" "$unit" "$farm_port" 180 \
+    sh /root/link-client.sh \
     | tee "$work/unit-start.log" || fail "the farm did not start as its unit runs it (log above)"
   # The ExecStartPre (tmpfiles.d/mogao-farm-pki.conf) made the TLS folder readable by the farm only.
   local modes

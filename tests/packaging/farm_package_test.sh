@@ -64,7 +64,8 @@ deb=${MOGAO_FARM_DEB:-}
 if [[ -z "$deb" ]]; then
   log "bash .ci/package $deb_dir (the packages of this tree; MOGAO_FARM_DEB=FILE tests that one instead)"
   rm -f "$deb_dir"/*.deb
-  "${package_env[@]}" bash "$repo/.ci/package" "$deb_dir" > "$deb_dir.log" 2>&1 || { tail -n 30 "$deb_dir.log"; fail "bash .ci/package $deb_dir failed"; }
+  "${package_env[@]}" bash "$repo/.ci/package" "$deb_dir" > "$deb_dir.log" 2>&1 \
+    || { tail -n 30 "$deb_dir.log"; fail "bash .ci/package $deb_dir failed"; }
   deb=$(ls "$deb_dir"/mogao-farm_*.deb)
 fi
 [[ -f "$deb" ]] || fail "no package $deb"
@@ -86,16 +87,19 @@ find "$cache" -maxdepth 1 -name '*.deb' -exec cp -n -t "$root/var/cache/apt/arch
 in_root env DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends "/tmp/$(basename "$deb")" \
   > "$work/apt.log" 2>&1 || { tail -n 40 "$work/apt.log"; fail "apt install ./$(basename "$deb") failed"; }
 find "$root/var/cache/apt/archives" -maxdepth 1 -name '*.deb' -exec cp -n -t "$cache/" {} + 2> /dev/null || true
-log "apt install ./$(basename "$deb"): $(($(date +%s) - t2)) s, $(grep -c '^Setting up' "$work/apt.log") packages set up"
+log "apt install ./$(basename "$deb"): $(($(date +%s) - t2)) s," \
+  "$(grep -c '^Setting up' "$work/apt.log") packages set up"
 
 # ---- what the package installed and set up ---------------------------------------------------------
 # root_stat PATH...: "PATH USER:GROUP MODE" with the root's user and group names (the host running
 # this test has no mogao-farm user: stat's %U prints 971 there), PATH without the root's prefix.
 root_stat() {
-  local p uid gid mode
+  local p uid gid mode user group
   for p in "$@"; do
     read -r uid gid mode < <(stat -c '%u %g %a' "$p")
-    echo "${p#"$root"} $(awk -F: -v id="$uid" '$3 == id { print $1; exit }' "$root/etc/passwd"):$(awk -F: -v id="$gid" '$3 == id { print $1; exit }' "$root/etc/group") $mode"
+    user=$(awk -F: -v id="$uid" '$3 == id { print $1; exit }' "$root/etc/passwd")
+    group=$(awk -F: -v id="$gid" '$3 == id { print $1; exit }' "$root/etc/group")
+    echo "${p#"$root"} $user:$group $mode"
   done
 }
 grep -q '^mogao-farm:x:971:971:[^:]*:/var/lib/mogao-farm:/bin/sh$' "$root/etc/passwd" \
@@ -120,12 +124,14 @@ t3=$(date +%s)
 cp "$appliance_deb" "$root/tmp/"
 in_root env DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends \
   "/tmp/$(basename "$appliance_deb")" libegl-mesa0 libgl1-mesa-dri prometheus-node-exporter \
-  > "$work/apt-client.log" 2>&1 || { tail -n 40 "$work/apt-client.log"; fail "apt install of the client and node exporter failed"; }
+  > "$work/apt-client.log" 2>&1 \
+  || { tail -n 40 "$work/apt-client.log"; fail "apt install of the client and node exporter failed"; }
 find "$root/var/cache/apt/archives" -maxdepth 1 -name '*.deb' -exec cp -n -t "$cache/" {} + 2> /dev/null || true
 in_root systemctl disable prometheus-node-exporter > /dev/null 2>&1 || true
 textfile_dir=/var/lib/prometheus/node-exporter
 [[ -d "$root$textfile_dir" ]] || fail "prometheus-node-exporter made no $textfile_dir"
-log "apt install ./$(basename "$appliance_deb") (the client), Mesa EGL, prometheus-node-exporter: $(($(date +%s) - t3)) s;" \
+log "apt install ./$(basename "$appliance_deb") (the client), Mesa EGL, prometheus-node-exporter:" \
+  "$(($(date +%s) - t3)) s;" \
   "$(root_stat "$root$textfile_dir")"
 sed -i "s|^MOGAO_FARM_ARGS=.*|MOGAO_FARM_ARGS=--metrics-file $textfile_dir/mogao-farm.prom|" "$root/etc/mogao/farm.env"
 
@@ -133,7 +139,8 @@ sed -i "s|^MOGAO_FARM_ARGS=.*|MOGAO_FARM_ARGS=--metrics-file $textfile_dir/mogao
 # the unit's start by hand --------------------------------------------------------------------------
 # pki_commands RUNNER...: init-ca, issue-farm, export-farm, each run through RUNNER.
 pki_commands() {
-  "$@" mogao-farm pki init-ca --dir /root/mogao-ca > "$work/pki.log" 2>&1 || { cat "$work/pki.log"; fail "pki init-ca"; }
+  "$@" mogao-farm pki init-ca --dir /root/mogao-ca > "$work/pki.log" 2>&1 \
+    || { cat "$work/pki.log"; fail "pki init-ca"; }
   "$@" mogao-farm pki issue-farm --dir /root/mogao-ca --name farm-1 --san ::1 >> "$work/pki.log" 2>&1 \
     || { cat "$work/pki.log"; fail "pki issue-farm"; }
   "$@" mogao-farm pki export-farm --dir /root/mogao-ca --name farm-1 --to /etc/mogao/pki >> "$work/pki.log" 2>&1 \
@@ -149,7 +156,8 @@ if boot_under_systemd; then
   configuration_error_under_systemd
   stop_container
 else
-  log "systemd cannot boot here ($nspawn_reason): the unit's ExecStartPre and ExecStart as systemd runs them, in a chroot"
+  log "systemd cannot boot here ($nspawn_reason):" \
+    "the unit's ExecStartPre and ExecStart as systemd runs them, in a chroot"
   pki_commands in_root
   start_as_the_unit_does
   check_served_frames

@@ -59,7 +59,8 @@ def expand(command, env):
         if m:
             words += env.get(m.group(1), "").split()
             continue
-        words.append(re.sub(r"\$\{([A-Za-z_][A-Za-z0-9_]*)\}", lambda g: env.get(g.group(1), ""), word).replace("\0", "$"))
+        words.append(re.sub(r"\$\{([A-Za-z_][A-Za-z0-9_]*)\}", lambda g: env.get(g.group(1), ""),
+                            word).replace("\0", "$"))
     return words
 
 

@@ -25,7 +25,8 @@ farm_check_host_dir() {
   # ports would be closed to the other hosts too. Checked by the filter's own parser, so that
   # what provisioning accepts is what the host loads at boot.
   f="$dir/etc/mogao/farm-network"
-  [[ -f "$f" ]] || img_die "$f missing: the farm network's prefixes, one per line (e.g. 10.77.0.0/24), from which Open MPI's ports may be reached"
+  [[ -f "$f" ]] || img_die "$f missing: the farm network's prefixes, one per line (e.g. 10.77.0.0/24)," \
+    "from which Open MPI's ports may be reached"
   local why
   if ! why=$(sh "$FARM_FIREWALL" --print "$f" 2>&1 > /dev/null); then
     why=${why#mogao-farm-firewall: }

@@ -108,7 +108,8 @@ def host_dirs(work, farm, deb, overlay, layout):
     run([farm, "pki", "init-ca", "--dir", pki])
     run([farm, "pki", "issue-farm", "--dir", pki, "--name", "farm", "--san", f"{V6}10"])
     run([farm, "pki", "issue-appliance", "--dir", pki, "--name", "museum-1"])
-    run(["ssh-keygen", "-q", "-t", "ed25519", "-N", "", "-C", "mogao-farm@farm-admin", "-f", os.path.join(keys, "user")])
+    run(["ssh-keygen", "-q", "-t", "ed25519", "-N", "", "-C", "mogao-farm@farm-admin", "-f",
+         os.path.join(keys, "user")])
     for name in HOSTS:
         run(["ssh-keygen", "-q", "-t", "ed25519", "-N", "", "-C", f"root@{name}", "-f", os.path.join(keys, name)])
     read = lambda p: open(p).read().strip()
@@ -173,7 +174,8 @@ def host_dirs(work, farm, deb, overlay, layout):
     shutil.copy(os.path.join(keys, "user"), f"{ssh}/id_ed25519")
     shutil.copy(os.path.join(keys, "user.pub"), f"{ssh}/id_ed25519.pub")
     write(f"{ssh}/known_hosts", "".join(
-        f"{name},{V4}{n} {read(os.path.join(keys, name + '.pub')).rsplit(' ', 1)[0]}\n" for name, (n, _, _) in HOSTS.items()))
+        f"{name},{V4}{n} {read(os.path.join(keys, name + '.pub')).rsplit(' ', 1)[0]}\n"
+        for name, (n, _, _) in HOSTS.items()))
     # restrict: no forwarding, no pty; the farm user only runs commands (orted) there.
     write(f"{render}/var/lib/mogao-farm/.ssh/authorized_keys",
           f"restrict,from=\"{V4}10\" {read(os.path.join(keys, 'user.pub'))}\n")
@@ -188,7 +190,8 @@ def kiosk_config(kiosk, work, pki):
     os.makedirs(os.path.join(out, "png"))
     os.makedirs(os.path.join(out, "content"))
     path = os.path.join(out, "kiosk.toml")
-    overrides = [f'farm.endpoint="[{V6}10]:{PORT}"', f'farm.ca="{pki}/ca.pem"', f'farm.cert="{pki}/appliance-museum-1.pem"',
+    overrides = [f'farm.endpoint="[{V6}10]:{PORT}"', f'farm.ca="{pki}/ca.pem"',
+                 f'farm.cert="{pki}/appliance-museum-1.pem"',
                  f'farm.key="{pki}/appliance-museum-1.key"', "display.rate_hz=2", 'outputs.backend="headless"',
                  'outputs.sizes=["320x180"]', f'outputs.png_dir="{out}/png"', "outputs.png_every=1",
                  "outputs.composite=false", 'calibration.source="ideal"', "calibration.projectors=1",
@@ -235,7 +238,8 @@ def main():
     ap.add_argument("--kiosk", required=True, help="mogao-kiosk (host): the appliance, headless")
     ap.add_argument("--image-tool", default="", help="mogao_kiosk_image_tool: PNG statistics")
     ap.add_argument("--work", default="")
-    ap.add_argument("--layout", choices=["both", "admin-only"], default=os.environ.get("MOGAO_FARM_TEST_LAYOUT", "both"),
+    ap.add_argument("--layout", choices=["both", "admin-only"],
+                    default=os.environ.get("MOGAO_FARM_TEST_LAYOUT", "both"),
                     help="both: ranks on farm-admin and farm-render2 (the test); admin-only: every rank on "
                          "farm-admin (diagnosis: the unit and the link without MPI between the hosts)")
     ap.add_argument("--overlay", action="store_true",
@@ -324,19 +328,22 @@ def main():
                         f"{name}: the package made user mogao-farm (971, home /var/lib/mogao-farm) and enabled, "
                         f"did not start, the unit: {text}")
             _, text = s.wait(r"(ok|FAIL) site-configured", 120, alive)
-            fails.check(text is not None and text.startswith("ok"), f"{name}: the site's files written after it: {text}")
+            fails.check(text is not None and text.startswith("ok"),
+                        f"{name}: the site's files written after it: {text}")
         _, text = admin.wait(r"(ok|FAIL) render-host-answers", 700, alive)
         fails.check(text is not None and text.startswith("ok"),
                     f"farm-admin: farm-render2 answers the farm user's ssh login with mogao-farm installed: {text}")
         t_ready, text = admin.wait(r"(ok|FAIL) farm-ready", a.timeout, alive)
-        ok = fails.check(text is not None and text.startswith("ok"), f"farm-admin: mogao-farm.service active (READY): {text}")
+        ok = fails.check(text is not None and text.startswith("ok"),
+                         f"farm-admin: mogao-farm.service active (READY): {text}")
         if ok:
             kv = farmvm.fields(text)
             results["host_qemu_start_to_farm_ready_s"] = round(t_ready - t_start, 1)
             results["guest_boot_to_farm_ready_s"] = round(int(kv["ready_us"]) / 1e6, 1)
             results["guest_exec_to_farm_ready_s"] = round((int(kv["ready_us"]) - int(kv["exec_us"])) / 1e6, 1)
             fails.check(kv.get("user") == "mogao-farm" and kv.get("main") == "mpirun",
-                        f"farm-admin: the unit's main process is mpirun as mogao-farm (main={kv.get('main')} user={kv.get('user')})")
+                        f"farm-admin: the unit's main process is mpirun as mogao-farm "
+                        f"(main={kv.get('main')} user={kv.get('user')})")
             # Restarts before READY are normal when the admin boots before the render hosts' sshd
             # is up (mpirun fails, Restart=on-failure tries again): recorded, not a failure.
             results["restarts_before_ready"] = int(kv.get("restarts", -1))
@@ -346,11 +353,13 @@ def main():
         expected = ["0", "1"] if a.layout == "both" else [str(r) for r in range(RANKS)]
         fails.check(sorted(r["rank"] for r in admin_ranks) == expected and
                     all(r["uid"] == "971" and r["seccomp"] == "2" and r["nnp"] == "1" for r in admin_ranks),
-                    f"farm-admin: ranks {expected} run as mogao-farm (uid 971) with seccomp and no_new_privs: {admin_ranks}")
+                    f"farm-admin: ranks {expected} run as mogao-farm (uid 971) with seccomp and no_new_privs: "
+                    f"{admin_ranks}")
         _, text = render.wait(r"(ok|FAIL|skip) rank-running", 300, alive)
         render_ranks = farmvm.parse_ranks(text or "")
         results["render2_ranks"] = render_ranks
-        a.layout == "admin-only" or fails.check(text is not None and text.startswith("ok") and [r["rank"] for r in render_ranks] == ["2"]
+        a.layout == "admin-only" or fails.check(text is not None and text.startswith("ok")
+                                                and [r["rank"] for r in render_ranks] == ["2"]
                     and "parent=orted" in text and "user=mogao-farm" in text,
                     f"farm-render2: rank 2 runs there, under orted, as mogao-farm (started over ssh): {text}")
         if a.layout == "both":
@@ -377,18 +386,22 @@ def main():
         if ok:
             t_kiosk = time.time()
             stats_file = os.path.join(kiosk_dir, "stats.json")
-            r = net.run([a.kiosk, "--config", kiosk_toml, "--frames", str(KIOSK_FRAMES), "--duration-s", str(KIOSK_TIMEOUT_S),
+            r = net.run([a.kiosk, "--config", kiosk_toml, "--frames", str(KIOSK_FRAMES),
+                         "--duration-s", str(KIOSK_TIMEOUT_S),
                          "--stats", stats_file, "--dump-content", os.path.join(kiosk_dir, "content")],
                         os.path.join(kiosk_dir, "kiosk.log"), timeout=KIOSK_TIMEOUT_S + 60)
             log(f"host kiosk exited {r} after {time.time() - t_kiosk:.1f} s")
             kres = farmvm.kiosk_results(kiosk_dir, stats_file, t_kiosk, a.image_tool)
             results.update(kres)
             fails.check(kres.get("kiosk_connected_s") is not None,
-                        f"host kiosk connected to [{V6}10]:{PORT} over IPv6 + mutual TLS ({kres.get('kiosk_connected_s')} s)")
+                        f"host kiosk connected to [{V6}10]:{PORT} over IPv6 + mutual TLS "
+                        f"({kres.get('kiosk_connected_s')} s)")
             fails.check(kres.get("kiosk_frames", 0) >= 1,
-                        f"host kiosk presented farm frames: {kres.get('kiosk_frames', 0)} (first after {kres.get('kiosk_first_frame_s')} s)")
+                        f"host kiosk presented farm frames: {kres.get('kiosk_frames', 0)} "
+                        f"(first after {kres.get('kiosk_first_frame_s')} s)")
             fails.check(kres.get("content_mean", 0) > 10 and kres.get("content_dark", 1) < 0.5,
-                        f"the farm's frame is not black: mean {kres.get('content_mean')}, dark fraction {kres.get('content_dark')}")
+                        f"the farm's frame is not black: mean {kres.get('content_mean')}, "
+                        f"dark fraction {kres.get('content_dark')}")
             if "output_mean" in kres:
                 fails.check(kres["output_mean"] > 10, f"the kiosk's output PNG is lit: mean {kres['output_mean']}")
         vms["farm-admin"].tell("kiosk-done")
@@ -396,7 +409,8 @@ def main():
         # --- watchdog ----------------------------------------------------------------------------
         _, text = admin.wait(r"(ok|FAIL) watchdog-pinged", 300, alive)
         fails.check(text is not None and text.startswith("ok"),
-                    f"farm-admin: up without restarts for longer than WatchdogSec (the admin rank's pings arrive): {text}")
+                    f"farm-admin: up without restarts for longer than WatchdogSec "
+                    f"(the admin rank's pings arrive): {text}")
         _, text = admin.wait(r"(ok|FAIL) watchdog-restart", 600, alive)
         fails.check(text is not None and text.startswith("ok"),
                     f"farm-admin: WatchdogSec killed the SIGSTOPped admin rank and the farm restarted: {text}")
@@ -406,7 +420,8 @@ def main():
             results["watchdog_stop_to_kill_s"] = float(kv["kill_after_s"])
         vms["farm-render2"].tell("watchdog-done")
         _, text = render.wait(r"(ok|FAIL|skip) rank-restarted", 300, alive)
-        a.layout == "admin-only" or fails.check(text is not None and text.startswith("ok"), f"farm-render2: a new rank replaced the old one: {text}")
+        a.layout == "admin-only" or fails.check(text is not None and text.startswith("ok"),
+                                                f"farm-render2: a new rank replaced the old one: {text}")
         if a.host_loss and a.layout == "both":
             render.wait(r"done ", 300, alive)  # farm-render2's own self-test ends before it is lost
             _, mac, mem = HOSTS["farm-render2"]

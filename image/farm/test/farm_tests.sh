@@ -30,9 +30,12 @@ if [[ $mode == check ]]; then
     && grep -q 'tcp dport 7443 accept' "$tmp/good" && grep -q 'policy drop' "$tmp/good" \
     || { echo "farm-firewall: unexpected ruleset:"; cat "$tmp/good"; exit 1; }
   printf '10.77.0.0/24\nnot-a-prefix\n' > "$tmp/bad"
-  if sh "$fw" --print "$tmp/bad" > "$tmp/closed" 2> "$tmp/err"; then echo "farm-firewall: a bad network file was accepted"; exit 1; fi
+  if sh "$fw" --print "$tmp/bad" > "$tmp/closed" 2> "$tmp/err"; then
+    echo "farm-firewall: a bad network file was accepted"; exit 1
+  fi
   grep -q "$tmp/bad:2: 'not-a-prefix'" "$tmp/err" && ! grep -q saddr "$tmp/closed" \
-    || { echo "farm-firewall: a bad file must close Open MPI's ports and name the line:"; cat "$tmp/err" "$tmp/closed"; exit 1; }
+    || { echo "farm-firewall: a bad file must close Open MPI's ports and name the line:"
+         cat "$tmp/err" "$tmp/closed"; exit 1; }
   # What the parser must refuse (each would have made nft fail at boot, or opened the host to all).
   for bad in 1.2.3.4/33 fd00::/129 300.1.1.1/8 1.2.3.4:80 . "10.0.0.1 10.0.0.2" dead.beef ::/0 0.0.0.0/0 10.0.0.0; do
     printf '%s\n' "$bad" > "$tmp/bad"
@@ -48,11 +51,13 @@ if [[ $mode == check ]]; then
       unshare -n -m sh -c 'mount --bind /dev/null /etc/protocols && nft -c -f "$1"' _ "$tmp/$rs" \
         || { echo "farm-firewall: nft refuses the $rs ruleset without /etc/protocols"; exit 1; }
     done
-    unshare -n sh -c 'sh "$1" "$2" "$3" && nft list table inet mogao_farm' _ "$fw" "$tmp/net" "$tmp/env" > "$tmp/loaded" 2>&1 \
+    unshare -n sh -c 'sh "$1" "$2" "$3" && nft list table inet mogao_farm' _ "$fw" "$tmp/net" "$tmp/env" \
+        > "$tmp/loaded" 2>&1 \
       && grep -qE 'ip saddr (\{ )?10.77.0.0/24( \})? accept' "$tmp/loaded" \
       || { echo "farm-firewall: the good filter did not load:"; cat "$tmp/loaded"; exit 1; }
     echo 'MOGAO_LISTEN=[::]:99999' > "$tmp/env-bad"
-    if unshare -n sh -c 'sh "$1" "$2" "$3"; rc=$?; nft list table inet mogao_farm; exit $rc' _ "$fw" "$tmp/net" "$tmp/env-bad" \
+    if unshare -n sh -c 'sh "$1" "$2" "$3"; rc=$?; nft list table inet mogao_farm; exit $rc' \
+        _ "$fw" "$tmp/net" "$tmp/env-bad" \
         > "$tmp/loaded" 2>&1 || ! grep -q 'policy drop' "$tmp/loaded" || grep -q saddr "$tmp/loaded"; then
       echo "farm-firewall: a ruleset nft refuses must load the closed filter and exit 1:"; cat "$tmp/loaded"; exit 1
     fi
@@ -87,7 +92,8 @@ PY
 fi
 
 [[ "${MOGAO_IMAGE_TESTS:-0}" == 1 ]] \
-  || skip "the image tests are opt-in (root, Debian mirrors, ~10 min on 2 cores; docs/services.md): set MOGAO_IMAGE_TESTS=1"
+  || skip "the image tests are opt-in (root, Debian mirrors, ~10 min on 2 cores; docs/services.md):" \
+    "set MOGAO_IMAGE_TESTS=1"
 [[ $(id -u) == 0 ]] || skip "the render-host image tests need root (chroot, file ownership, network namespaces)"
 
 case $mode in
@@ -97,7 +103,8 @@ case $mode in
     rm -f "$pkgdir"/*.deb
     start=$(date +%s)
     bash "$repo/.ci/package" "$pkgdir" > "$pkgdir/package.log" 2>&1 \
-      || { tail -n 40 "$pkgdir/package.log"; echo "bash .ci/package $pkgdir failed (log: $pkgdir/package.log)"; exit 1; }
+      || { tail -n 40 "$pkgdir/package.log"
+           echo "bash .ci/package $pkgdir failed (log: $pkgdir/package.log)"; exit 1; }
     grep -E '^(ccache|lintian|package build)' "$pkgdir/package.log" || true
     echo "farm_packages_build: $(( $(date +%s) - start )) s"
     ;;
@@ -105,7 +112,9 @@ case $mode in
     outdir=$3
     [[ -z "${MOGAO_FARM_IMAGE:-}" ]] || skip "MOGAO_FARM_IMAGE=$MOGAO_FARM_IMAGE given: not building an image"
     deb=${MOGAO_FARM_DEB:-$(ls "$4"/mogao-farm_*.deb 2>/dev/null | head -n1)}
-    [[ -f "$deb" ]] || { echo "no mogao-farm package in $4 (farm_packages_build makes it; or MOGAO_FARM_DEB=FILE)"; exit 1; }
+    [[ -f "$deb" ]] || {
+      echo "no mogao-farm package in $4 (farm_packages_build makes it; or MOGAO_FARM_DEB=FILE)"; exit 1
+    }
     source "$repo/image/lib/common.sh"
     why=$(img_build_preconditions mmdebstrap mke2fs debugfs mkfs.vfat mcopy sfdisk xz python3) || skip "$why"
     mkdir -p "$outdir"

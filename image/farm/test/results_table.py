@@ -62,12 +62,15 @@ def table(r):
     lines.append(f"| SIGSTOPped admin rank | watchdog kill {seconds(r, 'watchdog_stop_to_kill_s')}, active again "
                  f"{seconds(r, 'watchdog_stop_to_active_again_s')} after the stop |")
     if any(k.startswith("host_loss_") for k in r):
-        lines.append(f"| farm-render2's link cut while serving | new frame on the wall {seconds(r, 'host_loss_link_new_frame_s')}, "
+        lines.append(f"| farm-render2's link cut while serving | new frame on the wall "
+                     f"{seconds(r, 'host_loss_link_new_frame_s')}, "
                      f"admin serving on 1 render rank {seconds(r, 'host_loss_link_serving_1_s')} after the cut; "
                      f"rank 2 serving again {seconds(r, 'host_loss_link_back_s')} after the link came back |")
-        lines.append(f"| farm-render2's VM killed while serving | new frame on the wall {seconds(r, 'host_loss_vm_new_frame_s')}, "
+        lines.append(f"| farm-render2's VM killed while serving | new frame on the wall "
+                     f"{seconds(r, 'host_loss_vm_new_frame_s')}, "
                      f"admin serving on 1 render rank {seconds(r, 'host_loss_vm_serving_1_s')} after the kill; "
-                     f"rank 2 serving again {seconds(r, 'host_loss_vm_back_s')} after the rebooted host's sshd was up |")
+                     f"rank 2 serving again {seconds(r, 'host_loss_vm_back_s')} after the rebooted host's "
+                     f"sshd was up |")
     else:
         lines.append("| render host lost while serving | not measured in this run (`--host-loss`) |")
     lines.append(f"| `systemd-analyze security` online | {r.get('security_online_exposure', '?')} |")

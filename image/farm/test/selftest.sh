@@ -29,7 +29,8 @@ ranks() {
   for p in $(pgrep -x mogao-farm); do
     # MPI ranks only: the launcher's `mogao-farm health` check over ssh is one too, for a moment.
     [ -n "$(proc_env "$p" OMPI_COMM_WORLD_RANK)" ] || continue
-    printf '%s:%s:%s:%s:%s ' "$p" "$(awk '/^Uid:/ { print $2 }' /proc/$p/status)" "$(proc_env "$p" OMPI_COMM_WORLD_RANK)" \
+    printf '%s:%s:%s:%s:%s ' "$p" "$(awk '/^Uid:/ { print $2 }' /proc/$p/status)" \
+      "$(proc_env "$p" OMPI_COMM_WORLD_RANK)" \
       "$(awk '/^Seccomp:/ { print $2 }' /proc/$p/status)" "$(awk '/^NoNewPrivs:/ { print $2 }' /proc/$p/status)"
   done
 }
@@ -39,7 +40,8 @@ listeners() {
     while read -r line; do say "$line"; done
 }
 diagnose() {
-  ps -eo pid,ppid,user,stat,wchan:24,comm | grep -E ' (mpirun|orted|mogao-farm|ssh|sshd)$' | sed 's/^/MOGAO-SELFTEST diag ps /' > "$out"
+  ps -eo pid,ppid,user,stat,wchan:24,comm | grep -E ' (mpirun|orted|mogao-farm|ssh|sshd)$' \
+    | sed 's/^/MOGAO-SELFTEST diag ps /' > "$out"
   for p in $(pgrep -x mogao-farm); do
     ps -L -o tid,stat,wchan:24,time,pcpu -p "$p" | sed "s/^/MOGAO-SELFTEST diag threads $p /" > "$out"
   done
@@ -55,11 +57,13 @@ check_common() {
   [ -z "$failed" ] && ok "no-failed-units" || bad "failed-units $failed"
   pw=$(awk -F: '$2 !~ /^[*!]/ { print $1 }' /etc/shadow | tr '\n' ' ')
   [ -z "$pw" ] && ok "no-passwords" || bad "accounts-with-password $pw"
-  ok "units running=$(systemctl list-units --type=service --state=running --plain --no-legend | awk '{print $1}' | tr '\n' ',')"
+  ok "units running=$(systemctl list-units --type=service --state=running --plain --no-legend |
+    awk '{print $1}' | tr '\n' ',')"
 }
 
 stty -F "$ctl" -echo icanon 2>/dev/null
-say "start role=$role uptime=$(uptime_s) host=$(hostname) addrs=$(ip -br addr show scope global | awk '{ $1 = $2 = ""; print }' | tr -s ' ' ',')"
+say "start role=$role uptime=$(uptime_s) host=$(hostname)" \
+    "addrs=$(ip -br addr show scope global | awk '{ $1 = $2 = ""; print }' | tr -s ' ' ',')"
 
 # --- what docs/packaging.md tells a technician: the package with apt (offline here: the image holds
 # its dependencies), then the site's files; the test provisioned both under $stage ------------------
@@ -78,7 +82,11 @@ install_package() {
   user=$(getent passwd mogao-farm | cut -d: -f3,4,6)
   st="user=$user enabled=$(systemctl is-enabled $unit 2> /dev/null) active=$(systemctl is-active $unit 2> /dev/null)"
   if [ "$user" = 971:971:/var/lib/mogao-farm ] && [ "$(systemctl is-enabled $unit 2> /dev/null)" = enabled ] &&
-     [ "$(systemctl is-active $unit 2> /dev/null)" = inactive ]; then ok "package-state $st"; else bad "package-state $st"; fi
+     [ "$(systemctl is-active $unit 2> /dev/null)" = inactive ]; then
+    ok "package-state $st"
+  else
+    bad "package-state $st"
+  fi
   # The site's files: the farm's readable by its group only, the farm user's ssh files its own.
   cp -a "$stage/site/." /
   chown -R root:mogao-farm /etc/mogao
@@ -99,7 +107,8 @@ install_package
 if [ "$role" = render ]; then
   i=0
   while [ "$(systemctl is-active ssh.service)" != active ] && [ $i -lt 120 ]; do sleep 1; i=$((i + 1)); done
-  [ "$(systemctl is-active ssh.service)" = active ] && ok "sshd-active uptime=$(uptime_s)" || { bad "sshd-active"; dump_journal ssh.service; }
+  [ "$(systemctl is-active ssh.service)" = active ] && ok "sshd-active uptime=$(uptime_s)" \
+    || { bad "sshd-active"; dump_journal ssh.service; }
   ok "farm-unit-here state=$(systemctl is-active $unit) condition=$(prop $unit ConditionResult)"
   # The admin's mpirun logs in over ssh and starts orted, which starts this host's rank (unless
   # the test runs every rank on the admin: /etc/mogao/no-ranks-here, test copy only).
@@ -114,7 +123,8 @@ if [ "$role" = render ]; then
     say "skip rank-running (every rank runs on the admin in this test)"
   elif [ -n "$r" ]; then
     pid=${r%%:*}
-    ok "rank-running uptime=$(uptime_s) ranks=$r parent=$(ps -o comm= -p "$(ps -o ppid= -p "$pid" | tr -d ' ')") user=$(ps -o user= -p "$pid")"
+    ok "rank-running uptime=$(uptime_s) ranks=$r" \
+       "parent=$(ps -o comm= -p "$(ps -o ppid= -p "$pid" | tr -d ' ')") user=$(ps -o user= -p "$pid")"
   else
     bad "rank-running (no mogao-farm process in 900 s)"; dump_journal ssh.service
   fi
@@ -133,7 +143,8 @@ if [ "$role" = render ]; then
   if [ -z "$pid" ]; then say "skip rank-restarted (no rank here)"
   elif [ -n "$r2" ] && [ "${r2%%:*}" != "$pid" ]; then ok "rank-restarted ranks=$r2 old_pid=$pid"
   else bad "rank-restarted (ranks now '$r2', before $pid)"; fi
-  ok "ssh-logins $(journal ssh.service | grep -c 'Accepted publickey for mogao-farm') refused=$(journal ssh.service | grep -ciE 'Failed|Invalid user')"
+  ok "ssh-logins $(journal ssh.service | grep -c 'Accepted publickey for mogao-farm')" \
+     "refused=$(journal ssh.service | grep -ciE 'Failed|Invalid user')"
   check_common
   say "done fails=$fails uptime=$(uptime_s)"
   exit 0
@@ -142,11 +153,13 @@ fi
 # --- admin: once farm-render2 answers the farm's ssh login with its package installed (else the
 # launcher's health check would leave it out), `systemctl enable --now mogao-farm` ----------------------
 t0=$(uptime_s) i=0
-until runuser -u mogao-farm -- ssh -o BatchMode=yes -o ConnectTimeout=10 farm-render2 mogao-farm --version > /dev/null 2>&1; do
+until runuser -u mogao-farm -- ssh -o BatchMode=yes -o ConnectTimeout=10 farm-render2 mogao-farm --version \
+    > /dev/null 2>&1; do
   i=$((i + 1)); [ $i -ge 120 ] && break
   sleep 5
 done
-[ $i -lt 120 ] && ok "render-host-answers seconds=$(since "$t0")" || bad "render-host-answers (farm-render2: no ssh login or no mogao-farm there)"
+[ $i -lt 120 ] && ok "render-host-answers seconds=$(since "$t0")" \
+  || bad "render-host-answers (farm-render2: no ssh login or no mogao-farm there)"
 systemctl enable --now --no-block $unit
 
 # --- admin: mogao-farm.service reaches READY (Type=notify: active == READY=1 received) ------------
@@ -164,13 +177,15 @@ done
 r_ready=$(prop $unit NRestarts)
 if [ "$state" = active ]; then
   ok "farm-ready uptime=$(uptime_s) ready_us=$(prop $unit ActiveEnterTimestampMonotonic)" \
-     "exec_us=$(prop $unit ExecMainStartTimestampMonotonic) restarts=$(prop $unit NRestarts) pid=$(prop $unit MainPID)" \
+     "exec_us=$(prop $unit ExecMainStartTimestampMonotonic) restarts=$(prop $unit NRestarts)" \
+     "pid=$(prop $unit MainPID)" \
      "main=$(ps -o comm= -p "$(prop $unit MainPID)") user=$(ps -o user= -p "$(prop $unit MainPID)")"
 else
   bad "farm-ready state=$state restarts=$(prop $unit NRestarts) result=$(prop $unit Result)"
 fi
 dump_journal $unit 30
-say "boot userspace_us=$(systemctl show -P UserspaceTimestampMonotonic) network_online_us=$(prop network-online.target ActiveEnterTimestampMonotonic)" \
+say "boot userspace_us=$(systemctl show -P UserspaceTimestampMonotonic)" \
+    "network_online_us=$(prop network-online.target ActiveEnterTimestampMonotonic)" \
     "ssh_us=$(prop ssh.service ActiveEnterTimestampMonotonic)"
 sleep 5
 r=$(ranks)
@@ -188,7 +203,10 @@ answer=$(host_wait 900); say "host said '$answer'"
 wd_us=$(prop $unit WatchdogUSec)
 [ -z "$wd_us" ] && wd_us=0
 ready_us=$(prop $unit ActiveEnterTimestampMonotonic)
-case $wd_us in *min*|*s) wd_s=$(systemd-analyze timespan "$wd_us" 2>/dev/null | awk '/μs:|us:/ { print int($2 / 1000000) }') ;; *) wd_s=$((wd_us / 1000000)) ;; esac
+case $wd_us in
+  *min*|*s) wd_s=$(systemd-analyze timespan "$wd_us" 2>/dev/null | awk '/μs:|us:/ { print int($2 / 1000000) }') ;;
+  *) wd_s=$((wd_us / 1000000)) ;;
+esac
 [ -z "$wd_s" ] && wd_s=60
 while :; do
   now_us=$(awk '{ printf "%d", $1 * 1000000 }' /proc/uptime)
@@ -198,7 +216,8 @@ done
 n0=$(prop $unit NRestarts)
 [ "$(systemctl is-active $unit)" = active ] && [ "$n0" = "$r_ready" ] \
   && ok "watchdog-pinged active_s=$(( (now_us - ready_us) / 1000000 )) watchdog_s=$wd_s restarts=$n0" \
-  || { bad "watchdog-pinged state=$(systemctl is-active $unit) restarts=$n0 (killed by its own watchdog?)"; dump_journal $unit 20; }
+  || { bad "watchdog-pinged state=$(systemctl is-active $unit) restarts=$n0 (killed by its own watchdog?)"
+       dump_journal $unit 20; }
 
 # --- service watchdog: a hung admin rank (SIGSTOP) is killed (WatchdogSec) and the farm restarted --
 rank0=""
@@ -216,10 +235,12 @@ if [ -n "$rank0" ]; then
   done
   t1=$(awk '{ print $1 }' /proc/uptime)
   why=$(journal $unit | grep -m1 -i "watchdog timeout")
-  kill_t=$(journalctl -b -u $unit -o short-monotonic --no-pager 2>/dev/null | grep -m1 -i "watchdog timeout" | sed -E 's/^\[ *([0-9.]+)\].*/\1/')
+  kill_t=$(journalctl -b -u $unit -o short-monotonic --no-pager 2>/dev/null | grep -m1 -i "watchdog timeout" |
+    sed -E 's/^\[ *([0-9.]+)\].*/\1/')
   if [ "$n" -gt "$n0" ] && [ "$p" != "$main" ] && [ "$(systemctl is-active $unit)" = active ]; then
     ok "watchdog-restart seconds=$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.1f", b - a }')" \
-       "kill_after_s=$(awk -v a="$t0" -v b="${kill_t:-0}" 'BEGIN { printf "%.1f", b - a }') new_pid=$p restarts=$n reason='$why'"
+       "kill_after_s=$(awk -v a="$t0" -v b="${kill_t:-0}" 'BEGIN { printf "%.1f", b - a }')" \
+       "new_pid=$p restarts=$n reason='$why'"
   else
     bad "watchdog-restart (restarts=$n pid=$p state=$(systemctl is-active $unit) reason='$why')"
     dump_journal $unit 30
