@@ -108,9 +108,8 @@ TEST_F(LiveFramesTest, StillViewConvergesTowardTheReferenceWithNewSamplesEachPas
         ASSERT_EQ(frame.passes, pass);
         if (pass == 1 || pass == 4 || pass == 16 || pass == 64) psnr_after.push_back(psnr(frame.image, reference));
     }
-    // 1 + 1 + 63 x 2 samples: the first two passes at the request's 1 spp, later ones at least 2
-    // (jittered).
-    EXPECT_EQ(live.render(request).samples, 1 + 1 + 63 * 2);
+    // 1 + 63 x 2 samples: the first pass at the request's 1 spp, later ones at least 2 (jittered).
+    EXPECT_EQ(live.render(request).samples, 1 + 64 * 2);
     for (std::size_t i = 1; i < psnr_after.size(); ++i)
         EXPECT_GT(psnr_after[i], psnr_after[i - 1] + 1.0) << "after pass index " << i;
     // Every pass drew new random numbers: no two passes share a frame_id (the RNG key).
@@ -147,15 +146,15 @@ TEST_F(LiveFramesTest, AnyMotionStartsOver) {
 
 TEST_F(LiveFramesTest, ConvergedStillViewIsServedWithoutRendering) {
     LiveOptions options;
-    options.converged_spp = 6;  // 1 + 1 + 2 + 2
+    options.converged_spp = 5;  // 1 + 2 + 2
     LiveFrames live(source(), options, 1.f, ToneMap::clamp);
     ViewRequest request = view();
-    for (std::uint64_t id = 1; id <= 7; ++id) {
+    for (std::uint64_t id = 1; id <= 6; ++id) {
         request.frame_id = id;
         const LiveFrame frame = live.render(request);
-        EXPECT_EQ(frame.rendered_now, id <= 4) << id;
+        EXPECT_EQ(frame.rendered_now, id <= 3) << id;
     }
-    EXPECT_EQ(calls_.size(), 4u);
+    EXPECT_EQ(calls_.size(), 3u);
 }
 
 TEST_F(LiveFramesTest, WithoutProgressiveEachRequestRendersAlone) {
@@ -311,14 +310,14 @@ TEST_F(LiveFramesTest, TemporalAccumulationBringsAMovingFrameCloserToTheReferenc
 }
 
 // A still view: the guides are traced with its first pass only, and frames are filtered while they
-// hold at most denoise_max_spp samples (1, 1 + 1, then 1 + 1 + 2), raw after that (1 + 1 + 2 + 2 = 6).
+// hold at most denoise_max_spp samples (1, then 1 + 2), raw after that (1 + 2 + 2 = 5).
 TEST_F(LiveFramesTest, StillViewIsDenoisedUpToDenoiseMaxSppWithTheFirstPassesGuides) {
     LiveOptions options;
     options.denoise = true;
     options.denoise_max_spp = 4;
     LiveFrames live(source(), options, 1.f, ToneMap::clamp);
     ViewRequest request = view();
-    const bool expected[] = {true, true, true, false};
+    const bool expected[] = {true, true, false, false};
     for (std::uint64_t id = 1; id <= 4; ++id) {
         request.frame_id = id;
         const LiveFrame frame = live.render(request);
