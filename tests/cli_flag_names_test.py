@@ -39,11 +39,11 @@ NUMERIC = re.compile(r"^(INT|UINT|FLOAT|NUMBER)\b")
 
 
 def doc_names(doc_text, label):
-    """The `--names` on the docs/cli.md line that starts with LABEL."""
-    for line in doc_text.splitlines():
-        if line.startswith(label):
-            return set(re.findall(r"`(--[\w-]+)`", line))
-    sys.exit(f"FAIL: docs/cli.md has no line starting with '{label}'")
+    """The `--names` of the docs/cli.md paragraph that starts with LABEL (up to its blank line)."""
+    for paragraph in re.split(r"\n\s*\n", doc_text):
+        if paragraph.startswith(label):
+            return set(re.findall(r"`(--[\w-]+)`", paragraph.split(" -- ")[0]))
+    sys.exit(f"FAIL: docs/cli.md has no paragraph starting with '{label}'")
 
 
 def run_help(path, words):

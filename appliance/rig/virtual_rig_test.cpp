@@ -429,6 +429,16 @@ TEST(RigFile, ErrorsNameTheField) {
 
 // The camera's intrinsics as a chessboard leaves them: [prior] principal point and distortion errors, read
 // and range-checked by name.
+// The error parse_rig gives for a rig whose [prior] holds `prior` ("no error" when none).
+std::string prior_error(const std::string& prior) {
+    try {
+        (void)parse_rig("[camera]\n[[projectors]]\n[prior]\n" + prior + "\n", "bad.toml");
+    } catch (const RigError& e) {
+        return std::string(e.what());
+    }
+    return std::string("no error");
+}
+
 TEST(RigFile, CameraPriorErrorsAreReadAndChecked) {
     const VirtualRig rig = parse_rig(
         "[camera]\n[[projectors]]\n[prior]\ncamera_focal_error = 0.01\ncamera_principal_point_error_px = [7, -9]\n"
@@ -437,21 +447,14 @@ TEST(RigFile, CameraPriorErrorsAreReadAndChecked) {
     EXPECT_EQ(rig.prior.camera_focal_error, 0.01);
     EXPECT_EQ(rig.prior.camera_principal_point_error_px, Eigen::Vector2d(7.0, -9.0));
     EXPECT_EQ(rig.prior.camera_distortion_error, (std::array<double, 5>{0.01, -0.004, 0.0, 0.0, 0.001}));
-    const auto message = [](const std::string& prior) {
-        try {
-            (void)parse_rig("[camera]\n[[projectors]]\n[prior]\n" + prior + "\n", "bad.toml");
-        } catch (const RigError& e) {
-            return std::string(e.what());
-        }
-        return std::string("no error");
-    };
-    EXPECT_NE(message("camera_principal_point_error_px = [500, 0]").find("prior.camera_principal_point_error_px[0]"),
+    EXPECT_NE(
+        prior_error("camera_principal_point_error_px = [500, 0]").find("prior.camera_principal_point_error_px[0]"),
+        std::string::npos);
+    EXPECT_NE(prior_error("camera_distortion_error = [0, 2, 0, 0, 0]").find("prior.camera_distortion_error[1]"),
               std::string::npos);
-    EXPECT_NE(message("camera_distortion_error = [0, 2, 0, 0, 0]").find("prior.camera_distortion_error[1]"),
+    EXPECT_NE(prior_error("camera_distortion_error = [0, 0]").find("camera_distortion_error: must be an array of 5"),
               std::string::npos);
-    EXPECT_NE(message("camera_distortion_error = [0, 0]").find("camera_distortion_error: must be an array of 5"),
-              std::string::npos);
-    EXPECT_NE(message("camera_focal_error = 0.9").find("prior.camera_focal_error"), std::string::npos);
+    EXPECT_NE(prior_error("camera_focal_error = 0.9").find("prior.camera_focal_error"), std::string::npos);
 }
 
 // The screen's heights as a tape measured them ([prior] screen_bottom_error_m, screen_top_error_m): read, checked
@@ -466,21 +469,13 @@ TEST(RigFile, ScreenHeightErrorsAreToldNotFilmed) {
     EXPECT_EQ(rig.prior.screen_top_error_m, -0.015);
     EXPECT_EQ(rig.screen.bottom_m, 0.8);  // the truth stays
     EXPECT_EQ(rig.screen.top_m, 2.3);
-    const auto message = [](const std::string& prior) {
-        try {
-            (void)parse_rig("[camera]\n[[projectors]]\n[prior]\n" + prior + "\n", "bad.toml");
-        } catch (const RigError& e) {
-            return std::string(e.what());
-        }
-        return std::string("no error");
-    };
     // The standard screen is 1.5 m high: +-0.15 m.
-    EXPECT_NE(message("screen_bottom_error_m = 0.2")
+    EXPECT_NE(prior_error("screen_bottom_error_m = 0.2")
                   .find("bad.toml': rig: prior.screen_bottom_error_m (0.1 x the screen's height) must be in "
                         "[-0.150000, 0.150000] (got 0.200000)"),
               std::string::npos);
-    EXPECT_NE(message("screen_top_error_m = -0.151").find("prior.screen_top_error_m"), std::string::npos);
-    EXPECT_EQ(message("screen_top_error_m = -0.149"), "no error");
+    EXPECT_NE(prior_error("screen_top_error_m = -0.151").find("prior.screen_top_error_m"), std::string::npos);
+    EXPECT_EQ(prior_error("screen_top_error_m = -0.149"), "no error");
     VirtualRig truth = standard();
     VirtualRig told = truth;
     told.prior.screen_bottom_error_m = 0.02;

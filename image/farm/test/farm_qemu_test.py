@@ -182,6 +182,14 @@ def host_dirs(work, farm, deb, overlay, layout):
     return pki, dirs
 
 
+def expect_ok(serial, marker, timeout, alive, fails, what):
+    """Waits up to TIMEOUT s for selftest.sh's 'ok MARKER' or 'FAIL MARKER' line and checks that it
+    is ok (WHAT: the check, in words). Returns the line when ok, else None."""
+    _, text = serial.wait(rf"(ok|FAIL) {marker}", timeout, alive)
+    ok = fails.check(text is not None and text.startswith("ok"), f"{what}: {text}")
+    return text if ok else None
+
+
 def kiosk_config(kiosk, work, pki):
     """kiosk/config/kiosk.example.toml with this test's overrides (mogao-kiosk --print-config; section.key=TOML value,
     empty: commented out): headless, one 320x180 output, the walk."""
@@ -318,21 +326,16 @@ def main():
         # The technician's install on each host (selftest.sh install_package), then the admin's
         # start once farm-render2 answers its ssh login with the package there.
         for name, s in serials.items():
-            _, text = s.wait(r"(ok|FAIL) package-installed", 600, alive)
-            fails.check(text is not None and text.startswith("ok"),
-                        f"{name}: apt install ./mogao-farm_*.deb (offline, stock Debian 12): {text}")
-            if text and text.startswith("ok"):
+            text = expect_ok(s, "package-installed", 600, alive, fails,
+                             f"{name}: apt install ./mogao-farm_*.deb (offline, stock Debian 12)")
+            if text:
                 results[f"{name}_package_install_s"] = float(farmvm.fields(text)["seconds"])
-            _, text = s.wait(r"(ok|FAIL) package-state", 60, alive)
-            fails.check(text is not None and text.startswith("ok"),
-                        f"{name}: the package made user mogao-farm (971, home /var/lib/mogao-farm) and enabled, "
-                        f"did not start, the unit: {text}")
-            _, text = s.wait(r"(ok|FAIL) site-configured", 120, alive)
-            fails.check(text is not None and text.startswith("ok"),
-                        f"{name}: the site's files written after it: {text}")
-        _, text = admin.wait(r"(ok|FAIL) render-host-answers", 700, alive)
-        fails.check(text is not None and text.startswith("ok"),
-                    f"farm-admin: farm-render2 answers the farm user's ssh login with mogao-farm installed: {text}")
+            expect_ok(s, "package-state", 60, alive, fails,
+                      f"{name}: the package made user mogao-farm (971, home /var/lib/mogao-farm) and enabled, "
+                      "did not start, the unit")
+            expect_ok(s, "site-configured", 120, alive, fails, f"{name}: the site's files written after it")
+        expect_ok(admin, "render-host-answers", 700, alive, fails,
+                  "farm-admin: farm-render2 answers the farm user's ssh login with mogao-farm installed")
         t_ready, text = admin.wait(r"(ok|FAIL) farm-ready", a.timeout, alive)
         ok = fails.check(text is not None and text.startswith("ok"),
                          f"farm-admin: mogao-farm.service active (READY): {text}")
@@ -407,14 +410,11 @@ def main():
         vms["farm-admin"].tell("kiosk-done")
 
         # --- watchdog ----------------------------------------------------------------------------
-        _, text = admin.wait(r"(ok|FAIL) watchdog-pinged", 300, alive)
-        fails.check(text is not None and text.startswith("ok"),
-                    f"farm-admin: up without restarts for longer than WatchdogSec "
-                    f"(the admin rank's pings arrive): {text}")
-        _, text = admin.wait(r"(ok|FAIL) watchdog-restart", 600, alive)
-        fails.check(text is not None and text.startswith("ok"),
-                    f"farm-admin: WatchdogSec killed the SIGSTOPped admin rank and the farm restarted: {text}")
-        if text and text.startswith("ok"):
+        expect_ok(admin, "watchdog-pinged", 300, alive, fails,
+                  "farm-admin: up without restarts for longer than WatchdogSec (the admin rank's pings arrive)")
+        text = expect_ok(admin, "watchdog-restart", 600, alive, fails,
+                         "farm-admin: WatchdogSec killed the SIGSTOPped admin rank and the farm restarted")
+        if text:
             kv = farmvm.fields(text)
             results["watchdog_stop_to_active_again_s"] = float(kv["seconds"])
             results["watchdog_stop_to_kill_s"] = float(kv["kill_after_s"])
