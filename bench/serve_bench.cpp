@@ -180,7 +180,12 @@ std::vector<Config> all_configs(const BenchArgs& a) {
     second1.key = "cache-second-pass-1spp";
     second1.name = "all + denoiser + cache, second still pass of 1 spp";
     second1.live.still_second_pass_spp = 1;
-    std::vector<Config> out{today, all, denoise, floor, cache, temporal, second1};
+    // The cache configuration with a still view's first pass of 2 spp (1 by default).
+    Config first2 = cache;
+    first2.key = "cache-first-pass-2spp";
+    first2.name = "all + denoiser + cache, first still pass of 2 spp";
+    first2.live.still_first_pass_spp = 2;
+    std::vector<Config> out{today, all, denoise, floor, cache, temporal, second1, first2};
     const auto without = [&](const char* key, const char* name, auto change) {
         Config c = all;
         c.key = key;
@@ -339,7 +344,13 @@ nlohmann::json run_config(const Config& c, FrameDispatcher& farm, const Scene& s
         ++still_frames;
         const double p = psnr(upsample(last.image, reference.size), reference);
         if (to38 < 0 && p >= 38.0) to38 = served;
-        curve.push_back({{"seconds", served}, {"psnr_db", p}, {"samples", last.samples}});
+        curve.push_back({{"seconds", served},
+                         {"psnr_db", p},
+                         {"samples", last.samples},
+                         {"frame_seconds", last.seconds},
+                         {"render_phase_seconds", last.stats.render_phase_seconds},
+                         {"rank_render_seconds", last.stats.rank_render_seconds},
+                         {"denoise_seconds", last.denoise_seconds}});
     }
     encoder.finish();
     shots.still = upsample(last.image, reference.size);
@@ -541,13 +552,12 @@ int main(int argc, char** argv) {
     app.add_option("--reference-spp", a.reference_spp, "Reference samples per pixel (two halves)")
         ->check(CLI::Range(2, 8192));
     app.add_option("--configs", a.configs,
-                   "today, all, denoise, denoise-floor-0.2, cache, temporal, cache-second-pass-1spp, no-progressive, "
-                   "no-target, no-pipeline, "
-                   "no-rank-speed, no-rate-aim")
+                   "today, all, denoise, denoise-floor-0.2, cache, temporal, cache-second-pass-1spp, "
+                   "cache-first-pass-2spp, no-progressive, no-target, no-pipeline, no-rank-speed, no-rate-aim")
         ->delimiter(',')
         ->check(CLI::IsMember({"today", "all", "denoise", "denoise-floor-0.2", "cache", "temporal",
-                               "cache-second-pass-1spp", "no-progressive", "no-target", "no-pipeline", "no-rank-speed",
-                               "no-rate-aim"}));
+                               "cache-second-pass-1spp", "cache-first-pass-2spp", "no-progressive", "no-target",
+                               "no-pipeline", "no-rank-speed", "no-rate-aim"}));
     app.add_option("--quality", a.quality,
                    "Preset whose request quality every request uses (" + quality_preset_names() +
                        "); default: the request's defaults")
@@ -559,6 +569,8 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1, 1 << 20));
     app.add_option("--denoise-iterations", a.denoise_iterations, "denoise configuration: a-trous levels")
         ->check(CLI::Range(0, AtrousParams::kMaxIterations));
+    app.add_flag("--jitter-cached-one-spp", setup.jitter_cached_one_spp,
+                 "Moving frames from the radiance cache jittered, their guides from a guide pass (as before)");
     app.add_option("--json", a.json, "Write every figure (and the curves) as JSON");
     app.add_option("--side-by-side", a.side_by_side,
                    "PNG: moving frame | still view after --still-seconds | reference");

@@ -115,8 +115,10 @@ int run_farm(const MpiSession& mpi, const FarmSetup& setup, const AdminJob& admi
 
     // 2. Render ranks (or a lone admin) build the BVH; the admin of a larger farm only schedules.
     std::optional<Renderer> renderer;
-    // The denoiser's guides at pixel centres, traced on the renderer's BVH: the renderer's own
-    // jittered first hits cost 13-19 % less CPU but served frames 0.5-1.8 dB worse (serve bench).
+    // The denoiser's guides at pixel centres, traced on the renderer's BVH for frames whose samples
+    // are jittered: the renderer's own jittered first hits cost less CPU but served frames worse
+    // (serve bench). A frame sampled at pixel centres takes its own first hits instead (a moving
+    // frame from the radiance cache: RendererOptions::jitter_cached_one_spp).
     std::optional<GuidePass> guides;
     double bvh_seconds = 0.0;
     const bool renders = !mpi.is_admin() || mpi.size() == 1;
@@ -125,6 +127,7 @@ int run_farm(const MpiSession& mpi, const FarmSetup& setup, const AdminJob& admi
         try {
             RendererOptions options;
             options.embree_config = fmt::format("threads={}", setup.dispatch.threads);
+            options.jitter_cached_one_spp = setup.jitter_cached_one_spp;
             renderer.emplace(*scene, options);
             guides.emplace(*scene, renderer->render_scene());
         } catch (const std::exception& e) {

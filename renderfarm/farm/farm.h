@@ -24,6 +24,9 @@ struct FarmSetup {
     std::filesystem::path scene_file;
     SceneLoadOptions scene_options;
     DispatchSettings dispatch;  // exposure is taken from the scene
+    // RendererOptions::jitter_cached_one_spp of the render ranks (off: a moving frame from the
+    // radiance cache samples pixel centres and takes its guides from its own camera rays).
+    bool jitter_cached_one_spp = false;
 };
 
 // What the admin does once the farm stands: returns the process exit code.

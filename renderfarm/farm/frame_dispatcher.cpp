@@ -212,10 +212,12 @@ PackedPixels wire_format(std::int32_t linear) {
     return linear == 2 ? PackedPixels::linear_guided : linear == 1 ? PackedPixels::linear : PackedPixels::srgb8;
 }
 
-// Begins the guide pass's frame when `format` needs guides and a guide pass is given (without one
-// the renderer's own first hits are the guides, tile_pass.h); throws when it cannot.
-const GuidePass* begin_guides(GuidePass* guides, PackedPixels format, const ViewRequest& view) {
-    if (format != PackedPixels::linear_guided || guides == nullptr) return nullptr;
+// Begins the guide pass's frame when `format` needs guides and a guide pass is given, unless the
+// renderer's frame samples the pixel centres: without a guide pass the renderer's own first hits are
+// the guides (tile_pass.h), and at pixel centres they are the guide pass's. Throws when it cannot.
+const GuidePass* begin_guides(const Renderer& renderer, GuidePass* guides, PackedPixels format,
+                              const ViewRequest& view) {
+    if (format != PackedPixels::linear_guided || guides == nullptr || renderer.samples_pixel_centres()) return nullptr;
     if (Status s = guides->begin_frame(view); !s.ok()) throw std::invalid_argument(s.error().message);
     return guides;
 }
@@ -240,7 +242,7 @@ void serve_render_rank(Renderer* renderer, const DispatchSettings& settings, con
             const PackedPixels format = wire_format(wire.linear);
             const TilePassResult pass =
                 render_tile_pass(*renderer, rects, settings.cell_size, settings.threads, settings.exposure,
-                                 settings.tone_map, format, begin_guides(guides, format, view), &control);
+                                 settings.tone_map, format, begin_guides(*renderer, guides, format, view), &control);
             std::vector<double> tiles_flat;
             tiles_flat.reserve(pass.tile_times.size() * 5);
             for (const TileTime& t : pass.tile_times)
@@ -359,7 +361,7 @@ void FrameDispatcher::gather_local(const ViewRequest& view, const Assignment& as
     local_->begin_frame(view);
     const GuidePass* guides = nullptr;
     try {
-        guides = begin_guides(local_guides_, format, view);
+        guides = begin_guides(*local_, local_guides_, format, view);
     } catch (const std::runtime_error& e) {
         throw FarmError(e.what());
     }

@@ -26,8 +26,9 @@ LiveFrames::LiveFrames(FrameSource source, LiveOptions options, float exposure, 
     if (!source_) throw std::invalid_argument("LiveFrames: no frame source");
     if (options_.frame_time_s < 0) throw std::invalid_argument("LiveOptions.frame_time_s must be >= 0");
     if (options_.converged_spp < 1) throw std::invalid_argument("LiveOptions.converged_spp must be >= 1");
-    if (options_.still_second_pass_spp < 1 || options_.still_pass_spp < 1)
-        throw std::invalid_argument("LiveOptions.still_second_pass_spp and still_pass_spp must be >= 1");
+    if (options_.still_first_pass_spp < 1 || options_.still_second_pass_spp < 1 || options_.still_pass_spp < 1)
+        throw std::invalid_argument(
+            "LiveOptions.still_first_pass_spp, still_second_pass_spp and still_pass_spp must be >= 1");
     options_.controller.target_seconds = options_.frame_time_s > 0 ? options_.frame_time_s : 1.0;
     (void)FrameTimeController(options_.controller);  // validates the controller's settings now
     if (options_.denoise_max_spp < 1) throw std::invalid_argument("LiveOptions.denoise_max_spp must be >= 1");
@@ -106,6 +107,10 @@ ViewRequest LiveFrames::plan(Session& s, const ViewRequest& request, FrameChoice
         view.frame_id = pass_frame_id(s.accumulation.first_frame_id(), s.accumulation.passes());
     } else {
         view.radiance_cache = options_.radiance_cache && !still;
+        if (still && options_.progressive) {
+            choice.spp = std::max(choice.spp, options_.still_first_pass_spp);
+            view.quality.spp = choice.spp;
+        }
     }
     return view;
 }

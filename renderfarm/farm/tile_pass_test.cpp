@@ -219,6 +219,30 @@ TEST(TilePass, GuidedPackingWithoutAGuidePassCarriesTheRenderersFirstHits) {
     expect_guided_packing_agrees(scene, renderer, view, nullptr);
 }
 
+// A moving frame from the radiance cache at 1 spp samples pixel centres with the default options,
+// so the renderer's own first hits are its guides (the farm then traces no guide pass for it); any
+// other 1-spp frame stays jittered, and jitter_cached_one_spp jitters the cached one too.
+TEST(TilePass, ACachedOneSppFrameSamplesPixelCentresAndCarriesItsOwnGuides) {
+    const Scene scene = small_scene();
+    Renderer renderer(scene, RendererOptions{});
+    ViewRequest view = guided_view();
+    renderer.begin_frame(view);
+    EXPECT_FALSE(renderer.samples_pixel_centres()) << "a path-traced 1-spp frame is jittered";
+    view.radiance_cache = true;
+    renderer.begin_frame(view);
+    EXPECT_TRUE(renderer.samples_pixel_centres());
+    expect_guided_packing_agrees(scene, renderer, view, nullptr);
+    view.quality.spp = 2;
+    renderer.begin_frame(view);
+    EXPECT_FALSE(renderer.samples_pixel_centres()) << "two samples are a pixel's Sobol' points";
+    RendererOptions jittered;
+    jittered.jitter_cached_one_spp = true;
+    renderer.set_path_options(jittered);
+    view.quality.spp = 1;
+    renderer.begin_frame(view);
+    EXPECT_FALSE(renderer.samples_pixel_centres());
+}
+
 TEST(TilePass, GuidedPackingReportsTheGuidePassErrorAndRefusesMismatchedBuffers) {
     const Scene scene = small_scene();
     Renderer renderer(scene, RendererOptions{});

@@ -295,6 +295,7 @@ void Renderer::set_path_options(const RendererOptions& options) {
     impl_->options.coherent_shadow_packets_baseline = options.coherent_shadow_packets_baseline;
     impl_->options.russian_roulette = options.russian_roulette;
     impl_->options.jitter_one_spp = options.jitter_one_spp;
+    impl_->options.jitter_cached_one_spp = options.jitter_cached_one_spp;
     impl_->options.glossy_vndf_sampling = options.glossy_vndf_sampling;
 }
 
@@ -320,11 +321,11 @@ void Renderer::begin_frame(const ViewRequest& request) {
     s.context.coherent_shadow_packets = s.options.coherent_shadow_packets_baseline;
     s.context.russian_roulette = s.options.russian_roulette;
     s.context.glossy_vndf = s.options.glossy_vndf_sampling;
-    s.jitter_samples = s.spp > 1 || s.options.jitter_one_spp;
+    s.cached = request.radiance_cache;
+    s.jitter_samples = s.spp > 1 || (s.options.jitter_one_spp && (!s.cached || s.options.jitter_cached_one_spp));
     // Last frame's training estimates join the cache before this frame reads it.
     s.cache->commit();
     ++s.frames_begun;
-    s.cached = request.radiance_cache;
     s.cache_frame = CacheFrame{s.cache.get(), origin, s.key, s.frames_begun << 32, size.width};
     // The column table holds pixel-centre angles: only for the centre-sampled baseline.
     s.columns =
@@ -337,6 +338,11 @@ const RenderScene& Renderer::render_scene() const { return impl_->geometry; }
 ImageSize Renderer::render_size() const {
     impl_->check_ready();
     return impl_->size;
+}
+
+bool Renderer::samples_pixel_centres() const {
+    impl_->check_ready();
+    return !impl_->jitter_samples;
 }
 
 TileStats Renderer::render(const PixelRect& rect, RgbFloatImage& frame) const {

@@ -78,6 +78,13 @@ struct RendererOptions {
     // area average: antialiased edges). Off samples the pixel centre (x + 0.5, y + 0.5), as before,
     // which never converges to the area average. spp > 1 always takes the pixel's Sobol' points.
     bool jitter_one_spp = true;
+    // A radiance-cache frame (ViewRequest::radiance_cache) of one sample per pixel takes it at the
+    // pixel centre even with jitter_one_spp: its first camera hits are then the guide pass's
+    // (guide_pass.h), so the farm takes the denoiser's guides from them and traces no guide ray
+    // (samples_pixel_centres()). Such frames are biased and never accumulated; their cells'
+    // jittered lookups and the temporal accumulation's reprojection already vary them from frame to
+    // frame. On: jittered like any 1-spp frame. The serve bench measures both (docs/renderer.md).
+    bool jitter_cached_one_spp = false;
     // Glossy materials' bounces drawn from the GGX visible normals (Heitz 2018) mixed with the
     // cosine lobe by one-sample MIS (integrator.h); off: every bounce cosine-sampled, as before.
     // Matte materials are unaffected either way.
@@ -127,7 +134,8 @@ public:
     Renderer& operator=(Renderer&&) noexcept;
 
     // Replaces the path switches (legacy_light_sampling, packet_secondary_rays, camera_column_table,
-    // native_packet_width, russian_roulette, jitter_one_spp, glossy_vndf_sampling) from the next begin_frame on, so a
+    // native_packet_width, russian_roulette, jitter_one_spp, jitter_cached_one_spp, glossy_vndf_sampling) from the
+    // next begin_frame on, so a
     // benchmark times both paths on one BVH; embree_config and rebase_on_eye keep their constructor values. Not
     // thread-safe.
     void set_path_options(const RendererOptions& options);
@@ -139,6 +147,11 @@ public:
 
     // Size of the frame buffer for the current frame. Throws std::logic_error before begin_frame.
     [[nodiscard]] ImageSize render_size() const;
+
+    // Whether the current frame's camera rays go through the pixel centres (one sample, not
+    // jittered): its first hits, the guides render() writes, are then the guide pass's. Throws
+    // std::logic_error before begin_frame.
+    [[nodiscard]] bool samples_pixel_centres() const;
 
     // Renders the pixels of `rect` into `frame`. Throws std::invalid_argument if rect is not inside
     // [0, render_size()) or frame.size != render_size(), std::logic_error before begin_frame.
