@@ -53,9 +53,18 @@ void KioskDisplay::refresh_content(const Rgb8Image& content) {
 }
 
 void KioskDisplay::repaint() {
-    // Outputs with a flip pending are left alone; the others show the current frame again.
-    if (Status s = presenter_.repaint(); !s) spdlog::warn("repaint: {}", s.error().message);
+    // Nothing while a round is in flight: its completion draws what is due.
+    if (Status s = presenter_.present_due(); !s) spdlog::warn("repaint: {}", s.error().message);
     account();
+}
+
+void KioskDisplay::set_content_transform(const ContentTransform& t) {
+    const ContentTransform& now = backend_->renderer().content_transform();
+    if (t.scale_u == now.scale_u && t.scale_v == now.scale_v && t.offset_u == now.offset_u &&
+        t.offset_v == now.offset_v)
+        return;
+    backend_->renderer().set_content_transform(t);
+    presenter_.invalidate();
 }
 
 Status KioskDisplay::on_flip() {

@@ -55,7 +55,10 @@ public:
     // The same frame with different pixels (the on-wall status drawn over it, or taken off): shown at
     // once as the current content under the current frame's tag (not counted as a new farm frame).
     void refresh_content(const Rgb8Image& content);
-    // The current frame again on every ready output (the tick's idle repaint).
+    // The tick's idle repaint: the current frame again on every output when the wall would change
+    // (the late warp's content transform changed since its last round; ScreenPresenter::present_due).
+    // An unchanged wall is left alone: a software rasteriser spends tens of ms per output on a round
+    // that changes nothing, and a KMS output keeps scanning out its last buffer.
     void repaint();
     // Page-flip events of the backend (KMS): outputs ready again get pending content.
     [[nodiscard]] Status on_flip();
@@ -78,8 +81,9 @@ public:
     [[nodiscard]] int event_fd() const { return backend_->event_fd(); }
     [[nodiscard]] const ScreenPresenter& presenter() const { return presenter_; }
     // The late warp's content transform for the rounds from now on (ProjectorRenderer); the
-    // connecting screen resets it to the identity.
-    void set_content_transform(const ContentTransform& t) { backend_->renderer().set_content_transform(t); }
+    // connecting screen resets it to the identity. A different transform makes the current frame due
+    // again (the next repaint, show or completed round draws it).
+    void set_content_transform(const ContentTransform& t);
     [[nodiscard]] ContentTransform content_transform() const { return backend_->renderer().content_transform(); }
     // See ScreenPresenter::on_output_presented (the kiosk feeds its watchdog there).
     void on_output_presented(std::function<void()> callback) { presenter_.on_output_presented(std::move(callback)); }

@@ -74,6 +74,11 @@ Status ScreenPresenter::repaint() {
     return present_round();
 }
 
+Status ScreenPresenter::present_due() {
+    last_presents_ = 0;
+    return present_round();
+}
+
 Status ScreenPresenter::on_ready(const std::vector<std::size_t>& outputs) {
     last_presents_ = 0;
     for (const std::size_t i : outputs) {

@@ -52,8 +52,17 @@ public:
     [[nodiscard]] Status swap_calibration(const ScreenCalibration& screen);
 
     // Presents the current content again, as a round on every lit output, when no round is in
-    // flight (the idle repaint of the display tick). No-op before the first show().
+    // flight. No-op before the first show().
     [[nodiscard]] Status repaint();
+
+    // The current content is due again (the renderer's content transform changed): the next round
+    // draws it, now when no round is in flight and the caller asks (present_due()), or when the
+    // round in flight completes. No-op before the first show().
+    void invalidate() { dirty_ = dirty_ || has_content_; }
+    // Presents the current content as a round when it is due (a show, swap or invalidate() not yet
+    // drawn) and no round is in flight: the idle repaint of the display tick, which leaves an
+    // unchanged wall alone.
+    [[nodiscard]] Status present_due();
 
     // Outputs that became ready (dispatch_events); once the round in flight completed on all of
     // them, presents pending content as the next round.

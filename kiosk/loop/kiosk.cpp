@@ -225,12 +225,13 @@ void Kiosk::on_tick() {
     // by the pattern alone (and a repaint would keep a KMS output's flip pending at every tick).
     const bool holding = pattern_base_.has_value();
     if (!holding) (void)update_late_warp();
-    // Nothing new since the previous tick: show the current frame again (headless PNGs keep
-    // coming, a KMS output is refreshed, the late warp's new shift reaches the wall). A frame shown
-    // since then already carried the shift of its own round, and a frame already decoded and
-    // waiting is shown next, with this tick's shift: a repaint first would only delay it by a whole
-    // round (on a software rasteriser, hundreds of ms for three outputs). A turn after that round
-    // reaches the wall with the next frame or at the next tick, whichever comes first.
+    // Nothing new since the previous tick: show the current frame again if the wall would change
+    // (the late warp's new shift; an unchanged wall is not drawn again: on a software rasteriser a
+    // round of three outputs is tens of ms of CPU taken from the farm). A frame shown since then
+    // already carried the shift of its own round, and a frame already decoded and waiting is shown
+    // next, with this tick's shift: a repaint first would only delay it by a whole round. A turn
+    // after that round reaches the wall with the next frame or at the next tick, whichever comes
+    // first.
     if (!holding && !shown_since_tick_ && !frame_waiting()) {
         parts_.display.repaint();
         check_frames_shown();
