@@ -127,6 +127,33 @@ TEST_F(LiveFramesTest, StillViewConvergesTowardTheReferenceWithNewSamplesEachPas
                 psnr_after[0], psnr_after[1], psnr_after[2], psnr_after[3], psnr(single(view(), 127), reference));
 }
 
+// A visitor who stops: the first request at the pose is a moving frame (from the radiance cache,
+// never accumulated), the repeat starts the still view's accumulation with still_first_pass_spp
+// samples, the next pass adds still_second_pass_spp.
+TEST_F(LiveFramesTest, AStillViewsFirstPassTakesItsOwnSampleCount) {
+    for (const int first : {1, 2, 3}) {
+        LiveOptions options;
+        options.radiance_cache = true;
+        options.still_first_pass_spp = first;
+        options.still_second_pass_spp = 2;
+        LiveFrames live(source(), options, 1.f, ToneMap::clamp);
+        ViewRequest request = view(10.0);
+        request.frame_id = 1;
+        (void)live.render(request);  // somewhere else
+        request = view();
+        request.frame_id = 2;
+        EXPECT_EQ(live.render(request).samples, 1) << "the first frame at a new pose is a moving frame";
+        request.frame_id = 3;
+        const LiveFrame still = live.render(request);
+        EXPECT_TRUE(still.still);
+        EXPECT_EQ(still.rendered.quality.spp, first);
+        EXPECT_EQ(still.samples, first);
+        EXPECT_EQ(still.passes, 1);
+        request.frame_id = 4;
+        EXPECT_EQ(live.render(request).samples, first + 2);
+    }
+}
+
 TEST_F(LiveFramesTest, AnyMotionStartsOver) {
     LiveFrames live(source(), {}, 1.f, ToneMap::clamp);
     ViewRequest request = view();
@@ -544,6 +571,9 @@ TEST(LiveOptions, BadOptionsAreRefused) {
     LiveOptions zero;
     zero.converged_spp = 0;
     EXPECT_THROW(LiveFrames(none, zero, 1.f, ToneMap::clamp), std::invalid_argument);
+    LiveOptions no_first_pass;
+    no_first_pass.still_first_pass_spp = 0;
+    EXPECT_THROW(LiveFrames(none, no_first_pass, 1.f, ToneMap::clamp), std::invalid_argument);
     EXPECT_THROW(LiveFrames(FrameSource{}, {}, 1.f, ToneMap::clamp), std::invalid_argument);
 }
 
