@@ -12,6 +12,8 @@
 #include <utility>
 #include <vector>
 
+#include "renderfarm/denoise/float_lanes.h"
+
 namespace mogao {
 namespace {
 
@@ -166,10 +168,21 @@ struct Planes {
     float* colour_scale;  // 1 / (σ_l sqrt(g3x3(Var)) + ε) of the current level
 };
 
+// Floats of zeros before and after each plane: the filter's chunks of up to eight pixels read taps
+// up to 2 x the largest step beyond a row's ends (and a chunk up to 7 pixels past the last pixel),
+// with weight 0; the margin keeps those reads inside the storage.
+constexpr std::size_t kPlaneMargin = (std::size_t{2} << AtrousParams::kMaxIterations) + 16;
+
 Planes make_planes(std::vector<float>& storage, std::size_t n) {
-    storage.resize(kPlanes * n);
-    float* p = storage.data();
-    const auto next = [&] { return std::exchange(p, p + n); };
+    const std::size_t stride = n + 2 * kPlaneMargin;
+    storage.resize(kPlanes * stride);
+    for (std::size_t k = 0; k < kPlanes; ++k) {  // the margins only: every plane's pixels are written before use
+        float* margin_before = storage.data() + k * stride;
+        std::fill(margin_before, margin_before + kPlaneMargin, 0.0f);
+        std::fill(margin_before + kPlaneMargin + n, margin_before + stride, 0.0f);
+    }
+    float* p = storage.data() + kPlaneMargin;
+    const auto next = [&] { return std::exchange(p, p + stride); };
     Planes planes{};
     planes.ping = {next(), next(), next(), next(), next()};
     planes.pong = {next(), next(), next(), next(), next()};
@@ -373,100 +386,95 @@ void colour_scales(ImageSize size, float sigma_colour, const Signal& s, const Pl
     });
 }
 
-// Accumulators of one row's weighted sums.
-struct RowSums {
-    std::vector<float> w, r, g, b, v;
-    explicit RowSums(int width) : w(width), r(width), g(width), b(width), v(width) {}
-    void clear() {
-        for (std::vector<float>* a : {&w, &r, &g, &b, &v}) std::fill(a->begin(), a->end(), 0.0f);
-    }
-};
-
-// Adds one tap (offset ox, oy in pixels, kernel weight hw) of row `row` [xa, xb) to the sums (built
-// twice: common/cpu_level.h).
-MOGAO_ALWAYS_INLINE inline void add_tap_body(const Signal& src, const Planes& planes, const GeometryWeight& gw,
-                                             std::size_t row, int xa, int xb, int ox, int oy, int width, float hw,
-                                             RowSums& sums) {
-    const std::ptrdiff_t offset = static_cast<std::ptrdiff_t>(oy) * width + ox;
-    const std::size_t p0 = row + static_cast<std::size_t>(xa);
+// One à-trous level [D] for the pixels [x0, x0 + W) of row y, W the lanes of F (the last chunk of a
+// row may run past its end: those lanes are computed and not stored). Their centre values and
+// weighted sums stay in registers while the 25 taps are read: per tap and pixel only the tap's own
+// planes are loaded. Built twice (common/cpu_level.h): eight lanes with AVX, four without. A tap row
+// outside the image is skipped; a tap column outside it (the row's ends) gets weight 0 lane by lane.
+template <typename F>
+MOGAO_ALWAYS_INLINE inline void filter_chunk_body(ImageSize size, int step, const GeometryWeight& gw, const Signal& src,
+                                                  const Signal& dst, const Planes& planes, int y, int x0) {
+    using lanes::abs, lanes::exp_neg, lanes::load, lanes::select, lanes::splat;
+    constexpr int kW = lanes::kWidth<F>;
+    const int w = size.width, h = size.height;
     const Geometry& g = planes.geometry;
-    const float* lum = src.lum;
-    const float* cs = planes.colour_scale;
-    float* sw = sums.w.data() + xa;
-    float* sr = sums.r.data() + xa;
-    float* sg = sums.g.data() + xa;
-    float* sb = sums.b.data() + xa;
-    float* sv = sums.v.data() + xa;
-    const int count = xb - xa;
-    const float fx = static_cast<float>(ox), fy = static_cast<float>(oy);
-#pragma GCC ivdep  // the sums never alias the inputs; spares GCC the run-time alias checks it refuses to emit
-    for (int k = 0; k < count; ++k) {
-        const std::size_t p = p0 + static_cast<std::size_t>(k);
-        const std::size_t q = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(p) + offset);
-        // One exp for all three factors; cs <= kHuge is finite, so an equal luminance adds 0.
-        float e = geometry_exponent(g, gw, p, q, fx, fy) + std::abs(lum[p] - lum[q]) * cs[p];
-        e = e < kMaxExponent ? e : kMaxExponent;  // inf and NaN (sky p) give the limit
-        const float wt = hw * g.mask[q] * fast_exp_neg(e);
-        sw[k] += wt;
-        sr[k] += wt * src.r[q];
-        sg[k] += wt * src.g[q];
-        sb[k] += wt * src.b[q];
-        sv[k] += wt * wt * src.var[q];
+    const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x0);
+    const F nx = load<F>(g.nx + p), ny = load<F>(g.ny + p), nz = load<F>(g.nz + p), z = load<F>(g.z + p);
+    const F dzdx = load<F>(g.dzdx + p), dzdy = load<F>(g.dzdy + p), lum = load<F>(src.lum + p);
+    const F cs = load<F>(planes.colour_scale + p), z_eps = gw.depth_eps * z;
+    F lane_x{};
+    for (int k = 0; k < kW; ++k) lane_x[k] = static_cast<float>(x0 + k);
+    F sw{}, sr{}, sg{}, sb{}, sv{};
+    for (int ky = -2; ky <= 2; ++ky) {
+        const int oy = ky * step;
+        if (y + oy < 0 || y + oy >= h) continue;
+        for (int kx = -2; kx <= 2; ++kx) {
+            const int ox = kx * step;
+            const float fx = static_cast<float>(ox), fy = static_cast<float>(oy);
+            const std::ptrdiff_t q = static_cast<std::ptrdiff_t>(p) + static_cast<std::ptrdiff_t>(oy) * w + ox;
+            const F ex = nx - load<F>(g.nx + q), ey = ny - load<F>(g.ny + q), ez = nz - load<F>(g.nz + q);
+            const F allowed = gw.sigma_depth * abs(dzdx * fx + dzdy * fy) + z_eps;
+            F e = (ex * ex + ey * ey + ez * ez) * gw.inv_sigma_normal2 + abs(z - load<F>(g.z + q)) / allowed +
+                  abs(lum - load<F>(src.lum + q)) * cs;
+            e = select(e < splat<F>(kMaxExponent), e, splat<F>(kMaxExponent));  // inf and NaN (sky p) give the limit
+            F wt = (kB3[kx + 2] * kB3[ky + 2]) * load<F>(g.mask + q) * exp_neg(e);
+            if (x0 + ox < 0 || x0 + kW - 1 + ox >= w) {
+                const F tap_x = lane_x + fx;
+                wt = select((tap_x >= splat<F>(0.0f)) & (tap_x < splat<F>(static_cast<float>(w))), wt, F{});
+            }
+            sw += wt;
+            sr += wt * load<F>(src.r + q);
+            sg += wt * load<F>(src.g + q);
+            sb += wt * load<F>(src.b + q);
+            sv += wt * wt * load<F>(src.var + q);
+        }
+    }
+    const int lanes_in_row = std::min(kW, w - x0);
+    for (int k = 0; k < lanes_in_row; ++k) {
+        const std::size_t i = p + static_cast<std::size_t>(k);
+        if (g.mask[i] == 0.0f) {
+            dst.r[i] = src.r[i], dst.g[i] = src.g[i], dst.b[i] = src.b[i], dst.var[i] = 0.0f;
+            dst.lum[i] = src.lum[i];
+            continue;
+        }
+        const float inv = 1.0f / sw[k];
+        dst.r[i] = sr[k] * inv, dst.g[i] = sg[k] * inv, dst.b[i] = sb[k] * inv;
+        dst.var[i] = sv[k] * inv * inv;
+        dst.lum[i] = luminance(dst.r[i], dst.g[i], dst.b[i]);
     }
 }
-MOGAO_TARGET_X86_64_V3 void add_tap_v3(const Signal& src, const Planes& planes, const GeometryWeight& gw,
-                                       std::size_t row, int xa, int xb, int ox, int oy, int width, float hw,
-                                       RowSums& sums) {
-    add_tap_body(src, planes, gw, row, xa, xb, ox, oy, width, hw, sums);
+#if MOGAO_HAS_X86_64_V3
+using WideLanes = lanes::F8;
+#else
+using WideLanes = lanes::F4;  // no AVX build: filter_row_v3 is never chosen (use_x86_64_v3)
+#endif
+MOGAO_TARGET_X86_64_V3 void filter_row_v3(ImageSize size, int step, const GeometryWeight& gw, const Signal& src,
+                                          const Signal& dst, const Planes& planes, int y) {
+    for (int x0 = 0; x0 < size.width; x0 += lanes::kWidth<WideLanes>)
+        filter_chunk_body<WideLanes>(size, step, gw, src, dst, planes, y, x0);
 }
-void add_tap_base(const Signal& src, const Planes& planes, const GeometryWeight& gw, std::size_t row, int xa, int xb,
-                  int ox, int oy, int width, float hw, RowSums& sums) {
-    add_tap_body(src, planes, gw, row, xa, xb, ox, oy, width, hw, sums);
+void filter_row_base(ImageSize size, int step, const GeometryWeight& gw, const Signal& src, const Signal& dst,
+                     const Planes& planes, int y) {
+    for (int x0 = 0; x0 < size.width; x0 += lanes::kWidth<lanes::F4>)
+        filter_chunk_body<lanes::F4>(size, step, gw, src, dst, planes, y, x0);
 }
 
 // The build of the tap loops this run uses.
 struct Kernels {
     decltype(&geometry_weights_base) geometry_weights;
-    decltype(&add_tap_base) add_tap;
+    decltype(&filter_row_base) filter_row;
 };
 
 Kernels kernels_for(CpuLevel level) {
-    if (use_x86_64_v3(level)) return {geometry_weights_v3, add_tap_v3};
-    return {geometry_weights_base, add_tap_base};
+    if (use_x86_64_v3(level)) return {geometry_weights_v3, filter_row_v3};
+    return {geometry_weights_base, filter_row_base};
 }
 
 // One à-trous level [D]: every surface pixel becomes the weighted mean of its 5x5 taps at `step`.
 void filter_level(const Kernels& kernels, ImageSize size, int step, const GeometryWeight& gw, const Signal& src,
                   const Signal& dst, const Planes& planes, int threads) {
-    const int w = size.width, h = size.height;
-    for_row_bands(h, threads, [&](int y0, int y1) {
-        RowSums sums(w);
-        for (int y = y0; y < y1; ++y) {
-            sums.clear();
-            const std::size_t row = static_cast<std::size_t>(y) * w;
-            for (int ky = -2; ky <= 2; ++ky) {
-                const int oy = ky * step;
-                if (y + oy < 0 || y + oy >= h) continue;
-                for (int kx = -2; kx <= 2; ++kx) {
-                    const int ox = kx * step;
-                    const int xa = std::max(0, -ox), xb = std::min(w, w - ox);
-                    if (xa < xb)
-                        kernels.add_tap(src, planes, gw, row, xa, xb, ox, oy, w, kB3[kx + 2] * kB3[ky + 2], sums);
-                }
-            }
-            for (int x = 0; x < w; ++x) {
-                const std::size_t i = row + x;
-                if (planes.geometry.mask[i] == 0.0f) {
-                    dst.r[i] = src.r[i], dst.g[i] = src.g[i], dst.b[i] = src.b[i], dst.var[i] = 0.0f;
-                    dst.lum[i] = src.lum[i];
-                    continue;
-                }
-                const float inv = 1.0f / sums.w[x];
-                dst.r[i] = sums.r[x] * inv, dst.g[i] = sums.g[x] * inv, dst.b[i] = sums.b[x] * inv;
-                dst.var[i] = sums.v[x] * inv * inv;
-                dst.lum[i] = luminance(dst.r[i], dst.g[i], dst.b[i]);
-            }
-        }
+    for_row_bands(size.height, threads, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y) kernels.filter_row(size, step, gw, src, dst, planes, y);
     });
 }
 
