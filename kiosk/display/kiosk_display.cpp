@@ -53,8 +53,10 @@ void KioskDisplay::refresh_content(const Rgb8Image& content) {
 }
 
 void KioskDisplay::repaint() {
-    // Nothing while a round is in flight: its completion draws what is due.
-    if (Status s = presenter_.present_due(); !s) spdlog::warn("repaint: {}", s.error().message);
+    // Nothing while a round is in flight: its completion draws what is due. A recording is the wall
+    // at every display round, so while recording an unchanged frame is drawn (and recorded) again.
+    Status s = recorder_ ? presenter_.repaint() : presenter_.present_due();
+    if (!s) spdlog::warn("repaint: {}", s.error().message);
     account();
 }
 

@@ -58,7 +58,8 @@ public:
     // The tick's idle repaint: the current frame again on every output when the wall would change
     // (the late warp's content transform changed since its last round; ScreenPresenter::present_due).
     // An unchanged wall is left alone: a software rasteriser spends tens of ms per output on a round
-    // that changes nothing, and a KMS output keeps scanning out its last buffer.
+    // that changes nothing, and a KMS output keeps scanning out its last buffer. While recording
+    // (record_to) every idle tick is a round, as the recording is the wall at every display round.
     void repaint();
     // Page-flip events of the backend (KMS): outputs ready again get pending content.
     [[nodiscard]] Status on_flip();
