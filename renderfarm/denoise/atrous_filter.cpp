@@ -26,19 +26,6 @@ constexpr float kB3[5] = {1.0f / 16, 1.0f / 4, 3.0f / 8, 1.0f / 4, 1.0f / 16};  
 
 std::string size_text(ImageSize s) { return std::to_string(s.width) + "x" + std::to_string(s.height); }
 
-// exp(-x) for x in [0, kMaxExponent] (callers clamp): 2^y, y = -x log2(e), split into the integer
-// part t = trunc(y) (the float's exponent field) and f = y - t in (-1, 0] (degree-5 Taylor series of
-// 2^f, relative error < 2e-4 — ample for filter weights, which are renormalised). Branch-free, so
-// the row loops below vectorise.
-MOGAO_ALWAYS_INLINE inline float fast_exp_neg(float x) {
-    const float y = -x * 1.44269504f;
-    const int whole = static_cast<int>(y);
-    const float f = y - static_cast<float>(whole);
-    const float p =
-        1.0f + f * (0.69314718f + f * (0.24022651f + f * (0.05550411f + f * (0.00961813f + f * 0.00133336f))));
-    return p * std::bit_cast<float>(static_cast<std::uint32_t>(whole + 127) << 23);
-}
-
 inline float finite_or_zero(float v) { return std::isfinite(v) ? v : 0.0f; }
 inline float luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; }
 
@@ -243,99 +230,109 @@ void prepare(const RgbFloatImage& noisy, const GuideBuffers& guides, const Plane
     });
 }
 
-// The geometry exponent of tap q for pixel p, offset (ox, oy) pixels (GeometryWeight's formula);
-// NaN for a sky p (0/0), which callers clamp to kMaxExponent.
-MOGAO_ALWAYS_INLINE inline float geometry_exponent(const Geometry& g, const GeometryWeight& gw, std::size_t p,
-                                                   std::size_t q, float ox, float oy) {
-    const float ex = g.nx[p] - g.nx[q], ey = g.ny[p] - g.ny[q], ez = g.nz[p] - g.nz[q];
-    const float allowed = gw.sigma_depth * std::abs(g.dzdx[p] * ox + g.dzdy[p] * oy) + gw.depth_eps * g.z[p];
-    return (ex * ex + ey * ey + ez * ez) * gw.inv_sigma_normal2 + std::abs(g.z[p] - g.z[q]) / allowed;
-}
-
-// exp(-(geometry exponent)) of taps q = p + offset for p in [i, i + count), times hw and q's
-// surface mask, into `out`. The loop vectorises (built twice: common/cpu_level.h).
-MOGAO_ALWAYS_INLINE inline void geometry_weights_body(const Geometry& g, const GeometryWeight& gw, std::size_t i,
-                                                      std::ptrdiff_t offset, int count, float ox, float oy, float hw,
-                                                      float* out) {
-#pragma GCC ivdep  // out never aliases the geometry planes
-    for (int k = 0; k < count; ++k) {
-        const std::size_t p = i + static_cast<std::size_t>(k);
-        const std::size_t q = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(p) + offset);
-        float e = geometry_exponent(g, gw, p, q, ox, oy);
-        e = e < kMaxExponent ? e : kMaxExponent;  // also maps NaN to the limit
-        out[k] = hw * g.mask[q] * fast_exp_neg(e);
-    }
-}
-MOGAO_TARGET_X86_64_V3 void geometry_weights_v3(const Geometry& g, const GeometryWeight& gw, std::size_t i,
-                                                std::ptrdiff_t offset, int count, float ox, float oy, float hw,
-                                                float* out) {
-    geometry_weights_body(g, gw, i, offset, count, ox, oy, hw, out);
-}
-void geometry_weights_base(const Geometry& g, const GeometryWeight& gw, std::size_t i, std::ptrdiff_t offset, int count,
-                           float ox, float oy, float hw, float* out) {
-    geometry_weights_body(g, gw, i, offset, count, ox, oy, hw, out);
-}
-
-// The 5x5 neighbourhood on the same surface of row y's pixels: for each tap inside the image, the
-// geometry weights of pixels [xa, xb) into wt, then add(xa, xb, at), `at` the tap's index for x = 0.
-using GeometryWeightsFn = decltype(&geometry_weights_base);
-
-template <typename Add>
-void surface_taps_5x5(GeometryWeightsFn geometry_weights, const Planes& planes, const GeometryWeight& gw,
-                      ImageSize size, int y, std::vector<float>& wt, Add&& add) {
+// Sums over the 5x5 neighbourhood on the same surface of the pixels [x0, x0 + W) of row y (W the
+// lanes of F; the last chunk of a row may run past its end, those lanes are not used), the weights
+// the geometry terms only (GeometryWeight's formula, [S] §4.2): sw = Σ w, s1 = Σ w a and, with
+// kSquares, s2 = Σ w a². A tap outside the image adds nothing. The chunk's centre values and sums stay
+// in registers across the taps, as in filter_chunk_body.
+template <typename F, bool kSquares>
+MOGAO_ALWAYS_INLINE inline void surface_sums(ImageSize size, const GeometryWeight& gw, const Geometry& g,
+                                             const float* a, int y, int x0, F& sw, F& s1, F& s2) {
+    using lanes::abs, lanes::exp_neg, lanes::load, lanes::select, lanes::splat;
+    constexpr int kW = lanes::kWidth<F>;
     const int w = size.width, h = size.height;
-    const std::size_t row = static_cast<std::size_t>(y) * w;
+    const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x0);
+    const F nx = load<F>(g.nx + p), ny = load<F>(g.ny + p), nz = load<F>(g.nz + p), z = load<F>(g.z + p);
+    const F dzdx = load<F>(g.dzdx + p), dzdy = load<F>(g.dzdy + p), z_eps = gw.depth_eps * z;
+    F lane_x{};
+    for (int k = 0; k < kW; ++k) lane_x[k] = static_cast<float>(x0 + k);
     for (int oy = -2; oy <= 2; ++oy) {
         if (y + oy < 0 || y + oy >= h) continue;
         for (int ox = -2; ox <= 2; ++ox) {
-            const int xa = std::max(0, -ox), xb = std::min(w, w - ox);
-            const std::ptrdiff_t offset = static_cast<std::ptrdiff_t>(oy) * w + ox;
-            geometry_weights(planes.geometry, gw, row + xa, offset, xb - xa, float(ox), float(oy), 1.0f,
-                             wt.data() + xa);
-            add(xa, xb, static_cast<std::ptrdiff_t>(row) + offset);
+            const float fx = static_cast<float>(ox), fy = static_cast<float>(oy);
+            const std::ptrdiff_t q = static_cast<std::ptrdiff_t>(p) + static_cast<std::ptrdiff_t>(oy) * w + ox;
+            const F ex = nx - load<F>(g.nx + q), ey = ny - load<F>(g.ny + q), ez = nz - load<F>(g.nz + q);
+            const F allowed = gw.sigma_depth * abs(dzdx * fx + dzdy * fy) + z_eps;
+            F e = (ex * ex + ey * ey + ez * ez) * gw.inv_sigma_normal2 + abs(z - load<F>(g.z + q)) / allowed;
+            e = select(e < splat<F>(kMaxExponent), e, splat<F>(kMaxExponent));  // NaN (sky p) gives the limit
+            F wt = load<F>(g.mask + q) * exp_neg(e);
+            if (x0 + ox < 0 || x0 + kW - 1 + ox >= w) {
+                const F tap_x = lane_x + fx;
+                wt = select((tap_x >= splat<F>(0.0f)) & (tap_x < splat<F>(static_cast<float>(w))), wt, F{});
+            }
+            const F aq = load<F>(a + q);
+            sw += wt;
+            s1 += wt * aq;
+            if constexpr (kSquares) s2 += wt * aq * aq;
         }
     }
 }
 
-// Spatial luminance variance of each surface pixel over its 5x5 neighbourhood on the same surface
-// (weights: the geometry terms only) — [S] §4.2's estimate for frames without history.
-void estimate_variance(GeometryWeightsFn geometry_weights, ImageSize size, const GeometryWeight& gw,
-                       const Planes& planes, int threads) {
+// Spatial luminance variance of row y's surface pixels over their 5x5 neighbourhood on the same
+// surface — [S] §4.2's estimate for frames without history — into ping.var.
+template <typename F>
+MOGAO_ALWAYS_INLINE inline void spatial_variance_row_body(ImageSize size, const GeometryWeight& gw,
+                                                          const Planes& planes, int y) {
     const int w = size.width;
     const Signal& s = planes.ping;
-    for_row_bands(size.height, threads, [&](int y0, int y1) {
-        std::vector<float> sw(w), s1(w), s2(w), wt(w);
-        for (int y = y0; y < y1; ++y) {
-            std::fill(sw.begin(), sw.end(), 0.0f), std::fill(s1.begin(), s1.end(), 0.0f);
-            std::fill(s2.begin(), s2.end(), 0.0f);
-            surface_taps_5x5(geometry_weights, planes, gw, size, y, wt, [&](int xa, int xb, std::ptrdiff_t at) {
-                const float* lq = s.lum + at;
-                for (int x = xa; x < xb; ++x) {
-                    sw[x] += wt[x];
-                    s1[x] += wt[x] * lq[x];
-                    s2[x] += wt[x] * lq[x] * lq[x];
-                }
-            });
-            const std::size_t row = static_cast<std::size_t>(y) * w;
-            for (int x = 0; x < w; ++x) {
-                if (planes.geometry.mask[row + x] == 0.0f) continue;
-                const float mean = s1[x] / sw[x];
-                s.var[row + x] = std::max(0.0f, s2[x] / sw[x] - mean * mean);
-            }
+    for (int x0 = 0; x0 < w; x0 += lanes::kWidth<F>) {
+        F sw{}, s1{}, s2{};
+        surface_sums<F, true>(size, gw, planes.geometry, s.lum, y, x0, sw, s1, s2);
+        const std::size_t p = static_cast<std::size_t>(y) * w + x0;
+        for (int k = 0; k < std::min(lanes::kWidth<F>, w - x0); ++k) {
+            if (planes.geometry.mask[p + k] == 0.0f) continue;
+            const float mean = s1[k] / sw[k];
+            s.var[p + k] = std::max(0.0f, s2[k] / sw[k] - mean * mean);
         }
-    });
+    }
+}
+
+// The mean of `raw` over row y's surface pixels' 5x5 neighbourhood on the same surface, into ping.var.
+template <typename F>
+MOGAO_ALWAYS_INLINE inline void smoothed_variance_row_body(ImageSize size, const GeometryWeight& gw,
+                                                           const Planes& planes, const float* raw, int y) {
+    const int w = size.width;
+    for (int x0 = 0; x0 < w; x0 += lanes::kWidth<F>) {
+        F sw{}, sv{}, unused{};
+        surface_sums<F, false>(size, gw, planes.geometry, raw, y, x0, sw, sv, unused);
+        const std::size_t p = static_cast<std::size_t>(y) * w + x0;
+        for (int k = 0; k < std::min(lanes::kWidth<F>, w - x0); ++k) {
+            if (planes.geometry.mask[p + k] != 0.0f) planes.ping.var[p + k] = sv[k] / sw[k];
+        }
+    }
+}
+
+#if MOGAO_HAS_X86_64_V3
+using WideLanes = lanes::F8;
+#else
+using WideLanes = lanes::F4;  // no AVX build: the _v3 functions are never chosen (use_x86_64_v3)
+#endif
+MOGAO_TARGET_X86_64_V3 void spatial_variance_row_v3(ImageSize size, const GeometryWeight& gw, const Planes& planes,
+                                                    int y) {
+    spatial_variance_row_body<WideLanes>(size, gw, planes, y);
+}
+void spatial_variance_row_base(ImageSize size, const GeometryWeight& gw, const Planes& planes, int y) {
+    spatial_variance_row_body<lanes::F4>(size, gw, planes, y);
+}
+MOGAO_TARGET_X86_64_V3 void smoothed_variance_row_v3(ImageSize size, const GeometryWeight& gw, const Planes& planes,
+                                                     const float* raw, int y) {
+    smoothed_variance_row_body<WideLanes>(size, gw, planes, raw, y);
+}
+void smoothed_variance_row_base(ImageSize size, const GeometryWeight& gw, const Planes& planes, const float* raw,
+                                int y) {
+    smoothed_variance_row_body<lanes::F4>(size, gw, planes, raw, y);
 }
 
 // Luminance variance of each surface pixel from a variance of its colour the caller measured (e.g.
 // across a progressive accumulation's passes, progressive_accumulator.h), per channel: demodulated
 // like the colour, the channels taken as fully correlated (an upper bound whatever their
 // correlation), Var(l) = (Σ_c w_c σ_c / max(a_c, kMinAlbedo))², then averaged over the pixel's 5x5
-// neighbourhood on the same surface (the geometry weights of estimate_variance), which steadies an
+// neighbourhood on the same surface (the geometry weights of the spatial estimate), which steadies an
 // estimate from as few as two passes. The pong variance plane is the scratch (filter_level rewrites it).
-void given_variance(GeometryWeightsFn geometry_weights, const RgbFloatImage& variance, const GuideBuffers& guides,
+template <typename Row>
+void given_variance(Row smoothed_variance_row, const RgbFloatImage& variance, const GuideBuffers& guides,
                     const GeometryWeight& gw, const Planes& planes, int threads) {
     const ImageSize size = variance.size;
-    const int w = size.width;
     float* raw = planes.pong.var;
     for (std::size_t i = 0; i < static_cast<std::size_t>(size.pixel_count()); ++i) {
         const float* v = variance.pixels.data() + 3 * i;
@@ -346,44 +343,49 @@ void given_variance(GeometryWeightsFn geometry_weights, const RgbFloatImage& var
         raw[i] = sd * sd;
     }
     for_row_bands(size.height, threads, [&](int y0, int y1) {
-        std::vector<float> sw(w), sv(w), wt(w);
-        for (int y = y0; y < y1; ++y) {
-            std::fill(sw.begin(), sw.end(), 0.0f), std::fill(sv.begin(), sv.end(), 0.0f);
-            surface_taps_5x5(geometry_weights, planes, gw, size, y, wt, [&](int xa, int xb, std::ptrdiff_t at) {
-                const float* vq = raw + at;
-                for (int x = xa; x < xb; ++x) sw[x] += wt[x], sv[x] += wt[x] * vq[x];
-            });
-            const std::size_t row = static_cast<std::size_t>(y) * w;
-            for (int x = 0; x < w; ++x) {
-                if (planes.geometry.mask[row + x] != 0.0f) planes.ping.var[row + x] = sv[x] / sw[x];
-            }
-        }
+        for (int y = y0; y < y1; ++y) smoothed_variance_row(size, gw, planes, raw, y);
     });
 }
 
-// colour_scale = 1 / (σ_l sqrt(g3x3(Var)) + ε) [S eq. 5], g3x3 = (1/4, 1/2, 1/4)² over surface pixels.
-void colour_scales(ImageSize size, float sigma_colour, const Signal& s, const Planes& planes, int threads) {
+// colour_scale = 1 / (σ_l sqrt(g3x3(Var)) + ε) [S eq. 5], g3x3 = (1/4, 1/2, 1/4)² over surface pixels,
+// for row y, in chunks of pixels as filter_chunk_body (built twice).
+template <typename F>
+MOGAO_ALWAYS_INLINE inline void colour_scales_row_body(ImageSize size, float sigma_colour, const Signal& s,
+                                                       const Planes& planes, int y) {
+    using lanes::load, lanes::select, lanes::splat;
     constexpr float k[3] = {0.25f, 0.5f, 0.25f};
+    constexpr int kW = lanes::kWidth<F>;
     const int w = size.width, h = size.height;
     const float* mask = planes.geometry.mask;
-    for_row_bands(h, threads, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y) {
-            for (int x = 0; x < w; ++x) {
-                const std::size_t i = static_cast<std::size_t>(y) * w + x;
-                float sw = 0.0f, sv = 0.0f;
-                for (int dy = std::max(-1, -y); dy <= std::min(1, h - 1 - y); ++dy) {
-                    for (int dx = std::max(-1, -x); dx <= std::min(1, w - 1 - x); ++dx) {
-                        const std::size_t j = i + static_cast<std::size_t>(static_cast<std::ptrdiff_t>(dy) * w + dx);
-                        const float wt = k[dx + 1] * k[dy + 1] * mask[j];
-                        sw += wt;
-                        sv += wt * s.var[j];
-                    }
+    for (int x0 = 0; x0 < w; x0 += kW) {
+        const std::ptrdiff_t p = static_cast<std::ptrdiff_t>(y) * w + x0;
+        F lane_x{}, sw{}, sv{};
+        for (int i = 0; i < kW; ++i) lane_x[i] = static_cast<float>(x0 + i);
+        for (int dy = -1; dy <= 1; ++dy) {
+            if (y + dy < 0 || y + dy >= h) continue;
+            for (int dx = -1; dx <= 1; ++dx) {
+                const std::ptrdiff_t q = p + static_cast<std::ptrdiff_t>(dy) * w + dx;
+                F wt = (k[dx + 1] * k[dy + 1]) * load<F>(mask + q);
+                if (x0 + dx < 0 || x0 + kW - 1 + dx >= w) {
+                    const F tap_x = lane_x + static_cast<float>(dx);
+                    wt = select((tap_x >= splat<F>(0.0f)) & (tap_x < splat<F>(static_cast<float>(w))), wt, F{});
                 }
-                const float sd = sw > 0.0f ? std::sqrt(sv / sw) : 0.0f;
-                planes.colour_scale[i] = sigma_colour > 0.0f ? 1.0f / (sigma_colour * sd + kLuminanceEps) : kHuge;
+                sw += wt;
+                sv += wt * load<F>(s.var + q);
             }
         }
-    });
+        for (int i = 0; i < std::min(kW, w - x0); ++i) {
+            const float sd = sw[i] > 0.0f ? std::sqrt(sv[i] / sw[i]) : 0.0f;
+            planes.colour_scale[p + i] = sigma_colour > 0.0f ? 1.0f / (sigma_colour * sd + kLuminanceEps) : kHuge;
+        }
+    }
+}
+MOGAO_TARGET_X86_64_V3 void colour_scales_row_v3(ImageSize size, float sigma_colour, const Signal& s,
+                                                 const Planes& planes, int y) {
+    colour_scales_row_body<WideLanes>(size, sigma_colour, s, planes, y);
+}
+void colour_scales_row_base(ImageSize size, float sigma_colour, const Signal& s, const Planes& planes, int y) {
+    colour_scales_row_body<lanes::F4>(size, sigma_colour, s, planes, y);
 }
 
 // One à-trous level [D] for the pixels [x0, x0 + W) of row y, W the lanes of F (the last chunk of a
@@ -443,11 +445,6 @@ MOGAO_ALWAYS_INLINE inline void filter_chunk_body(ImageSize size, int step, cons
         dst.lum[i] = luminance(dst.r[i], dst.g[i], dst.b[i]);
     }
 }
-#if MOGAO_HAS_X86_64_V3
-using WideLanes = lanes::F8;
-#else
-using WideLanes = lanes::F4;  // no AVX build: filter_row_v3 is never chosen (use_x86_64_v3)
-#endif
 MOGAO_TARGET_X86_64_V3 void filter_row_v3(ImageSize size, int step, const GeometryWeight& gw, const Signal& src,
                                           const Signal& dst, const Planes& planes, int y) {
     for (int x0 = 0; x0 < size.width; x0 += lanes::kWidth<WideLanes>)
@@ -461,13 +458,16 @@ void filter_row_base(ImageSize size, int step, const GeometryWeight& gw, const S
 
 // The build of the tap loops this run uses.
 struct Kernels {
-    decltype(&geometry_weights_base) geometry_weights;
+    decltype(&spatial_variance_row_base) spatial_variance_row;
+    decltype(&smoothed_variance_row_base) smoothed_variance_row;
+    decltype(&colour_scales_row_base) colour_scales_row;
     decltype(&filter_row_base) filter_row;
 };
 
 Kernels kernels_for(CpuLevel level) {
-    if (use_x86_64_v3(level)) return {geometry_weights_v3, filter_row_v3};
-    return {geometry_weights_base, filter_row_base};
+    if (use_x86_64_v3(level))
+        return {spatial_variance_row_v3, smoothed_variance_row_v3, colour_scales_row_v3, filter_row_v3};
+    return {spatial_variance_row_base, smoothed_variance_row_base, colour_scales_row_base, filter_row_base};
 }
 
 // One à-trous level [D]: every surface pixel becomes the weighted mean of its 5x5 taps at `step`.
@@ -499,12 +499,16 @@ Status AtrousDenoiser::run(const RgbFloatImage& noisy, const GuideBuffers& guide
     const Kernels kernels = kernels_for(params.cpu);
     prepare(noisy, guides, planes, threads);
     if (variance) {
-        given_variance(kernels.geometry_weights, *variance, guides, gw, planes, threads);
+        given_variance(kernels.smoothed_variance_row, *variance, guides, gw, planes, threads);
     } else {
-        estimate_variance(kernels.geometry_weights, size, gw, planes, threads);
+        for_row_bands(size.height, threads, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) kernels.spatial_variance_row(size, gw, planes, y);
+        });
     }
     for (int level = 0; level < params.iterations; ++level) {
-        colour_scales(size, params.sigma_colour, planes.ping, planes, threads);
+        for_row_bands(size.height, threads, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) kernels.colour_scales_row(size, params.sigma_colour, planes.ping, planes, y);
+        });
         filter_level(kernels, size, 1 << level, gw, planes.ping, planes.pong, planes, threads);
         std::swap(planes.ping, planes.pong);
     }

@@ -68,9 +68,9 @@ MOGAO_ALWAYS_INLINE inline F abs(F v) {
     return std::bit_cast<F>(std::bit_cast<Mask<F>>(v) & 0x7fffffff);
 }
 
-// exp(-x) for x in [0, 40] lane by lane, the same formula as the scalar fast_exp_neg of
-// atrous_filter.cpp: 2^y, y = -x log2(e), split into t = trunc(y) (the exponent field) and
-// f = y - t in (-1, 0] (degree-5 Taylor series of 2^f, relative error < 2e-4).
+// exp(-x) for x in [0, 40] lane by lane (callers clamp): 2^y, y = -x log2(e), split into the integer
+// part t = trunc(y) (the float's exponent field) and f = y - t in (-1, 0] (degree-5 Taylor series of
+// 2^f, relative error < 2e-4 — ample for filter weights, which are renormalised). Branch-free.
 template <typename F>
 MOGAO_ALWAYS_INLINE inline F exp_neg(F x) {
     const F y = -x * 1.44269504f;
