@@ -197,6 +197,50 @@ TEST(ColourCalibration, CameraVignettingIsNotTakenForTheProjectorsFalloff) {
     }
 }
 
+// The joint fit alone (camera_vignetting.h), on light made by its own model: three projectors side by side in the
+// camera's image recover the camera's vignetting and each fall-off; one projector whose image is centred on the
+// camera's, where the two radial laws are one, leaves the camera flat (the prior) instead of guessing.
+TEST(ColourCalibration, CameraVignettingFitToldApartOnlyWhereTheProjectorsSitApart) {
+    const auto sample = [](std::size_t k, double cx, double cy, double px, double py, double f, double amp) {
+        const double c2 = cx * cx + cy * cy;
+        const double p2 = px * px + py * py;
+        return FlatFieldSample{k, amp * (1.0 - f * p2) * (1.0 - 0.18 * c2 - 0.04 * c2 * c2), c2, p2};
+    };
+    std::vector<FlatFieldSample> three;
+    const std::array<double, 3> falloff{0.1, 0.25, 0.0};
+    for (std::size_t k = 0; k < 3; ++k) {
+        for (int j = 0; j <= 20; ++j) {
+            for (int i = 0; i <= 20; ++i) {
+                const double px = -0.8 + 0.08 * i;  // the projector's image, about its principal point
+                const double py = -0.45 + 0.045 * j;
+                three.push_back(sample(k, 0.55 * (static_cast<double>(k) - 1.0) + 0.3 * px, 0.3 * py, px, py,
+                                       falloff[k], 0.3 + 0.05 * static_cast<double>(k)));
+            }
+        }
+    }
+    const CameraVignetting v = fit_camera_vignetting(three, 3, 0.2);
+    EXPECT_NEAR(v.a, 0.18, 1e-4);
+    EXPECT_NEAR(v.b, 0.04, 1e-3);
+    EXPECT_NEAR(v.corner, 0.78, 1e-4);
+    for (std::size_t k = 0; k < 3; ++k) EXPECT_NEAR(v.projector_falloff[k], falloff[k], 1e-4) << k;
+    std::vector<FlatFieldSample> centred;
+    for (const FlatFieldSample& s : three) {
+        if (s.projector != 1) continue;
+        FlatFieldSample c = s;
+        c.projector = 0;
+        c.camera_rho2 = 0.09 * s.projector_rho2;  // the camera's radius a fixed multiple of the projector's
+        c.light = 0.3 * (1.0 - 0.1 * s.projector_rho2);
+        centred.push_back(c);
+    }
+    const CameraVignetting flat = fit_camera_vignetting(centred, 1, 0.2);
+    std::printf("centred: V at rho = 1 %.4f (sigma %.4f); f %.4f\n", flat.corner, flat.corner_sigma,
+                flat.projector_falloff[0]);
+    EXPECT_NEAR(flat.corner, 1.0, 1e-3);  // the prior's: all of it is taken as the projector's fall-off
+    EXPECT_NEAR(flat.projector_falloff[0], 0.1, 1e-3);
+    EXPECT_GT(flat.corner_sigma, 100.0 * v.corner_sigma);  // and says it could not tell
+    EXPECT_THROW((void)fit_camera_vignetting(centred, 0, 0.2), std::invalid_argument);
+}
+
 TEST(ColourCalibration, RefusesAutoExposureAndAChannelTooDarkForTheCamera) {
     rig::VirtualRig rig = colour_rig();
     RigPatternSource locked(rig);
