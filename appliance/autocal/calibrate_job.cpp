@@ -92,6 +92,14 @@ nlohmann::json seam_figures(const rig::VirtualRig& rig, const ScreenCalibration&
 nlohmann::json colour_report(const ColourResult& c) {
     nlohmann::json out = {{"captures", c.captures}, {"matched_white", c.matched_white}, {"black_floor", c.black_floor},
                           {"ambient", c.ambient},   {"alpha_scale", c.alpha_scale},     {"white_floor", c.white_floor}};
+    // The camera's vignetting as measured (camera_vignetting.h): V = 1 - a rho^2 - b rho^4, V at rho = 1.
+    out["camera_vignetting"] = {{"measured", c.vignetting.measured},
+                                {"a", c.vignetting.a},
+                                {"b", c.vignetting.b},
+                                {"at_rho_1", c.vignetting.corner},
+                                {"at_rho_1_sigma", c.vignetting.corner_sigma},
+                                {"projector_falloff", c.vignetting.projector_falloff},
+                                {"samples", c.vignetting.samples}};
     for (const ProjectorPhotometry& p : c.projectors) {
         nlohmann::json ch = nlohmann::json::array();
         for (const ChannelResponse& r : p.channels) {

@@ -34,6 +34,8 @@ void check_options(const ColourOptions& o) {
     if (!(o.max_fit_rms > 0.0)) fail("max_fit_rms must be > 0");
     if (o.mask_erode_px < 0 || o.mask_erode_px > 32) fail("mask_erode_px must be 0..32");
     if (o.falloff_min_samples < 6) fail("falloff_min_samples must be >= 6");
+    if (!(o.vignetting_prior_sigma > 0.0)) fail("vignetting_prior_sigma must be > 0");
+    if (o.vignetting_step_px < 1 || o.vignetting_step_px > 16) fail("vignetting_step_px must be 1..16");
 }
 
 // Projector k shows channel c at level s (the other channels and projectors black).
@@ -72,10 +74,18 @@ double fit_gamma(const ChannelResponse& r, double* rms) {
 struct Captured {
     cv::Mat2f screen;  // per camera pixel: the screen point (theta, h) it sees, NaN off the screen
     cv::Mat1f black;
-    cv::Mat1f black_low;             // all-black at low_end_exposure, averaged
-    std::vector<cv::Mat1b> inside;   // per projector: camera pixels it clearly lights
-    std::vector<cv::Mat1b> outside;  // per projector: camera pixels it clearly does not light
+    cv::Mat1f black_low;                        // all-black at low_end_exposure, averaged
+    std::vector<cv::Mat1b> inside;              // per projector: camera pixels it clearly lights
+    std::vector<cv::Mat1b> outside;             // per projector: camera pixels it clearly does not light
+    std::vector<cv::Mat1f> full;                // per projector: its channels' full levels summed, minus black
+    std::vector<std::array<cv::Mat1f, 3>> top;  // per projector and channel: its full level minus black
+    cv::Mat1f flat;                             // the camera's vignetting V per pixel (step 1a), empty: 1
 };
+
+// Camera pixel (x, y)'s value as the screen's light: divided by the camera's vignetting there.
+float unvignetted(const cv::Mat1f& image, const Captured& cap, int x, int y) {
+    return cap.flat.empty() ? image(y, x) : image(y, x) / cap.flat(y, x);
+}
 
 // The screen point (theta, h) each camera pixel's centre sees through the camera model, NaN where
 // it sees no screen (beyond the arc's ends or the heights).
@@ -115,9 +125,11 @@ Eigen::Vector2d seen_pixel(const cv::Mat2f& screen_at, const DeviceModel& d, con
 // channels summed, minus black) over the camera pixels `in` at the projector positions the
 // models give them, in least squares; scaled to a mean of 1 over those pixels, which are
 // returned in `samples` (the amplitudes A_kc are then their means, so that A_kc F(p) is the light).
-LensFalloff fit_falloff(const cv::Mat1f& full, const cv::Mat1b& in, const cv::Mat2f& screen_at, const DeviceModel& d,
-                        const ScreenModel& screen, const ColourOptions& o, std::size_t k,
-                        std::vector<cv::Point>& samples) {
+LensFalloff fit_falloff(const Captured& cap, std::size_t k, const DeviceModel& d, const ScreenModel& screen,
+                        const ColourOptions& o, std::vector<cv::Point>& samples) {
+    const cv::Mat1f& full = cap.full[k];
+    const cv::Mat1b& in = cap.inside[k];
+    const cv::Mat2f& screen_at = cap.screen;
     Eigen::Matrix<double, 6, 6> ata = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Matrix<double, 6, 1> atb = Eigen::Matrix<double, 6, 1>::Zero();
     Eigen::Matrix<double, 6, 1> basis_sum = Eigen::Matrix<double, 6, 1>::Zero();
@@ -130,7 +142,7 @@ LensFalloff fit_falloff(const cv::Mat1f& full, const cv::Mat1b& in, const cv::Ma
             const std::array<double, 6> b = falloff_basis(d, p.x(), p.y());
             const Eigen::Map<const Eigen::Matrix<double, 6, 1>> q(b.data());
             ata += q * q.transpose();
-            atb += q * static_cast<double>(full(y, x));
+            atb += q * static_cast<double>(unvignetted(full, cap, x, y));
             basis_sum += q;
             samples.emplace_back(x, y);
         }
@@ -197,9 +209,8 @@ void measure_low_end(PatternSource& source, const std::vector<DeviceModel>& proj
 }
 
 // Step 1 for projector k: ramps per channel, the coverage masks from the full-level images.
-ProjectorPhotometry measure_projector(PatternSource& source, const ScreenModel& screen,
-                                      const std::vector<DeviceModel>& projectors, std::size_t k, const ColourOptions& o,
-                                      Captured& cap, int& captures) {
+ProjectorPhotometry measure_projector(PatternSource& source, const std::vector<DeviceModel>& projectors, std::size_t k,
+                                      const ColourOptions& o, Captured& cap, int& captures) {
     ProjectorPhotometry pp;
     pp.id = projectors[k].id;
     const int n = o.ramp_steps;
@@ -234,8 +245,8 @@ ProjectorPhotometry measure_projector(PatternSource& source, const ScreenModel& 
                                  std::to_string(cv::countNonZero(in)) +
                                  " pixels of it (need >= 100) to measure its response");
     }
-    std::vector<cv::Point> samples;
-    if (o.lens_falloff) pp.falloff = fit_falloff(full, in, cap.screen, projectors[k], screen, o, k, samples);
+    cap.full.push_back(full);
+    cap.top.push_back({diffs[0].back(), diffs[1].back(), diffs[2].back()});
     for (std::size_t c = 0; c < 3; ++c) {
         ChannelResponse& r = pp.channels[c];
         r.levels.push_back(0.0);
@@ -264,14 +275,49 @@ ProjectorPhotometry measure_projector(PatternSource& source, const ScreenModel& 
                                      " rms from the nearest gamma (gate " + std::to_string(o.max_fit_rms) +
                                      "): not a projector response (saturation, changing exposure?)");
         }
-        if (samples.empty()) continue;
-        // A_kc with the fall-off: the full level's mean over the pixels the fall-off was fitted on.
-        const cv::Mat1f& top_level = diffs[c].back();
-        double sum = 0.0;
-        for (const cv::Point& p : samples) sum += top_level(p);
-        r.amplitude = sum / static_cast<double>(samples.size());
     }
     return pp;
+}
+
+// Step 1b for projector k (after step 1a): its fall-off, and A_kc with it: the full level's mean (the screen's
+// light, unvignetted) over the pixels the fall-off was fitted on.
+void measure_falloff(const Captured& cap, const ScreenModel& screen, const DeviceModel& d, std::size_t k,
+                     const ColourOptions& o, ProjectorPhotometry& pp) {
+    std::vector<cv::Point> samples;
+    pp.falloff = fit_falloff(cap, k, d, screen, o, samples);
+    for (std::size_t c = 0; c < 3; ++c) {
+        double sum = 0.0;
+        for (const cv::Point& p : samples) sum += unvignetted(cap.top[k][c], cap, p.x, p.y);
+        pp.channels[c].amplitude = sum / static_cast<double>(samples.size());
+    }
+}
+
+// Step 1a: the camera's vignetting from every projector's full-level image (camera_vignetting.h), and its map
+// over the camera's pixels into cap.flat.
+CameraVignetting measure_vignetting(Captured& cap, const ScreenModel& screen, const DeviceModel& camera,
+                                    const std::vector<DeviceModel>& projectors, const ColourOptions& o) {
+    std::vector<FlatFieldSample> samples;
+    const int step = o.vignetting_step_px;
+    for (std::size_t k = 0; k < projectors.size(); ++k) {
+        for (int y = step / 2; y < cap.full[k].rows; y += step) {
+            for (int x = step / 2; x < cap.full[k].cols; x += step) {
+                if (cap.inside[k](y, x) == 0) continue;
+                const Eigen::Vector2d p = seen_pixel(cap.screen, projectors[k], screen, x, y);
+                if (!p.allFinite()) continue;
+                samples.push_back({k, static_cast<double>(cap.full[k](y, x)), radial_rho2(camera, x + 0.5, y + 0.5),
+                                   radial_rho2(projectors[k], p.x(), p.y())});
+            }
+        }
+    }
+    if (static_cast<int>(samples.size()) < o.falloff_min_samples) return {};  // fit_falloff refuses next
+    const CameraVignetting v = fit_camera_vignetting(samples, projectors.size(), o.vignetting_prior_sigma);
+    cap.flat = cv::Mat1f(cap.full[0].size());
+    for (int y = 0; y < cap.flat.rows; ++y) {
+        for (int x = 0; x < cap.flat.cols; ++x) {
+            cap.flat(y, x) = static_cast<float>(vignetting_at(v, radial_rho2(camera, x + 0.5, y + 0.5)));
+        }
+    }
+    return v;
 }
 
 // Step 2: betas and ambient by least squares on the long-exposure black image; a projector's black
@@ -320,7 +366,7 @@ void measure_black(PatternSource& source, const ColourOptions& o, const Captured
                 continue;
             }
             ata += a * a.transpose();
-            atb += a * (static_cast<double>(dark(y, x)) / o.dark_exposure);
+            atb += a * (static_cast<double>(unvignetted(dark, cap, x, y)) / o.dark_exposure);
             ++rows;
             overlaps += lit >= 2;
         }
@@ -336,6 +382,27 @@ void measure_black(PatternSource& source, const ColourOptions& o, const Captured
     const Eigen::VectorXd sol = ata.ldlt().solve(atb);
     ambient = sol[0];
     for (std::size_t k = 0; k < n; ++k) pps[k].black = std::max(0.0, sol[static_cast<long>(k) + 1]);
+}
+
+// The all-black image at low_end_exposure (4 averaged, into cap.black_low), and the base-exposure black from it
+// wherever it is not saturated (the camera is linear in exposure): a camera clips its noise at 0, so a dark
+// image's mean reads high (by 0.008 of full scale on the noisy rig, 3 % read noise), and every ramp level minus
+// that black read low, most at the low end: the response looked steeper (gamma 2.29 for 2.2) and the seams got
+// worse. Returns the captures taken.
+int capture_low_black(PatternSource& source, const ColourOptions& options, std::size_t n, Captured& cap) {
+    source.set_relative_exposure(options.low_end_exposure);
+    cap.black_low = cv::Mat1f(cap.black.size(), 0.0f);
+    for (int f = 0; f < 4; ++f) cap.black_low += source.show(std::vector<cv::Mat>(n));
+    cap.black_low /= 4.0f;
+    source.set_relative_exposure(1.0);
+    for (int y = 0; y < cap.black.rows; ++y) {
+        for (int x = 0; x < cap.black.cols; ++x) {
+            if (cap.black_low(y, x) < 0.98f) {
+                cap.black(y, x) = cap.black_low(y, x) / static_cast<float>(options.low_end_exposure);
+            }
+        }
+    }
+    return 4;
 }
 
 }  // namespace
@@ -391,27 +458,16 @@ ColourResult calibrate_colour(PatternSource& source, const ScreenModel& screen, 
         }
         cap.screen = camera_screen_points(camera, screen);
     }  // written below; the source may reuse its buffer
-    res.captures = 1;
-    source.set_relative_exposure(options.low_end_exposure);
-    cap.black_low = cv::Mat1f(cap.black.size(), 0.0f);
-    for (int f = 0; f < 4; ++f) cap.black_low += source.show(std::vector<cv::Mat>(n));
-    cap.black_low /= 4.0f;
-    source.set_relative_exposure(1.0);
-    res.captures += 4;
-    // The base-exposure black, wherever the long exposure is not saturated, from the long exposure (the camera
-    // is linear in exposure): a camera clips its noise at 0, so a dark image's mean reads high (by 0.008 of full
-    // scale on the noisy rig, 3 % read noise), and every ramp level minus that black read low, most at the low
-    // end: the response looked steeper (gamma 2.29 for 2.2) and the seams got worse.
-    for (int y = 0; y < cap.black.rows; ++y) {
-        for (int x = 0; x < cap.black.cols; ++x) {
-            if (cap.black_low(y, x) < 0.98f) {
-                cap.black(y, x) = cap.black_low(y, x) / static_cast<float>(options.low_end_exposure);
-            }
-        }
-    }
+    res.captures = 1 + capture_low_black(source, options, n, cap);
     for (std::size_t k = 0; k < n; ++k) {
-        res.projectors.push_back(measure_projector(source, screen, projectors, k, options, cap, res.captures));
-        projectors[k].falloff = res.projectors[k].falloff;
+        res.projectors.push_back(measure_projector(source, projectors, k, options, cap, res.captures));
+    }
+    if (options.lens_falloff) {
+        if (options.camera_vignetting) res.vignetting = measure_vignetting(cap, screen, camera, projectors, options);
+        for (std::size_t k = 0; k < n; ++k) {
+            measure_falloff(cap, screen, projectors[k], k, options, res.projectors[k]);
+            projectors[k].falloff = res.projectors[k].falloff;
+        }
     }
     measure_black(source, options, cap, screen, projectors, res.projectors, res.ambient, res.captures);
     // Step 3: matched white, blacks per channel, black floor over the screen.

@@ -26,12 +26,13 @@
 //     normalised response R_kc(s) = y_kc(s) / A_kc (made non-decreasing) is interpolated as a
 //     power law between measured levels (linear in log s - log R, so a pure gamma is exact) and
 //     continued below s_1 with the first segment's exponent.
+//  1a. Camera vignetting (`camera_vignetting`, with `lens_falloff`): V(rho) fitted jointly with a radial
+//     fall-off per projector to every projector's summed full-level image (camera_vignetting.h, model and
+//     why); the images of steps 1b and 2 are divided by V, so that they are the screen's light.
 //  1b. Fall-off (`lens_falloff`): F_k = the quadratic in projector k's image positions fitted by
 //     least squares to its summed full-level images over the eroded mask, each camera pixel placed
 //     in the projector by the camera and projector models through the screen; scaled to mean 1
 //     there, and A_kc taken as the mean over the same pixels, so A_kc F_k(p) is the light of pixel p.
-//     The camera's own vignetting is taken to be calibrated out (a flat-field image) or negligible;
-//     the virtual rig's camera has none.
 //  2. Black: `dark_frames` all-black images at `dark_exposure` x the base exposure (black levels are
 //     ~0.2 % of white, below one 8-bit code at the base exposure), averaged; least squares over
 //     the camera pixels inside the screen: L0(p) = a + sum_k beta_k M_k(p) with M_k the coverage
@@ -56,6 +57,7 @@
 #include <vector>
 
 #include "appliance/autocal/autocal.h"
+#include "appliance/autocal/camera_vignetting.h"
 
 namespace mogao::autocal {
 
@@ -69,7 +71,10 @@ struct ColourOptions {
     double max_fit_rms = 0.03;      // rms of the measured response around a pure gamma, gate
     int mask_erode_px = 2;          // coverage masks shrunk by this many camera pixels (blur, seams)
     bool lens_falloff = true;       // step 1b: measure each projector's fall-off and attenuate per pixel
-    int falloff_min_samples = 1000;  // camera pixels a projector's fall-off fit needs, >= 6
+    int falloff_min_samples = 1000;       // camera pixels a projector's fall-off fit needs, >= 6
+    bool camera_vignetting = true;        // step 1a: measure the camera's vignetting (with lens_falloff only)
+    double vignetting_prior_sigma = 0.2;  // its prior on a and b (camera_vignetting.h), > 0
+    int vignetting_step_px = 2;           // every this many camera pixels (x and y) a sample of it, 1..16
 };
 
 struct ChannelResponse {
@@ -95,6 +100,7 @@ struct ColourResult {
     double ambient = 0.0;                   // a, camera units (mono)
     double alpha_scale = 1.0;               // s
     double white_floor = 1.0;               // S: the wall's white is S W_c
+    CameraVignetting vignetting;            // step 1a's (measured = false when not)
     int captures = 0;
 };
 

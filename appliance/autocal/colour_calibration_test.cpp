@@ -12,6 +12,7 @@
 #include "appliance/autocal/colour_truth.h"
 #include "appliance/autocal/rig_bridge.h"
 #include "appliance/rig/rig_file.h"
+#include "appliance/rig/virtual_rig.h"
 
 namespace mogao::autocal {
 namespace {
@@ -145,6 +146,99 @@ TEST(ColourCalibration, LensFalloffIsMeasuredAndAttenuatedPerPixel) {
             EXPECT_NEAR(back.black[k][ch] / black, 1.0, 0.05) << k << " " << ch;
         }
     }
+}
+
+// The camera's own vignetting (20 % lost at its corners) on the fall-off rig: a fall-off fitted to the raw images
+// took it for the projectors' (the side projectors' images reach the camera's corners), brightened the screen
+// toward them and left the overlaps where the two projectors' fits of it differ. Measured with the projectors'
+// fall-offs (camera_vignetting.h), the fall-offs are the rig's and the seams stay within the goal; checked against
+// the rig's true fall-offs and vignetting, and the seams against its ground-truth light.
+TEST(ColourCalibration, CameraVignettingIsNotTakenForTheProjectorsFalloff) {
+    rig::VirtualRig rig = scaled_rig(rig::load_rig(std::string(MOGAO_SOURCE_DIR) + "/rigs/falloff.toml"), 0.25, 0.25);
+    rig.camera.vignetting = 0.2;
+    RigPatternSource source(rig);
+    const CalibrationPrior prior = prior_from_rig(rig);
+    AutocalResult r = calibrate(source, prior, {960, 540}, fast_options());
+    const ColourResult c = calibrate_colour(source, prior.screen, r.camera, r.projectors, r.calibration);
+    ASSERT_TRUE(c.vignetting.measured);
+    const double half_diagonal = 0.5 * std::hypot(rig.camera.resolution.width, rig.camera.resolution.height);
+    const double corner_rho2 = (std::pow(rig.camera.intrinsics.cx_px, 2) + std::pow(rig.camera.intrinsics.cy_px, 2)) /
+                               (half_diagonal * half_diagonal);
+    std::printf(
+        "camera vignetting at rho = 1: %.4f (sigma %.4f), truth %.4f; at the top-left corner %.4f, truth %.4f\n",
+        c.vignetting.corner, c.vignetting.corner_sigma, 1.0 - rig.camera.vignetting,
+        vignetting_at(c.vignetting, corner_rho2), camera_vignetting(rig.camera, 0.0, 0.0));
+    EXPECT_NEAR(c.vignetting.corner, 1.0 - rig.camera.vignetting, 0.03);
+    for (std::size_t k = 0; k < 3; ++k) {
+        DeviceModel truth = r.projectors[k];
+        truth.falloff = falloff_of(rig.projectors[k]);
+        const ImageSize res = truth.resolution;
+        double lo = 1e9;
+        double hi = 0.0;
+        for (int j = 0; j <= 4; ++j) {
+            for (int i = 0; i <= 4; ++i) {
+                const double x = res.width * (0.1 + 0.2 * i);
+                const double y = res.height * (0.1 + 0.2 * j);
+                const double ratio = falloff_at(r.projectors[k], x, y) / falloff_at(truth, x, y);
+                lo = std::min(lo, ratio);
+                hi = std::max(hi, ratio);
+            }
+        }
+        std::printf("%s: measured / true fall-off spread %.4f\n", rig.projectors[k].id.c_str(), hi / lo - 1.0);
+        EXPECT_LT(hi / lo - 1.0, 0.02) << rig.projectors[k].id;
+    }
+    for (const double level : {0.0, 0.05, 0.5, 1.0}) {
+        SCOPED_TRACE(level);
+        const SeamColour a = measure_seam_colour(rig, r.calibration, level);
+        std::printf("content %.2f: seam luminance p95 %.2f %%, max %.2f %%; whole screen max %.2f %%\n", level,
+                    100.0 * a.seam_luminance_p95, 100.0 * a.seam_luminance_deviation,
+                    100.0 * a.luminance_max_deviation);
+        EXPECT_LT(a.seam_luminance_p95, level == 0.0 ? 0.012 : 0.015);  // as the fall-off test: scale 0.25
+    }
+}
+
+// The joint fit alone (camera_vignetting.h), on light made by its own model: three projectors side by side in the
+// camera's image recover the camera's vignetting and each fall-off; one projector whose image is centred on the
+// camera's, where the two radial laws are one, leaves the camera flat (the prior) instead of guessing.
+TEST(ColourCalibration, CameraVignettingFitToldApartOnlyWhereTheProjectorsSitApart) {
+    const auto sample = [](std::size_t k, double cx, double cy, double px, double py, double f, double amp) {
+        const double c2 = cx * cx + cy * cy;
+        const double p2 = px * px + py * py;
+        return FlatFieldSample{k, amp * (1.0 - f * p2) * (1.0 - 0.18 * c2 - 0.04 * c2 * c2), c2, p2};
+    };
+    std::vector<FlatFieldSample> three;
+    const std::array<double, 3> falloff{0.1, 0.25, 0.0};
+    for (std::size_t k = 0; k < 3; ++k) {
+        for (int j = 0; j <= 20; ++j) {
+            for (int i = 0; i <= 20; ++i) {
+                const double px = -0.8 + 0.08 * i;  // the projector's image, about its principal point
+                const double py = -0.45 + 0.045 * j;
+                three.push_back(sample(k, 0.55 * (static_cast<double>(k) - 1.0) + 0.3 * px, 0.3 * py, px, py,
+                                       falloff[k], 0.3 + 0.05 * static_cast<double>(k)));
+            }
+        }
+    }
+    const CameraVignetting v = fit_camera_vignetting(three, 3, 0.2);
+    EXPECT_NEAR(v.a, 0.18, 1e-4);
+    EXPECT_NEAR(v.b, 0.04, 1e-3);
+    EXPECT_NEAR(v.corner, 0.78, 1e-4);
+    for (std::size_t k = 0; k < 3; ++k) EXPECT_NEAR(v.projector_falloff[k], falloff[k], 1e-4) << k;
+    std::vector<FlatFieldSample> centred;
+    for (const FlatFieldSample& s : three) {
+        if (s.projector != 1) continue;
+        FlatFieldSample c = s;
+        c.projector = 0;
+        c.camera_rho2 = 0.09 * s.projector_rho2;  // the camera's radius a fixed multiple of the projector's
+        c.light = 0.3 * (1.0 - 0.1 * s.projector_rho2);
+        centred.push_back(c);
+    }
+    const CameraVignetting flat = fit_camera_vignetting(centred, 1, 0.2);
+    std::printf("centred: V at rho = 1 %.4f (sigma %.4f); f %.4f\n", flat.corner, flat.corner_sigma,
+                flat.projector_falloff[0]);
+    EXPECT_NEAR(flat.corner, 1.0, 1e-3);  // the prior's: all of it is taken as the projector's fall-off
+    EXPECT_NEAR(flat.projector_falloff[0], 0.1, 1e-3);
+    EXPECT_GT(flat.corner_sigma, 100.0 * v.corner_sigma);  // and says it could not tell
+    EXPECT_THROW((void)fit_camera_vignetting(centred, 0, 0.2), std::invalid_argument);
 }
 
 TEST(ColourCalibration, RefusesAutoExposureAndAChannelTooDarkForTheCamera) {
