@@ -40,12 +40,13 @@ for pid in os.listdir("/proc"):
 PY
 }
 
-# stop_farm [SIGNAL]: signal every process of the farm's session, wait until they are gone.
+# stop_farm [SIGNAL [WAIT_S]]: signal every process of the farm's session, wait until they are gone (up to
+# WAIT_S seconds, 10 by default), then SIGKILL what is left.
 stop_farm() {
-  local sig=${1:-TERM} pids
+  local sig=${1:-TERM} wait_s=${2:-10} pids
   pids=$(farm_pids)
   [[ -n "$pids" ]] && kill -s "$sig" $pids 2>/dev/null
-  for _ in $(seq 1 100); do
+  for _ in $(seq 1 $((wait_s * 10))); do
     [[ -z "$(farm_pids)" ]] && break
     sleep 0.1
   done
