@@ -29,6 +29,7 @@ namespace mogao {
 struct ContentTransform {
     float scale_u = 1.0f, scale_v = 1.0f;
     float offset_u = 0.0f, offset_v = 0.0f;
+    friend bool operator==(const ContentTransform&, const ContentTransform&) = default;
 };
 
 class ProjectorRenderer {

@@ -61,10 +61,7 @@ void KioskDisplay::repaint() {
 }
 
 void KioskDisplay::set_content_transform(const ContentTransform& t) {
-    const ContentTransform& now = backend_->renderer().content_transform();
-    if (t.scale_u == now.scale_u && t.scale_v == now.scale_v && t.offset_u == now.offset_u &&
-        t.offset_v == now.offset_v)
-        return;
+    if (t == backend_->renderer().content_transform()) return;
     backend_->renderer().set_content_transform(t);
     presenter_.invalidate();
 }

@@ -277,7 +277,7 @@ bool Kiosk::update_late_warp() {
     }
     const ContentTransform before = parts_.display.content_transform();
     parts_.display.set_content_transform(t);
-    return t.scale_u != before.scale_u || t.offset_u != before.offset_u;
+    return t != before;
 }
 
 void Kiosk::submit_next_view() {

@@ -230,6 +230,50 @@ void prepare(const RgbFloatImage& noisy, const GuideBuffers& guides, const Plane
     });
 }
 
+// The columns x0, x0 + 1, ... of a chunk's lanes.
+template <typename F>
+MOGAO_ALWAYS_INLINE inline F lane_columns(int x0) {
+    F x{};
+    for (int k = 0; k < lanes::kWidth<F>; ++k) x[k] = static_cast<float>(x0 + k);
+    return x;
+}
+
+// `wt` with the lanes whose tap column (lane_x + ox) lies outside [0, w) set to 0 (a row's ends); the
+// chunk starts at column x0.
+template <typename F>
+MOGAO_ALWAYS_INLINE inline F inside_columns(F wt, const F& lane_x, int x0, int ox, int w) {
+    using lanes::select, lanes::splat;
+    if (x0 + ox >= 0 && x0 + lanes::kWidth<F> - 1 + ox < w) return wt;
+    const F tap_x = lane_x + static_cast<float>(ox);
+    return select((tap_x >= splat<F>(0.0f)) & (tap_x < splat<F>(static_cast<float>(w))), wt, F{});
+}
+
+// The centre values of a chunk of pixels [x0, x0 + W) of a row starting at pixel index p (W the
+// lanes of F) that every tap's geometry weight reads, held in registers while the taps are walked.
+template <typename F>
+struct ChunkCentre {
+    F nx, ny, nz, z, dzdx, dzdy, z_eps, lane_x;
+    MOGAO_ALWAYS_INLINE ChunkCentre(const Geometry& g, const GeometryWeight& gw, std::size_t p, int x0)
+        : nx(lanes::load<F>(g.nx + p)),
+          ny(lanes::load<F>(g.ny + p)),
+          nz(lanes::load<F>(g.nz + p)),
+          z(lanes::load<F>(g.z + p)),
+          dzdx(lanes::load<F>(g.dzdx + p)),
+          dzdy(lanes::load<F>(g.dzdy + p)),
+          z_eps(gw.depth_eps * z),
+          lane_x(lane_columns<F>(x0)) {}
+
+    // The geometry exponent of tap q, offset (fx, fy) pixels (GeometryWeight's formula); NaN for a
+    // sky centre (0/0), which callers clamp.
+    MOGAO_ALWAYS_INLINE F geometry_exponent(const Geometry& g, const GeometryWeight& gw, std::ptrdiff_t q, float fx,
+                                            float fy) const {
+        using lanes::abs, lanes::load;
+        const F ex = nx - load<F>(g.nx + q), ey = ny - load<F>(g.ny + q), ez = nz - load<F>(g.nz + q);
+        const F allowed = gw.sigma_depth * abs(dzdx * fx + dzdy * fy) + z_eps;
+        return (ex * ex + ey * ey + ez * ez) * gw.inv_sigma_normal2 + abs(z - load<F>(g.z + q)) / allowed;
+    }
+};
+
 // Sums over the 5x5 neighbourhood on the same surface of the pixels [x0, x0 + W) of row y (W the
 // lanes of F; the last chunk of a row may run past its end, those lanes are not used), the weights
 // the geometry terms only (GeometryWeight's formula, [S] §4.2): sw = Σ w, s1 = Σ w a and, with
@@ -238,28 +282,17 @@ void prepare(const RgbFloatImage& noisy, const GuideBuffers& guides, const Plane
 template <typename F, bool kSquares>
 MOGAO_ALWAYS_INLINE inline void surface_sums(ImageSize size, const GeometryWeight& gw, const Geometry& g,
                                              const float* a, int y, int x0, F& sw, F& s1, F& s2) {
-    using lanes::abs, lanes::exp_neg, lanes::load, lanes::select, lanes::splat;
-    constexpr int kW = lanes::kWidth<F>;
+    using lanes::exp_neg, lanes::load, lanes::select, lanes::splat;
     const int w = size.width, h = size.height;
     const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x0);
-    const F nx = load<F>(g.nx + p), ny = load<F>(g.ny + p), nz = load<F>(g.nz + p), z = load<F>(g.z + p);
-    const F dzdx = load<F>(g.dzdx + p), dzdy = load<F>(g.dzdy + p), z_eps = gw.depth_eps * z;
-    F lane_x{};
-    for (int k = 0; k < kW; ++k) lane_x[k] = static_cast<float>(x0 + k);
+    const ChunkCentre<F> c(g, gw, p, x0);
     for (int oy = -2; oy <= 2; ++oy) {
         if (y + oy < 0 || y + oy >= h) continue;
         for (int ox = -2; ox <= 2; ++ox) {
-            const float fx = static_cast<float>(ox), fy = static_cast<float>(oy);
             const std::ptrdiff_t q = static_cast<std::ptrdiff_t>(p) + static_cast<std::ptrdiff_t>(oy) * w + ox;
-            const F ex = nx - load<F>(g.nx + q), ey = ny - load<F>(g.ny + q), ez = nz - load<F>(g.nz + q);
-            const F allowed = gw.sigma_depth * abs(dzdx * fx + dzdy * fy) + z_eps;
-            F e = (ex * ex + ey * ey + ez * ez) * gw.inv_sigma_normal2 + abs(z - load<F>(g.z + q)) / allowed;
+            F e = c.geometry_exponent(g, gw, q, static_cast<float>(ox), static_cast<float>(oy));
             e = select(e < splat<F>(kMaxExponent), e, splat<F>(kMaxExponent));  // NaN (sky p) gives the limit
-            F wt = load<F>(g.mask + q) * exp_neg(e);
-            if (x0 + ox < 0 || x0 + kW - 1 + ox >= w) {
-                const F tap_x = lane_x + fx;
-                wt = select((tap_x >= splat<F>(0.0f)) & (tap_x < splat<F>(static_cast<float>(w))), wt, F{});
-            }
+            const F wt = inside_columns(load<F>(g.mask + q) * exp_neg(e), c.lane_x, x0, ox, w);
             const F aq = load<F>(a + q);
             sw += wt;
             s1 += wt * aq;
@@ -352,24 +385,20 @@ void given_variance(Row smoothed_variance_row, const RgbFloatImage& variance, co
 template <typename F>
 MOGAO_ALWAYS_INLINE inline void colour_scales_row_body(ImageSize size, float sigma_colour, const Signal& s,
                                                        const Planes& planes, int y) {
-    using lanes::load, lanes::select, lanes::splat;
+    using lanes::load;
     constexpr float k[3] = {0.25f, 0.5f, 0.25f};
     constexpr int kW = lanes::kWidth<F>;
     const int w = size.width, h = size.height;
     const float* mask = planes.geometry.mask;
     for (int x0 = 0; x0 < w; x0 += kW) {
         const std::ptrdiff_t p = static_cast<std::ptrdiff_t>(y) * w + x0;
-        F lane_x{}, sw{}, sv{};
-        for (int i = 0; i < kW; ++i) lane_x[i] = static_cast<float>(x0 + i);
+        const F lane_x = lane_columns<F>(x0);
+        F sw{}, sv{};
         for (int dy = -1; dy <= 1; ++dy) {
             if (y + dy < 0 || y + dy >= h) continue;
             for (int dx = -1; dx <= 1; ++dx) {
                 const std::ptrdiff_t q = p + static_cast<std::ptrdiff_t>(dy) * w + dx;
-                F wt = (k[dx + 1] * k[dy + 1]) * load<F>(mask + q);
-                if (x0 + dx < 0 || x0 + kW - 1 + dx >= w) {
-                    const F tap_x = lane_x + static_cast<float>(dx);
-                    wt = select((tap_x >= splat<F>(0.0f)) & (tap_x < splat<F>(static_cast<float>(w))), wt, F{});
-                }
+                const F wt = inside_columns((k[dx + 1] * k[dy + 1]) * load<F>(mask + q), lane_x, x0, dx, w);
                 sw += wt;
                 sv += wt * load<F>(s.var + q);
             }
@@ -401,29 +430,20 @@ MOGAO_ALWAYS_INLINE inline void filter_chunk_body(ImageSize size, int step, cons
     const int w = size.width, h = size.height;
     const Geometry& g = planes.geometry;
     const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x0);
-    const F nx = load<F>(g.nx + p), ny = load<F>(g.ny + p), nz = load<F>(g.nz + p), z = load<F>(g.z + p);
-    const F dzdx = load<F>(g.dzdx + p), dzdy = load<F>(g.dzdy + p), lum = load<F>(src.lum + p);
-    const F cs = load<F>(planes.colour_scale + p), z_eps = gw.depth_eps * z;
-    F lane_x{};
-    for (int k = 0; k < kW; ++k) lane_x[k] = static_cast<float>(x0 + k);
+    const ChunkCentre<F> c(g, gw, p, x0);
+    const F lum = load<F>(src.lum + p), cs = load<F>(planes.colour_scale + p);
     F sw{}, sr{}, sg{}, sb{}, sv{};
     for (int ky = -2; ky <= 2; ++ky) {
         const int oy = ky * step;
         if (y + oy < 0 || y + oy >= h) continue;
         for (int kx = -2; kx <= 2; ++kx) {
             const int ox = kx * step;
-            const float fx = static_cast<float>(ox), fy = static_cast<float>(oy);
             const std::ptrdiff_t q = static_cast<std::ptrdiff_t>(p) + static_cast<std::ptrdiff_t>(oy) * w + ox;
-            const F ex = nx - load<F>(g.nx + q), ey = ny - load<F>(g.ny + q), ez = nz - load<F>(g.nz + q);
-            const F allowed = gw.sigma_depth * abs(dzdx * fx + dzdy * fy) + z_eps;
-            F e = (ex * ex + ey * ey + ez * ez) * gw.inv_sigma_normal2 + abs(z - load<F>(g.z + q)) / allowed +
+            F e = c.geometry_exponent(g, gw, q, static_cast<float>(ox), static_cast<float>(oy)) +
                   abs(lum - load<F>(src.lum + q)) * cs;
             e = select(e < splat<F>(kMaxExponent), e, splat<F>(kMaxExponent));  // inf and NaN (sky p) give the limit
-            F wt = (kB3[kx + 2] * kB3[ky + 2]) * load<F>(g.mask + q) * exp_neg(e);
-            if (x0 + ox < 0 || x0 + kW - 1 + ox >= w) {
-                const F tap_x = lane_x + fx;
-                wt = select((tap_x >= splat<F>(0.0f)) & (tap_x < splat<F>(static_cast<float>(w))), wt, F{});
-            }
+            const F wt =
+                inside_columns((kB3[kx + 2] * kB3[ky + 2]) * load<F>(g.mask + q) * exp_neg(e), c.lane_x, x0, ox, w);
             sw += wt;
             sr += wt * load<F>(src.r + q);
             sg += wt * load<F>(src.g + q);
