@@ -97,7 +97,10 @@ std::vector<BorderPiece> on_screen_border(const DeviceModel& d, const ScreenMode
                                                                {Eigen::Vector2d(w, h), Eigen::Vector2d(0, h)},
                                                                {Eigen::Vector2d(0, h), Eigen::Vector2d(0, 0)}}};
     std::vector<BorderPiece> pieces;
-    for (const auto& [a, b] : sides) {
+    for (const auto& side : sides) {
+        // Named copies, not structured bindings: clang 14 cannot capture a binding in a lambda.
+        const Eigen::Vector2d a = side[0];
+        const Eigen::Vector2d b = side[1];
         const auto at = [&](double t) -> Eigen::Vector2d { return a + t * (b - a); };
         const auto on = [&](double t) { return lands_on_screen(d, s, at(t)); };
         const int steps = std::max(16, static_cast<int>(std::ceil((b - a).norm() / 4.0)));
