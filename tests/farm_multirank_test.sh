@@ -22,11 +22,16 @@ n=$(ls "$work"/one/frame-*.ppm | wc -l)
 for f in stats.json tile-costs.json frame-0000.jpg; do
   [ -s "$work/four/$f" ] || { echo "FAIL: $f missing"; fail=1; }
 done
-# The 4-rank run used 3 render ranks: every frame has three rank times.
-python3 - "$work/four/stats.json" <<'PY' || fail=1
-import json, sys
+# The 4-rank run used 3 render ranks: every frame has three rank times. Render threads (automatic,
+# renderfarm/farm/render_threads.h): this host's CPUs shared among its render ranks, at least one.
+python3 - "$work/four/stats.json" "$work/one/stats.json" <<'PY' || fail=1
+import json, os, sys
 s = json.load(open(sys.argv[1]))
+cpus = len(os.sched_getaffinity(0))
 assert s["run"]["render_ranks"] == 3, s["run"]
+assert s["run"]["threads_per_rank"] == max(1, cpus // 3), (s["run"], cpus)
+one = json.load(open(sys.argv[2]))["run"]
+assert one["threads_per_rank"] == cpus, (one, cpus)
 for f in s["frames"]:
     assert len(f["rank_render_seconds"]) == 3, f
     assert 0 < f["balance_efficiency"] <= 1, f

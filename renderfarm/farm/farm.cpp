@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "renderfarm/farm/render_threads.h"
 #include "renderfarm/trace/renderer.h"
 
 namespace mogao {
@@ -88,6 +89,7 @@ RunInfo describe_run(const MpiSession& mpi, const FarmSetup& setup, const Dispat
     run.bvh_build_seconds = max_bvh;
     spdlog::info("scene {}: {} triangles instanced from {} meshes, loaded in {:.2f} s; BVH {:.2f} s", run.scene,
                  report.instanced_triangles, report.meshes.size(), load_seconds, max_bvh);
+    spdlog::info("{} render rank(s), {} render thread(s) each", run.render_ranks, run.threads_per_rank);
     for (const MeshLoadFigures& m : report.meshes)
         spdlog::info("  mesh {:<12} {:>9} triangles {:>8} vertices {:6.3f} s  {}", m.name, m.triangles, m.vertices,
                      m.seconds, m.source);
@@ -122,11 +124,13 @@ int run_farm(const MpiSession& mpi, const FarmSetup& setup, const AdminJob& admi
     std::optional<GuidePass> guides;
     double bvh_seconds = 0.0;
     const bool renders = !mpi.is_admin() || mpi.size() == 1;
+    DispatchSettings dispatch = setup.dispatch;
+    dispatch.threads = agree_render_threads(mpi, setup.dispatch.threads, renders);
     if (renders) {
         const auto bvh_start = Clock::now();
         try {
             RendererOptions options;
-            options.embree_config = fmt::format("threads={}", setup.dispatch.threads);
+            options.embree_config = fmt::format("threads={}", dispatch.threads);
             options.jitter_cached_one_spp = setup.jitter_cached_one_spp;
             renderer.emplace(*scene, options);
             guides.emplace(*scene, renderer->render_scene());
@@ -140,7 +144,6 @@ int run_farm(const MpiSession& mpi, const FarmSetup& setup, const AdminJob& admi
     MPI_Reduce(&bvh_seconds, &max_bvh, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
     if (!mpi.all(!renders || renderer.has_value())) return 1;
 
-    DispatchSettings dispatch = setup.dispatch;
     dispatch.exposure = scene->exposure;
     dispatch.tone_map = scene->tone_map;
     if (!mpi.is_admin()) {

@@ -258,6 +258,8 @@ void serve_render_rank(Renderer* renderer, const DispatchSettings& settings, con
                                                     pass.tile_times.size());
             beat.finish();
             send_reply(header, pass.packed_pixels.data(), pass.packed_pixels.size(), tiles_flat);
+            // While the admin composites, filters and encodes: off the next frame's critical path.
+            renderer->commit_radiance_cache();
         } catch (const std::exception& e) {
             int rank = 0;
             MPI_Comm_rank(MPI_COMM_WORLD, &rank);
@@ -281,6 +283,8 @@ FrameDispatcher::FrameDispatcher(const MpiSession& mpi, DispatchSettings setting
     if (mpi.size() == 1 && !local) throw std::invalid_argument("a one-process farm needs a local renderer");
     if (!(settings_.rank_beat_s > 0)) throw std::invalid_argument("DispatchSettings.rank_beat_s must be > 0");
     if (settings_.cut_block < 1) throw std::invalid_argument("DispatchSettings.cut_block must be >= 1");
+    if (settings_.threads < 1)
+        throw std::invalid_argument("DispatchSettings.threads must be >= 1 (run_farm resolves 0: render_threads.h)");
 }
 
 FrameDispatcher::~FrameDispatcher() { stop(); }

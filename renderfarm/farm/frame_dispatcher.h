@@ -63,7 +63,7 @@ struct DispatchSettings {
     int snap = 16;                      // PBT/equal split snap, pixels
     int roundrobin_tile = 32;           // round-robin tile, pixels
     int cell_size = 16;                 // tile timing / cost-map cell, pixels
-    int threads = 1;                    // render threads per rank
+    int threads = 0;                    // render threads per rank; 0 = automatic (render_threads.h)
     float exposure = 1.f;               // the scene's exposure (sRGB8 conversion happens on the ranks)
     ToneMap tone_map = ToneMap::clamp;  // the scene's tone map (film.h)
     // Feed the PBT with tile times x the rank's speed (its share of a core) instead of wall time.

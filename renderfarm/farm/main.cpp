@@ -54,7 +54,11 @@ void add_farm_flags(CLI::App& command, mogao::FarmSetup& setup, std::string& sca
         ->check(CLI::IsMember({4, 8, 16, 32}));
     command.add_option("--rr-tile-px", setup.dispatch.roundrobin_tile, "Round-robin tile size in pixels")
         ->check(CLI::Range(8, 1024));
-    command.add_option("--threads", setup.dispatch.threads, "Render threads per rank")->check(CLI::Range(1, 256));
+    command
+        .add_option("--threads", setup.dispatch.threads,
+                    "Render threads per render rank (0 = this host's CPUs shared among its render ranks, the same "
+                    "on every rank: render_threads.h)")
+        ->check(CLI::Range(0, 256));
     command
         .add_option("--rank-deadline-s", setup.dispatch.rank_deadline_s,
                     "Most seconds a render rank that owes a frame may stay silent (rendering ranks report their "

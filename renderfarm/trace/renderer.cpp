@@ -371,6 +371,8 @@ TileStats Renderer::render(const PixelRect& rect, RgbFloatImage& window, int ori
 
 void Renderer::clear_radiance_cache() { impl_->cache->clear(); }
 
+void Renderer::commit_radiance_cache() { impl_->cache->commit(); }
+
 RadianceCacheStats Renderer::radiance_cache_stats() const { return {impl_->cache->cells(), impl_->cache->dropped()}; }
 
 TileStats Renderer::render_recording(const PixelRect& rect, RgbFloatImage& frame, RecordedRays& log) const {

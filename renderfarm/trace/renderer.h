@@ -177,6 +177,11 @@ public:
     // The radiance cache (radiance_cache.h): emptied (a benchmark's cold start), and its size.
     // Neither may run concurrently with render() or begin_frame().
     void clear_radiance_cache();
+    // Merges the training estimates of the frames rendered so far into the radiance cache now
+    // instead of at the next begin_frame(): a render rank calls it once its tiles are sent, so the
+    // merge runs while the admin composites, filters and encodes, not before the next frame's tiles.
+    // The cache's content is the same either way. Not concurrently with render() or begin_frame().
+    void commit_radiance_cache();
     [[nodiscard]] RadianceCacheStats radiance_cache_stats() const;
 
     // Benchmark baseline: generates and intersects exactly the camera ray packets render() would
