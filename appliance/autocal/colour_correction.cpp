@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <stdexcept>
 
@@ -96,6 +97,65 @@ void scale_blend(const DeviceModel& d, double scale, double white, ProjectorCali
         d, pc, [&](float& w, double f) { w = static_cast<float>(std::clamp(w * scale * white / f, 0.0, 1.0)); });
 }
 
+// Which other projectors' models light screen point (theta, h): bit j for projector j != k (the first 32; an edge
+// of a later one is not told from its neighbours' and keeps the deficit at the pixel's centre).
+std::uint32_t cover_mask(const std::vector<DeviceModel>& models, const ScreenModel& screen, std::size_t k, double theta,
+                         double h) {
+    std::uint32_t mask = 0;
+    for (std::size_t j = 0; j < models.size() && j < 32; ++j) {
+        if (j != k && model_pixel(models[j], screen, theta, h).allFinite()) mask |= 1U << j;
+    }
+    return mask;
+}
+
+// The deficit D_c = max(0, T_c - black_c) at output pixel (x, y) of projector k, f its fall-off there. On an
+// edge pixel (another projector's image edge crosses it) D is the mean over kSub x kSub points of the pixel's
+// footprint, placed through the warp: the pixel's light is uniform, the other projector's black covers only part
+// of it, and the deficit at its centre alone gave the whole pixel that projector's black or none of it (a line
+// one pixel wide of +-one projector's black). Mean over the pixel: exact up to the geometry's error at the edge.
+std::array<double, 3> pixel_deficit(std::size_t k, const std::vector<DeviceModel>& models, const ScreenModel& screen,
+                                    const std::vector<std::array<double, 3>>& blacks,
+                                    const std::array<double, 3>& floor, const ProjectorCalibration& pc, int x, int y,
+                                    double f, bool edge) {
+    constexpr int kSub = 8;
+    const double arc = screen.arc_deg * kDeg;
+    std::array<double, 3> sum{};
+    int n = 0;
+    for (int j = 0; j < (edge ? kSub : 1); ++j) {
+        for (int i = 0; i < (edge ? kSub : 1); ++i) {
+            const double dx = edge ? (i + 0.5) / kSub - 0.5 : 0.0;
+            const double dy = edge ? (j + 0.5) / kSub - 0.5 : 0.0;
+            const ContentUv uv = sample_warp_at(pc.warp, pc.output, x + dx, y + dy);
+            if (!uv.valid()) continue;
+            const double theta = uv.u * arc - arc / 2.0;
+            const double h = screen.top_m - uv.v * (screen.top_m - screen.bottom_m);
+            const std::array<double, 3> b = black_at(models, screen, blacks, theta, h, k, f);
+            for (std::size_t c = 0; c < 3; ++c) sum[c] += std::max(0.0, floor[c] - b[c]);
+            ++n;
+        }
+    }
+    for (double& d : sum) d /= std::max(n, 1);
+    return sum;
+}
+
+// Whether a neighbour of (x, y) (8-connected, among the pixels that show content) sees other projectors than
+// (x, y) does: then an image edge crosses the pixel (it lies within 0.71 px of the pixel's centre, and the
+// neighbour across it lies 1 px or more from it).
+bool crosses_edge(const std::vector<std::uint32_t>& masks, ImageSize out, int x, int y) {
+    constexpr std::uint32_t kNone = 0xFFFFFFFFU;
+    const std::uint32_t m = masks[static_cast<std::size_t>(y) * static_cast<std::size_t>(out.width) + x];
+    for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+            const int nx = x + dx;
+            const int ny = y + dy;
+            if (nx < 0 || ny < 0 || nx >= out.width || ny >= out.height) continue;
+            const std::uint32_t n = masks[static_cast<std::size_t>(ny) * static_cast<std::size_t>(out.width) + nx];
+            if (n != kNone && n != m) return true;
+        }
+    }
+    return false;
+}
+
 // Step 4's beta for projector k (blacks and floor in matched-white units, blend not yet scaled);
 // returns the largest deficit D / W it met.
 double apply_beta(std::size_t k, const std::vector<DeviceModel>& models, const ScreenModel& screen,
@@ -103,24 +163,32 @@ double apply_beta(std::size_t k, const std::vector<DeviceModel>& models, const S
                   ProjectorCalibration& pc) {
     // Beta per output pixel: black steps are as sharp as the other projectors' image edges, so a
     // coarser grid would smear the compensating step over several pixels.
-    pc.beta.size = pc.output;
-    pc.beta.rgb.assign(static_cast<std::size_t>(pc.output.pixel_count()) * 3, 0.0F);
-    double worst = 0.0;
-    for (int y = 0; y < pc.output.height; ++y) {
-        for (int x = 0; x < pc.output.width; ++x) {
+    const ImageSize out = pc.output;
+    pc.beta.size = out;
+    pc.beta.rgb.assign(static_cast<std::size_t>(out.pixel_count()) * 3, 0.0F);
+    std::vector<std::uint32_t> masks(static_cast<std::size_t>(out.pixel_count()), 0xFFFFFFFFU);
+    for (int y = 0; y < out.height; ++y) {
+        for (int x = 0; x < out.width; ++x) {
             double theta = 0.0;
             double h = 0.0;
             float alpha = 0.0F;
             if (!pixel_on_screen(pc, screen, x, y, theta, h, alpha)) continue;
+            masks[static_cast<std::size_t>(y) * static_cast<std::size_t>(out.width) + x] =
+                cover_mask(models, screen, k, theta, h);
+        }
+    }
+    double worst = 0.0;
+    for (int y = 0; y < out.height; ++y) {
+        for (int x = 0; x < out.width; ++x) {
+            const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(out.width) + x;
+            if (masks[i] == 0xFFFFFFFFU) continue;
             const double f = falloff_at_output(models[k], pc, x, y);
-            const std::array<double, 3> b = black_at(models, screen, blacks, theta, h, k, f);
-            const std::size_t g = (static_cast<std::size_t>(y) * static_cast<std::size_t>(pc.output.width) +
-                                   static_cast<std::size_t>(x)) *
-                                  3;
+            const float alpha = sample_blend(pc.blend, out, x, y);
+            const std::array<double, 3> d =
+                pixel_deficit(k, models, screen, blacks, floor, pc, x, y, f, crosses_edge(masks, out, x, y));
             for (std::size_t c = 0; c < 3; ++c) {
-                const double deficit = std::max(0.0, floor[c] - b[c]);
-                worst = std::max(worst, deficit);
-                pc.beta.rgb[g + c] = static_cast<float>(std::clamp(alpha * deficit / f, 0.0, 1.0));
+                worst = std::max(worst, d[c]);
+                pc.beta.rgb[i * 3 + c] = static_cast<float>(std::clamp(alpha * d[c] / f, 0.0, 1.0));
             }
         }
     }
