@@ -79,6 +79,7 @@ nlohmann::json seam_figures(const rig::VirtualRig& rig, const ScreenCalibration&
         out.push_back({{"level", level},
                        {"reference_luminance", s.reference_luminance},
                        {"seam_luminance_deviation", s.seam_luminance_deviation},
+                       {"seam_luminance_pixel_max", s.seam_luminance_pixel_max},
                        {"luminance_max_deviation", s.luminance_max_deviation},
                        {"seam_delta_e76", s.seam_delta_e},
                        {"seam_luminance_p95", s.seam_luminance_p95},

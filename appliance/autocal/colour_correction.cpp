@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <stdexcept>
 
@@ -96,6 +97,87 @@ void scale_blend(const DeviceModel& d, double scale, double white, ProjectorCali
         d, pc, [&](float& w, double f) { w = static_cast<float>(std::clamp(w * scale * white / f, 0.0, 1.0)); });
 }
 
+// Which other projectors' models light screen point (theta, h): bit j for projector j != k (the first 32; an edge
+// of a later one is not told from its neighbours' and keeps the light at the pixel's centre).
+std::uint32_t cover_mask(const std::vector<DeviceModel>& models, const ScreenModel& screen, std::size_t k, double theta,
+                         double h) {
+    std::uint32_t mask = 0;
+    for (std::size_t j = 0; j < models.size() && j < 32; ++j) {
+        if (j != k && model_pixel(models[j], screen, theta, h).allFinite()) mask |= 1U << j;
+    }
+    return mask;
+}
+
+constexpr std::uint32_t kNotShown = 0xFFFFFFFFU;
+
+// cover_mask at every output pixel of projector k that shows content (kNotShown elsewhere).
+std::vector<std::uint32_t> coverage_masks(std::size_t k, const std::vector<DeviceModel>& models,
+                                          const ScreenModel& screen, const ProjectorCalibration& pc) {
+    std::vector<std::uint32_t> masks(static_cast<std::size_t>(pc.output.pixel_count()), kNotShown);
+    for (int y = 0; y < pc.output.height; ++y) {
+        for (int x = 0; x < pc.output.width; ++x) {
+            double theta = 0.0;
+            double h = 0.0;
+            float alpha = 0.0F;
+            if (!pixel_on_screen(pc, screen, x, y, theta, h, alpha)) continue;
+            masks[static_cast<std::size_t>(y) * static_cast<std::size_t>(pc.output.width) + x] =
+                cover_mask(models, screen, k, theta, h);
+        }
+    }
+    return masks;
+}
+
+// The relative light L_j of every projector j over output pixel (x, y) of projector k: F_j where its model lights
+// the pixel, 0 elsewhere; L_k = f, k's fall-off there. On an edge pixel (another projector's image edge crosses
+// it) L_j is the mean over kSub x kSub points of the pixel's footprint, placed on the screen through the warp: the
+// pixel's light is uniform and the other projector's black covers only part of it, so the deficit at its centre
+// alone gave the whole pixel that projector's black or none of it (a line one pixel wide of +-one projector's
+// black). Over the pixel the mean is exact, up to the geometry's error at the edge.
+std::vector<double> footprint_light(std::size_t k, const std::vector<DeviceModel>& models, const ScreenModel& screen,
+                                    const ProjectorCalibration& pc, int x, int y, double f, bool edge) {
+    constexpr int kSub = 8;
+    const int side = edge ? kSub : 1;
+    const double arc = screen.arc_deg * kDeg;
+    std::vector<double> light(models.size(), 0.0);
+    int n = 0;
+    for (int t = 0; t < side * side || n == 0; ++t) {
+        // The pixel's centre alone where it is no edge pixel, or where no point of its footprint shows content.
+        const bool centre = t >= side * side || !edge;
+        const double dx = centre ? 0.0 : ((t % side) + 0.5) / side - 0.5;
+        const double dy = centre ? 0.0 : ((t / side) + 0.5) / side - 0.5;
+        const ContentUv uv = sample_warp_at(pc.warp, pc.output, x + dx, y + dy);
+        if (!uv.valid() && !centre) continue;
+        const double theta = uv.u * arc - arc / 2.0;
+        const double h = screen.top_m - uv.v * (screen.top_m - screen.bottom_m);
+        for (std::size_t j = 0; j < models.size(); ++j) {
+            if (j == k) continue;
+            const Eigen::Vector2d p = model_pixel(models[j], screen, theta, h);
+            if (p.allFinite()) light[j] += falloff_at(models[j], p.x(), p.y());
+        }
+        ++n;
+    }
+    for (double& l : light) l /= n;
+    light[k] = f;
+    return light;
+}
+
+// Whether a neighbour of (x, y) (8-connected, among the pixels that show content) sees other projectors than
+// (x, y) does: then an image edge crosses the pixel (it lies within 0.71 px of the pixel's centre, and the
+// neighbour across it lies 1 px or more from it).
+bool crosses_edge(const std::vector<std::uint32_t>& masks, ImageSize out, int x, int y) {
+    const std::uint32_t m = masks[static_cast<std::size_t>(y) * static_cast<std::size_t>(out.width) + x];
+    for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+            const int nx = x + dx;
+            const int ny = y + dy;
+            if (nx < 0 || ny < 0 || nx >= out.width || ny >= out.height) continue;
+            const std::uint32_t n = masks[static_cast<std::size_t>(ny) * static_cast<std::size_t>(out.width) + nx];
+            if (n != kNotShown && n != m) return true;
+        }
+    }
+    return false;
+}
+
 // Step 4's beta for projector k (blacks and floor in matched-white units, blend not yet scaled);
 // returns the largest deficit D / W it met.
 double apply_beta(std::size_t k, const std::vector<DeviceModel>& models, const ScreenModel& screen,
@@ -103,24 +185,25 @@ double apply_beta(std::size_t k, const std::vector<DeviceModel>& models, const S
                   ProjectorCalibration& pc) {
     // Beta per output pixel: black steps are as sharp as the other projectors' image edges, so a
     // coarser grid would smear the compensating step over several pixels.
-    pc.beta.size = pc.output;
-    pc.beta.rgb.assign(static_cast<std::size_t>(pc.output.pixel_count()) * 3, 0.0F);
+    const ImageSize out = pc.output;
+    pc.beta.size = out;
+    pc.beta.rgb.assign(static_cast<std::size_t>(out.pixel_count()) * 3, 0.0F);
+    const std::vector<std::uint32_t> masks = coverage_masks(k, models, screen, pc);
     double worst = 0.0;
-    for (int y = 0; y < pc.output.height; ++y) {
-        for (int x = 0; x < pc.output.width; ++x) {
-            double theta = 0.0;
-            double h = 0.0;
-            float alpha = 0.0F;
-            if (!pixel_on_screen(pc, screen, x, y, theta, h, alpha)) continue;
+    for (int y = 0; y < out.height; ++y) {
+        for (int x = 0; x < out.width; ++x) {
+            const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(out.width) + x;
+            if (masks[i] == kNotShown) continue;
             const double f = falloff_at_output(models[k], pc, x, y);
-            const std::array<double, 3> b = black_at(models, screen, blacks, theta, h, k, f);
-            const std::size_t g = (static_cast<std::size_t>(y) * static_cast<std::size_t>(pc.output.width) +
-                                   static_cast<std::size_t>(x)) *
-                                  3;
+            const float alpha = sample_blend(pc.blend, out, x, y);
+            const std::vector<double> light =
+                footprint_light(k, models, screen, pc, x, y, f, crosses_edge(masks, out, x, y));
             for (std::size_t c = 0; c < 3; ++c) {
-                const double deficit = std::max(0.0, floor[c] - b[c]);
+                double black = 0.0;
+                for (std::size_t j = 0; j < models.size(); ++j) black += light[j] * blacks[j][c];
+                const double deficit = std::max(0.0, floor[c] - black);
                 worst = std::max(worst, deficit);
-                pc.beta.rgb[g + c] = static_cast<float>(std::clamp(alpha * deficit / f, 0.0, 1.0));
+                pc.beta.rgb[i * 3 + c] = static_cast<float>(std::clamp(alpha * deficit / f, 0.0, 1.0));
             }
         }
     }
@@ -128,7 +211,7 @@ double apply_beta(std::size_t k, const std::vector<DeviceModel>& models, const S
 }
 
 // measured_colour's least squares: normal equations of beta_kc(p) = a(p) . (t_c, b_0c, ..)
-// with a = alpha (1, -[j lights p]...), sampled every other pixel.
+// with a = alpha (1, -L_0, -L_1, ..) (footprint_light), sampled every other pixel.
 struct BlackSystem {
     Eigen::MatrixXd ata;
     Eigen::MatrixXd atb;  // (n + 1) x 3
@@ -139,25 +222,20 @@ struct BlackSystem {
 void accumulate_blacks(const ProjectorCalibration& pc, std::size_t k, const std::vector<DeviceModel>& models,
                        const ScreenModel& screen, double scale, double white, BlackSystem& sys) {
     const auto n = static_cast<long>(models.size());
+    const std::vector<std::uint32_t> masks = coverage_masks(k, models, screen, pc);
     Eigen::VectorXd a(n + 1);
     for (int y = 0; y < pc.output.height; y += 2) {
         for (int x = 0; x < pc.output.width; x += 2) {
-            double theta = 0.0;
-            double h = 0.0;
-            float weight = 0.0F;
-            if (!pixel_on_screen(pc, screen, x, y, theta, h, weight)) continue;
-            // beta_k = alpha_k (t - sum_j b_j F_j) / F_k with w = alpha_k s S / F_k.
-            const double alpha = weight / (scale * white);
-            a[0] = alpha;
-            for (long j = 0; j < n; ++j) {
-                const DeviceModel& m = models[static_cast<std::size_t>(j)];
-                if (static_cast<std::size_t>(j) == k) {
-                    a[j + 1] = -alpha * falloff_at_output(m, pc, x, y);
-                    continue;
-                }
-                const Eigen::Vector2d p = model_pixel(m, screen, theta, h);
-                a[j + 1] = p.allFinite() ? -alpha * falloff_at(m, p.x(), p.y()) : 0.0;
+            if (masks[static_cast<std::size_t>(y) * static_cast<std::size_t>(pc.output.width) + x] == kNotShown) {
+                continue;
             }
+            // beta_k = alpha_k (t - sum_j b_j L_j) / F_k with w = alpha_k s S / F_k (L_j as apply_beta's).
+            const double alpha = sample_blend(pc.blend, pc.output, x, y) / (scale * white);
+            const std::vector<double> light =
+                footprint_light(k, models, screen, pc, x, y, falloff_at_output(models[k], pc, x, y),
+                                crosses_edge(masks, pc.output, x, y));
+            a[0] = alpha;
+            for (long j = 0; j < n; ++j) a[j + 1] = -alpha * light[static_cast<std::size_t>(j)];
             const std::array<float, 3> beta =
                 pc.beta.rgb.empty() ? std::array<float, 3>{} : sample_beta(pc.beta, pc.output, x, y);
             sys.ata += a * a.transpose();

@@ -15,37 +15,70 @@ namespace {
 struct Point {
     std::array<double, 3> rgb{};
     int lit = 0;
+    int shown_by = -1;           // the projector with the largest blend weight there
+    std::array<int, 2> pixel{};  // its output pixel there
 };
+
+// The light at screen point s for flat content `level`.
+Point light_at(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double level,
+               const rig::ScreenPoint& s) {
+    Point pt;
+    pt.rgb = {rig.ambient, rig.ambient, rig.ambient};
+    float most = 0.0F;
+    for (std::size_t k = 0; k < calibration.projectors.size(); ++k) {
+        const ProjectorCalibration& pc = calibration.projectors[k];
+        const auto xy = output_pixel(rig, static_cast<int>(k), pc, s);
+        if (!xy) continue;
+        const auto [x, y] = *xy;
+        const bool shown = sample_warp(pc.warp, pc.output, x, y).valid();
+        const float w = shown ? sample_blend(pc.blend, pc.output, x, y) : 0.0F;
+        const std::array<float, 3> beta = sample_beta(pc.beta, pc.output, x, y);
+        if (w > 0.0F) ++pt.lit;
+        if (w > most) {
+            most = w;
+            pt.shown_by = static_cast<int>(k);
+            pt.pixel = *xy;
+        }
+        const rig::RigProjector& rp = rig.projectors[k];
+        const double f = rig::projector_falloff(rp, x + 0.5, y + 0.5);
+        for (std::size_t c = 0; c < 3; ++c) {
+            const double signal =
+                shown ? apply_response(pc.response, static_cast<int>(c), static_cast<float>(level) * w + beta[c]) : 0.0;
+            pt.rgb[c] +=
+                f * rp.brightness[c] * (rp.black_level + (1.0 - rp.black_level) * std::pow(signal, rp.gamma[c]));
+        }
+    }
+    return pt;
+}
 
 // The light at every grid point for flat content `level`.
 std::vector<Point> screen_light(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double level,
                                 double inset) {
     std::vector<Point> points;
-    for (const rig::ScreenPoint& s : seam_grid(rig, inset)) {
-        Point pt;
-        pt.rgb = {rig.ambient, rig.ambient, rig.ambient};
-        for (std::size_t k = 0; k < calibration.projectors.size(); ++k) {
-            const ProjectorCalibration& pc = calibration.projectors[k];
-            const auto xy = output_pixel(rig, static_cast<int>(k), pc, s);
-            if (!xy) continue;
-            const auto [x, y] = *xy;
-            const bool shown = sample_warp(pc.warp, pc.output, x, y).valid();
-            const float w = shown ? sample_blend(pc.blend, pc.output, x, y) : 0.0F;
-            const std::array<float, 3> beta = sample_beta(pc.beta, pc.output, x, y);
-            if (w > 0.0F) ++pt.lit;
-            const rig::RigProjector& rp = rig.projectors[k];
-            const double f = rig::projector_falloff(rp, x + 0.5, y + 0.5);
-            for (std::size_t c = 0; c < 3; ++c) {
-                const double signal =
-                    shown ? apply_response(pc.response, static_cast<int>(c), static_cast<float>(level) * w + beta[c])
-                          : 0.0;
-                pt.rgb[c] +=
-                    f * rp.brightness[c] * (rp.black_level + (1.0 - rp.black_level) * std::pow(signal, rp.gamma[c]));
-            }
-        }
-        points.push_back(pt);
-    }
+    for (const rig::ScreenPoint& s : seam_grid(rig, inset)) points.push_back(light_at(rig, calibration, level, s));
     return points;
+}
+
+// The light of `p` averaged over the footprint of the output pixel that shows it (p.shown_by's), at
+// kSub x kSub points of that pixel placed on the screen by the rig's true projector.
+std::array<double, 3> pixel_light(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double level,
+                                  const Point& p) {
+    constexpr int kSub = 8;
+    std::array<double, 3> sum{};
+    int n = 0;
+    for (int j = 0; j < kSub; ++j) {
+        for (int i = 0; i < kSub; ++i) {
+            const auto s =
+                rig::projector_to_screen(rig, p.shown_by, p.pixel[0] + (i + 0.5) / kSub, p.pixel[1] + (j + 0.5) / kSub);
+            if (!s) continue;
+            const Point q = light_at(rig, calibration, level, *s);
+            for (std::size_t c = 0; c < 3; ++c) sum[c] += q.rgb[c];
+            ++n;
+        }
+    }
+    if (n == 0) return p.rgb;
+    for (double& v : sum) v /= n;
+    return sum;
 }
 
 double median(std::vector<double> v) {
@@ -119,6 +152,9 @@ SeamColour measure_seam_colour(const rig::VirtualRig& rig, const ScreenCalibrati
         if (p.lit >= 2) {
             ++out.seam_samples;
             out.seam_luminance_deviation = std::max(out.seam_luminance_deviation, dev);
+            const double pixel_dev =
+                std::abs(luminance(pixel_light(rig, calibration, level, p)) / out.reference_luminance - 1.0);
+            out.seam_luminance_pixel_max = std::max(out.seam_luminance_pixel_max, pixel_dev);
             out.seam_delta_e = std::max(out.seam_delta_e, de);
             seam_dev.push_back(dev);
             seam_de.push_back(de);

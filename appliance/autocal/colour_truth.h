@@ -27,14 +27,21 @@ struct SeamColour {
     double reference_luminance = 0.0;       // median Y over points lit by one projector
     double luminance_max_deviation = 0.0;   // max |Y / reference - 1| over all points
     double seam_luminance_deviation = 0.0;  // the same over the seam points
-    double delta_e_max = 0.0;               // max CIE76 Delta E from the reference colour, all points
-    double seam_delta_e = 0.0;              // the same over the seam points
-    double seam_luminance_p95 = 0.0;        // 95th percentile of the seam points' |Y / reference - 1|
-    double seam_delta_e_p95 = 0.0;          // 95th percentile of the seam points' Delta E
+    // The same with each seam point's light averaged over the footprint of the output pixel that shows it (the
+    // projector with the largest blend weight there): what a viewer who does not resolve a projector's pixel
+    // sees. A point alone can sit on another projector's black edge inside that pixel, a step of that
+    // projector's black that no calibration removes (one pixel's light is uniform; the black is emitted
+    // whatever the signal): |Y / reference - 1| there is at least half of it on one side of the edge.
+    double seam_luminance_pixel_max = 0.0;
+    double delta_e_max = 0.0;         // max CIE76 Delta E from the reference colour, all points
+    double seam_delta_e = 0.0;        // the same over the seam points
+    double seam_luminance_p95 = 0.0;  // 95th percentile of the seam points' |Y / reference - 1|
+    double seam_delta_e_p95 = 0.0;    // 95th percentile of the seam points' Delta E
 };
 
 // Points: a grid of 401 x 101 content points inset by `inset` of the frame on each side. The
-// reference colour is the per-channel median over points lit by one projector.
+// reference colour is the per-channel median over points lit by one projector. A seam point's pixel mean is
+// taken over 8 x 8 points of the pixel's footprint, placed on the screen by the rig's true projector.
 [[nodiscard]] SeamColour measure_seam_colour(const rig::VirtualRig& rig, const ScreenCalibration& calibration,
                                              double level, double inset = 0.01);
 

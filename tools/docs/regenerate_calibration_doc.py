@@ -30,12 +30,14 @@ def seam_cell(before, after, key, scale, fmt):
 
 
 def colour_rows(name, r):
-    """One row per content level: seam luminance and Delta E (p95 and max), before -> after."""
+    """One row per content level: seam luminance (p95, max, max of the pixel means) and Delta E (p95 and max),
+    before -> after."""
     rows = []
     g = r["ground_truth"]
     for b, a in zip(g["seams_before_colour"], g["seams"]):
         rows.append(f"| {name} | {a['level']:.2f} | {seam_cell(b, a, 'seam_luminance_p95', 100, '{:.2f}')} % | "
                     f"{seam_cell(b, a, 'seam_luminance_deviation', 100, '{:.2f}')} % | "
+                    f"{seam_cell(b, a, 'seam_luminance_pixel_max', 100, '{:.2f}')} % | "
                     f"{seam_cell(b, a, 'seam_delta_e76_p95', 1, '{:.2f}')} | "
                     f"{seam_cell(b, a, 'seam_delta_e76', 1, '{:.2f}')} |")
     return rows
@@ -72,11 +74,14 @@ def main():
              "|---|---|---|---|---|---|---|---|---|---|--:|"]
     colour = [f"Same run. Flat content at each level, the rig's ground-truth light at 401 x 101 content points; "
               "seam = points two projectors light; luminance deviation |Y / Y_ref - 1| with Y_ref the median of the "
-              "points one projector lights; CIE76 Delta E against that reference colour (CIELAB relative to the "
-              "screen's own white). Before = the geometric calibration alone (gamma 2.2 assumed, no beta); after = "
-              "with the colour and black-level step.", "",
-              "| rig | content | seam luminance p95 | seam luminance max | seam ΔE76 p95 | seam ΔE76 max |",
-              "|---|---|---|---|---|---|"]
+              "points one projector lights; pixel mean = the light averaged over the footprint of the output pixel "
+              "that shows the point (the projector with the largest blend weight there; 8 x 8 points of it); CIE76 "
+              "Delta E against that reference colour (CIELAB relative to the screen's own white). Before = the "
+              "geometric calibration alone (gamma 2.2 assumed, no beta); after = with the colour and black-level "
+              "step.", "",
+              "| rig | content | seam luminance p95 | seam luminance max | seam luminance max, pixel mean | "
+              "seam ΔE76 p95 | seam ΔE76 max |",
+              "|---|---|---|---|---|---|---|"]
     runs = []
     for rig in sorted(glob.glob(os.path.join(ROOT, "rigs", "*.toml"))):
         stem = os.path.splitext(os.path.basename(rig))[0]
