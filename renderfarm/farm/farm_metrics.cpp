@@ -218,6 +218,7 @@ void FarmMetricsFile::update(const FarmMetrics& metrics, const FarmCounters& cou
     const double now = unix_now();
     FarmCounters written = counters;
     written.up = counters.up && !stopping_;  // never 1 again once a stop signal came
+    const bool writes_up = written.up;
     try {
         metrics.write(file_, written, now);
         last_error_.clear();
@@ -229,8 +230,11 @@ void FarmMetricsFile::update(const FarmMetrics& metrics, const FarmCounters& cou
     std::string text = metrics.text(written, now);
     if (busy_.test_and_set()) return;
     down_text_ = std::move(text);
-    wrote_down_ = !counters.up || stopping_;  // the file just written already says up 0
+    wrote_down_ = !writes_up;  // the file just written already says up 0
     busy_.clear();
+    // A stop signal during the write above found the file saying up 0 and wrote its down text, which
+    // the up 1 text then replaced; mpirun may SIGKILL the admin a second later: say down now.
+    if (writes_up && stopping_) (void)write_down();
 }
 
 }  // namespace mogao

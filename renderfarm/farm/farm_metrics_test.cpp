@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -205,6 +206,36 @@ TEST(FarmMetricsFile, SaysDownFromTheStopSignalsHandler) {
     EXPECT_EQ(samples(read_text(file)).at("mogao_farm_up"), "0");
     f.update(m, counters());  // the loop's next round, before it saw the stop
     EXPECT_EQ(samples(read_text(file)).at("mogao_farm_up"), "0");
+}
+
+// The stop signal may come while the loop's update is writing up 1 (it finds the file up 1, writes
+// its down text, and the update's rename then puts up 1 back); mpirun SIGKILLs the admin a second
+// later, before any further update. The update that was interrupted must leave up 0 itself. The
+// "signal" comes from another thread at a random moment of a stream of updates; each round ends
+// after the update it interrupted, as a SIGKILL would end it.
+TEST(FarmMetricsFile, SaysDownWhenTheStopComesDuringAnUpdate) {
+    const testing::ScratchDir dir("farm-metrics-race");
+    FarmMetrics m("0");
+    int up_left = 0;
+    for (int round = 0; round < 200; ++round) {
+        const auto file = dir.path() / ("round-" + std::to_string(round) + ".prom");
+        FarmMetricsFile f(file);
+        f.update(m, counters());
+        std::atomic<bool> killed{false};
+        std::atomic<int> updates{0};
+        std::thread loop([&] {
+            while (!killed.load()) {
+                f.update(m, counters());
+                updates.fetch_add(1);
+            }
+        });
+        while (updates.load() < 3 + round % 7) std::this_thread::yield();
+        FarmMetricsFile::on_stop_signal();
+        killed = true;
+        loop.join();
+        if (samples(read_text(file)).at("mogao_farm_up") != "0") ++up_left;
+    }
+    EXPECT_EQ(up_left, 0) << "rounds whose file said up 1 after the stop";
 }
 
 // std::terminate (an exception on a gRPC thread, noexcept violated) still leaves up 0 behind. The
