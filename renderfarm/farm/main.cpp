@@ -382,6 +382,7 @@ void apply_flags(RenderCommand& r, ServeCommand& s) {
 int run_serve_command(mogao::MpiSession& mpi, mogao::FarmSetup& setup, ServeCommand& s) {
     setup.dispatch.frame_budget_s = s.frame_budget_s;
     s.options.budget.frame_s = s.frame_budget_s;
+    s.options.budget.share_min_scale = s.options.live.controller.min_scale;
     // Only the admin talks to appliances, so only the admin host holds the link's key, its
     // revocation list and the view policies (render hosts have no /etc/mogao/pki). Every rank
     // then agrees: one that returned alone would wait in MPI_Finalize while the others wait

@@ -49,6 +49,9 @@ void RequestPolicy::validate() const {
         throw std::invalid_argument(fmt::format("RequestPolicy.max_megapixels = {} must be > 0", max_megapixels));
     if (!std::isfinite(max_gigarays) || max_gigarays <= 0)
         throw std::invalid_argument(fmt::format("RequestPolicy.max_gigarays = {} must be > 0", max_gigarays));
+    if (!(min_resolution_scale >= 0 && min_resolution_scale <= 1))
+        throw std::invalid_argument(
+            fmt::format("RequestPolicy.min_resolution_scale = {} must be in [0, 1]", min_resolution_scale));
 }
 
 LightCounts LightCounts::of(const Scene& scene) {
@@ -86,6 +89,7 @@ PolicyDecision apply_request_policy(const ViewRequest& request, const LightCount
     halve_while_over(v, q.max_bounces, 0, "max_bounces", lights, budget, d.changes);
     const auto too_many_rays = [&](const ViewRequest& r) { return estimated_rays(r, lights) > budget; };
     if (too_many_rays(v)) scale_pixels(v, budget / estimated_rays(v, lights), too_many_rays);
+    q.resolution_scale = std::max(q.resolution_scale, std::min(requested_scale, policy.min_resolution_scale));
     if (q.resolution_scale < requested_scale) note(d.changes, "resolution_scale", requested_scale, q.resolution_scale);
     d.degraded = !d.changes.empty();
     d.rendered_rays = estimated_rays(v, lights);

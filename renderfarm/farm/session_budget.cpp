@@ -18,6 +18,9 @@ SessionBudgets::SessionBudgets(TimeBudget budget, LightCounts lights) : budget_(
         throw std::invalid_argument(fmt::format("TimeBudget.aim = {} must be in (0, 1]", budget_.aim));
     if (!(budget_.band >= 1) || !std::isfinite(budget_.band))
         throw std::invalid_argument(fmt::format("TimeBudget.band = {} must be finite and >= 1", budget_.band));
+    if (!(budget_.share_min_scale >= 0 && budget_.share_min_scale <= 1))
+        throw std::invalid_argument(
+            fmt::format("TimeBudget.share_min_scale = {} must be in [0, 1]", budget_.share_min_scale));
 }
 
 double SessionBudgets::rate(const std::string& who) const {
@@ -35,7 +38,16 @@ BudgetDecision SessionBudgets::apply(const ViewRequest& request, const std::stri
     RequestPolicy bound;
     bound.max_megapixels = 1e6;  // pixels are bounded by the request policy already
     bound.max_gigarays = rays_per_s * budget_.aim * out.limit_s / 1e9;
+    const bool share_governs = out.limit_s < budget_.frame_s;
+    if (share_governs) bound.min_resolution_scale = budget_.share_min_scale;
     PolicyDecision degraded = apply_request_policy(request, lights_, bound);
+    if (share_governs && degraded.rendered_rays / rays_per_s > budget_.frame_s) {
+        // The floor does not fit the frame budget itself: held to frame_s, with no floor.
+        out.limit_s = budget_.frame_s;
+        bound.min_resolution_scale = 0.0;
+        bound.max_gigarays = rays_per_s * budget_.aim * out.limit_s / 1e9;
+        degraded = apply_request_policy(request, lights_, bound);
+    }
     out.view = degraded.view;
     out.degraded = degraded.degraded;
     out.changes = degraded.changes;

@@ -39,6 +39,11 @@ struct TimeBudget {
     double aim = 0.5;                 // (0, 1]: degraded requests aim at aim * frame_s
     double band = 2.0;                // >= 1: a rate is replaced when a frame measures outside [rate/band, rate*band]
     std::size_t max_appliances = 64;  // rates remembered
+    // A request degraded to its share of the farm (share_s < frame_s) keeps at least this resolution
+    // scale: the share is the frame-time target's (live_frames.h), whose controller trades bounces, not
+    // pixels, below its floor (its min_scale, which serve passes here). Degraded to frame_s itself, a
+    // request may go lower. In [0, 1].
+    double share_min_scale = 0.5;
 };
 
 struct BudgetDecision {

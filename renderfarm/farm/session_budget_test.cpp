@@ -86,6 +86,32 @@ TEST(SessionBudgets, AShareOfTheFarmDegradesToTheShareButOnlyTheBudgetRefuses) {
     EXPECT_LE(tiny.predicted_s, 1.0);
 }
 
+// Two galleries sharing the farm: an ordinary view (1 spp, no bounces: nothing but pixels to lower)
+// over its share is held at the frame-time controller's resolution floor, not shrunk to the share
+// (the controller trades bounces below its floor; a served 184x91 frame was the result before).
+// Held to the frame budget itself, the scale may still go below the floor.
+TEST(SessionBudgets, AShareKeepsTheResolutionFloorTheBudgetDoesNot) {
+    SessionBudgets budgets({.frame_s = 1.0, .aim = 0.5, .share_min_scale = 0.5}, kRoom);
+    const ViewRequest view = ordinary_view();
+    budgets.observe("museum-1", view, 0.4);  // its full-scale frame: 0.4 s
+    const BudgetDecision shared = budgets.apply(view, "museum-1", 1.0 / 15.0);
+    EXPECT_DOUBLE_EQ(shared.view.quality.resolution_scale, 0.5);
+    SessionBudgets no_floor({.frame_s = 1.0, .aim = 0.5, .share_min_scale = 0.0}, kRoom);
+    no_floor.observe("museum-1", view, 0.4);
+    EXPECT_LT(no_floor.apply(view, "museum-1", 1.0 / 15.0).view.quality.resolution_scale, 0.3);  // as before
+    // A view whose floor does not fit the budget: held to the budget, below the floor.
+    budgets.observe("museum-1", view, 40.0);
+    const BudgetDecision slow = budgets.apply(view, "museum-1", 1.0 / 15.0);
+    EXPECT_DOUBLE_EQ(slow.limit_s, 1.0);
+    EXPECT_LT(slow.view.quality.resolution_scale, 0.5);
+    EXPECT_LE(slow.predicted_s, 1.0);
+    // A request asking for less than the floor keeps its own scale.
+    ViewRequest small = view;
+    small.quality.resolution_scale = 0.3;
+    budgets.observe("museum-3", small, 0.4);
+    EXPECT_LE(budgets.apply(small, "museum-3", 1.0 / 15.0).view.quality.resolution_scale, 0.3);
+}
+
 TEST(SessionBudgets, RefusesWhatCannotFitEvenFullyDegradedWithTheReason) {
     SessionBudgets budgets({.frame_s = 1.0}, kRoom);
     const ViewRequest dear = dear_view();
