@@ -81,6 +81,7 @@ PolicyDecision apply_request_policy(const ViewRequest& request, const LightCount
     const double requested_scale = q.resolution_scale;
     const auto too_many_pixels = [&](const ViewRequest& r) { return pixels_of(r) > max_pixels; };
     if (too_many_pixels(v)) scale_pixels(v, max_pixels / pixels_of(v), too_many_pixels);
+    const double pixel_bound_scale = q.resolution_scale;  // the floor below is the ray bound's only
 
     const double budget = policy.max_gigarays * 1e9;
     halve_while_over(v, q.spp, 1, "spp", lights, budget, d.changes);
@@ -89,7 +90,7 @@ PolicyDecision apply_request_policy(const ViewRequest& request, const LightCount
     halve_while_over(v, q.max_bounces, 0, "max_bounces", lights, budget, d.changes);
     const auto too_many_rays = [&](const ViewRequest& r) { return estimated_rays(r, lights) > budget; };
     if (too_many_rays(v)) scale_pixels(v, budget / estimated_rays(v, lights), too_many_rays);
-    q.resolution_scale = std::max(q.resolution_scale, std::min(requested_scale, policy.min_resolution_scale));
+    q.resolution_scale = std::max(q.resolution_scale, std::min(pixel_bound_scale, policy.min_resolution_scale));
     if (q.resolution_scale < requested_scale) note(d.changes, "resolution_scale", requested_scale, q.resolution_scale);
     d.degraded = !d.changes.empty();
     d.rendered_rays = estimated_rays(v, lights);

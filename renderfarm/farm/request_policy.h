@@ -31,8 +31,8 @@ struct RequestPolicy {
     double max_megapixels = 8.3;  // rendered pixels per frame, millions (8.3: 3840x2160)
     double max_gigarays = 0.1;    // estimated rays per frame, billions (12 s at 8 Mrays/s)
     // The least resolution scale the ray bound may lower a request to, in [0, 1] (0: no floor; a request
-    // asking for less keeps its own): the other knobs are lowered first, and the scale stops here even
-    // when the estimate is then still over max_gigarays.
+    // asking for less, or held lower by max_megapixels, keeps that): the other knobs are lowered first,
+    // and the scale stops here even when the estimate is then still over max_gigarays.
     double min_resolution_scale = 0.0;
     void validate() const;
 };

@@ -90,6 +90,24 @@ TEST(RequestPolicy, PixelBoundCutsTheScaleOnly) {
     EXPECT_EQ(d.view.quality.spp, 1);
 }
 
+// The resolution floor bounds the ray bound's cut only: a ray bound no floor fits leaves the scale at
+// the floor (over the ray estimate), and a pixel bound below the floor still holds.
+TEST(RequestPolicy, TheResolutionFloorHoldsAgainstRaysNotPixels) {
+    RequestPolicy policy{100.0, 1e-6};  // 1000 rays: far below any frame
+    policy.min_resolution_scale = 0.5;
+    const PolicyDecision rays = apply_request_policy(request(400, 300, 4), {}, policy);
+    EXPECT_DOUBLE_EQ(rays.view.quality.resolution_scale, 0.5);
+    EXPECT_EQ(rays.view.quality.spp, 1);  // the other knobs lowered first
+    RequestPolicy pixels{1.0, 100.0};     // 1 Mpixel: a quarter of the scale of 4000 x 4000
+    pixels.min_resolution_scale = 0.5;
+    const PolicyDecision p = apply_request_policy(request(4000, 4000, 1), {}, pixels);
+    const ImageSize size = render_size(p.view);
+    EXPECT_LE(double(size.width) * size.height, 1e6);
+    RequestPolicy bad;
+    bad.min_resolution_scale = 1.5;
+    EXPECT_THROW(bad.validate(), std::invalid_argument);
+}
+
 TEST(RequestPolicy, BadBoundsAreNamed) {
     for (const RequestPolicy& p : {RequestPolicy{0.0, 1.0}, RequestPolicy{1.0, -1.0},
                                    RequestPolicy{std::numeric_limits<double>::quiet_NaN(), 1.0}}) {
