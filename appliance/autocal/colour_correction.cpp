@@ -132,13 +132,14 @@ std::vector<std::uint32_t> coverage_masks(std::size_t k, const std::vector<Devic
 // it) L_j is the mean over kSub x kSub points of the pixel's footprint, placed on the screen through the warp: the
 // pixel's light is uniform and the other projector's black covers only part of it, so the deficit at its centre
 // alone gave the whole pixel that projector's black or none of it (a line one pixel wide of +-one projector's
-// black). Over the pixel the mean is exact, up to the geometry's error at the edge.
-std::vector<double> footprint_light(std::size_t k, const std::vector<DeviceModel>& models, const ScreenModel& screen,
-                                    const ProjectorCalibration& pc, int x, int y, double f, bool edge) {
+// black). Over the pixel the mean is exact, up to the geometry's error at the edge. Into `light` (one entry per
+// projector; the caller's buffer, reused from pixel to pixel).
+void footprint_light(std::size_t k, const std::vector<DeviceModel>& models, const ScreenModel& screen,
+                     const ProjectorCalibration& pc, int x, int y, double f, bool edge, std::vector<double>& light) {
     constexpr int kSub = 8;
     const int side = edge ? kSub : 1;
     const double arc = screen.arc_deg * kDeg;
-    std::vector<double> light(models.size(), 0.0);
+    light.assign(models.size(), 0.0);
     int n = 0;
     for (int t = 0; t < side * side || n == 0; ++t) {
         // The pixel's centre alone where it is no edge pixel, or where no point of its footprint shows content.
@@ -158,7 +159,6 @@ std::vector<double> footprint_light(std::size_t k, const std::vector<DeviceModel
     }
     for (double& l : light) l /= n;
     light[k] = f;
-    return light;
 }
 
 // Whether a neighbour of (x, y) (8-connected, among the pixels that show content) sees other projectors than
@@ -190,14 +190,14 @@ double apply_beta(std::size_t k, const std::vector<DeviceModel>& models, const S
     pc.beta.rgb.assign(static_cast<std::size_t>(out.pixel_count()) * 3, 0.0F);
     const std::vector<std::uint32_t> masks = coverage_masks(k, models, screen, pc);
     double worst = 0.0;
+    std::vector<double> light;
     for (int y = 0; y < out.height; ++y) {
         for (int x = 0; x < out.width; ++x) {
             const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(out.width) + x;
             if (masks[i] == kNotShown) continue;
             const double f = falloff_at_output(models[k], pc, x, y);
             const float alpha = sample_blend(pc.blend, out, x, y);
-            const std::vector<double> light =
-                footprint_light(k, models, screen, pc, x, y, f, crosses_edge(masks, out, x, y));
+            footprint_light(k, models, screen, pc, x, y, f, crosses_edge(masks, out, x, y), light);
             for (std::size_t c = 0; c < 3; ++c) {
                 double black = 0.0;
                 for (std::size_t j = 0; j < models.size(); ++j) black += light[j] * blacks[j][c];
@@ -224,6 +224,7 @@ void accumulate_blacks(const ProjectorCalibration& pc, std::size_t k, const std:
     const auto n = static_cast<long>(models.size());
     const std::vector<std::uint32_t> masks = coverage_masks(k, models, screen, pc);
     Eigen::VectorXd a(n + 1);
+    std::vector<double> light;
     for (int y = 0; y < pc.output.height; y += 2) {
         for (int x = 0; x < pc.output.width; x += 2) {
             if (masks[static_cast<std::size_t>(y) * static_cast<std::size_t>(pc.output.width) + x] == kNotShown) {
@@ -231,9 +232,8 @@ void accumulate_blacks(const ProjectorCalibration& pc, std::size_t k, const std:
             }
             // beta_k = alpha_k (t - sum_j b_j L_j) / F_k with w = alpha_k s S / F_k (L_j as apply_beta's).
             const double alpha = sample_blend(pc.blend, pc.output, x, y) / (scale * white);
-            const std::vector<double> light =
-                footprint_light(k, models, screen, pc, x, y, falloff_at_output(models[k], pc, x, y),
-                                crosses_edge(masks, pc.output, x, y));
+            footprint_light(k, models, screen, pc, x, y, falloff_at_output(models[k], pc, x, y),
+                            crosses_edge(masks, pc.output, x, y), light);
             a[0] = alpha;
             for (long j = 0; j < n; ++j) a[j + 1] = -alpha * light[static_cast<std::size_t>(j)];
             const std::array<float, 3> beta =
