@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -151,9 +152,12 @@ std::atomic<FarmMetricsFile*> g_current_file{nullptr};  // lock-free: read from 
 
 double unix_now() { return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count(); }
 
-// Temporary, fchmod, write, fsync, rename: each async-signal-safe (signal-safety(7)), so that a
-// signal handler may call it; no allocation, no lock, errno left as found.
-bool write_signal_safe(const char* tmp, const char* file, const std::string& text) noexcept {
+// Temporary, fchmod, write, rename: each async-signal-safe (signal-safety(7)), so that a signal
+// handler may call it; no allocation, no lock, errno left as found (0 on success, else the failing
+// call's, in `*error`). No fsync: a gauge file keeps nothing worth a power cut (the farm rewrites it
+// at its next start, and its timestamp tells staleness), while an fsync on a busy disk can take
+// seconds, and mpirun SIGKILLs the admin one second after a stop: the rename must land before that.
+bool replace_file(const char* tmp, const char* file, const std::string& text, int* error = nullptr) noexcept {
     const int saved_errno = errno;
     const int fd = ::open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     bool ok = fd >= 0 && ::fchmod(fd, 0644) == 0;
@@ -163,9 +167,9 @@ bool write_signal_safe(const char* tmp, const char* file, const std::string& tex
         ok = n > 0;
         if (ok) done += static_cast<std::size_t>(n);
     }
-    ok = ok && ::fsync(fd) == 0;
     if (fd >= 0) ok = ::close(fd) == 0 && ok;
     ok = ok && ::rename(tmp, file) == 0;
+    if (error != nullptr) *error = ok ? 0 : errno;
     if (!ok) ::unlink(tmp);
     errno = saved_errno;
     return ok;
@@ -174,8 +178,9 @@ bool write_signal_safe(const char* tmp, const char* file, const std::string& tex
 
 FarmMetricsFile::FarmMetricsFile(std::filesystem::path file) : file_(std::move(file)) {
     if (file_.empty()) return;
-    down_tmp_ =
-        (file_.parent_path() / ("." + file_.filename().string() + ".down." + std::to_string(::getpid()))).string();
+    const std::string stem = (file_.parent_path() / ("." + file_.filename().string())).string();
+    down_tmp_ = stem + ".down." + std::to_string(::getpid());
+    up_tmp_ = stem + ".up." + std::to_string(::getpid());
     g_current_file = this;
     previous_ = std::set_terminate(&FarmMetricsFile::on_terminate);
 }
@@ -202,13 +207,13 @@ void FarmMetricsFile::on_stop_signal() noexcept {
     }
 }
 
-bool FarmMetricsFile::write_down() noexcept {
+bool FarmMetricsFile::write_down(bool again, int* error) noexcept {
     // Skipped while update() is changing the text (a signal or terminate from inside it): the loop's
     // own last update, or staleness, tells then.
     if (busy_.test_and_set()) return false;
     bool ok = true;
-    if (!down_text_.empty() && !wrote_down_)
-        ok = wrote_down_ = write_signal_safe(down_tmp_.c_str(), file_.c_str(), down_text_);
+    if (!down_text_.empty() && (again || !wrote_down_))
+        ok = wrote_down_ = replace_file(down_tmp_.c_str(), file_.c_str(), down_text_, error);
     busy_.clear();
     return ok;
 }
@@ -219,22 +224,21 @@ void FarmMetricsFile::update(const FarmMetrics& metrics, const FarmCounters& cou
     FarmCounters written = counters;
     written.up = counters.up && !stopping_;  // never 1 again once a stop signal came
     const bool writes_up = written.up;
-    try {
-        metrics.write(file_, written, now);
-        last_error_.clear();
-    } catch (const std::exception& e) {
-        if (last_error_ != e.what()) spdlog::warn("metrics: {}", e.what());
-        last_error_ = e.what();
-    }
+    const std::string text = metrics.text(written, now);
     written.up = false;
-    std::string text = metrics.text(written, now);
-    if (busy_.test_and_set()) return;
-    down_text_ = std::move(text);
-    wrote_down_ = !writes_up;  // the file just written already says up 0
+    std::string down = metrics.text(written, now);
+    if (busy_.test_and_set()) return;  // only from inside a handler's write: the handler tells
+    down_text_ = std::move(down);      // the handlers' text from now on: these counts with up 0
+    wrote_down_ = false;
     busy_.clear();
-    // A stop signal during the write above found the file saying up 0 and wrote its down text, which
-    // the up 1 text then replaced; mpirun may SIGKILL the admin a second later: say down now.
-    if (writes_up && stopping_) (void)write_down();
+    int error = 0;
+    if (writes_up && !stopping_) (void)replace_file(up_tmp_.c_str(), file_.c_str(), text, &error);
+    // A stop signal during that write found the file saying up 0 and wrote its down text, which the
+    // rename then replaced with up 1: say down again, microseconds later (no fsync on either path).
+    if (!writes_up || stopping_) (void)write_down(/*again=*/true, &error);
+    const std::string message = error == 0 ? "" : "cannot write " + file_.string() + ": " + std::strerror(error);
+    if (!message.empty() && message != last_error_) spdlog::warn("metrics: {}", message);
+    last_error_ = message;
 }
 
 }  // namespace mogao

@@ -121,10 +121,13 @@ public:
 
 private:
     static void on_terminate();
-    [[nodiscard]] bool write_down() noexcept;  // false when it could not be written
+    // The last update's counts with up 0, unless written already (or `again`); false when it could not
+    // be written (`*error`: its errno, when given).
+    [[nodiscard]] bool write_down(bool again = false, int* error = nullptr) noexcept;
 
     std::filesystem::path file_;
     std::string down_tmp_;  // the temporary for write_down, built before any signal
+    std::string up_tmp_;    // update's own, so that a handler never writes into it
     std::string last_error_;
     std::string down_text_;  // the last update's text with up 0
     std::atomic_flag busy_;  // held while down_text_ changes or is written
