@@ -115,7 +115,34 @@ Eigen::Matrix3d read_rotation(const Reader& r) {
     return m;
 }
 
-DeviceModel read_device(const Reader& r, bool camera, bool distortion_allowed) {
+// A projector's lens distortion as the calibration's trial fits it: k1, k2, k3 within [-1, 1], p1, p2
+// within [-0.1, 0.1] (rig_model.cpp's limits), and the radial map r -> r (1 + k1 r^2 + k2 r^4 + k3 r^6)
+// increasing out to 1.2 times the normalised radius of the image's farthest corner, so that each image
+// position has one ray (warps and self-recalibration invert it).
+void check_projector_distortion(const Reader& r, const DeviceModel& d) {
+    const auto& k = d.distortion;
+    const std::array<double, 5> limit{1.0, 1.0, 0.1, 0.1, 1.0};
+    for (std::size_t i = 0; i < k.size(); ++i) {
+        if (!(std::abs(k[i]) <= limit[i])) {
+            r.fail(fmt::format("distortion[{}]", i),
+                   fmt::format(" = {} is outside [-{}, {}] (a projection lens's)", k[i], limit[i], limit[i]));
+        }
+    }
+    double corner2 = 0.0;
+    for (const double x : {0.0, double(d.resolution.width)})
+        for (const double y : {0.0, double(d.resolution.height)})
+            corner2 = std::max(corner2, std::pow((x - d.cx_px) / d.fx_px, 2) + std::pow((y - d.cy_px) / d.fy_px, 2));
+    for (int i = 0; i <= 100; ++i) {
+        const double r2 = 1.44 * corner2 * (i / 100.0) * (i / 100.0);
+        if (!(1.0 + r2 * (3.0 * k[0] + r2 * (5.0 * k[1] + r2 * 7.0 * k[4])) > 0.0)) {
+            r.fail("distortion", fmt::format(" is not one-to-one out to 1.2 times the image's corners (d/dr of "
+                                             "r (1 + k1 r^2 + k2 r^4 + k3 r^6) <= 0 at r = {:.4g})",
+                                             std::sqrt(r2)));
+        }
+    }
+}
+
+DeviceModel read_device(const Reader& r, bool camera) {
     DeviceModel d;
     const Json& id = r.at("id");
     if (!id.is_string() || id.get<std::string>().empty() || id.get<std::string>().size() > 256) {
@@ -130,15 +157,8 @@ DeviceModel read_device(const Reader& r, bool camera, bool distortion_allowed) {
     d.cx_px = r.number("cx_px", -kBig, kBig, "[-1e6, 1e6] px");
     d.cy_px = r.number("cy_px", -kBig, kBig, "[-1e6, 1e6] px");
     const std::vector<double> k = r.numbers("distortion", 5, -kBig, kBig, "[-1e6, 1e6]");
-    for (std::size_t i = 0; i < 5; ++i) {
-        if (!camera && !distortion_allowed && k[i] != 0.0) {
-            r.fail(fmt::format("distortion[{}]", i),
-                   " must be 0 (projectors are pinholes here: self-recalibration does not model a projector's lens "
-                   "distortion, which this calibration's distortion trial kept: calibrate again with "
-                   "--pinhole-projectors, or run without self-recalibration)");
-        }
-        d.distortion[i] = k[i];
-    }
+    std::copy(k.begin(), k.end(), d.distortion.begin());
+    if (!camera) check_projector_distortion(r, d);
     d.rotation = read_rotation(r);
     const std::vector<double> p = r.numbers("position_m", 3, -1e3, 1e3, "[-1000, 1000] m");
     d.position_m = Eigen::Vector3d(p[0], p[1], p[2]);
@@ -192,11 +212,11 @@ Json models_json(const CalibrationModels& m, const std::string& name) {
                 {"camera", device_json(m.camera)},
                 {"projectors", projectors}};
     // nlohmann would write a non-finite number as null: validate so that what is written reads back.
-    (void)models_from_json(out, name, true);
+    (void)models_from_json(out, name);
     return out;
 }
 
-CalibrationModels models_from_json(const Json& json, const std::string& name, bool projector_distortion) {
+CalibrationModels models_from_json(const Json& json, const std::string& name) {
     const Reader root(name, json, "");
     const Json& format = root.at("format");
     if (format != kFormat) root.fail("format", fmt::format(" = {} is not \"{}\"", format.dump(), kFormat));
@@ -205,14 +225,13 @@ CalibrationModels models_from_json(const Json& json, const std::string& name, bo
         root.fail("version", fmt::format(" = {} is not {} (the one this reader knows)", version.dump(), kVersion));
     CalibrationModels m;
     m.screen = read_screen(root.child("screen"));
-    m.camera = read_device(root.child("camera"), true, true);
+    m.camera = read_device(root.child("camera"), true);
     const Json& projectors = root.at("projectors");
     if (!projectors.is_array() || projectors.empty() || projectors.size() > kMaxProjectors) {
         root.fail("projectors", fmt::format(" must be an array of 1 to {} projectors", kMaxProjectors));
     }
     for (std::size_t k = 0; k < projectors.size(); ++k) {
-        m.projectors.push_back(
-            read_device(Reader(name, projectors[k], fmt::format("projectors[{}]", k)), false, projector_distortion));
+        m.projectors.push_back(read_device(Reader(name, projectors[k], fmt::format("projectors[{}]", k)), false));
     }
     return m;
 }

@@ -13,13 +13,11 @@
 //   DEVICE = {"id": "proj0", "resolution": [width, height],   // pixels, [1, 16384] per side
 //             "fx_px", "fy_px",                                 // focal lengths, pixels, > 0
 //             "cx_px", "cy_px",                                 // principal point, image positions
-//             "distortion": [k1, k2, p1, p2, k3],               // OpenCV Brown-Conrady; a projector's is
-//                                                                // written as fitted (the distortion
-//                                                                // trial), read back only by
-//                                                                // models_from_json(.., true): readers
-//                                                                // that model projectors as pinholes
-//                                                                // (read_models: self-recalibration)
-//                                                                // refuse it, naming the field
+//             "distortion": [k1, k2, p1, p2, k3],               // OpenCV Brown-Conrady; a projector's as
+//                                                                // fitted (the distortion trial; zeros for
+//                                                                // a pinhole): k1, k2, k3 in [-1, 1], p1, p2
+//                                                                // in [-0.1, 0.1], one-to-one out to 1.2x
+//                                                                // the image's corners
 //             "rotation": [[r00, r01, r02], [..], [..]],         // device -> screen frame, row-major,
 //                                                                // orthonormal, det +1 (within 1e-6)
 //             "position_m": [x, y, z],                          // device centre, screen frame, metres
@@ -66,16 +64,13 @@ struct CalibrationModels {
 // not read back (non-finite numbers, bad sizes): nothing invalid is written.
 [[nodiscard]] nlohmann::json models_json(const CalibrationModels& models, const std::string& name = "models");
 
-// Parses and validates `json` as read from `name`; a projector's distortion must be 0 unless
-// `projector_distortion`. Throws ModelStoreError.
-[[nodiscard]] CalibrationModels models_from_json(const nlohmann::json& json, const std::string& name,
-                                                 bool projector_distortion = false);
+// Parses and validates `json` as read from `name`. Throws ModelStoreError.
+[[nodiscard]] CalibrationModels models_from_json(const nlohmann::json& json, const std::string& name);
 
 // Writes atomically. Throws ModelStoreError (invalid models) or std::system_error naming the file.
 void write_models(const std::filesystem::path& file, const CalibrationModels& models);
 
-// Reads and validates (at most 16 MiB), projectors as pinholes (what self-recalibration models). Throws
-// ModelStoreError naming the file.
+// Reads and validates (at most 16 MiB). Throws ModelStoreError naming the file.
 [[nodiscard]] CalibrationModels read_models(const std::filesystem::path& file);
 
 // The models belong to `calibration`: as many projectors, the same ids in the same order and the

@@ -89,12 +89,10 @@ TEST_F(ModelStoreTest, RoundTripKeepsEveryField) {
     // A flat projector writes no "falloff" (files from before it read the same); absent reads flat.
     EXPECT_FALSE(models_json(models_)["projectors"][0].contains("falloff"));
     EXPECT_FALSE(fs::exists(file.string() + ".tmp")) << "no temporary left behind";
-    // A projector's fitted lens distortion is written; models_from_json(.., true) reads it back.
+    // A projector's fitted lens distortion is written and read back (self-recalibration models it).
     models_.projectors[2].distortion = {-0.04, 0.01, 0.001, -0.002, 0.0};
     write_models(file, models_);
-    const CalibrationModels lens = models_from_json(models_json(models_), file.string(), true);
-    EXPECT_EQ(lens.projectors[2].distortion, models_.projectors[2].distortion);
-    EXPECT_THROW((void)read_models(file), ModelStoreError);
+    EXPECT_EQ(read_models(file).projectors[2].distortion, models_.projectors[2].distortion);
 }
 
 TEST_F(ModelStoreTest, MatchesTheCalibrationBuiltFromIt) {
@@ -156,11 +154,12 @@ TEST_F(ModelStoreTest, BadInputNamesFileFieldAndLimit) {
                   j["projectors"][1]["falloff"][3] = -3.0;
               }).find(file + ": projectors[1].falloff gives "),
               std::string::npos);
-    // A projector's lens distortion (the calibration's distortion trial): written and read back where the reader
-    // says it models it; refused by read_models, whose readers (self-recalibration) take projectors as pinholes.
-    EXPECT_NE(error_of([](nlohmann::json& j) { j["projectors"][0]["distortion"][0] = 0.1; })
-                  .find(file + ": projectors[0].distortion[0] must be 0 (projectors are pinholes here: "
-                               "self-recalibration does not model"),
+    // A projector's lens distortion: within a projection lens's coefficients, and one ray per image position.
+    EXPECT_EQ(error_of([](nlohmann::json& j) { j["projectors"][0]["distortion"][2] = 0.5; }),
+              file + ": projectors[0].distortion[2] = 0.5 is outside [-0.1, 0.1] (a projection lens's)");
+    EXPECT_NE(error_of([](nlohmann::json& j) {
+                  j["projectors"][0]["distortion"] = {-0.9, 0.0, 0.0, 0.0, 0.0};
+              }).find(file + ": projectors[0].distortion is not one-to-one out to 1.2 times the image's corners"),
               std::string::npos);
     EXPECT_EQ(error_of([](nlohmann::json& j) {
                   j["camera"]["resolution"] = {640.5, 480};

@@ -65,8 +65,9 @@ double bilinear(const cv::Mat1f& m, double x, double y) {
 double blend_at(const autocal::DeviceModel& d, const ProjectorCalibration& pc, const Eigen::Vector3d& s) {
     const Eigen::Vector2d n = project_normalised(d.rotation, d.position_m, s);
     if (!n.allFinite()) return 0.0;
-    const double x = n.x() * d.fx_px + d.cx_px;
-    const double y = n.y() * d.fy_px + d.cy_px;
+    const Eigen::Vector2d px = autocal::device_image(d, {n.x(), n.y(), 1.0});  // through its lens distortion
+    const double x = px.x();
+    const double y = px.y();
     if (!(x >= 0.0 && y >= 0.0 && x < d.resolution.width && y < d.resolution.height)) return 0.0;
     return sample_blend(pc.blend, pc.output, static_cast<int>(x), static_cast<int>(y));
 }

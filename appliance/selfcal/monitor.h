@@ -4,7 +4,9 @@
 // match features between prediction and camera frame (ORB: Rublee, Rabaud, Konolige, Bradski 2011;
 // Lowe's ratio test, Lowe 2004), and turn the matches into a robust pose of the camera and of each
 // projector (robust_pose.h), using what is known: the screen is the cylinder, devices are rigid
-// pinholes with fixed intrinsics. Visitors in front of the screen are masked first (cells whose
+// with fixed intrinsics and lens distortion (a bump moves a pose, never a lens), so every fit is
+// on undistorted normalised rays, pinhole maths, and pixels come through the distortion
+// (autocal::device_image, device_ray). Visitors in front of the screen are masked first (cells whose
 // brightness disagrees with the prediction in a coherent blob; monitor.cpp, occluder_mask) so
 // that the content they carry displaced never reaches a fit.
 //

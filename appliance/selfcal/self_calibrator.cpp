@@ -149,12 +149,14 @@ double SelfCalibrator::device_drift_px(const autocal::DeviceModel& d, const Pose
         for (int i = 0; i < kGx; ++i) {
             const double x = (i + 0.5) * d.resolution.width / kGx;
             const double y = (j + 0.5) * d.resolution.height / kGy;
-            const Eigen::Vector3d ray((x - d.cx_px) / d.fx_px, (y - d.cy_px) / d.fy_px, 1.0);
-            const Eigen::Vector3d s = autocal::ray_on_screen(m.screen, d, ray);
+            // Through the device's lens distortion both ways (a bump moves the pose, not the lens).
+            const Eigen::Vector3d s = autocal::ray_on_screen(m.screen, d, autocal::device_ray(d, x, y));
             if (!s.allFinite()) continue;
-            const Eigen::Vector2d q = project_normalised(moved.rotation, moved.position_m, s);
+            const Eigen::Vector2d seen = project_normalised(moved.rotation, moved.position_m, s);
+            if (!seen.allFinite()) continue;
+            const Eigen::Vector2d q = autocal::device_image(d, {seen.x(), seen.y(), 1.0});
             if (!q.allFinite()) continue;
-            sum += std::hypot(q.x() * d.fx_px + d.cx_px - x, q.y() * d.fy_px + d.cy_px - y);
+            sum += std::hypot(q.x() - x, q.y() - y);
             ++n;
         }
     }
@@ -178,8 +180,7 @@ double SelfCalibrator::on_screen_fraction(const autocal::DeviceModel& d) const {
         for (int i = 0; i < kG; ++i) {
             const double x = (i + 0.5) * d.resolution.width / kG;
             const double y = (j + 0.5) * d.resolution.height / kG;
-            const Eigen::Vector3d p =
-                autocal::ray_on_screen(s, d, {(x - d.cx_px) / d.fx_px, (y - d.cy_px) / d.fy_px, 1.0});
+            const Eigen::Vector3d p = autocal::ray_on_screen(s, d, autocal::device_ray(d, x, y));
             if (!p.allFinite()) continue;
             const double theta = std::atan2(p.x(), -p.z());
             if (std::abs(theta) <= half_arc && p.y() >= s.bottom_m && p.y() <= s.top_m) ++on;

@@ -15,6 +15,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "appliance/autocal/colour_truth.h"
+#include "appliance/autocal/model_store.h"
 #include "appliance/autocal/rig_bridge.h"
 #include "appliance/rig/rig_file.h"
 #include "appliance/selfcal/calibration_store.h"
@@ -99,6 +100,43 @@ TEST(SelfcalRig, StartingFromAFullCalibrationsEstimateABumpIsStillCorrected) {
     } catch (const std::invalid_argument& e) {
         EXPECT_NE(std::string(e.what()).find("calibrate at the same"), std::string::npos) << e.what();
     }
+}
+
+// Every projection lens distorts. On rigs/realistic-lens.toml (projector k1 up to 0.04, the rig's [prior]
+// errors) the full calibration keeps each projector's distortion; the monitor starts from its models file
+// as the kiosk does (written, read back), fits poses on undistorted rays and must correct a bump as on
+// pinholes, and must not take the lens for a drift before it.
+TEST(SelfcalRig, StartingFromAnEstimateWithProjectorLensDistortionABumpIsCorrected) {
+    SimulationOptions o = quick(16);
+    const rig::VirtualRig rig = rig::load_rig(std::string(MOGAO_SOURCE_DIR) + "/rigs/realistic-lens.toml");
+    const rig::VirtualRig scaled = autocal::scaled_rig(rig, o.projector_scale, o.camera_scale);
+    autocal::RigPatternSource source(scaled);
+    const autocal::AutocalResult est = autocal::calibrate(source, autocal::prior_from_rig(scaled), {1920, 1080});
+    int distorting = 0;
+    for (const autocal::DeviceModel& d : est.projectors) distorting += std::abs(d.distortion[0]) > 0.01 ? 1 : 0;
+    ASSERT_GE(distorting, 2) << "the estimate should keep the projectors' lens distortion";
+    const std::filesystem::path file =
+        std::filesystem::temp_directory_path() / ("selfcal-lens-" + std::to_string(::getpid()) + ".models.json");
+    autocal::write_models(file, {est.screen, est.camera, est.projectors});
+    const autocal::CalibrationModels read = autocal::read_models(file);
+    std::filesystem::remove(file);
+    o.start_model = SystemModel{read.screen, read.camera, read.projectors};
+    Bump b = parse_bump(scaled, "proj1:yaw=1deg");
+    b.at_s = 2.0;
+    o.bumps = {b};
+    const SimulationReport r = simulate(rig, o);
+    EXPECT_LT(r.start_error_px, 0.5);
+    for (const SimulationFrame& f : r.frames) {
+        if (f.t_s < b.at_s) {
+            EXPECT_EQ(f.state, SelfcalState::calibrated) << "t=" << f.t_s << "\n" << journal(r);
+        }
+    }
+    ASSERT_TRUE(r.detected_after_s.has_value()) << journal(r);
+    EXPECT_LE(*r.detected_after_s, 2.0);
+    ASSERT_TRUE(r.corrected_after_s.has_value()) << journal(r);
+    EXPECT_EQ(r.corrections, 1) << journal(r);
+    EXPECT_LT(r.final_error_px, 1.0);
+    EXPECT_EQ(r.final_state, SelfcalState::calibrated);
 }
 
 // The shift goal: a 10 mm shift (about 3 projector pixels at half resolution) is

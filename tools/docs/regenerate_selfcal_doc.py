@@ -13,11 +13,12 @@ Figures there are never pasted.
                                            [--only scenarios|autocal]
 
 A second table (<!-- generated:selfcal-from-autocal -->) starts the monitor from a full
-calibration's estimate instead of the rig's exact models: `mogao-calibrate-sim rig --rig
-rigs/standard.toml --scale S` on the same rig, its calibration.models.json passed to
-`mogao-calibrate-sim selfcal-simulate --models`, at half resolution and at full resolution (three 1920x1080
-projectors, the 1280x720 camera: the appliance's own cost per monitored frame). --only regenerates
-one of the two tables.
+calibration's estimate instead of the rig's exact models: `mogao-calibrate-sim rig --rig RIG --scale S`
+on the same rig, its calibration.models.json passed to `mogao-calibrate-sim selfcal-simulate --models`:
+rigs/standard.toml at half resolution and at full resolution (three 1920x1080 projectors, the 1280x720
+camera: the appliance's own cost per monitored frame), and the rigs/realistic*.toml rigs (a real
+installation's errors, projector lens distortion kept) at half resolution, realistic-lens also at full.
+--only regenerates one of the two tables.
 
 --long-static-frames is the long static run (default 1200: 10 simulated minutes; 7200: the
 simulated hour, a benchmark of about 20 minutes of a core; 0: none), run beside the others at
@@ -30,6 +31,8 @@ import argparse, datetime, os, platform, re, subprocess, sys, tempfile
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BLOCK = re.compile(r"^<!-- generated:selfcal-scenarios -->\n.*?^<!-- /generated -->$", re.S | re.M)
 AUTOCAL_BLOCK = re.compile(r"^<!-- generated:selfcal-from-autocal -->\n.*?^<!-- /generated -->$", re.S | re.M)
+# Rigs with a real installation's errors, and the calibration flags each needs (docs/calibration.md's rig table).
+REALISTIC = {"realistic": [], "realistic-lens": [], "realistic-optics": [], "realistic-install": ["--fit-screen"]}
 COMMON = ["--rate-hz", "2", "--bump-at-s", "2", "--projector-scale", "0.5", "--camera-scale", "0.5"]
 
 
@@ -85,7 +88,7 @@ def scenarios(static_frames):
 
 
 def autocal_scenarios(static_frames):
-    """(name, scale, extra): runs started from autocal's estimate at that scale (projectors and camera)."""
+    """(rig stem, name, scale, extra): runs started from autocal's estimate at that scale (projectors and camera)."""
     half = [(f"proj1 {axis} {deg}°", ["--bump", f"proj1:{axis}={deg}deg", "--frames", "60"])
             for axis, deg in (("yaw", "0.2"), ("yaw", "1"), ("yaw", "3"), ("pitch", "1"), ("roll", "1"))]
     half += [("proj1 shift 10 mm (x)", ["--bump", "proj1:x=10mm", "--frames", "60"]),
@@ -103,7 +106,17 @@ def autocal_scenarios(static_frames):
     full += [
             ("static, 1 min, visitors 10–40 %, exposure ±30 %, full resolution",
              ["--frames", "120", "--occlusion", "0.1", "--occlusion-max", "0.4", "--exposure-jitter", "0.3"])]
-    return [(n, "0.5", e) for n, e in half] + [(n, "1", e) for n, e in full]
+    out = [("standard", n, "0.5", e) for n, e in half] + [("standard", n, "1", e) for n, e in full]
+    # The rigs with a real installation's errors (their [prior]: camera intrinsics, screen, projector lenses):
+    # the monitor starts from a calibration that estimated what the rig did not hand it, lens distortion kept.
+    for stem in REALISTIC:
+        out += [(stem, "proj1 yaw 1°", "0.5", ["--bump", "proj1:yaw=1deg", "--frames", "60"]),
+                (stem, "proj1 shift 10 mm (x)", "0.5", ["--bump", "proj1:x=10mm", "--frames", "60"]),
+                (stem, f"static, {static_frames / 2 / 60:.0f} min, visitors 10–40 %, exposure ±30 %", "0.5",
+                 ["--frames", str(static_frames), "--occlusion", "0.1", "--occlusion-max", "0.4",
+                  "--exposure-jitter", "0.3"])]
+    out.append(("realistic-lens", "proj1 yaw 1°, full resolution", "1", ["--bump", "proj1:yaw=1deg", "--frames", "40"]))
+    return out
 
 
 def field(text, pattern, default="—"):
@@ -158,12 +171,13 @@ def write_block(pattern, tag, lines):
 def from_autocal_table(args, tool):
     """The monitor started from autocal's estimate (the full calibration's residual included)."""
     autocal = os.path.join(ROOT, args.build, "kiosk", "calibrate", "mogao-calibrate-sim")
-    rig = os.path.join(ROOT, "rigs", "standard.toml")
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
                             text=True).stdout.strip()
     lines = [f"Run {datetime.date.today()} at commit {commit} on {platform.node()} by "
              f"`tools/docs/regenerate_selfcal_doc.py --only autocal --static-frames {args.static_frames}`: "
-             "rigs/standard.toml calibrated by `mogao-calibrate-sim rig --rig rigs/standard.toml --scale S` (S = 0.5: "
+             "rigs/standard.toml (rows without a rig name) and the rigs/realistic*.toml rigs (named; their "
+             "errors in the prior, projector lens distortion kept by the calibration, `realistic-install` with "
+             "`--fit-screen`) calibrated by `mogao-calibrate-sim rig --rig RIG --scale S` (S = 0.5: "
              "projectors and camera at half resolution; S = 1: three 1920x1080 projectors and the 1280x720 camera), "
              "the monitor started from its calibration.models.json "
              "(`mogao-calibrate-sim selfcal-simulate --models`), errors against "
@@ -176,29 +190,30 @@ def from_autocal_table(args, tool):
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     with tempfile.TemporaryDirectory() as work:
         models = {}
-        for scale in ("0.5", "1"):
-            out = os.path.join(work, scale)
-            os.makedirs(out)
-            p = subprocess.run([autocal, "rig", "--rig", rig, "--out", out, "--scale", scale],
-                               capture_output=True, text=True)
-            if p.returncode != 0:
-                sys.exit(f"mogao-calibrate-sim rig --scale {scale} failed: {p.stderr.strip()}")
-            models[scale] = os.path.join(out, "calibration.models.json")
-        for name, scale, extra in autocal_scenarios(args.static_frames):
+        for stem, name, scale, extra in autocal_scenarios(args.static_frames):
+            rig = os.path.join(ROOT, "rigs", stem + ".toml")
+            if (stem, scale) not in models:
+                out = os.path.join(work, f"{stem}-{scale}")
+                os.makedirs(out)
+                p = subprocess.run([autocal, "rig", "--rig", rig, "--out", out, "--scale", scale] +
+                                   REALISTIC.get(stem, []), capture_output=True, text=True)
+                if p.returncode != 0:
+                    sys.exit(f"mogao-calibrate-sim rig --rig {rig} --scale {scale} failed: {p.stderr.strip()}")
+                models[(stem, scale)] = os.path.join(out, "calibration.models.json")
             jitter = [] if "--exposure-jitter" in extra else ["--exposure-jitter", "0.1"]
             cmd = [tool, "selfcal-simulate", "--rig", rig, "--rate-hz", "2", "--bump-at-s", "2", "--projector-scale",
                    scale,
-                   "--camera-scale", scale, "--models", models[scale]] + jitter + extra
+                   "--camera-scale", scale, "--models", models[(stem, scale)]] + jitter + extra
             p = subprocess.run(cmd, capture_output=True, text=True)
             if p.returncode != 0:
-                sys.exit(f"{name}: mogao-calibrate-sim selfcal-simulate failed: {p.stderr.strip()}")
-            lines.append(row(f"{name} (x{scale})" if scale != "1" else name, p.stdout, start=True))
+                sys.exit(f"{stem}: {name}: mogao-calibrate-sim selfcal-simulate failed: {p.stderr.strip()}")
+            label = (f"{stem}: " if stem != "standard" else "") + name + (f" (x{scale})" if scale != "1" else "")
+            lines.append(row(label, p.stdout, start=True))
             print(lines[-1], flush=True)
     write_block(AUTOCAL_BLOCK, "selfcal-from-autocal", lines)
 
 
 def scenarios_table(args, tool):
-    rig = os.path.join(ROOT, "rigs", "standard.toml")
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
                             text=True).stdout.strip()
     hour = f" --long-static-frames {args.long_frames}"
