@@ -2,12 +2,15 @@
 // The self-recalibration state machine (self_calibrator.h).
 #include "appliance/selfcal/self_calibrator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <numbers>
 #include <stdexcept>
 #include <utility>
+
+#include <Eigen/Cholesky>
 
 #include "appliance/autocal/bundle_adjust.h"
 #include "appliance/autocal/colour_calibration.h"
@@ -16,6 +19,13 @@
 namespace mogao::selfcal {
 
 namespace {
+
+// Whether measurement z (covariance r) is nearer "no change" than the filter's state x, in r's metric.
+bool says_no_change(const Pose6& z, const Cov6& r, const Pose6& x) {
+    const Eigen::LDLT<Cov6> ldlt(r);
+    const Pose6 to_state = z - x;
+    return z.dot(ldlt.solve(z)) < to_state.dot(ldlt.solve(to_state));
+}
 
 constexpr double kRad2Deg = 180.0 / std::numbers::pi;
 // A matched feature's position error is not independent of its neighbours' (same blur, same
@@ -104,6 +114,8 @@ SelfCalibrator::SelfCalibrator(const SystemModel& model, const ScreenCalibration
     }
     filters_.assign(model.projectors.size(), PoseKalman(options.kalman));
     typical_matches_.assign(model.projectors.size(), -1.0);
+    contested_.assign(model.projectors.size(), 0);
+    seen_above_.assign(model.projectors.size(), 0);
     lost_since_.assign(model.projectors.size(), -1.0);
 }
 
@@ -200,7 +212,10 @@ void SelfCalibrator::filter(const FrameMeasurement& m, double dt, StepResult& r)
             ++short_of_evidence;
             continue;
         }
-        (void)filters_[k].update(pm.delta, kCovarianceInflation * pm.fit.covariance);
+        const Pose6 before = filters_[k].state();
+        const Cov6 rk = kCovarianceInflation * pm.fit.covariance;
+        contested_[k] =
+            filters_[k].update(pm.delta, rk) == KalmanUpdate::rejected && says_no_change(pm.delta, rk, before);
         ps.measured = true;
         const double seen = static_cast<double>(pm.matches);
         typical_matches_[k] = typical_matches_[k] < 0.0 ? seen : 0.8 * typical_matches_[k] + 0.2 * seen;
@@ -278,6 +293,8 @@ void SelfCalibrator::advance_correction(double t_s, StepResult& r) {
     m.projectors = after_models_;
     monitor_.set_reference(m, wall_);
     for (PoseKalman& f : filters_) f.reset();
+    std::fill(contested_.begin(), contested_.end(), 0);
+    std::fill(seen_above_.begin(), seen_above_.end(), 0);
     state_ = SelfcalState::calibrated;
     std::string saved = "not saved (no store)";
     if (!options_.store.empty()) {
@@ -309,9 +326,17 @@ void SelfCalibrator::decide(double t_s, StepResult& r) {
         // Hysteresis: once detected, a drift stays until it falls under half the threshold, so a
         // drift near the threshold cannot restart the hold time frame after frame.
         const bool holding = state_ == SelfcalState::drift_detected || state_ == SelfcalState::cannot_correct;
-        const bool above = holding ? ps.drift_px > 0.5 * options_.drift_threshold_px
-                                   : ps.drift_px > options_.drift_threshold_px &&
-                                         filters_[k].significance() > options_.kalman.gate_chi2;
+        // A measurement the filter rejected that says "no change" contests the drift: the state came from
+        // an earlier, wrong measurement (few matches behind visitors, errors its covariance understates),
+        // and correcting on it would move a projector that never moved. It stays contested until a
+        // measurement is accepted or the rejected ones make a step (PoseKalman).
+        // A fresh drift must be seen in two measured frames in a row: one measurement the filter accepted
+        // can carry it past the threshold alone.
+        const bool fresh = ps.drift_px > options_.drift_threshold_px &&
+                           filters_[k].significance() > options_.kalman.gate_chi2 && !contested_[k];
+        if (ps.measured) seen_above_[k] = fresh ? seen_above_[k] + 1 : 0;
+        const bool above = !contested_[k] &&
+                           (holding ? ps.drift_px > 0.5 * options_.drift_threshold_px : fresh && seen_above_[k] >= 2);
         if (above) {
             drifting.push_back(static_cast<int>(k));
         }

@@ -154,6 +154,8 @@ private:
     std::string reason_;
     bool report_after_ = false;
     std::vector<double> typical_matches_;  // per projector: running mean of its matches when measured
+    std::vector<char> contested_;          // per projector: its last measurement, rejected, said "no change"
+    std::vector<int> seen_above_;          // per projector: measured frames in a row with a fresh drift
     std::vector<double> lost_since_;       // per projector: since when it is lost, -1 if not
     bool pattern_mode_ = false;            // the pattern pair is wanted
     double pattern_since_ = 0.0;
