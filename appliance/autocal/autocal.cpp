@@ -22,6 +22,9 @@
 namespace mogao::autocal {
 namespace {
 
+// The start's edge gate with the screen still to be fitted, in units of AutocalOptions::max_edge_rms_m.
+constexpr double kStartEdgeGateScale = 5.0;
+
 constexpr double kDeg = std::numbers::pi / 180.0;
 
 // A straight piece of a device's image border, image positions (pixel centres at +0.5).
@@ -288,7 +291,12 @@ EdgeFit fit_camera_to_lit_screen(PatternSource& source, const CalibrationPrior& 
     report.captures = 2 * frames;
     cv::Mat1f lit;
     cv::subtract(white, black, lit);
-    EdgeFit edge = fit_camera_pose(lit, prior, options);
+    // With the screen still to be fitted, an edge fit on the prior's cylinder is only a start (a radius or arc 2 %
+    // off, as a tape measures them, leaves the lit edges 10-15 mm off it): its gate is five times looser here, a
+    // sanity limit, and the gate itself holds the bundle adjustment's edge fit (adopt_bundle).
+    AutocalOptions start_options = options;
+    if (options.fit_screen) start_options.max_edge_rms_m = kStartEdgeGateScale * options.max_edge_rms_m;
+    EdgeFit edge = fit_camera_pose(lit, prior, start_options);
     report.edge_points = edge.points;
     report.edge_rms_m = edge.rms_m;
     report.camera_position_m = edge.camera.position_m;
@@ -338,6 +346,14 @@ void adopt_bundle(const BundleResult& ba, const CalibrationPrior& prior, const A
     result.projectors = ba.projectors;
     result.report.camera_position_m = ba.camera.position_m;
     result.report.edge_rms_m = ba.edge_rms_m;
+    if (options.fit_screen && ba.edge_rms_m > options.max_edge_rms_m) {
+        throw CalibrationRefused("camera pose: edge fit rms " + std::to_string(ba.edge_rms_m * 1000.0) +
+                                 " mm above its gate " + std::to_string(options.max_edge_rms_m * 1000.0) +
+                                 " mm after the bundle adjustment with the screen fitted (radius " +
+                                 std::to_string(ba.screen.radius_m) + " m, arc " + std::to_string(ba.screen.arc_deg) +
+                                 " deg): the screen is not a cylinder of the prior's heights, or the camera's "
+                                 "intrinsics are off");
+    }
     for (std::size_t k = 0; k < ba.projectors.size(); ++k) {
         result.report.projectors[k].rms_px = ba.rms_px[k];
         result.report.projectors[k].rms_sigma = ba.rms_sigma[k];

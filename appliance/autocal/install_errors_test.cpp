@@ -86,6 +86,26 @@ TEST(InstallErrors, TapeMeasuredHeightsAreRefusedOrFitted) {
     EXPECT_NEAR(fitted.result.screen.radius_m, rig.screen.radius_m * 1.46 / 1.5, 0.01);
 }
 
+// With the screen to be fitted, the camera pose's first edge fit (on the told cylinder) is only a start: its gate is
+// five times looser there (a sanity limit), and the gate holds the bundle adjustment's edge fit instead. Here the
+// gate is tightened to 5 mm so that the told screen's start (5.6 mm: heights 2 cm off each) fails it: taken
+// as told, the start is refused; fitted, the screen's edges meet the gate after the bundle adjustment (4.1 mm).
+TEST(InstallErrors, WithTheScreenFittedTheEdgeGateHoldsTheFittedScreen) {
+    rig::VirtualRig rig = standard_half();
+    rig.prior.screen_bottom_error_m = 0.02;
+    rig.prior.screen_top_error_m = -0.02;
+    AutocalOptions told;
+    told.max_edge_rms_m = 0.005;
+    const Outcome refused = calibrate_rig(rig, told, "edge gate 5 mm, heights taken as told");
+    EXPECT_NE(refused.refused.find("camera pose: edge fit rms"), std::string::npos) << refused.refused;
+    AutocalOptions fit = told;
+    fit.fit_screen = true;
+    const Outcome fitted = calibrate_rig(rig, fit, "edge gate 5 mm, screen fitted");
+    EXPECT_TRUE(meets_goals(fitted)) << fitted.refused << " " << fitted.geometry.mean_px << " / "
+                                     << fitted.geometry.p95_px;
+    EXPECT_LE(fitted.result.report.edge_rms_m, fit.max_edge_rms_m);
+}
+
 // Both heights 2 cm high: the screen told where it is not along its axis, its size right. The edges fix the
 // camera's pose to the screen, so the whole room is told 2 cm higher, and content lands where it belongs.
 TEST(InstallErrors, ACommonHeightErrorMovesNothing) {
