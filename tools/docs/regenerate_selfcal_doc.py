@@ -214,6 +214,7 @@ def from_autocal_table(args, tool):
 
 
 def scenarios_table(args, tool):
+    rig = os.path.join(ROOT, "rigs", "standard.toml")
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
                             text=True).stdout.strip()
     hour = f" --long-static-frames {args.long_frames}"
