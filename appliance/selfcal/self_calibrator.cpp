@@ -116,6 +116,7 @@ SelfCalibrator::SelfCalibrator(const SystemModel& model, const ScreenCalibration
     typical_matches_.assign(model.projectors.size(), -1.0);
     contested_.assign(model.projectors.size(), 0);
     seen_above_.assign(model.projectors.size(), 0);
+    stepped_.assign(model.projectors.size(), 0);
     lost_since_.assign(model.projectors.size(), -1.0);
 }
 
@@ -214,8 +215,9 @@ void SelfCalibrator::filter(const FrameMeasurement& m, double dt, StepResult& r)
         }
         const Pose6 before = filters_[k].state();
         const Cov6 rk = kCovarianceInflation * pm.fit.covariance;
-        contested_[k] =
-            filters_[k].update(pm.delta, rk) == KalmanUpdate::rejected && says_no_change(pm.delta, rk, before);
+        const KalmanUpdate u = filters_[k].update(pm.delta, rk);
+        contested_[k] = u == KalmanUpdate::rejected && says_no_change(pm.delta, rk, before);
+        stepped_[k] = u == KalmanUpdate::step_accepted;
         ps.measured = true;
         const double seen = static_cast<double>(pm.matches);
         typical_matches_[k] = typical_matches_[k] < 0.0 ? seen : 0.8 * typical_matches_[k] + 0.2 * seen;
@@ -295,6 +297,7 @@ void SelfCalibrator::advance_correction(double t_s, StepResult& r) {
     for (PoseKalman& f : filters_) f.reset();
     std::fill(contested_.begin(), contested_.end(), 0);
     std::fill(seen_above_.begin(), seen_above_.end(), 0);
+    std::fill(stepped_.begin(), stepped_.end(), 0);
     state_ = SelfcalState::calibrated;
     std::string saved = "not saved (no store)";
     if (!options_.store.empty()) {
@@ -331,10 +334,11 @@ void SelfCalibrator::decide(double t_s, StepResult& r) {
         // and correcting on it would move a projector that never moved. It stays contested until a
         // measurement is accepted or the rejected ones make a step (PoseKalman).
         // A fresh drift must be seen in two measured frames in a row: one measurement the filter accepted
-        // can carry it past the threshold alone.
+        // can carry it past the threshold alone. A step (PoseKalman: rejected measurements that agree, a
+        // bump's way into the filter) is that agreement already.
         const bool fresh = ps.drift_px > options_.drift_threshold_px &&
                            filters_[k].significance() > options_.kalman.gate_chi2 && !contested_[k];
-        if (ps.measured) seen_above_[k] = fresh ? seen_above_[k] + 1 : 0;
+        if (ps.measured) seen_above_[k] = fresh ? std::max(seen_above_[k] + 1, stepped_[k] ? 2 : 0) : 0;
         const bool above = !contested_[k] &&
                            (holding ? ps.drift_px > 0.5 * options_.drift_threshold_px : fresh && seen_above_[k] >= 2);
         if (above) {

@@ -156,6 +156,7 @@ private:
     std::vector<double> typical_matches_;  // per projector: running mean of its matches when measured
     std::vector<char> contested_;          // per projector: its last measurement, rejected, said "no change"
     std::vector<int> seen_above_;          // per projector: measured frames in a row with a fresh drift
+    std::vector<char> stepped_;            // per projector: its last measurement made a step (PoseKalman)
     std::vector<double> lost_since_;       // per projector: since when it is lost, -1 if not
     bool pattern_mode_ = false;            // the pattern pair is wanted
     double pattern_since_ = 0.0;
