@@ -291,9 +291,10 @@ EdgeFit fit_camera_to_lit_screen(PatternSource& source, const CalibrationPrior& 
     report.captures = 2 * frames;
     cv::Mat1f lit;
     cv::subtract(white, black, lit);
-    // With the screen still to be fitted, an edge fit on the prior's cylinder is only a start (a radius or arc 2 %
-    // off, as a tape measures them, leaves the lit edges 10-15 mm off it): its gate is five times looser here, a
-    // sanity limit, and the gate itself holds the bundle adjustment's edge fit (adopt_bundle).
+    // With the screen still to be fitted, an edge fit on the prior's cylinder is only a start (the told screen and
+    // the camera's prior intrinsics together left the lit edges 13 mm off it on realistic-install at full
+    // resolution): its gate is five times looser here, a sanity limit, and the gate itself holds the bundle
+    // adjustment's edge fit (adopt_bundle).
     AutocalOptions start_options = options;
     if (options.fit_screen) start_options.max_edge_rms_m = kStartEdgeGateScale * options.max_edge_rms_m;
     EdgeFit edge = fit_camera_pose(lit, prior, start_options);
