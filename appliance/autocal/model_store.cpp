@@ -8,6 +8,7 @@
 #include <Eigen/LU>
 #include <fmt/format.h>
 
+#include "appliance/rig/rig_model.h"
 #include "common/file_io.h"
 
 namespace mogao::autocal {
@@ -115,13 +116,13 @@ Eigen::Matrix3d read_rotation(const Reader& r) {
     return m;
 }
 
-// A projector's lens distortion as the calibration's trial fits it: k1, k2, k3 within [-1, 1], p1, p2
-// within [-0.1, 0.1] (rig_model.cpp's limits), and the radial map r -> r (1 + k1 r^2 + k2 r^4 + k3 r^6)
-// increasing out to 1.2 times the normalised radius of the image's farthest corner, so that each image
-// position has one ray (warps and self-recalibration invert it).
+// A projector's lens distortion as the calibration's trial fits it: within a projection lens's coefficients
+// (rig::kProjectorDistortionLimits) and one-to-one out to 1.2 times the normalised radius of the image's
+// farthest corner (rig::distortion_fold_radius), so that each image position has one ray (warps and
+// self-recalibration invert it).
 void check_projector_distortion(const Reader& r, const DeviceModel& d) {
     const auto& k = d.distortion;
-    const std::array<double, 5> limit{1.0, 1.0, 0.1, 0.1, 1.0};
+    const auto& limit = rig::kProjectorDistortionLimits;
     for (std::size_t i = 0; i < k.size(); ++i) {
         if (!(std::abs(k[i]) <= limit[i])) {
             r.fail(fmt::format("distortion[{}]", i),
@@ -132,13 +133,10 @@ void check_projector_distortion(const Reader& r, const DeviceModel& d) {
     for (const double x : {0.0, double(d.resolution.width)})
         for (const double y : {0.0, double(d.resolution.height)})
             corner2 = std::max(corner2, std::pow((x - d.cx_px) / d.fx_px, 2) + std::pow((y - d.cy_px) / d.fy_px, 2));
-    for (int i = 0; i <= 100; ++i) {
-        const double r2 = 1.44 * corner2 * (i / 100.0) * (i / 100.0);
-        if (!(1.0 + r2 * (3.0 * k[0] + r2 * (5.0 * k[1] + r2 * 7.0 * k[4])) > 0.0)) {
-            r.fail("distortion", fmt::format(" is not one-to-one out to 1.2 times the image's corners (d/dr of "
-                                             "r (1 + k1 r^2 + k2 r^4 + k3 r^6) <= 0 at r = {:.4g})",
-                                             std::sqrt(r2)));
-        }
+    if (const std::optional<double> fold = rig::distortion_fold_radius(k, 1.2 * std::sqrt(corner2))) {
+        r.fail("distortion", fmt::format(" is not one-to-one out to 1.2 times the image's corners (d/dr of "
+                                         "r (1 + k1 r^2 + k2 r^4 + k3 r^6) <= 0 at r = {:.4g})",
+                                         *fold));
     }
 }
 

@@ -24,6 +24,15 @@ double corner_radius(const RigProjector& p) {
     return corner;
 }
 
+std::optional<double> distortion_fold_radius(const std::array<double, 5>& k, double r_max) {
+    for (int i = 0; i <= 100; ++i) {
+        const double r = r_max * i / 100.0;
+        const double r2 = r * r;
+        if (!(1.0 + r2 * (3.0 * k[0] + r2 * (5.0 * k[1] + r2 * 7.0 * k[4])) > 0.0)) return r;
+    }
+    return std::nullopt;
+}
+
 namespace detail {
 
 void check(bool ok, const std::string& field, const std::string& limit) {
@@ -72,21 +81,17 @@ void validate_pose(const RigPose& pose, const RigScreen& screen, const std::stri
 // times the normalised radius of the image's farthest corner (one ray per image position).
 void validate_projector_distortion(const RigProjector& p, const std::string& f) {
     const auto& k = p.intrinsics.distortion;
-    const std::array<double, 5> limit{1.0, 1.0, 0.1, 0.1, 1.0};
     for (std::size_t i = 0; i < k.size(); ++i) {
-        check_range(k[i], -limit[i], limit[i], f + ".distortion[" + std::to_string(i) + "]");
+        check_range(k[i], -kProjectorDistortionLimits[i], kProjectorDistortionLimits[i],
+                    f + ".distortion[" + std::to_string(i) + "]");
     }
     const double corner = corner_radius(p);
-    for (int i = 0; i <= 100; ++i) {
-        const double r2 = std::pow(1.2 * corner * i / 100.0, 2);
-        const double slope = 1.0 + r2 * (3.0 * k[0] + r2 * (5.0 * k[1] + r2 * 7.0 * k[4]));
-        check(
-            slope > 0.0 && (i < 100 || std::sqrt(r2) * (1.0 + r2 * (k[0] + r2 * (k[1] + r2 * k[4]))) > corner),
-            f + ".distortion",
-            "one-to-one out to 1.2 times the image's corners (d/dr of r (1 + k1 r^2 + k2 r^4 + k3 r^6) > 0 for r <= " +
-                std::to_string(1.2 * corner) + ", and that radius mapped beyond the corners' " +
-                std::to_string(corner) + ")");
-    }
+    const double r_max = 1.2 * corner;
+    const double r2 = r_max * r_max;
+    check(!distortion_fold_radius(k, r_max) && r_max * (1.0 + r2 * (k[0] + r2 * (k[1] + r2 * k[4]))) > corner,
+          f + ".distortion",
+          "one-to-one out to 1.2 times the image's corners (d/dr of r (1 + k1 r^2 + k2 r^4 + k3 r^6) > 0 for r <= " +
+              std::to_string(r_max) + ", and that radius mapped beyond the corners' " + std::to_string(corner) + ")");
 }
 
 void validate_camera(const RigCamera& c, const RigScreen& s, const std::string& f) {

@@ -13,6 +13,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -139,6 +140,14 @@ void validate_rig(const VirtualRig& rig);
 // The normalised radius of projector p's image corner farthest from its principal point; a projector's
 // distortion is validated (one-to-one) out to 1.2 times it, and ground truth is given only within that.
 [[nodiscard]] double corner_radius(const RigProjector& p);
+
+// A projection lens's Brown-Conrady coefficients (k1, k2, p1, p2, k3) lie within +-these.
+inline constexpr std::array<double, 5> kProjectorDistortionLimits{1.0, 1.0, 0.1, 0.1, 1.0};
+
+// The first of 101 evenly spaced normalised radii in [0, r_max] where the radial map
+// r (1 + k1 r^2 + k2 r^4 + k3 r^6) of coefficients k does not increase (d/dr <= 0: two rays would share an
+// image position), or nullopt where it increases throughout.
+[[nodiscard]] std::optional<double> distortion_fold_radius(const std::array<double, 5>& k, double r_max);
 
 namespace detail {
 // Throws std::invalid_argument "rig: FIELD must be LIMIT" (the rig's one error form).
