@@ -169,6 +169,9 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& s
         }
         std::optional<MainThreadQueue<ServedFrame>::Job> job = queue.next(std::chrono::milliseconds(100));
         if (!job) continue;
+        // Late binding: the call waited in the queue while other sessions' frames were rendered; the
+        // frame shows the newest view its session has asked for since (link_server.h).
+        if (auto newer = server.take_newer_request(job->view.session)) job->view = std::move(*newer);
         try {
             const std::string who = server.appliance_of(job->view.session);
             const std::string key = who.empty() ? "session " + std::to_string(job->view.session) : who;

@@ -15,6 +15,7 @@
 #include <mutex>
 #include <optional>
 #include <thread>
+#include <utility>
 
 #include "renderfarm/link/link_log.h"
 #include "renderfarm/link/mogao_link.grpc.pb.h"
@@ -44,6 +45,9 @@ struct SessionState {
     std::uint64_t last_frame_id = 0;  // frames queued or sent
     std::uint64_t acked_frame_id = 0;
     bool rendering = false;
+    // The newer request a renderer call took over (LinkServer::take_newer_request): what its frame answers.
+    std::optional<ViewRequest> answering;
+    std::int64_t answering_received_ns = 0;
     std::deque<v1::FrameMsg> outbox;  // rendered, waiting for the handler thread to write
     bool closed = false;
     std::string close_reason;
@@ -87,7 +91,9 @@ struct LinkServer::Impl final : v1::Tour::Service {
     void close(SessionState& s, const std::string& reason);
     void render_loop();
     std::shared_ptr<SessionState> pick_ready();  // with mutex held
-    std::optional<v1::FrameMsg> render(const SessionState& s, const ViewRequest& request, std::int64_t received_ns,
+    // The request and receive time a renderer call took over from `s` (take_newer_request), cleared.
+    std::optional<std::pair<ViewRequest, std::int64_t>> take_answering(SessionState& s);
+    std::optional<v1::FrameMsg> render(SessionState& s, ViewRequest request, std::int64_t received_ns,
                                        std::string& refused);
 };
 
@@ -389,24 +395,31 @@ void LinkServer::Impl::render_loop() {
     }
 }
 
-std::optional<v1::FrameMsg> LinkServer::Impl::render(const SessionState& s, const ViewRequest& request,
-                                                     std::int64_t received_ns, std::string& refused) {
+std::optional<v1::FrameMsg> LinkServer::Impl::render(SessionState& s, ViewRequest request, std::int64_t received_ns,
+                                                     std::string& refused) {
     const std::int64_t start_ns = realtime_ns();
     RenderedFrame rendered;
     try {
         rendered = renderer(request);
     } catch (const RequestRefused& e) {
+        take_answering(s);  // no frame: the newer request it took is dropped with it
         link_log().warn("{}: request {}: refused: {}", s.name(), request.frame_id, e.what());
         refused = e.what();
         return std::nullopt;
     } catch (const std::exception& e) {
+        take_answering(s);
         link_log().error("{}: request {}: renderer failed: {}", s.name(), request.frame_id, e.what());
         return std::nullopt;
     } catch (...) {
+        take_answering(s);
         link_log().error("{}: request {}: renderer failed with a non-standard exception", s.name(), request.frame_id);
         return std::nullopt;
     }
     const std::int64_t end_ns = realtime_ns();
+    if (auto answered = take_answering(s)) {  // the renderer took a newer request: the frame answers that
+        request = std::move(answered->first);
+        received_ns = answered->second;
+    }
     const auto side_ok = [](int v) { return v >= 1 && v <= kMaxLinkImageSide; };
     if (rendered.jpeg.empty() || rendered.jpeg.size() > kMaxFrameJpegBytes || !side_ok(rendered.size.width) ||
         !side_ok(rendered.size.height)) {
@@ -506,6 +519,31 @@ LinkServerStats LinkServer::stats() const {
     stats.certificates = impl_->certificates->current();
     if (impl_->revocation) stats.crl_next_update_s = impl_->revocation->next_update_s();
     return stats;
+}
+
+std::optional<std::pair<ViewRequest, std::int64_t>> LinkServer::Impl::take_answering(SessionState& s) {
+    const std::lock_guard lock(mutex);
+    if (!s.answering) return std::nullopt;
+    std::optional<std::pair<ViewRequest, std::int64_t>> out{{std::move(*s.answering), s.answering_received_ns}};
+    s.answering.reset();
+    return out;
+}
+
+std::optional<ViewRequest> LinkServer::take_newer_request(std::uint64_t session) {
+    const std::lock_guard lock(impl_->mutex);
+    for (auto& s : impl_->sessions) {
+        if (s->id != session) continue;
+        if (s->closed || !s->rendering || !s->pending) return std::nullopt;
+        // The request the call was made for (or one taken over before) is now stale.
+        ++s->dropped;
+        ++impl_->totals.requests_dropped;
+        s->answering = std::move(*s->pending);
+        s->answering->session = s->id;
+        s->answering_received_ns = s->pending_received_ns;
+        s->pending.reset();
+        return s->answering;
+    }
+    return std::nullopt;
 }
 
 std::string LinkServer::appliance_of(std::uint64_t session) const {

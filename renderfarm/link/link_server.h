@@ -29,6 +29,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -120,6 +121,17 @@ public:
     // The certificate common name of open session `session` (ViewRequest::session), so that the
     // farm applies that appliance's view policy; empty once the session has closed, or for 0.
     [[nodiscard]] std::string appliance_of(std::uint64_t session) const;
+
+    // Late binding, for a renderer that queues its calls (the farm's main thread serves every session's
+    // call in turn): called when the renderer is about to start on a request of `session`, it takes the
+    // newest request the session has sent since that call was made, if any. The renderer then renders
+    // that one instead, and the frame answers it: the link labels the frame with its id, pose and
+    // times, and counts the request the call was made for as dropped as stale. Without this, a
+    // request waits in the renderer's queue while every other session's frame is rendered, and the
+    // frame shows a view as old as that wait (motion-to-photon grows with the number of sessions).
+    // Nullopt when the session has no newer request, is not in a renderer call, or has closed.
+    // Thread-safe.
+    [[nodiscard]] std::optional<ViewRequest> take_newer_request(std::uint64_t session);
 
     // Ends every session (appliances see UNAVAILABLE/CANCELLED and reconnect elsewhere or later),
     // waits for a renderer call in progress, closes the port. Idempotent.

@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <condition_variable>
+#include <mutex>
+#include <optional>
 #include <thread>
 
 #include "renderfarm/link/link_client.h"
@@ -155,6 +158,62 @@ TEST(LinkStream, NewestRequestWinsWhileTheRendererIsBusy) {
     EXPECT_EQ(renderer.rendered_ids(), (std::vector<std::uint64_t>{1, 10}));
     EXPECT_EQ(server.stats().requests_dropped, 8u);
     EXPECT_EQ(client.stats().requests_coalesced, 0u);
+    received.expect_clean_and_increasing();
+}
+
+// A renderer that queues its calls (the farm: one main thread serves every session's call in turn) takes the
+// session's newest request when it starts on a call: the frame shows that view and answers that request, the
+// one the call was made for counts as dropped. Without the take-over the frame would answer request 1, as old
+// as the wait in the queue.
+TEST(LinkStream, ARendererThatQueuesItsCallsAnswersTheNewestRequestTakenOver) {
+    REQUIRE_IPV6_LOOPBACK();
+    SyntheticRenderer synthetic;
+    std::atomic<LinkServer*> link{nullptr};
+    std::mutex mutex;
+    std::condition_variable cv;
+    bool go = false;
+    int waiting = 0;
+    const FrameRenderer queued = [&](const ViewRequest& r) {
+        {
+            std::unique_lock lock(mutex);
+            ++waiting;
+            cv.wait(lock, [&] { return go; });  // the call waits its turn
+        }
+        const std::optional<ViewRequest> newer = link.load()->take_newer_request(r.session);
+        return synthetic(newer ? *newer : r);
+    };
+    LinkServer server(test_server_options(), queued);
+    link = &server;
+    Received received;
+    LinkClient client(test_client_options(server.endpoint().port, TestPki::get().museum1), received.callback());
+    ASSERT_EQ(client.submit(test_request(1.0)), 1u);
+    ASSERT_TRUE(wait_until([&] {
+        const std::lock_guard lock(mutex);
+        return waiting == 1;
+    }));
+    for (std::uint64_t i = 2; i <= 5; ++i) {
+        ASSERT_EQ(client.submit(test_request(static_cast<double>(i))), i);
+        ASSERT_TRUE(wait_until([&] { return server.stats().requests_received == i; })) << "request " << i;
+    }
+    {
+        const std::lock_guard lock(mutex);
+        go = true;
+    }
+    cv.notify_all();
+    ASSERT_TRUE(wait_until([&] { return received.request_ids().size() == 1; }));
+    EXPECT_EQ(received.request_ids(), (std::vector<std::uint64_t>{5}));
+    EXPECT_EQ(synthetic.rendered_ids(), (std::vector<std::uint64_t>{5}));
+    EXPECT_EQ(server.stats().requests_dropped, 4u);  // 2, 3 replaced while pending; 1 taken over by 5
+    {
+        const std::lock_guard lock(received.mutex);
+        EXPECT_DOUBLE_EQ(received.frames.at(0).pose.yaw_deg, 5.0);
+    }
+    // Nothing newer: the call renders the request it was made for.
+    ASSERT_EQ(client.submit(test_request(6.0)), 6u);
+    ASSERT_TRUE(wait_until([&] { return received.request_ids().size() == 2; }));
+    EXPECT_EQ(received.request_ids(), (std::vector<std::uint64_t>{5, 6}));
+    EXPECT_EQ(server.stats().requests_dropped, 4u);
+    EXPECT_FALSE(server.take_newer_request(12345).has_value());  // no such session
     received.expect_clean_and_increasing();
 }
 
