@@ -86,7 +86,7 @@ struct LiveOptions {
     // session_budget.h): no longer than the target or the other active sessions' median recent
     // frame, whichever is longer, so a dear request is degraded instead of holding the others'
     // frames back, and an ordinary one is not shrunk below the floors when the farm is slow.
-    bool share_frame_time = false;
+    bool share_frame_time = true;  // on by default: measured against round-robin (docs/reliability.md)
     FrameTimeTarget controller;    // its other settings (target_seconds is taken from frame_time_s)
     bool per_session_maps = true;  // one PBT cost map per session; false = all share one (stream 0)
     std::size_t max_sessions = 64;

@@ -108,10 +108,12 @@ void add_live_flags(CLI::App& serve, mogao::ServeOptions& options, double& frame
     serve.add_flag("--temporal,!--no-temporal", live.temporal,
                    "Blend each filtered moving frame with the session's earlier frames, reprojected by depth, before "
                    "the denoiser (default: on whenever the denoiser is)");
-    serve.add_flag("--share-frame-time,!--no-share-frame-time", live.share_frame_time,
-                   "Share the frame-time target among the sessions served in the last 2 s: with N appliances each "
-                   "frame aims at the target / N and a dearer request is degraded to that share, so each keeps "
-                   "its frame rate and latency with fewer pixels (default off: each frame aims at the whole target)");
+    serve.add_flag(
+        "--share-frame-time,!--no-share-frame-time", live.share_frame_time,
+        "Share the frame-time target among the sessions served in the last 2 s: with N appliances each "
+        "frame aims at the target / N and a dearer request is degraded to that share, so each keeps "
+        "its frame rate and latency with fewer pixels (default; --no-share-frame-time: each frame aims at the "
+        "whole target, sessions in turn)");
     serve.add_flag("--per-session-cost-maps,!--shared-cost-map", live.per_session_maps,
                    "One PBT cost map per session (default; --shared-cost-map: one for all)");
     serve.add_flag("--pipeline,!--no-pipeline", options.pipeline,
