@@ -8,9 +8,10 @@
       average, the kiosk's and the farm's metrics files (frames, frame-time sum and count). One JSON
       line per sample in DIR/samples.jsonl, flushed, so a stopped run keeps what it measured.
   soak.py report --out DIR [--write-docs docs/reliability.md]
-      Reads DIR/samples.jsonl and the kiosk's DIR/kiosk-stats.json (motion-to-photon of every frame)
-      and prints the table; writes DIR/soak.json and DIR/soak.png; with --write-docs, the doc's
-      `soak` generated block and docs/reliability/soak.png beside it.
+      Reads DIR/samples.jsonl, the kiosk's DIR/kiosk-stats.json and its frame log
+      DIR/kiosk-frames.jsonl (motion-to-photon of every frame) and prints the table; writes
+      DIR/soak.json and DIR/soak.png; with --write-docs, the doc's `soak` generated block and
+      docs/reliability/soak.png beside it.
 
 Goals read (docs/reliability.md, "Soak"): after the first 10 minutes, RSS growth of every process
 <= 1 MiB per hour (least-squares slope of the samples), open fds and threads constant; the
@@ -48,6 +49,28 @@ def proc_status(pid):
     rss = re.search(r"^VmRSS:\s+(\d+)", text, re.M)
     threads = re.search(r"^Threads:\s+(\d+)", text, re.M)
     return {"rss_kib": int(rss.group(1)) if rss else 0, "threads": int(threads.group(1)) if threads else 0}
+
+
+def rss_by_mapping(pid):
+    """RSS (KiB) of /proc/PID/smaps by kind of mapping: "heap" (malloc's main arena, [heap]), "anon"
+    (other anonymous memory: thread arenas, large malloc blocks, GL buffers), "file" and "other"
+    ([stack], [vvar]...): where a growth lives. None when the process is gone."""
+    out = {"heap": 0, "anon": 0, "file": 0, "other": 0}
+    kind = "other"
+    try:
+        with open(f"/proc/{pid}/smaps") as f:
+            for line in f:
+                head = line.split(None, 1)[0]
+                if not head.endswith(":"):  # a mapping's line: address perms offset dev inode [path]
+                    fields = line.split(None, 5)
+                    path = fields[5].strip() if len(fields) > 5 else ""
+                    kind = ("heap" if path == "[heap]" else "anon" if not path else
+                            "other" if path.startswith("[") else "file")
+                elif head == "Rss:":
+                    out[kind] += int(line.split()[1])
+    except OSError:
+        return None
+    return out
 
 
 def fd_count(pid):
@@ -115,7 +138,7 @@ def sample_once(out, kiosk_pid, farm_sid, start):
         fds = fd_count(pid)
         if name is None or status is None or fds is None:
             continue
-        procs[name] = dict(status, fds=fds, pid=pid)
+        procs[name] = dict(status, fds=fds, pid=pid, rss_by_mapping_kib=rss_by_mapping(pid))
     kiosk = metrics(os.path.join(out, "kiosk.prom"))
     farm = metrics(os.path.join(out, "farm.prom"))
     return {
@@ -192,23 +215,36 @@ def process_rows(samples):
             "fds_grow": max(fds[-third:]) > max(fds[:third]),
             "threads_grow": max(threads[-third:]) > max(threads[:third]),
         })
+        kinds = [(t, p["rss_by_mapping_kib"]) for t, p in after if p.get("rss_by_mapping_kib")]
+        rows[-1]["rss_growth_by_mapping_mib_per_h"] = {
+            k: slope_per_hour([(t, m[k] / 1024.0) for t, m in kinds]) for k in ("heap", "anon", "file", "other")
+        } if len(kinds) >= 2 else None
         rows[-1]["ok"] = ((growth is None or growth <= GROWTH_LIMIT_MIB_H) and not rows[-1]["fds_grow"]
                           and not rows[-1]["threads_grow"])
     return rows
 
 
-def latency_minutes(stats, start_unix_s):
+def read_frames(out, stats):
+    """Every presented frame: the kiosk's frame log, else the statistics file's (first) frames."""
+    path = os.path.join(out, "kiosk-frames.jsonl")
+    if not os.path.exists(path):
+        return stats.get("frames", [])
+    with open(path) as f:
+        return [json.loads(line) for line in f if line.strip()]
+
+
+def latency_minutes(frames, start_unix_s):
     """Per minute of the run: frames presented, motion-to-photon p50/p95 (ms)."""
     buckets = {}
-    for fr in stats.get("frames", []):
+    for fr in frames:
         minute = int((fr["presented_ns"] / 1e9 - start_unix_s) // 60)
         buckets.setdefault(minute, []).append(fr["motion_to_photon_ms"])
     return [{"minute": m, "frames": len(v), "p50_ms": percentile(v, 0.5), "p95_ms": percentile(v, 0.95)}
             for m, v in sorted(buckets.items()) if m >= 0]
 
 
-def window_latency(stats, start_unix_s, lo_min, hi_min):
-    v = [fr["motion_to_photon_ms"] for fr in stats.get("frames", [])
+def window_latency(frames, start_unix_s, lo_min, hi_min):
+    v = [fr["motion_to_photon_ms"] for fr in frames
          if lo_min * 60 <= fr["presented_ns"] / 1e9 - start_unix_s < hi_min * 60]
     span = (hi_min - lo_min) * 60.0
     return {"frames": len(v), "fps": len(v) / span, "p50_ms": percentile(v, 0.5), "p95_ms": percentile(v, 0.95)}
@@ -230,10 +266,11 @@ def analyse(out):
         raise SystemExit(f"soak.py: {out}/samples.jsonl has {len(samples)} sample(s); a report needs 2")
     with open(os.path.join(out, "kiosk-stats.json")) as f:
         stats = json.load(f)
+    frames = read_frames(out, stats)
     start = samples[0]["unix_s"] - samples[0]["t_s"]
     minutes = samples[-1]["t_s"] / 60.0
-    first = window_latency(stats, start, 0, min(10, minutes))
-    last = window_latency(stats, start, max(0, minutes - 10), minutes)
+    first = window_latency(frames, start, 0, min(10, minutes))
+    last = window_latency(frames, start, max(0, minutes - 10), minutes)
     for w, lo, hi in ((first, 0, min(10, minutes)), (last, max(0, minutes - 10), minutes)):
         w["farm_frame_ms"] = farm_frame_ms(samples, lo, hi)
         loads = [x["loadavg_1min"] for x in samples if lo <= x["t_s"] / 60.0 <= hi]
@@ -255,7 +292,7 @@ def analyse(out):
         "log_bytes_per_h": {
             k: 60.0 * (samples[-1][k] - samples[0][k]) / max(minutes, 1e-9) for k in ("farm_log_bytes",
                                                                                       "kiosk_log_bytes")},
-        "per_minute": latency_minutes(stats, start),
+        "per_minute": latency_minutes(frames, start),
     }, samples
 
 
@@ -273,6 +310,12 @@ def markdown(result, meta, command):
     lines.append(s.table(["process", "RSS at 10 min (MiB)", "RSS at end (MiB)", "RSS growth after 10 min (MiB/h)",
                           "open fds after 10 min (min–max)", "threads after 10 min (min–max)", "within the goal"],
                          rows))
+    by_kind = ["{}: {}".format(p["process"], ", ".join(f"{k} {v:+.2f}" for k, v in
+                                                    p["rss_growth_by_mapping_mib_per_h"].items() if v is not None))
+               for p in result["processes"] if p.get("rss_growth_by_mapping_mib_per_h")]
+    if by_kind:
+        lines += ["", "Where RSS grew after 10 minutes (MiB/h; `heap`: malloc's main arena, `anon`: other anonymous "
+                  "memory such as thread arenas and large blocks, `file`: mapped files): " + "; ".join(by_kind) + "."]
     lines.append("")
     f, l = result["first_10_min"], result["last_10_min"]
     rows = [[name, w["frames"], fmt(w["fps"], ".2f"), fmt(w["p50_ms"], ".0f"), fmt(w["p95_ms"], ".0f"),

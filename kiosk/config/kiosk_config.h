@@ -147,6 +147,9 @@ struct StatsConfig {
     std::filesystem::path status_file;   // kiosk/stats/kiosk_status.h, rewritten while running; empty = none
     double status_period_s = 1.0;        // its rewrite period, [0.1, 3600]
     std::filesystem::path metrics_file;  // kiosk/stats/kiosk_metrics.h, rewritten with the status; empty = none
+    int frames_kept =
+        4096;  // KioskStats::kDefaultFramesKept: per-frame records kept for the statistics file, [0, 1000000]
+    std::filesystem::path frame_log;  // every frame's record as a JSON line (kiosk/stats/frame_log.h); empty = none
 };
 
 // [status]: the state on the wall (kiosk/display/on_wall_status.h, docs/kiosk.md "On-wall status").

@@ -256,6 +256,7 @@ void Kiosk::on_tick() {
                      link.sessions_opened, link.connected);
         last_log_ = now;
     }
+    memory_release_.tick(now);  // months on the wall: freed memory goes back (common/memory_release.h)
     parts_.notifier.watchdog();
 }
 

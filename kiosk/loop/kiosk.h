@@ -32,6 +32,7 @@
 #include "appliance/decode/last_good_frame.h"
 #include "appliance/warp/late_warp.h"
 #include "common/event_loop.h"
+#include "common/memory_release.h"
 #include "common/service_notify.h"
 #include "common/signal_fd.h"
 #include "common/timer_fd.h"
@@ -172,6 +173,7 @@ private:
     bool shown_since_tick_ = true;
     std::chrono::steady_clock::time_point start_;
     std::chrono::steady_clock::time_point last_log_;
+    MemoryRelease memory_release_;
     std::chrono::steady_clock::time_point last_status_;
     bool status_failing_ = false;      // the status file's last write failed (logged once)
     bool metrics_failing_ = false;     // the metrics file's last write failed (logged once)

@@ -126,6 +126,15 @@ KioskDisplay open_display(const KioskConfig& config, ScreenCalibration screen) {
     auto display = KioskDisplay::create(std::move(backend), std::move(screen), &notes);
     if (!display) throw KioskSetupError(1, "outputs: " + display.error().message);
     for (const auto& n : notes) spdlog::warn("outputs: {}", n);
+    display->stats() = KioskStats(KioskStats::kDefaultWindow, static_cast<std::size_t>(config.stats.frames_kept));
+    if (!config.stats.frame_log.empty()) {
+        try {
+            display->stats().open_frame_log(config.stats.frame_log);
+        } catch (const std::exception& e) {
+            throw KioskSetupError(1, fmt::format("[stats] frame_log: {}", e.what()));
+        }
+        spdlog::info("frame log: every presented frame is appended to {}", config.stats.frame_log.string());
+    }
     if (headless != nullptr && !config.outputs.png_dir.empty()) {
         try {
             display->record_to(HeadlessRecorder(*headless, config.outputs.png_dir, config.outputs.png_every));

@@ -40,25 +40,74 @@ nlohmann::json summary_json(const StatsSummary& s) {
             {"bandwidth_bytes_per_s", round3(s.bandwidth_bytes_per_s)}};
 }
 
+// One frame's entry of the per-frame list and the frame log (docs/kiosk.md).
+nlohmann::json frame_record(const PresentedFrame& f) {
+    nlohmann::json j = {{"request_id", f.request_id},
+                        {"link_frame_id", f.link_frame_id},
+                        {"jpeg_bytes", f.jpeg_bytes},
+                        {"request_ns", f.request_ns},
+                        {"receive_ns", f.receive_ns},
+                        {"presented_ns", f.presented_ns},
+                        {"motion_to_photon_ms", round3(ms(f.presented_ns - f.request_ns))},
+                        {"decode_ms", round3(f.decode_ms)},
+                        {"display_round", f.display_round},
+                        {"served", {f.served.width, f.served.height}}};
+    if (f.served_spp > 0) j["served_spp"] = f.served_spp, j["served_bounces"] = f.served_bounces;
+    return j;
+}
+
 }  // namespace
 
-KioskStats::KioskStats(std::size_t window, std::size_t max_history)
+KioskStats::KioskStats(std::size_t window, std::size_t frames_kept)
     : window_size_(std::max<std::size_t>(window, 2)),
-      max_history_(max_history),
-      motion_to_photon_(motion_to_photon_buckets()) {}
+      frames_kept_(frames_kept),
+      latency_ms_(0.005, 0.01, 3.6e6),  // 10 us to 1 h
+      served_height_(0.005, 1, 65536),
+      motion_to_photon_(motion_to_photon_buckets()) {
+    history_.reserve(frames_kept_);  // once: the list never reallocates while the wall plays
+}
+
+void KioskStats::open_frame_log(const std::filesystem::path& path) { frame_log_ = std::make_unique<FrameLog>(path); }
+
+void KioskStats::add_to_totals(const PresentedFrame& f) {
+    Totals& t = totals_;
+    const double latency = ms(f.presented_ns - f.request_ns);
+    if (frames_ == 1) t.first_presented_ns = f.presented_ns, t.first_bytes = f.jpeg_bytes;
+    t.last_presented_ns = f.presented_ns;
+    t.latency_sum_ms += latency;
+    t.latency_max_ms = frames_ == 1 ? latency : std::max(t.latency_max_ms, latency);
+    t.link_sum_ms += ms(f.receive_ns - f.request_ns);
+    t.kiosk_sum_ms += ms(f.presented_ns - f.receive_ns);
+    t.decode_sum_ms += f.decode_ms;
+    t.served_height_sum += f.served.height;
+    t.served_height_min = frames_ == 1 ? f.served.height : std::min(t.served_height_min, f.served.height);
+    latency_ms_.add(latency);
+    served_height_.add(f.served.height);
+    if (f.served_spp == 0) return;
+    const bool first = t.quality_frames++ == 0;
+    t.spp_min = first ? f.served_spp : std::min(t.spp_min, f.served_spp);
+    t.bounce_min = first ? f.served_bounces : std::min(t.bounce_min, f.served_bounces);
+    t.spp_sum += f.served_spp, t.bounce_sum += f.served_bounces;
+}
 
 void KioskStats::presented(const PresentedFrame& frame) {
     if (frame.request_id <= last_request_id_) ++out_of_order_;
     last_request_id_ = frame.request_id;
     ++frames_;
     bytes_ += frame.jpeg_bytes;
+    add_to_totals(frame);
     motion_to_photon_.observe(double(frame.presented_ns - frame.request_ns) * 1e-9);
     window_.push_back(frame);
     while (window_.size() > window_size_) window_.pop_front();
-    if (history_.size() < max_history_) history_.push_back(frame);
+    if (history_.size() < frames_kept_) history_.push_back(frame);
+    if (frame_log_) frame_log_->append(frame_record(frame).dump());
 }
 
 void KioskStats::event(std::int64_t realtime_ns, std::string what, std::uint64_t last_request_id) {
+    if (events_.size() >= kMaxEvents) {
+        ++events_dropped_;
+        return;
+    }
     events_.push_back({{"time_ns", realtime_ns},
                        {"event", std::move(what)},
                        {"display_round", rounds_},
@@ -105,10 +154,28 @@ StatsSummary KioskStats::window_summary() const {
 }
 
 StatsSummary KioskStats::total_summary() const {
-    std::vector<const PresentedFrame*> frames;
-    for (const auto& f : history_) frames.push_back(&f);
-    StatsSummary s = summarise(frames);
+    if (every_frame_kept()) {
+        std::vector<const PresentedFrame*> frames;
+        for (const auto& f : history_) frames.push_back(&f);
+        return summarise(frames);
+    }
+    const Totals& t = totals_;
+    const auto n = static_cast<double>(frames_);
+    StatsSummary s;
     s.frames = frames_;
+    s.latency_mean_ms = t.latency_sum_ms / n;
+    s.latency_max_ms = t.latency_max_ms;
+    s.latency_p50_ms = latency_ms_.quantile(0.50);
+    s.latency_p95_ms = latency_ms_.quantile(0.95);
+    s.link_mean_ms = t.link_sum_ms / n;
+    s.kiosk_mean_ms = t.kiosk_sum_ms / n;
+    s.decode_mean_ms = t.decode_sum_ms / n;
+    s.bytes_per_frame = static_cast<double>(bytes_) / n;
+    const double span_s = static_cast<double>(t.last_presented_ns - t.first_presented_ns) / 1e9;
+    if (span_s > 0) {
+        s.fps = (n - 1) / span_s;
+        s.bandwidth_bytes_per_s = static_cast<double>(bytes_ - t.first_bytes) / span_s;
+    }
     return s;
 }
 
@@ -123,75 +190,68 @@ std::string KioskStats::log_line() const {
 
 namespace {
 
-// The served scale of each frame (height over the content's); empty when the content's height is
-// unknown.
-std::vector<double> served_scales(const std::vector<PresentedFrame>& history, const nlohmann::json& extra) {
-    std::vector<double> out;
+// The content's height from run_stats_json's "content": [width, height]; 0 when absent.
+double content_height(const nlohmann::json& extra) {
     const auto content = extra.find("content");
-    if (content == extra.end() || !content->is_array() || content->size() != 2 || !(*content)[1].is_number())
-        return out;
-    const double height = (*content)[1].get<double>();
-    if (height <= 0) return out;
-    for (const auto& f : history) out.push_back(f.served.height / height);
-    return out;
-}
-
-// The samples per pixel and bounces of the frames the farm reported them for: mean and least of
-// each; null when no frame carried them (a farm from before the fields).
-nlohmann::json served_quality_summary(const std::vector<PresentedFrame>& history) {
-    double spp_sum = 0, bounce_sum = 0;
-    std::uint32_t spp_min = 0, bounce_min = 0;
-    std::size_t n = 0;
-    for (const auto& f : history) {
-        if (f.served_spp == 0) continue;
-        spp_min = n == 0 ? f.served_spp : std::min(spp_min, f.served_spp);
-        bounce_min = n == 0 ? f.served_bounces : std::min(bounce_min, f.served_bounces);
-        spp_sum += f.served_spp, bounce_sum += f.served_bounces, ++n;
-    }
-    if (n == 0) return nullptr;
-    return {{"frames", n},
-            {"spp", {{"mean", round3(spp_sum / double(n))}, {"min", spp_min}}},
-            {"bounces", {{"mean", round3(bounce_sum / double(n))}, {"min", bounce_min}}}};
-}
-
-// Their mean, least and 5th percentile; null without any.
-nlohmann::json served_scale_summary(std::vector<double> scales) {
-    if (scales.empty()) return nullptr;
-    double sum = 0;
-    for (const double v : scales) sum += v;
-    return {{"mean", round3(sum / static_cast<double>(scales.size()))},
-            {"min", round3(*std::min_element(scales.begin(), scales.end()))},
-            {"p05", round3(percentile(scales, 0.05))}};
+    if (content == extra.end() || !content->is_array() || content->size() != 2 || !(*content)[1].is_number()) return 0;
+    return std::max(0.0, (*content)[1].get<double>());
 }
 
 }  // namespace
 
+// The samples per pixel and bounces of the frames the farm reported them for: mean and least of
+// each; null when no frame carried them (a farm from before the fields).
+nlohmann::json KioskStats::served_quality_json() const {
+    const Totals& t = totals_;
+    if (t.quality_frames == 0) return nullptr;
+    const auto n = static_cast<double>(t.quality_frames);
+    return {{"frames", t.quality_frames},
+            {"spp", {{"mean", round3(t.spp_sum / n)}, {"min", t.spp_min}}},
+            {"bounces", {{"mean", round3(t.bounce_sum / n)}, {"min", t.bounce_min}}}};
+}
+
+// The served scale's mean, least and 5th percentile over the run; null without frames or content.
+nlohmann::json KioskStats::served_scale_json(const nlohmann::json& extra) const {
+    const double height = content_height(extra);
+    if (frames_ == 0 || height <= 0) return nullptr;
+    double p05 = served_height_.quantile(0.05);
+    if (every_frame_kept()) {
+        std::vector<double> heights;
+        for (const auto& f : history_) heights.push_back(f.served.height);
+        p05 = percentile(std::move(heights), 0.05);
+    }
+    return {{"mean", round3(totals_.served_height_sum / static_cast<double>(frames_) / height)},
+            {"min", round3(totals_.served_height_min / height)},
+            {"p05", round3(p05 / height)}};
+}
+
 nlohmann::json KioskStats::to_json(const nlohmann::json& extra) const {
-    const std::vector<double> scales = served_scales(history_, extra);
+    const double height = content_height(extra);
     nlohmann::json frames = nlohmann::json::array();
     for (const auto& f : history_) {
-        frames.push_back({{"request_id", f.request_id},
-                          {"link_frame_id", f.link_frame_id},
-                          {"jpeg_bytes", f.jpeg_bytes},
-                          {"request_ns", f.request_ns},
-                          {"receive_ns", f.receive_ns},
-                          {"presented_ns", f.presented_ns},
-                          {"motion_to_photon_ms", round3(ms(f.presented_ns - f.request_ns))},
-                          {"decode_ms", round3(f.decode_ms)},
-                          {"display_round", f.display_round},
-                          {"served", {f.served.width, f.served.height}}});
-        if (!scales.empty()) frames.back()["served_scale"] = round3(scales[frames.size() - 1]);
-        if (f.served_spp > 0)
-            frames.back()["served_spp"] = f.served_spp, frames.back()["served_bounces"] = f.served_bounces;
+        frames.push_back(frame_record(f));
+        if (height > 0) frames.back()["served_scale"] = round3(f.served.height / height);
     }
     nlohmann::json total = summary_json(total_summary());
-    total["served_scale"] = served_scale_summary(scales);
-    total["served_quality"] = served_quality_summary(history_);
-    nlohmann::json out = {
-        {"frames_presented", frames_},      {"jpeg_bytes_presented", bytes_},           {"frames_rejected", rejected_},
-        {"frames_superseded", superseded_}, {"frames_out_of_order", out_of_order_},     {"display_rounds", rounds_},
-        {"total", std::move(total)},        {"window", summary_json(window_summary())}, {"events", events_},
-        {"frames", std::move(frames)}};
+    total["percentiles"] = every_frame_kept() ? "exact" : "sketch (within 0.5 %)";
+    total["served_scale"] = served_scale_json(extra);
+    total["served_quality"] = served_quality_json();
+    nlohmann::json out = {{"frames_presented", frames_},
+                          {"jpeg_bytes_presented", bytes_},
+                          {"frames_rejected", rejected_},
+                          {"frames_superseded", superseded_},
+                          {"frames_out_of_order", out_of_order_},
+                          {"display_rounds", rounds_},
+                          {"total", std::move(total)},
+                          {"window", summary_json(window_summary())},
+                          {"events", events_},
+                          {"events_dropped", events_dropped_},
+                          {"frames_kept", frames_kept_},
+                          {"frames", std::move(frames)}};
+    if (frame_log_) {
+        out["frame_log"] = {{"path", frame_log_->path().string()}, {"lines", frame_log_->lines()}};
+        if (!frame_log_->error().empty()) out["frame_log"]["error"] = frame_log_->error();
+    }
     for (const auto& [key, value] : extra.items()) out[key] = value;
     return out;
 }

@@ -12,8 +12,11 @@
 //   bytes            = JPEG bytes of the frame
 // Rates over a sliding window of the last `window` presented frames: fps = (n - 1) / span of their
 // presented times, bandwidth = bytes of all but the first / span (the first frame's bytes arrived
-// before the span began). Totals and latency percentiles cover the whole run (the per-frame list
-// in the JSON keeps the first `max_history` frames; the counters keep counting after that).
+// before the span began). Totals cover the whole run in fixed memory: means, least and greatest
+// from running sums; percentiles exact while every frame is kept, else from a QuantileSketch (within
+// 0.5 % of a value of that rank; quantile_sketch.h). The per-frame list in the JSON keeps the first
+// `frames_kept` frames (allocated once); an optional FrameLog (frame_log.h) appends every frame's
+// record to a file instead, for runs of any length. Events are kept up to kMaxEvents (then counted).
 //
 // Not thread-safe: the event loop owns it.
 //
@@ -25,6 +28,7 @@
 #include <cstdint>
 #include <deque>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -33,6 +37,8 @@
 #include "common/pixel_rect.h"
 #include "common/prometheus_text.h"
 #include "common/view_request.h"
+#include "kiosk/stats/frame_log.h"
+#include "kiosk/stats/quantile_sketch.h"
 
 namespace mogao {
 
@@ -69,7 +75,15 @@ struct StatsSummary {
 
 class KioskStats {
 public:
-    explicit KioskStats(std::size_t window = 120, std::size_t max_history = 100'000);
+    static constexpr std::size_t kDefaultWindow = 120;
+    static constexpr std::size_t kDefaultFramesKept = 4096;  // [stats].frames_kept's default
+    static constexpr std::size_t kMaxEvents = 1000;
+
+    explicit KioskStats(std::size_t window = kDefaultWindow, std::size_t frames_kept = kDefaultFramesKept);
+
+    // Appends every frame presented from now on to `path` (FrameLog). Throws std::system_error
+    // naming the path.
+    void open_frame_log(const std::filesystem::path& path);
 
     void presented(const PresentedFrame& frame);
     void rejected() { ++rejected_; }                       // a frame failed to decode (last good kept)
@@ -81,7 +95,7 @@ public:
     [[nodiscard]] std::uint64_t frames() const { return frames_; }
     [[nodiscard]] std::uint64_t rounds() const { return rounds_; }
     [[nodiscard]] StatsSummary window_summary() const;  // the sliding window
-    [[nodiscard]] StatsSummary total_summary() const;   // the kept history
+    [[nodiscard]] StatsSummary total_summary() const;   // the whole run
     // Motion-to-photon of every presented frame, seconds (kiosk_metrics.h's buckets), for the metrics.
     [[nodiscard]] const prometheus::Histogram& motion_to_photon() const { return motion_to_photon_; }
 
@@ -101,12 +115,33 @@ public:
     void write_json(const std::filesystem::path& path, const nlohmann::json& extra = nlohmann::json::object()) const;
 
 private:
+    // Running sums over every presented frame (fixed memory).
+    struct Totals {
+        double latency_sum_ms = 0, latency_max_ms = 0, link_sum_ms = 0, kiosk_sum_ms = 0, decode_sum_ms = 0;
+        std::int64_t first_presented_ns = 0, last_presented_ns = 0;
+        std::size_t first_bytes = 0;
+        double served_height_sum = 0;
+        int served_height_min = 0;
+        std::uint64_t quality_frames = 0;  // frames whose spp the farm reported
+        double spp_sum = 0, bounce_sum = 0;
+        std::uint32_t spp_min = 0, bounce_min = 0;
+    };
+
     [[nodiscard]] static StatsSummary summarise(const std::vector<const PresentedFrame*>& frames);
+    [[nodiscard]] bool every_frame_kept() const { return history_.size() == frames_; }
+    void add_to_totals(const PresentedFrame& frame);
+    [[nodiscard]] nlohmann::json served_scale_json(const nlohmann::json& extra) const;
+    [[nodiscard]] nlohmann::json served_quality_json() const;
 
     std::size_t window_size_;
-    std::size_t max_history_;
+    std::size_t frames_kept_;
     std::deque<PresentedFrame> window_;
-    std::vector<PresentedFrame> history_;
+    std::vector<PresentedFrame> history_;  // the first frames_kept_ frames
+    Totals totals_;
+    QuantileSketch latency_ms_;     // motion-to-photon of every frame
+    QuantileSketch served_height_;  // served height of every frame
+    std::unique_ptr<FrameLog> frame_log_;
+    std::uint64_t events_dropped_ = 0;
     std::uint64_t frames_ = 0;
     std::uint64_t bytes_ = 0;
     std::uint64_t rejected_ = 0;

@@ -12,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "common/jpeg_codec.h"
+#include "common/memory_release.h"
 #include "common/program_cli.h"
 #include "common/service_notify.h"
 #include "renderfarm/farm/farm_metrics.h"
@@ -157,8 +158,10 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& s
     auto last_stats = start;
     auto last_metrics = start - std::chrono::seconds(1);
     const auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
+    MemoryRelease memory_release;  // months of service: freed frame buffers go back (common/memory_release.h)
     while (!g_stop && (options.duration_s <= 0 || elapsed() < options.duration_s)) {
         notifier.watchdog();
+        memory_release.tick();
         if (std::chrono::duration<double>(Clock::now() - last_stats).count() >= options.stats_period_s) {
             log_stats(server, queue, policy.changed());
             last_stats = Clock::now();

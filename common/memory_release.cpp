@@ -1,0 +1,27 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "common/memory_release.h"
+
+#include <malloc.h>
+#include <unistd.h>
+
+#include <fstream>
+
+namespace mogao {
+
+bool release_free_memory() { return ::malloc_trim(0) != 0; }
+
+std::size_t resident_bytes() {
+    std::ifstream statm("/proc/self/statm");
+    std::size_t pages = 0, resident = 0;
+    if (!(statm >> pages >> resident)) return 0;
+    return resident * static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
+}
+
+void MemoryRelease::tick(Clock::time_point now) {
+    if (now - last_ < period_) return;
+    last_ = now;
+    release_free_memory();
+    ++releases_;
+}
+
+}  // namespace mogao
