@@ -4,6 +4,7 @@
 #include <malloc.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <fstream>
 
 namespace mogao {
@@ -20,7 +21,9 @@ std::size_t resident_bytes() {
 void MemoryRelease::tick(Clock::time_point now) {
     if (now - last_ < period_) return;
     last_ = now;
+    const auto start = Clock::now();
     release_free_memory();
+    max_ms_ = std::max(max_ms_, std::chrono::duration<double, std::milli>(Clock::now() - start).count());
     ++releases_;
 }
 

@@ -31,6 +31,7 @@ ROOT = os.path.dirname(os.path.dirname(HERE))
 WARMUP_MIN = 10.0
 GROWTH_LIMIT_MIB_H = 1.0
 P95_TOLERANCE = 0.10
+FLOOR_WINDOW_MIN = 10.0
 
 
 def summarize_module():
@@ -182,6 +183,29 @@ def slope_per_hour(points):
     return 60.0 * sum((p[0] - mx) * (p[1] - my) for p in points) / sxx
 
 
+def slope_error_per_hour(points):
+    """Standard error of slope_per_hour's slope (residuals' spread); None with fewer than 3 points."""
+    slope = slope_per_hour(points)
+    if slope is None:
+        return None
+    n = len(points)
+    mx = sum(p[0] for p in points) / n
+    my = sum(p[1] for p in points) / n
+    sxx = sum((p[0] - mx) ** 2 for p in points)
+    b = slope / 60.0
+    residual = sum((p[1] - my - b * (p[0] - mx)) ** 2 for p in points) / (n - 2)
+    return 60.0 * (residual / sxx) ** 0.5
+
+
+def floor_points(points, window_min=FLOOR_WINDOW_MIN):
+    """The least value of each whole window of (minutes, value) points after the warm-up, at the
+    window's mean time: the memory a process holds whatever it has in flight at the moment."""
+    windows = {}
+    for t, v in points:
+        windows.setdefault(int((t - WARMUP_MIN) // window_min), []).append((t, v))
+    return [(sum(t for t, _ in w) / len(w), min(v for _, v in w)) for _, w in sorted(windows.items()) if len(w) >= 3]
+
+
 def percentile(values, q):
     if not values:
         return None
@@ -198,7 +222,10 @@ def process_rows(samples):
         after = [(t, p) for t, p in series if t >= WARMUP_MIN]
         if not series:
             continue
-        growth = slope_per_hour([(t, p["rss_kib"] / 1024.0) for t, p in after])
+        rss = [(t, p["rss_kib"] / 1024.0) for t, p in after]
+        growth = slope_per_hour(rss)
+        floors = floor_points(rss)
+        floor_growth = slope_per_hour(floors)
         fds = [p["fds"] for _, p in after] or [series[-1][1]["fds"]]
         threads = [p["threads"] for _, p in after] or [series[-1][1]["threads"]]
         third = max(1, len(after) // 3)
@@ -207,6 +234,9 @@ def process_rows(samples):
             "rss_mib_at_warmup": after[0][1]["rss_kib"] / 1024.0 if after else None,
             "rss_mib_at_end": series[-1][1]["rss_kib"] / 1024.0,
             "rss_growth_mib_per_h": growth,
+            "rss_growth_error_mib_per_h": slope_error_per_hour(rss),
+            "rss_floors_mib": [round(v, 2) for _, v in floors],
+            "rss_floor_growth_mib_per_h": floor_growth,
             "fds": [min(fds), max(fds)],
             "threads": [min(threads), max(threads)],
             # Transient workers (a render pass's tile threads, the denoiser's row bands) make the
@@ -219,7 +249,10 @@ def process_rows(samples):
         rows[-1]["rss_growth_by_mapping_mib_per_h"] = {
             k: slope_per_hour([(t, m[k] / 1024.0) for t, m in kinds]) for k in ("heap", "anon", "file", "other")
         } if len(kinds) >= 2 else None
-        rows[-1]["ok"] = ((growth is None or growth <= GROWTH_LIMIT_MIB_H) and not rows[-1]["fds_grow"]
+        # Judged on the floors where there are enough of them: a process that hands freed memory back
+        # swings with what it has in flight at the moment of a sample, a leak raises its floor.
+        judged = floor_growth if floor_growth is not None else growth
+        rows[-1]["ok"] = ((judged is None or judged <= GROWTH_LIMIT_MIB_H) and not rows[-1]["fds_grow"]
                           and not rows[-1]["threads_grow"])
     return rows
 
@@ -304,11 +337,14 @@ def markdown(result, meta, command):
     s = summarize_module()
     lines = [s.header(meta, "bench/soak/run", command), ""]
     rows = [[p["process"], fmt(p["rss_mib_at_warmup"], ".1f"), fmt(p["rss_mib_at_end"], ".1f"),
-             fmt(p["rss_growth_mib_per_h"], "+.2f"), "–".join(str(x) for x in sorted(set(p["fds"]))),
+             fmt(p["rss_growth_mib_per_h"], "+.2f") + " ± " + fmt(p.get("rss_growth_error_mib_per_h"), ".2f"),
+             fmt(p.get("rss_floor_growth_mib_per_h"), "+.2f"), "–".join(str(x) for x in sorted(set(p["fds"]))),
              "–".join(str(x) for x in sorted(set(p["threads"]))), "yes" if p["ok"] else "**no**"]
             for p in result["processes"]]
-    lines.append(s.table(["process", "RSS at 10 min (MiB)", "RSS at end (MiB)", "RSS growth after 10 min (MiB/h)",
-                          "open fds after 10 min (min–max)", "threads after 10 min (min–max)", "within the goal"],
+    lines.append(s.table(["process", "RSS at 10 min (MiB)", "RSS at end (MiB)",
+                          "RSS growth after 10 min, every sample (MiB/h ± s.e.)",
+                          "RSS growth of the 10-min floors (MiB/h)", "open fds after 10 min (min–max)",
+                          "threads after 10 min (min–max)", "within the goal"],
                          rows))
     by_kind = ["{}: {}".format(p["process"], ", ".join(f"{k} {v:+.2f}" for k, v in
                                                     p["rss_growth_by_mapping_mib_per_h"].items() if v is not None))

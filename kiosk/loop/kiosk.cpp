@@ -252,8 +252,8 @@ void Kiosk::on_tick() {
         write_status(running_state());
     }
     if (std::chrono::duration<double>(now - last_log_).count() >= config_.stats.log_period_s) {
-        spdlog::info("stats: {} link_sessions={} link_connected={}", parts_.display.stats().log_line(),
-                     link.sessions_opened, link.connected);
+        spdlog::info("stats: {} link_sessions={} link_connected={} memory_release_max_ms={:.1f}",
+                     parts_.display.stats().log_line(), link.sessions_opened, link.connected, memory_release_.max_ms());
         last_log_ = now;
     }
     memory_release_.tick(now);  // months on the wall: freed memory goes back (common/memory_release.h)

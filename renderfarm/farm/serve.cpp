@@ -59,13 +59,14 @@ RenderedFrame serve_request(MainThreadQueue<ServedFrame>& queue, const ViewReque
     return encode(frame, encoder);
 }
 
-void log_stats(const LinkServer& server, const MainThreadQueue<ServedFrame>& queue, std::uint64_t degraded) {
+void log_stats(const LinkServer& server, const MainThreadQueue<ServedFrame>& queue, std::uint64_t degraded,
+               const MemoryRelease& memory_release) {
     const LinkServerStats s = server.stats();
     spdlog::info(
         "link: {} sessions active, {} frames sent, {} requests ({} dropped as stale, {} superseded in the "
-        "farm's queue, {} invalid, {} changed by the view or request policy), {} MB",
+        "farm's queue, {} invalid, {} changed by the view or request policy), {} MB; longest memory release {:.1f} ms",
         s.sessions_active, s.frames_sent, s.requests_received, s.requests_dropped, queue.superseded(),
-        s.requests_invalid, degraded, static_cast<double>(s.jpeg_bytes_sent) / 1e6);
+        s.requests_invalid, degraded, static_cast<double>(s.jpeg_bytes_sent) / 1e6, memory_release.max_ms());
 }
 
 // The frame budget across frames (session_budget.h): degrades a request to its appliance's measured
@@ -154,16 +155,16 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& s
     const auto counters = [&](bool up) {
         return FarmCounters{up, server.stats(), queue.superseded(), policy.changed(), run.render_ranks};
     };
+    MemoryRelease memory_release;  // months of service: freed frame buffers go back (common/memory_release.h)
     const auto start = Clock::now();
     auto last_stats = start;
     auto last_metrics = start - std::chrono::seconds(1);
     const auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
-    MemoryRelease memory_release;  // months of service: freed frame buffers go back (common/memory_release.h)
     while (!g_stop && (options.duration_s <= 0 || elapsed() < options.duration_s)) {
         notifier.watchdog();
         memory_release.tick();
         if (std::chrono::duration<double>(Clock::now() - last_stats).count() >= options.stats_period_s) {
-            log_stats(server, queue, policy.changed());
+            log_stats(server, queue, policy.changed(), memory_release);
             last_stats = Clock::now();
         }
         if (Clock::now() - last_metrics >= std::chrono::seconds(1)) {
