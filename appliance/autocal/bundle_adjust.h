@@ -36,7 +36,8 @@
 // (a decoded block of b pixels: b / sqrt(12), the uniform distribution's; a phase-refined position: its own,
 // phase_shift.h); s_k and sigma_e are the
 // measured residual rms of the previous round (maximum likelihood for Gaussian noise);
-// correspondences beyond 4x the median residual of their projector are dropped between rounds.
+// correspondences beyond 4x the median residual of their projector, and with refine_screen edge points beyond 4x
+// the median distance of all edge points, are dropped between rounds.
 #pragma once
 
 #include <limits>
@@ -98,7 +99,8 @@ struct BundleResult {
     std::vector<double> rms_px;     // per projector, correspondence residual of the last round (inliers), px
     std::vector<double> rms_sigma;  // the same in units of each point's sigma_px (about 1 for a good fit)
     std::vector<int> inliers;       // per projector
-    double edge_rms_m = 0.0;
+    double edge_rms_m = 0.0;        // of the edge points kept (inliers), metres on the screen
+    int edge_inliers = 0;           // edge points kept (with refine_screen, those beyond 4x the median are dropped)
     // Conditioning at the solution, from the normal matrix N = J^T J of the whitened residuals (prior
     // included): standard deviations sqrt(diag(N^-1)) of the camera's fx, cx, cy (px), k1, k2 when
     // refined (else empty), and the condition number of N after scaling it to unit diagonal (its

@@ -221,7 +221,7 @@ EdgeFit fit_camera_pose(const cv::Mat1f& lit, const CalibrationPrior& prior, con
     constexpr double kPrior = 1e-3;  // weak pull to the prior pose (m and rad)
     EdgeFit fit;
     for (int iter = 0; iter < 25; ++iter) {
-        const double gate = std::max(0.02, 0.3 * std::pow(0.75, iter));
+        const double gate = std::max(kEdgeGateM, 0.3 * std::pow(0.75, iter));
         const auto [r, o] = pose(p);
         std::vector<int> used;
         std::vector<double> res;
@@ -265,18 +265,32 @@ EdgeFit fit_camera_pose(const cv::Mat1f& lit, const CalibrationPrior& prior, con
     fit.camera = prior.camera;
     fit.camera.rotation = r;
     fit.camera.position_m = o;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        if (!std::isfinite(edge_residual(prior.screen, r, o, rays[i], edges[i].vertical_scan, 0.02))) continue;
-        const Eigen::Vector3d x = ray_on_screen(prior.screen, fit.camera, rays[i]);
-        ScreenEdge which = std::atan2(x.x(), -x.z()) > 0.0 ? ScreenEdge::right_end : ScreenEdge::left_end;
-        if (edges[i].vertical_scan) {
-            which = std::abs(x.y() - prior.screen.top_m) < std::abs(x.y() - prior.screen.bottom_m) ? ScreenEdge::top
-                                                                                                   : ScreenEdge::bottom;
-        }
-        fit.edges.push_back({rays[i], which, {image[i].x, image[i].y}});
-    }
+    for (const EdgePoint& e : edges) fit.candidates.push_back({e.image, e.vertical_scan});
+    fit.edges = select_edges(fit.candidates, fit.camera, prior.screen, kEdgeGateM);
     check_edge_fit(fit, options);
     return fit;
+}
+
+std::vector<EdgeObservation> select_edges(const std::vector<EdgeCandidate>& candidates, const DeviceModel& camera,
+                                          const ScreenModel& screen, double gate_m) {
+    std::vector<cv::Point2d> image;
+    for (const EdgeCandidate& c : candidates) image.push_back(c.image);
+    const std::vector<Eigen::Vector3d> rays = camera_rays(camera, image);
+    std::vector<EdgeObservation> out;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        const bool vertical = candidates[i].vertical_scan;
+        if (!std::isfinite(edge_residual(screen, camera.rotation, camera.position_m, rays[i], vertical, gate_m))) {
+            continue;
+        }
+        const Eigen::Vector3d x = ray_on_screen(screen, camera, rays[i]);
+        ScreenEdge which = std::atan2(x.x(), -x.z()) > 0.0 ? ScreenEdge::right_end : ScreenEdge::left_end;
+        if (vertical) {
+            which = std::abs(x.y() - screen.top_m) < std::abs(x.y() - screen.bottom_m) ? ScreenEdge::top
+                                                                                       : ScreenEdge::bottom;
+        }
+        out.push_back({rays[i], which, {image[i].x, image[i].y}});
+    }
+    return out;
 }
 
 ProjectorFit fit_projector(const DeviceModel& camera, const CalibrationPrior& prior, int k,

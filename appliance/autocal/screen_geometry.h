@@ -32,13 +32,32 @@ namespace mogao::autocal {
 [[nodiscard]] std::optional<Eigen::Vector3d> cylinder_hit(const ScreenModel& screen, const Eigen::Vector3d& o,
                                                           const Eigen::Vector3d& d);
 
+// How far on the screen (metres) an edge point may lie from the edge it is assigned to: the last gate of the
+// camera pose's edge fit, and select_edges' after the bundle adjustment.
+inline constexpr double kEdgeGateM = 0.02;
+
+// A crossing of the lit screen's edge found in the camera image, before it is assigned to an edge.
+struct EdgeCandidate {
+    cv::Point2d image;           // camera image position, pixel centres at +0.5
+    bool vertical_scan = false;  // found scanning a column: on the top or bottom edge, if on any
+};
+
 struct EdgeFit {
     DeviceModel camera;
     int points = 0;       // edge points used (inliers)
     int side_points = 0;  // of which on the arc's ends
     double rms_m = 0.0;
-    std::vector<EdgeObservation> edges;  // the inliers with the edge each lies on (for bundle_adjust)
+    std::vector<EdgeObservation> edges;     // the inliers with the edge each lies on (for bundle_adjust)
+    std::vector<EdgeCandidate> candidates;  // every crossing found, inliers or not (for select_edges)
 };
+
+// The candidates that lie within `gate_m` metres on the screen of one of its edges as `camera` sees `screen`, each
+// with the edge it lies on. fit_camera_pose assigns them with the prior's intrinsics and told screen; a model that
+// is refined later (the camera's intrinsics, the screen's radius and arc) assigns them again: points that the
+// prior's errors put beyond the gate, most at the image's rim where a lens error is largest, are then kept.
+[[nodiscard]] std::vector<EdgeObservation> select_edges(const std::vector<EdgeCandidate>& candidates,
+                                                        const DeviceModel& camera, const ScreenModel& screen,
+                                                        double gate_m);
 
 // Step 2: lit = all projectors white minus all black. Throws CalibrationRefused when the edges are
 // too few or the fit is above its gate.
