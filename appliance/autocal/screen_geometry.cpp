@@ -22,17 +22,12 @@ std::string fmt(double v) {
     return buf;
 }
 
-struct EdgePoint {
-    cv::Point2d image;
-    bool vertical_scan = false;  // found scanning a column: top or bottom edge
-};
-
 // Sub-pixel crossings of the local half level where the lit mask changes, along columns and rows.
-std::vector<EdgePoint> find_edges(const cv::Mat1f& lit) {
+std::vector<EdgeCandidate> find_edges(const cv::Mat1f& lit) {
     std::vector<float> values(lit.begin(), lit.end());
     std::nth_element(values.begin(), values.begin() + static_cast<long>(values.size() * 9 / 10), values.end());
     const float level = 0.5f * values[values.size() * 9 / 10];
-    std::vector<EdgePoint> out;
+    std::vector<EdgeCandidate> out;
     constexpr int kReach = 3;
     const auto scan = [&](int n, int len, bool vertical) {
         for (int i = 0; i < n; ++i) {
@@ -208,9 +203,9 @@ void check_edge_fit(const EdgeFit& fit, const AutocalOptions& options) {
 }  // namespace
 
 EdgeFit fit_camera_pose(const cv::Mat1f& lit, const CalibrationPrior& prior, const AutocalOptions& options) {
-    const std::vector<EdgePoint> edges = find_edges(lit);
+    const std::vector<EdgeCandidate> edges = find_edges(lit);
     std::vector<cv::Point2d> image;
-    for (const EdgePoint& e : edges) image.push_back(e.image);
+    for (const EdgeCandidate& e : edges) image.push_back(e.image);
     const std::vector<Eigen::Vector3d> rays = camera_rays(prior.camera, image);
     const Eigen::Matrix3d r0 = prior.camera.rotation;
     const Eigen::Vector3d o0 = prior.camera.position_m;
@@ -265,7 +260,7 @@ EdgeFit fit_camera_pose(const cv::Mat1f& lit, const CalibrationPrior& prior, con
     fit.camera = prior.camera;
     fit.camera.rotation = r;
     fit.camera.position_m = o;
-    for (const EdgePoint& e : edges) fit.candidates.push_back({e.image, e.vertical_scan});
+    fit.candidates = edges;
     fit.edges = select_edges(fit.candidates, fit.camera, prior.screen, kEdgeGateM);
     check_edge_fit(fit, options);
     return fit;

@@ -52,9 +52,9 @@ struct EdgeFit {
 };
 
 // The candidates that lie within `gate_m` metres on the screen of one of its edges as `camera` sees `screen`, each
-// with the edge it lies on. fit_camera_pose assigns them with the prior's intrinsics and told screen; a model that
-// is refined later (the camera's intrinsics, the screen's radius and arc) assigns them again: points that the
-// prior's errors put beyond the gate, most at the image's rim where a lens error is largest, are then kept.
+// with the edge it lies on. fit_camera_pose assigns them with the prior's intrinsics and told screen; with the screen
+// fitted, calibrate assigns them again through the refined model: points that the prior's errors put beyond the
+// gate are then kept.
 [[nodiscard]] std::vector<EdgeObservation> select_edges(const std::vector<EdgeCandidate>& candidates,
                                                         const DeviceModel& camera, const ScreenModel& screen,
                                                         double gate_m);
