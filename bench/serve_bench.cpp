@@ -122,24 +122,43 @@ FrameQuality frame_quality(const Rgb8Image& served, const Rgb8Image& reference) 
     return {psnr(served, reference), quality::ssim_luminance(served, reference), quality::gmsd(served, reference)};
 }
 
-// What the farm served for each counted moving frame: its scale, spp and bounces.
+// What the farm served for each counted moving frame: its scale, spp and bounces, and where its
+// time went on the admin (seconds: the whole frame, the render phase, the slowest rank's tracing,
+// the filter; the rest of `frame_seconds` is compositing, accumulation and the hand-off).
 struct ServedLog {
     nlohmann::json frames = nlohmann::json::array();
     double scale_sum = 0, scale_min = 1, spp_sum = 0, bounces_sum = 0;
+    double frame_s = 0, render_phase_s = 0, slowest_rank_s = 0, denoise_s = 0;
     void add(const LiveFrame& f) {
         const Quality& q = f.rendered.quality;
-        frames.push_back({{"scale", q.resolution_scale}, {"spp", q.spp}, {"bounces", q.max_bounces}});
+        const auto& ranks = f.stats.rank_render_seconds;
+        const double slowest = ranks.empty() ? 0.0 : *std::max_element(ranks.begin(), ranks.end());
+        frames.push_back({{"scale", q.resolution_scale},
+                          {"spp", q.spp},
+                          {"bounces", q.max_bounces},
+                          {"frame_seconds", f.seconds},
+                          {"render_phase_seconds", f.stats.render_phase_seconds},
+                          {"slowest_rank_seconds", slowest},
+                          {"denoise_seconds", f.denoise_seconds}});
         scale_sum += q.resolution_scale;
         scale_min = std::min(scale_min, q.resolution_scale);
         spp_sum += q.spp;
         bounces_sum += q.max_bounces;
+        frame_s += f.seconds;
+        render_phase_s += f.stats.render_phase_seconds;
+        slowest_rank_s += slowest;
+        denoise_s += f.denoise_seconds;
     }
     [[nodiscard]] nlohmann::json summary() const {
         const double n = std::max<double>(1, double(frames.size()));
         return {{"scale_mean", scale_sum / n},
                 {"scale_min", scale_min},
                 {"spp_mean", spp_sum / n},
-                {"bounces_mean", bounces_sum / n}};
+                {"bounces_mean", bounces_sum / n},
+                {"frame_seconds_mean", frame_s / n},
+                {"render_phase_seconds_mean", render_phase_s / n},
+                {"slowest_rank_seconds_mean", slowest_rank_s / n},
+                {"denoise_seconds_mean", denoise_s / n}};
     }
 };
 
