@@ -277,9 +277,24 @@ cv::Mat1f show_averaged(PatternSource& source, const std::vector<cv::Mat>& signa
     return sum;
 }
 
+cv::Mat1f lit_screen(PatternSource& source, const std::vector<ImageSize>& sizes, const cv::Mat1f& black, int frames,
+                     int& captures) {
+    cv::Mat1f lit(black.size(), 0.0f);
+    for (std::size_t k = 0; k < sizes.size(); ++k) {
+        std::vector<cv::Mat> signals(sizes.size());
+        signals[k] = cv::Mat1f(sizes[k].height, sizes[k].width, 1.0f);
+        cv::Mat1f one;
+        cv::subtract(show_averaged(source, signals, frames), black, one);
+        lit = cv::max(lit, one);
+        captures += frames;
+    }
+    return lit;
+}
+
 namespace {
 
-// Step 2: all projectors white minus all black shows the screen's lit edges, and the camera's pose from them.
+// Step 2: the projectors white minus all black show the screen's lit edges, and the camera's pose from them. Every
+// projector white at once is shown too (what the camera saw: the images route writes it as camera-white.png).
 EdgeFit fit_camera_to_lit_screen(PatternSource& source, const CalibrationPrior& prior,
                                  const std::vector<ImageSize>& sizes, const AutocalOptions& options,
                                  AutocalReport& report) {
@@ -287,10 +302,9 @@ EdgeFit fit_camera_to_lit_screen(PatternSource& source, const CalibrationPrior& 
     const int frames = options.frames_per_pattern;
     const cv::Mat1f black = show_averaged(source, signals, frames).clone();  // the source may reuse its buffer
     for (std::size_t k = 0; k < sizes.size(); ++k) signals[k] = cv::Mat1f(sizes[k].height, sizes[k].width, 1.0f);
-    const cv::Mat1f white = show_averaged(source, signals, frames);
+    (void)show_averaged(source, signals, frames);
     report.captures = 2 * frames;
-    cv::Mat1f lit;
-    cv::subtract(white, black, lit);
+    const cv::Mat1f lit = lit_screen(source, sizes, black, frames, report.captures);
     // With the screen still to be fitted, an edge fit on the prior's cylinder is only a start (the told screen and
     // the camera's prior intrinsics together left the lit edges 13 mm off it on realistic-install at full
     // resolution): its gate is five times looser here, a sanity limit, and the gate itself holds the bundle

@@ -27,10 +27,10 @@
 //     `shadow_noise_sigmas` times the noise of white - black, estimated from the black image.
 //  1b. Phase shift (phase_shift.h; Gühring 2001): `phase_shifts` sinusoids per axis refine each pixel whose Gray
 //     block is at most half a period to a sub-pixel position with its own uncertainty.
-//  2. Camera pose: the lit region of all projectors at full white ends at the screen's edges
-//     (projectors overfill them). Edge points are located to sub-pixel as the crossing of the local
-//     half level; Gauss-Newton on the camera's 6 pose parameters minimises the distance, on the
-//     screen, of each edge point's ray from the edge it belongs to (h = top/bottom, theta = +-arc/2),
+//  2. Camera pose: the lit region of the projectors at full white ends at the screen's edges
+//     (projectors overfill them; one projector at a time, lit_screen). Edge points are located to sub-pixel as
+//     the crossing of the local half level; Gauss-Newton on the camera's 6 pose parameters minimises the distance,
+//     on the screen, of each edge point's ray from the edge it belongs to (h = top/bottom, theta = +-arc/2),
 //     from the prior pose, with a weak pull to the prior (the ends fix the yaw about the axis).
 //  3. Projector: camera ray of each correspondence -> cylinder -> 3D point; SQPnP with the
 //     data-sheet intrinsics for the pose, then Levenberg-Marquardt on focal length, principal point
@@ -237,6 +237,15 @@ public:
 // The mean of `frames` camera images of the same signals (frames >= 1): the camera's temporal
 // noise falls as 1/sqrt(frames); each frame is one capture.
 [[nodiscard]] cv::Mat1f show_averaged(PatternSource& source, const std::vector<cv::Mat>& signals, int frames);
+
+// The screen's lit image for the edge fit (step 2), camera pixels in the camera's linear units: per
+// pixel the largest over projectors k of (projector k white, the others black) minus `black` (every
+// projector black). Not every projector white at once: where projectors overlap, their sum saturates a
+// camera exposed for one of them, and a clipped edge of twice the height crosses its half level outward,
+// 0.67 sigma of the camera's blur for a Gaussian one (millimetres on the virtual rigs). Shows each
+// projector's white `frames` times (n x frames captures, added to `captures`).
+[[nodiscard]] cv::Mat1f lit_screen(PatternSource& source, const std::vector<ImageSize>& sizes, const cv::Mat1f& black,
+                                   int frames, int& captures);
 
 // Throws CalibrationRefused naming the camera's auto-exposure unless source.exposure_locked().
 void require_locked_exposure(const PatternSource& source);

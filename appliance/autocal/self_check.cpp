@@ -239,19 +239,17 @@ DeviceModel pixel_edge_fit(const ScreenModel& s, const DeviceModel& start, const
 }
 
 // The check's camera: the calibration's intrinsics (refined or the prior's), posed by the screen's lit frame
-// alone (white minus black; edge points as in step 2 of autocal.h, fitted in camera pixels).
+// alone (each projector's white minus black, lit_screen; edge points as in step 2 of autocal.h, fitted in camera
+// pixels).
 DeviceModel frame_camera(PatternSource& source, const CalibrationPrior& prior, const AutocalResult& r,
                          const SelfCheckOptions& o, SelfCheckResult& out) {
     const std::size_t n = r.projectors.size();
     std::vector<cv::Mat> signals(n);
+    std::vector<ImageSize> sizes(n);
+    for (std::size_t k = 0; k < n; ++k) sizes[k] = r.projectors[k].resolution;
     const cv::Mat1f black = show_averaged(source, signals, o.frames).clone();
-    for (std::size_t k = 0; k < n; ++k) {
-        signals[k] = cv::Mat1f(r.projectors[k].resolution.height, r.projectors[k].resolution.width, 1.0F);
-    }
-    const cv::Mat1f white = show_averaged(source, signals, o.frames);
-    out.captures += 2 * o.frames;
-    cv::Mat1f lit;
-    cv::subtract(white, black, lit);
+    out.captures += o.frames;
+    const cv::Mat1f lit = lit_screen(source, sizes, black, o.frames, out.captures);
     CalibrationPrior start = prior;
     start.screen = r.screen;
     start.camera = r.camera;

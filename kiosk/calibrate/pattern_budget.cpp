@@ -16,7 +16,7 @@ PatternBudget pattern_budget(const autocal::CalibrationPrior& prior, bool colour
     };
     PatternBudget b;
     b.identification = 2 + n;
-    b.geometry = 2;
+    b.geometry = 2 + n;
     for (const autocal::DeviceModel& p : prior.projectors) {
         b.geometry += 2 + 2 * (bits(p.resolution.width) + bits(p.resolution.height)) + 2 * options.phase_shifts;
     }
@@ -30,7 +30,7 @@ PatternBudget pattern_budget(const autocal::CalibrationPrior& prior, bool colour
         }
         b.colour = 5 + n * 3 * ((steps - 1) + low) + colour_options.dark_frames;
     }
-    b.self_check = self_check.frames * (3 + n);
+    b.self_check = self_check.frames * (2 + 2 * n);
     return b;
 }
 

@@ -4,14 +4,14 @@
 //
 // Count (an upper bound: the Gray code stops at the first bit the camera cannot resolve,
 // appliance/autocal/gray_code.h): identification 2 + N (all black, all white, then each output white alone,
-// connector_identity.h); geometry F * (2 + sum_k (2 + 2 * (bits(width_k) + bits(height_k)) + 2 * S)) (black
-// and white of all, per projector white and black, each Gray bit and its inverse per axis, S phase
-// shifts per axis; bits(n) = gray_code_bits, at most max_gray_bits; F frames_per_pattern); colour 5 + N * 3 *
-// ((ramp_steps - 1) + low) + dark_frames, low = 2 + the ramp levels in (0, 1/4] other than 1/32 and 1/16
-// (appliance/autocal/colour_calibration.h, step 1's low end); self-check F' * (3 + N) (black and white of all for
-// the frame, black, then each projector's marks; F' its frames, appliance/autocal/self_check.h). Time per image =
-// settle + (drop_frames + 1) / camera fps
-// + exposure (the flip itself is within one refresh, part of the settle).
+// connector_identity.h); geometry F * (2 + N + sum_k (2 + 2 * (bits(width_k) + bits(height_k)) + 2 * S)) (black and
+// white of all, each projector white alone for the lit edges, per projector white and black, each Gray bit and its
+// inverse per axis, S phase shifts per axis; bits(n) = gray_code_bits, at most max_gray_bits; F
+// frames_per_pattern); colour 5 + N * 3 * ((ramp_steps - 1) + low) + dark_frames, low = 2 + the ramp levels in (0,
+// 1/4] other than 1/32 and 1/16 (appliance/autocal/colour_calibration.h, step 1's low end); self-check F' * (2 + 2
+// N) (black and each projector white alone for the frame, black, then each projector's marks; F' its frames,
+// appliance/autocal/self_check.h). Time per image = settle + (drop_frames + 1) / camera fps + exposure (the flip
+// itself is within one refresh, part of the settle).
 #pragma once
 
 #include "appliance/autocal/autocal.h"

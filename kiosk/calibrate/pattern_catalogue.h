@@ -7,7 +7,9 @@
 // phase_shift.h) with every step it may take, in the order it takes them:
 //   black                          every projector black
 //   white                          every projector white
-//   p<k>-white                     projector k white, the others black
+//   p<k>-white                     projector k white, the others black (shown for the lit edges, each projector
+//                                  in turn after `white`, and again before its Gray code: the same picture,
+//                                  so a folder of captures holds it once)
 //   p<k>-<axis>-bit<BB>            projector k's Gray-code bit BB (0 = the coarsest) along `columns` or
 //   p<k>-<axis>-bit<BB>-inverse    `rows`, and its inverse; every bit of the axis (or max_gray_bits):
 //                                  the live run stops at the first bit the camera cannot resolve, the

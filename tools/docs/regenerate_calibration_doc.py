@@ -73,8 +73,8 @@ def main():
              "| rig | result | geometry mean / p95 / max (px) | self-check mean / p95 (px) | camera "
              "intrinsics (trial's "
              "relative cost) | projector distortion (trial's relative cost per projector) | seam luminance max | "
-             "predicted seam | camera position error | reprojection rms (px) | compute s |",
-             "|---|---|---|---|---|---|---|---|---|---|--:|"]
+             "predicted seam | camera position error | lit edges rms | reprojection rms (px) | compute s |",
+             "|---|---|---|---|---|---|---|---|---|---|---|--:|"]
     colour = [f"Same run. Flat content at each level, the rig's ground-truth light at 401 x 101 content points; "
               "seam = points two projectors light; luminance deviation |Y / Y_ref - 1| with Y_ref the median of the "
               "points one projector lights; pixel mean = the light averaged over the footprint of the output pixel "
@@ -106,7 +106,7 @@ def main():
             if p.returncode != 0:
                 why = p.stderr.strip().replace("mogao-calibrate-sim rig: ", "").replace("|", "/")
                 if not why.startswith("self-check:"):
-                    lines.append(f"| {name} | refused: {why} | — | — | — | — | — | — | — | — | — |")
+                    lines.append(f"| {name} | refused: {why} | — | — | — | — | — | — | — | — | — | — |")
                     continue
                 # What the self-check refused, against the truth: the same run with its gate off.
                 result = f"refused: {why} (figures: the same run with the gate off)"
@@ -125,7 +125,8 @@ def main():
                      f"{distortion_cell(r['projectors'])} | "
                      f"{100 * g['seam_luminance_max_deviation']:.2f} % | "
                      f"{100 * r['predicted']['seam_weight_sum_max_deviation']:.2f} % | "
-                     f"{g['camera_position_error_mm']:.2f} mm | {rms} | {r['timing']['compute_s']:.1f} |")
+                     f"{g['camera_position_error_mm']:.2f} mm | {r['camera']['edge_rms_mm']:.2f} mm | {rms} | "
+                     f"{r['timing']['compute_s']:.1f} |")
     doc = os.path.join(ROOT, "docs", "calibration.md")
     text = open(doc).read()
     if not BLOCK.search(text):
