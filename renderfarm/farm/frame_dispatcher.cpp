@@ -406,7 +406,7 @@ struct FrameDispatcher::Watch {
 // its budget, and throws RankTimeout (the farm broken) when a rank that owes a reply falls silent
 // (heartbeat about once a second).
 template <typename Done>
-void FrameDispatcher::poll_until(Watch& watch, const Done& done, const char* phase) {
+void FrameDispatcher::poll_until(Watch& watch, const Done& done, const char* phase, int transfer_from) {
     auto next_beat = Clock::now() + std::chrono::seconds(1);
     double last_poll = watch.now();
     while (!done()) {
@@ -418,6 +418,14 @@ void FrameDispatcher::poll_until(Watch& watch, const Done& done, const char* pha
         }
         last_poll = watch.now();
         drain_progress(watch);
+        // While one rank's pixels transfer, a rank that has finished cannot be heard: it waits in its own send
+        // until the admin takes its reply. Were they judged, a rank stopped between its reply header and its
+        // pixels would have the others named in its place. So only the transferring rank is judged; the others'
+        // silence counts again from the transfer's end.
+        if (transfer_from > 0) {
+            for (int r = 1; r <= mpi_.render_ranks(); ++r)
+                if (r != transfer_from && watch.liveness.owes(r)) watch.liveness.heard(r, watch.now());
+        }
         if (settings_.frame_budget_s > 0 && !watch.cut_sent && watch.now() > settings_.frame_budget_s) send_cuts(watch);
         if (const std::vector<int> silent = watch.liveness.silent(watch.now()); !silent.empty())
             lost(watch, silent, phase);
@@ -510,7 +518,7 @@ bool FrameDispatcher::gather(const ViewRequest& view, const Assignment& assignme
         const int source = probe_reply(watch);
         // While its pixels transfer the rank sends nothing else: their time at the slowest link is allowed.
         RankReply reply = receive_reply(
-            source, [&](const std::function<bool()>& done) { poll_until(watch, done, nullptr); },
+            source, [&](const std::function<bool()>& done) { poll_until(watch, done, nullptr, source); },
             [&](const ReplyHeader& h) {
                 // The ranks that finished meanwhile wait in their own sends, silent, until the admin
                 // is done with this one: the transfer's time is allowed to every rank that owes.

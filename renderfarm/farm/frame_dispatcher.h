@@ -125,8 +125,10 @@ private:
                 std::vector<TileTime>& normalised);
     CostMap& stream_map(std::uint64_t stream, ImageSize size);
     struct Watch;  // one frame's liveness and budget (frame_dispatcher.cpp)
+    // Polls `done` under the frame's liveness; `transfer_from` > 0: that rank's reply is transferring, so it alone
+    // is judged (the others that finished wait in their own sends, silent).
     template <typename Done>
-    void poll_until(Watch& watch, const Done& done, const char* phase);
+    void poll_until(Watch& watch, const Done& done, const char* phase, int transfer_from = 0);
     int probe_reply(Watch& watch);
     void drain_progress(Watch& watch);
     void send_cuts(Watch& watch);
