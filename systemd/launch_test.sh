@@ -8,9 +8,11 @@
 #   * the wait works where /proc/uptime is hidden (the unit's ProcSubset=pid; needs a mount
 #     namespace, as root);
 #   * a host back while the farm serves without it ends the job after 2 answers in a row
-#     (MOGAO_REJOIN_CHECK_S), and not at all with 0;
+#     (MOGAO_REJOIN_CHECK_S, the second MOGAO_REJOIN_CONFIRM_S after the first), and not at all with 0;
+#   * the hosts of the ranks the previous job named lost (its --lost-ranks-file) are left out unasked;
 #   * a host file whose last line lacks its newline still has that host;
-#   * bad MOGAO_BOOT_GRACE_S / MOGAO_REJOIN_CHECK_S / RANKS are refused with exit 2, naming the variable.
+#   * bad MOGAO_BOOT_GRACE_S / MOGAO_REJOIN_CHECK_S / MOGAO_REJOIN_CONFIRM_S / RANKS are refused with
+#     exit 2, naming the variable.
 # usage: launch_test.sh LAUNCHER
 set -euo pipefail
 launcher=$1
@@ -82,10 +84,37 @@ rc=0; out=$(REJOIN=1 MPIRUN="$work/mpirun-serving" LIMIT=30 run 0 2) || rc=$?
 rejoin_took=$(($(date +%s) - start))
 [ $rc = 1 ] || fail "rejoin: exit $rc, expected 1 (the job ended by SIGTERM): $out"
 echo "$out" | grep -q "mpirun: SIGTERM" || fail "rejoin: mpirun not ended: $out"
-echo "$out" | grep -q "render host(s) render2 answer again (2 checks in a row)" || fail "rejoin: not logged: $out"
+echo "$out" | grep -q "render host(s) render2 answer again (2 checks in a row, 1 s apart)" \
+  || fail "rejoin: not logged: $out"
 [ "$(cat "$work/calls")" = 4 ] || fail "rejoin: render2 asked $(cat "$work/calls") times, expected 4"
+# The confirming check comes MOGAO_REJOIN_CONFIRM_S after the first answer, not a whole period later:
+# checks at 3 s (answers) and 4 s end the job, where two periods would take 6 s.
+start=$(date +%s)
+rc=0; out=$(MOGAO_REJOIN_CONFIRM_S=1 REJOIN=3 MPIRUN="$work/mpirun-serving" LIMIT=30 run 0 1) || rc=$?
+confirm_took=$(($(date +%s) - start))
+echo "$out" | grep -q "answer again (2 checks in a row, 1 s apart)" || fail "rejoin confirm: not logged: $out"
+((confirm_took <= 5)) || fail "rejoin confirm: the job ended after $confirm_took s, expected about 4"
 rc=0; out=$(REJOIN=0 MPIRUN="$work/mpirun-serving" LIMIT=4 run 0 2) || rc=$?
 [ $rc = 124 ] || fail "no rejoin (MOGAO_REJOIN_CHECK_S=0): the job ended (exit $rc): $out"
+
+# The previous job named rank 2 lost (the admin's --lost-ranks-file, beside the host file it ran on):
+# render2 is left out unasked, even within the boot grace and though it would answer, the file is
+# consumed, and mpirun's job is told where to write it.
+printf 'admin slots=2\nrender2 slots=1\n' > "$work/farm-hosts.live"
+printf '2\n' > "$work/lost-ranks"
+out=$(LIMIT=10 run $((up + 600)) 0)
+echo "$out" | grep -q "render host render2 left out unasked: named lost by the previous job (rank 2)" \
+  || fail "named lost: render2 not left out with the reason: $out"
+echo "$out" | grep -q "mpirun --hostfile .* -n 2 mogao-farm serve --lost-ranks-file $work/lost-ranks$" \
+  || fail "named lost: expected 2 ranks and the lost-ranks file: $out"
+[ ! -e "$work/calls" ] || fail "named lost: render2 asked $(cat "$work/calls") times, expected 0"
+[ ! -e "$work/lost-ranks" ] || fail "named lost: the file was not consumed"
+# Only the admin's own rank named (or nothing readable): every render host is asked as usual.
+printf 'admin slots=2\nrender2 slots=1\n' > "$work/farm-hosts.live"
+printf '1\nx\n' > "$work/lost-ranks"
+out=$(run 0 0)
+echo "$out" | grep -q "mpirun --hostfile .* -n 3 mogao-farm serve" || fail "admin rank named: render2 dropped: $out"
+[ "$(cat "$work/calls")" = 1 ] || fail "admin rank named: render2 asked $(cat "$work/calls") times, expected 1"
 
 # A host file whose last line has no newline: its host is still asked and used.
 printf 'admin slots=2\nrender2 slots=1' > "$work/hosts"
@@ -95,10 +124,10 @@ printf 'admin slots=2 # this machine\nrender2 slots=1\n' > "$work/hosts"
 
 rc=0; err=$(sh "$launcher" "$work/hosts" 0 true 2>&1) || rc=$?
 [ $rc = 2 ] && echo "$err" | grep -q "RANKS must be a number >= 1" || fail "RANKS 0: rc $rc, '$err'"
-for bad in "MOGAO_BOOT_GRACE_S=-1" "MOGAO_BOOT_GRACE_S=2m" "MOGAO_REJOIN_CHECK_S=1.5"; do
+for bad in "MOGAO_BOOT_GRACE_S=-1" "MOGAO_BOOT_GRACE_S=2m" "MOGAO_REJOIN_CHECK_S=1.5" "MOGAO_REJOIN_CONFIRM_S=x"; do
   rc=0; err=$(env "$bad" sh "$launcher" "$work/hosts" 3 true 2>&1) || rc=$?
   [ $rc = 2 ] && echo "$err" | grep -q "${bad%%=*} must be whole seconds" || fail "$bad: rc $rc, '$err'"
 done
 echo "PASS: launcher waits for booting hosts only within the grace (3 checks)," \
-  "${hidden:-}leaves lost ones out at once, ends the wait at the grace ($took s)," \
-  "restarts for a host back after 2 checks ($rejoin_took s at 1 s a check)"
+  "${hidden:-}leaves lost ones out at once (named ones unasked), ends the wait at the grace ($took s)," \
+  "restarts for a host back after 2 checks ($rejoin_took s at 1 s a check; $confirm_took s at 3 s, confirmed 1 s later)"

@@ -4,7 +4,8 @@
 # naming the rank, instead of leaving the admin polling forever (render-node failure):
 #   stop   SIGSTOP of rank 2 (a hung process; before the deadline existed the job never ended)
 #   kill   SIGKILL of rank 2 (a dead host: Open MPI's own error handling ends the job)
-# The farm's exit code is non-zero either way, so systemd restarts the service (docs/services.md).
+# The farm's exit code is non-zero either way, so systemd restarts the service (docs/services.md); the
+# admin names the stopped rank in --lost-ranks-file, where the restart's launcher looks for it.
 set -euo pipefail
 farm=$1 MPIEXEC=$2 scene=$3 work=$4
 source "$(dirname "$0")/mpi_env.sh"
@@ -29,7 +30,7 @@ run_case() {
   local how=$1 out="$work/$1" log="$work/$1.log"
   mkdir -p "$out"
   mpirun_n 4 "$farm" render --scene "$scene" --frames 100000 --path orbit --width 64 --height 48 --spp 1 \
-    --contact-sheet 0 --rank-deadline-s "$deadline" --out "$out" 2> "$log" &
+    --contact-sheet 0 --rank-deadline-s "$deadline" --out "$out" --lost-ranks-file "$work/$how.lost" 2> "$log" &
   local mpirun_pid=$!
   # Wait until frames flow, then take rank 2 away.
   for _ in $(seq 600); do [ -e "$out/frame-0002.jpg" ] && break; sleep 0.1; done
@@ -62,6 +63,9 @@ run_case() {
     grep -qE "render rank\(s\) (([0-9]+, )*2(, [0-9]+)*|\(view broadcast\)) did not reply to frame" "$log" ||
       { echo "FAIL(stop): the log does not name rank 2"; cat "$log"; return 1; }
     grep -q "aborting the MPI job" "$log" || { echo "FAIL(stop): no abort logged"; cat "$log"; return 1; }
+    # The launcher of the restart reads the lost ranks from --lost-ranks-file (one per line).
+    grep -qx 2 "$work/stop.lost" 2>/dev/null ||
+      { echo "FAIL(stop): --lost-ranks-file does not name rank 2: '$(cat "$work/stop.lost" 2>&1)'"; return 1; }
   fi
 }
 

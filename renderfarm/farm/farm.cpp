@@ -7,15 +7,18 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstring>
 #include <ctime>
 #include <fstream>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "common/file_io.h"
 #include "renderfarm/farm/render_threads.h"
 #include "renderfarm/trace/renderer.h"
 
@@ -72,6 +75,19 @@ void end_mpirun_if_abort_hangs(long grace_ms) {
 }
 
 using Clock = std::chrono::steady_clock;
+
+// Tells the launcher of the restart which ranks were lost (FarmSetup::lost_ranks_file). A failure is
+// logged and ignored: the abort must go ahead, and the launcher then checks every host as usual.
+void write_lost_ranks(const std::filesystem::path& file, const std::vector<int>& ranks) {
+    if (file.empty()) return;
+    std::string text;
+    for (int r : ranks) text += std::to_string(r) + "\n";
+    try {
+        write_file_atomically(file, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
+    } catch (const std::exception& e) {
+        spdlog::error("admin: cannot write the lost ranks to {}: {}", file.string(), e.what());
+    }
+}
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
@@ -166,6 +182,7 @@ int run_farm(const MpiSession& mpi, const FarmSetup& setup, const AdminJob& admi
         // A rank stopped answering mid-frame: the others wait in a collective that never ends, and
         // MPI_Finalize would wait for them. End the whole job so that systemd restarts the farm.
         spdlog::critical("admin: a render rank was lost; aborting the MPI job (exit code {})", kRankLostExitCode);
+        write_lost_ranks(setup.lost_ranks_file, dispatcher.lost_ranks());
         end_mpirun_if_abort_hangs(kAbortGraceMs);
         MPI_Abort(MPI_COMM_WORLD, kRankLostExitCode);
     }

@@ -27,6 +27,10 @@ struct FarmSetup {
     // RendererOptions::jitter_cached_one_spp of the render ranks (off: a moving frame from the
     // radiance cache samples pixel centres and takes its guides from its own camera rays).
     bool jitter_cached_one_spp = false;
+    // Where the admin writes the ranks it names lost (one decimal rank per line, written atomically)
+    // before it aborts the job with kRankLostExitCode; empty = nowhere. systemd/mogao-farm-launch
+    // reads it at the restart to leave those ranks' hosts out without waiting for their health check.
+    std::filesystem::path lost_ranks_file;
 };
 
 // What the admin does once the farm stands: returns the process exit code.

@@ -439,6 +439,7 @@ void FrameDispatcher::poll_until(Watch& watch, const Done& done, const char* pha
 
 void FrameDispatcher::lost(const Watch& watch, const std::vector<int>& ranks, const char* phase) {
     broken_ = true;
+    lost_ranks_ = ranks;
     std::string who;
     for (int r : ranks) who += (who.empty() ? "" : ", ") + std::to_string(r);
     if (phase) who = phase;  // the broadcast is not any one rank's

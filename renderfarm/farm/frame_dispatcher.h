@@ -117,6 +117,8 @@ public:
     void set_heartbeat(std::function<void()> heartbeat) { heartbeat_ = std::move(heartbeat); }
     // True after a RankTimeout: the MPI job must be aborted.
     [[nodiscard]] bool broken() const { return broken_; }
+    // The ranks that RankTimeout named silent (empty before one).
+    [[nodiscard]] const std::vector<int>& lost_ranks() const { return lost_ranks_; }
     // Benchmarks compare raw and speed-normalised tile times in one run.
     void set_normalise_rank_speed(bool on) { settings_.normalise_rank_speed = on; }
 
@@ -153,6 +155,7 @@ private:
     std::uint64_t sequence_ = 0;  // frames sent to the ranks (WireView::sequence)
     bool stopped_ = false;
     bool broken_ = false;
+    std::vector<int> lost_ranks_;
     std::function<void()> heartbeat_;
 };
 

@@ -66,6 +66,9 @@ void add_farm_flags(CLI::App& command, mogao::FarmSetup& setup, std::string& sca
                     "job is aborted (exit 3) so that systemd restarts the farm over the hosts that answer (0 = wait "
                     "forever)")
         ->check(CLI::Range(0.0, 86400.0));
+    command.add_option("--lost-ranks-file", setup.lost_ranks_file,
+                       "Where the admin writes the ranks it took for lost (one per line) before it aborts the job; "
+                       "mogao-farm-launch passes it and reads it at the restart (docs/services.md)");
     command.add_flag("--rank-speed,!--no-rank-speed", setup.dispatch.normalise_rank_speed,
                      "Normalise each rank's tile times by its measured speed before the PBT (default; --no-rank-speed: "
                      "raw wall time)");
