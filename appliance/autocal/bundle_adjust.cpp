@@ -389,8 +389,9 @@ void reweight(Problem& pb, const Eigen::VectorXd& q, std::size_t k, bool last, B
 
 // Re-weights the edges from their current residuals (sigma_m = the inliers' rms) and, unless `keep_all`, drops their
 // outliers (beyond 4x the median distance), as reweight does a projector's correspondences. An edge point
-// can lie off the screen's edge yet within the assignment's gate (select_edges): on realistic-install the top and
-// bottom edges' crossings inside the projectors' overlaps lay 4 to 5 mm off it (the others within 0.5 mm).
+// can lie off the screen's edge yet within the assignment's gate (select_edges). Measured on realistic-install with
+// the screen fitted: without the rule its geometry error is larger, also with the lit edges found one projector at
+// a time (autocal::lit_screen, which removed the overlaps' saturated crossings that first called for it).
 void reweight_edges(Problem& pb, const Eigen::VectorXd& q, bool keep_all, BundleResult& out) {
     const Eigen::VectorXd r =
         pb.edge_residuals(q.data(), pb.screen_params(q), pb.rays_of(-1, pb.intrinsic_params(q))) * pb.sigma_m;
