@@ -11,10 +11,11 @@ truth of what it refused. Figures there are never pasted.
   tools/docs/regenerate_calibration_doc.py [--build build-calib] [--scale 0.5]
 Python 3 standard library only.
 """
-import argparse, datetime, glob, json, os, platform, re, subprocess, sys, tempfile
+import argparse, datetime, glob, json, os, platform, subprocess, tempfile
+
+from generated_block import replace_block
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-BLOCK = re.compile(r"^<!-- generated:calibration-rigs -->\n.*?^<!-- /generated -->$", re.S | re.M)
 # Rigs also run with these options (a second row): the option they exist to show.
 EXTRA_RUNS = {"roughscreen": ["--fit-screen"], "falloff": ["--no-falloff"], "bulge": ["--no-bow"],
               "realistic": ["--fixed-camera-intrinsics"], "focal": ["--fixed-camera-intrinsics"],
@@ -25,7 +26,6 @@ X1_RUNS = {"standard": [], "focal": [], "realistic": [], "realistic-lens": [], "
            "realistic-install": ["--fit-screen"]}
 # Rigs already at small resolutions, run at their own (x1): the QEMU test's rig (rigs/qemu.toml).
 OWN_SCALE = {"qemu"}
-COLOUR = re.compile(r"^<!-- generated:calibration-colour -->\n.*?^<!-- /generated -->$", re.S | re.M)
 
 
 def seam_cell(before, after, key, scale, fmt):
@@ -128,17 +128,8 @@ def main():
                      f"{g['camera_position_error_mm']:.2f} mm | {r['camera']['edge_rms_mm']:.2f} mm | {rms} | "
                      f"{r['timing']['compute_s']:.1f} |")
     doc = os.path.join(ROOT, "docs", "calibration.md")
-    text = open(doc).read()
-    if not BLOCK.search(text):
-        sys.exit("docs/calibration.md: no <!-- generated:calibration-rigs --> block")
-    text = BLOCK.sub(lambda m: "<!-- generated:calibration-rigs -->\n" + "\n".join(lines) + "\n<!-- /generated -->",
-                     text)
-    if not COLOUR.search(text):
-        sys.exit("docs/calibration.md: no <!-- generated:calibration-colour --> block")
-    text = COLOUR.sub(lambda m: "<!-- generated:calibration-colour -->\n" + "\n".join(colour) + "\n<!-- /generated -->",
-                      text)
-    open(doc, "w").write(text)
-
+    replace_block(doc, "calibration-rigs", lines)
+    replace_block(doc, "calibration-colour", colour)
 
 if __name__ == "__main__":
     main()

@@ -15,10 +15,11 @@ the count of silent errors (calibrated with a geometry mean or p95 above 1 px).
   tools/docs/regenerate_unseen_rigs_doc.py [--build build] [--scale 0.5] [--draws 3] [--seed 1]
 Python 3.11 standard library only (tomllib).
 """
-import argparse, datetime, glob, json, os, platform, random, re, subprocess, sys, tempfile, tomllib
+import argparse, datetime, glob, json, os, platform, random, subprocess, tempfile, tomllib
+
+from generated_block import replace_block
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-BLOCK = re.compile(r"^<!-- generated:calibration-unseen -->\n.*?^<!-- /generated -->$", re.S | re.M)
 
 
 def u(rng, half):
@@ -150,14 +151,7 @@ def main():
              "| drawn rig | result | geometry mean / p95 / max (px) | self-check mean (distance to truth) px | "
              "seam luminance max | compute s |",
              "|---|---|---|---|---|--:|"] + rows
-    doc = os.path.join(ROOT, "docs", "calibration.md")
-    text = open(doc).read()
-    if not BLOCK.search(text):
-        sys.exit("docs/calibration.md: no <!-- generated:calibration-unseen --> block")
-    text = BLOCK.sub(lambda m: "<!-- generated:calibration-unseen -->\n" + "\n".join(lines) + "\n<!-- /generated -->",
-                     text)
-    open(doc, "w").write(text)
-
+    replace_block(os.path.join(ROOT, "docs", "calibration.md"), "calibration-unseen", lines)
 
 if __name__ == "__main__":
     main()
