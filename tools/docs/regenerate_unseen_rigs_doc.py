@@ -15,7 +15,7 @@ the count of silent errors (calibrated with a geometry mean or p95 above 1 px).
   tools/docs/regenerate_unseen_rigs_doc.py [--build build] [--scale 0.5] [--draws 3] [--seed 1]
 Python 3.11 standard library only (tomllib).
 """
-import argparse, datetime, glob, json, os, platform, random, subprocess, tempfile, tomllib
+import argparse, copy, datetime, glob, json, os, platform, random, subprocess, tempfile, tomllib
 
 from generated_block import replace_block
 
@@ -28,7 +28,7 @@ def u(rng, half):
 
 def draw_rig(base, rng, name):
     """A copy of `base` (a parsed rig) with its errors and placements drawn anew; keys it lacks stay absent."""
-    rig = json.loads(json.dumps(base))
+    rig = copy.deepcopy(base)
     rig["name"] = name
     cam, prior = rig["camera"], rig["prior"]
     cam["position_m"] = [cam["position_m"][0] + u(rng, 0.1), cam["position_m"][1] + u(rng, 0.05),
