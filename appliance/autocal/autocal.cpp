@@ -293,6 +293,11 @@ cv::Mat1f lit_screen(PatternSource& source, const std::vector<ImageSize>& sizes,
 
 namespace {
 
+// Whether the bundle adjustment fits any of the screen's shape (its radius and arc, or its top edge's height): the
+// edge fit on the told screen is then only a start, gated after the adjustment (adopt_bundle), and the edge points
+// are assigned again through the adjusted model (reselect_edges).
+bool screen_fitted(const AutocalOptions& options) { return options.fit_screen || options.fit_heights; }
+
 // Step 2: the projectors white minus all black show the screen's lit edges, and the camera's pose from them. Every
 // projector white at once is shown too (what the camera saw: the images route writes it as camera-white.png).
 EdgeFit fit_camera_to_lit_screen(PatternSource& source, const CalibrationPrior& prior,
@@ -310,7 +315,7 @@ EdgeFit fit_camera_to_lit_screen(PatternSource& source, const CalibrationPrior& 
     // resolution): its gate is five times looser here, a sanity limit, and the gate itself holds the bundle
     // adjustment's edge fit (adopt_bundle).
     AutocalOptions start_options = options;
-    if (options.fit_screen) start_options.max_edge_rms_m = kStartEdgeGateScale * options.max_edge_rms_m;
+    if (screen_fitted(options)) start_options.max_edge_rms_m = kStartEdgeGateScale * options.max_edge_rms_m;
     EdgeFit edge = fit_camera_pose(lit, prior, start_options);
     report.edge_points = edge.points;
     report.edge_rms_m = edge.rms_m;
@@ -361,14 +366,15 @@ void adopt_bundle(const BundleResult& ba, const CalibrationPrior& prior, const A
     result.projectors = ba.projectors;
     result.report.camera_position_m = ba.camera.position_m;
     result.report.edge_rms_m = ba.edge_rms_m;
-    if (options.fit_screen && ba.edge_inliers > 0) result.report.edge_points = ba.edge_inliers;
-    if (options.fit_screen && ba.edge_rms_m > options.max_edge_rms_m) {
+    if (screen_fitted(options) && ba.edge_inliers > 0) result.report.edge_points = ba.edge_inliers;
+    if (screen_fitted(options) && ba.edge_rms_m > options.max_edge_rms_m) {
         throw CalibrationRefused("camera pose: edge fit rms " + std::to_string(ba.edge_rms_m * 1000.0) +
                                  " mm above its gate " + std::to_string(options.max_edge_rms_m * 1000.0) +
                                  " mm after the bundle adjustment with the screen fitted (radius " +
                                  std::to_string(ba.screen.radius_m) + " m, arc " + std::to_string(ba.screen.arc_deg) +
-                                 " deg): the screen is not a cylinder of the prior's heights, or the camera's "
-                                 "intrinsics are off");
+                                 " deg, top " + std::to_string(ba.screen.top_m) +
+                                 " m): the screen is not the prior's cylinder (--fit-screen where its radius or arc "
+                                 "are known only roughly), or the camera's intrinsics are off");
     }
     for (std::size_t k = 0; k < ba.projectors.size(); ++k) {
         result.report.projectors[k].rms_px = ba.rms_px[k];
@@ -386,8 +392,9 @@ void adopt_bundle(const BundleResult& ba, const CalibrationPrior& prior, const A
     }
 }
 
-// With the screen fitted: the edge points assigned again through the adjusted model (select_edges), and the
-// adjustment run again on them from the prior's intrinsics and the adjusted poses and screen. The pose's edge fit
+// With the screen fitted (its radius and arc, or its top edge): the edge points assigned again through the adjusted
+// model (select_edges), and the adjustment run again on them from the prior's intrinsics and the adjusted poses and
+// screen. The pose's edge fit
 // assigned them through the prior's intrinsics and the told screen: on realistic-install at half resolution it left
 // out 45 % of the top edge's points (the prior's errors put them more than kEdgeGateM off), and the intrinsics and
 // the arc were then fitted to a part of the edge. (On a told screen the assignment is left as it was: assigned
@@ -397,7 +404,7 @@ std::vector<EdgeObservation> reselect_edges(const EdgeFit& edge, const Calibrati
                                             const std::vector<ProjectorObservations>& observations,
                                             const BundleOptions& bo, BundleResult& ba) {
     std::vector<EdgeObservation> edges = edge.edges;
-    if (!bo.refine_screen) return edges;  // a told screen: assigned on it, as the edge gate judges them
+    if (!bo.refine_screen && !bo.refine_heights) return edges;  // a told screen: assigned on it, as judged
     for (int round = 0; round < 2; ++round) {
         std::vector<EdgeObservation> again = select_edges(edge.candidates, ba.camera, ba.screen, kEdgeGateM);
         if (again.size() <= edges.size()) break;  // the same points, or fewer: keep the adjustment as it is
@@ -433,6 +440,7 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
     // Step 4: camera pose and projector models refined together on every observation.
     BundleOptions bo;
     bo.refine_screen = options.fit_screen;
+    bo.refine_heights = options.fit_heights;
     bo.camera_sigma = options.camera_sigma;
     BundleResult ba = bundle_adjust(prior.screen, edge.camera, result.projectors, edge.edges, observations, bo);
     // The bow first: on a bowed screen free intrinsics take up part of the bow (k1, k2 bend the rays much as

@@ -38,7 +38,9 @@
 //  4. Bundle adjustment (bundle_adjust.h; Sajadi & Majumder 2010): camera pose and all projector
 //     models together on every correspondence and edge point, the 3D points constrained to the
 //     cylinder; with `fit_screen` also its radius and arc (the heights fix the scale), the projector fit
-//     gate then applied after it, and the fitted screen checked to be one. With
+//     gate then applied after it, and the fitted screen checked to be one; without, with `fit_heights`, its top
+//     edge's height (the bottom fixes the position, the told radius the scale), the edge gate then applied after
+//     it. With
 //     `refine_camera_intrinsics` (a trial, kept where it pays) also the camera's focal length, principal point and k1,
 //     k2 (Sajadi & Majumder 2009 for an uncalibrated camera on an extruded screen), each camera ray re-derived from its
 //     image position; the projector fit gate is then applied after it, and the refined intrinsics are gated
@@ -175,6 +177,17 @@ struct AutocalOptions {
     // Fit the cylinder's radius and arc in the bundle adjustment (bundle_adjust.h, refine_screen) when the prior's
     // are known only roughly; the heights stay as measured. The fitted screen is AutocalResult::screen.
     bool fit_screen = false;
+    // On a told radius and arc (without fit_screen), fit the screen's top edge height (bundle_adjust.h,
+    // refine_heights); the bottom edge stays as measured (the gauge). A tape leaves the heights millimetres off, and
+    // a told span that is off pulls the camera and the projectors with it: content lands up to a pixel off with
+    // nothing refused (docs/calibration.md, "Screen heights fitted"). The edge gate (max_edge_rms_m) then judges the
+    // adjusted fit, not the pose's start on the told heights, and the edge points are assigned again through the
+    // adjusted model, as with fit_screen. Off by default: with the span free, the camera's focal length is the only
+    // tie between the screen's horizontal and vertical extents, so a wrong arc is taken up by the focal length and
+    // the span together, consistently: the self-check cannot see it (roughscreen.toml, its arc 3 degrees off:
+    // refused with told heights, calibrated 2 px off with fitted ones). For a site whose arc and radius are known
+    // (drawings, a measured chord) and whose heights were taped.
+    bool fit_heights = false;
     // Try the screen's bow (ScreenModel::bow_m, 4 modes that vanish on its frame) in a second bundle adjustment,
     // from the first's result: for a screen that is not quite a cylinder (fabric bowed between its frame). The 3D
     // points then follow the bowed surface along the camera rays; its shape is seen through the camera-projector
@@ -330,7 +343,7 @@ struct AutocalReport {
 };
 
 struct AutocalResult {
-    ScreenModel screen;  // the prior's, or the fitted one with AutocalOptions::fit_screen
+    ScreenModel screen;  // the prior's, or the fitted one (AutocalOptions::fit_screen, fit_heights)
     ScreenCalibration calibration;
     DeviceModel camera;                   // fitted pose
     std::vector<DeviceModel> projectors;  // fitted models

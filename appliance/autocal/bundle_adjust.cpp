@@ -22,9 +22,10 @@ constexpr int kProj = 9;  // projector: fx, cx, cy, rotation vector (3), positio
 // then, when any projector's distortion is refined, its k1, k2, p1, p2 (every projector's block has them; a
 // projector whose distortion stays has those columns held fixed).
 constexpr int kProjDistortion = 4;
-// Screen (last, when refined): radius offset (m) and arc offset (rad) with refine_screen, then the
-// four bow amplitudes (m, ScreenModel::bow_m) with refine_bow.
+// Screen (last, when refined): radius offset (m) and arc offset (rad) with refine_screen, the top edge's
+// offset (m) with refine_heights, then the four bow amplitudes (m, ScreenModel::bow_m) with refine_bow.
 constexpr int kScreenShape = 2;
+constexpr int kScreenSpan = 1;
 constexpr int kScreenBow = 4;
 // Camera intrinsics (last, with refine_camera_intrinsics): fx (fy = fx * the prior's aspect), cx, cy, k1, k2.
 constexpr int kIntrinsics = 5;
@@ -92,15 +93,19 @@ DeviceModel projector_at(const DeviceModel& p0, const double* q, bool distortion
     return p;
 }
 
-// The screen the parameters describe: the prior's, with the radius and arc offsets and the bow
-// when refined.
-ScreenModel screen_at(const ScreenModel& s0, const double* qs, bool shape, bool bow) {
+// The screen the parameters describe: the prior's, with the radius and arc offsets, the top edge and
+// the bow when refined.
+ScreenModel screen_at(const ScreenModel& s0, const double* qs, bool shape, bool span, bool bow) {
     ScreenModel s = s0;
     if (qs == nullptr) return s;
     if (shape) {
         s.radius_m = s0.radius_m + qs[0];
         s.arc_deg = s0.arc_deg + qs[1] * 180.0 / std::numbers::pi;
         qs += kScreenShape;
+    }
+    if (span) {
+        s.top_m = s0.top_m + qs[0];
+        qs += kScreenSpan;
     }
     if (bow) {
         for (std::size_t i = 0; i < s.bow_m.size(); ++i) s.bow_m[i] = s0.bow_m[i] + qs[i];
@@ -124,6 +129,7 @@ struct Problem {
     std::vector<double> sigma_px;
     double sigma_m = 0.005;
     bool refine_screen = false;
+    bool refine_heights = false;
     bool refine_bow = false;
     bool refine_intrinsics = false;
     std::vector<bool> refine_distortion{};  // per projector (empty: none)
@@ -133,7 +139,7 @@ struct Problem {
     Eigen::Index intrinsics_index = 0;  // first camera intrinsic in q (after the screen's)
 
     [[nodiscard]] int screen_count() const {
-        return (refine_screen ? kScreenShape : 0) + (refine_bow ? kScreenBow : 0);
+        return (refine_screen ? kScreenShape : 0) + (refine_heights ? kScreenSpan : 0) + (refine_bow ? kScreenBow : 0);
     }
     [[nodiscard]] int parameter_count() const {
         return static_cast<int>(intrinsics_index) + (refine_intrinsics ? kIntrinsics : 0);
@@ -145,7 +151,7 @@ struct Problem {
         return refine_intrinsics ? q.data() + intrinsics_index : nullptr;
     }
     [[nodiscard]] ScreenModel screen(const double* qs) const {
-        return screen_at(screen0, qs, refine_screen, refine_bow);
+        return screen_at(screen0, qs, refine_screen, refine_heights, refine_bow);
     }
     // The prior's intrinsics as parameters, and their prior standard deviations.
     [[nodiscard]] Eigen::Matrix<double, kIntrinsics, 1> intrinsics0() const {
@@ -482,6 +488,7 @@ BundleResult bundle_adjust(const ScreenModel& screen, const DeviceModel& camera,
     // The screen needs the edges (its ends and heights) and the camera refined with it; so do the camera's
     // intrinsics (the edges tie its focal length to the screen's known size).
     pb.refine_screen = options.refine_screen && refine_camera;
+    pb.refine_heights = options.refine_heights && !pb.refine_screen && refine_camera;
     pb.refine_bow = options.refine_bow && refine_camera;
     pb.refine_intrinsics = options.refine_camera_intrinsics && refine_camera;
     pb.camera_sigma = options.camera_sigma;

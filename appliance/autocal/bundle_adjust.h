@@ -77,6 +77,11 @@ struct BundleOptions {
     // the scale): for a screen whose radius and arc are known only roughly. The 3D points follow the fitted
     // cylinder; its curvature is seen through the camera-projector baselines, its ends through the edges.
     bool refine_screen = false;
+    // On a told cylinder (without refine_screen), its top edge's height too (ScreenModel::top_m; with the camera,
+    // like refine_screen): the bottom edge stays as the gauge (both edges moved together is the camera and the
+    // projectors moved). The lit top edge and the projectors' correspondences (through the camera-projector
+    // baselines) tell the span. With refine_screen the heights fix the scale and stay.
+    bool refine_heights = false;
     // The screen's bow too (ScreenModel::bow_m; with the camera, like refine_screen): the 3D points then
     // follow the bowed surface along the camera rays, and the projectors' rays tell its depth (stereo).
     bool refine_bow = false;

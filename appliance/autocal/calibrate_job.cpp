@@ -206,7 +206,7 @@ Rgb8Image self_check_image(const SelfCheckResult& c) {
     return out;
 }
 
-// report.json's "screen": the fitted cylinder, the bow's trial and the prior's size.
+// report.json's "screen": the fitted cylinder (radius, arc, top edge), the bow's trial and the prior's size.
 nlohmann::json screen_report(const AutocalResult& r, const CalibrationPrior& prior, const CalibrateJob& job) {
     return {{"fitted", job.options.fit_screen},
             {"bow_m", r.screen.bow_m},
@@ -219,7 +219,11 @@ nlohmann::json screen_report(const AutocalResult& r, const CalibrationPrior& pri
             {"radius_m", r.screen.radius_m},
             {"arc_deg", r.screen.arc_deg},
             {"prior_radius_m", prior.screen.radius_m},
-            {"prior_arc_deg", prior.screen.arc_deg}};
+            {"prior_arc_deg", prior.screen.arc_deg},
+            {"heights_fitted", job.options.fit_heights && !job.options.fit_screen},
+            {"bottom_m", r.screen.bottom_m},
+            {"top_m", r.screen.top_m},
+            {"prior_top_m", prior.screen.top_m}};
 }
 
 // report.json's "predicted": the blend's worst weight-sum deviation as the fitted models predict it.

@@ -8,7 +8,7 @@
 //   --content            the content frame WIDTHxHEIGHT, pixels (the farm's frame)
 //   --alpha-bits         alpha map bits, 8 or 16
 //   --warp-step-px       warp grid step, output pixels
-//   --fit-screen, --no-bow, --pinhole-projectors, --no-colour, --no-falloff   switches of the fit
+//   --fit-screen, --fit-heights, --no-bow, --pinhole-projectors, --no-colour, --no-falloff   switches of the fit
 //   --max-self-check-px  the self-check gate, projector pixels (self_check.h)
 //
 // They fill CalibrationSettings (calibration_settings.h), which autocal::CalibrateJob and calibrate::OnSiteJob hold.
@@ -46,6 +46,8 @@ inline void add_calibration_flags(CLI::App& cmd, CalibrationFlags& flags, Calibr
         ->check(CLI::Range(1, 64));
     cmd.add_flag("--fit-screen", job.options.fit_screen,
                  "Fit the screen's radius and arc too (known only roughly; the heights are taken as measured)");
+    cmd.add_flag("--fit-heights", job.options.fit_heights,
+                 "Fit the screen's top edge height too (heights taped, radius and arc known; the bottom edge stays)");
     cmd.add_flag("--no-bow", flags.no_bow,
                  "Take the screen as an exact cylinder: do not try a bow (kept by default only where it pays)");
     cmd.add_flag("--pinhole-projectors", flags.pinhole_projectors,

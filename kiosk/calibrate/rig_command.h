@@ -4,7 +4,8 @@
 //
 //   mogao-calibrate-sim rig --rig rigs/standard.toml --out DIR [--scale 0.5] [--content 1920x1080]
 //                 [--alpha-bits 16] [--warp-step-px 2] [--gray-bits N] [--frames-per-pattern 1] [--no-colour]
-//                 [--no-falloff] [--fit-screen] [--no-bow] [--fixed-camera-intrinsics] [--intrinsics-min-gain 0.01]
+//                 [--no-falloff] [--fit-screen] [--fit-heights] [--no-bow] [--fixed-camera-intrinsics]
+//                 [--intrinsics-min-gain 0.01]
 //                 [--pinhole-projectors] [--distortion-min-gain 0.01] [--max-self-check-px 0.65]
 //
 // Exit codes: 0 success, 1 the job failed or the calibration was refused (the message says why; nothing in DIR

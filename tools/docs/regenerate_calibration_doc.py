@@ -16,14 +16,15 @@ import argparse, datetime, glob, json, os, platform, subprocess, tempfile
 from generated_block import replace_block
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-# Rigs also run with these options (a second row): the option they exist to show.
-EXTRA_RUNS = {"roughscreen": ["--fit-screen"], "falloff": ["--no-falloff"], "bulge": ["--no-bow"],
-              "realistic": ["--fixed-camera-intrinsics"], "focal": ["--fixed-camera-intrinsics"],
-              "grazing": ["--intrinsics-min-gain", "0"], "standard": ["--intrinsics-min-gain", "0"],
-              "realistic-lens": ["--pinhole-projectors"], "realistic-install": ["--fit-screen"]}
-# Rigs also run at full resolution (x1), with the options they need there.
-X1_RUNS = {"standard": [], "focal": [], "realistic": [], "realistic-lens": [], "realistic-optics": [],
-           "realistic-install": ["--fit-screen"]}
+# Rigs also run with these options (a row each): the options they exist to show.
+EXTRA_RUNS = {"roughscreen": [["--fit-screen"], ["--fit-heights"]], "falloff": [["--no-falloff"]],
+              "bulge": [["--no-bow"]], "realistic": [["--fixed-camera-intrinsics"]],
+              "focal": [["--fixed-camera-intrinsics"]], "grazing": [["--intrinsics-min-gain", "0"]],
+              "standard": [["--intrinsics-min-gain", "0"]], "realistic-lens": [["--pinhole-projectors"]],
+              "realistic-install": [["--fit-screen"], ["--fit-heights"]]}
+# Rigs also run at full resolution (x1), a row for each list of options they need there.
+X1_RUNS = {"standard": [[]], "focal": [[]], "realistic": [[]], "realistic-lens": [[]], "realistic-optics": [[]],
+           "realistic-install": [["--fit-screen"], ["--fit-heights"]]}
 # Rigs already at small resolutions, run at their own (x1): the QEMU test's rig (rigs/qemu.toml).
 OWN_SCALE = {"qemu"}
 
@@ -92,11 +93,10 @@ def main():
         # The goals hold at full resolution, and the compute goal is for three 1920x1080 projectors: x1 too,
         # for every rig with a real installation's errors (those whose camera integrates 4 x 4 points per
         # pixel take two to three minutes of simulation each at x1).
-        if stem in X1_RUNS:
-            x1 = X1_RUNS[stem]
+        for x1 in X1_RUNS.get(stem, []):
             runs.append((f"{stem} (x1)" + (f" `{' '.join(x1)}`" if x1 else ""), rig, x1))
-        if stem in EXTRA_RUNS:
-            runs.append((f"{stem} `{' '.join(EXTRA_RUNS[stem])}`", rig, EXTRA_RUNS[stem]))
+        for extra in EXTRA_RUNS.get(stem, []):
+            runs.append((f"{stem} `{' '.join(extra)}`", rig, extra))
     for name, rig, extra in runs:
         with tempfile.TemporaryDirectory() as out:
             scale = "1" if name.split()[0] in OWN_SCALE or "(x1)" in name else args.scale
