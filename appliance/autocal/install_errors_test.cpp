@@ -116,6 +116,23 @@ TEST(InstallErrors, HeightsAFewMillimetresOffAreFitted) {
     EXPECT_LT(fitted.geometry.p95_px, 0.5 * told.geometry.p95_px);
 }
 
+// The radius told 2 % long (6 cm), the heights right. Taken as told, the screen's shape is wrong and the self-check
+// refuses it. With the top edge fitted the told radius is the scale: the span comes out 2 % long too, the room
+// scaled about the bottom edge, which the camera sees alike, so content lands where it belongs.
+TEST(InstallErrors, WithTheHeightsFittedARadiusOffIsTheRoomScaled) {
+    rig::VirtualRig rig = standard_half();
+    rig.prior.screen_radius_error_m = 0.06;
+    const Outcome told = calibrate_rig(rig, {}, "radius 6 cm long, heights taken as exact");
+    EXPECT_NE(told.refused.find("self-check"), std::string::npos) << told.refused;
+    AutocalOptions top;
+    top.fit_heights = true;
+    const Outcome fitted = calibrate_rig(rig, top, "radius 6 cm long, top edge fitted");
+    EXPECT_TRUE(meets_goals(fitted)) << fitted.refused << " " << fitted.geometry.mean_px << " / "
+                                     << fitted.geometry.p95_px;
+    const double span = rig.screen.top_m - rig.screen.bottom_m;
+    EXPECT_NEAR(fitted.result.screen.top_m - fitted.result.screen.bottom_m, span * 3.06 / 3.0, 0.004);
+}
+
 // With the screen to be fitted, the camera pose's first edge fit (on the told cylinder) is only a start: its gate is
 // five times looser there (a sanity limit), and the gate holds the bundle adjustment's edge fit instead. Here the
 // gate is tightened to 5 mm so that the told screen's start (5.6 mm: heights 2 cm off each) fails it: taken
