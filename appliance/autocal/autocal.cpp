@@ -394,12 +394,11 @@ void adopt_bundle(const BundleResult& ba, const CalibrationPrior& prior, const A
 
 // With the screen fitted (its radius and arc, or its top edge): the edge points assigned again through the adjusted
 // model (select_edges), and the adjustment run again on them from the prior's intrinsics and the adjusted poses and
-// screen. The pose's edge fit
-// assigned them through the prior's intrinsics and the told screen: on realistic-install at half resolution it left
-// out 45 % of the top edge's points (the prior's errors put them more than kEdgeGateM off), and the intrinsics and
-// the arc were then fitted to a part of the edge. (On a told screen the assignment is left as it was: assigned
-// again, standard.toml with the camera's k1 0.01 off calibrated 0.72 px off instead of 0.24.) Returns the edges
-// `ba` was adjusted on.
+// screen. The pose's edge fit assigned them through the prior's intrinsics and the told screen: on realistic-install at
+// half resolution it left out 45 % of the top edge's points (the prior's errors put them more than kEdgeGateM off), and
+// the intrinsics and the arc were then fitted to a part of the edge. (On a told screen the assignment is left as it
+// was: assigned again, standard.toml with the camera's k1 0.01 off calibrated 0.72 px off instead of 0.24.) Returns the
+// edges `ba` was adjusted on.
 std::vector<EdgeObservation> reselect_edges(const EdgeFit& edge, const CalibrationPrior& prior,
                                             const std::vector<ProjectorObservations>& observations,
                                             const BundleOptions& bo, BundleResult& ba) {
