@@ -65,6 +65,15 @@ bool meets_goals(const Outcome& o) {
            o.geometry.missing + o.geometry.outside < o.geometry.samples / 100;
 }
 
+// Calibrates with the top edge's height fitted (AutocalOptions::fit_heights) and expects the goals met.
+Outcome calibrate_heights_fitted(const rig::VirtualRig& rig, const char* what) {
+    AutocalOptions top;
+    top.fit_heights = true;
+    Outcome o = calibrate_rig(rig, top, what);
+    EXPECT_TRUE(meets_goals(o)) << what << ": " << o.refused << " " << o.geometry.mean_px << " / " << o.geometry.p95_px;
+    return o;
+}
+
 // The screen's heights as a tape measures them: the bottom edge told 2 cm high, the top edge 2 cm low, so the
 // screen is told 4 cm (2.7 %) short of its 1.5 m. Taken as exact (the default), the screen's shape is wrong and
 // content lands pixels off: the self-check must refuse it, naming the screen's size. With the top edge's height
@@ -82,11 +91,7 @@ TEST(InstallErrors, TapeMeasuredHeightsAreFittedOrRefused) {
     EXPECT_GT(told.geometry.mean_px, 1.0);  // the failure the refusal exists for (measured 3.7 px)
     EXPECT_NE(told.refused.find("self-check"), std::string::npos) << told.refused;
     EXPECT_NE(told.refused.find("the screen's size in the site file"), std::string::npos) << told.refused;
-    AutocalOptions top;
-    top.fit_heights = true;
-    const Outcome heights = calibrate_rig(rig, top, "top edge fitted");
-    EXPECT_TRUE(meets_goals(heights)) << heights.refused << " " << heights.geometry.mean_px << " / "
-                                      << heights.geometry.p95_px;
+    const Outcome heights = calibrate_heights_fitted(rig, "top edge fitted");
     EXPECT_EQ(heights.result.screen.bottom_m, prior.screen.bottom_m);  // the gauge
     const double true_span = rig.screen.top_m - rig.screen.bottom_m;
     EXPECT_NEAR(heights.result.screen.top_m - heights.result.screen.bottom_m, true_span, 0.004);
@@ -108,11 +113,7 @@ TEST(InstallErrors, HeightsAFewMillimetresOffAreFitted) {
     rig.prior.screen_top_error_m = -0.003;
     const Outcome told = calibrate_rig(rig, {}, "span 8 mm short, taken as exact");
     EXPECT_FALSE(meets_goals(told));  // the error fitting the top edge removes
-    AutocalOptions top;
-    top.fit_heights = true;
-    const Outcome fitted = calibrate_rig(rig, top, "span 8 mm short, top edge fitted");
-    EXPECT_TRUE(meets_goals(fitted)) << fitted.refused << " " << fitted.geometry.mean_px << " / "
-                                     << fitted.geometry.p95_px;
+    const Outcome fitted = calibrate_heights_fitted(rig, "span 8 mm short, top edge fitted");
     EXPECT_LT(fitted.geometry.p95_px, 0.5 * told.geometry.p95_px);
 }
 
@@ -124,11 +125,7 @@ TEST(InstallErrors, WithTheHeightsFittedARadiusOffIsTheRoomScaled) {
     rig.prior.screen_radius_error_m = 0.06;
     const Outcome told = calibrate_rig(rig, {}, "radius 6 cm long, heights taken as exact");
     EXPECT_NE(told.refused.find("self-check"), std::string::npos) << told.refused;
-    AutocalOptions top;
-    top.fit_heights = true;
-    const Outcome fitted = calibrate_rig(rig, top, "radius 6 cm long, top edge fitted");
-    EXPECT_TRUE(meets_goals(fitted)) << fitted.refused << " " << fitted.geometry.mean_px << " / "
-                                     << fitted.geometry.p95_px;
+    const Outcome fitted = calibrate_heights_fitted(rig, "radius 6 cm long, top edge fitted");
     const double span = rig.screen.top_m - rig.screen.bottom_m;
     EXPECT_NEAR(fitted.result.screen.top_m - fitted.result.screen.bottom_m, span * 3.06 / 3.0, 0.004);
 }
