@@ -7,9 +7,11 @@
 #
 #   build_vimc.sh KVER OUTDIR      prints the path of OUTDIR/vimc-KVER-VERSION.ko (cached)
 #
-# Needs the host packages linux-headers-KVER and linux-source-X.Y of the SAME Debian version as the
-# image's kernel (modversions: another version's symbol CRCs are refused by the kernel). Exit 77 with
-# the reason on stderr when they are missing or differ; 1 when the build fails.
+# Needs the host packages linux-headers-KVER (of the image kernel's version: modversions, another
+# version's symbol CRCs are refused by the kernel) and linux-source-X.Y of the same upstream version.
+# The symbol CRCs come from the headers, so the source may differ in its Debian revision only (the
+# security archive can move linux-source ahead of the kernel: 6.1.192-3 beside headers 6.1.192-2).
+# Exit 77 with the reason on stderr when they are missing or differ; 1 when the build fails.
 set -u
 kver=$1 out=$2
 why() { echo "$*" >&2; exit 77; }
@@ -20,8 +22,8 @@ source_tar=/usr/src/linux-source-$series.tar.xz
 [[ -f $source_tar ]] || why "no $source_tar (apt-get install linux-source-$series)"
 hv=$(dpkg-query -W -f='${Version}' "linux-headers-$kver" 2>/dev/null)
 sv=$(dpkg-query -W -f='${Version}' "linux-source-$series" 2>/dev/null)
-[[ -n $hv && $hv == "$sv" ]] \
-  || why "linux-headers-$kver is '$hv' but linux-source-$series is '$sv': they must be the same version"
+[[ -n $hv && ${hv%-*} == "${sv%-*}" ]] \
+  || why "linux-headers-$kver is '$hv' but linux-source-$series is '$sv': they must be the same upstream version"
 ko=$out/vimc-$kver-$hv.ko
 if [[ -s $ko ]]; then echo "$ko"; exit 0; fi
 
