@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <vector>
@@ -419,6 +420,29 @@ std::vector<EdgeObservation> reselect_edges(const EdgeFit& edge, const Calibrati
     return edges;
 }
 
+// On told heights: the final fit against one with the top edge free (trials::check_told_heights, with the freedoms
+// the trials kept), refused when content would move by more than the gate between them.
+void check_heights(const BundleResult& ba, const CalibrationPrior& prior, const std::vector<EdgeObservation>& edges,
+                   const std::vector<ProjectorObservations>& observations, BundleOptions bo,
+                   const AutocalOptions& options, AutocalReport& report) {
+    bo.refine_projector_distortion.assign(report.distortion.size(), false);
+    for (std::size_t k = 0; k < report.distortion.size(); ++k)
+        bo.refine_projector_distortion[k] = report.distortion[k].kept;
+    trials::check_told_heights(ba, edges, observations, bo, options, report.heights);
+    const HeightsCheck& h = report.heights;
+    if (!h.tried || h.shift_mean_px <= options.max_heights_shift_px) return;
+    char why[640];
+    std::snprintf(why, sizeof why,
+                  "screen heights: the camera sees the top edge at %.4f m where %.4f m was told (bottom %.4f m as "
+                  "told): content would move by %.2f px mean (%.2f max) in the projectors' pixels, above the gate "
+                  "%.2f px (--max-heights-shift-px): measure the screen's heights again, or calibrate with "
+                  "--fit-heights where its radius and arc are known (a radius or arc told wrong shows here too: "
+                  "--fit-screen where they are known only roughly)",
+                  h.fitted_top_m, prior.screen.top_m, prior.screen.bottom_m, h.shift_mean_px, h.shift_max_px,
+                  options.max_heights_shift_px);
+    throw CalibrationRefused(why);
+}
+
 }  // namespace
 
 AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, ImageSize content,
@@ -451,6 +475,7 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
     const std::vector<EdgeObservation> edges = reselect_edges(edge, prior, observations, bo, ba);
     // Last, with what the other trials kept free: each projector's lens distortion.
     trials::try_projector_distortion(ba, prior, edges, observations, bo, options, result.report);
+    if (!screen_fitted(options)) check_heights(ba, prior, edges, observations, bo, options, result.report);
     adopt_bundle(ba, prior, options, result);
     result.calibration = calibration_from_models(result.projectors, result.screen, content, options);
     result.report.predicted_seam = predicted_seam_deviation(result.projectors, result.screen, result.calibration);

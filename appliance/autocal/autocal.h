@@ -188,6 +188,14 @@ struct AutocalOptions {
     // refused with told heights, calibrated 2 px off with fitted ones). For a site whose arc and radius are known
     // (drawings, a measured chord) and whose heights were taped.
     bool fit_heights = false;
+    // On told heights (neither fit_screen nor fit_heights), check them against what the camera sees: the final
+    // bundle adjustment is run once more with the top edge free (the bottom as told, the gauge), and the content
+    // of both fits is compared in every projector's pixels (HeightsCheck). Refused when the mean shift is above
+    // max_heights_shift_px: a tape error of a few millimetres in the span moves content by about as much as the
+    // geometry goal allows (docs/calibration.md, "Screen heights checked"), and the self-check, posed on the same
+    // told frame, cannot see it. The refusal names the heights and --fit-heights. Off: the heights are taken as told.
+    bool check_heights = true;
+    double max_heights_shift_px = 0.3;  // > 0, projector pixels (mean over each projector's content grid)
     // Try the screen's bow (ScreenModel::bow_m, 4 modes that vanish on its frame) in a second bundle adjustment,
     // from the first's result: for a screen that is not quite a cylinder (fabric bowed between its frame). The 3D
     // points then follow the bowed surface along the camera rays; its shape is seen through the camera-projector
@@ -313,6 +321,16 @@ struct BowTrial {
     std::array<double, 4> bow_m{};  // the fitted bow (kept or not)
 };
 
+// What the told heights' check (AutocalOptions::check_heights) found: the top edge the camera sees with the bottom
+// as told, and how far content moves, in the showing projector's pixels, between the fit on the told span and the
+// fit on that one (a grid of 17 x 9 content points per projector, both fits' models through model_pixel).
+struct HeightsCheck {
+    bool tried = false;
+    double fitted_top_m = 0.0;
+    double shift_mean_px = 0.0;
+    double shift_max_px = 0.0;
+};
+
 // The blend's predicted seam and where it is (predicted_seam_deviation).
 struct PredictedSeam {
     double deviation = 0.0;  // max |sum of the weights - 1|
@@ -339,6 +357,7 @@ struct AutocalReport {
     IntrinsicsTrial intrinsics;
     BowTrial bow;
     std::vector<DistortionTrial> distortion;  // per projector (empty when not tried)
+    HeightsCheck heights;                     // AutocalOptions::check_heights (not tried on a fitted screen)
     PredictedSeam predicted_seam;  // predicted_seam_deviation of the result (the gate max_predicted_seam's figure)
 };
 

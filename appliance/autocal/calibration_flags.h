@@ -10,6 +10,7 @@
 //   --warp-step-px       warp grid step, output pixels
 //   --fit-screen, --fit-heights, --no-bow, --pinhole-projectors, --no-colour, --no-falloff   switches of the fit
 //   --max-self-check-px  the self-check gate, projector pixels (self_check.h)
+//   --max-heights-shift-px  the told heights' check gate, projector pixels (autocal.h, check_heights)
 //
 // They fill CalibrationSettings (calibration_settings.h), which autocal::CalibrateJob and calibrate::OnSiteJob hold.
 #pragma once
@@ -56,6 +57,11 @@ inline void add_calibration_flags(CLI::App& cmd, CalibrationFlags& flags, Calibr
     cmd.add_option("--max-self-check-px", job.self_check.max_mean_px,
                    "Self-check gate: refuse when the verification marks land further than this from where they "
                    "belong (mean, projector pixels; measured from the camera images against the screen's frame)")
+        ->check(CLI::PositiveNumber);
+    cmd.add_option("--max-heights-shift-px", job.options.max_heights_shift_px,
+                   "Told heights' gate: refuse when the top edge the camera sees would move content by more than "
+                   "this from where the told heights put it (mean, projector pixels; not checked with --fit-screen "
+                   "or --fit-heights)")
         ->check(CLI::PositiveNumber);
     cmd.add_flag("--no-colour", flags.no_colour, "Geometry only: no response, black-level and colour matching step");
     cmd.add_flag("--no-falloff", flags.no_falloff,

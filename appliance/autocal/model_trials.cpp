@@ -2,9 +2,12 @@
 // The calibration's model trials: the bow, the camera's intrinsics, the projectors' distortion (model_trials.h).
 #include "appliance/autocal/model_trials.h"
 
+#include "appliance/autocal/colour_calibration.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -186,6 +189,44 @@ void try_projector_distortion(BundleResult& ba, const CalibrationPrior& prior,
     }
     report.condition_number = free.condition_number;
     ba = std::move(free);
+}
+
+// AutocalOptions::check_heights: the final adjustment again with the top edge free, from its result. The shift is
+// measured on content, not on the screen: where each fit's warp puts content (u, v) in the projector's image, so
+// that it counts only what a told span that is off would move on the wall (the fitted projectors take up part of
+// it). Content u spans the arc and v the span (autocal.h's content convention, v = 0 at the top).
+void check_told_heights(const BundleResult& ba, const std::vector<EdgeObservation>& edges,
+                        const std::vector<ProjectorObservations>& observations, BundleOptions bo,
+                        const AutocalOptions& options, HeightsCheck& check) {
+    if (!options.check_heights || edges.empty() || !bo.refine_camera) return;
+    bo.refine_heights = true;
+    const BundleResult fitted = bundle_adjust(ba.screen, ba.camera, ba.projectors, edges, observations, bo);
+    constexpr int kColumns = 17;
+    constexpr int kRows = 9;
+    const double arc = ba.screen.arc_deg * std::numbers::pi / 180.0;
+    double sum = 0.0;
+    double largest = 0.0;
+    int n = 0;
+    for (std::size_t k = 0; k < ba.projectors.size(); ++k) {
+        for (int i = 0; i < kColumns; ++i) {
+            for (int j = 0; j < kRows; ++j) {
+                const double theta = ((i + 0.5) / kColumns - 0.5) * arc;
+                const double v = (j + 0.5) / kRows;
+                const auto h = [v](const ScreenModel& s) { return s.top_m - v * (s.top_m - s.bottom_m); };
+                const Eigen::Vector2d told = model_pixel(ba.projectors[k], ba.screen, theta, h(ba.screen));
+                const Eigen::Vector2d seen = model_pixel(fitted.projectors[k], fitted.screen, theta, h(fitted.screen));
+                if (!told.allFinite() || !seen.allFinite()) continue;  // not this projector's content
+                const double d = (told - seen).norm();
+                sum += d;
+                largest = std::max(largest, d);
+                ++n;
+            }
+        }
+    }
+    check.tried = true;
+    check.fitted_top_m = fitted.screen.top_m;
+    check.shift_mean_px = n > 0 ? sum / n : 0.0;
+    check.shift_max_px = largest;
 }
 
 }  // namespace mogao::autocal::trials

@@ -31,4 +31,10 @@ void try_projector_distortion(BundleResult& ba, const CalibrationPrior& prior,
                               const std::vector<ProjectorObservations>& observations, BundleOptions bo,
                               const AutocalOptions& options, AutocalReport& report);
 
+// AutocalOptions::check_heights, on told heights only (`bo` as the final adjustment, refine_heights off): `ba` is
+// adjusted once more with the top edge free and `check` filled; `ba` itself is left as it is.
+void check_told_heights(const BundleResult& ba, const std::vector<EdgeObservation>& edges,
+                        const std::vector<ProjectorObservations>& observations, BundleOptions bo,
+                        const AutocalOptions& options, HeightsCheck& check);
+
 }  // namespace mogao::autocal::trials

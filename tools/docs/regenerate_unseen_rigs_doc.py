@@ -139,7 +139,8 @@ def main():
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
                             text=True).stdout.strip()
     rows = []
-    default = Tally("As a technician runs it (the defaults, `--fit-screen` where refused naming the screen)")
+    default = Tally("As a technician runs it (the defaults; `--fit-heights` where refused naming the heights, "
+                    "`--fit-screen` where refused naming the screen)")
     heights = Tally("With `--fit-heights` (the drawn rigs whose heights were taped)")
     with tempfile.TemporaryDirectory() as work:
         for base_path in sorted(glob.glob(os.path.join(ROOT, "rigs", "realistic*.toml"))):
@@ -153,15 +154,23 @@ def main():
                 out = os.path.join(work, f"out-{stem}-{d}")
                 report, why = run(tool, rig_path, out, args.scale, [])
                 name = f"{stem} draw {d}"
-                if report is None and "screen" in why:
+                fitted_heights = None
+                if report is None and "screen heights" in why:
+                    # What the refusal tells the technician: the told heights disagree with the screen the camera
+                    # sees; with its radius and arc known, fit the top edge.
+                    report, why = run(tool, rig_path, out + "-heights", args.scale, ["--fit-heights"])
+                    name += " `--fit-heights` (refused without: heights)"
+                    fitted_heights = (report, why)
+                elif report is None and "screen" in why:
                     # What the refusal tells the technician: the screen's size is not what the site file says.
                     report, why = run(tool, rig_path, out + "-fit", args.scale, ["--fit-screen"])
                     name += " `--fit-screen` (refused without: screen)"
                 rows.append(default.row(name, report, why))
                 print(rows[-1], flush=True)
                 if "screen_top_error_m" in rig["prior"]:
-                    report, why = run(tool, rig_path, out + "-heights", args.scale, ["--fit-heights"])
-                    rows.append(heights.row(f"{stem} draw {d} `--fit-heights`", report, why))
+                    if fitted_heights is None:
+                        fitted_heights = run(tool, rig_path, out + "-heights", args.scale, ["--fit-heights"])
+                    rows.append(heights.row(f"{stem} draw {d} `--fit-heights`", *fitted_heights))
                     print(rows[-1], flush=True)
     lines = [f"Run {datetime.date.today()} at commit {commit} on {platform.node()} by "
              f"`tools/docs/regenerate_unseen_rigs_doc.py --scale {args.scale} --draws {args.draws} --seed {args.seed}` "
