@@ -13,6 +13,7 @@ Python 3 standard library only.
 """
 import argparse, datetime, glob, json, os, platform, subprocess, tempfile
 
+from calibration_cells import heights_cell
 from generated_block import replace_block
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -25,6 +26,9 @@ EXTRA_RUNS = {"roughscreen": [["--fit-screen"], ["--fit-heights"]], "falloff": [
 # Rigs also run at full resolution (x1), a row for each list of options they need there.
 X1_RUNS = {"standard": [[]], "focal": [[]], "realistic": [[]], "realistic-lens": [[]], "realistic-optics": [[]],
            "realistic-install": [["--fit-screen"], ["--fit-heights"]]}
+# The gates after which the table still shows a refused run's figures (the run again with them lifted), by the
+# refusal's first words: what these two gates judge is the error the truth measures.
+GATES = [("self-check:", "--max-self-check-px"), ("screen heights:", "--max-heights-shift-px")]
 # Rigs already at small resolutions, run at their own (x1): the QEMU test's rig (rigs/qemu.toml).
 OWN_SCALE = {"qemu"}
 
@@ -71,11 +75,11 @@ def main():
              "but x1 for rigs marked so; errors in that rig's projector pixels, against the rig's ground "
              "truth; compute = "
              "the calibration's wall time without the rig's camera simulation, colour step included, 2 cores).", "",
-             "| rig | result | geometry mean / p95 / max (px) | self-check mean / p95 (px) | camera "
-             "intrinsics (trial's "
+             "| rig | result | geometry mean / p95 / max (px) | self-check mean / p95 (px) | heights check (px) | "
+             "camera intrinsics (trial's "
              "relative cost) | projector distortion (trial's relative cost per projector) | seam luminance max | "
              "predicted seam | camera position error | lit edges rms | reprojection rms (px) | compute s |",
-             "|---|---|---|---|---|---|---|---|---|---|---|--:|"]
+             "|---|---|---|---|---|---|---|---|---|---|---|---|--:|"]
     colour = [f"Same run. Flat content at each level, the rig's ground-truth light at 401 x 101 content points; "
               "seam = points two projectors light; luminance deviation |Y / Y_ref - 1| with Y_ref the median of the "
               "points one projector lights; pixel mean = the light averaged over the footprint of the output pixel "
@@ -105,12 +109,15 @@ def main():
             result = "calibrated"
             if p.returncode != 0:
                 why = p.stderr.strip().replace("mogao-calibrate-sim rig: ", "").replace("|", "/")
-                if not why.startswith("self-check:"):
-                    lines.append(f"| {name} | refused: {why} | — | — | — | — | — | — | — | — | — | — |")
+                gate = next((flag for prefix, flag in GATES if why.startswith(prefix)), None)
+                if gate is None:
+                    lines.append(f"| {name} | refused: {why} | — | — | — | — | — | — | — | — | — | — | — |")
                     continue
-                # What the self-check refused, against the truth: the same run with its gate off.
+                # What the self-check or the heights' check refused, against the truth: the same run with every
+                # such gate off.
                 result = f"refused: {why} (figures: the same run with the gate off)"
-                subprocess.run(command + ["--max-self-check-px", "1e9"], capture_output=True, text=True, check=True)
+                lifted = [a for _, flag in GATES for a in (flag, "1e9")]
+                subprocess.run(command + lifted, capture_output=True, text=True, check=True)
             r = json.load(open(os.path.join(out, "report.json")))
         g = r["ground_truth"]
         if "seams_before_colour" in g:
@@ -121,7 +128,8 @@ def main():
         intrinsics = ("prior's, taken as exact" if not trial.get("tried") else
                       f"{'refined' if trial['kept'] else 'prior' + chr(39) + 's'} ({trial['relative_cost']:.4f})")
         lines.append(f"| {name} | {result} | {g['geometry_mean_px']:.3f} / {g['geometry_p95_px']:.3f} / "
-                     f"{g['geometry_max_px']:.3f} | {c['mean_px']:.3f} / {c['p95_px']:.3f} | {intrinsics} | "
+                     f"{g['geometry_max_px']:.3f} | {c['mean_px']:.3f} / {c['p95_px']:.3f} | "
+                     f"{heights_cell(r['screen'])} | {intrinsics} | "
                      f"{distortion_cell(r['projectors'])} | "
                      f"{100 * g['seam_luminance_max_deviation']:.2f} % | "
                      f"{100 * r['predicted']['seam_weight_sum_max_deviation']:.2f} % | "

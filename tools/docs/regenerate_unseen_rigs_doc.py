@@ -18,6 +18,7 @@ Python 3.11 standard library only (tomllib).
 """
 import argparse, copy, datetime, glob, json, os, platform, random, subprocess, tempfile, tomllib
 
+from calibration_cells import heights_cell
 from generated_block import replace_block
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -109,7 +110,7 @@ class Tally:
     def row(self, name, report, why):
         if report is None:
             self.refused += 1
-            return f"| {name} | refused: {why} | — | — | — | — |"
+            return f"| {name} | refused: {why} | — | — | — | — | — |"
         self.calibrated += 1
         g, c = report["ground_truth"], report["self_check"]
         gap = abs(c["mean_px"] - g["geometry_mean_px"])
@@ -118,7 +119,7 @@ class Tally:
         self.worst_gap = max(self.worst_gap, gap)
         self.silent += g["geometry_mean_px"] > 1.0 or g["geometry_p95_px"] > 1.0
         return (f"| {name} | calibrated | {g['geometry_mean_px']:.3f} / {g['geometry_p95_px']:.3f} / "
-                f"{g['geometry_max_px']:.3f} | {c['mean_px']:.3f} ({gap:.3f}) | "
+                f"{g['geometry_max_px']:.3f} | {c['mean_px']:.3f} ({gap:.3f}) | {heights_cell(report['screen'])} | "
                 f"{100 * g['seam_luminance_max_deviation']:.2f} % | {report['timing']['compute_s']:.1f} |")
 
     def summary(self):
@@ -179,8 +180,8 @@ def main():
              "seam luminance maximum at white after the colour step; compute = the calibration's wall time, 2 cores).",
              "", default.summary(), "", heights.summary(), "",
              "| drawn rig | result | geometry mean / p95 / max (px) | self-check mean (distance to truth) px | "
-             "seam luminance max | compute s |",
-             "|---|---|---|---|---|--:|"] + rows
+             "heights check mean / max (px) | seam luminance max | compute s |",
+             "|---|---|---|---|---|---|--:|"] + rows
     replace_block(os.path.join(ROOT, "docs", "calibration.md"), "calibration-unseen", lines)
 
 if __name__ == "__main__":
