@@ -38,8 +38,11 @@ TEST(QualityPreset, EveryPresetIsAValidRequestAndTheyGoFromFastToAccurate) {
 // for a frame-time target may use it, and the fastest one must, or its moving frames pay for full
 // paths; the most accurate preset traces every frame unbiased and keeps 4:4:4 chroma.
 TEST(QualityPreset, OnlyPresetsWithAFrameTimeTargetUseTheBiasedRadianceCache) {
-    for (const QualityPreset& p : quality_presets())
-        if (p.radiance_cache) EXPECT_GT(p.frame_time_ms, 0.0) << p.name << " uses the radiance cache";
+    for (const QualityPreset& p : quality_presets()) {
+        if (p.radiance_cache) {
+            EXPECT_GT(p.frame_time_ms, 0.0) << p.name << " uses the radiance cache";
+        }
+    }
     EXPECT_TRUE(quality_presets().front().radiance_cache);
     EXPECT_TRUE(quality_presets().front().denoise);
     EXPECT_FALSE(quality_presets().back().radiance_cache);
