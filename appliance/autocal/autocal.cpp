@@ -59,6 +59,7 @@ void check_inputs(const CalibrationPrior& prior, ImageSize content, const Autoca
     if (!(o.phase_sigma_floor_px > 0.0)) fail("options.phase_sigma_floor_px: > 0");
     if (!(o.shadow_noise_sigmas >= 0.0)) fail("options.shadow_noise_sigmas: >= 0");
     if (!(o.bow_min_gain >= 0.0 && o.bow_min_gain < 1.0)) fail("options.bow_min_gain: [0, 1)");
+    if (!(o.max_heights_shift_px > 0.0)) fail("options.max_heights_shift_px: > 0");
     if (!(o.camera_sigma.focal > 0.0 && o.camera_sigma.principal_point > 0.0 && o.camera_sigma.distortion > 0.0)) {
         fail("options.camera_sigma: focal, principal_point and distortion > 0");
     }

@@ -323,7 +323,8 @@ struct BowTrial {
 
 // What the told heights' check (AutocalOptions::check_heights) found: the top edge the camera sees with the bottom
 // as told, and how far content moves, in the showing projector's pixels, between the fit on the told span and the
-// fit on that one (a grid of 17 x 9 content points per projector, both fits' models through model_pixel).
+// fit with the top edge free (a grid of 17 x 9 content points over the screen, each through both fits' models and
+// screens: model_pixel; points a projector does not show are left out).
 struct HeightsCheck {
     bool tried = false;
     double fitted_top_m = 0.0;

@@ -84,6 +84,9 @@ TEST(Autocal, SpeedKnobsOutOfRangeAreRefusedByName) {
     o = {};
     o.phase_period_px = 2.0;
     EXPECT_NE(message(o).find("options.phase_period_px"), std::string::npos) << message(o);
+    o = {};
+    o.max_heights_shift_px = 0.0;
+    EXPECT_NE(message(o).find("options.max_heights_shift_px"), std::string::npos) << message(o);
     EXPECT_DOUBLE_EQ(source.simulate_s(), 0.0);  // nothing was shown
 }
 
