@@ -224,12 +224,7 @@ nlohmann::json screen_report(const AutocalResult& r, const CalibrationPrior& pri
             {"bottom_m", r.screen.bottom_m},
             {"top_m", r.screen.top_m},
             {"prior_top_m", prior.screen.top_m},
-            {"heights_check",
-             {{"tried", r.report.heights.tried},
-              {"fitted_top_m", r.report.heights.fitted_top_m},
-              {"shift_mean_px", r.report.heights.shift_mean_px},
-              {"shift_max_px", r.report.heights.shift_max_px},
-              {"gate_px", job.options.max_heights_shift_px}}}};
+            {"heights_check", heights_check_report(r.report.heights, job.options.max_heights_shift_px)}};
 }
 
 // report.json's "predicted": the blend's worst weight-sum deviation as the fitted models predict it.

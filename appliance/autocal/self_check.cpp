@@ -406,6 +406,14 @@ void check_self_check_gate(const SelfCheckResult& check, const SelfCheckOptions&
         "calibration of the camera, the intrinsics' refinement where the command has it, or fitting the screen)");
 }
 
+nlohmann::json heights_check_report(const HeightsCheck& h, double gate_px) {
+    return {{"tried", h.tried},
+            {"fitted_top_m", h.fitted_top_m},
+            {"shift_mean_px", h.shift_mean_px},
+            {"shift_max_px", h.shift_max_px},
+            {"gate_px", gate_px}};
+}
+
 nlohmann::json self_check_report(const SelfCheckResult& c, const SelfCheckOptions& o) {
     return {{"mean_px", c.mean_px},
             {"p95_px", c.p95_px},

@@ -94,6 +94,11 @@ void check_self_check_gate(const SelfCheckResult& check, const SelfCheckOptions&
 // report.json's "self_check" block: the figures, the gate and how many marks and captures.
 [[nodiscard]] nlohmann::json self_check_report(const SelfCheckResult& check, const SelfCheckOptions& o);
 
+// report.json's "screen.heights_check", the other check that needs no ground truth (autocal.h,
+// AutocalOptions::check_heights): whether it ran, the top edge the camera sees (metres), how far content
+// moves between the told and the seen top edge in projector pixels (mean, max) and the gate it was held to.
+[[nodiscard]] nlohmann::json heights_check_report(const HeightsCheck& h, double gate_px);
+
 // Runs the check on `source` (the projectors showing `calibrated` and the camera it was made with).
 // `prior`: what the calibration was told (the check's camera starts from its intrinsics). Throws
 // std::invalid_argument for bad options and CalibrationRefused when fewer than min_marks marks are found or

@@ -36,7 +36,7 @@ nlohmann::json run_from_images(const OnSiteJob& job, const fs::path& images) {
                                {"edge_rms_mm", r.report.edge_rms_m * 1e3}}},
                              {"captures", source.images()}};
     for (std::size_t k = 0; k < r.projectors.size(); ++k) report["projectors"].push_back(fit_json(r, k));
-    report["screen"] = screen_json(r);
+    report["screen"] = screen_json(r, job.options);
     const autocal::CalibrationModels models{r.screen, r.camera, r.projectors};
     write_calibration(job.out / "calibration.mpcdi", models, r.calibration, geometry);
     if (!job.install.empty()) write_calibration(job.install, models, r.calibration, geometry);

@@ -38,13 +38,18 @@ nlohmann::json fit_json(const autocal::AutocalResult& r, std::size_t k) {
             {"mean_view_angle_deg", p.mean_view_angle_deg}};
 }
 
-nlohmann::json screen_json(const autocal::AutocalResult& r) {
+nlohmann::json screen_json(const autocal::AutocalResult& r, const autocal::AutocalOptions& options) {
     return {{"radius_m", r.screen.radius_m},
             {"arc_deg", r.screen.arc_deg},
             {"bow_m", r.screen.bow_m},
             {"bow_kept", r.report.bow.kept},
             {"cylinder_rms_sigma", r.report.bow.cylinder_rms_sigma},
-            {"bowed_rms_sigma", r.report.bow.bowed_rms_sigma}};
+            {"bowed_rms_sigma", r.report.bow.bowed_rms_sigma},
+            {"fitted", options.fit_screen},
+            {"heights_fitted", options.fit_heights && !options.fit_screen},
+            {"bottom_m", r.screen.bottom_m},
+            {"top_m", r.screen.top_m},
+            {"heights_check", autocal::heights_check_report(r.report.heights, options.max_heights_shift_px)}};
 }
 
 namespace {
@@ -227,7 +232,7 @@ nlohmann::json finish(const OnSiteJob& job, const Identified& id, const autocal:
     if (colour) report["colour"] = colour_json(*colour);
     report["self_check"] = autocal::self_check_report(check, job.self_check);
     // The screen the calibration used: the site file's cylinder, with the bow where it paid (autocal.h).
-    report["screen"] = screen_json(r);
+    report["screen"] = screen_json(r, job.options);
     const autocal::CalibrationModels models{r.screen, r.camera, r.projectors};
     write_calibration(job.out / "calibration.mpcdi", models, r.calibration, job);
     if (!job.install.empty()) write_calibration(job.install, models, r.calibration, job);

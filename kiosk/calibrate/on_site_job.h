@@ -74,7 +74,7 @@ nlohmann::json run_on_site(const OnSiteJob& job, OutputBackend& outputs, Calibra
 // Shared with the captured-images route (images_job.h):
 // report.json's per-projector fit and screen entries (above);
 [[nodiscard]] nlohmann::json fit_json(const autocal::AutocalResult& r, std::size_t k);
-[[nodiscard]] nlohmann::json screen_json(const autocal::AutocalResult& r);
+[[nodiscard]] nlohmann::json screen_json(const autocal::AutocalResult& r, const autocal::AutocalOptions& options);
 // the MPCDI and its models at `mpcdi`, the previous ones kept as <file>.last-good (above);
 void write_calibration(const std::filesystem::path& mpcdi, const autocal::CalibrationModels& models,
                        const ScreenCalibration& c, const OnSiteJob& job);

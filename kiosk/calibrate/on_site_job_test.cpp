@@ -132,6 +132,15 @@ TEST_F(OnSiteJobTest, HeadlessOutputsFilmedThroughTheRigCalibrateAsWellAsTheRigI
                 check["p95_px"].get<double>(), check["marks_found"].get<int>(), check["marks_shown"].get<int>());
     EXPECT_NEAR(check["mean_px"].get<double>(), g.mean_px, 0.2);
     EXPECT_GE(check["marks_found"].get<int>(), 48);
+    // The told heights' check reaches the technician's report as the rig route computes it.
+    const nlohmann::json& heights = r["screen"]["heights_check"];
+    ASSERT_TRUE(heights["tried"].get<bool>()) << r["screen"].dump();
+    ASSERT_TRUE(ref.report.heights.tried);
+    EXPECT_NEAR(heights["shift_mean_px"].get<double>(), ref.report.heights.shift_mean_px, 0.01);
+    EXPECT_NEAR(heights["fitted_top_m"].get<double>(), ref.report.heights.fitted_top_m, 1e-4);
+    EXPECT_LE(heights["shift_mean_px"].get<double>(), heights["gate_px"].get<double>());
+    EXPECT_DOUBLE_EQ(heights["gate_px"].get<double>(), job_.options.max_heights_shift_px);
+    EXPECT_DOUBLE_EQ(r["screen"]["top_m"].get<double>(), ref.screen.top_m);
     EXPECT_TRUE(fs::exists(job_.out / "calibration.models.json"));
     EXPECT_FALSE(cv::imread((job_.out / "camera-white.png").string()).empty());
     // The previous run's calibration is kept, and its cabling compared.
