@@ -10,6 +10,8 @@
 #   * a host back while the farm serves without it ends the job after 2 answers in a row
 #     (MOGAO_REJOIN_CHECK_S, the second MOGAO_REJOIN_CONFIRM_S after the first), and not at all with 0;
 #   * the hosts of the ranks the previous job named lost (its --lost-ranks-file) are left out unasked;
+#   * a job that ends naming lost ranks is started again by the launcher at once, at most
+#     MOGAO_RELAUNCH_MAX times in a row;
 #   * a host file whose last line lacks its newline still has that host;
 #   * bad MOGAO_BOOT_GRACE_S / MOGAO_REJOIN_CHECK_S / MOGAO_REJOIN_CONFIRM_S / RANKS are refused with
 #     exit 2, naming the variable.
@@ -117,6 +119,39 @@ out=$(run 0 0)
 echo "$out" | grep -q "mpirun --hostfile .* -n 3 mogao-farm serve" || fail "admin rank named: render2 dropped: $out"
 [ "$(cat "$work/calls")" = 1 ] || fail "admin rank named: render2 asked $(cat "$work/calls") times, expected 1"
 
+# A job that ends naming rank 2 lost (as the admin does before it aborts) is started again by the
+# launcher itself, at once, without render2 and without asking it; a job that keeps naming lost
+# ranks is started again at most MOGAO_RELAUNCH_MAX times, then the launcher exits with its status.
+cat > "$work/mpirun-loses" <<'MPI'
+#!/bin/sh
+n=$(cat "$WORK/jobs" 2>/dev/null || echo 0); n=$((n + 1)); echo $n > "$WORK/jobs"
+echo "mpirun $*"
+for last; do :; done
+[ "$n" -le "${LOSE_JOBS:-1}" ] || exit 0
+echo 2 > "$last"; exit 3
+MPI
+chmod +x "$work/mpirun-loses"
+rm -f "$work/jobs" "$work/lost-ranks"
+rc=0; out=$(WORK=$work MPIRUN="$work/mpirun-loses" LIMIT=20 run 0 0) || rc=$?
+[ $rc = 0 ] || fail "relaunch: exit $rc, expected 0 from the second job: $out"
+[ "$(cat "$work/jobs")" = 2 ] || fail "relaunch: $(cat "$work/jobs") jobs, expected 2: $out"
+echo "$out" | grep -q "the job ended (exit 3) naming lost rank(s) 2: starting it again" \
+  || fail "relaunch: not logged: $out"
+echo "$out" | grep -q "render host render2 left out unasked: named lost by the previous job (rank 2)" \
+  || fail "relaunch: render2 not left out unasked: $out"
+[ "$(echo "$out" | grep -c "mpirun --hostfile .* -n 2 mogao-farm serve")" = 1 ] \
+  || fail "relaunch: the second job should have 2 ranks: $out"
+[ "$(cat "$work/calls")" = 1 ] || fail "relaunch: render2 asked $(cat "$work/calls") times, expected 1 (first start)"
+rm -f "$work/jobs" "$work/lost-ranks"
+rc=0; out=$(WORK=$work MPIRUN="$work/mpirun-loses" LOSE_JOBS=9 MOGAO_RELAUNCH_MAX=2 LIMIT=20 run 0 0) || rc=$?
+[ $rc = 3 ] || fail "relaunch limit: exit $rc, expected the job's 3: $out"
+[ "$(cat "$work/jobs")" = 3 ] || fail "relaunch limit: $(cat "$work/jobs") jobs, expected 1 + 2 relaunches: $out"
+rm -f "$work/jobs" "$work/lost-ranks"
+rc=0; out=$(WORK=$work MPIRUN="$work/mpirun-loses" MOGAO_RELAUNCH_MAX=0 LIMIT=20 run 0 0) || rc=$?
+[ $rc = 3 ] && [ "$(cat "$work/jobs")" = 1 ] || fail "MOGAO_RELAUNCH_MAX=0: exit $rc, $(cat "$work/jobs") jobs: $out"
+[ -s "$work/lost-ranks" ] || fail "MOGAO_RELAUNCH_MAX=0: the lost ranks are not left for systemd's restart"
+rm -f "$work/jobs" "$work/lost-ranks"
+
 # A host file whose last line has no newline: its host is still asked and used.
 printf 'admin slots=2\nrender2 slots=1' > "$work/hosts"
 out=$(run 0 0)
@@ -129,6 +164,10 @@ for bad in "MOGAO_BOOT_GRACE_S=-1" "MOGAO_BOOT_GRACE_S=2m" "MOGAO_REJOIN_CHECK_S
   rc=0; err=$(env "$bad" sh "$launcher" "$work/hosts" 3 true 2>&1) || rc=$?
   [ $rc = 2 ] && echo "$err" | grep -q "${bad%%=*} must be whole seconds" || fail "$bad: rc $rc, '$err'"
 done
+rc=0; err=$(MOGAO_RELAUNCH_MAX=-1 sh "$launcher" "$work/hosts" 3 true 2>&1) || rc=$?
+[ $rc = 2 ] && echo "$err" | grep -q "MOGAO_RELAUNCH_MAX must be a whole number" \
+  || fail "RELAUNCH_MAX -1: rc $rc, '$err'"
 echo "PASS: launcher waits for booting hosts only within the grace (3 checks)," \
   "${hidden:-}leaves lost ones out at once (named ones unasked), ends the wait at the grace ($took s)," \
+  "starts a job that named lost ranks again itself," \
   "restarts for a host back after 2 checks ($rejoin_took s at 1 s a check; $confirm_took s at 5 s, confirmed 1 s later)"

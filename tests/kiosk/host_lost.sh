@@ -3,15 +3,16 @@
 # Fault: a render host of a multi-host farm is lost while the farm serves an appliance, twice, and
 # then one comes back (render-node failure: docs/services.md "Render-node failure"):
 #   cut   render host R2's link goes down (a hung or unreachable host: its rank no longer answers,
-#         nothing reports an error; the admin's frame deadline ends the job: its default, 4 x the frame's
-#         expected time and at least 2 s)
+#         nothing reports an error; the admin's liveness check ends the job when the rank's heartbeat
+#         has been silent for its limit, renderfarm/farm/rank_liveness.h)
 #   dead  render host R1 dies: SIGKILL to every process in its namespace, and its link goes down
 #   back  R2's link comes up again: the launcher's watcher (MOGAO_REJOIN_CHECK_S=2) sees it answer
 #         twice in a row and ends the job, and the restarted farm renders on R2 again
-# Each time the farm is restarted by a loop standing in for systemd's Restart=on-failure
-# (RestartSec=500ms, as the unit has it), through systemd/mogao-farm-launch as the unit runs it: the
-# launcher asks each render host for `mogao-farm health` through the rsh agent, leaves out the host
-# that does not answer within 2 s and starts mpirun over the others. After the first fault the farm
+# After a loss the launcher starts the job again itself; for a return the farm is restarted by a loop
+# standing in for systemd's Restart=on-failure (RestartSec=500ms, as the unit has it), through
+# systemd/mogao-farm-launch as the unit runs it. The launcher leaves out the host the admin named
+# lost, asks each other render host for `mogao-farm health` through the rsh agent, leaves out the
+# one that does not answer within 2 s and starts mpirun over the others. After the first fault the farm
 # serves with one render rank (R1), after the second with the admin alone (which then renders), and
 # after R2's return with R2.
 # Checks: the launcher names the host it left out each time; the farm comes back with 1, then 0, then 1
@@ -197,8 +198,11 @@ for name, t in (("cut", int(sys.argv[2])), ("dead", int(sys.argv[3])), ("back", 
     resume = (first["presented_ns"] - t) / 1e9
     ended = next((ns for what, ns in supervise if what == "exit" and ns > t), None)
     started = next((ns for what, ns in supervise if what == "start" and ns > t), None)
-    steps = (f"job ended +{(ended - t) / 1e9:.1f} s, restarted +{(started - t) / 1e9:.1f} s, "
-             if ended and started else "")
+    # A loss's job is started again by the launcher itself (no supervise line); a return's by the loop.
+    if ended and started and ended < first["presented_ns"]:
+        steps = f"job ended +{(ended - t) / 1e9:.1f} s, restarted +{(started - t) / 1e9:.1f} s, "
+    else:
+        steps, ended = "job started again by the launcher, ", None
     print(f"{name}: new frame on the wall {resume:.1f} s after the {'return' if name == 'back' else 'loss'} "
           f"(request {first['request_id']}; {steps}kiosk reconnected +{(up['time_ns'] - t) / 1e9:.1f} s)")
     # A return: the watcher takes 2 checks to trust it; the appliance's wait is from the job's end.
