@@ -103,6 +103,29 @@ TEST(InstallErrors, TapeMeasuredHeightsAreFittedOrRefused) {
     EXPECT_NEAR(fitted.result.screen.radius_m, rig.screen.radius_m * 1.46 / 1.5, 0.01);
 }
 
+// Radius, arc and heights all as a tape measures them (the radius told 2 % long, the arc 2 degrees short, the span
+// told 4 cm short): without fit_screen the told screen's shape is wrong and the calibration is refused, naming the
+// heights and --fit-screen; with it, the told span is the only scale left and content lands where it belongs (a room
+// scaled uniformly is the same room to the camera and to the content).
+TEST(InstallErrors, RadiusArcAndHeightsAllTapeMeasuredAreFittedWithTheScreen) {
+    rig::VirtualRig rig = standard_half();
+    rig.prior.screen_radius_error_m = 0.06;
+    rig.prior.screen_arc_error_deg = -2.0;
+    rig.prior.screen_bottom_error_m = 0.02;
+    rig.prior.screen_top_error_m = -0.02;
+    const Outcome told = calibrate_rig(rig, {}, "radius, arc and heights taken as exact");
+    ASSERT_FALSE(told.refused.empty());
+    EXPECT_NE(told.refused.find("--fit-screen"), std::string::npos) << told.refused;
+    AutocalOptions fit;
+    fit.fit_screen = true;
+    const Outcome fitted = calibrate_rig(rig, fit, "radius, arc and heights tape-measured, screen fitted");
+    EXPECT_TRUE(meets_goals(fitted)) << fitted.refused << " " << fitted.geometry.mean_px << " / "
+                                     << fitted.geometry.p95_px;
+    EXPECT_NEAR(fitted.result.screen.arc_deg, rig.screen.arc_deg, 0.3);
+    const double told_over_true_span = 1.46 / (rig.screen.top_m - rig.screen.bottom_m);
+    EXPECT_NEAR(fitted.result.screen.radius_m, rig.screen.radius_m * told_over_true_span, 0.01);
+}
+
 // Heights a few millimetres off, as a careful tape leaves them: the span told 8 mm short (0.5 %). Taken as exact
 // with the heights' check off, content lands further off than the goals allow (measured p95 1.15 px) while the edges
 // still meet their gate and the self-check, through the same told screen, passes (0.27 px): a silent error. The
