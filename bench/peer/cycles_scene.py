@@ -3,10 +3,10 @@
 "A peer: Blender Cycles"). Run by bench/peer/run inside Blender:
 
   blender -b --factory-startup --python-exit-code 1 -P bench/peer/cycles_scene.py -- \
-      --dir DIR --spp 1,4,16,64 [--ref-spp 1024] [--threads 1] [--ref-threads 2] [--window FILE]
+      --dir DIR --spp 1,4,16,64|none [--ref-spp 1024|0] [--threads 1] [--ref-threads 2] [--window FILE]
 
-Reads DIR/scene.obj, DIR/peer.json (mogao_peer_bench export). Writes DIR/cycles-<spp>.pfm (seed 1, one
-thread) and DIR/cycles-ref-a.pfm, cycles-ref-b.pfm (two halves of ref-spp/2 samples, seeds 1000/1001),
+Reads DIR/scene.obj, DIR/peer.json (mogao_peer_bench export). Writes DIR/cycles-<spp>.pfm (seed 1, on
+--threads threads) and DIR/cycles-ref-a.pfm, cycles-ref-b.pfm (two halves of ref-spp/2 samples, seeds 1000/1001),
 DIR/cycles-times.csv (spp, CPU s of the Blender process during bpy.ops.render.render, wall s) and
 DIR/cycles-calibration.csv. Linear radiance, PFM rows bottom up (as Blender's pixel buffers).
 
@@ -15,7 +15,9 @@ Mapping (each one checked or stated in docs/quality.md):
     Glossy BSDF 'GGX' colour k_s, roughness sqrt(alpha)) (Cycles' roughness r gives alpha = r^2). Exact
     in form; Cycles' single-scattering GGX uses the separable Smith G1(o) G1(i), ours the
     height-correlated G2 (differs at grazing angles only). Principled BSDF is not used: its Fresnel
-    term and specular tint have no counterpart in our model.
+    term and specular tint have no counterpart in our model. A textured material (peer.json "texture")
+    multiplies its diffuse colour by an Image Texture node (sRGB, bilinear 'Linear', REPEAT or EXTEND as
+    both wrap modes say): ours filters the same texels by ray-cone mip level, Cycles has no mip chain.
   * lights: strength chosen so that a white Lambert plane receives our irradiance. The factor per light
     type is MEASURED here on every run (calibrate()): a white plane under each light alone, compared
     with the analytic irradiance; so no assumption about Blender's watts conventions enters. Point:
@@ -42,8 +44,8 @@ def parse():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
     p = argparse.ArgumentParser()
     p.add_argument("--dir", required=True)
-    p.add_argument("--spp", default="1,4,16,64")
-    p.add_argument("--ref-spp", type=int, default=1024)
+    p.add_argument("--spp", default="1,4,16,64", help="'none': no curve (the reference alone)")
+    p.add_argument("--ref-spp", type=int, default=1024, help="0: no reference (the curve alone)")
     p.add_argument("--threads", type=int, default=1)
     p.add_argument("--ref-threads", type=int, default=2)
     p.add_argument("--reps", type=int, default=1)
@@ -178,7 +180,7 @@ def add_light(spec, factors):
     bpy.context.scene.collection.objects.link(obj)
 
 
-def make_material(name, spec):
+def make_material(name, spec, folder=None):
     mat = bpy.data.materials.get(name) or bpy.data.materials.new(name)
     mat.use_nodes = True
     nodes, links = mat.node_tree.nodes, mat.node_tree.links
@@ -188,6 +190,19 @@ def make_material(name, spec):
     diffuse = nodes.new("ShaderNodeBsdfDiffuse")
     diffuse.inputs["Color"].default_value = (*[(1 - k) * a for k, a in zip(ks, spec["albedo"])], 1.0)
     diffuse.inputs["Roughness"].default_value = 0.0  # Lambert (Oren-Nayar off)
+    if spec.get("texture"):
+        # Our tint: (1 - k_s) a times the texture's linear colour (sRGB decoded, as texture.h), bilinear on
+        # level 0 (Cycles has no mip chain: ours filters by ray cone, a model mismatch the report measures).
+        tex = nodes.new("ShaderNodeTexImage")
+        tex.image = bpy.data.images.load(os.path.join(folder, spec["texture"]))
+        tex.image.colorspace_settings.name = "sRGB"
+        tex.interpolation = "Linear"
+        tex.extension = "EXTEND" if spec.get("wrap") == ["clamp", "clamp"] else "REPEAT"
+        tint = nodes.new("ShaderNodeVectorMath")
+        tint.operation = "MULTIPLY"
+        tint.inputs[1].default_value = [(1 - k) * a for k, a in zip(ks, spec["albedo"])]
+        links.new(tex.outputs["Color"], tint.inputs[0])
+        links.new(tint.outputs["Vector"], diffuse.inputs["Color"])
     if max(ks) <= 0:
         links.new(diffuse.outputs[0], out.inputs["Surface"])
         return mat
@@ -288,7 +303,7 @@ def build_scene(d, peer, factors):
         raise SystemExit(f"OBJ import changed the scene: bounds {lo} {hi} faces {faces}, file {flo} {fhi} {ffaces}")
     print("imported %d triangles, bounds %s %s" % (faces, lo, hi), flush=True)
     for name, spec in peer["materials"].items():
-        make_material(name, spec)
+        make_material(name, spec, d)
     for spec in peer["lights"]:
         add_light(spec, factors)
     cam = peer["camera"]
@@ -316,7 +331,7 @@ def main():
           % (time.perf_counter() - t0, warm_cpu, s.cycles.sampling_pattern), flush=True)
     times = ["spp,cpu_s,wall_s"]
     window_start = time.monotonic()  # CLOCK_MONOTONIC, as perf record -k mono
-    for spp in [int(x) for x in a.spp.split(",")]:
+    for spp in [] if a.spp == "none" else [int(x) for x in a.spp.split(",")]:
         s.cycles.samples, s.cycles.seed = spp, 1
         best = None
         for _ in range(a.reps):
@@ -329,14 +344,15 @@ def main():
         with open(a.window, "w") as f:
             f.write("%.6f %.6f\n" % (window_start, time.monotonic()))
     s.render.threads = a.ref_threads
-    for half, seed in (("a", 1000), ("b", 1001)):
+    for half, seed in (("a", 1000), ("b", 1001)) if a.ref_spp > 0 else ():
         s.cycles.samples, s.cycles.seed = a.ref_spp // 2, seed
         px, cpu, wall = render_pixels(tmp)
         write_pfm(os.path.join(a.dir, "cycles-ref-%s.pfm" % half), px)
         print("reference half %s: %d spp, %.1f s wall" % (half, a.ref_spp // 2, wall), flush=True)
-    with open(os.path.join(a.dir, "cycles-times.csv"), "w") as f:
-        f.write("\n".join(times) + "\n")
-        f.write("# warm-up render (sync + BVH + 1 spp) cpu_s %.6f wall_s %.6f\n" % (warm_cpu, warm_wall))
+    if len(times) > 1:
+        with open(os.path.join(a.dir, "cycles-times.csv"), "w") as f:
+            f.write("\n".join(times) + "\n")
+            f.write("# warm-up render (sync + BVH + 1 spp) cpu_s %.6f wall_s %.6f\n" % (warm_cpu, warm_wall))
 
 
 main()

@@ -4,10 +4,12 @@
 #include <cerrno>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 #include <variant>
 
+#include "common/png_io.h"
 #include "renderfarm/trace/camera.h"
 #include "renderfarm/trace/shading.h"
 
@@ -23,10 +25,21 @@ std::string num(double v) {
     return buf;
 }
 
+bool is_textured(const Mesh& mesh) { return mesh.texture != nullptr && mesh.uvs.size() == mesh.positions.size(); }
+
+// A textured instance's material: its material with the mesh's texture, one per (material, mesh).
+std::string textured_material_name(const Scene& scene, const Instance& inst) {
+    return scene.materials[inst.material].name + "__texture" + std::to_string(inst.mesh);
+}
+
+std::string texture_file(std::size_t mesh) { return "texture" + std::to_string(mesh) + ".png"; }
+
 void write_instance(std::ostream& out, const Scene& scene, const Instance& inst, ExportStats& stats) {
     const Mesh& mesh = scene.meshes[inst.mesh];
     const Eigen::Matrix3d normal_matrix = inst.object_to_world.linear().inverse().transpose();
-    out << "o " << inst.name << "\nusemtl " << scene.materials[inst.material].name << '\n';
+    const bool textured = is_textured(mesh);
+    out << "o " << inst.name << "\nusemtl "
+        << (textured ? textured_material_name(scene, inst) : scene.materials[inst.material].name) << '\n';
     for (const Eigen::Vector3f& p : mesh.positions) {
         const Eigen::Vector3d w = inst.object_to_world * (mesh.origin + p.cast<double>());
         out << "v " << num(w.x()) << ' ' << num(w.y()) << ' ' << num(w.z()) << '\n';
@@ -40,17 +53,38 @@ void write_instance(std::ostream& out, const Scene& scene, const Instance& inst,
             out << "vn " << num(w.x()) << ' ' << num(w.y()) << ' ' << num(w.z()) << '\n';
         }
     }
+    if (textured) {
+        // OBJ's v points up the image, ours down (texture.h): v_obj = 1 - v.
+        for (const Eigen::Vector2f& uv : mesh.uvs) out << "vt " << num(uv.x()) << ' ' << num(1.0 - uv.y()) << '\n';
+    }
     const std::size_t base = stats.vertices + 1;  // OBJ indices are 1-based and global
+    const std::size_t uv_base = stats.uvs + 1;
     for (const auto& t : mesh.triangles) {
         out << 'f';
         for (const std::uint32_t i : t) {
             out << ' ' << base + i;
-            if (normals) out << "//" << base + i;
+            if (textured) out << '/' << uv_base + i;
+            if (normals) out << (textured ? "/" : "//") << base + i;
         }
         out << '\n';
     }
+    if (textured) stats.uvs += mesh.uvs.size();
     stats.vertices += mesh.positions.size();
     stats.triangles += mesh.triangles.size();
+}
+
+struct TexturedUse {
+    std::size_t material = 0;
+    std::size_t mesh = 0;
+};
+
+// Every (material, textured mesh) pair the instances use, by its exported material name.
+std::map<std::string, TexturedUse> textured_materials(const Scene& scene) {
+    std::map<std::string, TexturedUse> uses;
+    for (const Instance& inst : scene.instances)
+        if (is_textured(scene.meshes[inst.mesh]))
+            uses[textured_material_name(scene, inst)] = {inst.material, inst.mesh};
+    return uses;
 }
 
 }  // namespace
@@ -72,10 +106,24 @@ Result<ExportStats> write_obj(const Scene& scene, const std::filesystem::path& d
     if (!out.flush()) return errno_error("cannot write " + obj.string());
     std::ofstream m(mtl);
     if (!m) return errno_error("cannot write " + mtl.string());
-    for (const Material& mat : scene.materials)
-        m << "newmtl " << mat.name << "\nKd " << mat.albedo.x() << ' ' << mat.albedo.y() << ' ' << mat.albedo.z()
-          << "\nKs " << mat.specular.x() << ' ' << mat.specular.y() << ' ' << mat.specular.z() << "\nNs "
-          << mat.shininess << "\n\n";
+    const auto write_material = [&m](const Material& mat, const std::string& name, const std::string& map_kd) {
+        m << "newmtl " << name << "\nKd " << mat.albedo.x() << ' ' << mat.albedo.y() << ' ' << mat.albedo.z() << "\nKs "
+          << mat.specular.x() << ' ' << mat.specular.y() << ' ' << mat.specular.z() << "\nNs " << mat.shininess << '\n';
+        if (!map_kd.empty()) m << "map_Kd " << map_kd << '\n';
+        m << '\n';
+    };
+    for (const Material& mat : scene.materials) write_material(mat, mat.name, "");
+    for (const auto& [name, use] : textured_materials(scene)) {
+        write_material(scene.materials[use.material], name, texture_file(use.mesh));
+        if (!stats.textures_written.contains(use.mesh)) {
+            try {
+                write_png(dir / texture_file(use.mesh), scene.meshes[use.mesh].texture->image);
+            } catch (const std::exception& e) {
+                return make_error(EIO, e.what());
+            }
+            stats.textures_written.insert(use.mesh);
+        }
+    }
     if (!m.flush()) return errno_error("cannot write " + mtl.string());
     return stats;
 }
@@ -132,6 +180,19 @@ Status write_peer_json(const Scene& scene, const ViewRequest& request, const std
                              {"specular", to_json(m.specular)},
                              {"shininess", m.shininess},
                              {"ggx_alpha", ggx_alpha_from_shininess(m.shininess)}};
+    for (const auto& [name, use] : textured_materials(scene)) {
+        const Material& m = scene.materials[use.material];
+        const Texture& t = *scene.meshes[use.mesh].texture;
+        materials[name] = {{"albedo", to_json(m.albedo)},
+                           {"specular", to_json(m.specular)},
+                           {"shininess", m.shininess},
+                           {"ggx_alpha", ggx_alpha_from_shininess(m.shininess)},
+                           {"texture", texture_file(use.mesh)},
+                           {"texture_source", t.source},
+                           {"wrap",
+                            {t.wrap_u == TextureWrap::repeat ? "repeat" : "clamp",
+                             t.wrap_v == TextureWrap::repeat ? "repeat" : "clamp"}}};
+    }
     j["materials"] = materials;
     j["lights"] = lights_json(scene);
     j["exposure"] = scene.exposure;
@@ -140,8 +201,8 @@ Status write_peer_json(const Scene& scene, const ViewRequest& request, const std
                                                           : "clamp";
     nlohmann::json unexported = nlohmann::json::array();
     for (const Mesh& mesh : scene.meshes)
-        if (!mesh.colors.empty() || mesh.texture != nullptr) unexported.push_back(mesh.source);
-    j["meshes_with_colour_not_exported"] = unexported;
+        if (!mesh.colors.empty()) unexported.push_back(mesh.source);
+    j["meshes_with_vertex_colour_not_exported"] = unexported;
     const std::filesystem::path file = dir / "peer.json";
     std::ofstream out(file);
     if (!out) return errno_error("cannot write " + file.string());
@@ -162,6 +223,8 @@ Result<ExportStats> read_obj_stats(const std::filesystem::path& file) {
             stats.lo = stats.lo.cwiseMin(p);
             stats.hi = stats.hi.cwiseMax(p);
             ++stats.vertices;
+        } else if (line.rfind("vt ", 0) == 0) {
+            ++stats.uvs;
         } else if (line.rfind("f ", 0) == 0) {
             std::istringstream s(line.substr(2));
             int corners = 0;

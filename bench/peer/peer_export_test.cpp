@@ -74,6 +74,58 @@ TEST(PeerExport, JsonHasCameraAndEveryLightAndRefusesCylinder) {
     EXPECT_THROW((void)write_peer_json(scene, r, dir), std::invalid_argument);
 }
 
+// One textured triangle (a 2x1 texture, uvs in our top-left convention) and one plain instance: the
+// textured one gets its own material with map_Kd, its vt lines with v flipped, v/vt/vn faces and the PNG.
+TEST(PeerExport, TexturedMeshWritesItsCoordinatesTextureAndMaterial) {
+    Scene scene;
+    scene.source = "in-code";
+    Mesh tri;
+    tri.source = "tri";
+    tri.positions = {{0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}};
+    tri.normals = {{0.f, 0.f, 1.f}, {0.f, 0.f, 1.f}, {0.f, 0.f, 1.f}};
+    tri.triangles = {{0u, 1u, 2u}};
+    Mesh plain = tri;
+    plain.source = "plain";
+    tri.uvs = {{0.f, 0.f}, {1.f, 0.f}, {0.f, 0.25f}};
+    auto texture = std::make_shared<Texture>();
+    texture->source = "checker.png";
+    texture->image = Rgb8Image(ImageSize{2, 1});
+    texture->image.pixels = {255, 0, 0, 0, 0, 255};
+    texture->wrap_v = TextureWrap::clamp;
+    tri.texture = texture;
+    scene.meshes = {tri, plain};
+    scene.materials = {Material{"stone"}};
+    scene.instances = {Instance{"a", 0, 0}, Instance{"b", 1, 0}};
+    const std::filesystem::path dir = temp_dir("textured");
+    const Result<ExportStats> written = write_obj(scene, dir);
+    ASSERT_TRUE(written.ok()) << written.error().message;
+    EXPECT_EQ(written->uvs, 3u);
+    EXPECT_TRUE(std::filesystem::exists(dir / "texture0.png"));
+    EXPECT_FALSE(std::filesystem::exists(dir / "texture1.png"));
+    const Result<ExportStats> read = read_obj_stats(dir / "scene.obj");
+    ASSERT_TRUE(read.ok()) << read.error().message;
+    EXPECT_EQ(read->uvs, 3u);
+    EXPECT_EQ(read->triangles, 2u);
+    std::ifstream obj(dir / "scene.obj");
+    const std::string text{std::istreambuf_iterator<char>(obj), std::istreambuf_iterator<char>()};
+    EXPECT_NE(text.find("usemtl stone__texture0\n"), std::string::npos) << text;
+    EXPECT_NE(text.find("vt 0 0.75\n"), std::string::npos) << text;  // v = 0.25 down the image = 0.75 up it
+    EXPECT_NE(text.find("f 1/1/1 2/2/2 3/3/3\n"), std::string::npos) << text;
+    EXPECT_NE(text.find("f 4//4 5//5 6//6\n"), std::string::npos) << text;  // the plain instance
+    std::ifstream mtl(dir / "scene.mtl");
+    const std::string mtl_text{std::istreambuf_iterator<char>(mtl), std::istreambuf_iterator<char>()};
+    EXPECT_NE(mtl_text.find("newmtl stone__texture0\n"), std::string::npos) << mtl_text;
+    EXPECT_NE(mtl_text.find("map_Kd texture0.png\n"), std::string::npos) << mtl_text;
+    ViewRequest r;
+    r.camera = PinholeCamera{45.0};
+    r.size = {64, 48};
+    ASSERT_TRUE(write_peer_json(scene, r, dir).ok());
+    std::ifstream json(dir / "peer.json");
+    const std::string json_text{std::istreambuf_iterator<char>(json), std::istreambuf_iterator<char>()};
+    EXPECT_NE(json_text.find("\"texture\": \"texture0.png\""), std::string::npos) << json_text;
+    EXPECT_NE(json_text.find("\"clamp\""), std::string::npos) << json_text;
+}
+
 TEST(PeerExport, PfmRoundTripsAndRefusesTruncated) {
     RgbFloatImage img(ImageSize{3, 2});
     for (std::size_t i = 0; i < img.pixels.size(); ++i) img.pixels[i] = 0.25f * static_cast<float>(i);

@@ -20,7 +20,7 @@ ViewerPose look_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
 }  // namespace
 
 std::vector<QualityView> quality_views(const Scene& scene, int width, int height) {
-    std::vector<QualityView> views(3);
+    std::vector<QualityView> views(4);
     views[0].name = "walk";
     views[0].label = "walk frame 30 (cylinder)";
     views[0].request.camera = CylinderScreen{3.0, 150.0, 0.2, 2.8, {0.0, 1.6, 0.0}};
@@ -41,6 +41,13 @@ std::vector<QualityView> quality_views(const Scene& scene, int width, int height
     views[2].request.camera = PinholeCamera{45.0};
     views[2].request.pose = look_at({0.8, 1.6, 3.2}, {0.0, 1.3, 0.0});
     views[2].request.size = {width, pinhole_height};
+    // The room from near the entrance, wide: both wall lamps (x = -1.6 and +1.6 m, 2.6 m up), the area
+    // light's pool on the floor and the sun's patch in one frame, the lights' shadows crossing.
+    views[3].name = "room";
+    views[3].label = "room with its lights (pinhole)";
+    views[3].request.camera = PinholeCamera{65.0};
+    views[3].request.pose = look_at({0.0, 1.6, 5.0}, {0.0, 1.6, 0.0});
+    views[3].request.size = {width, pinhole_height};
     return views;
 }
 

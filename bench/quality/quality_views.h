@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // The views the quality curves are measured on (docs/quality.md): the grotto walk frame as the tour
-// renders it (cylindrical screen), a close-up of the textured bali-mask scan and a still view of the
-// gilt Buddha (pinhole), plus the knobs of their converged references.
+// renders it (cylindrical screen), a close-up of the textured bali-mask scan, a still view of the
+// gilt Buddha and a wide view of the room with its lights (pinhole; the last for the Cycles peer,
+// bench/peer), plus the knobs of their converged references.
 #pragma once
 
 #include <string>
@@ -13,7 +14,7 @@
 namespace mogao::quality {
 
 struct QualityView {
-    std::string name;     // file-name-safe id: walk, mask, still
+    std::string name;     // file-name-safe id: walk, mask, still, room
     std::string label;    // for tables and plots
     ViewRequest request;  // quality = the farm's defaults (view_request.h); size = the measured size
 };
