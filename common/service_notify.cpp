@@ -15,8 +15,9 @@ namespace mogao {
 #ifdef MOGAO_HAVE_LIBSYSTEMD
 namespace {
 
-// The watchdog period when this process was started by the service's main process: mpirun in
-// mogao-farm.service. systemd sets WATCHDOG_PID to the main process (mpirun), which passes its
+// The watchdog period when this process's parent is the process WATCHDOG_PID names: mpirun in
+// mogao-farm.service. systemd sets WATCHDOG_PID to the unit's main process (the launcher,
+// systemd/mogao-farm-launch, which hands mpirun its own PID in its place), and mpirun passes its
 // environment on to the ranks it starts; sd_watchdog_enabled() then tells the admin rank that the
 // watchdog is not its business, no WATCHDOG=1 is sent, and systemd kills the farm after WatchdogSec.
 // The rank's loop is what the watchdog is for, and NotifyAccess=all lets it ping.

@@ -12,6 +12,7 @@
 #   * the hosts of the ranks the previous job named lost (its --lost-ranks-file) are left out unasked;
 #   * a job that ends naming lost ranks is started again by the launcher at once, at most
 #     MOGAO_RELAUNCH_MAX times in a row;
+#   * under systemd's watchdog, mpirun's WATCHDOG_PID is its own PID (the admin rank's parent);
 #   * a host file whose last line lacks its newline still has that host;
 #   * bad MOGAO_BOOT_GRACE_S / MOGAO_REJOIN_CHECK_S / MOGAO_REJOIN_CONFIRM_S / RANKS are refused with
 #     exit 2, naming the variable.
@@ -151,6 +152,15 @@ rc=0; out=$(WORK=$work MPIRUN="$work/mpirun-loses" MOGAO_RELAUNCH_MAX=0 LIMIT=20
 [ $rc = 3 ] && [ "$(cat "$work/jobs")" = 1 ] || fail "MOGAO_RELAUNCH_MAX=0: exit $rc, $(cat "$work/jobs") jobs: $out"
 [ -s "$work/lost-ranks" ] || fail "MOGAO_RELAUNCH_MAX=0: the lost ranks are not left for systemd's restart"
 rm -f "$work/jobs" "$work/lost-ranks"
+
+# Under systemd's watchdog (WATCHDOG_PID names the unit's main process, the launcher) mpirun gets its
+# own PID as WATCHDOG_PID: the admin rank pings the watchdog only when it names the rank's parent.
+printf '#!/bin/sh\necho "watchdog pid ${WATCHDOG_PID:-none} own $$"\n' > "$work/mpirun-pid"
+chmod +x "$work/mpirun-pid"
+out=$(WATCHDOG_PID=1 MPIRUN="$work/mpirun-pid" run 0 0)
+echo "$out" | grep -Eq "^watchdog pid ([0-9]+) own \1$" || fail "WATCHDOG_PID is not mpirun's own PID: $out"
+out=$(MPIRUN="$work/mpirun-pid" run 0 0)
+echo "$out" | grep -q "^watchdog pid none own" || fail "WATCHDOG_PID set without systemd's watchdog: $out"
 
 # A host file whose last line has no newline: its host is still asked and used.
 printf 'admin slots=2\nrender2 slots=1' > "$work/hosts"

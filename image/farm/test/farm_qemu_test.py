@@ -344,8 +344,9 @@ def main():
             results["host_qemu_start_to_farm_ready_s"] = round(t_ready - t_start, 1)
             results["guest_boot_to_farm_ready_s"] = round(int(kv["ready_us"]) / 1e6, 1)
             results["guest_exec_to_farm_ready_s"] = round((int(kv["ready_us"]) - int(kv["exec_us"])) / 1e6, 1)
-            fails.check(kv.get("user") == "mogao-farm" and kv.get("main") == "mpirun",
-                        f"farm-admin: the unit's main process is mpirun as mogao-farm "
+            # The launcher (systemd/mogao-farm-launch, mpirun its child); ps shows 15 characters of its name.
+            fails.check(kv.get("user") == "mogao-farm" and kv.get("main") == "mogao-farm-launch"[:15],
+                        f"farm-admin: the unit's main process is mogao-farm-launch as mogao-farm "
                         f"(main={kv.get('main')} user={kv.get('user')})")
             # Restarts before READY are normal when the admin boots before the render hosts' sshd
             # is up (mpirun fails, Restart=on-failure tries again): recorded, not a failure.
