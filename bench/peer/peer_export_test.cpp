@@ -25,6 +25,11 @@ std::filesystem::path temp_dir(const std::string& name) {
     return dir;
 }
 
+std::string file_text(const std::filesystem::path& file) {
+    std::ifstream in(file);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
 // World bounds and vertex count straight from the loaded scene, independently of the writer.
 ExportStats scene_stats(const Scene& scene) {
     ExportStats s;
@@ -66,8 +71,7 @@ TEST(PeerExport, JsonHasCameraAndEveryLightAndRefusesCylinder) {
     r.camera = PinholeCamera{45.0};
     r.size = {64, 48};
     ASSERT_TRUE(write_peer_json(scene, r, dir).ok());
-    std::ifstream in(dir / "peer.json");
-    const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    const std::string text = file_text(dir / "peer.json");
     for (const char* key : {"\"vertical_fov_deg\"", "\"point\"", "\"sun\"", "\"area\"", "\"environment\"", "\"gilt\""})
         EXPECT_NE(text.find(key), std::string::npos) << key;
     r.camera = CylinderScreen{};
@@ -106,22 +110,19 @@ TEST(PeerExport, TexturedMeshWritesItsCoordinatesTextureAndMaterial) {
     ASSERT_TRUE(read.ok()) << read.error().message;
     EXPECT_EQ(read->uvs, 3u);
     EXPECT_EQ(read->triangles, 2u);
-    std::ifstream obj(dir / "scene.obj");
-    const std::string text{std::istreambuf_iterator<char>(obj), std::istreambuf_iterator<char>()};
+    const std::string text = file_text(dir / "scene.obj");
     EXPECT_NE(text.find("usemtl stone__texture0\n"), std::string::npos) << text;
     EXPECT_NE(text.find("vt 0 0.75\n"), std::string::npos) << text;  // v = 0.25 down the image = 0.75 up it
     EXPECT_NE(text.find("f 1/1/1 2/2/2 3/3/3\n"), std::string::npos) << text;
     EXPECT_NE(text.find("f 4//4 5//5 6//6\n"), std::string::npos) << text;  // the plain instance
-    std::ifstream mtl(dir / "scene.mtl");
-    const std::string mtl_text{std::istreambuf_iterator<char>(mtl), std::istreambuf_iterator<char>()};
+    const std::string mtl_text = file_text(dir / "scene.mtl");
     EXPECT_NE(mtl_text.find("newmtl stone__texture0\n"), std::string::npos) << mtl_text;
     EXPECT_NE(mtl_text.find("map_Kd texture0.png\n"), std::string::npos) << mtl_text;
     ViewRequest r;
     r.camera = PinholeCamera{45.0};
     r.size = {64, 48};
     ASSERT_TRUE(write_peer_json(scene, r, dir).ok());
-    std::ifstream json(dir / "peer.json");
-    const std::string json_text{std::istreambuf_iterator<char>(json), std::istreambuf_iterator<char>()};
+    const std::string json_text = file_text(dir / "peer.json");
     EXPECT_NE(json_text.find("\"texture\": \"texture0.png\""), std::string::npos) << json_text;
     EXPECT_NE(json_text.find("\"clamp\""), std::string::npos) << json_text;
 }
