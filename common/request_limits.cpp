@@ -51,6 +51,9 @@ void validate_view_request(const ViewRequest& request) {
     require_finite("pose.eye.z", request.pose.eye.z());
     require_finite("pose.yaw_deg", request.pose.yaw_deg);
     require_finite("pose.pitch_deg", request.pose.pitch_deg);
+    if (!(request.scene_time_s >= 0.0) || !std::isfinite(request.scene_time_s)) {
+        fail("scene_time_s", request.scene_time_s, "[0, inf)");
+    }
     if (const auto* pinhole = std::get_if<PinholeCamera>(&request.camera)) {
         if (!(pinhole->vertical_fov_deg > 0.0 && pinhole->vertical_fov_deg < 180.0)) {
             fail("camera.vertical_fov_deg", pinhole->vertical_fov_deg, "(0, 180)");

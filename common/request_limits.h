@@ -8,7 +8,7 @@
 // kLinkImageSide.min); resolution_scale in (0, 1]; spp, max_bounces, ao_samples,
 // area_light_samples, jpeg_quality in their ranges below; pose eye/yaw/pitch finite; pinhole
 // vertical_fov_deg in (0, 180); cylinder radius_m > 0, arc_deg in (0, 360], top_m > bottom_m, all
-// finite (eye_m too).
+// finite (eye_m too); scene_time_s finite and >= 0.
 // Errors: validate_view_request throws std::invalid_argument whose message names the field, its
 // value and the limit, e.g. "ViewRequest.quality.spp = 0 is outside [1, 4096]".
 #pragma once

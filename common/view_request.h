@@ -72,6 +72,10 @@ struct ViewRequest {
     // Farm-internal, never on the link's wire: trace this frame with the renderer's radiance cache
     // (renderfarm/trace/radiance_cache.h: a biased, much cheaper estimate for moving views).
     bool radiance_cache = false;
+    // Farm-internal, never on the link's wire: the scene time of the frame, seconds (>= 0, finite),
+    // at which animated lights are evaluated (renderfarm/scene/scene.h, LightAnimation). The farm's
+    // admin stamps it; 0 for path tours.
+    double scene_time_s = 0.0;
 };
 
 // The size actually traced: size scaled by quality.resolution_scale, rounded to nearest, at least

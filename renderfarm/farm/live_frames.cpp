@@ -83,6 +83,23 @@ bool LiveFrames::is_still(const Session& s, const ViewRequest& request) const {
     return options_.progressive && s.last_request && same_view(request, *s.last_request);
 }
 
+double LiveFrames::scene_time_s() const {
+    if (options_.scene_clock) return options_.scene_clock();
+    return std::chrono::duration<double>(Clock::now() - created_).count();
+}
+
+// What the session learnt under other lights is dropped: its temporal history and its still view's
+// samples (a still view then starts again from its first pass).
+void LiveFrames::follow_lighting(Session& s, double time_s) {
+    if (!options_.lighting) return;
+    std::vector<float> state = options_.lighting(time_s);
+    if (s.lighting && *s.lighting != state) {
+        s.accumulation.reset();
+        s.temporal.clear();
+    }
+    s.lighting = std::move(state);
+}
+
 // The view to trace for `request`: still views at the request's own scale (to accumulate), moving
 // ones at the controller's choice; the pass's frame_id when it continues an accumulation.
 ViewRequest LiveFrames::plan(Session& s, const ViewRequest& request, FrameChoice& choice) const {
@@ -191,8 +208,11 @@ LiveFrame LiveFrames::render(const ViewRequest& request) {
     if (s.controller && options_.share_frame_time) {
         s.controller->set_target_seconds(options_.frame_time_s / double(active_sessions(request.session, start)));
     }
+    ViewRequest timed = request;
+    timed.scene_time_s = scene_time_s();
+    follow_lighting(s, timed.scene_time_s);
     frame.still = is_still(s, request);
-    frame.rendered = plan(s, request, choice);
+    frame.rendered = plan(s, timed, choice);
     const bool continues = options_.progressive && s.accumulation.continues(frame.rendered);
     RgbFloatImage radiance;
     if (continues && s.accumulation.samples() >= options_.converged_spp) {

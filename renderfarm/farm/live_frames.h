@@ -102,6 +102,13 @@ struct LiveOptions {
     // (renderfarm/denoise/temporal_accumulation.h): a moving view keeps most of its samples.
     bool temporal = false;
     TemporalParams temporal_params;
+    // The scene's lights at a scene time (renderfarm/scene/scene.h, lighting_state; empty: static
+    // lights). Every request is stamped with the scene time (ViewRequest::scene_time_s, from
+    // scene_clock, or seconds since this LiveFrames was made); a session whose lights changed since
+    // its previous frame starts its temporal history and its still view's accumulation anew (the
+    // render ranks empty their radiance caches themselves: renderer.h).
+    std::function<std::vector<float>(double)> lighting;
+    std::function<double()> scene_clock;  // seconds, non-decreasing; tests set it
 
     // The filter's settings for served frames: AtrousParams' defaults (chosen at 1 spp) on every
     // core of the admin, which waits for the ranks meanwhile.
@@ -157,13 +164,16 @@ private:
         TemporalHistory temporal;  // earlier moving frames (LiveOptions::temporal)
         std::uint64_t last_used = 0;
         std::optional<std::chrono::steady_clock::time_point> handed_back;  // the previous render() returned
-        double recent_seconds = 0.0;  // rendered frames' seconds, exponentially weighted (0: none yet)
+        double recent_seconds = 0.0;                 // rendered frames' seconds, exponentially weighted (0: none yet)
+        std::optional<std::vector<float>> lighting;  // the lights' state of its previous frame
     };
     Session& session(std::uint64_t id);
     // Sessions handed a frame within kActiveWindow before `now`, `current` counted even if new.
     [[nodiscard]] std::size_t active_sessions(std::uint64_t current, std::chrono::steady_clock::time_point now) const;
     static constexpr std::chrono::seconds kActiveWindow{2};
     [[nodiscard]] bool is_still(const Session& s, const ViewRequest& request) const;
+    [[nodiscard]] double scene_time_s() const;
+    void follow_lighting(Session& s, double scene_time_s);
     [[nodiscard]] ViewRequest plan(Session& s, const ViewRequest& request, FrameChoice& choice) const;
     [[nodiscard]] Rgb8Image to_display(const RgbFloatImage& radiance) const;
     [[nodiscard]] bool accumulates(const LiveFrame& frame) const;
@@ -176,6 +186,7 @@ private:
     ToneMap tone_map_;
     std::map<std::uint64_t, Session> sessions_;
     std::uint64_t frames_ = 0;
+    std::chrono::steady_clock::time_point created_ = std::chrono::steady_clock::now();  // scene time 0
     AtrousDenoiser denoiser_;  // scratch planes reused frame to frame
 };
 

@@ -337,6 +337,61 @@ TEST_F(LiveFramesTest, TemporalAccumulationBringsAMovingFrameCloserToTheReferenc
         << "a still view's first pass is not blended with the moving history";
 }
 
+double mean_of(const Rgb8Image& image) {
+    double sum = 0.0;
+    for (const std::uint8_t v : image.pixels) sum += v;
+    return sum / static_cast<double>(image.pixels.size());
+}
+
+// An animated light (scene.h): each request is stamped with the scene time; when the light changes,
+// the still view's accumulation starts again (it would otherwise average both lights) and the moving
+// frames' temporal history is dropped (it would otherwise carry the old light into the new frames).
+TEST_F(LiveFramesTest, ALightThatChangesRestartsTheStillViewAndDropsTheTemporalHistory) {
+    scene_.animated_lights = {{LightKind::area, 0, LightAnimation{1.0, {1.f, 0.f}}}};  // off at 1 s
+    double clock = 0.0;
+    LiveOptions options;
+    options.lighting = [this](double t) { return lighting_state(scene_, t); };
+    options.scene_clock = [&clock] { return clock; };
+    LiveFrames live(source(), options, 1.f, ToneMap::clamp);
+    ViewRequest still = view();
+    LiveFrame frame;
+    for (int pass = 1; pass <= 4; ++pass) {
+        clock = 0.2 * pass;
+        still.frame_id = static_cast<std::uint64_t>(pass);
+        frame = live.render(still);
+        ASSERT_EQ(frame.passes, pass);
+    }
+    const double lit = mean_of(frame.image);
+    ViewRequest unlit_view = still;
+    unlit_view.scene_time_s = 1.1;
+    const double unlit = mean_of(single(unlit_view, 16));  // sRGB8 means, the sky alone
+    ASSERT_GT(lit, unlit + 5.0) << "the light must change the picture for this test to see it";
+    clock = 1.1;
+    still.frame_id = 5;
+    frame = live.render(still);
+    EXPECT_EQ(frame.passes, 1) << "the still view's samples under the old light were kept";
+    EXPECT_DOUBLE_EQ(calls_.back().view.scene_time_s, 1.1);
+    EXPECT_NEAR(mean_of(frame.image), unlit, 2.0) << "lit " << lit;
+
+    // Moving frames, temporal accumulation on: the first frame after the change equals a frame of a
+    // session that never saw the old light (its history is empty too).
+    options.denoise = options.temporal = true;
+    LiveFrames temporal(source(), options, 1.f, ToneMap::clamp);
+    LiveFrames fresh(source(), options, 1.f, ToneMap::clamp);
+    for (int k = 6; k >= 1; --k) {
+        clock = 0.1 * (7 - k);
+        ViewRequest r = view(k);
+        r.frame_id = 100 + static_cast<std::uint64_t>(k);
+        (void)temporal.render(r);
+    }
+    clock = 1.5;
+    ViewRequest r = view(0.0);
+    r.frame_id = 200;
+    const LiveFrame after = temporal.render(r);
+    const LiveFrame alone = fresh.render(r);
+    EXPECT_EQ(after.image.pixels, alone.image.pixels) << "the old light's history was blended in";
+}
+
 // A still view: the guides are traced with its first pass only, and frames are filtered while they
 // hold at most denoise_max_spp samples (1, then 1 + 2), raw after that (1 + 2 + 2 = 5).
 TEST_F(LiveFramesTest, StillViewIsDenoisedUpToDenoiseMaxSppWithTheFirstPassesGuides) {

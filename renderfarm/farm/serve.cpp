@@ -131,6 +131,13 @@ void log_serving(const ServeOptions& options, const RunInfo& run, const std::str
         options.live.per_session_maps ? "per-session" : "shared", options.pipeline ? "on" : "off");
 }
 
+// The scene's animated lights, if any, for LiveFrames to follow (the scene outlives it).
+LiveOptions with_lighting(LiveOptions live, const Scene& scene) {
+    if (!scene.animated_lights.empty())
+        live.lighting = [&scene](double time_s) { return lighting_state(scene, time_s); };
+    return live;
+}
+
 }  // namespace
 
 int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& scene, RunInfo& run) {
@@ -138,7 +145,7 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& s
     MainThreadQueue<ServedFrame> queue;
     PolicyGate policy(scene, options.policy, ViewPolicies{options.view_policy, options.appliance_view_policies});
     BudgetGate budget(scene, options.budget);
-    LiveFrames live(farm, options.live);
+    LiveFrames live(farm, with_lighting(options.live, scene));
     LinkServerOptions link = options.link;
     // Pipelining needs a second call in flight (another session's) while one frame is encoded; each
     // session still has at most one, and the queue serialises them onto the main thread.

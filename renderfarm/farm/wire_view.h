@@ -23,6 +23,7 @@ struct WireView {
     std::int32_t linear;     // 0: sRGB8, 1: linear radiance (PackedPixels::linear), 2: and guides (::linear_guided)
     std::uint64_t sequence;  // the dispatcher's count of frames sent: names the frame in progress reports and cuts
     std::int32_t radiance_cache;  // ViewRequest::radiance_cache
+    double scene_time_s;          // ViewRequest::scene_time_s
 };
 static_assert(std::is_trivially_copyable_v<WireView>);
 
@@ -55,6 +56,7 @@ inline WireView to_wire(const ViewRequest& v) {
     w.jpeg_quality = v.quality.jpeg_quality;
     w.resolution_scale = v.quality.resolution_scale;
     w.radiance_cache = v.radiance_cache ? 1 : 0;
+    w.scene_time_s = v.scene_time_s;
     return w;
 }
 
@@ -75,6 +77,7 @@ inline ViewRequest from_wire(const WireView& w) {
     v.size = {w.width, w.height};
     v.quality = {w.spp, w.max_bounces, w.ao_samples, w.area_light_samples, w.resolution_scale, w.jpeg_quality};
     v.radiance_cache = w.radiance_cache != 0;
+    v.scene_time_s = w.scene_time_s;
     return v;
 }
 

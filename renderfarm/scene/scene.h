@@ -22,6 +22,18 @@ namespace mogao {
 
 using Rgb = Eigen::Vector3f;  // linear RGB
 
+// A light's power over time (scene file "animation"): piecewise constant, `scale[i]` multiplies the
+// light's irradiance, intensity or radiance from i * step_s to (i + 1) * step_s seconds of scene
+// time, the list repeating (a lighting cue, a flickering lamp). Scene time is the farm's: seconds
+// since it began serving (0 for path tours). An empty list is the light as given, at every time.
+struct LightAnimation {
+    double step_s = 1.0;       // > 0
+    std::vector<float> scale;  // each >= 0
+
+    // The factor at `time_s` (times before 0 and non-finite ones count as 0); 1 for an empty list.
+    [[nodiscard]] float scale_at(double time_s) const;
+};
+
 struct Material {
     std::string name;
     Rgb albedo{0.7f, 0.7f, 0.7f};  // diffuse reflectance, each channel in [0, 1]
@@ -66,6 +78,15 @@ struct EnvironmentLight {
     Rgb radiance{0.2f, 0.2f, 0.25f};
 };
 
+enum class LightKind { sun, point, area };
+
+// An animated light: which (its kind, its index in that kind's list of the Scene) and how.
+struct AnimatedLight {
+    LightKind kind = LightKind::point;
+    std::size_t index = 0;
+    LightAnimation animation;
+};
+
 // Display transform applied to exposure · L before the sRGB encoding (film.h has the formulas):
 // clamp to [0, 1], Reinhard (x / (1 + x)) or the ACES filmic fit of Narkowicz 2015.
 enum class ToneMap { clamp, reinhard, aces };
@@ -79,6 +100,7 @@ struct Scene {
     std::vector<PointLight> point_lights;
     std::vector<AreaLight> area_lights;
     std::vector<EnvironmentLight> environment_lights;
+    std::vector<AnimatedLight> animated_lights;  // in the scene file's order; at most one per light
     Viewer viewer;
     float exposure = 1.f;               // multiplies radiance before the sRGB transfer
     ToneMap tone_map = ToneMap::clamp;  // scene file "tone_map": "clamp" | "reinhard" | "aces"
@@ -91,5 +113,14 @@ struct Scene {
 
     [[nodiscard]] std::size_t triangle_count() const;  // summed over instances
 };
+
+// The factor of light `index` of `kind` at `time_s`: its animation's, or 1 when it has none.
+[[nodiscard]] float light_scale(const Scene& scene, LightKind kind, std::size_t index, double time_s);
+
+// The lights' state at a scene time: every animated light's factor (LightAnimation::scale_at), in
+// Scene::animated_lights' order. Equal states light the scene identically, so what was
+// learnt under one (a radiance cache, a temporal history, a still view's accumulated samples) is
+// valid under the other; a different state invalidates it. Empty when no light is animated.
+[[nodiscard]] std::vector<float> lighting_state(const Scene& scene, double time_s);
 
 }  // namespace mogao

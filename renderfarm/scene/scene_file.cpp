@@ -23,6 +23,7 @@ using Clock = std::chrono::steady_clock;
 
 constexpr double kMaxCoordinate = 1e9;  // metres; beyond this float BLAS + double rebasing lose meaning
 constexpr std::size_t kMaxInstances = 1'000'000;
+constexpr std::size_t kMaxAnimationSteps = 4096;  // per light: a cue list, not a recorded signal
 
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
@@ -355,6 +356,24 @@ private:
         }
     }
 
+    // A light's optional "animation": {"step_s": seconds per step, "scale": [factor per step, ...]}.
+    void parse_animation(const json& light, const std::string& field, LightKind kind, std::size_t index) {
+        auto it = light.find("animation");
+        if (it == light.end()) return;
+        LightAnimation a;
+        const std::string where = field + ".animation";
+        if (!it->is_object()) fields_.fail(where, "expected an object {\"step_s\": ..., \"scale\": [...]}");
+        fields_.only_keys(*it, where, {"step_s", "scale"});
+        a.step_s = fields_.number(fields_.member(*it, where, "step_s"), where + ".step_s", 1e-3, 1e6);
+        const json& scale = fields_.member(*it, where, "scale");
+        if (!scale.is_array() || scale.empty() || scale.size() > kMaxAnimationSteps)
+            fields_.fail(where + ".scale", fmt::format("expected an array of 1 to {} numbers", kMaxAnimationSteps));
+        for (std::size_t i = 0; i < scale.size(); ++i)
+            a.scale.push_back(
+                static_cast<float>(fields_.number(scale[i], fmt::format("{}.scale[{}]", where, i), 0, 1e6)));
+        scene_.animated_lights.push_back({kind, index, std::move(a)});
+    }
+
     void parse_lights(const json& lights) {
         if (!lights.is_array()) fields_.fail("lights", "expected an array");
         for (std::size_t i = 0; i < lights.size(); ++i) {
@@ -362,7 +381,7 @@ private:
             const json& l = lights[i];
             const std::string type = fields_.string(fields_.member(l, field, "type"), field + ".type");
             if (type == "sun") {
-                fields_.only_keys(l, field, {"type", "direction_to_light", "irradiance", "cast_shadows"});
+                fields_.only_keys(l, field, {"type", "direction_to_light", "irradiance", "cast_shadows", "animation"});
                 DirectionalLight sun;
                 const Eigen::Vector3d d = fields_.vec3(fields_.member(l, field, "direction_to_light"),
                                                        field + ".direction_to_light", -1e6, 1e6);
@@ -370,17 +389,20 @@ private:
                 sun.direction_to_light = d.normalized();
                 sun.irradiance = fields_.colour_or(l, field, "irradiance", sun.irradiance, 1e6);
                 sun.cast_shadows = fields_.boolean_or(l, field, "cast_shadows", true);
+                parse_animation(l, field, LightKind::sun, scene_.directional_lights.size());
                 scene_.directional_lights.push_back(sun);
             } else if (type == "point") {
-                fields_.only_keys(l, field, {"type", "position", "intensity", "cast_shadows"});
+                fields_.only_keys(l, field, {"type", "position", "intensity", "cast_shadows", "animation"});
                 PointLight point;
                 point.position = fields_.vec3(fields_.member(l, field, "position"), field + ".position",
                                               -kMaxCoordinate, kMaxCoordinate);
                 point.intensity = fields_.colour_or(l, field, "intensity", point.intensity, 1e9);
                 point.cast_shadows = fields_.boolean_or(l, field, "cast_shadows", true);
+                parse_animation(l, field, LightKind::point, scene_.point_lights.size());
                 scene_.point_lights.push_back(point);
             } else if (type == "area") {
-                fields_.only_keys(l, field, {"type", "corner", "edge_u", "edge_v", "radiance", "cast_shadows"});
+                fields_.only_keys(l, field,
+                                  {"type", "corner", "edge_u", "edge_v", "radiance", "cast_shadows", "animation"});
                 AreaLight area;
                 area.corner = fields_.vec3(fields_.member(l, field, "corner"), field + ".corner", -kMaxCoordinate,
                                            kMaxCoordinate);
@@ -390,6 +412,7 @@ private:
                     fields_.fail(field, "edge_u and edge_v must span a non-zero area");
                 area.radiance = fields_.colour_or(l, field, "radiance", area.radiance, 1e9);
                 area.cast_shadows = fields_.boolean_or(l, field, "cast_shadows", true);
+                parse_animation(l, field, LightKind::area, scene_.area_lights.size());
                 scene_.area_lights.push_back(area);
             } else if (type == "environment") {
                 fields_.only_keys(l, field, {"type", "radiance"});

@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "renderfarm/scene/scene_file.h"
 
+#include <cmath>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -215,6 +217,45 @@ TEST(SceneFile, BadInputNamesTheFieldAndTheRule) {
                  {"meshes.m.procedural", "torus"});
     expect_error(R"({ "meshes": { "m": { "file": "missing.obj" } }, "objects": [ { "mesh": "m" } ] })",
                  {"meshes.m.file", "missing.obj", "does not exist"});
+}
+
+// lights[].animation: the light's power over scene time, piecewise constant, the list repeating.
+TEST(SceneFile, AnimatedLightsScaleTheirPowerStepByStep) {
+    const Scene scene = parse_scene(minimal(R"([ { "mesh": "ball" } ])", R"(, "lights": [
+            { "type": "point", "position": [0, 2, 0], "animation": { "step_s": 0.5, "scale": [1, 0.25, 0] } },
+            { "type": "sun", "direction_to_light": [0, 1, 0] } ])"),
+                                    kOrigin);
+    ASSERT_EQ(scene.point_lights.size(), 1u);
+    ASSERT_EQ(scene.animated_lights.size(), 1u);
+    EXPECT_EQ(scene.animated_lights[0].kind, LightKind::point);
+    EXPECT_EQ(scene.animated_lights[0].index, 0u);
+    const LightAnimation& a = scene.animated_lights[0].animation;
+    EXPECT_FLOAT_EQ(a.scale_at(0.0), 1.f);
+    EXPECT_FLOAT_EQ(a.scale_at(0.49), 1.f);
+    EXPECT_FLOAT_EQ(a.scale_at(0.5), 0.25f);
+    EXPECT_FLOAT_EQ(a.scale_at(1.2), 0.f);
+    EXPECT_FLOAT_EQ(a.scale_at(1.5), 1.f);  // the list repeats
+    EXPECT_FLOAT_EQ(a.scale_at(-3.0), 1.f);
+    EXPECT_FLOAT_EQ(a.scale_at(std::nan("")), 1.f);
+    EXPECT_FLOAT_EQ(light_scale(scene, LightKind::sun, 0, 1.2), 1.f);  // not animated
+    EXPECT_FLOAT_EQ(light_scale(scene, LightKind::point, 0, 1.2), 0.f);
+    // Only the animated light is in the state; equal states at times one period apart.
+    EXPECT_EQ(lighting_state(scene, 0.1), std::vector<float>{1.f});
+    EXPECT_EQ(lighting_state(scene, 0.6), std::vector<float>{0.25f});
+    EXPECT_EQ(lighting_state(scene, 1.6), lighting_state(scene, 0.1));
+    EXPECT_TRUE(lighting_state(parse_scene(minimal(R"([ { "mesh": "ball" } ])"), kOrigin), 3.0).empty());
+
+    const auto with_animation = [](const std::string& animation) {
+        return minimal(R"([ { "mesh": "ball" } ])",
+                       R"(, "lights": [ { "type": "point", "position": [0, 2, 0], "animation": )" + animation + " } ]");
+    };
+    expect_error(with_animation("3"), {"lights[0].animation", "expected an object"});
+    expect_error(with_animation(R"({ "scale": [1] })"), {"lights[0].animation.step_s", "missing"});
+    expect_error(with_animation(R"({ "step_s": 0, "scale": [1] })"), {"lights[0].animation.step_s", "outside"});
+    expect_error(with_animation(R"({ "step_s": 1, "scale": [] })"), {"lights[0].animation.scale", "1 to 4096"});
+    expect_error(with_animation(R"({ "step_s": 1, "scale": [1, -2] })"), {"lights[0].animation.scale[1]", "outside"});
+    expect_error(with_animation(R"({ "step_s": 1, "scale": [1], "ease": "in" })"),
+                 {"lights[0].animation.ease", "unknown key"});
 }
 
 TEST(Procedural, GrottoRoomIsClosedExceptTheEntranceAndFacesInward) {

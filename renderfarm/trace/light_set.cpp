@@ -15,22 +15,24 @@ void require(bool ok, const Scene& scene, const std::string& what) {
 
 }  // namespace
 
-LightSet LightSet::from_scene(const Scene& scene) {
+LightSet LightSet::from_scene(const Scene& scene, double time_s) {
     LightSet set;
     for (std::size_t i = 0; i < scene.directional_lights.size(); ++i) {
         const DirectionalLight& l = scene.directional_lights[i];
         const double length = l.direction_to_light.norm();
         require(l.direction_to_light.allFinite() && length > 0.0 && l.irradiance.allFinite(), scene,
                 "directional light " + std::to_string(i) + " needs a finite non-zero direction and finite irradiance");
-        if (!has_power(l.irradiance)) continue;
-        set.directional.push_back({(l.direction_to_light / length).cast<float>(), l.irradiance, l.cast_shadows});
+        const Rgb irradiance = l.irradiance * light_scale(scene, LightKind::sun, i, time_s);
+        if (!has_power(irradiance)) continue;
+        set.directional.push_back({(l.direction_to_light / length).cast<float>(), irradiance, l.cast_shadows});
     }
     for (std::size_t i = 0; i < scene.point_lights.size(); ++i) {
         const PointLight& l = scene.point_lights[i];
         require(l.position.allFinite() && l.intensity.allFinite(), scene,
                 "point light " + std::to_string(i) + " needs finite position and intensity");
-        if (!has_power(l.intensity)) continue;
-        set.point.push_back({l.position, l.position.cast<float>(), l.intensity, l.cast_shadows});
+        const Rgb intensity = l.intensity * light_scale(scene, LightKind::point, i, time_s);
+        if (!has_power(intensity)) continue;
+        set.point.push_back({l.position, l.position.cast<float>(), intensity, l.cast_shadows});
     }
     for (std::size_t i = 0; i < scene.area_lights.size(); ++i) {
         const AreaLight& l = scene.area_lights[i];
@@ -38,9 +40,10 @@ LightSet LightSet::from_scene(const Scene& scene) {
         require(l.corner.allFinite() && l.edge_u.allFinite() && l.edge_v.allFinite() && l.radiance.allFinite() &&
                     cross.norm() > 0.0,
                 scene, "area light " + std::to_string(i) + " needs finite values and non-parallel edges");
-        if (!has_power(l.radiance)) continue;
+        const Rgb radiance = l.radiance * light_scale(scene, LightKind::area, i, time_s);
+        if (!has_power(radiance)) continue;
         set.area.push_back({l.corner, l.corner.cast<float>(), l.edge_u.cast<float>(), l.edge_v.cast<float>(),
-                            cross.normalized().cast<float>(), static_cast<float>(cross.norm()), l.radiance,
+                            cross.normalized().cast<float>(), static_cast<float>(cross.norm()), radiance,
                             l.cast_shadows});
     }
     for (const EnvironmentLight& l : scene.environment_lights) {

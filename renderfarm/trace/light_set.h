@@ -44,9 +44,10 @@ struct LightSet {
     bool has_environment = false;
     bool any_shadows = false;
 
-    // Throws std::invalid_argument for non-finite values, a zero directional direction or a
-    // degenerate area light (|edge_u x edge_v| == 0).
-    [[nodiscard]] static LightSet from_scene(const Scene& scene);
+    // The lights at scene time `time_s`: each one's power times its animation's factor then
+    // (LightAnimation::scale_at; a factor of 0 drops the light). Throws std::invalid_argument for
+    // non-finite values, a zero directional direction or a degenerate area light (|edge_u x edge_v| == 0).
+    [[nodiscard]] static LightSet from_scene(const Scene& scene, double time_s = 0.0);
     void rebase(const Eigen::Vector3d& origin);
 };
 

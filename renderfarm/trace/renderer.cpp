@@ -60,8 +60,10 @@ std::string describe(const PixelRect& r) {
 struct Renderer::Impl {
     Impl(const Scene& scene, const RendererOptions& opts)
         : options(opts),
+          source_scene(&scene),
           geometry(scene, opts.embree_config, opts.bvh),
           lights(LightSet::from_scene(scene)),
+          lighting(lighting_state(scene, 0.0)),
           native_width(native_packet_width(geometry.root())),
           cache(std::make_unique<RadianceCache>(opts.radiance_cache)) {
         materials.reserve(scene.materials.size());
@@ -69,8 +71,10 @@ struct Renderer::Impl {
     }
 
     RendererOptions options;
+    const Scene* source_scene;  // outlives the Renderer (renderer.h)
     RenderScene geometry;
     LightSet lights;
+    std::vector<float> lighting;  // the animated lights' factors `lights` holds (scene.h, lighting_state)
     std::vector<ShadingMaterial> materials;
     int native_width = 16;
     // Shared by every frame; lookups are const, deposits are queued under its mutex (radiance_cache.h).
@@ -303,6 +307,13 @@ void Renderer::begin_frame(const ViewRequest& request) {
     Impl& s = *impl_;
     const ImageSize size = render_size_for(request);  // validates before any state changes
     const Eigen::Vector3d origin = s.options.rebase_on_eye ? request.pose.eye : Eigen::Vector3d::Zero();
+    if (std::vector<float> lighting = lighting_state(*s.source_scene, request.scene_time_s); lighting != s.lighting) {
+        // An animated light changed: what the cache learnt (light, and each light's visibility by
+        // its index in `lights`) belongs to the old lights, its queued estimates included.
+        s.lights = LightSet::from_scene(*s.source_scene, request.scene_time_s);
+        s.lighting = std::move(lighting);
+        s.cache->clear();
+    }
     s.geometry.rebase(origin);
     s.lights.rebase(origin);
     s.size = size;

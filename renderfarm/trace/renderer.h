@@ -14,7 +14,9 @@
 // cache of earlier frames and trains it (cached_packet.h): its pixels then also depend on which
 // frames this Renderer drew before (still bit-identical for any split of one frame into rects on
 // one Renderer: a frame reads only what earlier frames committed, in a fixed order). Other frames
-// are the unbiased path tracer below and never touch the cache.
+// are the unbiased path tracer below and never touch the cache. Animated lights (scene.h,
+// LightAnimation) are evaluated at the request's scene_time_s; a frame whose lights differ from the
+// previous frame's rebuilds them and empties the cache (what it learnt belongs to the old lights).
 //
 // Determinism: a pixel's value depends only on (scene, request incl. seed and frame_id, x, y):
 // camera rays are traced in 4x4 packets aligned to the global image grid (x0 % 4 == 0,

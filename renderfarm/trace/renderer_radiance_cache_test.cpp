@@ -158,5 +158,41 @@ TEST(RendererRadianceCache, FramesThatDoNotAskNeitherReadNorTrainIt) {
     EXPECT_EQ(used.radiance_cache_stats().cells, 0u);
 }
 
+// An animated light (scene.h, LightAnimation): the cache learnt under the old lights is emptied when
+// a frame's scene time brings a change, kept while the lights stay the same, and frames under the
+// new lights converge to the new reference, not the old one.
+TEST(RendererRadianceCache, ALightThatChangesEmptiesTheCacheAndFramesFollowTheNewLight) {
+    Scene scene = lit_corner();
+    // At 1 s the main light goes out and the other one dims.
+    scene.animated_lights = {{LightKind::point, 0, LightAnimation{1.0, {1.f, 0.f}}},
+                             {LightKind::point, 1, LightAnimation{1.0, {1.f, 0.5f}}}};
+    const auto at = [](std::uint64_t frame_id, int spp, bool cached, double time_s) {
+        ViewRequest r = corner_view(frame_id, spp, cached);
+        r.scene_time_s = time_s;
+        return r;
+    };
+    Renderer reference_renderer(scene, RendererOptions{"threads=1", true});
+    const RgbFloatImage before = draw(reference_renderer, at(1000, 256, false, 0.0));
+    const RgbFloatImage after = draw(reference_renderer, at(1000, 256, false, 1.5));
+    ASSERT_GT(mean(before) / mean(after), 1.25) << "the dimmed light must change the picture for this test to see it";
+
+    Renderer renderer(scene, RendererOptions{"threads=1", true});
+    for (std::uint64_t f = 1; f <= 32; ++f) (void)draw(renderer, at(f, 1, true, 0.03 * static_cast<double>(f)));
+    renderer.begin_frame(at(33, 1, true, 0.99));  // same lights: the cache stays
+    EXPECT_GT(renderer.radiance_cache_stats().cells, 100u);
+    renderer.begin_frame(at(34, 1, true, 1.0));  // the light changed
+    EXPECT_EQ(renderer.radiance_cache_stats().cells, 0u);
+    for (std::uint64_t f = 35; f <= 66; ++f) (void)draw(renderer, at(f, 1, true, 1.0 + 0.01 * static_cast<double>(f)));
+    const RgbFloatImage cached = draw(renderer, at(67, 1, true, 1.9));
+    const double bias = mean(cached) / mean(after) - 1.0;
+    EXPECT_LT(std::abs(bias), 0.05) << "the cached frame's mean is " << 100.0 * bias
+                                    << " % off the reference under the new light";
+    // The path tracer follows the light too: the same frame at the same time, bit for bit, on a
+    // renderer that never saw the old light.
+    Renderer fresh(scene, RendererOptions{"threads=1", true});
+    EXPECT_EQ(draw(renderer, at(70, 1, false, 1.5)).pixels, draw(fresh, at(70, 1, false, 1.5)).pixels);
+    EXPECT_THROW(renderer.begin_frame(at(71, 1, true, -1.0)), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace mogao
