@@ -12,6 +12,11 @@
       DIR/kiosk-frames.jsonl (motion-to-photon of every frame) and prints the table; writes
       DIR/soak.json and DIR/soak.png; with --write-docs, the doc's `soak` generated block and
       docs/reliability/soak.png beside it.
+  soak.py heap --out DIR [--window-min 10]
+      After a run with --heaptrack: the heap the kiosk and the admin rank hold (live malloc
+      allocations, heaptrack's record DIR/kiosk-heap.zst and DIR/admin-heap.zst) per window after
+      the first 10 minutes, floor and peak, and their slopes per hour. Flat here while RSS grows: the growth is
+      not memory the program holds (the allocator keeps or fragments what was freed).
 
 Goals read (docs/reliability.md, "Soak"): after the first 10 minutes, RSS growth of every process
 <= 1 MiB per hour (least-squares slope of the samples), open fds and threads constant; the
@@ -23,6 +28,7 @@ import json
 import os
 import re
 import shutil
+import subprocess
 import sys
 import time
 
@@ -448,6 +454,47 @@ def report(args):
     return 0
 
 
+# ---- heap (a --heaptrack run) -------------------------------------------------------------------
+
+def heap_points(record):
+    """(minutes, MiB in use) of every snapshot of a heaptrack record (heaptrack_print's massif export)."""
+    massif = record + ".massif"
+    subprocess.run(["heaptrack_print", "-f", record, "--print-massif", massif, "--massif-threshold", "100",
+                    "--massif-detailed-freq", "1000000000", "--print-peaks", "0", "--print-allocators", "0",
+                    "--print-temporary", "0", "--print-leaks", "0"], check=True, stdout=subprocess.DEVNULL)
+    points, t = [], 0.0
+    with open(massif) as f:
+        for line in f:
+            if line.startswith("time="):
+                t = float(line[5:]) / 60.0
+            elif line.startswith("mem_heap_B="):
+                points.append((t, int(line[11:]) / 2**20))
+    return points
+
+
+def heap(args):
+    print("| process | windows | heap floor first / last window (MiB) | heap peak first / last window (MiB) "
+          "| floors' growth (MiB/h) | peaks' growth (MiB/h) |")
+    print("|---|--:|--:|--:|--:|--:|")
+    for name in ("kiosk", "admin"):
+        record = os.path.join(args.out, f"{name}-heap.zst")
+        if not os.path.exists(record):
+            print(f"| {name} | no record ({record}) | | | | |")
+            continue
+        points = heap_points(record)
+        # Whole windows after the warm-up only: the last, partial one holds the exit's frees.
+        last = WARMUP_MIN + args.window_min * ((points[-1][0] - WARMUP_MIN) // args.window_min) if points else 0
+        points = [p for p in points if WARMUP_MIN <= p[0] < last]
+        floors, peaks = window_points(points, min, args.window_min), window_points(points, max, args.window_min)
+        if len(floors) < 2:
+            too_short = f"too short: run past {WARMUP_MIN + 2 * args.window_min:.0f} min"
+            print(f"| {name} | {len(floors)} ({too_short}) | | | | |")
+            continue
+        print(f"| {name} | {len(floors)} | {floors[0][1]:.2f} / {floors[-1][1]:.2f} | {peaks[0][1]:.2f} / "
+              f"{peaks[-1][1]:.2f} | {fmt(slope_per_hour(floors), '+.2f')} | {fmt(slope_per_hour(peaks), '+.2f')} |")
+    return 0
+
+
 def main(argv):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -459,8 +506,11 @@ def main(argv):
     r = sub.add_parser("report")
     r.add_argument("--out", required=True)
     r.add_argument("--write-docs")
+    h = sub.add_parser("heap")
+    h.add_argument("--out", required=True)
+    h.add_argument("--window-min", type=float, default=WINDOW_MIN)
     args = ap.parse_args(argv)
-    return sample(args) if args.cmd == "sample" else report(args)
+    return {"sample": sample, "report": report, "heap": heap}[args.cmd](args)
 
 
 if __name__ == "__main__":
