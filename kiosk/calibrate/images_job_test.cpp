@@ -209,7 +209,7 @@ TEST_F(ImagesJobTest, CapturesOfAnotherSizeAreNamedBeforeAnyIsUsed) {
     ASSERT_TRUE(cv::imwrite(jpeg.string(), cv::Mat3b(72, 128, cv::Vec3b(90, 90, 90))));
     for (const auto& [file, size] : {std::pair{png, std::string("160x90")}, std::pair{jpeg, std::string("128x72")}}) {
         CapturesManifest m = read_captures_manifest(
-            folder_with([&](nlohmann::json& j) { j["captures"]["p2-rows-phase-p32-s7"] = file; }));
+            folder_with([&file = file](nlohmann::json& j) { j["captures"]["p2-rows-phase-p32-s7"] = file; }));
         try {
             check_captures(m, *catalogue_, rig_.camera.resolution);
             ADD_FAILURE() << file << ": a capture of another size must be refused";
