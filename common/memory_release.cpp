@@ -9,6 +9,10 @@
 
 namespace mogao {
 
+bool map_large_blocks(std::size_t bytes) {
+    return bytes <= (std::size_t{32} << 20) && ::mallopt(M_MMAP_THRESHOLD, static_cast<int>(bytes)) == 1;
+}
+
 bool release_free_memory() { return ::malloc_trim(0) != 0; }
 
 std::size_t resident_bytes() {

@@ -19,12 +19,28 @@
 // through it, 3 s the first time (0.1-0.2 s after) with 40 000 free holes in 440 MiB. The longest
 // call is kept (max_ms) and the programs log it with their periodic statistics, so a stall shows.
 // Under a sanitizer (its own allocator) it does nothing useful but is harmless.
+//
+// Trimming cannot hand back a page that still holds one live byte. glibc's mmap threshold, the size
+// from which a block gets its own mapping (unmapped when freed), starts at 128 KiB but rises to the
+// size of every mapped block freed, up to 32 MiB (mallopt(3), "M_MMAP_THRESHOLD"): after the first
+// frame is freed, frame-sized buffers grow the heap, small long-lived blocks settle in the holes
+// between them, and the pages those hold stay resident. map_large_blocks fixes the threshold, so a
+// large block that the arenas' free memory cannot hold gets its own mapping instead of growing the
+// heap. The price is a page fault per page of every new mapped block.
 #pragma once
 
 #include <chrono>
 #include <cstddef>
 
 namespace mogao {
+
+// glibc's initial mmap threshold, kept from the start instead of rising.
+inline constexpr std::size_t kLargeBlockBytes = 128 * 1024;
+
+// mallopt(M_MMAP_THRESHOLD, bytes): from now on a block of `bytes` or more that free memory in the
+// arenas cannot hold is mapped on its own (the heap does not grow for it).
+// Call it once, before the process's loop. False when glibc refuses the value (above 32 MiB).
+bool map_large_blocks(std::size_t bytes = kLargeBlockBytes);
 
 // malloc_trim(0): true when memory was released.
 bool release_free_memory();

@@ -2,7 +2,9 @@
 #include "common/memory_release.h"
 
 #include <gtest/gtest.h>
+#include <malloc.h>
 
+#include <algorithm>
 #include <cstring>
 #include <memory>
 #include <vector>
@@ -34,6 +36,24 @@ TEST(MemoryRelease, FreedBlocksBelowALiveOneAreHandedBackToTheKernel) {
     const std::size_t released = resident_bytes();
     EXPECT_LT(released + kBlock * kBlocks / 2, freed)
         << "resident " << freed / 1024 << " KiB before the release, " << released / 1024 << " KiB after";
+}
+
+// Without the fixed threshold, freeing the first mapped block raises glibc's threshold above its size,
+// and the second block of that size grows the heap (no new mapping).
+TEST(MemoryRelease, LargeBlocksKeepTheirOwnMappingAfterOneIsFreed) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+    GTEST_SKIP() << "a sanitizer's allocator replaces glibc's malloc (not run in the CI suite)";
+#endif
+    ASSERT_TRUE(map_large_blocks());
+    EXPECT_FALSE(map_large_blocks(std::size_t{64} << 20)) << "above glibc's 32 MiB limit";
+    // Larger than any free memory in the arenas (earlier tests leave some), which would serve it first.
+    const std::size_t kFrame = std::max<std::size_t>(3 << 20, ::mallinfo2().fordblks + (1 << 20));
+    for (int round = 0; round < 3; ++round) {
+        const auto mapped_before = ::mallinfo2().hblks;
+        auto frame = std::make_unique<char[]>(kFrame);
+        std::memset(frame.get(), round, kFrame);
+        EXPECT_EQ(::mallinfo2().hblks, mapped_before + 1) << "round " << round << ": the frame came from the heap";
+    }
 }
 
 TEST(MemoryRelease, ReleasesOncePerPeriod) {

@@ -25,6 +25,16 @@
 namespace mogao {
 namespace {
 
+void drop_textures(Scene& scene) {
+    std::size_t dropped = 0;
+    for (Mesh& mesh : scene.meshes) {
+        dropped += mesh.texture ? 1 : 0;
+        mesh.texture.reset();
+        std::vector<Eigen::Vector2f>().swap(mesh.uvs);  // uvs only with a texture (mesh.h)
+    }
+    if (dropped > 0) spdlog::info("admin: {} texture(s) dropped (only render ranks shade)", dropped);
+}
+
 // Open MPI 4.1's mpirun ends an aborted job only when every remote daemon has confirmed it; the
 // daemon of a host behind a cut link never does, and TCP would take minutes to give up on it. The
 // admin is started by mpirun itself (its parent: the launcher's mpirun, systemd's main process),
@@ -130,6 +140,9 @@ int run_farm(const MpiSession& mpi, const FarmSetup& setup, const AdminJob& admi
         if (!scene) spdlog::error("rank {}: {}", mpi.rank(), error);
         return 1;
     }
+    // An admin with render ranks never shades a pixel: the textures (the bali-mask's mip chain alone
+    // is about 250 MB) would only sit in its memory for months.
+    if (mpi.is_admin() && mpi.size() > 1) drop_textures(*scene);
 
     // 2. Render ranks (or a lone admin) build the BVH; the admin of a larger farm only schedules.
     std::optional<Renderer> renderer;
