@@ -114,9 +114,10 @@ FARM_MPI_ARGS=()        # more mpirun arguments (e2e_netns.sh multihost: host fi
 # the farm's full render of its pose, and on the loaded machine (or under TSan) a frame may outlast
 # the default 1 s and be cut. The slow-frame test sets its own.
 FARM_BUDGET_ARGS=(--frame-budget-s 0)
+FARM_SCENE=${FARM_SCENE:-$src/scenes/test-room.json}  # the scene served
 start_farm() {
   local logf=$1 listen=$2; shift 2
-  setsid "$@" "$MPIEXEC" --oversubscribe "${FARM_MPI_ARGS[@]}" -n 3 "$farm" serve --scene "$src/scenes/test-room.json" \
+  setsid "$@" "$MPIEXEC" --oversubscribe "${FARM_MPI_ARGS[@]}" -n 3 "$farm" serve --scene "$FARM_SCENE" \
     --listen "$listen" --tls-dir "$work/farm-tls" --duration-s 300 "${FARM_BUDGET_ARGS[@]}" >>"$logf" 2>&1 &
   farm_sid=$!
   disown "$farm_sid"  # stopped by session id in stop_farm; no job-control report when killed
