@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "renderfarm/farm/idle_pause.h"
 #include "renderfarm/farm/tile_pass.h"
 #include "renderfarm/farm/wire_view.h"
 
@@ -24,26 +25,43 @@ double seconds_since(Clock::time_point t) { return std::chrono::duration<double>
 
 // Waits without spinning: Open MPI busy-polls inside blocking calls, and when the admin shares cores
 // with render ranks (one machine, or a 2-core CI box) a spinning admin steals whole time slices from
-// them — seen as 4 ms spikes in tile times that mislead the PBT. 100 µs sleeps cost nothing per frame.
-void sleep_briefly() {
-    timespec pause{0, 100'000};
-    nanosleep(&pause, nullptr);
+// them — seen as 4 ms spikes in tile times that mislead the PBT. 100 µs sleeps cost nothing per
+// frame; a wait of unknown length sleeps longer as it goes on (IdleWait).
+void sleep_for(std::chrono::microseconds pause) {
+    const timespec t{0, static_cast<long>(pause.count()) * 1000};
+    nanosleep(&t, nullptr);
 }
 
+void sleep_briefly() { sleep_for(std::chrono::microseconds(100)); }
+
+// A wait of unknown length (the next frame's view may be hours away): the pause grows with the
+// wait (idle_pause.h).
+class IdleWait {
+public:
+    void pause() {
+        sleep_for(idle_pause(std::chrono::duration_cast<std::chrono::microseconds>(Clock::now() - start_)));
+    }
+
+private:
+    Clock::time_point start_ = Clock::now();
+};
+
 void wait_politely(MPI_Request& request) {
+    IdleWait idle;
     for (int done = 0;;) {
         MPI_Test(&request, &done, MPI_STATUS_IGNORE);
         if (done) return;
-        sleep_briefly();
+        idle.pause();
     }
 }
 
 MPI_Status probe_politely(int source, int tag) {
+    IdleWait idle;
     MPI_Status status;
     for (int found = 0;;) {
         MPI_Iprobe(source, tag, MPI_COMM_WORLD, &found, &status);
         if (found) return status;
-        sleep_briefly();
+        idle.pause();
     }
 }
 
