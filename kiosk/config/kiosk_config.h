@@ -57,6 +57,9 @@ enum class OutputKind { headless, kms };
 // [display] and [outputs].
 struct OutputsConfig {
     double rate_hz = 30.0;  // [display].rate_hz: request + repaint tick, [0.5, 240]
+    // [display].late_warp_duty: the largest share of the rasteriser's time the late warp's repaints
+    // may take (kiosk/loop/repaint_pacer.h), (0, 1]; 1 = a repaint at every tick that moved the wall.
+    double late_warp_duty = 1.0;
     // [display].flip_timeout_s: an output whose page flip has not completed after this long stops
     // the kiosk (exit 1) for systemd to restart it and set every mode again; 0 = off, else [1, 600].
     // 30 s: far above a healthy round anywhere measured (seconds on llvmpipe under QEMU TCG).

@@ -235,6 +235,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadField{"flip_timeout_s = 12", "flip_timeout_s = 0.5", "[display].flip_timeout_s = 0.5 is outside 0 (off)"},
         BadField{"flip_timeout_s = 12", "flip_timeout_s = 601", "[display].flip_timeout_s = 601 is outside"},
         BadField{"rate_hz = 25", "rate_hz = \"fast\"", "[display].rate_hz: expected a number, got a string"},
+        BadField{"late_warp_duty = 1.0", "late_warp_duty = 0", "[display].late_warp_duty = 0 is outside (0, 1]"},
         BadField{R"(backend = "headless")", R"(backend = "x11")",
                  "[outputs].backend: 'x11' is not one of headless, kms"},
         BadField{R"(sizes = ["320x240", "320x240", "320x240"])", R"(sizes = ["320x240", "320x", "320x240"])",
@@ -292,7 +293,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadField{R"(file = "out/stats.json")", "file = 3", "[stats].file: expected a string"},
         BadField{"[display]", "[displays]", "[displays]: unknown section (known: farm, display"},
         BadField{"rate_hz = 25", "[display.rate]\nhz = 25",
-                 "[display].rate: unknown field (known: rate_hz, flip_timeout_s)"},
+                 "[display].rate: unknown field (known: rate_hz, late_warp_duty, flip_timeout_s)"},
         BadField{"rate_hz = 25", "rate_hz = = 25", "not valid TOML"}));
 
 TEST_F(KioskConfigTest, MessagesCarryTheLineOfTheOffendingValue) {

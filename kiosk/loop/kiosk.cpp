@@ -53,6 +53,7 @@ Kiosk::Kiosk(const KioskConfig& config, KioskParts parts, KioskRunOptions option
       tick_(armed_tick(config.outputs.rate_hz)),
       start_(std::chrono::steady_clock::now()),
       last_log_(start_),
+      repaint_pacer_(config.outputs.late_warp_duty),
       last_status_(start_),
       last_frame_at_(start_) {
     map_large_blocks();  // frame buffers never share pages with small blocks (common/memory_release.h)
@@ -141,6 +142,8 @@ void Kiosk::on_frame() {
 
 void Kiosk::show_current() {
     const ContentFrame& f = *current_;
+    const std::uint64_t rounds = parts_.display.stats().rounds();
+    const auto start = std::chrono::steady_clock::now();
     if (wall_lines_.empty()) {
         parts_.display.show(f);
     } else {
@@ -148,6 +151,7 @@ void Kiosk::show_current() {
         marked.image = with_wall_lines(f.image);
         parts_.display.show(marked);
     }
+    if (parts_.display.stats().rounds() != rounds) repaint_pacer_.drew(start, std::chrono::steady_clock::now());
     shown_since_tick_ = true;
     check_frames_shown();
 }
@@ -233,8 +237,11 @@ void Kiosk::on_tick() {
     // next, with this tick's shift: a repaint first would only delay it by a whole round. A turn
     // after that round reaches the wall with the next frame or at the next tick, whichever comes
     // first.
-    if (!holding && !shown_since_tick_ && !frame_waiting()) {
+    // On a slow rasteriser the repaints also leave it rest between rounds ([display].late_warp_duty).
+    if (!holding && !shown_since_tick_ && !frame_waiting() && repaint_pacer_.may_repaint(now)) {
+        const std::uint64_t rounds = parts_.display.stats().rounds();
         parts_.display.repaint();
+        if (parts_.display.stats().rounds() != rounds) repaint_pacer_.drew(now, std::chrono::steady_clock::now());
         check_frames_shown();
     }
     shown_since_tick_ = false;

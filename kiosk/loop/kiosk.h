@@ -44,6 +44,7 @@
 #include "kiosk/live_calibration/calibration_inbox.h"
 #include "kiosk/live_calibration/selfcal_worker.h"
 #include "kiosk/loop/frame_inbox.h"
+#include "kiosk/loop/repaint_pacer.h"
 #include "kiosk/navigation/kiosk_navigation.h"
 #include "kiosk/navigation/pose_log.h"
 #include "kiosk/stats/kiosk_status.h"
@@ -174,6 +175,7 @@ private:
     std::chrono::steady_clock::time_point start_;
     std::chrono::steady_clock::time_point last_log_;
     MemoryRelease memory_release_;
+    RepaintPacer repaint_pacer_;  // [display].late_warp_duty
     std::chrono::steady_clock::time_point last_status_;
     bool status_failing_ = false;      // the status file's last write failed (logged once)
     bool metrics_failing_ = false;     // the metrics file's last write failed (logged once)
