@@ -67,8 +67,8 @@ HeadlessRecorder::HeadlessRecorder(const HeadlessOutputBackend& backend, std::fi
     writer_ = std::make_unique<Writer>();
 }
 
-std::size_t HeadlessRecorder::write_round(std::uint64_t round, std::uint64_t request_id) {
-    if (round % static_cast<std::uint64_t>(every_) != 0) return 0;
+std::size_t HeadlessRecorder::write_round(std::uint64_t round, std::uint64_t request_id, bool forced) {
+    if (!forced && round % static_cast<std::uint64_t>(every_) != 0) return 0;
     std::vector<std::pair<std::filesystem::path, Rgb8Image>> files;
     for (std::size_t i = 0; i < backend_->outputs().size(); ++i) {
         const Rgb8Image& frame = backend_->last_frame(i);

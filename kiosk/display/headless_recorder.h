@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: Apache-2.0
 // HeadlessRecorder: what the headless kiosk leaves behind for people and tests to look at.
 //
-// * Every k-th display round (a round = one show or repaint that presented the outputs), each
-//   output's pixels as <dir>/<output>-<round, 6 digits>-req<request id>.png (request id 0 = the
-//   kiosk's connecting screen), written atomically (common/png_io.h). The pixels are copied on the
-//   calling (display) thread and encoded on the recorder's own thread: a PNG encode of three
-//   projector outputs costs as much as drawing them on a software rasteriser, and it is no part
-//   of presenting. At most kMaxQueuedRounds rounds wait to be encoded; a round beyond that waits
-//   for the writer (no PNG is ever dropped). Destruction writes what is queued, then joins.
+// * Every k-th display round (a round = one show or repaint that presented the outputs), and every
+//   round the caller forces (a frame held unchanged: KioskDisplay::repaint), each output's pixels as
+//   <dir>/<output>-<round, 6 digits>-req<request id>.png (request id 0 = the kiosk's connecting screen), written
+//   atomically (common/png_io.h). The pixels are copied on the calling (display) thread and encoded on the recorder's
+//   own thread: a PNG encode of three projector outputs costs as much as drawing them on a software rasteriser, and it
+//   is no part of presenting. At most kMaxQueuedRounds rounds wait to be encoded; a round beyond that waits for the
+//   writer (no PNG is ever dropped). Destruction writes what is queued, then joins.
 // * At exit, <dir>/screen-composite.png: the light on the cylindrical screen computed by the CPU
 //   reference composite_on_screen (appliance/warp/composite.h) from the last frame of every
 //   output, encoded back to sRGB. It is content-sized and should look like the content frame:
@@ -40,8 +40,9 @@ public:
     HeadlessRecorder(const HeadlessOutputBackend& backend, std::filesystem::path dir, int every);
 
     // After display round `round` (counted from 1) showed request `request_id`: queues the PNGs
-    // when round % every == 0. Returns the number of files queued.
-    std::size_t write_round(std::uint64_t round, std::uint64_t request_id);
+    // when round % every == 0 or `forced`. Returns the number of files queued.
+    std::size_t write_round(std::uint64_t round, std::uint64_t request_id, bool forced = false);
+    [[nodiscard]] int every() const { return every_; }
     // Blocks until every queued PNG is on disk (or failed and was logged).
     void flush();
 

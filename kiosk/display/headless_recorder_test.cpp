@@ -63,6 +63,17 @@ TEST_F(HeadlessRecorderTest, EveryKthRoundIsOnDiskAfterFlush) {
     EXPECT_EQ(second.pixels, backend_->last_frame(1).pixels);
 }
 
+// A round the display forced (a held frame drawn again for the recording) is recorded whatever its number.
+TEST_F(HeadlessRecorderTest, AForcedRoundIsRecordedOffTheCadence) {
+    HeadlessRecorder recorder(*backend_, dir_, 4);
+    EXPECT_EQ(recorder.write_round(3, 5), 0u);
+    EXPECT_EQ(recorder.write_round(5, 5, true), 2u);
+    recorder.flush();
+    EXPECT_FALSE(std::filesystem::exists(png(0, 3, 5)));
+    EXPECT_TRUE(std::filesystem::exists(png(0, 5, 5)));
+    EXPECT_TRUE(std::filesystem::exists(png(1, 5, 5)));
+}
+
 TEST_F(HeadlessRecorderTest, DestructionWritesWhatIsStillQueued) {
     {
         HeadlessRecorder recorder(*backend_, dir_, 1);

@@ -59,7 +59,8 @@ public:
     // (the late warp's content transform changed since its last round; ScreenPresenter::present_due).
     // An unchanged wall is left alone: a software rasteriser spends tens of ms per output on a round
     // that changes nothing, and a KMS output keeps scanning out its last buffer. While recording
-    // (record_to) every idle tick is a round, as the recording is the wall at every display round.
+    // (record_to, a PNG every k-th round) a wall left unchanged for k idle ticks is drawn and recorded
+    // again, so that a held frame (the farm down) is still in the recording.
     void repaint();
     // Page-flip events of the backend (KMS): outputs ready again get pending content.
     [[nodiscard]] Status on_flip();
@@ -92,7 +93,7 @@ public:
 private:
     KioskDisplay(std::unique_ptr<OutputBackend> backend, ScreenPresenter presenter, ScreenCalibration screen)
         : backend_(std::move(backend)), presenter_(std::move(presenter)), screen_(std::move(screen)) {}
-    void account();  // after every present: rounds, PNGs, frames now on screen
+    void account(bool forced = false);  // after every present: rounds, PNGs (forced: recorded), frames now on screen
     // When the completed round reached the screen (CLOCK_REALTIME ns): the latest
     // OutputBackend::presented_ns of the lit outputs (KMS: page-flip timestamps; headless: the
     // round), or now when the backend cannot tell. Motion-to-photon ends here.
@@ -110,6 +111,7 @@ private:
     KioskStats stats_;
     std::map<std::uint64_t, PresentedFrame> pending_;
     std::uint64_t frames_on_screen_ = 0;
+    std::uint64_t idle_ticks_ = 0;  // repaint() calls since the last round (a recording forces one every k)
     // Per output: since when it has been not ready (a present in flight), as first seen by account().
     std::vector<std::optional<std::chrono::steady_clock::time_point>> busy_since_;
 };

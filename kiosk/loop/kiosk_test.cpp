@@ -267,6 +267,23 @@ TEST_F(KioskTest, OnTickDoesNotRedrawAnUnchangedWall) {
     EXPECT_EQ(display_->stats().rounds(), rounds + 1) << "the same frame, unmoved: nothing to draw";
 }
 
+// A recording kiosk draws a wall left unchanged again only every png_every-th idle tick (so that a
+// held frame is recorded), not at every tick: those rounds took the farm's cores for nothing.
+TEST_F(KioskTest, WhileRecordingAnUnchangedWallIsDrawnAgainEveryKthIdleTick) {
+    display_->record_to(HeadlessRecorder(*headless_, dir_ / "png", 3));
+    Kiosk& k = kiosk();
+    deliver(jpeg_frame(1, 80));
+    k.on_frame();
+    const std::uint64_t rounds = display_->stats().rounds();
+    wait_readable(k.tick_fd());
+    k.on_tick();  // a frame was shown since the previous tick: no repaint, no idle tick
+    for (int idle = 1; idle <= 6; ++idle) {
+        wait_readable(k.tick_fd());
+        k.on_tick();
+        EXPECT_EQ(display_->stats().rounds(), rounds + static_cast<std::uint64_t>(idle / 3)) << "idle tick " << idle;
+    }
+}
+
 // A frame already decoded and waiting is shown next, with the tick's shift: a repaint of the old
 // frame first would only delay it by a whole round.
 TEST_F(KioskTest, OnTickDoesNotRepaintWhileADecodedFrameWaits) {
