@@ -54,9 +54,9 @@ void KioskDisplay::refresh_content(const Rgb8Image& content) {
 
 void KioskDisplay::repaint() {
     // Nothing while a round is in flight: its completion draws what is due. A recording draws an
-    // unchanged frame again only after k idle ticks without a round: drawing it at every idle tick,
-    // as before, made the live tour's kiosk draw about two rounds in five for the recording alone, on
-    // the rasteriser that shares the cores with the farm.
+    // unchanged frame again after k idle ticks without a round, so that a held frame (the farm down)
+    // is still recorded; the other idle ticks draw only what changed, as without a recording: a round
+    // on a software rasteriser takes tens of ms of the cores the farm may render on.
     const bool force = recorder_ && ++idle_ticks_ >= static_cast<std::uint64_t>(recorder_->every());
     Status s = force ? presenter_.repaint() : presenter_.present_due();
     if (!s) spdlog::warn("repaint: {}", s.error().message);

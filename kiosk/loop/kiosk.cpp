@@ -56,7 +56,7 @@ Kiosk::Kiosk(const KioskConfig& config, KioskParts parts, KioskRunOptions option
       repaint_pacer_(config.outputs.late_warp_duty),
       last_status_(start_),
       last_frame_at_(start_) {
-    map_large_blocks();  // frame buffers never share pages with small blocks (common/memory_release.h)
+    map_large_blocks();  // large buffers map instead of growing the heap (common/memory_release.h)
     if (config.guard_deg > 0) {
         auto guarded = guard_band(config.screen, config.quality.content, config.guard_deg);
         if (!guarded) throw KioskSetupError(1, "[screen].guard_deg: " + guarded.error().message);

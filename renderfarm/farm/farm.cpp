@@ -140,8 +140,8 @@ int run_farm(const MpiSession& mpi, const FarmSetup& setup, const AdminJob& admi
         if (!scene) spdlog::error("rank {}: {}", mpi.rank(), error);
         return 1;
     }
-    // An admin with render ranks never shades a pixel: the textures (the bali-mask's mip chain alone
-    // is about 250 MB) would only sit in its memory for months.
+    // An admin with render ranks never shades a pixel: the textures and their mip chains would only
+    // sit in its memory for months.
     if (mpi.is_admin() && mpi.size() > 1) drop_textures(*scene);
 
     // 2. Render ranks (or a lone admin) build the BVH; the admin of a larger farm only schedules.

@@ -162,7 +162,7 @@ int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& s
     const auto counters = [&](bool up) {
         return FarmCounters{up, server.stats(), queue.superseded(), policy.changed(), run.render_ranks};
     };
-    map_large_blocks();            // frame buffers never share pages with small blocks
+    map_large_blocks();            // large buffers map instead of growing the heap
     MemoryRelease memory_release;  // months of service: freed frame buffers go back (common/memory_release.h)
     const auto start = Clock::now();
     auto last_stats = start;
