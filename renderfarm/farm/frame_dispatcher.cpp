@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "common/memory_release.h"
 #include "renderfarm/farm/idle_pause.h"
 #include "renderfarm/farm/tile_pass.h"
 #include "renderfarm/farm/wire_view.h"
@@ -244,6 +245,10 @@ const GuidePass* begin_guides(const Renderer& renderer, GuidePass* guides, Packe
 
 void serve_render_rank(Renderer* renderer, const DispatchSettings& settings, const std::string& load_error,
                        GuidePass* guides) {
+    // A render rank serves for months, as the admin does: once a minute what it freed goes back
+    // (common/memory_release.h). Unlike the admin it keeps glibc's rising mmap threshold, so its
+    // per-frame buffers are reused from the heap without a page fault per page and frame.
+    MemoryRelease memory_release;
     for (;;) {
         const WireView wire = receive_view();
         if (wire.stop) return;
@@ -278,6 +283,7 @@ void serve_render_rank(Renderer* renderer, const DispatchSettings& settings, con
             send_reply(header, pass.packed_pixels.data(), pass.packed_pixels.size(), tiles_flat);
             // While the admin composites, filters and encodes: off the next frame's critical path.
             renderer->commit_radiance_cache();
+            memory_release.tick();
         } catch (const std::exception& e) {
             int rank = 0;
             MPI_Comm_rank(MPI_COMM_WORLD, &rank);

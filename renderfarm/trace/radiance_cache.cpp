@@ -154,7 +154,13 @@ void RadianceCache::commit() {
         for (int c = 0; c < 3; ++c) s->sum[c] += d.white_radiance[c];
         s->weight += 1.0f;
     }
+    const std::size_t merged = pending_.size();
     pending_.clear();
+    if (pending_.capacity() > 2 * merged) {
+        std::vector<CacheDeposit> smaller;
+        smaller.reserve(merged);
+        pending_.swap(smaller);
+    }
 }
 
 void RadianceCache::clear() {

@@ -122,13 +122,18 @@ public:
     void deposit(std::span<const CacheDeposit> deposits);
 
     // Merges the queued estimates. A cell that finds no free slot within its probe window is
-    // dropped (counted): the cache never grows past its slots.
+    // dropped (counted): the cache never grows past its slots. The queue keeps its storage for the
+    // next frame unless it holds more than twice what this commit merged: then it shrinks to this
+    // commit's size, so one large frame (a still view's, a larger resolution) does not hold its
+    // memory for the rest of the farm's life.
     void commit();
 
     void clear();
 
     [[nodiscard]] std::size_t cells() const { return cells_; }
     [[nodiscard]] std::uint64_t dropped() const { return dropped_; }
+    // Estimates the queue can hold without allocating (its storage, kept between frames).
+    [[nodiscard]] std::size_t queue_capacity() const { return pending_.capacity(); }
 
 private:
     struct Slot {

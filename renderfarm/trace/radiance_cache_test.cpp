@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The radiance cache's hash grid (radiance_cache.h): cells, level of detail, merge order, bad input.
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -149,6 +150,27 @@ TEST(RadianceCache, AFullTableDropsCellsInsteadOfGrowing) {
     cache.commit();
     EXPECT_LE(cache.cells(), 256u);
     EXPECT_GE(cache.dropped(), 1000u - 256u);
+}
+
+// A farm serves for months: the queue must not keep the storage of its largest frame ever (in the
+// soak a render rank's memory rose one step and stayed there).
+TEST(RadianceCache, TheQueueGivesBackTheStorageOfALargeFrame) {
+    RadianceCache cache;
+    const auto frame = [&](int estimates) {
+        std::vector<CacheDeposit> d;
+        for (int i = 0; i < estimates; ++i)
+            d.push_back({cache.key({0.01 * i, 0.0, 0.0}, kUp, 0.0f), std::uint64_t(i), Eigen::Vector3f::Ones()});
+        cache.deposit(d);
+        cache.commit();
+    };
+    frame(100000);
+    ASSERT_GE(cache.queue_capacity(), 100000u);
+    frame(1000);
+    EXPECT_LE(cache.queue_capacity(), 2000u) << "a small frame after a large one";
+    frame(1500);
+    const std::size_t kept = cache.queue_capacity();
+    frame(1200);
+    EXPECT_EQ(cache.queue_capacity(), kept) << "frames of about the same size reuse the storage";
 }
 
 // Shadow-ray outcomes of one pixel: light group g unoccluded (visible) or occluded (blocked).
