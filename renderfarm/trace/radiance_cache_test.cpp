@@ -152,8 +152,8 @@ TEST(RadianceCache, AFullTableDropsCellsInsteadOfGrowing) {
     EXPECT_GE(cache.dropped(), 1000u - 256u);
 }
 
-// A farm serves for months: the queue must not keep the storage of its largest frame ever (in the
-// soak a render rank's memory rose one step and stayed there).
+// A farm serves for months: the queue must not keep the storage of its largest frame ever, or a
+// render rank's memory steps up to it and stays there.
 TEST(RadianceCache, TheQueueGivesBackTheStorageOfALargeFrame) {
     RadianceCache cache;
     const auto frame = [&](int estimates) {
