@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// Handing freed memory back to the kernel in processes that run for months (the farm's ranks, the
+// Handing freed memory back to the kernel in processes that run for months (the farm's admin, the
 // kiosk).
 //
 // Why: glibc's malloc keeps what a program frees in its arenas (the main heap and one arena per

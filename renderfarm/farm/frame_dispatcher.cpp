@@ -12,7 +12,6 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include "common/memory_release.h"
 #include "renderfarm/farm/idle_pause.h"
 #include "renderfarm/farm/tile_pass.h"
 #include "renderfarm/farm/wire_view.h"
@@ -245,10 +244,12 @@ const GuidePass* begin_guides(const Renderer& renderer, GuidePass* guides, Packe
 
 void serve_render_rank(Renderer* renderer, const DispatchSettings& settings, const std::string& load_error,
                        GuidePass* guides) {
-    // A render rank serves for months, as the admin does: once a minute what it freed goes back
-    // (common/memory_release.h). Unlike the admin it keeps glibc's rising mmap threshold, so its
-    // per-frame buffers are reused from the heap without a page fault per page and frame.
-    MemoryRelease memory_release;
+    // A render rank serves for months but, unlike the admin, never trims its heap
+    // (common/memory_release.h): loading the scene leaves the heap at a high-water mark (94 MiB for
+    // the grotto) that every frame's buffers fit in, so its resident memory stays flat. Trimming
+    // once a minute made it swing between 60 and 100 MiB with the trim's phase, which a 2-hour soak
+    // read as growth. What a rank keeps past its frames (the radiance cache's queue) gives its
+    // storage back itself.
     for (;;) {
         const WireView wire = receive_view();
         if (wire.stop) return;
@@ -283,7 +284,6 @@ void serve_render_rank(Renderer* renderer, const DispatchSettings& settings, con
             send_reply(header, pass.packed_pixels.data(), pass.packed_pixels.size(), tiles_flat);
             // While the admin composites, filters and encodes: off the next frame's critical path.
             renderer->commit_radiance_cache();
-            memory_release.tick();
         } catch (const std::exception& e) {
             int rank = 0;
             MPI_Comm_rank(MPI_COMM_WORLD, &rank);
