@@ -11,6 +11,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <thread>
@@ -392,13 +393,22 @@ int run_serve_command(mogao::MpiSession& mpi, mogao::FarmSetup& setup, ServeComm
     // revocation list and the view policies (render hosts have no /etc/mogao/pki). Every rank
     // then agrees: one that returned alone would wait in MPI_Finalize while the others wait
     // for it in their first collective (the two-host farm hung so).
-    const std::string error =
+    std::string error =
         mpi.is_admin() ? prepare_admin_link(s.options, s.tls_dir, s.farm_name, s.view_policy_file) : std::string();
+    // Listening before the scene loads: appliances reconnect while it loads (serve.h, ServeLink).
+    std::optional<mogao::ServeLink> link;
+    if (error.empty() && mpi.is_admin()) {
+        try {
+            link.emplace(s.options);
+        } catch (const std::exception& e) {
+            error = fmt::format("--listen {}: {}", s.options.link.listen, e.what());
+        }
+    }
     if (!error.empty()) spdlog::error("{}", error);
     if (!mpi.all(error.empty())) return 2;
     return mogao::run_farm(mpi, setup,
                            [&](mogao::FrameDispatcher& farm, const mogao::Scene& scene, mogao::RunInfo& run) {
-                               return mogao::run_serve(s.options, farm, scene, run);
+                               return mogao::run_serve(s.options, *link, farm, scene, run);
                            });
 }
 

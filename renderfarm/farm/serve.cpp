@@ -138,19 +138,38 @@ LiveOptions with_lighting(LiveOptions live, const Scene& scene) {
     return live;
 }
 
-}  // namespace
-
-int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& scene, RunInfo& run) {
-    install_stop_handlers();
-    MainThreadQueue<ServedFrame> queue;
-    PolicyGate policy(scene, options.policy, ViewPolicies{options.view_policy, options.appliance_view_policies});
-    BudgetGate budget(scene, options.budget);
-    LiveFrames live(farm, with_lighting(options.live, scene));
+LinkServerOptions link_options(const ServeOptions& options) {
     LinkServerOptions link = options.link;
     // Pipelining needs a second call in flight (another session's) while one frame is encoded; each
     // session still has at most one, and the queue serialises them onto the main thread.
     if (options.pipeline) link.render_threads = std::clamp(link.max_sessions, std::max(2, link.render_threads), 64);
-    LinkServer server(link, [&queue](const ViewRequest& view) { return serve_request(queue, view); });
+    return link;
+}
+
+}  // namespace
+
+// Declared in this order so that the server, whose handlers hold the queue, goes first.
+struct ServeLink::State {
+    MainThreadQueue<ServedFrame> queue;
+    LinkServer server;
+    explicit State(const ServeOptions& options)
+        : server(link_options(options), [this](const ViewRequest& view) { return serve_request(queue, view); }) {}
+};
+
+ServeLink::ServeLink(const ServeOptions& options) : state_(std::make_unique<State>(options)) {}
+
+ServeLink::~ServeLink() {
+    state_->queue.close();
+    state_->server.stop();
+}
+
+int run_serve(const ServeOptions& options, ServeLink& link, FrameDispatcher& farm, const Scene& scene, RunInfo& run) {
+    install_stop_handlers();
+    MainThreadQueue<ServedFrame>& queue = link.state_->queue;
+    LinkServer& server = link.state_->server;
+    PolicyGate policy(scene, options.policy, ViewPolicies{options.view_policy, options.appliance_view_policies});
+    BudgetGate budget(scene, options.budget);
+    LiveFrames live(farm, with_lighting(options.live, scene));
     log_serving(options, run, server.endpoint().to_string());
     ServiceNotifier notifier;
     notifier.ready();

@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <string>
 
 #include "renderfarm/farm/frame_dispatcher.h"
@@ -54,6 +55,28 @@ struct ServeOptions {
     std::filesystem::path metrics_file;
 };
 
-int run_serve(const ServeOptions& options, FrameDispatcher& farm, const Scene& scene, RunInfo& run);
+// The admin's end of the link, opened before the scene loads: appliances connect (TLS handshake,
+// session) and ask while every rank loads the scene and builds its BVH, and their requests wait in
+// the main-thread queue until run_serve takes them. A farm restarted over its surviving hosts so
+// shows its first frame sooner: the appliances' reconnects overlap the load instead of following it.
+class ServeLink {
+public:
+    // Listens on options.link.listen. Throws what LinkServer throws (LinkError naming the address or
+    // the TLS material).
+    explicit ServeLink(const ServeOptions& options);
+    // Fails the requests still waiting ("the farm is stopping"), so that no gRPC handler waits for a
+    // frame that never comes, then stops the server.
+    ~ServeLink();
+    ServeLink(const ServeLink&) = delete;
+    ServeLink& operator=(const ServeLink&) = delete;
+
+private:
+    struct State;
+    std::unique_ptr<State> state_;
+    friend int run_serve(const ServeOptions&, ServeLink&, FrameDispatcher&, const Scene&, RunInfo&);
+};
+
+// Serves the requests that arrive on `link` until SIGINT/SIGTERM, options.duration_s or a lost rank.
+int run_serve(const ServeOptions& options, ServeLink& link, FrameDispatcher& farm, const Scene& scene, RunInfo& run);
 
 }  // namespace mogao

@@ -49,12 +49,12 @@ struct LinkClientOptions {
     std::string server_name;
     // Reconnect backoff: initial, doubled after each failed attempt up to max, each wait scaled by
     // a random factor in [1 - jitter, 1 + jitter] so that a museum's appliances do not reconnect in
-    // lockstep after a farm restart. Reset to initial once a session is established. Max 1 s: a
-    // farm restarted over its surviving hosts serves again within seconds (docs/services.md), and a
-    // wall waiting up to 8 s more for its next attempt would double the outage; an attempt a
-    // second is nothing for a farm to answer.
+    // lockstep after a farm restart. Reset to initial once a session is established. Max 0.5 s: a
+    // farm restarted over its surviving hosts listens again within seconds (docs/services.md), and
+    // the wall waits on average half a wait past that for its next attempt; two attempts a second
+    // are nothing for a farm to answer.
     std::chrono::milliseconds initial_backoff{250};
-    std::chrono::milliseconds max_backoff{1000};
+    std::chrono::milliseconds max_backoff{500};
     double backoff_jitter = 0.2;     // [0, 1)
     std::size_t stats_window = 120;  // frames over which fps, bandwidth and latency are averaged, >= 2
 };
