@@ -14,9 +14,12 @@ fail=0
     --san ::1 > /dev/null \
   && "$farm" pki export-farm --dir "$work/pki" --name farm --to "$work/farm-tls" > /dev/null ||
   { echo "FAIL: pki"; exit 1; }
-free_port() { python3 -c 'import socket; s=socket.socket(socket.AF_INET6); s.bind(("::1", 0)); print(s.getsockname()[1])'; }
+free_port() {
+  python3 -c 'import socket; s = socket.socket(socket.AF_INET6); s.bind(("::1", 0)); print(s.getsockname()[1])'
+}
 accepts() {
-  python3 -c 'import socket,sys; socket.create_connection(("::1", int(sys.argv[1])), timeout=1).close()' "$1" 2> /dev/null
+  python3 -c 'import socket, sys; socket.create_connection(("::1", int(sys.argv[1])), timeout=1).close()' "$1" \
+    2> /dev/null
 }
 serving() { grep -q 'serving .* render ranks' "$1"; }  # the admin's line once the scene is loaded (serve.cpp)
 
