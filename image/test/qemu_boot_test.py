@@ -411,7 +411,7 @@ def main():
             deadline = time.monotonic() + 120
             while time.monotonic() < deadline and farm_proc.poll() is None:
                 with open(os.path.join(work, "farm.log")) as f:
-                    if re.search(r"serving .* on ", f.read()):
+                    if re.search(r"render ranks, .*\) on ", f.read()):  # the scene loaded, not just the link
                         break
                 time.sleep(0.5)
             served = farm_proc.poll() is None

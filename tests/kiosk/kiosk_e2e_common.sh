@@ -122,7 +122,7 @@ start_farm() {
   farm_sid=$!
   disown "$farm_sid"  # stopped by session id in stop_farm; no job-control report when killed
   for _ in $(seq 1 300); do
-    grep -q "serving .* on " "$logf" 2>/dev/null && return 0
+    grep -q "render ranks, .*) on " "$logf" 2>/dev/null && return 0  # the scene loaded, not just the link
     kill -0 "$farm_sid" 2>/dev/null || { cat "$logf"; fail "the farm exited during start-up"; }
     sleep 0.1
   done
