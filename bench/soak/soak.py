@@ -429,8 +429,28 @@ def plot(result, samples, path):
 
 
 
+def ended_early(samples):
+    """{process: minute of its last sample} for every process missing from the run's last sample."""
+    last_seen = {}
+    for s in samples:
+        for name in s["processes"]:
+            last_seen[name] = s["t_s"] / 60.0
+    final = samples[-1]["processes"] if samples else {}
+    return {name: minute for name, minute in sorted(last_seen.items()) if name not in final}
+
+
 def report(args):
     result, samples = analyse(args.out)
+    ended = ended_early(samples)
+    if ended:
+        # A process that died (the farm aborting, the kiosk crashing) leaves windows without its frames
+        # or memory: the run's figures do not describe a soak, so they must not reach the docs.
+        print("soak: the run is incomplete: " + ", ".join(f"{name} ended at minute {minute:.1f}"
+                                                            for name, minute in ended.items())
+              + f" (see {args.out}/farm.log and kiosk.log)", file=sys.stderr)
+        if args.write_docs:
+            print(f"soak: not writing {args.write_docs}", file=sys.stderr)
+            return 1
     try:
         with open(os.path.join(args.out, "meta.json")) as f:
             meta = json.load(f)
