@@ -246,10 +246,10 @@ void serve_render_rank(Renderer* renderer, const DispatchSettings& settings, con
                        GuidePass* guides) {
     // A render rank serves for months but, unlike the admin, never trims its heap
     // (common/memory_release.h): loading the scene leaves the heap at a high-water mark (94 MiB for
-    // the grotto) that every frame's buffers fit in, so its resident memory stays flat. Trimming
-    // once a minute made it swing between 60 and 100 MiB with the trim's phase, which a 2-hour soak
-    // read as growth. What a rank keeps past its frames (the radiance cache's queue) gives its
-    // storage back itself.
+    // the grotto) that its frames' buffers mostly fit in, so its resident memory settles (in a soak
+    // one rank stayed at the mark, the other settled 13 MiB above it within the hour). Trimmed once
+    // a minute, it swung between 60 and 100 MiB with the trim's phase instead. What a rank keeps
+    // past its frames (the radiance cache's queue) gives its storage back itself.
     for (;;) {
         const WireView wire = receive_view();
         if (wire.stop) return;
