@@ -21,7 +21,8 @@ accepts() {
   python3 -c 'import socket, sys; socket.create_connection(("::1", int(sys.argv[1])), timeout=1).close()' "$1" \
     2> /dev/null
 }
-serving() { grep -q 'serving .* render ranks' "$1"; }  # the admin's line once the scene is loaded (serve.cpp)
+# The admin's line once the scene is loaded (serve.cpp), as the other tests and benches wait for it.
+serving() { grep -q 'render ranks, .*) on ' "$1"; }
 
 # case NAME SCENE_TEXT EXPECTED_RC LOG_FRAGMENT: starts the farm on a pipe, checks it accepts while loading.
 case_run() {
@@ -57,7 +58,7 @@ case_run() {
   fi
 }
 case_run loads '{ "meshes": { "m": { "procedural": "box", "size": [1, 1, 1] } }, "objects": [ { "mesh": "m" } ] }' \
-  0 "render ranks"
+  0 "render ranks, "
 case_run fails '{ "meshes": ' 1 "not valid JSON"
 [ $fail -eq 0 ] && echo "PASS: the farm listens while its scene loads"
 exit $fail
