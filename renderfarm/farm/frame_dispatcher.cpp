@@ -467,10 +467,12 @@ void FrameDispatcher::lost(const Watch& watch, const std::vector<int>& ranks, co
     std::string who;
     for (int r : ranks) who += (who.empty() ? "" : ", ") + std::to_string(r);
     if (phase) who = phase;  // the broadcast is not any one rank's
+    const double limit = watch.liveness.limit_s(ranks);
+    const std::string every = limit > watch.liveness.silence_s() ? ", every rank that owed a reply silent at once" : "";
     throw RankTimeout(fmt::format(
         "render rank(s) {} did not reply to frame {} and sent no progress report for {:.1f} s (liveness limit "
-        "{} s, reports every {} s while rendering): host down, process stopped or link cut",
-        who, watch.frame_id, watch.liveness.silent_for(ranks.front(), watch.now()), settings_.rank_deadline_s,
+        "{} s{}, reports every {} s while rendering): host down, process stopped or link cut",
+        who, watch.frame_id, watch.liveness.silent_for(ranks.front(), watch.now()), limit, every,
         settings_.rank_beat_s));
 }
 

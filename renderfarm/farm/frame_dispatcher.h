@@ -14,7 +14,8 @@
 // Liveness (rank_liveness.h): while a render rank renders, its main thread reports the pass's
 // progress to the admin every `rank_beat_s` (the tiles are rendered on worker threads,
 // tile_pass.h TilePassControl), so a frame of any cost keeps its ranks heard. A rank that owes a
-// reply and has sent nothing for `rank_deadline_s` (dead host, SIGSTOP, cut link; every receive
+// reply and has sent nothing for `rank_deadline_s` (kAllRanksSilentFactor times it when every rank
+// that owes is silent at once) (dead host, SIGSTOP, cut link; every receive
 // of the reply is non-blocking under it) makes render() throw RankTimeout naming the silent ranks;
 // the MPI job is then unusable (a collective is half done): broken() turns true, stop() no longer
 // talks to the ranks, and the process must end the job with MPI_Abort so that the service restarts
@@ -70,7 +71,7 @@ struct DispatchSettings {
     bool normalise_rank_speed = true;
     std::size_t max_streams = 64;  // cost maps kept; the least recently used goes beyond it
     // Seconds a render rank that owes a reply may stay silent (no progress report, no reply) before
-    // it is taken for lost (rank_liveness.h); 0 = never.
+    // it is taken for lost (rank_liveness.h: longer when all are silent at once); 0 = never.
     double rank_deadline_s = 2.0;
     double rank_beat_s = 0.1;  // how often a rendering rank reports its progress, seconds (> 0)
     // Seconds after which a frame's remaining tiles are rendered coarse (see above); 0 = never.

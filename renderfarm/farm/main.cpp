@@ -61,11 +61,12 @@ void add_farm_flags(CLI::App& command, mogao::FarmSetup& setup, std::string& sca
                     "on every rank: render_threads.h)")
         ->check(CLI::Range(0, 256));
     command
-        .add_option("--rank-deadline-s", setup.dispatch.rank_deadline_s,
-                    "Most seconds a render rank that owes a frame may stay silent (rendering ranks report their "
-                    "progress every 0.1 s, however long the frame takes); a silent rank is taken as lost and the MPI "
-                    "job is aborted (exit 3) so that systemd restarts the farm over the hosts that answer (0 = wait "
-                    "forever)")
+        .add_option(
+            "--rank-deadline-s", setup.dispatch.rank_deadline_s,
+            "Most seconds a render rank that owes a frame may stay silent (rendering ranks report their "
+            "progress every 0.1 s, however long the frame takes); a silent rank is taken as lost and the MPI "
+            "job is aborted (exit 3) so that systemd restarts the farm over the hosts that answer; 4 times this when "
+            "every rank that owes a frame is silent at once, the stall of a shared machine (0 = wait forever)")
         ->check(CLI::Range(0.0, 86400.0));
     command.add_option("--lost-ranks-file", setup.lost_ranks_file,
                        "Where the admin writes the ranks it took for lost (one per line) before it aborts the job; "

@@ -36,14 +36,37 @@ bool RankLiveness::owes(int rank) const { return ranks_[index(rank)].owes; }
 
 double RankLiveness::silent_for(int rank, double now) const { return now - ranks_[index(rank)].last_heard; }
 
-std::vector<int> RankLiveness::silent(double now) const {
-    std::vector<int> lost;
-    if (silence_s_ <= 0) return lost;
+std::vector<int> RankLiveness::past(double now, double limit_s) const {
+    std::vector<int> ranks;
     for (std::size_t i = 0; i < ranks_.size(); ++i) {
         const Rank& r = ranks_[i];
-        if (r.owes && now - r.last_heard > silence_s_ + r.allowance) lost.push_back(static_cast<int>(i) + 1);
+        if (r.owes && now - r.last_heard > limit_s + r.allowance) ranks.push_back(static_cast<int>(i) + 1);
     }
-    return lost;
+    return ranks;
+}
+
+int RankLiveness::owing() const {
+    return static_cast<int>(std::count_if(ranks_.begin(), ranks_.end(), [](const Rank& r) { return r.owes; }));
+}
+
+bool RankLiveness::all_silent(double now) const {
+    const int owe = owing();
+    return owe >= 2 && static_cast<int>(past(now, silence_s_ * kAllRanksSilentShare).size()) == owe;
+}
+
+std::vector<int> RankLiveness::silent(double now) const {
+    if (silence_s_ <= 0) return {};
+    std::vector<int> lost = past(now, silence_s_);
+    if (lost.empty() || !all_silent(now)) return lost;
+    // Every rank that owes fell silent together: the shared machine's stall until the longer limit,
+    // then all of them are named.
+    if (past(now, silence_s_ * kAllRanksSilentFactor).empty()) return {};
+    return past(now, silence_s_ * kAllRanksSilentShare);
+}
+
+double RankLiveness::limit_s(const std::vector<int>& silent) const {
+    const int owe = owing();
+    return owe >= 2 && static_cast<int>(silent.size()) == owe ? silence_s_ * kAllRanksSilentFactor : silence_s_;
 }
 
 double full_pass_seconds(double seconds, double cut_at_s, std::uint64_t done, std::uint64_t total) {

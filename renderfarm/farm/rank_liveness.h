@@ -11,6 +11,17 @@
 //
 //   lost(rank, now) = owes_reply(rank) and now - last_heard(rank) > silence_s + allowance(rank)
 //
+// One exception: when two or more ranks owe a reply and, as one of them passes the limit, every
+// one of them has been silent for at least `kAllRanksSilentShare` of it, each is allowed
+// `kAllRanksSilentFactor` times the limit (plus its allowance) instead, and all are named together.
+// A lost host silences its ranks while the others keep reporting every beat (0.1 s); all of them
+// falling silent within a few beats of each other is what a stall of the machine they share looks
+// like (page cache or I/O pressure, a descheduled cgroup), and the farm can serve nothing either
+// way, so a restart gains nothing while the ranks may still answer. The cost: a farm whose render
+// ranks all live on one host names that host's loss after the longer limit; and a rank that had
+// replied to the frame before the stall owes nothing, so the others are judged by the ordinary
+// limit (their silence cannot be told from a lost host's then).
+//
 // So how long a frame's work takes never enters the decision: a frame of any cost is answered by
 // beats (a slow frame is never taken for a lost rank), and a lost rank is named `silence_s` after
 // its last beat whatever the frame. A frame deadline from the frame's expected time cannot tell
@@ -35,6 +46,12 @@ inline constexpr double kSlowestLinkBytesPerSecond = 12.5e6;
 // A gap this long between two of the admin's own polls is the admin's stall (descheduled, a
 // sanitizer, a long unpack), not the ranks' silence: it is allowed to every rank that owes a reply.
 inline constexpr double kAdminStallS = 0.5;
+// When every rank that owes a reply (two or more) is silent at once, the limit is this many times
+// `silence_s` (above): a stall of a loaded two-core machine silenced two render ranks 3.9 s at once.
+inline constexpr double kAllRanksSilentFactor = 4.0;
+// ... when each of them has been silent for at least this share of `silence_s` as the first passes it
+// (far above a beat, 0.1 s, the most by which ranks that stall together differ in their last report).
+inline constexpr double kAllRanksSilentShare = 0.5;
 
 class RankLiveness {
 public:
@@ -42,11 +59,14 @@ public:
     // silence_s <= 0: no rank is ever taken for lost.
     RankLiveness(int ranks, double silence_s, double now);
 
-    void heard(int rank, double now);                             // a beat or a reply header from `rank`
-    void allow(int rank, double extra_s);                         // `rank` may stay silent this much longer
-    void replied(int rank);                                       // its reply is in: it owes nothing more
-    [[nodiscard]] bool owes(int rank) const;                      // a reply is still owed by `rank`
-    [[nodiscard]] std::vector<int> silent(double now) const;      // lost ranks at `now`, ascending
+    void heard(int rank, double now);                         // a beat or a reply header from `rank`
+    void allow(int rank, double extra_s);                     // `rank` may stay silent this much longer
+    void replied(int rank);                                   // its reply is in: it owes nothing more
+    [[nodiscard]] bool owes(int rank) const;                  // a reply is still owed by `rank`
+    [[nodiscard]] std::vector<int> silent(double now) const;  // lost ranks at `now`, ascending
+    // The limit the ranks `silent(now)` returned were judged by: silence_s, or kAllRanksSilentFactor
+    // times it when they are every rank that owes a reply (two or more).
+    [[nodiscard]] double limit_s(const std::vector<int>& silent) const;
     [[nodiscard]] double silent_for(int rank, double now) const;  // seconds since `rank` was heard
     [[nodiscard]] double silence_s() const { return silence_s_; }
 
@@ -56,7 +76,10 @@ private:
         double allowance = 0.0;
         bool owes = true;
     };
-    [[nodiscard]] std::size_t index(int rank) const;  // throws for a rank outside 1..ranks
+    [[nodiscard]] std::size_t index(int rank) const;                        // throws for a rank outside 1..ranks
+    [[nodiscard]] std::vector<int> past(double now, double limit_s) const;  // owing ranks past limit_s
+    [[nodiscard]] int owing() const;
+    [[nodiscard]] bool all_silent(double now) const;  // two or more owe, each kAllRanksSilentShare silent
     double silence_s_;
     std::vector<Rank> ranks_;
 };

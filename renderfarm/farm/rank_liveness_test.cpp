@@ -34,6 +34,49 @@ TEST(RankLiveness, ASilentRankIsNamedAfterTheSilenceLimit) {
     EXPECT_TRUE(live.silent(30.0).empty() || live.silent(30.0) == std::vector<int>{2});
 }
 
+// Every rank that owes falling silent within a few beats of each other is the shared machine's
+// stall: each is allowed kAllRanksSilentFactor times the limit, and all are named together past it.
+TEST(RankLiveness, RanksSilentAllAtOnceAreAllowedTheLongerLimit) {
+    RankLiveness live(3, 2.0, 0.0);
+    for (double t = 0.1; t <= 10.0; t += 0.1) {
+        live.heard(1, t);
+        live.heard(2, t + 0.07);  // beats in another phase: the last ones differ by most of a beat
+        live.heard(3, t + 0.03);
+    }
+    const double stalled_until = 10.0 + 2.0 * kAllRanksSilentFactor;
+    EXPECT_TRUE(live.silent(12.05).empty()) << "rank 1 past the limit, the others a beat short of it";
+    EXPECT_TRUE(live.silent(12.5).empty()) << "all silent 2.5 s: the machine's stall, not three lost hosts";
+    EXPECT_TRUE(live.silent(stalled_until - 0.1).empty());
+    EXPECT_EQ(live.silent(stalled_until + 0.05), (std::vector<int>{1, 2, 3}));
+    EXPECT_DOUBLE_EQ(live.limit_s({1, 2, 3}), 2.0 * kAllRanksSilentFactor);
+    EXPECT_DOUBLE_EQ(live.limit_s({2}), 2.0);
+    // The stall ends for rank 1 only: ranks 2 and 3, silent past the ordinary limit, are named at once.
+    live.heard(1, 13.0);
+    EXPECT_EQ(live.silent(13.0), (std::vector<int>{2, 3}));
+}
+
+// A lost host's rank beside ranks that keep reporting is named at the ordinary limit.
+TEST(RankLiveness, ALostRankBesideReportingRanksGetsTheOrdinaryLimit) {
+    RankLiveness live(3, 2.0, 0.0);
+    for (double t = 0.1; t <= 3.0; t += 0.1) {
+        live.heard(1, t);
+        if (t < 1.0) live.heard(2, t);
+        live.heard(3, t);
+    }
+    EXPECT_EQ(live.silent(3.05), std::vector<int>{2});
+}
+
+// One rank that owes (the other replied, or a farm of one render rank) gets the ordinary limit: a
+// single silence says nothing of the machine.
+TEST(RankLiveness, ALoneOwingRankGetsTheOrdinaryLimit) {
+    RankLiveness one(1, 2.0, 0.0);
+    EXPECT_EQ(one.silent(2.1), std::vector<int>{1});
+    RankLiveness two(2, 2.0, 0.0);
+    two.replied(1);
+    EXPECT_EQ(two.silent(2.1), std::vector<int>{2});
+    EXPECT_DOUBLE_EQ(two.limit_s({2}), 2.0);
+}
+
 TEST(RankLiveness, RanksThatRepliedOweNothingAndAllowancesExtendTheLimit) {
     RankLiveness live(2, 1.0, 0.0);
     live.replied(1);
