@@ -468,12 +468,13 @@ void FrameDispatcher::lost(const Watch& watch, const std::vector<int>& ranks, co
     for (int r : ranks) who += (who.empty() ? "" : ", ") + std::to_string(r);
     if (phase) who = phase;  // the broadcast is not any one rank's
     const double limit = watch.liveness.limit_s(ranks);
+    double longest_silence = 0.0;
+    for (int r : ranks) longest_silence = std::max(longest_silence, watch.liveness.silent_for(r, watch.now()));
     const std::string every = limit > watch.liveness.silence_s() ? ", every rank that owed a reply silent at once" : "";
     throw RankTimeout(fmt::format(
         "render rank(s) {} did not reply to frame {} and sent no progress report for {:.1f} s (liveness limit "
         "{} s{}, reports every {} s while rendering): host down, process stopped or link cut",
-        who, watch.frame_id, watch.liveness.silent_for(ranks.front(), watch.now()), limit, every,
-        settings_.rank_beat_s));
+        who, watch.frame_id, longest_silence, limit, every, settings_.rank_beat_s));
 }
 
 // Takes every progress report waiting: a report of this frame counts its rank as heard.

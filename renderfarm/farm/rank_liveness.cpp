@@ -22,7 +22,16 @@ std::size_t RankLiveness::index(int rank) const {
 }
 
 void RankLiveness::heard(int rank, double now) {
-    Rank& r = ranks_[index(rank)];
+    const std::size_t heard_index = index(rank);
+    if (ranks_[heard_index].owes && all_silent(now)) {
+        // A stall of the shared machine ends: the ranks resume one by one, so the ones still silent
+        // are judged from its end, as for the admin's own stall (their silence so far is allowed).
+        for (std::size_t i = 0; i < ranks_.size(); ++i) {
+            Rank& other = ranks_[i];
+            if (i != heard_index && other.owes) other.allowance = std::max(other.allowance, now - other.last_heard);
+        }
+    }
+    Rank& r = ranks_[heard_index];
     r.last_heard = std::max(r.last_heard, now);
 }
 

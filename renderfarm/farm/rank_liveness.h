@@ -14,6 +14,8 @@
 // One exception: when two or more ranks owe a reply and, as one of them passes the limit, every
 // one of them has been silent for at least `kAllRanksSilentShare` of it, each is allowed
 // `kAllRanksSilentFactor` times the limit (plus its allowance) instead, and all are named together.
+// When the first of them is heard again the stall is over, and the others are judged from its end
+// (their silence so far allowed, as for the admin's own stall, below): ranks resume one by one.
 // A lost host silences its ranks while the others keep reporting every beat (0.1 s); all of them
 // falling silent within a few beats of each other is what a stall of the machine they share looks
 // like (page cache or I/O pressure, a descheduled cgroup), and the farm can serve nothing either

@@ -50,9 +50,27 @@ TEST(RankLiveness, RanksSilentAllAtOnceAreAllowedTheLongerLimit) {
     EXPECT_EQ(live.silent(stalled_until + 0.05), (std::vector<int>{1, 2, 3}));
     EXPECT_DOUBLE_EQ(live.limit_s({1, 2, 3}), 2.0 * kAllRanksSilentFactor);
     EXPECT_DOUBLE_EQ(live.limit_s({2}), 2.0);
-    // The stall ends for rank 1 only: ranks 2 and 3, silent past the ordinary limit, are named at once.
-    live.heard(1, 13.0);
-    EXPECT_EQ(live.silent(13.0), (std::vector<int>{2, 3}));
+}
+
+// When a stall ends the ranks resume one by one: the first heard ends it, and the others, silent past
+// the ordinary limit, are judged from its end (allowed its length), not named at once.
+TEST(RankLiveness, AfterAStallTheRanksStillSilentAreJudgedFromItsEnd) {
+    RankLiveness live(3, 2.0, 0.0);
+    for (double t = 0.1; t <= 10.0; t += 0.1) {
+        live.heard(1, t);
+        live.heard(2, t + 0.07);
+        live.heard(3, t + 0.03);
+    }
+    EXPECT_TRUE(live.silent(13.0).empty());
+    live.heard(1, 13.0);  // the stall ends for rank 1 first
+    EXPECT_TRUE(live.silent(13.05).empty()) << "ranks 2 and 3 resume a moment later";
+    for (double t = 13.05; t < 14.95; t += 0.1) {
+        live.heard(1, t);
+        live.heard(2, t);
+        ASSERT_TRUE(live.silent(t).empty()) << "at " << t << " s";
+    }
+    EXPECT_EQ(live.silent(15.1), std::vector<int>{3}) << "rank 3 never resumed: named the limit after the stall";
+    EXPECT_DOUBLE_EQ(live.limit_s({3}), 2.0);
 }
 
 // A lost host's rank beside ranks that keep reporting is named at the ordinary limit.
