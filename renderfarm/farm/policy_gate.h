@@ -1,18 +1,20 @@
 // SPDX-License-Identifier: Apache-2.0
 // PolicyGate: what the serving farm does to each request before rendering it. The view policy of
 // the appliance that sent it (view_policy.h, view_policy_file.h), then the farm's request bounds
-// (request_policy.h). Never refuses: a request outside either is moved or degraded, and each
-// change is logged once per session and change of decision (a session sending 60 such requests a
-// second logs once). Counts the changed requests for the log and the metrics.
+// (request_policy.h). Never refuses: a request outside either is moved or degraded. The changes are
+// logged through a LogThrottle (log_throttle.h): a session's first change of each kind (view policy,
+// request bounds) at once, then at most one line a minute with the count held back, because the
+// line carries the values (a visitor pressing against the visitable area's edge moves the eye, and
+// so the line, with every request). Counts the changed requests for the log and the metrics.
 //
 // Errors: the constructor throws std::invalid_argument naming the bad policy field; apply() does
 // not throw for a validated request.
 #pragma once
 
 #include <cstdint>
-#include <map>
 #include <string>
 
+#include "renderfarm/farm/log_throttle.h"
 #include "renderfarm/farm/request_policy.h"
 #include "renderfarm/farm/view_policy_file.h"
 #include "renderfarm/scene/scene.h"
@@ -23,8 +25,10 @@ class PolicyGate {
 public:
     PolicyGate(const Scene& scene, RequestPolicy policy, ViewPolicies view_policies);
 
-    // `appliance`: the certificate common name of the request's session (empty: the farm's policy).
-    [[nodiscard]] ViewRequest apply(const ViewRequest& request, const std::string& appliance);
+    // `appliance`: the certificate common name of the request's session (empty: the farm's policy);
+    // `now_s`: the log throttle's clock.
+    [[nodiscard]] ViewRequest apply(const ViewRequest& request, const std::string& appliance,
+                                    double now_s = log_clock_s());
     [[nodiscard]] std::uint64_t changed() const { return changed_; }
 
 private:
@@ -32,7 +36,7 @@ private:
     Viewer viewer_;
     RequestPolicy policy_;
     ViewPolicies view_policies_;
-    std::map<std::uint64_t, std::string> logged_;  // by session: the last change logged
+    LogThrottle log_;
     std::uint64_t changed_ = 0;
 };
 

@@ -16,6 +16,7 @@
 #include "common/program_cli.h"
 #include "common/service_notify.h"
 #include "renderfarm/farm/farm_metrics.h"
+#include "renderfarm/farm/log_throttle.h"
 #include "renderfarm/farm/main_thread_queue.h"
 #include "renderfarm/farm/policy_gate.h"
 #include "renderfarm/farm/session_budget.h"
@@ -70,8 +71,8 @@ void log_stats(const LinkServer& server, const MainThreadQueue<ServedFrame>& que
 }
 
 // The frame budget across frames (session_budget.h): degrades a request to its appliance's measured
-// rate (logged once per session and change of decision), learns the rate from each rendered frame,
-// and logs frames cut at the budget.
+// rate, learns the rate from each rendered frame, and logs degraded requests and frames cut at the
+// budget through a LogThrottle (a session's first of each at once, then about one line a minute).
 class BudgetGate {
 public:
     BudgetGate(const Scene& scene, TimeBudget budget) : budgets_(budget, LightCounts::of(scene)) {}
@@ -81,26 +82,26 @@ public:
         const BudgetDecision d = budgets_.apply(view, who, share_s);
         if (!d.degraded) return d.view;
         ++degraded_;
-        if (logged_.size() >= kLoggedSessions) logged_.clear();  // a farm serves for months: bounded
-        std::string& last = logged_[view.session];
-        if (last != d.changes) {
-            spdlog::warn("session {} ({}): degraded to {} of {:.3g} s (estimated {:.2f} s at its measured rate): {}",
+        if (const LogThrottle::Verdict t = log_.allow("degraded:" + std::to_string(view.session), log_clock_s());
+            t.write)
+            spdlog::warn("session {} ({}): degraded to {} of {:.3g} s (estimated {:.2f} s at its measured rate): {}{}",
                          view.session, who,
                          d.limit_s < budgets_.budget().frame_s ? "its share of the farm" : "the frame budget",
-                         d.limit_s, d.predicted_s, d.changes);
-            last = d.changes;
-        }
+                         d.limit_s, d.predicted_s, d.changes, held_back_note(t.held_back));
         return d.view;
     }
     void observe(const std::string& who, const LiveFrame& frame) {
         if (!frame.rendered_now) return;
         if (frame.stats.tiles_cut > 0) {
             ++cut_;
-            spdlog::warn(
-                "session {} ({}): frame {} cut at the frame budget of {} s: {} tiles rendered coarse (uncut "
-                "about {:.1f} s)",
-                frame.rendered.session, who, frame.rendered.frame_id, budgets_.budget().frame_s, frame.stats.tiles_cut,
-                frame.stats.full_seconds);
+            if (const LogThrottle::Verdict t =
+                    log_.allow("cut:" + std::to_string(frame.rendered.session), log_clock_s());
+                t.write)
+                spdlog::warn(
+                    "session {} ({}): frame {} cut at the frame budget of {} s: {} tiles rendered coarse (uncut "
+                    "about {:.1f} s){}",
+                    frame.rendered.session, who, frame.rendered.frame_id, budgets_.budget().frame_s,
+                    frame.stats.tiles_cut, frame.stats.full_seconds, held_back_note(t.held_back));
         }
         budgets_.observe(who, frame.rendered, frame.stats.full_seconds);
     }
@@ -108,9 +109,8 @@ public:
     [[nodiscard]] std::uint64_t cut() const { return cut_; }
 
 private:
-    static constexpr std::size_t kLoggedSessions = 1024;
     SessionBudgets budgets_;
-    std::map<std::uint64_t, std::string> logged_;  // by session: the last degradation logged
+    LogThrottle log_;
     std::uint64_t degraded_ = 0, cut_ = 0;
 };
 
