@@ -14,7 +14,9 @@
 // a converged path-traced reference of pose 30 (--ref-spp, another seed, every core): relMSE of
 // linear radiance (bench/quality/image_metrics.h) and GMSD of the tone-mapped sRGB8 frames
 // (bench/quality/gmsd.h: counts blur and blocks). "mean of 16" rows average 16 frames at pose 30
-// (the frame-to-frame noise averaged out): what is left is the cache's bias. Times: the render
+// (the frame-to-frame noise averaged out), their sub-pixel positions jittered as the path tracer's:
+// what is left is the cache's bias; one more row averages the pixel centres that served moving
+// frames sample (RendererOptions::jitter_cached_one_spp off), whose mean keeps their aliasing. Times: the render
 // thread's CPU time for pose 30, best of --reps (each rep on a fresh cache). --write-docs FILE
 // replaces the `<!-- generated:radiance-cache -->` block of FILE; --png-dir DIR writes the reference
 // and each setting's frame at pose 30 to look at.
@@ -59,6 +61,10 @@ struct Setting {
     int frames_averaged = 1;
     int visibility_min_samples = 8;  // RadianceCacheOptions: 0 traces every shadow ray
     int visibility_recheck_one_in = 8;
+    // RendererOptions::jitter_cached_one_spp: served moving frames sample pixel centres (off); the
+    // mean-of-16 rows that measure the cache's bias jitter, as the path tracer does, so that the
+    // mean integrates each pixel's area and what is left is the cache's bias, not aliasing.
+    bool jitter_cached = false;
 };
 
 struct Row {
@@ -136,9 +142,12 @@ std::vector<Setting> settings(int warm) {
     out.push_back({"cache, " + w + ", 1 in 4 trains", "cache-train4", true, 1, warm, 4.0f, 4});
     out.push_back({"cache, " + w + ", 1 in 64 trains", "cache-train64", true, 1, warm, 4.0f, 64});
     out.push_back({"path tracer, 1 spp, mean of 16 frames", "path-mean16", false, 1, 0, 4.0f, 16, 16});
-    out.push_back({"cache, " + w + ", mean of 16 frames (its bias)", "cache-mean16", true, 1, warm, 4.0f, 16, 16});
-    out.push_back(
-        {"cache, " + w + ", no visibility, mean of 16 frames", "cache-novis-mean16", true, 1, warm, 4.0f, 16, 16, 0});
+    out.push_back({"cache, " + w + ", mean of 16 frames, jittered (its bias)", "cache-mean16", true, 1, warm, 4.0f, 16,
+                   16, 8, 8, true});
+    out.push_back({"cache, " + w + ", no visibility, mean of 16 frames, jittered", "cache-novis-mean16", true, 1, warm,
+                   4.0f, 16, 16, 0, 8, true});
+    out.push_back({"cache, " + w + ", mean of 16 frames at pixel centres (as served)", "cache-mean16-centres", true, 1,
+                   warm, 4.0f, 16, 16});
     return out;
 }
 
@@ -174,6 +183,7 @@ int run(int argc, char** argv) {
             o.radiance_cache.train_one_in = all[i].train_one_in;
             o.radiance_cache.visibility_min_samples = all[i].visibility_min_samples;
             o.radiance_cache.visibility_recheck_one_in = all[i].visibility_recheck_one_in;
+            o.jitter_cached_one_spp = all[i].jitter_cached;
             Renderer renderer(scene, o);
             std::uint64_t rays = 0;
             double seconds = 0.0;
