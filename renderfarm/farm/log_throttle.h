@@ -14,6 +14,7 @@
 // std::invalid_argument for a non-finite or negative interval or max_keys == 0.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <map>
 #include <string>
