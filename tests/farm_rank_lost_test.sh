@@ -90,21 +90,22 @@ signal_ranks() {
   kill "-$sig" "${pids[@]}"
 }
 
-# Stops every render rank one second into a frame that takes seconds (256x192, 64 spp), so that each
-# one owes its reply: ranks that had replied to the frame would owe nothing and leave a lone silent
-# rank, which is named at the ordinary limit.
+# Stops every render rank half a second into a frame that takes seconds (256x192, 256 spp: 2-6 s with
+# the machine idle or loaded by a CI run), so that each one owes its reply: ranks that had replied to
+# the frame would owe nothing and leave a lone silent rank, which is named at the ordinary limit. A
+# frame of 1.4 s, stopped 1 s in, left only the slowest rank owing under CI's load.
 stop_all_inside_a_frame() {
   local parent=$1 out=$2 n
   n=$(frames_in "$out")
   wait_frames_above "$out" "$n" || { echo "FAIL(stall): no new frame within 120 s"; return 1; }
-  sleep 1
+  sleep 0.5
   signal_ranks STOP "$parent" "$out"
 }
 
 stall_case() {
   local out="$work/stall" log="$work/stall.log"
   mkdir -p "$out"
-  mpirun_n 4 "$farm" render --scene "$scene" --frames 100000 --path orbit --width 256 --height 192 --spp 64 \
+  mpirun_n 4 "$farm" render --scene "$scene" --frames 100000 --path orbit --width 256 --height 192 --spp 256 \
     --contact-sheet 0 --rank-deadline-s "$deadline" --out "$out" 2> "$log" &
   local mpirun_pid=$!
   wait_frames_above "$out" 1 || { echo "FAIL(stall): no frames"; cat "$log"; kill -9 $mpirun_pid; return 1; }
