@@ -8,9 +8,11 @@
 #include <numbers>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
+#include <opencv2/core/utility.hpp>
 
 #include "appliance/autocal/screen_geometry.h"
 
@@ -114,6 +116,7 @@ ScreenModel screen_at(const ScreenModel& s0, const double* qs, bool shape, bool 
 }
 
 using Rays = std::vector<Eigen::Vector3d>;
+using Points = std::vector<Eigen::Vector3d>;
 
 // Residuals of one block: the edges (block -1) or projector k's inlier correspondences. `qs` is the
 // screen's parameters (nullptr: the prior's screen, fixed); `qi` the camera's intrinsics (nullptr: the
@@ -210,18 +213,26 @@ struct Problem {
         return r;
     }
 
-    [[nodiscard]] Eigen::VectorXd projector_residuals(std::size_t k, const double* qc, const double* qp,
-                                                      const double* qs, const Rays& rays) const {
+    // Projector k's inlier points on the screen: its camera rays' hits for camera pose qc and screen qs.
+    [[nodiscard]] Points projector_points(std::size_t k, const double* qc, const double* qs, const Rays& rays) const {
         const ScreenModel screen = this->screen(qs);
         const DeviceModel c = camera_at(camera0, qc);
+        const std::vector<int>& use = inliers[k];
+        Points x(use.size());
+        for (std::size_t u = 0; u < use.size(); ++u)
+            x[u] = ray_on_screen(screen, c, rays[static_cast<std::size_t>(use[u])]);
+        return x;
+    }
+
+    // Projector k's residuals for its parameters qp, from its inlier points (projector_points).
+    [[nodiscard]] Eigen::VectorXd projector_residuals(std::size_t k, const double* qp, const Points& x) const {
         const DeviceModel p = projector_at(projectors0[k], qp, kp > kProj);
         const Eigen::Matrix3d rt = p.rotation.transpose();
         const std::vector<int>& use = inliers[k];
         Eigen::VectorXd r(2 * static_cast<Eigen::Index>(use.size()));
         for (std::size_t u = 0; u < use.size(); ++u) {
             const auto i = static_cast<std::size_t>(use[u]);
-            const Eigen::Vector3d x = ray_on_screen(screen, c, rays[i]);
-            const Eigen::Vector3d d = rt * (x - p.position_m);
+            const Eigen::Vector3d d = rt * (x[u] - p.position_m);
             Eigen::Vector2d e(1e3, 1e3);  // behind the projector or missed: a large, constant residual
             if (d.allFinite() && d.z() > 1e-9) {
                 const Eigen::Vector2d image = device_image(p, d);
@@ -233,11 +244,16 @@ struct Problem {
         return r;
     }
 
+    [[nodiscard]] const double* projector_params(const Eigen::VectorXd& v, int block) const {
+        return v.data() + kCam + kp * block;
+    }
+
     // Residuals of block (-1: edges) at parameters v, with the block's rays for v's camera intrinsics.
     [[nodiscard]] Eigen::VectorXd block_residuals(int block, const Eigen::VectorXd& v, const Rays& rays) const {
-        return block < 0 ? edge_residuals(v.data(), screen_params(v), rays)
-                         : projector_residuals(static_cast<std::size_t>(block), v.data(), v.data() + kCam + kp * block,
-                                               screen_params(v), rays);
+        if (block < 0) return edge_residuals(v.data(), screen_params(v), rays);
+        const auto k = static_cast<std::size_t>(block);
+        return projector_residuals(k, projector_params(v, block),
+                                   projector_points(k, v.data(), screen_params(v), rays));
     }
 };
 
@@ -256,7 +272,14 @@ double step_of(const Problem& pb, int idx) {
 void accumulate(const Problem& pb, const Eigen::VectorXd& q, int block, bool refine_camera, Eigen::MatrixXd& jtj,
                 Eigen::VectorXd& jtr, double& cost) {
     const Rays rays = pb.rays_of(block, pb.intrinsic_params(q));
-    const Eigen::VectorXd r0 = pb.block_residuals(block, q, rays);
+    // A projector's own parameters move only its projection, not the points on the screen: their columns reuse the
+    // points at q (the same numbers, without the screen intersections that are most of the adjustment's time).
+    const Points points =
+        block >= 0 ? pb.projector_points(static_cast<std::size_t>(block), q.data(), pb.screen_params(q), rays)
+                   : Points{};
+    const Eigen::VectorXd r0 =
+        block >= 0 ? pb.projector_residuals(static_cast<std::size_t>(block), pb.projector_params(q, block), points)
+                   : pb.block_residuals(block, q, rays);
     cost += r0.squaredNorm();
     std::vector<int> cols;
     if (refine_camera) {
@@ -269,17 +292,25 @@ void accumulate(const Problem& pb, const Eigen::VectorXd& q, int block, bool ref
     for (int j = 0; j < pb.screen_count(); ++j) cols.push_back(static_cast<int>(pb.screen_index) + j);
     for (int j = 0; j < (pb.refine_intrinsics ? kIntrinsics : 0); ++j)
         cols.push_back(static_cast<int>(pb.intrinsics_index) + j);
+    const Eigen::Index own_begin = kCam + pb.kp * static_cast<Eigen::Index>(block);
     Eigen::MatrixXd jac(r0.size(), static_cast<Eigen::Index>(cols.size()));
-    for (std::size_t c = 0; c < cols.size(); ++c) {
-        Eigen::VectorXd v = q;
-        const int idx = cols[c];
-        const double h = step_of(pb, idx);
-        v[idx] += h;
-        const Eigen::VectorXd r = idx >= pb.intrinsics_index
-                                      ? pb.block_residuals(block, v, pb.rays_of(block, pb.intrinsic_params(v), &rays))
-                                      : pb.block_residuals(block, v, rays);
-        jac.col(static_cast<Eigen::Index>(c)) = (r - r0) / h;
-    }
+    // Each column is a forward difference over the whole block, independent of the others: they run in parallel
+    // (OpenCV's pool, every core), each written to its own column, so the result does not depend on the threads.
+    cv::parallel_for_(cv::Range(0, static_cast<int>(cols.size())), [&](const cv::Range& range) {
+        for (int c = range.start; c < range.end; ++c) {
+            Eigen::VectorXd v = q;
+            const int idx = cols[static_cast<std::size_t>(c)];
+            const double h = step_of(pb, idx);
+            v[idx] += h;
+            Eigen::VectorXd r;
+            if (block >= 0 && idx >= own_begin && idx < own_begin + pb.kp)
+                r = pb.projector_residuals(static_cast<std::size_t>(block), pb.projector_params(v, block), points);
+            else if (idx >= pb.intrinsics_index)
+                r = pb.block_residuals(block, v, pb.rays_of(block, pb.intrinsic_params(v), &rays));
+            else r = pb.block_residuals(block, v, rays);
+            jac.col(c) = (r - r0) / h;
+        }
+    });
     const Eigen::MatrixXd a = jac.transpose() * jac;
     const Eigen::VectorXd b = jac.transpose() * r0;
     for (std::size_t i = 0; i < cols.size(); ++i) {
@@ -328,12 +359,14 @@ double normal_equations(const Problem& pb, const Eigen::VectorXd& q, bool refine
 
 double total_cost(const Problem& pb, const Eigen::VectorXd& q, bool refine_camera) {
     const double* qi = pb.intrinsic_params(q);
-    double cost =
-        refine_camera ? pb.edge_residuals(q.data(), pb.screen_params(q), pb.rays_of(-1, qi)).squaredNorm() : 0.0;
-    for (std::size_t k = 0; k < pb.obs.size(); ++k) {
-        const int b = static_cast<int>(k);
-        cost += pb.block_residuals(b, q, pb.rays_of(b, qi)).squaredNorm();
-    }
+    // Block b + 1's cost (b = -1: the edges), in parallel, then summed in block order as one loop would.
+    std::vector<double> costs(pb.obs.size() + 1, 0.0);
+    cv::parallel_for_(cv::Range(refine_camera ? -1 : 0, static_cast<int>(pb.obs.size())), [&](const cv::Range& range) {
+        for (int b = range.start; b < range.end; ++b)
+            costs[static_cast<std::size_t>(b + 1)] = pb.block_residuals(b, q, pb.rays_of(b, qi)).squaredNorm();
+    });
+    double cost = 0.0;
+    for (const double c : costs) cost += c;
     return cost + intrinsics_prior_residuals(pb, q).squaredNorm();
 }
 

@@ -38,6 +38,9 @@
 // measured residual rms of the previous round (maximum likelihood for Gaussian noise);
 // correspondences beyond 4x the median residual of their projector, and with refine_screen edge points beyond 4x
 // the median distance of all edge points, are dropped between rounds.
+// Threads: the Jacobian's columns and the cost's blocks run on OpenCV's pool (cv::parallel_for_, every core
+// unless cv::setNumThreads says otherwise); each writes its own column or block, so the result does not depend
+// on the number of threads.
 #pragma once
 
 #include <limits>

@@ -27,8 +27,9 @@ namespace mogao::autocal {
 [[nodiscard]] Eigen::Vector3d screen_position(const ScreenModel& screen, double theta, double h);
 
 // Forward intersection of o + t d with the screen's surface, o inside; nullopt when the ray is
-// vertical. A cylinder in closed form; with a bow, a step to the cylinder of the radius at the
-// cylinder's hit, then secant steps on the distance from the surface along the ray (to 1e-12 m).
+// vertical. A cylinder in closed form; with a bow, Newton steps on the distance from the surface along
+// the ray (to 1e-12 m) from the hit of the cylinder of radius R, kept inside the bracket of the cylinders
+// of radius R -/+ the bow's largest excursion (bisection where a step would leave it).
 [[nodiscard]] std::optional<Eigen::Vector3d> cylinder_hit(const ScreenModel& screen, const Eigen::Vector3d& o,
                                                           const Eigen::Vector3d& d);
 
