@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "appliance/autocal/bundle_adjust.h"
+#include "appliance/autocal/camera_timing.h"
 #include "appliance/autocal/colour_calibration.h"
 #include "appliance/autocal/gray_code.h"
 #include "appliance/autocal/model_trials.h"
@@ -42,6 +43,7 @@ void check_inputs(const CalibrationPrior& prior, ImageSize content, const Autoca
     if (o.warp_step_px < 1 || o.warp_step_px > 64) fail("options.warp_step_px: 1..64");
     if (!(o.blend_ramp > 0.0 && o.blend_ramp <= 0.5)) fail("options.blend_ramp: (0, 0.5]");
     if (!(o.max_predicted_seam > 0.0 && o.max_predicted_seam <= 1.0)) fail("options.max_predicted_seam: (0, 1]");
+    if (!(o.max_frame_straddle >= 0.0 && o.max_frame_straddle <= 1.0)) fail("options.max_frame_straddle: [0, 1]");
     if (o.max_gray_bits != 0 && (o.max_gray_bits < o.min_bits || o.max_gray_bits > 16)) {
         fail("options.max_gray_bits: 0 (all) or min_bits (" + std::to_string(o.min_bits) + ")..16, got " +
              std::to_string(o.max_gray_bits));
@@ -295,6 +297,22 @@ cv::Mat1f lit_screen(PatternSource& source, const std::vector<ImageSize>& sizes,
 
 namespace {
 
+// The camera's timing (camera_timing.h), before any other pattern: refused naming the settle and the dropped frames.
+void require_frames_after_the_flip(PatternSource& source, const std::vector<ImageSize>& sizes,
+                                   const AutocalOptions& options, AutocalReport& report) {
+    const FrameStraddle straddle = measure_frame_straddle(source, sizes, options.min_contrast, report.captures);
+    report.frame_straddle = straddle.share;
+    if (straddle.share <= options.max_frame_straddle) return;
+    char why[512];
+    std::snprintf(why, sizeof why,
+                  "camera timing: the first camera frame after a pattern change still holds %.1f %% of the previous "
+                  "pattern (measured on %d camera pixels; gate max_frame_straddle %.1f %%): its exposure straddles the "
+                  "projectors' flip, or the camera hands out frames queued before it; wait longer after each flip or "
+                  "drop more frames (mogao-calibrate site --settle-ms, --drop-frames; virtual rig: --drop-frames)",
+                  100.0 * straddle.share, straddle.pixels, 100.0 * options.max_frame_straddle);
+    throw CalibrationRefused(why);
+}
+
 // Whether the bundle adjustment fits any of the screen's shape (its radius and arc, or its top edge's height): the
 // edge fit on the told screen is then only a start, gated after the adjustment (adopt_bundle), and the edge points
 // are assigned again through the adjusted model (reselect_edges).
@@ -310,7 +328,7 @@ EdgeFit fit_camera_to_lit_screen(PatternSource& source, const CalibrationPrior& 
     const cv::Mat1f black = show_averaged(source, signals, frames).clone();  // the source may reuse its buffer
     for (std::size_t k = 0; k < sizes.size(); ++k) signals[k] = cv::Mat1f(sizes[k].height, sizes[k].width, 1.0f);
     (void)show_averaged(source, signals, frames);
-    report.captures = 2 * frames;
+    report.captures += 2 * frames;
     const cv::Mat1f lit = lit_screen(source, sizes, black, frames, report.captures);
     // With the screen still to be fitted, an edge fit on the prior's cylinder is only a start (the told screen and
     // the camera's prior intrinsics together left the lit edges 13 mm off it on realistic-install at full
@@ -453,6 +471,7 @@ AutocalResult calibrate(PatternSource& source, const CalibrationPrior& prior, Im
     std::vector<ImageSize> sizes;
     for (const DeviceModel& p : prior.projectors) sizes.push_back(p.resolution);
     AutocalResult result;
+    require_frames_after_the_flip(source, sizes, options, result.report);
     const EdgeFit edge = fit_camera_to_lit_screen(source, prior, sizes, options, result.report);
     result.camera = edge.camera;
     std::vector<ProjectorObservations> observations;

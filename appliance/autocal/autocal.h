@@ -237,6 +237,12 @@ struct AutocalOptions {
     // quantisation, about 1.5 / ramp width in pixels (1.3 % at 960 px wide, 0.7 % at 1920: docs/calibration.md);
     // a weight that jumps shows as a line of the jump's height.
     double max_predicted_seam = 0.05;
+    // Refused when the first camera frame after a pattern change holds more than this share of the previous
+    // pattern's light (camera_timing.h, measured before any other pattern), [0, 1]. A share s mixes each phase
+    // shift with the one before it: a constant offset of about s sin(2 pi / N) / (2 pi) of the period (N shifts;
+    // 0.07 px at 2 %, 8 shifts of 32 px). From about 5 % the previous pattern's ghost passes the shadow mask and
+    // the Gray code fails to decode, a refusal that would not name the cause.
+    double max_frame_straddle = 0.02;
 };
 
 // Shows one signal image per projector (CV_32FC1 grey or CV_32FC3 RGB in [0, 1], projector
@@ -354,6 +360,7 @@ struct AutocalReport {
     std::vector<double> camera_intrinsics_sigma;
     double condition_number = 0.0;
     int captures = 0;
+    double frame_straddle = 0.0;  // camera_timing.h: the previous pattern's share in a frame after a change
     std::vector<ProjectorReport> projectors;
     IntrinsicsTrial intrinsics;
     BowTrial bow;

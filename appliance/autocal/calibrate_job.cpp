@@ -161,7 +161,9 @@ nlohmann::json camera_report(const AutocalResult& r, const CalibrationPrior& pri
                             {"min_gain", options.intrinsics_min_gain}}},
                           {"intrinsics", intrinsics(r.camera)},
                           {"prior_intrinsics", intrinsics(prior.camera)},
-                          {"bundle_condition_number", r.report.condition_number}};
+                          {"bundle_condition_number", r.report.condition_number},
+                          {"frame_straddle", r.report.frame_straddle},
+                          {"max_frame_straddle", options.max_frame_straddle}};
     const std::vector<double>& s = r.report.camera_intrinsics_sigma;
     if (s.size() == 5) {
         out["intrinsics_sigma"] = {{"fx_px", s[0]}, {"cx_px", s[1]}, {"cy_px", s[2]}, {"k1", s[3]}, {"k2", s[4]}};
@@ -273,8 +275,10 @@ void write_job_outputs(const CalibrateJob& job, const AutocalResult& r, const ri
 }  // namespace
 
 nlohmann::json run_calibrate_job(const CalibrateJob& job) {
+    if (job.drop_frames < 0 || job.drop_frames > 30)
+        throw std::invalid_argument("calibrate: drop_frames: 0..30, got " + std::to_string(job.drop_frames));
     const rig::VirtualRig rig = scaled_rig(rig::load_rig(job.rig), job.scale, job.scale);
-    RigPatternSource source(rig);
+    RigPatternSource source(rig, job.drop_frames);
     const CalibrationPrior prior = prior_from_rig(rig);
     const auto t0 = std::chrono::steady_clock::now();
     AutocalResult r = calibrate(source, prior, job.content, job.options);  // throws before any write

@@ -42,6 +42,10 @@ namespace mogao::autocal {
 struct CalibrateJob : CalibrationSettings {
     std::filesystem::path rig;  // rigs/*.toml
     std::filesystem::path out;  // folder, created if missing
+    // The rig camera's frames dropped after each pattern change (RigPatternSource), [0, 30]: a rig whose camera
+    // straddles the flips (camera.straddle) is refused at 0 and calibrates with 1, as a site's camera with its
+    // settle time and dropped frames.
+    int drop_frames = 0;
 };
 
 // Runs the job; returns the report (also written as report.json). Throws rig::RigError,

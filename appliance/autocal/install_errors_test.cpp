@@ -3,6 +3,7 @@
 // scale (rig keys [prior] screen_bottom_error_m / screen_top_error_m, [camera] mjpeg_quality; docs/calibration.md,
 // "Rig files"): the calibration must meet its goals or refuse naming the cause, never put content silently off.
 // Measured against the virtual rig's ground truth (rig_bridge.h), never against the calibration's own prediction.
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -11,6 +12,7 @@
 #include <opencv2/core.hpp>
 
 #include "appliance/autocal/autocal.h"
+#include "appliance/autocal/camera_timing.h"
 #include "appliance/autocal/rig_bridge.h"
 #include "appliance/autocal/screen_geometry.h"
 #include "appliance/autocal/self_check.h"
@@ -32,8 +34,9 @@ struct Outcome {
 
 // Calibrates the rig as the calibrate command does (calibrate, then the self-check and its gate), measuring the
 // result against the rig's ground truth apart (also where the gate refuses it: `gate_refused` has the reason).
-Outcome calibrate_rig(const rig::VirtualRig& rig, const AutocalOptions& options, const char* what) {
-    RigPatternSource source(rig);
+Outcome calibrate_rig(const rig::VirtualRig& rig, const AutocalOptions& options, const char* what,
+                      int drop_frames = 0) {
+    RigPatternSource source(rig, drop_frames);
     const CalibrationPrior prior = prior_from_rig(rig);
     Outcome out;
     try {
@@ -271,6 +274,43 @@ TEST(InstallErrors, TheLitEdgesAreFoundOneProjectorAtATime) {
                 1e3 * all_at_once.rms_m, all_at_once.points, 1e3 * one_at_a_time.rms_m, one_at_a_time.points);
     EXPECT_LT(one_at_a_time.rms_m, 0.8 * all_at_once.rms_m);  // measured 1.19 mm against 2.03
     EXPECT_LE(one_at_a_time.rms_m, 0.0015);
+}
+
+// The camera's timing (camera_timing.h): a camera whose first frame after each pattern change still holds 30 % of
+// the previous pattern (rig camera.straddle; an exposure across the flip). The share is measured from the sequence
+// itself; the calibration refuses it naming the dropped frames, and calibrates within the goals with one frame
+// dropped after each change, as the site's camera source drops them. With its gate lifted the same rig must not
+// meet the goals: it is refused for a cause that does not name the timing (each projector's white holds a ghost
+// of the pattern before it, which passes the shadow mask and never decodes: "Gray-code decoding failed").
+TEST(InstallErrors, FramesStraddlingTheFlipAreMeasuredRefusedAndDropped) {
+    rig::VirtualRig rig = standard_half();
+    std::vector<ImageSize> sizes;
+    for (const DeviceModel& p : prior_from_rig(rig).projectors) sizes.push_back(p.resolution);
+    {
+        RigPatternSource clean(rig);
+        int captures = 0;
+        const FrameStraddle none = measure_frame_straddle(clean, sizes, 0.04, captures);
+        EXPECT_LT(std::abs(none.share), 0.005) << "a camera that does not straddle";
+        EXPECT_GT(none.pixels, 10000);
+        EXPECT_EQ(captures, 4);
+    }
+    rig.camera.straddle = 0.3;
+    {
+        RigPatternSource straddled(rig);
+        int captures = 0;
+        EXPECT_NEAR(measure_frame_straddle(straddled, sizes, 0.04, captures).share, 0.3, 0.01);
+    }
+    const Outcome refused = calibrate_rig(rig, AutocalOptions{}, "straddle 30 %");
+    EXPECT_NE(refused.refused.find("camera timing"), std::string::npos) << refused.refused;
+    EXPECT_NE(refused.refused.find("--drop-frames"), std::string::npos) << refused.refused;
+    AutocalOptions lifted;
+    lifted.max_frame_straddle = 1.0;
+    const Outcome unguarded = calibrate_rig(rig, lifted, "straddle 30 %, gate lifted");
+    EXPECT_FALSE(meets_goals(unguarded)) << "straddled patterns calibrated within the goals: the gate is not needed";
+    const Outcome dropped = calibrate_rig(rig, AutocalOptions{}, "straddle 30 %, one frame dropped", 1);
+    EXPECT_TRUE(meets_goals(dropped)) << dropped.refused << " " << dropped.geometry.mean_px << " / "
+                                      << dropped.geometry.p95_px;
+    EXPECT_LT(std::abs(dropped.result.report.frame_straddle), 0.005);
 }
 
 }  // namespace

@@ -14,6 +14,40 @@
 
 namespace mogao::autocal {
 
+namespace {
+
+bool same_signals(const std::vector<cv::Mat>& a, const std::vector<cv::Mat>& b) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t k = 0; k < a.size(); ++k) {
+        if (a[k].empty() != b[k].empty()) return false;
+        if (a[k].empty()) continue;
+        if (a[k].size() != b[k].size() || a[k].type() != b[k].type() || cv::norm(a[k], b[k], cv::NORM_INF) != 0.0)
+            return false;
+    }
+    return true;
+}
+
+}  // namespace
+
+cv::Mat1f RigPatternSource::show(const std::vector<cv::Mat>& signals) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const bool changed = anything_shown_ && !same_signals(signals, shown_);
+    cv::Mat1f img = sim_.capture(signals, frame_);
+    const double straddle = sim_.rig().camera.straddle;
+    if (changed && straddle > 0.0 && drop_frames_ == 0) {
+        // The same noise seed: the frame is one exposure, of two patterns' light in turn.
+        cv::addWeighted(img, 1.0 - straddle, sim_.capture(shown_, frame_), straddle, 0.0, img);
+    }
+    ++frame_;
+    if (!anything_shown_ || changed) {
+        shown_.clear();
+        for (const cv::Mat& m : signals) shown_.push_back(m.clone());
+        anything_shown_ = true;
+    }
+    simulate_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return img;
+}
+
 GeometryError measure_geometry(const rig::VirtualRig& rig, const ScreenCalibration& calibration, int step) {
     std::vector<double> errors;
     GeometryError out;

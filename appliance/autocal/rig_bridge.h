@@ -18,16 +18,15 @@ namespace mogao::autocal {
 
 // Shows patterns on the virtual rig and returns its camera image (a new noise seed per image).
 // Keeps the wall time spent simulating the camera, so that a job can report the calibration's own
-// compute time apart from the rig's.
+// compute time apart from the rig's. The camera's timing (rig::RigCamera::straddle): the first frame
+// after the shown signals change holds that share of the previous signals' light, unless `drop_frames`
+// (>= 0) frames are dropped after each change, as the site's camera source does (a dropped frame is not
+// simulated and takes no noise seed).
 class RigPatternSource : public PatternSource {
 public:
-    explicit RigPatternSource(const rig::VirtualRig& rig) : sim_(rig), base_exposure_(rig.camera.exposure) {}
-    [[nodiscard]] cv::Mat1f show(const std::vector<cv::Mat>& signals) override {
-        const auto t0 = std::chrono::steady_clock::now();
-        cv::Mat1f img = sim_.capture(signals, frame_++);
-        simulate_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        return img;
-    }
+    explicit RigPatternSource(const rig::VirtualRig& rig, int drop_frames = 0)
+        : sim_(rig), base_exposure_(rig.camera.exposure), drop_frames_(drop_frames) {}
+    [[nodiscard]] cv::Mat1f show(const std::vector<cv::Mat>& signals) override;
     [[nodiscard]] double simulate_s() const { return simulate_s_; }  // seconds inside show()
     [[nodiscard]] bool exposure_locked() const override { return !sim_.rig().camera.auto_exposure; }
     void set_relative_exposure(double factor) override { sim_.set_exposure(base_exposure_ * factor); }
@@ -36,6 +35,9 @@ public:
 private:
     rig::CameraSimulator sim_;
     double base_exposure_ = 1.0;
+    int drop_frames_ = 0;
+    std::vector<cv::Mat> shown_;  // the signals on the projectors (copies), for the next frame's straddle
+    bool anything_shown_ = false;
     std::uint64_t frame_ = 0;
     double simulate_s_ = 0.0;
 };

@@ -158,6 +158,7 @@ RigCamera read_camera(Table& t) {
     c.supersample = t.integer("supersample", c.supersample);
     c.vignetting = t.number("vignetting", c.vignetting);
     c.mjpeg_quality = t.integer("mjpeg_quality", c.mjpeg_quality);
+    c.straddle = t.number("straddle", c.straddle);
     const int seed = t.integer("seed", 1);
     if (seed < 0) t.fail("seed", "must be >= 0");
     c.seed = static_cast<std::uint64_t>(seed);

@@ -106,6 +106,7 @@ void validate_camera(const RigCamera& c, const RigScreen& s, const std::string& 
     check(c.bits >= 1 && c.bits <= 16, f + ".bits", "1..16");
     check(c.supersample >= 1 && c.supersample <= 4, f + ".supersample", "1..4");
     check_range(c.vignetting, 0.0, 0.45, f + ".vignetting");
+    check_range(c.straddle, 0.0, 1.0, f + ".straddle");
     check(c.mjpeg_quality >= 0 && c.mjpeg_quality <= 100, f + ".mjpeg_quality",
           "0..100 (0 = raw frames; got " + std::to_string(c.mjpeg_quality) + ")");
     check(c.mjpeg_quality == 0 || c.bits == 8, f + ".mjpeg_quality",

@@ -81,6 +81,11 @@ struct RigCamera {
     // (libjpeg-turbo, 4:2:0) and decoded back, as a USB camera's frames reach the host; 1..100, 0 = raw
     // frames. Needs bits = 8 (JPEG's baseline samples).
     int mjpeg_quality = 0;
+    // Timing: the share of the first frame after the shown patterns change that still holds the previous ones'
+    // light, [0, 1] (an exposure that straddles the flip, or with 1 a frame the driver queued before it). Only
+    // the pattern source sees it (autocal::RigPatternSource, which drops that frame when told to, as the site's
+    // camera source drops --drop-frames); CameraSimulator::capture films one pattern set. 0: none.
+    double straddle = 0.0;
     std::uint64_t seed = 1;
 };
 

@@ -544,5 +544,17 @@ TEST(VirtualRig, MjpegFramesAreTheRawFramesThroughAJpegCodec) {
               std::string::npos);
 }
 
+// The camera's timing (camera.straddle): read from the rig file, refused outside [0, 1] naming the field.
+TEST(RigFile, CameraStraddleIsReadAndRangeChecked) {
+    EXPECT_EQ(parse_rig("[camera]\nstraddle = 0.25\n[[projectors]]\n", "s.toml").camera.straddle, 0.25);
+    EXPECT_EQ(parse_rig("[camera]\n[[projectors]]\n", "s.toml").camera.straddle, 0.0);
+    try {
+        (void)parse_rig("[camera]\nstraddle = 1.5\n[[projectors]]\n", "bad.toml");
+        ADD_FAILURE() << "straddle = 1.5 was accepted";
+    } catch (const RigError& e) {
+        EXPECT_NE(std::string(e.what()).find("camera.straddle"), std::string::npos) << e.what();
+    }
+}
+
 }  // namespace
 }  // namespace mogao::rig

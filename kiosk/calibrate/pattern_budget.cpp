@@ -21,6 +21,7 @@ PatternBudget pattern_budget(const autocal::CalibrationPrior& prior, bool colour
         b.geometry += 2 + 2 * (bits(p.resolution.width) + bits(p.resolution.height)) + 2 * options.phase_shifts;
     }
     b.geometry *= options.frames_per_pattern;
+    b.geometry += 4;  // the camera timing's single frames (camera_timing.h)
     if (colour) {
         const int steps = colour_options.ramp_steps;
         int low = 2;

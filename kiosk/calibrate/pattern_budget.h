@@ -4,7 +4,8 @@
 //
 // Count (an upper bound: the Gray code stops at the first bit the camera cannot resolve,
 // appliance/autocal/gray_code.h): identification 2 + N (all black, all white, then each output white alone,
-// connector_identity.h); geometry F * (2 + N + sum_k (2 + 2 * (bits(width_k) + bits(height_k)) + 2 * S)) (black and
+// connector_identity.h); geometry 4 + F * (2 + N + sum_k (2 + 2 * (bits(width_k) + bits(height_k)) + 2 * S)) (the
+// camera timing's white, white, black, black, appliance/autocal/camera_timing.h; black and
 // white of all, each projector white alone for the lit edges, per projector white and black, each Gray bit and its
 // inverse per axis, S phase shifts per axis; bits(n) = gray_code_bits, at most max_gray_bits; F
 // frames_per_pattern); colour 5 + N * 3 * ((ramp_steps - 1) + low) + dark_frames, low = 2 + the ramp levels in (0,

@@ -4,7 +4,8 @@
 // captured-images route (image_folder_source.h) looks each shown pattern up in.
 //
 // The set is the live sequence of appliance/autocal's calibrate() (autocal.h, steps 1-2; gray_code.h,
-// phase_shift.h) with every step it may take, in the order it takes them:
+// phase_shift.h) with every step it may take, in the order it takes them (after the camera timing's white, white,
+// black, black, camera_timing.h: the same two pictures as `white` and `black`):
 //   black                          every projector black
 //   white                          every projector white
 //   p<k>-white                     projector k white, the others black (shown for the lit edges, each projector

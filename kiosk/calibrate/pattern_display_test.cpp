@@ -102,9 +102,9 @@ TEST(PatternBudget, StandardRigImageCount) {
     const auto prior = autocal::prior_from_rig(rig::load_rig(MOGAO_SOURCE_DIR "/rigs/standard.toml"));
     const PatternBudget b = pattern_budget(prior, true, {}, {});
     EXPECT_EQ(b.identification, 5);  // black, white, 3 alone
-    // black, white, 3 alone (the lit edges); per projector 1920x1080: 11 + 11 Gray bits, each with its inverse, +
-    // white, black, + 8 phase shifts per axis
-    EXPECT_EQ(b.geometry, 2 + 3 + 3 * (46 + 16));
+    // the camera timing's 4 single frames; black, white, 3 alone (the lit edges); per projector 1920x1080: 11 + 11
+    // Gray bits, each with its inverse, + white, black, + 8 phase shifts per axis
+    EXPECT_EQ(b.geometry, 4 + 2 + 3 + 3 * (46 + 16));
     EXPECT_EQ(b.self_check, 2 * (2 + 2 * 3));  // black, 3 alone (the frame), black, 3 projectors' marks
     EXPECT_EQ(b.colour, 5 + 3 * 3 * (8 + 4) + 8);
     EXPECT_EQ(pattern_budget(prior, false, {}, {}).colour, 0);
@@ -112,7 +112,7 @@ TEST(PatternBudget, StandardRigImageCount) {
     fewer.max_gray_bits = 6;
     fewer.phase_shifts = 0;
     fewer.frames_per_pattern = 2;
-    EXPECT_EQ(pattern_budget(prior, false, {}, fewer).geometry, 2 * (2 + 3 + 3 * (2 + 2 * (6 + 6))));
+    EXPECT_EQ(pattern_budget(prior, false, {}, fewer).geometry, 4 + 2 * (2 + 3 + 3 * (2 + 2 * (6 + 6))));
     EXPECT_NEAR(seconds_per_image(30.0, 150, 2), 0.25, 1e-12);
 }
 
