@@ -51,6 +51,8 @@
 //  cylinder
 //     -> content (u, v), left unclamped past the screen's edges (the blend is 0 there).
 //  0. The camera's auto-exposure must be locked (refused otherwise, before any pattern is shown).
+//  0b. The camera's timing (camera_timing.h): the previous pattern's share in the first frame after a change,
+//     refused above `max_frame_straddle` before the other patterns.
 //  6. Blend (linear light; Raskar et al. 1998, "The office of the future", and 1999, "Multi-projector
 //     displays using camera-based registration": weights falling with the distance to the edge of each
 //     projector's footprint, normalised to sum to 1): w_k = f(d_k) / sum_j f(d_j), d_j = Euclidean
