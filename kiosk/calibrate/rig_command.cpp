@@ -25,9 +25,9 @@ void add_rig_flags(CLI::App& cmd, RigCommand& flags, CalibrateJob& job) {
         ->check(CLI::Range(0, 16));
     cmd.add_option("--phase-period-px", job.options.phase_period_px, "Phase-shift period, projector pixels, 4..1024")
         ->check(CLI::Range(4.0, 1024.0));
-    cmd.add_option("--drop-frames", job.drop_frames,
-                   "Rig camera frames dropped after each pattern change, 0..30 (a camera that straddles the flips, "
-                   "rig camera.straddle, is refused without; the site's --drop-frames)")
+    // The site's flag, the same text (one meaning per flag name, docs/cli.md): the rig settles at once, so its
+    // frames are dropped right after each pattern change (a rig camera with camera.straddle needs one).
+    cmd.add_option("--drop-frames", job.drop_frames, "Camera frames dropped after the settle")
         ->check(CLI::Range(0, 30));
     cmd.add_flag("--fixed-camera-intrinsics", flags.fixed_intrinsics,
                  "Take the camera's intrinsics as exact: do not try refining its focal length, principal point and "
