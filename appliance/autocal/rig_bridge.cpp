@@ -31,7 +31,7 @@ bool same_signals(const std::vector<cv::Mat>& a, const std::vector<cv::Mat>& b) 
 
 cv::Mat1f RigPatternSource::show(const std::vector<cv::Mat>& signals) {
     const auto t0 = std::chrono::steady_clock::now();
-    const bool changed = anything_shown_ && !same_signals(signals, shown_);
+    const bool changed = !shown_.empty() && !same_signals(signals, shown_);
     cv::Mat1f img = sim_.capture(signals, frame_);
     const double straddle = sim_.rig().camera.straddle;
     if (changed && straddle > 0.0 && drop_frames_ == 0) {
@@ -39,10 +39,9 @@ cv::Mat1f RigPatternSource::show(const std::vector<cv::Mat>& signals) {
         cv::addWeighted(img, 1.0 - straddle, sim_.capture(shown_, frame_), straddle, 0.0, img);
     }
     ++frame_;
-    if (!anything_shown_ || changed) {
+    if (shown_.empty() || changed) {
         shown_.clear();
         for (const cv::Mat& m : signals) shown_.push_back(m.clone());
-        anything_shown_ = true;
     }
     simulate_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return img;

@@ -36,8 +36,7 @@ private:
     rig::CameraSimulator sim_;
     double base_exposure_ = 1.0;
     int drop_frames_ = 0;
-    std::vector<cv::Mat> shown_;  // the signals on the projectors (copies), for the next frame's straddle
-    bool anything_shown_ = false;
+    std::vector<cv::Mat> shown_;  // the signals on the projectors (copies; empty before the first show)
     std::uint64_t frame_ = 0;
     double simulate_s_ = 0.0;
 };
