@@ -85,12 +85,22 @@ namespace mogao::autocal {
 // inside the screen, radius_m outside it: the bow vanishes on the frame (arc ends, bottom and top
 // edges), where the screen is held, and its first mode (m = n = 1) is a bow of the whole screen, the
 // others bows of its halves (the lowest modes of a membrane clamped at its frame). Metres.
+// A screen that is not matte, as its data sheet gives it (told, never fitted): its peak gain over a matte
+// screen and half-gain angle. The light a device at P throws on screen point x looks from an observer at O
+// G = gain 2^-(alpha / half_gain_angle)^2 times as bright as from a matte screen, alpha the angle between the
+// direction x -> O and the ray P -> x mirrored about the cylinder's normal (a Gaussian lobe about the mirror
+// direction, peak and half-peak angle as the data sheet's; gain 1: matte, G = 1). The colour step divides the
+// camera's view of each projector by its G toward the camera and compensates the light as G toward `viewer_m`
+// shows it (colour_calibration.h): a gain screen is seamless from one place, the visitors' (screen frame).
 struct ScreenModel {
     double radius_m = 3.0;
     double arc_deg = 150.0;
     double bottom_m = 0.8;
     double top_m = 2.3;
-    std::array<double, 4> bow_m{};  // 0: a cylinder; fitted with AutocalOptions::fit_bow
+    std::array<double, 4> bow_m{};            // 0: a cylinder; fitted with AutocalOptions::fit_bow
+    double gain = 1.0;                        // [1, 3]
+    double half_gain_angle_deg = 40.0;        // [10, 90]
+    Eigen::Vector3d viewer_m{0.0, 1.6, 0.0};  // where the seams are judged from, inside the cylinder
 };
 
 // A projector's relative light over its image: its lens's fall-off (vignetting), the part of

@@ -80,11 +80,38 @@ struct Captured {
     std::vector<cv::Mat1f> full;                // per projector: its channels' full levels summed, minus black
     std::vector<std::array<cv::Mat1f, 3>> top;  // per projector and channel: its full level minus black
     cv::Mat1f flat;                             // the camera's vignetting V per pixel (step 1a), empty: 1
+    // Per projector, per camera pixel: the screen's gain G toward the camera (ScreenModel's comment) for that
+    // projector's light there; empty on a matte screen (G = 1).
+    std::vector<cv::Mat1f> to_camera;
 };
 
 // Camera pixel (x, y)'s value as the screen's light: divided by the camera's vignetting there.
 float unvignetted(const cv::Mat1f& image, const Captured& cap, int x, int y) {
     return cap.flat.empty() ? image(y, x) : image(y, x) / cap.flat(y, x);
+}
+
+// G toward the camera of projector k's light at camera pixel (x, y) (1 on a matte screen).
+double toward_camera(const Captured& cap, std::size_t k, int x, int y) {
+    return cap.to_camera.empty() ? 1.0 : static_cast<double>(cap.to_camera[k](y, x));
+}
+
+// Captured::to_camera for the fitted models (a gain screen only).
+std::vector<cv::Mat1f> gain_toward_camera(const cv::Mat2f& screen_at, const ScreenModel& screen,
+                                          const DeviceModel& camera, const std::vector<DeviceModel>& projectors) {
+    std::vector<cv::Mat1f> out;
+    if (screen.gain == 1.0) return out;
+    for (const DeviceModel& p : projectors) {
+        cv::Mat1f g(screen_at.size(), 1.0F);
+        for (int y = 0; y < g.rows; ++y) {
+            for (int x = 0; x < g.cols; ++x) {
+                const cv::Vec2f s = screen_at(y, x);
+                if (std::isnan(s[0])) continue;
+                g(y, x) = static_cast<float>(screen_gain_at(screen, s[0], s[1], p.position_m, camera.position_m));
+            }
+        }
+        out.push_back(g);
+    }
+    return out;
 }
 
 // The screen point (theta, h) each camera pixel's centre sees through the camera model, NaN where
@@ -142,7 +169,7 @@ LensFalloff fit_falloff(const Captured& cap, std::size_t k, const DeviceModel& d
             const std::array<double, 6> b = falloff_basis(d, p.x(), p.y());
             const Eigen::Map<const Eigen::Matrix<double, 6, 1>> q(b.data());
             ata += q * q.transpose();
-            atb += q * static_cast<double>(unvignetted(full, cap, x, y));
+            atb += q * (static_cast<double>(unvignetted(full, cap, x, y)) / toward_camera(cap, k, x, y));
             basis_sum += q;
             samples.emplace_back(x, y);
         }
@@ -287,7 +314,8 @@ void measure_falloff(const Captured& cap, const ScreenModel& screen, const Devic
     pp.falloff = fit_falloff(cap, k, d, screen, o, samples);
     for (std::size_t c = 0; c < 3; ++c) {
         double sum = 0.0;
-        for (const cv::Point& p : samples) sum += unvignetted(cap.top[k][c], cap, p.x, p.y);
+        for (const cv::Point& p : samples)
+            sum += unvignetted(cap.top[k][c], cap, p.x, p.y) / toward_camera(cap, k, p.x, p.y);
         pp.channels[c].amplitude = sum / static_cast<double>(samples.size());
     }
 }
@@ -304,8 +332,8 @@ CameraVignetting measure_vignetting(Captured& cap, const ScreenModel& screen, co
                 if (cap.inside[k](y, x) == 0) continue;
                 const Eigen::Vector2d p = seen_pixel(cap.screen, projectors[k], screen, x, y);
                 if (!p.allFinite()) continue;
-                samples.push_back({k, static_cast<double>(cap.full[k](y, x)), radial_rho2(camera, x + 0.5, y + 0.5),
-                                   radial_rho2(projectors[k], p.x(), p.y())});
+                samples.push_back({k, static_cast<double>(cap.full[k](y, x)) / toward_camera(cap, k, x, y),
+                                   radial_rho2(camera, x + 0.5, y + 0.5), radial_rho2(projectors[k], p.x(), p.y())});
             }
         }
     }
@@ -357,7 +385,7 @@ void measure_black(PatternSource& source, const ColourOptions& o, const Captured
                     const Eigen::Vector2d p = seen_pixel(cap.screen, projectors[k], screen, x, y);
                     if (p.allFinite()) f = falloff_at(projectors[k], p.x(), p.y());
                 }
-                a[static_cast<long>(k) + 1] = in ? f : 0.0;
+                a[static_cast<long>(k) + 1] = in ? f * toward_camera(cap, k, x, y) : 0.0;
                 lit += in;
             }
             if (!clear || lit == 0) continue;
@@ -457,6 +485,7 @@ ColourResult calibrate_colour(PatternSource& source, const ScreenModel& screen, 
                                         std::to_string(cap.black.cols) + "x" + std::to_string(cap.black.rows));
         }
         cap.screen = camera_screen_points(camera, screen);
+        cap.to_camera = gain_toward_camera(cap.screen, screen, camera, projectors);
     }  // written below; the source may reuse its buffer
     res.captures = 1 + capture_low_black(source, options, n, cap);
     for (std::size_t k = 0; k < n; ++k) {
@@ -497,7 +526,7 @@ ColourResult calibrate_colour(PatternSource& source, const ScreenModel& screen, 
     }
     res.black_floor = colour_detail::black_floor(projectors, screen, blacks);
     res.alpha_scale = apply_measured_colour(colour, projectors, screen, calibration);
-    res.white_floor = colour_detail::white_floor(projectors, calibration);
+    res.white_floor = colour_detail::white_floor(projectors, screen, calibration);
     models = projectors;
     return res;
 }

@@ -45,6 +45,10 @@
 //     standard white). Black floor: T_c = max over screen points of B_c(p) = sum_{k lighting p}
 //     black_kc F_k; deficit D_c(p) = T_c - B_c(p) >= 0. White floor S = min F_k(p) over the
 //     pixels that show content (1 without fall-off).
+//  Gain screen (ScreenModel::gain != 1, its data sheet told): in steps 1a, 1b and 2 each camera pixel's view of
+//     projector k is divided by the screen's gain toward the camera there (through the fitted models), so F_k, A_kc
+//     and the blacks are a matte screen's; in steps 3 and 4 every F_k(p) is the lens's times the gain toward
+//     ScreenModel::viewer_m at the screen point p shows: the compensation holds where the visitors stand.
 //  4. Per projector: LUT_kc(x) = R_kc^-1(x W_c / A_kc) (the ResponseCurve, x in matched-white
 //     units); beta_kc(p) = alpha_k(p) D_c(p) / (W_c F_k(p)) (the BlackOffset, one sample per output pixel, split
 //     between the projectors lighting p by their blend weights); alpha_k replaced by alpha_k s S / F_k with

@@ -33,9 +33,15 @@ double invert_measured(const ChannelResponse& r, double t) {
     return (lo + hi) / 2.0;
 }
 
-// Black light per channel at screen point (theta, h): sum of the blacks of the projectors there,
-// each through its lens's fall-off; projector `always` lights it with fall-off `always_falloff`
-// (the caller knows its pixel; models.size() = none).
+// How much brighter than a matte screen device d's light at screen point (theta, h) looks from the screen's viewer
+// (ScreenModel::gain; 1 on a matte screen).
+double toward_viewer(const DeviceModel& d, const ScreenModel& screen, double theta, double h) {
+    return screen_gain_at(screen, theta, h, d.position_m, screen.viewer_m);
+}
+
+// Black light per channel at screen point (theta, h) as the viewer sees it: sum of the blacks of the projectors
+// there, each through its lens's fall-off and the screen's gain; projector `always` lights it with fall-off
+// `always_falloff` (the caller knows its pixel; models.size() = none).
 std::array<double, 3> black_at(const std::vector<DeviceModel>& models, const ScreenModel& screen,
                                const std::vector<std::array<double, 3>>& blacks, double theta, double h,
                                std::size_t always, double always_falloff) {
@@ -45,7 +51,7 @@ std::array<double, 3> black_at(const std::vector<DeviceModel>& models, const Scr
         if (j != always) {
             const Eigen::Vector2d p = model_pixel(models[j], screen, theta, h);
             if (!p.allFinite()) continue;
-            f = falloff_at(models[j], p.x(), p.y());
+            f = falloff_at(models[j], p.x(), p.y()) * toward_viewer(models[j], screen, theta, h);
         }
         for (std::size_t c = 0; c < 3; ++c) b[c] += f * blacks[j][c];
     }
@@ -70,31 +76,43 @@ Eigen::Vector2d output_position(const DeviceModel& d, const ProjectorCalibration
     return {(x + 0.5) * d.resolution.width / pc.output.width, (y + 0.5) * d.resolution.height / pc.output.height};
 }
 
-double falloff_at_output(const DeviceModel& d, const ProjectorCalibration& pc, double x, double y) {
-    if (d.falloff.flat()) return 1.0;
-    const Eigen::Vector2d p = output_position(d, pc, x, y);
-    return falloff_at(d, p.x(), p.y());
+// The relative light of output pixel (x, y) of d as the viewer sees it: its lens's fall-off times the screen's
+// gain toward the viewer at the screen point its warp shows there (none where it shows no content).
+double falloff_at_output(const DeviceModel& d, const ScreenModel& screen, const ProjectorCalibration& pc, double x,
+                         double y) {
+    double f = 1.0;
+    if (!d.falloff.flat()) {
+        const Eigen::Vector2d p = output_position(d, pc, x, y);
+        f = falloff_at(d, p.x(), p.y());
+    }
+    if (screen.gain == 1.0) return f;
+    const ContentUv uv = sample_warp_at(pc.warp, pc.output, x, y);
+    if (!uv.valid()) return f;
+    const double arc = screen.arc_deg * kDeg;
+    return f * toward_viewer(d, screen, uv.u * arc - arc / 2.0, screen.top_m - uv.v * (screen.top_m - screen.bottom_m));
 }
 
-// Calls fn(weight, F) for every blend texel of pc (weight writable when pc is), F the fall-off at
-// the texel's output position.
+// Calls fn(weight, F) for every blend texel of pc (weight writable when pc is), F the relative light at
+// the texel's output position (falloff_at_output).
 template <typename Calibration, typename Fn>
-void for_each_blend_texel(const DeviceModel& d, Calibration& pc, Fn&& fn) {
+void for_each_blend_texel(const DeviceModel& d, const ScreenModel& screen, Calibration& pc, Fn&& fn) {
     const ImageSize g = pc.blend.size;
     for (int j = 0; j < g.height; ++j) {
         const double y = grid_to_output(j, pc.output.height, g.height);
         for (int i = 0; i < g.width; ++i) {
             fn(pc.blend.weight[static_cast<std::size_t>(j) * g.width + i],
-               falloff_at_output(d, pc, grid_to_output(i, pc.output.width, g.width), y));
+               falloff_at_output(d, screen, pc, grid_to_output(i, pc.output.width, g.width), y));
         }
     }
 }
 
 // Step 4's blend for the fall-off: w_k(p) x s x S / F_k(p) (s the black headroom), so that the
 // projectors' light sums to S W_c c wherever they show content c.
-void scale_blend(const DeviceModel& d, double scale, double white, ProjectorCalibration& pc) {
-    for_each_blend_texel(
-        d, pc, [&](float& w, double f) { w = static_cast<float>(std::clamp(w * scale * white / f, 0.0, 1.0)); });
+void scale_blend(const DeviceModel& d, const ScreenModel& screen, double scale, double white,
+                 ProjectorCalibration& pc) {
+    for_each_blend_texel(d, screen, pc, [&](float& w, double f) {
+        w = static_cast<float>(std::clamp(w * scale * white / f, 0.0, 1.0));
+    });
 }
 
 // Which other projectors' models light screen point (theta, h): bit j for projector j != k (the first 32; an edge
@@ -153,7 +171,8 @@ void footprint_light(std::size_t k, const std::vector<DeviceModel>& models, cons
         for (std::size_t j = 0; j < models.size(); ++j) {
             if (j == k) continue;
             const Eigen::Vector2d p = model_pixel(models[j], screen, theta, h);
-            if (p.allFinite()) light[j] += falloff_at(models[j], p.x(), p.y());
+            if (p.allFinite())
+                light[j] += falloff_at(models[j], p.x(), p.y()) * toward_viewer(models[j], screen, theta, h);
         }
         ++n;
     }
@@ -195,7 +214,7 @@ double apply_beta(std::size_t k, const std::vector<DeviceModel>& models, const S
         for (int x = 0; x < out.width; ++x) {
             const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(out.width) + x;
             if (masks[i] == kNotShown) continue;
-            const double f = falloff_at_output(models[k], pc, x, y);
+            const double f = falloff_at_output(models[k], screen, pc, x, y);
             const float alpha = sample_blend(pc.blend, out, x, y);
             footprint_light(k, models, screen, pc, x, y, f, crosses_edge(masks, out, x, y), light);
             for (std::size_t c = 0; c < 3; ++c) {
@@ -232,7 +251,7 @@ void accumulate_blacks(const ProjectorCalibration& pc, std::size_t k, const std:
             }
             // beta_k = alpha_k (t - sum_j b_j L_j) / F_k with w = alpha_k s S / F_k (L_j as apply_beta's).
             const double alpha = sample_blend(pc.blend, pc.output, x, y) / (scale * white);
-            footprint_light(k, models, screen, pc, x, y, falloff_at_output(models[k], pc, x, y),
+            footprint_light(k, models, screen, pc, x, y, falloff_at_output(models[k], screen, pc, x, y),
                             crosses_edge(masks, pc.output, x, y), light);
             a[0] = alpha;
             for (long j = 0; j < n; ++j) a[j + 1] = -alpha * light[static_cast<std::size_t>(j)];
@@ -294,11 +313,12 @@ ResponseCurve measured_lut(const ProjectorPhotometry& pp, const ColourOptions& o
 
 // Step 4's white floor S: the least relative light F any projector gives where it shows content
 // (blend > 0); 1 when every projector is flat. The wall's white is S W_c everywhere.
-double white_floor(const std::vector<DeviceModel>& models, const ScreenCalibration& calibration) {
+double white_floor(const std::vector<DeviceModel>& models, const ScreenModel& screen,
+                   const ScreenCalibration& calibration) {
     double floor = 1.0;
     for (std::size_t k = 0; k < models.size(); ++k) {
-        if (models[k].falloff.flat()) continue;
-        for_each_blend_texel(models[k], calibration.projectors[k], [&](float w, double f) {
+        if (models[k].falloff.flat() && screen.gain == 1.0) continue;
+        for_each_blend_texel(models[k], screen, calibration.projectors[k], [&](float w, double f) {
             if (w > 0.0F) floor = std::min(floor, f);
         });
     }
@@ -330,9 +350,10 @@ double apply_measured_colour(const MeasuredColour& colour, const std::vector<Dev
         }
     }
     // alpha s S / F + beta <= 1 with beta <= D / F and F >= S where alpha > 0: s = 1 - max D / S.
-    const double white = colour_detail::white_floor(models, calibration);
+    const double white = colour_detail::white_floor(models, screen, calibration);
     const double scale = 1.0 - worst / white;
-    for (std::size_t k = 0; k < models.size(); ++k) scale_blend(models[k], scale, white, calibration.projectors[k]);
+    for (std::size_t k = 0; k < models.size(); ++k)
+        scale_blend(models[k], screen, scale, white, calibration.projectors[k]);
     validate_screen(calibration);
     return scale;
 }
@@ -349,10 +370,10 @@ MeasuredColour measured_colour(const ScreenCalibration& calibration, const std::
         for (const float b : pc.beta.rgb) beta_max = std::max(beta_max, b);
     }
     // w = alpha s S / F: s is the largest w F / S (alpha = 1 where one projector alone shows content).
-    const double white = colour_detail::white_floor(models, calibration);
+    const double white = colour_detail::white_floor(models, screen, calibration);
     double scale = 0.0;
     for (std::size_t k = 0; k < n; ++k) {
-        for_each_blend_texel(models[k], calibration.projectors[k],
+        for_each_blend_texel(models[k], screen, calibration.projectors[k],
                              [&](float w, double f) { scale = std::max(scale, w * f / white); });
     }
     if (!(beta_max > 0.0F) || !(scale > 0.0)) return out;  // no black-level compensation

@@ -20,8 +20,10 @@ namespace mogao::autocal::colour_detail {
 // Step 4's LUT for one projector: the inverse of its measured response at each matched-white level.
 [[nodiscard]] ResponseCurve measured_lut(const ProjectorPhotometry& pp, const ColourOptions& o);
 
-// Step 4's white floor S: the least relative light F any projector gives where it shows content (blend > 0); 1 when
-// every projector is flat.
-[[nodiscard]] double white_floor(const std::vector<DeviceModel>& models, const ScreenCalibration& calibration);
+// Step 4's white floor S: the least relative light F any projector gives where it shows content (blend > 0), as the
+// screen's viewer sees it (its lens's fall-off times the screen's gain toward the viewer); 1 when every projector
+// is flat and the screen matte.
+[[nodiscard]] double white_floor(const std::vector<DeviceModel>& models, const ScreenModel& screen,
+                                 const ScreenCalibration& calibration);
 
 }  // namespace mogao::autocal::colour_detail

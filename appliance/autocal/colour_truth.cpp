@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "appliance/autocal/rig_bridge.h"
+#include "appliance/rig/screen_light.h"
 #include "appliance/warp/response_curve.h"
 #include "appliance/warp/warp_sampling.h"
 
@@ -19,9 +21,10 @@ struct Point {
     std::array<int, 2> pixel{};  // its output pixel there
 };
 
-// The light at screen point s for flat content `level`.
-Point light_at(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double level,
-               const rig::ScreenPoint& s) {
+// The light at screen point s for flat content `level`: each projector's, as the viewer sees it (`seen`: times the
+// screen's gain toward rig.viewer_m) or as it leaves a matte screen (what bounces), plus the ambient.
+Point direct_light(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double level,
+                   const rig::ScreenPoint& s, bool seen) {
     Point pt;
     pt.rgb = {rig.ambient, rig.ambient, rig.ambient};
     float most = 0.0F;
@@ -40,7 +43,8 @@ Point light_at(const rig::VirtualRig& rig, const ScreenCalibration& calibration,
             pt.pixel = *xy;
         }
         const rig::RigProjector& rp = rig.projectors[k];
-        const double f = rig::projector_falloff(rp, x + 0.5, y + 0.5);
+        const double f = rig::projector_falloff(rp, x + 0.5, y + 0.5) *
+                         (seen ? rig::screen_gain(rig.screen, s, rp.pose.position_m, rig.viewer_m) : 1.0);
         for (std::size_t c = 0; c < 3; ++c) {
             const double signal =
                 shown ? apply_response(pc.response, static_cast<int>(c), static_cast<float>(level) * w + beta[c]) : 0.0;
@@ -51,18 +55,48 @@ Point light_at(const rig::VirtualRig& rig, const ScreenCalibration& calibration,
     return pt;
 }
 
+// The light the viewer sees on the screen for flat content `level`: direct light through the screen's gain,
+// plus one bounce of the screen's own light (virtual_rig.h's header comment).
+class ViewedLight {
+public:
+    ViewedLight(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double level)
+        : rig_(rig), calibration_(calibration), level_(level) {
+        if (rig.screen.interreflection <= 0.0) return;
+        bounce_.emplace(rig.screen);
+        std::array<std::vector<double>, 3> leaving;
+        for (int i = 0; i < bounce_->patches(); ++i) {
+            const Point p = direct_light(rig, calibration, level, bounce_->centre(i), false);
+            for (std::size_t c = 0; c < 3; ++c) leaving[c].push_back(p.rgb[c] - rig.ambient);
+        }
+        for (std::size_t c = 0; c < 3; ++c) bounced_[c] = bounce_->bounce(leaving[c]);
+    }
+
+    [[nodiscard]] Point at(const rig::ScreenPoint& s) const {
+        Point p = direct_light(rig_, calibration_, level_, s, true);
+        if (bounce_) {
+            for (std::size_t c = 0; c < 3; ++c) p.rgb[c] += bounce_->at(bounced_[c], s);
+        }
+        return p;
+    }
+
+private:
+    const rig::VirtualRig& rig_;
+    const ScreenCalibration& calibration_;
+    double level_;
+    std::optional<rig::ScreenBounce> bounce_;
+    std::array<std::vector<double>, 3> bounced_;
+};
+
 // The light at every grid point for flat content `level`.
-std::vector<Point> screen_light(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double level,
-                                double inset) {
+std::vector<Point> screen_light(const ViewedLight& light, const rig::VirtualRig& rig, double inset) {
     std::vector<Point> points;
-    for (const rig::ScreenPoint& s : seam_grid(rig, inset)) points.push_back(light_at(rig, calibration, level, s));
+    for (const rig::ScreenPoint& s : seam_grid(rig, inset)) points.push_back(light.at(s));
     return points;
 }
 
 // The light of `p` averaged over the footprint of the output pixel that shows it (p.shown_by's), at
 // kSub x kSub points of that pixel placed on the screen by the rig's true projector.
-std::array<double, 3> pixel_light(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double level,
-                                  const Point& p) {
+std::array<double, 3> pixel_light(const rig::VirtualRig& rig, const ViewedLight& light, const Point& p) {
     constexpr int kSub = 8;
     std::array<double, 3> sum{};
     int n = 0;
@@ -71,7 +105,7 @@ std::array<double, 3> pixel_light(const rig::VirtualRig& rig, const ScreenCalibr
             const auto s =
                 rig::projector_to_screen(rig, p.shown_by, p.pixel[0] + (i + 0.5) / kSub, p.pixel[1] + (j + 0.5) / kSub);
             if (!s) continue;
-            const Point q = light_at(rig, calibration, level, *s);
+            const Point q = light.at(*s);
             for (std::size_t c = 0; c < 3; ++c) sum[c] += q.rgb[c];
             ++n;
         }
@@ -133,8 +167,10 @@ std::array<double, 3> rgb_to_lab(const std::array<double, 3>& rgb, const std::ar
 
 SeamColour measure_seam_colour(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double level,
                                double inset) {
-    const std::array<double, 3> white = rgb_to_xyz(reference_rgb(screen_light(rig, calibration, 1.0, inset)));
-    const std::vector<Point> pts = screen_light(rig, calibration, level, inset);
+    const std::array<double, 3> white =
+        rgb_to_xyz(reference_rgb(screen_light(ViewedLight(rig, calibration, 1.0), rig, inset)));
+    const ViewedLight light(rig, calibration, level);
+    const std::vector<Point> pts = screen_light(light, rig, inset);
     const std::array<double, 3> ref = reference_rgb(pts);
     const std::array<double, 3> ref_lab = rgb_to_lab(ref, white);
     SeamColour out;
@@ -152,8 +188,7 @@ SeamColour measure_seam_colour(const rig::VirtualRig& rig, const ScreenCalibrati
         if (p.lit >= 2) {
             ++out.seam_samples;
             out.seam_luminance_deviation = std::max(out.seam_luminance_deviation, dev);
-            const double pixel_dev =
-                std::abs(luminance(pixel_light(rig, calibration, level, p)) / out.reference_luminance - 1.0);
+            const double pixel_dev = std::abs(luminance(pixel_light(rig, light, p)) / out.reference_luminance - 1.0);
             out.seam_luminance_pixel_max = std::max(out.seam_luminance_pixel_max, pixel_dev);
             out.seam_delta_e = std::max(out.seam_delta_e, de);
             seam_dev.push_back(dev);

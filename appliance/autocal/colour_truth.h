@@ -3,7 +3,8 @@
 // own prediction): flat grey content through a ScreenCalibration (warp validity, blend, beta,
 // response, as render_output computes them) onto the rig's true light paths and responses
 // (virtual_rig.h: F(x, y) brightness_c (black + (1 - black) s^gamma_c) per projector, F the lens fall-off,
-// plus ambient).
+// times the screen's gain toward the rig's viewer (VirtualRig::viewer_m), plus one bounce of the screen's own
+// light and the ambient).
 //
 // Colour: the rig's linear RGB light is read as ITU-R BT.709 / sRGB primaries with D65 white
 // (IEC 61966-2-1 matrix to CIE XYZ), luminance Y = 0.2126 R + 0.7152 G + 0.0722 B; CIELAB (CIE

@@ -93,6 +93,13 @@ ScreenModel read_screen(const Reader& r) {
         const std::vector<double> bow = r.numbers("bow_m", s.bow_m.size(), -limit, limit, "[-0.1, 0.1] x radius_m");
         std::copy(bow.begin(), bow.end(), s.bow_m.begin());
     }
+    // Optional (files from before gain screens were modelled have none: a matte screen, viewed from the axis).
+    if (r.json().is_object() && r.json().contains("gain")) {
+        s.gain = r.number("gain", 1.0, 3.0, "[1, 3]");
+        s.half_gain_angle_deg = r.number("half_gain_angle_deg", 10.0, 90.0, "[10, 90] degrees");
+        const std::vector<double> v = r.numbers("viewer_m", 3, -1e3, 1e3, "[-1000, 1000] m");
+        s.viewer_m = {v[0], v[1], v[2]};
+    }
     return s;
 }
 
@@ -206,7 +213,10 @@ Json models_json(const CalibrationModels& m, const std::string& name) {
                   {"arc_deg", m.screen.arc_deg},
                   {"bottom_m", m.screen.bottom_m},
                   {"top_m", m.screen.top_m},
-                  {"bow_m", m.screen.bow_m}}},
+                  {"bow_m", m.screen.bow_m},
+                  {"gain", m.screen.gain},
+                  {"half_gain_angle_deg", m.screen.half_gain_angle_deg},
+                  {"viewer_m", {m.screen.viewer_m.x(), m.screen.viewer_m.y(), m.screen.viewer_m.z()}}}},
                 {"camera", device_json(m.camera)},
                 {"projectors", projectors}};
     // nlohmann would write a non-finite number as null: validate so that what is written reads back.

@@ -5,10 +5,12 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 
 #include <Eigen/Geometry>
 
+#include "appliance/rig/screen_light.h"
 #include "appliance/warp/response_curve.h"
 #include "appliance/warp/warp_sampling.h"
 
@@ -121,26 +123,40 @@ LensFalloff falloff_of(const rig::RigProjector& p) { return {{1.0, 0.0, 0.0, -p.
 
 LuminanceError measure_luminance(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double inset,
                                  SeamGridSize grid) {
-    std::vector<double> lum;
-    std::vector<bool> seam;
-    for (const rig::ScreenPoint& s : seam_grid(rig, inset, grid.columns, grid.rows)) {
+    // White content's light at s, as the viewer sees it (`seen`: through the screen's gain) or as it leaves a
+    // matte screen (what bounces); `lit` counts the projectors whose blend is on there.
+    const auto direct = [&](const rig::ScreenPoint& s, bool seen, int* lit) {
         double l = 0.0;
-        int lit = 0;
         for (std::size_t k = 0; k < calibration.projectors.size(); ++k) {
             const ProjectorCalibration& pc = calibration.projectors[k];
             const auto xy = output_pixel(rig, static_cast<int>(k), pc, s);
             if (!xy) continue;
             const float w = sample_blend(pc.blend, pc.output, (*xy)[0], (*xy)[1]);
-            if (w > 0.0f) ++lit;
+            if (w > 0.0f && lit != nullptr) ++*lit;
             const rig::RigProjector& rp = rig.projectors[k];
-            const double f = rig::projector_falloff(rp, (*xy)[0] + 0.5, (*xy)[1] + 0.5);
+            const double f = rig::projector_falloff(rp, (*xy)[0] + 0.5, (*xy)[1] + 0.5) *
+                             (seen ? rig::screen_gain(rig.screen, s, rp.pose.position_m, rig.viewer_m) : 1.0);
             for (int c = 0; c < 3; ++c) {
                 const double signal = apply_response(pc.response, c, w);
                 l += f * rp.brightness[static_cast<std::size_t>(c)] *
                      std::pow(signal, rp.gamma[static_cast<std::size_t>(c)]) / 3.0;
             }
         }
-        lum.push_back(l);
+        return l;
+    };
+    std::optional<rig::ScreenBounce> bounce;
+    std::vector<double> bounced;
+    if (rig.screen.interreflection > 0.0) {
+        bounce.emplace(rig.screen);
+        std::vector<double> leaving;
+        for (int i = 0; i < bounce->patches(); ++i) leaving.push_back(direct(bounce->centre(i), false, nullptr));
+        bounced = bounce->bounce(leaving);
+    }
+    std::vector<double> lum;
+    std::vector<bool> seam;
+    for (const rig::ScreenPoint& s : seam_grid(rig, inset, grid.columns, grid.rows)) {
+        int lit = 0;
+        lum.push_back(direct(s, true, &lit) + (bounce ? bounce->at(bounced, s) : 0.0));
         seam.push_back(lit >= 2);
     }
     LuminanceError out;

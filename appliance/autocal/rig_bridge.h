@@ -90,8 +90,9 @@ struct LuminanceError {
 [[nodiscard]] LensFalloff falloff_of(const rig::RigProjector& p);
 
 // White content through the calibration onto the rig (ground truth projections, the rig's
-// responses, brightness and lens fall-off, black level left out: black-level compensation is a
-// later step), on a grid of content points inset by `inset` of the frame on every side.
+// responses, brightness and lens fall-off, the screen's gain toward the rig's viewer and one bounce of its
+// own light; black level left out: black-level compensation is a later step), on a grid of content points
+// inset by `inset` of the frame on every side.
 // `grid`: the seam grid's size (pixel_dense_seam_grid for a maximum that sees one-pixel lines).
 [[nodiscard]] LuminanceError measure_luminance(const rig::VirtualRig& rig, const ScreenCalibration& calibration,
                                                double inset = 0.01, SeamGridSize grid = {});

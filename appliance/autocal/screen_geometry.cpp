@@ -158,6 +158,18 @@ Eigen::Vector3d screen_position(const ScreenModel& screen, double theta, double 
     return {r * std::sin(theta), h, -r * std::cos(theta)};
 }
 
+double screen_gain_at(const ScreenModel& screen, double theta, double h, const Eigen::Vector3d& source,
+                      const Eigen::Vector3d& observer) {
+    if (screen.gain == 1.0) return 1.0;
+    const Eigen::Vector3d x = screen_position(screen, theta, h);
+    const Eigen::Vector3d normal(-std::sin(theta), 0.0, std::cos(theta));  // toward the axis
+    const Eigen::Vector3d in = (x - source).normalized();
+    const Eigen::Vector3d mirrored = in - 2.0 * in.dot(normal) * normal;
+    const double alpha = std::acos(std::clamp(mirrored.dot((observer - x).normalized()), -1.0, 1.0));
+    const double t = alpha / (screen.half_gain_angle_deg * std::numbers::pi / 180.0);
+    return screen.gain * std::exp2(-t * t);
+}
+
 std::optional<Eigen::Vector3d> cylinder_hit(const ScreenModel& screen, const Eigen::Vector3d& o,
                                             const Eigen::Vector3d& d) {
     double bow = 0.0;

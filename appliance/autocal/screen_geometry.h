@@ -26,6 +26,11 @@ namespace mogao::autocal {
 // The screen point at (theta, h): at screen_radius_at's distance from the axis (screen frame).
 [[nodiscard]] Eigen::Vector3d screen_position(const ScreenModel& screen, double theta, double h);
 
+// G (ScreenModel's comment) at screen point (theta, h) for light from `source` seen from `observer` (screen
+// frame, metres; the cylinder's normal, the bow's slope left out); 1 on a matte screen.
+[[nodiscard]] double screen_gain_at(const ScreenModel& screen, double theta, double h, const Eigen::Vector3d& source,
+                                    const Eigen::Vector3d& observer);
+
 // Forward intersection of o + t d with the screen's surface, o inside; nullopt when the ray is
 // vertical. A cylinder in closed form; with a bow, Newton steps on the distance from the surface along
 // the ray (to 1e-12 m) from the hit of the cylinder of radius R, kept inside the bracket of the cylinders

@@ -59,7 +59,10 @@ CalibrationPrior prior_from_rig(const rig::VirtualRig& rig) {
                     rig.screen.arc_deg + e.screen_arc_error_deg,
                     rig.screen.bottom_m + e.screen_bottom_error_m,
                     rig.screen.top_m + e.screen_top_error_m,
-                    {}};
+                    {},
+                    rig.screen.gain + e.screen_gain_error,
+                    rig.screen.half_gain_angle_deg + e.screen_half_gain_angle_error_deg,
+                    rig.viewer_m};
     const rig::RigCamera& c = rig.camera;
     rig::RigPose pose = c.pose;
     pose.position_m += e.camera_position_error_m;

@@ -137,6 +137,8 @@ RigProjector read_projector(Table& t, int k) {
     // Lens distortion (OpenCV's k1, k2, p1, p2, k3 about the lens-shifted principal point) and defocus.
     p.intrinsics.distortion = t.numbers<5>("distortion", p.intrinsics.distortion);
     p.blur_px = t.number("blur_px", p.blur_px);
+    const auto centre = t.numbers<2>("distortion_centre_px", {0.0, 0.0});
+    p.distortion_centre_px = {centre[0], centre[1]};
     t.finish();
     return p;
 }
@@ -171,6 +173,7 @@ VirtualRig read_root(const toml::value& root, const std::string& file) {
     VirtualRig rig;
     rig.name = top.string("name", "rig");
     rig.ambient = top.number("ambient", rig.ambient);
+    rig.viewer_m = top.vector3("viewer_position_m", rig.viewer_m);
     if (const toml::value* s = top.find("screen")) {
         Table t(*s, "screen", file);
         rig.screen.radius_m = t.number("radius_m", rig.screen.radius_m);
@@ -178,6 +181,9 @@ VirtualRig read_root(const toml::value& root, const std::string& file) {
         rig.screen.bottom_m = t.number("bottom_m", rig.screen.bottom_m);
         rig.screen.top_m = t.number("top_m", rig.screen.top_m);
         rig.screen.bulge_m = t.number("bulge_m", rig.screen.bulge_m);
+        rig.screen.gain = t.number("gain", rig.screen.gain);
+        rig.screen.half_gain_angle_deg = t.number("half_gain_angle_deg", rig.screen.half_gain_angle_deg);
+        rig.screen.interreflection = t.number("interreflection", rig.screen.interreflection);
         t.finish();
     }
     // One camera as [camera], or several as [[cameras]] (the first is the calibration's).
@@ -210,6 +216,8 @@ VirtualRig read_root(const toml::value& root, const std::string& file) {
         rig.prior.screen_arc_error_deg = t.number("screen_arc_error_deg", 0.0);
         rig.prior.screen_bottom_error_m = t.number("screen_bottom_error_m", 0.0);
         rig.prior.screen_top_error_m = t.number("screen_top_error_m", 0.0);
+        rig.prior.screen_gain_error = t.number("screen_gain_error", 0.0);
+        rig.prior.screen_half_gain_angle_error_deg = t.number("screen_half_gain_angle_error_deg", 0.0);
         t.finish();
     }
     const toml::value* ps = top.find("projectors");

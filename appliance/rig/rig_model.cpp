@@ -12,13 +12,15 @@
 
 namespace mogao::rig {
 
-// The normalised radius of a projector's image corner farthest from its principal point.
+// The normalised radius of a projector's image corner farthest from its distortion's centre.
 double corner_radius(const RigProjector& p) {
     const RigIntrinsics& in = p.intrinsics;
+    const double cx = in.cx_px + p.distortion_centre_px.x();
+    const double cy = in.cy_px + p.distortion_centre_px.y();
     double corner = 0.0;
     for (const double x : {0.0, static_cast<double>(p.resolution.width)}) {
         for (const double y : {0.0, static_cast<double>(p.resolution.height)}) {
-            corner = std::max(corner, std::hypot((x - in.cx_px) / in.fx_px, (y - in.cy_px) / in.fy_px));
+            corner = std::max(corner, std::hypot((x - cx) / in.fx_px, (y - cy) / in.fy_px));
         }
     }
     return corner;
@@ -80,6 +82,10 @@ void validate_pose(const RigPose& pose, const RigScreen& screen, const std::stri
 // projection lens has, and the radial map r -> r (1 + k1 r^2 + k2 r^4 + k3 r^6) increasing out to 1.2
 // times the normalised radius of the image's farthest corner (one ray per image position).
 void validate_projector_distortion(const RigProjector& p, const std::string& f) {
+    check_range(p.distortion_centre_px.x(), -0.25 * p.resolution.width, 0.25 * p.resolution.width,
+                f + ".distortion_centre_px[0] (a quarter of the image's width)");
+    check_range(p.distortion_centre_px.y(), -0.25 * p.resolution.height, 0.25 * p.resolution.height,
+                f + ".distortion_centre_px[1] (a quarter of the image's height)");
     const auto& k = p.intrinsics.distortion;
     for (std::size_t i = 0; i < k.size(); ++i) {
         check_range(k[i], -kProjectorDistortionLimits[i], kProjectorDistortionLimits[i],
@@ -126,6 +132,9 @@ void validate_prior(const VirtualRig& rig) {
                 "prior.screen_bottom_error_m (0.1 x the screen's height)");
     check_range(e.screen_top_error_m, -0.1 * height, 0.1 * height,
                 "prior.screen_top_error_m (0.1 x the screen's height)");
+    check_range(s.gain + e.screen_gain_error, 1.0, 3.0, "screen.gain + prior.screen_gain_error (the told gain)");
+    check_range(s.half_gain_angle_deg + e.screen_half_gain_angle_error_deg, 10.0, 90.0,
+                "screen.half_gain_angle_deg + prior.screen_half_gain_angle_error_deg (the told angle)");
     check_range(e.camera_focal_error, -0.5, 0.5, "prior.camera_focal_error");
     check_range(e.camera_principal_point_error_px.x(), -0.25 * rig.camera.resolution.width,
                 0.25 * rig.camera.resolution.width, "prior.camera_principal_point_error_px[0]");
@@ -146,6 +155,9 @@ void validate_rig(const VirtualRig& rig) {
     check(std::isfinite(s.bottom_m) && std::isfinite(s.top_m) && s.top_m - s.bottom_m >= 0.01, "screen.top_m",
           "at least 0.01 m above screen.bottom_m");
     check_range(s.bulge_m, -0.02 * s.radius_m, 0.02 * s.radius_m, "screen.bulge_m (2 % of radius_m)");
+    check_range(s.gain, 1.0, 3.0, "screen.gain");
+    check_range(s.half_gain_angle_deg, 10.0, 90.0, "screen.half_gain_angle_deg");
+    check_range(s.interreflection, 0.0, 1.0, "screen.interreflection");
     // Its largest slope, pi |bulge| / the shorter of the screen's height and arc length, at most 0.2: a
     // slightly bowed screen (and the fixed-point intersection above converges).
     const double span = std::min(s.top_m - s.bottom_m, s.radius_m * s.arc_deg * kDeg);
@@ -167,6 +179,9 @@ void validate_rig(const VirtualRig& rig) {
         check_range(p.falloff, 0.0, 0.45, f + ".falloff");
         check_range(p.blur_px, 0.0, 10.0, f + ".blur_px");
     }
+    for (int i = 0; i < 3; ++i) check_range(rig.viewer_m[i], -1e3, 1e3, "viewer_position_m");
+    check(std::hypot(rig.viewer_m.x(), rig.viewer_m.z()) < s.radius_m - std::max(0.0, -s.bulge_m), "viewer_position_m",
+          "inside the cylinder");
     check(rig.more_cameras.size() <= 7, "cameras", "1..8 cameras");
     validate_camera(rig.camera, s, "camera");
     for (std::size_t i = 0; i < rig.more_cameras.size(); ++i) {

@@ -34,6 +34,14 @@ struct RigScreen {
     // is bulge_m away from it (positive: away from the viewer). [-0.02, 0.02] x radius_m; 0 = a cylinder.
     // The calibration is not told: it assumes the cylinder (rigs/bulge.toml).
     double bulge_m = 0.0;
+    // A screen that is not matte (virtual_rig.h's header comment, "Screen gain"): its data sheet's peak gain
+    // (luminance over a matte screen's, [1, 3]; 1 = matte, Lambertian) and half-gain angle (degrees off the peak
+    // where the luminance is half the peak's, [10, 90]). The calibration is not told.
+    double gain = 1.0;
+    double half_gain_angle_deg = 40.0;
+    // Screen-to-screen light: the screen's reflectance for one bounce of the light it throws onto itself
+    // (virtual_rig.h's header comment, "Interreflection"), [0, 1]; 0 = none. The calibration is not told.
+    double interreflection = 0.0;
 };
 
 struct RigPose {
@@ -62,6 +70,10 @@ struct RigProjector {
     std::array<double, 3> brightness{1.0, 1.0, 1.0};  // full white per channel, (0, 100]
     double falloff = 0.0;                             // lens fall-off at half the diagonal, [0, 0.45]
     double blur_px = 0.0;  // defocus: Gaussian sigma in projector pixels, [0, 10] (header comment)
+    // Where the lens's distortion is centred, in projector pixels from the principal point (x right, y down;
+    // each within a quarter of the image's side): a lens whose shift moved its distortion off the optical axis, a
+    // displacement no principal point or OpenCV coefficient expresses exactly (virtual_rig.h's header comment).
+    Eigen::Vector2d distortion_centre_px{0.0, 0.0};
 };
 
 struct RigCamera {
@@ -109,6 +121,10 @@ struct RigPrior {
     // changes its height and so the scale the calibration takes from it (docs/calibration.md, "Rig files").
     double screen_bottom_error_m = 0.0;
     double screen_top_error_m = 0.0;
+    // The screen's data sheet (added to the truth's RigScreen::gain and half_gain_angle_deg; the told values stay
+    // within their ranges): a gain screen's lobe as the calibration is told it.
+    double screen_gain_error = 0.0;
+    double screen_half_gain_angle_error_deg = 0.0;
 };
 
 struct VirtualRig {
@@ -118,6 +134,9 @@ struct VirtualRig {
     RigCamera camera;                      // camera 0: the one the calibration films with
     std::vector<RigCamera> more_cameras;   // cameras 1..7 (rig file: [[cameras]] after the first)
     double ambient = 0.01;                 // linear light everywhere on the screen, [0, 10]
+    // Where the ground truth's light is seen from (a gain screen looks different from every place; a matte one
+    // does not): a visitor's eye, screen frame, inside the cylinder. The camera films from its own pose.
+    Eigen::Vector3d viewer_m{0.0, 1.6, 0.0};
     RigPrior prior;
 };
 
@@ -142,8 +161,9 @@ void validate_rig(const VirtualRig& rig);
 [[nodiscard]] Eigen::Vector2d distort(const std::array<double, 5>& k, double x, double y);
 [[nodiscard]] Eigen::Vector2d undistort(const std::array<double, 5>& k, double xd, double yd);
 
-// The normalised radius of projector p's image corner farthest from its principal point; a projector's
-// distortion is validated (one-to-one) out to 1.2 times it, and ground truth is given only within that.
+// The normalised radius of projector p's image corner farthest from its distortion's centre (the principal point
+// moved by distortion_centre_px); a projector's distortion is validated (one-to-one) out to 1.2 times it, and
+// ground truth is given only within that.
 [[nodiscard]] double corner_radius(const RigProjector& p);
 
 // A projection lens's Brown-Conrady coefficients (k1, k2, p1, p2, k3) lie within +-these.

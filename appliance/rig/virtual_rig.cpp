@@ -13,6 +13,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "appliance/rig/screen_light.h"
 #include "common/jpeg_codec.h"
 
 namespace mogao::rig {
@@ -21,6 +22,8 @@ namespace {
 using detail::check_range;
 
 constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr int kPatchSamples = 4;  // per side: where each screen patch's light leaving it is sampled
+constexpr int kPatchBlock = 8;    // projector pixels per side averaged into each such sample
 
 // The far (forward) intersection of o + t d with the cylinder x^2 + z^2 = r^2, o inside.
 std::optional<Eigen::Vector3d> hit_cylinder(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double r) {
@@ -72,9 +75,9 @@ std::optional<ScreenPoint> on_screen(const RigScreen& screen, const Eigen::Vecto
     return s;
 }
 
-Eigen::Vector3d screen_position(const RigScreen& screen, ScreenPoint p) {
-    const double r = radius_at(screen, p.theta_rad, p.h_m);
-    return {r * std::sin(p.theta_rad), p.h_m, -r * std::cos(p.theta_rad)};
+// The distortion's centre of projector p in normalised coordinates (RigProjector::distortion_centre_px).
+Eigen::Vector2d distortion_centre(const RigProjector& p) {
+    return {p.distortion_centre_px.x() / p.intrinsics.fx_px, p.distortion_centre_px.y() / p.intrinsics.fy_px};
 }
 
 // Light per projector pixel value before the fall-off, per channel: brightness * (black + (1 - black) * s^gamma),
@@ -106,6 +109,11 @@ cv::Mat1f defocused_light(const RigProjector& p, const cv::Mat& signal) {
 
 }  // namespace
 
+Eigen::Vector3d screen_position(const RigScreen& screen, ScreenPoint p) {
+    const double r = radius_at(screen, p.theta_rad, p.h_m);
+    return {r * std::sin(p.theta_rad), p.h_m, -r * std::cos(p.theta_rad)};
+}
+
 double projector_falloff(const RigProjector& p, double x, double y) {
     const double half_diagonal = 0.5 * std::hypot(p.resolution.width, p.resolution.height);
     const double rho2 =
@@ -126,8 +134,9 @@ std::optional<ScreenPoint> projector_to_screen(const VirtualRig& rig, int k, dou
     const RigIntrinsics& in = p.intrinsics;
     Eigen::Vector3d d_dev((x - in.cx_px) / in.fx_px, (y - in.cy_px) / in.fy_px, 1.0);
     if (in.distortion != std::array<double, 5>{}) {
-        const Eigen::Vector2d u = undistort(in.distortion, d_dev.x(), d_dev.y());
-        const Eigen::Vector2d back = distort(in.distortion, u.x(), u.y());
+        const Eigen::Vector2d c = distortion_centre(p);
+        const Eigen::Vector2d u = c + undistort(in.distortion, d_dev.x() - c.x(), d_dev.y() - c.y());
+        const Eigen::Vector2d back = c + distort(in.distortion, u.x() - c.x(), u.y() - c.y());
         if (!((back - d_dev.head<2>()).norm() < 1e-10)) return std::nullopt;  // not converged: no ground truth
         d_dev.head<2>() = u;
     }
@@ -145,8 +154,9 @@ std::optional<Eigen::Vector2d> screen_to_projector(const VirtualRig& rig, int k,
     Eigen::Vector2d n(d.x() / d.z(), d.y() / d.z());
     if (in.distortion != std::array<double, 5>{}) {
         // Far outside the image the polynomial folds back: only rays within the validated radius count.
-        if (n.norm() > 1.2 * corner_radius(p)) return std::nullopt;
-        n = distort(in.distortion, n.x(), n.y());
+        const Eigen::Vector2d c = distortion_centre(p);
+        if ((n - c).norm() > 1.2 * corner_radius(p)) return std::nullopt;
+        n = c + distort(in.distortion, n.x() - c.x(), n.y() - c.y());
     }
     const Eigen::Vector2d xy(in.fx_px * n.x() + in.cx_px, in.fy_px * n.y() + in.cy_px);
     if (!(xy.x() >= 0.0 && xy.x() < p.resolution.width && xy.y() >= 0.0 && xy.y() < p.resolution.height)) {
@@ -207,6 +217,105 @@ CameraSimulator::CameraSimulator(const VirtualRig& rig) : rig_(rig) {
             }
         }
     });
+    if (rig_.screen.gain != 1.0 || rig_.screen.interreflection > 0.0) trace_screen_light();
+}
+
+void CameraSimulator::trace_screen_light() {
+    const RigCamera& cam = rig_.camera;
+    const ImageSize res = cam.resolution;
+    std::vector<cv::Point2d> distorted;
+    distorted.reserve(static_cast<std::size_t>(res.width) * res.height);
+    for (int y = 0; y < res.height; ++y) {
+        for (int x = 0; x < res.width; ++x) {
+            distorted.emplace_back((x + 0.5 - cam.intrinsics.cx_px) / cam.intrinsics.fx_px,
+                                   (y + 0.5 - cam.intrinsics.cy_px) / cam.intrinsics.fy_px);
+        }
+    }
+    std::vector<cv::Point2d> ideal(distorted.size());
+    cv::undistortPoints(distorted, ideal, cv::Matx33d::eye(), cam.intrinsics.distortion, cv::noArray(), cv::noArray(),
+                        cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100, 1e-14));
+    // Each pixel centre's ray on the cylinder, held to the screen: gain and bounce are smooth, so a pixel
+    // at the screen's edge takes its nearest screen point's.
+    const Eigen::Matrix3d r = device_to_screen(cam.pose);
+    const double half = rig_.screen.arc_deg * kDeg / 2.0;
+    pixel_point_.assign(ideal.size(), ScreenPoint{});
+    for (std::size_t i = 0; i < ideal.size(); ++i) {
+        const auto hit =
+            hit_cylinder(cam.pose.position_m, r * Eigen::Vector3d(ideal[i].x, ideal[i].y, 1.0), rig_.screen.radius_m);
+        if (!hit) continue;
+        pixel_point_[i] = {std::clamp(std::atan2(hit->x(), -hit->z()), -half, half),
+                           std::clamp(hit->y(), rig_.screen.bottom_m, rig_.screen.top_m)};
+    }
+    const std::size_t np = rig_.projectors.size();
+    if (rig_.screen.gain != 1.0) {
+        gain_.assign(np, std::vector<float>(ideal.size(), 1.0F));
+        for (std::size_t k = 0; k < np; ++k) {
+            for (std::size_t i = 0; i < ideal.size(); ++i) {
+                gain_[k][i] = static_cast<float>(
+                    screen_gain(rig_.screen, pixel_point_[i], rig_.projectors[k].pose.position_m, cam.pose.position_m));
+            }
+        }
+    }
+    if (rig_.screen.interreflection > 0.0) {
+        auto bounce = std::make_shared<ScreenBounce>(rig_.screen);
+        patch_pixel_.assign(np, {});
+        for (std::size_t k = 0; k < np; ++k) {
+            for (int i = 0; i < bounce->patches(); ++i) {
+                const ScreenPoint c = bounce->centre(i);
+                for (int j = 0; j < kPatchSamples * kPatchSamples; ++j) {
+                    const ScreenPoint q{
+                        c.theta_rad + ((j % kPatchSamples + 0.5) / kPatchSamples - 0.5) * bounce->patch_theta_rad(),
+                        c.h_m + ((j / kPatchSamples + 0.5) / kPatchSamples - 0.5) * bounce->patch_height_m()};
+                    const auto xy = screen_to_projector(rig_, static_cast<int>(k), q);
+                    patch_pixel_[k].push_back(xy ? Eigen::Vector2f(xy->cast<float>()) : Eigen::Vector2f(-1.0F, -1.0F));
+                }
+            }
+        }
+        bounce_ = std::move(bounce);
+    }
+}
+
+std::vector<double> CameraSimulator::patch_light(const std::vector<cv::Mat>& signals,
+                                                 const std::vector<cv::Mat1f>& blurred) const {
+    const int n = bounce_->patches();
+    std::vector<double> leaving(static_cast<std::size_t>(n), 0.0);
+    for (std::size_t k = 0; k < rig_.projectors.size(); ++k) {
+        const RigProjector& p = rig_.projectors[k];
+        // The projector's light image, averaged over blocks of kPatchBlock pixels: the patches' samples then
+        // see each block's mean, not one pixel of a fine stripe.
+        cv::Mat1f light = blurred[k];
+        if (light.empty()) {
+            light.create(p.resolution.height, p.resolution.width);
+            const float zero = 0.0F;
+            const cv::Mat& s = signals[k];
+            cv::parallel_for_(cv::Range(0, light.rows), [&](const cv::Range& rows) {
+                for (int y = rows.start; y < rows.end; ++y) {
+                    for (int x = 0; x < light.cols; ++x) {
+                        light(y, x) = static_cast<float>(
+                            s.empty() ? projector_light(p, &zero, 1)
+                                      : projector_light(p, s.ptr<float>(y) + x * s.channels(), s.channels()));
+                    }
+                }
+            });
+        }
+        cv::Mat1f coarse;
+        cv::resize(light, coarse,
+                   cv::Size((light.cols + kPatchBlock - 1) / kPatchBlock, (light.rows + kPatchBlock - 1) / kPatchBlock),
+                   0, 0, cv::INTER_AREA);
+        const std::vector<Eigen::Vector2f>& px = patch_pixel_[k];
+        for (int i = 0; i < n; ++i) {
+            double sum = 0.0;
+            for (int j = 0; j < kPatchSamples * kPatchSamples; ++j) {
+                const Eigen::Vector2f xy = px[static_cast<std::size_t>(i * kPatchSamples * kPatchSamples + j)];
+                if (xy.x() < 0.0F) continue;
+                const int cx = std::min(static_cast<int>(xy.x()) * coarse.cols / light.cols, coarse.cols - 1);
+                const int cy = std::min(static_cast<int>(xy.y()) * coarse.rows / light.rows, coarse.rows - 1);
+                sum += projector_falloff(p, xy.x(), xy.y()) * coarse(cy, cx);
+            }
+            leaving[static_cast<std::size_t>(i)] += sum / (kPatchSamples * kPatchSamples);
+        }
+    }
+    return leaving;
 }
 
 namespace {
@@ -292,6 +401,9 @@ cv::Mat1f CameraSimulator::capture(const std::vector<cv::Mat>& signals, std::uin
         if (rig_.projectors[k].blur_px > 0.0 && !signals[k].empty())
             blurred[k] = defocused_light(rig_.projectors[k], signals[k]);
     }
+    // Interreflection: the light the screen throws onto itself, one bounce (header comment).
+    std::optional<std::vector<double>> bounced;
+    if (bounce_) bounced = bounce_->bounce(patch_light(signals, blurred));
     const int ss = rig_.camera.supersample;
     const ImageSize res = rig_.camera.resolution;
     cv::Mat1f img(res.height, res.width, 0.0f);
@@ -299,10 +411,13 @@ cv::Mat1f CameraSimulator::capture(const std::vector<cv::Mat>& signals, std::uin
         for (int y = rows.start; y < rows.end; ++y) {
             for (int x = 0; x < res.width; ++x) {
                 double acc = 0.0;
+                const double on_screen_light =
+                    rig_.ambient +
+                    (bounced ? bounce_->at(*bounced, pixel_point_[static_cast<std::size_t>(y) * res.width + x]) : 0.0);
                 for (int sy = 0; sy < ss; ++sy) {
                     for (int sx = 0; sx < ss; ++sx) {
                         const std::size_t i = static_cast<std::size_t>(y * ss + sy) * samples_w_ + (x * ss + sx);
-                        double l = on_screen_[i] ? rig_.ambient : 0.3 * rig_.ambient;
+                        double l = on_screen_[i] ? on_screen_light : 0.3 * rig_.ambient;
                         for (std::size_t k = 0; k < np; ++k) {
                             const std::int32_t h = hit_[k][i];
                             if (h < 0) continue;
@@ -312,13 +427,16 @@ cv::Mat1f CameraSimulator::capture(const std::vector<cv::Mat>& signals, std::uin
                             const double f = p.falloff == 0.0 ? 1.0
                                                               : projector_falloff(p, h % p.resolution.width + 0.5,
                                                                                   h / p.resolution.width + 0.5);
+                            const double g =
+                                gain_.empty() ? 1.0 : gain_[k][static_cast<std::size_t>(y) * res.width + x];
                             if (!blurred[k].empty()) {
-                                l += f * blurred[k](h / p.resolution.width, h % p.resolution.width);
+                                l += g * f * blurred[k](h / p.resolution.width, h % p.resolution.width);
                                 continue;
                             }
-                            l += f * (s.empty() ? light(k, &zero, 1)
-                                                : light(k, s.ptr<float>() + static_cast<std::size_t>(h) * s.channels(),
-                                                        s.channels()));
+                            l += g * f *
+                                 (s.empty() ? light(k, &zero, 1)
+                                            : light(k, s.ptr<float>() + static_cast<std::size_t>(h) * s.channels(),
+                                                    s.channels()));
                         }
                         acc += l;
                     }

@@ -28,7 +28,20 @@
 // OpenCV calib3d "Camera Calibration and 3D Reconstruction", cv::projectPoints). An image position's
 // ray is the model inverted by fixed-point iteration (as cv::undistortPoints) to 1e-14.
 // A projector's distortion must keep its image one-to-one out to 1.2 times its corners' radius
-// (validate_rig), so that every image position has one ray.
+// (validate_rig), so that every image position has one ray. A projector's distortion may be centred off its
+// principal point (RigProjector::distortion_centre_px = (dx, dy), c = (dx / fx, dy / fy)): the ray (x, y, 1)
+// then reaches the distorted normalised position c + D(x - c, y - c), D the model above. Brown's decentring
+// terms (p1, p2) are this offset's leading part; the rest (third order in c) no OpenCV coefficient expresses.
+// Screen gain (RigScreen::gain = g, half_gain_angle_deg = b): the light a screen point sends toward an
+// observer is a matte screen's times G = g 2^(-(alpha / b)^2), alpha the angle between the direction to the
+// observer and the projector's ray mirrored about the cylinder's normal there (a Gaussian lobe about the
+// mirror direction whose peak and half-peak angle are the data sheet's; g = 1: G = 1, matte). The camera
+// sees it from its own pose, the ground truth from VirtualRig::viewer_m.
+// Interreflection (RigScreen::interreflection = rho): the screen lights itself. Cut into patches about
+// 0.1 m square (screen_light.h), each patch's light leaving it matte (the mean of its direct light) adds
+// rho sum_j F_ij L_j to patch i, F_ij = cos_i cos_j A_j / (pi d_ij^2) the form factor of a small patch
+// (Cohen & Wallace, "Radiosity and Realistic Image Synthesis", 1993, ch. 4; every pair of points of a
+// cylinder's inside sees the other); one bounce, interpolated bilinearly between patch centres, seen matte.
 //
 // Light (linear, relative to a projector's full white = 1): projector k at signal s in [0, 1]
 // (per channel c) puts F_k(x, y) * brightness_k[c] * (black + (1 - black) * s^gamma_k[c]) on the
@@ -62,6 +75,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -79,6 +93,8 @@ struct ScreenPoint {
     double h_m = 0.0;
 };
 
+class ScreenBounce;
+
 // Ground truth: where the ray through projector k's image position (x, y) lands on the screen, or
 // nullopt when it misses the screen (beyond the arc or the heights).
 [[nodiscard]] std::optional<ScreenPoint> projector_to_screen(const VirtualRig& rig, int k, double x, double y);
@@ -86,6 +102,9 @@ struct ScreenPoint {
 // Ground truth, the other way: the image position of projector k that lands on screen point p, or
 // nullopt when p is behind the projector or outside its image [0, W) x [0, H).
 [[nodiscard]] std::optional<Eigen::Vector2d> screen_to_projector(const VirtualRig& rig, int k, ScreenPoint p);
+
+// The screen's point (theta, h) in the screen frame (a bowed screen's at its own distance from the axis).
+[[nodiscard]] Eigen::Vector3d screen_position(const RigScreen& screen, ScreenPoint p);
 
 // Camera vignetting V at camera image position (x, y) (header comment; 1 on the principal point).
 [[nodiscard]] double camera_vignetting(const RigCamera& c, double x, double y);
@@ -126,6 +145,17 @@ private:
     int samples_h_ = 0;
     std::vector<std::uint8_t> on_screen_;         // per sample
     std::vector<std::vector<std::int32_t>> hit_;  // per projector, per sample: pixel index or -1
+    // Screen gain toward the camera (RigScreen::gain != 1): per projector, per camera pixel, G at the pixel's centre.
+    std::vector<std::vector<float>> gain_;
+    // Interreflection (RigScreen::interreflection > 0): the patches, each camera pixel's screen point (its centre's
+    // ray on the cylinder, clamped to the screen) and each patch centre's pixel of every projector (or -1).
+    std::shared_ptr<const ScreenBounce> bounce_;
+    std::vector<ScreenPoint> pixel_point_;
+    std::vector<std::vector<Eigen::Vector2f>> patch_pixel_;
+    void trace_screen_light();  // fills gain_, bounce_, pixel_point_ and patch_pixel_ (constructor)
+    // The light leaving every patch (direct light, matte) for the projectors' signals.
+    [[nodiscard]] std::vector<double> patch_light(const std::vector<cv::Mat>& signals,
+                                                  const std::vector<cv::Mat1f>& blurred) const;
 };
 
 }  // namespace mogao::rig

@@ -25,6 +25,7 @@ EXTRA_RUNS = {"roughscreen": [["--fit-screen"], ["--fit-heights"]], "falloff": [
               "realistic-install": [["--fit-screen"], ["--fit-heights"]]}
 # Rigs also run at full resolution (x1), a row for each list of options they need there.
 X1_RUNS = {"standard": [[]], "focal": [[]], "realistic": [[]], "realistic-lens": [[]], "realistic-optics": [[]],
+           "realistic-screen": [[]],
            "realistic-install": [["--fit-screen"], ["--fit-heights"]]}
 # The gates after which the table still shows a refused run's figures (the run again with them lifted), by the
 # refusal's first words: what these two gates judge is the error the truth measures.

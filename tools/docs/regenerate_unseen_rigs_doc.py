@@ -4,8 +4,9 @@
 never developed on. Each draw starts from one of rigs/realistic*.toml and draws every error and placement of
 that rig's kinds anew, within the ranges below (a real installation's, as those rig files state them): the
 camera's placement and its chessboard intrinsics' errors, the installer's pose errors, the projectors' poses,
-data-sheet focal errors, lens distortion and defocus, the screen heights a tape gives, the camera's
-vignetting and Motion-JPEG quality. Only kinds the base rig has are drawn (a rig without projector distortion
+data-sheet focal errors, lens distortion (and where its centre lies) and defocus, the screen heights a tape
+gives, the camera's vignetting and Motion-JPEG quality, the screen's gain (and its data sheet's errors) and the
+light it throws onto itself. Only kinds the base rig has are drawn (a rig without projector distortion
 gets none). The draws depend on the seed alone, never on a result. Each drawn rig is calibrated as a
 technician would run it: `mogao-calibrate-sim rig`, and again with `--fit-screen` where that is refused
 naming the screen (heights told wrong by a tape); a draw whose heights were taped also with `--fit-heights`
@@ -50,7 +51,15 @@ def draw_rig(base, rng, name):
              "camera_distortion_error": lambda: [u(rng, 0.012), u(rng, 0.005), 0.0, 0.0, 0.0],
              "projector_focal_error": lambda: u(rng, 0.04),
              "screen_bottom_error_m": lambda: u(rng, 0.02),
-             "screen_top_error_m": lambda: u(rng, 0.02)}
+             "screen_top_error_m": lambda: u(rng, 0.02),
+             "screen_gain_error": lambda: u(rng, 0.05),
+             "screen_half_gain_angle_error_deg": lambda: u(rng, 5.0)}
+    screen = rig["screen"]
+    if screen.get("gain", 1.0) != 1.0:
+        screen["gain"] = rng.uniform(1.1, 1.5)
+        screen["half_gain_angle_deg"] = rng.uniform(30.0, 60.0)
+    if screen.get("interreflection", 0.0) > 0.0:
+        screen["interreflection"] = rng.uniform(0.6, 0.9)
     for key, draw in draws.items():
         if key in prior:
             prior[key] = draw()
@@ -63,6 +72,8 @@ def draw_rig(base, rng, name):
             p["distortion"] = [u(rng, 0.05), u(rng, 0.01), u(rng, 0.002), u(rng, 0.002), 0.0]
         if "blur_px" in p:
             p["blur_px"] = rng.uniform(0.4, 1.0)
+        if "distortion_centre_px" in p:
+            p["distortion_centre_px"] = [u(rng, 80.0), u(rng, 60.0)]
     return rig
 
 
