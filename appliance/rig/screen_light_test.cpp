@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
 
+#include "appliance/rig/opencv_camera_model.h"
 #include "appliance/rig/rig_file.h"
 #include "appliance/rig/virtual_rig.h"
 
@@ -32,23 +33,10 @@ VirtualRig quiet_standard() {
     return rig;
 }
 
-// Where the rig camera sees screen point s: OpenCV's projectPoints with the camera's pose and lens.
+// The camera pixel that sees screen point s (OpenCV's camera model, opencv_camera_model.h).
 cv::Point camera_pixel(const VirtualRig& rig, ScreenPoint s) {
-    const RigCamera& cam = rig.camera;
-    const Eigen::Matrix3d r_sc = device_to_screen(cam.pose).transpose();
-    const Eigen::Vector3d t = -r_sc * cam.pose.position_m;
-    cv::Matx33d rm;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) rm(i, j) = r_sc(i, j);
-    cv::Vec3d rvec;
-    cv::Rodrigues(rm, rvec);
-    const cv::Matx33d kmat(cam.intrinsics.fx_px, 0, cam.intrinsics.cx_px - 0.5, 0, cam.intrinsics.fy_px,
-                           cam.intrinsics.cy_px - 0.5, 0, 0, 1);
-    const Eigen::Vector3d p = screen_position(rig.screen, s);
-    std::vector<cv::Point2d> image;
-    cv::projectPoints(std::vector<cv::Point3d>{{p.x(), p.y(), p.z()}}, rvec, cv::Vec3d(t.x(), t.y(), t.z()), kmat,
-                      cam.intrinsics.distortion, image);
-    return {static_cast<int>(std::floor(image[0].x + 0.5)), static_cast<int>(std::floor(image[0].y + 0.5))};
+    const cv::Point2d p = opencv_camera_image(rig.camera, screen_position(rig.screen, s));
+    return {static_cast<int>(std::floor(p.x)), static_cast<int>(std::floor(p.y))};
 }
 
 TEST(ScreenGain, PeaksInTheMirrorDirectionAndHalvesAtTheHalfGainAngle) {

@@ -16,6 +16,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "appliance/rig/opencv_camera_model.h"
 #include "appliance/rig/rig_file.h"
 
 namespace mogao::rig {
@@ -124,27 +125,13 @@ void expect_blocks_where_the_camera_model_projects_them(VirtualRig rig) {
     rig.camera.read_noise = 0.0;
     rig.camera.shot_noise = 0.0;
     const CameraSimulator sim(rig);
-    const RigCamera& cam = rig.camera;
-    // Independent camera model: OpenCV's projectPoints with the rig's pose and distortion.
-    const Eigen::Matrix3d r_sc = device_to_screen(cam.pose).transpose();
-    const Eigen::Vector3d t = -r_sc * cam.pose.position_m;
-    cv::Matx33d rm;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) rm(i, j) = r_sc(i, j);
-    cv::Vec3d rvec;
-    cv::Rodrigues(rm, rvec);
-    const cv::Matx33d kmat(cam.intrinsics.fx_px, 0, cam.intrinsics.cx_px - 0.5, 0, cam.intrinsics.fy_px,
-                           cam.intrinsics.cy_px - 0.5, 0, 0, 1);
     for (int k = 0; k < 3; ++k) {
         const double px = 960.0;
         const double py = 540.0;
         const auto s = projector_to_screen(rig, k, px, py);
         ASSERT_TRUE(s.has_value());
-        const double radius = rig.screen.radius_m;
-        const std::vector<cv::Point3d> world{
-            {radius * std::sin(s->theta_rad), s->h_m, -radius * std::cos(s->theta_rad)}};
-        std::vector<cv::Point2d> image;
-        cv::projectPoints(world, rvec, cv::Vec3d(t.x(), t.y(), t.z()), kmat, cam.intrinsics.distortion, image);
+        const cv::Point2d image =
+            opencv_camera_image(rig.camera, screen_position(rig.screen, *s)) - cv::Point2d(0.5, 0.5);
         std::vector<cv::Mat> signals(3);
         signals[static_cast<std::size_t>(k)] = cv::Mat1f(1080, 1920, 0.0f);
         cv::rectangle(signals[static_cast<std::size_t>(k)], cv::Rect(940, 520, 40, 40), 1.0, cv::FILLED);
@@ -153,8 +140,8 @@ void expect_blocks_where_the_camera_model_projects_them(VirtualRig rig) {
         cv::Mat1f smooth;
         cv::GaussianBlur(img, smooth, cv::Size(0, 0), 3.0);
         cv::minMaxLoc(smooth, nullptr, nullptr, nullptr, &peak);
-        EXPECT_NEAR(peak.x, image[0].x, 1.5) << "projector " << k;
-        EXPECT_NEAR(peak.y, image[0].y, 1.5) << "projector " << k;
+        EXPECT_NEAR(peak.x, image.x, 1.5) << "projector " << k;
+        EXPECT_NEAR(peak.y, image.y, 1.5) << "projector " << k;
     }
 }
 
