@@ -47,6 +47,28 @@ TEST(Autocal, StandardRigAccuracyAgainstGroundTruth) {
     EXPECT_LE(l.max_deviation, 0.01);
 }
 
+// A rig at reduced resolution is the same room: every projector's image position, scaled, lands where it did
+// (its lens's distortion and the distortion's centre, rigs/realistic-screen.toml, included).
+TEST(Autocal, AScaledRigLandsEveryScaledImagePositionWhereItDid) {
+    const rig::VirtualRig full = load("realistic-screen");
+    const rig::VirtualRig half = scaled_rig(full, 0.5, 0.5);
+    int compared = 0;
+    for (int k = 0; k < 3; ++k) {
+        for (const double x : {100.0, 700.0, 1300.0, 1850.0}) {
+            for (const double y : {80.0, 540.0, 1000.0}) {
+                const auto a = rig::projector_to_screen(full, k, x, y);
+                const auto b = rig::projector_to_screen(half, k, x / 2.0, y / 2.0);
+                ASSERT_EQ(a.has_value(), b.has_value()) << k << " " << x << " " << y;
+                if (!a) continue;
+                EXPECT_NEAR(a->theta_rad, b->theta_rad, 1e-9) << k << " " << x << " " << y;
+                EXPECT_NEAR(a->h_m, b->h_m, 1e-9) << k << " " << x << " " << y;
+                ++compared;
+            }
+        }
+    }
+    EXPECT_GT(compared, 12);  // 16: the rest of these positions light no screen
+}
+
 TEST(Autocal, RefusesAProjectorTheCameraBarelySees) {
     rig::VirtualRig rig = scaled_rig(load("standard"), 0.25, 0.5);
     rig.projectors[2].pose.yaw_deg = -120.0;  // a sliver of it on the arc's end

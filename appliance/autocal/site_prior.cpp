@@ -33,8 +33,12 @@ rig::VirtualRig scaled_rig(const rig::VirtualRig& rig, double projector_scale, d
     }
     rig::VirtualRig out = rig;
     for (rig::RigProjector& p : out.projectors) {
+        const ImageSize before = p.resolution;
         scale_device(p.resolution, p.intrinsics, projector_scale);
         p.blur_px *= projector_scale;  // the same defocus on the screen, in the scaled projector's pixels
+        // The same lens: its distortion's centre is in the projector's pixels too.
+        p.distortion_centre_px.x() *= static_cast<double>(p.resolution.width) / before.width;
+        p.distortion_centre_px.y() *= static_cast<double>(p.resolution.height) / before.height;
     }
     const ImageSize camera_before = out.camera.resolution;
     scale_device(out.camera.resolution, out.camera.intrinsics, camera_scale);
