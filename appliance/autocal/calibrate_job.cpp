@@ -17,6 +17,7 @@
 #include "appliance/calibration/mpcdi_screen.h"
 #include "appliance/calibration/mpcdi_writer.h"
 #include "appliance/rig/rig_file.h"
+#include "appliance/rig/screen_light.h"
 #include "appliance/warp/response_curve.h"
 #include "appliance/warp/warp_sampling.h"
 #include "common/png_io.h"
@@ -24,40 +25,55 @@
 namespace mogao::autocal {
 namespace {
 
-// The screen as the viewer sees it: per content pixel of a size x size/aspect image, the light of
-// every projector whose (ground-truth) pixel lands there, showing white content with grid lines.
+// The light of white content with grid lines at screen point s, every projector whose (ground-truth) pixel lands
+// there: as the rig's viewer sees it (`seen`: through the screen's gain) or as it leaves a matte screen.
+double preview_light(const rig::VirtualRig& rig, const ScreenCalibration& c, const rig::ScreenPoint& s, bool seen) {
+    double l = 0.0;
+    for (std::size_t k = 0; k < c.projectors.size(); ++k) {
+        const auto p = rig::screen_to_projector(rig, static_cast<int>(k), s);
+        if (!p) continue;
+        const ProjectorCalibration& pc = c.projectors[k];
+        const int px = static_cast<int>(p->x());
+        const int py = static_cast<int>(p->y());
+        const ContentUv uv = sample_warp(pc.warp, pc.output, px, py);
+        if (!uv.valid()) continue;
+        const double gu = uv.u * 16.0 - std::round(uv.u * 16.0);
+        const double gv = uv.v * 16.0 - std::round(uv.v * 16.0);
+        const double content = (std::abs(gu) < 0.01 || std::abs(gv) < 0.01) ? 0.1 : 1.0;
+        // The rig's light (mean of the channels, black level included) for the signal
+        // render_output gives: content x blend + beta -> response LUT, per channel.
+        const float w = sample_blend(pc.blend, pc.output, px, py);
+        const std::array<float, 3> beta = sample_beta(pc.beta, pc.output, px, py);
+        const rig::RigProjector& rp = rig.projectors[k];
+        const double f = rig::projector_falloff(rp, p->x(), p->y()) *
+                         (seen ? rig::screen_gain(rig.screen, s, rp.pose.position_m, rig.viewer_m) : 1.0);
+        for (std::size_t ch = 0; ch < 3; ++ch) {
+            const double signal =
+                apply_response(pc.response, static_cast<int>(ch), static_cast<float>(content) * w + beta[ch]);
+            l += f * rp.brightness[ch] * (rp.black_level + (1.0 - rp.black_level) * std::pow(signal, rp.gamma[ch])) /
+                 3.0;
+        }
+    }
+    return l;
+}
+
+// The screen as the viewer sees it: per content pixel of a size x size/aspect image, preview_light as seen, plus one
+// bounce of the screen's own light (virtual_rig.h's header comment).
 Rgb8Image preview(const rig::VirtualRig& rig, const ScreenCalibration& c, int width) {
     const int height = std::max(1, width * c.content.height / c.content.width);
+    std::optional<rig::ScreenBounce> bounce;
+    std::vector<double> bounced;
+    if (rig.screen.interreflection > 0.0) {
+        bounce.emplace(rig.screen);
+        std::vector<double> leaving;
+        for (int i = 0; i < bounce->patches(); ++i) leaving.push_back(preview_light(rig, c, bounce->centre(i), false));
+        bounced = bounce->bounce(leaving);
+    }
     cv::Mat1f light(height, width, 0.0f);
     for (int y = 0; y < height; ++y) {
         for (int x = 0; x < width; ++x) {
             const rig::ScreenPoint s = rig::screen_of(rig.screen, {(x + 0.5) / width, (y + 0.5) / height});
-            double l = 0.0;
-            for (std::size_t k = 0; k < c.projectors.size(); ++k) {
-                const auto p = rig::screen_to_projector(rig, static_cast<int>(k), s);
-                if (!p) continue;
-                const ProjectorCalibration& pc = c.projectors[k];
-                const int px = static_cast<int>(p->x());
-                const int py = static_cast<int>(p->y());
-                const ContentUv uv = sample_warp(pc.warp, pc.output, px, py);
-                if (!uv.valid()) continue;
-                const double gu = uv.u * 16.0 - std::round(uv.u * 16.0);
-                const double gv = uv.v * 16.0 - std::round(uv.v * 16.0);
-                const double content = (std::abs(gu) < 0.01 || std::abs(gv) < 0.01) ? 0.1 : 1.0;
-                // The rig's light (mean of the channels, black level included) for the signal
-                // render_output gives: content x blend + beta -> response LUT, per channel.
-                const float w = sample_blend(pc.blend, pc.output, px, py);
-                const std::array<float, 3> beta = sample_beta(pc.beta, pc.output, px, py);
-                const rig::RigProjector& rp = rig.projectors[k];
-                const double f = rig::projector_falloff(rp, p->x(), p->y());
-                for (std::size_t ch = 0; ch < 3; ++ch) {
-                    const double signal =
-                        apply_response(pc.response, static_cast<int>(ch), static_cast<float>(content) * w + beta[ch]);
-                    l += f * rp.brightness[ch] *
-                         (rp.black_level + (1.0 - rp.black_level) * std::pow(signal, rp.gamma[ch])) / 3.0;
-                }
-            }
-            light(y, x) = static_cast<float>(l);
+            light(y, x) = static_cast<float>(preview_light(rig, c, s, true) + (bounce ? bounce->at(bounced, s) : 0.0));
         }
     }
     Rgb8Image out(ImageSize{width, height});
