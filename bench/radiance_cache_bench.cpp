@@ -65,6 +65,7 @@ struct Setting {
     // mean-of-16 rows that measure the cache's bias jitter, as the path tracer does, so that the
     // mean integrates each pixel's area and what is left is the cache's bias, not aliasing.
     bool jitter_cached = false;
+    bool cache_direct = true;  // RadianceCacheOptions: cells whose lights are all known keep their direct light
 };
 
 struct Row {
@@ -129,10 +130,15 @@ std::vector<Setting> settings(int warm) {
         out.push_back({"path tracer, " + std::to_string(spp) + " spp", "path-" + std::to_string(spp), false, spp});
     const std::string w = std::to_string(warm) + " warm frames";
     out.push_back({"cache, cold (no frame before)", "cache-cold", true, 1, 0});
-    out.push_back(
-        {"cache, " + w + " (defaults: 4 footprints, 1 in 16 trains, visibility 8 / 1 in 8)", "cache", true, 1, warm});
+    out.push_back({"cache, " + w +
+                       " (defaults: 4 footprints, 1 in 16 trains, visibility 8 / 1 in 8, direct light from the cells)",
+                   "cache", true, 1, warm});
     out.push_back(
         {"cache, " + w + ", every shadow ray traced (no visibility)", "cache-novis", true, 1, warm, 4.0f, 16, 1, 0});
+    Setting traced_direct{"cache, " + w + ", direct light traced at every pixel (none from the cells)",
+                          "cache-direct-traced", true, 1, warm};
+    traced_direct.cache_direct = false;
+    out.push_back(traced_direct);
     out.push_back(
         {"cache, " + w + ", visibility after 12 agreeing rays", "cache-vis12", true, 1, warm, 4.0f, 16, 1, 12});
     out.push_back(
@@ -144,6 +150,19 @@ std::vector<Setting> settings(int warm) {
     out.push_back({"path tracer, 1 spp, mean of 16 frames", "path-mean16", false, 1, 0, 4.0f, 16, 16});
     out.push_back({"cache, " + w + ", mean of 16 frames, jittered (its bias)", "cache-mean16", true, 1, warm, 4.0f, 16,
                    16, 8, 8, true});
+    Setting traced_direct_mean{"cache, " + w + ", direct light traced at every pixel, mean of 16 frames, jittered",
+                               "cache-direct-traced-mean16",
+                               true,
+                               1,
+                               warm,
+                               4.0f,
+                               16,
+                               16,
+                               8,
+                               8,
+                               true};
+    traced_direct_mean.cache_direct = false;
+    out.push_back(traced_direct_mean);
     out.push_back({"cache, " + w + ", no visibility, mean of 16 frames, jittered", "cache-novis-mean16", true, 1, warm,
                    4.0f, 16, 16, 0, 8, true});
     out.push_back({"cache, " + w + ", mean of 16 frames at pixel centres (as served)", "cache-mean16-centres", true, 1,
@@ -184,6 +203,7 @@ int run(int argc, char** argv) {
             o.radiance_cache.visibility_min_samples = all[i].visibility_min_samples;
             o.radiance_cache.visibility_recheck_one_in = all[i].visibility_recheck_one_in;
             o.jitter_cached_one_spp = all[i].jitter_cached;
+            o.radiance_cache.cache_direct = all[i].cache_direct;
             Renderer renderer(scene, o);
             std::uint64_t rays = 0;
             double seconds = 0.0;

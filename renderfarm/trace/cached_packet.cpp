@@ -64,6 +64,44 @@ ShadowGates gates_of(const CacheFrame& cf, const PacketHits& hits, const LanePix
     return gates;
 }
 
+// Every light of the frame has a visibility group (so a cell can know them all).
+bool lights_tracked(const FrameContext& frame) {
+    const LightSet& lights = *frame.lights;
+    return lights.directional.size() + lights.point.size() + lights.area.size() <=
+           static_cast<std::size_t>(kVisibilityGroups);
+}
+
+// Which lanes take their lights' direct light from their cells (radiance_cache.h, CellDirect) and
+// which lanes' traced direct light trains their own cell. A lane qualifies when its material is
+// diffuse, it does not recheck, its own cell is usable and the jittered cell it reads is usable
+// with the same lights known (a jittered read never crosses into another lighting).
+struct DirectFromCells {
+    std::array<bool, kPacketLanes> used{};
+    std::array<bool, kPacketLanes> trains{};
+};
+
+DirectFromCells direct_from_cells(const CacheFrame& cf, const PacketHits& hits, const LanePixels& pixels,
+                                  const LaneCells& cells, const std::array<ShadingVertex, kPacketLanes>& vertices,
+                                  bool allowed, std::array<Eigen::Vector3f, kPacketLanes>& radiance,
+                                  const std::array<Eigen::Vector3f, kPacketLanes>& reflectance) {
+    DirectFromCells out;
+    if (!allowed) return out;
+    const RadianceCache& cache = *cf.cache;
+    for (std::size_t l = 0; l < kPacketLanes; ++l) {
+        if (!hits.alive[l] || vertices[l].material.glossy) continue;
+        const CellDirect own = cache.direct(cells.own[l]);
+        out.trains[l] = own.trainable && reflectance[l].minCoeff() > 1e-4f;
+        if (!own.usable || rechecks(cf, pixels.x[l], pixels.y[l])) continue;
+        const CellDirect read = cells.jittered[l] == cells.own[l] ? own : cache.direct(cells.jittered[l]);
+        if (!read.usable || read.known.visible != own.known.visible || read.known.blocked != own.known.blocked)
+            continue;
+        radiance[l] += reflectance[l].cwiseProduct(read.white);
+        out.used[l] = true;
+        out.trains[l] = false;
+    }
+    return out;
+}
+
 std::uint64_t pixel_order(const CacheFrame& cf, const LanePixels& pixels, std::size_t l) {
     return cf.order_base + static_cast<std::uint64_t>(pixels.y[l]) * static_cast<std::uint64_t>(cf.width) +
            static_cast<std::uint64_t>(pixels.x[l]);
@@ -77,16 +115,28 @@ void cached_radiance_packet(const FrameContext& frame, const CacheFrame& cf, con
                             std::vector<CacheDeposit>& deposits) {
     const LaneCells cells = cells_of(cf, hits, rngs);
     ShadowGates gates = gates_of(cf, hits, pixels, cells);
-    light_packet(frame, hits, rngs, radiance, rays, &gates);
+    std::array<ShadingVertex, kPacketLanes> vertices;
+    std::array<Eigen::Vector3f, kPacketLanes> reflectance;
+    for (std::size_t l = 0; l < kPacketLanes; ++l) {
+        if (!hits.alive[l]) continue;
+        vertices[l] = make_vertex(frame, hits.hit[l], hits.wo[l]);
+        reflectance[l] = vertices[l].material.diffuse * std::numbers::pi_v<float>;
+    }
+    const bool direct_allowed = cf.cache->options().cache_direct && lights_tracked(frame);
+    const DirectFromCells from_cells =
+        direct_from_cells(cf, hits, pixels, cells, vertices, direct_allowed, radiance, reflectance);
+    PacketHits lit = hits;
+    for (std::size_t l = 0; l < kPacketLanes; ++l) lit.alive[l] = hits.alive[l] && !from_cells.used[l];
+    std::array<Eigen::Vector3f, kPacketLanes> direct_light = radiance;
+    light_packet(frame, lit, rngs, radiance, rays, &gates);
+    for (std::size_t l = 0; l < kPacketLanes; ++l) direct_light[l] = radiance[l] - direct_light[l];
 
     PacketHits training = hits;
     std::array<bool, kPacketLanes> shown{};  // the lane shows its own training estimate (empty cell)
-    std::array<Eigen::Vector3f, kPacketLanes> reflectance;
     bool any = false;
     for (std::size_t l = 0; l < kPacketLanes; ++l) {
         training.alive[l] = false;
         if (!hits.alive[l]) continue;
-        reflectance[l] = make_vertex(frame, hits.hit[l], hits.wo[l]).material.diffuse * std::numbers::pi_v<float>;
         Eigen::Vector3f white;
         const bool found = cf.cache->lookup(cells.jittered[l], white);
         if (found) radiance[l] += reflectance[l].cwiseProduct(white);
@@ -104,9 +154,13 @@ void cached_radiance_packet(const FrameContext& frame, const CacheFrame& cf, con
     }
     for (std::size_t l = 0; l < kPacketLanes; ++l) {
         const bool traced = gates.rays_visible[l] != 0 || gates.rays_blocked[l] != 0;
-        if (!training.alive[l] && !traced) continue;
-        deposits.push_back({cells.own[l], pixel_order(cf, pixels, l), white[l], training.alive[l],
-                            gates.rays_visible[l], gates.rays_blocked[l]});
+        const bool direct = from_cells.trains[l];
+        if (!training.alive[l] && !traced && !direct) continue;
+        deposits.push_back(
+            {cells.own[l], pixel_order(cf, pixels, l), white[l], training.alive[l], gates.rays_visible[l],
+             gates.rays_blocked[l],
+             direct ? Eigen::Vector3f(direct_light[l].cwiseQuotient(reflectance[l])) : Eigen::Vector3f::Zero(),
+             direct});
         if (shown[l]) radiance[l] += reflectance[l].cwiseProduct(white[l]);
     }
 }

@@ -8,7 +8,11 @@
 //       a light that the pixel's own cell knows (radiance_cache.h, visibility) is not traced: the
 //       light adds its unoccluded contribution or nothing; 1 pixel in visibility_recheck_one_in
 //       traces anyway, and every traced outcome is deposited in the pixel's cell.
-//     + π ρ_d ⊙ W(cell at a jittered position)  (ρ_d = the tinted material's diffuse part,
+//       A diffuse pixel (no glossy lobe) whose own cell and jittered cell both know every light
+//       alike (radiance_cache.h, CellDirect) and that does not recheck takes ρ_d ⊙ D(jittered cell)
+//       instead and evaluates no light; a diffuse pixel that evaluated its lights in a cell no
+//       shadow edge crosses deposits D = its direct light / ρ_d there.
+//     + ρ_d ⊙ W(cell at a jittered position)  (ρ_d = the tinted material's diffuse part,
 //       (1 - k_s) a; W the cell's white radiance: the environment and every bounce, i.e. what a
 //       path of radiance_packet gathers beyond the first vertex's lights).
 // Training: a pixel whose cell is empty, and one pixel in RadianceCacheOptions::train_one_in

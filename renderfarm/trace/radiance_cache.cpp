@@ -28,6 +28,18 @@ std::uint16_t push_outcome(std::uint16_t state, bool visible) {
     return static_cast<std::uint16_t>((count << kHistoryBits) | history);
 }
 
+// Adds one estimate to a running sum of at most `window` estimates' weight (an exponential
+// window: older estimates weigh less).
+void merge(float (&sum)[3], float& weight, const Eigen::Vector3f& estimate, float window) {
+    if (weight + 1.0f > window) {
+        const float keep = (window - 1.0f) / weight;
+        for (float& c : sum) c *= keep;
+        weight = window - 1.0f;
+    }
+    for (int c = 0; c < 3; ++c) sum[c] += estimate[c];
+    weight += 1.0f;
+}
+
 std::uint64_t cell_coordinate(double position, double size) {
     return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(position / size)));
 }
@@ -100,15 +112,13 @@ bool RadianceCache::lookup(std::uint64_t key, Eigen::Vector3f& white_radiance) c
     return true;
 }
 
-CellVisibility RadianceCache::visibility(std::uint64_t key) const {
+CellVisibility RadianceCache::known(const Slot& s) const {
     CellVisibility known;
     const int need = options_.visibility_min_samples;
     if (need == 0) return known;
-    const Slot* s = find(key);
-    if (s == nullptr) return known;
     const auto window = static_cast<std::uint16_t>((1u << need) - 1u);
     for (int g = 0; g < kVisibilityGroups; ++g) {
-        const std::uint16_t state = s->visibility[g];
+        const std::uint16_t state = s.visibility[g];
         if ((state >> kHistoryBits) < need) continue;
         const auto recent = static_cast<std::uint16_t>(state & window);
         if (recent == window) known.visible |= static_cast<std::uint8_t>(1u << g);
@@ -117,14 +127,49 @@ CellVisibility RadianceCache::visibility(std::uint64_t key) const {
     return known;
 }
 
+CellVisibility RadianceCache::visibility(std::uint64_t key) const {
+    const Slot* s = find(key);
+    return s == nullptr ? CellVisibility{} : known(*s);
+}
+
+CellDirect RadianceCache::direct(std::uint64_t key) const {
+    CellDirect out;
+    const int need = options_.visibility_min_samples;
+    const Slot* s = find(key);
+    if (s == nullptr) return out;
+    out.known = known(*s);
+    bool settled = true;  // every group known or untouched
+    for (int g = 0; g < kVisibilityGroups; ++g) {
+        const std::uint16_t state = s->visibility[g];
+        const int count = state >> kHistoryBits;
+        if (count == 0) continue;  // no ray from this cell towards g: its light is in D as traced
+        const int recent_count = std::min(count, std::max(need, 1));
+        const auto window = static_cast<std::uint16_t>((1u << recent_count) - 1u);
+        const auto recent = static_cast<std::uint16_t>(state & window);
+        if (recent != 0 && recent != window) out.trainable = false;  // a shadow edge crosses the cell
+        if ((out.known.visible | out.known.blocked) & (1u << g)) continue;
+        settled = false;
+    }
+    if (!options_.cache_direct || need == 0 || !settled || !out.trainable) return out;
+    if (!(s->direct_weight >= static_cast<float>(need))) return out;
+    out.usable = true;
+    out.white = Eigen::Vector3f(s->direct_sum[0], s->direct_sum[1], s->direct_sum[2]) / s->direct_weight;
+    return out;
+}
+
 void RadianceCache::deposit(std::span<const CacheDeposit> deposits) {
     const std::lock_guard lock(pending_mutex_);
+    const auto bad = [](const Eigen::Vector3f& v) { return !v.allFinite() || v.minCoeff() < 0.0f; };
     for (CacheDeposit d : deposits) {
-        if (d.has_radiance && (!d.white_radiance.allFinite() || d.white_radiance.minCoeff() < 0.0f)) {
+        if (d.has_radiance && bad(d.white_radiance)) {
             ++dropped_;
-            if (d.rays_visible == 0 && d.rays_blocked == 0) continue;
-            d.has_radiance = false;  // its shadow-ray outcomes still count
+            d.has_radiance = false;  // its other parts still count
         }
+        if (d.has_direct && bad(d.direct_white)) {
+            ++dropped_;
+            d.has_direct = false;
+        }
+        if (!d.has_radiance && !d.has_direct && d.rays_visible == 0 && d.rays_blocked == 0) continue;
         pending_.push_back(d);
     }
 }
@@ -145,14 +190,8 @@ void RadianceCache::commit() {
             if ((d.rays_visible & bit) != 0) s->visibility[g] = push_outcome(s->visibility[g], true);
             if ((d.rays_blocked & bit) != 0) s->visibility[g] = push_outcome(s->visibility[g], false);
         }
-        if (!d.has_radiance) continue;
-        if (s->weight + 1.0f > window) {  // exponential window: older estimates weigh less
-            const float keep = (window - 1.0f) / s->weight;
-            for (float& c : s->sum) c *= keep;
-            s->weight = window - 1.0f;
-        }
-        for (int c = 0; c < 3; ++c) s->sum[c] += d.white_radiance[c];
-        s->weight += 1.0f;
+        if (d.has_radiance) merge(s->sum, s->weight, d.white_radiance, window);
+        if (d.has_direct) merge(s->direct_sum, s->direct_weight, d.direct_white, window);
     }
     const std::size_t merged = pending_.size();
     pending_.clear();

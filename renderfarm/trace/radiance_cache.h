@@ -37,6 +37,17 @@
 // Its bias: a shadow (or a lit patch) smaller than a cell that no recent ray from that cell hit is
 // missed until a recheck ray hits it; docs/renderer.md measures it against the converged reference.
 //
+// Direct light from the cells (RadianceCacheOptions::cache_direct): a cell also keeps the mean of
+// estimates of the lights' direct "white radiance" D = E_lights / π (traced per pixel, with the
+// shadow rays the cell does not know, at pixels of diffuse materials). Where every light group of
+// a cell is known (visible or blocked) or has never had a ray traced from the cell (below its
+// horizon, behind its emitter, or casting no shadows), direct(key) says the cell is usable: a
+// diffuse pixel there takes ρ D from the cell and evaluates no light (cached_packet.h). A cell that
+// a shadow edge crosses keeps a mixed history, is never usable and never trained, so its pixels go
+// on evaluating their lights per pixel and shadow edges stay as sharp as the pixels. Its bias, on
+// top of the visibility's: the direct light's smooth variation (distance, cosine, an area light's
+// extent) is taken as constant over a cell.
+//
 // Threading: lookup() is const and may run on many threads at once; deposit() may run
 // concurrently with lookup() and itself (a pending list under a mutex); commit() must not run
 // concurrently with either. commit() merges in a fixed order (by key, then each deposit's
@@ -57,12 +68,14 @@ struct RadianceCacheOptions {
     float base_cell_m = 0.002f;         // size of a level-0 cell, metres (> 0)
     float cell_footprints = 4.0f;       // a cell's size in ray-cone widths (pixels on screen), > 0
     int max_samples = 256;              // the exponential window's length, >= 1
-    int slots_log2 = 20;                // 2^slots_log2 cells at most (40 bytes each, allocated at the first
+    int slots_log2 = 20;                // 2^slots_log2 cells at most (56 bytes each, allocated at the first
                                         // estimate: a Renderer that never caches pays nothing), in [8, 26]
     int train_one_in = 16;              // pixels of a cached frame that also train the cache: 1 in N (>= 1)
     int visibility_min_samples = 8;     // agreeing shadow-ray outcomes before a cell knows a light,
                                         // in [0, 12]; 0: every shadow ray is traced
     int visibility_recheck_one_in = 8;  // pixels of a known cell that trace anyway: 1 in N (>= 1)
+    bool cache_direct = true;           // cells whose lights are all known keep the lights' direct light
+                                        // (see above; needs visibility_min_samples > 0)
 };
 
 // Lights whose visibility a cell keeps: the first 8 of the frame's light set (the rest are traced).
@@ -74,14 +87,25 @@ struct CellVisibility {
     std::uint8_t blocked = 0;  // ... all occluded
 };
 
+// What a cell offers a diffuse pixel of its lights' direct light (cache_direct, see above).
+struct CellDirect {
+    bool usable = false;    // every light group known or untouched, and at least visibility_min_samples
+                            // estimates of D merged
+    bool trainable = true;  // no light group's recent outcomes disagree (an absent cell: true)
+    CellVisibility known;   // as visibility(key)
+    Eigen::Vector3f white = Eigen::Vector3f::Zero();  // the mean of D's estimates (when usable)
+};
+
 // One estimate for the cell `key`; `order` fixes the merge order (renderer: frame, pixel).
 struct CacheDeposit {
     std::uint64_t key = 0;
     std::uint64_t order = 0;
     Eigen::Vector3f white_radiance = Eigen::Vector3f::Zero();
-    bool has_radiance = true;       // false: the deposit carries shadow-ray outcomes only
+    bool has_radiance = true;       // false: the deposit carries no estimate of W
     std::uint8_t rays_visible = 0;  // light groups with at least one unoccluded shadow ray traced
     std::uint8_t rays_blocked = 0;  // light groups with at least one occluded shadow ray traced
+    Eigen::Vector3f direct_white = Eigen::Vector3f::Zero();  // an estimate of D (when has_direct)
+    bool has_direct = false;
 };
 
 class RadianceCache {
@@ -118,6 +142,10 @@ public:
     // What the cell knows of its lights' visibility (nothing for an absent cell).
     [[nodiscard]] CellVisibility visibility(std::uint64_t key) const;
 
+    // The cell's direct light for a diffuse pixel (never usable with cache_direct off or
+    // visibility_min_samples 0).
+    [[nodiscard]] CellDirect direct(std::uint64_t key) const;
+
     // Queues estimates for the next commit(); non-finite or negative ones are dropped (counted).
     void deposit(std::span<const CacheDeposit> deposits);
 
@@ -141,7 +169,10 @@ private:
         float sum[3] = {0.0f, 0.0f, 0.0f};
         float weight = 0.0f;
         std::uint16_t visibility[kVisibilityGroups] = {};  // per light group: outcome count << 12 | history
+        float direct_sum[3] = {0.0f, 0.0f, 0.0f};          // D's estimates (cache_direct)
+        float direct_weight = 0.0f;
     };
+    [[nodiscard]] CellVisibility known(const Slot& s) const;
     [[nodiscard]] const Slot* find(std::uint64_t key) const;
     Slot* find_or_insert(std::uint64_t key);
 

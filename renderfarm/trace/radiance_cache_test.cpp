@@ -240,6 +240,68 @@ TEST(RadianceCache, VisibilityOffNeverKnowsALight) {
     EXPECT_EQ(cache.visibility(k).visible, 0);
 }
 
+// A deposit of one estimate of the lights' direct white radiance D, with light 0's outcome.
+CacheDeposit direct_estimate(std::uint64_t key, std::uint64_t order, float d, bool light0_visible) {
+    CacheDeposit out{key, order, Eigen::Vector3f::Zero(), false};
+    (light0_visible ? out.rays_visible : out.rays_blocked) = 1;
+    out.direct_white = Eigen::Vector3f(d, 2.0f * d, 3.0f * d);
+    out.has_direct = true;
+    return out;
+}
+
+TEST(RadianceCache, ACellOffersItsDirectLightOnceEveryLightIsSettled) {
+    RadianceCache cache;  // 8 agreeing outcomes, 8 estimates of D
+    const std::uint64_t k = cache.key({0.8, 0.0, 0.8}, kUp, 0.0f);
+    std::vector<CacheDeposit> d;
+    for (std::uint64_t i = 0; i < 7; ++i) d.push_back(direct_estimate(k, i, 0.5f + 0.1f * static_cast<float>(i), true));
+    cache.deposit(d);
+    cache.commit();
+    EXPECT_FALSE(cache.direct(k).usable) << "7 estimates, light 0 not yet known";
+    EXPECT_TRUE(cache.direct(k).trainable) << "its outcomes agree so far";
+
+    d = {direct_estimate(k, 7, 1.2f, true)};
+    cache.deposit(d);
+    cache.commit();
+    const CellDirect settled = cache.direct(k);
+    ASSERT_TRUE(settled.usable) << "light 0 known visible, lights 1-7 never traced from the cell";
+    EXPECT_EQ(settled.known.visible, 1);
+    EXPECT_NEAR(settled.white.x(), 0.85f, 1e-5f) << "the mean of 0.5, 0.6, ..., 1.2";
+    EXPECT_NEAR(settled.white.z(), 3.0f * 0.85f, 1e-5f);
+
+    d = {outcome(k, 8, 2, true)};  // light 2 seen once: learning, not known
+    cache.deposit(d);
+    cache.commit();
+    EXPECT_FALSE(cache.direct(k).usable) << "light 2 is neither known nor untouched";
+    EXPECT_TRUE(cache.direct(k).trainable);
+
+    d = {outcome(k, 9, 2, false)};  // light 2 both seen and hidden: a shadow edge crosses the cell
+    cache.deposit(d);
+    cache.commit();
+    EXPECT_FALSE(cache.direct(k).usable);
+    EXPECT_FALSE(cache.direct(k).trainable) << "its pixels go on tracing, and teach the cell no D";
+}
+
+TEST(RadianceCache, DirectLightFromCellsCanBeTurnedOffAndBadEstimatesAreDropped) {
+    RadianceCacheOptions off;
+    off.cache_direct = false;
+    RadianceCache plain(off);
+    RadianceCache cache;
+    const std::uint64_t k = cache.key({1.0, 0.0, 1.0}, kUp, 0.0f);
+    std::vector<CacheDeposit> d;
+    for (std::uint64_t i = 0; i < 8; ++i) d.push_back(direct_estimate(k, i, 1.0f, false));
+    d.push_back(direct_estimate(k, 8, -1.0f, false));
+    d.push_back(direct_estimate(k, 9, std::numeric_limits<float>::quiet_NaN(), false));
+    plain.deposit(d);
+    plain.commit();
+    cache.deposit(d);
+    cache.commit();
+    EXPECT_FALSE(plain.direct(k).usable);
+    ASSERT_TRUE(cache.direct(k).usable) << "light 0 known blocked by 10 outcomes";
+    EXPECT_EQ(cache.direct(k).known.blocked, 1);
+    EXPECT_FLOAT_EQ(cache.direct(k).white.x(), 1.0f) << "the negative and NaN estimates were not merged";
+    EXPECT_EQ(cache.dropped(), 2u);
+}
+
 TEST(RadianceCache, CellLevelIsTheCeilingOfLog2OfTheWantedSize) {
     RadianceCache cache;
     for (float cone = 1e-5f; cone < 10.0f; cone *= 1.37f) {

@@ -123,6 +123,33 @@ TEST(RendererRadianceCache, KnownLightsAreNotTracedAndTheFrameStaysClose) {
     EXPECT_LT(std::abs(mean(a) / mean(b) - 1.0), 0.02);
 }
 
+// Diffuse pixels in cells that know every light take the lights' direct light from the cell
+// (RadianceCacheOptions::cache_direct): the frame changes, and stays as close to the reference as
+// with the direct light traced at every pixel (its bias: the direct light constant over a cell).
+TEST(RendererRadianceCache, DirectLightFromSettledCellsKeepsTheFrameClose) {
+    const Scene scene = lit_corner();
+    Renderer reference_renderer(scene, RendererOptions{"threads=1", true});
+    const RgbFloatImage reference = draw(reference_renderer, corner_view(1000, 256, false));
+    RendererOptions traced_direct{"threads=1", true};
+    traced_direct.radiance_cache.cache_direct = false;
+    Renderer from_cells(scene, RendererOptions{"threads=1", true});
+    Renderer traced(scene, traced_direct);
+    for (std::uint64_t f = 1; f <= 16; ++f) {
+        (void)draw(from_cells, corner_view(f, 1, true));
+        (void)draw(traced, corner_view(f, 1, true));
+    }
+    const RgbFloatImage a = draw(from_cells, corner_view(17, 1, true));
+    const RgbFloatImage b = draw(traced, corner_view(17, 1, true));
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < a.pixels.size(); i += 3) differ += a.pixels[i] != b.pixels[i] ? 1 : 0;
+    EXPECT_GT(differ, a.pixels.size() / 3 / 4) << "a quarter of the pixels at least read their cell's direct light";
+    const double cells_error = rel_mse(a, reference);
+    const double traced_error = rel_mse(b, reference);
+    EXPECT_LT(cells_error, 1.25 * traced_error)
+        << "relMSE " << cells_error << " from the cells, " << traced_error << " traced at every pixel";
+    EXPECT_LT(std::abs(mean(a) / mean(b) - 1.0), 0.02);
+}
+
 TEST(RendererRadianceCache, AnySplitOfACachedFrameGivesTheSameBits) {
     const Scene scene = lit_corner();
     Renderer whole(scene, RendererOptions{"threads=1", true});
