@@ -52,14 +52,29 @@ LaneCells cells_of(const CacheFrame& cf, const PacketHits& hits, std::array<Pixe
     return cells;
 }
 
+// What each alive lane reads of its two cells (one probe each; the same read when they coincide).
+struct LaneReads {
+    std::array<CellRead, kPacketLanes> own;
+    std::array<CellRead, kPacketLanes> jittered;
+};
+
+LaneReads reads_of(const CacheFrame& cf, const PacketHits& hits, const LaneCells& cells) {
+    LaneReads reads;
+    for (std::size_t l = 0; l < kPacketLanes; ++l) {
+        if (!hits.alive[l]) continue;
+        reads.own[l] = cf.cache->read(cells.own[l]);
+        reads.jittered[l] = cells.jittered[l] == cells.own[l] ? reads.own[l] : cf.cache->read(cells.jittered[l]);
+    }
+    return reads;
+}
+
 // What each lane's own cell knows of its lights (nothing for a pixel that rechecks).
-ShadowGates gates_of(const CacheFrame& cf, const PacketHits& hits, const LanePixels& pixels, const LaneCells& cells) {
+ShadowGates gates_of(const CacheFrame& cf, const PacketHits& hits, const LanePixels& pixels, const LaneReads& reads) {
     ShadowGates gates;
     for (std::size_t l = 0; l < kPacketLanes; ++l) {
         if (!hits.alive[l] || rechecks(cf, pixels.x[l], pixels.y[l])) continue;
-        const CellVisibility known = cf.cache->visibility(cells.own[l]);
-        gates.known_visible[l] = known.visible;
-        gates.known_blocked[l] = known.blocked;
+        gates.known_visible[l] = reads.own[l].direct.known.visible;
+        gates.known_blocked[l] = reads.own[l].direct.known.blocked;
     }
     return gates;
 }
@@ -81,18 +96,17 @@ struct DirectFromCells {
 };
 
 DirectFromCells direct_from_cells(const CacheFrame& cf, const PacketHits& hits, const LanePixels& pixels,
-                                  const LaneCells& cells, const std::array<ShadingVertex, kPacketLanes>& vertices,
+                                  const LaneReads& reads, const std::array<ShadingVertex, kPacketLanes>& vertices,
                                   bool allowed, std::array<Eigen::Vector3f, kPacketLanes>& radiance,
                                   const std::array<Eigen::Vector3f, kPacketLanes>& reflectance) {
     DirectFromCells out;
     if (!allowed) return out;
-    const RadianceCache& cache = *cf.cache;
     for (std::size_t l = 0; l < kPacketLanes; ++l) {
         if (!hits.alive[l] || vertices[l].material.glossy) continue;
-        const CellDirect own = cache.direct(cells.own[l]);
+        const CellDirect& own = reads.own[l].direct;
         out.trains[l] = own.trainable && reflectance[l].minCoeff() > 1e-4f;
         if (!own.usable || rechecks(cf, pixels.x[l], pixels.y[l])) continue;
-        const CellDirect read = cells.jittered[l] == cells.own[l] ? own : cache.direct(cells.jittered[l]);
+        const CellDirect& read = reads.jittered[l].direct;
         if (!read.usable || read.known.visible != own.known.visible || read.known.blocked != own.known.blocked)
             continue;
         radiance[l] += reflectance[l].cwiseProduct(read.white);
@@ -114,7 +128,8 @@ void cached_radiance_packet(const FrameContext& frame, const CacheFrame& cf, con
                             std::array<Eigen::Vector3f, kPacketLanes>& radiance, std::uint64_t& rays,
                             std::vector<CacheDeposit>& deposits) {
     const LaneCells cells = cells_of(cf, hits, rngs);
-    ShadowGates gates = gates_of(cf, hits, pixels, cells);
+    const LaneReads reads = reads_of(cf, hits, cells);
+    ShadowGates gates = gates_of(cf, hits, pixels, reads);
     std::array<ShadingVertex, kPacketLanes> vertices;
     std::array<Eigen::Vector3f, kPacketLanes> reflectance;
     for (std::size_t l = 0; l < kPacketLanes; ++l) {
@@ -124,7 +139,7 @@ void cached_radiance_packet(const FrameContext& frame, const CacheFrame& cf, con
     }
     const bool direct_allowed = cf.cache->options().cache_direct && lights_tracked(frame);
     const DirectFromCells from_cells =
-        direct_from_cells(cf, hits, pixels, cells, vertices, direct_allowed, radiance, reflectance);
+        direct_from_cells(cf, hits, pixels, reads, vertices, direct_allowed, radiance, reflectance);
     PacketHits lit = hits;
     for (std::size_t l = 0; l < kPacketLanes; ++l) lit.alive[l] = hits.alive[l] && !from_cells.used[l];
     std::array<Eigen::Vector3f, kPacketLanes> direct_light = radiance;
@@ -137,9 +152,8 @@ void cached_radiance_packet(const FrameContext& frame, const CacheFrame& cf, con
     for (std::size_t l = 0; l < kPacketLanes; ++l) {
         training.alive[l] = false;
         if (!hits.alive[l]) continue;
-        Eigen::Vector3f white;
-        const bool found = cf.cache->lookup(cells.jittered[l], white);
-        if (found) radiance[l] += reflectance[l].cwiseProduct(white);
+        const bool found = reads.jittered[l].has_radiance;
+        if (found) radiance[l] += reflectance[l].cwiseProduct(reads.jittered[l].white);
         shown[l] = !found;
         if (found && !trains(cf, pixels.x[l], pixels.y[l])) continue;
         training.alive[l] = true;

@@ -133,10 +133,24 @@ CellVisibility RadianceCache::visibility(std::uint64_t key) const {
 }
 
 CellDirect RadianceCache::direct(std::uint64_t key) const {
-    CellDirect out;
-    const int need = options_.visibility_min_samples;
+    const Slot* s = find(key);
+    return s == nullptr ? CellDirect{} : direct_of(*s);
+}
+
+CellRead RadianceCache::read(std::uint64_t key) const {
+    CellRead out;
     const Slot* s = find(key);
     if (s == nullptr) return out;
+    out.has_radiance = s->weight > 0.0f;
+    if (out.has_radiance) out.white = Eigen::Vector3f(s->sum[0], s->sum[1], s->sum[2]) / s->weight;
+    out.direct = direct_of(*s);
+    return out;
+}
+
+CellDirect RadianceCache::direct_of(const Slot& slot) const {
+    CellDirect out;
+    const Slot* s = &slot;
+    const int need = options_.visibility_min_samples;
     out.known = known(*s);
     bool settled = true;  // every group known or untouched
     for (int g = 0; g < kVisibilityGroups; ++g) {

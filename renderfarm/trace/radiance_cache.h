@@ -96,6 +96,13 @@ struct CellDirect {
     Eigen::Vector3f white = Eigen::Vector3f::Zero();  // the mean of D's estimates (when usable)
 };
 
+// Everything a cached pixel reads of one cell, from one probe of the table.
+struct CellRead {
+    bool has_radiance = false;                        // W has an estimate
+    Eigen::Vector3f white = Eigen::Vector3f::Zero();  // the mean of W's estimates (when has_radiance)
+    CellDirect direct;                                // as direct(key)
+};
+
 // One estimate for the cell `key`; `order` fixes the merge order (renderer: frame, pixel).
 struct CacheDeposit {
     std::uint64_t key = 0;
@@ -146,6 +153,9 @@ public:
     // visibility_min_samples 0).
     [[nodiscard]] CellDirect direct(std::uint64_t key) const;
 
+    // lookup(), visibility() and direct() of one cell at once (one probe of the table).
+    [[nodiscard]] CellRead read(std::uint64_t key) const;
+
     // Queues estimates for the next commit(); non-finite or negative ones are dropped (counted).
     void deposit(std::span<const CacheDeposit> deposits);
 
@@ -173,6 +183,7 @@ private:
         float direct_weight = 0.0f;
     };
     [[nodiscard]] CellVisibility known(const Slot& s) const;
+    [[nodiscard]] CellDirect direct_of(const Slot& s) const;
     [[nodiscard]] const Slot* find(std::uint64_t key) const;
     Slot* find_or_insert(std::uint64_t key);
 
