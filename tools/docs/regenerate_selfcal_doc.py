@@ -32,7 +32,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 BLOCK = re.compile(r"^<!-- generated:selfcal-scenarios -->\n.*?^<!-- /generated -->$", re.S | re.M)
 AUTOCAL_BLOCK = re.compile(r"^<!-- generated:selfcal-from-autocal -->\n.*?^<!-- /generated -->$", re.S | re.M)
 # Rigs with a real installation's errors, and the calibration flags each needs (docs/calibration.md's rig table).
-REALISTIC = {"realistic": [], "realistic-lens": [], "realistic-optics": [], "realistic-install": ["--fit-screen"]}
+REALISTIC = {"realistic": [], "realistic-lens": [], "realistic-optics": [], "realistic-install": ["--fit-screen"],
+             "realistic-screen": []}
 COMMON = ["--rate-hz", "2", "--bump-at-s", "2", "--projector-scale", "0.5", "--camera-scale", "0.5"]
 
 
