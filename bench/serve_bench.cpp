@@ -124,11 +124,14 @@ FrameQuality frame_quality(const Rgb8Image& served, const Rgb8Image& reference) 
 
 // What the farm served for each counted moving frame: its scale, spp and bounces, and where its
 // time went on the admin (seconds: the whole frame, the render phase, the slowest rank's tracing,
-// the filter; the rest of `frame_seconds` is compositing, accumulation and the hand-off).
+// the filter; the rest of `frame_seconds` is compositing, accumulation and the hand-off); with
+// temporal, the share of its surface pixels that earlier frames supplied by reprojection.
 struct ServedLog {
     nlohmann::json frames = nlohmann::json::array();
     double scale_sum = 0, scale_min = 1, spp_sum = 0, bounces_sum = 0;
     double frame_s = 0, render_phase_s = 0, slowest_rank_s = 0, denoise_s = 0;
+    double reprojected_sum = 0;
+    int blended = 0;
     void add(const LiveFrame& f) {
         const Quality& q = f.rendered.quality;
         const auto& ranks = f.stats.rank_render_seconds;
@@ -140,6 +143,12 @@ struct ServedLog {
                           {"render_phase_seconds", f.stats.render_phase_seconds},
                           {"slowest_rank_seconds", slowest},
                           {"denoise_seconds", f.denoise_seconds}});
+        if (f.temporal.surface_pixels > 0) {
+            const double share = double(f.temporal.reprojected) / double(f.temporal.surface_pixels);
+            frames.back()["reprojected_share"] = share;
+            reprojected_sum += share;
+            ++blended;
+        }
         scale_sum += q.resolution_scale;
         scale_min = std::min(scale_min, q.resolution_scale);
         spp_sum += q.spp;
@@ -151,14 +160,16 @@ struct ServedLog {
     }
     [[nodiscard]] nlohmann::json summary() const {
         const double n = std::max<double>(1, double(frames.size()));
-        return {{"scale_mean", scale_sum / n},
-                {"scale_min", scale_min},
-                {"spp_mean", spp_sum / n},
-                {"bounces_mean", bounces_sum / n},
-                {"frame_seconds_mean", frame_s / n},
-                {"render_phase_seconds_mean", render_phase_s / n},
-                {"slowest_rank_seconds_mean", slowest_rank_s / n},
-                {"denoise_seconds_mean", denoise_s / n}};
+        nlohmann::json out = {{"scale_mean", scale_sum / n},
+                              {"scale_min", scale_min},
+                              {"spp_mean", spp_sum / n},
+                              {"bounces_mean", bounces_sum / n},
+                              {"frame_seconds_mean", frame_s / n},
+                              {"render_phase_seconds_mean", render_phase_s / n},
+                              {"slowest_rank_seconds_mean", slowest_rank_s / n},
+                              {"denoise_seconds_mean", denoise_s / n}};
+        if (blended > 0) out["reprojected_share_mean"] = reprojected_sum / blended;
+        return out;
     }
 };
 

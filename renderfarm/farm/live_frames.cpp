@@ -182,7 +182,7 @@ void LiveFrames::display(Session& s, const RgbFloatImage& radiance, LiveFrame& f
     RgbFloatImage blended;
     if (options_.temporal && !frame.still) {
         blended = s.temporal.accumulate(radiance, s.guides, make_camera_setup(frame.rendered, radiance.size),
-                                        options_.temporal_params);
+                                        options_.temporal_params, &frame.temporal);
         noisy = &blended;
     }
     // A still view's accumulation of two passes or more brings its own noise, measured from the

@@ -130,6 +130,9 @@ struct LiveFrame {
     double seconds = 0.0;          // render + composite (+ accumulate, + denoise) on the admin, wall
     double denoise_seconds = 0.0;  // the filter's part of `seconds`
     double gap_seconds = 0.0;      // since the session's previous frame was handed back (0: its first)
+    // With `temporal`, a moving frame's surface pixels and how many of them the previous frames
+    // supplied by reprojection (temporal_accumulation.h); both 0 when the frame was not blended.
+    TemporalStats temporal;
     FrameStats stats;
 };
 

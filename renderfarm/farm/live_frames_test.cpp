@@ -307,6 +307,12 @@ TEST_F(LiveFramesTest, TemporalAccumulationBringsAMovingFrameCloserToTheReferenc
     std::printf("moving frame after 9 frames, 1 spp: filtered %.2f dB, temporal + filtered %.2f dB\n", filtered_db,
                 temporal_db);
     EXPECT_GT(temporal_db, filtered_db + 1.0);
+    // A degree's turn: nearly every surface pixel was seen by the previous frame (the scene is static).
+    EXPECT_GT(b.temporal.surface_pixels, 0u);
+    EXPECT_GT(b.temporal.reprojected, b.temporal.surface_pixels * 8 / 10)
+        << b.temporal.reprojected << " of " << b.temporal.surface_pixels << " surface pixels reprojected";
+    EXPECT_LE(b.temporal.reprojected, b.temporal.surface_pixels);
+    EXPECT_EQ(a.temporal.surface_pixels, 0u) << "the filter alone blends nothing";
 
     ViewRequest still = request;
     still.frame_id = 200;
