@@ -112,7 +112,7 @@ bool RadianceCache::lookup(std::uint64_t key, Eigen::Vector3f& white_radiance) c
     return true;
 }
 
-CellVisibility RadianceCache::known(const Slot& s) const {
+CellVisibility RadianceCache::known_of(const Slot& s) const {
     CellVisibility known;
     const int need = options_.visibility_min_samples;
     if (need == 0) return known;
@@ -129,7 +129,7 @@ CellVisibility RadianceCache::known(const Slot& s) const {
 
 CellVisibility RadianceCache::visibility(std::uint64_t key) const {
     const Slot* s = find(key);
-    return s == nullptr ? CellVisibility{} : known(*s);
+    return s == nullptr ? CellVisibility{} : known_of(*s);
 }
 
 CellDirect RadianceCache::direct(std::uint64_t key) const {
@@ -147,14 +147,13 @@ CellRead RadianceCache::read(std::uint64_t key) const {
     return out;
 }
 
-CellDirect RadianceCache::direct_of(const Slot& slot) const {
+CellDirect RadianceCache::direct_of(const Slot& s) const {
     CellDirect out;
-    const Slot* s = &slot;
     const int need = options_.visibility_min_samples;
-    out.known = known(*s);
+    out.known = known_of(s);
     bool settled = true;  // every group known or untouched
     for (int g = 0; g < kVisibilityGroups; ++g) {
-        const std::uint16_t state = s->visibility[g];
+        const std::uint16_t state = s.visibility[g];
         const int count = state >> kHistoryBits;
         if (count == 0) continue;  // no ray from this cell towards g: its light is in D as traced
         const int recent_count = std::min(count, std::max(need, 1));
@@ -165,9 +164,9 @@ CellDirect RadianceCache::direct_of(const Slot& slot) const {
         settled = false;
     }
     if (!options_.cache_direct || need == 0 || !settled || !out.trainable) return out;
-    if (!(s->direct_weight >= static_cast<float>(need))) return out;
+    if (!(s.direct_weight >= static_cast<float>(need))) return out;
     out.usable = true;
-    out.white = Eigen::Vector3f(s->direct_sum[0], s->direct_sum[1], s->direct_sum[2]) / s->direct_weight;
+    out.white = Eigen::Vector3f(s.direct_sum[0], s.direct_sum[1], s.direct_sum[2]) / s.direct_weight;
     return out;
 }
 

@@ -182,7 +182,7 @@ private:
         float direct_sum[3] = {0.0f, 0.0f, 0.0f};          // D's estimates (cache_direct)
         float direct_weight = 0.0f;
     };
-    [[nodiscard]] CellVisibility known(const Slot& s) const;
+    [[nodiscard]] CellVisibility known_of(const Slot& s) const;
     [[nodiscard]] CellDirect direct_of(const Slot& s) const;
     [[nodiscard]] const Slot* find(std::uint64_t key) const;
     Slot* find_or_insert(std::uint64_t key);
