@@ -126,6 +126,10 @@ struct Bench {
 
 std::vector<Setting> settings(int warm) {
     std::vector<Setting> out;
+    const auto direct_traced = [](Setting s) {  // the same setting with no direct light from the cells
+        s.cache_direct = false;
+        return s;
+    };
     for (const int spp : {1, 2, 4})
         out.push_back({"path tracer, " + std::to_string(spp) + " spp", "path-" + std::to_string(spp), false, spp});
     const std::string w = std::to_string(warm) + " warm frames";
@@ -135,10 +139,8 @@ std::vector<Setting> settings(int warm) {
                    "cache", true, 1, warm});
     out.push_back(
         {"cache, " + w + ", every shadow ray traced (no visibility)", "cache-novis", true, 1, warm, 4.0f, 16, 1, 0});
-    Setting traced_direct{"cache, " + w + ", direct light traced at every pixel (none from the cells)",
-                          "cache-direct-traced", true, 1, warm};
-    traced_direct.cache_direct = false;
-    out.push_back(traced_direct);
+    out.push_back(direct_traced({"cache, " + w + ", direct light traced at every pixel (none from the cells)",
+                                 "cache-direct-traced", true, 1, warm}));
     out.push_back(
         {"cache, " + w + ", visibility after 12 agreeing rays", "cache-vis12", true, 1, warm, 4.0f, 16, 1, 12});
     out.push_back(
@@ -150,19 +152,8 @@ std::vector<Setting> settings(int warm) {
     out.push_back({"path tracer, 1 spp, mean of 16 frames", "path-mean16", false, 1, 0, 4.0f, 16, 16});
     out.push_back({"cache, " + w + ", mean of 16 frames, jittered (its bias)", "cache-mean16", true, 1, warm, 4.0f, 16,
                    16, 8, 8, true});
-    Setting traced_direct_mean{"cache, " + w + ", direct light traced at every pixel, mean of 16 frames, jittered",
-                               "cache-direct-traced-mean16",
-                               true,
-                               1,
-                               warm,
-                               4.0f,
-                               16,
-                               16,
-                               8,
-                               8,
-                               true};
-    traced_direct_mean.cache_direct = false;
-    out.push_back(traced_direct_mean);
+    out.push_back(direct_traced({"cache, " + w + ", direct light traced at every pixel, mean of 16 frames, jittered",
+                                 "cache-direct-traced-mean16", true, 1, warm, 4.0f, 16, 16, 8, 8, true}));
     out.push_back({"cache, " + w + ", no visibility, mean of 16 frames, jittered", "cache-novis-mean16", true, 1, warm,
                    4.0f, 16, 16, 0, 8, true});
     out.push_back({"cache, " + w + ", mean of 16 frames at pixel centres (as served)", "cache-mean16-centres", true, 1,

@@ -106,10 +106,9 @@ RadianceCache::Slot* RadianceCache::find_or_insert(std::uint64_t key) {
 }
 
 bool RadianceCache::lookup(std::uint64_t key, Eigen::Vector3f& white_radiance) const {
-    const Slot* s = find(key);
-    if (s == nullptr || !(s->weight > 0.0f)) return false;
-    white_radiance = Eigen::Vector3f(s->sum[0], s->sum[1], s->sum[2]) / s->weight;
-    return true;
+    const CellRead cell = read(key);
+    if (cell.has_radiance) white_radiance = cell.white;
+    return cell.has_radiance;
 }
 
 CellVisibility RadianceCache::known_of(const Slot& s) const {
