@@ -97,6 +97,7 @@ struct BenchArgs {
     std::string json, side_by_side;
     std::string quality;  // preset name; empty = Quality{}
     int denoise_max_spp = LiveOptions{}.denoise_max_spp, denoise_iterations = AtrousParams{}.iterations;
+    int shading_one_in = LiveOptions{}.shading_one_in;  // the sparse configuration's
 };
 
 // The images of the side-by-side PNG: a moving frame as rendered and upsampled, the still view.
@@ -130,7 +131,7 @@ struct ServedLog {
     nlohmann::json frames = nlohmann::json::array();
     double scale_sum = 0, scale_min = 1, spp_sum = 0, bounces_sum = 0;
     double frame_s = 0, render_phase_s = 0, slowest_rank_s = 0, denoise_s = 0;
-    double reprojected_sum = 0;
+    double reprojected_sum = 0, shaded_sum = 0;
     int blended = 0;
     void add(const LiveFrame& f) {
         const Quality& q = f.rendered.quality;
@@ -146,7 +147,11 @@ struct ServedLog {
         if (f.temporal.surface_pixels > 0) {
             const double share = double(f.temporal.reprojected) / double(f.temporal.surface_pixels);
             frames.back()["reprojected_share"] = share;
+            const double shaded = 1.0 - double(f.temporal.unshaded) / double(f.temporal.surface_pixels);
+            frames.back()["shaded_share"] = shaded;
+            frames.back()["filled_share"] = double(f.temporal.filled) / double(f.temporal.surface_pixels);
             reprojected_sum += share;
+            shaded_sum += shaded;
             ++blended;
         }
         scale_sum += q.resolution_scale;
@@ -168,7 +173,10 @@ struct ServedLog {
                               {"render_phase_seconds_mean", render_phase_s / n},
                               {"slowest_rank_seconds_mean", slowest_rank_s / n},
                               {"denoise_seconds_mean", denoise_s / n}};
-        if (blended > 0) out["reprojected_share_mean"] = reprojected_sum / blended;
+        if (blended > 0) {
+            out["reprojected_share_mean"] = reprojected_sum / blended;
+            out["shaded_share_mean"] = shaded_sum / blended;
+        }
         return out;
     }
 };
@@ -205,6 +213,7 @@ std::vector<Config> all_configs(const BenchArgs& a) {
     temporal.key = "temporal";
     temporal.name = "all + denoiser + cache + temporal";
     temporal.live.temporal = true;
+    temporal.live.shading_one_in = 1;  // every pixel shaded
     // The cache configuration with a still view's second pass of 1 spp (2 by default, as later ones).
     Config second1 = cache;
     second1.key = "cache-second-pass-1spp";
@@ -215,7 +224,12 @@ std::vector<Config> all_configs(const BenchArgs& a) {
     first1.key = "cache-first-pass-1spp";
     first1.name = "all + denoiser + cache, first still pass of 1 spp";
     first1.live.still_first_pass_spp = 1;
-    std::vector<Config> out{today, all, denoise, floor, cache, temporal, second1, first1};
+    // The temporal configuration with moving frames shading one pixel in --shading-one-in.
+    Config sparse = temporal;
+    sparse.key = "sparse";
+    sparse.name = "all + denoiser + cache + temporal, sparse shading";
+    sparse.live.shading_one_in = a.shading_one_in;
+    std::vector<Config> out{today, all, denoise, floor, cache, temporal, sparse, second1, first1};
     const auto without = [&](const char* key, const char* name, auto change) {
         Config c = all;
         c.key = key;
@@ -533,7 +547,11 @@ int admin(FrameDispatcher& farm, const Scene& scene, const BenchArgs& a) {
     const auto has = [&](const char* key) {
         return std::any_of(chosen.begin(), chosen.end(), [&](const Config& c) { return c.key == key; });
     };
-    const std::string pictured = has("cache") ? "cache" : has("denoise") ? "denoise" : "all";
+    const std::string pictured = has("sparse")     ? "sparse"
+                                 : has("cache")    ? "cache"
+                                 : has("temporal") ? "temporal"
+                                 : has("denoise")  ? "denoise"
+                                                   : "all";
     for (const Config& c : chosen) {
         Snapshots shots;
         results.push_back(run_config(c, farm, scene, a, reference, next_id, shots));
@@ -554,6 +572,7 @@ int admin(FrameDispatcher& farm, const Scene& scene, const BenchArgs& a) {
             {"quality", a.quality.empty() ? "request defaults" : a.quality},
             {"denoise_max_spp", a.denoise_max_spp},
             {"denoise_iterations", a.denoise_iterations},
+            {"shading_one_in", a.shading_one_in},
             {"baseline_full_resolution_1spp", baseline},
             {"configs", results}}.dump(2);
     }
@@ -582,10 +601,10 @@ int main(int argc, char** argv) {
     app.add_option("--reference-spp", a.reference_spp, "Reference samples per pixel (two halves)")
         ->check(CLI::Range(2, 8192));
     app.add_option("--configs", a.configs,
-                   "today, all, denoise, denoise-floor-0.2, cache, temporal, cache-second-pass-1spp, "
+                   "today, all, denoise, denoise-floor-0.2, cache, temporal, sparse, cache-second-pass-1spp, "
                    "cache-first-pass-1spp, no-progressive, no-target, no-pipeline, no-rank-speed, no-rate-aim")
         ->delimiter(',')
-        ->check(CLI::IsMember({"today", "all", "denoise", "denoise-floor-0.2", "cache", "temporal",
+        ->check(CLI::IsMember({"today", "all", "denoise", "denoise-floor-0.2", "cache", "temporal", "sparse",
                                "cache-second-pass-1spp", "cache-first-pass-1spp", "no-progressive", "no-target",
                                "no-pipeline", "no-rank-speed", "no-rate-aim"}));
     app.add_option("--quality", a.quality,
@@ -599,6 +618,8 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1, 1 << 20));
     app.add_option("--denoise-iterations", a.denoise_iterations, "denoise configuration: a-trous levels")
         ->check(CLI::Range(0, AtrousParams::kMaxIterations));
+    app.add_option("--shading-one-in", a.shading_one_in, "sparse configuration: moving frames shade 1 pixel in N")
+        ->check(CLI::Range(1, 16));
     app.add_flag("--jitter-cached-one-spp", setup.jitter_cached_one_spp,
                  "Moving frames from the radiance cache jittered, their guides from a guide pass (as before)");
     app.add_option("--json", a.json, "Write every figure (and the curves) as JSON");

@@ -54,6 +54,8 @@ void validate_view_request(const ViewRequest& request) {
     if (!(request.scene_time_s >= 0.0) || !std::isfinite(request.scene_time_s)) {
         fail("scene_time_s", request.scene_time_s, "[0, inf)");
     }
+    require_int("shading_one_in", request.shading_one_in, limits::kShadingOneIn);
+    require_int("shading_phase", request.shading_phase, IntRange{0, request.shading_one_in - 1});
     if (const auto* pinhole = std::get_if<PinholeCamera>(&request.camera)) {
         if (!(pinhole->vertical_fov_deg > 0.0 && pinhole->vertical_fov_deg < 180.0)) {
             fail("camera.vertical_fov_deg", pinhole->vertical_fov_deg, "(0, 180)");

@@ -38,6 +38,7 @@ inline constexpr IntRange kMaxBounces{0, 64};          // path-tracing bounces
 inline constexpr IntRange kAoSamples{0, 1024};         // occlusion rays for the environment light
 inline constexpr IntRange kAreaLightSamples{1, 1024};  // shadow rays per area light per sample
 inline constexpr IntRange kJpegQuality{1, 100};        // TurboJPEG quality
+inline constexpr IntRange kShadingOneIn{1, 16};        // a sparse cached frame shades 1 pixel in N
 }  // namespace request_limits
 
 void validate_view_request(const ViewRequest& request);

@@ -33,6 +33,8 @@ TEST(ViewValidation, RejectsEachOutOfRangeFieldByName) {
     const double inf = std::numeric_limits<double>::infinity();
     expect_rejected([](ViewRequest& r) { r.quality.spp = 0; }, "quality.spp", "[1, 4096]");
     expect_rejected([](ViewRequest& r) { r.quality.spp = 4097; }, "quality.spp", "[1, 4096]");
+    expect_rejected([](ViewRequest& r) { r.shading_one_in = 0; }, "shading_one_in", "[1, 16]");
+    expect_rejected([](ViewRequest& r) { r.shading_one_in = 4, r.shading_phase = 4; }, "shading_phase", "[0, 3]");
     expect_rejected([](ViewRequest& r) { r.quality.max_bounces = -1; }, "quality.max_bounces", "[0, 64]");
     expect_rejected([](ViewRequest& r) { r.quality.max_bounces = 65; }, "quality.max_bounces", "[0, 64]");
     expect_rejected([](ViewRequest& r) { r.quality.ao_samples = -1; }, "quality.ao_samples", "[0, 1024]");

@@ -76,7 +76,26 @@ struct ViewRequest {
     // at which animated lights are evaluated (renderfarm/scene/scene.h, LightAnimation). The farm's
     // admin stamps it; 0 for path tours.
     double scene_time_s = 0.0;
+    // Farm-internal, never on the link's wire: a cached frame (radiance_cache) shades only one pixel
+    // in `shading_one_in` (the pixels (x, y) with (x + k·y + shading_phase) mod N = 0, N =
+    // shading_one_in, k = ⌈N/2⌉, so every N consecutive phases shade every pixel once) and the
+    // cache's training pixels; every other surface pixel gets its primary hit's guides and the
+    // radiance kUnshadedRadiance, for the admin to take from the reprojected history
+    // (renderfarm/denoise/temporal_accumulation.h). 1 shades every pixel.
+    int shading_one_in = 1;  // [1, 16]
+    int shading_phase = 0;   // [0, shading_one_in)
 };
+
+// The red channel of a pixel a sparse cached frame did not shade (ViewRequest::shading_one_in): no
+// radiance is negative.
+inline constexpr float kUnshadedRadiance = -1.0f;
+
+// Whether a frame with `one_in` and `phase` (ViewRequest::shading_one_in, shading_phase) shades
+// pixel (x, y) of its render size.
+[[nodiscard]] inline bool shades_pixel(int one_in, int phase, int x, int y) {
+    const int k = (one_in + 1) / 2;
+    return (x + k * y + phase) % one_in == 0;
+}
 
 // The size actually traced: size scaled by quality.resolution_scale, rounded to nearest, at least
 // 1x1. The farm and the renderer both use this one definition.

@@ -2,7 +2,9 @@
 #include "renderfarm/denoise/temporal_accumulation.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -20,6 +22,13 @@ void check_sizes(const RgbFloatImage& current, const GuideBuffers& guides, const
 }
 
 Eigen::Vector3f at3(const std::vector<float>& v, std::size_t i) { return {v[3 * i], v[3 * i + 1], v[3 * i + 2]}; }
+
+constexpr float kMinAlbedo = 1e-3f;  // as the à-trous filter's demodulation (atrous_filter.h)
+
+// What pixel i's channel c is divided by to demodulate it.
+float demodulation(const GuideBuffers& guides, std::size_t i, std::size_t c) {
+    return std::max(guides.albedo[3 * i + c], kMinAlbedo);
+}
 
 }  // namespace
 
@@ -40,12 +49,15 @@ bool TemporalHistory::gather(const Eigen::Vector3f& position, const Eigen::Vecto
     if (!project_to_image(camera_, position.cast<double>(), px, py)) return false;
     const double fx = px - 0.5;
     const double fy = py - 0.5;
-    if (!(fx > -1.0 && fy > -1.0 && fx < camera_.size.width && fy < camera_.size.height)) return false;
+    // Only between the previous frame's pixel centres: beyond them a value would be extrapolated
+    // from the border pixel, and carried on from frame to frame it drifts with the motion.
+    if (!(fx >= 0.0 && fy >= 0.0 && fx <= camera_.size.width - 1.0 && fy <= camera_.size.height - 1.0)) return false;
     const int x0 = static_cast<int>(std::floor(fx));
     const int y0 = static_cast<int>(std::floor(fy));
     const auto wx = static_cast<float>(fx - x0);
     const auto wy = static_cast<float>(fy - y0);
     float weight = 0.0f;
+    int accepted = 0;
     value = Eigen::Vector3f::Zero();
     length = 0.0f;
     for (int k = 0; k < 4; ++k) {
@@ -59,17 +71,117 @@ bool TemporalHistory::gather(const Eigen::Vector3f& position, const Eigen::Vecto
         if (n.dot(normal) < params.normal_min_cos) continue;
         if (std::abs(n.dot(position - at3(position_, i))) > params.plane_tolerance * depth) continue;
         const float w = ((k & 1) != 0 ? wx : 1.0f - wx) * ((k >> 1) != 0 ? wy : 1.0f - wy);
-        value += w * Eigen::Vector3f(radiance_.at(x, y)[0], radiance_.at(x, y)[1], radiance_.at(x, y)[2]);
+        value += w * at3(illumination_, i);
         length += w * length_[i];
         weight += w;
+        ++accepted;
     }
     if (!(weight > 1e-3f)) return false;
     value /= weight;
     length /= weight;
+    if (params.sharp_history && accepted == 4) sharpen(fx, fy, value);
     return true;
 }
 
-// Rows [y0, y1) of accumulate(): writes their pixels of out, position and length; counts them.
+// The history at (fx, fy) by Catmull-Rom interpolation of the 4x4 previous pixels around it, once
+// gather() accepted all of the central 2x2, clamped per channel to their range. The outer twelve
+// taps are not tested: their weights are at most 0, so another surface there can only steepen the
+// curve, and the clamp bounds it (testing them cost more than the rest of the blend). Near the
+// image's border `value` stays bilinear.
+// Bilinear resampling, repeated frame after frame as the view moves, low-pass filters the history
+// (about a quarter of a pixel of blur per frame at half-pixel offsets); the cubic keeps it sharp.
+// The usual history filter of temporal anti-aliasing (Karis, "High-Quality Temporal
+// Supersampling", SIGGRAPH 2014 course).
+void TemporalHistory::sharpen(double fx, double fy, Eigen::Vector3f& value) const {
+    const int x0 = static_cast<int>(std::floor(fx));
+    const int y0 = static_cast<int>(std::floor(fy));
+    if (x0 < 1 || y0 < 1 || x0 + 2 >= camera_.size.width || y0 + 2 >= camera_.size.height) return;
+    const auto weights = [](float t) {
+        return std::array<float, 4>{t * (-0.5f + t * (1.0f - 0.5f * t)), 1.0f + t * t * (-2.5f + 1.5f * t),
+                                    t * (0.5f + t * (2.0f - 1.5f * t)), t * t * (-0.5f + 0.5f * t)};
+    };
+    const std::array<float, 4> wx = weights(static_cast<float>(fx - x0));
+    const std::array<float, 4> wy = weights(static_cast<float>(fy - y0));
+    Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+    Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
+    Eigen::Vector3f hi = Eigen::Vector3f::Constant(std::numeric_limits<float>::lowest());
+    for (int j = 0; j < 4; ++j) {
+        for (int k = 0; k < 4; ++k) {
+            const int x = x0 - 1 + k;
+            const int y = y0 - 1 + j;
+            const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(camera_.size.width) +
+                                  static_cast<std::size_t>(x);
+            const Eigen::Vector3f v = at3(illumination_, i);
+            sum += wx[static_cast<std::size_t>(k)] * wy[static_cast<std::size_t>(j)] * v;
+            if (j == 1 || j == 2) {
+                if (k == 1 || k == 2) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+            }
+        }
+    }
+    value = sum.cwiseMax(lo).cwiseMin(hi);
+}
+
+// The unshaded pixels no history covers (disoccluded, or new at the image's edge) from their
+// neighbours in the same frame within kFillRadius: the mean of those on the same surface (the
+// history's tests: normal_min_cos, plane_tolerance), weighted by 1 / (1 + distance²), or of any
+// surface neighbour when none is. Length 0: the pixel's first shaded sample replaces the fill.
+// Reads only pixels that are not holes, so the result does not depend on the order.
+std::size_t TemporalHistory::fill_holes(const Pass& f) {
+    constexpr int kFillRadius = 2;  // every pixel has a shaded one within 1 (view_request.h's pattern)
+    const int width = f.current.size.width;
+    const int height = f.current.size.height;
+    const auto hole = [&](std::size_t i) { return f.guides.hit[i] != 0 && f.illumination[3 * i] < 0.0f; };
+    std::vector<std::size_t> holes;
+    for (std::size_t i = 0; i < f.guides.hit.size(); ++i)
+        if (hole(i)) holes.push_back(i);
+    std::vector<Eigen::Vector3f> filled(holes.size(), Eigen::Vector3f::Zero());
+    for (std::size_t h = 0; h < holes.size(); ++h) {
+        const int x = static_cast<int>(holes[h] % static_cast<std::size_t>(width));
+        const int y = static_cast<int>(holes[h] / static_cast<std::size_t>(width));
+        const Eigen::Vector3f p = at3(f.position, holes[h]);
+        const Eigen::Vector3f n = at3(f.guides.normal, holes[h]);
+        Eigen::Vector3f same = Eigen::Vector3f::Zero(), any = Eigen::Vector3f::Zero();
+        float same_w = 0.0f, any_w = 0.0f;
+        for (int dy = -kFillRadius; dy <= kFillRadius; ++dy) {
+            for (int dx = -kFillRadius; dx <= kFillRadius; ++dx) {
+                const int qx = x + dx, qy = y + dy;
+                if (qx < 0 || qy < 0 || qx >= width || qy >= height) continue;
+                const std::size_t j = f.guides.pixel(qx, qy);
+                if (f.guides.hit[j] == 0 || hole(j)) continue;
+                const float w = 1.0f / float(1 + dx * dx + dy * dy);
+                const Eigen::Vector3f v = at3(f.illumination, j);
+                any += w * v, any_w += w;
+                if (at3(f.guides.normal, j).dot(n) < f.params.normal_min_cos ||
+                    std::abs(n.dot(p - at3(f.position, j))) > f.params.plane_tolerance * f.guides.depth[holes[h]])
+                    continue;
+                same += w * v, same_w += w;
+            }
+        }
+        filled[h] = same_w > 0.0f  ? Eigen::Vector3f(same / same_w)
+                    : any_w > 0.0f ? Eigen::Vector3f(any / any_w)
+                                   : Eigen::Vector3f::Zero();
+    }
+    for (std::size_t h = 0; h < holes.size(); ++h) {
+        const std::size_t i = holes[h];
+        set_pixel(f, i, filled[h]);
+        f.length[i] = 0.0f;
+    }
+    return holes.size();
+}
+
+// Pixel i's illumination becomes `value` and its output value ⊙ its albedo (re-modulated).
+void TemporalHistory::set_pixel(const Pass& f, std::size_t i, const Eigen::Vector3f& value) {
+    const int width = f.current.size.width;
+    float* o = f.out.at(static_cast<int>(i % static_cast<std::size_t>(width)),
+                        static_cast<int>(i / static_cast<std::size_t>(width)));
+    for (std::size_t c = 0; c < 3; ++c) {
+        f.illumination[3 * i + c] = value[static_cast<Eigen::Index>(c)];
+        o[c] = value[static_cast<Eigen::Index>(c)] * demodulation(f.guides, i, c);
+    }
+}
+
+// Rows [y0, y1) of accumulate(): writes their pixels of out, illumination, position and length;
+// counts them. A pixel that no history covers keeps its own radiance, bit for bit.
 void TemporalHistory::accumulate_rows(const Pass& f, int y0, int y1, TemporalStats& counted) const {
     for (int y = y0; y < y1; ++y) {
         for (int x = 0; x < f.current.size.width; ++x) {
@@ -80,31 +192,50 @@ void TemporalHistory::accumulate_rows(const Pass& f, int y0, int y1, TemporalSta
             const Eigen::Vector3f p =
                 (ray.origin + static_cast<double>(f.guides.depth[i]) * ray.direction).cast<float>();
             for (int c = 0; c < 3; ++c) f.position[3 * i + static_cast<std::size_t>(c)] = p[c];
+            const float* own = f.current.at(x, y);
+            const bool shaded = !(own[0] < 0.0f);  // kUnshadedRadiance: a sparse frame's unshaded pixel
+            if (!shaded) ++counted.unshaded;
+            Eigen::Vector3f illumination(kUnshadedRadiance, 0.0f, 0.0f);  // a hole until fill_holes()
+            if (shaded) {
+                for (std::size_t c = 0; c < 3; ++c)
+                    illumination[static_cast<Eigen::Index>(c)] = own[c] / demodulation(f.guides, i, c);
+            }
+            for (int c = 0; c < 3; ++c) f.illumination[3 * i + static_cast<std::size_t>(c)] = illumination[c];
             Eigen::Vector3f history;
             float frames = 0.0f;
             if (empty() || !gather(p, at3(f.guides.normal, i), f.guides.depth[i], f.params, history, frames)) {
-                f.length[i] = 1.0f;
+                f.length[i] = shaded ? 1.0f : 0.0f;
                 continue;
             }
             ++counted.reprojected;
-            const float a = std::max(f.params.alpha, 1.0f / (frames + 1.0f));
-            float* o = f.out.at(x, y);
-            for (int c = 0; c < 3; ++c) o[c] = (1.0f - a) * history[c] + a * o[c];
+            if (!shaded) {  // the history alone, still as many frames as it had
+                set_pixel(f, i, history);
+                f.length[i] = frames;
+                continue;
+            }
+            const float a = std::max(f.alpha, 1.0f / (frames + 1.0f));
+            set_pixel(f, i, (1.0f - a) * history + a * illumination);
             f.length[i] = frames + 1.0f;
         }
     }
 }
 
 RgbFloatImage TemporalHistory::accumulate(const RgbFloatImage& current, const GuideBuffers& guides,
-                                          const CameraSetup& camera, const TemporalParams& params,
-                                          TemporalStats* stats) {
+                                          const CameraSetup& camera, const TemporalParams& params, TemporalStats* stats,
+                                          int shading_one_in) {
     check_temporal_params(params);
     check_sizes(current, guides, camera);
+    if (shading_one_in < 1)
+        throw std::invalid_argument("temporal accumulation: shading_one_in must be >= 1, is " +
+                                    std::to_string(shading_one_in));
     const auto n = static_cast<std::size_t>(current.size.pixel_count());
     RgbFloatImage out = current;
+    std::vector<float> illumination(3 * n, 0.0f);
     std::vector<float> position(3 * n, 0.0f);
     std::vector<float> length(n, 0.0f);
-    const Pass f{current, guides, camera, make_cylinder_columns(camera), params, out, position, length};
+    const float alpha = 1.0f - std::pow(1.0f - params.alpha, static_cast<float>(shading_one_in));
+    const Pass f{current,      guides,   camera, make_cylinder_columns(camera), params, alpha, out,
+                 illumination, position, length};
     // Rows split over the cores (each pixel reads only the history and writes only itself, so the
     // result does not depend on the split): the admin runs this while the ranks wait.
     const int height = current.size.height;
@@ -122,9 +253,11 @@ RgbFloatImage TemporalHistory::accumulate(const RgbFloatImage& current, const Gu
     for (const TemporalStats& c : counted) {
         total.surface_pixels += c.surface_pixels;
         total.reprojected += c.reprojected;
+        total.unshaded += c.unshaded;
     }
+    total.filled = fill_holes(f);
     camera_ = camera;
-    radiance_ = out;
+    illumination_ = std::move(illumination);
     position_ = std::move(position);
     normal_ = guides.normal;
     hit_ = guides.hit;
@@ -134,7 +267,7 @@ RgbFloatImage TemporalHistory::accumulate(const RgbFloatImage& current, const Gu
 }
 
 void TemporalHistory::clear() {
-    radiance_ = {};
+    illumination_.clear();
     position_.clear();
     normal_.clear();
     hit_.clear();

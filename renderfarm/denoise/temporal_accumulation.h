@@ -16,14 +16,29 @@
 //   surface, its normal n' has n·n' >= normal_min_cos, and P lies within plane_tolerance · depth(p)
 //   of the tap's tangent plane: |n'·(P − P')| (robust at grazing angles, where neighbouring pixels'
 //   depths differ by far more than the surface's own offset);
-//   H, n = the accepted taps' weighted mean of the previous output and history length;
-//   out = (1 − a) H + a C,  a = max(alpha, 1 / (n + 1)),  new length n + 1;
-//   no accepted tap (disoccluded, or outside the previous image): out = C, length 1.
+//   C = the pixel's radiance demodulated: divided by max(albedo, 1e-3) per channel (the first
+//   hit's albedo guide; SVGF §4: the history holds untextured illumination, so texture, which each
+//   frame's guides give exactly at every pixel, is never resampled from earlier frames);
+//   H, n = the accepted taps' weighted mean of the previous illumination and history length (with
+//   sharp_history, H is the 4x4 Catmull-Rom interpolation instead where all four are accepted,
+//   clamped to their range);
+//   out = ((1 − a) H + a C) ⊙ max(albedo, 1e-3),  a = max(alpha, 1 / (n + 1)),  new length n + 1;
+//   no accepted tap (disoccluded, or outside the previous image): out = the pixel's own radiance,
+//   length 1.
 // a = 1/(n+1) makes the first frames of a point an exact running mean; alpha (SVGF: 0.2) keeps
 // the average exponential after that, so a change (a light switched, a tap wrongly accepted) fades
 // within about 1/alpha frames. Bias: the average lags by up to 1/alpha frames: glossy highlights,
 // which move with the eye, smear; everything the radiance cache or the path tracer estimates as
 // view-independent does not.
+//
+// A sparse frame (view_request.h, ViewRequest::shading_one_in) leaves most surface pixels unshaded
+// (kUnshadedRadiance in red): such a pixel takes the history H alone, its length unchanged; one the
+// history does not cover is filled from the frame's own pixels around it on the same surface, with
+// length 0 so that its first shaded sample replaces the fill. A pixel is shaded once every
+// shading_one_in frames, so a shaded pixel weighs its sample as alpha would over that many frames
+// (accumulate()): the lag stays, the average holds fewer samples (more noise for the spatial
+// filter), and each frame traces a fraction of the paths. This is checkerboard
+// rendering's reconstruction from temporal history, with the rotating pattern as its refresh.
 //
 // Frames may change size between calls (the frame-time target scales them): the history keeps its
 // own size and camera. Pure CPU code, no GL, no Embree; rows run on every core.
@@ -43,6 +58,9 @@ struct TemporalParams {
     float alpha = 0.2f;             // least weight of the current frame, (0, 1]; 1 = no accumulation
     float plane_tolerance = 0.01f;  // of the pixel's depth, > 0
     float normal_min_cos = 0.9f;    // in [-1, 1]
+    // The history interpolated by Catmull-Rom where the 2x2 bilinear taps are all the same surface
+    // (bilinear elsewhere): sharp where the view moves by fractions of a pixel; off: bilinear.
+    bool sharp_history = true;
 };
 
 // Throws std::invalid_argument naming the field and its limit.
@@ -52,6 +70,8 @@ void check_temporal_params(const TemporalParams& params);
 struct TemporalStats {
     std::size_t surface_pixels = 0;  // pixels that hit a surface
     std::size_t reprojected = 0;     // ... of which blended with the history
+    std::size_t unshaded = 0;        // ... of which a sparse frame did not shade (kUnshadedRadiance)
+    std::size_t filled = 0;          // ... of those, no history covered: filled from their neighbours
 };
 
 class TemporalHistory {
@@ -59,12 +79,16 @@ public:
     // Blends `current` (linear radiance, the size of `guides`, seen by `camera` whose size is the
     // frame's) with the history, keeps the result as the new history and returns it. Throws
     // std::invalid_argument for a size mismatch or bad params (naming the field and its limit).
+    // `shading_one_in`: the frame is sparse (ViewRequest::shading_one_in, >= 1), so each pixel is
+    // shaded once in that many frames and a shaded pixel's least weight is 1 − (1 − alpha)^N, the
+    // weight alpha would have given its new samples over N frames: the history lags by as many
+    // frames as in a full frame's.
     RgbFloatImage accumulate(const RgbFloatImage& current, const GuideBuffers& guides, const CameraSetup& camera,
-                             const TemporalParams& params, TemporalStats* stats = nullptr);
+                             const TemporalParams& params, TemporalStats* stats = nullptr, int shading_one_in = 1);
 
     // Forgets everything: the next frame starts its own history.
     void clear();
-    [[nodiscard]] bool empty() const { return radiance_.pixels.empty(); }
+    [[nodiscard]] bool empty() const { return illumination_.empty(); }
 
 private:
     // One accumulate() call's inputs and outputs.
@@ -74,20 +98,25 @@ private:
         const CameraSetup& camera;
         CylinderColumns columns;
         const TemporalParams& params;
+        float alpha;  // a shaded pixel's least weight: params.alpha over shading_one_in frames
         RgbFloatImage& out;
+        std::vector<float>& illumination;
         std::vector<float>& position;
         std::vector<float>& length;
     };
     void accumulate_rows(const Pass& f, int y0, int y1, TemporalStats& counted) const;
+    static std::size_t fill_holes(const Pass& f);
+    static void set_pixel(const Pass& f, std::size_t i, const Eigen::Vector3f& value);
+    void sharpen(double fx, double fy, Eigen::Vector3f& value) const;
     [[nodiscard]] bool gather(const Eigen::Vector3f& position, const Eigen::Vector3f& normal, float depth,
                               const TemporalParams& params, Eigen::Vector3f& value, float& length) const;
 
     CameraSetup camera_;
-    RgbFloatImage radiance_;         // the previous output
-    std::vector<float> position_;    // W*H*3 world metres of each pixel's hit
-    std::vector<float> normal_;      // W*H*3 unit world normals
-    std::vector<std::uint8_t> hit_;  // W*H
-    std::vector<float> length_;      // W*H frames averaged
+    std::vector<float> illumination_;  // W*H*3 the previous output demodulated (radiance / albedo)
+    std::vector<float> position_;      // W*H*3 world metres of each pixel's hit
+    std::vector<float> normal_;        // W*H*3 unit world normals
+    std::vector<std::uint8_t> hit_;    // W*H
+    std::vector<float> length_;        // W*H frames averaged
 };
 
 }  // namespace mogao

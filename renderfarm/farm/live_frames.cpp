@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "common/request_limits.h"
 #include "renderfarm/trace/film.h"
 
 namespace mogao {
@@ -29,6 +30,9 @@ LiveFrames::LiveFrames(FrameSource source, LiveOptions options, float exposure, 
     if (options_.still_first_pass_spp < 1 || options_.still_second_pass_spp < 1 || options_.still_pass_spp < 1)
         throw std::invalid_argument(
             "LiveOptions.still_first_pass_spp, still_second_pass_spp and still_pass_spp must be >= 1");
+    if (options_.shading_one_in < request_limits::kShadingOneIn.min ||
+        options_.shading_one_in > request_limits::kShadingOneIn.max)
+        throw std::invalid_argument("LiveOptions.shading_one_in must be in " + request_limits::kShadingOneIn.text());
     options_.controller.target_seconds = options_.frame_time_s > 0 ? options_.frame_time_s : 1.0;
     (void)FrameTimeController(options_.controller);  // validates the controller's settings now
     if (options_.denoise_max_spp < 1) throw std::invalid_argument("LiveOptions.denoise_max_spp must be >= 1");
@@ -124,12 +128,22 @@ ViewRequest LiveFrames::plan(Session& s, const ViewRequest& request, FrameChoice
         view.frame_id = pass_frame_id(s.accumulation.first_frame_id(), s.accumulation.passes());
     } else {
         view.radiance_cache = options_.radiance_cache && !still;
+        plan_sparse(s, view);
         if (still && options_.progressive) {
             choice.spp = std::max(choice.spp, options_.still_first_pass_spp);
             view.quality.spp = choice.spp;
         }
     }
     return view;
+}
+
+// A cached moving frame shades one pixel in shading_one_in when its history can supply the rest
+// (the denoiser blends it: display()); the pattern's phase moves on with each such frame.
+void LiveFrames::plan_sparse(Session& s, ViewRequest& view) const {
+    if (!view.radiance_cache || !options_.denoise || !options_.temporal || s.temporal.empty()) return;
+    if (options_.shading_one_in == 1) return;
+    view.shading_one_in = options_.shading_one_in;
+    view.shading_phase = static_cast<int>(s.sparse_frames++ % static_cast<std::uint64_t>(options_.shading_one_in));
 }
 
 // A pass joins the session's accumulation unless it was cut short or traced with the (biased) cache.
@@ -182,7 +196,7 @@ void LiveFrames::display(Session& s, const RgbFloatImage& radiance, LiveFrame& f
     RgbFloatImage blended;
     if (options_.temporal && !frame.still) {
         blended = s.temporal.accumulate(radiance, s.guides, make_camera_setup(frame.rendered, radiance.size),
-                                        options_.temporal_params, &frame.temporal);
+                                        options_.temporal_params, &frame.temporal, frame.rendered.shading_one_in);
         noisy = &blended;
     }
     // A still view's accumulation of two passes or more brings its own noise, measured from the

@@ -102,6 +102,14 @@ struct LiveOptions {
     // (renderfarm/denoise/temporal_accumulation.h): a moving view keeps most of its samples.
     bool temporal = false;
     TemporalParams temporal_params;
+    // With radiance_cache, denoise and temporal: a moving frame that has a history shades one pixel
+    // in `shading_one_in` ([1, 16]; 1 shades all), on a pattern that moves every frame
+    // (ViewRequest::shading_one_in; each pixel is shaded once in as many frames), and takes the
+    // others from the reprojected history (temporal_accumulation.h): the ranks trace each frame's
+    // camera rays and a fraction of its light. 4: as close to the reference as shading every pixel,
+    // with more moving frames a second; 8 was no faster, 2 slower (docs/renderer.md, the serve
+    // bench's temporal and sparse configurations).
+    int shading_one_in = 4;
     // The scene's lights at a scene time (renderfarm/scene/scene.h, lighting_state; empty: static
     // lights). Every request is stamped with the scene time (ViewRequest::scene_time_s, from
     // scene_clock, or seconds since this LiveFrames was made); a session whose lights changed since
@@ -169,6 +177,7 @@ private:
         std::optional<std::chrono::steady_clock::time_point> handed_back;  // the previous render() returned
         double recent_seconds = 0.0;                 // rendered frames' seconds, exponentially weighted (0: none yet)
         std::optional<std::vector<float>> lighting;  // the lights' state of its previous frame
+        std::uint64_t sparse_frames = 0;             // sparse frames asked for: the pattern's phase
     };
     Session& session(std::uint64_t id);
     // Sessions handed a frame within kActiveWindow before `now`, `current` counted even if new.
@@ -178,6 +187,7 @@ private:
     [[nodiscard]] double scene_time_s() const;
     void follow_lighting(Session& s, double scene_time_s);
     [[nodiscard]] ViewRequest plan(Session& s, const ViewRequest& request, FrameChoice& choice) const;
+    void plan_sparse(Session& s, ViewRequest& view) const;
     [[nodiscard]] Rgb8Image to_display(const RgbFloatImage& radiance) const;
     [[nodiscard]] bool accumulates(const LiveFrame& frame) const;
     void dispatch(Session& s, const ViewRequest& request, int spp, LiveFrame& frame, RgbFloatImage& radiance);

@@ -398,6 +398,48 @@ TEST_F(LiveFramesTest, ALightThatChangesRestartsTheStillViewAndDropsTheTemporalH
     EXPECT_EQ(after.image.pixels, alone.image.pixels) << "the old light's history was blended in";
 }
 
+// Cached moving frames with a history shade one pixel in shading_one_in, the pattern moving on a
+// phase each frame; the first frame of a session (no history), a still view's passes and sessions
+// without temporal accumulation shade every pixel. The served frames stay close to those of a
+// session that shades every pixel (no unshaded pixel shows).
+TEST_F(LiveFramesTest, CachedMovingFramesShadeOnePixelInNOnAMovingPattern) {
+    LiveOptions options;
+    options.radiance_cache = options.denoise = options.temporal = true;
+    LiveOptions every_pixel = options;
+    every_pixel.shading_one_in = 1;
+    LiveFrames sparse(source(), options, 1.f, ToneMap::clamp);
+    LiveFrames full(source(), every_pixel, 1.f, ToneMap::clamp);
+    std::vector<int> one_in, phase;
+    LiveFrame a, b;
+    for (std::uint64_t k = 0; k < 6; ++k) {
+        ViewRequest r = view(0.5 * static_cast<double>(k));
+        r.frame_id = 10 + k;
+        a = sparse.render(r);
+        one_in.push_back(calls_.back().view.shading_one_in);
+        phase.push_back(calls_.back().view.shading_phase);
+        b = full.render(r);
+        EXPECT_EQ(calls_.back().view.shading_one_in, 1);
+    }
+    EXPECT_EQ(one_in, (std::vector<int>{1, 4, 4, 4, 4, 4}));
+    EXPECT_EQ(phase, (std::vector<int>{0, 0, 1, 2, 3, 0}));
+    EXPECT_GT(a.temporal.unshaded, a.temporal.surface_pixels / 2);
+    EXPECT_GT(psnr(a.image, b.image), 30.0) << "the sparse session's frame against the full one's";
+    EXPECT_NEAR(mean_of(a.image), mean_of(b.image), 1.0);
+
+    ViewRequest still = view(2.5);  // the last view again: a still view's first pass, uncached
+    still.frame_id = 20;
+    (void)sparse.render(still);
+    EXPECT_EQ(calls_.back().view.shading_one_in, 1);
+    options.temporal = false;
+    LiveFrames no_history(source(), options, 1.f, ToneMap::clamp);
+    for (std::uint64_t k = 0; k < 3; ++k) {
+        ViewRequest r = view(0.5 * static_cast<double>(k));
+        r.frame_id = 30 + k;
+        (void)no_history.render(r);
+        EXPECT_EQ(calls_.back().view.shading_one_in, 1);
+    }
+}
+
 // A still view: the guides are traced with its first pass only, and frames are filtered while they
 // hold at most denoise_max_spp samples (1, then 1 + 2), raw after that (1 + 2 + 2 = 5).
 TEST_F(LiveFramesTest, StillViewIsDenoisedUpToDenoiseMaxSppWithTheFirstPassesGuides) {
@@ -635,6 +677,9 @@ TEST(LiveOptions, BadDenoiseOptionsAreRefusedNamingTheField) {
     alpha.temporal_params.alpha = 0.0f;
     EXPECT_NE(message(alpha).find("temporal_params"), std::string::npos) << message(alpha);
     EXPECT_NE(message(alpha).find("alpha"), std::string::npos) << message(alpha);
+    LiveOptions sparse;
+    sparse.shading_one_in = 0;
+    EXPECT_NE(message(sparse).find("shading_one_in"), std::string::npos) << message(sparse);
 }
 
 TEST(LiveOptions, BadOptionsAreRefused) {

@@ -22,8 +22,9 @@ struct WireView {
     std::int32_t stop;       // 1: no more frames, render ranks leave their loop
     std::int32_t linear;     // 0: sRGB8, 1: linear radiance (PackedPixels::linear), 2: and guides (::linear_guided)
     std::uint64_t sequence;  // the dispatcher's count of frames sent: names the frame in progress reports and cuts
-    std::int32_t radiance_cache;  // ViewRequest::radiance_cache
-    double scene_time_s;          // ViewRequest::scene_time_s
+    std::int32_t radiance_cache;                 // ViewRequest::radiance_cache
+    double scene_time_s;                         // ViewRequest::scene_time_s
+    std::int32_t shading_one_in, shading_phase;  // ViewRequest's
 };
 static_assert(std::is_trivially_copyable_v<WireView>);
 
@@ -57,6 +58,8 @@ inline WireView to_wire(const ViewRequest& v) {
     w.resolution_scale = v.quality.resolution_scale;
     w.radiance_cache = v.radiance_cache ? 1 : 0;
     w.scene_time_s = v.scene_time_s;
+    w.shading_one_in = v.shading_one_in;
+    w.shading_phase = v.shading_phase;
     return w;
 }
 
@@ -78,6 +81,8 @@ inline ViewRequest from_wire(const WireView& w) {
     v.quality = {w.spp, w.max_bounces, w.ao_samples, w.area_light_samples, w.resolution_scale, w.jpeg_quality};
     v.radiance_cache = w.radiance_cache != 0;
     v.scene_time_s = w.scene_time_s;
+    v.shading_one_in = w.shading_one_in;
+    v.shading_phase = w.shading_phase;
     return v;
 }
 

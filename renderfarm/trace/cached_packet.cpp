@@ -15,10 +15,6 @@ std::uint64_t pixel_hash(const CacheFrame& cf, int x, int y, std::uint64_t salt)
     return mix64(cf.frame_key ^ mix64(pixel ^ salt));
 }
 
-bool trains(const CacheFrame& cf, int x, int y) {
-    return pixel_hash(cf, x, y, 0) % static_cast<std::uint64_t>(cf.cache->options().train_one_in) == 0;
-}
-
 // A pixel of a cell that knows its lights still traces them, 1 in visibility_recheck_one_in.
 bool rechecks(const CacheFrame& cf, int x, int y) {
     constexpr std::uint64_t kSalt = 0x9E3779B97F4A7C15ull;  // independent of the training choice
@@ -123,6 +119,10 @@ std::uint64_t pixel_order(const CacheFrame& cf, const LanePixels& pixels, std::s
 
 }  // namespace
 
+bool trains_cache(const CacheFrame& cf, int x, int y) {
+    return pixel_hash(cf, x, y, 0) % static_cast<std::uint64_t>(cf.cache->options().train_one_in) == 0;
+}
+
 void cached_radiance_packet(const FrameContext& frame, const CacheFrame& cf, const PacketHits& hits,
                             const LanePixels& pixels, std::array<PixelSampler, kPacketLanes>& rngs,
                             std::array<Eigen::Vector3f, kPacketLanes>& radiance, std::uint64_t& rays,
@@ -155,7 +155,7 @@ void cached_radiance_packet(const FrameContext& frame, const CacheFrame& cf, con
         const bool found = reads.jittered[l].has_radiance;
         if (found) radiance[l] += reflectance[l].cwiseProduct(reads.jittered[l].white);
         shown[l] = !found;
-        if (found && !trains(cf, pixels.x[l], pixels.y[l])) continue;
+        if (found && !trains_cache(cf, pixels.x[l], pixels.y[l])) continue;
         training.alive[l] = true;
         any = true;
     }

@@ -52,6 +52,10 @@ struct LanePixels {
     std::array<int, kPacketLanes> y{};
 };
 
+// Whether pixel (x, y) of the frame is one of the 1 in RadianceCacheOptions::train_one_in that
+// trace a training path whatever their cell holds (chosen by a hash of the frame key and the pixel).
+[[nodiscard]] bool trains_cache(const CacheFrame& cache_frame, int x, int y);
+
 // Adds each alive lane's cached-frame radiance to radiance[l]; appends training estimates to
 // `deposits`; `rays` counts every ray traced.
 void cached_radiance_packet(const FrameContext& frame, const CacheFrame& cache_frame, const PacketHits& hits,

@@ -92,6 +92,8 @@ struct Renderer::Impl {
     FrameContext context;
     bool cached = false;  // ViewRequest::radiance_cache: cached_packet.h's light
     CacheFrame cache_frame;
+    int shading_one_in = 1;  // ViewRequest's, for cached frames (1 otherwise)
+    int shading_phase = 0;
 
     [[nodiscard]] int packet_width() const { return options.native_packet_width ? native_width : 16; }
 
@@ -216,6 +218,7 @@ struct Renderer::Impl {
                       GuideBuffers* guides = nullptr) const {
         std::array<Eigen::Vector3f, kLanes> sum;
         sum.fill(Eigen::Vector3f::Zero());
+        std::array<bool, kLanes> unshaded{};
         PacketHits hits;
         for (int sample = 0; sample < spp; ++sample) {
             RTCRayHit16 packet{};  // masked lanes stay zero (defined for tools like valgrind)
@@ -233,6 +236,7 @@ struct Renderer::Impl {
                     pixels.x[static_cast<std::size_t>(lane)] = block.x0 + lane % kBlock;
                     pixels.y[static_cast<std::size_t>(lane)] = block.y0 + lane / kBlock;
                 }
+                skip_unshaded(pixels, hits, unshaded);
                 cached_radiance_packet(context, cache_frame, hits, pixels, rngs, radiance, stats.rays, *deposits);
                 for (std::size_t l = 0; l < kLanes; ++l)
                     if (hits.alive[l]) sum[l] += radiance[l];
@@ -254,10 +258,26 @@ struct Renderer::Impl {
         for (int lane = 0; lane < kLanes; ++lane) {
             if (block.valid[static_cast<std::size_t>(lane)] == 0) continue;
             float* out = frame.at(block.x0 + lane % kBlock - origin_x, block.y0 + lane / kBlock - origin_y);
-            const Eigen::Vector3f value = sum[static_cast<std::size_t>(lane)] * inv_spp;
+            const Eigen::Vector3f value = unshaded[static_cast<std::size_t>(lane)]
+                                              ? Eigen::Vector3f(kUnshadedRadiance, 0.0f, 0.0f)
+                                              : Eigen::Vector3f(sum[static_cast<std::size_t>(lane)] * inv_spp);
             out[0] = value.x();
             out[1] = value.y();
             out[2] = value.z();
+        }
+    }
+
+    // A sparse cached frame (ViewRequest::shading_one_in): the surface lanes it does not shade stop
+    // after their primary hit (their guides are stored) and are marked in `unshaded`. The cache's
+    // training pixels are always shaded, so the cache learns as fast as from a full frame.
+    void skip_unshaded(const LanePixels& pixels, PacketHits& hits, std::array<bool, kLanes>& unshaded) const {
+        if (shading_one_in == 1) return;
+        for (std::size_t l = 0; l < kLanes; ++l) {
+            if (!hits.alive[l] || shades_pixel(shading_one_in, shading_phase, pixels.x[l], pixels.y[l]) ||
+                trains_cache(cache_frame, pixels.x[l], pixels.y[l]))
+                continue;
+            hits.alive[l] = false;
+            unshaded[l] = true;
         }
     }
 
@@ -333,6 +353,8 @@ void Renderer::begin_frame(const ViewRequest& request) {
     s.context.russian_roulette = s.options.russian_roulette;
     s.context.glossy_vndf = s.options.glossy_vndf_sampling;
     s.cached = request.radiance_cache;
+    s.shading_one_in = s.cached ? request.shading_one_in : 1;
+    s.shading_phase = s.cached ? request.shading_phase : 0;
     s.jitter_samples = s.spp > 1 || (s.options.jitter_one_spp && (!s.cached || s.options.jitter_cached_one_spp));
     // Last frame's training estimates join the cache before this frame reads it.
     s.cache->commit();

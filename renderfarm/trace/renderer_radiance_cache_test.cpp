@@ -170,6 +170,55 @@ TEST(RendererRadianceCache, AnySplitOfACachedFrameGivesTheSameBits) {
     }
 }
 
+// A sparse cached frame (ViewRequest::shading_one_in): each pixel is the full frame's, bit for bit,
+// or marked unshaded; about one surface pixel in N plus the training pixels is shaded, every pixel
+// of the pattern among them; the guides are the full frame's everywhere, and it traces fewer rays.
+TEST(RendererRadianceCache, ASparseFrameShadesItsPatternAndTheSameBitsThere) {
+    const Scene scene = lit_corner();
+    for (const int phase : {0, 3}) {  // a sparse frame trains less: each phase on caches alike
+        Renderer full(scene, RendererOptions{"threads=1", true});
+        Renderer sparse(scene, RendererOptions{"threads=1", true});
+        for (std::uint64_t f = 1; f <= 3; ++f) (void)draw(full, corner_view(f, 1, true));
+        for (std::uint64_t f = 1; f <= 3; ++f) (void)draw(sparse, corner_view(f, 1, true));
+        const ViewRequest whole = corner_view(4, 1, true);
+        ViewRequest thin = whole;
+        thin.shading_one_in = 4;
+        thin.shading_phase = phase;
+        const auto render = [](Renderer& r, const ViewRequest& v, GuideBuffers& guides, std::uint64_t& rays) {
+            r.begin_frame(v);
+            RgbFloatImage frame(r.render_size());
+            guides = GuideBuffers(frame.size);
+            rays = r.render(PixelRect::whole(frame.size), frame, 0, 0, guides).rays;
+            return frame;
+        };
+        GuideBuffers full_guides, sparse_guides;
+        std::uint64_t full_rays = 0, sparse_rays = 0;
+        const RgbFloatImage a = render(full, whole, full_guides, full_rays);
+        const RgbFloatImage b = render(sparse, thin, sparse_guides, sparse_rays);
+        EXPECT_EQ(sparse_guides.depth, full_guides.depth);
+        EXPECT_EQ(sparse_guides.normal, full_guides.normal);
+        std::size_t surface = 0, unshaded = 0;
+        for (int y = 0; y < a.size.height; ++y) {
+            for (int x = 0; x < a.size.width; ++x) {
+                const bool hit = full_guides.hit[full_guides.pixel(x, y)] != 0;
+                surface += hit ? 1 : 0;
+                if (b.at(x, y)[0] == kUnshadedRadiance) {
+                    ++unshaded;
+                    EXPECT_TRUE(hit) << x << ", " << y;
+                    EXPECT_FALSE(shades_pixel(4, phase, x, y)) << x << ", " << y;
+                    continue;
+                }
+                for (int c = 0; c < 3; ++c) ASSERT_EQ(b.at(x, y)[c], a.at(x, y)[c]) << x << ", " << y;
+            }
+        }
+        // 3/4 of the surface is off the pattern, less the training pixels (1 in 16) among them.
+        EXPECT_GT(unshaded, surface * 6 / 10) << "phase " << phase;
+        EXPECT_LT(unshaded, surface * 3 / 4) << "phase " << phase;
+        const auto camera_rays = static_cast<std::uint64_t>(a.size.pixel_count());
+        EXPECT_LT(sparse_rays - camera_rays, (full_rays - camera_rays) * 6 / 10) << "phase " << phase;
+    }
+}
+
 TEST(RendererRadianceCache, FramesThatDoNotAskNeitherReadNorTrainIt) {
     const Scene scene = lit_corner();
     Renderer fresh(scene, RendererOptions{"threads=1", true});
