@@ -130,7 +130,7 @@ FrameQuality frame_quality(const Rgb8Image& served, const Rgb8Image& reference) 
 struct ServedLog {
     nlohmann::json frames = nlohmann::json::array();
     double scale_sum = 0, scale_min = 1, spp_sum = 0, bounces_sum = 0;
-    double frame_s = 0, render_phase_s = 0, slowest_rank_s = 0, denoise_s = 0;
+    double frame_s = 0, render_phase_s = 0, slowest_rank_s = 0, denoise_s = 0, temporal_s = 0;
     double reprojected_sum = 0, shaded_sum = 0;
     int blended = 0;
     void add(const LiveFrame& f) {
@@ -143,7 +143,8 @@ struct ServedLog {
                           {"frame_seconds", f.seconds},
                           {"render_phase_seconds", f.stats.render_phase_seconds},
                           {"slowest_rank_seconds", slowest},
-                          {"denoise_seconds", f.denoise_seconds}});
+                          {"denoise_seconds", f.denoise_seconds},
+                          {"temporal_seconds", f.temporal_seconds}});
         if (f.temporal.surface_pixels > 0) {
             const double share = double(f.temporal.reprojected) / double(f.temporal.surface_pixels);
             frames.back()["reprojected_share"] = share;
@@ -162,6 +163,7 @@ struct ServedLog {
         render_phase_s += f.stats.render_phase_seconds;
         slowest_rank_s += slowest;
         denoise_s += f.denoise_seconds;
+        temporal_s += f.temporal_seconds;
     }
     [[nodiscard]] nlohmann::json summary() const {
         const double n = std::max<double>(1, double(frames.size()));
@@ -172,7 +174,8 @@ struct ServedLog {
                               {"frame_seconds_mean", frame_s / n},
                               {"render_phase_seconds_mean", render_phase_s / n},
                               {"slowest_rank_seconds_mean", slowest_rank_s / n},
-                              {"denoise_seconds_mean", denoise_s / n}};
+                              {"denoise_seconds_mean", denoise_s / n},
+                              {"temporal_seconds_mean", temporal_s / n}};
         if (blended > 0) {
             out["reprojected_share_mean"] = reprojected_sum / blended;
             out["shaded_share_mean"] = shaded_sum / blended;
@@ -211,7 +214,7 @@ std::vector<Config> all_configs(const BenchArgs& a) {
     // The cache configuration with each moving frame blended with earlier ones by reprojection.
     Config temporal = cache;
     temporal.key = "temporal";
-    temporal.name = "all + denoiser + cache + temporal";
+    temporal.name = "all + denoiser + cache + temporal, every pixel shaded";
     temporal.live.temporal = true;
     temporal.live.shading_one_in = 1;  // every pixel shaded
     // The cache configuration with a still view's second pass of 1 spp (2 by default, as later ones).
@@ -227,7 +230,7 @@ std::vector<Config> all_configs(const BenchArgs& a) {
     // The temporal configuration with moving frames shading one pixel in --shading-one-in.
     Config sparse = temporal;
     sparse.key = "sparse";
-    sparse.name = "all + denoiser + cache + temporal, sparse shading";
+    sparse.name = "all + denoiser + cache + temporal, 1 pixel in " + std::to_string(a.shading_one_in) + " shaded";
     sparse.live.shading_one_in = a.shading_one_in;
     std::vector<Config> out{today, all, denoise, floor, cache, temporal, sparse, second1, first1};
     const auto without = [&](const char* key, const char* name, auto change) {

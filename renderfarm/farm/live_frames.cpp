@@ -198,6 +198,7 @@ void LiveFrames::display(Session& s, const RgbFloatImage& radiance, LiveFrame& f
         blended = s.temporal.accumulate(radiance, s.guides, make_camera_setup(frame.rendered, radiance.size),
                                         options_.temporal_params, &frame.temporal, frame.rendered.shading_one_in);
         noisy = &blended;
+        frame.temporal_seconds = std::chrono::duration<double>(Clock::now() - start).count();
     }
     // A still view's accumulation of two passes or more brings its own noise, measured from the
     // passes' spread: the filter then does less as samples come in, instead of blurring as much at

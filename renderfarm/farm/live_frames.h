@@ -128,16 +128,17 @@ struct LiveOptions {
 };
 
 struct LiveFrame {
-    Rgb8Image image;               // what to encode and send: render_size(rendered)
-    ViewRequest rendered;          // the view as traced: scale, spp and frame_id of the pass
-    int samples = 0;               // samples per pixel in `image` (all accumulated passes)
-    int passes = 1;                // passes in `image`
-    bool still = false;            // the request repeated the session's previous view (a still view)
-    bool rendered_now = true;      // false: a converged still view, sent from the accumulation
-    bool denoised = false;         // `image` is the filtered frame
-    double seconds = 0.0;          // render + composite (+ accumulate, + denoise) on the admin, wall
-    double denoise_seconds = 0.0;  // the filter's part of `seconds`
-    double gap_seconds = 0.0;      // since the session's previous frame was handed back (0: its first)
+    Rgb8Image image;                // what to encode and send: render_size(rendered)
+    ViewRequest rendered;           // the view as traced: scale, spp and frame_id of the pass
+    int samples = 0;                // samples per pixel in `image` (all accumulated passes)
+    int passes = 1;                 // passes in `image`
+    bool still = false;             // the request repeated the session's previous view (a still view)
+    bool rendered_now = true;       // false: a converged still view, sent from the accumulation
+    bool denoised = false;          // `image` is the filtered frame
+    double seconds = 0.0;           // render + composite (+ accumulate, + denoise) on the admin, wall
+    double denoise_seconds = 0.0;   // the filter's part of `seconds`
+    double temporal_seconds = 0.0;  // ... of which the temporal accumulation's (temporal)
+    double gap_seconds = 0.0;       // since the session's previous frame was handed back (0: its first)
     // With `temporal`, a moving frame's surface pixels and how many of them the previous frames
     // supplied by reprojection (temporal_accumulation.h); both 0 when the frame was not blended.
     TemporalStats temporal;

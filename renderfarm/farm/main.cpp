@@ -113,6 +113,12 @@ void add_live_flags(CLI::App& serve, mogao::ServeOptions& options, double& frame
     serve.add_flag("--temporal,!--no-temporal", live.temporal,
                    "Blend each filtered moving frame with the session's earlier frames, reprojected by depth, before "
                    "the denoiser (default: on whenever the denoiser is)");
+    serve
+        .add_option("--shading-one-in", live.shading_one_in,
+                    "With the radiance cache and temporal accumulation: a moving frame shades one pixel in N on a "
+                    "pattern that moves every frame and takes the others from the reprojected history (default 4; "
+                    "1 shades every pixel)")
+        ->check(CLI::Range(1, 16));
     serve.add_flag(
         "--share-frame-time,!--no-share-frame-time", live.share_frame_time,
         "Share the frame-time target among the sessions served in the last 2 s: with N appliances each "
