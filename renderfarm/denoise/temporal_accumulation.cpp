@@ -121,50 +121,53 @@ void TemporalHistory::sharpen(double fx, double fy, Eigen::Vector3f& value) cons
     value = sum.cwiseMax(lo).cwiseMin(hi);
 }
 
-// The unshaded pixels no history covers (disoccluded, or new at the image's edge) from their
-// neighbours in the same frame within kFillRadius: the mean of those on the same surface (the
-// history's tests: normal_min_cos, plane_tolerance), weighted by 1 / (1 + distance²), or of any
-// surface neighbour when none is. Length 0: the pixel's first shaded sample replaces the fill.
-// Reads only pixels that are not holes, so the result does not depend on the order.
-std::size_t TemporalHistory::fill_holes(const Pass& f) {
-    constexpr int kFillRadius = 2;  // every pixel has a shaded one within 1 (view_request.h's pattern)
+// Hole i's illumination from the pixels within `radius` that are not holes: the mean of those on its surface (the
+// history's tests: normal_min_cos, plane_tolerance), weighted by 1 / (1 + distance²), or of any surface pixel when
+// none is. False when there is none.
+bool TemporalHistory::neighbour_fill(const Pass& f, std::size_t i, int radius, Eigen::Vector3f& value) {
     const int width = f.current.size.width;
     const int height = f.current.size.height;
-    const auto hole = [&](std::size_t i) { return f.guides.hit[i] != 0 && f.illumination[3 * i] < 0.0f; };
+    const int x = static_cast<int>(i % static_cast<std::size_t>(width));
+    const int y = static_cast<int>(i / static_cast<std::size_t>(width));
+    const Eigen::Vector3f p = at3(f.position, i);
+    const Eigen::Vector3f n = at3(f.guides.normal, i);
+    Eigen::Vector3f same = Eigen::Vector3f::Zero(), any = Eigen::Vector3f::Zero();
+    float same_w = 0.0f, any_w = 0.0f;
+    for (int qy = std::max(0, y - radius); qy <= std::min(height - 1, y + radius); ++qy) {
+        for (int qx = std::max(0, x - radius); qx <= std::min(width - 1, x + radius); ++qx) {
+            const std::size_t j = f.guides.pixel(qx, qy);
+            if (f.guides.hit[j] == 0 || f.illumination[3 * j] < 0.0f) continue;
+            const float w = 1.0f / float(1 + (qx - x) * (qx - x) + (qy - y) * (qy - y));
+            const Eigen::Vector3f v = at3(f.illumination, j);
+            any += w * v, any_w += w;
+            if (at3(f.guides.normal, j).dot(n) < f.params.normal_min_cos ||
+                std::abs(n.dot(p - at3(f.position, j))) > f.params.plane_tolerance * f.guides.depth[i])
+                continue;
+            same += w * v, same_w += w;
+        }
+    }
+    if (!(any_w > 0.0f)) return false;
+    value = same_w > 0.0f ? Eigen::Vector3f(same / same_w) : Eigen::Vector3f(any / any_w);
+    return true;
+}
+
+// The unshaded pixels no history covers (disoccluded, or new at the image's edge) from their neighbours in the same
+// frame (neighbour_fill): within 2 pixels, where the sparse pattern always has a shaded one (view_request.h); farther
+// where a frame cut at its budget copied an unshaded pixel over a whole block (tile_pass.h); 0 where no surface pixel
+// is within 32. Length 0: the pixel's first shaded sample replaces the fill. Reads only pixels that are not holes,
+// so the result does not depend on the order.
+std::size_t TemporalHistory::fill_holes(const Pass& f) {
     std::vector<std::size_t> holes;
     for (std::size_t i = 0; i < f.guides.hit.size(); ++i)
-        if (hole(i)) holes.push_back(i);
+        if (f.guides.hit[i] != 0 && f.illumination[3 * i] < 0.0f) holes.push_back(i);
     std::vector<Eigen::Vector3f> filled(holes.size(), Eigen::Vector3f::Zero());
     for (std::size_t h = 0; h < holes.size(); ++h) {
-        const int x = static_cast<int>(holes[h] % static_cast<std::size_t>(width));
-        const int y = static_cast<int>(holes[h] / static_cast<std::size_t>(width));
-        const Eigen::Vector3f p = at3(f.position, holes[h]);
-        const Eigen::Vector3f n = at3(f.guides.normal, holes[h]);
-        Eigen::Vector3f same = Eigen::Vector3f::Zero(), any = Eigen::Vector3f::Zero();
-        float same_w = 0.0f, any_w = 0.0f;
-        for (int dy = -kFillRadius; dy <= kFillRadius; ++dy) {
-            for (int dx = -kFillRadius; dx <= kFillRadius; ++dx) {
-                const int qx = x + dx, qy = y + dy;
-                if (qx < 0 || qy < 0 || qx >= width || qy >= height) continue;
-                const std::size_t j = f.guides.pixel(qx, qy);
-                if (f.guides.hit[j] == 0 || hole(j)) continue;
-                const float w = 1.0f / float(1 + dx * dx + dy * dy);
-                const Eigen::Vector3f v = at3(f.illumination, j);
-                any += w * v, any_w += w;
-                if (at3(f.guides.normal, j).dot(n) < f.params.normal_min_cos ||
-                    std::abs(n.dot(p - at3(f.position, j))) > f.params.plane_tolerance * f.guides.depth[holes[h]])
-                    continue;
-                same += w * v, same_w += w;
-            }
-        }
-        filled[h] = same_w > 0.0f  ? Eigen::Vector3f(same / same_w)
-                    : any_w > 0.0f ? Eigen::Vector3f(any / any_w)
-                                   : Eigen::Vector3f::Zero();
+        for (const int radius : {2, 8, 32})
+            if (neighbour_fill(f, holes[h], radius, filled[h])) break;
     }
     for (std::size_t h = 0; h < holes.size(); ++h) {
-        const std::size_t i = holes[h];
-        set_pixel(f, i, filled[h]);
-        f.length[i] = 0.0f;
+        set_pixel(f, holes[h], filled[h]);
+        f.length[holes[h]] = 0.0f;
     }
     return holes.size();
 }

@@ -106,6 +106,7 @@ private:
     };
     void accumulate_rows(const Pass& f, int y0, int y1, TemporalStats& counted) const;
     static std::size_t fill_holes(const Pass& f);
+    static bool neighbour_fill(const Pass& f, std::size_t i, int radius, Eigen::Vector3f& value);
     static void set_pixel(const Pass& f, std::size_t i, const Eigen::Vector3f& value);
     void sharpen(double fx, double fy, Eigen::Vector3f& value) const;
     [[nodiscard]] bool gather(const Eigen::Vector3f& position, const Eigen::Vector3f& normal, float depth,

@@ -172,6 +172,15 @@ TEST(TemporalAccumulation, ASparseFrameTakesTheHistoryWhereItDidNotShadeAndFills
     const RgbFloatImage filled = none.accumulate(current, seen.guides, after, {}, &stats);
     EXPECT_EQ(stats.filled, marked);
     EXPECT_LT(rms_error(filled, seen), 0.05);
+
+    // A frame cut at its budget copies an unshaded pixel over a whole 8x8 block: filled from beyond it.
+    RgbFloatImage cut = shade(seen, 0.0, rng);
+    for (int y = 8; y < 16; ++y)
+        for (int x = 16; x < 24; ++x) cut.at(x, y)[0] = kUnshadedRadiance;
+    const RgbFloatImage block = TemporalHistory().accumulate(cut, seen.guides, after, {}, &stats);
+    EXPECT_EQ(stats.filled, 64u);
+    for (const float v : block.pixels) ASSERT_GT(v, 0.0f) << "a hole left black";
+    EXPECT_LT(rms_error(block, seen), 0.05);
 }
 
 // A view turning by a fraction of a pixel each frame, with one pixel in four shaded: bilinear
