@@ -138,9 +138,10 @@ ViewRequest LiveFrames::plan(Session& s, const ViewRequest& request, FrameChoice
 }
 
 // A cached moving frame shades one pixel in shading_one_in when its history can supply the rest
-// (the denoiser blends it: display()); the pattern's phase moves on with each such frame.
+// (display() blends every filtered moving frame with it); the pattern's phase moves on with each such frame.
 void LiveFrames::plan_sparse(Session& s, ViewRequest& view) const {
     if (!view.radiance_cache || !options_.denoise || !options_.temporal || s.temporal.empty()) return;
+    if (view.quality.spp > options_.denoise_max_spp) return;  // not filtered, so not blended: shown as traced
     if (options_.shading_one_in == 1) return;
     view.shading_one_in = options_.shading_one_in;
     view.shading_phase = static_cast<int>(s.sparse_frames++ % static_cast<std::uint64_t>(options_.shading_one_in));

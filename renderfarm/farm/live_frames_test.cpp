@@ -399,9 +399,9 @@ TEST_F(LiveFramesTest, ALightThatChangesRestartsTheStillViewAndDropsTheTemporalH
 }
 
 // Cached moving frames with a history shade one pixel in shading_one_in, the pattern moving on a
-// phase each frame; the first frame of a session (no history), a still view's passes and sessions
-// without temporal accumulation shade every pixel. The served frames stay close to those of a
-// session that shades every pixel (no unshaded pixel shows).
+// phase each frame; the first frame of a session (no history), a still view's passes, sessions
+// without temporal accumulation and frames the filter does not take shade every pixel. The served frames stay close to
+// those of a session that shades every pixel (no unshaded pixel shows).
 TEST_F(LiveFramesTest, CachedMovingFramesShadeOnePixelInNOnAMovingPattern) {
     LiveOptions options;
     options.radiance_cache = options.denoise = options.temporal = true;
@@ -437,6 +437,17 @@ TEST_F(LiveFramesTest, CachedMovingFramesShadeOnePixelInNOnAMovingPattern) {
         r.frame_id = 30 + k;
         (void)no_history.render(r);
         EXPECT_EQ(calls_.back().view.shading_one_in, 1);
+    }
+    // Frames of more samples than the filter takes are shown as traced, never blended: never sparse.
+    options.temporal = true;
+    options.denoise_max_spp = 1;
+    LiveFrames unfiltered(source(), options, 1.f, ToneMap::clamp);
+    for (std::uint64_t k = 0; k < 4; ++k) {  // two filtered frames make a history, then two that are not
+        ViewRequest r = view(0.5 * static_cast<double>(k));
+        r.frame_id = 40 + k;
+        r.quality.spp = k < 2 ? 1 : 2;
+        (void)unfiltered.render(r);
+        EXPECT_EQ(calls_.back().view.shading_one_in, k == 1 ? 4 : 1) << "frame " << k;
     }
 }
 

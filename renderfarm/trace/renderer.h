@@ -17,6 +17,8 @@
 // are the unbiased path tracer below and never touch the cache. Animated lights (scene.h,
 // LightAnimation) are evaluated at the request's scene_time_s; a frame whose lights differ from the
 // previous frame's rebuilds them and empties the cache (what it learnt belongs to the old lights).
+// A cached request with shading_one_in > 1 (view_request.h) shades only its pattern's pixels and the
+// cache's training pixels; its other surface pixels get kUnshadedRadiance (their guides as usual).
 //
 // Determinism: a pixel's value depends only on (scene, request incl. seed and frame_id, x, y):
 // camera rays are traced in 4x4 packets aligned to the global image grid (x0 % 4 == 0,
