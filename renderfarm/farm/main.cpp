@@ -115,9 +115,9 @@ void add_live_flags(CLI::App& serve, mogao::ServeOptions& options, double& frame
                    "the denoiser (default: on whenever the denoiser is)");
     serve
         .add_option("--shading-one-in", live.shading_one_in,
-                    "With the radiance cache and temporal accumulation: a moving frame shades one pixel in N on a "
-                    "pattern that moves every frame and takes the others from the reprojected history (default 4; "
-                    "1 shades every pixel)")
+                    "With the radiance cache and temporal accumulation: a moving frame shades a sparse one-in-N "
+                    "pattern that moves every frame and takes the rest from the reprojected history (default 4; "
+                    "1 shades everything)")
         ->check(CLI::Range(1, 16));
     serve.add_flag(
         "--share-frame-time,!--no-share-frame-time", live.share_frame_time,
