@@ -17,7 +17,6 @@
 namespace mogao {
 namespace {
 
-constexpr float kMinAlbedo = 1e-3f;     // demodulation divides by max(albedo, this)
 constexpr float kHuge = 1e30f;          // the scale of a term whose σ is 0: any difference stops
 constexpr float kLuminanceEps = 1e-6f;  // ε of w_l [S eq. 5], in radiance units
 constexpr float kDepthEps = 1e-3f;      // ε_z of w_z [S eq. 3], relative to the centre's depth
@@ -213,9 +212,9 @@ void prepare(const RgbFloatImage& noisy, const GuideBuffers& guides, const Plane
                 const bool hit = guides.hit[i] != 0;
                 if (hit) {
                     const float* a = guides.albedo.data() + 3 * i;
-                    r /= std::max(a[0], kMinAlbedo);
-                    gr /= std::max(a[1], kMinAlbedo);
-                    b /= std::max(a[2], kMinAlbedo);
+                    r /= std::max(a[0], kDemodulationMinAlbedo);
+                    gr /= std::max(a[1], kDemodulationMinAlbedo);
+                    b /= std::max(a[2], kDemodulationMinAlbedo);
                 }
                 s.r[i] = r, s.g[i] = gr, s.b[i] = b, s.var[i] = 0.0f, s.lum[i] = luminance(r, gr, b);
                 const float* n = guides.normal.data() + 3 * i;
@@ -359,7 +358,7 @@ void smoothed_variance_row_base(ImageSize size, const GeometryWeight& gw, const 
 // Luminance variance of each surface pixel from a variance of its colour the caller measured (e.g.
 // across a progressive accumulation's passes, progressive_accumulator.h), per channel: demodulated
 // like the colour, the channels taken as fully correlated (an upper bound whatever their
-// correlation), Var(l) = (Σ_c w_c σ_c / max(a_c, kMinAlbedo))², then averaged over the pixel's 5x5
+// correlation), Var(l) = (Σ_c w_c σ_c / max(a_c, kDemodulationMinAlbedo))², then averaged over the pixel's 5x5
 // neighbourhood on the same surface (the geometry weights of the spatial estimate), which steadies an
 // estimate from as few as two passes. The pong variance plane is the scratch (filter_level rewrites it).
 template <typename Row>
@@ -370,9 +369,9 @@ void given_variance(Row smoothed_variance_row, const RgbFloatImage& variance, co
     for (std::size_t i = 0; i < static_cast<std::size_t>(size.pixel_count()); ++i) {
         const float* v = variance.pixels.data() + 3 * i;
         const float* a = guides.albedo.data() + 3 * i;
-        const float sd = 0.2126f * std::sqrt(v[0]) / std::max(a[0], kMinAlbedo) +
-                         0.7152f * std::sqrt(v[1]) / std::max(a[1], kMinAlbedo) +
-                         0.0722f * std::sqrt(v[2]) / std::max(a[2], kMinAlbedo);
+        const float sd = 0.2126f * std::sqrt(v[0]) / std::max(a[0], kDemodulationMinAlbedo) +
+                         0.7152f * std::sqrt(v[1]) / std::max(a[1], kDemodulationMinAlbedo) +
+                         0.0722f * std::sqrt(v[2]) / std::max(a[2], kDemodulationMinAlbedo);
         raw[i] = sd * sd;
     }
     for_row_bands(size.height, threads, [&](int y0, int y1) {
@@ -539,9 +538,9 @@ Status AtrousDenoiser::run(const RgbFloatImage& noisy, const GuideBuffers& guide
         float* o = out.pixels.data() + 3 * i;
         const bool hit = guides.hit[i] != 0;
         const float* a = guides.albedo.data() + 3 * i;
-        o[0] = hit ? s.r[i] * std::max(a[0], kMinAlbedo) : s.r[i];
-        o[1] = hit ? s.g[i] * std::max(a[1], kMinAlbedo) : s.g[i];
-        o[2] = hit ? s.b[i] * std::max(a[2], kMinAlbedo) : s.b[i];
+        o[0] = hit ? s.r[i] * std::max(a[0], kDemodulationMinAlbedo) : s.r[i];
+        o[1] = hit ? s.g[i] * std::max(a[1], kDemodulationMinAlbedo) : s.g[i];
+        o[2] = hit ? s.b[i] * std::max(a[2], kDemodulationMinAlbedo) : s.b[i];
     }
     return {};
 }

@@ -47,6 +47,10 @@
 
 namespace mogao {
 
+// Demodulation divides each channel by max(albedo, this) (see above); the temporal accumulation
+// (temporal_accumulation.h) demodulates the same way.
+inline constexpr float kDemodulationMinAlbedo = 1e-3f;
+
 struct AtrousParams {
     static constexpr int kMaxIterations = 10;  // step 2^9 = 512 px at the last one
     int iterations = 3;         // à-trous levels, steps 1, 2, 4 px: on the grotto at 1 spp as close to the

@@ -9,6 +9,8 @@
 #include <string>
 #include <thread>
 
+#include "renderfarm/denoise/atrous_filter.h"
+
 namespace mogao {
 namespace {
 
@@ -23,11 +25,9 @@ void check_sizes(const RgbFloatImage& current, const GuideBuffers& guides, const
 
 Eigen::Vector3f at3(const std::vector<float>& v, std::size_t i) { return {v[3 * i], v[3 * i + 1], v[3 * i + 2]}; }
 
-constexpr float kMinAlbedo = 1e-3f;  // as the à-trous filter's demodulation (atrous_filter.h)
-
 // What pixel i's channel c is divided by to demodulate it.
 float demodulation(const GuideBuffers& guides, std::size_t i, std::size_t c) {
-    return std::max(guides.albedo[3 * i + c], kMinAlbedo);
+    return std::max(guides.albedo[3 * i + c], kDemodulationMinAlbedo);
 }
 
 }  // namespace
