@@ -124,6 +124,7 @@ protected:
     }
     void TearDown() override {
         kiosk_.reset();
+        display_.reset();  // joins a recorder's PNG writer, which may still be writing under dir_
         fs::remove_all(dir_);
     }
 
