@@ -42,20 +42,23 @@ void check_temporal_params(const TemporalParams& params) {
         throw std::invalid_argument("temporal accumulation: normal_min_cos must be in [-1, 1]");
 }
 
-bool TemporalHistory::gather(const Eigen::Vector3f& position, const Eigen::Vector3f& normal, float depth,
-                             const TemporalParams& params, Eigen::Vector3f& value, float& length) const {
-    double px = 0.0;
-    double py = 0.0;
-    if (!project_to_image(camera_, position.cast<double>(), px, py)) return false;
-    const double fx = px - 0.5;
-    const double fy = py - 0.5;
+bool TemporalHistory::gather(const Pass& f, const Eigen::Vector3f& position, const Eigen::Vector3f& normal, float depth,
+                             Eigen::Vector3f& value, float& length) const {
+    const TemporalParams& params = f.params;
+    float px = 0.0f;
+    float py = 0.0f;
+    if (!f.to_history.project(position, px, py)) return false;
+    const float fx = px - 0.5f;
+    const float fy = py - 0.5f;
     // Only between the previous frame's pixel centres: beyond them a value would be extrapolated
     // from the border pixel, and carried on from frame to frame it drifts with the motion.
-    if (!(fx >= 0.0 && fy >= 0.0 && fx <= camera_.size.width - 1.0 && fy <= camera_.size.height - 1.0)) return false;
+    if (!(fx >= 0.0f && fy >= 0.0f && fx <= static_cast<float>(camera_.size.width - 1) &&
+          fy <= static_cast<float>(camera_.size.height - 1)))
+        return false;
     const int x0 = static_cast<int>(std::floor(fx));
     const int y0 = static_cast<int>(std::floor(fy));
-    const auto wx = static_cast<float>(fx - x0);
-    const auto wy = static_cast<float>(fy - y0);
+    const float wx = fx - static_cast<float>(x0);
+    const float wy = fy - static_cast<float>(y0);
     float weight = 0.0f;
     int accepted = 0;
     value = Eigen::Vector3f::Zero();
@@ -92,7 +95,7 @@ bool TemporalHistory::gather(const Eigen::Vector3f& position, const Eigen::Vecto
 // (about a quarter of a pixel of blur per frame at half-pixel offsets); the cubic keeps it sharp.
 // The usual history filter of temporal anti-aliasing (Karis, "High-Quality Temporal
 // Supersampling", SIGGRAPH 2014 course).
-void TemporalHistory::sharpen(double fx, double fy, Eigen::Vector3f& value) const {
+void TemporalHistory::sharpen(float fx, float fy, Eigen::Vector3f& value) const {
     const int x0 = static_cast<int>(std::floor(fx));
     const int y0 = static_cast<int>(std::floor(fy));
     if (x0 < 1 || y0 < 1 || x0 + 2 >= camera_.size.width || y0 + 2 >= camera_.size.height) return;
@@ -100,25 +103,24 @@ void TemporalHistory::sharpen(double fx, double fy, Eigen::Vector3f& value) cons
         return std::array<float, 4>{t * (-0.5f + t * (1.0f - 0.5f * t)), 1.0f + t * t * (-2.5f + 1.5f * t),
                                     t * (0.5f + t * (2.0f - 1.5f * t)), t * t * (-0.5f + 0.5f * t)};
     };
-    const std::array<float, 4> wx = weights(static_cast<float>(fx - x0));
-    const std::array<float, 4> wy = weights(static_cast<float>(fy - y0));
-    Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-    Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
-    Eigen::Vector3f hi = Eigen::Vector3f::Constant(std::numeric_limits<float>::lowest());
-    for (int j = 0; j < 4; ++j) {
-        for (int k = 0; k < 4; ++k) {
-            const int x = x0 - 1 + k;
-            const int y = y0 - 1 + j;
-            const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(camera_.size.width) +
-                                  static_cast<std::size_t>(x);
-            const Eigen::Vector3f v = at3(illumination_, i);
-            sum += wx[static_cast<std::size_t>(k)] * wy[static_cast<std::size_t>(j)] * v;
-            if (j == 1 || j == 2) {
-                if (k == 1 || k == 2) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
-            }
+    const std::array<float, 4> wx = weights(fx - static_cast<float>(x0));
+    const std::array<float, 4> wy = weights(fy - static_cast<float>(y0));
+    // Rows of three interleaved channels, no branch per tap: this runs for most pixels of a moving frame.
+    const auto width = static_cast<std::size_t>(camera_.size.width);
+    const float* top_left =
+        &illumination_[3 * (static_cast<std::size_t>(y0 - 1) * width + static_cast<std::size_t>(x0 - 1))];
+    const float* centre = top_left + 3 * width + 3;  // (x0, y0); the next row's is centre + 3 * width
+    for (std::size_t c = 0; c < 3; ++c) {
+        float sum = 0.0f;
+        for (std::size_t j = 0; j < 4; ++j) {
+            const float* row = top_left + 3 * j * width + c;
+            sum += wy[j] * (wx[0] * row[0] + wx[1] * row[3] + wx[2] * row[6] + wx[3] * row[9]);
         }
+        const float* below = centre + 3 * width;
+        const float lo = std::min(std::min(centre[c], centre[3 + c]), std::min(below[c], below[3 + c]));
+        const float hi = std::max(std::max(centre[c], centre[3 + c]), std::max(below[c], below[3 + c]));
+        value[static_cast<Eigen::Index>(c)] = std::clamp(sum, lo, hi);
     }
-    value = sum.cwiseMax(lo).cwiseMin(hi);
 }
 
 // Hole i's illumination from the pixels within `radius` that are not holes: the mean of those on its surface (the
@@ -191,9 +193,7 @@ void TemporalHistory::accumulate_rows(const Pass& f, int y0, int y1, TemporalSta
             const std::size_t i = f.guides.pixel(x, y);
             if (f.guides.hit[i] == 0) continue;
             ++counted.surface_pixels;
-            const Ray ray = generate_column_ray(f.camera, f.columns, x, y + 0.5);
-            const Eigen::Vector3f p =
-                (ray.origin + static_cast<double>(f.guides.depth[i]) * ray.direction).cast<float>();
+            const Eigen::Vector3f p = f.rays.point(x, y, f.guides.depth[i]);
             for (int c = 0; c < 3; ++c) f.position[3 * i + static_cast<std::size_t>(c)] = p[c];
             const float* own = f.current.at(x, y);
             const bool shaded = !(own[0] < 0.0f);  // kUnshadedRadiance: a sparse frame's unshaded pixel
@@ -206,7 +206,7 @@ void TemporalHistory::accumulate_rows(const Pass& f, int y0, int y1, TemporalSta
             for (int c = 0; c < 3; ++c) f.illumination[3 * i + static_cast<std::size_t>(c)] = illumination[c];
             Eigen::Vector3f history;
             float frames = 0.0f;
-            if (empty() || !gather(p, at3(f.guides.normal, i), f.guides.depth[i], f.params, history, frames)) {
+            if (empty() || !gather(f, p, at3(f.guides.normal, i), f.guides.depth[i], history, frames)) {
                 f.length[i] = shaded ? 1.0f : 0.0f;
                 continue;
             }
@@ -237,8 +237,17 @@ RgbFloatImage TemporalHistory::accumulate(const RgbFloatImage& current, const Gu
     std::vector<float> position(3 * n, 0.0f);
     std::vector<float> length(n, 0.0f);
     const float alpha = 1.0f - std::pow(1.0f - params.alpha, static_cast<float>(shading_one_in));
-    const Pass f{current,      guides,   camera, make_cylinder_columns(camera), params, alpha, out,
-                 illumination, position, length};
+    const Pass f{current,
+                 guides,
+                 camera,
+                 PixelCentreRays(camera),
+                 FrameProjection(empty() ? camera : camera_),
+                 params,
+                 alpha,
+                 out,
+                 illumination,
+                 position,
+                 length};
     // Rows split over the cores (each pixel reads only the history and writes only itself, so the
     // result does not depend on the split): the admin runs this while the ranks wait.
     const int height = current.size.height;

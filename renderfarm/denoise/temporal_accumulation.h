@@ -50,6 +50,7 @@
 
 #include "common/image.h"
 #include "renderfarm/trace/camera.h"
+#include "renderfarm/trace/frame_projection.h"
 #include "renderfarm/trace/guide_buffers.h"
 
 namespace mogao {
@@ -96,7 +97,8 @@ private:
         const RgbFloatImage& current;
         const GuideBuffers& guides;
         const CameraSetup& camera;
-        CylinderColumns columns;
+        PixelCentreRays rays;        // the current frame's
+        FrameProjection to_history;  // into the previous frame's image (its camera_)
         const TemporalParams& params;
         float alpha;  // a shaded pixel's least weight: params.alpha over shading_one_in frames
         RgbFloatImage& out;
@@ -108,9 +110,9 @@ private:
     static std::size_t fill_holes(const Pass& f);
     static bool neighbour_fill(const Pass& f, std::size_t i, int radius, Eigen::Vector3f& value);
     static void set_pixel(const Pass& f, std::size_t i, const Eigen::Vector3f& value);
-    void sharpen(double fx, double fy, Eigen::Vector3f& value) const;
-    [[nodiscard]] bool gather(const Eigen::Vector3f& position, const Eigen::Vector3f& normal, float depth,
-                              const TemporalParams& params, Eigen::Vector3f& value, float& length) const;
+    void sharpen(float fx, float fy, Eigen::Vector3f& value) const;
+    [[nodiscard]] bool gather(const Pass& f, const Eigen::Vector3f& position, const Eigen::Vector3f& normal,
+                              float depth, Eigen::Vector3f& value, float& length) const;
 
     CameraSetup camera_;
     std::vector<float> illumination_;  // W*H*3 the previous output demodulated (radiance / albedo)

@@ -1,0 +1,182 @@
+// SPDX-License-Identifier: Apache-2.0
+// The temporal accumulation's cost on the admin for a moving frame at the size the live tour serves
+// (480x270: 960x540 at its resolution-scale floor), against the à-trous filter that follows it on
+// the same frame, and its per-pixel reprojection in float (renderfarm/trace/frame_projection.h)
+// against camera.h's double-precision functions, all measured in this run.
+//   mogao_bench_temporal [--width 480] [--height 270] [--frames 60] [--shading-one-in 4]
+// The frames are analytic, so the bench needs no scene: a cylinder screen camera turning by 0.25
+// degrees a frame inside a textured cylindrical wall 4 m around its eye (every pixel a surface, so
+// every pixel is reprojected: the dearest case), radiance = albedo x a smooth light + noise.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <string>
+
+#include "common/view_request.h"
+#include "renderfarm/denoise/atrous_filter.h"
+#include "renderfarm/denoise/temporal_accumulation.h"
+#include "renderfarm/trace/camera.h"
+#include "renderfarm/trace/frame_projection.h"
+
+namespace {
+
+using namespace mogao;
+using Clock = std::chrono::steady_clock;
+
+struct Options {
+    int width = 480;
+    int height = 270;
+    int frames = 60;
+    int shading_one_in = 4;
+};
+
+CameraSetup camera_at(const Options& o, int frame) {
+    ViewRequest r;
+    r.size = {o.width, o.height};
+    CylinderScreen screen;
+    screen.radius_m = 3.0;
+    screen.arc_deg = 150.0;
+    screen.bottom_m = 0.8;
+    screen.top_m = 2.3;
+    r.camera = screen;
+    r.pose.eye = {0.0, 1.6, 0.0};
+    r.pose.yaw_deg = 0.25 * frame;
+    return make_camera_setup(r, r.size);
+}
+
+// One frame of the wall x^2 + z^2 = kWall^2 around the eye: guides and radiance (sparse frames mark
+// the pixels off their pattern kUnshadedRadiance, as the render ranks do).
+constexpr double kWall = 4.0;
+void make_frame(const CameraSetup& camera, int frame, int one_in, std::mt19937& rng, RgbFloatImage& radiance,
+                GuideBuffers& guides) {
+    std::normal_distribution<float> noise(0.0f, 0.05f);
+    radiance = RgbFloatImage(camera.size);
+    guides = GuideBuffers(camera.size);
+    for (int y = 0; y < camera.size.height; ++y) {
+        for (int x = 0; x < camera.size.width; ++x) {
+            const Ray ray = generate_ray(camera, x + 0.5, y + 0.5);
+            const Eigen::Vector2d d(ray.direction.x(), ray.direction.z());
+            const Eigen::Vector2d e(ray.origin.x(), ray.origin.z());
+            const double a = d.squaredNorm(), b = 2.0 * e.dot(d), c = e.squaredNorm() - kWall * kWall;
+            const double t = (-b + std::sqrt(b * b - 4.0 * a * c)) / (2.0 * a) / ray.direction.norm();
+            const Eigen::Vector3d p = ray.origin + t * ray.direction;
+            const double theta = std::atan2(p.x(), -p.z());
+            const float albedo = 0.2f + 0.6f * static_cast<float>((static_cast<int>(std::floor(theta * 60.0)) +
+                                                                   static_cast<int>(std::floor(p.y() * 20.0))) &
+                                                                  1);
+            const Eigen::Vector3f normal = Eigen::Vector3d(-p.x(), 0.0, -p.z()).normalized().cast<float>();
+            const float albedo_rgb[3] = {albedo, albedo, albedo};
+            const std::size_t i = guides.pixel(x, y);
+            guides.set_surface(i, albedo_rgb, normal.data(), static_cast<float>(t));
+            const bool shaded = one_in == 1 || shades_pixel(one_in, frame % one_in, x, y);
+            const float light = 0.5f + 0.3f * static_cast<float>(std::cos(2.0 * theta));
+            float* out = radiance.at(x, y);
+            for (int k = 0; k < 3; ++k)
+                out[k] = shaded ? albedo * std::max(0.0f, light + noise(rng)) : kUnshadedRadiance;
+        }
+    }
+}
+
+double ms_since(Clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// Nanoseconds per pixel to place every pixel's point at its depth and project it into the previous
+// frame's camera: double (generate_ray, project_to_image) and float (frame_projection.h).
+void projection_table(const Options& o) {
+    const CameraSetup now = camera_at(o, 1);
+    const CameraSetup before = camera_at(o, 0);
+    const double pixels = static_cast<double>(now.size.pixel_count());
+    double sink = 0.0;
+    constexpr int kReps = 20;
+    const auto time_double = Clock::now();
+    const CylinderColumns columns = make_cylinder_columns(now);
+    for (int rep = 0; rep < kReps; ++rep) {
+        for (int y = 0; y < now.size.height; ++y) {
+            for (int x = 0; x < now.size.width; ++x) {
+                const Ray ray = generate_column_ray(now, columns, x, y + 0.5);
+                double px = 0.0, py = 0.0;
+                if (project_to_image(before, ray.origin + kWall * ray.direction, px, py)) sink += px + py;
+            }
+        }
+    }
+    const double double_ns = ms_since(time_double) * 1e6 / (kReps * pixels);
+    const auto time_float = Clock::now();
+    const PixelCentreRays rays(now);
+    const FrameProjection projection(before);
+    for (int rep = 0; rep < kReps; ++rep) {
+        for (int y = 0; y < now.size.height; ++y) {
+            for (int x = 0; x < now.size.width; ++x) {
+                float px = 0.0f, py = 0.0f;
+                if (projection.project(rays.point(x, y, static_cast<float>(kWall)), px, py)) sink += px + py;
+            }
+        }
+    }
+    const double float_ns = ms_since(time_float) * 1e6 / (kReps * pixels);
+    std::printf("\n| reprojection of one pixel | ns | ratio |\n|---|--:|--:|\n");
+    std::printf("| double: generate_column_ray + project_to_image (camera.h) | %.1f | 1.00 |\n", double_ns);
+    std::printf("| float: PixelCentreRays + FrameProjection (frame_projection.h) | %.1f | %.2f |\n", float_ns,
+                float_ns / double_ns);
+    std::printf("(checksum %.0f)\n", sink);
+}
+
+void accumulation_table(const Options& o) {
+    std::printf(
+        "| frame, %dx%d | temporal accumulation ms | à-trous filter ms | temporal / filter |\n|---|--:|--:|--:|\n",
+        o.width, o.height);
+    for (const int one_in : {1, o.shading_one_in}) {
+        std::mt19937 rng(1);
+        TemporalHistory history;
+        AtrousDenoiser denoiser;
+        AtrousParams filter;
+        filter.threads = 0;
+        double temporal_ms = 0.0;
+        double filter_ms = 0.0;
+        int timed = 0;
+        for (int frame = 0; frame < o.frames; ++frame) {
+            const CameraSetup camera = camera_at(o, frame);
+            RgbFloatImage radiance;
+            GuideBuffers guides;
+            make_frame(camera, frame, frame == 0 ? 1 : one_in, rng, radiance, guides);
+            const auto start = Clock::now();
+            const RgbFloatImage blended =
+                history.accumulate(radiance, guides, camera, TemporalParams{}, nullptr, frame == 0 ? 1 : one_in);
+            const double t = ms_since(start);
+            const auto filter_start = Clock::now();
+            RgbFloatImage out;
+            if (Status st = denoiser.run(blended, guides, filter, out); !st.ok())
+                throw std::runtime_error(st.error().message);
+            if (frame >= 2) temporal_ms += t, filter_ms += ms_since(filter_start), ++timed;
+        }
+        std::printf("| %s | %.2f | %.2f | %.2f |\n",
+                    one_in == 1 ? "every pixel shaded" : ("1 pixel in " + std::to_string(one_in) + " shaded").c_str(),
+                    temporal_ms / timed, filter_ms / timed, temporal_ms / filter_ms);
+    }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    Options o;
+    for (int i = 1; i + 1 < argc; i += 2) {
+        const std::string flag = argv[i];
+        const int value = std::stoi(argv[i + 1]);
+        if (flag == "--width") o.width = value;
+        else if (flag == "--height") o.height = value;
+        else if (flag == "--frames") o.frames = value;
+        else if (flag == "--shading-one-in") o.shading_one_in = value;
+        else {
+            std::fprintf(stderr, "mogao_bench_temporal: unknown flag %s\n", flag.c_str());
+            return 2;
+        }
+    }
+    if (o.width < 16 || o.height < 16 || o.frames < 4 || o.shading_one_in < 1 || o.shading_one_in > 16) {
+        std::fprintf(stderr,
+                     "mogao_bench_temporal: --width and --height >= 16, --frames >= 4, --shading-one-in in [1, 16]\n");
+        return 2;
+    }
+    accumulation_table(o);
+    projection_table(o);
+    return 0;
+}
