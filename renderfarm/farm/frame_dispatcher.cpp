@@ -34,6 +34,10 @@ void sleep_for(std::chrono::microseconds pause) {
 
 void sleep_briefly() { sleep_for(std::chrono::microseconds(100)); }
 
+// How long the admin polls a rank's pixel transfer without pausing (FrameDispatcher::poll_until):
+// a moving frame's pixels, a few MB, take a few ms over shared memory and tens over a gigabit link.
+constexpr double kTransferSpinS = 0.1;
+
 // A wait of unknown length (the next frame's view may be hours away): the pause grows with the
 // wait (idle_pause.h).
 class IdleWait {
@@ -432,7 +436,8 @@ struct FrameDispatcher::Watch {
 template <typename Done>
 void FrameDispatcher::poll_until(Watch& watch, const Done& done, const char* phase, int transfer_from) {
     auto next_beat = Clock::now() + std::chrono::seconds(1);
-    double last_poll = watch.now();
+    const double started = watch.now();
+    double last_poll = started;
     while (!done()) {
         // The admin itself stalled (descheduled on a loaded host, a sanitizer, a long unpack):
         // the ranks could not be heard meanwhile, so the stall is not their silence.
@@ -457,7 +462,12 @@ void FrameDispatcher::poll_until(Watch& watch, const Done& done, const char* pha
             heartbeat_();
             next_beat = Clock::now() + std::chrono::seconds(1);
         }
-        sleep_briefly();
+        // A rank's pixels arrive in fragments (Open MPI's shared-memory and TCP transports move a
+        // large message a fragment per progress call on the receiving side), so a pause between
+        // polls paces the transfer: 100 µs per fragment made a moving frame's pixels, a few MB,
+        // take about 12 ms where the copy takes 2. While pixels flow, poll without pausing, for at
+        // most kTransferSpinS (a stalled transfer is then waited for like any other reply).
+        if (transfer_from == 0 || watch.now() - started > kTransferSpinS) sleep_briefly();
     }
 }
 
