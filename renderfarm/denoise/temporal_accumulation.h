@@ -3,7 +3,8 @@
 // variance-guided filtering (Schied et al., "Spatiotemporal Variance-Guided Filtering: Real-Time
 // Reconstruction for Path-Traced Global Illumination", HPG 2017, §4.1). The scene is static, so a
 // surface point that a pixel sees now was seen by the previous frame at a known image position: its
-// camera projects the point there exactly (renderfarm/trace/camera.h, project_to_image). Each
+// camera projects the point there (renderfarm/trace/camera.h's project_to_image, evaluated in float
+// from per-frame tables: renderfarm/trace/frame_projection.h, within 1e-3 px of the exact one). Each
 // pixel blends the previous frame's value there with its own, an exponential moving average
 // over the frames that saw the point, so a moving view keeps most of its samples; the edge-avoiding
 // à-trous filter (atrous_filter.h) then works on a far less noisy frame.
