@@ -238,7 +238,6 @@ RgbFloatImage TemporalHistory::accumulate(const RgbFloatImage& current, const Gu
     const float alpha = 1.0f - std::pow(1.0f - params.alpha, static_cast<float>(shading_one_in));
     const Pass f{current,
                  guides,
-                 camera,
                  PixelCentreRays(camera),
                  FrameProjection(empty() ? camera : camera_),
                  params,

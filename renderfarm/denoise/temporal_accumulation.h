@@ -97,7 +97,6 @@ private:
     struct Pass {
         const RgbFloatImage& current;
         const GuideBuffers& guides;
-        const CameraSetup& camera;
         PixelCentreRays rays;        // the current frame's
         FrameProjection to_history;  // into the previous frame's image (its camera_)
         const TemporalParams& params;

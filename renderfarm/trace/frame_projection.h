@@ -5,8 +5,9 @@
 //
 // Both camera models' ray directions are separable at pixel centres: R d = R(column part) + R(row
 // part), so a direction is one vector sum and a normalisation (camera.h's formulas regrouped):
-//   pinhole   R d_cam    = R (l_x, 0, 0) + R (0, l_y, -1),  l_x = (2 px/W - 1) tan(fov/2) W/H, l_y = (1 - 2 py/H)
-//   tan(fov/2) cylinder  R d_screen = R (r sinθ_x, 0, -r cosθ_x) + R ((0, y_y, 0) - eye_m)
+//   pinhole   R d_cam    = R (l_x, 0, 0) + R (0, l_y, -1)
+//             with l_x = (2 px/W - 1) tan(fov/2) W/H and l_y = (1 - 2 py/H) tan(fov/2);
+//   cylinder  R d_screen = R (r sinθ_x, 0, -r cosθ_x) + R ((0, y_y, 0) - eye_m)
 // The projection is project_to_image's in float, with the quadratic's positive root taken in the
 // form that does not cancel (Press et al., Numerical Recipes 3rd ed., §5.6).
 // Accuracy: world positions within tens of metres of the eye land within 1e-3 px of the
