@@ -19,7 +19,10 @@
 // at the configuration's first frame only if it is the first configuration of the run: the ranks
 // keep their caches between configurations, as a farm keeps them between sessions), and temporal
 // (the cache configuration with every filtered moving frame first blended with the session's
-// earlier frames by reprojection: renderfarm/denoise/temporal_accumulation.h).
+// earlier frames by reprojection: renderfarm/denoise/temporal_accumulation.h), sparse (the temporal
+// configuration shading one pixel in --shading-one-in of each moving frame that has a history) and
+// sparse-all-levels (sparse with its blended frames filtered by --denoise-iterations levels, as every
+// other filtered frame, instead of LiveOptions::blended_denoise_iterations).
 // With both all and denoise in the run, the denoiser's ratios are printed: frames/s on / off and the
 // moving frame's PSNR on - off. --quality takes a preset's request quality (spp, bounces, AO, area
 // samples, JPEG; common/quality_preset.h) for every request and the reference; without it the
@@ -232,7 +235,12 @@ std::vector<Config> all_configs(const BenchArgs& a) {
     sparse.key = "sparse";
     sparse.name = "all + denoiser + cache + temporal, 1 pixel in " + std::to_string(a.shading_one_in) + " shaded";
     sparse.live.shading_one_in = a.shading_one_in;
-    std::vector<Config> out{today, all, denoise, floor, cache, temporal, sparse, second1, first1};
+    // The sparse configuration with its blended frames filtered by as many levels as any other frame.
+    Config sparse_levels = sparse;
+    sparse_levels.key = "sparse-all-levels";
+    sparse_levels.name = sparse.name + ", " + std::to_string(a.denoise_iterations) + " filter levels";
+    sparse_levels.live.blended_denoise_iterations = a.denoise_iterations;
+    std::vector<Config> out{today, all, denoise, floor, cache, temporal, sparse, sparse_levels, second1, first1};
     const auto without = [&](const char* key, const char* name, auto change) {
         Config c = all;
         c.key = key;
@@ -604,12 +612,13 @@ int main(int argc, char** argv) {
     app.add_option("--reference-spp", a.reference_spp, "Reference samples per pixel (two halves)")
         ->check(CLI::Range(2, 8192));
     app.add_option("--configs", a.configs,
-                   "today, all, denoise, denoise-floor-0.2, cache, temporal, sparse, cache-second-pass-1spp, "
-                   "cache-first-pass-1spp, no-progressive, no-target, no-pipeline, no-rank-speed, no-rate-aim")
+                   "today, all, denoise, denoise-floor-0.2, cache, temporal, sparse, sparse-all-levels, "
+                   "cache-second-pass-1spp, cache-first-pass-1spp, no-progressive, no-target, no-pipeline, "
+                   "no-rank-speed, no-rate-aim")
         ->delimiter(',')
         ->check(CLI::IsMember({"today", "all", "denoise", "denoise-floor-0.2", "cache", "temporal", "sparse",
-                               "cache-second-pass-1spp", "cache-first-pass-1spp", "no-progressive", "no-target",
-                               "no-pipeline", "no-rank-speed", "no-rate-aim"}));
+                               "sparse-all-levels", "cache-second-pass-1spp", "cache-first-pass-1spp", "no-progressive",
+                               "no-target", "no-pipeline", "no-rank-speed", "no-rate-aim"}));
     app.add_option("--quality", a.quality,
                    "Preset whose request quality every request uses (" + quality_preset_names() +
                        "); default: the request's defaults")

@@ -39,6 +39,10 @@ LiveFrames::LiveFrames(FrameSource source, LiveOptions options, float exposure, 
     const RgbFloatImage probe(ImageSize{1, 1});
     if (Status st = validate_denoise_input(probe, GuideBuffers(probe.size), options_.denoise_params); !st.ok())
         throw std::invalid_argument("LiveOptions.denoise_params: " + st.error().message);
+    AtrousParams blended = options_.denoise_params;
+    blended.iterations = options_.blended_denoise_iterations;
+    if (Status st = validate_denoise_input(probe, GuideBuffers(probe.size), blended); !st.ok())
+        throw std::invalid_argument("LiveOptions.blended_denoise_iterations: " + st.error().message);
     try {
         check_temporal_params(options_.temporal_params);
     } catch (const std::invalid_argument& e) {
@@ -195,7 +199,9 @@ void LiveFrames::display(Session& s, const RgbFloatImage& radiance, LiveFrame& f
     const auto start = Clock::now();
     const RgbFloatImage* noisy = &radiance;
     RgbFloatImage blended;
+    AtrousParams params = options_.denoise_params;
     if (options_.temporal && !frame.still) {
+        params.iterations = options_.blended_denoise_iterations;
         blended = s.temporal.accumulate(radiance, s.guides, make_camera_setup(frame.rendered, radiance.size),
                                         options_.temporal_params, &frame.temporal, frame.rendered.shading_one_in);
         noisy = &blended;
@@ -206,8 +212,7 @@ void LiveFrames::display(Session& s, const RgbFloatImage& radiance, LiveFrame& f
     // 64 spp as at 1 (the spatial estimate also counts shading and texture as noise).
     const RgbFloatImage variance = frame.passes >= 2 ? s.accumulation.variance_of_mean() : RgbFloatImage{};
     RgbFloatImage filtered;
-    if (Status st = denoiser_.run(*noisy, s.guides, options_.denoise_params, filtered,
-                                  variance.pixels.empty() ? nullptr : &variance);
+    if (Status st = denoiser_.run(*noisy, s.guides, params, filtered, variance.pixels.empty() ? nullptr : &variance);
         !st.ok())
         throw std::runtime_error(st.error().message);
     frame.image = to_display(filtered);

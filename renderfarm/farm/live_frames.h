@@ -102,6 +102,13 @@ struct LiveOptions {
     // (renderfarm/denoise/temporal_accumulation.h): a moving view keeps most of its samples.
     bool temporal = false;
     TemporalParams temporal_params;
+    // The à-trous levels ([0, 10], AtrousParams::iterations) for a frame blended with its history
+    // (temporal): the blend already averages a few frames, so the filter needs fewer levels than
+    // denoise_params.iterations, which every other filtered frame keeps. 1: moving frames closer to
+    // the converged reference than with 3 (PSNR, SSIM and GMSD; the wider levels blur detail the
+    // history keeps), at a larger scale; 0 measured closer still but leaves grain and isolated
+    // bright pixels on the walls (the serve bench's sparse and sparse-all-levels configurations).
+    int blended_denoise_iterations = 1;
     // With radiance_cache, denoise and temporal: a moving frame that has a history shades one pixel
     // in `shading_one_in` ([1, 16]; 1 shades all), on a pattern that moves every frame
     // (ViewRequest::shading_one_in; each pixel is shaded once in as many frames), and takes the

@@ -343,6 +343,38 @@ TEST_F(LiveFramesTest, TemporalAccumulationBringsAMovingFrameCloserToTheReferenc
         << "a still view's first pass is not blended with the moving history";
 }
 
+// A moving frame blended with its history is filtered with blended_denoise_iterations levels, every other
+// filtered frame (a still view's) with denoise_params.iterations.
+TEST_F(LiveFramesTest, ABlendedFrameIsFilteredWithItsOwnLevelsAndAStillViewWithTheFilters) {
+    ViewRequest request = view(0.0);
+    request.size = {96, 72};
+    LiveOptions unfiltered_blend;  // still views filtered with the default levels, blended frames not at all
+    unfiltered_blend.denoise = unfiltered_blend.temporal = true;
+    unfiltered_blend.blended_denoise_iterations = 0;
+    LiveOptions never_filtered = unfiltered_blend;
+    never_filtered.denoise_params.iterations = 0;
+    LiveOptions filtered_blend = unfiltered_blend;
+    filtered_blend.blended_denoise_iterations = 2;
+    LiveFrames a(source(), unfiltered_blend, 1.f, ToneMap::clamp);
+    LiveFrames b(source(), never_filtered, 1.f, ToneMap::clamp);
+    LiveFrames c(source(), filtered_blend, 1.f, ToneMap::clamp);
+    for (int k = 3; k >= 1; --k) {
+        ViewRequest r = request;
+        r.pose.yaw_deg += k;
+        r.frame_id = 500 + static_cast<std::uint64_t>(3 - k);
+        const LiveFrame fa = a.render(r), fb = b.render(r), fc = c.render(r);
+        ASSERT_TRUE(fa.denoised);
+        EXPECT_EQ(fa.image.pixels, fb.image.pixels) << "frame " << k << ": blended, filtered with its own levels";
+        EXPECT_NE(fa.image.pixels, fc.image.pixels) << "frame " << k;
+    }
+    ViewRequest still = request;
+    still.pose.yaw_deg += 1;  // the last moving view again: a still view's first pass
+    still.frame_id = 600;
+    const LiveFrame sa = a.render(still), sb = b.render(still);
+    ASSERT_TRUE(sa.still);
+    EXPECT_NE(sa.image.pixels, sb.image.pixels) << "a still view is filtered with denoise_params' levels";
+}
+
 double mean_of(const Rgb8Image& image) {
     double sum = 0.0;
     for (const std::uint8_t v : image.pixels) sum += v;
@@ -688,6 +720,9 @@ TEST(LiveOptions, BadDenoiseOptionsAreRefusedNamingTheField) {
     alpha.temporal_params.alpha = 0.0f;
     EXPECT_NE(message(alpha).find("temporal_params"), std::string::npos) << message(alpha);
     EXPECT_NE(message(alpha).find("alpha"), std::string::npos) << message(alpha);
+    LiveOptions blended;
+    blended.blended_denoise_iterations = AtrousParams::kMaxIterations + 1;
+    EXPECT_NE(message(blended).find("blended_denoise_iterations"), std::string::npos) << message(blended);
     LiveOptions sparse;
     sparse.shading_one_in = 0;
     EXPECT_NE(message(sparse).find("shading_one_in"), std::string::npos) << message(sparse);
