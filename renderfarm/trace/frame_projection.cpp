@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "renderfarm/trace/frame_projection.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <variant>
@@ -9,6 +10,32 @@ namespace mogao {
 namespace {
 
 constexpr double kDegToRad = std::numbers::pi / 180.0;
+
+// atan2(y, x) in float without libm's call: the ratio of the smaller to the larger magnitude in [0, 1],
+// atan there by an odd polynomial of degree 15 (coefficients fitted to atan on [0, 1] by iteratively
+// reweighted least squares toward the minimax, Lawson's algorithm; largest error 4e-8 rad, 1.1e-7
+// rad evaluated in float), then the octant restored. libm's atan2f was a tenth of the admin's time
+// on moving frames. 0 at (0, 0).
+float fast_atan2(float y, float x) {
+    const float ax = std::abs(x);
+    const float ay = std::abs(y);
+    const float hi = std::max(ax, ay);
+    if (!(hi > 0.0f)) return 0.0f;
+    const float a = std::min(ax, ay) / hi;
+    const float a2 = a * a;
+    float p = -0.0040547464f;
+    p = p * a2 + 0.021863656f;
+    p = p * a2 - 0.055913421f;
+    p = p * a2 + 0.096422854f;
+    p = p * a2 - 0.13908668f;
+    p = p * a2 + 0.19946574f;
+    p = p * a2 - 0.33329862f;
+    p = p * a2 + 0.99999934f;
+    float r = p * a;
+    if (ay > ax) r = std::numbers::pi_v<float> / 2.0f - r;
+    if (x < 0.0f) r = std::numbers::pi_v<float> - r;
+    return y < 0.0f ? -r : r;
+}
 
 }  // namespace
 
@@ -79,7 +106,7 @@ bool FrameProjection::project(const Eigen::Vector3f& p, float& px, float& py) co
     // The positive root of a s² + b s + c: (−b + root) / 2a, or 2c / (−b − root) where b > 0 would cancel.
     const float s = b <= 0.0f ? (root - b) / (2.0f * a) : 2.0f * c_ / (-b - root);
     const Eigen::Vector3f on_screen = e + s * q;
-    px = (std::atan2(on_screen.x(), -on_screen.z()) + half_arc_) * px_per_rad_;
+    px = (fast_atan2(on_screen.x(), -on_screen.z()) + half_arc_) * px_per_rad_;
     py = (top_ - on_screen.y()) * py_per_m_;
     return true;
 }

@@ -10,6 +10,7 @@
 //   cylinder  R d_screen = R (r sinθ_x, 0, -r cosθ_x) + R ((0, y_y, 0) - eye_m)
 // The projection is project_to_image's in float, with the quadratic's positive root taken in the
 // form that does not cancel (Press et al., Numerical Recipes 3rd ed., §5.6).
+// The cylinder's screen angle is a polynomial atan2 in float (frame_projection.cpp, fast_atan2).
 // Accuracy: world positions within tens of metres of the eye land within 1e-3 px of the
 // double-precision functions' (frame_projection_test.cpp); the costs are what a pass over a frame
 // avoids: per-pixel trigonometry and 3x3 products in double.

@@ -12,7 +12,8 @@
 namespace mogao {
 namespace {
 
-// A grotto-like cylinder view (the live tour's) and a pinhole, each with an off-axis pose.
+// A grotto-like cylinder view (the live tour's), a cylinder almost all the way round (its screen angles in
+// every octant), and a pinhole, each with an off-axis pose.
 std::vector<CameraSetup> cameras() {
     ViewRequest cylinder;
     cylinder.size = {480, 270};
@@ -26,10 +27,15 @@ std::vector<CameraSetup> cameras() {
     cylinder.pose.eye = {2.0, 1.6, -5.0};
     cylinder.pose.yaw_deg = 37.0;
     cylinder.pose.pitch_deg = -4.0;
+    ViewRequest round = cylinder;
+    round.size = {960, 160};
+    screen.arc_deg = 350.0;
+    round.camera = screen;
     ViewRequest pinhole = cylinder;
     pinhole.size = {320, 200};
     pinhole.camera = PinholeCamera{70.0};
-    return {make_camera_setup(cylinder, cylinder.size), make_camera_setup(pinhole, pinhole.size)};
+    return {make_camera_setup(cylinder, cylinder.size), make_camera_setup(round, round.size),
+            make_camera_setup(pinhole, pinhole.size)};
 }
 
 TEST(FrameProjection, PixelCentreRaysAreGenerateRaysDirections) {
