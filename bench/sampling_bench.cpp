@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 // Cheaper and better samples, as time against error: Russian roulette (RendererOptions::
-// russian_roulette) and the Sobol' sub-pixel position at 1 spp (RendererOptions::jitter_one_spp),
-// each against the former setting measured in the same run (ratios are meaningful on any machine,
-// absolute times are not).
+// russian_roulette), the Sobol' sub-pixel position at 1 spp (RendererOptions::jitter_one_spp) and the
+// environment taken from escaping bounce rays (RendererOptions::environment_from_bounce), each against
+// the former setting measured in the same run (ratios are meaningful on any machine, absolute times
+// are not).
 //
 //   mogao_bench_sampling [--scene scenes/grotto.json] [--scans DIR] [--width 240] [--height 135]
 //                        [--bounces 6] [--ref-spp 256] [--max-spp 16] [--passes 16] [--reps 2]
@@ -14,9 +15,10 @@
 // seed, rendered on every core). Times: the render thread's CPU time, best of --reps, the settings
 // interleaved so that drift on a shared machine affects them alike.
 //  (1) equal spp: time, rays per sample and relMSE at spp 1, 2, 4, ..., --max-spp for
-//      before (pixel centre at 1 spp, no roulette), roulette alone, the 1-spp position alone, both;
-//      at spp > 1 the position setting changes nothing (the pixel's samples are a Sobol' net either
-//      way), so those cells are the same render and are measured once;
+//      before (pixel centre at 1 spp, no roulette, the environment's own ray at every vertex), roulette
+//      alone, the 1-spp position alone, the environment from the bounce alone, all three; at spp > 1
+//      the position setting changes nothing (the pixel's samples are a Sobol' net either way), so
+//      those cells are the same render and are measured once;
 //  (2) equal time: each setting's relMSE interpolated log-log at the before-setting's times, and
 //      the ratio before/setting (> 1: the setting has the smaller error at equal time);
 //  (3) --passes one-spp frames accumulated over frame ids (what the farm does for a still view):
@@ -64,19 +66,34 @@ struct Setting {
     const char* png;  // --png-dir file of its 1-spp frame
     bool roulette;
     bool jitter;
+    bool environment_from_bounce;
 };
-constexpr std::array<Setting, 4> kSettings = {{
-    {"before: pixel centre at 1 spp, no roulette", "one-spp-before", false, false},
-    {"Russian roulette", "one-spp-roulette", true, false},
-    {"Sobol' position at 1 spp", "one-spp-sobol", false, true},
-    {"both (defaults)", "one-spp-defaults", true, true},
+constexpr std::array<Setting, 5> kSettings = {{
+    {"before: pixel centre at 1 spp, no roulette, sky's own ray", "one-spp-before", false, false, false},
+    {"Russian roulette", "one-spp-roulette", true, false, false},
+    {"Sobol' position at 1 spp", "one-spp-sobol", false, true, false},
+    {"environment from the bounce", "one-spp-sky-bounce", false, false, true},
+    {"all three (defaults)", "one-spp-defaults", true, true, true},
 }};
 
 RendererOptions options_of(const Setting& s) {
     RendererOptions o;
     o.russian_roulette = s.roulette;
     o.jitter_one_spp = s.jitter;
+    o.environment_from_bounce = s.environment_from_bounce;
     return o;
+}
+
+// The setting whose render setting s is at `spp`: above 1 spp the first one that differs from it at most by
+// the 1-spp position (the same render).
+std::size_t rendered_as(std::size_t s, int spp) {
+    if (spp == 1) return s;
+    for (std::size_t c = 0; c < kSettings.size(); ++c) {
+        if (kSettings[c].roulette == kSettings[s].roulette &&
+            kSettings[c].environment_from_bounce == kSettings[s].environment_from_bounce)
+            return c;
+    }
+    return s;
 }
 
 struct Point {
@@ -101,17 +118,18 @@ void save_png(const std::string& dir, const char* name, const RgbFloatImage& fra
     write_png(std::filesystem::path(dir) / (std::string(name) + ".png"), out);
 }
 
-// (1): curves[setting][k] at spp 2^k; settings 2 and 3 copy 0 and 1 above 1 spp (same renders).
+// (1): curves[setting][k] at spp 2^k; above 1 spp a setting that differs from an earlier one only by the
+// 1-spp position copies it (rendered_as: the same render).
 std::vector<std::vector<Point>> equal_spp(Renderer& renderer, const ViewRequest& view, const RgbFloatImage& reference,
                                           int max_spp, int reps, const Scene& scene, const std::string& png_dir) {
     std::vector<std::vector<Point>> curves(kSettings.size());
     for (int spp = 1; spp <= max_spp; spp *= 2) {
         ViewRequest v = view;
         v.quality.spp = spp;
-        const std::size_t measured = spp == 1 ? kSettings.size() : 2;
-        std::vector<Point> row(measured);
+        std::vector<Point> row(kSettings.size());
         for (int r = 0; r < std::max(1, reps); ++r) {
-            for (std::size_t s = 0; s < measured; ++s) {
+            for (std::size_t s = 0; s < kSettings.size(); ++s) {
+                if (rendered_as(s, spp) != s) continue;
                 renderer.set_path_options(options_of(kSettings[s]));
                 renderer.begin_frame(v);
                 RgbFloatImage frame(renderer.render_size());
@@ -125,7 +143,7 @@ std::vector<std::vector<Point>> equal_spp(Renderer& renderer, const ViewRequest&
                 if (spp == 1 && r == 0) save_png(png_dir, kSettings[s].png, frame, scene);
             }
         }
-        for (std::size_t s = 0; s < kSettings.size(); ++s) curves[s].push_back(row[s < measured ? s : s - 2]);
+        for (std::size_t s = 0; s < kSettings.size(); ++s) curves[s].push_back(row[rendered_as(s, spp)]);
     }
     return curves;
 }
@@ -148,7 +166,9 @@ std::array<double, 2> accumulated_passes(Renderer& renderer, const ViewRequest& 
                                          int passes, const Scene& scene, const std::string& png_dir) {
     std::array<double, 2> out{};
     for (int jitter = 0; jitter < 2; ++jitter) {
-        renderer.set_path_options(options_of(kSettings[jitter == 0 ? 1 : 3]));
+        Setting setting = kSettings.back();  // the defaults, with the pixel centre or the Sobol' position
+        setting.jitter = jitter == 1;
+        renderer.set_path_options(options_of(setting));
         RgbFloatImage sum(reference.size, 0.0f);
         for (int p = 0; p < passes; ++p) {
             ViewRequest v = view;

@@ -286,7 +286,7 @@ void direct_light_queries(const FrameContext& frame, const ShadingVertex& x, con
             one_light_query(frame, x, throughput, sel, pair.point(s, frame.area_light_samples), bounce_follows, sink);
         }
     }
-    if (parts == DirectParts::kAll && frame.lights->has_environment)
+    if (parts == DirectParts::kAll && frame.lights->has_environment && !environment_from_bounce(frame, bounce_follows))
         environment_queries(frame, x, throughput, sampler, sink);
 }
 
@@ -380,6 +380,8 @@ Eigen::Vector3f radiance_at(const FrameContext& frame, const SurfaceHit& first, 
         rtcIntersect1(frame.scene->root(), &context, &ray_hit);
         ++rays;
         const bool escaped = ray_hit.hit.geomID == RTC_INVALID_GEOMETRY_ID;
+        if (escaped && environment_from_bounce(frame, true) && frame.lights->has_environment)
+            radiance += bounce.throughput.cwiseProduct(frame.lights->environment);
         radiance +=
             bounce_emission(frame, x, bounce.direction, escaped ? kInfinity : ray_hit.ray.tfar, bounce.throughput);
         if (escaped) break;  // see header

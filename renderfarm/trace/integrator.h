@@ -26,16 +26,23 @@
 // p = (1 - p_g) cosθ/π + p_g G1(wo) D(h) / (4 cosθo): Veach's one-sample MIS with the balance
 // heuristic (Veach 1997, §9.2.4), so whichever lobe dominates a direction carries it. The same
 // p is the bounce pdf in the area-light MIS weights below. Matte materials (p_g = 0) draw and
-// compute exactly what they did without it. A bounce ray that escapes contributes nothing: the environment (the only
-// thing an escaping ray could see) is already counted by next-event estimation at every vertex, so adding it again
-// would double count it; area lights are not intersectable either (scene.h), so no emission is ever found by a bounce
-// ray. Russian roulette (FrameContext::russian_roulette; Arvo & Kirk, "Particle Transport and Image Synthesis",
-// SIGGRAPH 1990, §4; as PBRT 4th ed. §14.5.1 / pbrt-v4's PathIntegrator): the bounce leaving a vertex of depth >=
-// kRouletteMinDepth (the camera ray's hit is depth 0, so the first bounce is always traced) survives with probability q
-// = min(1, sqrt(max channel of the path throughput after the bounce)) (the square root as Cycles takes it: a
-// gentler cut than q = max channel, which in a room lit mostly by interreflection raised the error per sample by more
-// than it saved; docs/renderer.md, "Cheaper and better samples"), and a surviving path's throughput is divided by q.
-// The expected value of every later term is unchanged (E[X/q · 1{u < q}] = E[X]), so the estimator stays unbiased;
+// compute exactly what they did without it. Environment from the bounce (FrameContext::environment_from_bounce, with
+// ao_samples <= 1): at a vertex a bounce follows, the environment gets no ray of its own; the bounce ray, if it
+// escapes, adds throughput_after_bounce · L_env, that is β f cosθ / p(wi) L_env (divided by q where roulette kept
+// it): a one-sample estimate of the same ∫ f L_env V cosθ dω with the bounce's pdf (for a matte surface the cosine,
+// the pdf next-event estimation uses), so it is unbiased and saves one ray per such vertex (PBRT 4th ed.
+// §13.1: any pdf that is non-zero where the integrand is gives an unbiased estimate). Lost bounces (below the surface,
+// ended by roulette) lose its term, as unbiased as roulette itself. The last vertex, vertices with ao_samples > 1 and
+// cache training paths keep next-event estimation. Otherwise a bounce ray that escapes contributes nothing: the
+// environment (the only thing an escaping ray could see) is then counted by next-event estimation, so adding it
+// again would double count it; area lights are not intersectable either (scene.h), so no emission is ever found by
+// a bounce ray. Russian roulette (FrameContext::russian_roulette; Arvo & Kirk, "Particle Transport and Image
+// Synthesis", SIGGRAPH 1990, §4; as PBRT 4th ed. §14.5.1 / pbrt-v4's PathIntegrator): the bounce leaving a vertex of
+// depth >= kRouletteMinDepth (the camera ray's hit is depth 0, so the first bounce is always traced) survives with
+// probability q = min(1, sqrt(max channel of the path throughput after the bounce)) (the square root as Cycles takes
+// it: a gentler cut than q = max channel, which in a room lit mostly by interreflection raised the error per sample by
+// more than it saved; docs/renderer.md, "Cheaper and better samples"), and a surviving path's throughput is divided by
+// q. The expected value of every later term is unchanged (E[X/q · 1{u < q}] = E[X]), so the estimator stays unbiased;
 // paths whose throughput has become small end early and save their bounce and next-event rays. A throughput >= 1 in
 // every channel (albedo 1) is never rouletted. The decision draws a PixelSampler pair of its own only when q < 1, so a
 // frame without roulette (or with q = 1 everywhere) draws the numbers it drew before. Random numbers: one PixelSampler
@@ -102,7 +109,15 @@ struct FrameContext {
     // taken as white Lambertian, only the environment is sampled there and its bounce adds no area
     // emission, so a path estimates the white radiance of the cache's part of the light.
     bool cache_training = false;
+    bool environment_from_bounce = false;  // the environment from escaping bounce rays (see above)
 };
+
+// Whether a vertex takes the environment from its bounce ray instead of next-event estimation (see above):
+// FrameContext::environment_from_bounce, a bounce follows, one environment sample (ao_samples <= 1) and no
+// cache training path (whose first vertex samples only the environment).
+[[nodiscard]] inline bool environment_from_bounce(const FrameContext& frame, bool bounce_follows) {
+    return frame.environment_from_bounce && bounce_follows && frame.ao_samples <= 1 && !frame.cache_training;
+}
 
 // The white Lambertian material of a cache training path's first vertex (albedo 1).
 [[nodiscard]] ShadingMaterial white_lambert();

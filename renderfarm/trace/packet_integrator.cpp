@@ -200,6 +200,8 @@ void bounce(const FrameContext& frame, std::array<Lane, kPacketLanes>& lanes,
             radiance[l] += bounce_emission(frame, vertices[l], bounces[l].direction, escaped ? kInfinity : t,
                                            bounces[l].throughput);
         }
+        if (escaped && environment_from_bounce(frame, true) && frame.lights->has_environment)
+            radiance[l] += bounces[l].throughput.cwiseProduct(frame.lights->environment);
         if (escaped) {
             lanes[l].alive = false;  // see integrator.h
             continue;

@@ -321,6 +321,7 @@ void Renderer::set_path_options(const RendererOptions& options) {
     impl_->options.jitter_one_spp = options.jitter_one_spp;
     impl_->options.jitter_cached_one_spp = options.jitter_cached_one_spp;
     impl_->options.glossy_vndf_sampling = options.glossy_vndf_sampling;
+    impl_->options.environment_from_bounce = options.environment_from_bounce;
 }
 
 void Renderer::begin_frame(const ViewRequest& request) {
@@ -352,6 +353,7 @@ void Renderer::begin_frame(const ViewRequest& request) {
     s.context.coherent_shadow_packets = s.options.coherent_shadow_packets_baseline;
     s.context.russian_roulette = s.options.russian_roulette;
     s.context.glossy_vndf = s.options.glossy_vndf_sampling;
+    s.context.environment_from_bounce = s.options.environment_from_bounce;
     s.cached = request.radiance_cache;
     s.shading_one_in = s.cached ? request.shading_one_in : 1;
     s.shading_phase = s.cached ? request.shading_phase : 0;

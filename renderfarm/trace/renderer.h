@@ -93,6 +93,10 @@ struct RendererOptions {
     // cosine lobe by one-sample MIS (integrator.h); off: every bounce cosine-sampled, as before.
     // Matte materials are unaffected either way.
     bool glossy_vndf_sampling = true;
+    // Where a bounce follows a path vertex, the environment is taken from that bounce ray when it
+    // escapes (integrator.h, "Environment from the bounce") instead of from an occlusion ray of its
+    // own: one ray fewer per vertex, unbiased. Off: the environment's own ray at every vertex, as before.
+    bool environment_from_bounce = true;
     // The radiance cache of frames whose request asks for it (ViewRequest::radiance_cache;
     // radiance_cache.h, cached_packet.h). Frames that do not ask neither read nor train it.
     RadianceCacheOptions radiance_cache = {};
@@ -138,10 +142,9 @@ public:
     Renderer& operator=(Renderer&&) noexcept;
 
     // Replaces the path switches (legacy_light_sampling, packet_secondary_rays, camera_column_table,
-    // native_packet_width, russian_roulette, jitter_one_spp, jitter_cached_one_spp, glossy_vndf_sampling) from the
-    // next begin_frame on, so a
-    // benchmark times both paths on one BVH; embree_config and rebase_on_eye keep their constructor values. Not
-    // thread-safe.
+    // native_packet_width, russian_roulette, jitter_one_spp, jitter_cached_one_spp, glossy_vndf_sampling,
+    // environment_from_bounce) from the next begin_frame on, so a benchmark times both paths on one BVH;
+    // embree_config and rebase_on_eye keep their constructor values. Not thread-safe.
     void set_path_options(const RendererOptions& options);
 
     // Validates the request (std::invalid_argument naming the field and limit, see
