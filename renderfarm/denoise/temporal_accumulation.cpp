@@ -42,11 +42,8 @@ void check_temporal_params(const TemporalParams& params) {
 }
 
 bool TemporalHistory::gather(const Pass& f, const Eigen::Vector3f& position, const Eigen::Vector3f& normal, float depth,
-                             Eigen::Vector3f& value, float& length) const {
+                             float px, float py, Eigen::Vector3f& value, float& length) const {
     const TemporalParams& params = f.params;
-    float px = 0.0f;
-    float py = 0.0f;
-    if (!f.to_history.project(position, px, py)) return false;
     const float fx = px - 0.5f;
     const float fy = py - 0.5f;
     // Only between the previous frame's pixel centres: beyond them a value would be extrapolated
@@ -54,24 +51,24 @@ bool TemporalHistory::gather(const Pass& f, const Eigen::Vector3f& position, con
     if (!(fx >= 0.0f && fy >= 0.0f && fx <= static_cast<float>(camera_.size.width - 1) &&
           fy <= static_cast<float>(camera_.size.height - 1)))
         return false;
-    const int x0 = static_cast<int>(std::floor(fx));
-    const int y0 = static_cast<int>(std::floor(fy));
+    const int x0 = static_cast<int>(fx);  // fx >= 0: truncation is floor
+    const int y0 = static_cast<int>(fy);
     const float wx = fx - static_cast<float>(x0);
     const float wy = fy - static_cast<float>(y0);
+    const float tolerance = params.plane_tolerance * depth;
     float weight = 0.0f;
     int accepted = 0;
     value = Eigen::Vector3f::Zero();
     length = 0.0f;
     for (int k = 0; k < 4; ++k) {
-        const int x = x0 + (k & 1);
-        const int y = y0 + (k >> 1);
-        if (x < 0 || y < 0 || x >= camera_.size.width || y >= camera_.size.height) continue;
+        const int x = std::min(x0 + (k & 1), camera_.size.width - 1);  // x0 = W - 1 only where wx = 0
+        const int y = std::min(y0 + (k >> 1), camera_.size.height - 1);
         const std::size_t i =
             static_cast<std::size_t>(y) * static_cast<std::size_t>(camera_.size.width) + static_cast<std::size_t>(x);
         if (hit_[i] == 0) continue;
         const Eigen::Vector3f n = at3(normal_, i);
         if (n.dot(normal) < params.normal_min_cos) continue;
-        if (std::abs(n.dot(position - at3(position_, i))) > params.plane_tolerance * depth) continue;
+        if (std::abs(n.dot(position) - plane_[i]) > tolerance) continue;  // |n'·(P − P')|
         const float w = ((k & 1) != 0 ? wx : 1.0f - wx) * ((k >> 1) != 0 ? wy : 1.0f - wy);
         value += w * at3(illumination_, i);
         length += w * length_[i];
@@ -184,16 +181,29 @@ void TemporalHistory::set_pixel(const Pass& f, std::size_t i, const Eigen::Vecto
     }
 }
 
-// Rows [y0, y1) of accumulate(): writes their pixels of out, illumination, position and length;
-// counts them. A pixel that no history covers keeps its own radiance, bit for bit.
+// Rows [y0, y1) of accumulate(): writes their pixels of out, illumination, position, plane and
+// length; counts them. A pixel that no history covers keeps its own radiance, bit for bit. Each
+// row's points and their positions in the previous image are computed first, a row at a time
+// (PixelCentreRays::points_row, FrameProjection::project_row: vectorised), then each pixel's taps.
 void TemporalHistory::accumulate_rows(const Pass& f, int y0, int y1, TemporalStats& counted) const {
+    const int width = f.current.size.width;
+    const auto w = static_cast<std::size_t>(width);
+    std::vector<float> px(w), py(w), pz(w), hx(w), hy(w);
+    std::vector<std::uint8_t> in_view(w, 0);
     for (int y = y0; y < y1; ++y) {
-        for (int x = 0; x < f.current.size.width; ++x) {
-            const std::size_t i = f.guides.pixel(x, y);
+        const std::size_t row = f.guides.pixel(0, y);
+        f.rays.points_row(y, &f.guides.depth[row], width, px.data(), py.data(), pz.data());
+        if (!empty())
+            f.to_history.project_row(px.data(), py.data(), pz.data(), width, hx.data(), hy.data(), in_view.data());
+        for (int x = 0; x < width; ++x) {
+            const std::size_t i = row + static_cast<std::size_t>(x);
             if (f.guides.hit[i] == 0) continue;
             ++counted.surface_pixels;
-            const Eigen::Vector3f p = f.rays.point(x, y, f.guides.depth[i]);
+            const auto xs = static_cast<std::size_t>(x);
+            const Eigen::Vector3f p(px[xs], py[xs], pz[xs]);
+            const Eigen::Vector3f normal = at3(f.guides.normal, i);
             for (int c = 0; c < 3; ++c) f.position[3 * i + static_cast<std::size_t>(c)] = p[c];
+            f.plane[i] = normal.dot(p);
             const float* own = f.current.at(x, y);
             const bool shaded = !(own[0] < 0.0f);  // kUnshadedRadiance: a sparse frame's unshaded pixel
             if (!shaded) ++counted.unshaded;
@@ -205,7 +215,8 @@ void TemporalHistory::accumulate_rows(const Pass& f, int y0, int y1, TemporalSta
             for (int c = 0; c < 3; ++c) f.illumination[3 * i + static_cast<std::size_t>(c)] = illumination[c];
             Eigen::Vector3f history;
             float frames = 0.0f;
-            if (empty() || !gather(f, p, at3(f.guides.normal, i), f.guides.depth[i], history, frames)) {
+            if (empty() || in_view[xs] == 0 ||
+                !gather(f, p, normal, f.guides.depth[i], hx[xs], hy[xs], history, frames)) {
                 f.length[i] = shaded ? 1.0f : 0.0f;
                 continue;
             }
@@ -234,6 +245,7 @@ RgbFloatImage TemporalHistory::accumulate(const RgbFloatImage& current, const Gu
     RgbFloatImage out = current;
     std::vector<float> illumination(3 * n, 0.0f);
     std::vector<float> position(3 * n, 0.0f);
+    std::vector<float> plane(n, 0.0f);
     std::vector<float> length(n, 0.0f);
     const float alpha = 1.0f - std::pow(1.0f - params.alpha, static_cast<float>(shading_one_in));
     const Pass f{current,
@@ -245,6 +257,7 @@ RgbFloatImage TemporalHistory::accumulate(const RgbFloatImage& current, const Gu
                  out,
                  illumination,
                  position,
+                 plane,
                  length};
     // Rows split over the cores (each pixel reads only the history and writes only itself, so the
     // result does not depend on the split): the admin runs this while the ranks wait.
@@ -268,7 +281,7 @@ RgbFloatImage TemporalHistory::accumulate(const RgbFloatImage& current, const Gu
     total.filled = fill_holes(f);
     camera_ = camera;
     illumination_ = std::move(illumination);
-    position_ = std::move(position);
+    plane_ = std::move(plane);
     normal_ = guides.normal;
     hit_ = guides.hit;
     length_ = std::move(length);
@@ -278,7 +291,7 @@ RgbFloatImage TemporalHistory::accumulate(const RgbFloatImage& current, const Gu
 
 void TemporalHistory::clear() {
     illumination_.clear();
-    position_.clear();
+    plane_.clear();
     normal_.clear();
     hit_.clear();
     length_.clear();

@@ -104,6 +104,7 @@ private:
         RgbFloatImage& out;
         std::vector<float>& illumination;
         std::vector<float>& position;
+        std::vector<float>& plane;
         std::vector<float>& length;
     };
     void accumulate_rows(const Pass& f, int y0, int y1, TemporalStats& counted) const;
@@ -111,12 +112,13 @@ private:
     static bool neighbour_fill(const Pass& f, std::size_t i, int radius, Eigen::Vector3f& value);
     static void set_pixel(const Pass& f, std::size_t i, const Eigen::Vector3f& value);
     void sharpen(float fx, float fy, Eigen::Vector3f& value) const;
+    // The history at the previous image's position (px, py) (project_row's) for the point `position`.
     [[nodiscard]] bool gather(const Pass& f, const Eigen::Vector3f& position, const Eigen::Vector3f& normal,
-                              float depth, Eigen::Vector3f& value, float& length) const;
+                              float depth, float px, float py, Eigen::Vector3f& value, float& length) const;
 
     CameraSetup camera_;
     std::vector<float> illumination_;  // W*H*3 the previous output demodulated (radiance / albedo)
-    std::vector<float> position_;      // W*H*3 world metres of each pixel's hit
+    std::vector<float> plane_;         // W*H n·P of each pixel's hit: its tangent plane's offset, metres
     std::vector<float> normal_;        // W*H*3 unit world normals
     std::vector<std::uint8_t> hit_;    // W*H
     std::vector<float> length_;        // W*H frames averaged

@@ -158,7 +158,8 @@ bool LiveFrames::accumulates(const LiveFrame& frame) const {
 
 Rgb8Image LiveFrames::to_display(const RgbFloatImage& radiance) const {
     Rgb8Image out(radiance.size);
-    to_srgb8(radiance, PixelRect::whole(radiance.size), exposure_, out, tone_map_);
+    // Every core of the admin: the render ranks wait for the next request meanwhile.
+    to_srgb8(radiance, PixelRect::whole(radiance.size), exposure_, out, tone_map_, 0);
     return out;
 }
 

@@ -7,6 +7,9 @@
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
 
 #include "common/srgb.h"
 
@@ -45,17 +48,47 @@ struct SrgbTable {
     }
 };
 
+// encode_srgb8 with its tables looked up once (to_srgb8 encodes every channel of a frame).
+class SrgbEncoder {
+public:
+    SrgbEncoder() : table_(table()), thresholds_(code_thresholds()) {}
+    [[nodiscard]] std::uint8_t operator()(float linear) const {
+        // NaN fails the comparison and ends at 0; +inf clamps to 1.
+        const float v = linear > 0.0f ? std::min(linear, 1.0f) : 0.0f;
+        std::uint8_t code = table_.code[std::bit_cast<std::uint32_t>(v) >> kShift];
+        while (code < 255 && static_cast<double>(v) >= thresholds_[code]) ++code;
+        return code;
+    }
+
+private:
+    static const SrgbTable& table() {
+        static const SrgbTable t;
+        return t;
+    }
+    const SrgbTable& table_;
+    const std::array<double, 255>& thresholds_;
+};
+
+// Rows [y0, y1) of rect.
+void to_srgb8_rows(const RgbFloatImage& in, const PixelRect& rect, int y0, int y1, float exposure, Rgb8Image& out,
+                   ToneMap op) {
+    const SrgbEncoder encode;
+    for (int y = y0; y < y1; ++y) {
+        const float* src = in.at(rect.x0, y);
+        std::uint8_t* dst = out.at(rect.x0, y);
+        for (int i = 0; i < 3 * (rect.x1 - rect.x0); ++i) {
+            const float v = exposure * src[i];
+            // NaN fails the comparison and stays NaN -> code 0; +inf -> 1 for every operator.
+            dst[i] = encode(op == ToneMap::clamp || !(v > 0.0f) ? v : (std::isinf(v) ? 1.0f : tone_map(op, v)));
+        }
+    }
+}
+
 }  // namespace
 
 std::uint8_t encode_srgb8(float linear) {
-    static const SrgbTable table;
-    // NaN fails the comparison and ends at 0; +inf clamps to 1.
-    const float v = linear > 0.0f ? std::min(linear, 1.0f) : 0.0f;
-    const auto bits = std::bit_cast<std::uint32_t>(v);
-    std::uint8_t code = table.code[bits >> kShift];
-    const auto& t = code_thresholds();
-    while (code < 255 && static_cast<double>(v) >= t[code]) ++code;
-    return code;
+    static const SrgbEncoder encode;
+    return encode(linear);
 }
 
 float tone_map(ToneMap op, float x) {
@@ -89,7 +122,7 @@ const char* tone_map_name(ToneMap op) {
     return "?";
 }
 
-void to_srgb8(const RgbFloatImage& in, const PixelRect& rect, float exposure, Rgb8Image& out, ToneMap op) {
+void to_srgb8(const RgbFloatImage& in, const PixelRect& rect, float exposure, Rgb8Image& out, ToneMap op, int threads) {
     if (!(in.size == out.size)) throw std::invalid_argument("to_srgb8: input and output sizes differ");
     if (rect.x0 < 0 || rect.y0 < 0 || rect.x1 > in.size.width || rect.y1 > in.size.height) {
         throw std::invalid_argument("to_srgb8: rect is outside the image");
@@ -97,18 +130,20 @@ void to_srgb8(const RgbFloatImage& in, const PixelRect& rect, float exposure, Rg
     if (!(exposure >= 0.0f) || !std::isfinite(exposure)) {
         throw std::invalid_argument("to_srgb8: exposure must be finite and >= 0");
     }
-    for (int y = rect.y0; y < rect.y1; ++y) {
-        for (int x = rect.x0; x < rect.x1; ++x) {
-            const float* src = in.at(x, y);
-            std::uint8_t* dst = out.at(x, y);
-            for (int c = 0; c < 3; ++c) {
-                const float v = exposure * src[c];
-                // NaN fails the comparison and stays NaN -> code 0; +inf -> 1 for every operator.
-                dst[c] =
-                    encode_srgb8(op == ToneMap::clamp || !(v > 0.0f) ? v : (std::isinf(v) ? 1.0f : tone_map(op, v)));
-            }
-        }
+    if (threads < 0) throw std::invalid_argument("to_srgb8: threads must be >= 0, is " + std::to_string(threads));
+    if (rect.empty()) return;
+    const int rows = rect.y1 - rect.y0;
+    if (threads == 0) threads = static_cast<int>(std::thread::hardware_concurrency());
+    threads = std::clamp(threads, 1, std::max(1, rows / 16));  // a band of at least 16 rows
+    std::vector<std::thread> workers;
+    for (int t = 1; t < threads; ++t) {
+        workers.emplace_back([&, t] {
+            to_srgb8_rows(in, rect, rect.y0 + rows * t / threads, rect.y0 + rows * (t + 1) / threads, exposure, out,
+                          op);
+        });
     }
+    to_srgb8_rows(in, rect, rect.y0, rect.y0 + rows / threads, exposure, out, op);
+    for (std::thread& w : workers) w.join();
 }
 
 }  // namespace mogao

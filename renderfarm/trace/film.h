@@ -38,7 +38,9 @@ namespace mogao {
 [[nodiscard]] ToneMap parse_tone_map(const std::string& name);
 [[nodiscard]] const char* tone_map_name(ToneMap op);
 
+// `threads`: row bands of rect run on this many threads (0 = std::thread::hardware_concurrency; the
+// same bytes for any count); std::invalid_argument when negative.
 void to_srgb8(const RgbFloatImage& in, const PixelRect& rect, float exposure, Rgb8Image& out,
-              ToneMap op = ToneMap::clamp);
+              ToneMap op = ToneMap::clamp, int threads = 1);
 
 }  // namespace mogao

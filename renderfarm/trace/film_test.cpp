@@ -52,6 +52,25 @@ TEST(Film, AppliesExposureInsideRectOnly) {
     EXPECT_THROW(to_srgb8(in, {0, 0, 1, 1}, -1.0f, out), std::invalid_argument);
 }
 
+// Row bands on threads write the same bytes as one thread, inside rect only, whatever the band count.
+TEST(Film, ThreadedBandsWriteTheSameBytes) {
+    RgbFloatImage in({37, 71});
+    for (int y = 0; y < in.size.height; ++y)
+        for (int x = 0; x < in.size.width; ++x)
+            for (int c = 0; c < 3; ++c) in.at(x, y)[c] = 0.013f * static_cast<float>((x * 7 + y * 13 + c * 5) % 97);
+    const PixelRect rect{3, 2, 35, 70};
+    Rgb8Image one(in.size, 9);
+    to_srgb8(in, rect, 1.5f, one, ToneMap::aces, 1);
+    for (const int threads : {0, 2, 3, 8}) {
+        Rgb8Image banded(in.size, 9);
+        to_srgb8(in, rect, 1.5f, banded, ToneMap::aces, threads);
+        EXPECT_EQ(banded.pixels, one.pixels) << threads << " threads";
+    }
+    EXPECT_EQ(one.at(0, 0)[0], 9);  // outside rect: untouched
+    EXPECT_EQ(one.at(3, 2)[0], encode_srgb8(tone_map(ToneMap::aces, 1.5f * in.at(3, 2)[0])));
+    EXPECT_THROW(to_srgb8(in, rect, 1.0f, one, ToneMap::clamp, -1), std::invalid_argument);
+}
+
 // Highlights: with clamp everything above 1 is one flat code; the tone maps keep an ordering
 // up to several times white, match their formulas, and stay monotonic and within [0, 1].
 TEST(Film, ToneMapsKeepHighlightsApart) {

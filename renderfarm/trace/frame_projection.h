@@ -16,6 +16,7 @@
 // avoids: per-pixel trigonometry and 3x3 products in double.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
@@ -34,10 +35,16 @@ public:
     }
     // The world point at `depth` metres along pixel (x, y)'s ray (GuideBuffers::depth's convention).
     [[nodiscard]] Eigen::Vector3f point(int x, int y, float depth) const { return eye_ + depth * direction(x, y); }
+    // point() of pixels (0..n-1, y) at depth[0..n-1] into px, py, pz (world metres, one array per axis);
+    // n <= W. The same arithmetic a lane at a time, on eight lanes where the CPU has AVX2 (the last
+    // bits may differ from point(), which contracts no multiply-add: cpu_level.h).
+    void points_row(int y, const float* depth, int n, float* px, float* py, float* pz) const;
 
 private:
+    void split_columns();
     Eigen::Vector3f eye_;
     std::vector<Eigen::Vector3f> columns_, rows_;
+    std::vector<float> column_x_, column_y_, column_z_;  // columns_ by axis, for points_row
 };
 
 // project_to_image of `camera` in float: false where it is false, else the continuous image position.
@@ -45,6 +52,11 @@ class FrameProjection {
 public:
     explicit FrameProjection(const CameraSetup& camera);
     [[nodiscard]] bool project(const Eigen::Vector3f& p, float& px, float& py) const;
+    // project() of the n points (x[i], y[i], z[i]): image position in (px[i], py[i]) and ok[i] = 1
+    // where project() is true, else 0 (px, py then unspecified). Branch-free, eight lanes at a time
+    // where the CPU has AVX2; within float rounding of project() (frame_projection_test.cpp).
+    void project_row(const float* x, const float* y, const float* z, int n, float* px, float* py,
+                     std::uint8_t* ok) const;
 
 private:
     bool cylinder_ = false;
