@@ -4,15 +4,22 @@
 // the same frame, and its per-pixel reprojection in float (renderfarm/trace/frame_projection.h)
 // against camera.h's double-precision functions, all measured in this run.
 //   mogao_bench_temporal [--width 480] [--height 270] [--frames 60] [--shading-one-in 4]
+//                        [--write-docs docs/renderer.md]
+// --write-docs FILE replaces the block between `<!-- generated:temporal -->` and `<!-- /generated -->`.
 // The frames are analytic, so the bench needs no scene: a cylinder screen camera turning by 0.25
 // degrees a frame inside a textured cylindrical wall 4 m around its eye (every pixel a surface, so
 // every pixel is reprojected: the dearest case), radiance = albedo x a smooth light + noise.
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <random>
+#include <sstream>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
+#include "bench/quality/bench_report.h"
 #include "common/view_request.h"
 #include "renderfarm/denoise/atrous_filter.h"
 #include "renderfarm/denoise/temporal_accumulation.h"
@@ -23,6 +30,7 @@ namespace {
 
 using namespace mogao;
 using Clock = std::chrono::steady_clock;
+using bench::fmt;
 
 struct Options {
     int width = 480;
@@ -83,8 +91,9 @@ double ms_since(Clock::time_point start) {
 }
 
 // Nanoseconds per pixel to place every pixel's point at its depth and project it into the previous
-// frame's camera: double (generate_ray, project_to_image) and float (frame_projection.h).
-void projection_table(const Options& o) {
+// frame's camera: double (generate_ray, project_to_image), float a pixel at a time and float a row at
+// a time (frame_projection.h).
+std::string projection_table(const Options& o) {
     const CameraSetup now = camera_at(o, 1);
     const CameraSetup before = camera_at(o, 0);
     const double pixels = static_cast<double>(now.size.pixel_count());
@@ -114,17 +123,33 @@ void projection_table(const Options& o) {
         }
     }
     const double float_ns = ms_since(time_float) * 1e6 / (kReps * pixels);
-    std::printf("\n| reprojection of one pixel | ns | ratio |\n|---|--:|--:|\n");
-    std::printf("| double: generate_column_ray + project_to_image (camera.h) | %.1f | 1.00 |\n", double_ns);
-    std::printf("| float: PixelCentreRays + FrameProjection (frame_projection.h) | %.1f | %.2f |\n", float_ns,
-                float_ns / double_ns);
-    std::printf("(checksum %.0f)\n", sink);
+    const auto w = static_cast<std::size_t>(now.size.width);
+    std::vector<float> depth(w, static_cast<float>(kWall)), x(w), y(w), z(w), px(w), py(w);
+    std::vector<std::uint8_t> ok(w);
+    const auto time_row = Clock::now();
+    for (int rep = 0; rep < kReps; ++rep) {
+        for (int row = 0; row < now.size.height; ++row) {
+            rays.points_row(row, depth.data(), now.size.width, x.data(), y.data(), z.data());
+            projection.project_row(x.data(), y.data(), z.data(), now.size.width, px.data(), py.data(), ok.data());
+            for (std::size_t i = 0; i < w; i += 97) sink += ok[i] != 0 ? px[i] + py[i] : 0.0;
+        }
+    }
+    const double row_ns = ms_since(time_row) * 1e6 / (kReps * pixels);
+    std::ostringstream md;
+    md << "\n| reprojection of one pixel | ns | ratio |\n|---|--:|--:|\n"
+       << "| double: generate_column_ray + project_to_image (camera.h) | " << fmt("%.1f", double_ns) << " | 1.00 |\n"
+       << "| float, a pixel at a time: PixelCentreRays::point + FrameProjection::project | " << fmt("%.1f", float_ns)
+       << " | " << fmt("%.2f", float_ns / double_ns) << " |\n"
+       << "| float, a row at a time: points_row + project_row (frame_projection.h) | " << fmt("%.1f", row_ns) << " | "
+       << fmt("%.2f", row_ns / double_ns) << " |\n\n"
+       << "(checksum " << fmt("%.0f", sink) << ")\n";
+    return md.str();
 }
 
-void accumulation_table(const Options& o) {
-    std::printf(
-        "| frame, %dx%d | temporal accumulation ms | à-trous filter ms | temporal / filter |\n|---|--:|--:|--:|\n",
-        o.width, o.height);
+std::string accumulation_table(const Options& o) {
+    std::ostringstream md;
+    md << "| frame, " << o.width << "x" << o.height
+       << " | temporal accumulation ms | à-trous filter ms | temporal / filter |\n|---|--:|--:|--:|\n";
     for (const int one_in : {1, o.shading_one_in}) {
         std::mt19937 rng(1);
         TemporalHistory history;
@@ -149,34 +174,41 @@ void accumulation_table(const Options& o) {
                 throw std::runtime_error(st.error().message);
             if (frame >= 2) temporal_ms += t, filter_ms += ms_since(filter_start), ++timed;
         }
-        std::printf("| %s | %.2f | %.2f | %.2f |\n",
-                    one_in == 1 ? "every pixel shaded" : ("1 pixel in " + std::to_string(one_in) + " shaded").c_str(),
-                    temporal_ms / timed, filter_ms / timed, temporal_ms / filter_ms);
+        md << "| " << (one_in == 1 ? "every pixel shaded" : "1 pixel in " + std::to_string(one_in) + " shaded") << " | "
+           << fmt("%.2f", temporal_ms / timed) << " | " << fmt("%.2f", filter_ms / timed) << " | "
+           << fmt("%.2f", temporal_ms / filter_ms) << " |\n";
     }
+    return md.str();
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
     Options o;
     for (int i = 1; i + 1 < argc; i += 2) {
         const std::string flag = argv[i];
+        if (flag == "--write-docs") continue;  // bench::print_and_write_block reads it
         const int value = std::stoi(argv[i + 1]);
         if (flag == "--width") o.width = value;
         else if (flag == "--height") o.height = value;
         else if (flag == "--frames") o.frames = value;
         else if (flag == "--shading-one-in") o.shading_one_in = value;
-        else {
-            std::fprintf(stderr, "mogao_bench_temporal: unknown flag %s\n", flag.c_str());
-            return 2;
-        }
+        else throw std::invalid_argument("unknown flag " + flag);
     }
-    if (o.width < 16 || o.height < 16 || o.frames < 4 || o.shading_one_in < 1 || o.shading_one_in > 16) {
-        std::fprintf(stderr,
-                     "mogao_bench_temporal: --width and --height >= 16, --frames >= 4, --shading-one-in in [1, 16]\n");
-        return 2;
-    }
-    accumulation_table(o);
-    projection_table(o);
+    if (o.width < 16 || o.height < 16 || o.frames < 4 || o.shading_one_in < 1 || o.shading_one_in > 16)
+        throw std::invalid_argument("--width and --height >= 16, --frames >= 4, --shading-one-in in [1, 16]");
+    const double load_start = bench::load_average();
+    const std::string accumulation = accumulation_table(o);
+    const std::string projection = projection_table(o);
+    std::ostringstream md;
+    md << "_Run " << bench::run_context() << ", load average " << fmt("%.2f", load_start) << " at start, "
+       << fmt("%.2f", bench::load_average()) << " at end. Analytic frames (a cylinder camera turning 0.25° a frame "
+       << "inside a textured wall: every pixel reprojected), " << o.frames << " frames, the first two not timed; the "
+       << "filter with its default three levels on every core. Regenerate: `build/bench/mogao_bench_temporal "
+       << "--write-docs docs/renderer.md`._\n\n"
+       << accumulation << projection;
+    bench::print_and_write_block(argc, argv, "temporal", md.str());
     return 0;
 }
+
+}  // namespace
+
+int main(int argc, char** argv) { return mogao::bench::run_main("mogao_bench_temporal", run, argc, argv); }
