@@ -116,7 +116,13 @@ nlohmann::json colour_report(const ColourResult& c) {
                                 {"at_rho_1", c.vignetting.corner},
                                 {"at_rho_1_sigma", c.vignetting.corner_sigma},
                                 {"projector_falloff", c.vignetting.projector_falloff},
-                                {"samples", c.vignetting.samples}};
+                                {"samples", c.vignetting.samples},
+                                {"fit_rms", c.vignetting.rms}};
+    // A gain screen's half-gain angle as the colour step used it (estimated from the images, or the data sheet's).
+    out["screen_half_gain_angle"] = {{"degrees", c.half_gain_angle_deg},
+                                     {"estimated", c.half_gain_angle_estimated},
+                                     {"fit_rms_at_data_sheet", c.told_half_gain_rms},
+                                     {"fit_rms_at_estimate", c.half_gain_rms}};
     for (const ProjectorPhotometry& p : c.projectors) {
         nlohmann::json ch = nlohmann::json::array();
         for (const ChannelResponse& r : p.channels) {
@@ -306,6 +312,7 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
         const auto t1 = std::chrono::steady_clock::now();
         colour =
             calibrate_colour(source, r.screen, r.camera, r.projectors, r.calibration, job.colour_options);  // throws
+        r.screen.half_gain_angle_deg = colour->half_gain_angle_deg;  // the models file keeps what was measured
         calibrate_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
     }
     // The self-check sees only the camera images and the calibration (no ground truth); its gate refuses

@@ -85,6 +85,16 @@ CameraVignetting fit_camera_vignetting(const std::vector<FlatFieldSample>& sampl
         std::sqrt(std::max(0.0, cov(2 * n, 2 * n) + cov(2 * n + 1, 2 * n + 1) + 2.0 * cov(2 * n, 2 * n + 1)));
     for (long k = 0; k < n; ++k) out.projector_falloff.push_back(theta[n + k]);
     out.samples = static_cast<int>(samples.size());
+    double sse = 0.0, light = 0.0;
+    for (const FlatFieldSample& s : samples) {
+        const long k = static_cast<long>(s.projector);
+        const double c = s.camera_rho2;
+        const double model = theta[k] * (1.0 - theta[n + k] * s.projector_rho2) * (1.0 - out.a * c - out.b * c * c);
+        sse += (s.light - model) * (s.light - model);
+        light += s.light;
+    }
+    out.rms = std::sqrt(sse / static_cast<double>(samples.size())) /
+              std::max(light / static_cast<double>(samples.size()), 1e-12);
     out.measured = true;
     return out;
 }

@@ -38,6 +38,7 @@ struct CameraVignetting {
     double corner_sigma = 0.0;              // its standard deviation from the fit's covariance; 0 when not measured
     std::vector<double> projector_falloff;  // f_k of the joint fit (light lost at rho_k = 1), per projector
     int samples = 0;
+    double rms = 0.0;  // the fit's residual rms over the samples' mean light (relative)
     bool measured = false;
 };
 

@@ -463,10 +463,55 @@ double response_at(const ChannelResponse& r, double s) {
     return s <= l[i] ? a * s / l[i] : a + (b - a) * (s - l[i]) / (l[i + 1] - l[i]);
 }
 
-ColourResult calibrate_colour(PatternSource& source, const ScreenModel& screen, const DeviceModel& camera,
+// The screen lobe's half-gain angle that best explains the projectors' full-white images (a gain screen,
+// with the camera's vignetting measured; ColourOptions::estimate_half_gain_angle): the angle b in [10, 90]
+// degrees whose gain toward the camera, divided out, leaves the smallest residual in step 1a's joint fit
+// of a radial camera vignetting and a radial fall-off per projector. A wrong b leaves each projector's
+// light a lobe about its own mirror point, which neither radial family takes up (docs/calibration.md,
+// "Screen gain"). A grid of 5 degrees brackets the minimum, a golden-section search refines it to 0.05.
+// Returns b, or the told one (and `estimated` false) where the fit has too few samples.
+double estimate_half_gain_angle(const Captured& cap, const ScreenModel& told, const DeviceModel& camera,
+                                const std::vector<DeviceModel>& projectors, const ColourOptions& o, double& told_rms,
+                                double& rms, bool& estimated) {
+    const auto residual = [&](double b) {
+        ScreenModel trial = told;
+        trial.half_gain_angle_deg = b;
+        Captured c = cap;  // shares the images; its gain and vignetting maps are its own
+        c.to_camera = gain_toward_camera(cap.screen, trial, camera, projectors);
+        const CameraVignetting v = measure_vignetting(c, trial, camera, projectors, o);
+        return v.measured ? v.rms : std::numeric_limits<double>::quiet_NaN();
+    };
+    told_rms = residual(told.half_gain_angle_deg);
+    estimated = std::isfinite(told_rms);
+    if (!estimated) return told.half_gain_angle_deg;
+    double best = 10.0;
+    double best_rms = residual(best);
+    for (double b = 15.0; b <= 90.0; b += 5.0) {
+        const double r = residual(b);
+        if (r < best_rms) best = b, best_rms = r;
+    }
+    double lo = std::max(10.0, best - 5.0);
+    double hi = std::min(90.0, best + 5.0);
+    const double phi = (std::sqrt(5.0) - 1.0) / 2.0;
+    double a = hi - phi * (hi - lo), fa = residual(a);
+    double b = lo + phi * (hi - lo), fb = residual(b);
+    while (hi - lo > 0.05) {
+        if (fa < fb) {
+            hi = b, b = a, fb = fa, a = hi - phi * (hi - lo), fa = residual(a);
+        } else {
+            lo = a, a = b, fa = fb, b = lo + phi * (hi - lo), fb = residual(b);
+        }
+    }
+    const double found = (lo + hi) / 2.0;
+    rms = residual(found);
+    return found;
+}
+
+ColourResult calibrate_colour(PatternSource& source, const ScreenModel& told, const DeviceModel& camera,
                               std::vector<DeviceModel>& models, ScreenCalibration& calibration,
                               const ColourOptions& options) {
     std::vector<DeviceModel> projectors = models;  // `models` changes only when all has succeeded
+    ScreenModel screen = told;                     // its half-gain angle estimated below (a gain screen)
     check_options(options);
     if (projectors.size() != calibration.projectors.size() || projectors.empty()) {
         throw std::invalid_argument("calibrate_colour: " + std::to_string(projectors.size()) + " models for " +
@@ -491,7 +536,15 @@ ColourResult calibrate_colour(PatternSource& source, const ScreenModel& screen, 
     for (std::size_t k = 0; k < n; ++k) {
         res.projectors.push_back(measure_projector(source, projectors, k, options, cap, res.captures));
     }
+    res.half_gain_angle_deg = screen.half_gain_angle_deg;
     if (options.lens_falloff) {
+        if (options.camera_vignetting && options.estimate_half_gain_angle && screen.gain != 1.0) {
+            screen.half_gain_angle_deg =
+                estimate_half_gain_angle(cap, told, camera, projectors, options, res.told_half_gain_rms,
+                                         res.half_gain_rms, res.half_gain_angle_estimated);
+            res.half_gain_angle_deg = screen.half_gain_angle_deg;
+            cap.to_camera = gain_toward_camera(cap.screen, screen, camera, projectors);
+        }
         if (options.camera_vignetting) res.vignetting = measure_vignetting(cap, screen, camera, projectors, options);
         for (std::size_t k = 0; k < n; ++k) {
             measure_falloff(cap, screen, projectors[k], k, options, res.projectors[k]);

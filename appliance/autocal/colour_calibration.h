@@ -48,7 +48,10 @@
 //  Gain screen (ScreenModel::gain != 1, its data sheet told): in steps 1a, 1b and 2 each camera pixel's view of
 //     projector k is divided by the screen's gain toward the camera there (through the fitted models), so F_k, A_kc
 //     and the blacks are a matte screen's; in steps 3 and 4 every F_k(p) is the lens's times the gain toward
-//     ScreenModel::viewer_m at the screen point p shows: the compensation holds where the visitors stand.
+//     ScreenModel::viewer_m at the screen point p shows: the compensation holds where the visitors stand. The
+//     lobe's half-gain angle is measured rather than taken from the data sheet (estimate_half_gain_angle): the
+//     angle whose gain toward the camera, divided out, leaves the least residual in step 1a's fit; the peak gain
+//     cancels (it scales every projector alike) and stays the data sheet's.
 //  4. Per projector: LUT_kc(x) = R_kc^-1(x W_c / A_kc) (the ResponseCurve, x in matched-white
 //     units); beta_kc(p) = alpha_k(p) D_c(p) / (W_c F_k(p)) (the BlackOffset, one sample per output pixel, split
 //     between the projectors lighting p by their blend weights); alpha_k replaced by alpha_k s S / F_k with
@@ -79,6 +82,9 @@ struct ColourOptions {
     bool camera_vignetting = true;        // step 1a: measure the camera's vignetting (with lens_falloff only)
     double vignetting_prior_sigma = 0.2;  // its prior on a and b (camera_vignetting.h), > 0
     int vignetting_step_px = 2;           // every this many camera pixels (x and y) a sample of it, 1..16
+    // A gain screen's half-gain angle estimated from the camera's images (step 1a), not taken from its
+    // data sheet (with camera_vignetting and lens_falloff; a matte screen has none).
+    bool estimate_half_gain_angle = true;
 };
 
 struct ChannelResponse {
@@ -105,6 +111,12 @@ struct ColourResult {
     double alpha_scale = 1.0;               // s
     double white_floor = 1.0;               // S: the wall's white is S W_c
     CameraVignetting vignetting;            // step 1a's (measured = false when not)
+    // The gain screen's half-gain angle the step used, degrees: estimated (step 1a) or the data sheet's; with
+    // step 1a's residual rms (relative) at the data sheet's angle and at the estimate.
+    double half_gain_angle_deg = 0.0;
+    bool half_gain_angle_estimated = false;
+    double told_half_gain_rms = 0.0;
+    double half_gain_rms = 0.0;
     int captures = 0;
 };
 
@@ -112,6 +124,7 @@ struct ColourResult {
 // blends, the fitted `camera` and `projectors` give each output pixel's screen point, which
 // projectors light it and which projector pixel each camera pixel sees). Sets each projector
 // model's `falloff` to the measured one (what the models file keeps for self-recalibration).
+// The screen's half-gain angle the step used is in ColourResult (the caller keeps it in its screen model).
 // Throws CalibrationRefused when the camera's exposure is not locked, a channel is too dark for
 // the camera, a response is not monotone or far from any gamma (max_fit_rms), a fall-off cannot
 // be measured (too few pixels seen) or is no lens's (outside [0.05, 5] of its mean), or the black

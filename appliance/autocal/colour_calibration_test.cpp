@@ -239,6 +239,42 @@ TEST(ColourCalibration, AGainScreenIsSeamlessWhereTheVisitorStands) {
     EXPECT_GT(told_matte.seam_luminance_p95, 0.05);
 }
 
+// A gain screen whose data sheet is 8 degrees off in its half-gain angle (32 told for 40): the colour step measures
+// the angle from the camera's images (the residual of step 1a's radial fit) and compensates with it; made to take
+// the data sheet's, the visitor sees the wrong lobe's seams. The peak gain cancels (it scales every projector alike).
+TEST(ColourCalibration, AGainScreensHalfGainAngleIsMeasuredNotTakenFromItsDataSheet) {
+    rig::VirtualRig rig = scaled_rig(rig::load_rig(std::string(MOGAO_SOURCE_DIR) + "/rigs/standard.toml"), 0.25, 0.25);
+    rig.screen.gain = 1.3;
+    rig.screen.half_gain_angle_deg = 40.0;
+    rig.prior.screen_half_gain_angle_error_deg = -8.0;
+    const auto calibrate_with = [&](bool estimate, const char* what, ColourResult& c) {
+        RigPatternSource source(rig);
+        const CalibrationPrior prior = prior_from_rig(rig);
+        EXPECT_DOUBLE_EQ(prior.screen.half_gain_angle_deg, 32.0);
+        AutocalResult r = calibrate(source, prior, {960, 540}, fast_options());
+        ColourOptions o;
+        o.estimate_half_gain_angle = estimate;
+        c = calibrate_colour(source, prior.screen, r.camera, r.projectors, r.calibration, o);
+        const SeamColour a = measure_seam_colour(rig, r.calibration, 1.0);
+        std::printf(
+            "%s: half-gain angle %.2f deg (fit rms %.4f, %.4f at the data sheet's), seam luminance at white "
+            "p95 %.2f %%, max %.2f %%\n",
+            what, c.half_gain_angle_deg, c.half_gain_rms, c.told_half_gain_rms, 100.0 * a.seam_luminance_p95,
+            100.0 * a.seam_luminance_deviation);
+        return a;
+    };
+    ColourResult measured, told;
+    const SeamColour with = calibrate_with(true, "measured", measured);
+    const SeamColour without = calibrate_with(false, "data sheet", told);
+    EXPECT_TRUE(measured.half_gain_angle_estimated);
+    EXPECT_NEAR(measured.half_gain_angle_deg, 40.0, 1.5);
+    EXPECT_LT(measured.half_gain_rms, measured.told_half_gain_rms);
+    EXPECT_FALSE(told.half_gain_angle_estimated);
+    EXPECT_DOUBLE_EQ(told.half_gain_angle_deg, 32.0);
+    EXPECT_LT(with.seam_luminance_p95, 0.015);
+    EXPECT_GT(without.seam_luminance_p95, 2.0 * with.seam_luminance_p95);
+}
+
 // The joint fit alone (camera_vignetting.h), on light made by its own model: three projectors side by side in the
 // camera's image recover the camera's vignetting and each fall-off; one projector whose image is centred on the
 // camera's, where the two radial laws are one, leaves the camera flat (the prior) instead of guessing.
