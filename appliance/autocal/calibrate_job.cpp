@@ -123,6 +123,8 @@ nlohmann::json colour_report(const ColourResult& c) {
                                      {"estimated", c.half_gain_angle_estimated},
                                      {"fit_rms_at_data_sheet", c.told_half_gain_rms},
                                      {"fit_rms_at_estimate", c.half_gain_rms}};
+    // The screen's reflectance for its own light (step 0), fitted where no projector's direct light reaches.
+    out["screen_bounce"] = {{"reflectance", c.screen_bounce_reflectance}, {"samples", c.screen_bounce_samples}};
     for (const ProjectorPhotometry& p : c.projectors) {
         nlohmann::json ch = nlohmann::json::array();
         for (const ChannelResponse& r : p.channels) {

@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "appliance/autocal/colour_correction.h"
+#include "appliance/autocal/screen_bounce.h"
 #include "appliance/autocal/screen_geometry.h"
 #include "appliance/warp/calibration_validation.h"
 #include "appliance/warp/response_curve.h"
@@ -463,6 +464,62 @@ double response_at(const ChannelResponse& r, double s) {
     return s <= l[i] ? a * s / l[i] : a + (b - a) * (s - l[i]) / (l[i + 1] - l[i]);
 }
 
+// Step 0: the screen's own light out of every full-level image (ColourOptions::screen_bounce): the bounce of the
+// light each image shows on the screen's patches (divided by the gain toward the camera, the light leaving them
+// matte), rho fitted where the projector does not light the screen (its `outside` mask eroded by 8 more
+// pixels, away from its blurred edge), then rho times that bounce subtracted.
+void remove_screen_bounce(Captured& cap, const ScreenModel& screen, ColourResult& res) {
+    const ScreenBounce patches(screen);
+    cv::Mat1i patch_of(cap.screen.size(), -1);
+    std::vector<double> pixels_in(static_cast<std::size_t>(patches.patches()), 0.0);
+    for (int y = 0; y < patch_of.rows; ++y) {
+        for (int x = 0; x < patch_of.cols; ++x) {
+            const cv::Vec2f s = cap.screen(y, x);
+            if (std::isnan(s[0])) continue;
+            patch_of(y, x) = patches.patch_at(s[0], s[1]);
+            if (patch_of(y, x) >= 0) pixels_in[static_cast<std::size_t>(patch_of(y, x))] += 1.0;
+        }
+    }
+    const auto bounce_image = [&](const cv::Mat1f& image, std::size_t k) {
+        std::vector<double> leaving(pixels_in.size(), 0.0);
+        for (int y = 0; y < image.rows; ++y)
+            for (int x = 0; x < image.cols; ++x)
+                if (patch_of(y, x) >= 0 && cap.outside[k](y, x) == 0)
+                    leaving[static_cast<std::size_t>(patch_of(y, x))] += image(y, x) / toward_camera(cap, k, x, y);
+        for (std::size_t p = 0; p < leaving.size(); ++p) leaving[p] /= std::max(1.0, pixels_in[p]);
+        const std::vector<double> field = patches.bounce(leaving);
+        cv::Mat1f out(image.size(), 0.0f);
+        for (int y = 0; y < image.rows; ++y)
+            for (int x = 0; x < image.cols; ++x)
+                if (patch_of(y, x) >= 0)
+                    out(y, x) = static_cast<float>(patches.at(field, cap.screen(y, x)[0], cap.screen(y, x)[1]));
+        return out;
+    };
+    const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, {17, 17});
+    std::vector<cv::Mat1f> bounce_full;
+    double sxy = 0.0, sxx = 0.0;
+    for (std::size_t k = 0; k < cap.full.size(); ++k) {
+        bounce_full.push_back(bounce_image(cap.full[k], k));
+        cv::Mat1b far;
+        cv::erode(cap.outside[k], far, kernel);
+        for (int y = 0; y < far.rows; ++y) {
+            for (int x = 0; x < far.cols; ++x) {
+                if (far(y, x) == 0 || patch_of(y, x) < 0) continue;
+                sxy += static_cast<double>(cap.full[k](y, x)) * bounce_full[k](y, x);
+                sxx += static_cast<double>(bounce_full[k](y, x)) * bounce_full[k](y, x);
+                ++res.screen_bounce_samples;
+            }
+        }
+    }
+    res.screen_bounce_reflectance = sxx > 0.0 ? std::max(0.0, sxy / sxx) : 0.0;
+    const auto rho = static_cast<float>(res.screen_bounce_reflectance);
+    if (rho == 0.0f) return;
+    for (std::size_t k = 0; k < cap.full.size(); ++k) {
+        cap.full[k] -= rho * bounce_full[k];
+        for (cv::Mat1f& top : cap.top[k]) top -= rho * bounce_image(top, k);
+    }
+}
+
 // The screen lobe's half-gain angle that best explains the projectors' full-white images (a gain screen,
 // with the camera's vignetting measured; ColourOptions::estimate_half_gain_angle): the angle b in [10, 90]
 // degrees whose gain toward the camera, divided out, leaves the smallest residual in step 1a's joint fit
@@ -538,6 +595,7 @@ ColourResult calibrate_colour(PatternSource& source, const ScreenModel& told, co
     }
     res.half_gain_angle_deg = screen.half_gain_angle_deg;
     if (options.lens_falloff) {
+        if (options.screen_bounce) remove_screen_bounce(cap, screen, res);
         if (options.camera_vignetting && options.estimate_half_gain_angle && screen.gain != 1.0) {
             screen.half_gain_angle_deg =
                 estimate_half_gain_angle(cap, told, camera, projectors, options, res.told_half_gain_rms,

@@ -26,6 +26,14 @@
 //     normalised response R_kc(s) = y_kc(s) / A_kc (made non-decreasing) is interpolated as a
 //     power law between measured levels (linear in log s - log R, so a pure gamma is exact) and
 //     continued below s_1 with the first segment's exponent.
+//  0. Screen bounce (`screen_bounce`, with `lens_falloff`): a concave screen lights itself, so each projector's
+//     full-level images hold, besides its direct light, the light its own light throws across the screen (seen
+//     also where it does not reach: its only light there). Modelled as one bounce between patches of the fitted
+//     screen (screen_bounce.h) from the light each image shows on them, its reflectance rho fitted by least
+//     squares to the pixels no projector's direct light reaches in each image, and rho times the bounce taken
+//     out of every image before steps 1a and 1b: each projector's fall-off and amplitudes are then its direct
+//     light's. Left in, a projector's own bounce is flattened with its light while the others' is not, which
+//     differs on the two sides of a seam.
 //  1a. Camera vignetting (`camera_vignetting`, with `lens_falloff`): V(rho) fitted jointly with a radial
 //     fall-off per projector to every projector's summed full-level image (camera_vignetting.h, model and
 //     why); the images of steps 1b and 2 are divided by V, so that they are the screen's light.
@@ -85,6 +93,9 @@ struct ColourOptions {
     // A gain screen's half-gain angle estimated from the camera's images (step 1a), not taken from its
     // data sheet (with camera_vignetting and lens_falloff; a matte screen has none).
     bool estimate_half_gain_angle = true;
+    // Step 0: the light a concave screen throws onto itself, measured and taken out of each projector's images
+    // (with lens_falloff).
+    bool screen_bounce = true;
 };
 
 struct ChannelResponse {
@@ -117,6 +128,10 @@ struct ColourResult {
     bool half_gain_angle_estimated = false;
     double told_half_gain_rms = 0.0;
     double half_gain_rms = 0.0;
+    // Step 0: the screen's reflectance for its own light (rho, screen_bounce.h) fitted where no projector lights
+    // it directly, and how many camera pixels that fit had; 0 when not measured.
+    double screen_bounce_reflectance = 0.0;
+    int screen_bounce_samples = 0;
     int captures = 0;
 };
 

@@ -275,6 +275,43 @@ TEST(ColourCalibration, AGainScreensHalfGainAngleIsMeasuredNotTakenFromItsDataSh
     EXPECT_GT(without.seam_luminance_p95, 2.0 * with.seam_luminance_p95);
 }
 
+// A concave screen that throws back 80 % of its light onto itself: the colour step measures that reflectance where
+// no projector's direct light reaches and takes each projector's bounce out of its images before it fits the
+// fall-offs; left in, each projector's own bounce is flattened with its light and the others' is not, which the
+// two sides of a seam show differently (most on a gain screen, where the camera sees the direct light through the
+// lobe and the bounce matte). On a screen that does not light itself the measured reflectance is ~0.
+TEST(ColourCalibration, AScreenThatLightsItselfHasItsBounceMeasuredAndTakenOut) {
+    rig::VirtualRig rig = scaled_rig(rig::load_rig(std::string(MOGAO_SOURCE_DIR) + "/rigs/standard.toml"), 0.25, 0.25);
+    const auto calibrate_with = [&](const rig::VirtualRig& truth, bool bounce, const char* what, ColourResult& c) {
+        RigPatternSource source(truth);
+        const CalibrationPrior prior = prior_from_rig(truth);
+        AutocalResult r = calibrate(source, prior, {960, 540}, fast_options());
+        ColourOptions o;
+        o.screen_bounce = bounce;
+        c = calibrate_colour(source, prior.screen, r.camera, r.projectors, r.calibration, o);
+        const SeamColour a = measure_seam_colour(truth, r.calibration, 1.0);
+        std::printf("%s: reflectance %.3f from %d pixels, seam luminance at white p95 %.2f %%, max %.2f %%\n", what,
+                    c.screen_bounce_reflectance, c.screen_bounce_samples, 100.0 * a.seam_luminance_p95,
+                    100.0 * a.seam_luminance_deviation);
+        return a;
+    };
+    rig.screen.gain = 1.3;  // told exactly: the camera sees the direct light through the lobe, the bounce matte
+    rig.screen.half_gain_angle_deg = 40.0;
+    ColourResult none, measured, ignored;
+    const SeamColour floor = calibrate_with(rig, true, "no interreflection", none);
+    EXPECT_LT(none.screen_bounce_reflectance, 0.02);
+    EXPECT_GT(none.screen_bounce_samples, 10000);
+    rig.screen.interreflection = 0.8;
+    const SeamColour with = calibrate_with(rig, true, "interreflection 0.8, taken out", measured);
+    const SeamColour without = calibrate_with(rig, false, "interreflection 0.8, left in", ignored);
+    EXPECT_NEAR(measured.screen_bounce_reflectance, 0.8, 0.1);
+    EXPECT_EQ(ignored.screen_bounce_reflectance, 0.0);
+    // What the bounce adds to the seams' p95 over the same screen without it (at quarter scale the rig's own p95 is
+    // about 1.1 %): at most half of what it adds left in.
+    EXPECT_LT(with.seam_luminance_p95 - floor.seam_luminance_p95,
+              0.5 * (without.seam_luminance_p95 - floor.seam_luminance_p95));
+}
+
 // The joint fit alone (camera_vignetting.h), on light made by its own model: three projectors side by side in the
 // camera's image recover the camera's vignetting and each fall-off; one projector whose image is centred on the
 // camera's, where the two radial laws are one, leaves the camera flat (the prior) instead of guessing.
