@@ -181,6 +181,8 @@ nlohmann::json connectors_json(const Identified& id, const PatternDisplay& displ
 nlohmann::json colour_json(const autocal::ColourResult& c) {
     nlohmann::json out = {{"captures", c.captures}, {"matched_white", c.matched_white}, {"black_floor", c.black_floor},
                           {"ambient", c.ambient},   {"alpha_scale", c.alpha_scale},     {"white_floor", c.white_floor}};
+    out["screen_half_gain_angle"] = {{"degrees", c.half_gain_angle_deg}, {"estimated", c.half_gain_angle_estimated}};
+    out["screen_bounce"] = {{"reflectance", c.screen_bounce_reflectance}, {"samples", c.screen_bounce_samples}};
     for (const autocal::ProjectorPhotometry& p : c.projectors) {
         nlohmann::json ch = nlohmann::json::array();
         for (const autocal::ChannelResponse& r : p.channels) {
@@ -278,6 +280,7 @@ nlohmann::json run_on_site(const OnSiteJob& job, OutputBackend& outputs, Calibra
         if (job.colour) {
             colour = autocal::calibrate_colour(source, r->screen, r->camera, r->projectors, r->calibration,
                                                job.colour_options);
+            r->screen.half_gain_angle_deg = colour->half_gain_angle_deg;  // the models file keeps what was measured
         }
         check = autocal::run_self_check(source, prior, *r, job.self_check);  // step 3b
         autocal::check_self_check_gate(*check, job.self_check);
