@@ -74,40 +74,38 @@ struct ProjectionConstants {
     float sx, sy, half_w, half_h;
 };
 
-MOGAO_ALWAYS_INLINE inline void project_cylinder_body(const ProjectionConstants& constants, const float* __restrict x,
-                                                      const float* __restrict y, const float* __restrict z, int n,
-                                                      float* __restrict px, float* __restrict py,
-                                                      std::uint8_t* __restrict ok) {
-    const ProjectionConstants k = constants;
-    for (int i = 0; i < n; ++i) {
-        const float dx = x[i] - k.ex, dy = y[i] - k.ey, dz = z[i] - k.ez;
-        const float qx = k.m[0] * dx + k.m[1] * dy + k.m[2] * dz;
-        const float qy = k.m[3] * dx + k.m[4] * dy + k.m[5] * dz;
-        const float qz = k.m[6] * dx + k.m[7] * dy + k.m[8] * dz;
+// The camera model's part of project(): pixel i's image position and answer from q = Rᵀ (p − eye).
+struct CylinderProjection {
+    MOGAO_ALWAYS_INLINE static void apply(const ProjectionConstants& k, float qx, float qy, float qz, float& px,
+                                          float& py, std::uint8_t& ok) {
         const float a = qx * qx + qz * qz;
         const float b = 2.0f * (k.sex * qx + k.sez * qz);
         const float root = std::sqrt(std::max(b * b - 4.0f * a * k.c, 0.0f));
         const float s = b <= 0.0f ? (root - b) / (2.0f * a) : 2.0f * k.c / (-b - root);
         const float sx = k.sex + s * qx, sy = k.sey + s * qy, sz = k.sez + s * qz;
-        px[i] = (fast_atan2(sx, -sz) + k.half_arc) * k.px_per_rad;
-        py[i] = (k.top - sy) * k.py_per_m;
-        ok[i] = static_cast<std::uint8_t>(a > 0.0f && k.c < 0.0f);
+        px = (fast_atan2(sx, -sz) + k.half_arc) * k.px_per_rad;
+        py = (k.top - sy) * k.py_per_m;
+        ok = static_cast<std::uint8_t>(a > 0.0f && k.c < 0.0f);
     }
-}
+};
+struct PinholeProjection {
+    MOGAO_ALWAYS_INLINE static void apply(const ProjectionConstants& k, float qx, float qy, float qz, float& px,
+                                          float& py, std::uint8_t& ok) {
+        px = (qx / -qz * k.sx + 1.0f) * k.half_w;
+        py = (1.0f - qy / -qz * k.sy) * k.half_h;
+        ok = static_cast<std::uint8_t>(qz < 0.0f);
+    }
+};
 
-MOGAO_ALWAYS_INLINE inline void project_pinhole_body(const ProjectionConstants& constants, const float* __restrict x,
-                                                     const float* __restrict y, const float* __restrict z, int n,
-                                                     float* __restrict px, float* __restrict py,
-                                                     std::uint8_t* __restrict ok) {
+template <typename Model>
+MOGAO_ALWAYS_INLINE inline void project_body(const ProjectionConstants& constants, const float* __restrict x,
+                                             const float* __restrict y, const float* __restrict z, int n,
+                                             float* __restrict px, float* __restrict py, std::uint8_t* __restrict ok) {
     const ProjectionConstants k = constants;
     for (int i = 0; i < n; ++i) {
         const float dx = x[i] - k.ex, dy = y[i] - k.ey, dz = z[i] - k.ez;
-        const float qx = k.m[0] * dx + k.m[1] * dy + k.m[2] * dz;
-        const float qy = k.m[3] * dx + k.m[4] * dy + k.m[5] * dz;
-        const float qz = k.m[6] * dx + k.m[7] * dy + k.m[8] * dz;
-        px[i] = (qx / -qz * k.sx + 1.0f) * k.half_w;
-        py[i] = (1.0f - qy / -qz * k.sy) * k.half_h;
-        ok[i] = static_cast<std::uint8_t>(qz < 0.0f);
+        Model::apply(k, k.m[0] * dx + k.m[1] * dy + k.m[2] * dz, k.m[3] * dx + k.m[4] * dy + k.m[5] * dz,
+                     k.m[6] * dx + k.m[7] * dy + k.m[8] * dz, px[i], py[i], ok[i]);
     }
 }
 
@@ -119,19 +117,19 @@ void points_base(const RowRays& r, const float* depth, int n, float* px, float* 
 }
 MOGAO_TARGET_X86_64_V3 void project_cylinder_v3(const ProjectionConstants& k, const float* x, const float* y,
                                                 const float* z, int n, float* px, float* py, std::uint8_t* ok) {
-    project_cylinder_body(k, x, y, z, n, px, py, ok);
+    project_body<CylinderProjection>(k, x, y, z, n, px, py, ok);
 }
 void project_cylinder_base(const ProjectionConstants& k, const float* x, const float* y, const float* z, int n,
                            float* px, float* py, std::uint8_t* ok) {
-    project_cylinder_body(k, x, y, z, n, px, py, ok);
+    project_body<CylinderProjection>(k, x, y, z, n, px, py, ok);
 }
 MOGAO_TARGET_X86_64_V3 void project_pinhole_v3(const ProjectionConstants& k, const float* x, const float* y,
                                                const float* z, int n, float* px, float* py, std::uint8_t* ok) {
-    project_pinhole_body(k, x, y, z, n, px, py, ok);
+    project_body<PinholeProjection>(k, x, y, z, n, px, py, ok);
 }
 void project_pinhole_base(const ProjectionConstants& k, const float* x, const float* y, const float* z, int n,
                           float* px, float* py, std::uint8_t* ok) {
-    project_pinhole_body(k, x, y, z, n, px, py, ok);
+    project_body<PinholeProjection>(k, x, y, z, n, px, py, ok);
 }
 
 }  // namespace
