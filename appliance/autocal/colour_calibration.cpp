@@ -496,17 +496,23 @@ void remove_screen_bounce(Captured& cap, const ScreenModel& screen, ColourResult
         return out;
     };
     const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, {17, 17});
-    std::vector<cv::Mat1f> bounce_full;
+    // Per projector, each channel's bounce; the bounce is linear in the light and `full` is the channels' sum,
+    // so its bounce is theirs.
+    std::vector<std::array<cv::Mat1f, 3>> bounce_top;
     double sxy = 0.0, sxx = 0.0;
     for (std::size_t k = 0; k < cap.full.size(); ++k) {
-        bounce_full.push_back(bounce_image(cap.full[k], k));
+        bounce_top.push_back(
+            {bounce_image(cap.top[k][0], k), bounce_image(cap.top[k][1], k), bounce_image(cap.top[k][2], k)});
+        cv::Mat1f bounce_full;
+        cv::add(bounce_top[k][0], bounce_top[k][1], bounce_full);
+        bounce_full += bounce_top[k][2];
         cv::Mat1b far;
         cv::erode(cap.outside[k], far, kernel);
         for (int y = 0; y < far.rows; ++y) {
             for (int x = 0; x < far.cols; ++x) {
                 if (far(y, x) == 0 || patch_of(y, x) < 0) continue;
-                sxy += static_cast<double>(cap.full[k](y, x)) * bounce_full[k](y, x);
-                sxx += static_cast<double>(bounce_full[k](y, x)) * bounce_full[k](y, x);
+                sxy += static_cast<double>(cap.full[k](y, x)) * bounce_full(y, x);
+                sxx += static_cast<double>(bounce_full(y, x)) * bounce_full(y, x);
                 ++res.screen_bounce_samples;
             }
         }
@@ -515,8 +521,10 @@ void remove_screen_bounce(Captured& cap, const ScreenModel& screen, ColourResult
     const auto rho = static_cast<float>(res.screen_bounce_reflectance);
     if (rho == 0.0f) return;
     for (std::size_t k = 0; k < cap.full.size(); ++k) {
-        cap.full[k] -= rho * bounce_full[k];
-        for (cv::Mat1f& top : cap.top[k]) top -= rho * bounce_image(top, k);
+        for (std::size_t c = 0; c < 3; ++c) {
+            cap.full[k] -= rho * bounce_top[k][c];
+            cap.top[k][c] -= rho * bounce_top[k][c];
+        }
     }
 }
 
