@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 // ProjectorRenderer: what an OutputBackend draws its outputs with, independent of the graphics API.
-// It holds one content frame and the calibration of each projector (warp map, blend mask, response
-// LUT and black offset: common/projector_calibration.h), and draws one projector's picture into
-// the target its backend has bound (OutputBackend::begin_frame). The formula it implements per
-// output pixel is render_output's (appliance/warp/composite.h; docs/calibration.md); today's one
+// It holds one content frame, the screen's indirect light field to take off it (set_indirect_light)
+// and the calibration of each projector (warp map, blend mask, response LUT and black offset:
+// common/projector_calibration.h), and draws one projector's picture into the target its backend
+// has bound (OutputBackend::begin_frame). The formula it implements per output pixel is
+// render_output's (appliance/warp/composite.h; docs/calibration.md); today's one
 // implementation is the GLES 3 WarpBlendRenderer (drivers/egl/warp_blend_renderer.h), whose header
 // gives the pixel-centre conventions and the precision.
 //
@@ -46,6 +47,28 @@ public:
     // add_projector; on any error the old calibration stays in use. EINVAL also for an index >=
     // projector_count().
     [[nodiscard]] virtual Status replace_projector(std::size_t index, const ProjectorCalibration& calibration) = 0;
+
+    // The screen's own light (interreflection of a concave screen), to be taken off the content
+    // before the blend: a small content-space RGB field, linear light in content units (1 = the
+    // light that content 1.0 makes; RgbFloatImage rows top first, width*height*3 values). Texel
+    // (i, j) lies at the content's normalised ((i + 0.5) / W, (j + 0.5) / H), the pixel-centre
+    // convention of sample_content (appliance/warp/composite.h); it is read bilinearly, texel
+    // indices clamped to the edge (a 1x1 field is a constant), at the warp map's content
+    // coordinate uv BEFORE the content transform: the field lies on the screen, in the
+    // calibration's content coordinates, while the content frame is fetched at uv * scale +
+    // offset. Per channel c: linear'_c = max(linear_c - indirect_c(uv), 0), then the blend as
+    // render_output's formula (Bimber et al., "Compensating indirect scattering for immersive and
+    // semi-immersive projection displays", IEEE VR 2006). An empty field (0 x 0, no values; the
+    // default) subtracts nothing and draws exactly what a renderer without one draws. Shared by
+    // all projectors; used by draw() from the next call on; meant to be called every frame (an
+    // implementation reallocates its storage only when the size changes). EINVAL for a size with
+    // one side 0, a size that does not match the values, or a value that is not finite or is < 0
+    // (the message names the indirect light field, the texel and the limit); E2BIG for a side
+    // beyond the implementation's maximum texture size. On an error the previous field stays in
+    // use.
+    [[nodiscard]] virtual Status set_indirect_light(const RgbFloatImage& field) = 0;
+    // The field's size as last set successfully (0 x 0: none).
+    [[nodiscard]] virtual ImageSize indirect_light_size() const = 0;
 
     // Used by draw() from the next call on.
     virtual void set_content_transform(const ContentTransform& transform) = 0;

@@ -101,6 +101,9 @@ struct ScreenModel {
     double gain = 1.0;                        // [1, 3]
     double half_gain_angle_deg = 40.0;        // [10, 90]
     Eigen::Vector3d viewer_m{0.0, 1.6, 0.0};  // where the seams are judged from, inside the cylinder
+    // The screen's reflectance for its own light (rho, [0, 1)): what one bounce between its patches throws back
+    // (screen_bounce.h), measured by the colour step; 0 before it, and on a screen that does not light itself.
+    double interreflection = 0.0;
 };
 
 // A projector's relative light over its image: its lens's fall-off (vignetting), the part of

@@ -18,6 +18,7 @@
 #include "appliance/calibration/mpcdi_writer.h"
 #include "appliance/rig/rig_file.h"
 #include "appliance/rig/screen_light.h"
+#include "appliance/warp/composite.h"
 #include "appliance/warp/response_curve.h"
 #include "appliance/warp/warp_sampling.h"
 #include "common/png_io.h"
@@ -25,9 +26,18 @@
 namespace mogao::autocal {
 namespace {
 
-// The light of white content with grid lines at screen point s, every projector whose (ground-truth) pixel lands
-// there: as the rig's viewer sees it (`seen`: through the screen's gain) or as it leaves a matte screen.
-double preview_light(const rig::VirtualRig& rig, const ScreenCalibration& c, const rig::ScreenPoint& s, bool seen) {
+// The preview's content: white with grid lines every 1/16 of the frame.
+double preview_content(double u, double v) {
+    const double gu = u * 16.0 - std::round(u * 16.0);
+    const double gv = v * 16.0 - std::round(v * 16.0);
+    return (std::abs(gu) < 0.01 || std::abs(gv) < 0.01) ? 0.1 : 1.0;
+}
+
+// The light of the preview's content at screen point s, every projector whose (ground-truth) pixel lands
+// there: as the rig's viewer sees it (`seen`: through the screen's gain) or as it leaves a matte screen. The content
+// is shown less `indirect` (the outputs' field for it, empty: none).
+double preview_light(const rig::VirtualRig& rig, const ScreenCalibration& c, const RgbFloatImage& indirect,
+                     const rig::ScreenPoint& s, bool seen) {
     double l = 0.0;
     for (std::size_t k = 0; k < c.projectors.size(); ++k) {
         const auto p = rig::screen_to_projector(rig, static_cast<int>(k), s);
@@ -37,9 +47,9 @@ double preview_light(const rig::VirtualRig& rig, const ScreenCalibration& c, con
         const int py = static_cast<int>(p->y());
         const ContentUv uv = sample_warp(pc.warp, pc.output, px, py);
         if (!uv.valid()) continue;
-        const double gu = uv.u * 16.0 - std::round(uv.u * 16.0);
-        const double gv = uv.v * 16.0 - std::round(uv.v * 16.0);
-        const double content = (std::abs(gu) < 0.01 || std::abs(gv) < 0.01) ? 0.1 : 1.0;
+        const double content =
+            std::max(0.0, preview_content(uv.u, uv.v) -
+                              (indirect.pixels.empty() ? 0.0 : sample_content(indirect, uv.u, uv.v)[1]));
         // The rig's light (mean of the channels, black level included) for the signal
         // render_output gives: content x blend + beta -> response LUT, per channel.
         const float w = sample_blend(pc.blend, pc.output, px, py);
@@ -59,21 +69,33 @@ double preview_light(const rig::VirtualRig& rig, const ScreenCalibration& c, con
 
 // The screen as the viewer sees it: per content pixel of a size x size/aspect image, preview_light as seen, plus one
 // bounce of the screen's own light (virtual_rig.h's header comment).
-Rgb8Image preview(const rig::VirtualRig& rig, const ScreenCalibration& c, int width) {
+Rgb8Image preview(const rig::VirtualRig& rig, const ScreenCalibration& c, int width,
+                  const IndirectLight* compensation) {
     const int height = std::max(1, width * c.content.height / c.content.width);
+    RgbFloatImage indirect;
+    if (compensation != nullptr) {
+        RgbFloatImage content(ImageSize{width, height});
+        for (int y = 0; y < height; ++y)
+            for (int x = 0; x < width; ++x)
+                std::fill_n(content.at(x, y), 3,
+                            static_cast<float>(preview_content((x + 0.5) / width, (y + 0.5) / height)));
+        indirect = compensation->field(compensation->patch_means(content));
+    }
     std::optional<rig::ScreenBounce> bounce;
     std::vector<double> bounced;
     if (rig.screen.interreflection > 0.0) {
         bounce.emplace(rig.screen);
         std::vector<double> leaving;
-        for (int i = 0; i < bounce->patches(); ++i) leaving.push_back(preview_light(rig, c, bounce->centre(i), false));
+        for (int i = 0; i < bounce->patches(); ++i)
+            leaving.push_back(preview_light(rig, c, indirect, bounce->centre(i), false));
         bounced = bounce->bounce(leaving);
     }
     cv::Mat1f light(height, width, 0.0f);
     for (int y = 0; y < height; ++y) {
         for (int x = 0; x < width; ++x) {
             const rig::ScreenPoint s = rig::screen_of(rig.screen, {(x + 0.5) / width, (y + 0.5) / height});
-            light(y, x) = static_cast<float>(preview_light(rig, c, s, true) + (bounce ? bounce->at(bounced, s) : 0.0));
+            light(y, x) =
+                static_cast<float>(preview_light(rig, c, indirect, s, true) + (bounce ? bounce->at(bounced, s) : 0.0));
         }
     }
     Rgb8Image out(ImageSize{width, height});
@@ -88,10 +110,11 @@ Rgb8Image preview(const rig::VirtualRig& rig, const ScreenCalibration& c, int wi
 }
 
 // Seams against the rig's ground truth at black, dark, mid grey and white content.
-nlohmann::json seam_figures(const rig::VirtualRig& rig, const ScreenCalibration& c) {
+nlohmann::json seam_figures(const rig::VirtualRig& rig, const ScreenCalibration& c,
+                            const IndirectLight* indirect = nullptr) {
     nlohmann::json out = nlohmann::json::array();
     for (const double level : {0.0, 0.05, 0.5, 1.0}) {
-        const SeamColour s = measure_seam_colour(rig, c, level);
+        const SeamColour s = measure_seam_colour(rig, c, level, 0.01, indirect);
         out.push_back({{"level", level},
                        {"reference_luminance", s.reference_luminance},
                        {"seam_luminance_deviation", s.seam_luminance_deviation},
@@ -134,6 +157,22 @@ nlohmann::json colour_report(const ColourResult& c) {
             {{"id", p.id}, {"black", p.black}, {"gain", p.gain}, {"falloff", p.falloff.c}, {"channels", ch}});
     }
     return out;
+}
+
+// The outputs' compensation of the screen's own light: whether they subtract it, and its field for white content
+// (content units: the share of the calibrated white taken out, largest and mean over the patches).
+nlohmann::json indirect_light_report(const IndirectLight* indirect) {
+    if (indirect == nullptr) return {{"compensated", false}};
+    const RgbFloatImage white = indirect->flat_field(1.0);
+    double most = 0.0, sum = 0.0;
+    for (const float v : white.pixels) {
+        most = std::max(most, static_cast<double>(v));
+        sum += v;
+    }
+    return {{"compensated", true},
+            {"patches", {indirect->columns(), indirect->rows()}},
+            {"white_field_max", most},
+            {"white_field_mean", white.pixels.empty() ? 0.0 : sum / static_cast<double>(white.pixels.size())}};
 }
 
 // Projector k's part of report.json: decoding, fit, coverage, its lens distortion and the distortion trial's outcome
@@ -281,14 +320,15 @@ nlohmann::json ground_truth_report(const GeometryError& g, const LuminanceError&
 // The job's files: the models first, so that whoever sees the new MPCDI (the kiosk's watcher) finds its models;
 // then the MPCDI, the previews and report.json.
 void write_job_outputs(const CalibrateJob& job, const AutocalResult& r, const rig::VirtualRig& rig,
-                       const SelfCheckResult& check, const nlohmann::json& report) {
+                       const SelfCheckResult& check, const IndirectLight* indirect, const nlohmann::json& report) {
     std::filesystem::create_directories(job.out);
     MpcdiExportOptions mo;
     mo.alpha_bit_depth = job.alpha_bits;
     mo.write_response = job.colour;
     write_models(models_path_for(job.out / "calibration.mpcdi"), CalibrationModels{r.screen, r.camera, r.projectors});
     write_mpcdi(job.out / "calibration.mpcdi", to_mpcdi(r.calibration, mo));
-    write_png(job.out / "preview.png", preview(rig, r.calibration, 960));  // libpng: no imgcodecs in the image
+    write_png(job.out / "preview.png",
+              preview(rig, r.calibration, 960, indirect));  // libpng: no imgcodecs in the image
     if (!check.filmed.empty()) write_png(job.out / "self-check.png", self_check_image(check));
     const std::filesystem::path json = job.out / "report.json";
     std::ofstream f(json);
@@ -314,7 +354,7 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
         const auto t1 = std::chrono::steady_clock::now();
         colour =
             calibrate_colour(source, r.screen, r.camera, r.projectors, r.calibration, job.colour_options);  // throws
-        r.screen.half_gain_angle_deg = colour->half_gain_angle_deg;  // the models file keeps what was measured
+        keep_screen_measurements(*colour, r.screen);
         calibrate_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
     }
     // The self-check sees only the camera images and the calibration (no ground truth); its gate refuses
@@ -324,8 +364,12 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
     calibrate_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t2).count();
     check_self_check_gate(check, job.self_check);
     const GeometryError g = measure_geometry(rig, r.calibration, 4);
+    // The outputs take the screen's own light out of each frame when the colour step measured it.
+    std::optional<IndirectLight> indirect;
+    if (colour && job.indirect_light) indirect.emplace(r.screen, r.projectors, r.calibration);
+    const IndirectLight* shown_less = indirect && indirect->active() ? &*indirect : nullptr;
     // One grid point per projector pixel: a seam's maximum must see a line one pixel wide.
-    const LuminanceError l = measure_luminance(rig, r.calibration, 0.01, pixel_dense_seam_grid(rig));
+    const LuminanceError l = measure_luminance(rig, r.calibration, 0.01, pixel_dense_seam_grid(rig), shown_less);
     nlohmann::json report = {{"rig", rig.name},
                              {"rig_file", job.rig.string()},
                              {"scale", job.scale},
@@ -350,14 +394,15 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
                              {"ground_truth", ground_truth_report(g, l, r, rig)}};
     if (colour) {
         report["colour"] = colour_report(*colour);
+        report["colour"]["indirect_light"] = indirect_light_report(shown_less);
         report["captures"] = r.report.captures + check.captures + colour->captures;
         report["ground_truth"]["seams_before_colour"] = seams_before;
     }
-    report["ground_truth"]["seams"] = seam_figures(rig, r.calibration);
+    report["ground_truth"]["seams"] = seam_figures(rig, r.calibration, shown_less);
     for (std::size_t k = 0; k < r.report.projectors.size(); ++k)
         report["projectors"].push_back(
             projector_json(r, k, rig, job.options, source.simulator().camera_coverage(static_cast<int>(k))));
-    write_job_outputs(job, r, rig, check, report);
+    write_job_outputs(job, r, rig, check, shown_less, report);
     return report;
 }
 

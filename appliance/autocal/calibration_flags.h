@@ -8,7 +8,8 @@
 //   --content            the content frame WIDTHxHEIGHT, pixels (the farm's frame)
 //   --alpha-bits         alpha map bits, 8 or 16
 //   --warp-step-px       warp grid step, output pixels
-//   --fit-screen, --fit-heights, --no-bow, --pinhole-projectors, --no-colour, --no-falloff   switches of the fit
+//   --fit-screen, --fit-heights, --no-bow, --pinhole-projectors, --no-colour, --no-falloff, --no-indirect-light
+//   switches of the fit
 //   --max-self-check-px  the self-check gate, projector pixels (self_check.h)
 //   --max-heights-shift-px  the told heights' check gate, projector pixels (autocal.h, check_heights)
 //
@@ -31,6 +32,7 @@ struct CalibrationFlags {
     bool pinhole_projectors = false;
     bool no_colour = false;
     bool no_falloff = false;
+    bool no_indirect_light = false;
 };
 
 inline CLI::Option* add_scale_flag(CLI::App& cmd, double& scale) {
@@ -66,6 +68,9 @@ inline void add_calibration_flags(CLI::App& cmd, CalibrationFlags& flags, Calibr
     cmd.add_flag("--no-colour", flags.no_colour, "Geometry only: no response, black-level and colour matching step");
     cmd.add_flag("--no-falloff", flags.no_falloff,
                  "Colour step without the lens fall-off: one gain per projector and channel (flat projectors)");
+    cmd.add_flag("--no-indirect-light", flags.no_indirect_light,
+                 "Judge the calibration with outputs that leave the screen's own light on the picture (a kiosk with "
+                 "[calibration] indirect_light = false)");
 }
 
 // After the parse: the flags into the job. Throws CLI::ValidationError naming --content (exit 2).
@@ -75,6 +80,7 @@ inline void apply_calibration_flags(const CalibrationFlags& flags, CalibrationSe
     }
     job.colour = !flags.no_colour;
     job.colour_options.lens_falloff = !flags.no_falloff;
+    job.indirect_light = !flags.no_indirect_light;
     job.options.fit_bow = !flags.no_bow;
     job.options.fit_projector_distortion = !flags.pinhole_projectors;
 }

@@ -19,6 +19,9 @@ struct CalibrationSettings {
     AutocalOptions options;         // the geometric calibration (autocal.h)
     bool colour = true;             // the photometric step (colour_calibration.h) after the geometry
     ColourOptions colour_options;
+    // Whether the outputs take the screen's own light out of each frame (indirect_light.h; the kiosk's
+    // [calibration] indirect_light): the ground-truth figures show content as such outputs show it.
+    bool indirect_light = true;
     // The self-check after the geometry (self_check.h): marks through the new warp and blend, filmed; its
     // gate (self_check.max_mean_px, --max-self-check-px) refuses the calibration like the others.
     SelfCheckOptions self_check;

@@ -572,6 +572,11 @@ double estimate_half_gain_angle(const Captured& cap, const ScreenModel& told, co
     return found;
 }
 
+void keep_screen_measurements(const ColourResult& colour, ScreenModel& screen) {
+    screen.half_gain_angle_deg = colour.half_gain_angle_deg;
+    screen.interreflection = std::clamp(colour.screen_bounce_reflectance, 0.0, 0.99);
+}
+
 ColourResult calibrate_colour(PatternSource& source, const ScreenModel& told, const DeviceModel& camera,
                               std::vector<DeviceModel>& models, ScreenCalibration& calibration,
                               const ColourOptions& options) {

@@ -149,6 +149,10 @@ struct ColourResult {
                                             std::vector<DeviceModel>& projectors, ScreenCalibration& calibration,
                                             const ColourOptions& options = {});
 
+// What the colour step measured of the screen, into the screen's model (what the models file keeps): the half-gain
+// angle it used and the screen's reflectance for its own light (clamped to [0, 0.99], the models file's range).
+void keep_screen_measurements(const ColourResult& colour, ScreenModel& screen);
+
 // The colour a calibration measured, in the part that does not depend on where the projectors
 // point: what a bumped projector keeps (self-recalibration, appliance/selfcal, re-applies it to the
 // corrected geometry). A projector's response and its black light are properties of its lamp,

@@ -8,6 +8,7 @@
 
 #include "appliance/autocal/rig_bridge.h"
 #include "appliance/rig/screen_light.h"
+#include "appliance/warp/composite.h"
 #include "appliance/warp/response_curve.h"
 #include "appliance/warp/warp_sampling.h"
 
@@ -21,10 +22,19 @@ struct Point {
     std::array<int, 2> pixel{};  // its output pixel there
 };
 
+// Flat content `level` as the outputs show it at content point uv: less the indirect light's field there
+// (render_output's `indirect`, clamped at 0), or as it is without one.
+std::array<float, 3> shown_content(double level, const RgbFloatImage& indirect, ContentUv uv) {
+    const auto l = static_cast<float>(level);
+    if (indirect.pixels.empty() || !uv.valid()) return {l, l, l};
+    const std::array<float, 3> f = sample_content(indirect, uv.u, uv.v);
+    return {std::max(l - f[0], 0.0F), std::max(l - f[1], 0.0F), std::max(l - f[2], 0.0F)};
+}
+
 // The light at screen point s for flat content `level`: each projector's, as the viewer sees it (`seen`: times the
 // screen's gain toward rig.viewer_m) or as it leaves a matte screen (what bounces), plus the ambient.
 Point direct_light(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double level,
-                   const rig::ScreenPoint& s, bool seen) {
+                   const RgbFloatImage& indirect, const rig::ScreenPoint& s, bool seen) {
     Point pt;
     pt.rgb = {rig.ambient, rig.ambient, rig.ambient};
     float most = 0.0F;
@@ -33,7 +43,8 @@ Point direct_light(const rig::VirtualRig& rig, const ScreenCalibration& calibrat
         const auto xy = output_pixel(rig, static_cast<int>(k), pc, s);
         if (!xy) continue;
         const auto [x, y] = *xy;
-        const bool shown = sample_warp(pc.warp, pc.output, x, y).valid();
+        const ContentUv uv = sample_warp(pc.warp, pc.output, x, y);
+        const bool shown = uv.valid();
         const float w = shown ? sample_blend(pc.blend, pc.output, x, y) : 0.0F;
         const std::array<float, 3> beta = sample_beta(pc.beta, pc.output, x, y);
         if (w > 0.0F) ++pt.lit;
@@ -45,9 +56,10 @@ Point direct_light(const rig::VirtualRig& rig, const ScreenCalibration& calibrat
         const rig::RigProjector& rp = rig.projectors[k];
         const double f = rig::projector_falloff(rp, x + 0.5, y + 0.5) *
                          (seen ? rig::screen_gain(rig.screen, s, rp.pose.position_m, rig.viewer_m) : 1.0);
+        const std::array<float, 3> content = shown_content(level, indirect, uv);
         for (std::size_t c = 0; c < 3; ++c) {
             const double signal =
-                shown ? apply_response(pc.response, static_cast<int>(c), static_cast<float>(level) * w + beta[c]) : 0.0;
+                shown ? apply_response(pc.response, static_cast<int>(c), content[c] * w + beta[c]) : 0.0;
             pt.rgb[c] +=
                 f * rp.brightness[c] * (rp.black_level + (1.0 - rp.black_level) * std::pow(signal, rp.gamma[c]));
         }
@@ -59,20 +71,22 @@ Point direct_light(const rig::VirtualRig& rig, const ScreenCalibration& calibrat
 // plus one bounce of the screen's own light (virtual_rig.h's header comment).
 class ViewedLight {
 public:
-    ViewedLight(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double level)
+    ViewedLight(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double level,
+                const IndirectLight* compensation)
         : rig_(rig), calibration_(calibration), level_(level) {
+        if (compensation != nullptr) indirect_ = compensation->flat_field(level);
         if (rig.screen.interreflection <= 0.0) return;
         bounce_.emplace(rig.screen);
         std::array<std::vector<double>, 3> leaving;
         for (int i = 0; i < bounce_->patches(); ++i) {
-            const Point p = direct_light(rig, calibration, level, bounce_->centre(i), false);
+            const Point p = direct_light(rig, calibration, level, indirect_, bounce_->centre(i), false);
             for (std::size_t c = 0; c < 3; ++c) leaving[c].push_back(p.rgb[c] - rig.ambient);
         }
         for (std::size_t c = 0; c < 3; ++c) bounced_[c] = bounce_->bounce(leaving[c]);
     }
 
     [[nodiscard]] Point at(const rig::ScreenPoint& s) const {
-        Point p = direct_light(rig_, calibration_, level_, s, true);
+        Point p = direct_light(rig_, calibration_, level_, indirect_, s, true);
         if (bounce_) {
             for (std::size_t c = 0; c < 3; ++c) p.rgb[c] += bounce_->at(bounced_[c], s);
         }
@@ -83,6 +97,7 @@ private:
     const rig::VirtualRig& rig_;
     const ScreenCalibration& calibration_;
     double level_;
+    RgbFloatImage indirect_;  // the compensation's field for this level (empty: none)
     std::optional<rig::ScreenBounce> bounce_;
     std::array<std::vector<double>, 3> bounced_;
 };
@@ -166,16 +181,17 @@ std::array<double, 3> rgb_to_lab(const std::array<double, 3>& rgb, const std::ar
 }
 
 SeamColour measure_seam_colour(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double level,
-                               double inset) {
+                               double inset, const IndirectLight* indirect) {
     const std::array<double, 3> white =
-        rgb_to_xyz(reference_rgb(screen_light(ViewedLight(rig, calibration, 1.0), rig, inset)));
-    const ViewedLight light(rig, calibration, level);
+        rgb_to_xyz(reference_rgb(screen_light(ViewedLight(rig, calibration, 1.0, indirect), rig, inset)));
+    const ViewedLight light(rig, calibration, level, indirect);
     const std::vector<Point> pts = screen_light(light, rig, inset);
     const std::array<double, 3> ref = reference_rgb(pts);
     const std::array<double, 3> ref_lab = rgb_to_lab(ref, white);
     SeamColour out;
     std::vector<double> seam_dev;
     std::vector<double> seam_de;
+    std::vector<double> all_dev;
     out.level = level;
     out.samples = static_cast<int>(pts.size());
     out.reference_luminance = luminance(ref);
@@ -184,6 +200,7 @@ SeamColour measure_seam_colour(const rig::VirtualRig& rig, const ScreenCalibrati
         const std::array<double, 3> lab = rgb_to_lab(p.rgb, white);
         const double de = std::hypot(lab[0] - ref_lab[0], lab[1] - ref_lab[1], lab[2] - ref_lab[2]);
         out.luminance_max_deviation = std::max(out.luminance_max_deviation, dev);
+        all_dev.push_back(dev);
         out.delta_e_max = std::max(out.delta_e_max, de);
         if (p.lit >= 2) {
             ++out.seam_samples;
@@ -196,6 +213,7 @@ SeamColour measure_seam_colour(const rig::VirtualRig& rig, const ScreenCalibrati
         }
     }
     out.seam_luminance_p95 = percentile(seam_dev, 0.95);
+    out.luminance_p95 = percentile(all_dev, 0.95);
     out.seam_delta_e_p95 = percentile(seam_de, 0.95);
     return out;
 }

@@ -16,6 +16,7 @@
 #include <array>
 #include <vector>
 
+#include "appliance/autocal/indirect_light.h"
 #include "appliance/rig/virtual_rig.h"
 #include "common/projector_calibration.h"
 
@@ -37,14 +38,18 @@ struct SeamColour {
     double delta_e_max = 0.0;         // max CIE76 Delta E from the reference colour, all points
     double seam_delta_e = 0.0;        // the same over the seam points
     double seam_luminance_p95 = 0.0;  // 95th percentile of the seam points' |Y / reference - 1|
+    double luminance_p95 = 0.0;       // the same over all points (a smooth field over the screen shows here)
     double seam_delta_e_p95 = 0.0;    // 95th percentile of the seam points' Delta E
 };
 
 // Points: a grid of 401 x 101 content points inset by `inset` of the frame on each side. The
 // reference colour is the per-channel median over points lit by one projector. A seam point's pixel mean is
 // taken over 8 x 8 points of the pixel's footprint, placed on the screen by the rig's true projector.
+// With `indirect`, the content is shown less the indirect light's field for flat content at `level`
+// (indirect_light.h; render_output's `indirect`), as the outputs show it.
 [[nodiscard]] SeamColour measure_seam_colour(const rig::VirtualRig& rig, const ScreenCalibration& calibration,
-                                             double level, double inset = 0.01);
+                                             double level, double inset = 0.01,
+                                             const IndirectLight* indirect = nullptr);
 
 // Linear RGB (BT.709 primaries) -> CIELAB against white `white_xyz`.
 [[nodiscard]] std::array<double, 3> rgb_to_lab(const std::array<double, 3>& rgb,

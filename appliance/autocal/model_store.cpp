@@ -100,6 +100,9 @@ ScreenModel read_screen(const Reader& r) {
         const std::vector<double> v = r.numbers("viewer_m", 3, -1e3, 1e3, "[-1000, 1000] m");
         s.viewer_m = {v[0], v[1], v[2]};
     }
+    // Optional (files from before the screen's own light was measured have none: no indirect light).
+    if (r.json().is_object() && r.json().contains("interreflection"))
+        s.interreflection = r.number("interreflection", 0.0, 0.99, "[0, 0.99]");
     return s;
 }
 
@@ -216,6 +219,7 @@ Json models_json(const CalibrationModels& m, const std::string& name) {
                   {"bow_m", m.screen.bow_m},
                   {"gain", m.screen.gain},
                   {"half_gain_angle_deg", m.screen.half_gain_angle_deg},
+                  {"interreflection", m.screen.interreflection},
                   {"viewer_m", {m.screen.viewer_m.x(), m.screen.viewer_m.y(), m.screen.viewer_m.z()}}}},
                 {"camera", device_json(m.camera)},
                 {"projectors", projectors}};

@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 
 #include "appliance/rig/screen_light.h"
+#include "appliance/warp/composite.h"
 #include "appliance/warp/response_curve.h"
 #include "appliance/warp/warp_sampling.h"
 
@@ -122,7 +123,8 @@ std::optional<std::array<int, 2>> output_pixel(const rig::VirtualRig& rig, int k
 LensFalloff falloff_of(const rig::RigProjector& p) { return {{1.0, 0.0, 0.0, -p.falloff, 0.0, -p.falloff}}; }
 
 LuminanceError measure_luminance(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double inset,
-                                 SeamGridSize grid) {
+                                 SeamGridSize grid, const IndirectLight* indirect) {
+    const RgbFloatImage field = indirect != nullptr ? indirect->flat_field(1.0) : RgbFloatImage{};
     // White content's light at s, as the viewer sees it (`seen`: through the screen's gain) or as it leaves a
     // matte screen (what bounces); `lit` counts the projectors whose blend is on there.
     const auto direct = [&](const rig::ScreenPoint& s, bool seen, int* lit) {
@@ -136,8 +138,15 @@ LuminanceError measure_luminance(const rig::VirtualRig& rig, const ScreenCalibra
             const rig::RigProjector& rp = rig.projectors[k];
             const double f = rig::projector_falloff(rp, (*xy)[0] + 0.5, (*xy)[1] + 0.5) *
                              (seen ? rig::screen_gain(rig.screen, s, rp.pose.position_m, rig.viewer_m) : 1.0);
+            // White content, less the indirect light's field where the outputs subtract one.
+            std::array<float, 3> content{1.0F, 1.0F, 1.0F};
+            if (const ContentUv uv = sample_warp(pc.warp, pc.output, (*xy)[0], (*xy)[1]);
+                uv.valid() && !field.pixels.empty()) {
+                const std::array<float, 3> less = sample_content(field, uv.u, uv.v);
+                for (std::size_t c = 0; c < 3; ++c) content[c] = std::max(1.0F - less[c], 0.0F);
+            }
             for (int c = 0; c < 3; ++c) {
-                const double signal = apply_response(pc.response, c, w);
+                const double signal = apply_response(pc.response, c, content[static_cast<std::size_t>(c)] * w);
                 l += f * rp.brightness[static_cast<std::size_t>(c)] *
                      std::pow(signal, rp.gamma[static_cast<std::size_t>(c)]) / 3.0;
             }

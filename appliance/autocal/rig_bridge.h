@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "appliance/autocal/autocal.h"
+#include "appliance/autocal/indirect_light.h"
 #include "appliance/autocal/site_prior.h"
 #include "appliance/rig/virtual_rig.h"
 
@@ -94,7 +95,9 @@ struct LuminanceError {
 // own light; black level left out: black-level compensation is a later step), on a grid of content points
 // inset by `inset` of the frame on every side.
 // `grid`: the seam grid's size (pixel_dense_seam_grid for a maximum that sees one-pixel lines).
+// With `indirect`, white content is shown less the indirect light's field (indirect_light.h), as the outputs show it.
 [[nodiscard]] LuminanceError measure_luminance(const rig::VirtualRig& rig, const ScreenCalibration& calibration,
-                                               double inset = 0.01, SeamGridSize grid = {});
+                                               double inset = 0.01, SeamGridSize grid = {},
+                                               const IndirectLight* indirect = nullptr);
 
 }  // namespace mogao::autocal

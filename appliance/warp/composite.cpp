@@ -22,6 +22,21 @@ void require_image(const RgbFloatImage& image, const std::string& what) {
     }
 }
 
+// The indirect light field of render_output: sized like its values, finite and >= 0 (negative
+// light would add to the content instead of taking the screen's own light off it).
+void require_indirect(const RgbFloatImage& field) {
+    const std::string what = "render_output: indirect light field";
+    require_image(field, what);
+    const auto bad =
+        std::find_if(field.pixels.begin(), field.pixels.end(), [](float v) { return !std::isfinite(v) || v < 0.0F; });
+    if (bad == field.pixels.end()) return;
+    const auto i = static_cast<std::size_t>(bad - field.pixels.begin());
+    const auto texel = static_cast<int>(i / 3);
+    throw std::invalid_argument(
+        what + ": value " + std::to_string(*bad) + " at (" + std::to_string(texel % field.size.width) + ", " +
+        std::to_string(texel / field.size.width) + ") channel " + std::to_string(i % 3) + ", must be finite and >= 0");
+}
+
 // Bilinear, clamp-to-edge, at pixel-index coordinates (pixel i's centre is i).
 std::array<float, 3> bilinear(const RgbFloatImage& image, double px, double py) {
     const double x = std::clamp(px, 0.0, static_cast<double>(image.size.width - 1));
@@ -52,15 +67,24 @@ std::array<float, 3> sample_content(const RgbFloatImage& content, double u, doub
     return bilinear(content, u * content.size.width - 0.5, v * content.size.height - 0.5);
 }
 
-RgbFloatImage render_output(const ProjectorCalibration& projector, const RgbFloatImage& content_linear) {
+RgbFloatImage render_output(const ProjectorCalibration& projector, const RgbFloatImage& content_linear,
+                            const RgbFloatImage& indirect) {
     validate_projector(projector, "render_output: projector '" + projector.id + "'");
     require_image(content_linear, "render_output: content");
+    const bool has_indirect = !(indirect.size == ImageSize{} && indirect.pixels.empty());
+    if (has_indirect) require_indirect(indirect);
     RgbFloatImage out(projector.output, 0.0F);
     for (int y = 0; y < projector.output.height; ++y) {
         for (int x = 0; x < projector.output.width; ++x) {
             const ContentUv uv = sample_warp(projector.warp, projector.output, x, y);
             if (!uv.valid()) continue;  // no content: signal 0
-            const std::array<float, 3> rgb = sample_content(content_linear, uv.u, uv.v);
+            std::array<float, 3> rgb = sample_content(content_linear, uv.u, uv.v);
+            if (has_indirect) {
+                // At the screen point uv itself: the field lives in the calibration's content
+                // coordinates, as the warp does.
+                const std::array<float, 3> screen_light = sample_content(indirect, uv.u, uv.v);
+                for (std::size_t c = 0; c < 3; ++c) rgb[c] = std::max(rgb[c] - screen_light[c], 0.0F);
+            }
             const float weight = sample_blend(projector.blend, projector.output, x, y);
             const std::array<float, 3> beta = sample_beta(projector.beta, projector.output, x, y);
             float* dst = out.at(x, y);

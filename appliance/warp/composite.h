@@ -29,12 +29,26 @@ namespace mogao {
 // Precondition: content non-empty with width*height*3 values.
 [[nodiscard]] std::array<float, 3> sample_content(const RgbFloatImage& content, double u, double v);
 
-// The projector's input signal: per output pixel, warp (sample_warp) -> sample_content ->
-// x blend weight (sample_blend) + black offset (sample_beta, per channel) -> clamp to [0, 1] ->
-// response LUT per channel. Pixels with no
-// content (NaN warp) are signal 0 (black). Returns an image of projector.output size.
-// Throws std::invalid_argument for an invalid projector (validate_projector) or content image.
-[[nodiscard]] RgbFloatImage render_output(const ProjectorCalibration& projector, const RgbFloatImage& content_linear);
+// The projector's input signal, per output pixel (x, y) and channel c:
+//
+//   uv         = sample_warp(x, y)                  the content point the pixel lands on
+//   linear_c   = sample_content(content_linear, uv)
+//   linear'_c  = max(linear_c - sample_content(indirect, uv)_c, 0)     (linear_c when indirect is empty)
+//   out_c      = lut_c(clamp(linear'_c * sample_blend(x, y) + sample_beta(x, y)_c, 0, 1))
+//
+// `indirect` is the screen's own light (interreflection of a concave screen) that the content
+// would otherwise get on top of itself, taken off before the blend (Bimber et al., "Compensating
+// indirect scattering for immersive and semi-immersive projection displays", IEEE VR 2006): a
+// content-space RGB field of any size (e.g. one texel per 0.1 m screen patch), linear light in
+// content units (1 = the light content 1.0 makes), read like the content (bilinear at texel
+// centres (i + 0.5) / W, clamp to edge; 1x1 is a constant). Where it exceeds the content the
+// pixel shows beta alone. Empty (0 x 0, no values; the default) subtracts nothing: the result is
+// bit for bit the one without it. Pixels with no content (NaN warp) are signal 0 (black). Returns
+// an image of projector.output size. Throws std::invalid_argument for an invalid projector
+// (validate_projector) or content image, and for an indirect field whose size does not match its
+// values or that holds a non-finite or negative value.
+[[nodiscard]] RgbFloatImage render_output(const ProjectorCalibration& projector, const RgbFloatImage& content_linear,
+                                          const RgbFloatImage& indirect = {});
 
 // The light on the screen, content-sized: for every content pixel, the sum over projectors of
 // response^-1(signal) (invert_response) bilinearly sampled at the output position that lands on

@@ -3,8 +3,11 @@
 // content image, put them back on the screen, and compare with the content.
 #include "appliance/warp/composite.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -200,6 +203,88 @@ TEST(RenderOutput, BlackOffsetIsAddedPerChannelAfterTheBlendAndBeforeTheResponse
     } catch (const std::invalid_argument& e) {
         EXPECT_NE(std::string(e.what()).find(".beta"), std::string::npos) << e.what();
     }
+}
+
+// The screen's own light (Bimber et al., IEEE VR 2006) comes off the content at the warp's content
+// point, bilinear over the field at texel centres, before the blend; beta is still added after.
+TEST(RenderOutput, IndirectLightIsTakenOffTheContentBeforeTheBlend) {
+    IdealCalibrationParams params;
+    params.projectors = 1;
+    params.output = {8, 4};
+    params.content = {8, 4};
+    ProjectorCalibration p = make_ideal_calibration(params).projectors[0];
+    p.blend.weight[5] = 0.5F;  // output pixel (5, 0)
+    p.warp.uv[2 * 6] = NAN;    // output pixel (6, 0): no content
+    p.warp.uv[2 * 6 + 1] = NAN;
+    p.beta.size = {1, 1};
+    p.beta.rgb = {0.01F, 0.02F, 0.03F};
+    const RgbFloatImage content = test_content(params.content);
+    RgbFloatImage field({2, 1});  // texel centres at u = 0.25 and 0.75; blue of texel 1 beyond any content
+    field.pixels = {0.1F, 0.2F, 0.05F, 0.3F, 0.0F, 5.0F};
+    const RgbFloatImage out = render_output(p, content, field);
+    // Output pixel x lands on content pixel x, u = (x + 0.5) / 8: field position u * 2 - 0.5,
+    // clamped to [0, 1] (the edge texels' values beyond their centres).
+    const std::pair<int, double> at_field[] = {{0, 0.0}, {3, 0.375}, {4, 0.625}, {5, 0.875}, {7, 1.0}};
+    for (const auto& [x, f] : at_field) {
+        for (int c = 0; c < 3; ++c) {
+            const auto cu = static_cast<std::size_t>(c);
+            const double indirect = field.pixels[cu] * (1.0 - f) + field.pixels[3 + cu] * f;
+            const double linear = std::max(content.at(x, 0)[c] - indirect, 0.0) * (x == 5 ? 0.5 : 1.0);
+            EXPECT_NEAR(out.at(x, 0)[c], apply_response(p.response, c, static_cast<float>(linear + p.beta.rgb[cu])),
+                        1e-6F)
+                << "pixel " << x << " channel " << c;
+        }
+    }
+    // Where the field exceeds the content the pixel shows the black level (beta) alone.
+    EXPECT_EQ(out.at(7, 0)[2], apply_response(p.response, 2, 0.03F));
+    EXPECT_EQ(out.at(5, 0)[2], apply_response(p.response, 2, 0.03F));
+    EXPECT_LT(out.at(3, 0)[0], render_output(p, content).at(3, 0)[0]);
+    EXPECT_EQ(out.at(6, 0)[0], 0.0F);  // no content stays black, field or not
+    // A 1x1 field is a constant.
+    RgbFloatImage constant({1, 1});
+    constant.pixels = {0.1F, 0.2F, 0.05F};
+    const RgbFloatImage flat = render_output(p, content, constant);
+    EXPECT_NEAR(flat.at(7, 2)[1],
+                apply_response(p.response, 1, std::max(content.at(7, 2)[1] - 0.2F, 0.0F) + p.beta.rgb[1]), 1e-6F);
+}
+
+TEST(RenderOutput, EmptyIndirectLightIsTheCallWithout) {
+    IdealCalibrationParams params;
+    params.output = {96, 64};
+    params.content = {240, 80};
+    const ScreenCalibration s = make_ideal_calibration(params);
+    const RgbFloatImage content = test_content(s.content);
+    for (const ProjectorCalibration& p : s.projectors) {
+        const RgbFloatImage plain = render_output(p, content);
+        EXPECT_EQ(render_output(p, content, RgbFloatImage{}).pixels, plain.pixels);
+        EXPECT_EQ(render_output(p, content, RgbFloatImage({3, 2}, 0.0F)).pixels, plain.pixels);  // zero light
+    }
+}
+
+TEST(RenderOutput, BadIndirectLightIsRefusedByName) {
+    const ProjectorCalibration p = make_ideal_calibration(IdealCalibrationParams{}).projectors[0];
+    const RgbFloatImage content(ImageSize{16, 8}, 0.5F);
+    const auto refused = [&](const RgbFloatImage& field, const std::string& says) {
+        try {
+            (void)render_output(p, content, field);
+            ADD_FAILURE() << "accepted a field that should say " << says;
+        } catch (const std::invalid_argument& e) {
+            EXPECT_NE(std::string(e.what()).find("indirect light field"), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+        }
+    };
+    RgbFloatImage field({7, 3}, 0.1F);
+    field.at(2, 1)[1] = NAN;
+    refused(field, "at (2, 1) channel 1, must be finite and >= 0");
+    field.at(2, 1)[1] = -0.01F;
+    refused(field, "at (2, 1) channel 1, must be finite and >= 0");
+    field.at(2, 1)[1] = INFINITY;
+    refused(field, "must be finite and >= 0");
+    field = RgbFloatImage({7, 3}, 0.1F);
+    field.pixels.pop_back();
+    refused(field, "expected");
+    field = RgbFloatImage({0, 3});
+    refused(field, "size 0x3");
 }
 
 }  // namespace

@@ -41,6 +41,7 @@ uniform sampler2D u_warp;     // GL_RGB32F (u, v, blend weight when the blend ma
 uniform sampler2D u_blend;    // GL_R32F weight in linear light (the general variant's bilinear blend)
 uniform sampler2D u_lut;      // GL_RGB16F, N x 1, GL_LINEAR: texel i = (lut_r[i], lut_g[i], lut_b[i])
 uniform sampler2D u_beta;     // GL_RGB32F black offset per channel, linear light (read only with HAS_BETA)
+uniform sampler2D u_indirect; // GL_RGB32F screen's own light in content space, content units (only HAS_INDIRECT)
 uniform vec2 u_output_size;   // projector pixels
 uniform vec2 u_warp_scale;    // warp size / output size (exactly 1.0 when equal)
 uniform vec2 u_blend_scale;   // blend size / output size
@@ -132,6 +133,21 @@ vec3 beta_at(vec2 p) {
 #endif
 #endif
 
+#ifdef HAS_INDIRECT
+// The screen's own light at content point uv (the warp's, before the late warp's transform: the
+// field lies on the screen). Bilinear with the content's pixel-centre convention and edge clamping,
+// sample_content's (appliance/warp/composite.h). uv is clamped first because the no-content
+// marker would overflow the float-to-int conversion; valid uv are uploaded within [-1, 2], where
+// the clamp changes nothing.
+vec3 indirect_at(vec2 uv) {
+    ivec2 size = textureSize(u_indirect, 0);
+    Taps t = taps_at(clamp(uv, -1.0, 2.0) * vec2(size) - 0.5, size);
+    vec4 w = weights(t.f);
+    return texelFetch(u_indirect, t.lo, 0).rgb * w.x + texelFetch(u_indirect, ivec2(t.hi.x, t.lo.y), 0).rgb * w.y +
+           texelFetch(u_indirect, ivec2(t.lo.x, t.hi.y), 0).rgb * w.z + texelFetch(u_indirect, t.hi, 0).rgb * w.w;
+}
+#endif
+
 // Bilinear in linear light by the texture unit (GL_LINEAR on a half-float texture, filterable in
 // core GLES 3.0): the same taps and weights as taps_at with edge clamping, the texels already
 // decoded to linear light on upload. One filtered fetch instead of four fetches and the weighting.
@@ -158,7 +174,13 @@ void main() {
     // A select rather than an early return: a software rasteriser runs both sides of a divergent
     // branch anyway, and the no-content marker's uv is clamped to the content's edge by the fetch.
     bool content = warp_blend_at(p, uv, weight);
-    vec3 linear = content_at(uv * u_content_scale + u_content_offset) * weight;
+    vec3 content_light = content_at(uv * u_content_scale + u_content_offset);
+#ifdef HAS_INDIRECT
+    // The screen's own light is already on the screen: take it off the content, before the blend
+    // (Bimber et al., IEEE VR 2006); light cannot be negative.
+    content_light = max(content_light - indirect_at(uv), 0.0);
+#endif
+    vec3 linear = content_light * weight;
 #ifdef HAS_BETA
     linear += beta_at(p);  // added after the blend, not scaled by the content (docs/calibration.md)
 #endif
@@ -221,6 +243,25 @@ Result<GlTexture> upload_beta(const std::string& who, const BlackOffset& beta, G
     return upload(who + " beta map", GL_RGB32F, beta.size, GL_RGB, GL_FLOAT, beta.rgb.data());
 }
 
+// set_indirect_light's checks, before anything is uploaded (so a bad field leaves the old one).
+Status check_indirect_light(const RgbFloatImage& field, GLint max_size) {
+    if (auto s = check_size("indirect light field", field.size, max_size); !s) return s;
+    if (field.pixels.size() != static_cast<std::size_t>(field.size.pixel_count()) * 3) {
+        return make_error(EINVAL, "indirect light field " + size_text(field.size) + " holds " +
+                                      std::to_string(field.pixels.size()) + " values, expected width*height*3");
+    }
+    // Negative light would brighten the content instead of taking the screen's own light off it.
+    const auto bad =
+        std::find_if(field.pixels.begin(), field.pixels.end(), [](float v) { return !std::isfinite(v) || v < 0.0f; });
+    if (bad == field.pixels.end()) return {};
+    const auto i = static_cast<std::size_t>(bad - field.pixels.begin());
+    const auto texel = static_cast<int>(i / 3);
+    return make_error(EINVAL, "indirect light field has value " + std::to_string(*bad) + " at (" +
+                                  std::to_string(texel % field.size.width) + ", " +
+                                  std::to_string(texel / field.size.width) + ") channel " + std::to_string(i % 3) +
+                                  ", must be finite and >= 0");
+}
+
 // IEEE 754 binary32 -> binary16, round to nearest even; finite inputs within the half range
 // (the sRGB decode table: 0 and normal numbers in [3e-4, 1]).
 std::uint16_t to_half(float value) {
@@ -258,13 +299,15 @@ const std::array<std::uint16_t, 256>& srgb8_decode_half_table() {
 
 }  // namespace
 
-Result<WarpBlendRenderer::Program> WarpBlendRenderer::make_program(bool exact_maps, bool has_beta) {
+Result<WarpBlendRenderer::Program> WarpBlendRenderer::make_program(bool exact_maps, bool has_beta, bool has_indirect) {
     const std::string fragment = std::string("#version 300 es\n") + (exact_maps ? "#define EXACT_MAPS 1\n" : "") +
-                                 (has_beta ? "#define HAS_BETA 1\n" : "") + kFragmentShader;
+                                 (has_beta ? "#define HAS_BETA 1\n" : "") +
+                                 (has_indirect ? "#define HAS_INDIRECT 1\n" : "") + kFragmentShader;
     auto linked = link_program(kVertexShader, fragment);
     if (!linked) {
         return with_context(linked.error(), std::string("WarpBlendRenderer (") + (exact_maps ? "exact" : "general") +
-                                                " maps, " + (has_beta ? "with" : "without") + " beta)");
+                                                " maps, " + (has_beta ? "with" : "without") + " beta, " +
+                                                (has_indirect ? "with" : "without") + " indirect light)");
     }
     Program p;
     p.program = std::move(linked.value());
@@ -275,6 +318,7 @@ Result<WarpBlendRenderer::Program> WarpBlendRenderer::make_program(bool exact_ma
     glUniform1i(glGetUniformLocation(id, "u_blend"), 2);
     glUniform1i(glGetUniformLocation(id, "u_lut"), 3);
     glUniform1i(glGetUniformLocation(id, "u_beta"), 4);
+    glUniform1i(glGetUniformLocation(id, "u_indirect"), 5);  // location -1 (ignored) in variants without it
     p.output_size = glGetUniformLocation(id, "u_output_size");
     p.warp_scale = glGetUniformLocation(id, "u_warp_scale");
     p.blend_scale = glGetUniformLocation(id, "u_blend_scale");
@@ -284,30 +328,36 @@ Result<WarpBlendRenderer::Program> WarpBlendRenderer::make_program(bool exact_ma
     return p;
 }
 
+Status WarpBlendRenderer::link_programs(bool has_indirect) {
+    for (const bool exact : {false, true}) {
+        for (const bool beta : {false, true}) {
+            auto program = make_program(exact, beta, has_indirect);
+            if (!program) return program.error();
+            programs_[program_index(exact, beta, has_indirect)] = std::move(program.value());
+        }
+    }
+    return {};
+}
+
 Result<WarpBlendRenderer> WarpBlendRenderer::create() {
     // Without a current context every GL call is silently ignored; say so instead.
     if (eglGetCurrentContext() == EGL_NO_CONTEXT) {
         return make_error(EINVAL, "WarpBlendRenderer::create: no EGL context is current on this thread");
     }
     WarpBlendRenderer r;
-    for (const bool exact : {false, true}) {
-        for (const bool beta : {false, true}) {
-            auto program = make_program(exact, beta);
-            if (!program) return program.error();
-            r.programs_[program_index(exact, beta)] = std::move(program.value());
-        }
-    }
+    if (auto s = r.link_programs(false); !s) return s.error();
     GLint max_texture = 0;
     GLint max_renderbuffer = 0;
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture);
     glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_renderbuffer);
     r.max_texture_size_ = std::min(max_texture, max_renderbuffer);
-    // Bound on the beta unit for projectors without a beta map, so the unit never holds an
-    // incomplete texture; the shader does not read it then (the variant without HAS_BETA).
+    // Bound on the beta unit for projectors without a beta map and on the indirect light's unit
+    // without a field, so no unit ever holds an incomplete texture; the shader does not read it
+    // then (the variants without HAS_BETA or HAS_INDIRECT).
     const float zero[3] = {0.0f, 0.0f, 0.0f};
-    auto no_beta = upload("no-beta placeholder", GL_RGB32F, ImageSize{1, 1}, GL_RGB, GL_FLOAT, zero);
-    if (!no_beta) return no_beta.error();
-    r.no_beta_ = std::move(no_beta.value());
+    auto placeholder = upload("zero placeholder", GL_RGB32F, ImageSize{1, 1}, GL_RGB, GL_FLOAT, zero);
+    if (!placeholder) return placeholder.error();
+    r.zero_rgb_ = std::move(placeholder.value());
     if (auto s = gl_check("WarpBlendRenderer::create"); !s) return s.error();
     return r;
 }
@@ -337,6 +387,32 @@ Status WarpBlendRenderer::set_content(const Rgb8Image& frame) {
     if (!texture) return texture.error();
     content_ = std::move(texture.value());
     content_size_ = frame.size;
+    return {};
+}
+
+Status WarpBlendRenderer::set_indirect_light(const RgbFloatImage& field) {
+    if (field.size == ImageSize{} && field.pixels.empty()) {  // none: the draws use the variants without it
+        indirect_ = GlTexture{};
+        indirect_size_ = {};
+        return {};
+    }
+    if (auto s = check_indirect_light(field, max_texture_size_); !s) return s;
+    // The variants with the lookup are linked on the first field, not at create(): most screens
+    // have none, and linking is the larger part of create()'s time on a software rasteriser.
+    if (!programs_[program_index(false, false, true)].program.valid()) {
+        if (auto s = link_programs(true); !s) return s;
+    }
+    if (indirect_.valid() && field.size == indirect_size_) {  // every frame: no reallocation
+        glBindTexture(GL_TEXTURE_2D, indirect_.get());
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 4);  // float rows are always 4-byte aligned
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, field.size.width, field.size.height, GL_RGB, GL_FLOAT,
+                        field.pixels.data());
+        return gl_check("upload indirect light field");
+    }
+    auto texture = upload("indirect light field", GL_RGB32F, field.size, GL_RGB, GL_FLOAT, field.pixels.data());
+    if (!texture) return texture.error();
+    indirect_ = std::move(texture.value());
+    indirect_size_ = field.size;
     return {};
 }
 
@@ -452,7 +528,8 @@ Status WarpBlendRenderer::draw(std::size_t index, ImageSize target) {
     const Projector& p = projectors_[index];
     const bool has_beta = p.beta.valid();
     const bool exact = p.warp_size == target && p.blend_size == target && (!has_beta || p.beta_size == target);
-    const Program& program = programs_[program_index(exact, has_beta)];
+    const bool has_indirect = indirect_.valid();
+    const Program& program = programs_[program_index(exact, has_beta, has_indirect)];
     glUseProgram(program.program.get());
     // The shader maps each target pixel centre to warp/blend coordinates by size ratios, so a
     // target larger or smaller than the calibration's output is the same picture resampled.
@@ -467,9 +544,13 @@ Status WarpBlendRenderer::draw(std::size_t index, ImageSize target) {
                 has_beta ? static_cast<float>(p.beta_size.height) / out_h : 0.0f);
     glUniform2f(program.content_scale, transform_.scale_u, transform_.scale_v);
     glUniform2f(program.content_offset, transform_.offset_u, transform_.offset_v);
-    const GLuint textures[] = {content_.get(), p.warp.get(), p.blend.get(), p.lut.get(),
-                               has_beta ? p.beta.get() : no_beta_.get()};
-    for (GLuint unit = 0; unit < 5; ++unit) {
+    const GLuint textures[] = {content_.get(),
+                               p.warp.get(),
+                               p.blend.get(),
+                               p.lut.get(),
+                               has_beta ? p.beta.get() : zero_rgb_.get(),
+                               has_indirect ? indirect_.get() : zero_rgb_.get()};
+    for (GLuint unit = 0; unit < 6; ++unit) {
         glActiveTexture(GL_TEXTURE0 + unit);
         glBindTexture(GL_TEXTURE_2D, textures[unit]);
     }

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -15,6 +16,7 @@
 #include <limits>
 #include <string>
 #include <thread>
+#include <utility>
 
 #include "common/png_io.h"
 #include "drivers/egl/egl_test_support.h"
@@ -64,9 +66,21 @@ std::size_t at(ImageSize s, int x, int y) {
     return static_cast<std::size_t>(y) * static_cast<std::size_t>(s.width) + static_cast<std::size_t>(x);
 }
 
+// The screen's own light at the warp's content point (u, v): bilinear at texel centres
+// (i + 0.5) / W with edge clamping, sample_content's convention; 0 without a field.
+std::array<double, 3> indirect_at(const RgbFloatImage& field, double u, double v) {
+    std::array<double, 3> light{};
+    if (field.size.width == 0) return light;
+    const Taps t = taps_at(u * field.size.width - 0.5, v * field.size.height - 0.5, field.size);
+    for (int k = 0; k < 4; ++k) {
+        for (std::size_t ch = 0; ch < 3; ++ch) light[ch] += t.w(k) * field.at(t.x(k), t.y(k))[ch];
+    }
+    return light;
+}
+
 // The CPU reference: see the maths in warp_blend_renderer.h.
 Rgb8Image reference_render(const Rgb8Image& content, const ProjectorCalibration& c,
-                           const WarpBlendRenderer::ContentTransform& late = {}) {
+                           const WarpBlendRenderer::ContentTransform& late = {}, const RgbFloatImage& indirect = {}) {
     Rgb8Image out(c.output);
     // Scales in float, as the renderer passes them to the shader.
     const double wsx = static_cast<float>(c.warp.size.width) / static_cast<float>(c.output.width);
@@ -110,12 +124,14 @@ Rgb8Image reference_render(const Rgb8Image& content, const ProjectorCalibration&
                         beta[ch] += t.w(k) * c.beta.rgb[at(c.beta.size, t.x(k), t.y(k)) * 3 + ch];
                 }
             }
+            const std::array<double, 3> screen_light = indirect_at(indirect, u, v);  // before the late warp
             u = u * double{late.scale_u} + double{late.offset_u};  // the late warp's map (float inputs)
             v = v * double{late.scale_v} + double{late.offset_v};
             const Taps ct = taps_at(u * content.size.width - 0.5, v * content.size.height - 0.5, content.size);
             for (int ch = 0; ch < 3; ++ch) {
                 double linear = 0.0;
                 for (int k = 0; k < 4; ++k) linear += ct.w(k) * srgb_decode(content.at(ct.x(k), ct.y(k))[ch]);
+                linear = std::max(linear - screen_light[static_cast<std::size_t>(ch)], 0.0);
                 const double pos = std::clamp(linear * weight + beta[ch], 0.0, 1.0) * static_cast<double>(n - 1);
                 const auto i = std::min(static_cast<std::size_t>(pos), n - 2);
                 const double f = pos - static_cast<double>(i);
@@ -477,6 +493,129 @@ TEST_F(WarpBlendRendererTest, RejectsBadBetaNamingProjectorAndMap) {
     auto out = renderer_->render(*ok);
     ASSERT_TRUE(out);
     EXPECT_EQ(max_abs_diff(*out, uniform_content({8, 8}, 0)).max, 0);
+}
+
+// A coarse screen-light field (7 x 3 texels over the content), brighter to the right and
+// downwards, per channel: up to 0.44, so that dark content is clamped at 0 and bright is not.
+RgbFloatImage gradient_field(float scale = 1.0f) {
+    RgbFloatImage field({7, 3});
+    for (int y = 0; y < 3; ++y) {
+        for (int x = 0; x < 7; ++x) {
+            for (int ch = 0; ch < 3; ++ch) {
+                field.at(x, y)[ch] = scale * static_cast<float>(0.02 + 0.05 * x + 0.03 * y + 0.05 * ch);
+            }
+        }
+    }
+    return field;
+}
+
+// The screen's own light comes off the content before the blend, read at the warp's content
+// point (not the late warp's): both shader variants (coarse maps and maps of the target's size)
+// against the CPU reference, with and without a content transform.
+TEST_F(WarpBlendRendererTest, IndirectLightIsTakenOffLikeTheCpuReference) {
+    const Rgb8Image content = noise_content({80, 50}, 13);
+    ProjectorCalibration busy = busy_calibration({64, 48});
+    busy.beta = ramp_beta(busy.output);
+    const RgbFloatImage field = gradient_field();
+    const Rgb8Image without = render(content, busy);
+    ASSERT_TRUE(renderer_->set_indirect_light(field).ok());
+    EXPECT_EQ(renderer_->indirect_light_size(), (ImageSize{7, 3}));
+    const Rgb8Image out = render(content, busy);
+    Diff d = max_abs_diff(out, reference_render(content, busy, {}, field));
+    EXPECT_LE(d.max, 2) << "coarse maps, at (" << d.x << ", " << d.y << ")";
+    EXPECT_GT(max_abs_diff(out, without).max, 40);  // the field does change the picture
+
+    ProjectorCalibration exact = identity_calibration("exact", {80, 50});
+    exact.blend.size = {80, 50};  // every map the target's size: the exact-maps variant
+    exact.blend.weight.assign(80 * 50, 0.9f);
+    exact.beta = ramp_beta({640, 400});  // 80 x 50
+    d = max_abs_diff(render(content, exact), reference_render(content, exact, {}, field));
+    EXPECT_LE(d.max, 2) << "maps of the target's size, at (" << d.x << ", " << d.y << ")";
+
+    WarpBlendRenderer::ContentTransform t;
+    t.scale_u = 0.8f;
+    t.offset_u = 0.15f;
+    renderer_->set_content_transform(t);
+    const Rgb8Image moved = render(content, busy);
+    d = max_abs_diff(moved, reference_render(content, busy, t, field));
+    EXPECT_LE(d.max, 2) << "content transform, at (" << d.x << ", " << d.y << ")";
+    // Read at the transformed uv instead, the field would be 0.15 * 7 texels off: clearly different.
+    RgbFloatImage shifted({7, 3});
+    for (int y = 0; y < 3; ++y) {
+        for (int x = 0; x < 7; ++x) std::copy_n(field.at(std::min(x + 1, 6), y), 3, shifted.at(x, y));
+    }
+    EXPECT_GT(max_abs_diff(moved, reference_render(content, busy, t, shifted)).max, 2);
+}
+
+// By hand: identity map, uniform content 200 (linear 0.578), blend 0.5, gamma 2.2, a constant
+// (1x1) field; blue's field exceeds the content, so blue shows the black offset alone.
+TEST_F(WarpBlendRendererTest, IndirectLightByHand) {
+    const ImageSize size{12, 6};
+    ProjectorCalibration c = with_uniform_blend(identity_calibration("hand", size), 0.5f);
+    c.response = gamma_response(2.2, 4096);
+    c.beta.size = {1, 1};
+    c.beta.rgb = {0.004f, 0.01f, 0.03f};
+    RgbFloatImage field({1, 1});
+    field.pixels = {0.1f, 0.3f, 0.9f};
+    ASSERT_TRUE(renderer_->set_indirect_light(field).ok());
+    const Rgb8Image out = render(uniform_content(size, 200), c);
+    for (int ch = 0; ch < 3; ++ch) {
+        const auto chu = static_cast<std::size_t>(ch);
+        const double linear = std::max(srgb_decode(200) - field.pixels[chu], 0.0) * 0.5 + c.beta.rgb[chu];
+        for (const auto& [x, y] : {std::pair{0, 0}, std::pair{5, 3}, std::pair{11, 5}}) {
+            EXPECT_NEAR(out.at(x, y)[ch], to_code(std::pow(linear, 1.0 / 2.2)), 1) << "channel " << ch;
+        }
+    }
+    EXPECT_NEAR(out.at(5, 3)[2], to_code(std::pow(0.03, 1.0 / 2.2)), 1);  // black level only
+}
+
+// A new field of the same size every frame updates in place; an empty one draws exactly (bit for
+// bit) what a renderer that never had a field draws.
+TEST_F(WarpBlendRendererTest, IndirectLightUpdatesPerFrameAndEmptyIsNone) {
+    const Rgb8Image content = noise_content({80, 50}, 17);
+    ProjectorCalibration busy = busy_calibration({64, 48});
+    busy.beta = ramp_beta(busy.output);
+    const Rgb8Image before = render(content, busy);
+    EXPECT_EQ(renderer_->indirect_light_size(), (ImageSize{0, 0}));
+    for (const float scale : {1.0f, 0.3f, 1.6f}) {
+        const RgbFloatImage field = gradient_field(scale);
+        ASSERT_TRUE(renderer_->set_indirect_light(field).ok());
+        const Diff d = max_abs_diff(render(content, busy), reference_render(content, busy, {}, field));
+        EXPECT_LE(d.max, 2) << "field x" << scale << " at (" << d.x << ", " << d.y << ")";
+    }
+    ASSERT_TRUE(renderer_->set_indirect_light(RgbFloatImage{}).ok());
+    EXPECT_EQ(renderer_->indirect_light_size(), (ImageSize{0, 0}));
+    EXPECT_EQ(render(content, busy).pixels, before.pixels);
+}
+
+TEST_F(WarpBlendRendererTest, RejectsBadIndirectLightKeepingTheOldField) {
+    const Rgb8Image content = noise_content({40, 30}, 19);
+    const ProjectorCalibration c = busy_calibration({32, 24});
+    const RgbFloatImage good = gradient_field();
+    ASSERT_TRUE(renderer_->set_indirect_light(good).ok());
+    const Rgb8Image with_good = render(content, c);
+    const auto refused = [&](const RgbFloatImage& field, int code, const std::string& says) {
+        const Status s = renderer_->set_indirect_light(field);
+        ASSERT_FALSE(s.ok()) << says;
+        EXPECT_EQ(s.code(), code) << s.error().message;
+        EXPECT_NE(s.error().message.find(says), std::string::npos) << s.error().message;
+    };
+    RgbFloatImage bad = good;
+    bad.at(3, 2)[1] = kNaN;
+    refused(bad, EINVAL, "indirect light field has value nan at (3, 2) channel 1, must be finite and >= 0");
+    bad.at(3, 2)[1] = -0.25f;
+    refused(bad, EINVAL, "indirect light field has value -0.250000 at (3, 2) channel 1, must be finite and >= 0");
+    bad.at(3, 2)[1] = std::numeric_limits<float>::infinity();
+    refused(bad, EINVAL, "at (3, 2) channel 1, must be finite and >= 0");
+    bad = good;
+    bad.pixels.pop_back();
+    refused(bad, EINVAL, "indirect light field 7x3 holds 62 values, expected width*height*3");
+    refused(RgbFloatImage({0, 3}), EINVAL, "indirect light field size 0x3 is empty");
+    bad = RgbFloatImage{};
+    bad.size = {1 << 20, 1};
+    refused(bad, E2BIG, "indirect light field size 1048576x1 exceeds GL_MAX_TEXTURE_SIZE");
+    EXPECT_EQ(renderer_->indirect_light_size(), good.size);
+    EXPECT_EQ(render(content, c).pixels, with_good.pixels);
 }
 
 TEST_F(WarpBlendRendererTest, MatchesGoldenPng) {

@@ -280,7 +280,7 @@ nlohmann::json run_on_site(const OnSiteJob& job, OutputBackend& outputs, Calibra
         if (job.colour) {
             colour = autocal::calibrate_colour(source, r->screen, r->camera, r->projectors, r->calibration,
                                                job.colour_options);
-            r->screen.half_gain_angle_deg = colour->half_gain_angle_deg;  // the models file keeps what was measured
+            autocal::keep_screen_measurements(*colour, r->screen);
         }
         check = autocal::run_self_check(source, prior, *r, job.self_check);  // step 3b
         autocal::check_self_check_gate(*check, job.self_check);

@@ -76,8 +76,10 @@ struct OutputsConfig {
 struct CalibrationConfig {
     std::filesystem::path mpcdi;  // source = FILE; empty: source = "ideal"
     bool watch = true;            // MPCDI: swap in the file when it changes (inotify; docs/kiosk.md)
-    int projectors = 3;           // ideal: [1, 64]
-    double overlap = 0.15;        // ideal: [0, 0.5)
+    bool indirect_light =
+        true;               // MPCDI: take the screen's own light off each frame (kiosk/display/frame_indirect_light.h)
+    int projectors = 3;     // ideal: [1, 64]
+    double overlap = 0.15;  // ideal: [0, 0.5)
     ImageSize output{1024, 768};  // ideal: each projector, [1, 16384] per side
     double gamma = 2.2;           // ideal: projector response gamma, (0, 10]
 };

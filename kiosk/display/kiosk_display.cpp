@@ -18,12 +18,26 @@ Result<KioskDisplay> KioskDisplay::create(std::unique_ptr<OutputBackend> backend
     return KioskDisplay(std::move(backend), std::move(presenter).value(), std::move(screen));
 }
 
+void KioskDisplay::take_off_indirect_light(IndirectLightSource source) {
+    indirect_source_ = std::move(source);
+    indirect_ = indirect_source_ ? indirect_source_(screen_) : std::nullopt;
+    if (!indirect_) (void)backend_->renderer().set_indirect_light({});
+}
+
+void KioskDisplay::update_indirect_light(const Rgb8Image& content) {
+    if (!indirect_) return;
+    Status s =
+        backend_->renderer().set_indirect_light(indirect_->field(content, backend_->renderer().content_transform()));
+    if (!s) spdlog::warn("indirect light: {}", s.error().message);  // the last field stays in use
+}
+
 Status KioskDisplay::show_connecting_screen(ImageSize content, const std::string& endpoint) {
     return show_card(make_connecting_screen(content, "FARM " + endpoint));
 }
 
 Status KioskDisplay::show_card(const Rgb8Image& card) {
     set_content_transform({});  // the card is made for the screen itself
+    update_indirect_light(card);
     if (Status s = presenter_.show(card, 0); !s) return s;
     account();
     return {};
@@ -34,6 +48,7 @@ void KioskDisplay::show(const ContentFrame& f) {
         f.request_id,        f.link_frame_id, f.jpeg_bytes, f.times.request_ns, f.times.receive_ns, 0, f.decode_ms,
         stats_.rounds() + 1, f.image.size,    f.spp,        f.bounces};
     while (pending_.size() > kMaxPendingFrames) pending_.erase(pending_.begin());
+    update_indirect_light(f.image);
     if (Status s = presenter_.show(f.image, f.request_id); !s) spdlog::warn("present: {}", s.error().message);
     account();
 }
@@ -41,11 +56,13 @@ void KioskDisplay::show(const ContentFrame& f) {
 Status KioskDisplay::swap_calibration(ScreenCalibration screen) {
     Status s = presenter_.swap_calibration(screen);
     if (s) screen_ = std::move(screen);
+    if (s && indirect_source_) take_off_indirect_light(indirect_source_);  // the new blends and models
     account();
     return s;
 }
 
 void KioskDisplay::refresh_content(const Rgb8Image& content) {
+    update_indirect_light(content);
     if (Status s = presenter_.show(content, presenter_.current_tag()); !s) {
         spdlog::warn("present: {}", s.error().message);
     }

@@ -16,6 +16,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -26,6 +27,7 @@
 #include "common/projector_calibration.h"
 #include "common/result.h"
 #include "drivers/output.h"
+#include "kiosk/display/frame_indirect_light.h"
 #include "kiosk/display/headless_recorder.h"
 #include "kiosk/display/screen_presenter.h"
 #include "kiosk/stats/kiosk_stats.h"
@@ -37,6 +39,13 @@ public:
     // `backend`'s outputs showing `screen` (ScreenPresenter::create; its notes are appended).
     [[nodiscard]] static Result<KioskDisplay> create(std::unique_ptr<OutputBackend> backend, ScreenCalibration screen,
                                                      std::vector<std::string>* notes);
+
+    // What gives the screen's own light to take off each frame for a calibration (frame_indirect_light.h;
+    // nullopt: nothing to take off): asked now for the current calibration and again after every swap. Without one
+    // (the default) the outputs take nothing off.
+    using IndirectLightSource = std::function<std::optional<FrameIndirectLight>(const ScreenCalibration&)>;
+    void take_off_indirect_light(IndirectLightSource source);
+    [[nodiscard]] bool takes_off_indirect_light() const { return indirect_.has_value(); }
 
     // Headless PNGs of every k-th round and the composite at exit (the recorder reads `backend`).
     void record_to(HeadlessRecorder recorder) { recorder_.emplace(std::move(recorder)); }
@@ -94,6 +103,7 @@ private:
     KioskDisplay(std::unique_ptr<OutputBackend> backend, ScreenPresenter presenter, ScreenCalibration screen)
         : backend_(std::move(backend)), presenter_(std::move(presenter)), screen_(std::move(screen)) {}
     void account(bool forced = false);  // after every present: rounds, PNGs (forced: recorded), frames now on screen
+    void update_indirect_light(const Rgb8Image& content);  // the field for the content about to be shown
     // When the completed round reached the screen (CLOCK_REALTIME ns): the latest
     // OutputBackend::presented_ns of the lit outputs (KMS: page-flip timestamps; headless: the
     // round), or now when the backend cannot tell. Motion-to-photon ends here.
@@ -108,6 +118,8 @@ private:
     ScreenPresenter presenter_;
     ScreenCalibration screen_;
     std::optional<HeadlessRecorder> recorder_;
+    IndirectLightSource indirect_source_;
+    std::optional<FrameIndirectLight> indirect_;
     KioskStats stats_;
     std::map<std::uint64_t, PresentedFrame> pending_;
     std::uint64_t frames_on_screen_ = 0;

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "appliance/autocal/model_store.h"
 #include "drivers/headless/headless_output.h"
 #include "drivers/kms/kms_backend.h"
 #include "kiosk/live_calibration/screen_calibration_source.h"
@@ -126,6 +127,16 @@ KioskDisplay open_display(const KioskConfig& config, ScreenCalibration screen) {
     auto display = KioskDisplay::create(std::move(backend), std::move(screen), &notes);
     if (!display) throw KioskSetupError(1, "outputs: " + display.error().message);
     for (const auto& n : notes) spdlog::warn("outputs: {}", n);
+    if (!config.calibration.mpcdi.empty() && config.calibration.indirect_light) {
+        // The models file beside the MPCDI (written with it) gives the screen's reflectance for its own light.
+        display->take_off_indirect_light(
+            [models = autocal::models_path_for(config.calibration.mpcdi)](const ScreenCalibration& s) {
+                std::string note;
+                std::optional<FrameIndirectLight> light = load_frame_indirect_light(models, s, &note);
+                spdlog::info("calibration: {}", note);
+                return light;
+            });
+    }
     display->stats() = KioskStats(KioskStats::kDefaultWindow, static_cast<std::size_t>(config.stats.frames_kept));
     if (!config.stats.frame_log.empty()) {
         try {

@@ -1,0 +1,166 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "appliance/autocal/indirect_light.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+#include "appliance/autocal/bundle_adjust.h"
+#include "appliance/autocal/screen_geometry.h"
+#include "appliance/warp/warp_sampling.h"
+
+namespace mogao::autocal {
+namespace {
+
+void check(const ScreenModel& screen, const std::vector<DeviceModel>& projectors,
+           const ScreenCalibration& calibration) {
+    if (!(screen.interreflection >= 0.0 && screen.interreflection < 1.0))
+        throw std::invalid_argument("indirect light: screen interreflection " + std::to_string(screen.interreflection) +
+                                    " outside [0, 1)");
+    if (projectors.size() != calibration.projectors.size())
+        throw std::invalid_argument("indirect light: " + std::to_string(projectors.size()) + " projector models for " +
+                                    std::to_string(calibration.projectors.size()) + " calibrated projectors");
+}
+
+// 1 / G at screen point (theta, h): the blend-weighted mean over the projectors whose shown pixel lands there of
+// 1 / (the gain toward the viewer of that projector's light); 0 where none shows content.
+double inverse_gain_at(const ScreenModel& screen, const std::vector<DeviceModel>& projectors,
+                       const ScreenCalibration& calibration, double theta, double h) {
+    const Eigen::Vector3d p = screen_position(screen, theta, h);
+    double weights = 0.0, sum = 0.0;
+    for (std::size_t k = 0; k < projectors.size(); ++k) {
+        const DeviceModel& d = projectors[k];
+        const Eigen::Vector3d q = d.rotation.transpose() * (p - d.position_m);  // device frame
+        if (q.z() <= 0.0) continue;                                             // behind the lens
+        const Eigen::Vector2d xy = device_image(d, q);
+        if (!xy.allFinite()) continue;
+        const ProjectorCalibration& pc = calibration.projectors[k];
+        const double sx = static_cast<double>(pc.output.width) / d.resolution.width;
+        const double sy = static_cast<double>(pc.output.height) / d.resolution.height;
+        const int x = static_cast<int>(std::floor(xy.x() * sx)), y = static_cast<int>(std::floor(xy.y() * sy));
+        if (x < 0 || y < 0 || x >= pc.output.width || y >= pc.output.height) continue;
+        if (!sample_warp(pc.warp, pc.output, x, y).valid()) continue;
+        const double w = sample_blend(pc.blend, pc.output, x, y);
+        if (!(w > 0.0)) continue;
+        weights += w;
+        sum += w / screen_gain_at(screen, theta, h, d.position_m, screen.viewer_m);
+    }
+    return weights > 0.0 ? sum / weights : 0.0;
+}
+
+}  // namespace
+
+IndirectLight::IndirectLight(const ScreenModel& screen, const std::vector<DeviceModel>& projectors,
+                             const ScreenCalibration& calibration, double patch_m)
+    : bounce_(screen, patch_m), rho_(screen.interreflection) {
+    check(screen, projectors, calibration);
+    const double arc = screen.arc_deg * std::numbers::pi / 180.0;
+    const double height = screen.top_m - screen.bottom_m;
+    inverse_gain_.resize(static_cast<std::size_t>(bounce_.patches()), 0.0);
+    if (!active()) return;
+    for (int r = 0; r < rows(); ++r) {
+        for (int c = 0; c < columns(); ++c) {
+            const double theta = -arc / 2.0 + (c + 0.5) * arc / columns();
+            const double h = screen.bottom_m + (r + 0.5) * height / rows();
+            inverse_gain_[static_cast<std::size_t>(r * columns() + c)] =
+                inverse_gain_at(screen, projectors, calibration, theta, h);
+        }
+    }
+}
+
+bool IndirectLight::shown(int column, int row) const {
+    if (column < 0 || row < 0 || column >= columns() || row >= rows()) return false;
+    return inverse_gain_[static_cast<std::size_t>((rows() - 1 - row) * columns() + column)] > 0.0;
+}
+
+std::vector<std::array<double, 3>> IndirectLight::indirect(const std::vector<std::array<double, 3>>& c) const {
+    std::vector<std::array<double, 3>> leaving(c.size());
+    for (std::size_t j = 0; j < c.size(); ++j) {
+        for (std::size_t ch = 0; ch < 3; ++ch) leaving[j][ch] = c[j][ch] * inverse_gain_[j];
+    }
+    std::vector<std::array<double, 3>> out = bounce_.bounce_rgb(leaving);
+    for (auto& v : out) {
+        for (double& x : v) x *= rho_;
+    }
+    return out;
+}
+
+RgbFloatImage IndirectLight::field(const RgbFloatImage& patches) const {
+    if (patches.size.width != columns() || patches.size.height != rows())
+        throw std::invalid_argument("indirect light: patch means of " + std::to_string(patches.size.width) + "x" +
+                                    std::to_string(patches.size.height) + " for a field of " +
+                                    std::to_string(columns()) + "x" + std::to_string(rows()));
+    if (!active()) return {};
+    const auto n = static_cast<std::size_t>(bounce_.patches());
+    // Patch values bottom row first (ScreenBounce's order); the image's row 0 is the top.
+    std::vector<std::array<double, 3>> content(n), shown_c(n);
+    for (int r = 0; r < rows(); ++r) {
+        for (int c = 0; c < columns(); ++c) {
+            const float* px = patches.at(c, rows() - 1 - r);
+            content[static_cast<std::size_t>(r * columns() + c)] = {px[0], px[1], px[2]};
+        }
+    }
+    // Two Jacobi steps: f0 = I[c] - I0, c' = max(c - f0, 0), f = I[c'] - I0 (the header's fixed point).
+    std::vector<std::array<double, 3>> f;
+    shown_c = content;
+    for (int step = 0; step < 2; ++step) {
+        f = indirect(shown_c);
+        std::array<double, 3> least{};
+        least.fill(std::numeric_limits<double>::infinity());
+        for (std::size_t j = 0; j < n; ++j) {
+            if (inverse_gain_[j] <= 0.0) continue;
+            for (std::size_t ch = 0; ch < 3; ++ch) least[ch] = std::min(least[ch], f[j][ch]);
+        }
+        for (std::size_t j = 0; j < n; ++j) {
+            for (std::size_t ch = 0; ch < 3; ++ch) {
+                f[j][ch] = std::max(0.0, f[j][ch] - (std::isfinite(least[ch]) ? least[ch] : 0.0));
+                shown_c[j][ch] = std::max(0.0, content[j][ch] - f[j][ch]);
+            }
+        }
+    }
+    RgbFloatImage out(ImageSize{columns(), rows()});
+    for (int r = 0; r < rows(); ++r) {
+        for (int c = 0; c < columns(); ++c) {
+            const auto& v = f[static_cast<std::size_t>(r * columns() + c)];
+            float* px = out.at(c, rows() - 1 - r);
+            for (std::size_t ch = 0; ch < 3; ++ch) px[ch] = static_cast<float>(v[ch]);
+        }
+    }
+    return out;
+}
+
+RgbFloatImage IndirectLight::flat_field(double level) const {
+    return field(RgbFloatImage(ImageSize{columns(), rows()}, static_cast<float>(level)));
+}
+
+RgbFloatImage IndirectLight::patch_means(const RgbFloatImage& content_linear, int samples) const {
+    if (content_linear.size.width <= 0 || content_linear.size.height <= 0 ||
+        content_linear.pixels.size() != static_cast<std::size_t>(content_linear.size.pixel_count()) * 3)
+        throw std::invalid_argument("indirect light: empty or malformed content image");
+    samples = std::clamp(samples, 1, 64);
+    RgbFloatImage out(ImageSize{columns(), rows()});
+    const ImageSize s = content_linear.size;
+    for (int r = 0; r < rows(); ++r) {
+        for (int c = 0; c < columns(); ++c) {
+            std::array<double, 3> sum{};
+            for (int j = 0; j < samples; ++j) {
+                for (int i = 0; i < samples; ++i) {
+                    const double u = (c + (i + 0.5) / samples) / columns();
+                    const double v = (r + (j + 0.5) / samples) / rows();
+                    const int x = std::clamp(static_cast<int>(u * s.width), 0, s.width - 1);
+                    const int y = std::clamp(static_cast<int>(v * s.height), 0, s.height - 1);
+                    const float* px = content_linear.at(x, y);
+                    for (std::size_t ch = 0; ch < 3; ++ch) sum[ch] += px[ch];
+                }
+            }
+            float* o = out.at(c, r);
+            for (std::size_t ch = 0; ch < 3; ++ch) o[ch] = static_cast<float>(sum[ch] / (samples * samples));
+        }
+    }
+    return out;
+}
+
+}  // namespace mogao::autocal
