@@ -63,12 +63,16 @@ public:
     [[nodiscard]] RgbFloatImage patch_means(const RgbFloatImage& content_linear, int samples = 4) const;
 
 private:
-    // I[c] for patch means c (content units), per channel, patch index r * columns + c with r = 0 at the bottom.
-    [[nodiscard]] std::vector<std::array<double, 3>> indirect(const std::vector<std::array<double, 3>>& c) const;
+    // I[c] for patch means c (content units, one plane per channel), patch index r * columns + c with r = 0 at the
+    // bottom; written into `out` (same shape).
+    void indirect(const std::array<std::vector<float>, 3>& c, std::array<std::vector<float>, 3>& out) const;
 
     ScreenBounce bounce_;
     double rho_ = 0.0;
     std::vector<double> inverse_gain_;  // 1 / G_j per patch (bottom row first); 0 where no projector lights j
+    // rho F_ij / G_j, column j at [j * patches()], in float: the per-frame product reads it twice, and in float it
+    // is half the memory traffic (a field under 0.1 summed over about a thousand terms keeps 1e-6 of a code).
+    std::vector<float> transfer_;
 };
 
 }  // namespace mogao::autocal

@@ -82,25 +82,6 @@ std::vector<double> ScreenBounce::bounce(const std::vector<double>& leaving) con
     return out;
 }
 
-std::vector<std::array<double, 3>> ScreenBounce::bounce_rgb(const std::vector<std::array<double, 3>>& leaving) const {
-    const auto n = static_cast<std::size_t>(patches());
-    if (leaving.size() != n)
-        throw std::invalid_argument("screen bounce: " + std::to_string(leaving.size()) + " patch values for " +
-                                    std::to_string(n) + " patches");
-    std::vector<std::array<double, 3>> out(n);
-    for (std::size_t i = 0; i < n; ++i) {
-        double r = 0.0, g = 0.0, b = 0.0;
-        const double* f = &form_[i * n];
-        for (std::size_t j = 0; j < n; ++j) {
-            r += f[j] * leaving[j][0];
-            g += f[j] * leaving[j][1];
-            b += f[j] * leaving[j][2];
-        }
-        out[i] = {r, g, b};
-    }
-    return out;
-}
-
 double ScreenBounce::at(const std::vector<double>& field, double theta, double h) const {
     const double u = std::clamp((theta - theta0_) / dtheta_ - 0.5, 0.0, static_cast<double>(columns_ - 1));
     const double v = std::clamp((h - h0_) / dh_ - 0.5, 0.0, static_cast<double>(rows_ - 1));

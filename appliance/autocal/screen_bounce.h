@@ -13,7 +13,6 @@
 // (screen frame, autocal.h); light in whatever unit L is given in (the bounce comes out in it, per unit rho).
 #pragma once
 
-#include <array>
 #include <vector>
 
 #include "appliance/autocal/autocal.h"
@@ -32,9 +31,8 @@ public:
     [[nodiscard]] int patch_at(double theta, double h) const;
     // sum_j F_ij L_j for every patch i (rho = 1); `leaving` has patches() entries.
     [[nodiscard]] std::vector<double> bounce(const std::vector<double>& leaving) const;
-    // The same for three channels at once (one pass over the form factors).
-    [[nodiscard]] std::vector<std::array<double, 3>> bounce_rgb(
-        const std::vector<std::array<double, 3>>& leaving) const;
+    // F_ij (i receiving from j), row-major patches() x patches().
+    [[nodiscard]] const std::vector<double>& form_factors() const { return form_; }
     // A per-patch field (patches() entries) at (theta, h), bilinear between patch centres.
     [[nodiscard]] double at(const std::vector<double>& field, double theta, double h) const;
 

@@ -28,6 +28,7 @@
 #include "appliance/autocal/autocal.h"
 #include "appliance/autocal/colour_calibration.h"
 #include "appliance/autocal/colour_truth.h"
+#include "appliance/autocal/model_store.h"
 #include "appliance/autocal/rig_bridge.h"
 #include "appliance/calibration/mpcdi_screen.h"
 #include "appliance/calibration/mpcdi_writer.h"
@@ -36,6 +37,7 @@
 #include "appliance/warp/warp_sampling.h"
 #include "drivers/egl/egl_test_support.h"
 #include "drivers/headless/headless_output.h"
+#include "kiosk/display/frame_indirect_light.h"
 #include "kiosk/display/screen_presenter.h"
 #include "kiosk/live_calibration/screen_calibration_source.h"
 
@@ -56,6 +58,7 @@ struct Calibrated {
     rig::VirtualRig rig;
     ScreenCalibration calibration;  // as calibrate + calibrate_colour made it
     ScreenCalibration loaded;       // the same through an MPCDI file and the kiosk's loader
+    fs::path models;                // the fitted models beside the MPCDI, as the calibrate job writes them
 };
 
 const Calibrated& calibrated() {
@@ -67,7 +70,9 @@ const Calibrated& calibrated() {
         autocal::AutocalOptions options;
         options.warp_step_px = 4;
         autocal::AutocalResult r = autocal::calibrate(source, prior, kCalibrationContent, options);
-        (void)autocal::calibrate_colour(source, prior.screen, r.camera, r.projectors, r.calibration);
+        const autocal::ColourResult colour =
+            autocal::calibrate_colour(source, prior.screen, r.camera, r.projectors, r.calibration);
+        autocal::keep_screen_measurements(colour, r.screen);
         out.calibration = r.calibration;
         const fs::path dir = fs::path(::testing::TempDir()) / "warp_blend_rig_test";
         fs::create_directories(dir);
@@ -75,6 +80,8 @@ const Calibrated& calibrated() {
         export_options.alpha_bit_depth = 16;
         export_options.write_response = true;  // as mogao-calibrate-sim rig writes it (calibrate_job.cpp)
         write_mpcdi(dir / "calibration.mpcdi", to_mpcdi(r.calibration, export_options));
+        out.models = autocal::models_path_for(dir / "calibration.mpcdi");
+        autocal::write_models(out.models, autocal::CalibrationModels{r.screen, r.camera, r.projectors});
         CalibrationConfig config;
         config.mpcdi = dir / "calibration.mpcdi";
         out.loaded = load_screen_calibration(config, kCalibrationContent, nullptr);
@@ -155,6 +162,11 @@ public:
         std::vector<Rgb8Image> out;
         for (std::size_t i = 0; i < backend_->outputs().size(); ++i) out.push_back(backend_->last_frame(i));
         return out;
+    }
+
+    // The screen's own light to take off the next frames (KioskDisplay::update_indirect_light's call).
+    void set_indirect_light(const RgbFloatImage& field) {
+        EXPECT_TRUE(backend_->renderer().set_indirect_light(field).ok());
     }
 
     // The run-time calibration swap (kiosk/live_calibration/calibration_watcher.h -> ScreenPresenter): the current
@@ -252,10 +264,11 @@ SeamFigures seam_figures(const std::vector<Point>& pts, const std::vector<Point>
     return {static_cast<int>(dev.size()), percentile(dev, 0.95), percentile(de, 0.95)};
 }
 
-std::vector<Rgb8Image> cpu_outputs(const ScreenCalibration& cal, const Rgb8Image& content) {
+std::vector<Rgb8Image> cpu_outputs(const ScreenCalibration& cal, const Rgb8Image& content,
+                                   const RgbFloatImage& indirect = {}) {
     const RgbFloatImage linear = linear_of(content);
     std::vector<Rgb8Image> out;
-    for (const auto& p : cal.projectors) out.push_back(codes_of(render_output(p, linear)));
+    for (const auto& p : cal.projectors) out.push_back(codes_of(render_output(p, linear, indirect)));
     return out;
 }
 
@@ -379,6 +392,37 @@ TEST(WarpBlendOnRig, CalibrationSwapBringsBetaIntoTheGlOutput) {
     for (std::size_t k = 0; k < after.size(); ++k) {
         EXPECT_GE(max_code_diff(before[k], cpu[k]), 8) << c.loaded.projectors[k].id << ": before the swap";
         EXPECT_LE(max_code_diff(after[k], cpu[k]), kToleranceCodes) << c.loaded.projectors[k].id << ": after";
+    }
+}
+
+// The kiosk's per-frame indirect light: the models file beside the MPCDI (here given a screen that throws back 80 %
+// of its light; the colour rig's own screen is matte) gives the field for each frame (FrameIndirectLight), and the
+// GL outputs take it off as render_output does; the picture is darker where the field is, not the same.
+TEST(WarpBlendOnRig, TheScreensOwnLightFromTheModelsFileIsTakenOffTheGlOutputs) {
+    const Calibrated& c = calibrated();
+    autocal::CalibrationModels models = autocal::read_models(c.models);
+    EXPECT_LT(models.screen.interreflection, autocal::IndirectLight::kMinReflectance) << "a matte screen measured";
+    models.screen.interreflection = 0.8;
+    const fs::path lit = c.models.parent_path() / "lit.models.json";
+    autocal::write_models(lit, models);
+    std::string note;
+    const std::optional<FrameIndirectLight> light = load_frame_indirect_light(lit, c.loaded, &note);
+    ASSERT_TRUE(light) << note;
+    auto kiosk = KioskOutputs::open(c.loaded);
+    if (!kiosk) return;
+    const Rgb8Image content = structured_content({320, 180});
+    const RgbFloatImage field = light->field(content, {});
+    kiosk->set_indirect_light(field);
+    const std::vector<Rgb8Image> gl = kiosk->show(content);
+    const std::vector<Rgb8Image> cpu = cpu_outputs(c.loaded, content, field);
+    const std::vector<Rgb8Image> left_on = cpu_outputs(c.loaded, content);
+    for (std::size_t k = 0; k < gl.size(); ++k) {
+        const int d = max_code_diff(gl[k], cpu[k]);
+        const int taken = max_code_diff(left_on[k], cpu[k]);
+        std::printf("%s: GL vs render_output with the field max %d codes; the field takes off up to %d codes\n",
+                    c.loaded.projectors[k].id.c_str(), d, taken);
+        EXPECT_LE(d, kToleranceCodes) << c.loaded.projectors[k].id;
+        EXPECT_GE(taken, 4) << c.loaded.projectors[k].id;
     }
 }
 
