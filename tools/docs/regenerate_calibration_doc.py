@@ -22,7 +22,8 @@ EXTRA_RUNS = {"roughscreen": [["--fit-screen"], ["--fit-heights"]], "falloff": [
               "bulge": [["--no-bow"]], "realistic": [["--fixed-camera-intrinsics"]],
               "focal": [["--fixed-camera-intrinsics"]], "grazing": [["--intrinsics-min-gain", "0"]],
               "standard": [["--intrinsics-min-gain", "0"]], "realistic-lens": [["--pinhole-projectors"]],
-              "realistic-install": [["--fit-screen"], ["--fit-heights"]]}
+              "realistic-install": [["--fit-screen"], ["--fit-heights"]],
+              "realistic-screen": [["--no-indirect-light"]]}
 # Rigs also run at full resolution (x1), a row for each list of options they need there.
 X1_RUNS = {"standard": [[]], "focal": [[]], "realistic": [[]], "realistic-lens": [[]], "realistic-optics": [[]],
            "realistic-screen": [[]],
