@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "appliance/autocal/colour_report.h"
 #include "appliance/autocal/model_store.h"
 #include "appliance/autocal/rig_bridge.h"
 #include "appliance/calibration/mpcdi_screen.h"
@@ -178,22 +179,6 @@ nlohmann::json connectors_json(const Identified& id, const PatternDisplay& displ
     return out;
 }
 
-nlohmann::json colour_json(const autocal::ColourResult& c) {
-    nlohmann::json out = {{"captures", c.captures}, {"matched_white", c.matched_white}, {"black_floor", c.black_floor},
-                          {"ambient", c.ambient},   {"alpha_scale", c.alpha_scale},     {"white_floor", c.white_floor}};
-    out["screen_half_gain_angle"] = {{"degrees", c.half_gain_angle_deg}, {"estimated", c.half_gain_angle_estimated}};
-    out["screen_bounce"] = {{"reflectance", c.screen_bounce_reflectance}, {"samples", c.screen_bounce_samples}};
-    for (const autocal::ProjectorPhotometry& p : c.projectors) {
-        nlohmann::json ch = nlohmann::json::array();
-        for (const autocal::ChannelResponse& r : p.channels) {
-            ch.push_back({{"amplitude", r.amplitude}, {"gamma", r.gamma}, {"gamma_fit_rms", r.gamma_rms}});
-        }
-        out["projectors"].push_back(
-            {{"id", p.id}, {"black", p.black}, {"gain", p.gain}, {"falloff", p.falloff.c}, {"channels", ch}});
-    }
-    return out;
-}
-
 nlohmann::json previous_connectors(const fs::path& report) {
     std::ifstream f(report);
     if (!f) return nullptr;
@@ -232,7 +217,12 @@ nlohmann::json finish(const OnSiteJob& job, const Identified& id, const autocal:
     report["connectors"] = connectors_json(id, display, prior);
     report["cabling_changes"] = cabling_changes(previous_connectors(job.out / "report.json"), report["connectors"]);
     for (std::size_t k = 0; k < r.projectors.size(); ++k) report["projectors"].push_back(fit_json(r, k));
-    if (colour) report["colour"] = colour_json(*colour);
+    if (colour) {
+        report["colour"] = autocal::colour_report(*colour);
+        // What the kiosk will take off each frame of the screen's own light, from the models written below.
+        const autocal::IndirectLight indirect(r.screen, r.projectors, r.calibration);
+        report["colour"]["indirect_light"] = autocal::indirect_light_report(indirect.active() ? &indirect : nullptr);
+    }
     report["self_check"] = autocal::self_check_report(check, job.self_check);
     // The screen the calibration used: the site file's cylinder, with the bow where it paid (autocal.h).
     report["screen"] = screen_json(r, job.options);
