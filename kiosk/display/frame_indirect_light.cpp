@@ -10,32 +10,16 @@
 #include <fmt/format.h>
 
 #include "appliance/autocal/model_store.h"
+#include "common/srgb.h"
 
 namespace mogao {
-namespace {
-
-// IEC 61966-2-1 decoding of every 8-bit code, once.
-const std::array<float, 256>& srgb_to_linear() {
-    static const std::array<float, 256> table = [] {
-        std::array<float, 256> t{};
-        for (int i = 0; i < 256; ++i) {
-            const double c = i / 255.0;
-            t[static_cast<std::size_t>(i)] =
-                static_cast<float>(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
-        }
-        return t;
-    }();
-    return table;
-}
-
-}  // namespace
 
 RgbFloatImage FrameIndirectLight::field(const Rgb8Image& frame, const ContentTransform& transform) const {
     const ImageSize s = frame.size;
     if (s.width <= 0 || s.height <= 0 || frame.pixels.size() != static_cast<std::size_t>(s.pixel_count()) * 3)
         return {};
     constexpr int kSamples = 4;
-    const std::array<float, 256>& linear = srgb_to_linear();
+    const std::array<float, 256>& linear = srgb8_decode_table();
     const int columns = model_.columns(), rows = model_.rows();
     RgbFloatImage means(ImageSize{columns, rows});
     for (int r = 0; r < rows; ++r) {

@@ -2,7 +2,6 @@
 #include "kiosk/display/frame_indirect_light.h"
 
 #include <algorithm>
-#include <cmath>
 #include <filesystem>
 #include <string>
 
@@ -10,6 +9,7 @@
 
 #include "appliance/autocal/model_store.h"
 #include "appliance/warp/ideal_calibration.h"
+#include "common/srgb.h"
 
 namespace mogao {
 namespace {
@@ -44,10 +44,7 @@ ScreenCalibration one_projector() {
 // The frame's pixels decoded as the outputs decode them.
 RgbFloatImage linear_of(const Rgb8Image& frame) {
     RgbFloatImage out(frame.size);
-    for (std::size_t i = 0; i < frame.pixels.size(); ++i) {
-        const double c = frame.pixels[i] / 255.0;
-        out.pixels[i] = static_cast<float>(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
-    }
+    for (std::size_t i = 0; i < frame.pixels.size(); ++i) out.pixels[i] = srgb8_decode_table()[frame.pixels[i]];
     return out;
 }
 
