@@ -77,11 +77,6 @@ IndirectLight::IndirectLight(const ScreenModel& screen, const std::vector<Device
             transfer_[j * n + i] = static_cast<float>(rho_ * form[i * n + j] * inverse_gain_[j]);
 }
 
-bool IndirectLight::shown(int column, int row) const {
-    if (column < 0 || row < 0 || column >= columns() || row >= rows()) return false;
-    return inverse_gain_[static_cast<std::size_t>((rows() - 1 - row) * columns() + column)] > 0.0;
-}
-
 void IndirectLight::indirect(const std::array<std::vector<float>, 3>& c, std::array<std::vector<float>, 3>& out) const {
     const std::size_t n = inverse_gain_.size();
     for (std::vector<float>& o : out) std::fill(o.begin(), o.end(), 0.0F);

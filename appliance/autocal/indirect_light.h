@@ -49,8 +49,6 @@ public:
     [[nodiscard]] bool active() const { return rho_ >= kMinReflectance; }
     [[nodiscard]] int columns() const { return bounce_.columns(); }
     [[nodiscard]] int rows() const { return bounce_.rows(); }
-    // Whether any projector lights patch (column, row).
-    [[nodiscard]] bool shown(int column, int row) const;
 
     // The field to subtract (above) for content whose patch means (linear, content units, columns() x rows(),
     // row 0 at the top) are `patches`. Empty when !active(). Throws std::invalid_argument for another size.
