@@ -48,9 +48,8 @@ double preview_light(const rig::VirtualRig& rig, const ScreenCalibration& c, con
         const int py = static_cast<int>(p->y());
         const ContentUv uv = sample_warp(pc.warp, pc.output, px, py);
         if (!uv.valid()) continue;
-        const double content =
-            std::max(0.0, preview_content(uv.u, uv.v) -
-                              (indirect.pixels.empty() ? 0.0 : sample_content(indirect, uv.u, uv.v)[1]));
+        const auto grid = static_cast<float>(preview_content(uv.u, uv.v));
+        const double content = take_off_indirect_light({grid, grid, grid}, indirect, uv.u, uv.v)[1];
         // The rig's light (mean of the channels, black level included) for the signal
         // render_output gives: content x blend + beta -> response LUT, per channel.
         const float w = sample_blend(pc.blend, pc.output, px, py);

@@ -26,9 +26,8 @@ struct Point {
 // (render_output's `indirect`, clamped at 0), or as it is without one.
 std::array<float, 3> shown_content(double level, const RgbFloatImage& indirect, ContentUv uv) {
     const auto l = static_cast<float>(level);
-    if (indirect.pixels.empty() || !uv.valid()) return {l, l, l};
-    const std::array<float, 3> f = sample_content(indirect, uv.u, uv.v);
-    return {std::max(l - f[0], 0.0F), std::max(l - f[1], 0.0F), std::max(l - f[2], 0.0F)};
+    if (!uv.valid()) return {l, l, l};
+    return take_off_indirect_light({l, l, l}, indirect, uv.u, uv.v);
 }
 
 // The light at screen point s for flat content `level`: each projector's, as the viewer sees it (`seen`: times the

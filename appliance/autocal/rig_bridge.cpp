@@ -140,11 +140,8 @@ LuminanceError measure_luminance(const rig::VirtualRig& rig, const ScreenCalibra
                              (seen ? rig::screen_gain(rig.screen, s, rp.pose.position_m, rig.viewer_m) : 1.0);
             // White content, less the indirect light's field where the outputs subtract one.
             std::array<float, 3> content{1.0F, 1.0F, 1.0F};
-            if (const ContentUv uv = sample_warp(pc.warp, pc.output, (*xy)[0], (*xy)[1]);
-                uv.valid() && !field.pixels.empty()) {
-                const std::array<float, 3> less = sample_content(field, uv.u, uv.v);
-                for (std::size_t c = 0; c < 3; ++c) content[c] = std::max(1.0F - less[c], 0.0F);
-            }
+            if (const ContentUv uv = sample_warp(pc.warp, pc.output, (*xy)[0], (*xy)[1]); uv.valid())
+                content = take_off_indirect_light(content, field, uv.u, uv.v);
             for (int c = 0; c < 3; ++c) {
                 const double signal = apply_response(pc.response, c, content[static_cast<std::size_t>(c)] * w);
                 l += f * rp.brightness[static_cast<std::size_t>(c)] *

@@ -67,6 +67,14 @@ std::array<float, 3> sample_content(const RgbFloatImage& content, double u, doub
     return bilinear(content, u * content.size.width - 0.5, v * content.size.height - 0.5);
 }
 
+std::array<float, 3> take_off_indirect_light(std::array<float, 3> linear, const RgbFloatImage& indirect, double u,
+                                             double v) {
+    if (indirect.pixels.empty()) return linear;
+    const std::array<float, 3> screen_light = sample_content(indirect, u, v);
+    for (std::size_t c = 0; c < 3; ++c) linear[c] = std::max(linear[c] - screen_light[c], 0.0F);
+    return linear;
+}
+
 RgbFloatImage render_output(const ProjectorCalibration& projector, const RgbFloatImage& content_linear,
                             const RgbFloatImage& indirect) {
     validate_projector(projector, "render_output: projector '" + projector.id + "'");
@@ -78,13 +86,10 @@ RgbFloatImage render_output(const ProjectorCalibration& projector, const RgbFloa
         for (int x = 0; x < projector.output.width; ++x) {
             const ContentUv uv = sample_warp(projector.warp, projector.output, x, y);
             if (!uv.valid()) continue;  // no content: signal 0
-            std::array<float, 3> rgb = sample_content(content_linear, uv.u, uv.v);
-            if (has_indirect) {
-                // At the screen point uv itself: the field lives in the calibration's content
-                // coordinates, as the warp does.
-                const std::array<float, 3> screen_light = sample_content(indirect, uv.u, uv.v);
-                for (std::size_t c = 0; c < 3; ++c) rgb[c] = std::max(rgb[c] - screen_light[c], 0.0F);
-            }
+            // At the screen point uv itself: the field lives in the calibration's content
+            // coordinates, as the warp does.
+            const std::array<float, 3> rgb =
+                take_off_indirect_light(sample_content(content_linear, uv.u, uv.v), indirect, uv.u, uv.v);
             const float weight = sample_blend(projector.blend, projector.output, x, y);
             const std::array<float, 3> beta = sample_beta(projector.beta, projector.output, x, y);
             float* dst = out.at(x, y);

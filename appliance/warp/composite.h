@@ -29,6 +29,11 @@ namespace mogao {
 // Precondition: content non-empty with width*height*3 values.
 [[nodiscard]] std::array<float, 3> sample_content(const RgbFloatImage& content, double u, double v);
 
+// Content light `linear` at content point (u, v) less the indirect light field there (render_output's
+// linear'_c below: sample_content of the field, clamped at 0); `linear` unchanged when the field is empty.
+[[nodiscard]] std::array<float, 3> take_off_indirect_light(std::array<float, 3> linear, const RgbFloatImage& indirect,
+                                                           double u, double v);
+
 // The projector's input signal, per output pixel (x, y) and channel c:
 //
 //   uv         = sample_warp(x, y)                  the content point the pixel lands on
