@@ -274,6 +274,10 @@ public:
     // Manual exposure relative to the one the source was set up with (1 = that one); the colour
     // step lengthens it for black levels and sets it back.
     virtual void set_relative_exposure(double factor) = 0;
+    // True when the camera's frames come through a lossy codec (Motion-JPEG, as negotiated with the
+    // device): the colour step then averages each image over several exposures
+    // (ColourOptions::dither_frames). Known once a frame has been shown.
+    [[nodiscard]] virtual bool lossy_frames() const { return false; }
 };
 
 // The mean of `frames` camera images of the same signals (frames >= 1): the camera's temporal

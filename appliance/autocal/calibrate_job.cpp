@@ -268,6 +268,8 @@ nlohmann::json ground_truth_report(const GeometryError& g, const LuminanceError&
             {"outside", g.outside},
             {"luminance_max_deviation", l.max_deviation},
             {"seam_luminance_max_deviation", l.seam_max_deviation},
+            {"seam_luminance_max_at",
+             {{"theta_deg", l.seam_max_at.theta_rad * 180.0 / std::numbers::pi}, {"h_m", l.seam_max_at.h_m}}},
             {"camera_position_error_mm", (r.camera.position_m - rig.camera.pose.position_m).norm() * 1e3}};
 }
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 
@@ -30,6 +31,9 @@ void check_options(const ColourOptions& o) {
     if (o.dark_frames < 1 || o.dark_frames > 64) fail("dark_frames must be 1..64");
     if (!(o.dark_exposure >= 1.0 && o.dark_exposure <= 1000.0)) fail("dark_exposure must be in [1, 1000]");
     if (!(o.low_end_exposure >= 1.0 && o.low_end_exposure <= 1000.0)) fail("low_end_exposure must be in [1, 1000]");
+    if (o.dither_frames < 1 || o.dither_frames > 64) fail("dither_frames must be 1..64");
+    if (o.full_level_frames < 1 || o.full_level_frames > 64) fail("full_level_frames must be 1..64");
+    if (!(o.dither_span >= 0.0 && o.dither_span <= 0.5)) fail("dither_span must be in [0, 0.5]");
     if (o.lut_entries < 2 || o.lut_entries > kMaxResponseEntries) fail("lut_entries must be 2..2^20");
     if (!(o.min_amplitude > 0.0 && o.min_amplitude < 1.0)) fail("min_amplitude must be in (0, 1)");
     if (!(o.max_fit_rms > 0.0)) fail("max_fit_rms must be > 0");
@@ -80,7 +84,10 @@ struct Captured {
     std::vector<cv::Mat1b> outside;             // per projector: camera pixels it clearly does not light
     std::vector<cv::Mat1f> full;                // per projector: its channels' full levels summed, minus black
     std::vector<std::array<cv::Mat1f, 3>> top;  // per projector and channel: its full level minus black
-    cv::Mat1f flat;                             // the camera's vignetting V per pixel (step 1a), empty: 1
+    // Per projector: its white minus black at low_end_exposure, in base exposure units, NaN where the camera
+    // saturates (step 0's measurement where it does not light the screen); empty: not taken.
+    std::vector<cv::Mat1f> white_low;
+    cv::Mat1f flat;  // the camera's vignetting V per pixel (step 1a), empty: 1
     // Per projector, per camera pixel: the screen's gain G toward the camera (ScreenModel's comment) for that
     // projector's light there; empty on a matte screen (G = 1).
     std::vector<cv::Mat1f> to_camera;
@@ -196,6 +203,54 @@ LensFalloff fit_falloff(const Captured& cap, std::size_t k, const DeviceModel& d
     return f;
 }
 
+// The mean image of `signals` over camera images at relative exposure `exposure`, in its units. Raw frames:
+// `frames` images at that exposure. Lossy frames (PatternSource::lossy_frames): max(frames, dithered) images at
+// exposure (1 + span frac(j phi)), j = 0, 1, ... (phi the golden ratio's fraction: spread evenly over the span for
+// any count), each divided by its factor (1 + ...); the span is cut where the first image's 99.9th percentile would
+// pass 0.95 of full scale. 1 (full scale) wherever a frame saturates (>= 0.98), so that the callers' saturation
+// tests see it. Leaves the source at the locked exposure (1), also when show() throws.
+// Why (ColourOptions::dither_frames): a Motion-JPEG camera quantises each 8 x 8 block's mean in steps of about a
+// code and drops the noise that would dither it, so a flat field's slowly varying light gives wide areas the same
+// rounding, the same in every frame at one exposure. At quality 72 the full-level images were off by up to 0.7 %
+// of a channel's white: the joint fit of step 1a read the camera's vignetting as a 0.175, b 0.051 for a 0.208,
+// b 0 (raw frames: 0.205, 0.005), and the ramp's lower levels and black were off by more. Each exposure moves every
+// block's light by a different fraction of its step, so the mean over several dithers the rounding out.
+cv::Mat1f exposure_dithered_mean(PatternSource& source, const std::vector<cv::Mat>& signals, double exposure,
+                                 int frames, int dithered, double span, int& captures) {
+    const bool dither = source.lossy_frames() && dithered > 1 && span > 0.0;
+    const int n = dither ? std::max(frames, dithered) : frames;
+    const double phi = (std::sqrt(5.0) - 1.0) / 2.0;
+    cv::Mat1f sum;
+    cv::Mat1f peak;
+    try {
+        for (int j = 0; j < n; ++j) {
+            const double factor = dither ? 1.0 + span * std::fmod(j * phi, 1.0) : 1.0;
+            source.set_relative_exposure(exposure * factor);
+            const cv::Mat1f img = source.show(signals);
+            ++captures;
+            if (j == 0) {
+                sum = cv::Mat1f(img.size(), 0.0f);
+                peak = img.clone();
+                if (dither) {
+                    std::vector<float> v(img.begin(), img.end());
+                    const auto at = v.begin() + static_cast<long>(v.size() * 999 / 1000);
+                    std::nth_element(v.begin(), at, v.end());
+                    span = std::clamp(0.95 / std::max(static_cast<double>(*at), 1e-6) - 1.0, 0.0, span);
+                }
+            }
+            sum += img / static_cast<float>(factor);
+            peak = cv::max(peak, img);
+        }
+    } catch (...) {
+        source.set_relative_exposure(1.0);
+        throw;
+    }
+    source.set_relative_exposure(1.0);
+    sum /= static_cast<float>(n);
+    sum.setTo(1.0f, peak >= 0.98f);
+    return sum;
+}
+
 // Step 1's low end for channel c of projector k: levels up to 1/4 again, and 1/32, 1/16, at
 // low_end_exposure x the locked exposure (a few camera codes at the base exposure), in base
 // exposure units; replaces or adds to the measured levels unless the camera saturates there.
@@ -207,23 +262,16 @@ void measure_low_end(PatternSource& source, const std::vector<DeviceModel>& proj
         if (s > 0.0 && s <= 0.25 && s != low[0] && s != low[1]) low.push_back(s);
     }
     std::vector<std::pair<double, double>> got;
-    source.set_relative_exposure(o.low_end_exposure);
-    try {
-        for (const double s : low) {
-            const cv::Mat1f img = source.show(channel_signal(projectors, k, c, s));
-            ++captures;
-            double peak = 0.0;
-            cv::minMaxLoc(img, nullptr, &peak, nullptr, nullptr, in);
-            if (peak >= 0.98) continue;  // saturated: keep the base-exposure value
-            cv::Mat1f d;
-            cv::subtract(img, cap.black_low, d);
-            got.emplace_back(s, masked_mean(d, in) / o.low_end_exposure);
-        }
-    } catch (...) {
-        source.set_relative_exposure(1.0);
-        throw;
+    for (const double s : low) {
+        const cv::Mat1f img = exposure_dithered_mean(source, channel_signal(projectors, k, c, s), o.low_end_exposure, 1,
+                                                     o.dither_frames, o.dither_span, captures);
+        double peak = 0.0;
+        cv::minMaxLoc(img, nullptr, &peak, nullptr, nullptr, in);
+        if (peak >= 0.98) continue;  // saturated: keep the base-exposure value
+        cv::Mat1f d;
+        cv::subtract(img, cap.black_low, d);
+        got.emplace_back(s, masked_mean(d, in) / o.low_end_exposure);
     }
-    source.set_relative_exposure(1.0);
     for (const auto& [s, v] : got) {
         const auto it = std::find(r.levels.begin(), r.levels.end(), s);
         if (it != r.levels.end()) {
@@ -248,8 +296,10 @@ ProjectorPhotometry measure_projector(PatternSource& source, const std::vector<D
         for (int i = 1; i < n; ++i) {
             const double s = static_cast<double>(i) / (n - 1);
             cv::Mat1f d;
-            cv::subtract(source.show(channel_signal(projectors, k, c, s)), cap.black, d);
-            ++captures;
+            cv::subtract(
+                exposure_dithered_mean(source, channel_signal(projectors, k, c, s), 1.0, 1,
+                                       i == n - 1 ? o.full_level_frames : o.dither_frames, o.dither_span, captures),
+                cap.black, d);
             diffs[c].push_back(d);
         }
         full += diffs[c].back();
@@ -355,18 +405,8 @@ void measure_black(PatternSource& source, const ColourOptions& o, const Captured
                    const std::vector<DeviceModel>& projectors, std::vector<ProjectorPhotometry>& pps, double& ambient,
                    int& captures) {
     const std::size_t n = pps.size();
-    source.set_relative_exposure(o.dark_exposure);
-    cv::Mat1f dark(cap.black.size(), 0.0f);
-    std::vector<cv::Mat> off(n);
-    try {
-        for (int f = 0; f < o.dark_frames; ++f) dark += source.show(off);
-    } catch (...) {
-        source.set_relative_exposure(1.0);
-        throw;
-    }
-    source.set_relative_exposure(1.0);
-    captures += o.dark_frames;
-    dark /= static_cast<float>(o.dark_frames);
+    const cv::Mat1f dark = exposure_dithered_mean(source, std::vector<cv::Mat>(n), o.dark_exposure, o.dark_frames,
+                                                  o.dither_frames, o.dither_span, captures);
     Eigen::MatrixXd ata = Eigen::MatrixXd::Zero(static_cast<long>(n) + 1, static_cast<long>(n) + 1);
     Eigen::VectorXd atb = Eigen::VectorXd::Zero(static_cast<long>(n) + 1);
     long rows = 0;
@@ -419,11 +459,9 @@ void measure_black(PatternSource& source, const ColourOptions& o, const Captured
 // that black read low, most at the low end: the response looked steeper (gamma 2.29 for 2.2) and the seams got
 // worse. Returns the captures taken.
 int capture_low_black(PatternSource& source, const ColourOptions& options, std::size_t n, Captured& cap) {
-    source.set_relative_exposure(options.low_end_exposure);
-    cap.black_low = cv::Mat1f(cap.black.size(), 0.0f);
-    for (int f = 0; f < 4; ++f) cap.black_low += source.show(std::vector<cv::Mat>(n));
-    cap.black_low /= 4.0f;
-    source.set_relative_exposure(1.0);
+    int captures = 0;
+    cap.black_low = exposure_dithered_mean(source, std::vector<cv::Mat>(n), options.low_end_exposure, 4,
+                                           options.dither_frames, options.dither_span, captures);
     for (int y = 0; y < cap.black.rows; ++y) {
         for (int x = 0; x < cap.black.cols; ++x) {
             if (cap.black_low(y, x) < 0.98f) {
@@ -431,7 +469,7 @@ int capture_low_black(PatternSource& source, const ColourOptions& options, std::
             }
         }
     }
-    return 4;
+    return captures;
 }
 
 }  // namespace
@@ -464,10 +502,39 @@ double response_at(const ChannelResponse& r, double s) {
     return s <= l[i] ? a * s / l[i] : a + (b - a) * (s - l[i]) / (l[i + 1] - l[i]);
 }
 
+// Step 0's measurement: each projector's white (every channel at full level) at low_end_exposure, minus the black
+// at that exposure, in base exposure units; NaN where the camera saturates. Where the projector does not light the
+// screen its light's bounce is a few camera codes at the base exposure, and a Motion-JPEG camera quantises a flat
+// dark area's 8 x 8 block means in steps of about a code, the same error in every block: fitted there, a matte
+// screen read rho 0.02 (0.0004 from raw frames), and the bounce taken out left each projector a spurious
+// fall-off. At this exposure the same step is low_end_exposure times smaller. Returns the captures taken.
+int capture_bounce_whites(PatternSource& source, const std::vector<DeviceModel>& projectors, const ColourOptions& o,
+                          Captured& cap) {
+    int captures = 0;
+    for (std::size_t k = 0; k < projectors.size(); ++k) {
+        std::vector<cv::Mat> signals(projectors.size());
+        const ImageSize r = projectors[k].resolution;
+        signals[k] = cv::Mat(r.height, r.width, CV_32FC3, cv::Scalar(1.0, 1.0, 1.0));
+        const cv::Mat1f img =
+            exposure_dithered_mean(source, signals, o.low_end_exposure, 1, o.dither_frames, o.dither_span, captures);
+        cv::Mat1f d(img.size());
+        for (int y = 0; y < img.rows; ++y) {
+            for (int x = 0; x < img.cols; ++x) {
+                d(y, x) = img(y, x) >= 0.98f
+                              ? std::numeric_limits<float>::quiet_NaN()
+                              : (img(y, x) - cap.black_low(y, x)) / static_cast<float>(o.low_end_exposure);
+            }
+        }
+        cap.white_low.push_back(d);
+    }
+    return captures;
+}
+
 // Step 0: the screen's own light out of every full-level image (ColourOptions::screen_bounce): the bounce of the
 // light each image shows on the screen's patches (divided by the gain toward the camera, the light leaving them
 // matte), rho fitted where the projector does not light the screen (its `outside` mask eroded by 8 more
-// pixels, away from its blurred edge), then rho times that bounce subtracted.
+// pixels, away from its blurred edge; from capture_bounce_whites' images where taken), then rho times that bounce
+// subtracted.
 void remove_screen_bounce(Captured& cap, const ScreenModel& screen, ColourResult& res) {
     const ScreenBounce patches(screen);
     cv::Mat1i patch_of(cap.screen.size(), -1);
@@ -511,7 +578,9 @@ void remove_screen_bounce(Captured& cap, const ScreenModel& screen, ColourResult
         for (int y = 0; y < far.rows; ++y) {
             for (int x = 0; x < far.cols; ++x) {
                 if (far(y, x) == 0 || patch_of(y, x) < 0) continue;
-                sxy += static_cast<double>(cap.full[k](y, x)) * bounce_full(y, x);
+                const float seen = cap.white_low.empty() ? cap.full[k](y, x) : cap.white_low[k](y, x);
+                if (std::isnan(seen)) continue;
+                sxy += static_cast<double>(seen) * bounce_full(y, x);
                 sxx += static_cast<double>(bounce_full(y, x)) * bounce_full(y, x);
                 ++res.screen_bounce_samples;
             }
@@ -591,7 +660,9 @@ ColourResult calibrate_colour(PatternSource& source, const ScreenModel& told, co
     const std::size_t n = projectors.size();
     ColourResult res;
     Captured cap;
-    cap.black = source.show(std::vector<cv::Mat>(n)).clone();
+    int base_black_captures = 0;
+    cap.black = exposure_dithered_mean(source, std::vector<cv::Mat>(n), 1.0, 1, options.dither_frames,
+                                       options.dither_span, base_black_captures);
     if (options.lens_falloff) {
         if (camera.resolution.width != cap.black.cols || camera.resolution.height != cap.black.rows) {
             throw std::invalid_argument("calibrate_colour: the camera model is " +
@@ -602,13 +673,16 @@ ColourResult calibrate_colour(PatternSource& source, const ScreenModel& told, co
         cap.screen = camera_screen_points(camera, screen);
         cap.to_camera = gain_toward_camera(cap.screen, screen, camera, projectors);
     }  // written below; the source may reuse its buffer
-    res.captures = 1 + capture_low_black(source, options, n, cap);
+    res.captures = base_black_captures + capture_low_black(source, options, n, cap);
     for (std::size_t k = 0; k < n; ++k) {
         res.projectors.push_back(measure_projector(source, projectors, k, options, cap, res.captures));
     }
     res.half_gain_angle_deg = screen.half_gain_angle_deg;
     if (options.lens_falloff) {
-        if (options.screen_bounce) remove_screen_bounce(cap, screen, res);
+        if (options.screen_bounce) {
+            res.captures += capture_bounce_whites(source, projectors, options, cap);
+            remove_screen_bounce(cap, screen, res);
+        }
         if (options.camera_vignetting && options.estimate_half_gain_angle && screen.gain != 1.0) {
             screen.half_gain_angle_deg =
                 estimate_half_gain_angle(cap, told, camera, projectors, options, res.told_half_gain_rms,

@@ -60,6 +60,15 @@
 //     lobe's half-gain angle is measured rather than taken from the data sheet (estimate_half_gain_angle): the
 //     angle whose gain toward the camera, divided out, leaves the least residual in step 1a's fit; the peak gain
 //     cancels (it scales every projector alike) and stays the data sheet's.
+//  Exposure dither (a camera whose frames come through Motion-JPEG, PatternSource::lossy_frames): the codec
+//     rounds each 8 x 8 block's mean to its quantisation step and drops the noise that would dither it, so a flat
+//     image's wide areas share one rounding, the same in every frame at one exposure (0.7 % of white at quality 72,
+//     more at the ramp's low end and in black). Every image above is then the mean of `dither_frames` images
+//     (`full_level_frames` at the full level) at exposures spread over [1, 1 + dither_span] x its own, each
+//     divided by its exposure: the camera is linear in exposure, and each exposure moves every block's light by a
+//     different fraction of its step. The span is cut where the brightest pixels would saturate. The screen
+//     bounce's reflectance (step 0) is fitted on one white image per projector at low_end_exposure, where the
+//     bounce is a few codes at the base exposure.
 //  4. Per projector: LUT_kc(x) = R_kc^-1(x W_c / A_kc) (the ResponseCurve, x in matched-white
 //     units); beta_kc(p) = alpha_k(p) D_c(p) / (W_c F_k(p)) (the BlackOffset, one sample per output pixel, split
 //     between the projectors lighting p by their blend weights); alpha_k replaced by alpha_k s S / F_k with
@@ -81,11 +90,17 @@ struct ColourOptions {
     int dark_frames = 8;            // averaged black images, 1..64
     double dark_exposure = 40.0;    // exposure multiplier for the black images, [1, 1000]
     double low_end_exposure = 8.0;  // exposure multiplier for the ramp's low end (levels <= 1/4), [1, 1000]
-    int lut_entries = 4096;         // ResponseCurve samples, 2..kMaxResponseEntries (fine: x^(1/gamma) is steep near 0)
-    double min_amplitude = 0.05;    // a channel's full white must reach this much of full scale
-    double max_fit_rms = 0.03;      // rms of the measured response around a pure gamma, gate
-    int mask_erode_px = 2;          // coverage masks shrunk by this many camera pixels (blur, seams)
-    bool lens_falloff = true;       // step 1b: measure each projector's fall-off and attenuate per pixel
+    // Exposure dither (see "Method"; lossy frames only): every image of a ramp level or of black is the mean of
+    // `dither_frames` images at exposures spread over [1, 1 + dither_span] x its own, 1..64; the full level's of
+    // `full_level_frames`, 1..64 (steps 1a and 1b fit its shape). dither_span in [0, 0.5]; 1 frame: none.
+    int dither_frames = 4;
+    int full_level_frames = 8;
+    double dither_span = 0.5;
+    int lut_entries = 4096;       // ResponseCurve samples, 2..kMaxResponseEntries (fine: x^(1/gamma) is steep near 0)
+    double min_amplitude = 0.05;  // a channel's full white must reach this much of full scale
+    double max_fit_rms = 0.03;    // rms of the measured response around a pure gamma, gate
+    int mask_erode_px = 2;        // coverage masks shrunk by this many camera pixels (blur, seams)
+    bool lens_falloff = true;     // step 1b: measure each projector's fall-off and attenuate per pixel
     int falloff_min_samples = 1000;       // camera pixels a projector's fall-off fit needs, >= 6
     bool camera_vignetting = true;        // step 1a: measure the camera's vignetting (with lens_falloff only)
     double vignetting_prior_sigma = 0.2;  // its prior on a and b (camera_vignetting.h), > 0

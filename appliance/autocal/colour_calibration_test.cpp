@@ -356,6 +356,51 @@ TEST(ColourCalibration, CameraVignettingFitToldApartOnlyWhereTheProjectorsSitApa
     EXPECT_THROW((void)fit_camera_vignetting(centred, 0, 0.2), std::invalid_argument);
 }
 
+// A Motion-JPEG camera (quality 72) on the falloff rig with the camera's vignetting: the codec rounds each 8 x 8
+// block's mean to its quantisation step and drops the noise that would dither it, the same in every frame at one
+// exposure. Each image taken once, the joint fit of step 1a misreads the vignetting and the blacks and ramp levels
+// are off; averaged over exposures spread by half (ColourOptions::dither_frames) they come out as from raw frames.
+TEST(ColourCalibration, AMotionJpegCamerasRoundingIsDitheredOutByExposure) {
+    rig::VirtualRig rig = scaled_rig(rig::load_rig(std::string(MOGAO_SOURCE_DIR) + "/rigs/falloff.toml"), 0.5, 0.5);
+    rig.camera.vignetting = 0.2;
+    rig.camera.mjpeg_quality = 72;
+    RigPatternSource source(rig);
+    ASSERT_TRUE(source.lossy_frames());
+    const CalibrationPrior prior = prior_from_rig(rig);
+    const AutocalResult r = calibrate(source, prior, {960, 540}, fast_options());
+    struct Run {
+        double corner_error = 0.0;
+        double seam_max = 0.0;
+        int captures = 0;
+    };
+    const auto colour_with = [&](int dither_frames, int full_level_frames, const char* what) {
+        ColourOptions o;
+        o.dither_frames = dither_frames;
+        o.full_level_frames = full_level_frames;
+        AutocalResult mine = r;
+        const ColourResult c =
+            calibrate_colour(source, prior.screen, mine.camera, mine.projectors, mine.calibration, o);
+        Run run;
+        run.corner_error = std::abs(c.vignetting.corner - (1.0 - rig.camera.vignetting));
+        run.captures = c.captures;
+        for (const double level : {0.05, 0.5, 1.0}) {
+            const SeamColour a = measure_seam_colour(rig, mine.calibration, level);
+            run.seam_max = std::max(run.seam_max, a.seam_luminance_pixel_max);
+        }
+        std::printf(
+            "%s: %d captures, vignetting at rho = 1 off by %.4f, seam luminance pixel max over 0.05, 0.5, 1: "
+            "%.2f %%\n",
+            what, run.captures, run.corner_error, 100.0 * run.seam_max);
+        return run;
+    };
+    const Run once = colour_with(1, 1, "every image once");
+    const Run dithered = colour_with(4, 8, "dithered by exposure (the defaults)");
+    EXPECT_GT(dithered.captures, 3 * once.captures);
+    EXPECT_LT(dithered.corner_error, 0.01);
+    EXPECT_LT(dithered.seam_max, 0.6 * once.seam_max);
+    EXPECT_LT(dithered.seam_max, 0.01);
+}
+
 TEST(ColourCalibration, RefusesAutoExposureAndAChannelTooDarkForTheCamera) {
     rig::VirtualRig rig = colour_rig();
     RigPatternSource locked(rig);

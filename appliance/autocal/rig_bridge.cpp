@@ -160,7 +160,8 @@ LuminanceError measure_luminance(const rig::VirtualRig& rig, const ScreenCalibra
     }
     std::vector<double> lum;
     std::vector<bool> seam;
-    for (const rig::ScreenPoint& s : seam_grid(rig, inset, grid.columns, grid.rows)) {
+    const std::vector<rig::ScreenPoint> points = seam_grid(rig, inset, grid.columns, grid.rows);
+    for (const rig::ScreenPoint& s : points) {
         int lit = 0;
         lum.push_back(direct(s, true, &lit) + (bounce ? bounce->at(bounced, s) : 0.0));
         seam.push_back(lit >= 2);
@@ -173,7 +174,10 @@ LuminanceError measure_luminance(const rig::VirtualRig& rig, const ScreenCalibra
     for (std::size_t i = 0; i < lum.size(); ++i) {
         const double d = std::abs(lum[i] / median - 1.0);
         out.max_deviation = std::max(out.max_deviation, d);
-        if (seam[i]) out.seam_max_deviation = std::max(out.seam_max_deviation, d);
+        if (seam[i] && d > out.seam_max_deviation) {
+            out.seam_max_deviation = d;
+            out.seam_max_at = points[i];
+        }
     }
     return out;
 }

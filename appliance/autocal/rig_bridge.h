@@ -31,6 +31,7 @@ public:
     [[nodiscard]] double simulate_s() const { return simulate_s_; }  // seconds inside show()
     [[nodiscard]] bool exposure_locked() const override { return !sim_.rig().camera.auto_exposure; }
     void set_relative_exposure(double factor) override { sim_.set_exposure(base_exposure_ * factor); }
+    [[nodiscard]] bool lossy_frames() const override { return sim_.rig().camera.mjpeg_quality > 0; }
     [[nodiscard]] const rig::CameraSimulator& simulator() const { return sim_; }
 
 private:
@@ -83,6 +84,7 @@ struct LuminanceError {
     int samples = 0;
     double max_deviation = 0.0;       // max |L / median - 1| over the screen (white content)
     double seam_max_deviation = 0.0;  // the same over points lit by two or more projectors
+    rig::ScreenPoint seam_max_at;     // where the seam's maximum is (theta, h)
 };
 
 // The rig's true lens fall-off of projector `p` as a model's LensFalloff (virtual_rig.h's

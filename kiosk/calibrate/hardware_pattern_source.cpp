@@ -52,6 +52,7 @@ cv::Mat1f HardwarePatternSource::capture() {
                                  std::to_string(camera_size_.width) + "x" + std::to_string(camera_size_.height));
     }
     cv::Mat1f image = camera_image(frame.value(), transfer_);
+    lossy_ = frame.value().format == CaptureFormat::mjpeg;
     ++done_;
     if (progress_) {
         CaptureProgress p;

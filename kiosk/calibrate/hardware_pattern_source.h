@@ -49,6 +49,8 @@ public:
     [[nodiscard]] cv::Mat1f show(const std::vector<cv::Mat>& signals) override;
     [[nodiscard]] bool exposure_locked() const override { return camera_->exposure_locked(); }
     void set_relative_exposure(double factor) override;
+    // The last frame's wire format was Motion-JPEG.
+    [[nodiscard]] bool lossy_frames() const override { return lossy_; }
 
     // One image of what `per_output[i]` on output i looks like (identification: outputs by index).
     [[nodiscard]] cv::Mat1f show_outputs(const std::vector<cv::Mat>& per_output);
@@ -71,6 +73,7 @@ private:
     int expected_;
     ProgressFn progress_;
     int done_ = 0;
+    bool lossy_ = false;
     std::chrono::steady_clock::time_point start_;
 };
 

@@ -8,7 +8,7 @@ namespace mogao::calibrate {
 
 PatternBudget pattern_budget(const autocal::CalibrationPrior& prior, bool colour,
                              const autocal::ColourOptions& colour_options, const autocal::AutocalOptions& options,
-                             const autocal::SelfCheckOptions& self_check) {
+                             const autocal::SelfCheckOptions& self_check, bool lossy_frames) {
     const int n = static_cast<int>(prior.projectors.size());
     const auto bits = [&](int extent) {
         const int all = autocal::gray_code_bits(extent);
@@ -29,7 +29,15 @@ PatternBudget pattern_budget(const autocal::CalibrationPrior& prior, bool colour
             const double s = static_cast<double>(i) / (steps - 1);
             if (s <= 0.25 && s != 1.0 / 32.0 && s != 1.0 / 16.0) ++low;
         }
-        b.colour = 5 + n * 3 * ((steps - 1) + low) + colour_options.dark_frames;
+        // Each image's count (colour_calibration.h, exposure dither): `raw` frames, with lossy frames at least the
+        // dither's.
+        const bool dither = lossy_frames && colour_options.dither_frames > 1 && colour_options.dither_span > 0.0;
+        const auto frames = [&](int raw, int dithered) { return dither ? std::max(raw, dithered) : raw; };
+        const int d = colour_options.dither_frames;
+        const int bounce = colour_options.lens_falloff && colour_options.screen_bounce ? n : 0;
+        b.colour = frames(1, d) + frames(4, d) + bounce * frames(1, d) +
+                   n * 3 * ((steps - 2 + low) * frames(1, d) + frames(1, colour_options.full_level_frames)) +
+                   frames(colour_options.dark_frames, d);
     }
     b.self_check = self_check.frames * (2 + 2 * n);
     return b;

@@ -81,6 +81,8 @@ Result<CameraFrame> RigCamera::next_frame() {
         }
     }
     frame.colour = std::move(colour);
+    // A Motion-JPEG camera's frames (the rig camera's mjpeg_quality) were decoded from that codec.
+    frame.format = sim_.rig().camera.mjpeg_quality > 0 ? CaptureFormat::mjpeg : CaptureFormat::grey;
     frame.sequence = frame_;
     frame.timestamp_ns = static_cast<std::int64_t>(frame_) * 33'333'333;
     ++frame_;
