@@ -453,13 +453,16 @@ void measure_black(PatternSource& source, const ColourOptions& o, const Captured
     for (std::size_t k = 0; k < n; ++k) pps[k].black = std::max(0.0, sol[static_cast<long>(k) + 1]);
 }
 
-// The all-black image at low_end_exposure (4 averaged, into cap.black_low), and the base-exposure black from it
-// wherever it is not saturated (the camera is linear in exposure): a camera clips its noise at 0, so a dark
+// The all-black image at the locked exposure (cap.black) and at low_end_exposure (4 averaged, into cap.black_low);
+// cap.black then from cap.black_low wherever that is not saturated (the camera is linear in exposure): a camera
+// clips its noise at 0, so a dark
 // image's mean reads high (by 0.008 of full scale on the noisy rig, 3 % read noise), and every ramp level minus
 // that black read low, most at the low end: the response looked steeper (gamma 2.29 for 2.2) and the seams got
 // worse. Returns the captures taken.
-int capture_low_black(PatternSource& source, const ColourOptions& options, std::size_t n, Captured& cap) {
+int capture_blacks(PatternSource& source, const ColourOptions& options, std::size_t n, Captured& cap) {
     int captures = 0;
+    cap.black = exposure_dithered_mean(source, std::vector<cv::Mat>(n), 1.0, 1, options.dither_frames,
+                                       options.dither_span, captures);
     cap.black_low = exposure_dithered_mean(source, std::vector<cv::Mat>(n), options.low_end_exposure, 4,
                                            options.dither_frames, options.dither_span, captures);
     for (int y = 0; y < cap.black.rows; ++y) {
@@ -660,9 +663,7 @@ ColourResult calibrate_colour(PatternSource& source, const ScreenModel& told, co
     const std::size_t n = projectors.size();
     ColourResult res;
     Captured cap;
-    int base_black_captures = 0;
-    cap.black = exposure_dithered_mean(source, std::vector<cv::Mat>(n), 1.0, 1, options.dither_frames,
-                                       options.dither_span, base_black_captures);
+    res.captures = capture_blacks(source, options, n, cap);
     if (options.lens_falloff) {
         if (camera.resolution.width != cap.black.cols || camera.resolution.height != cap.black.rows) {
             throw std::invalid_argument("calibrate_colour: the camera model is " +
@@ -672,8 +673,7 @@ ColourResult calibrate_colour(PatternSource& source, const ScreenModel& told, co
         }
         cap.screen = camera_screen_points(camera, screen);
         cap.to_camera = gain_toward_camera(cap.screen, screen, camera, projectors);
-    }  // written below; the source may reuse its buffer
-    res.captures = base_black_captures + capture_low_black(source, options, n, cap);
+    }
     for (std::size_t k = 0; k < n; ++k) {
         res.projectors.push_back(measure_projector(source, projectors, k, options, cap, res.captures));
     }

@@ -35,8 +35,7 @@ struct PatternBudget {
 [[nodiscard]] PatternBudget pattern_budget(const autocal::CalibrationPrior& prior, bool colour,
                                            const autocal::ColourOptions& colour_options,
                                            const autocal::AutocalOptions& options,
-                                           const autocal::SelfCheckOptions& self_check = {},
-                                           bool lossy_frames = false);
+                                           const autocal::SelfCheckOptions& self_check = {}, bool lossy_frames = false);
 
 // Seconds to capture one image: settle_ms / 1000 + (drop_frames + 1) / fps. fps > 0.
 [[nodiscard]] double seconds_per_image(double fps, int settle_ms, int drop_frames);

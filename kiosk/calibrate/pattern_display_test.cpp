@@ -105,7 +105,7 @@ TEST(PatternBudget, StandardRigImageCount) {
     // the camera timing's 4 single frames; black, white, 3 alone (the lit edges); per projector 1920x1080: 11 + 11
     // Gray bits, each with its inverse, + white, black, + 8 phase shifts per axis
     EXPECT_EQ(b.geometry, 4 + 2 + 3 + 3 * (46 + 16));
-    EXPECT_EQ(b.self_check, 2 * (2 + 2 * 3));  // black, 3 alone (the frame), black, 3 projectors' marks
+    EXPECT_EQ(b.self_check, 2 * (2 + 2 * 3));          // black, 3 alone (the frame), black, 3 projectors' marks
     EXPECT_EQ(b.colour, 5 + 3 + 3 * 3 * (8 + 4) + 8);  // black, black x4 long, each white long for the bounce
     // Motion-JPEG frames: 4 dithered exposures per image, 8 at the full level, 8 black frames long.
     EXPECT_EQ(pattern_budget(prior, true, {}, {}, {}, true).colour, 4 + 4 + 3 * 4 + 3 * 3 * (11 * 4 + 8) + 8);
