@@ -110,11 +110,11 @@ Rgb8Image preview(const rig::VirtualRig& rig, const ScreenCalibration& c, int wi
 }
 
 // Seams against the rig's ground truth at black, dark, mid grey and white content.
-nlohmann::json seam_figures(const rig::VirtualRig& rig, const ScreenCalibration& c,
+nlohmann::json seam_figures(const rig::VirtualRig& rig, const ScreenCalibration& c, bool defocused,
                             const IndirectLight* indirect = nullptr) {
     nlohmann::json out = nlohmann::json::array();
     for (const double level : {0.0, 0.05, 0.5, 1.0}) {
-        const SeamColour s = measure_seam_colour(rig, c, level, 0.01, indirect);
+        const SeamColour s = measure_seam_colour(rig, c, level, 0.01, indirect, defocused);
         out.push_back({{"level", level},
                        {"reference_luminance", s.reference_luminance},
                        {"seam_luminance_deviation", s.seam_luminance_deviation},
@@ -306,7 +306,7 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
     nlohmann::json seams_before;
     std::optional<ColourResult> colour;
     if (job.colour) {
-        seams_before = seam_figures(rig, r.calibration);
+        seams_before = seam_figures(rig, r.calibration, job.defocused_truth);
         const auto t1 = std::chrono::steady_clock::now();
         colour =
             calibrate_colour(source, r.screen, r.camera, r.projectors, r.calibration, job.colour_options);  // throws
@@ -325,7 +325,8 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
     if (colour && job.indirect_light) indirect.emplace(r.screen, r.projectors, r.calibration);
     const IndirectLight* shown_less = indirect && indirect->active() ? &*indirect : nullptr;
     // One grid point per projector pixel: a seam's maximum must see a line one pixel wide.
-    const LuminanceError l = measure_luminance(rig, r.calibration, 0.01, pixel_dense_seam_grid(rig), shown_less);
+    const LuminanceError l =
+        measure_luminance(rig, r.calibration, 0.01, pixel_dense_seam_grid(rig), shown_less, job.defocused_truth);
     nlohmann::json report = {{"rig", rig.name},
                              {"rig_file", job.rig.string()},
                              {"scale", job.scale},
@@ -354,7 +355,8 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
         report["captures"] = r.report.captures + check.captures + colour->captures;
         report["ground_truth"]["seams_before_colour"] = seams_before;
     }
-    report["ground_truth"]["seams"] = seam_figures(rig, r.calibration, shown_less);
+    report["ground_truth"]["seams"] = seam_figures(rig, r.calibration, job.defocused_truth, shown_less);
+    report["ground_truth"]["defocused"] = job.defocused_truth;
     for (std::size_t k = 0; k < r.report.projectors.size(); ++k)
         report["projectors"].push_back(
             projector_json(r, k, rig, job.options, source.simulator().camera_coverage(static_cast<int>(k))));

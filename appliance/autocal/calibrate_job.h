@@ -46,6 +46,10 @@ struct CalibrateJob : CalibrationSettings {
     // straddles the flips (camera.straddle) is refused at 0 and calibrates with 1, as a site's camera with its
     // settle time and dropped frames.
     int drop_frames = 0;
+    // The ground truth's seams with the rig's projector defocus (projector_footprint.h: each pixel's light spread
+    // by its aperture and the lens's blur_px, as the screen shows it) instead of each projector pixel's light as a
+    // sharp step (the default, which the figures in docs/calibration.md use).
+    bool defocused_truth = false;
 };
 
 // Runs the job; returns the report (also written as report.json). Throws rig::RigError,

@@ -208,7 +208,8 @@ LensFalloff fit_falloff(const Captured& cap, std::size_t k, const DeviceModel& d
 // exposure (1 + span frac(j phi)), j = 0, 1, ... (phi the golden ratio's fraction: spread evenly over the span for
 // any count), each divided by its factor (1 + ...); the span is cut where the first image's 99.9th percentile would
 // pass 0.95 of full scale. 1 (full scale) wherever a frame saturates (>= 0.98), so that the callers' saturation
-// tests see it. Leaves the source at the locked exposure (1), also when show() throws.
+// tests see it. Changes the source's exposure only when it must (a dither, or exposure != 1), and then leaves it at
+// the locked one (1), also when show() throws.
 // Why (ColourOptions::dither_frames): a Motion-JPEG camera quantises each 8 x 8 block's mean in steps of about a
 // code and drops the noise that would dither it, so a flat field's slowly varying light gives wide areas the same
 // rounding, the same in every frame at one exposure. At quality 72 the full-level images were off by up to 0.7 %
@@ -219,13 +220,14 @@ cv::Mat1f exposure_dithered_mean(PatternSource& source, const std::vector<cv::Ma
                                  int frames, int dithered, double span, int& captures) {
     const bool dither = source.lossy_frames() && dithered > 1 && span > 0.0;
     const int n = dither ? std::max(frames, dithered) : frames;
+    const bool changes = dither || exposure != 1.0;
     const double phi = (std::sqrt(5.0) - 1.0) / 2.0;
     cv::Mat1f sum;
     cv::Mat1f peak;
     try {
         for (int j = 0; j < n; ++j) {
             const double factor = dither ? 1.0 + span * std::fmod(j * phi, 1.0) : 1.0;
-            source.set_relative_exposure(exposure * factor);
+            if (changes && (j == 0 || dither)) source.set_relative_exposure(exposure * factor);
             const cv::Mat1f img = source.show(signals);
             ++captures;
             if (j == 0) {
@@ -242,10 +244,10 @@ cv::Mat1f exposure_dithered_mean(PatternSource& source, const std::vector<cv::Ma
             peak = cv::max(peak, img);
         }
     } catch (...) {
-        source.set_relative_exposure(1.0);
+        if (changes) source.set_relative_exposure(1.0);
         throw;
     }
-    source.set_relative_exposure(1.0);
+    if (changes) source.set_relative_exposure(1.0);
     sum /= static_cast<float>(n);
     sum.setTo(1.0f, peak >= 0.98f);
     return sum;
@@ -455,10 +457,9 @@ void measure_black(PatternSource& source, const ColourOptions& o, const Captured
 
 // The all-black image at the locked exposure (cap.black) and at low_end_exposure (4 averaged, into cap.black_low);
 // cap.black then from cap.black_low wherever that is not saturated (the camera is linear in exposure): a camera
-// clips its noise at 0, so a dark
-// image's mean reads high (by 0.008 of full scale on the noisy rig, 3 % read noise), and every ramp level minus
-// that black read low, most at the low end: the response looked steeper (gamma 2.29 for 2.2) and the seams got
-// worse. Returns the captures taken.
+// clips its noise at 0, so a dark image's mean reads high (by 0.008 of full scale on the noisy rig, 3 % read
+// noise), and every ramp level minus that black read low, most at the low end: the response looked steeper (gamma
+// 2.29 for 2.2) and the seams got worse. Returns the captures taken.
 int capture_blacks(PatternSource& source, const ColourOptions& options, std::size_t n, Captured& cap) {
     int captures = 0;
     cap.black = exposure_dithered_mean(source, std::vector<cv::Mat>(n), 1.0, 1, options.dither_frames,

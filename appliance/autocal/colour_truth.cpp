@@ -6,6 +6,9 @@
 #include <cmath>
 #include <optional>
 
+#include <opencv2/core.hpp>
+
+#include "appliance/autocal/projector_footprint.h"
 #include "appliance/autocal/rig_bridge.h"
 #include "appliance/rig/screen_light.h"
 #include "appliance/warp/composite.h"
@@ -30,38 +33,96 @@ std::array<float, 3> shown_content(double level, const RgbFloatImage& indirect, 
     return take_off_indirect_light({l, l, l}, indirect, uv.u, uv.v);
 }
 
+// Projector output pixel (x, y) for flat content `level`: its light before the lens fall-off (the rig's response,
+// brightness and black level; the black also where it shows no content), and its blend weight in `weight`.
+std::array<double, 3> pixel_rgb(const rig::RigProjector& rp, const ProjectorCalibration& pc, double level,
+                                const RgbFloatImage& indirect, int x, int y, float* weight) {
+    const ContentUv uv = sample_warp(pc.warp, pc.output, x, y);
+    const bool shown = uv.valid();
+    const float w = shown ? sample_blend(pc.blend, pc.output, x, y) : 0.0F;
+    const std::array<float, 3> beta = sample_beta(pc.beta, pc.output, x, y);
+    const std::array<float, 3> content = shown_content(level, indirect, uv);
+    std::array<double, 3> rgb{};
+    for (std::size_t c = 0; c < 3; ++c) {
+        const double signal = shown ? apply_response(pc.response, static_cast<int>(c), content[c] * w + beta[c]) : 0.0;
+        rgb[c] = rp.brightness[c] * (rp.black_level + (1.0 - rp.black_level) * std::pow(signal, rp.gamma[c]));
+    }
+    if (weight != nullptr) *weight = w;
+    return rgb;
+}
+
+// Per projector with a defocus (RigProjector::blur_px > 0): pixel_rgb of every output pixel, row-major; empty for a
+// sharp one (a point takes its one pixel's light).
+using PixelLights = std::vector<std::vector<std::array<float, 3>>>;
+PixelLights defocused_pixel_lights(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double level,
+                                   const RgbFloatImage& indirect) {
+    PixelLights out(calibration.projectors.size());
+    for (std::size_t k = 0; k < out.size(); ++k) {
+        const rig::RigProjector& rp = rig.projectors[k];
+        if (rp.blur_px <= 0.0) continue;
+        const ProjectorCalibration& pc = calibration.projectors[k];
+        out[k].resize(static_cast<std::size_t>(pc.output.pixel_count()));
+        cv::parallel_for_(cv::Range(0, pc.output.height), [&](const cv::Range& rows) {
+            for (int y = rows.start; y < rows.end; ++y) {
+                for (int x = 0; x < pc.output.width; ++x) {
+                    const std::array<double, 3> rgb = pixel_rgb(rp, pc, level, indirect, x, y, nullptr);
+                    out[k][static_cast<std::size_t>(y) * pc.output.width + x] = {
+                        static_cast<float>(rgb[0]), static_cast<float>(rgb[1]), static_cast<float>(rgb[2])};
+                }
+            }
+        });
+    }
+    return out;
+}
+
+// The light of `lights` (one projector's, row-major, `size`) at image position (x, y) through its pixels' footprint
+// (projector_footprint.h).
+std::array<double, 3> footprint_rgb(const std::vector<std::array<float, 3>>& lights, ImageSize size, double blur_px,
+                                    double x, double y) {
+    const FootprintTaps tx = footprint_taps(x, size.width, blur_px);
+    const FootprintTaps ty = footprint_taps(y, size.height, blur_px);
+    std::array<double, 3> rgb{};
+    for (int j = 0; j < ty.count; ++j) {
+        const std::size_t row = static_cast<std::size_t>(ty.first + j) * size.width;
+        for (int i = 0; i < tx.count; ++i) {
+            const double w = ty.weight[static_cast<std::size_t>(j)] * tx.weight[static_cast<std::size_t>(i)];
+            const std::array<float, 3>& v = lights[row + static_cast<std::size_t>(tx.first + i)];
+            for (std::size_t c = 0; c < 3; ++c) rgb[c] += w * v[c];
+        }
+    }
+    return rgb;
+}
+
 // The light at screen point s for flat content `level`: each projector's, as the viewer sees it (`seen`: times the
-// screen's gain toward rig.viewer_m) or as it leaves a matte screen (what bounces), plus the ambient.
+// screen's gain toward rig.viewer_m) or as it leaves a matte screen (what bounces), plus the ambient. A defocused
+// projector's light is its pixels' through their footprint (`lights`, defocused_pixel_lights), a sharp one's its
+// one pixel's.
 Point direct_light(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double level,
-                   const RgbFloatImage& indirect, const rig::ScreenPoint& s, bool seen) {
+                   const RgbFloatImage& indirect, const PixelLights& lights, const rig::ScreenPoint& s, bool seen) {
     Point pt;
     pt.rgb = {rig.ambient, rig.ambient, rig.ambient};
     float most = 0.0F;
     for (std::size_t k = 0; k < calibration.projectors.size(); ++k) {
         const ProjectorCalibration& pc = calibration.projectors[k];
+        const auto position = rig::screen_to_projector(rig, static_cast<int>(k), s);
         const auto xy = output_pixel(rig, static_cast<int>(k), pc, s);
-        if (!xy) continue;
+        if (!xy || !position) continue;
         const auto [x, y] = *xy;
-        const ContentUv uv = sample_warp(pc.warp, pc.output, x, y);
-        const bool shown = uv.valid();
-        const float w = shown ? sample_blend(pc.blend, pc.output, x, y) : 0.0F;
-        const std::array<float, 3> beta = sample_beta(pc.beta, pc.output, x, y);
+        const rig::RigProjector& rp = rig.projectors[k];
+        float w = 0.0F;
+        std::array<double, 3> rgb = pixel_rgb(rp, pc, level, indirect, x, y, &w);
         if (w > 0.0F) ++pt.lit;
         if (w > most) {
             most = w;
             pt.shown_by = static_cast<int>(k);
             pt.pixel = *xy;
         }
-        const rig::RigProjector& rp = rig.projectors[k];
-        const double f = rig::projector_falloff(rp, x + 0.5, y + 0.5) *
+        const bool defocused = !lights[k].empty();
+        if (defocused) rgb = footprint_rgb(lights[k], pc.output, rp.blur_px, position->x(), position->y());
+        const double f = (defocused ? rig::projector_falloff(rp, position->x(), position->y())
+                                    : rig::projector_falloff(rp, x + 0.5, y + 0.5)) *
                          (seen ? rig::screen_gain(rig.screen, s, rp.pose.position_m, rig.viewer_m) : 1.0);
-        const std::array<float, 3> content = shown_content(level, indirect, uv);
-        for (std::size_t c = 0; c < 3; ++c) {
-            const double signal =
-                shown ? apply_response(pc.response, static_cast<int>(c), content[c] * w + beta[c]) : 0.0;
-            pt.rgb[c] +=
-                f * rp.brightness[c] * (rp.black_level + (1.0 - rp.black_level) * std::pow(signal, rp.gamma[c]));
-        }
+        for (std::size_t c = 0; c < 3; ++c) pt.rgb[c] += f * rgb[c];
     }
     return pt;
 }
@@ -71,21 +132,23 @@ Point direct_light(const rig::VirtualRig& rig, const ScreenCalibration& calibrat
 class ViewedLight {
 public:
     ViewedLight(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double level,
-                const IndirectLight* compensation)
+                const IndirectLight* compensation, bool defocused)
         : rig_(rig), calibration_(calibration), level_(level) {
         if (compensation != nullptr) indirect_ = compensation->flat_field(level);
+        lights_ = defocused ? defocused_pixel_lights(rig, calibration, level, indirect_)
+                            : PixelLights(calibration.projectors.size());
         if (rig.screen.interreflection <= 0.0) return;
         bounce_.emplace(rig.screen);
         std::array<std::vector<double>, 3> leaving;
         for (int i = 0; i < bounce_->patches(); ++i) {
-            const Point p = direct_light(rig, calibration, level, indirect_, bounce_->centre(i), false);
+            const Point p = direct_light(rig, calibration, level, indirect_, lights_, bounce_->centre(i), false);
             for (std::size_t c = 0; c < 3; ++c) leaving[c].push_back(p.rgb[c] - rig.ambient);
         }
         for (std::size_t c = 0; c < 3; ++c) bounced_[c] = bounce_->bounce(leaving[c]);
     }
 
     [[nodiscard]] Point at(const rig::ScreenPoint& s) const {
-        Point p = direct_light(rig_, calibration_, level_, indirect_, s, true);
+        Point p = direct_light(rig_, calibration_, level_, indirect_, lights_, s, true);
         if (bounce_) {
             for (std::size_t c = 0; c < 3; ++c) p.rgb[c] += bounce_->at(bounced_[c], s);
         }
@@ -97,6 +160,7 @@ private:
     const ScreenCalibration& calibration_;
     double level_;
     RgbFloatImage indirect_;  // the compensation's field for this level (empty: none)
+    PixelLights lights_;      // defocused projectors' pixel lights
     std::optional<rig::ScreenBounce> bounce_;
     std::array<std::vector<double>, 3> bounced_;
 };
@@ -180,10 +244,10 @@ std::array<double, 3> rgb_to_lab(const std::array<double, 3>& rgb, const std::ar
 }
 
 SeamColour measure_seam_colour(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double level,
-                               double inset, const IndirectLight* indirect) {
+                               double inset, const IndirectLight* indirect, bool defocused) {
     const std::array<double, 3> white =
-        rgb_to_xyz(reference_rgb(screen_light(ViewedLight(rig, calibration, 1.0, indirect), rig, inset)));
-    const ViewedLight light(rig, calibration, level, indirect);
+        rgb_to_xyz(reference_rgb(screen_light(ViewedLight(rig, calibration, 1.0, indirect, defocused), rig, inset)));
+    const ViewedLight light(rig, calibration, level, indirect, defocused);
     const std::vector<Point> pts = screen_light(light, rig, inset);
     const std::array<double, 3> ref = reference_rgb(pts);
     const std::array<double, 3> ref_lab = rgb_to_lab(ref, white);

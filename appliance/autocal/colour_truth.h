@@ -47,9 +47,11 @@ struct SeamColour {
 // taken over 8 x 8 points of the pixel's footprint, placed on the screen by the rig's true projector.
 // With `indirect`, the content is shown less the indirect light's field for flat content at `level`
 // (indirect_light.h; render_output's `indirect`), as the outputs show it.
+// `defocused`: each defocused projector's (RigProjector::blur_px > 0) light at a point is its pixels' spread by their
+// aperture and the blur (projector_footprint.h), as the screen shows it; else each pixel's light is a sharp step.
 [[nodiscard]] SeamColour measure_seam_colour(const rig::VirtualRig& rig, const ScreenCalibration& calibration,
-                                             double level, double inset = 0.01,
-                                             const IndirectLight* indirect = nullptr);
+                                             double level, double inset = 0.01, const IndirectLight* indirect = nullptr,
+                                             bool defocused = false);
 
 // Linear RGB (BT.709 primaries) -> CIELAB against white `white_xyz`.
 [[nodiscard]] std::array<double, 3> rgb_to_lab(const std::array<double, 3>& rgb,

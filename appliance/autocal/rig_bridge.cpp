@@ -9,7 +9,9 @@
 #include <stdexcept>
 
 #include <Eigen/Geometry>
+#include <opencv2/core.hpp>
 
+#include "appliance/autocal/projector_footprint.h"
 #include "appliance/rig/screen_light.h"
 #include "appliance/warp/composite.h"
 #include "appliance/warp/response_curve.h"
@@ -122,31 +124,86 @@ std::optional<std::array<int, 2>> output_pixel(const rig::VirtualRig& rig, int k
 
 LensFalloff falloff_of(const rig::RigProjector& p) { return {{1.0, 0.0, 0.0, -p.falloff, 0.0, -p.falloff}}; }
 
+namespace {
+
+// Projector output pixel (x, y) showing white content (less the indirect light's `field` where the outputs subtract
+// one): its light before the lens fall-off (the rig's response and brightness, black level left out), mono (the
+// channels' mean), and its blend weight in `weight`.
+double white_pixel_light(const rig::RigProjector& rp, const ProjectorCalibration& pc, const RgbFloatImage& field, int x,
+                         int y, float* weight) {
+    const float w = sample_blend(pc.blend, pc.output, x, y);
+    std::array<float, 3> content{1.0F, 1.0F, 1.0F};
+    if (const ContentUv uv = sample_warp(pc.warp, pc.output, x, y); uv.valid())
+        content = take_off_indirect_light(content, field, uv.u, uv.v);
+    double l = 0.0;
+    for (int c = 0; c < 3; ++c) {
+        const double signal = apply_response(pc.response, c, content[static_cast<std::size_t>(c)] * w);
+        l += rp.brightness[static_cast<std::size_t>(c)] * std::pow(signal, rp.gamma[static_cast<std::size_t>(c)]) / 3.0;
+    }
+    if (weight != nullptr) *weight = w;
+    return l;
+}
+
+// white_pixel_light of every output pixel of each defocused projector (RigProjector::blur_px > 0), row-major; empty
+// for a sharp one.
+std::vector<std::vector<float>> defocused_white_lights(const rig::VirtualRig& rig, const ScreenCalibration& calibration,
+                                                       const RgbFloatImage& field) {
+    std::vector<std::vector<float>> out(calibration.projectors.size());
+    for (std::size_t k = 0; k < out.size(); ++k) {
+        if (rig.projectors[k].blur_px <= 0.0) continue;
+        const ProjectorCalibration& pc = calibration.projectors[k];
+        out[k].resize(static_cast<std::size_t>(pc.output.pixel_count()));
+        cv::parallel_for_(cv::Range(0, pc.output.height), [&](const cv::Range& rows) {
+            for (int y = rows.start; y < rows.end; ++y) {
+                for (int x = 0; x < pc.output.width; ++x) {
+                    out[k][static_cast<std::size_t>(y) * pc.output.width + x] =
+                        static_cast<float>(white_pixel_light(rig.projectors[k], pc, field, x, y, nullptr));
+                }
+            }
+        });
+    }
+    return out;
+}
+
+}  // namespace
+
 LuminanceError measure_luminance(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double inset,
-                                 SeamGridSize grid, const IndirectLight* indirect) {
+                                 SeamGridSize grid, const IndirectLight* indirect, bool defocused) {
     const RgbFloatImage field = indirect != nullptr ? indirect->flat_field(1.0) : RgbFloatImage{};
+    const std::vector<std::vector<float>> lights = defocused
+                                                       ? defocused_white_lights(rig, calibration, field)
+                                                       : std::vector<std::vector<float>>(calibration.projectors.size());
     // White content's light at s, as the viewer sees it (`seen`: through the screen's gain) or as it leaves a
-    // matte screen (what bounces); `lit` counts the projectors whose blend is on there.
+    // matte screen (what bounces); `lit` counts the projectors whose blend is on there. A defocused projector's
+    // light is its pixels' through their footprint (projector_footprint.h), a sharp one's its one pixel's.
     const auto direct = [&](const rig::ScreenPoint& s, bool seen, int* lit) {
         double l = 0.0;
         for (std::size_t k = 0; k < calibration.projectors.size(); ++k) {
             const ProjectorCalibration& pc = calibration.projectors[k];
+            const auto position = rig::screen_to_projector(rig, static_cast<int>(k), s);
             const auto xy = output_pixel(rig, static_cast<int>(k), pc, s);
-            if (!xy) continue;
-            const float w = sample_blend(pc.blend, pc.output, (*xy)[0], (*xy)[1]);
-            if (w > 0.0f && lit != nullptr) ++*lit;
+            if (!xy || !position) continue;
             const rig::RigProjector& rp = rig.projectors[k];
-            const double f = rig::projector_falloff(rp, (*xy)[0] + 0.5, (*xy)[1] + 0.5) *
-                             (seen ? rig::screen_gain(rig.screen, s, rp.pose.position_m, rig.viewer_m) : 1.0);
-            // White content, less the indirect light's field where the outputs subtract one.
-            std::array<float, 3> content{1.0F, 1.0F, 1.0F};
-            if (const ContentUv uv = sample_warp(pc.warp, pc.output, (*xy)[0], (*xy)[1]); uv.valid())
-                content = take_off_indirect_light(content, field, uv.u, uv.v);
-            for (int c = 0; c < 3; ++c) {
-                const double signal = apply_response(pc.response, c, content[static_cast<std::size_t>(c)] * w);
-                l += f * rp.brightness[static_cast<std::size_t>(c)] *
-                     std::pow(signal, rp.gamma[static_cast<std::size_t>(c)]) / 3.0;
+            float w = 0.0F;
+            double light = white_pixel_light(rp, pc, field, (*xy)[0], (*xy)[1], &w);
+            if (w > 0.0f && lit != nullptr) ++*lit;
+            const bool spread = !lights[k].empty();
+            if (spread) {
+                const FootprintTaps tx = footprint_taps(position->x(), pc.output.width, rp.blur_px);
+                const FootprintTaps ty = footprint_taps(position->y(), pc.output.height, rp.blur_px);
+                light = 0.0;
+                for (int j = 0; j < ty.count; ++j) {
+                    const std::size_t row = static_cast<std::size_t>(ty.first + j) * pc.output.width;
+                    for (int i = 0; i < tx.count; ++i) {
+                        light += ty.weight[static_cast<std::size_t>(j)] * tx.weight[static_cast<std::size_t>(i)] *
+                                 lights[k][row + static_cast<std::size_t>(tx.first + i)];
+                    }
+                }
             }
+            const double f = (spread ? rig::projector_falloff(rp, position->x(), position->y())
+                                     : rig::projector_falloff(rp, (*xy)[0] + 0.5, (*xy)[1] + 0.5)) *
+                             (seen ? rig::screen_gain(rig.screen, s, rp.pose.position_m, rig.viewer_m) : 1.0);
+            l += f * light;
         }
         return l;
     };

@@ -98,8 +98,10 @@ struct LuminanceError {
 // inset by `inset` of the frame on every side.
 // `grid`: the seam grid's size (pixel_dense_seam_grid for a maximum that sees one-pixel lines).
 // With `indirect`, white content is shown less the indirect light's field (indirect_light.h), as the outputs show it.
+// `defocused`: each defocused projector's (RigProjector::blur_px > 0) light at a point is its pixels' spread by their
+// aperture and the blur (projector_footprint.h), as the screen shows it; else each pixel's light is a sharp step.
 [[nodiscard]] LuminanceError measure_luminance(const rig::VirtualRig& rig, const ScreenCalibration& calibration,
                                                double inset = 0.01, SeamGridSize grid = {},
-                                               const IndirectLight* indirect = nullptr);
+                                               const IndirectLight* indirect = nullptr, bool defocused = false);
 
 }  // namespace mogao::autocal
