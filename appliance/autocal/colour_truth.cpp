@@ -79,17 +79,10 @@ PixelLights defocused_pixel_lights(const rig::VirtualRig& rig, const ScreenCalib
 // (projector_footprint.h).
 std::array<double, 3> footprint_rgb(const std::vector<std::array<float, 3>>& lights, ImageSize size, double blur_px,
                                     double x, double y) {
-    const FootprintTaps tx = footprint_taps(x, size.width, blur_px);
-    const FootprintTaps ty = footprint_taps(y, size.height, blur_px);
     std::array<double, 3> rgb{};
-    for (int j = 0; j < ty.count; ++j) {
-        const std::size_t row = static_cast<std::size_t>(ty.first + j) * size.width;
-        for (int i = 0; i < tx.count; ++i) {
-            const double w = ty.weight[static_cast<std::size_t>(j)] * tx.weight[static_cast<std::size_t>(i)];
-            const std::array<float, 3>& v = lights[row + static_cast<std::size_t>(tx.first + i)];
-            for (std::size_t c = 0; c < 3; ++c) rgb[c] += w * v[c];
-        }
-    }
+    for_each_footprint_pixel(x, y, size.width, size.height, blur_px, [&](std::size_t i, double w) {
+        for (std::size_t c = 0; c < 3; ++c) rgb[c] += w * lights[i][c];
+    });
     return rgb;
 }
 
@@ -105,9 +98,9 @@ Point direct_light(const rig::VirtualRig& rig, const ScreenCalibration& calibrat
     for (std::size_t k = 0; k < calibration.projectors.size(); ++k) {
         const ProjectorCalibration& pc = calibration.projectors[k];
         const auto position = rig::screen_to_projector(rig, static_cast<int>(k), s);
-        const auto xy = output_pixel(rig, static_cast<int>(k), pc, s);
-        if (!xy || !position) continue;
-        const auto [x, y] = *xy;
+        if (!position) continue;
+        const std::array<int, 2> xy = output_pixel_at(pc, *position);
+        const auto [x, y] = xy;
         const rig::RigProjector& rp = rig.projectors[k];
         float w = 0.0F;
         std::array<double, 3> rgb = pixel_rgb(rp, pc, level, indirect, x, y, &w);
@@ -115,7 +108,7 @@ Point direct_light(const rig::VirtualRig& rig, const ScreenCalibration& calibrat
         if (w > most) {
             most = w;
             pt.shown_by = static_cast<int>(k);
-            pt.pixel = *xy;
+            pt.pixel = xy;
         }
         const bool defocused = !lights[k].empty();
         if (defocused) rgb = footprint_rgb(lights[k], pc.output, rp.blur_px, position->x(), position->y());

@@ -14,6 +14,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 
 namespace mogao::autocal {
 
@@ -28,5 +29,20 @@ struct FootprintTaps {
 // +-5 sigma and to [0, extent) (so the weights sum to less than 1 within 5 sigma of the border). sigma in [0, 10];
 // sigma = 0 gives the one pixel floor(t) (clamped to the image) with weight 1.
 [[nodiscard]] FootprintTaps footprint_taps(double t, int extent, double sigma);
+
+// Calls add(i, weight) for each pixel of a `width` x `height` image (i its row-major index) whose light reaches
+// image position (x, y), with its weight Kx Ky (footprint_taps along each axis).
+template <class Add>
+void for_each_footprint_pixel(double x, double y, int width, int height, double sigma, Add&& add) {
+    const FootprintTaps tx = footprint_taps(x, width, sigma);
+    const FootprintTaps ty = footprint_taps(y, height, sigma);
+    for (int j = 0; j < ty.count; ++j) {
+        const std::size_t row = static_cast<std::size_t>(ty.first + j) * static_cast<std::size_t>(width);
+        for (int i = 0; i < tx.count; ++i) {
+            add(row + static_cast<std::size_t>(tx.first + i),
+                ty.weight[static_cast<std::size_t>(j)] * tx.weight[static_cast<std::size_t>(i)]);
+        }
+    }
+}
 
 }  // namespace mogao::autocal

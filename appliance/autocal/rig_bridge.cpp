@@ -118,8 +118,12 @@ std::optional<std::array<int, 2>> output_pixel(const rig::VirtualRig& rig, int k
                                                const rig::ScreenPoint& s) {
     const auto p = rig::screen_to_projector(rig, k, s);
     if (!p) return std::nullopt;
-    return std::array<int, 2>{std::clamp(static_cast<int>(std::floor(p->x())), 0, pc.output.width - 1),
-                              std::clamp(static_cast<int>(std::floor(p->y())), 0, pc.output.height - 1)};
+    return output_pixel_at(pc, *p);
+}
+
+std::array<int, 2> output_pixel_at(const ProjectorCalibration& pc, const Eigen::Vector2d& position) {
+    return {std::clamp(static_cast<int>(std::floor(position.x())), 0, pc.output.width - 1),
+            std::clamp(static_cast<int>(std::floor(position.y())), 0, pc.output.height - 1)};
 }
 
 LensFalloff falloff_of(const rig::RigProjector& p) { return {{1.0, 0.0, 0.0, -p.falloff, 0.0, -p.falloff}}; }
@@ -181,27 +185,20 @@ LuminanceError measure_luminance(const rig::VirtualRig& rig, const ScreenCalibra
         for (std::size_t k = 0; k < calibration.projectors.size(); ++k) {
             const ProjectorCalibration& pc = calibration.projectors[k];
             const auto position = rig::screen_to_projector(rig, static_cast<int>(k), s);
-            const auto xy = output_pixel(rig, static_cast<int>(k), pc, s);
-            if (!xy || !position) continue;
+            if (!position) continue;
+            const std::array<int, 2> xy = output_pixel_at(pc, *position);
             const rig::RigProjector& rp = rig.projectors[k];
             float w = 0.0F;
-            double light = white_pixel_light(rp, pc, field, (*xy)[0], (*xy)[1], &w);
+            double light = white_pixel_light(rp, pc, field, xy[0], xy[1], &w);
             if (w > 0.0f && lit != nullptr) ++*lit;
             const bool spread = !lights[k].empty();
             if (spread) {
-                const FootprintTaps tx = footprint_taps(position->x(), pc.output.width, rp.blur_px);
-                const FootprintTaps ty = footprint_taps(position->y(), pc.output.height, rp.blur_px);
                 light = 0.0;
-                for (int j = 0; j < ty.count; ++j) {
-                    const std::size_t row = static_cast<std::size_t>(ty.first + j) * pc.output.width;
-                    for (int i = 0; i < tx.count; ++i) {
-                        light += ty.weight[static_cast<std::size_t>(j)] * tx.weight[static_cast<std::size_t>(i)] *
-                                 lights[k][row + static_cast<std::size_t>(tx.first + i)];
-                    }
-                }
+                for_each_footprint_pixel(position->x(), position->y(), pc.output.width, pc.output.height, rp.blur_px,
+                                         [&](std::size_t i, double weight) { light += weight * lights[k][i]; });
             }
             const double f = (spread ? rig::projector_falloff(rp, position->x(), position->y())
-                                     : rig::projector_falloff(rp, (*xy)[0] + 0.5, (*xy)[1] + 0.5)) *
+                                     : rig::projector_falloff(rp, xy[0] + 0.5, xy[1] + 0.5)) *
                              (seen ? rig::screen_gain(rig.screen, s, rp.pose.position_m, rig.viewer_m) : 1.0);
             l += f * light;
         }

@@ -79,6 +79,8 @@ struct SeamGridSize {
 // lights screen point `s`; nullopt where projector k does not reach it.
 [[nodiscard]] std::optional<std::array<int, 2>> output_pixel(const rig::VirtualRig& rig, int k,
                                                              const ProjectorCalibration& pc, const rig::ScreenPoint& s);
+// The same from the projection itself (an image position, pixel centres at +0.5): floor, clamped to the output.
+[[nodiscard]] std::array<int, 2> output_pixel_at(const ProjectorCalibration& pc, const Eigen::Vector2d& position);
 
 struct LuminanceError {
     int samples = 0;
