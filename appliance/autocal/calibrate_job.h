@@ -47,9 +47,9 @@ struct CalibrateJob : CalibrationSettings {
     // settle time and dropped frames.
     int drop_frames = 0;
     // The ground truth's seams with the rig's projector defocus (projector_footprint.h: each pixel's light spread
-    // by its aperture and the lens's blur_px, as the screen shows it) instead of each projector pixel's light as a
-    // sharp step (the default, which the figures in docs/calibration.md use).
-    bool defocused_truth = false;
+    // by its aperture and the lens's blur_px), as the screen shows it and the rig's camera films it; false: each
+    // projector pixel's light as a sharp step, a screen no defocused rig has (--sharp-truth, for comparison).
+    bool defocused_truth = true;
 };
 
 // Runs the job; returns the report (also written as report.json). Throws rig::RigError,

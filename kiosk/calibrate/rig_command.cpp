@@ -29,9 +29,11 @@ void add_rig_flags(CLI::App& cmd, RigCommand& flags, CalibrateJob& job) {
     // frames are dropped right after each pattern change (a rig camera with camera.straddle needs one).
     cmd.add_option("--drop-frames", job.drop_frames, "Camera frames dropped after the settle")
         ->check(CLI::Range(0, 30));
-    cmd.add_flag("--defocused-truth", job.defocused_truth,
-                 "Ground truth: each projector pixel's light spread by its aperture and the rig's defocus (blur_px), "
-                 "not a sharp step");
+    // The truth is the screen's light through the rig's defocus (blur_px) unless this flag is given.
+    cmd.add_flag_callback(
+        "--sharp-truth", [&job] { job.defocused_truth = false; },
+        "Ground truth: each projector pixel's light as a sharp step, not spread by the rig's defocus (blur_px) as "
+        "the screen shows it");
     cmd.add_flag("--fixed-camera-intrinsics", flags.fixed_intrinsics,
                  "Take the camera's intrinsics as exact: do not try refining its focal length, principal point and "
                  "k1, k2 (kept by default only where they pay)");

@@ -82,7 +82,8 @@ def main():
              "relative cost) | projector distortion (trial's relative cost per projector) | seam luminance max | "
              "predicted seam | camera position error | lit edges rms | reprojection rms (px) | compute s |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|--:|"]
-    colour = [f"Same run. Flat content at each level, the rig's ground-truth light at 401 x 101 content points; "
+    colour = [f"Same run. Flat content at each level, the rig's ground-truth light at 401 x 101 content points "
+              "(each projector pixel's light spread by the rig's defocus where it has one, as the screen shows it); "
               "seam = points two projectors light; luminance deviation |Y / Y_ref - 1| with Y_ref the median of the "
               "points one projector lights; pixel mean = the light averaged over the footprint of the output pixel "
               "that shows the point (the projector with the largest blend weight there; 8 x 8 points of it); CIE76 "
