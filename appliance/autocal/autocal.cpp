@@ -593,4 +593,31 @@ std::optional<Eigen::Vector3d> falloff_out_of_range(const DeviceModel& d) {
     return std::nullopt;
 }
 
+CalibrationPrior with_bench_lenses(CalibrationPrior prior, const std::vector<std::optional<BenchLens>>& lenses) {
+    if (lenses.size() > prior.projectors.size()) {
+        throw std::invalid_argument("bench lenses: " + std::to_string(lenses.size()) + " given for " +
+                                    std::to_string(prior.projectors.size()) + " projectors");
+    }
+    for (std::size_t k = 0; k < lenses.size(); ++k) {
+        if (!lenses[k]) continue;
+        const BenchLens& b = *lenses[k];
+        DeviceModel& d = prior.projectors[k];
+        const double sx = static_cast<double>(d.resolution.width) / b.size.width;
+        const double sy = static_cast<double>(d.resolution.height) / b.size.height;
+        if (!(std::abs(sx - sy) <= 1e-3 * std::max(sx, sy))) {
+            throw std::invalid_argument(b.source + ": projector '" + d.id + "' runs at " +
+                                        std::to_string(d.resolution.width) + "x" + std::to_string(d.resolution.height) +
+                                        ", not a uniform scale of the bench's " + std::to_string(b.size.width) + "x" +
+                                        std::to_string(b.size.height));
+        }
+        // A uniform rescale of the image about its (0, 0) corner, pixel edges staying edges.
+        d.fx_px = b.fx_px * sx;
+        d.fy_px = b.fy_px * sy;
+        d.cx_px = b.cx_px * sx;
+        d.cy_px = b.cy_px * sy;
+        d.distortion = b.distortion;
+    }
+    return prior;
+}
+
 }  // namespace mogao::autocal

@@ -153,6 +153,28 @@ struct CalibrationPrior {
     std::vector<DeviceModel> projectors;
 };
 
+// A projector's lens measured on the bench (`mogao-calibrate procam`, docs/calibration.md "Projector intrinsics on
+// the bench"; a site or rig file's projectors[k].procam): focal lengths and principal point in autocal's pixel
+// convention (centres at +0.5) at the bench's resolution `size`, and OpenCV's distortion k1, k2, p1, p2, k3
+// (dimensionless: the same at any resolution). `source` names the file, for errors and the report.
+struct BenchLens {
+    std::string source;
+    ImageSize size;
+    double fx_px = 0.0;
+    double fy_px = 0.0;
+    double cx_px = 0.0;
+    double cy_px = 0.0;
+    std::array<double, 5> distortion{};
+};
+
+// `prior` with projector k's data-sheet intrinsics replaced by lenses[k] where it is set, scaled to the prior's
+// resolution when that is a uniform scale of the bench's (a projector run at half resolution): the projector fits
+// start from it, its distortion held until the distortion trial frees it. Throws std::invalid_argument naming the
+// source and both sizes when the aspects differ (by more than 0.1 %), or when `lenses` has more entries than the
+// prior has projectors.
+[[nodiscard]] CalibrationPrior with_bench_lenses(CalibrationPrior prior,
+                                                 const std::vector<std::optional<BenchLens>>& lenses);
+
 // What is known of the camera's intrinsics before calibrating (a chessboard calibration's
 // uncertainty), as one standard deviation each: the weak prior that keeps the refinement of
 // AutocalOptions::refine_camera_intrinsics well posed where the screen and the projectors say

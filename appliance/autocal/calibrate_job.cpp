@@ -299,7 +299,7 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
         throw std::invalid_argument("calibrate: drop_frames: 0..30, got " + std::to_string(job.drop_frames));
     const rig::VirtualRig rig = scaled_rig(rig::load_rig(job.rig), job.scale, job.scale);
     RigPatternSource source(rig, job.drop_frames);
-    const CalibrationPrior prior = prior_from_rig(rig);
+    const CalibrationPrior prior = with_bench_lenses(prior_from_rig(rig), job.bench_lenses);
     const auto t0 = std::chrono::steady_clock::now();
     AutocalResult r = calibrate(source, prior, job.content, job.options);  // throws before any write
     double calibrate_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -357,9 +357,12 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
     }
     report["ground_truth"]["seams"] = seam_figures(rig, r.calibration, job.defocused_truth, shown_less);
     report["ground_truth"]["defocused"] = job.defocused_truth;
-    for (std::size_t k = 0; k < r.report.projectors.size(); ++k)
+    for (std::size_t k = 0; k < r.report.projectors.size(); ++k) {
         report["projectors"].push_back(
             projector_json(r, k, rig, job.options, source.simulator().camera_coverage(static_cast<int>(k))));
+        const bool bench = k < job.bench_lenses.size() && job.bench_lenses[k];
+        report["projectors"].back()["prior_lens"] = bench ? job.bench_lenses[k]->source : "data sheet";
+    }
     write_job_outputs(job, r, rig, check, shown_less, report);
     return report;
 }

@@ -30,7 +30,9 @@
 
 #include <filesystem>
 #include <iosfwd>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -50,6 +52,10 @@ struct CalibrateJob : CalibrationSettings {
     // by its aperture and the lens's blur_px), as the screen shows it and the rig's camera films it; false: each
     // projector pixel's light as a sharp step, a screen no defocused rig has (--sharp-truth, for comparison).
     bool defocused_truth = true;
+    // Per projector (the rig file's order), its lens measured on the bench where the rig names a procam file
+    // (projectors[k].procam; kiosk/calibrate/procam_command.h reads them): the prior's intrinsics then
+    // (with_bench_lenses). Empty: the data sheets'.
+    std::vector<std::optional<BenchLens>> bench_lenses;
 };
 
 // Runs the job; returns the report (also written as report.json). Throws rig::RigError,

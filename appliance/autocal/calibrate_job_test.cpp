@@ -166,5 +166,36 @@ TEST(CalibrateJob, PredictedSeamAboveItsGateKeepsThePreviousCalibration) {
     std::filesystem::remove_all(job.out);
 }
 
+// A projector lens measured on the bench (BenchLens, as `mogao-calibrate procam` gives it) in place of the data
+// sheet's: on the rig with the projectors' lens distortion and their distortion trial off, the projectors are
+// pinholes with the data sheets; with bench lenses (each the rig's own lens off by a bench calibration's errors:
+// focal 0.4 %, principal point 2-3 px, k1 0.004) their distortion is held as measured and the geometry's error
+// falls (at half scale, colour on: mean 0.143 -> 0.034 px). The report names each projector's prior lens.
+TEST(CalibrateJob, ABenchLensReplacesTheDataSheetAndCarriesItsDistortion) {
+    CalibrateJob job;
+    job.rig = std::string(MOGAO_SOURCE_DIR) + "/rigs/realistic-lens.toml";
+    job.out = temp_dir("bench-lens");
+    job.scale = 0.25;
+    job.content = {960, 540};
+    job.colour = false;
+    job.options.fit_projector_distortion = false;
+    const nlohmann::json data_sheet = run_calibrate_job(job)["ground_truth"];
+    const rig::VirtualRig rig = rig::load_rig(job.rig);
+    for (const rig::RigProjector& p : rig.projectors) {
+        const rig::RigIntrinsics& in = p.intrinsics;
+        std::array<double, 5> distortion = in.distortion;
+        distortion[0] += 0.004;
+        job.bench_lenses.push_back(BenchLens{p.id + ".json", p.resolution, in.fx_px * 1.004, in.fy_px * 1.004,
+                                             in.cx_px + 2.0, in.cy_px - 3.0, distortion});
+    }
+    const nlohmann::json report = run_calibrate_job(job);
+    const nlohmann::json& bench = report["ground_truth"];
+    // At quarter scale (measured: mean 0.086 -> 0.060 px, p95 0.155 -> 0.098 px).
+    EXPECT_LT(bench["geometry_mean_px"].get<double>(), 0.8 * data_sheet["geometry_mean_px"].get<double>());
+    EXPECT_LT(bench["geometry_p95_px"].get<double>(), 0.75 * data_sheet["geometry_p95_px"].get<double>());
+    EXPECT_EQ(report["projectors"][1]["prior_lens"], rig.projectors[1].id + ".json");
+    std::filesystem::remove_all(job.out);
+}
+
 }  // namespace
 }  // namespace mogao::autocal

@@ -118,7 +118,7 @@ struct HeldOutError {
 void write_procam_file(const std::filesystem::path& path, const nlohmann::json& j);
 
 // The projector's intrinsics and distortion from a procam file: what the on-site calibration takes
-// as the projector's prior (kiosk/calibrate/procam_command.h, projector_prior_from_procam). Throws
+// as the projector's prior (kiosk/calibrate/procam_command.h, bench_lens_from_procam). Throws
 // ProcamError naming the file and the field: unreadable, not JSON, another format, a missing or
 // non-numeric field, a size outside 2..16384, fx or fy not positive, or the principal point
 // outside the image.

@@ -139,6 +139,7 @@ RigProjector read_projector(Table& t, int k) {
     p.blur_px = t.number("blur_px", p.blur_px);
     const auto centre = t.numbers<2>("distortion_centre_px", {0.0, 0.0});
     p.distortion_centre_px = {centre[0], centre[1]};
+    p.procam = t.string("procam", "");  // resolved against the file's folder by load_rig
     t.finish();
     return p;
 }
@@ -264,7 +265,11 @@ VirtualRig load_rig(const std::filesystem::path& path) {
     if (!in) throw RigError("rig file '" + path.string() + "': cannot be opened");
     std::ostringstream text;
     text << in.rdbuf();
-    return parse_rig(text.str(), path.string());
+    VirtualRig rig = parse_rig(text.str(), path.string());
+    for (RigProjector& p : rig.projectors) {
+        if (!p.procam.empty() && p.procam.is_relative()) p.procam = path.parent_path() / p.procam;
+    }
+    return rig;
 }
 
 }  // namespace mogao::rig

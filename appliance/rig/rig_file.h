@@ -19,7 +19,8 @@ public:
     using std::runtime_error::runtime_error;
 };
 
-// Reads and validates (validate_rig) a rig file. Returns a complete rig or throws RigError.
+// Reads and validates (validate_rig) a rig file. Returns a complete rig or throws RigError. A projector's `procam`
+// path is resolved against the file's folder (parse_rig keeps it as written).
 [[nodiscard]] VirtualRig load_rig(const std::filesystem::path& path);
 
 // Same from TOML text; `name` is used in messages.

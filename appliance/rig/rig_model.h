@@ -13,6 +13,7 @@
 
 #include <array>
 #include <cstdint>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -74,6 +75,10 @@ struct RigProjector {
     // each within a quarter of the image's side): a lens whose shift moved its distortion off the optical axis, a
     // displacement no principal point or OpenCV coefficient expresses exactly (virtual_rig.h's header comment).
     Eigen::Vector2d distortion_centre_px{0.0, 0.0};
+    // What the calibration is told, not the simulation: the projector's lens as measured on the bench (a
+    // `mogao-calibrate procam` file; `procam` in the file, resolved against the file's folder), which replaces
+    // its data sheet's throw ratio and lens shift in the prior. Empty: none.
+    std::filesystem::path procam;
 };
 
 struct RigCamera {

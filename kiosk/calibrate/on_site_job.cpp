@@ -22,6 +22,7 @@
 #include "common/srgb.h"
 #include "kiosk/calibrate/connector_identity.h"
 #include "kiosk/calibrate/pattern_budget.h"
+#include "kiosk/calibrate/procam_command.h"
 
 namespace mogao::calibrate {
 
@@ -216,7 +217,11 @@ nlohmann::json finish(const OnSiteJob& job, const Identified& id, const autocal:
                              {"drop_frames", job.timing.drop_frames}};
     report["connectors"] = connectors_json(id, display, prior);
     report["cabling_changes"] = cabling_changes(previous_connectors(job.out / "report.json"), report["connectors"]);
-    for (std::size_t k = 0; k < r.projectors.size(); ++k) report["projectors"].push_back(fit_json(r, k));
+    const auto lenses = bench_lenses_of(rig::load_rig(job.site), job.site.string());
+    for (std::size_t k = 0; k < r.projectors.size(); ++k) {
+        report["projectors"].push_back(fit_json(r, k));
+        report["projectors"].back()["prior_lens"] = k < lenses.size() && lenses[k] ? lenses[k]->source : "data sheet";
+    }
     if (colour) {
         report["colour"] = autocal::colour_report(*colour);
         // What the kiosk will take off each frame of the screen's own light, from the models written below.
@@ -240,7 +245,9 @@ nlohmann::json finish(const OnSiteJob& job, const Identified& id, const autocal:
 }  // namespace
 
 autocal::CalibrationPrior site_prior(const OnSiteJob& job) {
-    return autocal::prior_from_rig(autocal::scaled_rig(rig::load_rig(job.site), job.scale, job.scale));
+    const rig::VirtualRig site = rig::load_rig(job.site);
+    return autocal::with_bench_lenses(autocal::prior_from_rig(autocal::scaled_rig(site, job.scale, job.scale)),
+                                      bench_lenses_of(site, job.site.string()));
 }
 
 nlohmann::json run_on_site(const OnSiteJob& job, OutputBackend& outputs, CalibrationCamera& camera,

@@ -62,7 +62,9 @@ struct OnSiteJob : autocal::CalibrationSettings {
     int flip_timeout_ms = 2000;
 };
 
-// The calibration prior the site file gives (scaled by job.scale). Throws rig::RigError.
+// The calibration prior the site file gives (scaled by job.scale), with the bench lenses its projectors name
+// (projectors[k].procam: procam_command.h, bench_lenses_of). Throws rig::RigError, or std::runtime_error naming
+// the procam file.
 [[nodiscard]] autocal::CalibrationPrior site_prior(const OnSiteJob& job);
 
 // Runs the job on `outputs` (the backend's GL context current on this thread) and `camera`; returns

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <iostream>
 #include <stdexcept>
+#include <utility>
 
 #include "appliance/procam/procam_job.h"
 #include "common/size_text.h"
@@ -91,22 +92,24 @@ int run_procam_command(const ProcamCommand& cmd) {
     }
 }
 
-autocal::DeviceModel projector_prior_from_procam(autocal::DeviceModel device, const procam::Intrinsics& bench) {
-    const double sx = static_cast<double>(device.resolution.width) / bench.size.width;
-    const double sy = static_cast<double>(device.resolution.height) / bench.size.height;
-    if (std::abs(sx - sy) > 1e-3 * std::max(sx, sy)) {
-        throw std::invalid_argument("projector prior: the device's " + std::to_string(device.resolution.width) + "x" +
-                                    std::to_string(device.resolution.height) +
-                                    " is not a uniform scale of the bench's " + std::to_string(bench.size.width) + "x" +
-                                    std::to_string(bench.size.height));
+autocal::BenchLens bench_lens_from_procam(const procam::Intrinsics& bench, std::string source) {
+    // OpenCV's pixel centre is at integer coordinates, autocal's at +0.5.
+    return {std::move(source),   bench.size,          bench.K(0, 0), bench.K(1, 1),
+            bench.K(0, 2) + 0.5, bench.K(1, 2) + 0.5, bench.dist};
+}
+
+std::vector<std::optional<autocal::BenchLens>> bench_lenses_of(const rig::VirtualRig& rig, const std::string& file) {
+    std::vector<std::optional<autocal::BenchLens>> lenses(rig.projectors.size());
+    for (std::size_t k = 0; k < lenses.size(); ++k) {
+        const std::filesystem::path& path = rig.projectors[k].procam;
+        if (path.empty()) continue;
+        try {
+            lenses[k] = bench_lens_from_procam(procam::read_procam_projector(path), path.string());
+        } catch (const std::exception& e) {
+            throw std::runtime_error(file + ": projectors[" + std::to_string(k) + "].procam: " + e.what());
+        }
     }
-    // OpenCV's pixel centre is at integer coordinates, autocal's at +0.5: x_autocal = x_opencv + 0.5,
-    // then a uniform rescale of the image about its (0, 0) corner.
-    device.fx_px = bench.K(0, 0) * sx;
-    device.fy_px = bench.K(1, 1) * sy;
-    device.cx_px = (bench.K(0, 2) + 0.5) * sx;
-    device.cy_px = (bench.K(1, 2) + 0.5) * sy;
-    return device;
+    return lenses;
 }
 
 }  // namespace mogao::calibrate

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,7 @@
 
 #include "appliance/autocal/autocal.h"
 #include "appliance/procam/procam_calibration.h"
+#include "appliance/rig/rig_model.h"
 
 namespace mogao::calibrate {
 
@@ -37,14 +39,15 @@ void add_procam_command(CLI::App& parent, ProcamCommand& cmd);
 // the reason), 2 a malformed --projector-size or --board.
 [[nodiscard]] int run_procam_command(const ProcamCommand& cmd);
 
-// The on-site calibration's projector prior (appliance/autocal: CalibrationPrior::projectors, the
-// data-sheet intrinsics autocal starts its projector fits from) from a procam file's projector:
-// fx, fy and the principal point, moved from OpenCV's pixel centres (integer) to autocal's (+0.5)
-// and scaled to the device's resolution when it is a uniform scale of the bench's (a projector run
-// at half resolution). autocal models projectors as pinholes: the lens distortion is not carried
-// (its effect at the image corners is in the procam report). Throws std::invalid_argument if the
-// device's aspect differs from the bench's.
-[[nodiscard]] autocal::DeviceModel projector_prior_from_procam(autocal::DeviceModel device,
-                                                               const procam::Intrinsics& bench);
+// A procam file's projector as the calibration's bench lens (appliance/autocal's BenchLens, which
+// with_bench_lenses puts into the prior in place of the data sheet's): the principal point moved from OpenCV's
+// pixel centres (integer) to autocal's (+0.5); focal lengths and distortion as measured, at the bench's size.
+[[nodiscard]] autocal::BenchLens bench_lens_from_procam(const procam::Intrinsics& bench, std::string source);
+
+// The bench lenses a rig or site file names (projectors[k].procam, already resolved by rig::load_rig), each read
+// with procam::read_procam_projector: one entry per projector, empty where none is named. Throws
+// std::runtime_error naming `file`'s field (projectors[k].procam) and the procam file's own error.
+[[nodiscard]] std::vector<std::optional<autocal::BenchLens>> bench_lenses_of(const rig::VirtualRig& rig,
+                                                                             const std::string& file);
 
 }  // namespace mogao::calibrate

@@ -5,6 +5,9 @@
 #include <cstdio>
 #include <iostream>
 
+#include "appliance/rig/rig_file.h"
+#include "kiosk/calibrate/procam_command.h"
+
 namespace mogao::calibrate {
 namespace {
 
@@ -84,7 +87,9 @@ void add_rig_command(CLI::App& parent, RigCommand& cmd) {
 
 int run_rig_command(const RigCommand& cmd) {
     try {
-        print_report(autocal::run_calibrate_job(cmd.job), cmd.job);
+        autocal::CalibrateJob job = cmd.job;
+        job.bench_lenses = bench_lenses_of(rig::load_rig(job.rig), job.rig.string());
+        print_report(autocal::run_calibrate_job(job), job);
         return 0;
     } catch (const std::exception& e) {
         std::cerr << "mogao-calibrate-sim rig: " << e.what() << "\n";

@@ -142,7 +142,8 @@ class Tally:
                               for s in dark)
         return (f"| {name} | calibrated | {g['geometry_mean_px']:.3f} / {g['geometry_p95_px']:.3f} / "
                 f"{g['geometry_max_px']:.3f} | {c['mean_px']:.3f} ({gap:.3f}) | {heights_cell(report['screen'])} | "
-                f"{100 * g['seam_luminance_max_deviation']:.2f} % | {dark_cell} | {report['timing']['compute_s']:.1f} |")
+                f"{100 * g['seam_luminance_max_deviation']:.2f} % | {dark_cell} | "
+                f"{report['timing']['compute_s']:.1f} |")
 
     def summary(self):
         return (f"{self.what}: {self.calibrated + self.refused} runs, {self.calibrated} calibrated, {self.refused} "
