@@ -17,6 +17,7 @@ constexpr std::array kPresets{
                   .converged_spp = 256,
                   .denoise = true,
                   .radiance_cache = true,
+                  .follow_request_pace = true,
                   .chroma_444 = false},
     QualityPreset{.name = "balanced",
                   .request = Quality{4, 2, 0, 1, 1.0, 85},
@@ -25,6 +26,7 @@ constexpr std::array kPresets{
                   .converged_spp = 1024,
                   .denoise = true,
                   .radiance_cache = true,
+                  .follow_request_pace = true,
                   .chroma_444 = false},
     QualityPreset{.name = "exhibit",
                   .request = Quality{64, 4, 0, 1, 1.0, 95},
@@ -33,6 +35,7 @@ constexpr std::array kPresets{
                   .converged_spp = 4096,
                   .denoise = false,
                   .radiance_cache = false,
+                  .follow_request_pace = false,
                   .chroma_444 = true},
 };
 

@@ -39,6 +39,9 @@ struct QualityPreset {
     // serve: moving frames from the render ranks' radiance cache (renderfarm/trace/radiance_cache.h;
     // biased, much cheaper; still views refine without it).
     bool radiance_cache = false;
+    // serve: a session whose requests come less often than the frame-time target has its frames take the
+    // time its pace gives them (renderfarm/farm/live_frames.h, LiveOptions::follow_request_pace).
+    bool follow_request_pace = false;
     // Measured in docs/quality.md but not applied by the farm yet: JPEG 4:4:4 instead of the
     // link's 4:2:0.
     bool chroma_444 = false;

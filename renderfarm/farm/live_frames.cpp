@@ -27,6 +27,9 @@ LiveFrames::LiveFrames(FrameSource source, LiveOptions options, float exposure, 
     if (!source_) throw std::invalid_argument("LiveFrames: no frame source");
     if (options_.frame_time_s < 0) throw std::invalid_argument("LiveOptions.frame_time_s must be >= 0");
     if (options_.converged_spp < 1) throw std::invalid_argument("LiveOptions.converged_spp must be >= 1");
+    if (!(options_.pace_share > 0 && options_.pace_share < 1))
+        throw std::invalid_argument("LiveOptions.pace_share must be in (0, 1)");
+    if (!(options_.max_pace_factor >= 1)) throw std::invalid_argument("LiveOptions.max_pace_factor must be >= 1");
     if (options_.still_first_pass_spp < 1 || options_.still_second_pass_spp < 1 || options_.still_pass_spp < 1)
         throw std::invalid_argument(
             "LiveOptions.still_first_pass_spp, still_second_pass_spp and still_pass_spp must be >= 1");
@@ -84,6 +87,20 @@ double LiveFrames::frame_share_seconds(std::uint64_t current) const {
     if (others.empty()) return 0.0;
     std::nth_element(others.begin(), others.begin() + others.size() / 2, others.end());
     return std::max(options_.frame_time_s, others[others.size() / 2]);
+}
+
+double LiveFrames::paced_target(Session& s, const ViewRequest& request, double gap_seconds,
+                                Clock::time_point now) const {
+    double target = options_.frame_time_s;
+    if (options_.share_frame_time) target /= double(active_sessions(request.session, now));
+    if (!options_.follow_request_pace) return target;
+    if (s.last_request && request.frame_id > s.last_request->frame_id && s.last_request->request_time_ns > 0 &&
+        request.request_time_ns > s.last_request->request_time_ns) {
+        const double period = 1e-9 * static_cast<double>(request.request_time_ns - s.last_request->request_time_ns) /
+                              static_cast<double>(request.frame_id - s.last_request->frame_id);
+        s.pace.note(period, gap_seconds, options_.pace_share);
+    }
+    return s.pace.target(target, options_.pace_share, options_.max_pace_factor);
 }
 
 // Whether `request` repeats the session's previous view: a still view, accumulated.
@@ -227,9 +244,7 @@ LiveFrame LiveFrames::render(const ViewRequest& request) {
     FrameChoice choice;
     LiveFrame frame;
     if (s.handed_back) frame.gap_seconds = std::chrono::duration<double>(start - *s.handed_back).count();
-    if (s.controller && options_.share_frame_time) {
-        s.controller->set_target_seconds(options_.frame_time_s / double(active_sessions(request.session, start)));
-    }
+    if (s.controller) s.controller->set_target_seconds(paced_target(s, request, frame.gap_seconds, start));
     ViewRequest timed = request;
     timed.scene_time_s = scene_time_s();
     follow_lighting(s, timed.scene_time_s);

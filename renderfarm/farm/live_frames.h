@@ -57,6 +57,7 @@
 #include "renderfarm/farm/frame_dispatcher.h"
 #include "renderfarm/farm/progressive_accumulator.h"
 #include "renderfarm/schedule/frame_time_controller.h"
+#include "renderfarm/schedule/request_pace.h"
 
 namespace mogao {
 
@@ -87,8 +88,16 @@ struct LiveOptions {
     // frame, whichever is longer, so a dear request is degraded instead of holding the others'
     // frames back, and an ordinary one is not shrunk below the floors when the farm is slow.
     bool share_frame_time = true;  // on by default: measured against round-robin (docs/reliability.md)
-    FrameTimeTarget controller;    // its other settings (target_seconds is taken from frame_time_s)
-    bool per_session_maps = true;  // one PBT cost map per session; false = all share one (stream 0)
+    // Follow the appliance's pace (renderfarm/schedule/request_pace.h): a session whose requests come less often
+    // than one per frame-time target (a 10 Hz kiosk against a 15 frames/s target) leaves the farm idle between
+    // frames. While the farm waits for its requests, its moving frames aim at pace_share of its request period
+    // instead, never below the (shared) target and never above max_pace_factor times it: the frame takes the time
+    // the appliance gives it, and the latency it adds stays bounded.
+    bool follow_request_pace = false;  // the interactive and balanced presets turn it on
+    double pace_share = 0.85;          // (0, 1)
+    double max_pace_factor = 2.0;      // >= 1
+    FrameTimeTarget controller;        // its other settings (target_seconds is taken from frame_time_s)
+    bool per_session_maps = true;      // one PBT cost map per session; false = all share one (stream 0)
     std::size_t max_sessions = 64;
     bool denoise = false;       // filter frames of at most denoise_max_spp samples (see above)
     int denoise_max_spp = 256;  // >= 1; past it a still view is sent raw (its noise is below the filter's bias)
@@ -184,12 +193,17 @@ private:
         std::uint64_t last_used = 0;
         std::optional<std::chrono::steady_clock::time_point> handed_back;  // the previous render() returned
         double recent_seconds = 0.0;                 // rendered frames' seconds, exponentially weighted (0: none yet)
+        RequestPace pace;                            // its requests' pace (follow_request_pace)
         std::optional<std::vector<float>> lighting;  // the lights' state of its previous frame
         std::uint64_t sparse_frames = 0;             // sparse frames asked for: the pattern's phase
     };
     Session& session(std::uint64_t id);
     // Sessions handed a frame within kActiveWindow before `now`, `current` counted even if new.
     [[nodiscard]] std::size_t active_sessions(std::uint64_t current, std::chrono::steady_clock::time_point now) const;
+    // The frame-time target of session `s`'s next frame (share_frame_time, follow_request_pace), after noting
+    // `request`'s pace and the farm's wait `gap_seconds` before it.
+    [[nodiscard]] double paced_target(Session& s, const ViewRequest& request, double gap_seconds,
+                                      std::chrono::steady_clock::time_point now) const;
     static constexpr std::chrono::seconds kActiveWindow{2};
     [[nodiscard]] bool is_still(const Session& s, const ViewRequest& request) const;
     [[nodiscard]] double scene_time_s() const;

@@ -10,6 +10,7 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -605,6 +606,41 @@ TEST_F(LiveFramesTest, SharedFrameTimeTargetIsDividedAmongTheActiveSessions) {
     EXPECT_GT(differs, 0) << "the shared target never changed a choice: the test cannot tell it from the whole target";
 }
 
+// The appliance's pace (LiveOptions::follow_request_pace, request_pace.h): requests stamped 20 ms apart, the farm
+// waiting a few ms for each, move the session's target from T to its cap 2 T (0.85 x 20 ms is above it) from the
+// second request on, when the period and the wait are first known; a replica controller given that target picks
+// exactly LiveFrames' scales, and one given T alone picks another at least once (targets tried until one tells them
+// apart, as for the shared target).
+TEST_F(LiveFramesTest, AFrameTakesTheTimeTheAppliancesPaceGivesIt) {
+    int differs = 0;
+    for (const double frame_time_s : {1e-3, 2.5e-4, 4e-3, 0.5e-4}) {
+        LiveOptions options;
+        options.frame_time_s = frame_time_s;
+        options.follow_request_pace = true;
+        options.controller.min_scale = 0.1;
+        LiveFrames live(source(), options, 1.f, ToneMap::clamp);
+        FrameTimeController replica(live.options().controller);
+        FrameTimeController alone(live.options().controller);
+        differs = 0;
+        for (std::uint64_t id = 1; id <= 8; ++id) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(3));
+            ViewRequest moving = view(static_cast<double>(id));
+            moving.frame_id = id;
+            moving.request_time_ns = static_cast<std::int64_t>(id) * 20'000'000;
+            replica.set_target_seconds(id >= 2 ? 2 * frame_time_s : frame_time_s);
+            const FrameChoice expected = replica.choose(moving);
+            const FrameChoice unpaced = alone.choose(moving);
+            const LiveFrame frame = live.render(moving);
+            EXPECT_DOUBLE_EQ(frame.rendered.quality.resolution_scale, expected.resolution_scale) << id;
+            differs += unpaced.resolution_scale != expected.resolution_scale ? 1 : 0;
+            replica.observe(expected, frame.seconds, frame.gap_seconds);
+            alone.observe(unpaced, frame.seconds, frame.gap_seconds);
+        }
+        if (differs > 0) break;
+    }
+    EXPECT_GT(differs, 0) << "the paced target never changed a choice: the test cannot tell it from the target";
+}
+
 // An equal turn: a session's share of the farm is the other active session's recent frame time
 // (here its one frame), never less than the target; alone, or with sharing off, there is none.
 TEST_F(LiveFramesTest, FrameShareIsTheOtherSessionsRecentFrameTimeAndNoneAlone) {
@@ -740,6 +776,12 @@ TEST(LiveOptions, BadOptionsAreRefused) {
     no_first_pass.still_first_pass_spp = 0;
     EXPECT_THROW(LiveFrames(none, no_first_pass, 1.f, ToneMap::clamp), std::invalid_argument);
     EXPECT_THROW(LiveFrames(FrameSource{}, {}, 1.f, ToneMap::clamp), std::invalid_argument);
+    LiveOptions whole_period;
+    whole_period.pace_share = 1.0;  // nothing left for the hand-off
+    EXPECT_THROW(LiveFrames(none, whole_period, 1.f, ToneMap::clamp), std::invalid_argument);
+    LiveOptions below_target;
+    below_target.max_pace_factor = 0.5;
+    EXPECT_THROW(LiveFrames(none, below_target, 1.f, ToneMap::clamp), std::invalid_argument);
 }
 
 }  // namespace

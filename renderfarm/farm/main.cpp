@@ -125,6 +125,10 @@ void add_live_flags(CLI::App& serve, mogao::ServeOptions& options, double& frame
         "frame aims at the target / N and a dearer request is degraded to that share, so each keeps "
         "its frame rate and latency with fewer pixels (default; --no-share-frame-time: each frame aims at the "
         "whole target, sessions in turn)");
+    serve.add_flag("--follow-request-pace,!--no-follow-request-pace", live.follow_request_pace,
+                   "A session whose requests come less often than the frame-time target has its moving frames take "
+                   "0.85 of its request period (at most twice the target) while the farm waits for its requests, "
+                   "instead of leaving the farm idle (default off; the interactive and balanced presets turn it on)");
     serve.add_flag("--per-session-cost-maps,!--shared-cost-map", live.per_session_maps,
                    "One PBT cost map per session (default; --shared-cost-map: one for all)");
     serve.add_flag("--pipeline,!--no-pipeline", options.pipeline,
@@ -280,6 +284,8 @@ void apply_serve_preset(const CLI::App& serve, const mogao::QualityPreset& p, mo
     if (unset("--converged-spp")) live.converged_spp = p.converged_spp;
     if (unset("--denoise") && unset("--no-denoise")) live.denoise = p.denoise;
     if (unset("--radiance-cache") && unset("--no-radiance-cache")) live.radiance_cache = p.radiance_cache;
+    if (unset("--follow-request-pace") && unset("--no-follow-request-pace"))
+        live.follow_request_pace = p.follow_request_pace;
 }
 
 // `mogao-farm health`: what mogao-farm-launch runs on each render host (over the same rsh agent
