@@ -75,6 +75,11 @@ PixelLights defocused_pixel_lights(const rig::VirtualRig& rig, const ScreenCalib
     return out;
 }
 
+// Whether image position `p` lies in projector `rp`'s image (not in the margin its defocus reaches past it).
+bool inside_image(const rig::RigProjector& rp, const Eigen::Vector2d& p) {
+    return p.x() >= 0.0 && p.y() >= 0.0 && p.x() < rp.resolution.width && p.y() < rp.resolution.height;
+}
+
 // The light of `lights` (one projector's, row-major, `size`) at image position (x, y) through its pixels' footprint
 // (projector_footprint.h).
 std::array<double, 3> footprint_rgb(const std::vector<std::array<float, 3>>& lights, ImageSize size, double blur_px,
@@ -97,20 +102,25 @@ Point direct_light(const rig::VirtualRig& rig, const ScreenCalibration& calibrat
     float most = 0.0F;
     for (std::size_t k = 0; k < calibration.projectors.size(); ++k) {
         const ProjectorCalibration& pc = calibration.projectors[k];
-        const auto position = rig::screen_to_projector(rig, static_cast<int>(k), s);
-        if (!position) continue;
-        const std::array<int, 2> xy = output_pixel_at(pc, *position);
-        const auto [x, y] = xy;
         const rig::RigProjector& rp = rig.projectors[k];
-        float w = 0.0F;
-        std::array<double, 3> rgb = pixel_rgb(rp, pc, level, indirect, x, y, &w);
-        if (w > 0.0F) ++pt.lit;
-        if (w > most) {
-            most = w;
-            pt.shown_by = static_cast<int>(k);
-            pt.pixel = xy;
-        }
         const bool defocused = !lights[k].empty();
+        // A defocused projector's light reaches past its image's edge (virtual_rig.h's header comment).
+        const auto position =
+            rig::screen_to_projector(rig, static_cast<int>(k), s, defocused ? rig::defocus_margin(rp) : 0);
+        if (!position) continue;
+        std::array<double, 3> rgb{};
+        if (inside_image(rp, *position)) {
+            const std::array<int, 2> xy = output_pixel_at(pc, *position);
+            float w = 0.0F;
+            rgb = pixel_rgb(rp, pc, level, indirect, xy[0], xy[1], &w);
+            if (w > 0.0F) ++pt.lit;
+            if (w > most) {
+                most = w;
+                pt.shown_by = static_cast<int>(k);
+                pt.pixel = xy;
+            }
+        }
+        const auto [x, y] = output_pixel_at(pc, *position);
         if (defocused) rgb = footprint_rgb(lights[k], pc.output, rp.blur_px, position->x(), position->y());
         const double f = (defocused ? rig::projector_falloff(rp, position->x(), position->y())
                                     : rig::projector_falloff(rp, x + 0.5, y + 0.5)) *

@@ -184,14 +184,18 @@ LuminanceError measure_luminance(const rig::VirtualRig& rig, const ScreenCalibra
         double l = 0.0;
         for (std::size_t k = 0; k < calibration.projectors.size(); ++k) {
             const ProjectorCalibration& pc = calibration.projectors[k];
-            const auto position = rig::screen_to_projector(rig, static_cast<int>(k), s);
+            const rig::RigProjector& rp = rig.projectors[k];
+            const bool spread = !lights[k].empty();
+            // A defocused projector's light reaches past its image's edge (virtual_rig.h's header comment).
+            const auto position =
+                rig::screen_to_projector(rig, static_cast<int>(k), s, spread ? rig::defocus_margin(rp) : 0);
             if (!position) continue;
             const std::array<int, 2> xy = output_pixel_at(pc, *position);
-            const rig::RigProjector& rp = rig.projectors[k];
+            const bool inside = position->x() >= 0.0 && position->y() >= 0.0 && position->x() < rp.resolution.width &&
+                                position->y() < rp.resolution.height;
             float w = 0.0F;
-            double light = white_pixel_light(rp, pc, field, xy[0], xy[1], &w);
+            double light = inside ? white_pixel_light(rp, pc, field, xy[0], xy[1], &w) : 0.0;
             if (w > 0.0f && lit != nullptr) ++*lit;
-            const bool spread = !lights[k].empty();
             if (spread) {
                 light = 0.0;
                 for_each_footprint_pixel(position->x(), position->y(), pc.output.width, pc.output.height, rp.blur_px,

@@ -92,18 +92,21 @@ double projector_light(const RigProjector& p, const float* v, int channels) {
     return sum / 3.0;
 }
 
-// The light of projector p's image for `signal`, defocused (RigProjector::blur_px): Gaussian, +-4 sigma,
-// zero beyond the image's border.
+// The light of projector p's image for `signal` (empty: the projector dark, its black level), defocused
+// (RigProjector::blur_px): Gaussian, +-4 sigma, on the image padded by defocus_margin(p) pixels of no light on
+// every side, so that the light its border pixels spread past the image's edge lands there.
 cv::Mat1f defocused_light(const RigProjector& p, const cv::Mat& signal) {
-    cv::Mat1f out(signal.rows, signal.cols);
-    for (int y = 0; y < signal.rows; ++y) {
-        for (int x = 0; x < signal.cols; ++x) {
-            out(y, x) =
-                static_cast<float>(projector_light(p, signal.ptr<float>(y) + x * signal.channels(), signal.channels()));
+    const int m = defocus_margin(p);
+    cv::Mat1f out(p.resolution.height + 2 * m, p.resolution.width + 2 * m, 0.0F);
+    const float zero = 0.0F;
+    for (int y = 0; y < p.resolution.height; ++y) {
+        for (int x = 0; x < p.resolution.width; ++x) {
+            out(y + m, x + m) = static_cast<float>(
+                signal.empty() ? projector_light(p, &zero, 1)
+                               : projector_light(p, signal.ptr<float>(y) + x * signal.channels(), signal.channels()));
         }
     }
-    const int half = static_cast<int>(std::ceil(4.0 * p.blur_px));
-    cv::GaussianBlur(out, out, cv::Size(2 * half + 1, 2 * half + 1), p.blur_px, p.blur_px, cv::BORDER_CONSTANT);
+    cv::GaussianBlur(out, out, cv::Size(2 * m + 1, 2 * m + 1), p.blur_px, p.blur_px, cv::BORDER_CONSTANT);
     return out;
 }
 
@@ -145,7 +148,9 @@ std::optional<ScreenPoint> projector_to_screen(const VirtualRig& rig, int k, dou
     return on_screen(rig.screen, *hit);
 }
 
-std::optional<Eigen::Vector2d> screen_to_projector(const VirtualRig& rig, int k, ScreenPoint s) {
+int defocus_margin(const RigProjector& p) { return p.blur_px > 0.0 ? static_cast<int>(std::ceil(4.0 * p.blur_px)) : 0; }
+
+std::optional<Eigen::Vector2d> screen_to_projector(const VirtualRig& rig, int k, ScreenPoint s, double margin_px) {
     const RigProjector& p = rig.projectors.at(static_cast<std::size_t>(k));
     const Eigen::Vector3d d =
         device_to_screen(p.pose).transpose() * (screen_position(rig.screen, s) - p.pose.position_m);
@@ -159,7 +164,8 @@ std::optional<Eigen::Vector2d> screen_to_projector(const VirtualRig& rig, int k,
         n = c + distort(in.distortion, n.x() - c.x(), n.y() - c.y());
     }
     const Eigen::Vector2d xy(in.fx_px * n.x() + in.cx_px, in.fy_px * n.y() + in.cy_px);
-    if (!(xy.x() >= 0.0 && xy.x() < p.resolution.width && xy.y() >= 0.0 && xy.y() < p.resolution.height)) {
+    const double m = margin_px;
+    if (!(xy.x() >= -m && xy.x() < p.resolution.width + m && xy.y() >= -m && xy.y() < p.resolution.height + m)) {
         return std::nullopt;
     }
     return xy;
@@ -208,15 +214,20 @@ CameraSimulator::CameraSimulator(const VirtualRig& rig) : rig_(rig) {
                 if (!s) continue;
                 on_screen_[i] = 1;
                 for (std::size_t k = 0; k < rig_.projectors.size(); ++k) {
-                    const auto xy = screen_to_projector(rig_, static_cast<int>(k), *s);
+                    const int m = defocus_margin(rig_.projectors[k]);
+                    const auto xy = screen_to_projector(rig_, static_cast<int>(k), *s, m);
                     if (!xy) continue;
-                    const int w = rig_.projectors[k].resolution.width;
-                    hit_[k][i] = static_cast<std::int32_t>(std::floor(xy->y())) * w +
-                                 static_cast<std::int32_t>(std::floor(xy->x()));
+                    const int w = rig_.projectors[k].resolution.width + 2 * m;
+                    hit_[k][i] = (static_cast<std::int32_t>(std::floor(xy->y())) + m) * w +
+                                 static_cast<std::int32_t>(std::floor(xy->x())) + m;
                 }
             }
         }
     });
+    dark_light_.assign(rig_.projectors.size(), cv::Mat1f());
+    for (std::size_t k = 0; k < rig_.projectors.size(); ++k) {
+        if (rig_.projectors[k].blur_px > 0.0) dark_light_[k] = defocused_light(rig_.projectors[k], cv::Mat());
+    }
     if (rig_.screen.gain != 1.0 || rig_.screen.interreflection > 0.0) trace_screen_light();
 }
 
@@ -284,7 +295,10 @@ std::vector<double> CameraSimulator::patch_light(const std::vector<cv::Mat>& sig
         // The projector's light image, averaged over blocks of kPatchBlock pixels: the patches' samples then
         // see each block's mean, not one pixel of a fine stripe.
         cv::Mat1f light = blurred[k];
-        if (light.empty()) {
+        if (!light.empty()) {  // the image itself, without its defocus margin
+            const int m = defocus_margin(p);
+            light = light(cv::Rect(m, m, p.resolution.width, p.resolution.height));
+        } else {
             light.create(p.resolution.height, p.resolution.width);
             const float zero = 0.0F;
             const cv::Mat& s = signals[k];
@@ -395,11 +409,12 @@ cv::Mat1f CameraSimulator::capture(const std::vector<cv::Mat>& signals, std::uin
     const auto light = [&](std::size_t k, const float* v, int channels) {
         return projector_light(rig_.projectors[k], v, channels);
     };
-    // Defocus (RigProjector::blur_px): each lit projector's light image, blurred; looked up in place of `light`.
+    // Defocus (RigProjector::blur_px): each projector's light image, blurred and padded by its margin (hit_ indexes
+    // the padded image); looked up in place of `light`. A dark projector's is the same every time.
     std::vector<cv::Mat1f> blurred(np);
     for (std::size_t k = 0; k < np; ++k) {
-        if (rig_.projectors[k].blur_px > 0.0 && !signals[k].empty())
-            blurred[k] = defocused_light(rig_.projectors[k], signals[k]);
+        if (rig_.projectors[k].blur_px <= 0.0) continue;
+        blurred[k] = signals[k].empty() ? dark_light_[k] : defocused_light(rig_.projectors[k], signals[k]);
     }
     // Interreflection: the light the screen throws onto itself, one bounce (header comment).
     std::optional<std::vector<double>> bounced;
@@ -424,13 +439,14 @@ cv::Mat1f CameraSimulator::capture(const std::vector<cv::Mat>& signals, std::uin
                             const float zero = 0.0f;
                             const cv::Mat& s = signals[k];
                             const RigProjector& p = rig_.projectors[k];
-                            const double f = p.falloff == 0.0 ? 1.0
-                                                              : projector_falloff(p, h % p.resolution.width + 0.5,
-                                                                                  h / p.resolution.width + 0.5);
+                            const int wp = blurred[k].empty() ? p.resolution.width : blurred[k].cols;
+                            const int m = blurred[k].empty() ? 0 : defocus_margin(p);
+                            const double f =
+                                p.falloff == 0.0 ? 1.0 : projector_falloff(p, h % wp - m + 0.5, h / wp - m + 0.5);
                             const double g =
                                 gain_.empty() ? 1.0 : gain_[k][static_cast<std::size_t>(y) * res.width + x];
                             if (!blurred[k].empty()) {
-                                l += g * f * blurred[k](h / p.resolution.width, h % p.resolution.width);
+                                l += g * f * blurred[k](h / wp, h % wp);
                                 continue;
                             }
                             l += g * f *
@@ -459,13 +475,17 @@ void CameraSimulator::set_exposure(double exposure) {
 double CameraSimulator::camera_coverage(int k) const {
     const std::vector<std::int32_t>& hits = hit_.at(static_cast<std::size_t>(k));
     const ImageSize r = rig_.projectors[static_cast<std::size_t>(k)].resolution;
+    const int m = defocus_margin(rig_.projectors[static_cast<std::size_t>(k)]);
     // Projector pixels in 8x8 blocks that some camera sample sees, over all blocks.
     const int bw = (r.width + 7) / 8;
     const int bh = (r.height + 7) / 8;
     std::vector<std::uint8_t> seen(static_cast<std::size_t>(bw) * bh, 0);
     for (std::int32_t h : hits) {
         if (h < 0) continue;
-        seen[static_cast<std::size_t>((h / r.width) / 8) * bw + (h % r.width) / 8] = 1;
+        const int x = h % (r.width + 2 * m) - m;
+        const int y = h / (r.width + 2 * m) - m;
+        if (x < 0 || y < 0 || x >= r.width || y >= r.height) continue;  // light spread past the image's edge
+        seen[static_cast<std::size_t>(y / 8) * bw + x / 8] = 1;
     }
     return static_cast<double>(std::count(seen.begin(), seen.end(), 1)) / static_cast<double>(seen.size());
 }

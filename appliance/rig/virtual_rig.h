@@ -54,8 +54,9 @@
 // ratio a data sheet calls uniformity, e.g. 85 % ~ falloff 0.15). Black light passes the same lens.
 // Defocus (RigProjector::blur_px): the light of projector k's image (after its response, before the
 // fall-off) is convolved with a Gaussian of standard deviation blur_px projector pixels (OpenCV's
-// GaussianBlur, kernel +-4 sigma); light that would spread beyond the image's border is lost (zero
-// outside the image), so the image's outermost pixel rows are dimmed by up to half.
+// GaussianBlur, kernel +-4 sigma, on the image padded by defocus_margin pixels of no light): the image's
+// outermost pixel rows are dimmed by up to half, and the light they lose spreads past the image's edge onto the
+// screen, as a defocused lens spreads it.
 // Camera vignetting (RigCamera::vignetting = v): the light reaching camera pixel (x, y) (its centre) is
 // multiplied by V = 1 - v min(rho^2, 2), rho = distance from the principal point / half the camera
 // image's diagonal: the same radial law as the projectors' fall-off (the leading term of cos^4), so v is
@@ -100,8 +101,13 @@ class ScreenBounce;
 [[nodiscard]] std::optional<ScreenPoint> projector_to_screen(const VirtualRig& rig, int k, double x, double y);
 
 // Ground truth, the other way: the image position of projector k that lands on screen point p, or
-// nullopt when p is behind the projector or outside its image [0, W) x [0, H).
-[[nodiscard]] std::optional<Eigen::Vector2d> screen_to_projector(const VirtualRig& rig, int k, ScreenPoint p);
+// nullopt when p is behind the projector or outside its image [0, W) x [0, H) grown by `margin_px` on every side
+// (defocus_margin: where a defocused projector's light still reaches).
+[[nodiscard]] std::optional<Eigen::Vector2d> screen_to_projector(const VirtualRig& rig, int k, ScreenPoint p,
+                                                                 double margin_px = 0.0);
+// How far past its image's edge a defocused projector's light reaches, in its pixels: ceil(4 blur_px), the
+// Gaussian's kernel radius (0 for a sharp projector).
+[[nodiscard]] int defocus_margin(const RigProjector& p);
 
 // The screen's point (theta, h) in the screen frame (a bowed screen's at its own distance from the axis).
 [[nodiscard]] Eigen::Vector3d screen_position(const RigScreen& screen, ScreenPoint p);
@@ -143,8 +149,11 @@ private:
     VirtualRig rig_;
     int samples_w_ = 0;
     int samples_h_ = 0;
-    std::vector<std::uint8_t> on_screen_;         // per sample
-    std::vector<std::vector<std::int32_t>> hit_;  // per projector, per sample: pixel index or -1
+    std::vector<std::uint8_t> on_screen_;  // per sample
+    // Per projector, per sample: its pixel's index in the image padded by defocus_margin on every side (the
+    // image itself for a sharp projector), or -1.
+    std::vector<std::vector<std::int32_t>> hit_;
+    std::vector<cv::Mat1f> dark_light_;  // per defocused projector: defocused_light of the dark projector
     // Screen gain toward the camera (RigScreen::gain != 1): per projector, per camera pixel, G at the pixel's centre.
     std::vector<std::vector<float>> gain_;
     // Interreflection (RigScreen::interreflection > 0): the patches, each camera pixel's screen point (its centre's
