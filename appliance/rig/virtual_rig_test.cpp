@@ -272,6 +272,33 @@ TEST(VirtualRig, DefocusIsAGaussianOfTheProjectorsLight) {
     EXPECT_GT(cv::norm(defocused, in_focus, cv::NORM_INF), 0.02);  // the block's edges spread
 }
 
+// A defocused projector's light spreads past its image's edge, as a lens spreads it (defocus_margin): with the
+// other projectors dark and no black level or ambient, the camera pixels just outside the middle projector's image
+// on the screen see none of its light when it is sharp and some when it is defocused, and about as much light
+// reaches the camera either way.
+TEST(VirtualRig, ADefocusedProjectorsLightSpreadsPastItsImagesEdge) {
+    VirtualRig sharp = standard();
+    sharp.camera.read_noise = 0.0;
+    sharp.camera.shot_noise = 0.0;
+    sharp.camera.bits = 16;
+    sharp.camera.blur_sigma_px = 0.0;
+    sharp.camera.exposure = 0.5;
+    sharp.ambient = 0.0;
+    for (RigProjector& p : sharp.projectors) p.black_level = 0.0;
+    VirtualRig blurred = sharp;
+    blurred.projectors[1].blur_px = 3.0;
+    std::vector<cv::Mat> signals(3);
+    signals[1] = cv::Mat1f(1080, 1920, 1.0F);
+    const cv::Mat1f in_focus = CameraSimulator(sharp).capture(signals, 0);
+    const cv::Mat1f defocused = CameraSimulator(blurred).capture(signals, 0);
+    int spread = 0;
+    for (int y = 0; y < in_focus.rows; ++y) {
+        for (int x = 0; x < in_focus.cols; ++x) spread += in_focus(y, x) == 0.0F && defocused(y, x) > 1e-3F ? 1 : 0;
+    }
+    EXPECT_GT(spread, 100) << "camera pixels lit only past the image's edge";
+    EXPECT_NEAR(cv::sum(defocused)[0] / cv::sum(in_focus)[0], 1.0, 0.005);
+}
+
 // Camera vignetting dims every camera pixel by 1 - v min(rho^2, 2) (rho over half the diagonal from the
 // principal point, written out here again): 20 % at a corner of a centred lens.
 TEST(VirtualRig, CameraVignettingFollowsItsRadialLaw) {
