@@ -91,9 +91,11 @@ double LiveFrames::frame_share_seconds(std::uint64_t current) const {
 
 double LiveFrames::paced_target(Session& s, const ViewRequest& request, double gap_seconds,
                                 Clock::time_point now) const {
+    const std::size_t sessions = active_sessions(request.session, now);
     double target = options_.frame_time_s;
-    if (options_.share_frame_time) target /= double(active_sessions(request.session, now));
-    if (!options_.follow_request_pace) return target;
+    if (options_.share_frame_time) target /= double(sessions);
+    // A farm shared by several sessions is busy with the others between one's frames: their wait is no idle time.
+    if (!options_.follow_request_pace || sessions > 1) return target;
     if (s.last_request && request.frame_id > s.last_request->frame_id && s.last_request->request_time_ns > 0 &&
         request.request_time_ns > s.last_request->request_time_ns) {
         const double period = 1e-9 * static_cast<double>(request.request_time_ns - s.last_request->request_time_ns) /

@@ -91,8 +91,9 @@ struct LiveOptions {
     // Follow the appliance's pace (renderfarm/schedule/request_pace.h): a session whose requests come less often
     // than one per frame-time target (a 10 Hz kiosk against a 15 frames/s target) leaves the farm idle between
     // frames. While the farm waits for its requests, its moving frames aim at pace_share of its request period
-    // instead, never below the (shared) target and never above max_pace_factor times it: the frame takes the time
-    // the appliance gives it, and the latency it adds stays bounded.
+    // instead, never below the target and never above max_pace_factor times it: the frame takes the time the
+    // appliance gives it, and the latency it adds stays bounded. Only a session served alone (no other in the
+    // last kActiveWindow) follows its pace: with several, the farm is busy with the others between one's frames.
     bool follow_request_pace = false;  // the interactive and balanced presets turn it on
     double pace_share = 0.85;          // (0, 1)
     double max_pace_factor = 2.0;      // >= 1
