@@ -109,8 +109,8 @@ Point direct_light(const rig::VirtualRig& rig, const ScreenCalibration& calibrat
             rig::screen_to_projector(rig, static_cast<int>(k), s, defocused ? rig::defocus_margin(rp) : 0);
         if (!position) continue;
         std::array<double, 3> rgb{};
+        const std::array<int, 2> xy = output_pixel_at(pc, *position);
         if (inside_image(rp, *position)) {
-            const std::array<int, 2> xy = output_pixel_at(pc, *position);
             float w = 0.0F;
             rgb = pixel_rgb(rp, pc, level, indirect, xy[0], xy[1], &w);
             if (w > 0.0F) ++pt.lit;
@@ -120,7 +120,7 @@ Point direct_light(const rig::VirtualRig& rig, const ScreenCalibration& calibrat
                 pt.pixel = xy;
             }
         }
-        const auto [x, y] = output_pixel_at(pc, *position);
+        const auto [x, y] = xy;
         if (defocused) rgb = footprint_rgb(lights[k], pc.output, rp.blur_px, position->x(), position->y());
         const double f = (defocused ? rig::projector_falloff(rp, position->x(), position->y())
                                     : rig::projector_falloff(rp, x + 0.5, y + 0.5)) *

@@ -240,16 +240,22 @@ TEST(VirtualRig, ProjectorDistortionIsOpenCvsModel) {
     EXPECT_GT(largest_shift, 5.0);  // 9.4 px at these points
 }
 
+// The standard rig filmed exactly: no camera noise or blur, 16 bits, an unclipped exposure, no ambient light.
+VirtualRig exact_camera_rig() {
+    VirtualRig rig = standard();
+    rig.camera.read_noise = 0.0;
+    rig.camera.shot_noise = 0.0;
+    rig.camera.bits = 16;
+    rig.camera.blur_sigma_px = 0.0;
+    rig.camera.exposure = 0.5;  // unclipped
+    rig.ambient = 0.0;
+    return rig;
+}
+
 // Defocus (blur_px) is a Gaussian of the projector's light: with a linear response and no black level the
 // rig shows a block defocused as the sharp rig shows the block blurred beforehand, and it keeps the light.
 TEST(VirtualRig, DefocusIsAGaussianOfTheProjectorsLight) {
-    VirtualRig sharp = standard();
-    sharp.camera.read_noise = 0.0;
-    sharp.camera.shot_noise = 0.0;
-    sharp.camera.bits = 16;
-    sharp.camera.blur_sigma_px = 0.0;
-    sharp.camera.exposure = 0.5;  // unclipped
-    sharp.ambient = 0.0;
+    VirtualRig sharp = exact_camera_rig();
     for (RigProjector& p : sharp.projectors) {
         p.gamma = {1.0, 1.0, 1.0};
         p.black_level = 0.0;
@@ -277,13 +283,7 @@ TEST(VirtualRig, DefocusIsAGaussianOfTheProjectorsLight) {
 // on the screen see none of its light when it is sharp and some when it is defocused, and about as much light
 // reaches the camera either way.
 TEST(VirtualRig, ADefocusedProjectorsLightSpreadsPastItsImagesEdge) {
-    VirtualRig sharp = standard();
-    sharp.camera.read_noise = 0.0;
-    sharp.camera.shot_noise = 0.0;
-    sharp.camera.bits = 16;
-    sharp.camera.blur_sigma_px = 0.0;
-    sharp.camera.exposure = 0.5;
-    sharp.ambient = 0.0;
+    VirtualRig sharp = exact_camera_rig();
     for (RigProjector& p : sharp.projectors) p.black_level = 0.0;
     VirtualRig blurred = sharp;
     blurred.projectors[1].blur_px = 3.0;
