@@ -52,12 +52,13 @@ void write_or_throw(const std::filesystem::path& path, const std::vector<std::ui
 
 // The simplified API (png_image_*) is used instead of png_create_*_struct because it reports
 // errors as return values: the classic API longjmp()s out of libpng, which skips C++ destructors.
-void write_png(const std::filesystem::path& path, const Rgb8Image& image) {
+void write_png(const std::filesystem::path& path, const Rgb8Image& image, PngCompression compression) {
     require_valid_image(image, "write_png " + quoted(path));
     PngImageGuard png;
     png.image.width = static_cast<png_uint_32>(image.size.width);
     png.image.height = static_cast<png_uint_32>(image.size.height);
     png.image.format = PNG_FORMAT_RGB;
+    if (compression == PngCompression::fast) png.image.flags |= PNG_IMAGE_FLAG_FAST;
     if (image.size.width > std::numeric_limits<png_int_32>::max() / 3) {
         throw EncodeError("write_png " + quoted(path) + ": width " + std::to_string(image.size.width) +
                           " is too large for a PNG row");

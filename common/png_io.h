@@ -13,10 +13,17 @@
 
 namespace mogao {
 
+// How hard write_png compresses. `fast` is libpng's PNG_IMAGE_FLAG_FAST (no row filters, zlib
+// level 3): several times faster than `small` (libpng's default), for a file about twice as large
+// on a rendered frame. For previews written while something else needs the CPU (a kiosk's output
+// PNGs beside the farm and the rasteriser).
+enum class PngCompression { small, fast };
+
 // 8-bit RGB PNG with an sRGB chunk. Throws std::invalid_argument for an inconsistent image and
 // EncodeError naming `path` and the reason if libpng fails or the file cannot be written (missing
 // directory, permissions, full disk).
-void write_png(const std::filesystem::path& path, const Rgb8Image& image);
+void write_png(const std::filesystem::path& path, const Rgb8Image& image,
+               PngCompression compression = PngCompression::small);
 
 // Any PNG libpng can read, converted to RGB8: grayscale is replicated to R=G=B, palettes are
 // expanded, alpha is composited over black, 16-bit samples are reduced to 8 bits, and a file whose

@@ -60,6 +60,15 @@ TEST_F(ImageFiles, PngRoundTripIsBitExact) {
     expect_same_pixels(read_png(dir_ / "frame.png"), image);
 }
 
+// The fast setting is still lossless; on a smooth image its file is larger (no row filters).
+TEST_F(ImageFiles, AFastPngIsBitExactAndLargerOnASmoothImage) {
+    const Rgb8Image image = test_images::gradient({256, 128});
+    write_png(dir_ / "small.png", image);
+    write_png(dir_ / "fast.png", image, PngCompression::fast);
+    expect_same_pixels(read_png(dir_ / "fast.png"), image);
+    EXPECT_GT(std::filesystem::file_size(dir_ / "fast.png"), std::filesystem::file_size(dir_ / "small.png"));
+}
+
 TEST_F(ImageFiles, PpmRoundTripIsBitExact) {
     const Rgb8Image image = test_images::noise({41, 19});
     write_ppm(dir_ / "frame.ppm", image);

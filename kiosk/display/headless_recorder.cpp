@@ -49,7 +49,7 @@ void HeadlessRecorder::Writer::run() {
         lock.unlock();
         for (const auto& [file, image] : round) {
             try {
-                write_png(file, image);
+                write_png(file, image, PngCompression::fast);  // beside the farm and the rasteriser
             } catch (const std::exception& e) {
                 spdlog::warn("PNG output: {}", e.what());
             }
