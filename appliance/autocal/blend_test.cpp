@@ -9,8 +9,10 @@
 #include <gtest/gtest.h>
 
 #include "appliance/autocal/autocal.h"
+#include "appliance/autocal/colour_truth.h"
 #include "appliance/autocal/rig_bridge.h"
 #include "appliance/rig/rig_file.h"
+#include "appliance/warp/warp_sampling.h"
 
 namespace mogao::autocal {
 namespace {
@@ -55,6 +57,44 @@ TEST(Blend, WeightsStayContinuousWhereImageBordersLeaveTheScreen) {
     // A correct blend leaves the ramps' pixel quantisation: about 1.5 / 115 px at half scale.
     EXPECT_LT(dense.seam_max_deviation, 0.02);
     EXPECT_LT(predicted, 0.02);
+}
+
+// The colour table's seams at black see a spot one projector pixel wide only on a pixel-dense grid: the default
+// 401 x 101 points fall between pixels (8 to 16 projector pixels apart at full resolution). One overlap pixel of
+// projector 0 that no default grid point lands on is lifted at black (a black offset far above its neighbours'); the
+// pixel-dense grid finds it at its own height, the default grid's maximum does not move. Sharp projectors: a point's
+// light is its one pixel's.
+TEST(Blend, ASeamPixelAtBlackIsSeenOnThePixelDenseGrid) {
+    const rig::VirtualRig rig = scaled_rig(load("standard"), 0.25, 0.25);
+    ScreenCalibration c = calibration_from_models(true_models(rig), screen_of(rig), {960, 540});
+    ProjectorCalibration& p0 = c.projectors[0];
+    const ImageSize out = p0.output;
+    std::vector<bool> on_grid(static_cast<std::size_t>(out.pixel_count()), false);
+    for (const rig::ScreenPoint& s : seam_grid(rig, 0.01))
+        if (const auto px = output_pixel(rig, 0, p0, s))
+            on_grid[static_cast<std::size_t>((*px)[1] * out.width + (*px)[0])] = true;
+    int spot_x = -1;
+    const int spot_y = out.height / 2;
+    for (int x = out.width - 1; x > 0 && spot_x < 0; --x) {
+        const float w = sample_blend(p0.blend, out, x, spot_y);  // in the overlap: both projectors show content
+        if (w > 0.2F && w < 0.8F && !on_grid[static_cast<std::size_t>(spot_y * out.width + x)]) spot_x = x;
+    }
+    ASSERT_GE(spot_x, 0) << "no overlap pixel between the default grid's points on projector 0's middle row";
+    const SeamColour sparse = measure_seam_colour(rig, c, 0.0);
+    const SeamColour dense = measure_seam_colour(rig, c, 0.0, 0.01, nullptr, false, pixel_dense_seam_grid(rig));
+    p0.beta.size = out;
+    p0.beta.rgb.assign(static_cast<std::size_t>(out.pixel_count()) * 3, 0.0F);
+    for (std::size_t ch = 0; ch < 3; ++ch)
+        p0.beta.rgb[3 * (static_cast<std::size_t>(spot_y) * out.width + spot_x) + ch] = 0.2F;
+    const SeamColour sparse_spot = measure_seam_colour(rig, c, 0.0);
+    const SeamColour dense_spot = measure_seam_colour(rig, c, 0.0, 0.01, nullptr, false, pixel_dense_seam_grid(rig));
+    std::printf("seam max at black: default grid %.4f -> %.4f, pixel-dense %.4f -> %.4f (%d seam points)\n",
+                sparse.seam_luminance_deviation, sparse_spot.seam_luminance_deviation, dense.seam_luminance_deviation,
+                dense_spot.seam_luminance_deviation, dense_spot.seam_samples);
+    EXPECT_GE(dense.seam_luminance_deviation, sparse.seam_luminance_deviation - 1e-9);
+    EXPECT_GT(dense_spot.seam_luminance_deviation, dense.seam_luminance_deviation + 0.5);
+    EXPECT_GT(dense_spot.seam_luminance_pixel_max, dense.seam_luminance_pixel_max + 0.5);
+    EXPECT_LT(sparse_spot.seam_luminance_deviation, sparse.seam_luminance_deviation + 0.01);
 }
 
 // The same blend on the same rig with its projectors defocused by 0.7 px (a focused real lens' blur): each pixel's

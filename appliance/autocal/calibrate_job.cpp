@@ -109,12 +109,14 @@ Rgb8Image preview(const rig::VirtualRig& rig, const ScreenCalibration& c, int wi
     return out;
 }
 
-// Seams against the rig's ground truth at black, dark, mid grey and white content.
-nlohmann::json seam_figures(const rig::VirtualRig& rig, const ScreenCalibration& c, bool defocused,
+// Seams against the rig's ground truth at black, dark, mid grey and white content, on the default grid or
+// (CalibrateJob::dense_seams) a pixel-dense one.
+nlohmann::json seam_figures(const rig::VirtualRig& rig, const ScreenCalibration& c, const CalibrateJob& job,
                             const IndirectLight* indirect = nullptr) {
     nlohmann::json out = nlohmann::json::array();
+    const SeamGridSize grid = job.dense_seams ? pixel_dense_seam_grid(rig) : SeamGridSize{};
     for (const double level : {0.0, 0.05, 0.5, 1.0}) {
-        const SeamColour s = measure_seam_colour(rig, c, level, 0.01, indirect, defocused);
+        const SeamColour s = measure_seam_colour(rig, c, level, 0.01, indirect, job.defocused_truth, grid);
         out.push_back({{"level", level},
                        {"reference_luminance", s.reference_luminance},
                        {"seam_luminance_deviation", s.seam_luminance_deviation},
@@ -306,7 +308,7 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
     nlohmann::json seams_before;
     std::optional<ColourResult> colour;
     if (job.colour) {
-        seams_before = seam_figures(rig, r.calibration, job.defocused_truth);
+        seams_before = seam_figures(rig, r.calibration, job);
         const auto t1 = std::chrono::steady_clock::now();
         colour =
             calibrate_colour(source, r.screen, r.camera, r.projectors, r.calibration, job.colour_options);  // throws
@@ -355,7 +357,8 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
         report["captures"] = r.report.captures + check.captures + colour->captures;
         report["ground_truth"]["seams_before_colour"] = seams_before;
     }
-    report["ground_truth"]["seams"] = seam_figures(rig, r.calibration, job.defocused_truth, shown_less);
+    report["ground_truth"]["seams"] = seam_figures(rig, r.calibration, job, shown_less);
+    report["ground_truth"]["seams_grid"] = job.dense_seams ? "pixel-dense" : "401x101";
     report["ground_truth"]["defocused"] = job.defocused_truth;
     for (std::size_t k = 0; k < r.report.projectors.size(); ++k) {
         report["projectors"].push_back(

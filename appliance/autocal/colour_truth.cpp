@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -202,13 +205,6 @@ double median(std::vector<double> v) {
     return v[v.size() / 2];
 }
 
-double percentile(std::vector<double> v, double q) {
-    if (v.empty()) return 0.0;
-    const auto i = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1));
-    std::nth_element(v.begin(), v.begin() + static_cast<long>(i), v.end());
-    return v[i];
-}
-
 double luminance(const std::array<double, 3>& rgb) { return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]; }
 
 double lab_f(double t) {
@@ -246,42 +242,128 @@ std::array<double, 3> rgb_to_lab(const std::array<double, 3>& rgb, const std::ar
     return {116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz)};
 }
 
+namespace {
+
+// How many projectors show content (blend weight > 0) at screen point s: Point::lit without the light.
+int projectors_showing(const rig::VirtualRig& rig, const ScreenCalibration& calibration, const rig::ScreenPoint& s) {
+    int lit = 0;
+    for (std::size_t k = 0; k < calibration.projectors.size(); ++k) {
+        const ProjectorCalibration& pc = calibration.projectors[k];
+        const auto position = rig::screen_to_projector(rig, static_cast<int>(k), s);
+        if (!position || !inside_image(rig.projectors[k], *position)) continue;
+        const auto [x, y] = output_pixel_at(pc, *position);
+        lit += sample_warp(pc.warp, pc.output, x, y).valid() && sample_blend(pc.blend, pc.output, x, y) > 0.0F;
+    }
+    return lit;
+}
+
+// The seam figures of one measurement, point by point (measure_seam_colour).
+class SeamTally {
+public:
+    SeamTally(const rig::VirtualRig& rig, const ViewedLight& light, const std::array<double, 3>& reference,
+              const std::array<double, 3>& white_xyz, double level)
+        : rig_(rig), light_(light), reference_(reference), white_(white_xyz) {
+        out_.level = level;
+        out_.reference_luminance = luminance(reference);
+        reference_lab_ = rgb_to_lab(reference, white_xyz);
+    }
+
+    // Point p in the figures over all points.
+    void add_to_all(const Point& p) {
+        const double dev = deviation(p);
+        ++out_.samples;
+        out_.luminance_max_deviation = std::max(out_.luminance_max_deviation, dev);
+        all_dev_.push_back(static_cast<float>(dev));
+        out_.delta_e_max = std::max(out_.delta_e_max, delta_e(p));
+    }
+
+    // Seam point p (lit >= 2) in the seam's figures; its pixel mean now (`pixel_now`) or, on a dense grid, in
+    // finish() for the seam points within kPixelCandidate of the point maximum.
+    void add_to_seam(const Point& p, bool pixel_now) {
+        const double dev = deviation(p);
+        const double de = delta_e(p);
+        ++out_.seam_samples;
+        out_.seam_luminance_deviation = std::max(out_.seam_luminance_deviation, dev);
+        out_.seam_delta_e = std::max(out_.seam_delta_e, de);
+        seam_dev_.push_back(static_cast<float>(dev));
+        seam_de_.push_back(static_cast<float>(de));
+        if (pixel_now) note_pixel(p);
+        else if (dev >= kPixelCandidate * out_.seam_luminance_deviation) candidates_.emplace_back(dev, p);
+    }
+
+    SeamColour finish() {
+        for (const auto& [dev, p] : candidates_)
+            if (dev >= kPixelCandidate * out_.seam_luminance_deviation) note_pixel(p);
+        // The seam's points are points of the screen too (on a dense grid, more than the default grid has).
+        out_.luminance_max_deviation = std::max(out_.luminance_max_deviation, out_.seam_luminance_deviation);
+        out_.delta_e_max = std::max(out_.delta_e_max, out_.seam_delta_e);
+        out_.seam_luminance_p95 = percentile(seam_dev_, 0.95);
+        out_.luminance_p95 = percentile(all_dev_, 0.95);
+        out_.seam_delta_e_p95 = percentile(seam_de_, 0.95);
+        return out_;
+    }
+
+private:
+    [[nodiscard]] double deviation(const Point& p) const {
+        return std::abs(luminance(p.rgb) / out_.reference_luminance - 1.0);
+    }
+    [[nodiscard]] double delta_e(const Point& p) const {
+        const std::array<double, 3> lab = rgb_to_lab(p.rgb, white_);
+        return std::hypot(lab[0] - reference_lab_[0], lab[1] - reference_lab_[1], lab[2] - reference_lab_[2]);
+    }
+
+    // A pixel's mean is at most the largest point deviation inside it, and a dense grid has a point in or next to
+    // every pixel: the pixels that hold the largest mean are among those of points near the largest deviation.
+    static constexpr double kPixelCandidate = 0.5;
+
+    void note_pixel(const Point& p) {
+        const double pixel_dev = std::abs(luminance(pixel_light(rig_, light_, p)) / out_.reference_luminance - 1.0);
+        out_.seam_luminance_pixel_max = std::max(out_.seam_luminance_pixel_max, pixel_dev);
+    }
+    static double percentile(std::vector<float> v, double q) {
+        if (v.empty()) return 0.0;
+        const auto i = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1));
+        std::nth_element(v.begin(), v.begin() + static_cast<long>(i), v.end());
+        return v[i];
+    }
+
+    const rig::VirtualRig& rig_;
+    const ViewedLight& light_;
+    std::array<double, 3> reference_, white_, reference_lab_{};
+    SeamColour out_;
+    std::vector<float> seam_dev_, seam_de_, all_dev_;
+    std::vector<std::pair<double, Point>> candidates_;
+};
+
+}  // namespace
+
 SeamColour measure_seam_colour(const rig::VirtualRig& rig, const ScreenCalibration& calibration, double level,
-                               double inset, const IndirectLight* indirect, bool defocused) {
+                               double inset, const IndirectLight* indirect, bool defocused, SeamGridSize grid) {
+    if (grid.columns < 2 || grid.rows < 2)
+        throw std::invalid_argument("measure_seam_colour: grid columns and rows >= 2");
     const std::array<double, 3> white =
         rgb_to_xyz(reference_rgb(screen_light(ViewedLight(rig, calibration, 1.0, indirect, defocused), rig, inset)));
     const ViewedLight light(rig, calibration, level, indirect, defocused);
-    const std::vector<Point> pts = screen_light(light, rig, inset);
-    const std::array<double, 3> ref = reference_rgb(pts);
-    const std::array<double, 3> ref_lab = rgb_to_lab(ref, white);
-    SeamColour out;
-    std::vector<double> seam_dev;
-    std::vector<double> seam_de;
-    std::vector<double> all_dev;
-    out.level = level;
-    out.samples = static_cast<int>(pts.size());
-    out.reference_luminance = luminance(ref);
-    for (const Point& p : pts) {
-        const double dev = std::abs(luminance(p.rgb) / out.reference_luminance - 1.0);
-        const std::array<double, 3> lab = rgb_to_lab(p.rgb, white);
-        const double de = std::hypot(lab[0] - ref_lab[0], lab[1] - ref_lab[1], lab[2] - ref_lab[2]);
-        out.luminance_max_deviation = std::max(out.luminance_max_deviation, dev);
-        all_dev.push_back(dev);
-        out.delta_e_max = std::max(out.delta_e_max, de);
-        if (p.lit >= 2) {
-            ++out.seam_samples;
-            out.seam_luminance_deviation = std::max(out.seam_luminance_deviation, dev);
-            const double pixel_dev = std::abs(luminance(pixel_light(rig, light, p)) / out.reference_luminance - 1.0);
-            out.seam_luminance_pixel_max = std::max(out.seam_luminance_pixel_max, pixel_dev);
-            out.seam_delta_e = std::max(out.seam_delta_e, de);
-            seam_dev.push_back(dev);
-            seam_de.push_back(de);
+    // The reference from the default grid: a median over the single-lit screen, which a denser grid does not move.
+    const std::vector<Point> coarse = screen_light(light, rig, inset);
+    SeamTally tally(rig, light, reference_rgb(coarse), white, level);
+    const SeamGridSize standard;
+    const bool dense = grid.columns != standard.columns || grid.rows != standard.rows;
+    for (const Point& p : coarse) {
+        tally.add_to_all(p);
+        if (!dense && p.lit >= 2) tally.add_to_seam(p, true);
+    }
+    // The seams on the dense grid, row by row (a pixel-dense grid of a wide rig holds millions of points), each point's
+    // light evaluated only where two projectors show content.
+    for (int j = 0; dense && j < grid.rows; ++j) {
+        for (int i = 0; i < grid.columns; ++i) {
+            const Eigen::Vector2d uv(inset + (1.0 - 2.0 * inset) * i / (grid.columns - 1),
+                                     inset + (1.0 - 2.0 * inset) * j / (grid.rows - 1));
+            const rig::ScreenPoint s = rig::screen_of(rig.screen, uv);
+            if (projectors_showing(rig, calibration, s) >= 2) tally.add_to_seam(light.at(s), false);
         }
     }
-    out.seam_luminance_p95 = percentile(seam_dev, 0.95);
-    out.luminance_p95 = percentile(all_dev, 0.95);
-    out.seam_delta_e_p95 = percentile(seam_de, 0.95);
-    return out;
+    return tally.finish();
 }
 
 }  // namespace mogao::autocal

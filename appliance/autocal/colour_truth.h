@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "appliance/autocal/indirect_light.h"
+#include "appliance/autocal/rig_bridge.h"
 #include "appliance/rig/virtual_rig.h"
 #include "common/projector_calibration.h"
 
@@ -42,16 +43,20 @@ struct SeamColour {
     double seam_delta_e_p95 = 0.0;    // 95th percentile of the seam points' Delta E
 };
 
-// Points: a grid of 401 x 101 content points inset by `inset` of the frame on each side. The
-// reference colour is the per-channel median over points lit by one projector. A seam point's pixel mean is
-// taken over 8 x 8 points of the pixel's footprint, placed on the screen by the rig's true projector.
+// Points: a grid of `grid` content points (401 x 101 by default; pixel_dense_seam_grid for a maximum that sees
+// lines one projector pixel wide) inset by `inset` of the frame on each side. The reference colour is the
+// per-channel median over the default grid's points lit by one projector. A seam point's pixel mean is taken
+// over 8 x 8 points of the pixel's footprint, placed on the screen by the rig's true projector: for every seam
+// point on the default grid, and on a denser one for the seam points within half of the seam's point maximum
+// (a pixel's mean is at most the largest deviation inside it, and such a grid has a point in or next to every
+// pixel). Throws std::invalid_argument for a grid under 2 x 2.
 // With `indirect`, the content is shown less the indirect light's field for flat content at `level`
 // (indirect_light.h; render_output's `indirect`), as the outputs show it.
 // `defocused`: each defocused projector's (RigProjector::blur_px > 0) light at a point is its pixels' spread by their
 // aperture and the blur (projector_footprint.h), as the screen shows it; else each pixel's light is a sharp step.
 [[nodiscard]] SeamColour measure_seam_colour(const rig::VirtualRig& rig, const ScreenCalibration& calibration,
                                              double level, double inset = 0.01, const IndirectLight* indirect = nullptr,
-                                             bool defocused = false);
+                                             bool defocused = false, SeamGridSize grid = {});
 
 // Linear RGB (BT.709 primaries) -> CIELAB against white `white_xyz`.
 [[nodiscard]] std::array<double, 3> rgb_to_lab(const std::array<double, 3>& rgb,
