@@ -25,8 +25,8 @@ namespace mogao::autocal {
 
 struct SeamColour {
     double level = 0.0;                     // content value (linear, all channels)
-    int samples = 0;                        // content points measured
-    int seam_samples = 0;                   // of those, lit by two or more projectors (blend > 0)
+    int samples = 0;                        // content points of the default grid (the figures over all points)
+    int seam_samples = 0;                   // points of the seam grid lit by two or more projectors (blend > 0)
     double reference_luminance = 0.0;       // median Y over points lit by one projector
     double luminance_max_deviation = 0.0;   // max |Y / reference - 1| over all points
     double seam_luminance_deviation = 0.0;  // the same over the seam points
