@@ -278,7 +278,7 @@ public:
     }
 
     // Seam point p (lit >= 2) in the seam's figures; its pixel mean now (`pixel_now`) or, on a dense grid, in
-    // finish() for the seam points within kPixelCandidate of the point maximum.
+    // finish() for the kPixelCandidates seam points of largest deviation.
     void add_to_seam(const Point& p, bool pixel_now) {
         const double dev = deviation(p);
         const double de = delta_e(p);
@@ -287,13 +287,23 @@ public:
         out_.seam_delta_e = std::max(out_.seam_delta_e, de);
         seam_dev_.push_back(static_cast<float>(dev));
         seam_de_.push_back(static_cast<float>(de));
-        if (pixel_now) note_pixel(p);
-        else if (dev >= kPixelCandidate * out_.seam_luminance_deviation) candidates_.emplace_back(dev, p);
+        if (pixel_now) {
+            note_pixel(p);
+            return;
+        }
+        // The kPixelCandidates points of largest deviation so far, a min-heap on their deviation.
+        const auto smaller_first = [](const auto& a, const auto& b) { return a.first > b.first; };
+        if (candidates_.size() == kPixelCandidates && dev <= candidates_.front().first) return;
+        if (candidates_.size() == kPixelCandidates) {
+            std::pop_heap(candidates_.begin(), candidates_.end(), smaller_first);
+            candidates_.pop_back();
+        }
+        candidates_.emplace_back(dev, p);
+        std::push_heap(candidates_.begin(), candidates_.end(), smaller_first);
     }
 
     SeamColour finish() {
-        for (const auto& [dev, p] : candidates_)
-            if (dev >= kPixelCandidate * out_.seam_luminance_deviation) note_pixel(p);
+        for (const auto& candidate : candidates_) note_pixel(candidate.second);
         // The seam's points are points of the screen too (on a dense grid, more than the default grid has).
         out_.luminance_max_deviation = std::max(out_.luminance_max_deviation, out_.seam_luminance_deviation);
         out_.delta_e_max = std::max(out_.delta_e_max, out_.seam_delta_e);
@@ -313,8 +323,9 @@ private:
     }
 
     // A pixel's mean is at most the largest point deviation inside it, and a dense grid has a point in or next to
-    // every pixel: the pixels that hold the largest mean are among those of points near the largest deviation.
-    static constexpr double kPixelCandidate = 0.5;
+    // every pixel: the pixel of the largest mean is among those of the points of largest deviation. Each pixel mean
+    // costs 64 lights, as many as 64 points: a bound keeps the dense grid's cost at about its points'.
+    static constexpr std::size_t kPixelCandidates = 4096;
 
     void note_pixel(const Point& p) {
         const double pixel_dev = std::abs(luminance(pixel_light(rig_, light_, p)) / out_.reference_luminance - 1.0);

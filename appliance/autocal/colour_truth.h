@@ -47,9 +47,9 @@ struct SeamColour {
 // lines one projector pixel wide) inset by `inset` of the frame on each side. The reference colour is the
 // per-channel median over the default grid's points lit by one projector. A seam point's pixel mean is taken
 // over 8 x 8 points of the pixel's footprint, placed on the screen by the rig's true projector: for every seam
-// point on the default grid, and on a denser one for the seam points within half of the seam's point maximum
-// (a pixel's mean is at most the largest deviation inside it, and such a grid has a point in or next to every
-// pixel). Throws std::invalid_argument for a grid under 2 x 2.
+// point on the default grid, and on a denser one for the 4096 seam points of largest deviation (a pixel's mean is
+// at most the largest deviation inside it, and such a grid has a point in or next to every pixel). Throws
+// std::invalid_argument for a grid under 2 x 2.
 // With `indirect`, the content is shown less the indirect light's field for flat content at `level`
 // (indirect_light.h; render_output's `indirect`), as the outputs show it.
 // `defocused`: each defocused projector's (RigProjector::blur_px > 0) light at a point is its pixels' spread by their

@@ -39,7 +39,7 @@ void add_rig_flags(CLI::App& cmd, RigCommand& flags, CalibrateJob& job) {
         "the screen shows it");
     cmd.add_flag("--dense-seams", job.dense_seams,
                  "Ground truth: the seams at each content level on a point per projector pixel, not on 401 x 101 "
-                 "points (minutes longer at full resolution)");
+                 "points (slower at full resolution)");
     cmd.add_flag("--fixed-camera-intrinsics", flags.fixed_intrinsics,
                  "Take the camera's intrinsics as exact: do not try refining its focal length, principal point and "
                  "k1, k2 (kept by default only where they pay)");
