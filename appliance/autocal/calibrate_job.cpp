@@ -358,7 +358,10 @@ nlohmann::json run_calibrate_job(const CalibrateJob& job) {
         report["ground_truth"]["seams_before_colour"] = seams_before;
     }
     report["ground_truth"]["seams"] = seam_figures(rig, r.calibration, job, shown_less);
-    report["ground_truth"]["seams_grid"] = job.dense_seams ? "pixel-dense" : "401x101";
+    const SeamGridSize standard;
+    report["ground_truth"]["seams_grid"] = job.dense_seams
+                                               ? std::string("pixel-dense")
+                                               : std::to_string(standard.columns) + "x" + std::to_string(standard.rows);
     report["ground_truth"]["defocused"] = job.defocused_truth;
     for (std::size_t k = 0; k < r.report.projectors.size(); ++k) {
         report["projectors"].push_back(
