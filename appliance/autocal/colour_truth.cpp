@@ -368,9 +368,7 @@ SeamColour measure_seam_colour(const rig::VirtualRig& rig, const ScreenCalibrati
     // light evaluated only where two projectors show content.
     for (int j = 0; dense && j < grid.rows; ++j) {
         for (int i = 0; i < grid.columns; ++i) {
-            const Eigen::Vector2d uv(inset + (1.0 - 2.0 * inset) * i / (grid.columns - 1),
-                                     inset + (1.0 - 2.0 * inset) * j / (grid.rows - 1));
-            const rig::ScreenPoint s = rig::screen_of(rig.screen, uv);
+            const rig::ScreenPoint s = seam_grid_point(rig, inset, grid.columns, grid.rows, i, j);
             if (projectors_showing(rig, calibration, s) >= 2) tally.add_to_seam(light.at(s), false);
         }
     }

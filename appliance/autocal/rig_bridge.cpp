@@ -94,13 +94,15 @@ std::vector<rig::ScreenPoint> seam_grid(const rig::VirtualRig& rig, double inset
     std::vector<rig::ScreenPoint> grid;
     grid.reserve(static_cast<std::size_t>(columns) * static_cast<std::size_t>(rows));
     for (int j = 0; j < rows; ++j) {
-        for (int i = 0; i < columns; ++i) {
-            const Eigen::Vector2d uv(inset + (1.0 - 2.0 * inset) * i / (columns - 1),
-                                     inset + (1.0 - 2.0 * inset) * j / (rows - 1));
-            grid.push_back(rig::screen_of(rig.screen, uv));
-        }
+        for (int i = 0; i < columns; ++i) grid.push_back(seam_grid_point(rig, inset, columns, rows, i, j));
     }
     return grid;
+}
+
+rig::ScreenPoint seam_grid_point(const rig::VirtualRig& rig, double inset, int columns, int rows, int i, int j) {
+    const Eigen::Vector2d uv(inset + (1.0 - 2.0 * inset) * i / (columns - 1),
+                             inset + (1.0 - 2.0 * inset) * j / (rows - 1));
+    return rig::screen_of(rig.screen, uv);
 }
 
 SeamGridSize pixel_dense_seam_grid(const rig::VirtualRig& rig, double per_pixel) {

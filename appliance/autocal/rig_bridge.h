@@ -64,6 +64,9 @@ struct GeometryError {
 // of the frame on every side, row by row, each as the screen point showing it (columns, rows >= 2).
 [[nodiscard]] std::vector<rig::ScreenPoint> seam_grid(const rig::VirtualRig& rig, double inset, int columns = 401,
                                                       int rows = 101);
+// Point (column i, row j) of that grid, without building it (a pixel-dense grid of a wide rig holds millions).
+[[nodiscard]] rig::ScreenPoint seam_grid_point(const rig::VirtualRig& rig, double inset, int columns, int rows, int i,
+                                               int j);
 
 // A seam grid fine enough that a line one projector pixel wide cannot fall between its points: as many
 // columns as the projectors have pixels side by side (their widths summed, overlaps counted twice) and
