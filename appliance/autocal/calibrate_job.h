@@ -54,8 +54,9 @@ struct CalibrateJob : CalibrationSettings {
     bool defocused_truth = true;
     // The seam figures at each content level (report.json's ground_truth.seams) on a grid of a point per projector
     // pixel (pixel_dense_seam_grid), which a line one pixel wide cannot fall between; false: the 401 x 101 grid, 8 to
-    // 16 projector pixels apart on a wide rig (faster at full resolution; --dense-seams).
-    bool dense_seams = false;
+    // 16 projector pixels apart on a wide rig (about a minute faster on a full-resolution defocused rig, blind to
+    // such a line; --coarse-seams).
+    bool dense_seams = true;
     // Per projector (the rig file's order), its lens measured on the bench where the rig names a procam file
     // (projectors[k].procam; kiosk/calibrate/procam_command.h reads them): the prior's intrinsics then
     // (with_bench_lenses). Empty: the data sheets'.

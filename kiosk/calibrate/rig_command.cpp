@@ -37,9 +37,10 @@ void add_rig_flags(CLI::App& cmd, RigCommand& flags, CalibrateJob& job) {
         "--sharp-truth", [&job] { job.defocused_truth = false; },
         "Ground truth: each projector pixel's light as a sharp step, not spread by the rig's defocus (blur_px) as "
         "the screen shows it");
-    cmd.add_flag("--dense-seams", job.dense_seams,
-                 "Ground truth: the seams at each content level on a point per projector pixel, not on 401 x 101 "
-                 "points (slower at full resolution)");
+    cmd.add_flag_callback(
+        "--coarse-seams", [&job] { job.dense_seams = false; },
+        "Ground truth: the seams at each content level on 401 x 101 points, not on a point per projector pixel "
+        "(faster at full resolution; a line one pixel wide can fall between them)");
     cmd.add_flag("--fixed-camera-intrinsics", flags.fixed_intrinsics,
                  "Take the camera's intrinsics as exact: do not try refining its focal length, principal point and "
                  "k1, k2 (kept by default only where they pay)");

@@ -13,7 +13,7 @@ Python 3 standard library only.
 """
 import argparse, datetime, glob, json, os, platform, subprocess, tempfile
 
-from calibration_cells import heights_cell
+from calibration_cells import heights_cell, seams_grid_phrase
 from generated_block import replace_block
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -82,7 +82,7 @@ def main():
              "relative cost) | projector distortion (trial's relative cost per projector) | seam luminance max | "
              "predicted seam | camera position error | lit edges rms | reprojection rms (px) | compute s |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|--:|"]
-    colour = [f"Same run. Flat content at each level, the rig's ground-truth light at 401 x 101 content points "
+    colour = ["Same run. Flat content at each level, the rig's ground-truth light {grid} "
               "(each projector pixel's light spread by the rig's defocus where it has one, as the screen shows it); "
               "seam = points two projectors light; luminance deviation |Y / Y_ref - 1| with Y_ref the median of the "
               "points one projector lights; pixel mean = the light averaged over the footprint of the output pixel "
@@ -93,7 +93,7 @@ def main():
               "| rig | content | seam luminance p95 | seam luminance max | seam luminance max, pixel mean | "
               "seam ΔE76 p95 | seam ΔE76 max |",
               "|---|---|---|---|---|---|---|"]
-    runs = []
+    runs, reports = [], []
     for rig in sorted(glob.glob(os.path.join(ROOT, "rigs", "*.toml"))):
         stem = os.path.splitext(os.path.basename(rig))[0]
         runs.append((f"{stem} (x1)" if stem in OWN_SCALE else stem, rig, []))
@@ -127,6 +127,7 @@ def main():
                     continue
                 result = f"refused: {why} (figures: the same run with the gate off)"
             r = json.load(open(os.path.join(out, "report.json")))
+        reports.append(r)
         g = r["ground_truth"]
         if "seams_before_colour" in g:
             colour += colour_rows(name, r)
@@ -145,6 +146,7 @@ def main():
                      f"{r['timing']['compute_s']:.1f} |")
     doc = os.path.join(ROOT, "docs", "calibration.md")
     replace_block(doc, "calibration-rigs", lines)
+    colour[0] = colour[0].format(grid=seams_grid_phrase(reports))
     replace_block(doc, "calibration-colour", colour)
 
 if __name__ == "__main__":

@@ -19,7 +19,7 @@ Python 3.11 standard library only (tomllib).
 """
 import argparse, copy, datetime, glob, json, os, platform, random, subprocess, tempfile, tomllib
 
-from calibration_cells import heights_cell
+from calibration_cells import heights_cell, seams_grid_phrase
 from generated_block import replace_block
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -164,7 +164,7 @@ def main():
     tool = os.path.join(ROOT, args.build, "kiosk", "calibrate", "mogao-calibrate-sim")
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
                             text=True).stdout.strip()
-    rows = []
+    rows, reports = [], []
     default = Tally("As a technician runs it (the defaults; `--fit-heights` where refused naming the heights, "
                     "`--fit-screen` where refused naming the screen)")
     heights = Tally("With `--fit-heights` (the drawn rigs whose heights were taped)")
@@ -192,20 +192,22 @@ def main():
                     report, why = run(tool, rig_path, out + "-fit", args.scale, ["--fit-screen"])
                     name += " `--fit-screen` (refused without: screen)"
                 rows.append(default.row(name, report, why))
+                reports.append(report)
                 print(rows[-1], flush=True)
                 if "screen_top_error_m" in rig["prior"]:
                     if fitted_heights is None:
                         fitted_heights = run(tool, rig_path, out + "-heights", args.scale, ["--fit-heights"])
                     rows.append(heights.row(f"{stem} draw {d} `--fit-heights`", *fitted_heights))
+                    reports.append(fitted_heights[0])
                     print(rows[-1], flush=True)
     lines = [f"Run {datetime.date.today()} at commit {commit} on {platform.node()} by "
              f"`tools/docs/regenerate_unseen_rigs_doc.py --scale {args.scale} --draws {args.draws} --seed {args.seed}` "
              f"(projector and camera resolution x{args.scale}; errors in the drawn rig's projector pixels against its "
              "ground truth; self-check from the camera images alone, its distance to the truth's mean in brackets; "
              "seam luminance maximum after the colour step at white, on a grid of one point per projector pixel, and "
-             "at content 0.05 and black, at a point and (in brackets) in an output pixel's mean, on 401 x 101 "
-             "points; the truth spreads each projector pixel's light by the rig's defocus, as the screen shows it; "
-             "compute = the calibration's wall time, 2 cores).",
+             f"at content 0.05 and black, at a point and (in brackets) in an output pixel's mean, "
+             f"{seams_grid_phrase(reports)}; the truth spreads each projector pixel's light by the rig's defocus, as "
+             "the screen shows it; compute = the calibration's wall time, 2 cores).",
              "", default.summary(), "", heights.summary(), "",
              "| drawn rig | result | geometry mean / p95 / max (px) | self-check mean (distance to truth) px | "
              "heights check mean / max (px) | seam luminance max | seam luminance max at 0.05; black | compute s |",
