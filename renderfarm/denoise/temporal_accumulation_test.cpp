@@ -148,6 +148,33 @@ std::size_t mark_unshaded(RgbFloatImage& frame, int one_in, int phase) {
     return marked;
 }
 
+// clear() drops the history (a light that changes, live_frames.h): what it held before (frames of another size, the
+// same wall where the next frames have sky) must not show in what it gives after, bit for bit.
+TEST(TemporalAccumulation, AClearedHistoryGivesWhatAFreshOneGives) {
+    std::mt19937 rng(11);
+    TemporalHistory used;
+    const ImageSize big{64, 40};
+    for (int k = 0; k < 3; ++k) {
+        const CameraSetup camera = camera_at(2.0 * k, big);
+        const Seen seen = wall(camera, 3.0);  // the same wall: a tap left over would pass every test
+        (void)used.accumulate(shade(seen, 0.2, rng, 5.0), seen.guides, camera, {});
+    }
+    used.clear();
+    TemporalHistory fresh;
+    std::mt19937 noise(12);
+    for (int k = 0; k < 4; ++k) {
+        const CameraSetup camera = camera_at(0.5 * k);
+        Seen seen = wall(camera, 3.0);
+        for (int y = 0; y < kSize.height / 2; ++y)  // the top half-rows sky, where the earlier frames had wall
+            for (int x = 0; x < kSize.width; ++x) seen.guides.set_sky(seen.guides.pixel(x, y));
+        RgbFloatImage frame = shade(seen, 0.2, noise);
+        if (k > 0) mark_unshaded(frame, 4, k);
+        const RgbFloatImage from_used = used.accumulate(frame, seen.guides, camera, {}, nullptr, k > 0 ? 4 : 1);
+        const RgbFloatImage from_fresh = fresh.accumulate(frame, seen.guides, camera, {}, nullptr, k > 0 ? 4 : 1);
+        ASSERT_EQ(from_used.pixels, from_fresh.pixels) << "frame " << k;
+    }
+}
+
 TEST(TemporalAccumulation, ASparseFrameTakesTheHistoryWhereItDidNotShadeAndFillsWhatIsNew) {
     TemporalHistory history;
     std::mt19937 rng(5);
