@@ -44,6 +44,7 @@ void check_inputs(const CalibrationPrior& prior, ImageSize content, const Autoca
     if (!(o.blend_ramp > 0.0 && o.blend_ramp <= 0.5)) fail("options.blend_ramp: (0, 0.5]");
     if (!(o.max_predicted_seam > 0.0 && o.max_predicted_seam <= 1.0)) fail("options.max_predicted_seam: (0, 1]");
     if (!(o.max_frame_straddle >= 0.0 && o.max_frame_straddle <= 1.0)) fail("options.max_frame_straddle: [0, 1]");
+    if (!(o.shadow_relative >= 0.0 && o.shadow_relative <= 0.5)) fail("options.shadow_relative: [0, 0.5]");
     if (o.max_gray_bits != 0 && (o.max_gray_bits < o.min_bits || o.max_gray_bits > 16)) {
         fail("options.max_gray_bits: 0 (all) or min_bits (" + std::to_string(o.min_bits) + ")..16, got " +
              std::to_string(o.max_gray_bits));

@@ -24,7 +24,8 @@
 //     the pixel's block, so the block's centre is the pixel's position. Each decoded camera pixel (all but at most two
 //     of the resolved bits per axis) gives a correspondence: its centre <-> the block's centre, with the block's size /
 //     sqrt(12) as its uncertainty (a uniform error over the block). The shadow mask's threshold is also
-//     `shadow_noise_sigmas` times the noise of white - black, estimated from the black image.
+//     `shadow_noise_sigmas` times the noise of white - black, estimated from the black image, and
+//     `shadow_relative` of the projector's own contrast (its 99th percentile).
 //  1b. Phase shift (phase_shift.h; Gühring 2001): `phase_shifts` sinusoids per axis refine each pixel whose Gray
 //     block is at most half a period to a sub-pixel position with its own uncertainty.
 //  2. Camera pose: the lit region of the projectors at full white ends at the screen's edges
@@ -208,6 +209,11 @@ struct AutocalOptions {
     // Shadow mask: a camera pixel counts only where white - black is also above this many sigmas of that
     // difference's noise (estimated from the black image), so that a noisy camera's dark pixels do not pass.
     double shadow_noise_sigmas = 5.0;  // >= 0
+    // Shadow mask: and above this share of the projector's own contrast (the 99th percentile of white - black over
+    // the pixels past min_contrast), [0, 0.5]. A screen that throws light back onto itself (a gain screen, a wide arc)
+    // lights the screen past the projector's image by a few percent of its direct light; filmed bright enough, those
+    // pixels pass an absolute threshold, carry no pattern, and the coarsest Gray bits stop resolving.
+    double shadow_relative = 0.1;
     double max_edge_rms_m = 0.01;      // camera pose fit gate
     double max_projector_rms = 3.0;    // projector fit gate, rms in units of the decoding uncertainty, > 0
     double max_view_angle_deg = 75.0;  // camera rays steeper than this to the screen normal: grazing

@@ -188,6 +188,7 @@ TEST(Autocal, NoisyRigMeetsTheGoalsWithPhaseShiftAndTheNoiseAwareMask) {
     };
     AutocalOptions fixed_mask;
     fixed_mask.shadow_noise_sigmas = 0.0;  // min_contrast alone, as before
+    fixed_mask.shadow_relative = 0.0;      // (the threshold relative to the contrast alone decodes it too)
     EXPECT_THROW((void)run(fixed_mask), CalibrationRefused);
     AutocalOptions gray_only;
     gray_only.phase_shifts = 0;

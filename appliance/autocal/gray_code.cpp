@@ -132,6 +132,21 @@ double flat_image_noise(const cv::Mat1f& img) {
     return mad_sigma(r) / 6.0;
 }
 
+// The projector's own contrast: the 99th percentile of white - black over the pixels above `floor` (0 when none are),
+// a robust maximum that a few hot or clipped pixels do not set.
+double high_contrast(const cv::Mat1f& contrast, double floor) {
+    std::vector<float> lit;
+    for (int y = 0; y < contrast.rows; ++y) {
+        for (int x = 0; x < contrast.cols; ++x) {
+            if (contrast(y, x) > floor) lit.push_back(contrast(y, x));
+        }
+    }
+    if (lit.empty()) return 0.0;
+    const auto at = lit.begin() + static_cast<long>(lit.size() * 99 / 100);
+    std::nth_element(lit.begin(), at, lit.end());
+    return *at;
+}
+
 // One axis's Gray decoding per camera pixel.
 struct AxisCode {
     cv::Mat1i code;   // Gray-decoded block index, -1 = not lit
@@ -220,7 +235,8 @@ Correspondences decode_projector(PatternSource& source, int k, const std::vector
     // pixels do not pass as lit.
     out.noise_sigma = flat_image_noise(black);
     out.shadow_threshold =
-        std::max(options.min_contrast, options.shadow_noise_sigmas * std::sqrt(2.0) * out.noise_sigma);
+        std::max({options.min_contrast, options.shadow_noise_sigmas * std::sqrt(2.0) * out.noise_sigma,
+                  options.shadow_relative * high_contrast(contrast, options.min_contrast)});
     AxisCode col{cv::Mat1i(contrast.size(), -1), cv::Mat1i(contrast.size(), 0), gray_code_bits(size.width)};
     for (int y = 0; y < contrast.rows; ++y) {
         for (int x = 0; x < contrast.cols; ++x) col.code(y, x) = contrast(y, x) > out.shadow_threshold ? 0 : -1;

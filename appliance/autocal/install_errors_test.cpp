@@ -13,6 +13,7 @@
 
 #include "appliance/autocal/autocal.h"
 #include "appliance/autocal/camera_timing.h"
+#include "appliance/autocal/gray_code.h"
 #include "appliance/autocal/rig_bridge.h"
 #include "appliance/autocal/screen_geometry.h"
 #include "appliance/autocal/self_check.h"
@@ -274,6 +275,42 @@ TEST(InstallErrors, TheLitEdgesAreFoundOneProjectorAtATime) {
                 1e3 * all_at_once.rms_m, all_at_once.points, 1e3 * one_at_a_time.rms_m, one_at_a_time.points);
     EXPECT_LT(one_at_a_time.rms_m, 0.8 * all_at_once.rms_m);  // measured 1.19 mm against 2.03
     EXPECT_LE(one_at_a_time.rms_m, 0.0015);
+}
+
+// Light the screen throws back onto itself (realistic-screen's gain screen), filmed brighter than the rig sets it
+// (exposure 1.3 of its 0.7): past a projector's image the screen's own light passes the absolute shadow threshold
+// (min_contrast), carries no pattern, and the coarsest Gray bits stop resolving over the lit pixels. The threshold
+// relative to the projector's own contrast (shadow_relative) keeps the mask to its image, and the calibration gets past
+// the Gray code: it meets the goals or is refused by a later check (the brighter lobe clips the lit edges, which the
+// screen heights' check sees), never a Gray-code failure.
+TEST(InstallErrors, LightTheScreenThrowsBackIsNotTakenForTheProjectors) {
+    rig::VirtualRig rig =
+        scaled_rig(rig::load_rig(std::string(MOGAO_SOURCE_DIR) + "/rigs/realistic-screen.toml"), 0.5, 0.5);
+    std::vector<ImageSize> sizes;
+    for (const DeviceModel& p : prior_from_rig(rig).projectors) sizes.push_back(p.resolution);
+    const AutocalOptions relative;
+    AutocalOptions absolute;
+    absolute.shadow_relative = 0.0;
+    const auto decode = [&](const AutocalOptions& o) {
+        RigPatternSource source(rig);
+        return decode_projector(source, 1, sizes, o);
+    };
+    const Correspondences as_set = decode(relative);
+    rig.camera.exposure = 1.3;
+    const Correspondences bright = decode(relative);
+    const Correspondences bright_absolute = decode(absolute);
+    std::printf(
+        "lit pixels / column, row bits: exposure 0.7 %d / %d, %d; 1.3 %d / %d, %d; 1.3 absolute mask %d / %d, "
+        "%d\n",
+        as_set.lit_pixels, as_set.column_bits, as_set.row_bits, bright.lit_pixels, bright.column_bits, bright.row_bits,
+        bright_absolute.lit_pixels, bright_absolute.column_bits, bright_absolute.row_bits);
+    EXPECT_LT(std::min(bright_absolute.column_bits, bright_absolute.row_bits), absolute.min_bits);
+    EXPECT_NEAR(bright.lit_pixels, as_set.lit_pixels, 0.1 * as_set.lit_pixels);
+    EXPECT_GE(bright.column_bits, as_set.column_bits - 1);
+    EXPECT_GE(bright.row_bits, as_set.row_bits - 1);
+    const Outcome o = calibrate_rig(rig, relative, "realistic-screen x0.5 at exposure 1.3");
+    EXPECT_EQ(o.refused.find("Gray-code"), std::string::npos) << o.refused;
+    EXPECT_TRUE(meets_goals(o) || !o.refused.empty()) << o.geometry.mean_px << " / " << o.geometry.p95_px;
 }
 
 // The camera's timing (camera_timing.h): a camera whose first frame after each pattern change still holds 30 % of
