@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "appliance/autocal/bundle_adjust.h"
+#include "appliance/autocal/camera_clipping.h"
 #include "appliance/autocal/camera_timing.h"
 #include "appliance/autocal/colour_calibration.h"
 #include "appliance/autocal/gray_code.h"
@@ -282,16 +283,38 @@ cv::Mat1f show_averaged(PatternSource& source, const std::vector<cv::Mat>& signa
     return sum;
 }
 
+namespace {
+
+// Refused where the camera clips a projector's white too far, or its grey as well (camera_clipping.h).
+void require_unclipped_edges(const DeclippedWhite& d, std::size_t projector) {
+    const bool grey_clips = d.grey_clipped_pixels > kMaxGreyClippedShare * d.clipped_pixels + kMaxGreyClippedPixels;
+    if (d.overdrive <= kMaxWhiteOverdrive && !grey_clips) return;
+    char why[512];
+    std::snprintf(why, sizeof why,
+                  "camera exposure: projector %zu's white is clipped by the camera on %d pixels, its light there %.2f "
+                  "times full scale (median; measured from its grey %.2f, itself clipped on %d pixels), above %.1f: "
+                  "the patterns' edges are clipped where they are located; lower the camera's exposure or gain to "
+                  "%s1/%.1f of the present",
+                  projector, d.clipped_pixels, d.overdrive, kLitGreySignal, d.grey_clipped_pixels, kMaxWhiteOverdrive,
+                  grey_clips ? "under " : "about ", grey_clips ? 1.0 / kLitGreySignal / kLitGreySignal : d.overdrive);
+    throw CalibrationRefused(why);
+}
+
+}  // namespace
+
 cv::Mat1f lit_screen(PatternSource& source, const std::vector<ImageSize>& sizes, const cv::Mat1f& black, int frames,
                      int& captures) {
     cv::Mat1f lit(black.size(), 0.0f);
     for (std::size_t k = 0; k < sizes.size(); ++k) {
         std::vector<cv::Mat> signals(sizes.size());
         signals[k] = cv::Mat1f(sizes[k].height, sizes[k].width, 1.0f);
-        cv::Mat1f one;
-        cv::subtract(show_averaged(source, signals, frames), black, one);
-        lit = cv::max(lit, one);
-        captures += frames;
+        const cv::Mat1f white = show_averaged(source, signals, frames).clone();  // the source may reuse its buffer
+        signals[k] = cv::Mat1f(sizes[k].height, sizes[k].width, kLitGreySignal);
+        const cv::Mat1f grey = show_averaged(source, signals, frames);
+        captures += 2 * frames;
+        const DeclippedWhite one = declip_white(white, grey, black);
+        require_unclipped_edges(one, k);
+        lit = cv::max(lit, one.light);
     }
     return lit;
 }

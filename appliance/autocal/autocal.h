@@ -316,8 +316,11 @@ public:
 // pixel the largest over projectors k of (projector k white, the others black) minus `black` (every
 // projector black). Not every projector white at once: where projectors overlap, their sum saturates a
 // camera exposed for one of them, and a clipped edge of twice the height crosses its half level outward,
-// 0.67 sigma of the camera's blur for a Gaussian one (millimetres on the virtual rigs). Shows each
-// projector's white `frames` times (n x frames captures, added to `captures`).
+// 0.67 sigma of the camera's blur for a Gaussian one (millimetres on the virtual rigs). Where the camera clips
+// a projector's white, its light there comes from the same projector at grey (camera_clipping.h). Shows each
+// projector's white and grey `frames` times (2 n x frames captures, added to `captures`). Throws
+// CalibrationRefused naming the camera's exposure where a white is clipped beyond kMaxWhiteOverdrive, or a grey
+// clips too.
 [[nodiscard]] cv::Mat1f lit_screen(PatternSource& source, const std::vector<ImageSize>& sizes, const cv::Mat1f& black,
                                    int frames, int& captures);
 

@@ -163,10 +163,10 @@ TEST(Autocal, FewerGrayBitsCaptureLessAndStayWithinABound) {
         EXPECT_EQ(p.column_bits, 6) << p.id;
         EXPECT_EQ(p.row_bits, 6) << p.id;
     }
-    // The camera timing's white, white, black, black; black, white and each projector white alone (the lit edges),
-    // then per projector white, black, 6 Gray bits and inverses per axis and 8 phase shifts per axis (the period
-    // widened to 8 of the finest 8-pixel blocks, so the phase still unwraps).
-    EXPECT_EQ(coarse.report.captures, 4 + 2 + 3 + 3 * (2 + 2 * (6 + 6) + 2 * 8));
+    // The camera timing's white, white, black, black; black, white and each projector white and grey alone (the lit
+    // edges), then per projector white, black, 6 Gray bits and inverses per axis and 8 phase shifts per axis (the
+    // period widened to 8 of the finest 8-pixel blocks, so the phase still unwraps).
+    EXPECT_EQ(coarse.report.captures, 4 + 2 + 2 * 3 + 3 * (2 + 2 * (6 + 6) + 2 * 8));
     const GeometryError g = measure_geometry(rig, coarse.calibration, 4);
     std::printf("6 bits: captures %d, geometry mean %.3f p95 %.3f px\n", coarse.report.captures, g.mean_px, g.p95_px);
     EXPECT_LE(g.mean_px, 0.6);  // measured 0.13 (p95 0.27) at this scale

@@ -134,21 +134,23 @@ protected:
 };
 
 TEST_F(ImagesJobTest, PatternSetHoldsTheLiveSequenceAndWritesEachFileOnce) {
-    // black, white, then per projector: white, Gray bits and inverses of both axes, 8 + 8 phase shifts.
+    // black, white, then per projector: white, grey, Gray bits and inverses of both axes, 8 + 8 phase shifts.
     const int column_bits = 9;  // 480 px
     const int row_bits = 9;     // 270 px
-    EXPECT_EQ(static_cast<int>(catalogue_->patterns().size()), 2 + 3 * (1 + 2 * (column_bits + row_bits) + 16));
+    EXPECT_EQ(static_cast<int>(catalogue_->patterns().size()), 2 + 3 * (2 + 2 * (column_bits + row_bits) + 16));
     EXPECT_EQ(filmed_, static_cast<int>(catalogue_->patterns().size()));
     const nlohmann::json m = read_json(root_ / "images" / "patterns.json");
     EXPECT_EQ(m["pattern_set"], catalogue_->set_signature());
-    EXPECT_EQ(m["patterns"][5]["kind"], "gray-code");
-    EXPECT_EQ(m["patterns"][5]["id"], "p0-columns-bit01");
+    EXPECT_EQ(m["patterns"][3]["id"], "p0-grey");
+    EXPECT_EQ(m["patterns"][6]["kind"], "gray-code");
+    EXPECT_EQ(m["patterns"][6]["id"], "p0-columns-bit01");
     // Every projector's black is one file, shared.
     EXPECT_EQ(m["patterns"][0]["files"]["proj1"], m["patterns"][2]["files"]["proj1"]);
     std::size_t pngs = 0;
     for (const auto& e : fs::recursive_directory_iterator(root_ / "images" / "p0"))
         pngs += e.path().extension() == ".png";
-    EXPECT_EQ(pngs, 2u + 1u + 2u * (column_bits + row_bits) + 16u - 1u);  // black, white, own patterns (white once)
+    // black, white, own patterns (white once), grey
+    EXPECT_EQ(pngs, 2u + 1u + 2u * (column_bits + row_bits) + 16u - 1u + 1u);
 }
 
 TEST_F(ImagesJobTest, CapturedImagesCalibrateAsWellAsTheLiveRun) {

@@ -16,7 +16,7 @@ PatternBudget pattern_budget(const autocal::CalibrationPrior& prior, bool colour
     };
     PatternBudget b;
     b.identification = 2 + n;
-    b.geometry = 2 + n;
+    b.geometry = 2 + 2 * n;
     for (const autocal::DeviceModel& p : prior.projectors) {
         b.geometry += 2 + 2 * (bits(p.resolution.width) + bits(p.resolution.height)) + 2 * options.phase_shifts;
     }
@@ -39,7 +39,7 @@ PatternBudget pattern_budget(const autocal::CalibrationPrior& prior, bool colour
                    n * 3 * ((steps - 2 + low) * frames(1, d) + frames(1, colour_options.full_level_frames)) +
                    frames(colour_options.dark_frames, d);
     }
-    b.self_check = self_check.frames * (2 + 2 * n);
+    b.self_check = self_check.frames * (2 + 3 * n);
     return b;
 }
 

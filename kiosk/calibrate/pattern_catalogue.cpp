@@ -8,6 +8,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "appliance/autocal/camera_clipping.h"
 #include "appliance/autocal/gray_code.h"
 #include "appliance/autocal/phase_shift.h"
 #include "common/png_io.h"
@@ -70,6 +71,8 @@ std::string kind_name(PatternSpec::Kind k) {
             return "white";
         case PatternSpec::Kind::projector_white:
             return "projector-white";
+        case PatternSpec::Kind::projector_grey:
+            return "projector-grey";
         case PatternSpec::Kind::gray_code:
             return "gray-code";
         case PatternSpec::Kind::phase_shift:
@@ -134,6 +137,7 @@ PatternCatalogue::PatternCatalogue(const std::vector<autocal::DeviceModel>& proj
         const std::string p = "p" + std::to_string(k);
         const std::string who = "projector " + std::to_string(k) + " '" + ids_[static_cast<std::size_t>(k)] + "' ";
         add(p + "-white", {PatternSpec::Kind::projector_white, k}, who + "white, the others black");
+        add(p + "-grey", {PatternSpec::Kind::projector_grey, k}, who + "grey, the others black");
         for (const bool rows : {false, true}) {
             const ImageSize s = sizes_[static_cast<std::size_t>(k)];
             const int all = autocal::gray_code_bits(rows ? s.height : s.width);
@@ -187,6 +191,11 @@ std::vector<cv::Mat> PatternCatalogue::signals(const PatternSpec& spec) const {
             out.at(static_cast<std::size_t>(spec.projector)) =
                 white(sizes_.at(static_cast<std::size_t>(spec.projector)));
             break;
+        case PatternSpec::Kind::projector_grey: {
+            const ImageSize s = sizes_.at(static_cast<std::size_t>(spec.projector));
+            out.at(static_cast<std::size_t>(spec.projector)) = cv::Mat1f(s.height, s.width, autocal::kLitGreySignal);
+            break;
+        }
         case PatternSpec::Kind::gray_code:
             out.at(static_cast<std::size_t>(spec.projector)) = autocal::gray_code_pattern(
                 sizes_.at(static_cast<std::size_t>(spec.projector)), spec.rows, spec.bit, spec.inverse);

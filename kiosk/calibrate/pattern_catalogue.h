@@ -11,6 +11,8 @@
 //   p<k>-white                     projector k white, the others black (shown for the lit edges, each projector
 //                                  in turn after `white`, and again before its Gray code: the same picture,
 //                                  so a folder of captures holds it once)
+//   p<k>-grey                      projector k at grey (autocal::kLitGreySignal), the others black: the lit
+//                                  edges' level where the camera clips the white (camera_clipping.h)
 //   p<k>-<axis>-bit<BB>            projector k's Gray-code bit BB (0 = the coarsest) along `columns` or
 //   p<k>-<axis>-bit<BB>-inverse    `rows`, and its inverse; every bit of the axis (or max_gray_bits):
 //                                  the live run stops at the first bit the camera cannot resolve, the
@@ -48,9 +50,9 @@
 namespace mogao::calibrate {
 
 struct PatternSpec {
-    enum class Kind { black, white, projector_white, gray_code, phase_shift };
+    enum class Kind { black, white, projector_white, projector_grey, gray_code, phase_shift };
     Kind kind = Kind::black;
-    int projector = -1;      // the projector lit (projector_white, gray_code, phase_shift), else -1
+    int projector = -1;      // the projector lit (projector_white, projector_grey, gray_code, phase_shift), else -1
     bool rows = false;       // axis: false = columns (stripes vary along x), true = rows
     int bit = -1;            // gray_code: 0 = the coarsest
     bool inverse = false;    // gray_code

@@ -102,10 +102,11 @@ TEST(PatternBudget, StandardRigImageCount) {
     const auto prior = autocal::prior_from_rig(rig::load_rig(MOGAO_SOURCE_DIR "/rigs/standard.toml"));
     const PatternBudget b = pattern_budget(prior, true, {}, {});
     EXPECT_EQ(b.identification, 5);  // black, white, 3 alone
-    // the camera timing's 4 single frames; black, white, 3 alone (the lit edges); per projector 1920x1080: 11 + 11
-    // Gray bits, each with its inverse, + white, black, + 8 phase shifts per axis
-    EXPECT_EQ(b.geometry, 4 + 2 + 3 + 3 * (46 + 16));
-    EXPECT_EQ(b.self_check, 2 * (2 + 2 * 3));          // black, 3 alone (the frame), black, 3 projectors' marks
+    // the camera timing's 4 single frames; black, white, 3 alone at white and at grey (the lit edges); per projector
+    // 1920x1080: 11 + 11 Gray bits, each with its inverse, + white, black, + 8 phase shifts per axis
+    EXPECT_EQ(b.geometry, 4 + 2 + 2 * 3 + 3 * (46 + 16));
+    // black, 3 alone at white and at grey (the frame), black, 3 projectors' marks
+    EXPECT_EQ(b.self_check, 2 * (2 + 3 * 3));
     EXPECT_EQ(b.colour, 5 + 3 + 3 * 3 * (8 + 4) + 8);  // black, black x4 long, each white long for the bounce
     // Motion-JPEG frames: 4 dithered exposures per image, 8 at the full level, 8 black frames long.
     EXPECT_EQ(pattern_budget(prior, true, {}, {}, {}, true).colour, 4 + 4 + 3 * 4 + 3 * 3 * (11 * 4 + 8) + 8);
@@ -114,7 +115,7 @@ TEST(PatternBudget, StandardRigImageCount) {
     fewer.max_gray_bits = 6;
     fewer.phase_shifts = 0;
     fewer.frames_per_pattern = 2;
-    EXPECT_EQ(pattern_budget(prior, false, {}, fewer).geometry, 4 + 2 * (2 + 3 + 3 * (2 + 2 * (6 + 6))));
+    EXPECT_EQ(pattern_budget(prior, false, {}, fewer).geometry, 4 + 2 * (2 + 2 * 3 + 3 * (2 + 2 * (6 + 6))));
     EXPECT_NEAR(seconds_per_image(30.0, 150, 2), 0.25, 1e-12);
 }
 
