@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <stdexcept>
@@ -443,9 +444,13 @@ void measure_black(PatternSource& source, const ColourOptions& o, const Captured
         }
     }
     if (saturated > rows / 100) {
-        throw CalibrationRefused("black level: " + std::to_string(saturated) +
-                                 " camera pixels saturate at the black exposure x" + std::to_string(o.dark_exposure) +
-                                 " (lower ColourOptions::dark_exposure)");
+        char why[320];
+        std::snprintf(why, sizeof why,
+                      "black level: %ld camera pixels (of %ld) saturate in the black images, filmed at %g times the "
+                      "camera's locked exposure (ColourOptions::dark_exposure): the camera is set too bright for "
+                      "the projectors' black; lower its exposure or gain",
+                      saturated, saturated + rows, o.dark_exposure);
+        throw CalibrationRefused(why);
     }
     ambient = 0.0;
     for (ProjectorPhotometry& pp : pps) pp.black = 0.0;
