@@ -290,13 +290,14 @@ void require_unclipped_edges(const DeclippedWhite& d, std::size_t projector) {
     const bool grey_clips = d.grey_clipped_pixels > kMaxGreyClippedShare * d.clipped_pixels + kMaxGreyClippedPixels;
     if (d.overdrive <= kMaxWhiteOverdrive && !grey_clips) return;
     char why[512];
-    std::snprintf(why, sizeof why,
-                  "camera exposure: projector %zu's white is clipped by the camera on %d pixels, its light there %.2f "
-                  "times full scale (median; measured from its grey %.2f, itself clipped on %d pixels), above %.1f: "
-                  "the patterns' edges are clipped where they are located; lower the camera's exposure or gain to "
-                  "%s1/%.1f of the present",
-                  projector, d.clipped_pixels, d.overdrive, kLitGreySignal, d.grey_clipped_pixels, kMaxWhiteOverdrive,
-                  grey_clips ? "under " : "about ", grey_clips ? 1.0 / kLitGreySignal / kLitGreySignal : d.overdrive);
+    std::snprintf(
+        why, sizeof why,
+        "camera exposure: projector %zu's white is clipped by the camera on %d pixels, its light there %.2f "
+        "times full scale (median; measured from its grey %.2f, itself clipped on %d pixels), above %.1f: "
+        "the phase patterns' sinusoids are clipped on too many of their images; lower the camera's exposure or gain to "
+        "%s1/%.1f of the present",
+        projector, d.clipped_pixels, d.overdrive, kLitGreySignal, d.grey_clipped_pixels, kMaxWhiteOverdrive,
+        grey_clips ? "under " : "about ", grey_clips ? 1.0 / kLitGreySignal / kLitGreySignal : d.overdrive);
     throw CalibrationRefused(why);
 }
 

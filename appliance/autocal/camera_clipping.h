@@ -14,10 +14,11 @@
 // its whole image (its response at that signal; the screen's gain, its thrown-back light and the camera's
 // vignetting scale both images alike), so the ratio white / grey is measured where neither is clipped (the
 // edges' slopes, the dim parts) and, where the white is clipped, its light is the grey's (smoothed over the
-// clipped pixels only, for the grey's lower signal-to-noise) times that ratio. The crossings are still found
+// clipped pixels only, for the grey's lower signal-to-noise) times that ratio, where that exceeds the clipped
+// value by three of its own sigmas (a white just at full scale keeps its own level). The crossings are still found
 // on the white image, at its full signal-to-noise: only their lit side's level comes from the grey.
-// Limits: a white above about twice full scale (kMaxWhiteOverdrive), or the grey clipped as well, is refused
-// by the caller, naming the exposure.
+// Limits: a white above about three times full scale (kMaxWhiteOverdrive), or the grey clipped as well, is
+// refused by the caller, naming the exposure.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -31,11 +32,14 @@ inline constexpr float kLitGreySignal = 0.5f;
 // that rounds full scale down by a code or two.
 inline constexpr float kCameraClipLevel = 0.98f;
 
-// Refused above this white (median over its clipped pixels, in units of full scale): the half level of an
-// edge whose lit side is twice full scale is itself clipped, and so are the crossings of the patterns' blurred
-// stripes. Measured on realistic-screen at half scale: within the goals up to a median of 1.97 (0.13 px mean),
-// outside them from 2.2 (0.30 px mean, p95 0.69; the lit edges alone, located on the grey, do not bring it back).
-inline constexpr double kMaxWhiteOverdrive = 2.0;
+// Refused above this white (median over its clipped pixels, in units of full scale). The phase patterns
+// (phase_shift.h) leave each pixel's clipped images out and need 3 of their 8 left: a sinusoid of full modulation
+// peaking at W times full scale clips on an arc of half-width acos(2 / W - 1), which holds at most 5 of 8
+// images 45 degrees apart while W < 3.24. Past it a pixel keeps its Gray-code position (not refined, with that
+// block's larger sigma). Measured on realistic-screen at half scale (mean / p95 px): 0.097 / 0.162 unclipped
+// (exposure 0.7), 0.111 / 0.171 at exposure 1.8 (median 2.2), 0.132 / 0.188 at 2.4 (median about 2.5), 0.120 /
+// 0.185 at 3.0 (median about 3.1, refused); at 4.0 its grey clips too.
+inline constexpr double kMaxWhiteOverdrive = 3.0;
 // Refused where the grey clips on more than this share of the white's clipped pixels, plus this many (noise).
 inline constexpr double kMaxGreyClippedShare = 0.01;
 inline constexpr int kMaxGreyClippedPixels = 16;

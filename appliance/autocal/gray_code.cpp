@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "appliance/autocal/camera_clipping.h"
 #include "appliance/autocal/phase_shift.h"
 
 namespace mogao::autocal {
@@ -190,22 +191,23 @@ int refine_by_phase(PatternSource& source, int k, std::size_t projectors, ImageS
         images.push_back(show_averaged(source, signals, o.frames_per_pattern).clone());
         captures += o.frames_per_pattern;
     }
-    const PhaseImage phase = decode_phase(images, period);
+    // Images the camera clipped are left out pixel by pixel (phase_shift.h; a gain screen filmed bright).
+    const PhaseImage phase = decode_phase(images, period, kCameraClipLevel);
     const cv::Mat1b lit(a.code >= 0);
     // The pattern pairs' temporal noise, or the phase images' own (for an even N, which also holds what the
     // sinusoid model misses, such as a wrong gamma's harmonics), the larger.
-    const double noise = std::max(image_noise, phase_image_noise(images, lit));
-    const double sigma_phi_b = noise * std::sqrt(2.0 / n);  // sigma_phi * b
+    const double noise = std::max(image_noise, phase_image_noise(images, lit, kCameraClipLevel));
     int refined = 0;
     for (int y = 0; y < a.code.rows; ++y) {
         for (int x = 0; x < a.code.cols; ++x) {
             if (a.code(y, x) < 0) continue;
             const int block = 1 << (a.extent_bits - a.depth(y, x));
             const double b = phase.modulation(y, x);
+            const double sigma_phi_b = noise * phase.noise_gain(y, x);  // sigma_phi * b
             // Unwrapping needs the Gray position within P/2; a modulation below a quarter of the
             // contrast (a sinusoid washed out by blur or a bad gamma) or within 4 sigma of the noise
             // is not trusted.
-            if (block > period / 2.0 || b < 0.25 * contrast(y, x) || b < 4.0 * sigma_phi_b) continue;
+            if (block > period / 2.0 || b < 0.25 * contrast(y, x) || !(b >= 4.0 * sigma_phi_b)) continue;
             p.position(y, x) = static_cast<float>(unwrap_position(p.position(y, x), phase.position(y, x), period));
             p.sigma(y, x) = static_cast<float>(
                 std::max(o.phase_sigma_floor_px, period / (2.0 * std::numbers::pi) * sigma_phi_b / b));

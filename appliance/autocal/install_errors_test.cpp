@@ -315,20 +315,22 @@ TEST(InstallErrors, LightTheScreenThrowsBackIsNotTakenForTheProjectors) {
 
 // A camera that clips the projectors' white (camera_clipping.h): realistic-screen (a gain screen) filmed brighter
 // than the rig sets its camera (0.7). The lit edges' half level comes from each projector's grey where its white
-// clips, so the camera's pose does not move outward with the clipped edges: at exposure 1.0 the geometry is what
-// it is at 0.7 (before: twice its mean), and 1.3 meets the goals (LightTheScreenThrowsBack... above); a white
-// clipped beyond twice full scale is refused naming the exposure (before: refused naming the screen's heights).
+// clips, so the camera's pose does not move outward with the clipped edges, and the phase patterns' clipped images
+// are left out of each pixel's fit (phase_shift.h): at exposure 2.4 (the white about 2.5 times full scale) the
+// geometry is close to what it is at 0.7 (before: refused; with that gate lifted, 0.30 / 0.69 px at 1.8), and
+// 1.3 meets the goals (LightTheScreenThrowsBack... above). A white clipped beyond three times full scale is
+// refused naming the exposure.
 TEST(InstallErrors, ACameraClippingTheWhiteKeepsTheLitEdges) {
     rig::VirtualRig rig =
         scaled_rig(rig::load_rig(std::string(MOGAO_SOURCE_DIR) + "/rigs/realistic-screen.toml"), 0.5, 0.5);
     const Outcome as_set = calibrate_rig(rig, AutocalOptions{}, "realistic-screen x0.5 at exposure 0.7");
-    rig.camera.exposure = 1.0;
-    const Outcome clipped = calibrate_rig(rig, AutocalOptions{}, "realistic-screen x0.5 at exposure 1.0");
+    rig.camera.exposure = 2.4;
+    const Outcome clipped = calibrate_rig(rig, AutocalOptions{}, "realistic-screen x0.5 at exposure 2.4");
     ASSERT_TRUE(meets_goals(as_set)) << as_set.refused;
     ASSERT_TRUE(meets_goals(clipped)) << clipped.refused;
-    EXPECT_LT(clipped.geometry.mean_px, as_set.geometry.mean_px + 0.03);
+    EXPECT_LT(clipped.geometry.mean_px, as_set.geometry.mean_px + 0.05);
     EXPECT_LT(clipped.geometry.p95_px, as_set.geometry.p95_px + 0.05);
-    for (const double exposure : {2.4, 6.0}) {
+    for (const double exposure : {3.5, 6.0}) {
         rig.camera.exposure = exposure;
         const Outcome refused = calibrate_rig(rig, AutocalOptions{}, "realistic-screen x0.5 overexposed");
         EXPECT_NE(refused.refused.find("camera exposure"), std::string::npos) << exposure << ": " << refused.refused;

@@ -17,8 +17,16 @@
 //    whenever the Gray-code position is within P/2 of the truth, i.e. its block is at most P/2.
 //  * Uncertainty: for image noise sigma_n per image, sigma_phi = sigma_n sqrt(2 / N) / b (Bruning
 //    et al.), so sigma_X = P / (2 pi) sigma_phi.
+//  * A camera that clips: where some of a pixel's N images reach `clip_level`, those images hold full
+//    scale, not a + b cos(...), and the estimator above is biased by the clipped peak's harmonics (a
+//    phase error that repeats N times a period). Those images are left out and a, b cos phi and b sin phi
+//    are fitted by least squares to the others (Chen & Zhang 2016, "High-quality 3D shape measurement
+//    using saturated fringe patterns", Optics and Lasers in Engineering 87): at least 3 must remain. The
+//    fit's noise gain g (sigma_phi = sigma_n g / b) comes from its normal matrix M: g^2 = b^2 d^T M^-1 d,
+//    d the gradient of phi in (a, b sin phi, b cos phi); sqrt(2 / N) where nothing clips.
 #pragma once
 
+#include <limits>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -34,13 +42,19 @@ namespace mogao::autocal {
                                             double gamma);
 
 struct PhaseImage {
-    cv::Mat1f position;    // projector image position within the period, [0, P) pixels
-    cv::Mat1f modulation;  // b, camera units
+    cv::Mat1f position;      // projector image position within the period, [0, P) pixels
+    cv::Mat1f modulation;    // b, camera units; 0 where fewer than 3 images are below the clip level
+    cv::Mat1f noise_gain;    // g above: sigma_phi = sigma_n g / b (sqrt(2 / N) unclipped; +inf where b is 0)
+    int clipped_pixels = 0;  // pixels with at least one image at or above the clip level
 };
 
-// Decodes `images` (the camera's views of patterns 0..N-1, CV_32FC1, one size). Throws
-// std::invalid_argument for fewer than 3 images or sizes that differ.
-[[nodiscard]] PhaseImage decode_phase(const std::vector<cv::Mat1f>& images, double period_px);
+// No clipping: every image value is used.
+inline constexpr float kNoClipLevel = std::numeric_limits<float>::infinity();
+
+// Decodes `images` (the camera's views of patterns 0..N-1, CV_32FC1, one size), leaving out per pixel the
+// images at or above `clip_level`. Throws std::invalid_argument for fewer than 3 images or sizes that differ.
+[[nodiscard]] PhaseImage decode_phase(const std::vector<cv::Mat1f>& images, double period_px,
+                                      float clip_level = kNoClipLevel);
 
 // The unwrapped position: x_gray (Gray-code block centre, pixels) moved to the nearest position
 // congruent to `phase_position` modulo the period.
@@ -52,8 +66,10 @@ struct PhaseImage {
 
 // Robust per-image noise of a set of N-step images (N even): the half-sum of opposite shifts,
 // (I_i + I_{i+N/2}) / 2, is a for every i, so their differences are noise alone; the median
-// absolute deviation over `mask` scaled to a Gaussian's sigma (1.4826 MAD) and to one image.
-// Returns 0 for N odd or an empty mask.
-[[nodiscard]] double phase_image_noise(const std::vector<cv::Mat1f>& images, const cv::Mat1b& mask);
+// absolute deviation over `mask` (less the pixels where one of the four images used is at or above
+// `clip_level`: a clipped image breaks the identity) scaled to a Gaussian's sigma (1.4826 MAD) and to one
+// image. Returns 0 for N odd or an empty mask.
+[[nodiscard]] double phase_image_noise(const std::vector<cv::Mat1f>& images, const cv::Mat1b& mask,
+                                       float clip_level = kNoClipLevel);
 
 }  // namespace mogao::autocal
