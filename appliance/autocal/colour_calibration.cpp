@@ -287,6 +287,25 @@ void measure_low_end(PatternSource& source, const std::vector<DeviceModel>& proj
     }
 }
 
+// Refused where a channel's full level saturates the camera on more than 1 % of the pixels the projector lights:
+// the response, the fall-off, the vignetting and the screen's bounce are all measured from those images, and a
+// clipped hot spot (a gain screen filmed brightly) reads as a dimmer projector there (seams of 5 % at white on
+// realistic-screen at exposure 2.4 at half scale, where the geometry still calibrates).
+void require_unclipped_channels(const cv::Mat1b& clipped, const cv::Mat1b& in, std::size_t k, const std::string& id) {
+    cv::Mat1b both;
+    cv::bitwise_and(clipped, in, both);
+    const int n_clipped = cv::countNonZero(both);
+    const int n_in = cv::countNonZero(in);
+    if (n_clipped <= n_in / 100) return;
+    char why[400];
+    std::snprintf(why, sizeof why,
+                  "colour: projector %zu '%s': a channel's full level saturates the camera on %d of the %d pixels it "
+                  "lights (more than 1 %%): its response and brightness cannot be measured there; the camera is set "
+                  "too bright for the colour step; lower its exposure or gain",
+                  k, id.c_str(), n_clipped, n_in);
+    throw CalibrationRefused(why);
+}
+
 // Step 1 for projector k: ramps per channel, the coverage masks from the full-level images.
 ProjectorPhotometry measure_projector(PatternSource& source, const std::vector<DeviceModel>& projectors, std::size_t k,
                                       const ColourOptions& o, Captured& cap, int& captures) {
@@ -295,14 +314,16 @@ ProjectorPhotometry measure_projector(PatternSource& source, const std::vector<D
     const int n = o.ramp_steps;
     std::array<std::vector<cv::Mat1f>, 3> diffs;
     cv::Mat1f full(cap.black.size(), 0.0f);
+    cv::Mat1b clipped(cap.black.size(), uchar{0});  // a channel's full level saturates the camera
     for (std::size_t c = 0; c < 3; ++c) {
         for (int i = 1; i < n; ++i) {
             const double s = static_cast<double>(i) / (n - 1);
-            cv::Mat1f d;
-            cv::subtract(
+            const cv::Mat1f seen =
                 exposure_dithered_mean(source, channel_signal(projectors, k, c, s), 1.0, 1,
-                                       i == n - 1 ? o.full_level_frames : o.dither_frames, o.dither_span, captures),
-                cap.black, d);
+                                       i == n - 1 ? o.full_level_frames : o.dither_frames, o.dither_span, captures);
+            if (i == n - 1) clipped.setTo(1, seen >= 0.98f);
+            cv::Mat1f d;
+            cv::subtract(seen, cap.black, d);
             diffs[c].push_back(d);
         }
         full += diffs[c].back();
@@ -326,6 +347,7 @@ ProjectorPhotometry measure_projector(PatternSource& source, const std::vector<D
                                  std::to_string(cv::countNonZero(in)) +
                                  " pixels of it (need >= 100) to measure its response");
     }
+    require_unclipped_channels(clipped, in, k, pp.id);
     cap.full.push_back(full);
     cap.top.push_back({diffs[0].back(), diffs[1].back(), diffs[2].back()});
     for (std::size_t c = 0; c < 3; ++c) {
@@ -402,13 +424,37 @@ CameraVignetting measure_vignetting(Captured& cap, const ScreenModel& screen, co
     return v;
 }
 
+// The black images' exposure multiplier: dark_exposure, or less where the brightest black a projector lights (the
+// 99.9th percentile of cap.black, measured at low_end_exposure) would pass kDarkHeadroom of full scale at it: a
+// camera exposed brightly (a gain screen's hot spot) then still measures every black instead of clipping the
+// brightest (which the least squares would drop, biasing the blacks low) or refusing. Not below low_end_exposure,
+// where the ramp's low end is measured; a camera that bright is refused below (saturated pixels).
+constexpr double kDarkHeadroom = 0.9;
+
+double dark_exposure_for(const Captured& cap, const ColourOptions& o) {
+    std::vector<float> lit_black;
+    for (int y = 0; y < cap.black.rows; ++y) {
+        for (int x = 0; x < cap.black.cols; ++x) {
+            bool lit = false;
+            for (const cv::Mat1b& in : cap.inside) lit = lit || in(y, x) != 0;
+            if (lit) lit_black.push_back(cap.black(y, x));
+        }
+    }
+    if (lit_black.empty()) return o.dark_exposure;
+    const auto at = lit_black.begin() + static_cast<long>(lit_black.size() * 999 / 1000);
+    std::nth_element(lit_black.begin(), at, lit_black.end());
+    const double brightest = std::max(static_cast<double>(*at), 1e-9);
+    return std::clamp(kDarkHeadroom / brightest, std::min(o.low_end_exposure, o.dark_exposure), o.dark_exposure);
+}
+
 // Step 2: betas and ambient by least squares on the long-exposure black image; a projector's black
 // passes its lens, so its regressor is its fall-off at the pixel (1 where it is flat).
 void measure_black(PatternSource& source, const ColourOptions& o, const Captured& cap, const ScreenModel& screen,
                    const std::vector<DeviceModel>& projectors, std::vector<ProjectorPhotometry>& pps, double& ambient,
                    int& captures) {
     const std::size_t n = pps.size();
-    const cv::Mat1f dark = exposure_dithered_mean(source, std::vector<cv::Mat>(n), o.dark_exposure, o.dark_frames,
+    const double exposure = dark_exposure_for(cap, o);
+    const cv::Mat1f dark = exposure_dithered_mean(source, std::vector<cv::Mat>(n), exposure, o.dark_frames,
                                                   o.dither_frames, o.dither_span, captures);
     Eigen::MatrixXd ata = Eigen::MatrixXd::Zero(static_cast<long>(n) + 1, static_cast<long>(n) + 1);
     Eigen::VectorXd atb = Eigen::VectorXd::Zero(static_cast<long>(n) + 1);
@@ -438,7 +484,7 @@ void measure_black(PatternSource& source, const ColourOptions& o, const Captured
                 continue;
             }
             ata += a * a.transpose();
-            atb += a * (static_cast<double>(unvignetted(dark, cap, x, y)) / o.dark_exposure);
+            atb += a * (static_cast<double>(unvignetted(dark, cap, x, y)) / exposure);
             ++rows;
             overlaps += lit >= 2;
         }
@@ -447,9 +493,9 @@ void measure_black(PatternSource& source, const ColourOptions& o, const Captured
         char why[320];
         std::snprintf(why, sizeof why,
                       "black level: %ld camera pixels (of %ld) saturate in the black images, filmed at %g times the "
-                      "camera's locked exposure (ColourOptions::dark_exposure): the camera is set too bright for "
-                      "the projectors' black; lower its exposure or gain",
-                      saturated, saturated + rows, o.dark_exposure);
+                      "camera's locked exposure (as low as the black's measurement allows): the camera is set too "
+                      "bright for the projectors' black; lower its exposure or gain",
+                      saturated, saturated + rows, exposure);
         throw CalibrationRefused(why);
     }
     ambient = 0.0;

@@ -42,7 +42,8 @@
 //     in the projector by the camera and projector models through the screen; scaled to mean 1
 //     there, and A_kc taken as the mean over the same pixels, so A_kc F_k(p) is the light of pixel p.
 //  2. Black: `dark_frames` all-black images at `dark_exposure` x the base exposure (black levels are
-//     ~0.2 % of white, below one 8-bit code at the base exposure), averaged; least squares over
+//     ~0.2 % of white, below one 8-bit code at the base exposure; less where the brightest black would pass
+//     0.9 of full scale at it, down to `low_end_exposure`: a camera exposed brightly), averaged; least squares over
 //     the camera pixels inside the screen: L0(p) = a + sum_k beta_k M_k(p) with M_k the coverage
 //     masks times F_k (a = ambient, beta_k = projector k's black). Needs at least one overlap to separate
 //     a from the betas. Black's chromaticity is taken to be the projector's white's (light leaking
@@ -88,7 +89,7 @@ namespace mogao::autocal {
 struct ColourOptions {
     int ramp_steps = 9;             // levels per channel including 0 and 1, 3..64
     int dark_frames = 8;            // averaged black images, 1..64
-    double dark_exposure = 40.0;    // exposure multiplier for the black images, [1, 1000]
+    double dark_exposure = 40.0;    // exposure multiplier for the black images (at most), [1, 1000]
     double low_end_exposure = 8.0;  // exposure multiplier for the ramp's low end (levels <= 1/4), [1, 1000]
     // Exposure dither (see "Method"; lossy frames only): every image of a ramp level or of black is the mean of
     // `dither_frames` images at exposures spread over [1, 1 + dither_span] x its own, 1..64; the full level's of

@@ -5,7 +5,11 @@
 // the refusals (auto-exposure not locked, a channel too dark for the camera).
 #include "appliance/autocal/colour_calibration.h"
 
+#include <array>
 #include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -399,6 +403,54 @@ TEST(ColourCalibration, AMotionJpegCamerasRoundingIsDitheredOutByExposure) {
     EXPECT_LT(dithered.corner_error, 0.01);
     EXPECT_LT(dithered.seam_max, 0.6 * once.seam_max);
     EXPECT_LT(dithered.seam_max, 0.01);
+}
+
+// A camera exposed brightly: realistic-screen (a gain screen) filmed at 2.0 for its own 0.7. Its black images, at
+// 40 times that exposure, would saturate in the gain's hot spot (refused before, naming the exposure); they are
+// filmed shorter, each projector's black relative to the matched white is what it is at the rig's own exposure,
+// and so are the seams at black and at white. At 2.4 a channel's full level saturates the camera there, and the
+// colour step refuses naming the exposure (with the black step passing, seams of 5 % at white at half scale).
+TEST(ColourCalibration, ABrightCameraFilmsItsBlackShorterAndRefusesClippedChannels) {
+    rig::VirtualRig rig =
+        scaled_rig(rig::load_rig(std::string(MOGAO_SOURCE_DIR) + "/rigs/realistic-screen.toml"), 0.25, 0.25);
+    struct Seen {
+        std::string refused;
+        std::vector<double> blacks;         // each projector's black over the matched white (green)
+        std::array<SeamColour, 2> seams{};  // at black and at white
+    };
+    const auto film = [&](double exposure) {
+        rig.camera.exposure = exposure;
+        RigPatternSource source(rig);
+        const CalibrationPrior prior = prior_from_rig(rig);
+        AutocalResult r = calibrate(source, prior, {960, 540}, fast_options());
+        Seen seen;
+        try {
+            const ColourResult c = calibrate_colour(source, prior.screen, r.camera, r.projectors, r.calibration);
+            for (const ProjectorPhotometry& p : c.projectors) seen.blacks.push_back(p.black / c.matched_white[1]);
+        } catch (const CalibrationRefused& e) {
+            seen.refused = e.what();
+            std::printf("exposure %.1f: refused: %s\n", exposure, e.what());
+            return seen;
+        }
+        seen.seams = {measure_seam_colour(rig, r.calibration, 0.0), measure_seam_colour(rig, r.calibration, 1.0)};
+        std::printf(
+            "exposure %.1f: blacks / matched white %.5f %.5f %.5f; seam luminance p95 at black %.2f %%, "
+            "at white %.2f %%\n",
+            exposure, seen.blacks[0], seen.blacks[1], seen.blacks[2], 100.0 * seen.seams[0].seam_luminance_p95,
+            100.0 * seen.seams[1].seam_luminance_p95);
+        return seen;
+    };
+    const Seen own = film(0.7);
+    ASSERT_TRUE(own.refused.empty()) << own.refused;
+    const Seen bright = film(2.0);
+    ASSERT_TRUE(bright.refused.empty()) << bright.refused;
+    for (std::size_t k = 0; k < own.blacks.size(); ++k)
+        EXPECT_NEAR(bright.blacks[k], own.blacks[k], 0.05 * own.blacks[k]);
+    EXPECT_LT(bright.seams[0].seam_luminance_p95, own.seams[0].seam_luminance_p95 + 0.005);
+    EXPECT_LT(bright.seams[1].seam_luminance_p95, own.seams[1].seam_luminance_p95 + 0.005);
+    const Seen clipped = film(2.4);
+    EXPECT_NE(clipped.refused.find("colour: projector"), std::string::npos) << clipped.refused;
+    EXPECT_NE(clipped.refused.find("lower its exposure or gain"), std::string::npos) << clipped.refused;
 }
 
 TEST(ColourCalibration, RefusesAutoExposureAndAChannelTooDarkForTheCamera) {
