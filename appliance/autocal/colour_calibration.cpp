@@ -12,6 +12,7 @@
 #include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
 
+#include "appliance/autocal/camera_clipping.h"
 #include "appliance/autocal/colour_correction.h"
 #include "appliance/autocal/screen_bounce.h"
 #include "appliance/autocal/screen_geometry.h"
@@ -250,7 +251,7 @@ cv::Mat1f exposure_dithered_mean(PatternSource& source, const std::vector<cv::Ma
     }
     if (changes) source.set_relative_exposure(1.0);
     sum /= static_cast<float>(n);
-    sum.setTo(1.0f, peak >= 0.98f);
+    sum.setTo(1.0f, peak >= kCameraClipLevel);
     return sum;
 }
 
@@ -321,7 +322,7 @@ ProjectorPhotometry measure_projector(PatternSource& source, const std::vector<D
             const cv::Mat1f seen =
                 exposure_dithered_mean(source, channel_signal(projectors, k, c, s), 1.0, 1,
                                        i == n - 1 ? o.full_level_frames : o.dither_frames, o.dither_span, captures);
-            if (i == n - 1) clipped.setTo(1, seen >= 0.98f);
+            if (i == n - 1) clipped.setTo(1, seen >= kCameraClipLevel);
             cv::Mat1f d;
             cv::subtract(seen, cap.black, d);
             diffs[c].push_back(d);
@@ -519,7 +520,7 @@ int capture_blacks(PatternSource& source, const ColourOptions& options, std::siz
                                            options.dither_frames, options.dither_span, captures);
     for (int y = 0; y < cap.black.rows; ++y) {
         for (int x = 0; x < cap.black.cols; ++x) {
-            if (cap.black_low(y, x) < 0.98f) {
+            if (cap.black_low(y, x) < kCameraClipLevel) {
                 cap.black(y, x) = cap.black_low(y, x) / static_cast<float>(options.low_end_exposure);
             }
         }
@@ -575,7 +576,7 @@ int capture_bounce_whites(PatternSource& source, const std::vector<DeviceModel>&
         cv::Mat1f d(img.size());
         for (int y = 0; y < img.rows; ++y) {
             for (int x = 0; x < img.cols; ++x) {
-                d(y, x) = img(y, x) >= 0.98f
+                d(y, x) = img(y, x) >= kCameraClipLevel
                               ? std::numeric_limits<float>::quiet_NaN()
                               : (img(y, x) - cap.black_low(y, x)) / static_cast<float>(o.low_end_exposure);
             }

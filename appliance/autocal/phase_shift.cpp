@@ -37,7 +37,7 @@ namespace {
 
 // One pixel's fit: position within the period, modulation and noise gain (phase_shift.h).
 struct PixelPhase {
-    double phi = 0.0;  // [0, 2 pi)
+    double phi = 0.0;  // (-pi, pi], radians
     double b = 0.0;
     double gain = std::numeric_limits<double>::infinity();
 };
