@@ -27,18 +27,64 @@
 namespace mogao::autocal {
 namespace {
 
-// The preview's content: white with grid lines every 1/16 of the frame.
-double preview_content(double u, double v) {
-    const double gu = u * 16.0 - std::round(u * 16.0);
-    const double gv = v * 16.0 - std::round(v * 16.0);
-    return (std::abs(gu) < 0.01 || std::abs(gv) < 0.01) ? 0.1 : 1.0;
+// An extent in content units ([0, 1] over the frame) across u and across v.
+struct ContentExtent {
+    double u = 0.0;
+    double v = 0.0;
+};
+
+// The share of a pixel of extent `pixel` centred at x that a grid line `line` wide covers (lines every 1/16): the
+// overlap of the two intervals. Each pixel shows the mean of the content over its extent, as a renderer that filters
+// its texture does: a line narrower than a pixel sampled at points breaks into dashes.
+double grid_line_coverage(double x, double pixel, double line) {
+    const double distance = std::abs(x - std::round(x * 16.0) / 16.0);
+    const double overlap = std::min(distance + 0.5 * pixel, 0.5 * line) - std::max(distance - 0.5 * pixel, -0.5 * line);
+    return std::clamp(overlap / pixel, 0.0, 1.0);
+}
+
+// The preview's content: white with grid lines (at 0.1) every 1/16 of the frame, `line` wide, as a pixel of extent
+// `pixel` centred at (u, v) shows it.
+double preview_content(double u, double v, ContentExtent pixel, ContentExtent line) {
+    const double dark =
+        1.0 - (1.0 - grid_line_coverage(u, pixel.u, line.u)) * (1.0 - grid_line_coverage(v, pixel.v, line.v));
+    return 1.0 - 0.9 * dark;
+}
+
+// The content extent of projector pixel (x, y): the bounding box of its steps to the next pixel across and down
+// (`fallback` where the warp has no content there).
+ContentExtent pixel_extent(const ProjectorCalibration& pc, int x, int y, ContentUv at, ContentExtent fallback) {
+    const ContentUv right = sample_warp(pc.warp, pc.output, std::min(x + 1, pc.output.width - 1), y);
+    const ContentUv down = sample_warp(pc.warp, pc.output, x, std::min(y + 1, pc.output.height - 1));
+    if (!right.valid() || !down.valid()) return fallback;
+    const ContentExtent e{std::abs(right.u - at.u) + std::abs(down.u - at.u),
+                          std::abs(right.v - at.v) + std::abs(down.v - at.v)};
+    return e.u > 0.0 && e.v > 0.0 ? e : fallback;
+}
+
+// The preview grid's line width: two preview pixels, or three pixels of the coarsest projector where those are wider.
+// The band of a line that covers whole projector pixels (its width less a pixel's) is then wider than the spacing of
+// the preview's samples, so that every row and column of the preview sees the line as dark as the projectors draw
+// it, not broken where it falls between its samples. The same for every projector: the content does not change at
+// a seam.
+ContentExtent grid_line_width(const ScreenCalibration& c, ContentExtent preview_pixel) {
+    ContentExtent line{2.0 * preview_pixel.u, 2.0 * preview_pixel.v};
+    for (const ProjectorCalibration& pc : c.projectors) {
+        const int x = pc.output.width / 2;
+        const int y = pc.output.height / 2;
+        const ContentUv at = sample_warp(pc.warp, pc.output, x, y);
+        if (!at.valid()) continue;
+        const ContentExtent e = pixel_extent(pc, x, y, at, {});
+        line.u = std::max(line.u, 3.0 * e.u);
+        line.v = std::max(line.v, 3.0 * e.v);
+    }
+    return line;
 }
 
 // The light of the preview's content at screen point s, every projector whose (ground-truth) pixel lands
 // there: as the rig's viewer sees it (`seen`: through the screen's gain) or as it leaves a matte screen. The content
 // is shown less `indirect` (the outputs' field for it, empty: none).
 double preview_light(const rig::VirtualRig& rig, const ScreenCalibration& c, const RgbFloatImage& indirect,
-                     const rig::ScreenPoint& s, bool seen) {
+                     ContentExtent line, const rig::ScreenPoint& s, bool seen) {
     double l = 0.0;
     for (std::size_t k = 0; k < c.projectors.size(); ++k) {
         const auto p = rig::screen_to_projector(rig, static_cast<int>(k), s);
@@ -48,7 +94,7 @@ double preview_light(const rig::VirtualRig& rig, const ScreenCalibration& c, con
         const int py = static_cast<int>(p->y());
         const ContentUv uv = sample_warp(pc.warp, pc.output, px, py);
         if (!uv.valid()) continue;
-        const auto grid = static_cast<float>(preview_content(uv.u, uv.v));
+        const auto grid = static_cast<float>(preview_content(uv.u, uv.v, pixel_extent(pc, px, py, uv, line), line));
         const double content = take_off_indirect_light({grid, grid, grid}, indirect, uv.u, uv.v)[1];
         // The rig's light (mean of the channels, black level included) for the signal
         // render_output gives: content x blend + beta -> response LUT, per channel.
@@ -72,13 +118,15 @@ double preview_light(const rig::VirtualRig& rig, const ScreenCalibration& c, con
 Rgb8Image preview(const rig::VirtualRig& rig, const ScreenCalibration& c, int width,
                   const IndirectLight* compensation) {
     const int height = std::max(1, width * c.content.height / c.content.width);
+    const ContentExtent pixel{1.0 / width, 1.0 / height};
+    const ContentExtent line = grid_line_width(c, pixel);
     RgbFloatImage indirect;
     if (compensation != nullptr) {
         RgbFloatImage content(ImageSize{width, height});
         for (int y = 0; y < height; ++y)
             for (int x = 0; x < width; ++x)
                 std::fill_n(content.at(x, y), 3,
-                            static_cast<float>(preview_content((x + 0.5) / width, (y + 0.5) / height)));
+                            static_cast<float>(preview_content((x + 0.5) / width, (y + 0.5) / height, pixel, line)));
         indirect = compensation->field(compensation->patch_means(content));
     }
     std::optional<rig::ScreenBounce> bounce;
@@ -87,15 +135,15 @@ Rgb8Image preview(const rig::VirtualRig& rig, const ScreenCalibration& c, int wi
         bounce.emplace(rig.screen);
         std::vector<double> leaving;
         for (int i = 0; i < bounce->patches(); ++i)
-            leaving.push_back(preview_light(rig, c, indirect, bounce->centre(i), false));
+            leaving.push_back(preview_light(rig, c, indirect, line, bounce->centre(i), false));
         bounced = bounce->bounce(leaving);
     }
     cv::Mat1f light(height, width, 0.0f);
     for (int y = 0; y < height; ++y) {
         for (int x = 0; x < width; ++x) {
             const rig::ScreenPoint s = rig::screen_of(rig.screen, {(x + 0.5) / width, (y + 0.5) / height});
-            light(y, x) =
-                static_cast<float>(preview_light(rig, c, indirect, s, true) + (bounce ? bounce->at(bounced, s) : 0.0));
+            light(y, x) = static_cast<float>(preview_light(rig, c, indirect, line, s, true) +
+                                             (bounce ? bounce->at(bounced, s) : 0.0));
         }
     }
     Rgb8Image out(ImageSize{width, height});

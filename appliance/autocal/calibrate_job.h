@@ -21,7 +21,9 @@
 //                      computed apart and never given to the check),
 //   preview.png        the screen as a viewer sees it (ground-truth light paths, the rig's
 //                      responses and black levels, mean of the channels): a white field with a
-//                      content grid every 1/16 of the frame, linear light -> gamma 2.2, 8 bits.
+//                      content grid every 1/16 of the frame (lines two preview pixels or three of the
+//                      coarsest projector's wide, each projector pixel showing the content's mean over its
+//                      extent), linear light -> gamma 2.2, 8 bits.
 //   self-check.png     the self-check's marks as the camera saw them (grey), each found mark's centroid
 //                      (green) and where its content belongs through the check's camera (red cross), 2x.
 // A refused calibration (CalibrationRefused, the self-check's gate included) writes nothing: whatever the

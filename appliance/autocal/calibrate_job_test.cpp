@@ -3,6 +3,7 @@
 // preview, and a refused rig leaving the previous calibration untouched.
 #include "appliance/autocal/calibrate_job.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -16,6 +17,7 @@
 #include "appliance/calibration/mpcdi_reader.h"
 #include "appliance/calibration/mpcdi_screen.h"
 #include "appliance/rig/rig_file.h"
+#include "common/png_io.h"
 
 namespace mogao::autocal {
 namespace {
@@ -25,6 +27,30 @@ std::filesystem::path temp_dir(const std::string& name) {
         std::filesystem::temp_directory_path() / ("mogao-autocal-" + name + "-" + std::to_string(::getpid()));
     std::filesystem::remove_all(d);
     return d;
+}
+
+// The columns (across = false) or rows (across = true) of `preview` in which the grid line at `at` (a fraction of
+// the frame; lines every 1/16) shows no pixel darker than half the white within 3 pixels: the gaps in the line.
+int gaps_in_grid_line(const Rgb8Image& preview, double at, bool across) {
+    const int along = across ? preview.size.height : preview.size.width;
+    const int extent = across ? preview.size.width : preview.size.height;
+    const int centre = static_cast<int>(std::lround(at * extent));
+    int white = 0;
+    for (int i = 0; i < along; ++i) {
+        const int x = across ? extent / 32 : i;  // between two lines
+        const int y = across ? i : extent / 32;
+        white = std::max(white, int(preview.at(x, y)[1]));
+    }
+    int gaps = 0;
+    for (int i = 4; i < along - 4; ++i) {  // the screen's edges left out
+        int darkest = 255;
+        for (int d = -3; d <= 3; ++d) {
+            const int c = std::clamp(centre + d, 0, extent - 1);
+            darkest = std::min(darkest, int(across ? preview.at(c, i)[1] : preview.at(i, c)[1]));
+        }
+        if (darkest > white / 2) ++gaps;
+    }
+    return gaps;
 }
 
 std::string slurp(const std::filesystem::path& p) {
@@ -91,7 +117,13 @@ TEST(CalibrateJob, MpcdiRoundTripGivesTheSameMaps) {
     EXPECT_LE((models.camera.position_m - direct.camera.position_m).norm(), 1e-12);
     EXPECT_EQ(report["projectors"].size(), 3u);
     EXPECT_LE(report["ground_truth"]["geometry_p95_px"].get<double>(), 0.8);
-    EXPECT_TRUE(std::filesystem::file_size(job.out / "preview.png") > 1000);
+    // The preview's grid lines are continuous across the screen (a line narrower than a preview pixel, sampled at
+    // points, broke into dashes).
+    const Rgb8Image preview = read_png(job.out / "preview.png");
+    for (int line = 4; line <= 12; line += 4) {
+        EXPECT_EQ(gaps_in_grid_line(preview, line / 16.0, false), 0) << "horizontal line " << line << "/16";
+        EXPECT_EQ(gaps_in_grid_line(preview, line / 16.0, true), 0) << "vertical line " << line << "/16";
+    }
     std::filesystem::remove_all(job.out);
 }
 
