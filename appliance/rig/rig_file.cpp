@@ -3,8 +3,10 @@
 #include "appliance/rig/rig_file.h"
 
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
+#include <string>
 
 #include <toml.hpp>
 
@@ -43,8 +45,11 @@ public:
     int integer(const std::string& key, int fallback) {
         const toml::value* v = find(key);
         if (v == nullptr) return fallback;
-        if (!v->is_integer() || v->as_integer() < -1000000000 || v->as_integer() > 1000000000)
-            fail(key, "must be an integer");
+        // Any int: a drawn camera seed reaches 2^30 (tools/docs/regenerate_unseen_rigs_doc.py).
+        if (!v->is_integer() || v->as_integer() < std::numeric_limits<int>::min() ||
+            v->as_integer() > std::numeric_limits<int>::max())
+            fail(key, "must be an integer in [" + std::to_string(std::numeric_limits<int>::min()) + ", " +
+                          std::to_string(std::numeric_limits<int>::max()) + "]");
         return static_cast<int>(v->as_integer());
     }
 

@@ -389,6 +389,11 @@ TEST(RigFile, ErrorsNameTheField) {
                   .find("camera.position_m must be inside the cylinder"),
               std::string::npos);
     EXPECT_NE(message("[camera]\nbits = 40\n[[projectors]]\n").find("camera.bits must be 1..16"), std::string::npos);
+    // A seed as the unseen-rig draws give it (up to 2^30) loads; one past an int names the limit.
+    EXPECT_EQ(parse_rig("[camera]\nseed = 1055676711\n[[projectors]]\n", "x.toml").camera.seed, 1055676711U);
+    EXPECT_NE(message("[camera]\nseed = 3000000000\n[[projectors]]\n")
+                  .find("camera.seed: must be an integer in [-2147483648, 2147483647]"),
+              std::string::npos);
     EXPECT_NE(
         message("[camera]\n[[projectors]]\ngamma = [2.2, 2.2]\n").find("projectors[0].gamma: must be an array of 3"),
         std::string::npos);
