@@ -20,6 +20,7 @@ namespace {
 // kNoContentUpload and valid uv are clamped to [-1, 2], which renders identically (clamp-to-edge)
 // and keeps them far from the marker.
 constexpr float kNoContentUpload = -1.0e30f;
+constexpr std::uint16_t kHalfOne = 0x3C00;  // 1.0 as an IEEE half float
 
 constexpr const char* kVertexShader = R"(#version 300 es
 // One triangle covering the viewport; no vertex attributes (vertex ids 0,1,2 -> (-1,-1),(3,-1),(-1,3)).
@@ -35,13 +36,13 @@ precision highp float;
 precision highp int;
 precision highp sampler2D;
 
-uniform sampler2D u_content;  // GL_RGB16F, linear light (decoded from sRGB once per frame on upload), GL_LINEAR
-uniform sampler2D u_warp;     // GL_RGB32F (u, v, blend weight when the blend mask has the warp's size);
+uniform sampler2D u_content;  // GL_RGBA16F, linear light (decoded from sRGB once per frame on upload), GL_LINEAR
+uniform sampler2D u_warp;     // GL_RGBA32F (u, v, blend weight when the blend mask has the warp's size);
                               // u < kNoContent marks "no content"
 uniform sampler2D u_blend;    // GL_R32F weight in linear light (the general variant's bilinear blend)
-uniform sampler2D u_lut;      // GL_RGB16F, N x 1, GL_LINEAR: texel i = (lut_r[i], lut_g[i], lut_b[i])
-uniform sampler2D u_beta;     // GL_RGB32F black offset per channel, linear light (read only with HAS_BETA)
-uniform sampler2D u_indirect; // GL_RGB32F screen's own light in content space, content units (only HAS_INDIRECT)
+uniform sampler2D u_lut;      // GL_RG32F, (N - 1) x 3: row ch, texel i = (lut[ch][i], lut[ch][i + 1])
+uniform sampler2D u_beta;     // GL_RGBA32F black offset per channel, linear light (read only with HAS_BETA)
+uniform sampler2D u_indirect; // GL_RGBA32F screen's own light in content space, content units (only HAS_INDIRECT)
 uniform vec2 u_output_size;   // projector pixels
 uniform vec2 u_warp_scale;    // warp size / output size (exactly 1.0 when equal)
 uniform vec2 u_blend_scale;   // blend size / output size
@@ -223,7 +224,16 @@ Result<GlTexture> upload(std::string_view what, GLenum internal_format, ImageSiz
     return texture;
 }
 
-// The black offset (beta) map: RGB32F, or an empty texture when the calibration has none (0 x 0
+// RGB float texels padded to RGBA (alpha 0, never read): a software rasteriser (llvmpipe) stores
+// three-channel formats as four channels, so an RGB upload is converted texel by texel and an RGB
+// fetch is slower than an RGBA one.
+std::vector<float> padded_rgba(const std::vector<float>& rgb) {
+    std::vector<float> rgba(rgb.size() / 3 * 4, 0.0f);
+    for (std::size_t i = 0, k = 0; i + 2 < rgb.size(); i += 3, k += 4) std::copy_n(&rgb[i], 3, &rgba[k]);
+    return rgba;
+}
+
+// The black offset (beta) map: RGBA32F, or an empty texture when the calibration has none (0 x 0
 // and no values; the draw then binds the renderer's placeholder and skips the lookups).
 Result<GlTexture> upload_beta(const std::string& who, const BlackOffset& beta, GLint max_size) {
     if (beta.size.width == 0 && beta.size.height == 0 && beta.rgb.empty()) return GlTexture{};
@@ -240,7 +250,7 @@ Result<GlTexture> upload_beta(const std::string& who, const BlackOffset& beta, G
                                       std::to_string(texel % beta.size.width) + ", " +
                                       std::to_string(texel / beta.size.width) + ") channel " + std::to_string(i % 3));
     }
-    return upload(who + " beta map", GL_RGB32F, beta.size, GL_RGB, GL_FLOAT, beta.rgb.data());
+    return upload(who + " beta map", GL_RGBA32F, beta.size, GL_RGBA, GL_FLOAT, padded_rgba(beta.rgb).data());
 }
 
 // set_indirect_light's checks, before anything is uploaded (so a bad field leaves the old one).
@@ -354,8 +364,8 @@ Result<WarpBlendRenderer> WarpBlendRenderer::create() {
     // Bound on the beta unit for projectors without a beta map and on the indirect light's unit
     // without a field, so no unit ever holds an incomplete texture; the shader does not read it
     // then (the variants without HAS_BETA or HAS_INDIRECT).
-    const float zero[3] = {0.0f, 0.0f, 0.0f};
-    auto placeholder = upload("zero placeholder", GL_RGB32F, ImageSize{1, 1}, GL_RGB, GL_FLOAT, zero);
+    const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    auto placeholder = upload("zero placeholder", GL_RGBA32F, ImageSize{1, 1}, GL_RGBA, GL_FLOAT, zero);
     if (!placeholder) return placeholder.error();
     r.zero_rgb_ = std::move(placeholder.value());
     if (auto s = gl_check("WarpBlendRenderer::create"); !s) return s.error();
@@ -370,20 +380,26 @@ Status WarpBlendRenderer::set_content(const Rgb8Image& frame) {
     }
     // Decoded to linear light here, once per frame, rather than by the texture unit at every fetch
     // of every output pixel of every draw (a software rasteriser's largest cost); half floats, so
-    // that the texture unit may filter them (docs/outputs.md: precision).
+    // that the texture unit may filter them (docs/outputs.md: precision); RGBA, alpha 1 and never
+    // read, for the reason padded_rgba gives.
     const std::array<std::uint16_t, 256>& decode = srgb8_decode_half_table();
-    content_linear_.resize(frame.pixels.size());
-    std::transform(frame.pixels.begin(), frame.pixels.end(), content_linear_.begin(),
-                   [&decode](std::uint8_t code) { return decode[code]; });
+    const std::size_t pixel_count = frame.pixels.size() / 3;
+    content_linear_.resize(pixel_count * 4);
+    for (std::size_t i = 0; i < pixel_count; ++i) {
+        content_linear_[4 * i] = decode[frame.pixels[3 * i]];
+        content_linear_[4 * i + 1] = decode[frame.pixels[3 * i + 1]];
+        content_linear_[4 * i + 2] = decode[frame.pixels[3 * i + 2]];
+        content_linear_[4 * i + 3] = kHalfOne;
+    }
     if (content_.valid() && frame.size == content_size_) {
         glBindTexture(GL_TEXTURE_2D, content_.get());
         glPixelStorei(GL_UNPACK_ALIGNMENT, 2);
-        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, frame.size.width, frame.size.height, GL_RGB, GL_HALF_FLOAT,
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, frame.size.width, frame.size.height, GL_RGBA, GL_HALF_FLOAT,
                         content_linear_.data());
         return gl_check("upload content frame");
     }
     auto texture =
-        upload("content frame", GL_RGB16F, frame.size, GL_RGB, GL_HALF_FLOAT, content_linear_.data(), GL_LINEAR);
+        upload("content frame", GL_RGBA16F, frame.size, GL_RGBA, GL_HALF_FLOAT, content_linear_.data(), GL_LINEAR);
     if (!texture) return texture.error();
     content_ = std::move(texture.value());
     content_size_ = frame.size;
@@ -405,11 +421,12 @@ Status WarpBlendRenderer::set_indirect_light(const RgbFloatImage& field) {
     if (indirect_.valid() && field.size == indirect_size_) {  // every frame: no reallocation
         glBindTexture(GL_TEXTURE_2D, indirect_.get());
         glPixelStorei(GL_UNPACK_ALIGNMENT, 4);  // float rows are always 4-byte aligned
-        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, field.size.width, field.size.height, GL_RGB, GL_FLOAT,
-                        field.pixels.data());
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, field.size.width, field.size.height, GL_RGBA, GL_FLOAT,
+                        padded_rgba(field.pixels).data());
         return gl_check("upload indirect light field");
     }
-    auto texture = upload("indirect light field", GL_RGB32F, field.size, GL_RGB, GL_FLOAT, field.pixels.data());
+    auto texture =
+        upload("indirect light field", GL_RGBA32F, field.size, GL_RGBA, GL_FLOAT, padded_rgba(field.pixels).data());
     if (!texture) return texture.error();
     indirect_ = std::move(texture.value());
     indirect_size_ = field.size;
@@ -462,11 +479,11 @@ Result<WarpBlendRenderer::Projector> WarpBlendRenderer::make_projector(const Pro
                                      " entries, more than GL_MAX_TEXTURE_SIZE " + std::to_string(max_texture_size_));
     }
 
-    // (u, v, blend weight): the exact-maps shader reads both maps with one fetch; the weight is
+    // (u, v, blend weight, 0; RGBA: padded_rgba): the exact-maps shader reads both maps with one fetch; the weight is
     // only there (and only read) when the blend mask has the warp map's size.
     const bool weight_in_warp = c.blend.size == c.warp.size;
-    std::vector<float> uvw(c.warp.uv.size() / 2 * 3);
-    for (std::size_t i = 0, k = 0; i < c.warp.uv.size(); i += 2, k += 3) {
+    std::vector<float> uvw(c.warp.uv.size() / 2 * 4);
+    for (std::size_t i = 0, k = 0; i < c.warp.uv.size(); i += 2, k += 4) {
         const float u = c.warp.uv[i];
         const float v = c.warp.uv[i + 1];
         const bool valid = std::isfinite(u) && std::isfinite(v);
@@ -491,7 +508,7 @@ Result<WarpBlendRenderer::Projector> WarpBlendRenderer::make_projector(const Pro
     p.output = c.output;
     p.warp_size = c.warp.size;
     p.blend_size = c.blend.size;
-    auto warp = upload(who + " warp map", GL_RGB32F, c.warp.size, GL_RGB, GL_FLOAT, uvw.data());
+    auto warp = upload(who + " warp map", GL_RGBA32F, c.warp.size, GL_RGBA, GL_FLOAT, uvw.data());
     if (!warp) return warp.error();
     auto blend = upload(who + " blend mask", GL_R32F, c.blend.size, GL_RED, GL_FLOAT, c.blend.weight.data());
     if (!blend) return blend.error();

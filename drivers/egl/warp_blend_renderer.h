@@ -14,7 +14,7 @@
 //   uv'    = uv * content_scale + content_offset  (per axis; identity unless set_content_transform)
 //   linear = bilinear over the 4 content texels around uv' * content.size - 0.5, each texel
 //            decoded sRGB -> linear first (on the CPU once per frame, uploaded as half floats,
-//            GL_RGB16F), so the filtering is in linear light; the texture unit filters (GL_LINEAR)
+//            GL_RGBA16F), so the filtering is in linear light; the texture unit filters (GL_LINEAR)
 //   ind_c  = bilinear(indirect, uv * indirect.size - 0.5)   per channel c, at the warp's uv (not
 //            uv': the field lies on the screen, in the calibration's content coordinates); 0 when
 //            no field is set (set_indirect_light)
@@ -72,9 +72,9 @@ public:
     // Call once per frame before draw()/render(); the texture is reallocated only on a size change.
     [[nodiscard]] Status set_content(const Rgb8Image& frame) override;
 
-    // Validates and uploads one projector's warp map (RGB32F: u, v and, when the blend mask has
+    // Validates and uploads one projector's warp map (RGBA32F: u, v and, when the blend mask has
     // the warp's size, the blend weight, so that one fetch reads both), blend mask (R32F), response LUT
-    // ((N - 1) x 3 RG32F: each entry with its successor) and black offset (beta, RGB32F; nothing
+    // ((N - 1) x 3 RG32F: each entry with its successor) and black offset (beta, RGBA32F; nothing
     // is uploaded or fetched when it is empty, 0 x 0), once. Returns the projector's index for
     // draw()/render(). EINVAL when a size is empty or does not match its data (beta:
     // width*height*3 values), the LUT channels differ in length or have < 2 entries, or a blend
@@ -87,7 +87,7 @@ public:
 
     // The screen's own light to take off the content before the blend (drivers/projector_renderer.h:
     // content space, linear light in content units, bilinear at texel centres, clamp to edge, at the
-    // warp's uv before the content transform). Uploaded as RGB32F, shared by all projectors, used
+    // warp's uv before the content transform). Uploaded as RGBA32F, shared by all projectors, used
     // from the next draw; the texture is reallocated only on a size change, so a per-frame field
     // costs one small glTexSubImage2D. Empty (0 x 0) releases it, and the draws use the shader
     // variants without the lookup: the output is exactly that of a renderer without a field.
@@ -164,13 +164,13 @@ private:
     ContentTransform transform_;
     GLint max_texture_size_ = 0;
     GlTexture content_;
-    GlTexture zero_rgb_;  // 1x1 zero RGB32F, bound on unit 4 without beta and on unit 5 without indirect light
+    GlTexture zero_rgb_;  // 1x1 zero RGBA32F, bound on unit 4 without beta and on unit 5 without indirect light
     ImageSize content_size_;
-    GlTexture indirect_;       // set_indirect_light's field, RGB32F; empty (not valid) when none
+    GlTexture indirect_;       // set_indirect_light's field, RGBA32F; empty (not valid) when none
     ImageSize indirect_size_;  // 0 x 0 when none
     std::vector<Projector> projectors_;
     std::vector<std::uint8_t> readback_;         // RGBA scratch for render()
-    std::vector<std::uint16_t> content_linear_;  // set_content's frame in linear light (half floats)
+    std::vector<std::uint16_t> content_linear_;  // set_content's frame in linear light (RGBA half floats)
 };
 
 }  // namespace mogao
