@@ -226,11 +226,10 @@ Result<GlTexture> upload(std::string_view what, GLenum internal_format, ImageSiz
 
 // RGB float texels padded to RGBA (alpha 0, never read): a software rasteriser (llvmpipe) stores
 // three-channel formats as four channels, so an RGB upload is converted texel by texel and an RGB
-// fetch is slower than an RGBA one.
-std::vector<float> padded_rgba(const std::vector<float>& rgb) {
-    std::vector<float> rgba(rgb.size() / 3 * 4, 0.0f);
+// fetch is slower than an RGBA one. Writes into `rgba`, so a per-frame caller can keep its storage.
+void pad_to_rgba(const std::vector<float>& rgb, std::vector<float>& rgba) {
+    rgba.assign(rgb.size() / 3 * 4, 0.0f);
     for (std::size_t i = 0, k = 0; i + 2 < rgb.size(); i += 3, k += 4) std::copy_n(&rgb[i], 3, &rgba[k]);
-    return rgba;
 }
 
 // The black offset (beta) map: RGBA32F, or an empty texture when the calibration has none (0 x 0
@@ -250,7 +249,9 @@ Result<GlTexture> upload_beta(const std::string& who, const BlackOffset& beta, G
                                       std::to_string(texel % beta.size.width) + ", " +
                                       std::to_string(texel / beta.size.width) + ") channel " + std::to_string(i % 3));
     }
-    return upload(who + " beta map", GL_RGBA32F, beta.size, GL_RGBA, GL_FLOAT, padded_rgba(beta.rgb).data());
+    std::vector<float> rgba;
+    pad_to_rgba(beta.rgb, rgba);
+    return upload(who + " beta map", GL_RGBA32F, beta.size, GL_RGBA, GL_FLOAT, rgba.data());
 }
 
 // set_indirect_light's checks, before anything is uploaded (so a bad field leaves the old one).
@@ -381,7 +382,7 @@ Status WarpBlendRenderer::set_content(const Rgb8Image& frame) {
     // Decoded to linear light here, once per frame, rather than by the texture unit at every fetch
     // of every output pixel of every draw (a software rasteriser's largest cost); half floats, so
     // that the texture unit may filter them (docs/outputs.md: precision); RGBA, alpha 1 and never
-    // read, for the reason padded_rgba gives.
+    // read, for the reason pad_to_rgba gives.
     const std::array<std::uint16_t, 256>& decode = srgb8_decode_half_table();
     const std::size_t pixel_count = frame.pixels.size() / 3;
     content_linear_.resize(pixel_count * 4);
@@ -418,15 +419,15 @@ Status WarpBlendRenderer::set_indirect_light(const RgbFloatImage& field) {
     if (!programs_[program_index(false, false, true)].program.valid()) {
         if (auto s = link_programs(true); !s) return s;
     }
+    pad_to_rgba(field.pixels, indirect_rgba_);
     if (indirect_.valid() && field.size == indirect_size_) {  // every frame: no reallocation
         glBindTexture(GL_TEXTURE_2D, indirect_.get());
         glPixelStorei(GL_UNPACK_ALIGNMENT, 4);  // float rows are always 4-byte aligned
         glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, field.size.width, field.size.height, GL_RGBA, GL_FLOAT,
-                        padded_rgba(field.pixels).data());
+                        indirect_rgba_.data());
         return gl_check("upload indirect light field");
     }
-    auto texture =
-        upload("indirect light field", GL_RGBA32F, field.size, GL_RGBA, GL_FLOAT, padded_rgba(field.pixels).data());
+    auto texture = upload("indirect light field", GL_RGBA32F, field.size, GL_RGBA, GL_FLOAT, indirect_rgba_.data());
     if (!texture) return texture.error();
     indirect_ = std::move(texture.value());
     indirect_size_ = field.size;
@@ -479,7 +480,7 @@ Result<WarpBlendRenderer::Projector> WarpBlendRenderer::make_projector(const Pro
                                      " entries, more than GL_MAX_TEXTURE_SIZE " + std::to_string(max_texture_size_));
     }
 
-    // (u, v, blend weight, 0; RGBA: padded_rgba): the exact-maps shader reads both maps with one fetch; the weight is
+    // (u, v, blend weight, 0; RGBA: pad_to_rgba): the exact-maps shader reads both maps with one fetch; the weight is
     // only there (and only read) when the blend mask has the warp map's size.
     const bool weight_in_warp = c.blend.size == c.warp.size;
     std::vector<float> uvw(c.warp.uv.size() / 2 * 4);

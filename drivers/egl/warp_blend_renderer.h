@@ -171,6 +171,7 @@ private:
     std::vector<Projector> projectors_;
     std::vector<std::uint8_t> readback_;         // RGBA scratch for render()
     std::vector<std::uint16_t> content_linear_;  // set_content's frame in linear light (RGBA half floats)
+    std::vector<float> indirect_rgba_;           // set_indirect_light's field padded to RGBA
 };
 
 }  // namespace mogao
