@@ -197,7 +197,11 @@ void TemporalHistory::accumulate_rows(const Pass& f, int y0, int y1, TemporalSta
             f.to_history.project_row(px.data(), py.data(), pz.data(), width, hx.data(), hy.data(), in_view.data());
         for (int x = 0; x < width; ++x) {
             const std::size_t i = row + static_cast<std::size_t>(x);
-            if (f.guides.hit[i] == 0) continue;
+            if (f.guides.hit[i] == 0) {  // the buffers are reused: zero what a sky pixel leaves (sharpen reads it)
+                for (std::size_t c = 0; c < 3; ++c) f.illumination[3 * i + c] = f.position[3 * i + c] = 0.0f;
+                f.plane[i] = f.length[i] = 0.0f;
+                continue;
+            }
             ++counted.surface_pixels;
             const auto xs = static_cast<std::size_t>(x);
             const Eigen::Vector3f p(px[xs], py[xs], pz[xs]);
@@ -243,10 +247,10 @@ RgbFloatImage TemporalHistory::accumulate(const RgbFloatImage& current, const Gu
                                     std::to_string(shading_one_in));
     const auto n = static_cast<std::size_t>(current.size.pixel_count());
     RgbFloatImage out = current;
-    std::vector<float> illumination(3 * n, 0.0f);
-    std::vector<float> position(3 * n, 0.0f);
-    std::vector<float> plane(n, 0.0f);
-    std::vector<float> length(n, 0.0f);
+    next_illumination_.resize(3 * n);
+    position_.resize(3 * n);
+    next_plane_.resize(n);
+    next_length_.resize(n);
     const float alpha = 1.0f - std::pow(1.0f - params.alpha, static_cast<float>(shading_one_in));
     const Pass f{current,
                  guides,
@@ -255,10 +259,10 @@ RgbFloatImage TemporalHistory::accumulate(const RgbFloatImage& current, const Gu
                  params,
                  alpha,
                  out,
-                 illumination,
-                 position,
-                 plane,
-                 length};
+                 next_illumination_,
+                 position_,
+                 next_plane_,
+                 next_length_};
     // Rows split over the cores (each pixel reads only the history and writes only itself, so the
     // result does not depend on the split): the admin runs this while the ranks wait.
     const int height = current.size.height;
@@ -280,11 +284,11 @@ RgbFloatImage TemporalHistory::accumulate(const RgbFloatImage& current, const Gu
     }
     total.filled = fill_holes(f);
     camera_ = camera;
-    illumination_ = std::move(illumination);
-    plane_ = std::move(plane);
-    normal_ = guides.normal;
-    hit_ = guides.hit;
-    length_ = std::move(length);
+    illumination_.swap(next_illumination_);
+    plane_.swap(next_plane_);
+    normal_.assign(guides.normal.begin(), guides.normal.end());
+    hit_.assign(guides.hit.begin(), guides.hit.end());
+    length_.swap(next_length_);
     if (stats != nullptr) *stats = total;
     return out;
 }

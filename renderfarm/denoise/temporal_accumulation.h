@@ -122,6 +122,13 @@ private:
     std::vector<float> normal_;        // W*H*3 unit world normals
     std::vector<std::uint8_t> hit_;    // W*H
     std::vector<float> length_;        // W*H frames averaged
+    // Scratch the next frame's history is written into (and each pixel's point), swapped with the
+    // history after each frame: a frame of a stable size allocates and zero-fills nothing. Every
+    // element is written by accumulate() before it is read.
+    std::vector<float> next_illumination_;
+    std::vector<float> next_plane_;
+    std::vector<float> next_length_;
+    std::vector<float> position_;  // W*H*3 the current frame's points, world metres
 };
 
 }  // namespace mogao
