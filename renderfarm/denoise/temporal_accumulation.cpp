@@ -286,8 +286,8 @@ RgbFloatImage TemporalHistory::accumulate(const RgbFloatImage& current, const Gu
     camera_ = camera;
     illumination_.swap(next_illumination_);
     plane_.swap(next_plane_);
-    normal_.assign(guides.normal.begin(), guides.normal.end());
-    hit_.assign(guides.hit.begin(), guides.hit.end());
+    normal_ = guides.normal;  // copy assignment keeps the storage of a size already seen
+    hit_ = guides.hit;
     length_.swap(next_length_);
     if (stats != nullptr) *stats = total;
     return out;
