@@ -22,7 +22,9 @@
 // earlier frames by reprojection: renderfarm/denoise/temporal_accumulation.h), sparse (the temporal
 // configuration shading one pixel in --shading-one-in of each moving frame that has a history) and
 // sparse-all-levels (sparse with its blended frames filtered by --denoise-iterations levels, as every
-// other filtered frame, instead of LiveOptions::blended_denoise_iterations).
+// other filtered frame, instead of LiveOptions::blended_denoise_iterations) and sparse-spatial-variance
+// (sparse with the filter's luminance variance estimated spatially at every pixel, not from the
+// history's moments: LiveOptions::temporal_variance off).
 // With both all and denoise in the run, the denoiser's ratios are printed: frames/s on / off and the
 // moving frame's PSNR on - off. --quality takes a preset's request quality (spp, bounces, AO, area
 // samples, JPEG; common/quality_preset.h) for every request and the reference; without it the
@@ -240,7 +242,13 @@ std::vector<Config> all_configs(const BenchArgs& a) {
     sparse_levels.key = "sparse-all-levels";
     sparse_levels.name = sparse.name + ", " + std::to_string(a.denoise_iterations) + " filter levels";
     sparse_levels.live.blended_denoise_iterations = a.denoise_iterations;
-    std::vector<Config> out{today, all, denoise, floor, cache, temporal, sparse, sparse_levels, second1, first1};
+    // The sparse configuration with the filter's luminance variance estimated spatially at every pixel.
+    Config sparse_spatial = sparse;
+    sparse_spatial.key = "sparse-spatial-variance";
+    sparse_spatial.name = sparse.name + ", spatial variance";
+    sparse_spatial.live.temporal_variance = false;
+    std::vector<Config> out{today,  all,           denoise,        floor,   cache, temporal,
+                            sparse, sparse_levels, sparse_spatial, second1, first1};
     const auto without = [&](const char* key, const char* name, auto change) {
         Config c = all;
         c.key = key;
@@ -558,11 +566,12 @@ int admin(FrameDispatcher& farm, const Scene& scene, const BenchArgs& a) {
     const auto has = [&](const char* key) {
         return std::any_of(chosen.begin(), chosen.end(), [&](const Config& c) { return c.key == key; });
     };
-    const std::string pictured = has("sparse")     ? "sparse"
-                                 : has("cache")    ? "cache"
-                                 : has("temporal") ? "temporal"
-                                 : has("denoise")  ? "denoise"
-                                                   : "all";
+    const std::string pictured = has("sparse")                    ? "sparse"
+                                 : has("sparse-spatial-variance") ? "sparse-spatial-variance"
+                                 : has("cache")                   ? "cache"
+                                 : has("temporal")                ? "temporal"
+                                 : has("denoise")                 ? "denoise"
+                                                                  : "all";
     for (const Config& c : chosen) {
         Snapshots shots;
         results.push_back(run_config(c, farm, scene, a, reference, next_id, shots));
@@ -613,12 +622,14 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(2, 8192));
     app.add_option("--configs", a.configs,
                    "today, all, denoise, denoise-floor-0.2, cache, temporal, sparse, sparse-all-levels, "
-                   "cache-second-pass-1spp, cache-first-pass-1spp, no-progressive, no-target, no-pipeline, "
+                   "sparse-spatial-variance, cache-second-pass-1spp, cache-first-pass-1spp, no-progressive, no-target, "
+                   "no-pipeline, "
                    "no-rank-speed, no-rate-aim")
         ->delimiter(',')
         ->check(CLI::IsMember({"today", "all", "denoise", "denoise-floor-0.2", "cache", "temporal", "sparse",
-                               "sparse-all-levels", "cache-second-pass-1spp", "cache-first-pass-1spp", "no-progressive",
-                               "no-target", "no-pipeline", "no-rank-speed", "no-rate-aim"}));
+                               "sparse-all-levels", "sparse-spatial-variance", "cache-second-pass-1spp",
+                               "cache-first-pass-1spp", "no-progressive", "no-target", "no-pipeline", "no-rank-speed",
+                               "no-rate-aim"}));
     app.add_option("--quality", a.quality,
                    "Preset whose request quality every request uses (" + quality_preset_names() +
                        "); default: the request's defaults")

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 // The temporal accumulation's cost on the admin for a moving frame at the size the live tour serves
 // (480x270: 960x540 at its resolution-scale floor), against the à-trous filter that follows it on
-// the same frame, and its per-pixel reprojection in float (renderfarm/trace/frame_projection.h)
-// against camera.h's double-precision functions, all measured in this run.
+// the same frame (one level, as LiveOptions::blended_denoise_iterations; its luminance variance
+// estimated spatially, or taken from the history's moments), and its per-pixel reprojection in float
+// (renderfarm/trace/frame_projection.h) against camera.h's double-precision functions, all measured in this run.
 //   mogao_bench_temporal [--width 480] [--height 270] [--frames 60] [--shading-one-in 4]
 //                        [--write-docs docs/renderer.md]
 // --write-docs FILE replaces the block between `<!-- generated:temporal -->` and `<!-- /generated -->`.
@@ -146,18 +147,33 @@ std::string projection_table(const Options& o) {
     return md.str();
 }
 
+// The share of surface pixels whose luminance variance the history gives (>= 0; sky is 0 too, but
+// these frames have none).
+double known_share(const std::vector<float>& variance) {
+    std::size_t known = 0;
+    for (const float v : variance) known += v >= 0.0f ? 1 : 0;
+    return variance.empty() ? 0.0 : static_cast<double>(known) / static_cast<double>(variance.size());
+}
+
+// Each frame blended, then filtered as a blended live frame is (one level): with the luminance
+// variance estimated spatially at every pixel, and with the history's temporal variance (the spatial
+// estimate only around the pixels without one), in alternating order.
 std::string accumulation_table(const Options& o) {
     std::ostringstream md;
     md << "| frame, " << o.width << "x" << o.height
-       << " | temporal accumulation ms | à-trous filter ms | temporal / filter |\n|---|--:|--:|--:|\n";
+       << " | temporal accumulation ms | filter ms, spatial variance | filter ms, temporal variance | temporal / "
+          "spatial variance | pixels with a temporal variance |\n|---|--:|--:|--:|--:|--:|\n";
     for (const int one_in : {1, o.shading_one_in}) {
         std::mt19937 rng(1);
         TemporalHistory history;
         AtrousDenoiser denoiser;
         AtrousParams filter;
         filter.threads = 0;
+        filter.iterations = 1;  // LiveOptions::blended_denoise_iterations
         double temporal_ms = 0.0;
         double filter_ms = 0.0;
+        double temporal_variance_ms = 0.0;
+        double known = 0.0;
         int timed = 0;
         for (int frame = 0; frame < o.frames; ++frame) {
             const CameraSetup camera = camera_at(o, frame);
@@ -168,15 +184,26 @@ std::string accumulation_table(const Options& o) {
             const RgbFloatImage blended =
                 history.accumulate(radiance, guides, camera, TemporalParams{}, nullptr, frame == 0 ? 1 : one_in);
             const double t = ms_since(start);
-            const auto filter_start = Clock::now();
-            RgbFloatImage out;
-            if (Status st = denoiser.run(blended, guides, filter, out); !st.ok())
-                throw std::runtime_error(st.error().message);
-            if (frame >= 2) temporal_ms += t, filter_ms += ms_since(filter_start), ++timed;
+            double ms[2] = {0.0, 0.0};  // spatial, temporal variance
+            for (int k = 0; k < 2; ++k) {
+                const int which = (frame + k) % 2;
+                const auto filter_start = Clock::now();
+                RgbFloatImage out;
+                if (Status st = denoiser.run(blended, guides, filter, out, nullptr,
+                                             which == 1 ? &history.luminance_variance() : nullptr);
+                    !st.ok())
+                    throw std::runtime_error(st.error().message);
+                ms[which] = ms_since(filter_start);
+            }
+            if (frame >= 2) {
+                temporal_ms += t, filter_ms += ms[0], temporal_variance_ms += ms[1], ++timed;
+                known += known_share(history.luminance_variance());
+            }
         }
         md << "| " << (one_in == 1 ? "every pixel shaded" : "1 pixel in " + std::to_string(one_in) + " shaded") << " | "
            << fmt("%.2f", temporal_ms / timed) << " | " << fmt("%.2f", filter_ms / timed) << " | "
-           << fmt("%.2f", temporal_ms / filter_ms) << " |\n";
+           << fmt("%.2f", temporal_variance_ms / timed) << " | " << fmt("%.2f", temporal_variance_ms / filter_ms)
+           << " | " << fmt("%.2f", known / timed) << " |\n";
     }
     return md.str();
 }
@@ -201,8 +228,10 @@ int run(int argc, char** argv) {
     std::ostringstream md;
     md << "_Run " << bench::run_context() << ", load average " << fmt("%.2f", load_start) << " at start, "
        << fmt("%.2f", bench::load_average()) << " at end. Analytic frames (a cylinder camera turning 0.25° a frame "
-       << "inside a textured wall: every pixel reprojected), " << o.frames << " frames, the first two not timed; the "
-       << "filter with its default three levels on every core. Regenerate: `build/bench/mogao_bench_temporal "
+       << "inside a textured wall: every pixel reprojected), " << o.frames << " frames, the first two not timed; each "
+       << "frame filtered by one à-trous level on every core, as a blended live frame is (the share of pixels with a "
+       << "temporal variance includes the history's first frames, when none has one). Regenerate: "
+          "`build/bench/mogao_bench_temporal "
        << "--write-docs docs/renderer.md`._\n\n"
        << accumulation << projection;
     bench::print_and_write_block(argc, argv, "temporal", md.str());

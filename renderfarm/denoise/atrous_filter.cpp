@@ -102,6 +102,22 @@ Status check_variance(const RgbFloatImage& variance, ImageSize size) {
     return {};
 }
 
+Status check_luminance_variance(const std::vector<float>& variance, ImageSize size, bool colour_variance_too) {
+    if (colour_variance_too)
+        return make_error(EINVAL, "denoise: variance and luminance_variance are both given (one or the other)");
+    if (variance.size() != static_cast<std::size_t>(size.pixel_count())) {
+        return make_error(EINVAL, "denoise: luminance_variance holds " + std::to_string(variance.size()) +
+                                      " values, the image " + size_text(size) + " (W*H expected)");
+    }
+    for (std::size_t i = 0; i < variance.size(); ++i) {
+        if (!std::isfinite(variance[i])) {
+            return make_error(EINVAL, "denoise: luminance_variance at pixel " + std::to_string(i) + " = " +
+                                          std::to_string(variance[i]) + " must be finite");
+        }
+    }
+    return {};
+}
+
 }  // namespace
 
 Status validate_denoise_input(const RgbFloatImage& noisy, const GuideBuffers& guides, const AtrousParams& params) {
@@ -300,19 +316,29 @@ MOGAO_ALWAYS_INLINE inline void surface_sums(ImageSize size, const GeometryWeigh
     }
 }
 
-// Spatial luminance variance of row y's surface pixels over their 5x5 neighbourhood on the same
-// surface — [S] §4.2's estimate for frames without history — into ping.var.
+// Luminance variance of row y's surface pixels into ping.var: `given`'s value where it is >= 0 (a
+// temporal estimate), else (or with no `given`) the spatial variance over the pixel's 5x5
+// neighbourhood on the same surface — [S] §4.2's estimate for frames without history. A chunk of
+// pixels that all have a given value skips the spatial sums.
 template <typename F>
 MOGAO_ALWAYS_INLINE inline void spatial_variance_row_body(ImageSize size, const GeometryWeight& gw,
-                                                          const Planes& planes, int y) {
+                                                          const Planes& planes, const float* given, int y) {
     const int w = size.width;
     const Signal& s = planes.ping;
+    const float* mask = planes.geometry.mask;
     for (int x0 = 0; x0 < w; x0 += lanes::kWidth<F>) {
-        F sw{}, s1{}, s2{};
-        surface_sums<F, true>(size, gw, planes.geometry, s.lum, y, x0, sw, s1, s2);
         const std::size_t p = static_cast<std::size_t>(y) * w + x0;
-        for (int k = 0; k < std::min(lanes::kWidth<F>, w - x0); ++k) {
-            if (planes.geometry.mask[p + k] == 0.0f) continue;
+        const int lanes_in_row = std::min(lanes::kWidth<F>, w - x0);
+        bool all_given = given != nullptr;
+        for (int k = 0; k < lanes_in_row && all_given; ++k) all_given = mask[p + k] == 0.0f || given[p + k] >= 0.0f;
+        F sw{}, s1{}, s2{};
+        if (!all_given) surface_sums<F, true>(size, gw, planes.geometry, s.lum, y, x0, sw, s1, s2);
+        for (int k = 0; k < lanes_in_row; ++k) {
+            if (mask[p + k] == 0.0f) continue;
+            if (given != nullptr && given[p + k] >= 0.0f) {
+                s.var[p + k] = given[p + k];
+                continue;
+            }
             const float mean = s1[k] / sw[k];
             s.var[p + k] = std::max(0.0f, s2[k] / sw[k] - mean * mean);
         }
@@ -340,11 +366,12 @@ using WideLanes = lanes::F8;
 using WideLanes = lanes::F4;  // no AVX build: the _v3 functions are never chosen (use_x86_64_v3)
 #endif
 MOGAO_TARGET_X86_64_V3 void spatial_variance_row_v3(ImageSize size, const GeometryWeight& gw, const Planes& planes,
-                                                    int y) {
-    spatial_variance_row_body<WideLanes>(size, gw, planes, y);
+                                                    const float* given, int y) {
+    spatial_variance_row_body<WideLanes>(size, gw, planes, given, y);
 }
-void spatial_variance_row_base(ImageSize size, const GeometryWeight& gw, const Planes& planes, int y) {
-    spatial_variance_row_body<lanes::F4>(size, gw, planes, y);
+void spatial_variance_row_base(ImageSize size, const GeometryWeight& gw, const Planes& planes, const float* given,
+                               int y) {
+    spatial_variance_row_body<lanes::F4>(size, gw, planes, given, y);
 }
 MOGAO_TARGET_X86_64_V3 void smoothed_variance_row_v3(ImageSize size, const GeometryWeight& gw, const Planes& planes,
                                                      const float* raw, int y) {
@@ -500,10 +527,15 @@ void filter_level(const Kernels& kernels, ImageSize size, int step, const Geomet
 }  // namespace
 
 Status AtrousDenoiser::run(const RgbFloatImage& noisy, const GuideBuffers& guides, const AtrousParams& params,
-                           RgbFloatImage& out, const RgbFloatImage* variance) {
+                           RgbFloatImage& out, const RgbFloatImage* variance,
+                           const std::vector<float>* luminance_variance) {
     if (Status s = validate_denoise_input(noisy, guides, params); !s.ok()) return s;
     if (variance) {
         if (Status s = check_variance(*variance, noisy.size); !s.ok()) return s;
+    }
+    if (luminance_variance) {
+        if (Status s = check_luminance_variance(*luminance_variance, noisy.size, variance != nullptr); !s.ok())
+            return s;
     }
     if (params.iterations == 0) {
         out = noisy;
@@ -520,8 +552,9 @@ Status AtrousDenoiser::run(const RgbFloatImage& noisy, const GuideBuffers& guide
     if (variance) {
         given_variance(kernels.smoothed_variance_row, *variance, guides, gw, planes, threads);
     } else {
+        const float* given = luminance_variance ? luminance_variance->data() : nullptr;
         for_row_bands(size.height, threads, [&](int y0, int y1) {
-            for (int y = y0; y < y1; ++y) kernels.spatial_variance_row(size, gw, planes, y);
+            for (int y = y0; y < y1; ++y) kernels.spatial_variance_row(size, gw, planes, given, y);
         });
     }
     for (int level = 0; level < params.iterations; ++level) {

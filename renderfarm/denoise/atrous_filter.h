@@ -34,7 +34,8 @@
 // length is not W·H·3, guides of another size or with buffers of the wrong length, iterations
 // outside [0, kMaxIterations], a σ that is negative or not finite, threads < 0, a hit pixel whose
 // depth is not finite and > 0. The message names the field and the limit; `out` is not touched.
-// Cost: (25 + 25 · iterations) taps per surface pixel, each one exp; threads split rows. The tap loops
+// Cost: (25 + 25 · iterations) taps per surface pixel, each one exp (the first 25 only where the
+// luminance variance is not given); threads split rows. The tap loops
 // run eight pixels at a time where the CPU has x86-64-v3 (AVX2, FMA), else four.
 #pragma once
 
@@ -77,8 +78,15 @@ public:
     // the filter lets less through and its output tends to `noisy` itself, where the spatial
     // estimate, which also sees shading and texture, would keep blurring them.
     // EINVAL naming the field for a variance of another size or a negative or non-finite value.
+    // `luminance_variance`, when given (not with `variance`): W*H values, the variance of each
+    // pixel's demodulated luminance l (squared illumination units), e.g. SVGF's temporal estimate
+    // (TemporalHistory::luminance_variance, temporal_accumulation.h); a negative value means unknown,
+    // and that pixel gets the spatial estimate. It then drives w_l as the spatial estimate would
+    // ([S] §4.2: the temporal variance where the history is long enough), and the 5x5 spatial pass
+    // runs only around the unknown pixels. EINVAL naming the field for another size, a non-finite
+    // value, or both variances given.
     Status run(const RgbFloatImage& noisy, const GuideBuffers& guides, const AtrousParams& params, RgbFloatImage& out,
-               const RgbFloatImage* variance = nullptr);
+               const RgbFloatImage* variance = nullptr, const std::vector<float>* luminance_variance = nullptr);
 
 private:
     // Planes of W*H floats, structure of arrays so the per-tap loops over a row vectorise:

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <limits>
 #include <random>
+#include <tuple>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -304,6 +306,63 @@ TEST(AtrousFilter, BadMeasuredVarianceIsNamedAndTheOutputKept) {
         RgbFloatImage out(ImageSize{1, 1}, 42.0f);
         AtrousDenoiser denoiser;
         const Status st = denoiser.run(e.s.noisy, e.s.guides, AtrousParams{}, out, variance);
+        ASSERT_FALSE(st.ok()) << needle;
+        EXPECT_EQ(st.code(), EINVAL);
+        EXPECT_NE(st.error().message.find(needle), std::string::npos) << st.error().message;
+        EXPECT_EQ(out.pixels[0], 42.0f) << "output touched on error";
+    }
+}
+
+// A given luminance variance (the temporal estimate, temporal_accumulation.h) replaces the spatial
+// one where it is >= 0: unknown everywhere is the spatial estimate bit for bit, and the true noise
+// keeps the shadow edge the spatial estimate blurs, yet still filters the noise.
+TEST(AtrousFilter, GivenLuminanceVarianceReplacesTheSpatialEstimateWhereKnown) {
+    const ShadowEdge e = make_shadow_edge(0.03f);
+    const auto n = static_cast<std::size_t>(kW * kH);
+    const std::vector<float> unknown(n, -1.0f);
+    std::vector<float> noise(n, 0.0f);  // the true variance of the demodulated luminance (channels independent)
+    for (std::size_t i = 0; i < n; ++i) {
+        if (e.s.guides.hit[i] == 0) continue;
+        for (int c = 0; c < 3; ++c) {
+            const double w = (c == 0 ? 0.2126 : (c == 1 ? 0.7152 : 0.0722)) / e.s.guides.albedo[3 * i + c];
+            noise[i] += static_cast<float>(w * w * e.variance.pixels[3 * i + c]);
+        }
+    }
+    AtrousDenoiser denoiser;
+    RgbFloatImage spatial, as_unknown, given;
+    ASSERT_TRUE(denoiser.run(e.s.noisy, e.s.guides, AtrousParams{}, spatial).ok());
+    ASSERT_TRUE(denoiser.run(e.s.noisy, e.s.guides, AtrousParams{}, as_unknown, nullptr, &unknown).ok());
+    ASSERT_TRUE(denoiser.run(e.s.noisy, e.s.guides, AtrousParams{}, given, nullptr, &noise).ok());
+    EXPECT_EQ(as_unknown.pixels, spatial.pixels);
+    const double step = 1.0 - 0.3;
+    const double spatial_bleed = 1.0 - mean_irradiance(spatial, e.s.guides, 23, 24, 0, 32);
+    const double given_bleed = 1.0 - mean_irradiance(given, e.s.guides, 23, 24, 0, 32);
+    std::printf("shadow edge: bleed %.4f (spatial) %.4f (given luminance variance); PSNR noisy %.2f, given %.2f dB\n",
+                spatial_bleed, given_bleed, linear_psnr(e.s.noisy, e.s.truth), linear_psnr(given, e.s.truth));
+    EXPECT_GT(spatial_bleed, 0.05 * step) << "control: the spatial estimate should blur the shadow edge";
+    EXPECT_LT(std::abs(given_bleed), 0.01 * step);
+    EXPECT_GT(linear_psnr(given, e.s.truth), linear_psnr(e.s.noisy, e.s.truth) + 3.0);
+    // Known on half the rows only: those rows take the given value, the rest stay spatial.
+    std::vector<float> half = noise;
+    std::fill(half.begin() + static_cast<std::ptrdiff_t>(n / 2), half.end(), -1.0f);
+    RgbFloatImage mixed;
+    ASSERT_TRUE(denoiser.run(e.s.noisy, e.s.guides, AtrousParams{}, mixed, nullptr, &half).ok());
+    EXPECT_LT(std::abs(1.0 - mean_irradiance(mixed, e.s.guides, 23, 24, 0, 8)), 0.01 * step);
+}
+
+TEST(AtrousFilter, BadLuminanceVarianceIsNamedAndTheOutputKept) {
+    const ShadowEdge e = make_shadow_edge(0.1f);
+    const auto n = static_cast<std::size_t>(kW * kH);
+    std::vector<float> shorter(n - 1, 0.0f), nan(n, 0.0f), fine(n, 0.0f);
+    nan[7] = std::numeric_limits<float>::quiet_NaN();
+    for (const auto& [variance, colour, needle] :
+         {std::tuple{&shorter, false, "luminance_variance holds 6143 values"},
+          std::tuple{&nan, false, "luminance_variance at pixel 7 = nan"},
+          std::tuple{&fine, true, "variance and luminance_variance are both given"}}) {
+        RgbFloatImage out(ImageSize{1, 1}, 42.0f);
+        AtrousDenoiser denoiser;
+        const Status st =
+            denoiser.run(e.s.noisy, e.s.guides, AtrousParams{}, out, colour ? &e.variance : nullptr, variance);
         ASSERT_FALSE(st.ok()) << needle;
         EXPECT_EQ(st.code(), EINVAL);
         EXPECT_NE(st.error().message.find(needle), std::string::npos) << st.error().message;

@@ -29,6 +29,8 @@ float demodulation(const GuideBuffers& guides, std::size_t i, std::size_t c) {
     return std::max(guides.albedo[3 * i + c], kDemodulationMinAlbedo);
 }
 
+float luminance(const Eigen::Vector3f& c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
+
 }  // namespace
 
 void check_temporal_params(const TemporalParams& params) {
@@ -42,7 +44,7 @@ void check_temporal_params(const TemporalParams& params) {
 }
 
 bool TemporalHistory::gather(const Pass& f, const Eigen::Vector3f& position, const Eigen::Vector3f& normal, float depth,
-                             float px, float py, Eigen::Vector3f& value, float& length) const {
+                             float px, float py, Eigen::Vector3f& value, float& length, float& second_moment) const {
     const TemporalParams& params = f.params;
     const float fx = px - 0.5f;
     const float fy = py - 0.5f;
@@ -60,6 +62,7 @@ bool TemporalHistory::gather(const Pass& f, const Eigen::Vector3f& position, con
     int accepted = 0;
     value = Eigen::Vector3f::Zero();
     length = 0.0f;
+    second_moment = 0.0f;
     for (int k = 0; k < 4; ++k) {
         const int x = std::min(x0 + (k & 1), camera_.size.width - 1);  // x0 = W - 1 only where wx = 0
         const int y = std::min(y0 + (k >> 1), camera_.size.height - 1);
@@ -72,12 +75,14 @@ bool TemporalHistory::gather(const Pass& f, const Eigen::Vector3f& position, con
         const float w = ((k & 1) != 0 ? wx : 1.0f - wx) * ((k >> 1) != 0 ? wy : 1.0f - wy);
         value += w * at3(illumination_, i);
         length += w * length_[i];
+        second_moment += w * second_moment_[i];
         weight += w;
         ++accepted;
     }
     if (!(weight > 1e-3f)) return false;
     value /= weight;
     length /= weight;
+    second_moment /= weight;
     if (params.sharp_history && accepted == 4) sharpen(fx, fy, value);
     return true;
 }
@@ -170,6 +175,20 @@ std::size_t TemporalHistory::fill_holes(const Pass& f) {
     return holes.size();
 }
 
+// Pixel i's second moment becomes `m2`, its length `length`, and its luminance variance follows from
+// them and the luminance of its illumination, set before (the header's formula).
+void TemporalHistory::set_moments(const Pass& f, std::size_t i, float m2, float length) {
+    f.second_moment[i] = m2;
+    f.length[i] = length;
+    if (length < kMinMomentsFrames) {
+        f.luminance_variance[i] = -1.0f;
+        return;
+    }
+    const float m1 = luminance(at3(f.illumination, i));
+    const float squared_weights = std::max(1.0f / length, f.alpha / (2.0f - f.alpha));
+    f.luminance_variance[i] = std::max(0.0f, m2 - m1 * m1) * squared_weights;
+}
+
 // Pixel i's illumination becomes `value` and its output value ⊙ its albedo (re-modulated).
 void TemporalHistory::set_pixel(const Pass& f, std::size_t i, const Eigen::Vector3f& value) {
     const int width = f.current.size.width;
@@ -199,7 +218,7 @@ void TemporalHistory::accumulate_rows(const Pass& f, int y0, int y1, TemporalSta
             const std::size_t i = row + static_cast<std::size_t>(x);
             if (f.guides.hit[i] == 0) {  // the buffers are reused: zero what a sky pixel leaves (sharpen reads it)
                 for (std::size_t c = 0; c < 3; ++c) f.illumination[3 * i + c] = f.position[3 * i + c] = 0.0f;
-                f.plane[i] = f.length[i] = 0.0f;
+                f.plane[i] = f.length[i] = f.second_moment[i] = f.luminance_variance[i] = 0.0f;
                 continue;
             }
             ++counted.surface_pixels;
@@ -219,20 +238,22 @@ void TemporalHistory::accumulate_rows(const Pass& f, int y0, int y1, TemporalSta
             for (int c = 0; c < 3; ++c) f.illumination[3 * i + static_cast<std::size_t>(c)] = illumination[c];
             Eigen::Vector3f history;
             float frames = 0.0f;
+            float second_moment = 0.0f;
+            const float l = shaded ? luminance(illumination) : 0.0f;
             if (empty() || in_view[xs] == 0 ||
-                !gather(f, p, normal, f.guides.depth[i], hx[xs], hy[xs], history, frames)) {
-                f.length[i] = shaded ? 1.0f : 0.0f;
+                !gather(f, p, normal, f.guides.depth[i], hx[xs], hy[xs], history, frames, second_moment)) {
+                set_moments(f, i, l * l, shaded ? 1.0f : 0.0f);
                 continue;
             }
             ++counted.reprojected;
             if (!shaded) {  // the history alone, still as many frames as it had
                 set_pixel(f, i, history);
-                f.length[i] = frames;
+                set_moments(f, i, second_moment, frames);
                 continue;
             }
             const float a = std::max(f.alpha, 1.0f / (frames + 1.0f));
             set_pixel(f, i, (1.0f - a) * history + a * illumination);
-            f.length[i] = frames + 1.0f;
+            set_moments(f, i, (1.0f - a) * second_moment + a * l * l, frames + 1.0f);
         }
     }
 }
@@ -251,6 +272,8 @@ RgbFloatImage TemporalHistory::accumulate(const RgbFloatImage& current, const Gu
     position_.resize(3 * n);
     next_plane_.resize(n);
     next_length_.resize(n);
+    next_second_moment_.resize(n);
+    luminance_variance_.resize(n);
     const float alpha = 1.0f - std::pow(1.0f - params.alpha, static_cast<float>(shading_one_in));
     const Pass f{current,
                  guides,
@@ -262,7 +285,9 @@ RgbFloatImage TemporalHistory::accumulate(const RgbFloatImage& current, const Gu
                  next_illumination_,
                  position_,
                  next_plane_,
-                 next_length_};
+                 next_length_,
+                 next_second_moment_,
+                 luminance_variance_};
     // Rows split over the cores (each pixel reads only the history and writes only itself, so the
     // result does not depend on the split): the admin runs this while the ranks wait.
     const int height = current.size.height;
@@ -289,6 +314,7 @@ RgbFloatImage TemporalHistory::accumulate(const RgbFloatImage& current, const Gu
     normal_ = guides.normal;  // copy assignment keeps the storage of a size already seen
     hit_ = guides.hit;
     length_.swap(next_length_);
+    second_moment_.swap(next_second_moment_);
     if (stats != nullptr) *stats = total;
     return out;
 }
@@ -299,6 +325,8 @@ void TemporalHistory::clear() {
     normal_.clear();
     hit_.clear();
     length_.clear();
+    second_moment_.clear();
+    luminance_variance_.clear();
 }
 
 }  // namespace mogao

@@ -41,6 +41,19 @@
 // filter), and each frame traces a fraction of the paths. This is checkerboard
 // rendering's reconstruction from temporal history, with the rotating pattern as its refresh.
 //
+// The history also keeps each pixel's second luminance moment (SVGF §4.2, the temporal variance):
+// m2, the running mean of l² over its samples, l the demodulated luminance (Rec. 709 weights),
+// blended with the same weights a as the illumination, so that the first moment m1 is the luminance
+// of the blended illumination itself. A pixel whose history holds n >= kMinMomentsFrames frames gets
+// the variance of its blended luminance
+//   Var(l̄) = max(0, m2 − m1²) · max(1/n, alpha / (2 − alpha))
+// where the factor is Σ a_k², the sum of the squared weights of its samples in the blend: 1/n for a
+// running mean, alpha / (2 − alpha) for the exponential average's steady state (the variance of a
+// weighted mean of independent samples is Σ a_k² σ²; SVGF feeds the samples' σ² itself, this is what
+// is left of it in the frame the filter sees). A shorter history gets −1 (unknown: the filter
+// estimates it spatially, as SVGF does for short histories). m2 is resampled bilinearly with the
+// illumination's accepted taps, carried unchanged by an unshaded pixel; a filled hole's is unknown.
+//
 // Frames may change size between calls (the frame-time target scales them): the history keeps its
 // own size and camera. Pure CPU code, no GL, no Embree; rows run on every core.
 #pragma once
@@ -88,6 +101,12 @@ public:
     RgbFloatImage accumulate(const RgbFloatImage& current, const GuideBuffers& guides, const CameraSetup& camera,
                              const TemporalParams& params, TemporalStats* stats = nullptr, int shading_one_in = 1);
 
+    // After accumulate(): the variance of each pixel's blended demodulated luminance (W*H of the
+    // frame, squared illumination units; 0 for sky, −1 where the history is shorter than
+    // kMinMomentsFrames), as AtrousDenoiser::run takes it. Empty before the first frame.
+    [[nodiscard]] const std::vector<float>& luminance_variance() const { return luminance_variance_; }
+    static constexpr float kMinMomentsFrames = 4.0f;  // SVGF §4.2: shorter histories are estimated spatially
+
     // Forgets everything: the next frame starts its own history.
     void clear();
     [[nodiscard]] bool empty() const { return illumination_.empty(); }
@@ -106,6 +125,8 @@ private:
         std::vector<float>& position;
         std::vector<float>& plane;
         std::vector<float>& length;
+        std::vector<float>& second_moment;
+        std::vector<float>& luminance_variance;
     };
     void accumulate_rows(const Pass& f, int y0, int y1, TemporalStats& counted) const;
     static std::size_t fill_holes(const Pass& f);
@@ -114,21 +135,26 @@ private:
     void sharpen(float fx, float fy, Eigen::Vector3f& value) const;
     // The history at the previous image's position (px, py) (project_row's) for the point `position`.
     [[nodiscard]] bool gather(const Pass& f, const Eigen::Vector3f& position, const Eigen::Vector3f& normal,
-                              float depth, float px, float py, Eigen::Vector3f& value, float& length) const;
+                              float depth, float px, float py, Eigen::Vector3f& value, float& length,
+                              float& second_moment) const;
+    static void set_moments(const Pass& f, std::size_t i, float m2, float length);
 
     CameraSetup camera_;
-    std::vector<float> illumination_;  // W*H*3 the previous output demodulated (radiance / albedo)
-    std::vector<float> plane_;         // W*H n·P of each pixel's hit: its tangent plane's offset, metres
-    std::vector<float> normal_;        // W*H*3 unit world normals
-    std::vector<std::uint8_t> hit_;    // W*H
-    std::vector<float> length_;        // W*H frames averaged
+    std::vector<float> illumination_;   // W*H*3 the previous output demodulated (radiance / albedo)
+    std::vector<float> plane_;          // W*H n·P of each pixel's hit: its tangent plane's offset, metres
+    std::vector<float> normal_;         // W*H*3 unit world normals
+    std::vector<std::uint8_t> hit_;     // W*H
+    std::vector<float> length_;         // W*H frames averaged
+    std::vector<float> second_moment_;  // W*H m2 of the luminance, see above
     // Scratch the next frame's history is written into (and each pixel's point), swapped with the
     // history after each frame: a frame of a stable size allocates and zero-fills nothing. Every
     // element is written by accumulate() before it is read.
     std::vector<float> next_illumination_;
     std::vector<float> next_plane_;
     std::vector<float> next_length_;
-    std::vector<float> position_;  // W*H*3 the current frame's points, world metres
+    std::vector<float> next_second_moment_;
+    std::vector<float> luminance_variance_;  // W*H the current frame's, see luminance_variance()
+    std::vector<float> position_;            // W*H*3 the current frame's points, world metres
 };
 
 }  // namespace mogao

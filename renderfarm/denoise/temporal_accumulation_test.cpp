@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 // Temporal accumulation (temporal_accumulation.h) on analytic scenes: a wall seen by a pinhole
 // camera, with guides computed exactly, so what is reprojected where is known.
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -91,6 +93,55 @@ TEST(TemporalAccumulation, AStillViewIsTheRunningMeanThenAnExponentialAverage) {
     for (int k = 0; k < 20; ++k) out = history.accumulate(shade(seen, 0.1, rng), seen.guides, camera, {});
     // Exponential average with alpha 0.2: noise variance a/(2-a) = 1/9 of one frame's.
     EXPECT_LT(rms_error(out, seen), 0.1 / 2.5);
+}
+
+// The luminance of pixel i of `f`, demodulated by the albedo `albedo` (the same for every channel).
+double demodulated_luminance(const RgbFloatImage& f, std::size_t i, double albedo) {
+    return (0.2126 * f.pixels[3 * i] + 0.7152 * f.pixels[3 * i + 1] + 0.0722 * f.pixels[3 * i + 2]) / albedo;
+}
+
+// A still view of a noisy wall: the history's luminance variance must be what the blended frame's
+// error against the noise-free truth measures (its variance over the pixels), unknown (-1) until four
+// frames are in, and 0 on sky.
+TEST(TemporalAccumulation, TheLuminanceVarianceIsTheBlendedFramesOwnNoise) {
+    const CameraSetup camera = camera_at(0.0);
+    Seen seen = wall(camera, 3.0);
+    constexpr float kAlbedo = 0.5f;
+    std::fill(seen.guides.albedo.begin(), seen.guides.albedo.end(), kAlbedo);
+    seen.guides.set_sky(0);
+    std::mt19937 rng(3), none(0);
+    const RgbFloatImage truth = shade(seen, 0.0, none);
+    TemporalHistory history;
+    EXPECT_TRUE(history.luminance_variance().empty());
+    RgbFloatImage out;
+    for (int k = 1; k <= 40; ++k) {
+        out = history.accumulate(shade(seen, 0.1, rng), seen.guides, camera, {});
+        const std::vector<float>& v = history.luminance_variance();
+        ASSERT_EQ(v.size(), static_cast<std::size_t>(kSize.pixel_count()));
+        EXPECT_EQ(v[0], 0.0f) << "sky, frame " << k;
+        if (k < 4) EXPECT_EQ(v[500], -1.0f) << "a history of " << k << " frames is too short";
+        if (k >= 4) EXPECT_GE(v[500], 0.0f) << "frame " << k;
+    }
+    double estimated = 0.0, measured = 0.0;
+    int unknown = 0;
+    for (std::size_t i = 1; i < static_cast<std::size_t>(kSize.pixel_count()); ++i) {
+        if (history.luminance_variance()[i] < 0.0f) {
+            ++unknown;
+            continue;
+        }
+        estimated += history.luminance_variance()[i];
+        measured += std::pow(demodulated_luminance(out, i, kAlbedo) - demodulated_luminance(truth, i, kAlbedo), 2);
+    }
+    const double samples = 0.1 * 0.1 * (0.2126 * 0.2126 + 0.7152 * 0.7152 + 0.0722 * 0.0722) / (kAlbedo * kAlbedo);
+    std::printf("blended luminance variance: estimated %.3g, measured %.3g (one frame's %.3g); %d pixels unknown\n",
+                estimated, measured, samples * static_cast<double>(kSize.pixel_count() - 1), unknown);
+    EXPECT_LE(unknown, kSize.width + kSize.height) << "at most the image's border may lack a history";
+    EXPECT_GT(estimated, 0.7 * measured);
+    EXPECT_LT(estimated, 1.4 * measured);
+    EXPECT_LT(measured, 0.2 * samples * static_cast<double>(kSize.pixel_count() - 1))
+        << "control: the blend averages several frames";
+    history.clear();
+    EXPECT_TRUE(history.luminance_variance().empty());
 }
 
 TEST(TemporalAccumulation, AMovingViewFindsEachPointWhereThePreviousCameraSawIt) {

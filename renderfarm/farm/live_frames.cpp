@@ -219,20 +219,24 @@ void LiveFrames::display(Session& s, const RgbFloatImage& radiance, LiveFrame& f
     const auto start = Clock::now();
     const RgbFloatImage* noisy = &radiance;
     RgbFloatImage blended;
+    const std::vector<float>* temporal_variance = nullptr;
     AtrousParams params = options_.denoise_params;
     if (options_.temporal && !frame.still) {
         params.iterations = options_.blended_denoise_iterations;
         blended = s.temporal.accumulate(radiance, s.guides, make_camera_setup(frame.rendered, radiance.size),
                                         options_.temporal_params, &frame.temporal, frame.rendered.shading_one_in);
         noisy = &blended;
+        if (options_.temporal_variance) temporal_variance = &s.temporal.luminance_variance();
         frame.temporal_seconds = std::chrono::duration<double>(Clock::now() - start).count();
     }
     // A still view's accumulation of two passes or more brings its own noise, measured from the
     // passes' spread: the filter then does less as samples come in, instead of blurring as much at
     // 64 spp as at 1 (the spatial estimate also counts shading and texture as noise).
     const RgbFloatImage variance = frame.passes >= 2 ? s.accumulation.variance_of_mean() : RgbFloatImage{};
+    const bool measured = !variance.pixels.empty();  // the passes' spread, where there is one, wins
     RgbFloatImage filtered;
-    if (Status st = denoiser_.run(*noisy, s.guides, params, filtered, variance.pixels.empty() ? nullptr : &variance);
+    if (Status st = denoiser_.run(*noisy, s.guides, params, filtered, measured ? &variance : nullptr,
+                                  measured ? nullptr : temporal_variance);
         !st.ok())
         throw std::runtime_error(st.error().message);
     frame.image = to_display(filtered);

@@ -119,6 +119,10 @@ struct LiveOptions {
     // history keeps), at a larger scale; 0 measured closer still but leaves grain and isolated
     // bright pixels on the walls (the serve bench's sparse and sparse-all-levels configurations).
     int blended_denoise_iterations = 1;
+    // A frame blended with its history gives the filter the history's temporal luminance variance
+    // (TemporalHistory::luminance_variance, SVGF §4.2) where it holds enough frames; the 5x5 spatial
+    // estimate runs only around the rest. false: the spatial estimate everywhere.
+    bool temporal_variance = true;
     // With radiance_cache, denoise and temporal: a moving frame that has a history shades one pixel
     // in `shading_one_in` ([1, 16]; 1 shades all), on a pattern that moves every frame
     // (ViewRequest::shading_one_in; each pixel is shaded once in as many frames), and takes the

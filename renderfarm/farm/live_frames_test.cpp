@@ -376,6 +376,31 @@ TEST_F(LiveFramesTest, ABlendedFrameIsFilteredWithItsOwnLevelsAndAStillViewWithT
     EXPECT_NE(sa.image.pixels, sb.image.pixels) << "a still view is filtered with denoise_params' levels";
 }
 
+// A blended frame's filter takes the history's temporal luminance variance (temporal_variance) once a
+// pixel's history holds four frames: before that, every pixel gets the spatial estimate, so the
+// frames are those of temporal_variance off bit for bit; after it they differ.
+TEST_F(LiveFramesTest, ABlendedFrameTakesTheTemporalVarianceOnceTheHistoryIsLongEnough) {
+    ViewRequest request = view(0.0);
+    request.size = {96, 72};
+    LiveOptions temporal_variance;
+    temporal_variance.denoise = temporal_variance.temporal = true;
+    LiveOptions spatial_variance = temporal_variance;
+    spatial_variance.temporal_variance = false;
+    ASSERT_TRUE(temporal_variance.temporal_variance) << "the default";
+    LiveFrames a(source(), temporal_variance, 1.f, ToneMap::clamp);
+    LiveFrames b(source(), spatial_variance, 1.f, ToneMap::clamp);
+    for (int k = 1; k <= 5; ++k) {
+        ViewRequest r = request;
+        r.pose.yaw_deg += 0.1 * k;
+        r.frame_id = 700 + static_cast<std::uint64_t>(k);
+        const LiveFrame fa = a.render(r), fb = b.render(r);
+        ASSERT_TRUE(fa.denoised && fb.denoised);
+        ASSERT_FALSE(fa.still);
+        if (k < 4) EXPECT_EQ(fa.image.pixels, fb.image.pixels) << "frame " << k << ": no pixel has four frames yet";
+        if (k >= 4) EXPECT_NE(fa.image.pixels, fb.image.pixels) << "frame " << k;
+    }
+}
+
 double mean_of(const Rgb8Image& image) {
     double sum = 0.0;
     for (const std::uint8_t v : image.pixels) sum += v;
