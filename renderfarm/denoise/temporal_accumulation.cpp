@@ -186,7 +186,10 @@ void TemporalHistory::set_moments(const Pass& f, std::size_t i, float m2, float 
     }
     const float m1 = luminance(at3(f.illumination, i));
     const float squared_weights = std::max(1.0f / length, f.alpha / (2.0f - f.alpha));
-    f.luminance_variance[i] = std::max(0.0f, m2 - m1 * m1) * squared_weights;
+    const float spread = m2 - m1 * m1;
+    // A non-finite sample (a NaN, a square past float's range) leaves the pixel to the spatial estimate,
+    // which reads such samples as 0, rather than a variance of 0 (max(0, NaN)) or one the filter refuses.
+    f.luminance_variance[i] = std::isfinite(spread) ? std::max(0.0f, spread) * squared_weights : -1.0f;
 }
 
 // Pixel i's illumination becomes `value` and its output value ⊙ its albedo (re-modulated).

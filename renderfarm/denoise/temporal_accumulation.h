@@ -103,7 +103,7 @@ public:
 
     // After accumulate(): the variance of each pixel's blended demodulated luminance (W*H of the
     // frame, squared illumination units; 0 for sky, −1 where the history is shorter than
-    // kMinMomentsFrames), as AtrousDenoiser::run takes it. Empty before the first frame.
+    // kMinMomentsFrames or a sample was not finite), as AtrousDenoiser::run takes it. Empty before the first frame.
     [[nodiscard]] const std::vector<float>& luminance_variance() const { return luminance_variance_; }
     static constexpr float kMinMomentsFrames = 4.0f;  // SVGF §4.2: shorter histories are estimated spatially
 

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -140,6 +141,14 @@ TEST(TemporalAccumulation, TheLuminanceVarianceIsTheBlendedFramesOwnNoise) {
     EXPECT_LT(estimated, 1.4 * measured);
     EXPECT_LT(measured, 0.2 * samples * static_cast<double>(kSize.pixel_count() - 1))
         << "control: the blend averages several frames";
+    // A NaN or an overflowing sample: unknown there (the filter's spatial estimate), never a non-finite variance.
+    RgbFloatImage bad = shade(seen, 0.1, rng);
+    bad.pixels[3 * 600] = std::numeric_limits<float>::quiet_NaN();
+    bad.pixels[3 * 601 + 1] = 3e30f;
+    (void)history.accumulate(bad, seen.guides, camera, {});
+    for (const float v : history.luminance_variance()) ASSERT_TRUE(std::isfinite(v));
+    EXPECT_EQ(history.luminance_variance()[600], -1.0f);
+    EXPECT_EQ(history.luminance_variance()[601], -1.0f);
     history.clear();
     EXPECT_TRUE(history.luminance_variance().empty());
 }
