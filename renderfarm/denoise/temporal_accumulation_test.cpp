@@ -120,8 +120,11 @@ TEST(TemporalAccumulation, TheLuminanceVarianceIsTheBlendedFramesOwnNoise) {
         const std::vector<float>& v = history.luminance_variance();
         ASSERT_EQ(v.size(), static_cast<std::size_t>(kSize.pixel_count()));
         EXPECT_EQ(v[0], 0.0f) << "sky, frame " << k;
-        if (k < 4) EXPECT_EQ(v[500], -1.0f) << "a history of " << k << " frames is too short";
-        if (k >= 4) EXPECT_GE(v[500], 0.0f) << "frame " << k;
+        if (k < 4) {
+            EXPECT_EQ(v[500], -1.0f) << "a history of " << k << " frames is too short";
+        } else {
+            EXPECT_GE(v[500], 0.0f) << "frame " << k;
+        }
     }
     double estimated = 0.0, measured = 0.0;
     int unknown = 0;

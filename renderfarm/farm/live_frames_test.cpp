@@ -396,8 +396,11 @@ TEST_F(LiveFramesTest, ABlendedFrameTakesTheTemporalVarianceOnceTheHistoryIsLong
         const LiveFrame fa = a.render(r), fb = b.render(r);
         ASSERT_TRUE(fa.denoised && fb.denoised);
         ASSERT_FALSE(fa.still);
-        if (k < 4) EXPECT_EQ(fa.image.pixels, fb.image.pixels) << "frame " << k << ": no pixel has four frames yet";
-        if (k >= 4) EXPECT_NE(fa.image.pixels, fb.image.pixels) << "frame " << k;
+        if (k < 4) {
+            EXPECT_EQ(fa.image.pixels, fb.image.pixels) << "frame " << k << ": no pixel has four frames yet";
+        } else {
+            EXPECT_NE(fa.image.pixels, fb.image.pixels) << "frame " << k;
+        }
     }
 }
 
