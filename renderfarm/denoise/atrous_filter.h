@@ -83,7 +83,8 @@ public:
     // (TemporalHistory::luminance_variance, temporal_accumulation.h); a negative value means unknown,
     // and that pixel gets the spatial estimate. It then drives w_l as the spatial estimate would
     // ([S] §4.2: the temporal variance where the history is long enough), and the 5x5 spatial pass
-    // runs only around the unknown pixels. EINVAL naming the field for another size, a non-finite
+    // runs only for the chunks of pixels the tap loops take together (eight with AVX2, else four) that
+    // hold an unknown one. EINVAL naming the field for another size, a non-finite
     // value, or both variances given.
     Status run(const RgbFloatImage& noisy, const GuideBuffers& guides, const AtrousParams& params, RgbFloatImage& out,
                const RgbFloatImage* variance = nullptr, const std::vector<float>* luminance_variance = nullptr);

@@ -44,7 +44,7 @@ void check_temporal_params(const TemporalParams& params) {
 }
 
 bool TemporalHistory::gather(const Pass& f, const Eigen::Vector3f& position, const Eigen::Vector3f& normal, float depth,
-                             float px, float py, Eigen::Vector3f& value, float& length, float& second_moment) const {
+                             float px, float py, Eigen::Vector3f& value, float& length, Moments& moments) const {
     const TemporalParams& params = f.params;
     const float fx = px - 0.5f;
     const float fy = py - 0.5f;
@@ -62,7 +62,7 @@ bool TemporalHistory::gather(const Pass& f, const Eigen::Vector3f& position, con
     int accepted = 0;
     value = Eigen::Vector3f::Zero();
     length = 0.0f;
-    second_moment = 0.0f;
+    moments = {};
     for (int k = 0; k < 4; ++k) {
         const int x = std::min(x0 + (k & 1), camera_.size.width - 1);  // x0 = W - 1 only where wx = 0
         const int y = std::min(y0 + (k >> 1), camera_.size.height - 1);
@@ -75,14 +75,16 @@ bool TemporalHistory::gather(const Pass& f, const Eigen::Vector3f& position, con
         const float w = ((k & 1) != 0 ? wx : 1.0f - wx) * ((k >> 1) != 0 ? wy : 1.0f - wy);
         value += w * at3(illumination_, i);
         length += w * length_[i];
-        second_moment += w * second_moment_[i];
+        moments.m1 += w * moments_[3 * i];
+        moments.m2 += w * moments_[3 * i + 1];
+        moments.factor += w * w * moments_[3 * i + 2];
         weight += w;
         ++accepted;
     }
     if (!(weight > 1e-3f)) return false;
     value /= weight;
     length /= weight;
-    second_moment /= weight;
+    moments.m1 /= weight, moments.m2 /= weight, moments.factor /= weight * weight;
     if (params.sharp_history && accepted == 4) sharpen(fx, fy, value);
     return true;
 }
@@ -170,26 +172,31 @@ std::size_t TemporalHistory::fill_holes(const Pass& f) {
     }
     for (std::size_t h = 0; h < holes.size(); ++h) {
         set_pixel(f, holes[h], filled[h]);
-        f.length[holes[h]] = 0.0f;
+        // Moments of the fill itself (no spread): a neighbour that resamples the hole next frame reads
+        // the light it shows, not a second moment of 0 beside a first moment of that light.
+        const float l = luminance(filled[h]);
+        set_moments(f, holes[h], {l, l * l, 1.0f}, 0.0f);
     }
     return holes.size();
 }
 
-// Pixel i's second moment becomes `m2`, its length `length`, and its luminance variance follows from
-// them and the luminance of its illumination, set before (the header's formula).
-void TemporalHistory::set_moments(const Pass& f, std::size_t i, float m2, float length) {
-    f.second_moment[i] = m2;
+// Pixel i's moments become `m`, its length `length`, and its luminance variance follows from them
+// (the header's formula).
+void TemporalHistory::set_moments(const Pass& f, std::size_t i, Moments m, float length) {
     f.length[i] = length;
-    if (length < kMinMomentsFrames) {
+    const float spread = m.m2 - m.m1 * m.m1;
+    if (!std::isfinite(spread)) {
+        // A non-finite sample (a NaN, a square past float's range): the moments start again from 0
+        // rather than carry it on for good, and the pixel is left to the spatial estimate (which reads
+        // such samples as 0), not given a variance of 0 (max(0, NaN)) or one the filter refuses.
+        m = {};
         f.luminance_variance[i] = -1.0f;
-        return;
+    } else {
+        f.luminance_variance[i] = length >= kMinMomentsFrames ? std::max(0.0f, spread) * m.factor : -1.0f;
     }
-    const float m1 = luminance(at3(f.illumination, i));
-    const float squared_weights = std::max(1.0f / length, f.alpha / (2.0f - f.alpha));
-    const float spread = m2 - m1 * m1;
-    // A non-finite sample (a NaN, a square past float's range) leaves the pixel to the spatial estimate,
-    // which reads such samples as 0, rather than a variance of 0 (max(0, NaN)) or one the filter refuses.
-    f.luminance_variance[i] = std::isfinite(spread) ? std::max(0.0f, spread) * squared_weights : -1.0f;
+    f.moments[3 * i] = m.m1;
+    f.moments[3 * i + 1] = m.m2;
+    f.moments[3 * i + 2] = m.factor;
 }
 
 // Pixel i's illumination becomes `value` and its output value ⊙ its albedo (re-modulated).
@@ -221,7 +228,8 @@ void TemporalHistory::accumulate_rows(const Pass& f, int y0, int y1, TemporalSta
             const std::size_t i = row + static_cast<std::size_t>(x);
             if (f.guides.hit[i] == 0) {  // the buffers are reused: zero what a sky pixel leaves (sharpen reads it)
                 for (std::size_t c = 0; c < 3; ++c) f.illumination[3 * i + c] = f.position[3 * i + c] = 0.0f;
-                f.plane[i] = f.length[i] = f.second_moment[i] = f.luminance_variance[i] = 0.0f;
+                f.plane[i] = f.length[i] = f.luminance_variance[i] = 0.0f;
+                for (std::size_t k = 0; k < 3; ++k) f.moments[3 * i + k] = 0.0f;
                 continue;
             }
             ++counted.surface_pixels;
@@ -241,22 +249,24 @@ void TemporalHistory::accumulate_rows(const Pass& f, int y0, int y1, TemporalSta
             for (int c = 0; c < 3; ++c) f.illumination[3 * i + static_cast<std::size_t>(c)] = illumination[c];
             Eigen::Vector3f history;
             float frames = 0.0f;
-            float second_moment = 0.0f;
+            Moments moments;
             const float l = shaded ? luminance(illumination) : 0.0f;
             if (empty() || in_view[xs] == 0 ||
-                !gather(f, p, normal, f.guides.depth[i], hx[xs], hy[xs], history, frames, second_moment)) {
-                set_moments(f, i, l * l, shaded ? 1.0f : 0.0f);
+                !gather(f, p, normal, f.guides.depth[i], hx[xs], hy[xs], history, frames, moments)) {
+                set_moments(f, i, {l, l * l, 1.0f}, shaded ? 1.0f : 0.0f);  // a hole's are set by fill_holes()
                 continue;
             }
             ++counted.reprojected;
             if (!shaded) {  // the history alone, still as many frames as it had
                 set_pixel(f, i, history);
-                set_moments(f, i, second_moment, frames);
+                set_moments(f, i, moments, frames);
                 continue;
             }
             const float a = std::max(f.alpha, 1.0f / (frames + 1.0f));
             set_pixel(f, i, (1.0f - a) * history + a * illumination);
-            set_moments(f, i, (1.0f - a) * second_moment + a * l * l, frames + 1.0f);
+            const float b = 1.0f - a;
+            set_moments(f, i, {b * moments.m1 + a * l, b * moments.m2 + a * l * l, b * b * moments.factor + a * a},
+                        frames + 1.0f);
         }
     }
 }
@@ -275,7 +285,7 @@ RgbFloatImage TemporalHistory::accumulate(const RgbFloatImage& current, const Gu
     position_.resize(3 * n);
     next_plane_.resize(n);
     next_length_.resize(n);
-    next_second_moment_.resize(n);
+    next_moments_.resize(3 * n);
     luminance_variance_.resize(n);
     const float alpha = 1.0f - std::pow(1.0f - params.alpha, static_cast<float>(shading_one_in));
     const Pass f{current,
@@ -289,7 +299,7 @@ RgbFloatImage TemporalHistory::accumulate(const RgbFloatImage& current, const Gu
                  position_,
                  next_plane_,
                  next_length_,
-                 next_second_moment_,
+                 next_moments_,
                  luminance_variance_};
     // Rows split over the cores (each pixel reads only the history and writes only itself, so the
     // result does not depend on the split): the admin runs this while the ranks wait.
@@ -317,7 +327,7 @@ RgbFloatImage TemporalHistory::accumulate(const RgbFloatImage& current, const Gu
     normal_ = guides.normal;  // copy assignment keeps the storage of a size already seen
     hit_ = guides.hit;
     length_.swap(next_length_);
-    second_moment_.swap(next_second_moment_);
+    moments_.swap(next_moments_);
     if (stats != nullptr) *stats = total;
     return out;
 }
@@ -328,7 +338,7 @@ void TemporalHistory::clear() {
     normal_.clear();
     hit_.clear();
     length_.clear();
-    second_moment_.clear();
+    moments_.clear();
     luminance_variance_.clear();
 }
 

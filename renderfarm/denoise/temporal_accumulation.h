@@ -41,18 +41,22 @@
 // filter), and each frame traces a fraction of the paths. This is checkerboard
 // rendering's reconstruction from temporal history, with the rotating pattern as its refresh.
 //
-// The history also keeps each pixel's second luminance moment (SVGF §4.2, the temporal variance):
-// m2, the running mean of l² over its samples, l the demodulated luminance (Rec. 709 weights),
-// blended with the same weights a as the illumination, so that the first moment m1 is the luminance
-// of the blended illumination itself. A pixel whose history holds n >= kMinMomentsFrames frames gets
-// the variance of its blended luminance
-//   Var(l̄) = max(0, m2 − m1²) · max(1/n, alpha / (2 − alpha))
-// where the factor is Σ a_k², the sum of the squared weights of its samples in the blend: 1/n for a
-// running mean, alpha / (2 − alpha) for the exponential average's steady state (the variance of a
-// weighted mean of independent samples is Σ a_k² σ²; SVGF feeds the samples' σ² itself, this is what
-// is left of it in the frame the filter sees). A shorter history gets −1 (unknown: the filter
-// estimates it spatially, as SVGF does for short histories). m2 is resampled bilinearly with the
-// illumination's accepted taps, carried unchanged by an unshaded pixel; a filled hole's is unknown.
+// The history also keeps each pixel's luminance moments (SVGF §4.2, the temporal variance): m1 and
+// m2, the running means of l and l² over its samples, l the demodulated luminance (Rec. 709 weights),
+// blended with the same weights a as the illumination and resampled bilinearly with its accepted taps
+// (never by Catmull-Rom, which would give m1 another resampling than m2); and f, the variance of the
+// blended value over one sample's: f = 1 for a first sample, f' = (1 − a)² f_H + a² at a blend, and
+// f_H = Σ w_k² f_k / (Σ w_k)² over the bilinear taps w_k (a resampled value averages its neighbours'
+// noise; the variance of a weighted mean of independent values is Σ w_k² σ_k² / (Σ w_k)²). A pixel
+// whose history holds at least kMinMomentsFrames frames gets the variance of its blended luminance
+//   Var(l̄) = max(0, m2 − m1²) · f.
+// SVGF feeds the samples' σ² = m2 − m1² itself; this is what is left of it in the frame the filter
+// sees. Neighbouring pixels that shared earlier samples are taken as independent, and resampling
+// widens m2 − m1² by the spread of the neighbours' means: under motion the estimate reads high (the
+// TemporalAccumulation tests print it against the blend's measured error, still and panning). A
+// shorter history gets −1 (unknown: the filter estimates it spatially, as SVGF does for short
+// histories). An unshaded pixel resamples its moments and adds none; a filled hole's are those of its
+// fill (l̄, l̄², 1), its variance unknown; a non-finite moment starts them again from 0.
 //
 // Frames may change size between calls (the frame-time target scales them): the history keeps its
 // own size and camera. Pure CPU code, no GL, no Embree; rows run on every core.
@@ -125,8 +129,12 @@ private:
         std::vector<float>& position;
         std::vector<float>& plane;
         std::vector<float>& length;
-        std::vector<float>& second_moment;
+        std::vector<float>& moments;
         std::vector<float>& luminance_variance;
+    };
+    struct Moments {
+        float m1 = 0.0f, m2 = 0.0f;  // running means of l and l² (above)
+        float factor = 0.0f;         // f: the variance of the blend over one sample's (above)
     };
     void accumulate_rows(const Pass& f, int y0, int y1, TemporalStats& counted) const;
     static std::size_t fill_holes(const Pass& f);
@@ -136,23 +144,23 @@ private:
     // The history at the previous image's position (px, py) (project_row's) for the point `position`.
     [[nodiscard]] bool gather(const Pass& f, const Eigen::Vector3f& position, const Eigen::Vector3f& normal,
                               float depth, float px, float py, Eigen::Vector3f& value, float& length,
-                              float& second_moment) const;
-    static void set_moments(const Pass& f, std::size_t i, float m2, float length);
+                              Moments& moments) const;
+    static void set_moments(const Pass& f, std::size_t i, Moments m, float length);
 
     CameraSetup camera_;
-    std::vector<float> illumination_;   // W*H*3 the previous output demodulated (radiance / albedo)
-    std::vector<float> plane_;          // W*H n·P of each pixel's hit: its tangent plane's offset, metres
-    std::vector<float> normal_;         // W*H*3 unit world normals
-    std::vector<std::uint8_t> hit_;     // W*H
-    std::vector<float> length_;         // W*H frames averaged
-    std::vector<float> second_moment_;  // W*H m2 of the luminance, see above
+    std::vector<float> illumination_;  // W*H*3 the previous output demodulated (radiance / albedo)
+    std::vector<float> plane_;         // W*H n·P of each pixel's hit: its tangent plane's offset, metres
+    std::vector<float> normal_;        // W*H*3 unit world normals
+    std::vector<std::uint8_t> hit_;    // W*H
+    std::vector<float> length_;        // W*H frames averaged
+    std::vector<float> moments_;       // W*H*3 (m1, m2, f) of the luminance, see above
     // Scratch the next frame's history is written into (and each pixel's point), swapped with the
     // history after each frame: a frame of a stable size allocates and zero-fills nothing. Every
     // element is written by accumulate() before it is read.
     std::vector<float> next_illumination_;
     std::vector<float> next_plane_;
     std::vector<float> next_length_;
-    std::vector<float> next_second_moment_;
+    std::vector<float> next_moments_;
     std::vector<float> luminance_variance_;  // W*H the current frame's, see luminance_variance()
     std::vector<float> position_;            // W*H*3 the current frame's points, world metres
 };

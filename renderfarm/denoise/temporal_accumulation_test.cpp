@@ -277,6 +277,46 @@ TEST(TemporalAccumulation, ASparseFrameTakesTheHistoryWhereItDidNotShadeAndFills
 // resampling blurs the history frame after frame; the Catmull-Rom history keeps the pattern, about as
 // well as frames that shade every pixel. Measured inside a border of 4 pixels: the columns the turn
 // brings in are filled from their neighbours (ASparseFrameTakesTheHistory... bounds those).
+// A sparse view panning by a quarter of a pixel a frame (resampled every frame, a quarter of each
+// frame's pixels shaded, new columns filled): the estimate still follows the blended frame's error
+// against the noise-free truth, inside the border the pan brings in.
+TEST(TemporalAccumulation, ASparsePanKeepsTheLuminanceVarianceNearTheBlendsError) {
+    constexpr float kAlbedo = 0.5f;
+    constexpr int kBorder = 6;
+    TemporalHistory history;
+    std::mt19937 rng(8), none(0);
+    RgbFloatImage out;
+    Seen seen;
+    for (int k = 0; k < 60; ++k) {
+        const CameraSetup camera = camera_at(0.43 * k);
+        seen = wall(camera, 3.0);
+        std::fill(seen.guides.albedo.begin(), seen.guides.albedo.end(), kAlbedo);
+        RgbFloatImage current = shade(seen, 0.1, rng);
+        const int n = k > 0 ? 4 : 1;
+        (void)mark_unshaded(current, n, k % n);
+        out = history.accumulate(current, seen.guides, camera, {}, nullptr, n);
+    }
+    const RgbFloatImage truth = shade(seen, 0.0, none);
+    double estimated = 0.0, measured = 0.0;
+    int known = 0;
+    for (int y = kBorder; y < kSize.height - kBorder; ++y) {
+        for (int x = kBorder; x < kSize.width - kBorder; ++x) {
+            const std::size_t i = seen.guides.pixel(x, y);
+            const float v = history.luminance_variance()[i];
+            if (v < 0.0f) continue;
+            ++known;
+            estimated += v;
+            measured += std::pow(demodulated_luminance(out, i, kAlbedo) - demodulated_luminance(truth, i, kAlbedo), 2);
+        }
+    }
+    const int inside = (kSize.width - 2 * kBorder) * (kSize.height - 2 * kBorder);
+    std::printf("sparse pan: blended luminance variance estimated %.3g, measured %.3g over %d of %d pixels\n",
+                estimated, measured, known, inside);
+    EXPECT_GT(known, inside * 9 / 10);
+    EXPECT_GT(estimated, 0.5 * measured);
+    EXPECT_LT(estimated, 2.0 * measured);
+}
+
 TEST(TemporalAccumulation, TheHistoryStaysSharpWhileTheViewMovesByFractionsOfAPixel) {
     constexpr double kFrequency = 6.0;  // about 10 pixels a period on the wall
     const auto run = [&](bool sharp, int one_in) {
