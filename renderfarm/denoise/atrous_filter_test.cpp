@@ -342,17 +342,18 @@ TEST(AtrousFilter, GivenLuminanceVarianceReplacesTheSpatialEstimateWhereKnown) {
     EXPECT_GT(spatial_bleed, 0.05 * step) << "control: the spatial estimate should blur the shadow edge";
     EXPECT_LT(std::abs(given_bleed), 0.01 * step);
     EXPECT_GT(linear_psnr(given, e.s.truth), linear_psnr(e.s.noisy, e.s.truth) + 3.0);
-    // Known at a random half of the pixels, so that most chunks of the tap loops mix known and unknown
-    // ones: finite, and between the two cases at the shadow edge.
-    std::vector<float> half = noise;
+    // Known at seven pixels in eight, at random, so that nearly every chunk of the tap loops mixes known
+    // and unknown ones: finite, and close to the all-given case at the shadow edge (the spatial
+    // estimate, computed for the whole chunk, must reach only its unknown pixels).
+    std::vector<float> most = noise;
     std::mt19937 pick(5);
-    for (float& v : half) v = (pick() & 1u) != 0 ? v : -1.0f;
+    for (float& v : most) v = pick() % 8 != 0 ? v : -1.0f;
     RgbFloatImage mixed;
-    ASSERT_TRUE(denoiser.run(e.s.noisy, e.s.guides, AtrousParams{}, mixed, nullptr, &half).ok());
+    ASSERT_TRUE(denoiser.run(e.s.noisy, e.s.guides, AtrousParams{}, mixed, nullptr, &most).ok());
     for (const float v : mixed.pixels) ASSERT_TRUE(std::isfinite(v));
     const double mixed_bleed = 1.0 - mean_irradiance(mixed, e.s.guides, 23, 24, 0, 32);
-    EXPECT_LT(mixed_bleed, spatial_bleed);
-    EXPECT_GT(mixed_bleed, given_bleed);
+    std::printf("seven in eight known: bleed %.4f\n", mixed_bleed);
+    EXPECT_LT(mixed_bleed, given_bleed + 0.35 * (spatial_bleed - given_bleed));
 }
 
 TEST(AtrousFilter, BadLuminanceVarianceIsNamedAndTheOutputKept) {

@@ -186,11 +186,16 @@ void TemporalHistory::set_moments(const Pass& f, std::size_t i, Moments m, float
     f.length[i] = length;
     const float spread = m.m2 - m.m1 * m.m1;
     if (!std::isfinite(spread)) {
-        // A non-finite sample (a NaN, a square past float's range): the moments start again from 0
-        // rather than carry it on for good, and the pixel is left to the spatial estimate (which reads
-        // such samples as 0), not given a variance of 0 (max(0, NaN)) or one the filter refuses.
+        // A non-finite sample (a NaN, a square past float's range): the pixel starts again rather than
+        // carry it on for good, and is left to the spatial estimate (which reads such samples as 0),
+        // not given a variance of 0 (max(0, NaN)) or one the filter refuses.
         m = {};
+        length = 0.0f;  // the next shaded sample replaces the pixel (a = 1)
+        f.length[i] = length;
         f.luminance_variance[i] = -1.0f;
+        // Nor does the illumination keep it (0 · NaN is NaN even at a = 1): this frame's output has it,
+        // as before; the history does not.
+        for (std::size_t c = 0; c < 3; ++c) f.illumination[3 * i + c] = 0.0f;
     } else {
         f.luminance_variance[i] = length >= kMinMomentsFrames ? std::max(0.0f, spread) * m.factor : -1.0f;
     }
@@ -210,9 +215,9 @@ void TemporalHistory::set_pixel(const Pass& f, std::size_t i, const Eigen::Vecto
     }
 }
 
-// Rows [y0, y1) of accumulate(): writes their pixels of out, illumination, position, plane and
-// length; counts them. A pixel that no history covers keeps its own radiance, bit for bit. Each
-// row's points and their positions in the previous image are computed first, a row at a time
+// Rows [y0, y1) of accumulate(): writes their pixels of out, illumination, position, plane,
+// length, moments and luminance variance; counts them. A pixel that no history covers keeps its own radiance, bit for
+// bit. Each row's points and their positions in the previous image are computed first, a row at a time
 // (PixelCentreRays::points_row, FrameProjection::project_row: vectorised), then each pixel's taps.
 void TemporalHistory::accumulate_rows(const Pass& f, int y0, int y1, TemporalStats& counted) const {
     const int width = f.current.size.width;

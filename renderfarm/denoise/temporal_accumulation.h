@@ -45,18 +45,23 @@
 // m2, the running means of l and l² over its samples, l the demodulated luminance (Rec. 709 weights),
 // blended with the same weights a as the illumination and resampled bilinearly with its accepted taps
 // (never by Catmull-Rom, which would give m1 another resampling than m2); and f, the variance of the
-// blended value over one sample's: f = 1 for a first sample, f' = (1 − a)² f_H + a² at a blend, and
+// blended value over one sample's: f = 1 for a first sample, f' = (1 − a)² f_H + a² at a blend, with
 // f_H = Σ w_k² f_k / (Σ w_k)² over the bilinear taps w_k (a resampled value averages its neighbours'
-// noise; the variance of a weighted mean of independent values is Σ w_k² σ_k² / (Σ w_k)²). A pixel
-// whose history holds at least kMinMomentsFrames frames gets the variance of its blended luminance
+// noise; the variance of a weighted mean of independent values is Σ w_k² σ_k² / (Σ w_k)²), also where
+// the illumination is sharpened by Catmull-Rom (the cubic's own Σ w², clamp aside, measured farther
+// from the blend's error: tests). A pixel whose history holds at least kMinMomentsFrames frames gets
+// the variance of its blended luminance
 //   Var(l̄) = max(0, m2 − m1²) · f.
 // SVGF feeds the samples' σ² = m2 − m1² itself; this is what is left of it in the frame the filter
-// sees. Neighbouring pixels that shared earlier samples are taken as independent, and resampling
-// widens m2 − m1² by the spread of the neighbours' means: under motion the estimate reads high (the
-// TemporalAccumulation tests print it against the blend's measured error, still and panning). A
-// shorter history gets −1 (unknown: the filter estimates it spatially, as SVGF does for short
-// histories). An unshaded pixel resamples its moments and adds none; a filled hole's are those of its
-// fill (l̄, l̄², 1), its variance unknown; a non-finite moment starts them again from 0.
+// sees. Two biases of opposite sign under motion: neighbouring pixels that shared earlier samples
+// are taken as independent (f reads low), and resampling widens m2 − m1² by the spread of the
+// neighbours' means (reads high); the TemporalAccumulation tests print the estimate against the
+// blend's measured error, still and panning. A shorter history gets −1 (unknown: the filter
+// estimates it spatially, as SVGF does for short histories). An unshaded pixel resamples its
+// moments and adds none; a filled hole's are those of its fill (l̄, l̄², 1), its variance unknown.
+// A non-finite spread (a NaN sample, a square past float's range) starts the pixel again: its
+// history's illumination, moments and length 0, so that its next shaded sample replaces it, and −1
+// until its history is long again (the frame that had it outputs it, as before).
 //
 // Frames may change size between calls (the frame-time target scales them): the history keeps its
 // own size and camera. Pure CPU code, no GL, no Embree; rows run on every core.
@@ -107,7 +112,8 @@ public:
 
     // After accumulate(): the variance of each pixel's blended demodulated luminance (W*H of the
     // frame, squared illumination units; 0 for sky, −1 where the history is shorter than
-    // kMinMomentsFrames or a sample was not finite), as AtrousDenoiser::run takes it. Empty before the first frame.
+    // kMinMomentsFrames, which a non-finite spread restarts), as AtrousDenoiser::run takes it. Empty before the first
+    // frame.
     [[nodiscard]] const std::vector<float>& luminance_variance() const { return luminance_variance_; }
     static constexpr float kMinMomentsFrames = 4.0f;  // SVGF §4.2: shorter histories are estimated spatially
 

@@ -152,6 +152,20 @@ TEST(TemporalAccumulation, TheLuminanceVarianceIsTheBlendedFramesOwnNoise) {
     for (const float v : history.luminance_variance()) ASSERT_TRUE(std::isfinite(v));
     EXPECT_EQ(history.luminance_variance()[600], -1.0f);
     EXPECT_EQ(history.luminance_variance()[601], -1.0f);
+    // They start again: unknown until four frames are in, then like their neighbours, the image finite.
+    for (int k = 1; k <= 4; ++k) {
+        out = history.accumulate(shade(seen, 0.1, rng), seen.guides, camera, {});
+        const std::vector<float>& v = history.luminance_variance();
+        for (const std::size_t i : {std::size_t{600}, std::size_t{601}}) {
+            if (k < 4) {
+                EXPECT_EQ(v[i], -1.0f) << "pixel " << i << ", frame " << k << " after";
+            } else {
+                EXPECT_GE(v[i], 0.0f) << "pixel " << i;
+                EXPECT_LT(v[i], 10.0f * (v[500] + v[599] + v[602]) / 3.0f) << "pixel " << i;
+            }
+        }
+    }
+    for (const float x : out.pixels) ASSERT_TRUE(std::isfinite(x)) << "the history kept a non-finite sample";
     history.clear();
     EXPECT_TRUE(history.luminance_variance().empty());
 }
@@ -273,10 +287,6 @@ TEST(TemporalAccumulation, ASparseFrameTakesTheHistoryWhereItDidNotShadeAndFills
     EXPECT_LT(rms_error(block, seen), 0.05);
 }
 
-// A view turning by a fraction of a pixel each frame, with one pixel in four shaded: bilinear
-// resampling blurs the history frame after frame; the Catmull-Rom history keeps the pattern, about as
-// well as frames that shade every pixel. Measured inside a border of 4 pixels: the columns the turn
-// brings in are filled from their neighbours (ASparseFrameTakesTheHistory... bounds those).
 // A sparse view panning by a quarter of a pixel a frame (resampled every frame, a quarter of each
 // frame's pixels shaded, new columns filled): the estimate still follows the blended frame's error
 // against the noise-free truth, inside the border the pan brings in.
@@ -317,6 +327,10 @@ TEST(TemporalAccumulation, ASparsePanKeepsTheLuminanceVarianceNearTheBlendsError
     EXPECT_LT(estimated, 2.0 * measured);
 }
 
+// A view turning by a fraction of a pixel each frame, with one pixel in four shaded: bilinear
+// resampling blurs the history frame after frame; the Catmull-Rom history keeps the pattern, about as
+// well as frames that shade every pixel. Measured inside a border of 4 pixels: the columns the turn
+// brings in are filled from their neighbours (ASparseFrameTakesTheHistory... bounds those).
 TEST(TemporalAccumulation, TheHistoryStaysSharpWhileTheViewMovesByFractionsOfAPixel) {
     constexpr double kFrequency = 6.0;  // about 10 pixels a period on the wall
     const auto run = [&](bool sharp, int one_in) {
