@@ -48,9 +48,9 @@
 // blended value over one sample's: f = 1 for a first sample, f' = (1 − a)² f_H + a² at a blend, with
 // f_H = Σ w_k² f_k / (Σ w_k)² over the bilinear taps w_k (a resampled value averages its neighbours'
 // noise; the variance of a weighted mean of independent values is Σ w_k² σ_k² / (Σ w_k)²), also where
-// the illumination is sharpened by Catmull-Rom (the cubic's own Σ w², clamp aside, measured farther
-// from the blend's error: tests). A pixel whose history holds at least kMinMomentsFrames frames gets
-// the variance of its blended luminance
+// the illumination is sharpened by Catmull-Rom (the cubic's own Σ w² in f was tried: it read farther
+// from the blend's measured error in the panning test than the bilinear weights do). A pixel whose
+// history holds at least kMinMomentsFrames frames gets the variance of its blended luminance
 //   Var(l̄) = max(0, m2 − m1²) · f.
 // SVGF feeds the samples' σ² = m2 − m1² itself; this is what is left of it in the frame the filter
 // sees. Two biases of opposite sign under motion: neighbouring pixels that shared earlier samples
