@@ -219,7 +219,10 @@ void TemporalHistory::set_pixel(const Pass& f, std::size_t i, const Eigen::Vecto
 // length, moments and luminance variance; counts them. A pixel that no history covers keeps its own radiance, bit for
 // bit. Each row's points and their positions in the previous image are computed first, a row at a time
 // (PixelCentreRays::points_row, FrameProjection::project_row: vectorised), then each pixel's taps.
-void TemporalHistory::accumulate_rows(const Pass& f, int y0, int y1, TemporalStats& counted) const {
+void TemporalHistory::accumulate_rows(const Pass& f, int y0, int y1, TemporalStats& result) const {
+    // Counted here and stored once at the end: the threads' results sit side by side in one cache line, and
+    // incrementing them in place at every pixel made the cores fight over it.
+    TemporalStats counted;
     const int width = f.current.size.width;
     const auto w = static_cast<std::size_t>(width);
     std::vector<float> px(w), py(w), pz(w), hx(w), hy(w);
@@ -274,6 +277,7 @@ void TemporalHistory::accumulate_rows(const Pass& f, int y0, int y1, TemporalSta
                         frames + 1.0f);
         }
     }
+    result = counted;
 }
 
 RgbFloatImage TemporalHistory::accumulate(const RgbFloatImage& current, const GuideBuffers& guides,

@@ -142,7 +142,7 @@ private:
         float m1 = 0.0f, m2 = 0.0f;  // running means of l and l² (above)
         float factor = 0.0f;         // f: the variance of the blend over one sample's (above)
     };
-    void accumulate_rows(const Pass& f, int y0, int y1, TemporalStats& counted) const;
+    void accumulate_rows(const Pass& f, int y0, int y1, TemporalStats& result) const;
     static std::size_t fill_holes(const Pass& f);
     static bool neighbour_fill(const Pass& f, std::size_t i, int radius, Eigen::Vector3f& value);
     static void set_pixel(const Pass& f, std::size_t i, const Eigen::Vector3f& value);
