@@ -130,12 +130,13 @@ FrameQuality frame_quality(const Rgb8Image& served, const Rgb8Image& reference) 
 
 // What the farm served for each counted moving frame: its scale, spp and bounces, and where its
 // time went on the admin (seconds: the whole frame, the render phase, the slowest rank's tracing,
-// the filter; the rest of `frame_seconds` is compositing, accumulation and the hand-off); with
+// the filter; the rest of `frame_seconds` is compositing, accumulation and the hand-off), and the
+// render ranks' balance (mean over max of their tracing times: 1 when none waits for another); with
 // temporal, the share of its surface pixels that earlier frames supplied by reprojection.
 struct ServedLog {
     nlohmann::json frames = nlohmann::json::array();
     double scale_sum = 0, scale_min = 1, spp_sum = 0, bounces_sum = 0;
-    double frame_s = 0, render_phase_s = 0, slowest_rank_s = 0, denoise_s = 0, temporal_s = 0;
+    double frame_s = 0, render_phase_s = 0, slowest_rank_s = 0, denoise_s = 0, temporal_s = 0, balance_sum = 0;
     double reprojected_sum = 0, shaded_sum = 0;
     int blended = 0;
     void add(const LiveFrame& f) {
@@ -148,6 +149,7 @@ struct ServedLog {
                           {"frame_seconds", f.seconds},
                           {"render_phase_seconds", f.stats.render_phase_seconds},
                           {"slowest_rank_seconds", slowest},
+                          {"balance_efficiency", f.stats.balance_efficiency},
                           {"denoise_seconds", f.denoise_seconds},
                           {"temporal_seconds", f.temporal_seconds}});
         if (f.temporal.surface_pixels > 0) {
@@ -167,6 +169,7 @@ struct ServedLog {
         frame_s += f.seconds;
         render_phase_s += f.stats.render_phase_seconds;
         slowest_rank_s += slowest;
+        balance_sum += f.stats.balance_efficiency;
         denoise_s += f.denoise_seconds;
         temporal_s += f.temporal_seconds;
     }
@@ -179,6 +182,7 @@ struct ServedLog {
                               {"frame_seconds_mean", frame_s / n},
                               {"render_phase_seconds_mean", render_phase_s / n},
                               {"slowest_rank_seconds_mean", slowest_rank_s / n},
+                              {"balance_efficiency_mean", balance_sum / n},
                               {"denoise_seconds_mean", denoise_s / n},
                               {"temporal_seconds_mean", temporal_s / n}};
         if (blended > 0) {
